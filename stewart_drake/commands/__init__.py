@@ -1,0 +1,1 @@
+"""One module per ``stewart-drake`` subcommand; each defines ``register(subparsers)``."""
