@@ -41,10 +41,33 @@ def leg_vectors(platform: Platform, poses, convention: str = "utn") -> np.ndarra
     return plate_anchors(platform, poses, convention) - platform.base_anchors
 
 
+CHUNK = 1 << 14  # poses per block in leg_lengths: keeps the temporaries in cache
+
+
 def leg_lengths(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
-    """``(..., 6)`` leg lengths L_i (metres) for ``(..., 6)`` poses."""
-    l = leg_vectors(platform, poses, convention)
-    return np.sqrt(np.einsum("...k,...k->...", l, l))
+    """``(..., 6)`` leg lengths L_i (metres) for ``(..., 6)`` poses.
+
+    The hot path of workspace sweeps: evaluated in blocks of ``CHUNK`` poses, one (n, 6) array per
+    coordinate, accumulated in place.
+    """
+    q = _poses(poses)
+    flat = q.reshape(-1, 6)
+    out = np.empty((flat.shape[0], 6))
+    r_T = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
+    base = platform.base_anchors  # (6, 3)
+    for s in range(0, flat.shape[0], CHUNK):
+        blk = flat[s : s + CHUNK]
+        R = rotation_matrix(blk[:, 3:], convention)  # (n, 3, 3)
+        acc = np.zeros((blk.shape[0], 6))
+        for k in range(3):  # coordinate k of every leg vector: (R r_T)_k + p_k - b_k
+            c = np.multiply.outer(R[:, k, 0], r_T[:, 0])
+            c += np.multiply.outer(R[:, k, 1], r_T[:, 1])
+            c += np.multiply.outer(R[:, k, 2], r_T[:, 2])
+            c += blk[:, k, None] - base[:, k]
+            c *= c
+            acc += c
+        np.sqrt(acc, out=out[s : s + CHUNK])
+    return out.reshape(q.shape)
 
 
 def leg_unit_vectors(platform: Platform, poses, convention: str = "utn") -> np.ndarray:

@@ -90,10 +90,17 @@ def rotation_matrix(angles, convention: str = "utn") -> np.ndarray:
     angles = np.asarray(angles, dtype=float)
     if angles.shape[-1:] != (3,):
         raise ValueError(f"angles need 3 numbers (about X, Y, Z), got shape {angles.shape}")
-    ax, ay, az = angles[..., 0], angles[..., 1], angles[..., 2]
-    if convention == "utn":
-        return _ry(ay) @ _rx(ax) @ _rz(az)
-    return _rz(az) @ _ry(ay) @ _rx(ax)
+    ca, cb, cg = np.moveaxis(np.cos(angles), -1, 0)
+    sa, sb, sg = np.moveaxis(np.sin(angles), -1, 0)
+    if convention == "utn":  # Ry(beta) Rx(alpha) Rz(gamma), the seeds' TTB written out
+        rows = (cb * cg + sa * sb * sg, sa * sb * cg - cb * sg, ca * sb,
+                ca * sg, ca * cg, -sa,
+                sa * cb * sg - sb * cg, sb * sg + sa * cb * cg, ca * cb)
+    else:  # Rz(psi) Ry(theta) Rx(phi) with (phi, theta, psi) = (a_x, a_y, a_z)
+        rows = (cb * cg, sa * sb * cg - ca * sg, ca * sb * cg + sa * sg,
+                cb * sg, sa * sb * sg + ca * cg, ca * sb * sg - sa * cg,
+                -sb, sa * cb, ca * cb)
+    return np.stack(rows, -1).reshape(angles.shape[:-1] + (3, 3))
 
 
 def angles_from_matrix(R, convention: str = "utn") -> np.ndarray:
