@@ -1,0 +1,73 @@
+"""``stewart-drake dsp-ik``: the six integer leg lengths the seed's DSP56800E firmware (tp17.C)
+computes for a pose, bit-exactly, with the float IK beside them."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._common import print_json
+
+ANGLE_UNITS = ("pi", "deg", "rad")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("dsp-ik", help="leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK")
+    p.add_argument("--pose", nargs=6, type=float, required=True, metavar=("PX", "PY", "PZ", "A", "B", "G"),
+                   help="position in mm (truncated to whole mm, as the firmware stores it) and the angles alpha, beta, gamma")
+    p.add_argument("--angle-unit", choices=ANGLE_UNITS, default="pi",
+                   help="unit of A B G: 'pi' = a fraction of pi as the firmware takes them (0.1 = 18°, the default), 'deg', 'rad'")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--trace", action="store_true", help="also print the firmware's intermediate words (sin/cos, matrix, plate joints)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    import sys
+
+    from ..fixedpoint.q15 import SaturationCounter
+    from ..fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
+    from ..rotations import angle_scale
+
+    raw = np.asarray(args.pose, dtype=float)
+    q = raw.copy()
+    q[3:] = raw[3:] * angle_scale(args.angle_unit) / np.pi  # -> fractions of pi
+    for k, name in enumerate(("A", "B", "G")):
+        if abs(q[3 + k]) > 1.0:
+            raise ValueError(f"angle {name} = {raw[3 + k]:g} {args.angle_unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]")
+    check_dsp_poses(q)
+    with SaturationCounter() as sat:
+        tr = tp17_trace(q)
+    if sat.total:
+        print(f"stewart-drake dsp-ik: warning: the firmware's arithmetic saturated ({dict(sat.counts)}); "
+              "its lengths for this pose are clipped, not geometric", file=sys.stderr)
+    res = tp17_error_stages(q)
+    dsp = tr.lengths.astype(int)
+    flt = res["float"]
+    out = {
+        "pose": {"px_mm": int(np.trunc(q[0])), "py_mm": int(np.trunc(q[1])), "pz_mm": int(np.trunc(q[2])),
+                 "alpha_pi": float(q[3]), "beta_pi": float(q[4]), "gamma_pi": float(q[5]),
+                 "angle_words": tr.angle_words.tolist()},
+        "geometry_mm": {"firmware": dict(TP17_GEOMETRY_MM), "float": {"a": 612.5, "b": 925, "d": 150}},
+        "dsp_lengths_mm": dsp.tolist(),
+        "float_lengths_mm": [round(float(v), 4) for v in flt],
+        "difference_mm": [round(float(v), 4) for v in dsp - flt],
+        "saturations": dict(sat.counts),
+    }
+    if args.trace:
+        out["trace"] = {"sin_q15": tr.sin.tolist(), "cos_q15": tr.cos.tolist(), "R_q15": tr.R.tolist(),
+                        "plate_joints_T_mm": tr.top_T.tolist(), "plate_joints_B_mm": tr.top_B.tolist(),
+                        "leg_vectors_mm": tr.leg.tolist(), "L32": tr.L32.tolist()}
+    if args.json:
+        print_json(out)
+        return 0
+    p = out["pose"]
+    print(f"pose: px={p['px_mm']} py={p['py_mm']} pz={p['pz_mm']} mm; alpha={p['alpha_pi']:g}π beta={p['beta_pi']:g}π "
+          f"gamma={p['gamma_pi']:g}π (FRAC16 words {p['angle_words']})")
+    print("firmware geometry a=612 b=925 d=150 mm (float IK: a=612.5)")
+    print(f"{'leg':>4} {'DSP mm':>8} {'float mm':>10} {'DSP-float':>10}")
+    for i in range(6):
+        print(f"{i + 1:>4} {dsp[i]:>8d} {flt[i]:>10.3f} {dsp[i] - flt[i]:>+10.3f}")
+    if args.trace:
+        for k, v in out["trace"].items():
+            print(f"{k}: {v}")
+    return 0

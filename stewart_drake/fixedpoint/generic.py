@@ -1,0 +1,196 @@
+"""A fixed-point inverse kinematics for any :class:`~stewart_drake.geometry.Platform`, with a chosen
+word length, to study word length against leg-length error.
+
+It follows the firmware's recipe (``tp17.C``) generalised, not its exact instruction sequence:
+
+1. angles -> fractions of pi in Q(f) words, f = word_bits - 1 (truncation toward zero, like FRAC16);
+2. sin(pi x), cos(pi x) as Q(f) words: ``trig="exact"`` rounds the true value (cos 0 saturates to
+   2^f - 1), ``trig="tfr16"`` uses the DSP library (word_bits = 16 only);
+3. each rotation-matrix entry as the firmware forms it: a sum of signed products of two or three
+   sines/cosines, every product truncated back to Q(f) (``(a*b) >> f``, the ``extract_h(L_mult)``
+   idiom), sums saturated to the word (the products are derived from the convention's elementary
+   rotations, so ``utn`` and ``zyx`` both work);
+4. lengths as integer words of ``length_lsb`` metres (anchors, rotation centre and position rounded to
+   the nearest LSB); the plate anchor p + R r with each R·r product truncated as in 3 and the sums
+   saturated to the word;
+5. the squared length summed in a 2·word_bits accumulator (saturating) and its integer square root
+   rounded to the nearer of y, y + 1 (the mfr32Sqrt rule).
+
+Saturations are recorded in any active :class:`~.q15.SaturationCounter` under ``generic.*`` names.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import product
+
+import numpy as np
+
+from ..geometry import Platform
+from ..rotations import check_convention
+from .q15 import _sat, tfr16CosPIx, tfr16SinPIx
+
+TRIG_MODES = ("exact", "tfr16")
+
+
+@dataclass(frozen=True)
+class QFormat:
+    """Word length and scaling of the generic fixed-point IK.
+
+    word_bits   width of every data word, signed, 8..31 (the DSP: 16)
+    length_lsb  metres per LSB of a length word (the DSP: 1e-3, integer millimetres)
+    trig        ``exact`` (correctly rounded Q(word_bits-1) sine/cosine) or ``tfr16`` (the DSP library)
+    """
+
+    word_bits: int = 16
+    length_lsb: float = 1e-3
+    trig: str = "exact"
+
+    def __post_init__(self):
+        if not (isinstance(self.word_bits, (int, np.integer)) and 8 <= self.word_bits <= 31):
+            raise ValueError(f"word_bits must be an integer in 8..31, got {self.word_bits!r}")
+        if not (np.isfinite(self.length_lsb) and self.length_lsb > 0):
+            raise ValueError(f"length_lsb must be a positive number of metres, got {self.length_lsb!r}")
+        if self.trig not in TRIG_MODES:
+            raise ValueError(f"trig must be one of {', '.join(TRIG_MODES)}, got {self.trig!r}")
+        if self.trig == "tfr16" and self.word_bits != 16:
+            raise ValueError(f"trig='tfr16' is the 16-bit DSP library; it needs word_bits=16, got {self.word_bits}")
+
+    @property
+    def frac_bits(self) -> int:
+        return self.word_bits - 1
+
+    @property
+    def range_m(self) -> float:
+        """The largest length a word holds (metres)."""
+        return (2 ** (self.word_bits - 1) - 1) * self.length_lsb
+
+
+# ------------------------------------------------------------------------------------------------
+# Rotation matrices as sums of signed trig monomials, derived from the elementary rotations.
+# A polynomial is a dict {tuple of factor names: integer coefficient}; factors are "cX", "sX" etc.
+
+
+def _elementary(axis: str):
+    c, s = f"c{axis}", f"s{axis}"
+    one, zero = {(): 1}, {}
+    pos, neg = {(s,): 1}, {(s,): -1}
+    cc = {(c,): 1}
+    if axis == "x":
+        return [[one, zero, zero], [zero, cc, neg], [zero, pos, cc]]
+    if axis == "y":
+        return [[cc, zero, pos], [zero, one, zero], [neg, zero, cc]]
+    return [[cc, neg, zero], [pos, cc, zero], [zero, zero, one]]
+
+
+def _matmul(A, B):
+    out = [[{} for _ in range(3)] for _ in range(3)]
+    for i, j, k in product(range(3), range(3), range(3)):
+        for (fa, ca), (fb, cb) in product(A[i][k].items(), B[k][j].items()):
+            key = fa + fb
+            out[i][j][key] = out[i][j].get(key, 0) + ca * cb
+    return [[{k: v for k, v in e.items() if v} for e in row] for row in out]
+
+
+def rotation_monomials(convention: str = "utn"):
+    """3x3 nested lists of {factors: sign}: R_BT as sums of products of cx, sx, cy, sy, cz, sz (the
+    factors in the order the elementary rotations multiply)."""
+    check_convention(convention)
+    order = ("y", "x", "z") if convention == "utn" else ("z", "y", "x")
+    R = _elementary(order[0])
+    for ax in order[1:]:
+        R = _matmul(R, _elementary(ax))
+    return R
+
+
+# ------------------------------------------------------------------------------------------------
+
+
+def _trig_words(angles: np.ndarray, fmt: QFormat):
+    f = fmt.frac_bits
+    lo, hi = -(1 << f), (1 << f) - 1
+    x = angles / np.pi
+    if np.any(np.abs(x) > 1.0):
+        k = tuple(int(i) for i in np.argwhere(np.abs(x) > 1.0)[0])
+        raise ValueError(f"pose {k[:-1]}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
+    w = _sat(np.trunc(x * (1 << f)).astype(np.int64), lo, hi, "generic.angle")
+    if fmt.trig == "tfr16":
+        return tfr16SinPIx(w), tfr16CosPIx(w)
+    t = np.pi * w / (1 << f)
+    s = _sat(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
+    c = _sat(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
+    return s, c
+
+
+def fixed_point_rotation(angles, fmt: QFormat = QFormat(), convention: str = "utn") -> np.ndarray:
+    """``(..., 3, 3)`` Q(word_bits-1) words of R_BT for ``(..., 3)`` angles (radians)."""
+    angles = np.asarray(angles, dtype=float)
+    f = fmt.frac_bits
+    lo, hi = -(1 << f), (1 << f) - 1
+    s, c = _trig_words(angles, fmt)
+    words = {}
+    for k, ax in enumerate("xyz"):
+        words[f"s{ax}"], words[f"c{ax}"] = s[..., k], c[..., k]
+    S = angles.shape[:-1]
+    R = np.zeros(S + (3, 3), dtype=np.int64)
+    for i, j in product(range(3), range(3)):
+        acc = np.zeros(S, dtype=np.int64)
+        for factors, coef in rotation_monomials(convention)[i][j].items():
+            if not factors:  # the constant 1 (cannot occur in a 3-angle product, kept for safety)
+                term = np.full(S, hi, dtype=np.int64)
+            else:
+                term = words[factors[0]]
+                for fac in factors[1:]:
+                    term = _sat((term * words[fac]) >> f, lo, hi, "generic.mult")
+            for _ in range(abs(coef)):
+                acc = _sat(acc + (term if coef > 0 else -term), lo, hi, "generic.add")
+        R[..., i, j] = acc
+    return R
+
+
+def _isqrt_nearest(S: np.ndarray) -> np.ndarray:
+    S = np.maximum(S, 0)
+    y = np.floor(np.sqrt(S.astype(float))).astype(np.int64)
+    y -= (y * y > S).astype(np.int64)
+    y += ((y + 1) * (y + 1) <= S).astype(np.int64)
+    return np.where(np.abs((y + 1) * (y + 1) - S) < np.abs(y * y - S), y + 1, y)
+
+
+def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(), convention: str = "utn",
+                            return_words: bool = False) -> np.ndarray:
+    """``(..., 6)`` leg lengths (metres, integer multiples of ``fmt.length_lsb``) computed in fixed
+    point with ``fmt`` for ``(..., 6)`` SI poses. ``return_words``: the integer length words instead."""
+    q = np.asarray(poses, dtype=float)
+    if q.shape[-1:] != (6,):
+        raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
+    if not np.all(np.isfinite(q)):
+        k = tuple(int(i) for i in np.argwhere(~np.isfinite(q).all(-1))[0])
+        raise ValueError(f"pose {k} is not finite: {q[k].tolist()}")
+    f, lsb = fmt.frac_bits, fmt.length_lsb
+    lo, hi = -(1 << f), (1 << f) - 1
+
+    def words(x_m, what):
+        w = np.round(np.asarray(x_m) / lsb)
+        if np.any(np.abs(w) > hi + 1):
+            raise ValueError(f"{what} {np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())]:.6g} m does not fit a "
+                             f"{fmt.word_bits}-bit word of {lsb:g} m (range ±{fmt.range_m:.6g} m)")
+        return np.clip(w.astype(np.int64), lo, hi)
+
+    r_T = words(platform.top_anchors_per_leg - platform.rotation_centre, "a plate anchor offset")  # (6, 3)
+    B = words(platform.base_anchors, "a base anchor")  # (6, 3)
+    pos = _sat(np.round(q[..., :3] / lsb).astype(np.int64), lo, hi, "generic.position")
+    R = fixed_point_rotation(q[..., 3:], fmt, convention)  # (..., 3, 3)
+    S = q.shape[:-1]
+    acc_hi = (1 << (2 * fmt.word_bits - 1)) - 1
+    out = np.empty(S + (6,), dtype=np.int64)
+    for i in range(6):
+        sq = np.zeros(S, dtype=np.int64)
+        for r in range(3):
+            v = pos[..., r]
+            for k in range(3):
+                if r_T[i, k]:
+                    v = _sat(v + ((R[..., r, k] * r_T[i, k]) >> f), lo, hi, "generic.add")
+            v = _sat(v - B[i, r], lo, hi, "generic.sub")
+            sq = _sat(sq + v * v, -acc_hi - 1, acc_hi, "generic.L_add")
+        out[..., i] = _isqrt_nearest(sq)
+    return out if return_words else out * lsb
