@@ -1,0 +1,110 @@
+"""``stewart-drake dynamics``: leg forces along a trajectory (inverse dynamics, seed 004 part 2)."""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..rotations import angle_scale, length_scale
+from ._common import add_platform_arg, platform_from_args, print_json
+
+CSV_HELP = (
+    "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
+    "accelerations from a cubic spline through the samples) or 19 columns t, q(6), qd(6), qdd(6)"
+)
+
+
+def register(sub) -> None:
+    p = sub.add_parser("dynamics", help="leg forces along a trajectory (inverse dynamics, with or without Coriolis)")
+    add_platform_arg(p, default="utn-dynamic")
+    p.add_argument("--trajectory", default="seed", metavar="seed|FILE.csv",
+                   help="'seed' (px = -0.1 m, py = 0.1 sin(2t) m, pz = 0.7 m) or a CSV file: " + CSV_HELP)
+    p.add_argument("--t-end", type=float, default=4.0, help="seed trajectory: last time in s (default 4)")
+    p.add_argument("--dt", type=float, default=0.1, help="seed trajectory: time step in s (default 0.1, as the seed)")
+    p.add_argument("--coriolis", choices=["on", "off"], default="on", help="include C(q, q̇) q̇ (default on; off = the seed's model)")
+    p.add_argument("--legs", choices=["on", "off"], default="off", help="include the legs' masses (cylinder + piston, from the platform) (default off, as the seed)")
+    p.add_argument("--gravity", type=float, default=9.81, help="m/s² (default 9.81)")
+    p.add_argument("--convention", choices=["utn", "zyx"], default="utn", help="Euler convention of the CSV's angles (default utn)")
+    p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV positions (default m)")
+    p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
+    out = p.add_mutually_exclusive_group()
+    out.add_argument("--json", action="store_true", help="print JSON")
+    out.add_argument("--csv", action="store_true", help="print CSV: t,F1..F6 (N)")
+    p.set_defaults(func=run)
+
+
+def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad"):
+    """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (see ``CSV_HELP``). Errors name the line."""
+    f = Path(path)
+    if not f.is_file():
+        raise FileNotFoundError(f"trajectory file {path!r} does not exist")
+    rows, width = [], None
+    with f.open(newline="") as fh:
+        for lineno, row in enumerate(csv.reader(fh), start=1):
+            if not row or all(not c.strip() for c in row):
+                continue
+            try:
+                values = [float(c) for c in row]
+            except ValueError:
+                if not rows and lineno == 1:
+                    continue  # header
+                raise ValueError(f"{path}:{lineno}: not a number in {row!r}") from None
+            if len(values) not in (7, 19) or (width is not None and len(values) != width):
+                raise ValueError(f"{path}:{lineno}: expected {width or '7 or 19'} values (see --help), got {len(values)}")
+            width = len(values)
+            rows.append(values)
+    if len(rows) < (2 if width == 19 else 4):
+        raise ValueError(f"{path}: need at least {2 if width == 19 else 4} samples, got {len(rows)}")
+    a = np.array(rows)
+    t = a[:, 0]
+    if np.any(np.diff(t) <= 0):
+        k = int(np.argmax(np.diff(t) <= 0))
+        raise ValueError(f"{path}: times must increase; sample {k + 1} (t = {t[k + 1]} s) does not follow t = {t[k]} s")
+    scale = np.r_[np.full(3, length_scale(length_unit)), np.full(3, angle_scale(angle_unit))]
+    if width == 19:
+        return t, a[:, 1:7] * scale, a[:, 7:13] * scale, a[:, 13:19] * scale
+    from scipy.interpolate import CubicSpline
+
+    spline = CubicSpline(t, a[:, 1:7] * scale, axis=0)
+    return t, spline(t), spline(t, 1), spline(t, 2)
+
+
+def run(args) -> int:
+    from ..dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
+
+    platform = platform_from_args(args)
+    if args.trajectory == "seed":
+        if not (args.dt > 0 and args.t_end >= 0):
+            raise ValueError(f"--dt must be > 0 and --t-end >= 0, got dt = {args.dt}, t-end = {args.t_end}")
+        t = np.arange(0.0, args.t_end + args.dt / 2, args.dt)
+        q, qd, qdd = seed_trajectory(t)
+        convention = "utn"
+    else:
+        t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
+        convention = args.convention
+    if args.legs == "on":
+        if args.coriolis == "off":
+            raise ValueError("--legs on computes the complete model; it cannot be combined with --coriolis off")
+        F = leg_forces_with_legs(platform, q, qd, qdd, convention, gravity=args.gravity)
+    else:
+        F = leg_forces(platform, q, qd, qdd, convention, coriolis=args.coriolis == "on", gravity=args.gravity)
+    if args.json:
+        print_json({
+            "platform": platform.name, "trajectory": args.trajectory, "coriolis": args.coriolis == "on",
+            "legs": args.legs == "on", "gravity": args.gravity, "unit": "N", "t": t, "forces": F,
+            "max_abs_force": np.abs(F).max(axis=0),
+        })
+    elif args.csv:
+        w = csv.writer(sys.stdout, lineterminator="\n")
+        w.writerow(["t"] + [f"F{i}" for i in range(1, 7)])
+        for tk, Fk in zip(t, F):
+            w.writerow([f"{tk:.9g}"] + [f"{x:.12g}" for x in Fk])
+    else:
+        print(f"platform {platform.name}, trajectory {args.trajectory}, Coriolis {args.coriolis}, legs {args.legs}; forces in N")
+        print(f"{'t (s)':>8} " + " ".join(f"{'F' + str(i):>10}" for i in range(1, 7)))
+        for tk, Fk in zip(t, F):
+            print(f"{tk:8.3f} " + " ".join(f"{x:10.4f}" for x in Fk))
+    return 0
