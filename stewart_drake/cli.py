@@ -31,6 +31,9 @@ def main(argv=None) -> int:
     except (StewartError, ValueError, FileNotFoundError) as e:
         print(f"stewart-drake {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # e.g. `stewart-drake ... | head`
+        sys.stderr.close()
+        return 0
     except KeyboardInterrupt:
         print(f"stewart-drake {args.command}: interrupted", file=sys.stderr)
         return 130
