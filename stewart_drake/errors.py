@@ -41,3 +41,12 @@ class UnreachablePoseError(StewartError):
 
 class SingularPoseError(StewartError):
     """A pose is on, or too near, a singularity of the platform's Jacobian."""
+
+
+class ForwardKinematicsError(StewartError):
+    """Forward kinematics found no (trustworthy) pose for some leg-length set: Newton did not converge,
+    or no assembly exists. The message names the sample, the residual and the reason."""
+
+
+class SingularityWarning(UserWarning):
+    """A pose is near a singularity of the platform's Jacobian: results there are poorly conditioned."""

@@ -1,0 +1,114 @@
+"""Forward-kinematics throughput: batched Newton, Drake MathematicalProgram, all assembly modes.
+
+Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--quick]``. Pins nothing; prints absolute
+figures for this machine and ratios measured in the same run (the ratios travel between machines,
+the absolute numbers do not). Single core: set OMP/OPENBLAS threads to 1 before numpy loads.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+from stewart_drake.fk import forward_kinematics, sample_poses  # noqa: E402
+from stewart_drake.geometry import load_preset  # noqa: E402
+from stewart_drake.kinematics import leg_lengths  # noqa: E402
+
+
+def best_of(f, repeat=3):
+    ts = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = f()
+        ts.append(time.perf_counter() - t0)
+    return min(ts), out
+
+
+def newton_rates(n: int) -> list[tuple]:
+    rows = []
+    for name in ("utn-dynamic", "gonzalez-dutra-2009", "utn-kinematic"):
+        p = load_preset(name)
+        q = sample_poses(p, n, seed=1)
+        L = leg_lengths(p, q)
+        t_chk, r = best_of(lambda: forward_kinematics(p, L, on_singular="ignore"))
+        t_raw, _ = best_of(lambda: forward_kinematics(p, L, check_singularity=False))
+        # Trajectory following: start 1 mm / 1 mrad from the answer.
+        t_trk, r2 = best_of(lambda: forward_kinematics(p, L, q + 1e-3, check_singularity=False))
+        one = L[0]
+        t_one, _ = best_of(lambda: [forward_kinematics(p, one, check_singularity=False) for _ in range(200)])
+        rows.append((name, n, n / t_chk, n / t_raw, n / t_trk, 200 / t_one, r.iterations.mean(), r2.iterations.mean(), r.converged.mean()))
+    return rows
+
+
+def program_times(repeat: int) -> list[tuple]:
+    from stewart_drake.forward import ProgramFK
+
+    p = load_preset("gonzalez-dutra-2009")
+    q = p.home_pose() + [0.05, -0.03, 0.02, 0.1, -0.05, 0.2]
+    L = leg_lengths(p, q)
+    guess = q + [0.02, 0.01, -0.02, 0.1, 0.05, -0.1]
+    rows = []
+    for rot in ("quaternion", "matrix"):
+        for solver in ("snopt", "ipopt"):
+            prog = ProgramFK(p, rot, solver)
+            ts = [prog.solve(L, guess).solve_time_s for _ in range(repeat)]
+            wall, _ = best_of(lambda: prog.solve(L, guess))
+            rows.append((rot, solver, 1e3 * float(np.median(ts)), 1e3 * wall))
+    t_build, _ = best_of(lambda: ProgramFK(p))
+    rows.append(("(build program)", "", 1e3 * t_build, 1e3 * t_build))
+    return rows
+
+
+def assembly_times() -> list[tuple]:
+    from stewart_drake.forward import assembly_modes, dietmaier_platform, general_platform
+
+    cases = [("dietmaier-1998",) + dietmaier_platform()]
+    for seed in (0, 4):
+        cases.append((f"general 6-6 (seed {seed})",) + general_platform(seed))
+    for name in ("utn-dynamic", "gonzalez-dutra-2009"):
+        p = load_preset(name)
+        cases.append((f"{name} at home", p, leg_lengths(p, p.home_pose())))
+    rows = []
+    for label, p, L in cases:
+        t_fast, a = best_of(lambda: assembly_modes(p, L, polish=None), 2)
+        t_full, b = best_of(lambda: assembly_modes(p, L), 2)
+        rows.append((label, len(b), b.max_solutions, b.complete, sum(m.certified for m in b.modes), t_fast, t_full, b.starts))
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="smaller batches")
+    args = ap.parse_args(argv)
+    n = 20_000 if args.quick else 100_000
+
+    print(f"\n# Newton FK, batch of {n} poses (best of 3)")
+    print(f"{'platform':22s} {'solves/s':>10s} {'no check':>10s} {'tracking':>10s} {'1-call/s':>9s} {'iters':>6s} {'trk it':>6s} {'conv':>6s}")
+    rows = newton_rates(n)
+    for name, _, chk, raw, trk, one, it, it2, conv in rows:
+        print(f"{name:22s} {chk:10.3g} {raw:10.3g} {trk:10.3g} {one:9.3g} {it:6.2f} {it2:6.2f} {conv:6.3f}")
+    r0 = rows[0]
+    print(f"ratio batch/single-call (utn-dynamic): {r0[2] / r0[5]:.0f}x; singularity check costs {100 * (1 - r0[2] / r0[3]):.0f}% of the rate")
+
+    print("\n# MathematicalProgram FK, one solve from a guess 2 cm / 0.1 rad off (gonzalez-dutra-2009)")
+    prog_rows = program_times(20 if args.quick else 100)
+    for rot, solver, med, wall in prog_rows:
+        print(f"{rot:16s} {solver:6s} solver {med:7.3f} ms   wall {wall:7.3f} ms")
+    snopt_ms = prog_rows[0][3]
+    print(f"ratio SNOPT solve / Newton batch solve (gonzalez-dutra): {snopt_ms * 1e-3 * rows[1][2]:.0f}x")
+
+    print("\n# All assembly modes (Newton multi-start; 'full' adds the SNOPT confirmation)")
+    print(f"{'geometry':28s} {'modes':>5s} {'max':>4s} {'complete':>8s} {'certified':>9s} {'newton s':>9s} {'full s':>7s} {'starts':>7s}")
+    for label, k, kmax, comp, cert, tf, tfull, starts in assembly_times():
+        print(f"{label:28s} {k:5d} {kmax:4d} {str(comp):>8s} {cert:9d} {tf:9.3f} {tfull:7.3f} {starts:7d}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
