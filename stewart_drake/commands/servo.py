@@ -1,0 +1,73 @@
+"""``stewart-drake servo``: arm angles and PWM pulse widths of the RC-servo hexapod (seed 002)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from ._common import print_json
+
+
+def register(sub) -> None:
+    from ..servo import SERVO_PRESETS
+
+    p = sub.add_parser("servo", help="servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)")
+    p.add_argument("--preset", default="hobby-servo", choices=list(SERVO_PRESETS), help="servo hexapod (default hobby-servo)")
+    p.add_argument("--pose", nargs=6, type=float, metavar=("X", "Y", "Z", "PHI", "THETA", "PSI"),
+                   help="platform pose, R = Rz(psi)·Ry(theta)·Rx(phi) (default: home)")
+    p.add_argument("--from-home", action="store_true", help="Z is the offset from the home height h0")
+    p.add_argument("--trim", nargs=6, type=float, metavar="W0", help="per-servo neutral pulses W0_i in µs (default 1500)")
+    p.add_argument("--length-unit", choices=list(LENGTH_UNITS), default="mm", help="default mm")
+    p.add_argument("--angle-unit", choices=list(ANGLE_UNITS), default="deg", help="default deg")
+    p.add_argument("--write-sdf", metavar="DIR", help="also write DIR/servo-hexapod.sdf")
+    p.add_argument("--json", action="store_true", help="JSON output")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..servo import load_servo_preset, solve
+
+    hexapod = load_servo_preset(args.preset)
+    if args.trim is not None:
+        hexapod = hexapod.replace(neutral_us=args.trim)
+    if args.write_sdf:
+        from ..servo_model import write_sdf
+
+        print(write_sdf(hexapod, args.write_sdf))
+    k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
+    scale = np.r_[[k] * 3, [ka] * 3]
+    if args.pose is None:
+        raw = np.zeros(6) if args.from_home else hexapod.home_pose() / scale
+    else:
+        raw = np.array(args.pose, dtype=float)
+        if not np.all(np.isfinite(raw)):
+            raise ValueError(f"--pose has a non-finite number: {raw.tolist()}")
+    pose = raw * scale
+    if args.from_home:
+        pose[2] += hexapod.home_height
+    sol = solve(hexapod, pose)
+    result = {
+        "preset": hexapod.name,
+        "pose": raw.tolist(),
+        "units": {"length": args.length_unit, "angle": args.angle_unit, "convention": "zyx"},
+        "home_height": hexapod.home_height / k,
+        "alpha0_deg": np.degrees(hexapod.home_angles).tolist(),
+        "angles_deg": np.degrees(sol.angles).tolist(),
+        "pulse_us": sol.pulse.tolist(),
+        "pulse_raw_us": sol.pulse_raw.tolist(),
+        "ok": bool(sol.ok),
+        "violations": [dict((key, v) for key, v in d.items() if key != "pose") for d in sol.violations()],
+    }
+    if args.json:
+        print_json(result)
+    else:
+        print(f"{hexapod.name}: h0 = {result['home_height']:.3f} {args.length_unit}, alpha0 = {result['alpha0_deg'][0]:.3f} deg")
+        print("servo   angle (deg)   pulse (us)")
+        for i in range(6):
+            print(f"{i + 1:5d}   {result['angles_deg'][i]:11.3f}   {result['pulse_us'][i]:10.1f}")
+        for v in result["violations"]:
+            if v["kind"] == "unreachable":
+                print(f"servo {v['servo']}: unreachable (|L/sqrt(M^2+N^2)| = {abs(v['ratio']):.4f} > 1)")
+            else:
+                print(f"servo {v['servo']}: travel limit, {v['angle_deg']:.3f} deg from home, {v['excess_deg']:.3f} deg beyond ±{abs(v['limit_deg']):.0f}")
+    return 0 if sol.ok else 1

@@ -1,0 +1,152 @@
+"""RC-servo hexapod (seed 002): eq. 9 vs an independent root solve, pulses, limits, Drake checks."""
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from stewart_drake.errors import GeometryError
+from stewart_drake.servo import (
+    RATE_US_PER_RAD,
+    ServoPoseError,
+    anchor_positions,
+    angles_from_pulses,
+    arm_tips,
+    hobby_servo_hexapod,
+    quantise_pulses,
+    solve,
+)
+
+
+@pytest.fixture(scope="module")
+def hexapod():
+    return hobby_servo_hexapod()
+
+
+def random_poses(h, n, seed, dx=0.008, da=np.radians(6)):
+    rng = np.random.default_rng(seed)
+    return h.home_pose() + np.c_[rng.uniform(-dx, dx, (n, 3)), rng.uniform(-da, da, (n, 3))]
+
+
+def test_preset_dimensions_and_home(hexapod):
+    # Eq. 10 by hand for servo 2: pivot (60, 25) mm, anchor at 50 mm / 50°, a = 25, s = 110 mm.
+    d = 0.05 * np.array([np.cos(np.radians(50)), np.sin(np.radians(50))]) - [0.06, 0.025]
+    assert hexapod.home_height == pytest.approx(np.sqrt(0.11**2 + 0.025**2 - d @ d), abs=1e-15)
+    # At home the arm is at right angles to the rod (the definition behind eqs. 10-12).
+    tip = arm_tips(hexapod, hexapod.home_angles)
+    q = anchor_positions(hexapod, hexapod.home_pose())
+    arm, rod = tip - hexapod.base_pivots, q - tip
+    assert np.abs(np.einsum("ij,ij->i", arm, rod)).max() < 1e-15
+    # The seed's odd/even rule (eqs. 13-14) comes out of the mounting: odd servos -1, even +1.
+    assert hexapod.pulse_signs.tolist() == [-1, 1, -1, 1, -1, 1]
+
+
+def test_arm_angles_match_an_independent_root_solve(hexapod):
+    """Eq. 9 vs brentq on |arm tip(alpha) - anchor| - s = 0 in a ±60° bracket about alpha0 (one root there)."""
+    poses = random_poses(hexapod, 200, seed=3)
+    sol = solve(hexapod, poses)
+    assert sol.ok.all()
+    q = anchor_positions(hexapod, poses)
+    worst = 0.0
+    for k in range(len(poses)):
+        for i in range(6):
+            def f(a):
+                t = arm_tips(hexapod, np.full(6, a))[i]
+                return np.linalg.norm(t - q[k, i]) - hexapod.rod_length
+
+            a0 = hexapod.home_angles[i]
+            root = brentq(f, a0 - np.radians(60), a0 + np.radians(60), xtol=1e-15, rtol=1e-15)
+            worst = max(worst, abs(root - sol.angles[k, i]))
+    # Both are double-precision solutions of the same equation; asin near ±1 amplifies rounding a little.
+    assert worst < 1e-9
+
+
+def test_pulses_at_home_are_exactly_the_trims(hexapod):
+    trims = [1500, 1512, 1490, 1503, 1497, 1521]
+    h = hexapod.replace(neutral_us=trims)
+    sol = solve(h, h.home_pose())
+    assert sol.pulse.tolist() == [float(t) for t in trims]
+    assert np.abs(sol.delta).max() < 1e-15
+
+
+def test_pulse_formula_and_inverse(hexapod):
+    poses = random_poses(hexapod, 50, seed=4)
+    sol = solve(hexapod, poses)
+    expect = 1500 + np.array([-1, 1, -1, 1, -1, 1]) * (sol.angles - hexapod.home_angles) * 400 / np.radians(45)
+    assert np.abs(sol.pulse - expect).max() < 1e-9
+    assert RATE_US_PER_RAD * np.radians(1) == pytest.approx(400 / 45)
+    assert np.abs(angles_from_pulses(hexapod, sol.pulse) - sol.angles).max() < 1e-12
+
+
+def test_limits_are_reported_per_servo_never_nan(hexapod):
+    poses = np.array([hexapod.home_pose() + [0, 0, 0.1, 0, 0, 0],  # far too high: rods cannot reach
+                      hexapod.home_pose() + [0, 0, 0.010, 0, 0, np.radians(60)]])  # big yaw: travel
+    sol = solve(hexapod, poses)
+    assert np.all(np.isfinite(sol.angles)) and np.all(np.isfinite(sol.pulse))
+    v = sol.violations()
+    assert [d["servo"] for d in v if d["pose"] == [0]] == [1, 2, 3, 4, 5, 6]
+    assert all(d["kind"] == "unreachable" and d["ratio"] > 1 for d in v if d["pose"] == [0])
+    travel = [d for d in v if d["pose"] == [1] and d["kind"] == "travel"]
+    assert [d["servo"] for d in travel] == [1, 3, 5]
+    assert all(d["excess_deg"] > 0 for d in travel)
+    assert np.all(np.abs(sol.pulse - 1500) <= 400 + 1e-9)  # clamped to ±45°
+    assert not sol.ok.any()
+
+
+def test_bad_pose_is_named(hexapod):
+    with pytest.raises(ServoPoseError, match=r"pose \(1,\) has a non-finite number"):
+        solve(hexapod, [hexapod.home_pose(), [0, 0, np.nan, 0, 0, 0]])
+    with pytest.raises(ServoPoseError, match="needs 6 numbers"):
+        solve(hexapod, [0, 0, 0.1])
+
+
+def test_geometry_validation():
+    with pytest.raises(GeometryError, match="must exceed the arm length"):
+        hobby_servo_hexapod(rod_length=0.02)
+    with pytest.raises(GeometryError, match="not symmetric"):
+        h = hobby_servo_hexapod()
+        h.replace(platform_anchors=h.platform_anchors + np.r_[[[0.001, 0, 0]], np.zeros((5, 3))])
+
+
+def test_quantisation_rounds_half_away_from_zero():
+    assert quantise_pulses([1500.4, 1500.5, 1499.5, 1234.49]).tolist() == [1500, 1501, 1500, 1234]
+    with pytest.raises(ValueError, match="resolution"):
+        quantise_pulses([1500], 0)
+
+
+# ---- Drake ----------------------------------------------------------------------------------------
+
+
+def test_sdf_matches_committed_file(hexapod, tmp_path):
+    from stewart_drake.servo_model import SDF_DIR, write_sdf
+
+    path = write_sdf(hexapod, tmp_path)
+    assert path.read_text() == (SDF_DIR / "servo-hexapod.sdf").read_text()
+
+
+def test_drake_cross_checks(hexapod):
+    from stewart_drake.servo_model import compare_with_drake
+
+    poses = random_poses(hexapod, 15, seed=5)
+    r = compare_with_drake(hexapod, poses)
+    assert r["frames"] < 1e-15  # the same numbers read back
+    assert r["home"] < 1e-9  # SNOPT to 1e-12 feasibility; angle error ~ gap / (a · sin(rod, arm)) ≈ 1e-10
+    assert r["fk"] < 1e-12  # pure float kinematics: s = 0.11 m at ~1e-16 relative
+    # Drake IK vs pulse-derived angles: IK closes rods to IK_GAP_TOL_M = 1e-8 m; an arm of a = 25 mm
+    # turns ~gap / (a sin(arm, rod)) ≈ 1e-8 / 0.02 = 5e-7 rad for that.
+    assert r["ik"] < 1e-6
+    assert r["mirror_fk"] > 1e-3  # ignoring the odd/even sign breaks the rods by millimetres
+
+
+def test_controller_quantises_latches_and_delays(hexapod):
+    from stewart_drake.servo_model import run_controller
+
+    t = np.linspace(0, 0.2, 11)
+    poses = np.tile(hexapod.home_pose(), (11, 1))
+    poses[:, 3] = np.radians(5) * np.sin(2 * np.pi * 5 * t)
+    log = run_controller(hexapod, t, poses)
+    assert np.allclose(log["t"], np.arange(0, 0.2 + 1e-9, 0.02))
+    assert np.all(log["pulse_us"][0] == 1500)  # initial state: neutral
+    expected = quantise_pulses(solve(hexapod, log["pose"]).pulse)
+    assert np.array_equal(log["pulse_us"][1:], expected[:-1])  # one frame of delay, integer µs
+    assert np.all(log["pulse_us"] == np.round(log["pulse_us"]))
+    assert np.all(log["status"] == 0)
