@@ -1,0 +1,210 @@
+"""``stewart-drake run``: run a motion program (.stw, seed 004 part 3): trajectory → IK → forces.
+
+Everything is computed (and every error reported, as ``file:line:column: error: ...``) before any
+file is written; the output folder is then written in one go.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..rotations import CONVENTIONS
+from ._common import _jsonable, add_platform_arg, platform_from_args
+
+SIMULATE_CONTROLLERS = ("fixed", "float")
+SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)
+MAX_PRINTED = 20  # moves listed on the terminal
+
+
+def register(sub) -> None:
+    p = sub.add_parser("run", help="run a motion program (.stw): leg lengths and forces along its trajectory")
+    p.add_argument("program", metavar="PROGRAM.stw", help="motion-language source file")
+    add_platform_arg(p)
+    p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<program name>)")
+    p.add_argument("--rate", type=float, default=100.0, help="trajectory samples per second (default 100)")
+    p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention of alpha, beta, gama (default utn: Ry·Rx·Rz)")
+    p.add_argument("--coriolis", choices=["on", "off"], default="on", help="include C(q, q̇) q̇ in the forces (default on; off = the seed's model)")
+    p.add_argument("--simulate", action="store_true", help="also run the trajectory through the controller-in-the-loop Drake simulation")
+    p.add_argument("--controller", choices=SIMULATE_CONTROLLERS, default="fixed", help="with --simulate: fixed-point (DSP) or float controller (default fixed)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(func=run)
+
+
+def read_program(path: str) -> str:
+    f = Path(path)
+    if not f.is_file():
+        raise FileNotFoundError(f"program file {path!r} does not exist")
+    try:
+        return f.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{path}: not UTF-8 text (byte {e.start})") from None
+
+
+def run(args) -> int:
+    from ..script import ScriptError, run_program
+
+    text = read_program(args.program)
+    platform = platform_from_args(args)
+    if not (np.isfinite(args.rate) and args.rate > 0):
+        raise ValueError(f"--rate must be a positive number of samples per second, got {args.rate}")
+    try:
+        result = run_program(text, args.program, platform, rate=args.rate, convention=args.convention,
+                             coriolis=args.coriolis == "on")
+        sim = simulate(platform, result, args) if args.simulate else None
+    except ScriptError as e:
+        print(e.render(), file=sys.stderr)
+        return 2
+    out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
+    summary = summarize(result, args.program, platform.stroke)
+    if sim is not None:
+        summary["simulation"] = sim["summary"]
+    write_outputs(out, result, summary, sim)
+    if args.json:
+        json.dump(summary, sys.stdout, indent=2, default=_jsonable)
+        sys.stdout.write("\n")
+    else:
+        print_summary(summary, out)
+    return 0
+
+
+def simulate(platform, result, args) -> dict:
+    """Controller in the loop (issue 6's ``simulation``) along the program's trajectory."""
+    from ..simulation import Trajectory as SimTrajectory
+    from ..simulation import simulate as sim_run
+
+    if args.convention != "utn":
+        raise ValueError("--simulate drives the plant with utn-convention poses; use --convention utn")
+    traj = result.trajectory
+    if traj.duration <= 0:
+        raise ValueError("--simulate: the program has no moves or waits (its trajectory lasts 0 s)")
+    reference = SimTrajectory(Path(args.program).stem, traj.pose_at, traj.duration)
+    log = sim_run(platform, reference, controller=args.controller, duration=traj.duration + SETTLE, progress=True)
+    err = log.length_error(reference, platform)
+    return {
+        "log": log,
+        "length_error": err,
+        "summary": {
+            "controller": args.controller,
+            "plant_steps": len(log.t),
+            "settle_s": SETTLE,
+            "max_abs_length_error_mm": np.abs(err).max(axis=0) * 1e3,
+            "max_abs_actuator_force_N": np.abs(log.force).max(axis=0),
+        },
+    }
+
+
+def segment_ends(traj) -> dict:
+    """segment index -> index of its last sample."""
+    return {int(k): i for i, k in enumerate(traj.segment)}
+
+
+def summarize(result, program: str, stroke=None) -> dict:
+    traj, L, F = result.trajectory, result.L, result.F
+    ends = segment_ends(traj)
+    moves = []
+    for k, s in enumerate(traj.segments):
+        if s.kind != "move":
+            continue
+        n = ends[k]
+        mask = traj.segment == k
+        moves.append({
+            "move": s.ordinal,
+            "at": str(s.at) if s.at else None,
+            "target": list(s.values),
+            "units": list(s.units),
+            "t_end_s": float(traj.t[n]),
+            "lengths_mm": L[n] * 1e3,
+            "max_abs_force_N": None if F is None else np.abs(F[mask]).max(axis=0),
+        })
+    return {
+        "program": program,
+        "platform": result.platform,
+        "convention": result.convention,
+        "samples": len(traj.t),
+        "duration_s": traj.duration,
+        "moves": moves,
+        "stroke_mm": None if stroke is None else [float(v) * 1e3 for v in stroke],
+        "length_min_mm": L.min(axis=0) * 1e3,
+        "length_max_mm": L.max(axis=0) * 1e3,
+        "max_abs_force_N": None if F is None else np.abs(F).max(axis=0),
+        "notes": list(result.notes),
+    }
+
+
+def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
+    """Write ``trajectory.csv`` (t, q, q̇, q̈ in SI: readable by ``stewart-drake dynamics --trajectory``),
+    ``legs.csv`` (t, L mm, F N), ``summary.json``, ``lengths.png``, ``forces.png`` (and the simulation's
+    logs) into ``out``, replacing it atomically."""
+    out = out.resolve()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        traj = result.trajectory
+        with (tmp / "trajectory.csv").open("w", newline="") as fh:
+            w = csv.writer(fh)
+            names = ("px", "py", "pz", "alpha", "beta", "gama")
+            w.writerow(["t"] + list(names) + [f"{n}_dot" for n in names] + [f"{n}_ddot" for n in names])
+            for row in np.concatenate([traj.t[:, None], traj.q, traj.qd, traj.qdd], axis=1):
+                w.writerow([repr(float(v)) for v in row])
+        with (tmp / "legs.csv").open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["t_s"] + [f"L{i}_mm" for i in range(1, 7)] + ([f"F{i}_N" for i in range(1, 7)] if result.F is not None else []))
+            cols = [traj.t[:, None], result.L * 1e3] + ([result.F] if result.F is not None else [])
+            for row in np.concatenate(cols, axis=1):
+                w.writerow([f"{v:.10g}" for v in row])
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2, default=_jsonable), encoding="utf-8")
+        _plots(tmp, result, summary, sim)
+        if sim is not None:
+            sim["log"].save(tmp / "simulation")
+        old = None
+        if out.exists():
+            old = out.with_name(f".{out.name}.old-{os.getpid()}")
+            os.replace(out, old)
+        os.replace(tmp, out)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def _plots(folder: Path, result, summary: dict, sim: dict | None) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ..script.plots import plot_forces, plot_lengths, plot_tracking
+
+    plot_lengths(result, summary["platform"], summary.get("stroke_mm")).savefig(folder / "lengths.png", dpi=110, bbox_inches="tight")
+    if result.F is not None:
+        plot_forces(result).savefig(folder / "forces.png", dpi=110, bbox_inches="tight")
+    if sim is not None:
+        plot_tracking(sim["log"], sim["length_error"]).savefig(folder / "simulation.png", dpi=110, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def print_summary(summary: dict, out: Path) -> None:
+    print(f"{summary['program']}: {len(summary['moves'])} moves, {summary['duration_s']:.3f} s, "
+          f"{summary['samples']} samples, platform {summary['platform']}")
+    shown = summary["moves"][:MAX_PRINTED]
+    for m in shown:
+        L = " ".join(f"{v:8.2f}" for v in m["lengths_mm"])
+        F = "" if m["max_abs_force_N"] is None else f"   max |F| {np.max(m['max_abs_force_N']):8.2f} N"
+        print(f"  #{m['move']:<3} {m['at']:<22} t = {m['t_end_s']:7.3f} s  L (mm) = {L}{F}")
+    if len(summary["moves"]) > len(shown):
+        print(f"  ... and {len(summary['moves']) - len(shown)} more moves (see summary.json)")
+    for note in summary["notes"]:
+        print(f"  note: {note}")
+    if "simulation" in summary:
+        s = summary["simulation"]
+        print(f"  simulation ({s['controller']} controller): max |L - L_ref| = {np.max(s['max_abs_length_error_mm']):.3f} mm")
+    print(f"wrote {out}/")

@@ -1,0 +1,148 @@
+"""Run a checked ``Program``: evaluate its statements in order, feeding moves and waits to a
+``runtime.Motion``. Arithmetic is IEEE double; ``/`` is true division, ``DIV`` floor division, ``MOD``
+the remainder with the divisor's sign (Python's ``//`` and ``%``), so the emitted Python computes the
+same numbers."""
+
+from __future__ import annotations
+
+import math
+
+from . import ast
+from .check import assigned_names
+from .errors import UNDEFINED, ScriptError
+from .runtime import CONSTANTS, FUNCTIONS, Motion, fmt_number, for_range
+
+MAX_STEPS = 1_000_000  # statements executed + loop iterations
+
+
+def execute(program: ast.Program, motion: Motion) -> dict:
+    """Run ``program`` on ``motion``; return the final variables. Errors carry the program's source."""
+    it = _Interpreter(motion, assigned_names(program.body))
+    try:
+        it.block(program.body)
+    except ScriptError as e:
+        e.source = program.source
+        raise
+    return it.env
+
+
+class _Interpreter:
+    def __init__(self, motion: Motion, assigned: dict):
+        self.motion = motion
+        self.env: dict[str, float] = {}
+        self.assigned = assigned
+        self.steps = 0
+
+    def tick(self, at):
+        self.steps += 1
+        if self.steps > MAX_STEPS:
+            raise ScriptError(
+                f"the program ran more than {MAX_STEPS} steps (statements and loop iterations); does a loop never end?", at
+            )
+
+    def block(self, body):
+        for s in body:
+            self.tick(s.at)
+            self.stmt(s)
+
+    def stmt(self, s):
+        if isinstance(s, ast.Assign):
+            self.env[s.name] = self.eval(s.value)
+        elif isinstance(s, ast.Move):
+            pos = [self.eval(a.value) for a in s.args if a.name is None]
+            kws = {a.name: self.eval(a.value) for a in s.args if a.name is not None}
+            d = None if s.duration is None else self.eval(s.duration)
+            self.motion.move(*pos, duration=d, at=s.at, keyword=s.keyword, **kws)
+        elif isinstance(s, ast.Wait):
+            self.motion.wait(self.eval(s.duration), at=s.at)
+        elif isinstance(s, ast.Units):
+            self.motion.units(*(n for n, _ in s.names), at=s.at)
+        elif isinstance(s, ast.For):
+            step = 1.0 if s.step is None else self.eval(s.step)
+            for v in for_range(self.eval(s.start), self.eval(s.stop), step, at=s.at):
+                self.tick(s.at)
+                self.env[s.var] = v
+                self.block(s.body)
+        elif isinstance(s, ast.If):
+            for cond, body in s.branches:
+                if self.eval(cond):
+                    self.block(body)
+                    break
+            else:
+                self.block(s.orelse or ())
+        elif isinstance(s, ast.While):
+            while self.eval(s.cond):
+                self.tick(s.at)
+                self.block(s.body)
+        else:  # pragma: no cover
+            raise TypeError(f"unknown statement {type(s).__name__}")
+
+    def eval(self, e):
+        if isinstance(e, ast.Num):
+            return e.value
+        if isinstance(e, ast.Var):
+            if e.name in self.env:
+                return self.env[e.name]
+            if e.name in CONSTANTS:
+                return CONSTANTS[e.name][0]
+            first = self.assigned.get(e.name)
+            hint = f": it is first assigned at line {first.line}, column {first.column}, after this use" if first else ""
+            raise ScriptError(UNDEFINED.format(name=e.name) + hint, e.at)
+        if isinstance(e, ast.Unary):
+            v = self.eval(e.operand)
+            return -v if e.op == "-" else +v
+        if isinstance(e, ast.Not):
+            return not self.eval(e.operand)
+        if isinstance(e, ast.Call):
+            args = [self.eval(a) for a in e.args]
+            fn = FUNCTIONS[e.name][1]
+            try:
+                v = fn(*args)
+            except (ValueError, OverflowError):
+                v = math.nan
+            if not math.isfinite(v):
+                shown = ", ".join(fmt_number(a) for a in args)
+                raise ScriptError(f"{e.name}({shown}) has no finite value", e.at)
+            return float(v)
+        if isinstance(e, ast.Binary):
+            if e.op == "AND":
+                return bool(self.eval(e.left)) and bool(self.eval(e.right))
+            if e.op == "OR":
+                return bool(self.eval(e.left)) or bool(self.eval(e.right))
+            a, b = self.eval(e.left), self.eval(e.right)
+            return _binary(e.op, a, b, e.at)
+        raise TypeError(f"unknown expression {type(e).__name__}")  # pragma: no cover
+
+
+_COMPARE = {
+    "=": lambda a, b: a == b,
+    "<>": lambda a, b: a != b,
+    "<": lambda a, b: a < b,
+    "<=": lambda a, b: a <= b,
+    ">": lambda a, b: a > b,
+    ">=": lambda a, b: a >= b,
+}
+
+
+_ARITH = {
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b,
+    "DIV": lambda a, b: a // b,
+    "MOD": lambda a, b: a % b,
+}
+
+
+def _binary(op, a, b, at):
+    if op in _COMPARE:
+        return _COMPARE[op](a, b)
+    if op in ("/", "DIV", "MOD") and b == 0:
+        raise ScriptError(f"division by zero ({fmt_number(a)} {op} 0)", at)
+    try:
+        v = _ARITH[op](a, b)
+    except OverflowError:
+        v = math.inf
+    if not math.isfinite(v):
+        raise ScriptError(f"arithmetic overflow: {fmt_number(a)} {op} {fmt_number(b)} is not finite", at)
+    return v
