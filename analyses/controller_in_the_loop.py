@@ -1,0 +1,184 @@
+"""The fixed-point DSP controller in the loop with the closed-loop Drake plant (utn-dynamic): fixed vs
+float tracking, the sample-period/latency sweep, saturation, and a Meshcat animation."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewart_drake.control import ControllerConfig, DspTiming
+from stewart_drake.fixedpoint import fixed_point_leg_lengths
+from stewart_drake.geometry import load_preset
+from stewart_drake.kinematics import leg_lengths
+from stewart_drake.report import run_standalone
+from stewart_drake.simulation import ROTATING, SEED, ActuatorModel, build_simulation
+
+TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
+ORDER = 90
+
+PLATFORM = "utn-dynamic"
+
+
+def _bound_terms(platform, traj, log_float, duration, cfg: ControllerConfig):
+    """The tracking bound's ingredients (metres): float error, fixed-point IK error over the ticks,
+    the set-point LSB, the sensor resolution, and the timing bound v_max · t_delay of the float loop."""
+    T = cfg.timing.sample_period
+    ticks = traj.pose(np.arange(int(round(duration / T))) * T)
+    d_ik = float(np.abs(fixed_point_leg_lengths(platform, ticks, cfg.ik_format) - leg_lengths(platform, ticks)).max())
+    t = log_float.t
+    v_max = float(np.abs(np.gradient(leg_lengths(platform, traj.pose(t)), t, axis=0)).max())
+    a = cfg.gains.feedforward_filter
+    t_delay = cfg.timing.output_delay + T + ActuatorModel().time_constant + (1 - a) / a * T
+    return d_ik, cfg.ik_format.length_lsb, cfg.timing.sensor_resolution, v_max, t_delay
+
+
+def _tracking(section, platform, duration):
+    import matplotlib.pyplot as plt
+
+    cfg = ControllerConfig()
+    rows, logs = [], {}
+    fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True)
+    for j, traj in enumerate((SEED, ROTATING)):
+        for i, kind in enumerate(("float", "fixed")):
+            log = build_simulation(platform, traj, kind, cfg).run(duration)
+            logs[traj.name, kind] = log
+            e = log.length_error(traj, platform)
+            pe = log.pose_error(traj)
+            rows.append([traj.name, kind, float(np.abs(e).max() * 1e3), float(np.sqrt(np.mean(e**2)) * 1e3),
+                         float(np.abs(pe[:, :3]).max() * 1e3), float(np.degrees(np.abs(pe[:, 3:]).max())),
+                         int(log.saturations().sum()), float(np.abs(log.force).max())])
+            ax = axes[i, j]
+            ax.plot(log.t, e * 1e3, lw=0.8)
+            ax.set_title(f"{traj.name} trajectory, {kind} controller", fontsize=9)
+            ax.set_ylabel("L − IK(ref) [mm]")
+        d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs[traj.name, "float"], duration, cfg)
+        e_float = np.abs(logs[traj.name, "float"].length_error(traj, platform)).max()
+        e_fixed = np.abs(logs[traj.name, "fixed"].length_error(traj, platform)).max()
+        section.check(f"{traj.name}: float twin's leg error <= v_max·t_delay (timing bound, {v_max * 1e3:.0f} mm/s × {t_delay * 1e3:.0f} ms)",
+                      e_float * 1e3, v_max * t_delay * 1e3, "mm")
+        section.check(f"{traj.name}: fixed-point leg error <= float + Δ_IK + LSB + r (quantisation bound)",
+                      e_fixed * 1e3, (e_float + d_ik + lsb + r) * 1e3, "mm")
+        rows[-1].append(f"Δ_IK {d_ik * 1e3:.2f} mm")
+    for ax in axes[-1]:
+        ax.set_xlabel("t [s]")
+    section.table(["trajectory", "controller", "max |leg err| mm", "rms leg err mm", "max |pos err| mm",
+                   "max |angle err| deg", "saturated ticks", "max |force| N", "note"],
+                  [r + [""] * (9 - len(r)) for r in rows], caption=f"Tracking over {duration:g} s, T = 1 ms, one sample of output delay", fmt="{:.3f}")
+    section.figure(fig, "cil_tracking", "Leg-length tracking error (true length − exact IK of the reference), six legs.")
+    return logs
+
+
+def _sweep(section, platform, periods, duration):
+    import matplotlib.pyplot as plt
+
+    rows = []
+    res = {}
+    plant_step = 2.5e-4
+    for lat in ("computation", "sample"):
+        for T in periods:
+            timing = DspTiming(sample_period=T, latency=lat)
+            log = build_simulation(platform, SEED, "fixed", ControllerConfig(timing=timing), plant_time_step=plant_step).run(duration)
+            e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
+            res[lat, T] = e
+            rows.append([lat, T * 1e3, timing.output_delay * 1e6, e, int(log.saturations().sum())])
+    section.table(["latency", "T ms", "output delay µs", "max |leg err| mm", "saturated ticks"], rows,
+                  caption=f"Sweep (fixed-point controller, seed trajectory, {duration:g} s, plant step {plant_step * 1e3:g} ms)", fmt="{:.3f}")
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    for lat in ("computation", "sample"):
+        ax.semilogy([T * 1e3 for T in periods], [res[lat, T] for T in periods], "o-", label=f"latency: {lat}")
+    ax.set_xlabel("sample period T [ms]")
+    ax.set_ylabel("max |leg error| [mm]")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    section.figure(fig, "cil_sweep", "Tracking error against the sample period, for the two output-delay models.")
+    return res
+
+
+def _saturation(section, platform, ranges, duration):
+    rows = []
+    for rng in ranges:
+        cfg = ControllerConfig(timing=DspTiming(command_range=rng))
+        log = build_simulation(platform, SEED, "fixed", cfg).run(duration)
+        sat = log.saturations().astype(int)
+        st = log.status[:, 3]
+        first = log.t[np.argmax(st > 0)] if st[-1] > 0 else float("nan")
+        e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
+        rows.append([rng, " ".join(str(s) for s in sat), first, e])
+    section.table(["command range N", "saturated ticks per leg 1..6", "first saturation s", "max |leg err| mm"], rows,
+                  caption=f"Command range (Q15 full scale) against saturation, fixed-point controller, seed trajectory, {duration:g} s", fmt="{:.3f}")
+
+
+def _animation(section, platform, duration):
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    meshcat = Meshcat(MeshcatParams(host="localhost"))
+    build_simulation(platform, SEED, "fixed", meshcat=meshcat).run(duration)
+    html = meshcat.StaticHtml()
+    section.attach("controller_in_the_loop.html", html.encode("utf-8"),
+                   f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, self-contained HTML)")
+
+
+def build(section) -> None:
+    platform = load_preset(PLATFORM)
+    quick = section.quick
+    duration = 1.0 if quick else 4.0
+    section.text(
+        "The controller runs as a discrete Drake system with the DSP's timing: a periodic update at exactly k·T "
+        "reads the pose reference and the six leg lengths quantised to the sensor's 10 µm counts, computes the "
+        "set-points with the 16-bit fixed-point IK (integer millimetres, the DSP's tfr16 sine/cosine) and a "
+        "leg-position PID with velocity feed-forward in Q15/Q31 (saturating intrinsics, anti-windup by "
+        "conditional integration), and releases the command one sample later (the conservative default; the "
+        "cycle model's computation time of ~62 µs = 3.7 k cycles at 60 MHz is the alternative). Commands are "
+        "held between releases. The float twin runs the same law, timing and sensor in float64. Actuators: "
+        "force limit, 2 ms first-order lag; the stroke end stops are the prismatic joint limits of the "
+        "closed-loop plant (ball constraints, SAP, 1 ms step). Gains (kp 3000 N/m, ki 15000 N/(m·s), kd 80 N·s/m, "
+        "kv 80 N·s/m) were chosen by a sweep: the leg-space mass ranges from ~0.16 kg (rotation modes) to "
+        "~6.4 kg (translation), so one diagonal PID cannot damp both well; kd is near the light modes' limit."
+    )
+    logs = _tracking(section, platform, duration)
+    section.text(
+        "Bounds: the float twin has the DSP's timing and no arithmetic quantisation, and its error stays below "
+        "the distance the legs travel during the loop's feed-forward delay (output delay + measurement age + "
+        "actuator lag + the feed-forward filter's time constant). The fixed-point controller adds at most the "
+        "fixed-point IK's own set-point error Δ_IK (truncations in the 16-bit IK; up to ~2.7 mm on the "
+        "rotating trajectory), one set-point step (1 mm) and the sensor LSB. On the rotating trajectory most "
+        "of the fixed-point error is that set-point error (Δ_IK in the table). Plate position errors are "
+        "larger than leg errors: this tall, narrow platform (0.7 m high on a 0.4 m base) turns small leg-length "
+        "errors into larger sideways displacements (the inverse Jacobian's small singular values)."
+    )
+    periods = [5e-4, 1e-3, 2e-3] if quick else [2.5e-4, 5e-4, 1e-3, 1.5e-3, 2e-3]
+    res = _sweep(section, platform, periods, 0.5 if quick else 1.5)
+    def longest(lat):
+        ok = [T for T in periods if res[lat, T] < 5.0]
+        if not ok:
+            return "none of the periods tried"
+        return f"{max(ok) * 1e3:g} ms" + (" (the longest tried)" if max(ok) == max(periods) else "")
+
+    section.text(
+        "The sweep uses a 0.25 ms plant step so that a release between plant steps reaches the plant when it "
+        "happens (with a 1 ms plant step the plant samples the actuators only at k·T, and a 62 µs latency "
+        f"cannot be told from zero). The gains, designed at 1 kHz, track within 5 mm up to T = {longest('sample')} with "
+        f"one full sample of output delay and up to T = {longest('computation')} when the command is released after the "
+        "computation time. Beyond that the loop's delay destabilises the light rotation modes: the command "
+        "saturates and the error grows by an order of magnitude or more. The conservative timing model thus "
+        "costs real margin: a controller validated with the optimistic one could fail on the hardware."
+    )
+    peak_float = float(np.abs(logs["seed", "float"].force).max())
+    peak_fixed = float(np.abs(logs["seed", "fixed"].force).max())
+    _saturation(section, platform, [200.0, 10.0, 5.0, 3.0] if not quick else [200.0, 3.0], 1.0 if not quick else 0.3)
+    section.text(
+        f"With the 200 N full scale the seed trajectory never saturates: the float twin needs at most {peak_float:.1f} N, "
+        f"the fixed-point controller {peak_fixed:.1f} N, the difference being the 1 mm set-point steps of the "
+        "integer-millimetre IK passed through kp and the velocity feed-forward (force ripple, not motion). "
+        "A smaller full scale (a finer command LSB) first clips those spikes, then the steady holding force: "
+        "the legs that carry most of the plate's weight (4 and 5 here) saturate most, the anti-windup holds the "
+        "integrator, and tracking degrades by orders of magnitude once the range is below the holding force."
+    )
+    _animation(section, platform, 1.0 if quick else 4.0)
+
+
+def main(argv=None):
+    return run_standalone(__file__, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

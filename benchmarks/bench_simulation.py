@@ -1,0 +1,71 @@
+"""Real-time factor of the controller-in-the-loop simulation (simulated seconds per wall-clock second).
+
+Seed trajectory on utn-dynamic, plant step 1 ms (or the period if shorter), fixed-point and float
+controllers, and how the cost scales with the controller rate. Run by hand:
+
+    .venv/bin/python benchmarks/bench_simulation.py [--duration 4]
+
+Build time (Diagram + Simulator) is reported apart from the run. Figures are ratios measured in one run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+def rtf(platform, kind, period, duration, plant_step=None):
+    from stewart_drake.control import ControllerConfig, DspTiming
+    from stewart_drake.simulation import SEED, build_simulation
+
+    t0 = time.perf_counter()
+    sim = build_simulation(platform, SEED, kind, ControllerConfig(timing=DspTiming(sample_period=period)),
+                           plant_time_step=plant_step or min(period, 1e-3))
+    t1 = time.perf_counter()
+    sim.run(duration)
+    t2 = time.perf_counter()
+    return duration / (t2 - t1), t1 - t0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--duration", type=float, default=4.0, help="simulated seconds per run (default 4)")
+    args = ap.parse_args(argv)
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from stewart_drake.geometry import load_preset
+    from stewart_drake.model import build_plant, set_pose
+
+    p = load_preset("utn-dynamic")
+    # the plant alone (zero actuation, falls onto the end stops): the ceiling for everything else
+    b = DiagramBuilder()
+    plant, _ = build_plant(p, 1e-3, b)
+    src = b.AddSystem(ConstantVectorSource([0.0] * 6))
+    b.Connect(src.get_output_port(), plant.get_actuation_input_port())
+    sim = Simulator(b.Build())
+    set_pose(plant, plant.GetMyMutableContextFromRoot(sim.get_mutable_context()), p, p.home_pose())
+    t0 = time.perf_counter()
+    sim.AdvanceTo(args.duration)
+    plant_rtf = args.duration / (time.perf_counter() - t0)
+    print(f"plant alone, 1 ms step:             real-time factor {plant_rtf:6.2f}x")
+    for kind in ("fixed", "float"):
+        r, build = rtf(p, kind, 1e-3, args.duration)
+        print(f"{kind:5s} controller at 1 kHz, 1 ms plant: real-time factor {r:6.2f}x  (build {build:.2f} s)")
+    print("scaling with the controller rate (fixed point; plant step = min(T, 1 ms)):")
+    scaling = {period: rtf(p, "fixed", period, args.duration / 2)[0] for period in (4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4)}
+    for period, r in scaling.items():
+        print(f"  {1 / period:7.0f} Hz: real-time factor {r:6.2f}x   ({r / scaling[1e-3]:.2f} × the 1 kHz figure)")
+    print("controller rate at a fixed 0.25 ms plant step (isolates the controller's cost):")
+    for period in (2e-3, 1e-3, 5e-4, 2.5e-4):
+        r, _ = rtf(p, "fixed", period, args.duration / 4, plant_step=2.5e-4)
+        print(f"  {1 / period:7.0f} Hz: real-time factor {r:6.2f}x")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,470 @@
+"""Controller-in-the-loop simulation: trajectory source → DSP controller → actuators → closed-loop plant.
+
+The Diagram (``build_simulation``)::
+
+    PoseSource ──reference──▶ controller (fixed | float, discrete, period T) ──command──▶ Actuators
+        ▲                          ▲ leg_lengths                                           │ force
+        │                          └──────── MatrixGain (prismatic positions) ◀── plant ◀──┘
+        └ (trajectory: seed, rotating, or a (t, pose) CSV)
+
+Loggers record, at every plant step, the plant state (pose and leg lengths come from it), the
+controller's held command and set-point, its status (tick count, tick time, saturation counts) and the
+actuator forces; the reference is logged at the controller's ticks. Everything is deterministic: the
+same inputs give the same logs bit for bit (no randomness, no threads in the loop).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .control import STATUS, ControllerConfig, make_controller
+from .geometry import Platform
+from .kinematics import leg_lengths
+from .rotations import angles_from_matrix, pose_to_si, rotation_matrix
+
+# ----------------------------------------------------------------------------------------------
+# Trajectories: pose(t) for a scalar or an array of times, (..., 6) metres/radians, utn convention.
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A pose reference. ``pose(t)``: ``(..., 6)`` for times ``(...)`` (s); ``duration`` the natural
+    length in seconds (None: unbounded)."""
+
+    name: str
+    fn: object
+    duration: float | None = None
+
+    def pose(self, t) -> np.ndarray:
+        return self.fn(np.asarray(t, dtype=float))
+
+
+def _seed_pose(t):
+    """SPEC §3: px = −0.1 m, py = 0.1·sin(2t) m, pz = 0.7 m, no rotation."""
+    t = np.asarray(t, dtype=float)
+    z = np.zeros_like(t)
+    return np.stack([z - 0.1, 0.1 * np.sin(2.0 * t), z + 0.7, z, z, z], axis=-1)
+
+
+def _rotating_pose(t):
+    """The plate at pz = 0.7 m turning about Z by 15°·sin(2t) while tilting 5°·sin(3t) about X."""
+    t = np.asarray(t, dtype=float)
+    z = np.zeros_like(t)
+    return np.stack([z, z, z + 0.7, np.radians(5.0) * np.sin(3.0 * t), z, np.radians(15.0) * np.sin(2.0 * t)], axis=-1)
+
+
+SEED = Trajectory("seed", _seed_pose, 4.0)
+ROTATING = Trajectory("rotating", _rotating_pose, 4.0)
+TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
+
+
+def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+    """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
+    seconds) as a piecewise-linear Trajectory held constant after the last sample. Errors name the line."""
+    f = Path(path)
+    if not f.is_file():
+        raise FileNotFoundError(f"trajectory file {str(path)!r} does not exist")
+    rows = []
+    with f.open(newline="") as fh:
+        for lineno, row in enumerate(csv.reader(fh), start=1):
+            if not row or all(not c.strip() for c in row):
+                continue
+            try:
+                values = [float(c) for c in row]
+            except ValueError:
+                if not rows and lineno == 1:
+                    continue
+                raise ValueError(f"{path}:{lineno}: not a number in {row!r}") from None
+            if len(values) != 7:
+                raise ValueError(f"{path}:{lineno}: expected 7 values (t, px, py, pz, a_x, a_y, a_z), got {len(values)}")
+            if not all(math.isfinite(v) for v in values):
+                raise ValueError(f"{path}:{lineno}: values must be finite, got {row!r}")
+            if rows and values[0] <= rows[-1][0]:
+                raise ValueError(f"{path}:{lineno}: time {values[0]} s is not after the previous sample's {rows[-1][0]} s")
+            rows.append(values)
+    if len(rows) < 1:
+        raise ValueError(f"{path}: no samples")
+    data = np.array(rows)
+    ts, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+
+    def fn(t):
+        t = np.asarray(t, dtype=float)
+        return np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
+
+    return Trajectory(f.stem, fn, float(ts[-1]))
+
+
+def get_trajectory(name_or_path, **units) -> Trajectory:
+    """``seed``, ``rotating`` or a CSV file path."""
+    if isinstance(name_or_path, Trajectory):
+        return name_or_path
+    s = str(name_or_path)
+    if s in TRAJECTORIES:
+        return TRAJECTORIES[s]
+    if s.endswith(".csv") or Path(s).exists():
+        return load_trajectory_csv(s, **units)
+    raise ValueError(f"unknown trajectory {s!r}: not one of {', '.join(TRAJECTORIES)} and not a CSV file")
+
+
+# ----------------------------------------------------------------------------------------------
+# Actuators.
+
+
+@dataclass(frozen=True)
+class ActuatorModel:
+    """Leg actuators: a force limit (N, None: the platform's ``legs.max_force``) and a first-order lag
+    with time constant ``time_constant`` (s; 0: none). The stroke end stops are the prismatic joints'
+    limits in the plant (SAP enforces them as constraints)."""
+
+    max_force: float | None = None
+    time_constant: float = 2e-3
+
+    def __post_init__(self):
+        if self.max_force is not None and not (math.isfinite(self.max_force) and self.max_force > 0):
+            raise ValueError(f"ActuatorModel.max_force must be a positive number of newtons, got {self.max_force!r}")
+        if not (math.isfinite(self.time_constant) and self.time_constant >= 0):
+            raise ValueError(f"ActuatorModel.time_constant must be >= 0 s, got {self.time_constant!r}")
+
+
+def _systems():
+    """LeafSystem classes, built on first use (keeps pydrake out of import time)."""
+    global _SYS
+    if _SYS is not None:
+        return _SYS
+    from pydrake.systems.framework import LeafSystem
+
+    class PoseSource(LeafSystem):
+        """Output ``pose`` (6) = trajectory.pose(t)."""
+
+        def __init__(self, trajectory: Trajectory):
+            super().__init__()
+            self.trajectory = trajectory
+            # evaluated on a 1-element array, the same code path as a batch of times
+            self.DeclareVectorOutputPort("pose", 6, lambda c, o: o.SetFromVector(trajectory.pose(np.array([c.get_time()]))[0]))
+
+    class Actuators(LeafSystem):
+        """Input ``command`` (6, N) → output ``force`` (6, N): saturation at ±max_force, then a first-order
+        lag discretised exactly at ``period`` (the plant's step), F ← a·F + (1−a)·u, a = exp(−period/τ)."""
+
+        def __init__(self, max_force: float, time_constant: float, period: float):
+            super().__init__()
+            self.max_force = max_force
+            u = self.DeclareVectorInputPort("command", 6)
+            if time_constant > 0:
+                a = math.exp(-period / time_constant)
+                s = self.DeclareDiscreteState(6)
+
+                def update(context, xd):
+                    F = context.get_discrete_state(s).value()
+                    cmd = np.clip(u.Eval(context), -max_force, max_force)
+                    xd.set_value(s, a * F + (1 - a) * cmd)
+
+                self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, update)
+                self.DeclareStateOutputPort("force", s)
+                self.state_index = s
+            else:
+                self.state_index = None
+                self.DeclareVectorOutputPort("force", 6, lambda c, o: o.SetFromVector(np.clip(u.Eval(c), -max_force, max_force)))
+
+    _SYS = {"PoseSource": PoseSource, "Actuators": Actuators}
+    return _SYS
+
+
+_SYS = None
+
+
+def pose_source(trajectory: Trajectory):
+    """A LeafSystem with one output ``pose`` (6) = ``trajectory.pose(t)`` (any 6-vector function of time)."""
+    return _systems()["PoseSource"](trajectory)
+
+
+def actuator_system(max_force: float, time_constant: float, period: float):
+    """The actuator LeafSystem: input ``command`` (6, N) → output ``force`` (6, N); see ``ActuatorModel``."""
+    return _systems()["Actuators"](max_force, time_constant, period)
+
+
+def initial_leg_forces(platform: Platform, trajectory: Trajectory, t: float = 0.0, h: float = 1e-4) -> np.ndarray:
+    """``(6,)`` leg forces (N) that move plate and legs along the reference at time ``t``
+    (``dynamics.leg_forces_with_legs`` with central-difference rates): where the controller's integrator
+    starts, so a run begins in equilibrium instead of with a gravity sag."""
+    from .dynamics import leg_forces_with_legs
+
+    qm, q0, qp = trajectory.pose(np.array([t - h, t, t + h]))
+    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
+
+
+def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: float, h: float = 1e-6) -> None:
+    """Set every velocity in ``context`` to the reference's at time ``t`` (central differences of the
+    closed-form joint positions, step ``h`` s), so that a run starts on the trajectory, not at rest."""
+    from pydrake.multibody.math import SpatialVelocity
+
+    from .model import leg_joint_positions
+
+    qm, qp = trajectory.pose(np.array([t - h, t + h]))
+    Rm, Rp = rotation_matrix(qm[3:]), rotation_matrix(qp[3:])
+    W = (Rp - Rm) / (2 * h) @ rotation_matrix(trajectory.pose(t)[3:]).T  # [ω]×
+    w = np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]]) / 2
+    p_m = qm[:3] - Rm @ platform.rotation_centre
+    p_p = qp[:3] - Rp @ platform.rotation_centre
+    plant.SetFreeBodySpatialVelocity(context, plant.GetBodyByName("top"), SpatialVelocity(w, (p_p - p_m) / (2 * h)))
+    (am, Lm), (ap, Lp) = leg_joint_positions(platform, qm), leg_joint_positions(platform, qp)
+    for i in range(6):
+        plant.GetJointByName(f"universal_{i + 1}").set_angular_rates(context, (ap[i] - am[i]) / (2 * h))
+        plant.GetJointByName(f"prismatic_{i + 1}").set_translation_rate(context, (Lp[i] - Lm[i]) / (2 * h))
+
+
+# ----------------------------------------------------------------------------------------------
+# The Diagram.
+
+
+@dataclass
+class Simulation:
+    """A built controller-in-the-loop Diagram, ready to run (see ``build_simulation``)."""
+
+    platform: Platform
+    trajectory: Trajectory
+    kind: str
+    config: ControllerConfig
+    diagram: object
+    plant: object
+    controller: object
+    loggers: dict
+    simulator: object = None
+    meshcat: object = None
+    visualizer: object = None
+    plant_time_step: float = 1e-3
+    _ran: bool = False
+
+    def run(self, duration: float, progress: bool = False) -> "SimulationLog":
+        """Simulate ``duration`` seconds from t = 0 (once per Simulation) and return the logs."""
+        if not (math.isfinite(duration) and duration > 0):
+            raise ValueError(f"duration must be a positive number of seconds, got {duration!r}")
+        if self._ran:
+            raise RuntimeError("a Simulation runs once; build a new one")
+        self._ran = True
+        sim = self.simulator
+        if hasattr(self.controller, "prime"):  # batch the fixed-point IK of the known reference (speed only)
+            T = self.config.timing.sample_period
+            n = int(math.floor(duration / T + 1e-9)) + 1
+            self.controller.prime(self.trajectory.pose(np.arange(n) * T))
+        if self.meshcat is not None:
+            self.visualizer.StartRecording()
+        if progress:
+            from tqdm import tqdm
+
+            steps = max(1, int(round(duration / 0.05)))
+            with tqdm(total=steps, desc=f"simulate {self.kind} {duration:g} s", unit=" × 50 ms", leave=False) as bar:
+                for k in range(1, steps + 1):
+                    sim.AdvanceTo(duration * k / steps)
+                    bar.update(1)
+        else:
+            sim.AdvanceTo(duration)
+        if self.meshcat is not None:
+            self.visualizer.StopRecording()
+            self.visualizer.PublishRecording()
+        return self._collect()
+
+    def _collect(self) -> "SimulationLog":
+        ctx = self.simulator.get_context()
+        logs = {k: lg.FindLog(ctx) for k, lg in self.loggers.items()}
+        x = logs["state"]
+        t = x.sample_times().copy()
+        X = x.data().T
+        top = self.plant.GetBodyByName("top")
+        i0 = top.floating_positions_start()
+        quat = X[:, i0 : i0 + 4]
+        p_WT = X[:, i0 + 4 : i0 + 7]
+        R = _quat_to_matrix(quat)
+        angles = angles_from_matrix(R, "utn")
+        p_WC = p_WT + np.einsum("nij,j->ni", R, self.platform.rotation_centre)
+        pose = np.concatenate([p_WC, angles], axis=1)
+        joints = [self.plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
+        L = X[:, [j.position_start() for j in joints]]
+        ref = logs["reference"]
+        status = logs["status"].data().T
+        return SimulationLog(
+            kind=self.kind,
+            platform=self.platform.name,
+            trajectory=self.trajectory.name,
+            sample_period=self.config.timing.sample_period,
+            t=t,
+            pose=pose,
+            lengths=L,
+            command=logs["command"].data().T.copy(),
+            setpoint=logs["setpoint"].data().T.copy(),
+            force=logs["force"].data().T.copy(),
+            status=status.copy(),
+            t_ref=ref.sample_times().copy(),
+            reference=ref.data().T.copy(),
+        )
+
+
+def _quat_to_matrix(q) -> np.ndarray:
+    """``(n, 4)`` unit quaternions [w, x, y, z] → ``(n, 3, 3)``."""
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    w, x, y, z = q.T
+    return np.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        axis=-1,
+    ).reshape(-1, 3, 3)
+
+
+def build_simulation(
+    platform: Platform,
+    trajectory="seed",
+    controller: str = "fixed",
+    config: ControllerConfig | None = None,
+    actuators: ActuatorModel | None = None,
+    plant_time_step: float = 1e-3,
+    meshcat=None,
+) -> Simulation:
+    """Assemble the controller-in-the-loop Diagram and its Simulator, with the plant at the reference's
+    initial pose, legs at the matching lengths and the controller holding them against gravity.
+
+    ``controller``: ``fixed`` or ``float``; ``config``: timing and gains (refused if infeasible);
+    ``plant_time_step`` (s): the discrete plant's step; ``meshcat``: a ``Meshcat`` to record an animation.
+    """
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import LogVectorOutput, MatrixGain
+
+    from .model import build_plant, set_pose
+
+    if not (math.isfinite(plant_time_step) and plant_time_step > 0):
+        raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
+    trajectory = get_trajectory(trajectory)
+    config = config or ControllerConfig()
+    actuators = actuators or ActuatorModel()
+    builder = DiagramBuilder()
+    plant, scene_graph = build_plant(platform, plant_time_step, builder)
+    ctrl = builder.AddSystem(make_controller(controller, platform, config))
+    ctrl.set_name(f"{controller}_controller")
+    src = builder.AddSystem(pose_source(trajectory))
+    src.set_name("reference")
+    max_force = actuators.max_force or float(platform.legs.max_force)
+    act = builder.AddSystem(actuator_system(max_force, actuators.time_constant, plant_time_step))
+    act.set_name("actuators")
+    nx = plant.num_multibody_states()
+    D = np.zeros((6, nx))
+    for i in range(6):
+        D[i, plant.GetJointByName(f"prismatic_{i + 1}").position_start()] = 1.0
+    sensor = builder.AddSystem(MatrixGain(D))
+    sensor.set_name("leg_length_sensor")
+    builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
+    builder.Connect(plant.get_state_output_port(), sensor.get_input_port())
+    builder.Connect(sensor.get_output_port(), ctrl.GetInputPort("leg_lengths"))
+    builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
+    builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
+    T = config.timing.sample_period
+    loggers = {
+        "state": LogVectorOutput(plant.get_state_output_port(), builder),
+        "command": LogVectorOutput(ctrl.GetOutputPort("command"), builder),
+        "setpoint": LogVectorOutput(ctrl.GetOutputPort("setpoint"), builder),
+        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder),
+        "force": LogVectorOutput(act.get_output_port(), builder),
+        "reference": LogVectorOutput(src.get_output_port(), builder, T),
+    }
+    visualizer = None
+    if meshcat is not None:
+        from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
+
+        visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32))
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    root = simulator.get_mutable_context()
+    pose0 = trajectory.pose(0.0)
+    pc = plant.GetMyMutableContextFromRoot(root)
+    set_pose(plant, pc, platform, pose0)
+    set_velocity(plant, pc, platform, trajectory, 0.0)
+    L0 = leg_lengths(platform, pose0)
+    F0 = initial_leg_forces(platform, trajectory)
+    ctrl.initialize(ctrl.GetMyMutableContextFromRoot(root), L0, F0)
+    if act.state_index is not None:
+        act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
+    simulator.Initialize()
+    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step)
+
+
+def simulate(platform: Platform, trajectory="seed", controller: str = "fixed", duration: float | None = None, progress=False, **kwargs) -> "SimulationLog":
+    """Build and run: the logs of ``duration`` seconds (default the trajectory's own duration)."""
+    traj = get_trajectory(trajectory)
+    duration = duration if duration is not None else (traj.duration or 1.0)
+    return build_simulation(platform, traj, controller, **kwargs).run(duration, progress=progress)
+
+
+# ----------------------------------------------------------------------------------------------
+# Logs.
+
+
+@dataclass
+class SimulationLog:
+    """The logs of one run, numpy arrays in SI units.
+
+    ``t`` (n,) plant-step times; ``pose`` (n, 6) measured plate pose (utn); ``lengths`` (n, 6) true leg
+    lengths; ``command`` (n, 6) held controller output (N); ``setpoint`` (n, 6) held set-points (m);
+    ``force`` (n, 6) actuator forces (N); ``status`` (n, len(STATUS)); ``t_ref`` (m,), ``reference``
+    (m, 6) the pose reference at the controller's ticks.
+    """
+
+    kind: str
+    platform: str
+    trajectory: str
+    sample_period: float
+    t: np.ndarray
+    pose: np.ndarray
+    lengths: np.ndarray
+    command: np.ndarray
+    setpoint: np.ndarray
+    force: np.ndarray
+    status: np.ndarray
+    t_ref: np.ndarray
+    reference: np.ndarray
+
+    ARRAYS = ("t", "pose", "lengths", "command", "setpoint", "force", "status", "t_ref", "reference")
+
+    def tick_times(self) -> np.ndarray:
+        """The controller's tick times read from the logged status (one per tick, in order)."""
+        ticks = self.status[:, STATUS.index("ticks")].astype(int)
+        times = self.status[:, STATUS.index("last_tick_time")]
+        first = np.r_[True, np.diff(ticks) != 0] & (ticks > 0)
+        return times[first]
+
+    def saturations(self) -> np.ndarray:
+        """``(6,)`` saturated ticks per leg over the run."""
+        return self.status[-1, 4:10].copy()
+
+    def length_error(self, trajectory: Trajectory, platform: Platform) -> np.ndarray:
+        """``(n, 6)`` true leg length − the exact IK of the reference at the same time (m)."""
+        return self.lengths - leg_lengths(platform, trajectory.pose(self.t))
+
+    def pose_error(self, trajectory: Trajectory) -> np.ndarray:
+        """``(n, 6)`` measured pose − reference pose at the same time (m, rad)."""
+        return self.pose - trajectory.pose(self.t)
+
+    def save(self, directory) -> list[Path]:
+        """Write ``log.npz`` (every array) and ``log.csv`` (one row per plant step); return the paths."""
+        d = Path(directory)
+        d.mkdir(parents=True, exist_ok=True)
+        npz = d / "log.npz"
+        np.savez(npz, **{k: getattr(self, k) for k in self.ARRAYS}, kind=self.kind, platform=self.platform, trajectory=self.trajectory, sample_period=self.sample_period)
+        header = (
+            ["t"] + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")]
+            + [f"L{i}" for i in range(1, 7)] + [f"setpoint{i}" for i in range(1, 7)]
+            + [f"command{i}" for i in range(1, 7)] + [f"force{i}" for i in range(1, 7)] + list(STATUS)
+        )
+        rows = np.concatenate([self.t[:, None], self.pose, self.lengths, self.setpoint, self.command, self.force, self.status], axis=1)
+        path = d / "log.csv"
+        with path.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            w.writerows([[repr(float(v)) for v in r] for r in rows])
+        return [npz, path]

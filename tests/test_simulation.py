@@ -1,0 +1,178 @@
+"""The closed loop: trajectory source → DSP controller → actuators → closed-loop MultibodyPlant.
+
+Short runs (1 s simulated, ~1 s wall each) of the seed trajectory on ``utn-dynamic``.
+"""
+
+import numpy as np
+import pytest
+
+from stewart_drake.control import ControllerConfig, DspTiming, TimingError
+from stewart_drake.fixedpoint import fixed_point_leg_lengths
+from stewart_drake.geometry import load_preset
+from stewart_drake.kinematics import leg_lengths
+from stewart_drake.simulation import (
+    SEED,
+    ActuatorModel,
+    SimulationLog,
+    actuator_system,
+    build_simulation,
+    get_trajectory,
+    load_trajectory_csv,
+)
+
+PLATFORM = load_preset("utn-dynamic")
+DURATION = 1.0
+
+
+@pytest.fixture(scope="module")
+def runs():
+    """One float and one fixed run of the seed trajectory with the default (DSP) configuration."""
+    return {kind: build_simulation(PLATFORM, SEED, kind).run(DURATION) for kind in ("float", "fixed")}
+
+
+def test_run_starts_on_the_reference(runs):
+    """The plant starts at the reference pose (the logged pose goes through Drake's quaternion state and
+    back) with the leg lengths of the exact IK; the first samples move with the reference's velocity."""
+    for log in runs.values():
+        np.testing.assert_allclose(log.pose[0], SEED.pose(0.0), atol=1e-12)
+        np.testing.assert_allclose(log.lengths[0], leg_lengths(PLATFORM, SEED.pose(0.0)), atol=1e-12)
+        # after one plant step py has moved by ≈ 0.2 m/s · 1 ms (not 0: the run did not start at rest)
+        assert log.pose[1, 1] == pytest.approx(0.2e-3, rel=0.05)
+
+
+def test_closed_loop_ticks_are_k_T(runs):
+    for log in runs.values():
+        ticks = log.tick_times()
+        n = len(ticks)
+        assert n == round(DURATION / 1e-3)  # ticks at 0 … (N−1)·T have been seen by the last sample at N·T
+        np.testing.assert_array_equal(ticks, np.arange(n) * 1e-3)
+
+
+def test_fixed_closed_loop_setpoints_are_the_fixed_point_ik_of_the_reference(runs):
+    """In the loop too: the set-point held at (k+2)·T (sample latency, logged before the update) is the
+    fixed-point IK of the reference read at tick k."""
+    log = runs["fixed"]
+    words = fixed_point_leg_lengths(PLATFORM, log.reference, ControllerConfig().ik_format, return_words=True)
+    k = np.round(log.t / 1e-3).astype(int)
+    held = log.setpoint[k >= 2]
+    np.testing.assert_array_equal(held, words[k[k >= 2] - 2] * 1e-3)
+
+
+def test_seed_trajectory_tracks_within_the_quantisation_and_timing_bound(runs):
+    """Bound, leg by leg, on |L − IK(reference)|:
+
+    - the float twin has the same timing (one sample of output delay, 1 kHz, the same sensor and
+      actuators) and no arithmetic quantisation; its error E_float is the servo + timing error;
+    - the fixed-point controller tracks set-points that differ from the exact IK by at most Δ_IK
+      (the fixed-point IK's own error over the run, computed from the IK alone), moves in steps of one
+      set-point LSB (1 mm) that the loop can over- or undershoot by at most that step, and reads the
+      sensor to ±r/2. So |e_fixed| <= E_float + Δ_IK + LSB + r.
+    - E_float itself is bounded by the timing: the reference reaches the actuators, along the
+      feed-forward path, late by the output delay (T) + the measurement's age (T) + the actuator lag (τ)
+      + the feed-forward filter's time constant ((1 − α)/α · T); the error is at most the distance the
+      legs travel in that time, v_max · t_delay (the feedback only reduces it).
+    """
+    t = runs["float"].t
+    L_ref = leg_lengths(PLATFORM, SEED.pose(t))
+    v_max = np.abs(np.gradient(L_ref, t, axis=0)).max()
+    e_float = np.abs(runs["float"].length_error(SEED, PLATFORM)).max()
+    e_fixed = np.abs(runs["fixed"].length_error(SEED, PLATFORM)).max()
+    ticks = SEED.pose(np.arange(round(DURATION / 1e-3)) * 1e-3)
+    fmt = ControllerConfig().ik_format
+    d_ik = np.abs(fixed_point_leg_lengths(PLATFORM, ticks, fmt) - leg_lengths(PLATFORM, ticks)).max()
+    r = DspTiming().sensor_resolution
+    cfg, T = ControllerConfig(), 1e-3
+    alpha = cfg.gains.feedforward_filter
+    t_delay = cfg.timing.output_delay + T + ActuatorModel().time_constant + (1 - alpha) / alpha * T
+    assert e_float <= v_max * t_delay, (e_float, v_max, t_delay)
+    assert e_fixed <= e_float + d_ik + fmt.length_lsb + r, (e_fixed, e_float, d_ik)
+    # and the loop does something: without a controller the plate would fall to the stroke end
+    assert e_fixed < 3e-3 and e_float < 1e-3
+    assert runs["fixed"].saturations().sum() == 0
+
+
+def test_two_identical_runs_give_identical_logs(runs):
+    again = build_simulation(PLATFORM, SEED, "fixed").run(DURATION)
+    first = runs["fixed"]
+    for name in SimulationLog.ARRAYS:
+        np.testing.assert_array_equal(getattr(again, name), getattr(first, name), err_msg=name)
+
+
+def test_infeasible_timing_is_refused_by_the_diagram():
+    with pytest.raises(TimingError, match=r"longer than the sample period 40\.000 µs"):
+        build_simulation(PLATFORM, SEED, "fixed", ControllerConfig(timing=DspTiming(sample_period=40e-6)))
+
+
+def test_saturation_is_counted_in_the_loop():
+    """A command range of 3 N cannot hold the plate (≈13 N of weight on six legs, 2–5 N each): the
+    controller saturates and says so; the command never exceeds the range."""
+    cfg = ControllerConfig(timing=DspTiming(command_range=3.0))
+    log = build_simulation(PLATFORM, SEED, "fixed", cfg).run(0.2)
+    assert log.saturations().sum() > 0
+    assert np.all(np.abs(log.command) <= 3.0)
+
+
+@pytest.mark.parametrize("kind", ["fixed", "float"])
+def test_anti_windup_stops_the_integrator_at_saturation(kind):
+    """One tick computed directly: with an error that drives the output past the positive rail the
+    integrator does not grow; with the output inside the range it does."""
+    from stewart_drake.control import make_controller
+
+    ctrl = make_controller(kind, PLATFORM)
+    pose = SEED.pose(0.0)
+    L = leg_lengths(PLATFORM, pose)
+    pid = ctrl.initial_pid_state(L, np.full(6, 5.0))
+    # legs 0.3 m short of their set-points: the P term alone is 900 N > 200 N
+    u, _, pid_new, sat = ctrl.compute(pose, L - 0.3, pid)
+    assert np.all(sat == 1) and np.allclose(u, 200.0, rtol=1e-3)
+    np.testing.assert_array_equal(pid_new[:6], pid[:6])
+    # 1 mm short: unsaturated, the integrator grows by ki·T·e (float) or its Q31 word (fixed)
+    u, _, pid_new, sat = ctrl.compute(pose, L - 1e-3, pid)
+    assert np.all(sat == 0) and np.all(pid_new[:6] > pid[:6])
+
+
+def test_log_save_writes_npz_and_csv(runs, tmp_path):
+    paths = runs["fixed"].save(tmp_path)
+    data = np.load(paths[0])
+    np.testing.assert_array_equal(data["setpoint"], runs["fixed"].setpoint)
+    lines = paths[1].read_text().splitlines()
+    assert lines[0].startswith("t,pose_px") and len(lines) == len(runs["fixed"].t) + 1
+
+
+# ----------------------------------------------------------------------------------------------
+# Trajectories and actuators (no plant)
+
+
+def test_csv_trajectory_interpolates_and_names_bad_lines(tmp_path):
+    f = tmp_path / "traj.csv"
+    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n1,10,0,700,0,0,90\n")
+    traj = load_trajectory_csv(f, length_unit="mm", angle_unit="deg")
+    np.testing.assert_allclose(traj.pose(0.5), [0.005, 0, 0.7, 0, 0, np.pi / 4])
+    np.testing.assert_allclose(traj.pose(5.0), [0.01, 0, 0.7, 0, 0, np.pi / 2])  # held after the end
+    assert traj.duration == 1.0
+    bad = tmp_path / "bad.csv"
+    bad.write_text("0,0,0,0.7,0,0,0\n0,0,0,0.7,0,0,0\n")
+    with pytest.raises(ValueError, match=r"bad.csv:2: time 0.0 s is not after the previous sample's 0.0 s"):
+        load_trajectory_csv(bad)
+    bad.write_text("0,0,0,0.7,0,0\n")
+    with pytest.raises(ValueError, match=r"bad.csv:1: expected 7 values"):
+        load_trajectory_csv(bad)
+    with pytest.raises(ValueError, match="unknown trajectory 'spiral'"):
+        get_trajectory("spiral")
+
+
+def test_actuator_saturates_and_lags():
+    """Force limit, then a first-order lag exact at its period: the step response after n steps is
+    F_max·(1 − exp(−n·dt/τ))."""
+    from pydrake.systems.analysis import Simulator
+
+    dt, tau = 1e-3, 4e-3
+    act = actuator_system(50.0, tau, dt)
+    sim = Simulator(act)
+    ctx = sim.get_mutable_context()
+    act.get_input_port().FixValue(ctx, np.full(6, 500.0))  # beyond the 50 N limit
+    sim.AdvanceTo(10 * dt)
+    F = act.get_output_port().Eval(ctx)
+    np.testing.assert_allclose(F, 50.0 * (1 - np.exp(-10 * dt / tau)), rtol=1e-12)
+    with pytest.raises(ValueError, match="ActuatorModel.time_constant must be >= 0 s, got -1"):
+        ActuatorModel(time_constant=-1)

@@ -1,0 +1,40 @@
+"""``stewart-drake simulate``: a short run writes its logs, plots and summary; bad input exits 2."""
+
+import json
+
+import numpy as np
+
+from stewart_drake.cli import main
+
+
+def test_simulate_writes_logs_plots_and_summary(tmp_path, capsys):
+    out = tmp_path / "run"
+    rc = main(["simulate", "--trajectory", "rotating", "--controller", "float", "--duration", "0.1", "--out", str(out), "--no-progress"])
+    assert rc == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["ticks"] == 100 and summary["controller"] == "float" and summary["trajectory"] == "rotating"
+    assert summary["max_leg_error_mm"] < 1.0
+    for name in ("log.npz", "log.csv", "tracking.png"):
+        assert (out / name).is_file()
+    assert json.loads(capsys.readouterr().out)["ticks"] == 100
+    data = np.load(out / "log.npz")
+    assert data["pose"].shape == (101, 6)
+
+
+def test_simulate_reads_a_csv_trajectory(tmp_path):
+    csv = tmp_path / "lift.csv"
+    csv.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.1,0,0,705,0,0,2\n")
+    rc = main(["simulate", "--trajectory", str(csv), "--length-unit", "mm", "--angle-unit", "deg", "--out", str(tmp_path / "o"), "--no-progress"])
+    assert rc == 0
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["duration_s"] == 0.1 and summary["controller"] == "fixed"
+
+
+def test_simulate_refuses_infeasible_timing_and_bad_files(tmp_path, capsys):
+    assert main(["simulate", "--period", "2e-5", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "infeasible DSP timing" in err and "longer than the sample period 20.000 µs" in err
+    assert main(["simulate", "--trajectory", str(tmp_path / "none.csv"), "--out", str(tmp_path)]) == 2
+    assert "trajectory file" in capsys.readouterr().err
+    assert main(["simulate", "--duration", "-1", "--out", str(tmp_path)]) == 2
+    assert "--duration must be a positive number of seconds, got -1" in capsys.readouterr().err
