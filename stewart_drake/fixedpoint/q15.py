@@ -106,7 +106,7 @@ def _sat(x: np.ndarray, lo: int, hi: int, op: str) -> np.ndarray:
         flags = (x < lo) | (x > hi)
         for c in _ACTIVE:
             c.record(op, flags)
-    return np.clip(x, lo, hi)
+    return np.minimum(np.maximum(x, lo), hi)  # same result as np.clip, several times faster on small arrays
 
 
 def _i(x) -> np.ndarray:
