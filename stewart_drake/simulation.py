@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .control import STATUS, ControllerConfig, make_controller
+from .csvio import read_numeric_csv
 from .geometry import Platform
 from .kinematics import leg_lengths
 from .rotations import angles_from_matrix, pose_to_si, rotation_matrix
@@ -66,37 +67,18 @@ TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
 def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
     """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
     seconds) as a piecewise-linear Trajectory held constant after the last sample. Errors name the line."""
-    f = Path(path)
-    if not f.is_file():
-        raise FileNotFoundError(f"trajectory file {str(path)!r} does not exist")
-    rows = []
-    with f.open(newline="") as fh:
-        for lineno, row in enumerate(csv.reader(fh), start=1):
-            if not row or all(not c.strip() for c in row):
-                continue
-            try:
-                values = [float(c) for c in row]
-            except ValueError:
-                if not rows and lineno == 1:
-                    continue
-                raise ValueError(f"{path}:{lineno}: not a number in {row!r}") from None
-            if len(values) != 7:
-                raise ValueError(f"{path}:{lineno}: expected 7 values (t, px, py, pz, a_x, a_y, a_z), got {len(values)}")
-            if not all(math.isfinite(v) for v in values):
-                raise ValueError(f"{path}:{lineno}: values must be finite, got {row!r}")
-            if rows and values[0] <= rows[-1][0]:
-                raise ValueError(f"{path}:{lineno}: time {values[0]} s is not after the previous sample's {rows[-1][0]} s")
-            rows.append(values)
-    if len(rows) < 1:
-        raise ValueError(f"{path}: no samples")
-    data = np.array(rows)
+    data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
+    late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
+    if late.size:
+        k = late[0] + 1
+        raise ValueError(f"{path}:{lines[k]}: time {data[k, 0]} s is not after the previous sample's {data[k - 1, 0]} s")
     ts, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
 
     def fn(t):
         t = np.asarray(t, dtype=float)
         return np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
 
-    return Trajectory(f.stem, fn, float(ts[-1]))
+    return Trajectory(Path(path).stem, fn, float(ts[-1]))
 
 
 def get_trajectory(name_or_path, **units) -> Trajectory:

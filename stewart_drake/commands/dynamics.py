@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import csv
 import sys
-from pathlib import Path
 
 import numpy as np
 
+from ..csvio import read_numeric_csv
 from ..rotations import angle_scale, length_scale
 from ._common import add_platform_arg, platform_from_args, print_json
 
@@ -38,27 +38,10 @@ def register(sub) -> None:
 
 def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad"):
     """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (see ``CSV_HELP``). Errors name the line."""
-    f = Path(path)
-    if not f.is_file():
-        raise FileNotFoundError(f"trajectory file {path!r} does not exist")
-    rows, width = [], None
-    with f.open(newline="") as fh:
-        for lineno, row in enumerate(csv.reader(fh), start=1):
-            if not row or all(not c.strip() for c in row):
-                continue
-            try:
-                values = [float(c) for c in row]
-            except ValueError:
-                if not rows and lineno == 1:
-                    continue  # header
-                raise ValueError(f"{path}:{lineno}: not a number in {row!r}") from None
-            if len(values) not in (7, 19) or (width is not None and len(values) != width):
-                raise ValueError(f"{path}:{lineno}: expected {width or '7 or 19'} values (see --help), got {len(values)}")
-            width = len(values)
-            rows.append(values)
-    if len(rows) < (2 if width == 19 else 4):
-        raise ValueError(f"{path}: need at least {2 if width == 19 else 4} samples, got {len(rows)}")
-    a = np.array(rows)
+    a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
+    width = a.shape[1]
+    if len(a) < (2 if width == 19 else 4):
+        raise ValueError(f"{path}: need at least {2 if width == 19 else 4} samples, got {len(a)}")
     t = a[:, 0]
     if np.any(np.diff(t) <= 0):
         k = int(np.argmax(np.diff(t) <= 0))

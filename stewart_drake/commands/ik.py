@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import csv
-from pathlib import Path
-
 import numpy as np
 
+from ..csvio import read_numeric_csv
 from ..kinematics import check_stroke, leg_lengths
 from ..rotations import length_scale, pose_to_si
 from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
@@ -25,26 +23,7 @@ def register(sub) -> None:
 
 def read_poses_csv(path: str) -> np.ndarray:
     """``(n, 6)`` poses from a CSV file; a non-numeric first row is a header. Errors name the line."""
-    f = Path(path)
-    if not f.is_file():
-        raise FileNotFoundError(f"poses file {path!r} does not exist")
-    rows = []
-    with f.open(newline="") as fh:
-        for lineno, row in enumerate(csv.reader(fh), start=1):
-            if not row or all(not c.strip() for c in row):
-                continue
-            try:
-                values = [float(c) for c in row]
-            except ValueError:
-                if lineno == 1 and not rows:
-                    continue  # header
-                raise ValueError(f"{path}:{lineno}: not a number in {row!r}") from None
-            if len(values) != 6:
-                raise ValueError(f"{path}:{lineno}: expected 6 values (px,py,pz,a,b,g), got {len(values)}")
-            rows.append(values)
-    if not rows:
-        raise ValueError(f"{path}: no poses")
-    return np.array(rows)
+    return read_numeric_csv(path, "poses", (6,), "px,py,pz,a,b,g")[0]
 
 
 def run(args) -> int:
