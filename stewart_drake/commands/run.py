@@ -8,14 +8,12 @@ from __future__ import annotations
 
 import csv
 import json
-import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_folder
 from ..rotations import CONVENTIONS
 from ._common import _jsonable, add_platform_arg, platform_from_args
 
@@ -143,10 +141,7 @@ def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
     """Write ``trajectory.csv`` (t, q, q̇, q̈ in SI: readable by ``stewart-drake dynamics --trajectory``),
     ``legs.csv`` (t, L mm, F N), ``summary.json``, ``lengths.png``, ``forces.png`` (and the simulation's
     logs) into ``out``, replacing it atomically."""
-    out = out.resolve()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with atomic_folder(out) as tmp:
         traj = result.trajectory
         with (tmp / "trajectory.csv").open("w", newline="") as fh:
             w = csv.writer(fh)
@@ -164,16 +159,6 @@ def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
         _plots(tmp, result, summary, sim)
         if sim is not None:
             sim["log"].save(tmp / "simulation")
-        old = None
-        if out.exists():
-            old = out.with_name(f".{out.name}.old-{os.getpid()}")
-            os.replace(out, old)
-        os.replace(tmp, out)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def _plots(folder: Path, result, summary: dict, sim: dict | None) -> None:

@@ -33,6 +33,7 @@ def run(args) -> int:
 
     import numpy as np
 
+    from ..atomic import atomic_folder
     from ..control import ControllerConfig, DspTiming
     from ..geometry import load_platform
     from ..simulation import build_simulation, get_trajectory
@@ -47,7 +48,6 @@ def run(args) -> int:
     sim = build_simulation(platform, traj, args.controller, ControllerConfig(timing=timing), plant_time_step=plant_step)
     log = sim.run(duration, progress=not args.no_progress)
     out = Path(args.out)
-    paths = log.save(out)
     e = log.length_error(traj, platform)
     pe = log.pose_error(traj)
     summary = {
@@ -66,10 +66,11 @@ def run(args) -> int:
         "max_position_error_mm": float(np.abs(pe[:, :3]).max() * 1e3),
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
-        "files": [str(p) for p in paths],
     }
-    summary["files"] += [str(p) for p in write_plots(log, e, out)] + [str(out / "summary.json")]
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    with atomic_folder(out) as tmp:
+        written = log.save(tmp) + write_plots(log, e, tmp) + [tmp / "summary.json"]
+        summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
     print_json(summary)
     return 0
 

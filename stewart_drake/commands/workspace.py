@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from ._common import add_platform_arg, platform_from_args, print_json
 
@@ -114,9 +115,9 @@ def write_outputs(w, result: dict, out: Path) -> None:
 
     from ..workspace import view_figures
 
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "workspace.json").write_text(json.dumps(result, indent=2, default=lambda x: x.tolist() if hasattr(x, "tolist") else str(x)))
-    np.savetxt(out / "boundary.csv", w.boundary, delimiter=",", header="x_m,y_m,z_m", comments="", fmt="%.6f")
-    for name, fig in view_figures(w, title=result["platform"]).items():
-        fig.savefig(out / f"{name}.png", dpi=110, bbox_inches="tight")
-        plt.close(fig)
+    with atomic_folder(out) as tmp:
+        (tmp / "workspace.json").write_text(json.dumps(result, indent=2, default=lambda x: x.tolist() if hasattr(x, "tolist") else str(x)))
+        np.savetxt(tmp / "boundary.csv", w.boundary, delimiter=",", header="x_m,y_m,z_m", comments="", fmt="%.6f")
+        for name, fig in view_figures(w, title=result["platform"]).items():
+            fig.savefig(tmp / f"{name}.png", dpi=110, bbox_inches="tight")
+            plt.close(fig)

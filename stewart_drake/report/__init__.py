@@ -13,13 +13,12 @@ import html
 import importlib.util
 import io
 import json
-import os
-import shutil
 import sys
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from ..atomic import atomic_folder
 
 ANALYSES_DIR = Path(__file__).resolve().parents[2] / "analyses"
 
@@ -173,27 +172,14 @@ def render_html(sections: list[Section], title: str = "stewart-drake report") ->
 def write_report(sections: list[Section], out_dir, title: str = "stewart-drake report") -> Path:
     """Write ``index.html``, ``checks.json`` and every section file into ``out_dir``, atomically: the
     report is built in a temporary sibling folder and swapped in only when complete."""
-    out_dir = Path(out_dir).resolve()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
-    try:
+    with atomic_folder(out_dir) as tmp:
         for s in sections:
             for name, data in s.files.items():
                 (tmp / name).write_bytes(data)
         (tmp / "index.html").write_text(render_html(sections, title), encoding="utf-8")
         checks = [dict(c.__dict__, passed=c.passed) for s in sections for c in s.checks]
         (tmp / "checks.json").write_text(json.dumps(checks, indent=2), encoding="utf-8")
-        old = None
-        if out_dir.exists():
-            old = out_dir.with_name(f".{out_dir.name}.old-{os.getpid()}")
-            os.replace(out_dir, old)
-        os.replace(tmp, out_dir)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return out_dir / "index.html"
+    return Path(out_dir).resolve() / "index.html"
 
 
 def run_standalone(module_file: str, argv=None) -> int:
