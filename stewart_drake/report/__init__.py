@@ -144,17 +144,32 @@ def run_analyses(analyses: list[Analysis], quick: bool = False, log=sys.stderr) 
 _CSS = """
 body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:1em 0;font-size:90%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}
-th{background:#eee}caption{caption-side:top;text-align:left;font-style:italic;padding:4px 0}
+th{background:#eee;text-align:left}caption{caption-side:top;text-align:left;font-style:italic;padding:4px 0}
 img{max-width:100%}figure{margin:1em 0}figcaption{font-style:italic;font-size:90%}
 .pass{color:#070;font-weight:bold}.fail{color:#b00;font-weight:bold}
 """
 
 
+def _versions(sections: list[Section]) -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    def v(pkg):
+        try:
+            return version(pkg)
+        except PackageNotFoundError:
+            return "?"
+
+    mode = "quick mode (small samples)" if any(s.quick for s in sections) else "full mode"
+    return f"stewart-drake {v('stewart-drake')}, drake {v('drake')}, numpy {v('numpy')}, scipy {v('scipy')}; {mode}."
+
+
 def render_html(sections: list[Section], title: str = "stewart-drake report") -> str:
     checks = [c for s in sections for c in s.checks]
     n_fail = sum(not c.passed for c in checks)
+    anchor = {s.title: f"s{i}" for i, s in enumerate(sections)}
     rows = "".join(
-        f"<tr><td style='text-align:left'>{html.escape(c.section)}</td><td style='text-align:left'>{html.escape(c.what)}</td>"
+        f"<tr><td style='text-align:left'><a href='#{anchor.get(c.section, '')}'>{html.escape(c.section)}</a></td>"
+        f"<td style='text-align:left'>{html.escape(c.what)}</td>"
         f"<td>{c.worst:.4g} {html.escape(c.unit)}</td><td>{c.tolerance:.4g} {html.escape(c.unit)}</td>"
         f"<td class='{'pass' if c.passed else 'fail'}'>{'pass' if c.passed else 'FAIL'}</td></tr>"
         for c in checks
@@ -163,7 +178,7 @@ def render_html(sections: list[Section], title: str = "stewart-drake report") ->
     body = "".join(f'<section id="s{i}"><h2>{html.escape(s.title)}</h2>{"".join(s.blocks)}</section>' for i, s in enumerate(sections))
     return (
         f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
-        f"<h1>{html.escape(title)}</h1><h2>Summary of checks</h2><p>{len(checks)} checks, {n_fail} failed.</p>"
+        f"<h1>{html.escape(title)}</h1><p>{html.escape(_versions(sections))}</p><h2>Summary of checks</h2><p>{len(checks)} checks, {n_fail} failed.</p>"
         f"<table><thead><tr><th>section</th><th>what was compared</th><th>worst error</th><th>tolerance</th><th>result</th></tr></thead>"
         f"<tbody>{rows}</tbody></table><h2>Contents</h2><ol>{toc}</ol>{body}</body></html>"
     )
