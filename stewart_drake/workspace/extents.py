@@ -1,0 +1,76 @@
+"""Extents of a grid workspace: per axis the extreme inside nodes from the three views, then each
+extreme refined by a constrained optimisation (SLSQP on the limit margins) with an error bound.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics import leg_vectors
+from .limits import raw_margins
+from .slabs import _GridSpec
+
+
+def _extreme_indices(views) -> list:
+    """Per axis: (min index, max index) of inside nodes, from the views."""
+    top, front, side = views
+    ix = np.flatnonzero(top.any(axis=1))
+    iy = np.flatnonzero(top.any(axis=0))
+    iz = np.flatnonzero(front.any(axis=0))
+    return [(a[0], a[-1]) for a in (ix, iy, iz)]
+
+
+def _extents_from_views(axes, top, front, side, h):
+    """Grid-level extents: the true extreme lies within h beyond the extreme inside node."""
+    ext = np.array([[axes[k][i0] - h / 2, axes[k][i1] + h / 2] for k, (i0, i1) in enumerate(_extreme_indices((top, front, side)))])
+    return ext, h / 2
+
+
+def _extreme_plane_nodes(axes, top, front, side, k, idx) -> np.ndarray:
+    """``(m, 3)`` candidate inside nodes on the grid plane ``axes[k][idx]`` (from the two views that
+    hold it; a node is a candidate when both views have it)."""
+    if k == 0:
+        plane = top[idx][:, None] & front[idx][None, :]
+    elif k == 1:
+        plane = top[:, idx][:, None] & side[idx][None, :]
+    else:
+        plane = front[:, idx][:, None] & side[:, idx][None, :]
+    o1, o2 = [j for j in range(3) if j != k]
+    r = np.argwhere(plane)
+    pts = np.empty((len(r), 3))
+    pts[:, k], pts[:, o1], pts[:, o2] = axes[k][idx], axes[o1][r[:, 0]], axes[o2][r[:, 1]]
+    return pts
+
+
+def _refine_extents(spec: _GridSpec, extents, top, front, side, h, feas_tol: float = 1e-9):
+    """Each extreme found by a constrained optimisation (SLSQP on the per-leg margins, all smooth
+    pieces) from the extreme grid node; kept only if the optimum is feasible (every margin >=
+    -``feas_tol``) and at least as far out as the node. Returns (extents, error) where error is the
+    largest gap between a refined extreme and its grid bracket's far end (node ± h): under the grid
+    assumption (the boundary is resolved at h) the true extreme lies in that gap."""
+    from scipy.optimize import minimize
+
+    axes, o = spec.axes, spec.orientation
+    out = extents.copy()
+    gaps = []
+
+    def margins(p):
+        q = np.r_[p, o]
+        l = leg_vectors(spec.platform, q, spec.convention)
+        return np.concatenate([m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()])
+
+    for k, (i_lo, i_hi) in enumerate(_extreme_indices((top, front, side))):
+        for side_i, (idx, sign) in enumerate(((i_lo, -1), (i_hi, 1))):
+            node_c = axes[k][idx]
+            best = node_c
+            cands = [c for c in _extreme_plane_nodes(axes, top, front, side, k, idx) if margins(c).min() >= 0]
+            if cands:
+                cands = np.array(cands)
+                start = cands[np.argmin(np.linalg.norm(cands - cands.mean(axis=0), axis=1))]
+                res = minimize(lambda p: -sign * p[k], start, jac=lambda p: -sign * np.eye(3)[k], method="SLSQP",
+                               constraints={"type": "ineq", "fun": margins}, options={"ftol": 1e-12, "maxiter": 200})
+                if margins(res.x).min() >= -feas_tol and sign * res.x[k] >= sign * node_c:
+                    best = float(res.x[k])
+            out[k, side_i] = best
+            gaps.append(max(0.0, sign * (node_c + sign * h - best)))
+    return out, max(gaps)

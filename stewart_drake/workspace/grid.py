@@ -1,0 +1,186 @@
+"""The constant-orientation workspace: positions reachable at one orientation on a grid swept in
+x-slabs of bounded size (optionally on an executor), with the volume and its error bound, refined
+extents, boundary points and the three views (``Workspace``).
+"""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import Executor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry import Platform
+from ..kinematics import leg_vectors
+from ..rotations import check_convention
+from .executors import _run_tasks
+from .extents import _extents_from_views, _refine_extents
+from .limits import Limits, WorkspaceError, _check_orientation
+from .slabs import _grid_spec, _slab_task
+
+# Largest grid the sweep accepts (nodes); beyond this the resolution is surely a unit mistake.
+MAX_GRID_NODES = 5e10
+
+
+@dataclass
+class Workspace:
+    """A constant-orientation workspace (metres).
+
+    orientation (3,) rad; resolution h (m); axes: node coordinates along x, y, z;
+    extents (3, 2) [min, max] per axis: feasible extreme points (refined) or grid-node values;
+    extent_error (m): how much farther out any true extreme can lie, from the grid bracket; volume, volume_error (m³; the true volume lies in [volume_bounds]) assuming the grid
+    resolves the boundary (no feature thinner than one cell); volume_change_2h: |V(h) - V(2h)| from
+    every other node, a convergence indicator (much smaller than the bound on smooth workspaces);
+    top (nx, ny), front (nx, nz), side (ny, nz) bool: the views (projections along z, y, x);
+    boundary (m, 3) float32 points: inside nodes with an outside neighbour;
+    removed_m3: volume the stroke-feasible set loses to each optional limit (binding where > 0);
+    touches_bounds: inside nodes on the grid's outer faces (the box clipped the workspace).
+    """
+
+    orientation: np.ndarray
+    limits: Limits
+    resolution: float
+    axes: tuple
+    extents: np.ndarray
+    extent_error: float
+    volume: float
+    volume_error: float
+    volume_bounds: tuple
+    volume_change_2h: float
+    inside_nodes: int
+    top: np.ndarray
+    front: np.ndarray
+    side: np.ndarray
+    boundary: np.ndarray
+    removed_m3: dict = field(default_factory=dict)
+    touches_bounds: bool = False
+
+    @property
+    def binding(self) -> list[str]:
+        """Optional limits that remove part of the stroke workspace (stroke itself always binds)."""
+        return [n for n, v in self.removed_m3.items() if v > 0]
+
+    def summary(self) -> dict:
+        """A JSON-ready dict (metres, m³)."""
+        return {
+            "orientation_rad": self.orientation.tolist(),
+            "resolution_m": self.resolution,
+            "limits": list(self.limits.active),
+            "x_range": self.extents[0].tolist(),
+            "y_range": self.extents[1].tolist(),
+            "z_range": self.extents[2].tolist(),
+            "extent_error_m": self.extent_error,
+            "volume_m3": self.volume,
+            "volume_error_m3": self.volume_error,
+            "volume_bounds_m3": list(self.volume_bounds),
+            "volume_change_2h_m3": self.volume_change_2h,
+            "removed_by_limit_m3": dict(self.removed_m3),
+            "binding_limits": self.binding,
+            "touches_bounds": self.touches_bounds,
+        }
+
+
+def default_bounds(platform: Platform, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float = 0.0) -> np.ndarray:
+    """``(3, 2)`` a box that holds the whole stroke workspace: the intersection of the six balls'
+    bounding boxes (|p + l_i(0)| <= L_max), cut below at ``z_floor`` (default: the rotation centre
+    above the base plane, which excludes the mirror-image workspace under the base)."""
+    l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, _check_orientation(orientation)], convention)
+    lo = np.max(-l0 - platform.L_max, axis=0)
+    hi = np.min(-l0 + platform.L_max, axis=0)
+    lo[2] = max(lo[2], z_floor)
+    if np.any(hi <= lo):
+        raise WorkspaceError(f"the stroke workspace at orientation {np.asarray(orientation).tolist()} rad is empty (no common point of the legs' reach)")
+    return np.stack([lo, hi], -1)
+
+
+def _grid_axes(bounds, h) -> tuple:
+    axes = []
+    for lo, hi in bounds:
+        k0, k1 = math.floor(lo / h) - 1, math.ceil(hi / h) + 1  # one node beyond each side: outside
+        axes.append(np.arange(k0, k1 + 1) * h)
+    return tuple(axes)
+
+
+def constant_orientation_workspace(
+    platform: Platform,
+    orientation=(0.0, 0.0, 0.0),
+    resolution: float = 0.01,
+    limits: Limits = Limits(),
+    convention: str = "utn",
+    bounds=None,
+    refine: bool = True,
+    chunk_nodes: int = 1 << 21,
+    workers: int = 1,
+    executor: Executor | None = None,
+    progress: bool = False,
+) -> Workspace:
+    """The positions p (of the pose's rotation centre) reachable at ``orientation`` (3,) rad.
+
+    Grid nodes at multiples of ``resolution`` h (m) over ``bounds`` ((3, 2) m, default
+    ``default_bounds``), swept in x-slabs of about ``chunk_nodes`` nodes (memory ~ 10 bytes per
+    node of a slab, plus the views and the boundary points). Volume: node count × h³; its bound
+    comes from the cells with mixed corners. Extents are refined (``refine``) by a constrained
+    optimisation from the extreme nodes. ``workers`` > 1 runs slabs on a process pool; ``executor`` takes any
+    ``concurrent.futures.Executor`` (e.g. a Dask client's, see ``workspace_dask``).
+    """
+    check_convention(convention)
+    h = float(resolution)
+    if not (np.isfinite(h) and h > 0):
+        raise WorkspaceError(f"resolution must be a positive number of metres, got {resolution}")
+    b = default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
+    if b.shape != (3, 2) or not np.all(b[:, 1] > b[:, 0]):
+        raise WorkspaceError(f"bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {np.asarray(bounds).tolist()}")
+    axes = _grid_axes(b, h)
+    n_nodes = math.prod(len(a) for a in axes)
+    if n_nodes > MAX_GRID_NODES:
+        raise WorkspaceError(f"resolution {h} m gives {n_nodes:.3g} grid nodes (> {MAX_GRID_NODES:.0e}); is it in metres?")
+    spec = _grid_spec(platform, orientation, convention, limits, axes)
+    nx, ny, nz = (len(a) for a in axes)
+    per = max(2, int(chunk_nodes) // (ny * nz))  # a slab re-evaluates one plane each side: keep >= 2
+    tasks = [(spec, i, min(i + per, nx)) for i in range(0, nx, per)]
+    top, front, side = np.zeros((nx, ny), bool), np.zeros((nx, nz), bool), np.zeros((ny, nz), bool)
+    inside = full = mixed = inside_2h = 0
+    removed: dict = {n: 0 for n in limits.active if n != "stroke"}
+    edge = False
+    boundaries = []
+    for r in _run_tasks(_slab_task, tasks, executor, workers, progress, "workspace slabs"):
+        i0 = r["i0"]
+        k = len(r["top"])
+        top[i0 : i0 + k], front[i0 : i0 + k] = r["top"], r["front"]
+        side |= r["side"]
+        inside, full, mixed = inside + r["inside"], full + r["full"], mixed + r["mixed"]
+        inside_2h += r["inside_2h"]
+        for n, v in r["removed"].items():
+            removed[n] += v
+        edge |= r["edge"]
+        boundaries.append(r["boundary"])
+    bnd_idx = np.concatenate(boundaries)
+    if inside == 0:
+        raise WorkspaceError(f"no reachable position at orientation {spec.orientation.tolist()} rad with limits {list(limits.active)} at resolution {h} m")
+    boundary = np.stack([axes[k][bnd_idx[:, k]] for k in range(3)], -1).astype(np.float32)
+    h3 = h**3
+    vol = inside * h3
+    v_lo, v_hi = full * h3, (full + mixed) * h3
+    extents, ext_err = _extents_from_views(axes, top, front, side, h)
+    if refine:
+        extents, ext_err = _refine_extents(spec, extents, top, front, side, h)
+    return Workspace(
+        orientation=spec.orientation,
+        limits=limits,
+        resolution=h,
+        axes=axes,
+        extents=extents,
+        extent_error=ext_err,
+        volume=vol,
+        volume_error=max(vol - v_lo, v_hi - vol),
+        volume_bounds=(v_lo, v_hi),
+        volume_change_2h=abs(vol - inside_2h * 8 * h3),
+        inside_nodes=inside,
+        top=top,
+        front=front,
+        side=side,
+        boundary=boundary,
+        removed_m3={n: v * h3 for n, v in removed.items()},
+        touches_bounds=edge,
+    )

@@ -1,0 +1,184 @@
+"""Workspace limits and per-pose margins: ``Limits`` says which limits are on (stroke, joint cones,
+leg-leg collision, dexterity), and each limit gives a signed margin per pose (>= 0 inside, in the
+limit's unit from ``LIMIT_UNITS``) for any ``(..., 6)`` poses. Plain numpy, no Drake; metres and radians.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import StewartError
+from ..geometry import Platform
+from ..kinematics import condition_number, leg_vectors
+from ..rotations import check_convention, rotation_matrix
+
+LIMIT_NAMES = ("stroke", "base_joint", "top_joint", "collision", "dexterity")
+LIMIT_UNITS = {"stroke": "m", "base_joint": "rad", "top_joint": "rad", "collision": "m", "dexterity": "1"}
+AXES = ("x", "y", "z")
+_BLOCK = 4096  # poses per block in the collision kernel
+
+
+class WorkspaceError(StewartError):
+    """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Which limits bound the workspace. ``None`` switches a limit off.
+
+    stroke        bool           leg lengths within the platform's [L_min, L_max]
+    base_cone     float | None   max angle (rad) between a leg and its base joint axis
+    top_cone      float | None   max angle (rad) between a leg and its plate joint axis
+    base_axes     (6, 3) | None  neutral axis of each base joint in B (default +Z, the base normal)
+    top_axes      (6, 3) | None  neutral axis of each plate joint in T (default +Z, the plate normal)
+    leg_diameter  float | None   leg cylinder diameter (m) for leg-leg collision
+    max_condition float | None   Jacobian condition-number bound (dexterity)
+    """
+
+    stroke: bool = True
+    base_cone: float | None = None
+    top_cone: float | None = None
+    base_axes: np.ndarray | None = None
+    top_axes: np.ndarray | None = None
+    leg_diameter: float | None = None
+    max_condition: float | None = None
+
+    def __post_init__(self):
+        for name in ("base_cone", "top_cone"):
+            v = getattr(self, name)
+            if v is not None and not (0 < v <= math.pi):
+                raise WorkspaceError(f"Limits.{name} must be an angle in (0, pi] rad, got {v}")
+        if self.leg_diameter is not None and not (np.isfinite(self.leg_diameter) and self.leg_diameter > 0):
+            raise WorkspaceError(f"Limits.leg_diameter must be a positive length in metres, got {self.leg_diameter}")
+        if self.max_condition is not None and not (self.max_condition > 1):
+            raise WorkspaceError(f"Limits.max_condition must be > 1, got {self.max_condition}")
+        for name in ("base_axes", "top_axes"):
+            v = getattr(self, name)
+            if v is None:
+                continue
+            a = np.array(v, dtype=float)
+            n = np.linalg.norm(a, axis=-1) if a.shape == (6, 3) else None
+            if n is None or not np.all(n > 1e-12):
+                raise WorkspaceError(f"Limits.{name} must be six non-zero 3-vectors, shape (6, 3), got {np.shape(v)}")
+            object.__setattr__(self, name, a / n[:, None])
+
+    @property
+    def active(self) -> tuple[str, ...]:
+        """Names of the limits switched on, in ``LIMIT_NAMES`` order."""
+        on = {
+            "stroke": self.stroke,
+            "base_joint": self.base_cone is not None,
+            "top_joint": self.top_cone is not None,
+            "collision": self.leg_diameter is not None,
+            "dexterity": self.max_condition is not None,
+        }
+        return tuple(n for n in LIMIT_NAMES if on[n])
+
+
+def segment_distances(P1, Q1, P2, Q2) -> np.ndarray:
+    """``(...)`` shortest distance between segments P1Q1 and P2Q2 (``(..., 3)`` each, metres).
+
+    Clamped closest-point parameters (Ericson, *Real-Time Collision Detection* §5.1.9); parallel
+    segments take s = 0. Segments must have non-zero length.
+    """
+    P1, Q1, P2, Q2 = (np.moveaxis(v, -1, 0) for v in np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (P1, Q1, P2, Q2))))
+    d1, d2, r = Q1 - P1, Q2 - P2, P1 - P2  # (3, ...) components first: cheaper than einsum on a length-3 axis
+
+    def dot(u, v):
+        return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+    a, e, b, c, f = dot(d1, d1), dot(d2, d2), dot(d1, d2), dot(d1, r), dot(d2, r)
+    denom = a * e - b * b
+    parallel = denom <= 1e-12 * a * e
+    s = np.where(parallel, 0.0, np.clip((b * f - c * e) / np.where(parallel, 1.0, denom), 0.0, 1.0))
+    t = (b * s + f) / e
+    s = np.where(t < 0, np.clip(-c / a, 0.0, 1.0), np.where(t > 1, np.clip((b - c) / a, 0.0, 1.0), s))
+    t = np.clip(t, 0.0, 1.0)
+    gap = r + s * d1 - t * d2
+    return np.sqrt(dot(gap, gap))
+
+
+def leg_pairs(platform: Platform) -> np.ndarray:
+    """``(k, 2)`` leg index pairs (0-based) that can collide: every pair not sharing a joint."""
+    pairs = []
+    for i in range(6):
+        for j in range(i + 1, 6):
+            same_top = platform.leg_top[i] == platform.leg_top[j]
+            same_base = np.linalg.norm(platform.base_anchors[i] - platform.base_anchors[j]) < 1e-9
+            if not (same_top or same_base):
+                pairs.append((i, j))
+    return np.array(pairs, dtype=np.intp).reshape(-1, 2)
+
+
+def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention: str = "utn") -> dict:
+    """Per-element margins ``{name: (..., k)}`` (>= 0 inside) from leg vectors ``l`` ``(..., 6, 3)`` and
+    plate rotations ``R`` ``(..., 3, 3)`` (or one ``(3, 3)``): k = 6 legs (stroke, joints), the rows of
+    ``leg_pairs`` (collision), or 1 (dexterity, which needs ``poses``)."""
+    out = {}
+    L = np.sqrt(np.einsum("...k,...k->...", l, l))
+    if limits.stroke:
+        out["stroke"] = np.minimum(L - platform.L_min, platform.L_max - L)
+    if limits.base_cone is not None or limits.top_cone is not None:
+        u = l / L[..., None]
+        if limits.base_cone is not None:
+            axes = limits.base_axes if limits.base_axes is not None else np.array([0.0, 0.0, 1.0])
+            ang = np.arccos(np.clip(np.einsum("...ik,...ik->...i", u, np.broadcast_to(axes, u.shape)), -1, 1))
+            out["base_joint"] = limits.base_cone - ang
+        if limits.top_cone is not None:
+            axes_T = limits.top_axes if limits.top_axes is not None else np.tile([0.0, 0.0, 1.0], (6, 1))
+            n = np.einsum("...jk,ik->...ij", R, axes_T)  # (..., 6, 3) plate joint axes in B
+            ang = np.arccos(np.clip(np.einsum("...ik,...ik->...i", u, n), -1, 1))
+            out["top_joint"] = limits.top_cone - ang
+    if limits.leg_diameter is not None:
+        pairs = leg_pairs(platform)
+        if len(pairs):
+            B = platform.base_anchors
+            P = (B + l).reshape(-1, 6, 3)  # plate anchors in B
+            d = np.empty((len(P), len(pairs)))
+            for k in range(0, len(P), _BLOCK):  # blocks that stay in cache: ~6x faster than one pass
+                Pk = P[k : k + _BLOCK]
+                d[k : k + _BLOCK] = segment_distances(B[pairs[:, 0]], Pk[:, pairs[:, 0]], B[pairs[:, 1]], Pk[:, pairs[:, 1]])
+            out["collision"] = d.reshape(L.shape[:-1] + (len(pairs),)) - limits.leg_diameter
+        else:
+            out["collision"] = np.full(L.shape[:-1] + (1,), np.inf)
+    if limits.max_condition is not None:
+        if poses is None:
+            raise WorkspaceError("the dexterity limit needs the poses themselves")
+        out["dexterity"] = (limits.max_condition - condition_number(platform, poses, convention))[..., None]
+    return out
+
+
+def _margins_from_legs(platform: Platform, l, R, limits: Limits, poses=None, convention="utn") -> dict:
+    """``{name: (margin (...), index (...))}``: the worst element of each ``raw_margins`` entry; index is
+    the worst leg (0-based) or, for collision, the worst row of ``leg_pairs``."""
+    return {n: (m.min(axis=-1), m.argmin(axis=-1)) for n, m in raw_margins(platform, l, R, limits, poses, convention).items()}
+
+
+def limit_margins(platform: Platform, poses, limits: Limits = Limits(), convention: str = "utn") -> dict:
+    """Signed margins of ``(..., 6)`` poses to each active limit: ``{name: (margin (...), index (...))}``;
+    a pose is inside where every margin is >= 0. Units in ``LIMIT_UNITS``; ``index`` as in
+    ``_margins_from_legs`` (worst leg, 0-based, or worst row of ``leg_pairs``)."""
+    check_convention(convention)
+    q = np.asarray(poses, dtype=float)
+    l = leg_vectors(platform, q, convention)
+    R = rotation_matrix(q[..., 3:], convention)
+    return _margins_from_legs(platform, l, R, limits, q, convention)
+
+
+def classify(platform: Platform, poses, limits: Limits = Limits(), convention: str = "utn") -> np.ndarray:
+    """``(...)`` True where a ``(..., 6)`` pose satisfies every active limit."""
+    margins = limit_margins(platform, poses, limits, convention)
+    inside = np.ones(np.shape(poses)[:-1], bool)
+    for m, _ in margins.values():
+        inside &= m >= 0
+    return inside
+
+
+def _check_orientation(orientation) -> np.ndarray:
+    o = np.asarray(orientation, dtype=float)
+    if o.shape != (3,) or not np.all(np.isfinite(o)):
+        raise WorkspaceError(f"orientation must be 3 finite angles (rad) about X, Y, Z, got {np.asarray(orientation).tolist()}")
+    return o

@@ -1,0 +1,102 @@
+"""The grid kernel of the constant-orientation workspace: a small picklable ``_GridSpec`` and the
+x-slab worker that classifies nodes, counts cells and finds boundary nodes. Translation enters the
+inverse kinematics additively, l_i(p, R) = p + l_i(0, R), so l_i(0, R) comes from
+``kinematics.leg_vectors`` once and the grid positions are added (the tests check this node by node).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import Platform
+from ..kinematics import leg_vectors
+from ..rotations import rotation_matrix
+from .limits import Limits, _check_orientation, _margins_from_legs
+
+
+@dataclass(frozen=True)
+class _GridSpec:
+    """Everything a slab worker needs (small and picklable)."""
+
+    platform: Platform
+    orientation: np.ndarray
+    convention: str
+    limits: Limits
+    offsets: np.ndarray  # (6, 3) l_i(0, R): leg vectors with the rotation centre at the origin
+    R: np.ndarray  # (3, 3)
+    axes: tuple  # three 1-D arrays of node coordinates
+
+
+def _grid_spec(platform, orientation, convention, limits, axes) -> _GridSpec:
+    o = _check_orientation(orientation)
+    l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, o], convention)
+    return _GridSpec(platform, o, convention, limits, l0, rotation_matrix(o, convention), tuple(axes))
+
+
+def _inside_block(spec: _GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
+    """Classify the grid block xs × ys × zs: ``(inside, removed)`` where ``removed``
+    counts, per optional limit, the stroke-feasible nodes it rejects in each x-plane ``(nx,)``.
+    ``inside`` is bool ``(nx, ny, nz)``."""
+    p = spec.platform
+    shape = (len(xs), len(ys), len(zs))
+    ok = np.ones(shape, bool)
+    lo2, hi2 = p.L_min**2, p.L_max**2
+    if spec.limits.stroke:
+        for i in range(6):
+            c = spec.offsets[i]
+            d2 = ((xs + c[0]) ** 2)[:, None, None] + ((ys + c[1]) ** 2)[None, :, None] + ((zs + c[2]) ** 2)[None, None, :]
+            ok &= (d2 >= lo2) & (d2 <= hi2)
+    removed = {}
+    others = [n for n in spec.limits.active if n != "stroke"]
+    if others:
+        idx = np.nonzero(ok)
+        pos = np.stack([xs[idx[0]], ys[idx[1]], zs[idx[2]]], -1)
+        l = pos[:, None, :] + spec.offsets
+        poses = np.concatenate([pos, np.broadcast_to(spec.orientation, pos.shape)], -1)
+        margins = _margins_from_legs(p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention)
+        keep = np.ones(len(pos), bool)
+        for name in others:
+            bad = margins[name][0] < 0
+            removed[name] = np.bincount(idx[0][bad], minlength=shape[0])
+            keep &= ~bad
+        ok[idx] = keep
+    return ok, removed
+
+
+def _slab_task(spec: _GridSpec, i0: int, i1: int) -> dict:
+    """Sweep the owned x-planes i0..i1-1 (and one neighbour plane each side for cells and boundary)."""
+    x, y, z = spec.axes
+    lo, hi = max(i0 - 1, 0), min(i1 + 1, len(x))
+    m, removed_all = _inside_block(spec, x[lo:hi], y, z)
+    own = slice(i0 - lo, i1 - lo)
+    mo = m[own]
+    # cells between owned plane p and p+1
+    c_hi = min(i1, len(x) - 1)
+    cells = m[i0 - lo : c_hi - lo + 1].astype(np.int8)
+    full = mixed = 0
+    if len(cells) >= 2:
+        s = cells[:-1] + cells[1:]
+        s = s[:, :-1] + s[:, 1:]
+        s = s[..., :-1] + s[..., 1:]
+        full, mixed = int(np.count_nonzero(s == 8)), int(np.count_nonzero((s > 0) & (s < 8)))
+    # boundary: inside nodes with an outside (or off-grid) face neighbour
+    pad = np.pad(m, 1, constant_values=False)
+    nb = pad[:-2, 1:-1, 1:-1] & pad[2:, 1:-1, 1:-1] & pad[1:-1, :-2, 1:-1] & pad[1:-1, 2:, 1:-1] & pad[1:-1, 1:-1, :-2] & pad[1:-1, 1:-1, 2:]
+    bnd = np.argwhere(mo & ~nb[own]).astype(np.int32)
+    bnd[:, 0] += i0
+    return {
+        "i0": i0,
+        "inside": int(np.count_nonzero(mo)),
+        "full": full,
+        "mixed": mixed,
+        "top": mo.any(axis=2),
+        "front": mo.any(axis=1),
+        "side": mo.any(axis=0),
+        "boundary": bnd,
+        "removed": {n: int(v[own].sum()) for n, v in removed_all.items()},
+        "edge": bool((i0 == 0 and mo[0].any()) or (i1 == len(x) and mo[-1].any()) or mo[:, [0, -1], :].any() or mo[:, :, [0, -1]].any()),
+        "inside_2h": int(np.count_nonzero(mo[(np.arange(i0, i1) % 2) == 0][:, ::2, ::2])),
+    }
