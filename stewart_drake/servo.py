@@ -34,20 +34,28 @@ flagged per servo and never produce NaN: the angle is then the nearest one (arm 
 the anchor) and the commanded pulse is clamped to the servo's travel.
 """
 
-from __future__ import annotations
+# No "from __future__ import annotations": yaml_load_typed reads the config dataclasses' real field types.
 
 import dataclasses
 from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
 from .errors import GeometryError, StewartError
-from .rotations import rotation_matrix
+from .rotations import length_scale, rotation_matrix
 
 NEUTRAL_US = 1500.0
 RATE_US_PER_RAD = 400.0 / np.radians(45.0)  # 509.295... µs/rad = 8.888... µs/degree
 TRAVEL_RAD = np.radians(45.0)
 FRAME_RATE_HZ = 50.0
+# Typical standard hobby servo (MG996R class at 6 V): no-load speed 0.17 s per 60°, stall torque ~1 N·m.
+SERVO_SPEED_RAD_S = np.radians(60.0) / 0.17  # 6.16 rad/s
+SERVO_STALL_TORQUE = 1.0
+# A digital servo's position loop reaches full torque a couple of degrees from its target.
+SERVO_BAND_RAD = np.radians(2.0)
 # Home heights of the six legs must agree (the seed: "by symmetry eq. 10 gives the same for every leg").
 H0_AGREEMENT_M = 1e-9
 
@@ -84,11 +92,13 @@ class ServoHexapod:
     rate_us_per_rad: float = RATE_US_PER_RAD
     travel_rad: float = TRAVEL_RAD
     description: str = ""
-    # Physical data for the Drake model only (kg, N·m).
+    # Physical data for the Drake model only (kg, N·m, rad/s, rad): see servo_model.servo_gains.
     arm_mass: float = 0.005
     rod_mass: float = 0.005
     platform_mass: float = 0.15
-    servo_torque: float = 1.0
+    servo_torque: float = SERVO_STALL_TORQUE  # stall torque
+    servo_speed: float = SERVO_SPEED_RAD_S  # no-load speed
+    servo_band: float = SERVO_BAND_RAD  # position error at which the servo gives its stall torque
 
     def __post_init__(self):
         shapes = {"base_pivots": (6, 3), "arm_directions": (6,), "platform_anchors": (6, 3),
@@ -101,7 +111,8 @@ class ServoHexapod:
                 raise GeometryError(f"servo hexapod {name} has non-finite values: {arr.tolist()}")
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
-        for name in ("arm_length", "rod_length", "rate_us_per_rad", "travel_rad"):
+        for name in ("arm_length", "rod_length", "rate_us_per_rad", "travel_rad", "arm_mass", "rod_mass", "platform_mass",
+                     "servo_torque", "servo_speed", "servo_band"):
             v = getattr(self, name)
             if not np.isfinite(v) or v <= 0:
                 raise GeometryError(f"servo hexapod {name} must be a positive number, got {v}")
@@ -168,7 +179,8 @@ def hobby_servo_hexapod(
     rod_length: float = 0.110,
     trims_us=None,
 ) -> ServoHexapod:
-    """The preset ``hobby-servo``: a desk-size hexapod of six standard RC servos (MG996R class).
+    """The paired layout behind the preset ``hobby-servo`` (shipped as ``presets/servo-hobby.yaml``,
+    which uses these defaults): a desk-size hexapod of six standard RC servos (MG996R class).
 
     Dimensions (our documented choice; seed 002 gives none):
     - three servo pairs centred at 0°, 120°, 240°; each servo shaft is radial, its horn faces the
@@ -207,15 +219,179 @@ def hobby_servo_hexapod(
     )
 
 
-SERVO_PRESETS = {"hobby-servo": hobby_servo_hexapod}
+# ----------------------------------------------------------------------------------------------
+# YAML (edge units: length_unit m|mm, angles in degrees, pulses in µs), loaded with Drake's yaml_load_typed.
+
+SERVO_PRESETS = ("hobby-servo",)
+_PRESET_FILES = {"hobby-servo": "servo-hobby.yaml"}
+
+
+@dataclass
+class PairedLayoutConfig:
+    """Three pairs of servos at 0°, 120°, 240°, horns facing the centre, arms of a pair pointing away
+    from each other; anchors in pairs between them (``hobby_servo_hexapod`` documents the layout)."""
+
+    base_radius: float = 0.0  # arm planes' distance from the centre
+    pair_spacing: float = 0.0  # pivot to pivot within a pair
+    platform_radius: float = 0.0  # anchor circle
+    anchor_half_angle_deg: float = 0.0  # anchors of a pair at ±this about 60°, 180°, 300°
+
+
+@dataclass
+class ServoSpecConfig:
+    """The servos: pulses (µs), travel and rate, and the dynamics used by the Drake simulation."""
+
+    neutral_us: list[float] = field(default_factory=lambda: [NEUTRAL_US] * 6)  # W0_i, trims included
+    rate_us: float = 400.0  # pulse change ...
+    rate_deg: float = 45.0  # ... for this turn of the horn (the seed: 400 µs per 45°)
+    travel_deg: float = 45.0  # allowed |alpha - alpha0|
+    stall_torque: float = SERVO_STALL_TORQUE  # N·m
+    speed_s_per_60deg: float = 0.17  # no-load speed, the datasheet's unit
+    full_torque_error_deg: float = float(np.degrees(SERVO_BAND_RAD))  # error at which the stall torque is reached
+
+
+@dataclass
+class ServoMassesConfig:
+    """Masses for the Drake model, kg."""
+
+    arm: float = 0.005
+    rod: float = 0.005
+    platform: float = 0.15
+
+
+@dataclass
+class ServoHexapodConfig:
+    """One servo hexapod as written in YAML. Exactly one layout: ``paired``, or explicit
+    ``base_pivots`` + ``arm_directions_deg`` + ``platform_anchors`` + ``shaft_directions``."""
+
+    name: str = ""
+    description: str = ""
+    length_unit: str = "m"
+    arm_length: float = 0.0
+    rod_length: float = 0.0
+    paired: Optional[PairedLayoutConfig] = None
+    base_pivots: list[list[float]] = field(default_factory=list)
+    arm_directions_deg: list[float] = field(default_factory=list)
+    platform_anchors: list[list[float]] = field(default_factory=list)
+    shaft_directions: list[list[float]] = field(default_factory=list)
+    servo: ServoSpecConfig = field(default_factory=ServoSpecConfig)
+    masses: ServoMassesConfig = field(default_factory=ServoMassesConfig)
+
+
+def _positive(field_name: str, value, unit: str = "") -> float:
+    if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+        raise GeometryError(f"{field_name} must be a positive number{' of ' + unit if unit else ''}, got {value!r}")
+    return float(value)
+
+
+def _rows(field_name: str, value, shape) -> np.ndarray:
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise GeometryError(f"{field_name} must be {_shape_words(shape)}, got {value!r}") from None
+    if arr.shape != shape:
+        raise GeometryError(f"{field_name} must be {_shape_words(shape)}, got {value!r}")
+    if not np.all(np.isfinite(arr)):
+        raise GeometryError(f"{field_name} must be finite, got {value!r}")
+    return arr
+
+
+def _shape_words(shape) -> str:
+    return "6 numbers (one per servo)" if len(shape) == 1 else "6 points [x, y, z] (one per servo)"
+
+
+def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
+    """Build a validated ``ServoHexapod`` (SI units) from a parsed ``ServoHexapodConfig``; errors name
+    the field and its value."""
+    try:
+        k = length_scale(cfg.length_unit)
+    except ValueError:
+        raise GeometryError(f"length_unit must be m or mm, got {cfg.length_unit!r}") from None
+    u = cfg.length_unit
+    a = _positive("arm_length", cfg.arm_length, u) * k
+    s = _positive("rod_length", cfg.rod_length, u) * k
+    sv, m = cfg.servo, cfg.masses
+    extra = dict(
+        neutral_us=_rows("servo.neutral_us", sv.neutral_us, (6,)),
+        rate_us_per_rad=_positive("servo.rate_us", sv.rate_us, "µs") / np.radians(_positive("servo.rate_deg", sv.rate_deg, "degrees")),
+        travel_rad=np.radians(_positive("servo.travel_deg", sv.travel_deg, "degrees")),
+        servo_torque=_positive("servo.stall_torque", sv.stall_torque, "N·m"),
+        servo_speed=np.radians(60.0) / _positive("servo.speed_s_per_60deg", sv.speed_s_per_60deg, "seconds"),
+        servo_band=np.radians(_positive("servo.full_torque_error_deg", sv.full_torque_error_deg, "degrees")),
+        arm_mass=_positive("masses.arm", m.arm, "kg"),
+        rod_mass=_positive("masses.rod", m.rod, "kg"),
+        platform_mass=_positive("masses.platform", m.platform, "kg"),
+    )
+    if np.degrees(extra["travel_rad"]) >= 90:
+        raise GeometryError(f"servo.travel_deg must be below 90 degrees, got {sv.travel_deg!r}")
+    explicit = {"base_pivots": cfg.base_pivots, "arm_directions_deg": cfg.arm_directions_deg,
+                "platform_anchors": cfg.platform_anchors, "shaft_directions": cfg.shaft_directions}
+    given = [n for n, v in explicit.items() if len(v)]
+    name = cfg.name or "servo-hexapod"
+    if cfg.paired is not None:
+        if given:
+            raise GeometryError(f"servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {', '.join(given)})")
+        p = cfg.paired
+        h = hobby_servo_hexapod(
+            base_radius=_positive("paired.base_radius", p.base_radius, u) * k,
+            pair_spacing=_positive("paired.pair_spacing", p.pair_spacing, u) * k,
+            platform_radius=_positive("paired.platform_radius", p.platform_radius, u) * k,
+            anchor_half_angle_deg=float(p.anchor_half_angle_deg),
+            arm_length=a, rod_length=s,
+        )
+        return h.replace(name=name, description=cfg.description, **extra)
+    missing = [n for n in explicit if n not in given]
+    if missing:
+        raise GeometryError(f"servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, platform_anchors, "
+                            f"shaft_directions (missing {', '.join(missing)})")
+    return ServoHexapod(
+        name=name, description=cfg.description,
+        base_pivots=_rows("base_pivots", cfg.base_pivots, (6, 3)) * k,
+        arm_directions=np.radians(_rows("arm_directions_deg", cfg.arm_directions_deg, (6,))),
+        platform_anchors=_rows("platform_anchors", cfg.platform_anchors, (6, 3)) * k,
+        shaft_directions=_rows("shaft_directions", cfg.shaft_directions, (6, 3)),
+        arm_length=a, rod_length=s, **extra,
+    )
+
+
+def load_servo_yaml(path) -> ServoHexapod:
+    """Load a servo hexapod from a YAML file (schema: ``ServoHexapodConfig``)."""
+    from pydrake.common.yaml import yaml_load_typed
+
+    path = Path(path)
+    if not path.is_file():
+        raise GeometryError(f"servo hexapod file {str(path)!r} does not exist")
+    try:
+        cfg = yaml_load_typed(schema=ServoHexapodConfig, filename=str(path))
+    except RuntimeError as e:
+        raise GeometryError(f"{path}: {e}") from None
+    if not cfg.name:
+        cfg.name = path.stem
+    return servo_hexapod_from_config(cfg)
+
+
+def servo_preset_path(name: str) -> Path:
+    """The YAML file of a built-in servo hexapod preset."""
+    if name not in _PRESET_FILES:
+        raise GeometryError(f"unknown servo hexapod preset {name!r}; available: {', '.join(SERVO_PRESETS)}")
+    return Path(str(resources.files("stewart_drake") / "presets" / _PRESET_FILES[name]))
 
 
 def load_servo_preset(name: str) -> ServoHexapod:
-    """A servo hexapod preset by name."""
-    try:
-        return SERVO_PRESETS[name]()
-    except KeyError:
-        raise ValueError(f"unknown servo hexapod preset {name!r}; available: {', '.join(SERVO_PRESETS)}") from None
+    """A built-in servo hexapod preset by name (``SERVO_PRESETS``), read from its YAML file."""
+    return load_servo_yaml(servo_preset_path(name))
+
+
+def load_servo_hexapod(name_or_path) -> ServoHexapod:
+    """A preset name or a path to a servo hexapod YAML file."""
+    if isinstance(name_or_path, ServoHexapod):
+        return name_or_path
+    text = str(name_or_path)
+    if text in SERVO_PRESETS:
+        return load_servo_preset(text)
+    if text.endswith((".yaml", ".yml")) or Path(text).exists():
+        return load_servo_yaml(text)
+    raise GeometryError(f"unknown servo hexapod {text!r}: not a preset ({', '.join(SERVO_PRESETS)}) and not a YAML file")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -371,3 +547,13 @@ def quantise_pulses(pulse_us, resolution_us: float = 1.0) -> np.ndarray:
         raise ValueError(f"pulse resolution must be > 0 µs, got {resolution_us}")
     p = np.asarray(pulse_us, dtype=float) / resolution_us
     return np.copysign(np.floor(np.abs(p) + 0.5), p) * resolution_us
+
+
+def pose_jacobian(hexapod: ServoHexapod, poses, eps: float = 1e-7) -> np.ndarray:
+    """``(..., 6, 6)`` d alpha_i / d pose_k (rad per m or rad) by central differences of eq. 9;
+    truncation error ~eps² relative, far below anything it is used for (error propagation)."""
+    poses = check_poses(poses)
+    d = np.eye(6) * eps
+    plus = arm_angles(hexapod, poses[..., None, :] + d)[0]
+    minus = arm_angles(hexapod, poses[..., None, :] - d)[0]
+    return np.swapaxes((plus - minus) / (2 * eps), -1, -2)

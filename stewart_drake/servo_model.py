@@ -188,10 +188,13 @@ def write_sdf(hexapod: ServoHexapod, directory=SDF_DIR) -> Path:
     return path
 
 
-def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None):
-    """A finalized discrete (SAP) closed-loop ``MultibodyPlant`` of the hexapod and its ``SceneGraph``."""
+def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd_gains=None):
+    """A finalized discrete (SAP) closed-loop ``MultibodyPlant`` of the hexapod and its ``SceneGraph``.
+    ``pd_gains`` = (kp N·m/rad, kd N·m·s/rad) makes every servo a PD-controlled actuator (Drake's
+    implicit PD, clamped to the servo's effort limit, driven by the desired-state input port)."""
     from pydrake.multibody.parsing import Parser
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, DiscreteContactApproximation
+    from pydrake.multibody.tree import PdControllerGains
     from pydrake.systems.framework import DiagramBuilder
 
     if not time_step > 0:
@@ -203,6 +206,8 @@ def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None):
     home = servo_joint_home(hexapod)
     for i in range(6):
         plant.GetJointByName(f"servo_{i + 1}").set_default_angle(home[i])
+        if pd_gains is not None:
+            plant.GetJointActuatorByName(f"servo_{i + 1}").set_controller_gains(PdControllerGains(p=pd_gains[0], d=pd_gains[1]))
     plant.Finalize()
     return plant, scene_graph
 
@@ -425,3 +430,172 @@ def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None =
         out["t"] = data.sample_times()
         out[name] = data.data().T
     return out
+
+
+# ----------------------------------------------------------------------------------------------
+# The loop closed: controller → servos → closed-loop plant.
+
+
+def servo_gains(hexapod: ServoHexapod) -> tuple[float, float]:
+    """``(kp, kd)`` of the servo's position loop, from the datasheet numbers (a DC motor behind a
+    proportional position loop): kp = stall torque / ``servo_band`` (full torque that far from the
+    target; 1 N·m / 2° = 28.6 N·m/rad for the preset) and kd = stall torque / no-load speed (the motor's
+    back-EMF damping seen at the horn: 1 N·m / 6.16 rad/s = 0.162 N·m·s/rad)."""
+    return hexapod.servo_torque / hexapod.servo_band, hexapod.servo_torque / hexapod.servo_speed
+
+
+def make_servo_drive(hexapod: ServoHexapod, joint_home, time_step: float):
+    """A Drake ``LeafSystem``: six hobby servos' electronics, pulse width → the plant's PD set-point.
+
+    Input ``pulse_us`` (6). Each servo's target is the joint angle ``pulse_joint_angles`` (its physics:
+    (W − W0)/r from home, in the pulse-increasing sense). Every ``time_step`` the set-point moves toward
+    the target by at most ``servo_speed``·time_step (the no-load speed limit); output ``desired_state``
+    (12) = [set-points; their rates], for ``MultibodyPlant``'s desired-state port, whose implicit PD
+    (``servo_gains``) clamps the torque to the stall torque. Initial set-point: ``joint_home``.
+    """
+    from pydrake.systems.framework import BasicVector, LeafSystem
+
+    joint_home = np.asarray(joint_home, dtype=float)
+    step = hexapod.servo_speed * time_step
+
+    class ServoDrive(LeafSystem):
+        def __init__(self):
+            super().__init__()
+            self._pulse = self.DeclareVectorInputPort("pulse_us", 6)
+            self._xd = self.DeclareDiscreteState(BasicVector(np.r_[joint_home, np.zeros(6)]))
+            self.DeclarePeriodicDiscreteUpdateEvent(time_step, 0.0, self._update)
+            self.DeclareStateOutputPort("desired_state", self._xd)
+
+        def _update(self, context, state):
+            q = context.get_discrete_state(self._xd).value()[:6]
+            target = pulse_joint_angles(hexapod, self._pulse.Eval(context), joint_home)
+            dq = np.clip(target - q, -step, step)
+            state.get_mutable_vector(self._xd).SetFromVector(np.r_[q + dq, dq / time_step])
+
+    return ServoDrive()
+
+
+def joint_arm_angles(hexapod: ServoHexapod, joint_angles) -> np.ndarray:
+    """Arm elevations alpha (..., 6) (radians, eq. 9's angle) from servo joint angles (..., 6)."""
+    up = pivot_frames(hexapod)[:, :, 1] @ [0.0, 0.0, 1.0]
+    return up * np.asarray(joint_angles)
+
+
+def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None = None, time_step: float = 1e-3,
+                    frame_rate_hz: float = FRAME_RATE_HZ, resolution_us: float = 1.0) -> dict:
+    """The seed's control loop closed in simulation, one Diagram::
+
+        TrajectorySource(pose ref) → ServoController (50 Hz, 1 µs) → ServoDrive (speed limit) → plant (PD servos)
+
+    The reference is a first-order hold through ``(times, poses)`` (n,), (n, 6) (m, rad, zyx). The plant
+    starts at rest at home. Returns, sampled every ``time_step`` (k samples): ``t``, ``reference`` and
+    ``pose`` (platform, from the plant state) (k, 6); ``arm_angle`` (k, 6), the simulated arms' alpha;
+    ``arm_angle_ref`` (k, 6), eq. 9 at the reference; ``rod_gap`` (k, 6) | |arm tip − anchor| − s | (m),
+    the ball constraints' violation; ``pulse_us`` (k, 6); ``status`` (k, 6).
+    """
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
+    from pydrake.trajectories import PiecewisePolynomial
+
+    from .rotations import angles_from_matrix
+
+    times = np.asarray(times, dtype=float)
+    poses = np.asarray(poses, dtype=float)
+    if poses.shape != (len(times), 6) or len(times) < 2:
+        raise ValueError(f"run_closed_loop needs times (n,) and poses (n, 6) with n >= 2, got {times.shape} and {poses.shape}")
+    if not time_step > 0:
+        raise ValueError(f"time_step must be > 0, got {time_step}")
+    builder = DiagramBuilder()
+    plant, _ = build_plant(hexapod, time_step, builder, pd_gains=servo_gains(hexapod))
+    home = servo_joint_home(hexapod)
+    src = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, poses.T)))
+    ctrl = builder.AddSystem(make_servo_controller(hexapod, frame_rate_hz, resolution_us))
+    drive = builder.AddSystem(make_servo_drive(hexapod, home, time_step))
+    instance = plant.GetModelInstanceByName(SDF_NAME)
+    order = [int(plant.get_joint_actuator(a).joint().name().split("_")[1]) - 1 for a in plant.GetJointActuatorIndices(instance)]
+    if order != list(range(6)):
+        raise RuntimeError(f"servo actuators are not in the order servo_1..servo_6: {order}")
+    builder.Connect(src.get_output_port(), ctrl.GetInputPort("pose"))
+    builder.Connect(ctrl.GetOutputPort("pulse_us"), drive.GetInputPort("pulse_us"))
+    builder.Connect(drive.GetOutputPort("desired_state"), plant.get_desired_state_input_port(instance))
+    logs = {"reference": LogVectorOutput(src.get_output_port(), builder, time_step),
+            "state": LogVectorOutput(plant.get_state_output_port(), builder, time_step),
+            "pulse_us": LogVectorOutput(ctrl.GetOutputPort("pulse_us"), builder, time_step),
+            "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, time_step)}
+    diagram = builder.Build()
+    sim = Simulator(diagram)
+    sim.AdvanceTo(float(times[-1] if duration is None else duration))
+    ctx = sim.get_context()
+    out = {}
+    for name, log in logs.items():
+        data = log.FindLog(ctx)
+        out["t"] = data.sample_times()
+        out[name] = data.data().T
+    # Kinematics of the logged states.
+    pc = plant.CreateDefaultContext()
+    body = plant.GetBodyByName("platform")
+    servos = [plant.GetJointByName(f"servo_{i + 1}") for i in range(6)]
+    tips = [plant.GetFrameByName(f"arm_tip_{i + 1}") for i in range(6)]
+    anchors = [plant.GetFrameByName(f"platform_anchor_{i + 1}") for i in range(6)]
+    nq = plant.num_positions()
+    k = len(out["t"])
+    pose, joints, gap = np.empty((k, 6)), np.empty((k, 6)), np.empty((k, 6))
+    for j, x in enumerate(out.pop("state")):
+        plant.SetPositions(pc, x[:nq])
+        X = plant.EvalBodyPoseInWorld(pc, body)
+        pose[j] = np.r_[X.translation(), angles_from_matrix(X.rotation().matrix(), "zyx")]
+        joints[j] = [sj.get_angle(pc) for sj in servos]
+        gap[j] = [abs(np.linalg.norm(anchors[i].CalcPoseInWorld(pc).translation() - tips[i].CalcPoseInWorld(pc).translation())
+                      - hexapod.rod_length) for i in range(6)]
+    out.update(pose=pose, arm_angle=joint_arm_angles(hexapod, joints), rod_gap=gap,
+               arm_angle_ref=solve(hexapod, out["reference"]).angles)
+    return out
+
+
+def static_servo_torques(hexapod: ServoHexapod, poses, g: float = 9.81) -> np.ndarray:
+    """``(..., 6)`` the torques (N·m, about alpha) that hold the hexapod still at ``poses`` (..., 6),
+    by virtual work: Jᵀτ = −Q with J = dalpha/dpose and Q = [0, 0, −m g, 0, 0, 0] the gravity force on
+    the platform plus half of each rod (the centre of mass is the platform origin); each servo also
+    carries its arm's weight at a/2 and half its rod at a (cos alpha lever)."""
+    from .servo import arm_angles, pose_jacobian
+
+    m = hexapod.platform_mass + 3 * hexapod.rod_mass
+    J = pose_jacobian(hexapod, poses)
+    Q = np.zeros(np.shape(J)[:-2] + (6,))
+    Q[..., 2] = -m * g
+    tau = -np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
+    alpha = arm_angles(hexapod, poses)[0]
+    return tau + (hexapod.arm_mass / 2 + hexapod.rod_mass / 2) * g * hexapod.arm_length * np.cos(alpha)
+
+
+def tracking_bounds(hexapod: ServoHexapod, log: dict, time_step: float = 1e-3, frame_rate_hz: float = FRAME_RATE_HZ,
+                    resolution_us: float = 1.0) -> dict:
+    """Per-sample bounds on the closed-loop tracking error of ``run_closed_loop``'s ``log``, from the
+    loop's arithmetic, valid while every reference arm speed stays below ``servo_speed`` (checked):
+
+    arm (k, 6), radians: |alpha − alpha_ref(t)| <= max over s in [t − Λ, t] |alpha_ref(t) − alpha_ref(s)|
+        + q/2 + sag, where Λ = T (the pose is sampled once per frame and held) + 2 dt (the drive and the
+        plant read their inputs one step late) + kd/kp (the servo's PD lag); q/2 = half the pulse
+        resolution in angle (rounding; 0.056° for 1 µs); sag = static torque / kp (a proportional servo
+        under load). A reference arm speed below the no-load speed means the speed limit adds no lag.
+    pose (k, 6), m and rad: sum_i |J⁻¹_ki| arm_i, the first-order image of the arm bound (J = dalpha/dpose).
+    """
+    from .servo import pose_jacobian
+
+    t, ref = log["t"], log["arm_angle_ref"]
+    rate = np.abs(np.diff(ref, axis=0)) / np.diff(t)[:, None]
+    if rate.max() >= hexapod.servo_speed:
+        raise ValueError(f"reference arm speed {rate.max():.3g} rad/s reaches the servo's no-load speed "
+                         f"{hexapod.servo_speed:.3g} rad/s: the tracking bound does not apply")
+    kp, kd = servo_gains(hexapod)
+    lag = 1.0 / frame_rate_hz + 2 * time_step + kd / kp
+    n = int(np.ceil(lag / time_step))
+    padded = np.concatenate([np.repeat(ref[:1], n, axis=0), ref])  # at rest at alpha_ref(0) before t = 0
+    spread = np.max([np.abs(ref - padded[n - j: n - j + len(ref)]) for j in range(n + 1)], axis=0)
+    quant = resolution_us / 2 / hexapod.rate_us_per_rad
+    sag = np.abs(static_servo_torques(hexapod, log["reference"])) / kp
+    arm = spread + quant + sag
+    Jinv = np.linalg.inv(pose_jacobian(hexapod, log["reference"]))
+    return {"arm": arm, "pose": np.einsum("...ki,...i->...k", np.abs(Jinv), arm), "lag": lag, "quantisation": quant,
+            "sag": sag}

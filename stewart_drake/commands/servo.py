@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 import numpy as np
 
 from ..rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
@@ -12,7 +14,9 @@ def register(sub) -> None:
     from ..servo import SERVO_PRESETS
 
     p = sub.add_parser("servo", help="servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)")
-    p.add_argument("--preset", default="hobby-servo", choices=list(SERVO_PRESETS), help="servo hexapod (default hobby-servo)")
+    p.add_argument("--platform", default="hobby-servo", metavar="NAME|FILE",
+                   help=f"a servo hexapod preset ({', '.join(SERVO_PRESETS)}) or a servo hexapod YAML file (default hobby-servo)")
+    p.add_argument("--preset", dest="platform", help=argparse.SUPPRESS)  # the option's earlier name
     p.add_argument("--pose", nargs=6, type=float, metavar=("X", "Y", "Z", "PHI", "THETA", "PSI"),
                    help="platform pose, R = Rz(psi)·Ry(theta)·Rx(phi) (default: home)")
     p.add_argument("--from-home", action="store_true", help="Z is the offset from the home height h0")
@@ -25,9 +29,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..servo import load_servo_preset, solve
+    from ..servo import load_servo_hexapod, solve
 
-    hexapod = load_servo_preset(args.preset)
+    hexapod = load_servo_hexapod(args.platform)
     if args.trim is not None:
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
