@@ -7,15 +7,36 @@ One controller tick (every ``T`` seconds, at exactly t = k·T) does what the MC5
 2. compute the leg set-points with the inverse kinematics (fixed point: the ``fixedpoint`` package's
    Q15 IK, integer millimetres; float: the closed-form IK in float64);
 3. run a leg-position PID per leg (fixed point: Q15 gains, Q31 accumulators, saturating intrinsics;
-   float: the same law in float64) with command saturation and anti-windup by conditional integration;
+   float: the same law in float64) plus the model-based force feed-forward read from a table (see
+   below), with command saturation and anti-windup by conditional integration;
 4. release the new command to the actuators after the output delay (``DspTiming.latency``):
    ``"sample"`` (default, conservative) one full sample later, at (k+1)·T; ``"computation"`` after the
    cycle model's computation time, at k·T + t_comp; ``"none"`` at k·T (an ideal controller).
    Between releases the command is held (zero-order hold: the output ports read discrete state).
 
 Ports of both controllers: inputs ``reference`` (6: pose, metres/radians, ``utn`` convention unless
-configured) and ``leg_lengths`` (6: metres, the true prismatic positions: the controller quantises them);
-outputs ``command`` (6: leg forces, newtons), ``setpoint`` (6: metres) and ``status`` (see ``STATUS``).
+configured), ``leg_lengths`` (6: metres, the true prismatic positions: the controller quantises them) and
+the optional ``feedforward`` (6: leg forces, newtons; left unconnected it is zero); outputs ``command``
+(6: leg forces, newtons), ``setpoint`` (6: metres) and ``status`` (see ``STATUS``).
+
+Design for any platform (``ControllerConfig.for_platform``; what ``make_controller`` and
+``simulation.build_simulation`` use when no configuration is given):
+
+- the command range is the platform's actuator force (``legs.max_force``);
+- the gains come from the leg-space inertia M_L = J⁻ᵀ M J⁻¹ at home (plate **and** legs,
+  ``leg_space_inertia``) and the loop's delay (``design_gains``): one diagonal PID must serve the
+  lightest mode m_min and the heaviest m_max of M_L. The lightest sets the derivative gain
+  (kd = m_min·ω_c, crossover ω_c = ``PHASE_BUDGET``/t_d from the delay t_d = output delay + T (zero-order
+  hold and backward difference) + actuator lag), the heaviest the stiffness (kp = kd²/(4 ζ_h² m_max): its
+  damping ratio is ζ_h) and the integral (ki = kp·ω_h/4, ω_h = √(kp/m_max));
+- the force feed-forward F_ff(t) = ``dynamics.leg_forces_with_legs`` of the reference, sampled at the
+  ticks and advanced by the known delays (``simulation.feedforward_forces``) carries the plate and legs
+  along the reference; the PID only corrects what the model misses. On the DSP it is a table (six Q15
+  words per tick, written by the host with the pose table: 12 bytes per tick, 12 kB per second at 1 kHz)
+  and costs one ``L_deposit_h`` and one ``L_add`` per leg (``FEEDFORWARD_OPS_PER_LEG``, in the cycle
+  model). Computing it on the DSP instead would take the inverse dynamics per tick (``ONLINE_FEEDFORWARD_OPS``:
+  a linearised model F = F_home + M_L·L̈_ref, 36 multiply-accumulates and the second differences, is
+  ~150 cycles; the full model with the Jacobian solve is several thousand cycles, more than the IK).
 """
 
 from __future__ import annotations
@@ -39,6 +60,12 @@ LATENCY_MODES = ("sample", "computation", "none")
 # terms (L_mult ×4, L_shl ×4), the sums (L_add ×3, L_sub), the command word (extract_h), the set-point
 # scalings to counts (L_mult ×2).
 PID_OPS_PER_LEG = {"sub": 5, "add": 2, "shl": 2, "mult_r": 2, "L_mult": 6, "extract_h": 1, "L_shl": 4, "L_add": 3, "L_sub": 1}
+# The force feed-forward from its table: the word to the high half of a long (L_deposit_h), added to the sum.
+FEEDFORWARD_OPS_PER_LEG = {"L_deposit_h": 1, "L_add": 1}
+# The alternative, not implemented: a linearised feed-forward computed on the DSP per tick,
+# F = F_home + M_L·L̈_ref: six second differences of the set-points (sub ×2 each, scaled: shl), a 6×6
+# matrix-vector product (36 L_mult + 36 L_add), the constant (L_add ×6), the words (extract_h ×6).
+ONLINE_FEEDFORWARD_OPS = {"sub": 12, "shl": 6, "L_mult": 36, "L_add": 42, "extract_h": 6}
 # The measurement difference is scaled up by 2^DIFF_SHIFT before its 16-bit filter, so that a
 # difference of a few counts keeps its resolution (±512 counts per tick still fit a word).
 DIFF_SHIFT = 6
@@ -119,9 +146,13 @@ class DspTiming:
 
 def tick_cycles() -> int:
     """Cycles of one controller tick on the MC56F8367 from the ``fixedpoint`` cycle model: the firmware's
-    IK (``tp17_cycles``), six leg PIDs (``PID_OPS_PER_LEG``) and ``ISR_OVERHEAD_CYCLES``."""
+    IK (``tp17_cycles``), six leg PIDs (``PID_OPS_PER_LEG``) with their feed-forward words
+    (``FEEDFORWARD_OPS_PER_LEG``) and ``ISR_OVERHEAD_CYCLES``."""
     ik = tp17_cycles().cycles
-    pid = estimate_cycles({k: 6 * v for k, v in PID_OPS_PER_LEG.items()}).cycles
+    ops = {k: 6 * v for k, v in PID_OPS_PER_LEG.items()}
+    for k, v in FEEDFORWARD_OPS_PER_LEG.items():
+        ops[k] = ops.get(k, 0) + 6 * v
+    pid = estimate_cycles(ops).cycles
     return int(math.ceil(ik + pid + ISR_OVERHEAD_CYCLES))
 
 
@@ -130,7 +161,8 @@ class PidGains:
     """Leg-position PID with velocity feed-forward, in SI:
     force = kp·e + ki·∫e dt − kd·dL/dt + kv·dS/dt  (e = set-point S − measured length L).
 
-    kp N/m, ki N/(m·s), kd N·s/m, kv N·s/m. The derivative acts on the measurement (no kick from the
+    kp N/m, ki N/(m·s), kd N·s/m, kv N·s/m. The defaults are a sweep's on ``utn-dynamic``; for any
+    other platform use ``design_gains`` (``ControllerConfig.for_platform``). The derivative acts on the measurement (no kick from the
     IK's 1 mm set-point steps); the set-point rate enters as a feed-forward through its own
     first-order filter (``feedforward_filter``: the weight of the new difference, in (0, 1]), which
     smooths the steps without adding lag inside the loop; with kv = kd the pair acts as a derivative
@@ -164,6 +196,137 @@ class ControllerConfig:
     gains: PidGains = field(default_factory=PidGains)
     ik_format: QFormat = field(default_factory=lambda: QFormat(16, 1e-3, "tfr16"))
     convention: str = "utn"
+
+    @classmethod
+    def for_platform(cls, platform: Platform, timing: DspTiming | None = None, actuator_lag: float = 2e-3, poses=None, **kwargs) -> "ControllerConfig":
+        """The configuration designed for ``platform``: ``timing`` (default ``DspTiming()`` with its
+        command range the platform's actuator force ``legs.max_force``; a given timing is used as is) and
+        the gains of ``design_gains`` for that timing, an actuator lag ``actuator_lag`` (s) and the poses
+        the loop will visit ``poses`` (``(n, 6)``, e.g. the trajectory's; None: home only). ``kwargs``:
+        the other fields (``ik_format``, ``convention``, or ``gains`` to override the design)."""
+        timing = timing or DspTiming(command_range=float(platform.legs.max_force))
+        if "gains" not in kwargs:
+            kwargs["gains"] = design_gains(platform, timing, actuator_lag, poses=poses)
+        return cls(timing=timing, **kwargs)
+
+
+# ----------------------------------------------------------------------------------------------
+# Gain design from the platform.
+
+# Phase the loop's delay may use at the crossover of the lightest leg-space mode: ω_c = PHASE_BUDGET / t_d
+# (radians). Calibrated on utn-dynamic, where it gives the sweep's kd (80 N·s/m); the measured margin: the
+# loop stays within its tracking bounds up to ~1.3 × this crossover (``analyses/controller_in_the_loop``).
+PHASE_BUDGET = 1.2
+# Damping ratio of the heaviest leg-space mode under the PD part (sets kp from kd).
+HEAVY_MODE_DAMPING = 0.25
+# kp is at least this multiple of the struts' largest negative stiffness over the poses the loop visits
+# (``strut_stiffness``, ``design_gains(poses=...)``): the heaviest mode keeps a net stiffness kp − K of at
+# least half of kp everywhere on the trajectory.
+STIFFNESS_MARGIN = 2.0
+# Without the visited poses only home is known: the trajectories tried reach up to ~1.6 × home's stiffness
+# (utn-kinematic seed: 5.1 → 8.0 kN/m); the design assumes this factor (× STIFFNESS_MARGIN: 3 × home).
+UNKNOWN_POSE_STIFFNESS_FACTOR = 1.5
+# The integral gain is at most this fraction of the heaviest mode's Routh limit kd·(kp − K)/m_max (the PID
+# on a mass m with net stiffness k: m s³ + kd s² + k s + ki, stable iff ki < kd·k/m).
+ROUTH_FRACTION = 0.5
+# At most this many poses of a trajectory are used for the design (evenly spread; the extremes of mass and
+# stiffness vary slowly along a trajectory).
+DESIGN_POSES = 64
+
+
+def leg_space_inertia(platform: Platform, pose=None) -> np.ndarray:
+    """``(..., 6, 6)`` leg-space inertia M_L = J⁻ᵀ M J⁻¹ (kg) at ``pose`` (``(..., 6)``; default home): the
+    force on each leg per unit leg acceleration, plate and legs (``dynamics.leg_forces_with_legs`` without
+    gravity and at rest; J = ∂L/∂q). Its eigenvalues are the masses the leg PIDs see in the platform's modes."""
+    from .dynamics import leg_forces_with_legs
+    from .kinematics import length_jacobian
+
+    q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float)
+    z = np.zeros_like(q0)
+    JtM = np.stack([leg_forces_with_legs(platform, q0, z, z + e, gravity=0.0) for e in np.eye(6)], -1)  # J⁻ᵀ M
+    M_L = JtM @ np.linalg.inv(length_jacobian(platform, q0))
+    return (M_L + np.swapaxes(M_L, -1, -2)) / 2
+
+
+def strut_stiffness(platform: Platform, pose=None, h: float = 1e-6):
+    """The largest negative stiffness (N/m) the static leg forces present to the leg loops at ``pose``
+    (``(6,)`` → float, ``(..., 6)`` → array ``(...)``; default home): with constant forces, a leg-length
+    error e changes the forces needed to hold the plate by (∂F_static/∂L)·e; where that is negative (struts
+    pushing the plate up act like inverted pendulums, ``dynamics.open_loop_growth_rates``) the error grows
+    unless kp exceeds it. The largest eigenvalue of −sym(∂F_static/∂L) (0 if none is positive); central
+    differences of step ``h``."""
+    from .dynamics import leg_forces_with_legs
+    from .kinematics import length_jacobian
+
+    q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float)
+    z = np.zeros_like(q0)
+    dFdq = np.stack([(leg_forces_with_legs(platform, q0 + h * e, z, z) - leg_forces_with_legs(platform, q0 - h * e, z, z)) / (2 * h) for e in np.eye(6)], -1)
+    K = dFdq @ np.linalg.inv(length_jacobian(platform, q0))
+    k = np.maximum(0.0, np.linalg.eigvalsh(-(K + np.swapaxes(K, -1, -2)) / 2)[..., -1])
+    return float(k) if k.ndim == 0 else k
+
+
+def loop_delay(timing: DspTiming, actuator_lag: float = 2e-3) -> float:
+    """Seconds of delay around the leg loop at low frequency: the output delay, half a sample of
+    zero-order hold, half a sample of the backward-difference derivative, and the actuator lag."""
+    return timing.output_delay + timing.sample_period + actuator_lag
+
+
+def design_gains(platform: Platform, timing: DspTiming | None = None, actuator_lag: float = 2e-3, pose=None, poses=None) -> PidGains:
+    """Leg PID gains for ``platform`` from its leg-space inertia (``leg_space_inertia``: lightest mode
+    m_min, heaviest m_max), the struts' negative stiffness K (``strut_stiffness``) and the loop delay t_d
+    (``loop_delay``). The extremes are taken over ``pose`` (default home) and ``poses`` (``(n, 6)``, the
+    poses the loop will visit, e.g. samples of the trajectory; without them K is assumed to reach
+    ``UNKNOWN_POSE_STIFFNESS_FACTOR`` × its value at ``pose``):
+
+        ω_c = PHASE_BUDGET / t_d           crossover of the lightest mode (rad/s)
+        kd = kv = m_min · ω_c              the derivative dominates there (and the velocity feed-forward
+                                           matches it: kd·(dS/dt − dL/dt) acts on the error's rate)
+        kp = kd² / (4 ζ_h² m_max)          damping ratio ζ_h = HEAVY_MODE_DAMPING of the heaviest mode,
+                                           at most kd·ω_c/3 (the lightest mode keeps ≥ 70° of PD lead),
+                                           at least STIFFNESS_MARGIN × K (the struts' negative stiffness
+                                           eats into kp: heavy plates on flat legs need it)
+        ki = min(kp · ω_h / 4,             integral corner a quarter of the heaviest mode's frequency
+                 ROUTH_FRACTION · kd · (kp − K) / m_max)   and half its Routh limit
+
+    The Routh cap matters where the stiffness floor sets kp: kp then outgrows kd²/(4 ζ_h² m_max), the
+    heaviest mode's damping falls below ζ_h and kp·ω_h/4 exceeds kd·(kp − K)/m_max — a slow oscillation
+    (~2 Hz on utn-kinematic) that grows wherever the trajectory raises K.
+    On utn-dynamic (m 0.17 … 8.1 kg, t_d 4 ms at 1 kHz with a 2 ms actuator lag) this gives the
+    order of the sweep's kp 3000, ki 15000, kd 80; heavier platforms get proportionally stiffer gains.
+    """
+    timing = timing or DspTiming()
+    if not (math.isfinite(actuator_lag) and actuator_lag >= 0):
+        raise ValueError(f"actuator_lag must be >= 0 s, got {actuator_lag!r}")
+    q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float).reshape(6)
+    visited = np.concatenate([q0[None], _design_poses(poses)])
+    m = np.linalg.eigvalsh(leg_space_inertia(platform, visited))
+    m_min, m_max = float(m[:, 0].min()), float(m[:, -1].max())
+    if not m_min > 0:
+        raise ValueError(f"platform {platform.name!r}: the leg-space inertia is not positive definite (smallest eigenvalue {m_min:.3g} kg)")
+    K = float(strut_stiffness(platform, visited).max())
+    if poses is None:
+        K *= UNKNOWN_POSE_STIFFNESS_FACTOR
+    w_c = PHASE_BUDGET / loop_delay(timing, actuator_lag)
+    kd = m_min * w_c
+    # ... but keep the PD zero kp/kd at most ω_c/3 (≥ 70° of phase lead at the light mode's crossover),
+    # and at least STIFFNESS_MARGIN × the struts' negative stiffness (else the plate falls away)
+    kp = max(min(kd**2 / (4 * HEAVY_MODE_DAMPING**2 * m_max), kd * w_c / 3), STIFFNESS_MARGIN * K)
+    ki = min(kp * math.sqrt(kp / m_max) / 4, ROUTH_FRACTION * kd * (kp - K) / m_max)
+    return PidGains(kp=kp, ki=ki, kd=kd, kv=kd)
+
+
+def _design_poses(poses) -> np.ndarray:
+    """At most ``DESIGN_POSES`` of ``poses`` ``(n, 6)`` (None: none), evenly spread, first and last kept."""
+    if poses is None:
+        return np.zeros((0, 6))
+    poses = np.asarray(poses, dtype=float).reshape(-1, 6)
+    if not np.all(np.isfinite(poses)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(poses), axis=1))[0])
+        raise ValueError(f"design pose {bad} is not finite: {poses[bad]!r}")
+    if len(poses) > DESIGN_POSES:
+        poses = poses[np.unique(np.round(np.linspace(0, len(poses) - 1, DESIGN_POSES)).astype(int))]
+    return poses
 
 
 # ----------------------------------------------------------------------------------------------
@@ -245,6 +408,7 @@ class _ControllerBase:
         T = self.timing.sample_period
         self.DeclareVectorInputPort("reference", 6)
         self.DeclareVectorInputPort("leg_lengths", 6)
+        self._ff_port = self.DeclareVectorInputPort("feedforward", 6)
         self._held = self.DeclareDiscreteState(12)
         self._pending = self.DeclareDiscreteState(12)
         self._pid = self.DeclareDiscreteState(30)
@@ -262,8 +426,9 @@ class _ControllerBase:
     def _tick(self, context, discrete_state):
         ref = self.get_input_port(0).Eval(context)
         L = self.get_input_port(1).Eval(context)
+        ff = self._ff_port.Eval(context) if self._ff_port.HasValue(context) else None
         pid = context.get_discrete_state(self._pid).value()
-        command, setpoint, pid_new, saturated = self.compute(ref, L, pid)
+        command, setpoint, pid_new, saturated = self.compute(ref, L, pid, ff)
         st = context.get_discrete_state(self._status).value().copy()
         t = context.get_time()
         st[0] += 1
@@ -292,14 +457,18 @@ class _ControllerBase:
         discrete_state.set_value(self._status, st)
 
     # -- initial state --------------------------------------------------------------------------
-    def initialize(self, context, lengths, hold_forces=None) -> None:
+    def initialize(self, context, lengths, hold_forces=None, feedforward=None, rates=None) -> None:
         """Set the controller's state (in its own ``context``) as if it had been holding ``lengths``
-        (6, metres) with ``hold_forces`` (6, newtons; e.g. the static forces against gravity) for a while."""
+        (6, metres) with ``hold_forces`` (6, newtons; e.g. the static forces against gravity) for a while;
+        with a ``feedforward`` (6, N) the integrator holds only the difference hold − feed-forward; with
+        ``rates`` (6, m/s) as if the legs had been moving at those rates (the difference filters start
+        there: no start-up kick from a derivative that sees the motion but a feed-forward that does not)."""
         lengths = np.asarray(lengths, dtype=float).reshape(6)
         F = np.zeros(6) if hold_forces is None else np.asarray(hold_forces, dtype=float).reshape(6)
-        pid = self.initial_pid_state(lengths, F)
+        ff = np.zeros(6) if feedforward is None else np.asarray(feedforward, dtype=float).reshape(6)
+        pid = self.initial_pid_state(lengths, F - ff, rates)
         context.SetDiscreteState(self._pid, pid)
-        held = np.concatenate([self.command_from_integrator(pid[:6]), lengths])
+        held = np.concatenate([self.command_from_integrator(pid[:6], ff), lengths])
         context.SetDiscreteState(self._held, held)
         context.SetDiscreteState(self._pending, held)
         context.SetDiscreteState(self._status, np.zeros(len(STATUS)))
@@ -312,7 +481,7 @@ def _make_class(name, compute_mixin):
 
     def __init__(self, platform: Platform, config: ControllerConfig | None = None):
         LeafSystem.__init__(self)
-        self._declare(platform, config or ControllerConfig())
+        self._declare(platform, config or ControllerConfig.for_platform(platform))
         self._setup()
 
     return type(name, (compute_mixin, _ControllerBase, LeafSystem), {"__init__": __init__})
@@ -333,14 +502,21 @@ class _FloatLaw:
 
         return leg_lengths(self.platform, np.asarray(ref, dtype=float), self.config.convention)
 
-    def initial_pid_state(self, lengths, forces):
-        m = self.quantise(lengths)
-        return np.concatenate([np.clip(forces, -self._limit, self._limit), m, np.zeros(6), np.asarray(lengths, float), np.zeros(6)])
+    def initial_pid_state(self, lengths, forces, rates=None):
+        """PID state holding ``lengths`` (m) with integrator ``forces`` (N), legs moving at ``rates`` (m/s)."""
+        lengths = np.asarray(lengths, float)
+        d = np.zeros(6) if rates is None else np.asarray(rates, float) * self.timing.sample_period
+        m = self.quantise(lengths - d)
+        return np.concatenate([np.clip(forces, -self._limit, self._limit), m, d, lengths - d, d])
 
-    def command_from_integrator(self, integ):
-        return np.asarray(integ, dtype=float)
+    def command_from_integrator(self, integ, ff=None):
+        """The command (N) of the integrator alone plus the feed-forward ``ff`` (N), saturated."""
+        u = np.asarray(integ, dtype=float) + (0.0 if ff is None else np.asarray(ff, dtype=float))
+        return np.clip(u, -self._limit, self._limit)
 
-    def compute(self, ref, L, pid):
+    def compute(self, ref, L, pid, ff=None):
+        """One tick: (command N, set-point m, new PID state, saturated flags) for the reference pose,
+        the true leg lengths ``L`` (m), the PID state and the force feed-forward ``ff`` (N; None: none)."""
         g, T, lim = self.config.gains, self.timing.sample_period, self._limit
         sp = self.setpoints(ref)
         m = self.quantise(L)
@@ -349,6 +525,8 @@ class _FloatLaw:
         dfilt = dfilt + g.derivative_filter * ((m - prev) - dfilt)
         vfilt = vfilt + g.feedforward_filter * ((sp - sp_prev) - vfilt)
         u_raw = g.kp * e + integ - g.kd / T * dfilt + g.kv / T * vfilt
+        if ff is not None:
+            u_raw = u_raw + np.asarray(ff, dtype=float)
         u = np.clip(u_raw, -lim, lim)
         saturated = u_raw != u
         # anti-windup: integrate unless the output is saturated and the error pushes further into it
@@ -401,17 +579,34 @@ class _FixedLaw:
             w = self.ik_words(ref)
         return w
 
-    def initial_pid_state(self, lengths, forces):
+    def initial_pid_state(self, lengths, forces, rates=None):
+        """PID state words holding ``lengths`` (m) with integrator ``forces`` (N), legs moving at ``rates``
+        (m/s): the previous measurement and set-point one sample back, both difference filters at the
+        per-sample difference (counts·2^DIFF_SHIFT)."""
         q = self._q
         frac = np.clip(np.asarray(forces) / self.timing.command_range, -1.0, 1.0 - 2.0**-31)
         integ = q.sat32(np.round(frac * 2.0**31).astype(np.int64))
-        sp = np.round(np.asarray(lengths, dtype=float) / self.config.ik_format.length_lsb).astype(np.int64)
-        return np.concatenate([integ, self.quantise(lengths), np.zeros(6), sp, np.zeros(6)]).astype(float)
+        lengths = np.asarray(lengths, dtype=float)
+        d = np.zeros(6) if rates is None else np.asarray(rates, float) * self.timing.sample_period
+        sp = np.round((lengths - d) / self.config.ik_format.length_lsb).astype(np.int64)
+        filt = q.sat16(np.round(d / self.timing.sensor_resolution).astype(np.int64) * 2**DIFF_SHIFT)
+        return np.concatenate([integ, self.quantise(lengths - d), filt, sp, filt]).astype(float)
 
-    def command_from_integrator(self, integ):
-        return self._q.extract_h(np.asarray(integ, dtype=np.int64)) / 32768.0 * self.timing.command_range
+    def command_from_integrator(self, integ, ff=None):
+        """The command (N) of the integrator word alone plus the feed-forward's table word, saturated."""
+        u32 = np.asarray(integ, dtype=np.int64)
+        if ff is not None:
+            u32 = self._q.L_add(u32, self._q.L_deposit_h(self.feedforward_words(ff)))
+        return self._q.extract_h(u32) / 32768.0 * self.timing.command_range
 
-    def compute(self, ref, L, pid):
+    def feedforward_words(self, ff) -> np.ndarray:
+        """``(6,)`` Q15 command words of feed-forward forces ``ff`` (N), as the host writes the table:
+        rounded to the nearest LSB of the command range, saturated to the word."""
+        return self._q.sat16(np.round(np.asarray(ff, dtype=float) / self.timing.command_range * 32768.0).astype(np.int64))
+
+    def compute(self, ref, L, pid, ff=None):
+        """One tick in the firmware's arithmetic (see ``_FloatLaw.compute``); ``ff`` (N) enters as its
+        table word (``feedforward_words``) added to the Q31 sum."""
         q, g = self._q, self.gains
         sp = self.setpoint_words(ref)
         m = self.quantise(L)
@@ -427,6 +622,8 @@ class _FixedLaw:
         D = q.L_shl(q.L_mult(g.kd.mantissa, dfilt), g.kd.shift)
         V = q.L_shl(q.L_mult(g.kv.mantissa, vfilt), g.kv.shift)
         u32 = q.L_add(q.L_sub(q.L_add(P, integ), D), V)
+        if ff is not None:
+            u32 = q.L_add(u32, q.L_deposit_h(self.feedforward_words(ff)))
         # saturation: the command is a Q15 word; the sum saturated if it hit the Q31 rails
         saturated = (u32 >= q.MAX32) | (u32 <= q.MIN32)
         u16 = q.extract_h(u32)

@@ -3,9 +3,14 @@
 The Diagram (``build_simulation``)::
 
     PoseSource ──reference──▶ controller (fixed | float, discrete, period T) ──command──▶ Actuators
-        ▲                          ▲ leg_lengths                                           │ force
+        ▲  FeedforwardTable ──▶    ▲ leg_lengths                                           │ force
         │                          └──────── MatrixGain (prismatic positions) ◀── plant ◀──┘
         └ (trajectory: seed, rotating, or a (t, pose) CSV)
+
+The feed-forward table (``feedforward_forces``) holds, per tick, the leg forces of the inverse dynamics
+(plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
+with the pose table and download to the DSP. Without it (``feedforward=False``) the PID alone carries
+the plate.
 
 Loggers record, at every plant step, the plant state (pose and leg lengths come from it), the
 controller's held command and set-point, its status (tick count, tick time, saturation counts) and the
@@ -62,6 +67,23 @@ def _rotating_pose(t):
 SEED = Trajectory("seed", _seed_pose, 4.0)
 ROTATING = Trajectory("rotating", _rotating_pose, 4.0)
 TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
+
+
+def fit_trajectory(trajectory: Trajectory, platform: Platform, home_height: float = 0.7, stroke: float = 0.4) -> Trajectory:
+    """``trajectory`` (made for a platform whose home is pz = ``home_height`` with a stroke of ``stroke``
+    metres, as ``SEED`` and ``ROTATING`` are for utn-dynamic) moved to ``platform``'s home and its
+    positions scaled by the ratio of the strokes (angles unchanged): the same motion, relative to the
+    platform's size."""
+    s = (platform.stroke[1] - platform.stroke[0]) / stroke
+    centre = np.array([0.0, 0.0, home_height])
+    home = platform.home_pose()[:3]
+
+    def fn(t):
+        q = trajectory.pose(t).copy()
+        q[..., :3] = home + s * (q[..., :3] - centre)
+        return q
+
+    return Trajectory(trajectory.name, fn, trajectory.duration)
 
 
 def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
@@ -153,7 +175,26 @@ def _systems():
                 self.state_index = None
                 self.DeclareVectorOutputPort("force", 6, lambda c, o: o.SetFromVector(np.clip(u.Eval(c), -max_force, max_force)))
 
-    _SYS = {"PoseSource": PoseSource, "Actuators": Actuators}
+    class FeedforwardTable(LeafSystem):
+        """Output ``force`` (6, N) = ``feedforward_forces`` at the context's time, from a table filled in
+        one batch by ``prime(times)`` (a time not in the table is computed on its own: same numbers)."""
+
+        def __init__(self, platform: Platform, trajectory: Trajectory, lead: float, h: float):
+            super().__init__()
+            self.args = (platform, trajectory, lead, h)
+            self.table: dict[float, np.ndarray] = {}
+            self.DeclareVectorOutputPort("force", 6, lambda c, o: o.SetFromVector(self.force(c.get_time())))
+
+        def prime(self, times) -> None:
+            times = np.asarray(times, dtype=float)
+            for t, F in zip(times, feedforward_forces(*self.args[:2], times, *self.args[2:])):
+                self.table[float(t)] = F
+
+        def force(self, t: float) -> np.ndarray:
+            F = self.table.get(float(t))
+            return F if F is not None else feedforward_forces(*self.args[:2], [t], *self.args[2:])[0]
+
+    _SYS = {"PoseSource": PoseSource, "Actuators": Actuators, "FeedforwardTable": FeedforwardTable}
     return _SYS
 
 
@@ -177,6 +218,25 @@ def initial_leg_forces(platform: Platform, trajectory: Trajectory, t: float = 0.
     from .dynamics import leg_forces_with_legs
 
     qm, q0, qp = trajectory.pose(np.array([t - h, t, t + h]))
+    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
+
+
+def feedforward_lead(config: ControllerConfig, actuator_lag: float) -> float:
+    """Seconds by which the feed-forward table leads the reference: a force computed at tick k is
+    released after the output delay, held for a sample (on average half of it) and reaches the plate
+    through the actuator lag (a first-order lag τ delays slow signals by τ)."""
+    return config.timing.output_delay + config.timing.sample_period / 2 + actuator_lag
+
+
+def feedforward_forces(platform: Platform, trajectory: Trajectory, times, lead: float, h: float) -> np.ndarray:
+    """``(n, 6)`` feed-forward leg forces (N) at ``times`` (n,): ``dynamics.leg_forces_with_legs`` at the
+    reference pose of t + ``lead``, with its rates from central differences of step ``h`` (the sample
+    period: the second difference of the sampled reference, bounded also for piecewise-linear CSV
+    references)."""
+    from .dynamics import leg_forces_with_legs
+
+    t = np.asarray(times, dtype=float).reshape(-1) + lead
+    qm, q0, qp = trajectory.pose(t - h), trajectory.pose(t), trajectory.pose(t + h)
     return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
 
 
@@ -220,6 +280,7 @@ class Simulation:
     meshcat: object = None
     visualizer: object = None
     plant_time_step: float = 1e-3
+    feedforward: object = None
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> "SimulationLog":
@@ -230,10 +291,12 @@ class Simulation:
             raise RuntimeError("a Simulation runs once; build a new one")
         self._ran = True
         sim = self.simulator
+        T = self.config.timing.sample_period
+        n = int(math.floor(duration / T + 1e-9)) + 1
         if hasattr(self.controller, "prime"):  # batch the fixed-point IK of the known reference (speed only)
-            T = self.config.timing.sample_period
-            n = int(math.floor(duration / T + 1e-9)) + 1
             self.controller.prime(self.trajectory.pose(np.arange(n) * T))
+        if self.feedforward is not None:  # the feed-forward table at the ticks, in one batch
+            self.feedforward.prime(np.arange(n) * T)
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
@@ -308,12 +371,18 @@ def build_simulation(
     actuators: ActuatorModel | None = None,
     plant_time_step: float = 1e-3,
     meshcat=None,
+    feedforward: bool = True,
+    design_duration: float | None = None,
 ) -> Simulation:
     """Assemble the controller-in-the-loop Diagram and its Simulator, with the plant at the reference's
     initial pose, legs at the matching lengths and the controller holding them against gravity.
 
-    ``controller``: ``fixed`` or ``float``; ``config``: timing and gains (refused if infeasible);
-    ``plant_time_step`` (s): the discrete plant's step; ``meshcat``: a ``Meshcat`` to record an animation.
+    ``controller``: ``fixed`` or ``float``; ``config``: timing and gains (refused if infeasible; default
+    ``ControllerConfig.for_platform``: command range and gains designed for ``platform`` and the
+    actuators' lag); ``plant_time_step`` (s): the discrete plant's step; ``meshcat``: a ``Meshcat`` to
+    record an animation; ``feedforward``: connect the model-based force feed-forward table;
+    ``design_duration`` (s): the default gains are designed over the reference's poses from 0 to this
+    time (``design_poses``; default the trajectory's duration, else 4 s).
     """
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
@@ -324,8 +393,10 @@ def build_simulation(
     if not (math.isfinite(plant_time_step) and plant_time_step > 0):
         raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
     trajectory = get_trajectory(trajectory)
-    config = config or ControllerConfig()
     actuators = actuators or ActuatorModel()
+    if config is None:
+        poses = design_poses(trajectory, design_duration)
+        config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(platform, plant_time_step, builder)
     ctrl = builder.AddSystem(make_controller(controller, platform, config))
@@ -342,6 +413,12 @@ def build_simulation(
     sensor = builder.AddSystem(MatrixGain(D))
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
+    ff = None
+    if feedforward:
+        T = config.timing.sample_period
+        ff = builder.AddSystem(_systems()["FeedforwardTable"](platform, trajectory, feedforward_lead(config, actuators.time_constant), T))
+        ff.set_name("feedforward_table")
+        builder.Connect(ff.get_output_port(), ctrl.GetInputPort("feedforward"))
     builder.Connect(plant.get_state_output_port(), sensor.get_input_port())
     builder.Connect(sensor.get_output_port(), ctrl.GetInputPort("leg_lengths"))
     builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
@@ -369,17 +446,32 @@ def build_simulation(
     set_velocity(plant, pc, platform, trajectory, 0.0)
     L0 = leg_lengths(platform, pose0)
     F0 = initial_leg_forces(platform, trajectory)
-    ctrl.initialize(ctrl.GetMyMutableContextFromRoot(root), L0, F0)
+    h = 1e-6
+    rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
+    ctrl.initialize(ctrl.GetMyMutableContextFromRoot(root), L0, F0, None if ff is None else ff.force(0.0), rates0)
     if act.state_index is not None:
         act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
     simulator.Initialize()
-    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step)
+    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff)
+
+
+def design_poses(trajectory: Trajectory, duration: float | None = None, n: int = 64) -> np.ndarray:
+    """``(n, 6)`` poses of ``trajectory`` evenly spread over [0, ``duration``] (default the trajectory's
+    duration, else 4 s): what the default gain design (``control.design_gains``) takes as the poses the
+    loop will visit (the struts' stiffness and the leg-space masses vary along the way)."""
+    d = duration if duration is not None else (trajectory.duration or 4.0)
+    if not (math.isfinite(d) and d >= 0):
+        raise ValueError(f"design duration must be a number of seconds >= 0, got {d!r}")
+    return trajectory.pose(np.linspace(0.0, d, n))
 
 
 def simulate(platform: Platform, trajectory="seed", controller: str = "fixed", duration: float | None = None, progress=False, **kwargs) -> "SimulationLog":
-    """Build and run: the logs of ``duration`` seconds (default the trajectory's own duration)."""
+    """Build and run: the logs of ``duration`` seconds (default the trajectory's own duration); the
+    default gains are designed over the poses of the run."""
     traj = get_trajectory(trajectory)
     duration = duration if duration is not None else (traj.duration or 1.0)
+    if kwargs.get("config") is None:
+        kwargs.setdefault("design_duration", max(duration, traj.duration or 0.0))
     return build_simulation(platform, traj, controller, **kwargs).run(duration, progress=progress)
 
 

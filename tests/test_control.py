@@ -261,3 +261,131 @@ def test_fixed_pid_tick_matches_a_plain_integer_reimplementation():
             assert sat[i] == rail
             assert [int(new[6 * j + i]) for j in range(5)] == [integ, m, df, int(words[i]), vf]
     assert 100 < rails < 1100  # both saturated and unsaturated ticks were exercised
+
+
+# ----------------------------------------------------------------------------------------------
+# Gains designed from the platform; the force feed-forward word
+
+
+def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordinates():
+    """Independent check of ``leg_space_inertia``: with massless legs it must equal J⁻ᵀ M(q) J⁻¹ with
+    M(q) from ``dynamics.mass_matrix`` (Lagrangian A(q)ᵀ diag(m, I) A(q), another code path than the
+    Newton–Euler of ``leg_forces_with_legs``)."""
+    from dataclasses import replace
+
+    from stewart_drake.control import leg_space_inertia
+    from stewart_drake.dynamics import mass_matrix
+    from stewart_drake.kinematics import length_jacobian
+
+    p = load_preset("utn-kinematic")
+    bare = p.replace(legs=replace(p.legs, cylinder_mass=0.0, piston_mass=0.0))
+    q = p.home_pose() + np.array([0.02, -0.01, 0.03, 0.05, -0.04, 0.1])
+    Ji = np.linalg.inv(length_jacobian(bare, q))
+    np.testing.assert_allclose(leg_space_inertia(bare, q), Ji.T @ mass_matrix(bare, q) @ Ji, rtol=1e-9, atol=1e-9)
+    # the legs only add mass: every eigenvalue grows
+    assert np.all(np.linalg.eigvalsh(leg_space_inertia(p, q)) > np.linalg.eigvalsh(leg_space_inertia(bare, q)))
+
+
+@pytest.mark.parametrize("name", ["utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009"])
+def test_design_gains_follow_the_documented_rules(name):
+    from stewart_drake.control import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
+                                       UNKNOWN_POSE_STIFFNESS_FACTOR, design_gains, leg_space_inertia, loop_delay,
+                                       strut_stiffness)
+
+    p = load_preset(name)
+    cfg = ControllerConfig.for_platform(p)
+    assert cfg.timing.command_range == p.legs.max_force
+    g = cfg.gains
+    assert g == design_gains(p, cfg.timing)
+    m = np.linalg.eigvalsh(leg_space_inertia(p))
+    w_c = PHASE_BUDGET / loop_delay(cfg.timing)
+    assert loop_delay(cfg.timing) == pytest.approx(1e-3 + 1e-3 + 2e-3)  # output delay + ZOH/difference + lag
+    assert g.kd == pytest.approx(m[0] * w_c) and g.kv == g.kd
+    K = UNKNOWN_POSE_STIFFNESS_FACTOR * strut_stiffness(p)  # home only: the visited poses are unknown
+    kp = max(min(g.kd**2 / (4 * HEAVY_MODE_DAMPING**2 * m[-1]), g.kd * w_c / 3), STIFFNESS_MARGIN * K)
+    assert g.kp == pytest.approx(kp)
+    assert g.ki == pytest.approx(min(g.kp * np.sqrt(g.kp / m[-1]) / 4, ROUTH_FRACTION * g.kd * (g.kp - K) / m[-1]))
+    # every gain fits the firmware's Q15 mantissa + shift
+    fg = FixedGains.from_si(g, cfg.timing)
+    for q in (fg.kp, fg.ki, fg.kd, fg.kv):
+        assert 0 < q.mantissa <= 32767 and q.value > 0
+
+
+@pytest.mark.parametrize("name", ["utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009"])
+@pytest.mark.parametrize("base", ["seed", "rotating"])
+def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory(name, base):
+    """The PID on the heaviest leg-space mode m with the struts' negative stiffness K is
+    m s³ + kd s² + (kp − K) s + ki: stable iff kp > K and ki < kd·(kp − K)/m (Routh). Checked at 300 poses
+    over a full period (2π s) of each trajectory, more and other poses than the design's 64 over 4 s, with
+    the pose's own K and heaviest mass. (The home-only design of 6b broke it on utn-kinematic: kp 15.3 kN/m
+    against K up to 14.6 kN/m and ki 66 kN/(m·s), ~25 × the limit; the loop grew at ~2 Hz.)"""
+    from stewart_drake.control import design_gains, leg_space_inertia, strut_stiffness
+    from stewart_drake.simulation import design_poses, fit_trajectory, get_trajectory
+
+    p = load_preset(name)
+    traj = fit_trajectory(get_trajectory(base), p)
+    g = design_gains(p, poses=design_poses(traj))
+    q = traj.pose(np.linspace(0, 2 * np.pi, 300))
+    K = strut_stiffness(p, q)
+    m_max = np.linalg.eigvalsh(leg_space_inertia(p, q))[:, -1]
+    assert np.all(g.kp > 1.5 * K), (g.kp, K.max())
+    limit = g.kd * (g.kp - K) / m_max
+    assert np.all(g.ki < 0.8 * limit), (g.ki, limit.min())
+
+
+def test_strut_stiffness_and_inertia_are_vectorised_over_poses():
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
+
+    p = load_preset("utn-kinematic")
+    q = p.home_pose() + np.array([[0, 0, 0, 0, 0, 0], [0.02, -0.01, 0.01, 0.05, 0.0, 0.2]])
+    assert strut_stiffness(p, q) == pytest.approx([strut_stiffness(p, qi) for qi in q], rel=1e-12)
+    np.testing.assert_allclose(leg_space_inertia(p, q), [leg_space_inertia(p, qi) for qi in q], rtol=1e-12)
+
+
+def test_strut_stiffness_matches_the_open_loop_growth():
+    """The negative stiffness K of the struts and the open-loop growth rate λ (``dynamics``) describe the
+    same instability: the fastest growth needs λ² ≤ K / m_min (a stiffness K on the lightest mass), and
+    the slowest unstable mode at least K / m_max — so λ_max² · m_min <= K <= λ_max² · m_max."""
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
+    from stewart_drake.dynamics import open_loop_growth_rates
+
+    for name in ("utn-dynamic", "utn-kinematic"):
+        p = load_preset(name)
+        K = strut_stiffness(p)
+        lam = open_loop_growth_rates(p, p.home_pose())[0]
+        m = np.linalg.eigvalsh(leg_space_inertia(p))
+        assert lam**2 * m[0] <= K <= lam**2 * m[-1], (name, K, lam, m)
+
+
+def test_fixed_feedforward_is_one_saturating_word_added_to_the_sum():
+    """The feed-forward enters the fixed-point law as its Q15 table word deposited in the high half and
+    added with a saturating L_add; everything else in the tick is unchanged (Python integers)."""
+    rng = np.random.default_rng(7)
+    ctrl = make_controller("fixed", PLATFORM)
+    for trial in range(60):
+        pose = SEED.pose(rng.uniform(0, 4))
+        L = leg_lengths(PLATFORM, pose) + rng.normal(0, 1e-3, 6)
+        pid = ctrl.initial_pid_state(L, rng.uniform(-50, 50, 6))
+        ff = rng.uniform(-300, 300, 6)  # beyond the 200 N range for some legs: the word saturates
+        cmd0, sp0, st0, _ = ctrl.compute(pose, L, pid)
+        cmd, sp, st, sat = ctrl.compute(pose, L, pid, ff)
+        np.testing.assert_array_equal(sp, sp0)
+        np.testing.assert_array_equal(st[6:], st0[6:])  # filters and memories do not see the feed-forward
+        for i in range(6):
+            w = max(-32768, min(32767, round(ff[i] / 200.0 * 32768)))
+            u0 = int(round(cmd0[i] / 200.0 * 32768))  # the high word of the feed-forward-free sum
+            # adding w·2^16 changes only the high word: floor(u / 2^16) + w, then the rails
+            assert int(round(cmd[i] / 200.0 * 32768)) == max(-32768, min(32767, u0 + w))
+        assert np.all(np.abs(cmd) <= 200.0)
+
+
+def test_controller_without_a_feedforward_connection_is_unchanged():
+    """Left unconnected, the feed-forward port is zero: the tick equals ``compute`` without it."""
+    ctrl = make_controller("float", PLATFORM)
+    pose = SEED.pose(0.3)
+    L = leg_lengths(PLATFORM, pose)
+    pid = ctrl.initial_pid_state(L, np.full(6, 3.0))
+    a = ctrl.compute(pose, L, pid)
+    b = ctrl.compute(pose, L, pid, np.zeros(6))
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x, y)

@@ -13,6 +13,8 @@ def register(sub) -> None:
     p.add_argument("--trajectory", default="seed", metavar="seed|rotating|FILE.csv",
                    help="the pose reference: the seed's (px=-0.1, py=0.1 sin 2t, pz=0.7 m), a rotating one, or a CSV "
                         "of t,px,py,pz,ax,ay,az rows (SI unless --length-unit/--angle-unit)")
+    p.add_argument("--fit", action="store_true",
+                   help="move and scale the trajectory (made for utn-dynamic: pz 0.7 m, 0.4 m stroke) to the platform's home height and stroke")
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
     p.add_argument("--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin")
@@ -22,6 +24,7 @@ def register(sub) -> None:
     p.add_argument("--sensor-resolution", type=float, default=1e-5, metavar="M",
                    help="leg-length sensor resolution, m per count (default 1e-5; 1e-3: integer mm as the firmware's words)")
     p.add_argument("--plant-step", type=float, default=None, metavar="S", help="plant time step, s (default: the period, at most 1 ms)")
+    p.add_argument("--no-feedforward", action="store_true", help="no model-based force feed-forward (the PID alone carries the plate)")
     p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds (default: the trajectory's, 4 s for seed)")
     p.add_argument("--out", default="simulation", metavar="DIR", help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -36,16 +39,21 @@ def run(args) -> int:
     from ..atomic import atomic_folder
     from ..control import ControllerConfig, DspTiming
     from ..geometry import load_platform
-    from ..simulation import build_simulation, get_trajectory
+    from ..simulation import build_simulation, design_poses, fit_trajectory, get_trajectory
 
     platform = load_platform(args.platform)
     traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)
+    if args.fit:
+        traj = fit_trajectory(traj, platform)
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
     if not duration > 0:
         raise ValueError(f"--duration must be a positive number of seconds, got {args.duration}")
-    timing = DspTiming(sample_period=args.period, latency=args.latency, sensor_resolution=args.sensor_resolution).check()
+    timing = DspTiming(sample_period=args.period, latency=args.latency, sensor_resolution=args.sensor_resolution,
+                       command_range=float(platform.legs.max_force)).check()
     plant_step = args.plant_step if args.plant_step is not None else min(args.period, 1e-3)
-    sim = build_simulation(platform, traj, args.controller, ControllerConfig(timing=timing), plant_time_step=plant_step)
+    # command range and gains designed for the platform over the poses of the run
+    config = ControllerConfig.for_platform(platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0)))
+    sim = build_simulation(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward)
     log = sim.run(duration, progress=not args.no_progress)
     out = Path(args.out)
     e = log.length_error(traj, platform)
@@ -56,6 +64,9 @@ def run(args) -> int:
         "controller": args.controller,
         "sample_period_s": args.period,
         "latency": args.latency,
+        "feedforward": not args.no_feedforward,
+        "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
+        "command_range_N": config.timing.command_range,
         "output_delay_s": timing.output_delay,
         "computation_time_s": timing.computation_time,
         "plant_time_step_s": plant_step,
