@@ -357,20 +357,26 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
     )
 
 
-def load_platform_yaml(path) -> Platform:
-    """Load one platform from a YAML file (schema: ``PlatformConfig``)."""
+def load_yaml_config(path, schema, kind: str):
+    """Parse a YAML file into the dataclass ``schema`` with Drake's ``yaml_load_typed``; errors name the
+    file (``kind`` says what it should hold). A config with an empty ``name`` takes the file's stem."""
     from pydrake.common.yaml import yaml_load_typed
 
     path = Path(path)
     if not path.is_file():
-        raise GeometryError(f"platform file {str(path)!r} does not exist")
+        raise GeometryError(f"{kind} file {str(path)!r} does not exist")
     try:
-        cfg = yaml_load_typed(schema=PlatformConfig, filename=str(path))
+        cfg = yaml_load_typed(schema=schema, filename=str(path))
     except RuntimeError as e:
         raise GeometryError(f"{path}: {e}") from None
     if not cfg.name:
         cfg.name = path.stem
-    return platform_from_config(cfg)
+    return cfg
+
+
+def load_platform_yaml(path) -> Platform:
+    """Load one platform from a YAML file (schema: ``PlatformConfig``)."""
+    return platform_from_config(load_yaml_config(path, PlatformConfig, "platform"))
 
 
 def preset_path(name: str) -> Path:

@@ -45,6 +45,7 @@ from typing import Optional
 import numpy as np
 
 from .errors import GeometryError, StewartError
+from .geometry import load_yaml_config
 from .rotations import length_scale, rotation_matrix
 
 NEUTRAL_US = 1500.0
@@ -356,18 +357,7 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
 
 def load_servo_yaml(path) -> ServoHexapod:
     """Load a servo hexapod from a YAML file (schema: ``ServoHexapodConfig``)."""
-    from pydrake.common.yaml import yaml_load_typed
-
-    path = Path(path)
-    if not path.is_file():
-        raise GeometryError(f"servo hexapod file {str(path)!r} does not exist")
-    try:
-        cfg = yaml_load_typed(schema=ServoHexapodConfig, filename=str(path))
-    except RuntimeError as e:
-        raise GeometryError(f"{path}: {e}") from None
-    if not cfg.name:
-        cfg.name = path.stem
-    return servo_hexapod_from_config(cfg)
+    return servo_hexapod_from_config(load_yaml_config(path, ServoHexapodConfig, "servo hexapod"))
 
 
 def servo_preset_path(name: str) -> Path:

@@ -30,6 +30,21 @@ IK_GAP_TOL_M = 1e-8
 _F = "{:.15g}"
 
 
+def _simulate_and_read_logs(diagram, logs: dict, t_end: float) -> dict:
+    """Simulate ``diagram`` to ``t_end``; return ``{"t": sample times, name: (n, k) logged data}``."""
+    from pydrake.systems.analysis import Simulator
+
+    sim = Simulator(diagram)
+    sim.AdvanceTo(t_end)
+    ctx = sim.get_context()
+    out = {}
+    for name, log in logs.items():
+        data = log.FindLog(ctx)
+        out["t"] = data.sample_times()
+        out[name] = data.data().T
+    return out
+
+
 # ----------------------------------------------------------------------------------------------
 # Small SDF writers (shared with leg_model).
 
@@ -406,7 +421,6 @@ def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None =
     logged once per frame. Drake publishes a log sample at t_k before that instant's update, so
     ``pulse_us[k]`` is the pulse held during [t_k - T, t_k), computed from ``pose[k - 1]`` (the one-frame
     delay); ``pulse_us[0]`` is the initial (neutral) state."""
-    from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
     from pydrake.trajectories import PiecewisePolynomial
@@ -420,15 +434,7 @@ def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None =
     T = 1.0 / frame_rate_hz
     logs = {name: LogVectorOutput(ctrl.GetOutputPort(name), builder, T) for name in ("pulse_us", "status")}
     logs["pose"] = LogVectorOutput(src.get_output_port(), builder, T)
-    diagram = builder.Build()
-    sim = Simulator(diagram)
-    sim.AdvanceTo(float(times[-1] if duration is None else duration))
-    ctx = sim.get_context()
-    out = {}
-    for name, log in logs.items():
-        data = log.FindLog(ctx)
-        out["t"] = data.sample_times()
-        out[name] = data.data().T
+    out = _simulate_and_read_logs(builder.Build(), logs, float(times[-1] if duration is None else duration))
     return out
 
 
@@ -493,7 +499,6 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     ``arm_angle_ref`` (k, 6), eq. 9 at the reference; ``rod_gap`` (k, 6) | |arm tip − anchor| − s | (m),
     the ball constraints' violation; ``pulse_us`` (k, 6); ``status`` (k, 6).
     """
-    from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
     from pydrake.trajectories import PiecewisePolynomial
@@ -523,15 +528,7 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
             "state": LogVectorOutput(plant.get_state_output_port(), builder, time_step),
             "pulse_us": LogVectorOutput(ctrl.GetOutputPort("pulse_us"), builder, time_step),
             "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, time_step)}
-    diagram = builder.Build()
-    sim = Simulator(diagram)
-    sim.AdvanceTo(float(times[-1] if duration is None else duration))
-    ctx = sim.get_context()
-    out = {}
-    for name, log in logs.items():
-        data = log.FindLog(ctx)
-        out["t"] = data.sample_times()
-        out[name] = data.data().T
+    out = _simulate_and_read_logs(builder.Build(), logs, float(times[-1] if duration is None else duration))
     # Kinematics of the logged states.
     pc = plant.CreateDefaultContext()
     body = plant.GetBodyByName("platform")
