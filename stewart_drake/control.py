@@ -492,6 +492,10 @@ class _FloatLaw:
 
     def _setup(self):
         self._limit = self.timing.command_range
+        # (6,) metres added to every set-point (None: nothing). A probe, not a feature: a constant offset
+        # from t = 0 is a set-point step on the legs, whose length response measures the loop's gain from
+        # set-point errors to length errors (``simulation.setpoint_step_gain``).
+        self.setpoint_offset = None
 
     def quantise(self, L):
         r = self.timing.sensor_resolution
@@ -500,7 +504,8 @@ class _FloatLaw:
     def setpoints(self, ref) -> np.ndarray:
         from .kinematics import leg_lengths
 
-        return leg_lengths(self.platform, np.asarray(ref, dtype=float), self.config.convention)
+        sp = leg_lengths(self.platform, np.asarray(ref, dtype=float), self.config.convention)
+        return sp if self.setpoint_offset is None else sp + self.setpoint_offset
 
     def initial_pid_state(self, lengths, forces, rates=None):
         """PID state holding ``lengths`` (m) with integrator ``forces`` (N), legs moving at ``rates`` (m/s)."""

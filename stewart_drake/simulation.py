@@ -455,6 +455,61 @@ def build_simulation(
     return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff)
 
 
+def setpoint_step_response(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, step: float = 1e-3,
+                           duration: float = 0.3, actuators: ActuatorModel | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The float twin's closed-loop response, on the actual plant at home, to a set-point step of ``step``
+    metres on leg ``leg`` (0-based) at t = 0: ``(t (n,), s (n, 6))``, s = (L(t) − L_rest(t)) / step for
+    all six legs, L_rest a run without the step (removes any residual drift of the equilibrium). The
+    controller is ``config`` (the run's gains, timing and feed-forward) with an ideal sensor (resolution
+    1 nm: the sensor's counts are a separate term of the bounds, and a 10 µm quantiser would add its own
+    chatter to a small-signal measurement). Samples at the plant steps (the controller's period by
+    default), so s[n] is the sampled step response of the discrete loop from set-point words to lengths."""
+    from dataclasses import replace
+
+    if not (isinstance(leg, (int, np.integer)) and 0 <= leg < 6):
+        raise ValueError(f"leg must be 0 … 5, got {leg!r}")
+    if not (math.isfinite(step) and step != 0):
+        raise ValueError(f"step must be a non-zero number of metres, got {step!r}")
+    cfg = config or ControllerConfig.for_platform(platform)
+    cfg = replace(cfg, timing=replace(cfg.timing, sensor_resolution=1e-9))
+    home = platform.home_pose()
+    rest = Trajectory("home", lambda t: np.broadcast_to(home, np.shape(t) + (6,)).copy(), duration)
+    runs = []
+    for delta in (0.0, step):
+        sim = build_simulation(platform, rest, "float", cfg, actuators)
+        off = np.zeros(6)
+        off[leg] = delta
+        sim.controller.setpoint_offset = off
+        runs.append(sim.run(duration))
+    return runs[1].t, (runs[1].lengths - runs[0].lengths) / step
+
+
+def setpoint_step_gain(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, **kwargs) -> dict:
+    """The ℓ1 gain ‖h‖₁ of the closed loop from a leg's set-point to leg lengths, from the float twin's
+    set-point step response (``setpoint_step_response``; ``kwargs`` go there): h[n] = s[n] − s[n−1] is the
+    sampled impulse response, ‖h‖₁ = Σ|h[n]| the total variation of the step response (plus
+    |1 − s_end|, the least variation still to come before the stepped leg settles at its DC gain 1).
+
+    Why it bounds the fixed-point controller's extra error: the fixed-point set-points are the float
+    twin's plus an error sequence ε[k] (the 16-bit IK's error, the 1 mm LSB steps, and the sensor's counts
+    acting like a set-point offset) with |ε[k]| ≤ A = Δ_IK + LSB + r. The loop about the trajectory is
+    linear in that small perturbation, so the extra length error is y = h * ε and
+    |y[n]| ≤ Σ_k |h[n−k]|·|ε[k]| ≤ ‖h‖₁·A — tight for the worst-case input ε[k] = A·sign h[n−k].
+    The stepped leg's ‖h‖₁ ≥ 1 (the variation from 0 to the DC gain 1 is at least 1; overshoot adds twice
+    each excursion). With all six set-points in error at once, leg i collects Σ_j ‖h_ij‖₁; ``coupled`` is
+    the column sum Σ_i ‖h_ij‖₁ of the stepped leg, equal to that row sum when the platform's symmetry
+    maps any leg onto any other (the hexapods here, at home).
+
+    Returns ``{"diagonal": ‖h_jj‖₁, "coupled": Σ_i ‖h_ij‖₁, "tail": |1 − s_jj(end)|, "peak": max s_jj,
+    "t": t, "s": s}``."""
+    t, s = setpoint_step_response(platform, config, leg, **kwargs)
+    tv = np.abs(np.diff(np.vstack([np.zeros((1, 6)), s]), axis=0)).sum(axis=0)
+    tail = float(abs(1.0 - s[-1, leg]))
+    diag = float(tv[leg] + tail)
+    coupled = float(tv.sum() - tv[leg] + diag + np.abs(np.delete(s[-1], leg)).sum())
+    return {"diagonal": diag, "coupled": coupled, "tail": tail, "peak": float(s[:, leg].max()), "t": t, "s": s}
+
+
 def design_poses(trajectory: Trajectory, duration: float | None = None, n: int = 64) -> np.ndarray:
     """``(n, 6)`` poses of ``trajectory`` evenly spread over [0, ``duration``] (default the trajectory's
     duration, else 4 s): what the default gain design (``control.design_gains``) takes as the poses the

@@ -277,3 +277,39 @@ def test_feedforward_table_is_the_inverse_dynamics_ahead_of_time_and_helps():
     e_ff = np.abs(log.length_error(SEED, PLATFORM)).max()
     e_pid = np.abs(build_simulation(PLATFORM, SEED, "float", feedforward=False).run(0.6).length_error(SEED, PLATFORM)).max()
     assert e_ff < e_pid / 4, (e_ff, e_pid)
+
+
+def test_setpoint_l1_gain_bounds_the_fixed_point_excess_on_gonzalez():
+    """The fixed-point set-points are the float twin's plus an error of amplitude A = Δ_IK + LSB + r; the
+    loop passes it to the legs with the ℓ1 gain ‖h‖₁ of its impulse response (set-point → lengths), not
+    with gain 1: gonzalez-dutra-2009's stiff loop overshoots a 1 mm set-point step, and its fixed-point
+    error exceeded float + A over 4 s. Measured from the float twin's step response at home
+    (``setpoint_step_gain``): the stepped leg's ‖h_ii‖₁ ≥ 1 (total variation from 0 to the DC gain 1, which
+    the integrator restores), > 1 with the overshoot; the six legs' sum is at least that; and the bound
+    float + ‖h‖₁·A holds on a 1 s run (both trajectories)."""
+    from stewart_drake.simulation import ROTATING, design_poses, fit_trajectory, setpoint_step_gain
+
+    platform = load_preset("gonzalez-dutra-2009")
+    for base in (SEED, ROTATING):
+        traj = fit_trajectory(base, platform)
+        cfg = ControllerConfig.for_platform(platform, poses=design_poses(traj, 4.0))
+        g = setpoint_step_gain(platform, cfg, duration=1.0)
+        s = g["s"][:, 0]
+        assert abs(s[-1] - 1.0) < 0.02, s[-1]  # DC gain 1: the integrator removes the static error
+        assert g["peak"] > 1.1 and g["diagonal"] >= 2 * g["peak"] - 1 - 1e-9, g  # overshoot: up, back down
+        assert g["coupled"] >= g["diagonal"] >= 1.0
+        logs = {kind: build_simulation(platform, traj, kind, cfg).run(1.0) for kind in ("float", "fixed")}
+        e_float, e_fixed = (np.abs(logs[k].length_error(traj, platform)).max() for k in ("float", "fixed"))
+        ticks = traj.pose(np.arange(1000) * 1e-3)
+        d_ik = np.abs(fixed_point_leg_lengths(platform, ticks, cfg.ik_format) - leg_lengths(platform, ticks)).max()
+        amplitude = d_ik + cfg.ik_format.length_lsb + cfg.timing.sensor_resolution
+        assert e_fixed <= e_float + g["coupled"] * amplitude, (base.name, e_fixed, e_float, g["coupled"], amplitude)
+
+
+def test_setpoint_step_response_is_refused_for_a_bad_leg_or_step():
+    from stewart_drake.simulation import setpoint_step_response
+
+    with pytest.raises(ValueError, match="leg must be 0 … 5, got 6"):
+        setpoint_step_response(PLATFORM, leg=6)
+    with pytest.raises(ValueError, match="step must be a non-zero number of metres, got 0.0"):
+        setpoint_step_response(PLATFORM, step=0.0)
