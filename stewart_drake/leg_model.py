@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .atomic import write_text_atomic
 from .leg import Leg3R, dh_rows, frame_transforms
 from .servo_model import cylinder_inertia, inertial_xml, visual_xml, xml_vec
 
@@ -76,11 +77,7 @@ def sdf_text(leg: Leg3R) -> str:
 def write_sdf(leg: Leg3R, directory=SDF_DIR) -> Path:
     """Write ``<directory>/leg-3r.sdf`` atomically; return its path."""
     path = Path(directory) / f"{SDF_NAME}.sdf"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".sdf.tmp")
-    tmp.write_text(sdf_text(leg), encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_text_atomic(path, sdf_text(leg))
 
 
 class LegPlant:

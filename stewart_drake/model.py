@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .atomic import write_text_atomic
 from .geometry import Platform
 from .kinematics import leg_vectors
 from .rotations import rotation_matrix
@@ -151,11 +152,7 @@ def sdf_path(name: str, directory=SDF_DIR) -> Path:
 def write_sdf(platform: Platform, directory=SDF_DIR) -> Path:
     """Write ``<directory>/<platform.name>.sdf`` (atomically) and return its path."""
     path = sdf_path(platform.name, directory)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".sdf.tmp")
-    tmp.write_text(sdf_text(platform), encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_text_atomic(path, sdf_text(platform))
 
 
 def add_platform(plant, platform: Platform):

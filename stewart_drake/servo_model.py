@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .atomic import write_text_atomic
 from .servo import FRAME_RATE_HZ, ServoHexapod, angles_from_pulses, quantise_pulses, solve
 
 SDF_DIR = Path(__file__).resolve().parents[1] / "sdf"
@@ -196,11 +197,7 @@ def sdf_text(hexapod: ServoHexapod) -> str:
 def write_sdf(hexapod: ServoHexapod, directory=SDF_DIR) -> Path:
     """Write ``<directory>/servo-hexapod.sdf`` atomically; return its path."""
     path = Path(directory) / f"{SDF_NAME}.sdf"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".sdf.tmp")
-    tmp.write_text(sdf_text(hexapod), encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_text_atomic(path, sdf_text(hexapod))
 
 
 def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd_gains=None):
