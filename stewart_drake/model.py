@@ -21,7 +21,7 @@ import numpy as np
 from .atomic import write_text_atomic
 from .geometry import Platform
 from .kinematics import leg_vectors
-from .rotations import rotation_matrix
+from .rotations import angles_from_matrix, rotation_matrix
 
 SDF_DIR = Path(__file__).resolve().parents[1] / "sdf"
 _F = "{:.15g}"
@@ -74,8 +74,6 @@ def home_leg_frames(platform: Platform) -> np.ndarray:
 
 def _rpy(R) -> tuple:
     """Roll-pitch-yaw (SDF pose order) of a 3x3 rotation matrix, via our ``zyx`` convention."""
-    from .rotations import angles_from_matrix
-
     return tuple(angles_from_matrix(R, "zyx"))
 
 
