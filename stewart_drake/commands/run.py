@@ -7,7 +7,6 @@ file is written; the output folder is then written in one go.
 from __future__ import annotations
 
 import csv
-import json
 import sys
 from pathlib import Path
 
@@ -15,7 +14,7 @@ import numpy as np
 
 from ..atomic import atomic_folder
 from ..rotations import CONVENTIONS
-from ._common import _jsonable, add_platform_arg, platform_from_args
+from ._common import OutputFolder, add_force_arg, add_platform_arg, dumps_strict, platform_from_args, print_json
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
 SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)
@@ -33,6 +32,7 @@ def register(sub) -> None:
     p.add_argument("--simulate", action="store_true", help="also run the trajectory through the controller-in-the-loop Drake simulation")
     p.add_argument("--controller", choices=SIMULATE_CONTROLLERS, default="fixed", help="with --simulate: fixed-point (DSP) or float controller (default fixed)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -50,6 +50,8 @@ def run(args) -> int:
     from ..script import ScriptError, run_program
 
     text = read_program(args.program)
+    out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
+    out_folder = OutputFolder(str(out), force=args.force)
     platform = platform_from_args(args)
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise ValueError(f"--rate must be a positive number of samples per second, got {args.rate}")
@@ -60,14 +62,12 @@ def run(args) -> int:
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
-    out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
     summary = summarize(result, args.program, platform.stroke)
     if sim is not None:
         summary["simulation"] = sim["summary"]
-    write_outputs(out, result, summary, sim)
+    write_outputs(out_folder, result, summary, sim)
     if args.json:
-        json.dump(summary, sys.stdout, indent=2, default=_jsonable)
-        sys.stdout.write("\n")
+        print_json(summary)
     else:
         print_summary(summary, out)
     return 0
@@ -137,7 +137,7 @@ def summarize(result, program: str, stroke=None) -> dict:
     }
 
 
-def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
+def write_outputs(out, result, summary: dict, sim: dict | None) -> None:
     """Write ``trajectory.csv`` (t, q, q̇, q̈ in SI: readable by ``stewart-drake dynamics --trajectory``),
     ``legs.csv`` (t, L mm, F N), ``summary.json``, ``lengths.png``, ``forces.png`` (and the simulation's
     logs) into ``out``, replacing it atomically."""
@@ -155,7 +155,7 @@ def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
             cols = [traj.t[:, None], result.L * 1e3] + ([result.F] if result.F is not None else [])
             for row in np.concatenate(cols, axis=1):
                 w.writerow([f"{v:.10g}" for v in row])
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2, default=_jsonable), encoding="utf-8")
+        (tmp / "summary.json").write_text(dumps_strict(summary), encoding="utf-8")
         _plots(tmp, result, summary, sim)
         if sim is not None:
             sim["log"].save(tmp / "simulation")

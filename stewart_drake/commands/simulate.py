@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import add_platform_arg, print_json
+from ._common import add_force_arg, add_platform_arg, dumps_strict, output_folder, print_json
 
 
 def register(sub) -> None:
@@ -28,6 +28,7 @@ def register(sub) -> None:
     p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds (default: the trajectory's, 4 s for seed)")
     p.add_argument("--out", default="simulation", metavar="DIR", help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -41,6 +42,7 @@ def run(args) -> int:
     from ..geometry import load_platform
     from ..simulation import build_simulation, design_poses, fit_trajectory, get_trajectory
 
+    out_folder = output_folder(args)
     platform = load_platform(args.platform)
     traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)
     if args.fit:
@@ -78,10 +80,10 @@ def run(args) -> int:
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
-    with atomic_folder(out) as tmp:
+    with atomic_folder(out_folder) as tmp:
         written = log.save(tmp) + write_plots(log, e, tmp) + [tmp / "summary.json"]
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
+        (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
     return 0
 
