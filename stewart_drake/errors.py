@@ -77,7 +77,7 @@ class OutputError(StewartError):
                      "remove it or choose another name (it is never overwritten)")
 
 
-class YamlError(InputError):
+class YamlError(GeometryError, InputError):
     """A YAML file is unreadable, too large, too deep, or not in the schema. Messages start with
     ``file:line:`` where known and name the field (``plate.mass``) and the value as written."""
 
@@ -92,6 +92,9 @@ class YamlError(InputError):
     DUPLICATE_KEY = "{path}:{line}: {field}: key given twice"
     WRONG_TYPE = "{path}:{line}: {field}: expected {expected}, got {value}"
     BAD_VALUE = "{path}:{line}: {field}: {value} {problem}"
+    MISSING = "{kind} file {path!r} does not exist"
+    NOT_A_FILE = "{kind} file {path!r} is a folder, not a file"
+    UNIT = "{path}:{line}: length_unit: unknown length unit {value!r}; use m or mm"
 
 
 class CsvError(InputError):
