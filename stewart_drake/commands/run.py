@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_folder
+from ..errors import InputError
 from ..rotations import CONVENTIONS
 from ._common import OutputFolder, add_force_arg, add_platform_arg, dumps_strict, platform_from_args, print_json
 
@@ -36,14 +37,27 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+MAX_PROGRAM_BYTES = 1_000_000
+
+
 def read_program(path: str) -> str:
+    """The text of a program file (UTF-8, at most ``MAX_PROGRAM_BYTES``); errors name the file."""
     f = Path(path)
+    if not f.exists():
+        raise InputError(f"program file {path!r} does not exist")
     if not f.is_file():
-        raise FileNotFoundError(f"program file {path!r} does not exist")
+        raise InputError(f"program file {path!r} is {'a folder' if f.is_dir() else 'not a regular file'}, not a file")
+    with f.open("rb") as fh:
+        data = fh.read(MAX_PROGRAM_BYTES + 1)
+    if len(data) > MAX_PROGRAM_BYTES:
+        raise InputError(f"{path}: larger than the {MAX_PROGRAM_BYTES}-byte limit for a program")
     try:
-        return f.read_text(encoding="utf-8")
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
-        raise ValueError(f"{path}: not UTF-8 text (byte {e.start})") from None
+        raise InputError(f"{path}: not UTF-8 text (byte {e.start})") from None
+    if "\0" in text:
+        raise InputError(f"{path}:{text[:text.index(chr(0))].count(chr(10)) + 1}: a NUL byte; not a program text file")
+    return text
 
 
 def run(args) -> int:
