@@ -103,11 +103,12 @@ def _refused_location(path: Path, typed: str, option: str) -> None:
 def _probe_writable(path: Path, typed: str, option: str) -> None:
     """Raise ``OutputError`` unless a folder can be created beside (or at) ``path``: tried for real in
     the nearest existing ancestor (mkdir + rmdir), so /proc, read-only mounts and permissions count."""
-    parent = path.parent
-    while not parent.exists():
-        parent = parent.parent
+    parent, shown = path.parent, Path(typed).parent
+    while not parent.exists() and not parent.is_symlink():
+        parent, shown = parent.parent, shown.parent
     if not parent.is_dir():
-        raise OutputError(OutputError.NOT_A_FOLDER.format(option=option, typed=typed, part=str(parent)))
+        part = str(shown) if str(shown) not in ("", ".") else str(parent)
+        raise OutputError(OutputError.NOT_A_FOLDER.format(option=option, typed=typed, part=part))
     probe = parent / f".{path.name or 'out'}.sd-tmp-{os.getpid()}-{secrets.token_hex(4)}"
     try:
         os.mkdir(probe)
@@ -302,7 +303,7 @@ def safe_file_stem(name: str, default: str = "platform", max_len: int = 100) -> 
     """A file name stem derived from a name read from an input file: letters, digits, ``._+-`` only
     (other runs become "_"), no leading dot, at most ``max_len`` characters; ``default`` if nothing is
     left. The result never names a folder, so it stays inside the folder it is joined to."""
-    stem = _UNSAFE.sub("_", str(name)).lstrip(".")[:max_len].strip("_") or default
+    stem = _UNSAFE.sub("_", str(name)).strip("._")[:max_len].strip("._") or default
     return stem if stem not in (".", "..") else default
 
 

@@ -144,8 +144,10 @@ def sdf_text(platform: Platform) -> str:
 
 
 def model_name(platform: Platform) -> str:
-    """The Drake model instance name of ``platform``: its name ("platform" if empty)."""
-    return platform.name or "platform"
+    """The Drake model instance name of ``platform``: its name reduced to letters, digits and ``._+-``
+    (``atomic.safe_file_stem``; Drake refuses "::" and blank names), "platform" if nothing is left.
+    The presets' names are unchanged by this."""
+    return safe_file_stem(platform.name, "platform")
 
 
 def sdf_path(name: str, directory=SDF_DIR) -> Path:

@@ -92,6 +92,9 @@ def load_yaml_typed(path, schema, kind: str, check: Callable[[Any, dict], None] 
     root = compose(text, shown)
     if root is None:
         raise YamlError(YamlError.TOP.format(path=shown, kind=kind, got="an empty file"))
+    _check_tag(root, shown)
+    if not isinstance(root, yaml.MappingNode):
+        raise YamlError(YamlError.TOP.format(path=shown, kind=kind, got=_describe(root)))
     _check_size(root, shown)
     where: dict = {}
     cfg = _convert(root, schema, (), shown, where)
@@ -102,7 +105,11 @@ def load_yaml_typed(path, schema, kind: str, check: Callable[[Any, dict], None] 
 
 def compose(text: str, shown: str):
     """The YAML node tree of ``text`` (None for an empty document); syntax errors as ``YamlError``."""
-    loader = _Loader(text)
+    try:
+        loader = _Loader(text)
+    except yaml.reader.ReaderError as e:
+        line = text[: max(e.position, 0)].count("\n") + 1
+        raise YamlError(YamlError.SYNTAX.format(path=shown, line=line, problem=f"{e.reason} (character #x{e.character:04x})")) from None
     loader.path = shown
     try:
         return loader.get_single_node()

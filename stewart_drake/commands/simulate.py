@@ -102,7 +102,7 @@ def write_plots(log, length_error, out: Path) -> list[Path]:
     ax[1].plot(log.t, log.force)
     ax[1].set_ylabel("actuator force [N]")
     ax[1].set_xlabel("t [s]")
-    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform}, T = {log.sample_period * 1e3:g} ms")
+    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace("$", r"\$")}, T = {log.sample_period * 1e3:g} ms")
     path = out / "tracking.png"
     fig.savefig(path, dpi=100, bbox_inches="tight")
     plt.close(fig)

@@ -119,6 +119,6 @@ def write_outputs(w, result: dict, out) -> None:
     with atomic_folder(out) as tmp:
         (tmp / "workspace.json").write_text(dumps_strict(result))
         np.savetxt(tmp / "boundary.csv", w.boundary, delimiter=",", header="x_m,y_m,z_m", comments="", fmt="%.6f")
-        for name, fig in view_figures(w, title=result["platform"]).items():
+        for name, fig in view_figures(w, title=result["platform"].replace("$", r"\$")).items():
             fig.savefig(tmp / f"{name}.png", dpi=110, bbox_inches="tight")
             plt.close(fig)
