@@ -6,6 +6,15 @@ Messages name the offending thing and value; tests match them, so they live here
 from __future__ import annotations
 
 
+def counted(index) -> str:
+    """A batch index as people count, for messages: ``(0,)`` -> "1", ``(1, 2)`` -> "2,3", ``()`` -> "1"
+    (a single sample), an int ``k`` -> "k+1"."""
+    if isinstance(index, (int,)) or hasattr(index, "__index__"):
+        return str(int(index) + 1)
+    index = tuple(index)
+    return ",".join(str(int(i) + 1) for i in index) if index else "1"
+
+
 class StewartError(ValueError):
     """Base class of every error the toolkit raises on bad input or an impossible request."""
 
@@ -28,7 +37,7 @@ class UnreachablePoseError(StewartError):
         self.excess = abs(length - limit)
         super().__init__(
             self.TEMPLATE.format(
-                index=pose_index,
+                index=counted(pose_index),
                 leg=leg,
                 length_mm=length * 1e3,
                 excess_mm=self.excess * 1e3,

@@ -44,7 +44,7 @@ from typing import Optional
 
 import numpy as np
 
-from .errors import GeometryError, StewartError
+from .errors import GeometryError, StewartError, counted
 from .geometry import load_yaml_config
 from .rotations import length_scale, rotation_matrix
 
@@ -451,7 +451,7 @@ def check_poses(poses) -> np.ndarray:
     bad = ~np.all(np.isfinite(poses), axis=-1)
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0]) if poses.ndim > 1 else ()
-        raise ServoPoseError(f"pose {idx} has a non-finite number: {poses[idx].tolist()}")
+        raise ServoPoseError(f"pose {counted(idx)} has a non-finite number: {poses[idx].tolist()}")
     return poses
 
 

@@ -58,6 +58,16 @@ def _jsonable(x):
     raise TypeError(f"not JSON serialisable: {type(x).__name__}")
 
 
+def reject_unused(args, needs: str, applies: bool, **defaults) -> None:
+    """Raise ``UsageError`` when an option was changed from its default (``defaults``: attribute name
+    -> default) although it does not apply (``applies`` false): an ignored option is an error."""
+    if applies:
+        return
+    for name, default in defaults.items():
+        if getattr(args, name) != default:
+            raise UsageError(UsageError.NEEDS.format(option="--" + name.replace("_", "-"), needs=needs))
+
+
 def finite_option(value, option: str) -> float:
     """``value`` if it is a finite number, else a ``UsageError`` naming the option."""
     if value is not None and not math.isfinite(value):

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..csvio import read_numeric_csv
 from ..rotations import angle_scale, length_scale
-from ._common import add_platform_arg, platform_from_args, print_json
+from ._common import add_platform_arg, platform_from_args, print_json, reject_unused
 
 CSV_HELP = (
     "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
@@ -58,6 +58,9 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
 def run(args) -> int:
     from ..dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 
+    seed = args.trajectory == "seed"
+    reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
+    reject_unused(args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn")
     platform = platform_from_args(args)
     if args.trajectory == "seed":
         if not (args.dt > 0 and args.t_end >= 0):

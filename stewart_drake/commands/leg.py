@@ -30,6 +30,7 @@ def register(sub) -> None:
         q.add_argument("--l2", type=float, help="shank length (default 80 mm)")
         q.add_argument("--l3", type=float, help="foot length (default 30 mm)")
         q.add_argument("--length-unit", choices=["m", "mm"], default="mm", help="default mm")
+    for q in (fk, ik):
         q.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="deg", help="default deg")
         q.add_argument("--json", action="store_true", help="JSON output")
     p.set_defaults(func=run)
@@ -47,7 +48,6 @@ def run(args) -> int:
     from ..leg import foot, forward_kinematics, inverse_kinematics, inverse_kinematics_3r, limit_violations, within_limits
 
     leg = _leg(args)
-    k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     if args.op == "sdf":
         from ..leg_model import SDF_NAME, sdf_text
 
@@ -58,6 +58,7 @@ def run(args) -> int:
         else:
             print(sdf_text(leg), end="")
         return 0
+    k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     units = {"length": args.length_unit, "angle": args.angle_unit}
     if args.op == "fk":
         args.q = [args.q1, args.q2]

@@ -15,7 +15,7 @@ import numpy as np
 from ..atomic import atomic_folder
 from ..errors import InputError
 from ..rotations import CONVENTIONS
-from ._common import OutputFolder, add_force_arg, add_platform_arg, dumps_strict, platform_from_args, print_json
+from ._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
 SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)
@@ -63,6 +63,7 @@ def read_program(path: str) -> str:
 def run(args) -> int:
     from ..script import ScriptError, run_program
 
+    reject_unused(args, "--simulate", args.simulate, controller="fixed")
     text = read_program(args.program)
     out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
     out_folder = OutputFolder(str(out), force=args.force)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import add_force_arg, add_platform_arg, dumps_strict, output_folder, print_json
+from ._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
 
 
 def register(sub) -> None:
@@ -42,6 +42,7 @@ def run(args) -> int:
     from ..geometry import load_platform
     from ..simulation import build_simulation, design_poses, fit_trajectory, get_trajectory
 
+    reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
     out_folder = output_folder(args)
     platform = load_platform(args.platform)
     traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from ._common import add_force_arg, dumps_strict, add_platform_arg, output_folder, platform_from_args, print_json
+from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
@@ -65,6 +65,11 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
 def run(args) -> int:
     from .. import workspace as ws
 
+    names = [n.strip() for n in args.limits.split(",")]
+    reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
+    reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
+    reject_unused(args, "--limits ...,dexterity", "dexterity" in names, max_condition=100.0)
+    reject_unused(args, "--out", args.out is not None, force=False)
     out = output_folder(args)
     platform = platform_from_args(args)
     if not (args.resolution > 0 and math.isfinite(args.resolution)):
