@@ -29,7 +29,9 @@ def run(args) -> int:
         if os.path.exists(args.write) and not os.path.isdir(args.write):
             raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
         target = os.path.join(args.write, sdf_path(platform.name, "").name)
-        print(write_output_file(target, sdf_text(platform), option="--write"))
+        written = write_output_file(target, sdf_text(platform), option="--write")
+        if not args.inspect:
+            print(written)
     if args.inspect:
         h = make_plant(platform)
         plant = h.plant
@@ -44,6 +46,8 @@ def run(args) -> int:
             "time_step_s": plant.time_step(),
         }
         base, top = anchor_frames(h)
+        if args.write:
+            info["sdf_file"] = str(written)
         info["anchor_error_m"] = float(max(abs(base - platform.base_anchors).max(), abs(top - platform.top_anchors_per_leg).max()))
         if args.json:
             print_json(info)
