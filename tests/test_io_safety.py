@@ -471,3 +471,40 @@ def test_sigkill_never_leaves_partial_output_or_litter(tmp_path, name, argv):
     subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, check=True)
     assert _complete(tmp_path / "dest")
     assert sorted(os.listdir(tmp_path)) == ["dest"]
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["workspace", "--joint-cone", "30"], "stewart-drake workspace: error: --joint-cone only applies with --limits ...,joints"),
+    (["workspace", "--leg-diameter", "0.05"], "stewart-drake workspace: error: --leg-diameter only applies with --limits ...,collision"),
+    (["workspace", "--max-condition", "50"], "stewart-drake workspace: error: --max-condition only applies with --limits ...,dexterity"),
+    (["workspace", "--force"], "stewart-drake workspace: error: --force only applies with --out"),
+    (["run", str(EXAMPLE), "--controller", "float"], "stewart-drake run: error: --controller only applies with --simulate"),
+    (["simulate", "--length-unit", "mm"], "stewart-drake simulate: error: --length-unit only applies with --trajectory FILE.csv"),
+    (["dynamics", "--trajectory", "t.csv", "--t-end", "2"], "stewart-drake dynamics: error: --t-end only applies with --trajectory seed"),
+    (["dynamics", "--angle-unit", "deg"], "stewart-drake dynamics: error: --angle-unit only applies with --trajectory FILE.csv"),
+    (["fk", "--lengths", "473", "473", "473", "473", "473", "-473"],
+     "stewart-drake fk: error: --lengths: leg 6 length -473 mm must be a positive number"),
+    (["fk", "--length-unit", "m", "--lengths", "0.473", "0.473", "0.473", "0.473", "0.473", "-0.473"],
+     "stewart-drake fk: error: --lengths: leg 6 length -0.473 m must be a positive number"),
+])
+def test_ignored_options_and_inputs_echoed_as_written(here, capsys, argv, message):
+    rc, out, err = cli(capsys, *argv)
+    assert rc == 2 and out == "" and err.strip() == message
+    assert sorted(p.name for p in here.iterdir()) == []  # refused before anything was written
+
+
+def test_compile_refuses_python_that_would_not_parse(here, capsys):
+    n = 100  # Python allows 100 indentation levels at most
+    (here / "nest.stw").write_text("x = 1\n" + "IF x > 0 THEN\n" * n + "mover(z = 110) en 1\n" + "END\n" * n)
+    rc, out, err = cli(capsys, "compile", "nest.stw", "--emit", "python")
+    assert rc == 2 and out == "" and err.strip() == ("stewart-drake compile: error: nest.stw: the Python translation does not compile "
+                                                     "(too many levels of indentation); the program nests blocks too deeply for Python")
+    (here / "nest.stw").write_text("x = 1\n" + "IF x > 0 THEN\n" * 20 + "mover(z = 110) en 1\n" + "END\n" * 20)
+    rc, out, _ = cli(capsys, "compile", "nest.stw", "--emit", "python")
+    assert rc == 0 and compile(out, "nest.py", "exec")
+
+
+def test_model_write_inspect_json_is_one_document(here, capsys):
+    rc, out, _ = cli(capsys, "model", "--write", "m", "--inspect", "--json")
+    info = json.loads(out)
+    assert rc == 0 and info["sdf_file"] == str(here / "m" / "utn-kinematic.sdf") and Path(info["sdf_file"]).is_file()
