@@ -30,7 +30,7 @@ def main(argv=None) -> int:
         return int(args.func(args) or 0)
     except (StewartError, ValueError, FileNotFoundError) as e:
         print(f"stewart-drake {args.command}: error: {e}", file=sys.stderr)
-        return 2
+        return getattr(e, "exit_code", 2)  # PhysicalLimitError: 1
     except BrokenPipeError:  # e.g. `stewart-drake ... | head`
         sys.stderr.close()
         return 0

@@ -92,6 +92,7 @@ class PlatformConfig:
     rotation_centre: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     home_height: Optional[float] = None
     legs: LegConfig = field(default_factory=LegConfig)
+    plate_below_base_allowed: bool = False
 
 
 # ----------------------------------------------------------------------------------------------
@@ -126,6 +127,7 @@ class Platform:
     home_height: Optional[float] = None
     legs: LegConfig = field(default_factory=LegConfig)
     description: str = ""
+    plate_below_base_allowed: bool = False  # poses may put plate anchors at or below z = 0 (sanity.above_base)
 
     def __post_init__(self):
         conv = {
@@ -341,6 +343,7 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
         rotation_centre=np.asarray(cfg.rotation_centre, dtype=float) * k,
         home_height=None if cfg.home_height is None else cfg.home_height * k,
         legs=legs,
+        plate_below_base_allowed=bool(cfg.plate_below_base_allowed),
     )
     if cfg.utn is not None:
         return Platform.utn(cfg.utn.b * k, cfg.utn.d * k, cfg.utn.a * k, **common)
@@ -375,8 +378,12 @@ def load_yaml_config(path, schema, kind: str):
 
 
 def load_platform_yaml(path) -> Platform:
-    """Load one platform from a YAML file (schema: ``PlatformConfig``)."""
-    return platform_from_config(load_yaml_config(path, PlatformConfig, "platform"))
+    """Load one platform from a YAML file (schema: ``PlatformConfig``); refused when singular at home."""
+    from .sanity import check_home
+
+    platform = platform_from_config(load_yaml_config(path, PlatformConfig, "platform"))
+    check_home(platform)
+    return platform
 
 
 def preset_path(name: str) -> Path:
