@@ -327,7 +327,7 @@ def human_bytes(n: float) -> str:
         return f"~10^{int(math.floor(math.log10(n / 1e9)))} GB"
     for unit, k in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
         if n >= k:
-            return f"{n / k:.3g} {unit}"
+            return f"~{n / k:.3g} {unit}"
     return f"{n:.0f} B"
 
 
@@ -355,7 +355,7 @@ def check_work(option: str, value: str, count: float, what: str, bytes_per: floa
     budget = memory_budget()
     if bytes_per and need > budget:
         raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value, estimate=f"{count:.2g} {what} ({human_bytes(need)})",
-                                                      limit=f"{human_bytes(budget)} on this machine", hint=hint))
+                                                      limit=f"{human_bytes(budget).lstrip('~')} on this machine", hint=hint))
     if max_count is not None and count > max_count:
         raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value, estimate=f"{count:.2g} {what}",
                                                       limit=f"{max_count:.2g} {what}", hint=hint))
@@ -363,6 +363,18 @@ def check_work(option: str, value: str, count: float, what: str, bytes_per: floa
         raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value,
                                                       estimate=f"{count:.2g} {what} ({human_seconds(count * seconds_per)})",
                                                       limit=human_seconds(max_seconds), hint=hint))
+
+
+def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
+    """A rotation centre ``(3,)`` (m, plate frame): finite and within ``FAR_FACTOR`` × ``platform_size``
+    of the plate's origin (farther is a unit mistake), else ``StewartError``."""
+    c = check_finite(centre, f"{option} (m)")
+    size = platform_size(platform)
+    r = float(np.linalg.norm(c))
+    if r > FAR_FACTOR * size:
+        raise StewartError(f"{option} {' '.join(fmt_value(x) for x in c)} m is {r / size:.3g} × the platform's size ({size:.3f} m) from the plate; "
+                           f"centres beyond {FAR_FACTOR:g} × are surely a unit mistake (the centre is in metres)")
+    return c
 
 
 def check_file_rows(path, option: str, bytes_per_row: float, min_row_bytes: int = 12) -> None:
@@ -373,3 +385,39 @@ def check_file_rows(path, option: str, bytes_per_row: float, min_row_bytes: int 
     except OSError:
         return
     check_work(option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file")
+
+
+# ----------------------------------------------------------------------------------------------
+# RC servos.
+
+# The pulse widths an RC servo's PWM input accepts (µs): the 50 Hz frame's extreme range that hobby
+# servos take (1000-2000 µs nominal, 500-2500 µs extended); wider pulses are not servo commands.
+SERVO_PULSE_RANGE_US = (500.0, 2500.0)
+
+
+def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
+    """``StewartError`` unless every neutral pulse W0_i (µs) is finite and leaves room for the full travel:
+    W0_i ± travel·rate within ``SERVO_PULSE_RANGE_US``."""
+    w0 = np.asarray(hexapod.neutral_us, dtype=float)
+    check_finite(w0, f"{what} (µs)")
+    swing = float(hexapod.travel_rad * hexapod.rate_us_per_rad)
+    lo, hi = SERVO_PULSE_RANGE_US[0] + swing, SERVO_PULSE_RANGE_US[1] - swing
+    bad = (w0 < lo) | (w0 > hi)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise StewartError(
+            f"{what}: servo {i + 1}'s neutral pulse {fmt_value(w0[i])} µs is outside [{lo:.0f}, {hi:.0f}] µs: with its travel of "
+            f"±{swing:.0f} µs the pulse must stay within an RC servo's {SERVO_PULSE_RANGE_US[0]:.0f}-{SERVO_PULSE_RANGE_US[1]:.0f} µs")
+
+
+def plate_floor(platform, orientation, convention: str = "utn") -> float:
+    """The height (m) the rotation centre must exceed, at ``orientation`` (3,) rad, for every plate
+    anchor to be above the base plane: max_i −(R_BT (p_TTi − p_TC))_z; −inf when the platform allows
+    its plate below the base. Positions above it form the half-space a workspace may count."""
+    from .rotations import rotation_matrix
+
+    if getattr(platform, "plate_below_base_allowed", False):
+        return -math.inf
+    R = rotation_matrix(np.asarray(orientation, dtype=float), convention)
+    r = (platform.top_anchors_per_leg - platform.rotation_centre) @ R.T
+    return float(np.max(-r[:, 2]))

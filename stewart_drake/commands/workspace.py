@@ -11,6 +11,7 @@ import numpy as np
 
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
+from ..sanity import check_centre, check_finite
 from ._common import add_platform_arg, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
@@ -68,6 +69,9 @@ def run(args) -> int:
     platform = platform_from_args(args)
     if not (args.resolution > 0 and math.isfinite(args.resolution)):
         raise ValueError(f"--resolution must be a positive number of metres, got {args.resolution}")
+    if args.centre is not None:
+        check_centre(platform, args.centre)
+    check_finite(args.orientation, "--orientation")
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     orientation = to_radians(args.orientation, args.angle_unit)
