@@ -172,15 +172,13 @@ class _ToAst(Transformer_NonRecursive):
 
     # -- program structure
     def start(self, items):
-        return [s for s in items if s is not None]
+        stmts = [s for s in items if s is not None]
+        _check_nesting(stmts)  # bodies were checked as they were built; the top level here
+        return stmts
 
     def body(self, items):
         stmts = tuple(s for s in items if s is not None)
-        for s in stmts:
-            if _stmt_depth(s) > MAX_STMT_DEPTH:
-                raise ScriptError(f"statements nested more than {MAX_STMT_DEPTH} levels deep", s.at, kind="syntax error")
-            if _stmt_depth(s, loops_only=True) > MAX_LOOP_DEPTH:
-                raise ScriptError(f"loops (FOR, WHILE) nested more than {MAX_LOOP_DEPTH} levels deep", s.at, kind="syntax error")
+        _check_nesting(stmts)
         return stmts
 
     def assign(self, items):
@@ -279,6 +277,14 @@ def _expr_loc(e) -> Loc:
     while isinstance(e, ast.Binary):
         e = e.left
     return e.at
+
+
+def _check_nesting(stmts) -> None:
+    for s in stmts:
+        if _stmt_depth(s) > MAX_STMT_DEPTH:
+            raise ScriptError(f"statements nested more than {MAX_STMT_DEPTH} levels deep", s.at, kind="syntax error")
+        if _stmt_depth(s, loops_only=True) > MAX_LOOP_DEPTH:
+            raise ScriptError(f"loops (FOR, WHILE) nested more than {MAX_LOOP_DEPTH} levels deep", s.at, kind="syntax error")
 
 
 def _stmt_depth(s, loops_only: bool = False) -> int:
