@@ -92,7 +92,7 @@ def main(argv=None) -> int:
         return int(args.func(args) or 0)
     except (StewartError, ValueError) as e:
         print(f"stewart-drake {name}: error: {_one_line(e)}", file=sys.stderr)
-        return 2
+        return getattr(e, "exit_code", 2)  # PhysicalLimitError: 1
     except OSError as e:
         if isinstance(e, BrokenPipeError):  # e.g. `stewart-drake ... | head`
             sys.stderr.close()

@@ -93,6 +93,7 @@ class PlatformConfig:
     rotation_centre: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     home_height: Optional[float] = None
     legs: LegConfig = field(default_factory=LegConfig)
+    plate_below_base_allowed: bool = False
 
 
 # ----------------------------------------------------------------------------------------------
@@ -127,6 +128,7 @@ class Platform:
     home_height: Optional[float] = None
     legs: LegConfig = field(default_factory=LegConfig)
     description: str = ""
+    plate_below_base_allowed: bool = False  # poses may put plate anchors at or below z = 0 (sanity.above_base)
 
     def __post_init__(self):
         conv = {
@@ -342,6 +344,7 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
         rotation_centre=np.asarray(cfg.rotation_centre, dtype=float) * k,
         home_height=None if cfg.home_height is None else cfg.home_height * k,
         legs=legs,
+        plate_below_base_allowed=bool(cfg.plate_below_base_allowed),
     )
     if cfg.utn is not None:
         return Platform.utn(cfg.utn.b * k, cfg.utn.d * k, cfg.utn.a * k, **common)
@@ -444,12 +447,17 @@ def load_yaml_config(path, schema, kind: str, check=None):
 
 def load_platform_yaml(path) -> Platform:
     """Load one platform from a YAML file (schema: ``PlatformConfig``); every field is checked
-    (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used."""
+    (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used; a
+    platform singular at its home pose is refused."""
+    from .sanity import check_home
+
     cfg = load_yaml_config(path, PlatformConfig, "platform", _check_platform_fields(str(path)))
     try:
-        return platform_from_config(cfg)
+        platform = platform_from_config(cfg)
     except GeometryError as e:
         raise GeometryError(f"{path}: {e}") from None
+    check_home(platform)
+    return platform
 
 
 def preset_path(name: str) -> Path:

@@ -74,7 +74,7 @@ def run(args) -> int:
         else:
             print(f"foot Px = {out['foot'][0]:.6g} {args.length_unit}, Py = {out['foot'][1]:.6g} {args.length_unit}, "
                   f"gamma = {out['gamma']:.6g} {args.angle_unit}" + ("" if out["within_limits"] else "  (outside joint limits)"))
-        return 0
+        return 0 if out["within_limits"] else 1
     args.target = [args.px, args.py]
     t = np.array(args.target) * k
     if not np.all(np.isfinite(t)):

@@ -10,6 +10,7 @@ import numpy as np
 from ..atomic import write_output_file
 from ..errors import OutputError
 from ..rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from ..sanity import check_finite
 from ._common import print_json
 
 
@@ -34,8 +35,12 @@ def register(sub) -> None:
 def run(args) -> int:
     from ..servo import load_servo_hexapod, solve
 
+    from ..sanity import check_servo_neutrals
+
     hexapod = load_servo_hexapod(args.platform)
+    check_servo_neutrals(hexapod, f"{args.platform}: servo.neutral_us")
     if args.trim is not None:
+        check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
         from ..servo_model import SDF_NAME, sdf_text

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
+from ..sanity import check_centre, check_finite
+from ._common import add_force_arg, add_platform_arg, dumps_strict, output_folder, platform_from_args, print_json, reject_unused
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
@@ -74,6 +75,9 @@ def run(args) -> int:
     platform = platform_from_args(args)
     if not (args.resolution > 0 and math.isfinite(args.resolution)):
         raise ValueError(f"--resolution must be a positive number of metres, got {args.resolution}")
+    if args.centre is not None:
+        check_centre(platform, args.centre)
+    check_finite(args.orientation, "--orientation")
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     orientation = to_radians(args.orientation, args.angle_unit)
