@@ -6,9 +6,11 @@ The program is checked and run first (syntax, variables, argument counts, reacha
 
 from __future__ import annotations
 
+import builtins
 import sys
-from pathlib import Path
 
+from ..atomic import check_output_file, write_output_file
+from ..errors import InputError
 from ..rotations import CONVENTIONS
 from ._common import add_platform_arg, platform_from_args
 from .run import read_program
@@ -31,6 +33,8 @@ def run(args) -> int:
     from ..script.runtime import check_reachable
 
     text = read_program(args.program)
+    if args.output:
+        check_output_file(args.output, option="--output")
     platform = platform_from_args(args)
     try:
         program, motion = compile_program(text, args.program, platform)
@@ -48,8 +52,13 @@ def run(args) -> int:
         code = emit_matlab(motion)
     else:
         code = emit_python(program, platform=args.platform, convention=args.convention, rate=args.rate)
+        try:
+            builtins.compile(code, f"{args.program} (Python translation)", "exec")
+        except (SyntaxError, RecursionError, MemoryError) as e:
+            raise InputError(f"{args.program}: the Python translation does not compile ({getattr(e, 'msg', type(e).__name__)}); "
+                             "the program nests blocks too deeply for Python") from None
     if args.output:
-        Path(args.output).write_text(code, encoding="utf-8")
+        write_output_file(args.output, code, option="--output")
     else:
         sys.stdout.write(code)
     return 0

@@ -11,7 +11,7 @@ import numpy as np
 from ..csvio import read_numeric_csv
 from ..rotations import angle_scale, length_scale
 from ..sanity import check_file_rows, check_finite, check_gravity, check_trajectory, check_work, fmt_value, require_plate
-from ._common import add_platform_arg, platform_from_args, print_json
+from ._common import add_platform_arg, platform_from_args, print_json, reject_unused
 
 CSV_HELP = (
     "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
@@ -82,6 +82,9 @@ def seed_times(t_end: float, dt: float) -> np.ndarray:
 def run(args) -> int:
     from ..dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 
+    seed = args.trajectory == "seed"
+    reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
+    reject_unused(args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn")
     platform = platform_from_args(args)
     require_plate(platform, "dynamics")
     gravity = check_gravity(args.gravity)

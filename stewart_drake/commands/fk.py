@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import UsageError
 from ..rotations import length_scale, pose_from_si, pose_to_si
 from ..sanity import check_finite, check_positive, check_work
 from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
@@ -53,6 +54,9 @@ MAX_ITER = 1000
 def run(args) -> int:
     from ..fk import forward_kinematics
 
+    for i, v in enumerate(args.lengths, 1):
+        if not v > 0:
+            raise UsageError(f"--lengths: leg {i} length {v} {args.length_unit} must be a positive number")
     platform = platform_from_args(args)
     k = length_scale(args.length_unit)
     check_finite(args.lengths, "--lengths")

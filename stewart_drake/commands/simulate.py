@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..sanity import check_file_rows, check_positive, check_timing, check_trajectory, check_work, fmt_value, require_plate
-from ._common import add_platform_arg, print_json
+from ._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -48,6 +48,7 @@ def register(sub) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--allow-out-of-stroke", action="store_true",
                    help="simulate even a reference that leaves the stroke (a warning, also in summary.json 'warnings'); default: exit 1")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -59,6 +60,8 @@ def run(args) -> int:
     from ..geometry import load_platform
     from ..simulation import ActuatorModel, build_simulation, design_poses, fit_trajectory, get_trajectory, tracking_verdict
 
+    reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
+    out_folder = output_folder(args)
     platform = load_platform(args.platform)
     require_plate(platform, "simulate")
     period = check_positive(args.period, "--period", "seconds")
@@ -111,10 +114,10 @@ def run(args) -> int:
     verdict = tracking_verdict(platform, e, pe, log)
     summary.update(verdict)
     summary["warnings"] = warnings
-    with atomic_folder(out) as tmp:
+    with atomic_folder(out_folder) as tmp:
         written = log.save(tmp) + write_plots(log, e, tmp) + [tmp / "summary.json"]
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
+        (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
     if verdict["failures"]:
         for f in verdict["failures"]:
@@ -137,7 +140,7 @@ def write_plots(log, length_error, out: Path) -> list[Path]:
     ax[1].plot(log.t, log.force)
     ax[1].set_ylabel("actuator force [N]")
     ax[1].set_xlabel("t [s]")
-    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform}, T = {log.sample_period * 1e3:g} ms")
+    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace("$", r"\$")}, T = {log.sample_period * 1e3:g} ms")
     path = out / "tracking.png"
     fig.savefig(path, dpi=100, bbox_inches="tight")
     plt.close(fig)

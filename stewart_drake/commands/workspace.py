@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 from pathlib import Path
@@ -12,7 +11,7 @@ import numpy as np
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from ..sanity import check_centre, check_finite
-from ._common import add_platform_arg, platform_from_args, print_json
+from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
@@ -38,6 +37,7 @@ def register(sub) -> None:
     p.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes for the sweep (default 1)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.add_argument("--out", metavar="DIR", help="write workspace.json, boundary.csv and the views (top, front, side, 3d PNG) into DIR")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -66,6 +66,12 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
 def run(args) -> int:
     from .. import workspace as ws
 
+    names = [n.strip() for n in args.limits.split(",")]
+    reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
+    reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
+    reject_unused(args, "--limits ...,dexterity", "dexterity" in names, max_condition=100.0)
+    reject_unused(args, "--out", args.out is not None, force=False)
+    out = output_folder(args)
     platform = platform_from_args(args)
     if not (args.resolution > 0 and math.isfinite(args.resolution)):
         raise ValueError(f"--resolution must be a positive number of metres, got {args.resolution}")
@@ -86,8 +92,8 @@ def run(args) -> int:
     result["rotation_limits"] = [r.as_dict() for r in rot]
     result["rotation_centre_m"] = list(platform.rotation_centre if args.centre is None else args.centre)
     result["mobility"] = ws.stewart_mobility("SPS")["m"]
-    if args.out:
-        write_outputs(w, result, Path(args.out))
+    if out is not None:
+        write_outputs(w, result, out)
     if args.json:
         print_json(result)
     else:
@@ -110,7 +116,7 @@ def run(args) -> int:
     return 0
 
 
-def write_outputs(w, result: dict, out: Path) -> None:
+def write_outputs(w, result: dict, out) -> None:
     """workspace.json, boundary.csv (metres) and the four views as PNG into ``out``."""
     import matplotlib
 
@@ -120,8 +126,8 @@ def write_outputs(w, result: dict, out: Path) -> None:
     from ..workspace import view_figures
 
     with atomic_folder(out) as tmp:
-        (tmp / "workspace.json").write_text(json.dumps(result, indent=2, default=lambda x: x.tolist() if hasattr(x, "tolist") else str(x)))
+        (tmp / "workspace.json").write_text(dumps_strict(result))
         np.savetxt(tmp / "boundary.csv", w.boundary, delimiter=",", header="x_m,y_m,z_m", comments="", fmt="%.6f")
-        for name, fig in view_figures(w, title=result["platform"]).items():
+        for name, fig in view_figures(w, title=result["platform"].replace("$", r"\$")).items():
             fig.savefig(tmp / f"{name}.png", dpi=110, bbox_inches="tight")
             plt.close(fig)

@@ -26,6 +26,7 @@ from itertools import product
 
 import numpy as np
 
+from ..errors import counted
 from ..geometry import Platform
 from ..rotations import check_convention
 from .q15 import _sat, tfr16CosPIx, tfr16SinPIx
@@ -112,7 +113,7 @@ def _trig_words(angles: np.ndarray, fmt: QFormat):
     x = angles / np.pi
     if np.any(np.abs(x) > 1.0):
         k = tuple(int(i) for i in np.argwhere(np.abs(x) > 1.0)[0])
-        raise ValueError(f"pose {k[:-1]}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
+        raise ValueError(f"pose {counted(k[:-1])}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
     w = _sat(np.trunc(x * (1 << f)).astype(np.int64), lo, hi, "generic.angle")
     if fmt.trig == "tfr16":
         return tfr16SinPIx(w), tfr16CosPIx(w)
@@ -165,7 +166,7 @@ def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(),
         raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
     if not np.all(np.isfinite(q)):
         k = tuple(int(i) for i in np.argwhere(~np.isfinite(q).all(-1))[0])
-        raise ValueError(f"pose {k} is not finite: {q[k].tolist()}")
+        raise ValueError(f"pose {counted(k)} is not finite: {q[k].tolist()}")
     f, lsb = fmt.frac_bits, fmt.length_lsb
     lo, hi = -(1 << f), (1 << f) - 1
 

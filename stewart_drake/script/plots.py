@@ -34,7 +34,8 @@ def plot_lengths(result, platform_name: str, stroke_mm=None, ax=None):
     _move_marks(ax, result)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("leg length (mm)")
-    ax.set_title(f"leg lengths, platform {platform_name} (grey: end of each move)")
+    name = platform_name.replace("$", r"\$")  # a name is text, not mathtext
+    ax.set_title(f"leg lengths, platform {name} (grey: end of each move)")
     ax.legend(fontsize=8, ncol=6, loc="upper right")
     return fig or ax.figure
 
