@@ -62,44 +62,6 @@ class SingularityWarning(UserWarning):
 
 
 # ----------------------------------------------------------------------------------------------
-# Physical sanity and bounded work (``sanity``). A ``PhysicalLimitError`` is a result outside the
-# platform's physical limits (exit 1); a ``WorkTooLargeError`` is a request too big to run (exit 2).
-
-
-class PhysicalLimitError(StewartError):
-    """A well-formed request whose answer lies outside physical limits (plate below the base, a leg
-    out of stroke along a trajectory, lost tracking, a saturated leg): the CLI exits 1."""
-
-    exit_code = 1
-
-
-class WorkTooLargeError(StewartError):
-    """A user-controlled size (resolution, duration, rows, iterations) whose memory or time estimate
-    exceeds what the tool allows; raised before anything is allocated."""
-
-
-BELOW_BASE = (
-    "{what}: the plate is {where} the base: plate anchor {anchor} is at z = {z_mm:.3f} mm (the base plane is z = 0); "
-    "a platform whose plate may go below its base says so with 'plate_below_base_allowed: true'"
-)
-FAR_POSITION = (
-    "{what}: position {pos_m} m is {ratio:.3g} × the platform's size ({size_m:.3f} m); positions beyond "
-    "{limit:g} × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
-)
-NOT_FINITE = "{what} must be finite, got {value}"
-OUT_OF_STROKE = (
-    "{what} leaves the stroke: first at t = {t:.4f} s, leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
-    "{side} the stroke {bound} {limit_mm:.3f} mm{hint}"
-)
-NO_PLATE = (
-    "platform {name!r} has no plate mass properties (YAML key 'plate' missing, or its mass is 0): "
-    "'{command}' needs plate.mass and plate.inertia (or plate.thickness and plate.density for a utn platform)"
-)
-SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
-WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"
-
-
-# ----------------------------------------------------------------------------------------------
 # Input/output errors and message templates (files, options, output folders).
 
 
@@ -163,3 +125,41 @@ class UsageError(StewartError):
     NEEDS = "{option} only applies with {needs}"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     INTERNAL = "internal error ({kind}: {detail}); please report it with the command line"
+
+
+# ----------------------------------------------------------------------------------------------
+# Physical sanity and bounded work (``sanity``). A ``PhysicalLimitError`` is a result outside the
+# platform's physical limits (exit 1); a ``WorkTooLargeError`` is a request too big to run (exit 2).
+
+
+class PhysicalLimitError(StewartError):
+    """A well-formed request whose answer lies outside physical limits (plate below the base, a leg
+    out of stroke along a trajectory, lost tracking, a saturated leg): the CLI exits 1."""
+
+    exit_code = 1
+
+
+class WorkTooLargeError(StewartError):
+    """A user-controlled size (resolution, duration, rows, iterations) whose memory or time estimate
+    exceeds what the tool allows; raised before anything is allocated."""
+
+
+BELOW_BASE = (
+    "{what}: the plate is {where} the base: plate anchor {anchor} is at z = {z_mm:.3f} mm (the base plane is z = 0); "
+    "a platform whose plate may go below its base says so with 'plate_below_base_allowed: true'"
+)
+FAR_POSITION = (
+    "{what}: position {pos_m} m is {ratio:.3g} × the platform's size ({size_m:.3f} m); positions beyond "
+    "{limit:g} × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
+)
+NOT_FINITE = "{what} must be finite, got {value}"
+OUT_OF_STROKE = (
+    "{what} leaves the stroke: first at t = {t:.4f} s, leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
+    "{side} the stroke {bound} {limit_mm:.3f} mm{hint}"
+)
+NO_PLATE = (
+    "platform {name!r} has no plate mass properties (YAML key 'plate' missing, or its mass is 0): "
+    "'{command}' needs plate.mass and plate.inertia (or plate.thickness and plate.density for a utn platform)"
+)
+SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
+WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"

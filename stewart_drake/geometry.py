@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import GeometryError, YamlError
 from .rotations import length_scale
+from .sanity import check_home
 from .yamlio import Rule, check_rules, load_yaml_typed
 
 SQRT3 = np.sqrt(3.0)
@@ -447,16 +448,13 @@ def load_yaml_config(path, schema, kind: str, check=None):
 
 def load_platform_yaml(path) -> Platform:
     """Load one platform from a YAML file (schema: ``PlatformConfig``); every field is checked
-    (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used; a
-    platform singular at its home pose is refused."""
-    from .sanity import check_home
-
+    (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used."""
     cfg = load_yaml_config(path, PlatformConfig, "platform", _check_platform_fields(str(path)))
     try:
         platform = platform_from_config(cfg)
     except GeometryError as e:
         raise GeometryError(f"{path}: {e}") from None
-    check_home(platform)
+    check_home(platform)  # sanity: a platform singular at its home pose is refused when loaded
     return platform
 
 

@@ -148,7 +148,8 @@ def check_poses(platform, poses, convention: str = "utn", what: str = "pose", ti
         i = int(np.argmin(finite))
         raise StewartError(NOT_FINITE.format(what=label(i), value="[" + ", ".join(fmt_value(x) for x in q[i]) + "]"))
     size = platform_size(platform)
-    r = np.linalg.norm(q[:, :3], axis=1)
+    with np.errstate(over="ignore"):  # |p| of 1e308 is inf: far, as it should be
+        r = np.linalg.norm(q[:, :3], axis=1)
     far = r > FAR_FACTOR * size
     if np.any(far):
         i = int(np.argmax(far))
@@ -378,13 +379,20 @@ def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
 
 
 def check_file_rows(path, option: str, bytes_per_row: float, min_row_bytes: int = 12) -> None:
-    """Refuse a CSV file whose rows (at most size / ``min_row_bytes``) could not be held in memory
-    (``bytes_per_row`` each), before reading it. A missing file is left to the reader to report."""
+    """Refuse a CSV file whose rows could not be held in memory (``bytes_per_row`` each), before reading
+    it: judged first by its size (at most size / ``min_row_bytes`` rows), then, if that is not enough to
+    accept it, by counting its lines. A missing file is left to the reader to report."""
     try:
         size = os.path.getsize(path)
+        check_work(option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file")
     except OSError:
         return
-    check_work(option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file")
+    except WorkTooLargeError:
+        if size > memory_budget():
+            raise
+        with open(path, "rb") as fh:  # count the rows (bounded memory, ~1 GB/s) before judging by size
+            rows = sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 24), b"")) + 1
+        check_work(option, repr(str(path)), rows, "rows", bytes_per_row, hint="; split the file")
 
 
 # ----------------------------------------------------------------------------------------------

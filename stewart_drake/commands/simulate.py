@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..sanity import check_file_rows, check_positive, check_timing, check_trajectory, check_work, fmt_value, require_plate
-from ._common import add_force_arg, add_platform_arg, dumps_strict, output_folder, print_json, reject_unused
+from ._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and

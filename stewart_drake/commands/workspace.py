@@ -11,7 +11,7 @@ import numpy as np
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from ..sanity import check_centre, check_finite
-from ._common import add_force_arg, add_platform_arg, dumps_strict, output_folder, platform_from_args, print_json, reject_unused
+from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
