@@ -92,7 +92,10 @@ def _foreign_entries(folder: Path, ours: list[str]) -> list[str]:
 
 
 def _refused_location(path: Path, typed: str, option: str) -> None:
-    cwd = Path.cwd().resolve()
+    try:
+        cwd = Path.cwd().resolve()
+    except OSError:  # the working directory was removed: nothing to protect there
+        cwd = Path(path.anchor)
     home = Path.home().resolve()
     if path == Path(path.anchor) or path == home or path == cwd or path in cwd.parents:
         what = "the root folder" if path == Path(path.anchor) else ("your home folder" if path == home else

@@ -84,8 +84,8 @@ def test_report_writes_atomically(tmp_path, capsys, monkeypatch):
     from stewart_drake import report
 
     out = tmp_path / "rep"
-    rc, stdout, _ = run(capsys, "report", "--only", "seed_table", "--out", str(out), "--quick")
-    assert rc == 0 and (out / "index.html").exists()
+    rc, stdout, err = run(capsys, "report", "--only", "seed_table", "--out", str(out), "--quick")
+    assert rc == 0 and (out / "index.html").exists(), err
     before = (out / "index.html").read_text()
 
     def boom(*a, **k):

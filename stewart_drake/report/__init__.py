@@ -124,8 +124,10 @@ def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = N
     return sorted(found, key=lambda a: (a.order, a.name))
 
 
-def run_analyses(analyses: list[Analysis], quick: bool = False, log=sys.stderr) -> list[Section]:
-    """Build each analysis's section, printing progress; an analysis that raises becomes a failed check."""
+def run_analyses(analyses: list[Analysis], quick: bool = False, log=None) -> list[Section]:
+    """Build each analysis's section, printing progress to ``log`` (default: the current stderr); an
+    analysis that raises becomes a failed check."""
+    log = log or sys.stderr
     sections = []
     for k, a in enumerate(analyses, 1):
         print(f"[{k}/{len(analyses)}] {a.title} ...", file=log, flush=True)
