@@ -497,3 +497,10 @@ def test_model_write_inspect_json_is_one_document(here, capsys):
     rc, out, _ = cli(capsys, "model", "--write", "m", "--inspect", "--json")
     info = json.loads(out)
     assert rc == 0 and info["sdf_file"] == str(here / "m" / "utn-kinematic.sdf") and Path(info["sdf_file"]).is_file()
+
+
+def test_servo_write_sdf_json_is_one_document(here, capsys):
+    rc, out, _ = cli(capsys, "servo", "--write-sdf", "s", "--json")
+    info = json.loads(out)
+    assert rc == 0 and info["sdf_file"] == str(here / "s" / "servo-hexapod.sdf") and Path(info["sdf_file"]).is_file()
+    assert read_manifest(here / "s") == ["servo-hexapod.sdf"]

@@ -47,7 +47,9 @@ def run(args) -> int:
 
         if os.path.exists(args.write_sdf) and not os.path.isdir(args.write_sdf):
             raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write-sdf", typed=args.write_sdf, part=args.write_sdf))
-        print(write_output_file(os.path.join(args.write_sdf, f"{SDF_NAME}.sdf"), sdf_text(hexapod), option="--write-sdf"))
+        sdf_file = write_output_file(os.path.join(args.write_sdf, f"{SDF_NAME}.sdf"), sdf_text(hexapod), option="--write-sdf")
+        if not args.json:
+            print(sdf_file)
     k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     scale = np.r_[[k] * 3, [ka] * 3]
     if args.pose is None:
@@ -72,6 +74,8 @@ def run(args) -> int:
         "ok": bool(sol.ok),
         "violations": [dict((key, v) for key, v in d.items() if key != "pose") for d in sol.violations()],
     }
+    if args.write_sdf:
+        result["sdf_file"] = str(sdf_file)
     if args.json:
         print_json(result)
     else:
