@@ -1,0 +1,273 @@
+"""All assembly modes of a Stewart–Gough platform by parameter homotopy, every path accounted for.
+
+Method: the Study-coordinate system of ``study`` (40 isolated solutions for a general 6-6 platform,
+16 for 3-6 / 6-3) is continued from the shipped generic start system of the platform's class
+(``start``) to the platform's own parameters (anchors, squared lengths), all paths together
+(``track``), with a random γ per length set (seeded). Each path's end point is classified:
+
+  real       finite, real (pose recovered, Newton-polished on the real system, certified)
+  complex    finite, not real
+  infinity   e·e → 0: the pose's translation is unbounded (no assembly)
+  singular   the end point is a singular root (Jacobian rank-deficient: a multiple root, a root on a
+             positive-dimensional set)
+  failed     the tracker gave up; failed paths are re-tracked once with tighter steps
+             (``TrackOptions.tighter``) before they are reported as failed
+
+Guarantee (``COMPLETE_TEXT``): by the parameter-homotopy theorem (Morgan & Sommese 1989), for all
+parameters outside a proper algebraic subset of the family — which the random complex start point
+and γ avoid with probability one — the end points of the paths from all solutions of the start point
+include every isolated solution of the target. So when no path failed and the finite end points are
+distinct (two paths ending together would reveal a path jump), the real end points are all the
+isolated real assembly modes. ``complete`` is False otherwise and ``failed_paths`` names the paths.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry import Platform
+from ..fk import validate_lengths
+from .certify import certify, newton_real, pose_bounds, real_forms
+from .start import load_start_system
+from .study import (
+    GENERAL,
+    SIX_THREE,
+    architecture,
+    evaluate,
+    hessian_forms,
+    leg_matrices,
+    pose_from_study,
+    study_parameters,
+)
+from .track import DONE, FAILED, STALLED, TrackOptions, track
+
+REAL, COMPLEX, INFINITY, SINGULAR, FAIL = "real", "complex", "infinity", "singular", "failed"
+CLASSES = (REAL, COMPLEX, INFINITY, SINGULAR, FAIL)
+INFINITY_TOL = 1e-7  # |e·e| / ‖x‖² below this: the translation is unbounded
+SINGULAR_COND = 1e9  # end-point Jacobian condition number above this: a singular root
+SINGULAR_END = 1e-6  # a path stalled (not at infinity) closer than this to t = 1 ends at a singular root
+REAL_TOL = 1e-7  # max |Im| of the normalised end point below this: a real solution
+DISTINCT_TOL = 1e-6  # relative distance of two finite end points below this: the same root
+COMPLETE_TEXT = (
+    "parameter homotopy from a generic start system of the {kind} family ({n} paths, Morgan–Sommese): with "
+    "probability one over the random start point and gamma, the path end points include every isolated complex "
+    "solution; every path reached t = 1 and the finite end points are distinct, so every isolated real assembly "
+    "mode is listed (a positive-dimensional solution set, a self-motion, would not be)"
+)
+
+
+@dataclass(frozen=True)
+class CertifiedMode:
+    """One real solution: pose p_BC ``(3,)`` m, R_BT ``(3, 3)``; ``residual`` max leg-length error (m);
+    ``certified`` (the Krawczyk/Kantorovich test of ``certify`` passed); ``radius`` (an exact solution
+    lies within it, Study coordinates), ``uniqueness`` (no other within it), ``position_bound`` (m)
+    and ``angle_bound`` (rad) derived from ``radius``; ``path`` the path index that reached it."""
+
+    position: np.ndarray
+    rotation: np.ndarray
+    residual: float
+    certified: bool
+    radius: float
+    uniqueness: float
+    position_bound: float
+    angle_bound: float
+    path: int
+
+
+@dataclass(frozen=True)
+class HomotopyResult:
+    """Outcome for one length set. ``classes`` ``(n_paths,)`` per-path class (``CLASSES``); ``modes``
+    the real solutions; ``complete`` and ``guarantee`` as in the module docstring; ``failed_paths``
+    path indices that failed even after re-tracking; ``retracked`` those re-tracked; ``steps``
+    ``(n_paths,)`` tracker steps; ``attempts`` how many random γ were used."""
+
+    kind: str
+    architecture: str
+    lengths: np.ndarray
+    classes: tuple
+    modes: list
+    complete: bool
+    guarantee: str
+    failed_paths: list
+    retracked: list
+    duplicate_paths: list
+    steps: np.ndarray
+    attempts: int = 1
+    time_s: float = 0.0
+    timing: dict = field(default_factory=dict)
+
+    @property
+    def n_paths(self) -> int:
+        return len(self.classes)
+
+    def counts(self) -> dict:
+        """Paths per class."""
+        return {c: int(sum(k == c for k in self.classes)) for c in CLASSES}
+
+    @property
+    def max_solutions(self) -> int:
+        return self.n_paths
+
+
+def _normalise(x: np.ndarray) -> np.ndarray:
+    """Scale Study points ``(k, 8)`` so that e·e = 1, with the sign making the largest |e_j| real part
+    positive (x and −x are the same pose)."""
+    ee = np.einsum("kj,kj->k", x[:, :4], x[:, :4])
+    y = x / np.sqrt(ee)[:, None]
+    j = np.argmax(np.abs(y[:, :4]), axis=1)
+    sign = np.sign(y[np.arange(len(y)), j].real)
+    return y * np.where(sign == 0, 1, sign)[:, None]
+
+
+def solve_batch(
+    platform: Platform,
+    lengths,
+    *,
+    seed: int = 0,
+    options: TrackOptions = TrackOptions(),
+    retrack: bool = True,
+    gamma_retries: int = 2,
+    path_max_steps: dict | None = None,
+) -> list[HomotopyResult]:
+    """All assembly modes for each of the ``(m, 6)`` (or ``(6,)``) leg-length sets (m), every path
+    classified; one ``HomotopyResult`` per set. The paths of all sets are tracked together (the start
+    system is loaded once). A failed path is re-tracked with ``options.tighter()``; a set that still
+    has one is re-solved whole with a new random γ, up to ``gamma_retries`` times (``retrack=False``
+    disables both). ``path_max_steps`` {path index: steps} caps the steps of those paths of every set
+    in every attempt — a deliberate failure, to check that the result then says incomplete."""
+    t_start = time.perf_counter()
+    L = np.atleast_2d(validate_lengths(lengths))
+    if L.ndim != 2 or L.shape[1] != 6:
+        raise ValueError(f"lengths must have shape (6,) or (m, 6), got {np.shape(lengths)}")
+    m = len(L)
+    arch = architecture(platform)
+    S = load_start_system(arch.kind)
+    a, b, s, scale = study_parameters(platform, L, arch)
+    N = len(S.x)
+    B1 = leg_matrices(a, b)
+    rng = np.random.default_rng(seed)
+    n = m * N
+    s0 = np.broadcast_to(S.s, (n, 6))
+    s1 = np.repeat(s, N, axis=0)
+    x0 = np.tile(S.x, (m, 1))
+    cap = np.full(N, options.max_steps)
+    for k, v in (path_max_steps or {}).items():
+        cap[int(k)] = v
+    cap = np.tile(cap, m)
+
+    def run(rows, g_rows):
+        """Track rows (path indices into the batch) with γ per row; failed rows re-tracked tighter."""
+        paths = track(x0[rows], S.B, B1, s0[rows], s1[rows], S.v, g_rows, options, cap[rows])
+        bad = np.flatnonzero(paths.state == FAILED)
+        if retrack and len(bad):
+            again = track(x0[rows][bad], S.B, B1, s0[rows][bad], s1[rows][bad], S.v, g_rows[bad], options.tighter(), cap[rows][bad] * 10)
+            paths.x[bad], paths.state[bad], paths.t[bad] = again.x, again.state, again.t
+            paths.steps[bad] += again.steps
+        return paths, rows[bad] if retrack else np.zeros(0, int)
+
+    t0 = time.perf_counter()
+    gamma = np.exp(2j * np.pi * rng.uniform(size=m))
+    paths, retracked = run(np.arange(n), np.repeat(gamma, N))
+    attempts = np.ones(m, int)
+    # A set with a path that still failed is tracked again, all its paths, with a new random γ (a new
+    # arc of the same homotopy: the path correspondence changes, so all paths are redone together).
+    for _ in range(gamma_retries if retrack else 0):
+        sets = np.unique(np.flatnonzero(paths.state == FAILED) // N)
+        if len(sets) == 0:
+            break
+        rows = (sets[:, None] * N + np.arange(N)).ravel()
+        g_new = np.exp(2j * np.pi * rng.uniform(size=len(sets)))
+        again, rt = run(rows, np.repeat(g_new, N))
+        for j, sj in enumerate(sets):
+            r = slice(j * N, (j + 1) * N)
+            if np.sum(again.state[r] == FAILED) < np.sum(paths.state[sj * N:(sj + 1) * N] == FAILED):
+                sl = slice(sj * N, (sj + 1) * N)
+                paths.x[sl], paths.state[sl], paths.t[sl] = again.x[r], again.state[r], again.t[r]
+                paths.steps[sl] += again.steps[r]
+                attempts[sj] += 1
+        retracked = np.union1d(retracked, rt)
+    t_track = time.perf_counter() - t0
+    t_retrack = 0.0
+    # End-point analysis, all sets at once.
+    x = paths.x
+    with np.errstate(all="ignore"):
+        F, J = evaluate(x, np.broadcast_to(B1, (n, 6, 4, 4)), s1, S.v)
+        sv = np.linalg.svd(J, compute_uv=False)
+        cond = sv[:, 0] / sv[:, -1]
+        ee = np.abs(np.einsum("kj,kj->k", x[:, :4], x[:, :4])) / np.einsum("kj,kj->k", np.abs(x), np.abs(x))
+        y = _normalise(x)
+    done = paths.state == DONE
+    stalled = paths.state == STALLED
+    cls = np.full(n, FAIL, dtype=object)
+    at_inf = (done | stalled) & ~(ee > INFINITY_TOL)
+    cls[at_inf] = INFINITY
+    sing = ~at_inf & ((done & ~(cond < SINGULAR_COND)) | (stalled & (1 - paths.t <= SINGULAR_END)))
+    cls[sing] = SINGULAR
+    finished = done
+    fin = finished & ~at_inf & ~sing
+    is_real = fin & (np.max(np.abs(y.imag), axis=1) <= REAL_TOL * np.linalg.norm(y, axis=1))
+    cls[fin] = COMPLEX
+    cls[is_real] = REAL
+    t_class = time.perf_counter() - t0 - t_track - t_retrack
+    # Real solutions: polish on the real system (chart e·e = 1) and certify, per set.
+    Q, c = real_forms(hessian_forms(B1.real, s[0]))
+    results = []
+    for j in range(m):
+        sl = slice(j * N, (j + 1) * N)
+        cj = cls[sl]
+        Qj, cj_ = (Q, c) if j == 0 else real_forms(hessian_forms(B1.real, s[j]))
+        ridx = np.flatnonzero(cj == REAL)
+        xr = newton_real(y[sl][ridx].real, Qj, cj_)
+        cert = certify(xr, Qj, cj_)
+        # Finite end points distinct (as poses: x ~ -x), else the paths are named.
+        yf = y[sl]
+        fidx = np.flatnonzero((cj == REAL) | (cj == COMPLEX) | (cj == SINGULAR))
+        dup = []
+        for ii, p in enumerate(fidx):
+            for q in fidx[ii + 1:]:
+                d = min(np.linalg.norm(yf[p] - yf[q]), np.linalg.norm(yf[p] + yf[q]))
+                if d <= DISTINCT_TOL * max(1.0, np.linalg.norm(yf[p])):
+                    dup += [int(p), int(q)]
+        dup = sorted(set(dup))
+        failed = [int(k) for k in np.flatnonzero(cj == FAIL)]
+        p_BC, R_BT = pose_from_study(xr, scale, arch.kind)
+        from ..fk import _legs
+
+        _, _, Lp = _legs(platform, p_BC, R_BT)
+        res = np.abs(Lp - L[j]).max(axis=-1) if len(xr) else np.zeros(0)
+        dp, da = pose_bounds(xr, cert.radius)
+        if arch.kind == SIX_THREE:  # bounds were for the inverse motion: position bound grows by |p|
+            dp = dp + np.linalg.norm(p_BC, axis=1) / scale * da
+        modes = [
+            CertifiedMode(p_BC[k], R_BT[k], float(res[k]), bool(cert.certified[k]), float(cert.radius[k]),
+                          float(cert.uniqueness[k]), float(dp[k] * scale), float(da[k]), int(ridx[k]))
+            for k in range(len(ridx))
+        ]
+        complete = not failed and not dup
+        guarantee = COMPLETE_TEXT.format(kind=arch.kind, n=N) if complete else (
+            "not complete: " + "; ".join(
+                ([f"path(s) {', '.join(map(str, failed))} failed even after re-tracking with tighter steps"] if failed else [])
+                + ([f"paths {', '.join(map(str, dup))} reached the same finite end point"] if dup else [])
+            ) + " — an isolated solution may be missing"
+        )
+        rt = [int(k - j * N) for k in retracked if j * N <= k < (j + 1) * N]
+        results.append(
+            HomotopyResult(arch.kind, arch.describe(), L[j], tuple(cj.tolist()), modes, complete, guarantee, failed, rt, dup,
+                           paths.steps[sl].copy(), int(attempts[j]))
+        )
+    total = time.perf_counter() - t_start
+    timing = {"track": t_track, "retrack": t_retrack, "classify": t_class, "certify": total - (t0 - t_start) - t_track - t_retrack - t_class}
+    return [
+        HomotopyResult(**{**r.__dict__, "time_s": total / m, "timing": timing}) for r in results
+    ]
+
+
+def solve(platform: Platform, lengths, **kwargs) -> HomotopyResult:
+    """All assembly modes for one ``(6,)`` leg-length set (m); keywords as ``solve_batch``."""
+    L = validate_lengths(lengths)
+    if L.shape != (6,):
+        raise ValueError(f"solve takes one length set of shape (6,), got {L.shape}")
+    return solve_batch(platform, L, **kwargs)[0]
