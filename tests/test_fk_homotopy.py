@@ -41,7 +41,7 @@ def _same_sets(hom_modes, ms_modes):
 def _check_against_multistart(platform, L, r):
     """complete, every real solution certified, the real set equal to the multi-start's."""
     assert r.complete, r.guarantee
-    assert sum(r.counts().values()) == r.n_paths
+    assert sum(r.counts().values()) == r.max_solutions
     assert all(m.certified for m in r.modes)
     assert all(m.residual < 1e-12 for m in r.modes)  # m; the legs of every mode have the given lengths
     ms = assembly_modes(platform, L, polish=None)
@@ -137,12 +137,15 @@ def test_presets_at_three_poses_batched(name, kind, n_inf):
     L = leg_lengths(p, q)
     rs = solve_batch(p, L)
     for Lj, r, qj in zip(L, rs, q):
-        assert r.kind == kind and r.n_paths == {"6-6": 40, "3-6": 16}[kind]
+        assert r.kind == kind and r.max_solutions == {"6-6": 40, "3-6": 16}[kind]
         assert r.counts()["infinity"] == n_inf
         _check_against_multistart(p, Lj, r)
         assert np.min([np.abs(m.position - qj[:3]).max() for m in r.modes]) < 1e-12  # the IK pose is among them
     one = solve(p, L[1])
     assert _same_sets(one.modes, rs[1].modes)
+    direct = solve(p, L[2], two_stage=False)  # straight from the shipped start system: same modes
+    assert direct.stage == "direct" and direct.n_paths == direct.max_solutions and direct.complete
+    assert direct.counts()["infinity"] == n_inf and _same_sets(direct.modes, rs[2].modes)
 
 
 def test_perturbed_path_is_reported_incomplete():
@@ -194,5 +197,5 @@ def test_explicit_yaml_3_6_is_classified(tmp_path):
     assert architecture(p).kind == "3-6"
     L = leg_lengths(p, p.home_pose() + [0.02, -0.01, 0.03, 0.1, 0.05, -0.1])
     r = solve(p, L)
-    assert r.n_paths == 16
+    assert r.max_solutions == 16
     _check_against_multistart(p, L, r)

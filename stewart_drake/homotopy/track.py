@@ -41,10 +41,10 @@ class TrackOptions:
     h_max: float = 0.5
     h_min: float = 1e-12
     max_steps: int = 600
-    target: float = 1e-3
-    tol: float = 1e-4
-    max_jump: float = 0.02
-    contraction: float = 0.1
+    target: float = 1e-2
+    tol: float = 1e-3
+    max_jump: float = 0.1
+    contraction: float = 0.3
     end_newton: int = 3
     endgame: float = 1e-2
 
@@ -67,13 +67,16 @@ class Paths:
 
 class Homotopy:
     """H(x, t) for shared leg matrices B0 → B1 ``(6, 4, 4)``, per-path s0 → s1 ``(n, 6)``, chart v ``(8,)``
-    and γ ``(n,)``. ``system(x, t, idx)`` gives H ``(k, 8)``, H_x ``(k, 8, 8)`` and dH/dt ``(k, 8)``."""
+    and γ ``(n,)``. ``system(x, t, idx)`` gives H_x ``(k, 8, 8)`` and [H | dH/dt] ``(k, 8, 2)``."""
 
     def __init__(self, B0, B1, s0, s1, v, gamma):
         B0 = np.asarray(B0, dtype=complex)
         dB = np.asarray(B1, dtype=complex) - B0
-        self.Br = np.concatenate([B0, dB], axis=1).reshape(48, 4).T.copy()  # e @ Br -> [B0 e | dB e]
-        self.Bt = np.concatenate([B0, dB], axis=1)  # (6, 8, 4): [u | τu] @ Bt = B(τ)ᵀ u
+        self.fixed = not np.any(dB)  # only the lengths move (the two-stage homotopy's second stage)
+        self.B0r = B0.reshape(24, 4).T.copy()  # e @ B0r = B0 e, legs stacked
+        self.dBr = dB.reshape(24, 4).T.copy()
+        self.B0t = B0.copy()  # (6, 4, 4): u_i @ B0_i = B0_iᵀ u_i
+        self.dBt = dB.copy()
         self.s0 = np.asarray(s0, dtype=complex)
         self.ds = np.asarray(s1, dtype=complex) - self.s0
         self.v = np.asarray(v, dtype=complex)
@@ -85,96 +88,121 @@ class Homotopy:
         tau, dtau = g_ * t / d, g_ / d**2
         n = len(x)
         e, g = x[:, :4], x[:, 4:]
-        BE = (e @ self.Br).reshape(n, 6, 2, 4)
-        Be = BE[:, :, 0] + tau[:, None, None] * BE[:, :, 1]
-        u = g[:, None, :] + Be
+        ds = self.ds[idx]
+        s = self.s0[idx] + tau[:, None] * ds
         ee = np.einsum("nk,nk->n", e, e)
-        s = self.s0[idx] + tau[:, None] * self.ds[idx]
-        H = np.empty((n, 8), complex)
-        H[:, :6] = np.einsum("nij,nij->ni", u, u) - s * ee[:, None]
-        H[:, 6] = np.einsum("nk,nk->n", g, e)
-        H[:, 7] = x @ self.v - 1
+        if self.fixed:
+            u = (e @ self.B0r).reshape(n, 6, 4)
+            u += g[:, None, :]
+            BTu = np.einsum("nij,ijk->nik", u, self.B0t)
+        else:
+            dBe = (e @ self.dBr).reshape(n, 6, 4)
+            u = (e @ self.B0r).reshape(n, 6, 4) + tau[:, None, None] * dBe
+            u += g[:, None, :]
+            BTu = np.einsum("nij,ijk->nik", u, self.B0t) + tau[:, None, None] * np.einsum("nij,ijk->nik", u, self.dBt)
+        R = np.zeros((n, 8, 2), complex)
+        R[:, :6, 0] = np.einsum("nij,nij->ni", u, u) - s * ee[:, None]
+        R[:, 6, 0] = np.einsum("nk,nk->n", g, e)
+        R[:, 7, 0] = x @ self.v - 1
+        Ht = -ds * ee[:, None]
+        if not self.fixed:
+            Ht += 2 * np.einsum("nij,nij->ni", u, dBe)
+        R[:, :6, 1] = Ht * dtau[:, None]
         J = np.empty((n, 8, 8), complex)
-        uu = np.concatenate([u, tau[:, None, None] * u], axis=2).transpose(1, 0, 2)  # (6, n, 8)
-        J[:, :6, :4] = 2 * (np.matmul(uu, self.Bt).transpose(1, 0, 2) - s[..., None] * e[:, None, :])
+        J[:, :6, :4] = 2 * (BTu - s[..., None] * e[:, None, :])
         J[:, :6, 4:] = 2 * u
         J[:, 6, :4] = g
         J[:, 6, 4:] = e
         J[:, 7, :] = self.v
-        Ht = np.zeros((n, 8), complex)
-        Ht[:, :6] = (2 * np.einsum("nij,nij->ni", u, BE[:, :, 1]) - self.ds[idx] * ee[:, None]) * dtau[:, None]
-        return H, J, Ht
+        return J, R
 
 
 def _newton_tangent(hom, x, t, idx):
     """One Newton step at (x, t) and the tangent dx/dt there: (x − H_x⁻¹ H, −H_x⁻¹ H_t)."""
-    H, J, Ht = hom.system(x, t, idx)
-    sol = np.linalg.solve(J, np.stack([H, Ht], -1))
+    J, R = hom.system(x, t, idx)
+    sol = np.linalg.solve(J, R)
     return x - sol[..., 0], -sol[..., 1]
+
+
+def _norm(z):
+    """``(n,)`` max-norm of complex rows (cheap; the tolerances are relative to it)."""
+    return np.abs(z).max(axis=1)
 
 
 def track(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOptions(), max_steps=None) -> Paths:
     """Track paths from solutions x0 ``(n, 8)`` of (B0 ``(6, 4, 4)``, s0 ``(n, 6)``) to (B1, s1); chart v
     ``(8,)``; gamma scalar or ``(n,)``. ``max_steps`` ``(n,)`` optionally caps each path's steps
-    below ``options.max_steps``. Returns ``Paths``."""
+    below ``options.max_steps``. Returns ``Paths``.
+
+    The loop works on a compacted copy of the active paths, compacted again only when fewer than
+    half of it are still active (gathering and scattering every step would cost more than the
+    finished rows' wasted arithmetic)."""
     o = options
     n = len(x0)
     s0 = np.broadcast_to(s0, (n, 6))
     s1 = np.broadcast_to(s1, (n, 6))
     hom = Homotopy(B0, B1, s0, s1, v, np.broadcast_to(np.asarray(gamma, dtype=complex), (n,)))
     cap = np.full(n, o.max_steps) if max_steps is None else np.minimum(np.asarray(max_steps), o.max_steps)
-    x = np.array(x0, dtype=complex)
-    t = np.zeros(n)
-    h = np.full(n, o.h0)
-    steps = np.zeros(n, dtype=int)
-    state = np.full(n, ACTIVE)
-    all_idx = np.arange(n)
+    X = np.array(x0, dtype=complex)
+    T = np.zeros(n)
+    STATE = np.full(n, ACTIVE)
+    STEPS = np.zeros(n, dtype=int)
     with np.errstate(all="ignore"):
-        _, xd = _newton_tangent(hom, x, t, all_idx)
-        xp, tp, xdp = x.copy(), t.copy(), xd.copy()
-        has_prev = np.zeros(n, bool)
+        idx = np.arange(n)
+        x, t = X.copy(), T.copy()
+        _, xd = _newton_tangent(hom, x, t, idx)
+        h = np.full(n, o.h0)
+        # A fictitious previous point on the tangent line: the first Hermite prediction is Euler's.
+        xp, tp, xdp = x - h[:, None] * xd, t - h, xd.copy()
+        steps = np.zeros(n, dtype=int)
+        state = np.full(n, ACTIVE)
+        capw = cap.copy()
         while True:
-            act = np.flatnonzero(state == ACTIVE)
-            if len(act) == 0:
-                break
-            xa, ta, xda = x[act], t[act], xd[act]
-            ha = np.minimum(h[act], 1 - ta)
-            tn = ta + ha
-            # Predictor: cubic Hermite through the last two points, Euler on the first step.
-            xhat = xa + ha[:, None] * xda
-            hp = has_prev[act]
-            if np.any(hp):
-                k = act[hp]
-                D = (ta[hp] - tp[k])[:, None]
-                sgm = (tn[hp][:, None] - tp[k][:, None]) / D
-                h00, h10 = 2 * sgm**3 - 3 * sgm**2 + 1, sgm**3 - 2 * sgm**2 + sgm
-                h01, h11 = -2 * sgm**3 + 3 * sgm**2, sgm**3 - sgm**2
-                xhat[hp] = h00 * xp[k] + h10 * D * xdp[k] + h01 * xa[hp] + h11 * D * xda[hp]
-            x1, _ = _newton_tangent(hom, xhat, tn, act)
-            x2, xd2 = _newton_tangent(hom, x1, tn, act)
-            norm = np.maximum(np.linalg.norm(xa, axis=1), 1.0)
-            d1 = np.linalg.norm(x1 - xhat, axis=1)
-            d2 = np.linalg.norm(x2 - x1, axis=1)
-            good = (d1 <= o.max_jump * norm) & (d2 <= o.contraction * d1 + 1e-14 * norm) & (d2 <= o.tol * norm)
-            good &= np.all(np.isfinite(x2), axis=1) & np.all(np.isfinite(xd2), axis=1)
-            steps[act] += 1
-            with np.errstate(divide="ignore"):
-                ratio = np.where(d1 > 0, (o.target * norm / d1) ** 0.25, 4.0)
-            ia, ib = act[good], act[~good]
-            xp[ia], tp[ia], xdp[ia], has_prev[ia] = xa[good], ta[good], xda[good], True
-            x[ia], xd[ia] = x2[good], xd2[good]
-            t[ia] = np.where(1 - tn[good] <= 1e-14, 1.0, tn[good])
-            h[ia] = np.minimum(ha[good] * np.clip(0.8 * ratio[good], 0.5, 2.0), o.h_max)
-            h[ib] = ha[~good] * np.clip(0.8 * ratio[~good], 0.1, 0.5)
-            state[ia[t[ia] >= 1.0]] = DONE
-            small = ib[h[ib] < o.h_min]
+            live = state == ACTIVE
+            n_live = int(live.sum())
+            if n_live < len(idx) / 2 or n_live == 0:  # write back, compact
+                X[idx], T[idx], STATE[idx], STEPS[idx] = x, t, state, steps
+                if n_live == 0:
+                    break
+                k = np.flatnonzero(live)
+                idx, x, t, xd, xp, tp, xdp, h, steps, state, capw = (
+                    idx[k], x[k], t[k], xd[k], xp[k], tp[k], xdp[k], h[k], steps[k], state[k], capw[k])
+                live = np.ones(len(idx), bool)
+            ha = np.where(live, np.minimum(h, 1 - t), 0.0)
+            tn = t + ha
+            # Predictor: cubic Hermite through (tp, xp, xdp) and (t, x, xd), evaluated at tn.
+            D = (t - tp)[:, None]
+            sg = (ha[:, None] + D) / D
+            sg2 = sg * sg
+            sg3 = sg2 * sg
+            xhat = (2 * sg3 - 3 * sg2 + 1) * xp + (sg3 - 2 * sg2 + sg) * D * xdp + (3 * sg2 - 2 * sg3) * x + (sg3 - sg2) * D * xd
+            x1, _ = _newton_tangent(hom, xhat, tn, idx)
+            x2, xd2 = _newton_tangent(hom, x1, tn, idx)
+            norm = np.maximum(_norm(x), 1.0)
+            d1 = _norm(x1 - xhat)
+            d2 = _norm(x2 - x1)
+            good = live & (d1 <= o.max_jump * norm) & (d2 <= o.contraction * d1 + 1e-14 * norm) & (d2 <= o.tol * norm)
+            good &= np.isfinite(d2) & np.all(np.isfinite(xd2), axis=1)
+            bad = live & ~good
+            steps += live
+            ratio = np.where(d1 > 0, (o.target * norm / d1) ** 0.25, 4.0)
+            g2 = good[:, None]
+            xp = np.where(g2, x, xp)
+            xdp = np.where(g2, xd, xdp)
+            tp = np.where(good, t, tp)
+            x = np.where(g2, x2, x)
+            xd = np.where(g2, xd2, xd)
+            t = np.where(good, np.where(1 - tn <= 1e-14, 1.0, tn), t)
+            h = np.where(good, np.minimum(ha * np.clip(0.8 * ratio, 0.5, 2.0), o.h_max), np.where(bad, ha * np.clip(0.8 * ratio, 0.1, 0.5), h))
+            state[good & (t >= 1.0)] = DONE
+            small = bad & (h < o.h_min)
             state[small] = np.where(1 - t[small] <= o.endgame, STALLED, FAILED)
-            state[act[(steps[act] >= cap[act]) & (state[act] == ACTIVE)]] = FAILED
-        done = np.flatnonzero(state == DONE)
+            state[(steps >= capw) & (state == ACTIVE)] = FAILED
+        done = np.flatnonzero(STATE == DONE)
         if len(done):
-            xd_ = x[done]
+            xe = X[done]
             for _ in range(o.end_newton):
-                xd_, _ = _newton_tangent(hom, xd_, np.ones(len(done)), done)
-            fin = np.all(np.isfinite(xd_), axis=1)
-            x[done[fin]] = xd_[fin]
-    return Paths(x, t, state, steps)
+                xe, _ = _newton_tangent(hom, xe, np.ones(len(done)), done)
+            fin = np.all(np.isfinite(xe), axis=1)
+            X[done[fin]] = xe[fin]
+    return Paths(X, T, STATE, STEPS)
