@@ -199,3 +199,97 @@ def test_explicit_yaml_3_6_is_classified(tmp_path):
     r = solve(p, L)
     assert r.max_solutions == 16
     _check_against_multistart(p, L, r)
+
+
+def test_branch_distance_matches_the_multistart_modes():
+    """Branch safety along a short tilt of utn-dynamic: at each sample the distance to the nearest
+    other mode equals the one computed from the multi-start's modes at the same lengths (second
+    method); the sampled pose is always found among the certified modes."""
+    from stewart_drake.fk import anchor_scale
+    from stewart_drake.homotopy.branches import branch_safety
+
+    p = load_preset("utn-dynamic")
+    t = np.linspace(0, 1, 4)
+    q = p.home_pose() + np.outer(t, [0.03, -0.02, 0.05, 0.2, 0.1, 0.3])
+    rep = branch_safety(p, t, q, "utn", samples=4)
+    assert rep.complete.all() and rep.on_mode.all()
+    r_a = anchor_scale(p)
+    for k in range(4):
+        am = assembly_modes(p, leg_lengths(p, q[k]), polish=None)
+        R_q = rotation_matrix(q[k, 3:], "utn")
+        d = [np.sqrt(np.sum((m.position - q[k, :3]) ** 2) + (r_a * np.arccos(np.clip((np.trace(m.rotation.T @ R_q) - 1) / 2, -1, 1))) ** 2) for m in am.modes]
+        d = np.sort(d)
+        assert d[0] < 1e-9  # the pose itself
+        assert rep.branch_distance[k] == pytest.approx(d[1], abs=1e-9)
+
+
+def test_run_check_branches_cli(tmp_path, capsys):
+    """``run --check-branches``: safe with the default margins on the circle example (exit 0, JSON
+    summary), exit 1 with a one-line reason when the margin is above the measured distance, exit 2 on a
+    negative margin."""
+    import json
+    from pathlib import Path
+
+    from stewart_drake.cli import main
+
+    prog = str(Path(__file__).resolve().parents[1] / "examples" / "circle.stw")
+    args = ["run", prog, "--platform", "utn-kinematic", "--check-branches", "--branch-samples", "5", "--json"]
+    assert main(args + ["--out", str(tmp_path / "a")]) == 0
+    b = json.loads(capsys.readouterr().out)["branches"]
+    assert b["safe"] and b["all_complete"] and b["samples_checked"] == 5 and b["modes_min"] >= 2
+    margin_mm = b["min_branch_distance_m"] * 1e3 * 1.01
+    assert main(args + ["--out", str(tmp_path / "b"), "--branch-margin", str(margin_mm)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not branch-safe" in err[0] and "nearest other assembly mode" in err[0]
+    assert main(args + ["--out", str(tmp_path / "c"), "--branch-margin", "-1"]) == 2
+    assert "--branch-margin" in capsys.readouterr().err
+
+
+def test_six_three_is_the_inverse_motion():
+    """6-3 (base joints shared in pairs): the solver classifies it and solves it as the inverse 3-6
+    motion. ``Platform`` rejects coincident base anchors, so the 6-3 geometry is given to the solver
+    as a plain namespace: utn-dynamic's plate anchors become the base anchors and vice versa; its
+    modes must be the inverses (R → Rᵀ, p → −Rᵀ p) of the 3-6 platform's, all certified."""
+    from types import SimpleNamespace
+
+    p = load_preset("utn-dynamic")
+    q = p.home_pose() + [0.02, -0.01, 0.03, 0.1, 0.05, -0.1]
+    L = leg_lengths(p, q)
+    inv = SimpleNamespace(
+        name="utn-dynamic-inverse", base_anchors=p.top_anchors_per_leg - p.rotation_centre,
+        top_anchors_per_leg=p.base_anchors.copy(), rotation_centre=np.zeros(3), stroke=p.stroke,
+    )
+    assert architecture(inv).kind == "6-3"
+    r63, r36 = solve(inv, L), solve(p, L)
+    assert r63.complete and r63.max_solutions == 16 and all(m.certified for m in r63.modes)
+    flipped = [SimpleNamespace(position=-m.rotation.T @ m.position, rotation=m.rotation.T) for m in r36.modes]
+    assert _same_sets(r63.modes, flipped)
+    assert max(m.residual for m in r63.modes) < 1e-12
+
+
+def test_fk_all_cli_reports_paths_and_certificates(capsys):
+    """``fk --all --json`` on the symmetric 6-6: path counts (12 at infinity) summing to max_solutions,
+    complete with its guarantee, every solution certified with a radius; ``--method multi-start``
+    finds the same poses. Lengths a thousand times too short: no real mode, proven (exit 1)."""
+    import json
+
+    from stewart_drake.cli import main
+
+    p = load_preset("gonzalez-dutra-2009")
+    L = leg_lengths(p, p.home_pose() + [0.02, -0.01, 0.01, 0.1, -0.05, 0.2])
+    base = ["fk", "--platform", "gonzalez-dutra-2009", "--length-unit", "m", "--lengths", *(repr(float(v)) for v in L), "--all", "--json"]
+    assert main(base) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["method"] == "homotopy" and d["architecture"] == "6-6" and d["complete"]
+    assert d["paths"]["infinity"] == 12 and sum(d["paths"].values()) == d["max_solutions"] == 40
+    assert d["paths"]["real"] == len(d["solutions"]) and "probability one" in d["guarantee"]
+    assert all(s["certified"] and 0 < s["certified_radius"] < 1e-6 < s["uniqueness_radius"] for s in d["solutions"])
+    assert main(base + ["--method", "multi-start"]) == 0
+    m = json.loads(capsys.readouterr().out)
+    assert m["method"] == "multi-start"
+    np.testing.assert_allclose(np.sort(np.array([s["pose"] for s in m["solutions"]]), 0),
+                               np.sort(np.array([s["pose"] for s in d["solutions"]]), 0), atol=1e-9)
+    short = ["fk", "--platform", "gonzalez-dutra-2009", "--length-unit", "mm", "--lengths", *(repr(float(v)) for v in L), "--all"]
+    assert main(short) == 1
+    err = capsys.readouterr().err
+    assert "no real assembly mode" in err and "cannot be assembled" in err

@@ -150,4 +150,8 @@ def run(args) -> int:
     if out.get("method") == "homotopy" and not out["complete"]:
         print(f"fk --all: {out['guarantee']}", file=sys.stderr)
         return 1
+    if out.get("method") == "homotopy" and not out["solutions"]:
+        print(f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
+              f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})", file=sys.stderr)
+        return 1
     return 0 if all(s["within_stroke"] for s in out["solutions"]) else 1

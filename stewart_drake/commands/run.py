@@ -33,6 +33,10 @@ def register(sub) -> None:
     p.add_argument("--simulate", action="store_true", help="also run the trajectory through the controller-in-the-loop Drake simulation")
     p.add_argument("--controller", choices=SIMULATE_CONTROLLERS, default="fixed", help="with --simulate: fixed-point (DSP) or float controller (default fixed)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--check-branches", action="store_true", help="check branch safety: the distance from the trajectory to the nearest other assembly mode and to a singularity (complete homotopy FK at sampled poses); exit 1 below a margin")
+    p.add_argument("--branch-margin", type=float, default=20.0, metavar="MM", help="with --check-branches: least allowed distance to another assembly mode, mm at the plate anchors (default 20)")
+    p.add_argument("--singularity-margin", type=float, default=0.02, metavar="SIGMA", help="with --check-branches: least allowed smallest singular value of the scaled inverse Jacobian (default 0.02)")
+    p.add_argument("--branch-samples", type=int, default=200, metavar="N", help="with --check-branches: trajectory samples checked, evenly spaced (default 200, at most 5000)")
     p.set_defaults(func=run)
 
 
@@ -64,13 +68,34 @@ def run(args) -> int:
     summary = summarize(result, args.program, platform.stroke)
     if sim is not None:
         summary["simulation"] = sim["summary"]
+    if args.check_branches:
+        summary["branches"] = check_branches(platform, result, args)
     write_outputs(out, result, summary, sim)
     if args.json:
         json.dump(summary, sys.stdout, indent=2, default=_jsonable)
         sys.stdout.write("\n")
     else:
         print_summary(summary, out)
+    if args.check_branches and not summary["branches"]["safe"]:
+        b = summary["branches"]
+        print(f"run --check-branches: not branch-safe: nearest other assembly mode {b['min_branch_distance_m'] * 1e3:.3f} mm "
+              f"(margin {args.branch_margin:g} mm) at t = {b['min_branch_distance_t_s']:.3f} s; smallest sigma_min "
+              f"{b['min_sigma_min']:.4g} (margin {args.singularity_margin:g}) at t = {b['min_sigma_min_t_s']:.3f} s"
+              + ("" if b["all_complete"] else f"; FK not complete at samples {b['incomplete_samples']}"), file=sys.stderr)
+        return 1
     return 0
+
+
+def check_branches(platform, result, args) -> dict:
+    """Branch-safety summary of the program's trajectory (``homotopy.branches``)."""
+    from ..homotopy.branches import branch_safety
+
+    for name, v in (("--branch-margin", args.branch_margin), ("--singularity-margin", args.singularity_margin)):
+        if not (np.isfinite(v) and v >= 0):
+            raise ValueError(f"{name} must be a non-negative number, got {v}")
+    traj = result.trajectory
+    rep = branch_safety(platform, traj.t, traj.q, args.convention, samples=args.branch_samples)
+    return rep.summary(args.branch_margin * 1e-3, args.singularity_margin)
 
 
 def simulate(platform, result, args) -> dict:
@@ -192,4 +217,9 @@ def print_summary(summary: dict, out: Path) -> None:
     if "simulation" in summary:
         s = summary["simulation"]
         print(f"  simulation ({s['controller']} controller): max |L - L_ref| = {np.max(s['max_abs_length_error_mm']):.3f} mm")
+    if "branches" in summary:
+        b = summary["branches"]
+        print(f"  branches ({b['samples_checked']} samples, {b['modes_min']}-{b['modes_max']} real modes, complete: {b['all_complete']}): "
+              f"nearest other mode {b['min_branch_distance_m'] * 1e3:.3f} mm at t = {b['min_branch_distance_t_s']:.3f} s, "
+              f"smallest sigma_min {b['min_sigma_min']:.4g} at t = {b['min_sigma_min_t_s']:.3f} s -> {'safe' if b['safe'] else 'NOT SAFE'}")
     print(f"wrote {out}/")
