@@ -65,49 +65,67 @@ class Paths:
     steps: np.ndarray
 
 
+def _block_diagonal(B: np.ndarray) -> np.ndarray:
+    """``(24, 24)`` block-diagonal matrix of the six ``(4, 4)`` blocks B_i: u_flat @ it = [u_iᵀ B_i]_i."""
+    D = np.zeros((24, 24), complex)
+    for i in range(6):
+        D[4 * i:4 * i + 4, 4 * i:4 * i + 4] = B[i]
+    return D
+
+
 class Homotopy:
     """H(x, t) for shared leg matrices B0 → B1 ``(6, 4, 4)``, per-path s0 → s1 ``(n, 6)``, chart v ``(8,)``
-    and γ ``(n,)``. ``system(x, t, idx)`` gives H_x ``(k, 8, 8)`` and [H | dH/dt] ``(k, 8, 2)``."""
+    and γ ``(n,)``. ``bind(idx)`` selects the rows of a working set; ``system(x, t)`` then gives
+    H_x ``(k, 8, 8)`` and [H | dH/dt] ``(k, 8, 2)`` for those rows. Products with the six B_i are
+    single matmuls: e @ Br = [B_i e]_i and u_flat @ blockdiag(B_i) = [B_iᵀ u_i]_i."""
 
     def __init__(self, B0, B1, s0, s1, v, gamma):
         B0 = np.asarray(B0, dtype=complex)
         dB = np.asarray(B1, dtype=complex) - B0
         self.fixed = not np.any(dB)  # only the lengths move (the two-stage homotopy's second stage)
-        self.B0r = B0.reshape(24, 4).T.copy()  # e @ B0r = B0 e, legs stacked
+        self.B0r = B0.reshape(24, 4).T.copy()
         self.dBr = dB.reshape(24, 4).T.copy()
-        self.B0t = B0.copy()  # (6, 4, 4): u_i @ B0_i = B0_iᵀ u_i
-        self.dBt = dB.copy()
-        self.s0 = np.asarray(s0, dtype=complex)
-        self.ds = np.asarray(s1, dtype=complex) - self.s0
+        self.B0d = _block_diagonal(B0)
+        self.dBd = _block_diagonal(dB)
+        self.S0 = np.asarray(s0, dtype=complex)
+        self.DS = np.asarray(s1, dtype=complex) - self.S0
         self.v = np.asarray(v, dtype=complex)
-        self.gamma = np.asarray(gamma, dtype=complex)
+        self.G = np.asarray(gamma, dtype=complex)
+        self.bind(np.arange(len(self.S0)))
 
-    def system(self, x, t, idx):
-        g_ = self.gamma[idx]
+    def bind(self, idx) -> None:
+        self.s0, self.ds, self.gamma = self.S0[idx], self.DS[idx], self.G[idx]
+
+    def system(self, x, t):
+        g_ = self.gamma
         d = g_ * t + (1 - t)
-        tau, dtau = g_ * t / d, g_ / d**2
+        tau = g_ * t / d
+        dtau = g_ / (d * d)
         n = len(x)
         e, g = x[:, :4], x[:, 4:]
-        ds = self.ds[idx]
-        s = self.s0[idx] + tau[:, None] * ds
+        ds = self.ds
+        s = self.s0 + tau[:, None] * ds
         ee = np.einsum("nk,nk->n", e, e)
         if self.fixed:
-            u = (e @ self.B0r).reshape(n, 6, 4)
+            uf = e @ self.B0r
+            u = uf.reshape(n, 6, 4)
             u += g[:, None, :]
-            BTu = np.einsum("nij,ijk->nik", u, self.B0t)
+            BTu = (uf @ self.B0d).reshape(n, 6, 4)
         else:
-            dBe = (e @ self.dBr).reshape(n, 6, 4)
-            u = (e @ self.B0r).reshape(n, 6, 4) + tau[:, None, None] * dBe
+            dBe = e @ self.dBr
+            uf = e @ self.B0r + tau[:, None] * dBe
+            u = uf.reshape(n, 6, 4)
             u += g[:, None, :]
-            BTu = np.einsum("nij,ijk->nik", u, self.B0t) + tau[:, None, None] * np.einsum("nij,ijk->nik", u, self.dBt)
-        R = np.zeros((n, 8, 2), complex)
+            BTu = (uf @ self.B0d + tau[:, None] * (uf @ self.dBd)).reshape(n, 6, 4)
+        R = np.empty((n, 8, 2), complex)
         R[:, :6, 0] = np.einsum("nij,nij->ni", u, u) - s * ee[:, None]
         R[:, 6, 0] = np.einsum("nk,nk->n", g, e)
         R[:, 7, 0] = x @ self.v - 1
-        Ht = -ds * ee[:, None]
+        Ht = ds * (-ee)[:, None]
         if not self.fixed:
-            Ht += 2 * np.einsum("nij,nij->ni", u, dBe)
+            Ht += 2 * np.einsum("nij,nij->ni", u, dBe.reshape(n, 6, 4))
         R[:, :6, 1] = Ht * dtau[:, None]
+        R[:, 6:, 1] = 0
         J = np.empty((n, 8, 8), complex)
         J[:, :6, :4] = 2 * (BTu - s[..., None] * e[:, None, :])
         J[:, :6, 4:] = 2 * u
@@ -117,9 +135,10 @@ class Homotopy:
         return J, R
 
 
-def _newton_tangent(hom, x, t, idx):
-    """One Newton step at (x, t) and the tangent dx/dt there: (x − H_x⁻¹ H, −H_x⁻¹ H_t)."""
-    J, R = hom.system(x, t, idx)
+def _newton_tangent(hom, x, t):
+    """One Newton step at (x, t) and the tangent dx/dt there: (x − H_x⁻¹ H, −H_x⁻¹ H_t), for the rows
+    ``hom`` is bound to."""
+    J, R = hom.system(x, t)
     sol = np.linalg.solve(J, R)
     return x - sol[..., 0], -sol[..., 1]
 
@@ -150,7 +169,7 @@ def track(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOptions(), 
     with np.errstate(all="ignore"):
         idx = np.arange(n)
         x, t = X.copy(), T.copy()
-        _, xd = _newton_tangent(hom, x, t, idx)
+        _, xd = _newton_tangent(hom, x, t)
         h = np.full(n, o.h0)
         # A fictitious previous point on the tangent line: the first Hermite prediction is Euler's.
         xp, tp, xdp = x - h[:, None] * xd, t - h, xd.copy()
@@ -168,6 +187,7 @@ def track(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOptions(), 
                 idx, x, t, xd, xp, tp, xdp, h, steps, state, capw = (
                     idx[k], x[k], t[k], xd[k], xp[k], tp[k], xdp[k], h[k], steps[k], state[k], capw[k])
                 live = np.ones(len(idx), bool)
+                hom.bind(idx)
             ha = np.where(live, np.minimum(h, 1 - t), 0.0)
             tn = t + ha
             # Predictor: cubic Hermite through (tp, xp, xdp) and (t, x, xd), evaluated at tn.
@@ -176,8 +196,8 @@ def track(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOptions(), 
             sg2 = sg * sg
             sg3 = sg2 * sg
             xhat = (2 * sg3 - 3 * sg2 + 1) * xp + (sg3 - 2 * sg2 + sg) * D * xdp + (3 * sg2 - 2 * sg3) * x + (sg3 - sg2) * D * xd
-            x1, _ = _newton_tangent(hom, xhat, tn, idx)
-            x2, xd2 = _newton_tangent(hom, x1, tn, idx)
+            x1, _ = _newton_tangent(hom, xhat, tn)
+            x2, xd2 = _newton_tangent(hom, x1, tn)
             norm = np.maximum(_norm(x), 1.0)
             d1 = _norm(x1 - xhat)
             d2 = _norm(x2 - x1)
@@ -201,8 +221,9 @@ def track(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOptions(), 
         done = np.flatnonzero(STATE == DONE)
         if len(done):
             xe = X[done]
+            hom.bind(done)
             for _ in range(o.end_newton):
-                xe, _ = _newton_tangent(hom, xe, np.ones(len(done)), done)
+                xe, _ = _newton_tangent(hom, xe, np.ones(len(done)))
             fin = np.all(np.isfinite(xe), axis=1)
             X[done[fin]] = xe[fin]
     return Paths(X, T, STATE, STEPS)
