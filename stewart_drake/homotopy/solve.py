@@ -2,16 +2,21 @@
 
 Method: the Study-coordinate system of ``study`` (40 isolated solutions for a general 6-6 platform,
 16 for 3-6 / 6-3) is continued from the shipped generic start system of the platform's class
-(``start``) to the platform's own parameters (anchors, squared lengths), all paths together
-(``track``), with a random γ per length set (seeded). Each path's end point is classified:
+(``start``) to the platform's own parameters, all paths together (``track``), with a random γ per
+length set (seeded). By default in two stages (``platform_start``): once per platform, the shipped
+start system is tracked to this platform's anchors at random complex squared lengths s*; then each
+length set tracks only the finite solutions found there (the platform's generic root count) over the
+six squared lengths. Each path's end point is classified:
 
   real       finite, real (pose recovered, Newton-polished on the real system, certified)
   complex    finite, not real
-  infinity   e·e → 0: the pose's translation is unbounded (no assembly)
+  infinity   |e·e| / ‖x‖² < INFINITY_TOL: the pose's translation is unbounded (no assembly). A real
+             assembly has |p| of the order of the leg lengths, so |e·e| / ‖x‖² ~ 1 / (1 + |p|²) in
+             scaled units — far above the tolerance; no real mode can be misfiled as infinite.
   singular   the end point is a singular root (Jacobian rank-deficient: a multiple root, a root on a
              positive-dimensional set)
-  failed     the tracker gave up; failed paths are re-tracked once with tighter steps
-             (``TrackOptions.tighter``) before they are reported as failed
+  failed     the tracker gave up; failed paths are re-tracked with tighter steps
+             (``TrackOptions.tighter``), then the whole set with a new γ, before they are reported
 
 Guarantee (``COMPLETE_TEXT``): by the parameter-homotopy theorem (Morgan & Sommese 1989), for all
 parameters outside a proper algebraic subset of the family — which the random complex start point
@@ -19,6 +24,9 @@ and γ avoid with probability one — the end points of the paths from all solut
 include every isolated solution of the target. So when no path failed and the finite end points are
 distinct (two paths ending together would reveal a path jump), the real end points are all the
 isolated real assembly modes. ``complete`` is False otherwise and ``failed_paths`` names the paths.
+What it does not cover: a positive-dimensional solution set (a self-motion of an architecturally
+singular platform); numerical path tracking itself is not interval-verified (the certificate is
+per returned solution, not per path).
 """
 
 from __future__ import annotations
@@ -181,6 +189,7 @@ class Start:
 
 
 _PLATFORM_STARTS: dict = {}
+MAX_CACHED_PLATFORMS = 32  # stage-one results kept (oldest dropped first)
 
 
 def platform_start(platform: Platform, arch, scale: float, B1: np.ndarray, seed: int = 0, options: TrackOptions = TrackOptions()) -> Start | None:
@@ -207,6 +216,8 @@ def platform_start(platform: Platform, arch, scale: float, B1: np.ndarray, seed:
         if np.all((cls == INFINITY) | (cls == REAL) | (cls == COMPLEX)) and not _duplicates(y, finite):
             out = Start("platform", B1, s_star, paths.x[finite], S.v, len(S.x) - len(finite), len(S.x))
             break
+    if len(_PLATFORM_STARTS) >= MAX_CACHED_PLATFORMS:
+        _PLATFORM_STARTS.pop(next(iter(_PLATFORM_STARTS)))
     _PLATFORM_STARTS[key] = out
     return out
 
