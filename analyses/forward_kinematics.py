@@ -4,7 +4,9 @@ Newton (``stewart_drake.fk``) from the home pose must give back every sampled wo
 in home's singularity-free region; poses across a singularity belong to another assembly mode for the
 same lengths and are recovered by starting near them (trajectory following). The multi-start search
 (``stewart_drake.forward``) must find all 16 modes of the 3-6 platform at home and all 40 real modes
-of Dietmaier's 1998 geometry.
+of Dietmaier's 1998 geometry. The complete homotopy solver (``stewart_drake.homotopy``) must classify
+every path, certify every real mode and agree with the multi-start on Dietmaier, the 3-fold-symmetric
+6-6 and the 3-6.
 """
 
 from __future__ import annotations

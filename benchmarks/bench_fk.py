@@ -145,12 +145,14 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
 
 def homotopy_batch(n: int) -> list[tuple]:
     """Batched mode: n length sets of one platform in one call, per-set time."""
+    from stewart_drake.forward import dietmaier_platform, planar_platform
     from stewart_drake.homotopy import solve_batch
 
     rows = []
     rng = np.random.default_rng(1)
-    for name in ("gonzalez-dutra-2009", "utn-dynamic"):
-        p = load_preset(name)
+    platforms = {"dietmaier-1998": dietmaier_platform()[0], "planar 6-6 seed 0": planar_platform(0)[0]}
+    platforms.update({name: load_preset(name) for name in ("gonzalez-dutra-2009", "utn-dynamic")})
+    for name, p in platforms.items():
         q = p.home_pose() + np.c_[rng.uniform(-0.05, 0.05, (n, 3)), rng.uniform(-0.2, 0.2, (n, 3))]
         L = leg_lengths(p, q)
         solve_batch(p, L[:1])  # stage one, cached

@@ -29,8 +29,9 @@ What this guarantees, and what not:
   the number of isolated (complex) solutions: 40 for a general 6-6 platform (Dietmaier 1998 shows all
   40 can be real), 16 when the legs share three plate (or base) joints in pairs (3-6). Then no
   solution was missed. Otherwise the search is probabilistic: a mode whose basin of attraction is tiny may be
-  missed; more starts (``n_starts``, ``max_rounds``) lower that risk but never to zero. Homotopy
-  continuation would be needed for a guarantee.
+  missed; more starts (``n_starts``, ``max_rounds``) lower that risk but never to zero. The complete
+  solver is ``stewart_drake.homotopy`` (parameter homotopy, every path classified, certified modes);
+  this search remains as an independent second method.
 - A platform whose solution set is not finite (an architecturally singular design, self-motions)
   returns finitely many sample points of it.
 """

@@ -319,8 +319,8 @@ def solve_batch(
         _, _, Lp = _legs(platform, p_BC, R_BT)
         res = np.abs(Lp - L[j]).max(axis=-1) if len(xr) else np.zeros(0)
         dp, da = pose_bounds(xr, cert.radius)
-        if arch.kind == SIX_THREE:  # bounds were for the inverse motion: position bound grows by |p|
-            dp = dp + np.linalg.norm(p_BC, axis=1) / scale * da
+        if arch.kind == SIX_THREE:  # bounds hold for the inverse motion (R', p'), p = −R'ᵀ p', |p'| = |p|:
+            dp = dp + (np.linalg.norm(p_BC, axis=1) / scale + dp) * da  # |δp| <= |δp'| + (|p'| + |δp'|) θ
         modes = [
             CertifiedMode(p_BC[k], R_BT[k], float(res[k]), bool(cert.certified[k]), float(cert.radius[k]),
                           float(cert.uniqueness[k]), float(dp[k] * scale), float(da[k]), int(ridx[k]))
