@@ -226,7 +226,7 @@ def test_branch_distance_matches_the_multistart_modes():
 def test_run_check_branches_cli(tmp_path, capsys):
     """``run --check-branches``: safe with the default margins on the circle example (exit 0, JSON
     summary), exit 1 with a one-line reason when the margin is above the measured distance, exit 2 on a
-    negative margin."""
+    negative margin or a branch option without --check-branches (nothing written)."""
     import json
     from pathlib import Path
 
@@ -243,6 +243,9 @@ def test_run_check_branches_cli(tmp_path, capsys):
     assert len(err) == 1 and "not branch-safe" in err[0] and "nearest other assembly mode" in err[0]
     assert main(args + ["--out", str(tmp_path / "c"), "--branch-margin", "-1"]) == 2
     assert "--branch-margin" in capsys.readouterr().err
+    assert main(["run", prog, "--platform", "utn-kinematic", "--out", str(tmp_path / "d"), "--branch-samples", "5"]) == 2
+    assert "--branch-samples needs --check-branches" in capsys.readouterr().err
+    assert not (tmp_path / "d").exists()
 
 
 def test_six_three_is_the_inverse_motion():
