@@ -41,7 +41,6 @@ from ..fk import _legs, validate_lengths
 from .certify import certify, newton_real, pose_bounds, real_forms
 from .start import load_start_system
 from .study import (
-    GENERAL,
     SIX_THREE,
     architecture,
     evaluate,
