@@ -121,3 +121,15 @@ def first_violation(limits: dict, peaks: dict) -> dict | None:
                 limit = limits[qty]
             best = {"index": k, "leg": i + 1, "quantity": qty, "value": float(arr[k, i]), "limit": float(limit)}
     return best
+
+
+ROTATING_AMPLITUDE = np.radians([0.0, 0.0, 0.0, 5.0, 0.0, 15.0])
+ROTATING_OMEGA = np.array([0.0, 0.0, 0.0, 3.0, 0.0, 2.0])
+
+
+def rotating_trajectory(t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, q̇, q̈)`` of ``simulation.ROTATING`` with exact derivatives: pz = 0.7 m, 5°·sin 3t about x,
+    15°·sin 2t about z (utn convention); each ``t.shape + (6,)``."""
+    from ..dynamics import harmonic_trajectory
+
+    return harmonic_trajectory(t, [0.0, 0.0, 0.7, 0.0, 0.0, 0.0], ROTATING_AMPLITUDE, ROTATING_OMEGA)

@@ -79,7 +79,7 @@ def legs_weight_wrench(platform: Platform, q, convention: str = "utn", gravity: 
 def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False,
                      loaded: bool = True) -> np.ndarray:
     """``(..., 6, 6)`` K (N/m, N/rad, N·m/m, N·m/rad) at poses q ``(..., 6)`` for leg stiffnesses k ``(6,)``
-    N/m. ``loaded=False`` (or zero gravity with no payload) gives Aᵀ diag(k) A."""
+    N/m. ``loaded=False`` gives Aᵀ diag(k) A (as does zero gravity, through the full expression)."""
     q = _poses(q)
     k = np.asarray(k, dtype=float)
     R = rotation_matrix(q[..., 3:], convention)
@@ -89,7 +89,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
     u = l / L[..., None]
     A = np.concatenate([u, np.cross(r, u)], -1)
     K = np.einsum("...ki,k,...kj->...ij", A, k, A)
-    if not loaded or gravity == 0:
+    if not loaded:
         return K
     F = static_leg_forces(platform, q, convention, legs, gravity)
     P = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
