@@ -79,9 +79,9 @@ def legs_weight_wrench(platform: Platform, q, convention: str = "utn", gravity: 
 def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False,
                      loaded: bool = True) -> np.ndarray:
     """``(..., 6, 6)`` K (N/m, N/rad, N·m/m, N·m/rad) at poses q ``(..., 6)`` for leg stiffnesses k ``(6,)``
-    N/m. ``loaded=False`` gives Aᵀ diag(k) A (as does zero gravity, through the full expression)."""
+    N/m (or one number for all). ``loaded=False`` gives Aᵀ diag(k) A (as does zero gravity, through the full expression)."""
     q = _poses(q)
-    k = np.asarray(k, dtype=float)
+    k = np.broadcast_to(np.asarray(k, dtype=float), (6,))
     R = rotation_matrix(q[..., 3:], convention)
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
