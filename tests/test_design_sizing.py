@@ -7,60 +7,15 @@ import json
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 
 from stewart_drake.cli import main
 from stewart_drake.design.boxquad import box_quadratic_max
 from stewart_drake.design.envelope import Envelope, EnvelopeError, cartesian_leg_forces, envelope_sizing, load_envelope
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.sizing import leg_motion, rotating_trajectory, size_trajectory
+from stewart_drake.design.verify import newton_euler_fd, sample_box
 from stewart_drake.geometry import load_platform
 from stewart_drake.simulation import ROTATING
-
-G = 9.81
-# Eighth-order central differences: truncation ~ h^8 |q^(9)| (negligible at h = 1e-3 s for these
-# harmonics), rounding ~ 1e-16 |x| / h for a first derivative and / h² for a second: <= 1e-9 here.
-H = 1e-3
-C1 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0, 4 / 5, -1 / 5, 4 / 105, -1 / 280])
-C2 = np.array([-1 / 560, 8 / 315, -1 / 5, 8 / 5, -205 / 72, 8 / 5, -1 / 5, 8 / 315, -1 / 560])
-OFFSETS = np.arange(-4, 5)
-
-
-def _utn_R(angles):
-    """R = Ry(b) Rx(a) Rz(g) by scipy (intrinsic Y, X, Z), not the toolkit's rotations."""
-    a = np.atleast_2d(angles)
-    return Rotation.from_euler("YXZ", np.stack([a[:, 1], a[:, 0], a[:, 2]], -1)).as_matrix()
-
-
-def newton_euler_fd(platform, pose_fn, t):
-    """Leg forces, lengths and their rates at times t (n,) from the pose function alone: positions and
-    orientations at t + k h, derivatives by finite differences, the plate's Newton–Euler equations and
-    a wrench balance with leg directions taken from the anchors."""
-    ts = t[:, None] + OFFSETS * H  # (n, 9)
-    q = pose_fn(ts)  # (n, 9, 6)
-    R = _utn_R(q[..., 3:].reshape(-1, 3)).reshape(q.shape[:2] + (3, 3))
-    p_cm = q[..., :3] + np.einsum("nkij,j->nki", R, platform.com - platform.rotation_centre)
-    anchors = q[..., None, :3] + np.einsum("nkij,lj->nkli", R, platform.top_anchors_per_leg - platform.rotation_centre)
-    L = np.linalg.norm(anchors - platform.base_anchors, axis=-1)  # (n, 9, 6)
-    Rd = np.einsum("k,nkij->nij", C1, R) / H
-    Rdd = np.einsum("k,nkij->nij", C2, R) / H**2
-    R0 = R[:, 4]
-    W = Rd @ np.swapaxes(R0, -1, -2)  # [ω]×
-    w = np.stack([W[:, 2, 1], W[:, 0, 2], W[:, 1, 0]], -1)
-    Wd = Rdd @ np.swapaxes(R0, -1, -2) + Rd @ np.swapaxes(Rd, -1, -2)  # d/dt(Ṙ Rᵀ) = R̈ Rᵀ + Ṙ Ṙᵀ
-    wd = np.stack([Wd[:, 2, 1], Wd[:, 0, 2], Wd[:, 1, 0]], -1)
-    a_cm = np.einsum("k,nki->ni", C2, p_cm) / H**2
-    f = platform.mass * (a_cm + [0, 0, G])
-    I_W = R0 @ platform.inertia @ np.swapaxes(R0, -1, -2)
-    tau = np.einsum("nij,nj->ni", I_W, wd) + np.cross(w, np.einsum("nij,nj->ni", I_W, w))
-    a0 = anchors[:, 4]
-    u = (a0 - platform.base_anchors) / L[:, 4, :, None]
-    Wmat = np.concatenate([u, np.cross(a0 - p_cm[:, 4, None], u)], -1)  # (n, 6 legs, 6)
-    F = np.linalg.solve(np.swapaxes(Wmat, -1, -2), np.concatenate([f, tau], -1)[..., None])[..., 0]
-    Ld = np.einsum("k,nkl->nl", C1, L) / H
-    Ldd = np.einsum("k,nkl->nl", C2, L) / H**2
-    return F, L[:, 4], Ld, Ldd
-
 
 @pytest.fixture(scope="module")
 def loaded_platform():
@@ -130,14 +85,6 @@ def test_box_quadratic_max_is_the_maximum():
     assert np.all(best - vals <= 0.02)
 
 
-def _samples(rng, n, bound):
-    """Uniform in the box, each coordinate pushed to ±bound with probability 1/2 (faces and vertices
-    are inside the closed box and hold the extremes of an affine function)."""
-    x = rng.uniform(-1, 1, (n, len(bound)))
-    x = np.where(rng.random(x.shape) < 0.5, np.sign(x), x)
-    return x * bound
-
-
 ENV_POSES = np.array([[0.0, 0.0, 0.7, 0.0, 0.0, 0.0], [0.05, -0.04, 0.72, 0.08, -0.05, 0.2], [-0.08, 0.06, 0.67, -0.05, 0.1, -0.15]])
 
 
@@ -149,7 +96,7 @@ def test_envelope_never_exceeded_and_attained(loaded_platform, legs):
     rng = np.random.default_rng(16)
     n = 30_000 if legs else 100_000  # the legs' inverse dynamics is ~5x slower per sample
     k = rng.integers(0, len(ENV_POSES), n)
-    V, A = _samples(rng, n, env.v_max), _samples(rng, n, env.a_max)
+    V, A = sample_box(rng, n, env.v_max), sample_box(rng, n, env.a_max)
     F = cartesian_leg_forces(p, ENV_POSES[k], V, A, legs=legs)
     scale = np.abs(es.peak_force).max()
     tol = 1e-9 * scale  # rounding of two different evaluations of the same dynamics
