@@ -94,7 +94,7 @@ def test_envelope_never_exceeded_and_attained(loaded_platform, legs):
     env = Envelope(ENV_POSES, np.array([0.3, 0.3, 0.2, 1.0, 1.5, 2.0]), np.array([3.0, 4.0, 6.0, 12.0, 10.0, 20.0]))
     es = envelope_sizing(p, env, legs=legs)
     rng = np.random.default_rng(16)
-    n = 30_000 if legs else 100_000  # the legs' inverse dynamics is ~5x slower per sample
+    n = 100_000
     k = rng.integers(0, len(ENV_POSES), n)
     V, A = sample_box(rng, n, env.v_max), sample_box(rng, n, env.a_max)
     F = cartesian_leg_forces(p, ENV_POSES[k], V, A, legs=legs)
