@@ -14,13 +14,14 @@ from stewart_drake.kinematics import condition_number
 def test_slice_maps_match_single_pose_computations():
     p = load_platform("utn-dynamic")
     o = np.radians([8.0, -5.0, 20.0])
-    m = slice_maps(p, half_width=0.5, n=21, orientation=o, k=1e5, modes=True)
+    base = np.r_[0.0, 0.0, p.home_height, o]
+    m = slice_maps(p, ranges=((-0.5, 0.5), (-0.5, 0.5)), n=21, base=base, k=1e5, modes=True)
     assert m.within.any() and not m.within.all()  # the slice reaches past the stroke
     assert np.all(np.isnan(m.condition[~m.within]))
     for i, j in [(10, 10), (3, 14), (16, 5)]:
         if not m.within[i, j]:
             continue
-        q = np.r_[m.x[i], m.y[j], m.z, o]
+        q = np.r_[m.u[i], m.v[j], p.home_height, o]
         assert np.isclose(m.condition[i, j], condition_number(p, q), rtol=1e-10)
         K = stiffness_matrix(p, q, 1e5)
         pr = principal_stiffness(K)
@@ -36,8 +37,9 @@ def test_assembly_mode_flips_across_a_singularity():
     """Turning the 3-6 plate about z far enough crosses a singularity: det J⁻¹ changes sign there and the
     far side is not in the home assembly's safe region."""
     p = load_platform("utn-dynamic")
-    m = slice_maps(p, half_width=0.05, n=5, orientation=np.radians([0.0, 0.0, 100.0]))
-    m0 = slice_maps(p, half_width=0.05, n=5)
-    assert m0.same_mode.all()
-    assert not m.same_mode[m.within].all() or np.nanmax(m.condition) > 1e3
-    assert not m.safe.any()
+    m = slice_maps(p, axes=(0, 5), ranges=((-0.05, 0.05), np.radians([-120.0, 120.0])), n=25)
+    yaw = np.degrees(m.v)
+    assert m.within.all()
+    beyond = np.abs(yaw) > 90
+    assert not m.same_mode[:, beyond].any() and m.same_mode[:, np.abs(yaw) < 90].all()  # at ±90° det J⁻¹ = 0
+    assert not m.safe[:, np.abs(yaw) >= 80].any() and m.safe[:, np.abs(yaw) <= 30].all()

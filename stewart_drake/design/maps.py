@@ -25,18 +25,22 @@ MAX_POINTS = 4_000_000  # slice nodes (work bounded before allocating)
 SAFE_CONDITION = 20.0  # default condition-number limit of the safe region
 
 
+AXIS_NAMES = ("x", "y", "z", "roll", "pitch", "yaw")
+
+
 @dataclass(frozen=True)
 class SliceMaps:
-    """Maps on the (nx, ny) grid ``x`` (nx,), ``y`` (ny,) m at height ``z`` and ``orientation`` (3,) rad.
-    NaN outside the stroke. ``condition`` (scaled 2-norm condition of J⁻¹), ``distance`` = 1/condition
-    (0 at a singularity), ``same_mode`` (sign of det J⁻¹ equals home's), ``safe``; when stiffness is
-    given: ``k_min`` (N/m, softest principal translational stiffness), ``softest`` (nx, ny, 3) its
-    direction; with modes: ``f1`` (Hz) the lowest natural frequency."""
+    """Maps on an (n, n) grid over two pose coordinates ``axes`` (indices into the pose), values ``u``
+    and ``v`` (n,) in SI (m or rad), the other coordinates at ``base`` (6,). NaN outside the stroke.
+    ``condition`` (scaled 2-norm condition of J⁻¹), ``distance`` = 1/condition (0 at a singularity),
+    ``same_mode`` (sign of det J⁻¹ equals home's), ``safe``; when stiffness is given: ``k_min`` (N/m,
+    softest principal translational stiffness), ``softest`` (n, n, 3) its direction; with modes:
+    ``f1`` (Hz) the lowest natural frequency."""
 
-    x: np.ndarray
-    y: np.ndarray
-    z: float
-    orientation: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    axes: tuple
+    base: np.ndarray
     within: np.ndarray
     condition: np.ndarray
     distance: np.ndarray
@@ -47,18 +51,17 @@ class SliceMaps:
     f1: np.ndarray | None = None
 
 
-def slice_poses(platform: Platform, half_width: float, n: int, z: float | None = None, orientation=(0.0, 0.0, 0.0)) -> tuple:
-    """``(x (n,), y (n,), poses (n, n, 6))``: a square grid centred on the home position."""
-    if n * n > MAX_POINTS:
-        raise ValueError(f"slice of {n} x {n} nodes is more than {MAX_POINTS}")
-    z = platform.home_height if z is None else float(z)
-    x = np.linspace(-half_width, half_width, n)
-    y = x.copy()
-    q = np.zeros((n, n, 6))
-    q[..., 0], q[..., 1] = np.meshgrid(x, y, indexing="ij")
-    q[..., 2] = z
-    q[..., 3:] = orientation
-    return x, y, q
+def slice_poses(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0.15)), n: int = 61, base=None) -> tuple:
+    """``(u (n,), v (n,), poses (n, n, 6))``: pose coordinates ``axes`` over ``ranges`` (SI), the others
+    at ``base`` (default the home pose)."""
+    if not (isinstance(n, (int, np.integer)) and 2 <= n and n * n <= MAX_POINTS):
+        raise ValueError(f"slice of {n} x {n} nodes: need 2 <= n and n² <= {MAX_POINTS}")
+    base = platform.home_pose() if base is None else np.asarray(base, dtype=float).reshape(6)
+    u = np.linspace(*ranges[0], n)
+    v = np.linspace(*ranges[1], n)
+    q = np.broadcast_to(base, (n, n, 6)).copy()
+    q[..., axes[0]], q[..., axes[1]] = np.meshgrid(u, v, indexing="ij")
+    return u, v, q
 
 
 def lowest_frequency(K, M) -> np.ndarray:
@@ -71,12 +74,14 @@ def lowest_frequency(K, M) -> np.ndarray:
     return np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi)
 
 
-def slice_maps(platform: Platform, half_width: float = 0.15, n: int = 61, z: float | None = None, orientation=(0.0, 0.0, 0.0),
+def slice_maps(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0.15)), n: int = 61, base=None,
                k=None, gravity: float = G_EARTH, modes: bool = False, max_condition: float = SAFE_CONDITION,
                convention: str = "utn") -> SliceMaps:
-    """Maps over the slice (see ``SliceMaps``); stiffness maps when leg stiffness ``k`` (N/m) is given,
-    and the lowest frequency too with ``modes`` (plate only)."""
-    x, y, q = slice_poses(platform, half_width, n, z, orientation)
+    """Maps over the slice (see ``SliceMaps``, ``slice_poses``); stiffness maps when leg stiffness ``k``
+    (N/m) is given, and the lowest frequency too with ``modes`` (plate only). The safe region is the
+    connected part holding the node nearest to the home pose's coordinates, of the nodes within
+    the stroke, in the home assembly mode and with condition <= ``max_condition``."""
+    x, y, q = slice_poses(platform, axes, ranges, n, base)
     L = leg_lengths(platform, q, convention)
     within = np.all((L >= platform.L_min) & (L <= platform.L_max), axis=-1)
     A = inverse_jacobian(platform, q, convention)
@@ -89,10 +94,11 @@ def slice_maps(platform: Platform, half_width: float = 0.15, n: int = 61, z: flo
     same = np.sign(np.linalg.det(A)) == sign_home
     ok = within & same & (cond <= max_condition)
     labels, _ = ndimage.label(ok)
-    i0 = np.unravel_index(np.argmin(np.sum((q[..., :2] - platform.home_pose()[:2]) ** 2, -1)), ok.shape)
+    home = platform.home_pose()[list(axes)]
+    i0 = (int(np.argmin(np.abs(x - home[0]))), int(np.argmin(np.abs(y - home[1]))))
     safe = ok & (labels == labels[i0]) if ok[i0] else np.zeros_like(ok)
     nan = np.where(within, 1.0, np.nan)
-    out = dict(x=x, y=y, z=float(q[0, 0, 2]), orientation=np.asarray(orientation, float), within=within,
+    out = dict(u=x, v=y, axes=tuple(axes), base=q[0, 0].copy(), within=within,
                condition=cond * nan, distance=np.where(np.isfinite(cond), 1 / cond, 0.0) * nan, same_mode=same, safe=safe)
     if k is not None:
         kmin = np.full(within.shape, np.nan)
