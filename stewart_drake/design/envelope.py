@@ -343,7 +343,7 @@ def envelope_sizing(platform: Platform, env: Envelope, legs: bool = False, gravi
         P = np.eye(3) - u[..., :, None] * u[..., None, :]
         B = np.concatenate([P, -P @ _skew(r)], -1) / np.sqrt(L)[..., None, None]  # (..., 6, 3, 6)
         signs = np.array(np.meshgrid(*[[-1.0, 1.0]] * 6, indexing="ij")).reshape(6, -1).T[:32]  # ±V give the same value
-        conv = np.max(np.sum(np.einsum("...kij,vj->...kvi", B, signs * env.v_max) ** 2, -1), -1)
+        conv = np.max(np.sum((B @ (signs * env.v_max).T) ** 2, -2), -1)
         alin = np.abs(Jinv) @ env.a_max
         out["peak_accel"][s : s + chunk] = np.maximum(alin + cmax + conv, alin + cmin_neg)
         out["allowed_accel"][s : s + chunk] = _allowed(c, G, qmax, -qmin_neg, platform.legs.max_force)
