@@ -236,3 +236,14 @@ def test_cli_size_bad_payload(capsys, args, needle):
     assert main(["size", "--trajectory", "seed", "--dt", "0.1"] + args) == 2
     err = capsys.readouterr().err
     assert needle in err and err.count("\n") == 1
+
+
+def test_envelope_without_velocity_is_affine(loaded_platform):
+    """Zero velocity bounds: the worst case is c + Σ|G| a_max; checked against the 64 vertices."""
+    env = Envelope(ENV_POSES[:1], np.zeros(6), np.array([3.0, 4.0, 6.0, 12.0, 10.0, 20.0]))
+    for legs in (False, True):
+        es = envelope_sizing(loaded_platform, env, legs=legs)
+        signs = np.array(np.meshgrid(*[[-1.0, 1.0]] * 6, indexing="ij")).reshape(6, -1).T
+        F = cartesian_leg_forces(loaded_platform, np.broadcast_to(ENV_POSES[0], (64, 6)), np.zeros((64, 6)), signs * env.a_max, legs=legs)
+        assert np.allclose(F.max(0), es.force_max[0], rtol=1e-12, atol=1e-12)
+        assert np.allclose(F.min(0), es.force_min[0], rtol=1e-12, atol=1e-12)

@@ -171,4 +171,9 @@ def _run_envelope(args, platform, header, legs) -> int:
         a = allowed["min_over_poses"]
         print("largest acceleration per axis the actuators allow at every pose (others zero, worst velocity): "
               + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, allowed["units"])))
-    return _report_violation(viol, f"at envelope pose {viol['index']} {np.round(viol['pose'], 6).tolist()}" if viol else "")
+    where = ""
+    if viol:
+        where = f"at envelope pose {viol['index']} {np.round(viol['pose'], 6).tolist()} (m, rad)"
+        if viol["quantity"] == "power":
+            where += " (power over an envelope is an upper bound: peak |F| x peak |L̇|)"
+    return _report_violation(viol, where)

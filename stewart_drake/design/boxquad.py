@@ -42,6 +42,8 @@ def box_quadratic_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
     b = np.asarray(b, dtype=float)
     d = b.shape[0]
     batch = Q.shape[:-2]
+    if d == 0:
+        return np.zeros(batch), np.zeros(batch + (0,))
     iu = np.triu_indices(d)
     Qf = Q[..., iu[0], iu[1]] * np.where(iu[0] == iu[1], 1.0, 2.0)
     pats = list(_patterns(d))
