@@ -43,3 +43,17 @@ def test_assembly_mode_flips_across_a_singularity():
     beyond = np.abs(yaw) > 90
     assert not m.same_mode[:, beyond].any() and m.same_mode[:, np.abs(yaw) < 90].all()  # at ±90° det J⁻¹ = 0
     assert not m.safe[:, np.abs(yaw) >= 80].any() and m.safe[:, np.abs(yaw) <= 30].all()
+
+
+def test_cli_stiffness_map(tmp_path):
+    from stewart_drake.cli import main
+
+    out = tmp_path / "maps"
+    assert main(["stiffness", "--pose", "0", "0", "700", "5", "0", "30", "--map", str(out), "--map-n", "9", "--map-half-width", "300"]) == 0
+    assert (out / "maps.png").stat().st_size > 1000
+    d = np.load(out / "maps.npz")
+    p = load_platform("utn-dynamic")
+    q = np.r_[d["x_m"][2], d["y_m"][6], 0.7, np.radians([5.0, 0.0, 30.0])]
+    assert np.isclose(d["k_min_n_per_m"][2, 6], principal_stiffness(stiffness_matrix(p, q, 1e5)).translational[0], rtol=1e-10)
+    assert main(["stiffness", "--pose", "0", "0", "700", "0", "0", "0", "--map", str(out), "--map-n", "5000"]) == 2
+    assert (out / "maps.png").exists()  # a refused run leaves the earlier output alone

@@ -24,6 +24,10 @@ def register(sub) -> None:
     p = sub.add_parser("stiffness", help="6×6 Cartesian stiffness, compliance and payload deflection at a pose")
     add_pose_args(p)
     p.add_argument("--json", action="store_true", help="print JSON (SI units: N/m, N/rad, N·m/rad; deflection in m and rad)")
+    p.add_argument("--map", metavar="DIR", help="also write maps over the x-y slice through the pose (condition number, safe region, "
+                   "assembly mode, minimum stiffness, softest direction, lowest frequency): DIR/maps.png and DIR/maps.npz")
+    p.add_argument("--map-half-width", type=float, default=150.0, help="--map: half-width of the square slice, in --length-unit (default 150)")
+    p.add_argument("--map-n", type=int, default=61, help="--map: nodes per side (default 61)")
     p.set_defaults(func=run)
 
 
@@ -85,6 +89,8 @@ def run(args) -> int:
         "payload_wrench": w, "deflection": d,
         "deflection_edge_units": np.r_[d[:3] / kl, d[3:] / ka],
     }
+    if args.map:
+        write_maps(args, platform, q, k)
     if args.json:
         print_json(out)
         return 0
@@ -102,3 +108,29 @@ def run(args) -> int:
     print(f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
           f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}")
     return 0
+
+
+def write_maps(args, platform, q, k) -> None:
+    """Maps over the x-y slice through pose q, written atomically into ``args.map``."""
+    from ..atomic import atomic_folder
+    from ..design.maps import MAX_POINTS, slice_maps
+    from ..design.plots import plot_slice_maps
+
+    hw = args.map_half_width * length_scale(args.length_unit)
+    if not (np.isfinite(hw) and hw > 0):
+        raise ValueError(f"--map-half-width must be a positive length, got {args.map_half_width}")
+    if not 2 <= args.map_n <= int(np.sqrt(MAX_POINTS)):
+        raise ValueError(f"--map-n must be between 2 and {int(np.sqrt(MAX_POINTS))}, got {args.map_n}")
+    ranges = ((q[0] - hw, q[0] + hw), (q[1] - hw, q[1] + hw))
+    m = slice_maps(platform, (0, 1), ranges, args.map_n, base=q, k=k, gravity=args.gravity, modes=True, convention=args.convention)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with atomic_folder(args.map) as tmp:
+        fig = plot_slice_maps(m, args.length_unit)
+        fig.savefig(tmp / "maps.png", dpi=110, bbox_inches="tight")
+        plt.close(fig)
+        np.savez(tmp / "maps.npz", x_m=m.u, y_m=m.v, base_pose=m.base, within=m.within, condition=m.condition, distance=m.distance,
+                 same_mode=m.same_mode, safe=m.safe, k_min_n_per_m=m.k_min, softest=m.softest, f1_hz=m.f1)
