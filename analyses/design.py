@@ -10,7 +10,7 @@ import numpy as np
 
 from stewart_drake.design.envelope import Envelope, cartesian_leg_forces, envelope_sizing
 from stewart_drake.design.maps import SAFE_CONDITION, slice_maps
-from stewart_drake.design.modes import analytic_modes, damping_matrix, mac, spatial_inertia, subspace_mac
+from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.sizing import rotating_trajectory, size_trajectory
 from stewart_drake.design.stiffness import principal_stiffness, static_wrench, stiffness_matrix

@@ -32,10 +32,8 @@ def register(sub) -> None:
 
 
 def prepare(args):
-    """``(platform with payload, pose q (6,) SI, k (6,) N/m, p_TP payload position m)``; exit-1 checks
-    (stroke, singularity) raise ``UnreachablePoseError``/``SingularPoseError``."""
+    """``(platform with payload, pose q (6,) SI, k (6,) N/m, p_TP payload position m)``."""
     from ..design.stiffness import leg_stiffness_vector
-    from ..kinematics import inverse_kinematics, require_nonsingular
 
     base = platform_from_args(args)
     platform, p_TP = platform_with_payload(base, args, args.length_unit)
