@@ -247,3 +247,10 @@ def test_envelope_without_velocity_is_affine(loaded_platform):
         F = cartesian_leg_forces(loaded_platform, np.broadcast_to(ENV_POSES[0], (64, 6)), np.zeros((64, 6)), signs * env.a_max, legs=legs)
         assert np.allclose(F.max(0), es.force_max[0], rtol=1e-12, atol=1e-12)
         assert np.allclose(F.min(0), es.force_min[0], rtol=1e-12, atol=1e-12)
+
+
+def test_cli_size_bad_limit_in_platform_file(tmp_path, capsys):
+    f = _platform_file(tmp_path, max_force=100.0, max_speed=-0.5)
+    assert main(["size", "--platform", f, "--trajectory", "seed", "--dt", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert "legs.max_speed must be a positive number, got -0.5" in err and err.count("\n") == 1

