@@ -208,7 +208,7 @@ def test_cli_size_speed_limit_on_envelope(tmp_path, capsys):
     env = _write(tmp_path, "env.yaml", ENV_YAML)
     assert main(["size", "--platform", f, "--envelope", env]) == 1
     err = capsys.readouterr().err
-    assert "speed" in err and "legs.max_speed 0.1 m/s" in err and "envelope pose 0" in err
+    assert "speed" in err and "legs.max_speed 0.1 m/s" in err and "envelope pose 1 " in err
 
 
 @pytest.mark.parametrize("text, needle", [

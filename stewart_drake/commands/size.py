@@ -173,7 +173,7 @@ def _run_envelope(args, platform, header, legs) -> int:
               + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, allowed["units"])))
     where = ""
     if viol:
-        where = f"at envelope pose {viol['index']} {np.round(viol['pose'], 6).tolist()} (m, rad)"
+        where = f"at envelope {env.shown(viol['index'])}"
         if viol["quantity"] == "power":
             where += " (power over an envelope is an upper bound: peak |F| x peak |L̇|)"
     return _report_violation(viol, where)

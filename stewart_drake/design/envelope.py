@@ -83,13 +83,20 @@ class EnvelopeConfig:
 @dataclass(frozen=True)
 class Envelope:
     """An envelope in SI: ``poses`` (n, 6) m/rad, ``v_max`` (6,) [m/s; rad/s], ``a_max`` (6,)
-    [m/s²; rad/s²], the Euler ``convention`` of the poses and ``source`` (file name, for messages)."""
+    [m/s²; rad/s²], the Euler ``convention`` of the poses, ``source`` (file name) and ``units`` (the
+    file's length and angle units), for messages."""
 
     poses: np.ndarray
     v_max: np.ndarray
     a_max: np.ndarray
     convention: str = "utn"
     source: str = "envelope"
+    units: tuple = ("m", "rad")
+
+    def shown(self, k: int) -> str:
+        """Pose k (0-based) as the file wrote it: ``pose k+1 [..] (mm, deg)``."""
+        scale = np.r_[np.full(3, length_scale(self.units[0])), np.full(3, angle_scale(self.units[1]))]
+        return f"pose {k + 1} {np.round(self.poses[k] / scale, 6).tolist()} ({self.units[0]}, {self.units[1]})"
 
 
 def _numbers(values, n, where, integer=False):
@@ -107,7 +114,8 @@ def _numbers(values, n, where, integer=False):
 
 
 def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envelope:
-    """Validate and convert to SI. Errors name the file and the field (``EnvelopeError``)."""
+    """Validate and convert to SI. Errors name the file and the field (``EnvelopeError``); poses are
+    counted from 1 in messages."""
     try:
         kl, ka = length_scale(cfg.length_unit), angle_scale(cfg.angle_unit)
         check_convention(cfg.convention)
@@ -133,7 +141,7 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
     else:
         if len(cfg.poses) > MAX_POSES:
             raise EnvelopeError(f"{source}: {len(cfg.poses)} poses, more than the limit {MAX_POSES}")
-        poses = np.array([_numbers(p, 6, f"{source}: poses[{k}]") for k, p in enumerate(cfg.poses)])
+        poses = np.array([_numbers(p, 6, f"{source}: poses (pose {k + 1})") for k, p in enumerate(cfg.poses)])
     bounds = {}
     for name, b in (("velocity", cfg.velocity), ("acceleration", cfg.acceleration)):
         lin = _numbers(b.linear, 3, f"{source}: {name}.linear")
@@ -142,7 +150,7 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
             if np.any(arr < 0):
                 raise EnvelopeError(f"{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {arr.tolist()}")
         bounds[name] = np.r_[lin * kl, ang * ka]
-    return Envelope(poses * scale, bounds["velocity"], bounds["acceleration"], cfg.convention, source)
+    return Envelope(poses * scale, bounds["velocity"], bounds["acceleration"], cfg.convention, source, (cfg.length_unit, cfg.angle_unit))
 
 
 def load_envelope(path) -> Envelope:
@@ -163,14 +171,14 @@ def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
         v = v[0]
         k = v["pose"][0]
         raise EnvelopeError(
-            f"{env.source}: pose {k} {np.round(env.poses[k], 6).tolist()} (m, rad) leaves the workspace: leg {v['leg']} length "
+            f"{env.source}: {env.shown(k)} leaves the workspace: leg {v['leg']} length "
             f"{v['length_m'] * 1e3:.3f} mm is {v['excess_m'] * 1e3:.3f} mm {'below' if v['side'] == 'min' else 'above'} the stroke")
     for s in range(0, len(env.poses), 1 << 16):
         k = condition_number(platform, env.poses[s : s + (1 << 16)], env.convention)
         bad = ~(k <= MAX_CONDITION)
         if bad.any():
             j = s + int(np.argmax(bad))
-            raise EnvelopeError(f"{env.source}: pose {j} {np.round(env.poses[j], 6).tolist()} (m, rad) is singular or nearly so (condition number {k[j - s]:.3g})")
+            raise EnvelopeError(f"{env.source}: {env.shown(j)} is singular or nearly so (condition number {k[j - s]:.3g})")
     return L
 
 
