@@ -254,3 +254,18 @@ def test_cli_size_bad_limit_in_platform_file(tmp_path, capsys):
     assert main(["size", "--platform", f, "--trajectory", "seed", "--dt", "0.1"]) == 2
     err = capsys.readouterr().err
     assert "legs.max_speed must be a positive number, got -0.5" in err and err.count("\n") == 1
+
+
+def test_cli_size_trajectory_csv(tmp_path, capsys):
+    """A 19-column CSV (t, q, q̇, q̈) in mm and degrees sizes like the same trajectory given directly."""
+    t = np.linspace(0, 2, 201)
+    q, qd, qdd = rotating_trajectory(t)
+    scale = np.r_[np.full(3, 1e3), np.full(3, 180 / np.pi)]
+    rows = np.concatenate([t[:, None], q * scale, qd * scale, qdd * scale], 1)
+    f = tmp_path / "traj.csv"
+    np.savetxt(f, rows, delimiter=",", fmt="%.17g")
+    assert main(["size", "--trajectory", str(f), "--length-unit", "mm", "--angle-unit", "deg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    s = size_trajectory(load_platform("utn-dynamic"), t, q, qd, qdd)
+    assert np.allclose([r["peak_force_n"] for r in out["legs"]], np.abs(s.force).max(0), rtol=1e-12)
+    assert np.allclose([r["peak_speed_m_s"] for r in out["legs"]], np.abs(s.speed).max(0), rtol=1e-12)
