@@ -12,14 +12,15 @@ pistons, ball constraints). Its constrained dynamics are reduced to the plate's 
 joint velocities follow from the ball-constraint Jacobian, v = N [v_C; ω]; the reduced inertia is
 Nᵀ M N (Drake's ``CalcMassMatrix``) and the stiffness −∂(Nᵀ τ)/∂x, by central differences (step
 ``FD_STEP``) of Drake's generalized forces τ (gravity + spring-loaded actuators F0 − k δL) on the
-constraint manifold. The static actuator forces F0 come from the same plant.
+constraint manifold. The static actuator forces F0 come from the same plant. Leg damping, if any,
+enters this reduced model as Aᵀ diag(c) A (only the plate-only path has Drake's own dampers).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .design.modes import Modes, analytic_modes, damping_matrix, modes_from_state_eigs
+from .design.modes import analytic_modes, damping_matrix, modes_from_state_eigs
 from .design.stiffness import displace, static_leg_forces
 from .dynamics import G_EARTH
 from .geometry import Platform
@@ -37,7 +38,8 @@ def _spatial_inertia(platform: Platform):
 
 
 def spring_plant(platform: Platform, q, k, c=0.0, convention: str = "utn", gravity: float = G_EARTH):
-    """``(plant, context)``: the plate on six spring-damper legs, at rest in equilibrium at pose q (6,)."""
+    """``(plant, context, joint)``: the plate on six spring-damper legs (continuous plant, the plate's
+    ``RpyFloatingJoint``), at rest in equilibrium at pose q (6,)."""
     from pydrake.math import RigidTransform, RotationMatrix
     from pydrake.multibody.plant import MultibodyPlant
     from pydrake.multibody.tree import LinearSpringDamper, RpyFloatingJoint
@@ -136,5 +138,3 @@ def _closed_loop_modes(platform: Platform, q, k, c, convention: str) -> dict:
     C_d = damping_matrix(platform, q, c, convention) if np.any(np.asarray(c) != 0) else None
     return {"modes": analytic_modes(K, M, C_d), "residual": float(np.abs(res).max()), "K": K, "M": M}
 
-
-__all__ = ["Modes", "drake_modes", "spring_plant"]
