@@ -391,6 +391,9 @@ PLATFORM_RULES = {
     "legs.cylinder_mass": Rule("pos", "kg", 1e4),
     "legs.piston_mass": Rule("pos", "kg", 1e4),
     "legs.max_force": Rule("pos", "N", 1e8),
+    "legs.max_speed": Rule("pos", "length"),
+    "legs.max_power": Rule("pos", "W", 1e9),
+    "legs.stiffness": Rule("pos", "N per length unit", 1e15),
 }
 PLATFORM_SHAPES = {
     "radial.base_angles_deg": (6, 6),

@@ -35,8 +35,11 @@ SAFE = {
     "--plant-step": ["0.001", "0", "-1", "abc"],
     "--tol": ["1e-13", "1e-6", "0", "-1", "abc"],
     "--seed": ["0", "1", "-1", "abc"],
+    "--map-n": ["3", "0", "-1", "abc"],
+    "--branch-samples": ["2", "0", "-1", "abc"],
 }
-SKIP = {"--all", "--help", "--version", "--simulate"}  # multi-start / full simulations: seconds each
+# multi-start/homotopy FK, full simulations, Drake linearisation, branch checks and maps: seconds each
+SKIP = {"--all", "--help", "--version", "--simulate", "--drake", "--check-branches", "--map"}
 HEAVY = {"workspace", "simulate", "run", "report"}
 
 
@@ -69,6 +72,8 @@ VALID_PATHS = {
     "--output": ["new.m", "new.py"],
     "--write-sdf": ["new_out"],
     "--only": ["seed_table", "leg"],
+    "--program": ["prog.stw"],
+    "--envelope": ["good.yaml", "missing.yaml"],
 }
 
 
