@@ -253,7 +253,7 @@ def test_cli_size_bad_limit_in_platform_file(tmp_path, capsys):
     f = _platform_file(tmp_path, max_force=100.0, max_speed=-0.5)
     assert main(["size", "--platform", f, "--trajectory", "seed", "--dt", "0.1"]) == 2
     err = capsys.readouterr().err
-    assert "legs.max_speed must be a positive number, got -0.5" in err and err.count("\n") == 1
+    assert "p.yaml:13: legs.max_speed: -0.5 must be > 0" in err and err.count("\n") == 1  # the YAML loader's field rule
 
 
 def test_cli_size_trajectory_csv(tmp_path, capsys):

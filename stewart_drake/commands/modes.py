@@ -70,6 +70,9 @@ def run(args) -> int:
             line += f"   {out['drake']['frequencies_hz'][i]:12.6f}  {out['drake']['mac'][i]:.6f}"
         print(line)
     c = out["controller"]
-    print(f"lowest mode {f1:.4g} Hz: {c['samples_per_lowest_period']:.4g} controller samples per period at {args.sample_rate:g} Hz; "
-          f"a {delay * 1e3:.3g} ms loop delay lags it by {c['phase_lag_at_lowest_deg']:.3g}°")
+    if c["samples_per_lowest_period"] is None:  # f1 = 0: nothing oscillates to be sampled
+        print(f"lowest mode {f1:.4g} Hz: it does not oscillate (neutral or unstable at this leg stiffness)")
+    else:
+        print(f"lowest mode {f1:.4g} Hz: {c['samples_per_lowest_period']:.4g} controller samples per period at {args.sample_rate:g} Hz; "
+              f"a {delay * 1e3:.3g} ms loop delay lags it by {c['phase_lag_at_lowest_deg']:.3g}°")
     return 0
