@@ -1,0 +1,117 @@
+"""A compiled firmware module — generated (``generate``) or a user's C implementing the ABI — loaded
+with cffi: batch IK, traced IK, and the controller tick on an ``sd_state``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .build import Compiler, Source, build, library_sources, load
+from .generate import OPS, TRACE_WORDS, GeneratedFirmware
+
+ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
+
+
+def _cdef(word: str, counting: bool) -> str:
+    s = f"""
+typedef {word} sd_word;
+typedef int32_t sd_count;
+typedef struct {{ int32_t integ[6]; sd_count prev[6]; int16_t dfilt[6]; sd_word setpoint[6]; int16_t vfilt[6]; int16_t saturated[6]; }} sd_state;
+int sd_ik(const sd_word pose[6], sd_word lengths[6]);
+int sd_ik_trace(const sd_word pose[6], int32_t trace[{TRACE_WORDS}]);
+void sd_init(sd_state *s);
+int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], const int16_t feedforward[6], int16_t command[6]);
+void sd_ik_batch(const sd_word *poses, long n, sd_word *lengths, int32_t *nsat);
+"""
+    if counting:
+        s += f"extern long sd_op_counts[{len(OPS)}];\n"
+    return s
+
+
+@dataclass
+class FirmwareModule:
+    """A loaded firmware: ``ffi``, ``lib``, the library ``path``, ``word_dtype`` of ``sd_word`` and which
+    optional ABI functions it defines (``has_tick``, ``has_trace``)."""
+
+    ffi: object
+    lib: object
+    path: Path
+    word: str
+    counting: bool = False
+
+    @property
+    def word_dtype(self):
+        return np.int16 if self.word == "int16_t" else np.int32
+
+    def _has(self, name: str) -> bool:
+        try:
+            getattr(self.lib, name)
+            return True
+        except (AttributeError, NotImplementedError):
+            return False
+
+    @property
+    def has_tick(self) -> bool:
+        return self._has("sd_tick") and self._has("sd_init")
+
+    @property
+    def has_trace(self) -> bool:
+        return self._has("sd_ik_trace")
+
+    def ik(self, words) -> tuple[np.ndarray, np.ndarray]:
+        """``(lengths (..., 6) int64, saturation counts (...) int64)`` of ``(..., 6)`` pose words."""
+        w = np.asarray(words)
+        flat = np.ascontiguousarray(w.reshape(-1, 6), dtype=self.word_dtype)
+        out = np.empty_like(flat)
+        nsat = np.empty(len(flat), dtype=np.int32)
+        f = self.ffi
+        self.lib.sd_ik_batch(f.from_buffer(f"{self.word}[]", flat), len(flat), f.from_buffer(f"{self.word}[]", out),
+                             f.from_buffer("int32_t[]", nsat))
+        return out.astype(np.int64).reshape(w.shape), nsat.astype(np.int64).reshape(w.shape[:-1])
+
+    def ik_trace(self, pose_words) -> np.ndarray:
+        """``(TRACE_WORDS,)`` int64 intermediate words of one pose (see ``generate.TRACE_FIELDS``)."""
+        p = np.ascontiguousarray(pose_words, dtype=self.word_dtype).reshape(6)
+        tr = np.zeros(TRACE_WORDS, dtype=np.int32)
+        self.lib.sd_ik_trace(self.ffi.from_buffer(f"{self.word}[]", p), self.ffi.from_buffer("int32_t[]", tr))
+        return tr.astype(np.int64)
+
+    def new_state(self):
+        s = self.ffi.new("sd_state *")
+        self.lib.sd_init(s)
+        return s
+
+    def op_counts(self) -> dict:
+        """The instrumented build's counters (name -> calls since the last ``reset_op_counts``)."""
+        return {n: int(self.lib.sd_op_counts[k]) for k, n in enumerate(OPS) if self.lib.sd_op_counts[k]}
+
+    def reset_op_counts(self) -> None:
+        for k in range(len(OPS)):
+            self.lib.sd_op_counts[k] = 0
+
+
+def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O2") -> FirmwareModule:
+    """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
+    sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c")]
+    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
+    path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt)
+    word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
+    ffi, lib = load(path, _cdef(word, counting))
+    return FirmwareModule(ffi, lib, path, word, counting)
+
+
+def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = None) -> FirmwareModule:
+    """Compile a user's C file implementing the ABI (``#include "sd_firmware.h"``; the header generated for
+    the same platform and format is on the include path, and so is ``dsp56800e.h``). The compiler's
+    messages name the user's file and line; raises build.CompileError."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"firmware file {str(path)!r} does not exist")
+    sources = [Source(path.name, path=path.resolve()), *library_sources("sd_host.c", "dsp56800e.c")]
+    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
+    lib_path = build(sources, headers=headers, compiler=compiler)
+    word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
+    ffi, lib = load(lib_path, _cdef(word, False))
+    return FirmwareModule(ffi, lib, lib_path, word)
