@@ -198,12 +198,12 @@ def build(sources: list[Source], *, headers: list[Source] = (), defines: tuple[s
 
 
 def _first_error(msg: str, compiler: Compiler) -> str:
-    """The compiler's first error line (file:line:col: error: ...) and the few lines of context after it."""
+    """The compiler's first error line (file:line:col: error: ...), else the start of its output."""
     lines = msg.strip().splitlines()
     for k, line in enumerate(lines):
         if re.search(r":\d+:(\d+:)? (fatal )?error", line):
-            return "\n".join(lines[k:k + 3])
-    return f"{compiler.name} failed: " + "\n".join(lines[:6])
+            return line
+    return f"{compiler.name} failed: " + " | ".join(lines[:3])
 
 
 @lru_cache(maxsize=None)

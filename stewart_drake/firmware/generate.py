@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..control import DIFF_SHIFT, ISR_OVERHEAD_CYCLES, ControllerConfig, FixedGains, counts_per_lsb
+from ..control import (DIFF_SHIFT, FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG, ControllerConfig, FixedGains,
+                       counts_per_lsb)
 from ..fixedpoint import q15
 from ..fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
 from ..fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
@@ -43,6 +44,7 @@ TABLE_CYCLES = 6.0
 # trace layout of sd_ik_trace (int32 words)
 TRACE_FIELDS = (("pose", 6), ("sin", 3), ("cos", 3), ("R", 9), ("leg", 18), ("sq", 6), ("lengths", 6))
 TRACE_WORDS = sum(n for _, n in TRACE_FIELDS)
+TRACE_AT = {name: sum(n for _, n in TRACE_FIELDS[:k]) for k, (name, _) in enumerate(TRACE_FIELDS)}
 FILES = ("sd_firmware.h", "sd_firmware.c", "README.md")
 
 
@@ -170,7 +172,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
                         e.op("add" if coef > 0 else "sub")
             if first:
                 e.emit(f"{target} = 0;")
-    e.emit("if (trace) { " + " ".join(f"trace[{15 + 3 * i + j}] = R{i}{j};" for i in range(3) for j in range(3)) + " }")
+    e.emit("if (trace) { " + " ".join(f"trace[{TRACE_AT['R'] + 3 * i + j}] = R{i}{j};" for i in range(3) for j in range(3)) + " }")
     # -- legs
     for i in range(6):
         e.emit(f"/* leg {i + 1}: plate anchor offset ({', '.join(str(int(v)) for v in r_T[i])}), base anchor ({', '.join(str(int(v)) for v in B[i])}) LSB */")
@@ -185,11 +187,11 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
             if B[i, r]:
                 e.emit(f"v = subw(v, {_c_int(B[i, r])}, &nsat);")
                 e.op("sub")
-            e.emit(f"if (trace) trace[{24 + 3 * i + r}] = (int32_t)v;")
+            e.emit(f"if (trace) trace[{TRACE_AT['leg'] + 3 * i + r}] = (int32_t)v;")
             e.emit("sq = sqacc(sq, v, &nsat);")
             e.op("L_mult")
             e.op("L_add")
-        e.emit(f"if (trace) trace[{42 + i}] = (int32_t)(sq > 2147483647L ? 2147483647L : sq);")
+        e.emit(f"if (trace) trace[{TRACE_AT['sq'] + i}] = (int32_t)(sq > 2147483647L ? 2147483647L : sq);")
         e.emit(f"lengths[{i}] = (sd_word)isqrt_near(sq, &nsat);")
         e.op("mfr32Sqrt")
     ik_ops = Counter(e.ops)
@@ -207,10 +209,12 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
                  f"   the emulation on all {2 ** fmt.word_bits} angle words) */\nstatic const {ttype} SIN_TABLE[{H + 1}] = {{\n    "
                  + ",\n    ".join(rows) + "\n};\n")
 
-    tick_ops = Counter({k: 6 * v for k, v in {"sub": 5, "add": 2, "shl": 2, "mult_r": 2, "L_mult": 6, "extract_h": 1,
-                                               "L_shl": 4, "L_add": 3, "L_sub": 1}.items()})
-    tick_ops["L_deposit_h"] += 6
-    tick_ops["L_add"] += 6
+    # the controller tick's operations beyond the IK: the cycle model's (control.PID_OPS_PER_LEG and
+    # FEEDFORWARD_OPS_PER_LEG, six legs); the emitted sd_tick below performs exactly these (a test counts them)
+    tick_ops = Counter()
+    for ops in (PID_OPS_PER_LEG, FEEDFORWARD_OPS_PER_LEG):
+        for k, v in ops.items():
+            tick_ops[k] += 6 * v
 
     g = GeneratedFirmware(platform.name, fmt, conv, config, ik_ops=ik_ops, tick_ops=tick_ops)
     ctx = dict(
@@ -218,7 +222,8 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
         word="int32_t" if wide else "int16_t", acc_hi=acc_hi, acc_lo=-acc_hi - 1, cpl=cpl, diff_shift=DIFF_SHIFT,
         kp=gains.kp, ki=gains.ki, kd=gains.kd, kv=gains.kv, alpha=gains.alpha, alpha_ff=gains.alpha_ff,
         T=config.timing.sample_period, res=config.timing.sensor_resolution, rng=config.timing.command_range,
-        sqrt_bits=fmt.word_bits, trace_words=TRACE_WORDS, ops=OPS,
+        sqrt_bits=fmt.word_bits, trace_words=TRACE_WORDS, ops=OPS, at_sin=TRACE_AT["sin"], at_cos=TRACE_AT["cos"],
+        at_len=TRACE_AT["lengths"],
     )
     g.files["sd_firmware.h"] = _header(ctx, config)
     g.files["sd_firmware.c"] = _source(ctx, e.lines, table)
@@ -424,8 +429,9 @@ static int ik_core(const sd_word pose[6], sd_word lengths[6], int32_t *trace)
 {chr(10).join(ik_lines)}
     if (trace) {{
         int k;
-        trace[6] = sx; trace[7] = sy; trace[8] = sz; trace[9] = cx; trace[10] = cy; trace[11] = cz;
-        for (k = 0; k < 6; k++) trace[48 + k] = lengths[k];
+        trace[{c['at_sin']}] = sx; trace[{c['at_sin']} + 1] = sy; trace[{c['at_sin']} + 2] = sz;
+        trace[{c['at_cos']}] = cx; trace[{c['at_cos']} + 1] = cy; trace[{c['at_cos']} + 2] = cz;
+        for (k = 0; k < 6; k++) trace[{c['at_len']} + k] = lengths[k];
     }}
     return nsat;
 }}

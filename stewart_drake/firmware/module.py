@@ -115,3 +115,54 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
     word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
     ffi, lib = load(lib_path, _cdef(word, False))
     return FirmwareModule(ffi, lib, lib_path, word)
+
+
+class TickRunner:
+    """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control._FixedLaw``
+    (integrator, previous measurement, its filtered difference, previous set-point, its filtered
+    difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer."""
+
+    FIELDS = (("integ", np.int32), ("prev", np.int32), ("dfilt", np.int16), ("setpoint", None), ("vfilt", np.int16), ("saturated", np.int16))
+
+    def __init__(self, module: FirmwareModule):
+        if not module.has_tick:
+            raise ValueError(f"firmware {module.path.name} does not define sd_init and sd_tick")
+        self.module = m = module
+        ffi = m.ffi
+        self._buf = bytearray(ffi.sizeof("sd_state"))
+        self._ptr = ffi.from_buffer("sd_state *", self._buf)
+        m.lib.sd_init(self._ptr)
+        self.views = {name: np.frombuffer(self._buf, dtype=dt or m.word_dtype, count=6, offset=ffi.offsetof("sd_state", name))
+                      for name, dt in self.FIELDS}
+        self.pose = np.zeros(6, dtype=m.word_dtype)
+        self.measured = np.zeros(6, dtype=np.int32)
+        self.feedforward = np.zeros(6, dtype=np.int16)
+        self.command = np.zeros(6, dtype=np.int16)
+        self._p = (ffi.from_buffer(f"{m.word}[]", self.pose), ffi.from_buffer("int32_t[]", self.measured),
+                   ffi.from_buffer("int16_t[]", self.feedforward), ffi.from_buffer("int16_t[]", self.command))
+        self._tick = m.lib.sd_tick
+        self._null = ffi.NULL
+
+    def set_state(self, state) -> None:
+        st = np.asarray(state)
+        v = self.views
+        v["integ"][:] = st[0:6]
+        v["prev"][:] = st[6:12]
+        v["dfilt"][:] = st[12:18]
+        v["setpoint"][:] = st[18:24]
+        v["vfilt"][:] = st[24:30]
+
+    def state(self) -> np.ndarray:
+        """The 30-word state vector (int64)."""
+        v = self.views
+        return np.concatenate([v["integ"], v["prev"], v["dfilt"], v["setpoint"], v["vfilt"]]).astype(np.int64)
+
+    def tick(self, pose_words, measured, feedforward_words=None) -> np.ndarray:
+        """One ``sd_tick`` on the held state; returns the six Q15 command words (int16 view, copied)."""
+        self.pose[:] = pose_words
+        self.measured[:] = measured
+        p_pose, p_meas, p_ff, p_cmd = self._p
+        if feedforward_words is not None:
+            self.feedforward[:] = feedforward_words
+        self._tick(self._ptr, p_pose, p_meas, p_ff if feedforward_words is not None else self._null, p_cmd)
+        return self.command.copy()
