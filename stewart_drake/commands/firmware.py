@@ -18,6 +18,8 @@ def _format_args(p) -> None:
     p.add_argument("--convention", choices=["utn", "zyx"], default="utn", help="Euler convention of the pose angles (default utn)")
     p.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="controller rate, Hz (default 1000)")
     p.add_argument("--sensor-resolution", type=float, default=1e-5, metavar="M", help="leg sensor, m per count (default 1e-5)")
+    p.add_argument("--trajectory", default=None, metavar="seed|rotating|FILE.csv",
+                   help="design the gains over this reference's poses, as `simulate` does (default: home only)")
 
 
 def register(sub) -> None:
@@ -51,8 +53,13 @@ def _config(args, platform):
         raise ValueError(f"--rate must be a positive number of Hz up to 1e6, got {args.rate:g}")
     fmt = QFormat(args.word_bits, args.length_lsb, args.trig)
     timing = DspTiming(sample_period=1.0 / args.rate, sensor_resolution=args.sensor_resolution,
-                       command_range=float(platform.legs.max_force))
-    return ControllerConfig.for_platform(platform, timing, ik_format=fmt, convention=args.convention)
+                       command_range=float(platform.legs.max_force)).check()
+    poses = None
+    if args.trajectory is not None:
+        from ..simulation import design_poses, get_trajectory
+
+        poses = design_poses(get_trajectory(args.trajectory))
+    return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=args.convention)
 
 
 def run_generate(args) -> int:
