@@ -24,6 +24,8 @@ int sd_ik_trace(const sd_word pose[6], int32_t trace[{TRACE_WORDS}]);
 void sd_init(sd_state *s);
 int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], const int16_t feedforward[6], int16_t command[6]);
 void sd_ik_batch(const sd_word *poses, long n, sd_word *lengths, int32_t *nsat);
+int sd_host_tick(sd_state *s, const sd_word pose[6], const double L[6], double res, const double *ff, double range,
+                 double lsb, double state[30], double out[18]);
 """
     if counting:
         s += f"extern long sd_op_counts[{len(OPS)}];\n"
@@ -96,7 +98,8 @@ def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, co
     """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
     sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
-    path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt)
+    path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt,
+                 flags=("-lm",))
     word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
     ffi, lib = load(path, _cdef(word, counting))
     return FirmwareModule(ffi, lib, path, word, counting)
@@ -111,7 +114,7 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
         raise FileNotFoundError(f"firmware file {str(path)!r} does not exist")
     sources = [Source(path.name, path=path.resolve()), *library_sources("sd_host.c", "dsp56800e.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
-    lib_path = build(sources, headers=headers, compiler=compiler)
+    lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
     word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
     ffi, lib = load(lib_path, _cdef(word, False))
     return FirmwareModule(ffi, lib, lib_path, word)

@@ -27,6 +27,16 @@ class _CFixedLaw(_FixedLaw):
         self.module = m
         self.runner = TickRunner(m)
         self._words: dict[bytes, np.ndarray] = {}
+        # the host's side of one tick (quantising, feed-forward words, state vector) runs in C too
+        # (sd_host.c: the same IEEE operations as _FixedLaw's numpy code), one call per tick
+        ffi = m.ffi
+        self._L, self._ff, self._state, self._out = np.zeros(6), np.zeros(6), np.zeros(30), np.zeros(18)
+        self._p_pose = ffi.from_buffer(f"{m.word}[]", self.runner.pose)
+        self._p_L, self._p_ff, self._p_state, self._p_out = (ffi.from_buffer("double[]", a) for a in (self._L, self._ff, self._state, self._out))
+        self._null = ffi.NULL
+        self._host_tick = m.lib.sd_host_tick
+        self._res, self._range = float(self.timing.sensor_resolution), float(self.timing.command_range)
+        self._lsb = float(self.config.ik_format.length_lsb)
 
     def prime(self, poses) -> None:
         """Convert ``(n, 6)`` reference poses to pose words in one batch and remember them (speed only)."""
@@ -42,15 +52,18 @@ class _CFixedLaw(_FixedLaw):
         if w is None:
             self.cache_misses += 1
             w = pose_words(ref, self.config.ik_format)
-        m = self.quantise(L)
-        if np.any(np.abs(m) > 2**31 - 1):
-            raise ValueError(f"measured leg lengths {np.asarray(L).tolist()} m do not fit the firmware's 32-bit sensor counts")
         r = self.runner
-        r.set_state(pid)
-        cmd = r.tick(w, m, None if ff is None else self.feedforward_words(ff))
-        command = cmd / 32768.0 * self.timing.command_range
-        sp = r.views["setpoint"].astype(np.int64)
-        return command, sp * self.config.ik_format.length_lsb, r.state().astype(float), r.views["saturated"].astype(float)
+        r.pose[:] = w
+        self._L[:] = L
+        self._state[:] = pid
+        if ff is not None:
+            self._ff[:] = ff
+        k = self._host_tick(r._ptr, self._p_pose, self._p_L, self._res, self._p_ff if ff is not None else self._null, self._range,
+                            self._lsb, self._p_state, self._p_out)
+        if k < 0:
+            raise ValueError(f"measured leg lengths {np.asarray(L).tolist()} m do not fit the firmware's 32-bit sensor counts")
+        o = self._out
+        return o[:6].copy(), o[6:12].copy(), self._state.copy(), o[12:].copy()
 
 
 _CLASSES: dict[str, type] = {}
