@@ -409,7 +409,9 @@ static int32_t isqrt_near(int64_t S, int *nsat)
     int k;
     SD_OP(SD_mfr32Sqrt);
     if (S < 0) S = 0;
-    for (k = {c['sqrt_bits'] - 1}; k >= 0; k--) {{
+    k = {c['sqrt_bits'] - 1};
+    while (k > 0 && ((int64_t)1 << (2 * k)) > S) k--; /* bits above sqrt(S) stay 0: skip their trials */
+    for (; k >= 0; k--) {{
         t = y | ((int64_t)1 << k);
         if (t * t <= S) y = t;
     }}
