@@ -667,15 +667,16 @@ def FixedPointController(platform: Platform, config: ControllerConfig | None = N
 
 def make_controller(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python", firmware=None):
     """``kind`` ``"fixed"`` or ``"float"``; for ``fixed``, ``engine`` ``"python"`` (the emulation) or ``"c"``
-    (the compiled firmware, ``firmware.sil``; ``firmware``: a user's C file implementing the ABI)."""
+    (the compiled firmware, ``firmware.sil``; ``firmware``: a user's C file implementing the ABI). The float
+    twin has no firmware: ``engine`` does not apply to it."""
     if kind == "fixed" and (engine == "c" or firmware is not None):
         from .firmware.sil import CFixedPointController  # the firmware package builds on this module
 
         return CFixedPointController(platform, config, firmware)
     if engine not in ("python", "c"):
         raise ValueError(f"engine must be 'python' or 'c', got {engine!r}")
-    if kind != "fixed" and (engine == "c" or firmware is not None):
-        raise ValueError(f"the C engine runs the fixed-point controller; controller {kind!r} has no firmware")
+    if kind != "fixed" and firmware is not None:
+        raise ValueError(f"a firmware file runs the fixed-point controller; controller {kind!r} has no firmware")
     if kind == "fixed":
         return FixedPointController(platform, config)
     if kind == "float":

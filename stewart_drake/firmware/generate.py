@@ -192,8 +192,9 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
             e.op("L_mult")
             e.op("L_add")
         e.emit(f"if (trace) trace[{TRACE_AT['sq'] + i}] = (int32_t)(sq > 2147483647L ? 2147483647L : sq);")
-        e.emit(f"lengths[{i}] = (sd_word)isqrt_near(sq, &nsat);")
+        e.emit(f"S[{i}] = sq;")
         e.op("mfr32Sqrt")
+    e.emit("isqrt_near6(S, lengths, &nsat);")
     ik_ops = Counter(e.ops)
 
     # trig table
@@ -402,23 +403,31 @@ static int64_t sqacc(int64_t sq, int64_t v, int *nsat)
     if (x > SD_ACC_HI) {{ ++*nsat; return SD_ACC_HI; }}
     return x;
 }}
-/* the nearer of y, y + 1 to sqrt(S) (y the largest with y^2 <= S: a {c['sqrt_bits']}-step bit search), saturated to the word */
-static int32_t isqrt_near(int64_t S, int *nsat)
+/* lengths[i] = the nearer of y, y + 1 to sqrt(S[i]) (y the largest with y^2 <= S[i]: a {c['sqrt_bits']}-step bit search,
+   skipping the trial bits above the largest root, which stay 0), saturated to the word; the six searches
+   run side by side (independent: the same results, scheduled in parallel). S[i] < 2^{2 * c['wb'] - 1}: 32-bit words. */
+static void isqrt_near6(const int64_t S[6], sd_word lengths[6], int *nsat)
 {{
-    int64_t y = 0, t, dy, dr;
-    int k;
-    SD_OP(SD_mfr32Sqrt);
-    if (S < 0) S = 0;
-    k = {c['sqrt_bits'] - 1};
-    while (k > 0 && ((int64_t)1 << (2 * k)) > S) k--; /* bits above sqrt(S) stay 0: skip their trials */
-    for (; k >= 0; k--) {{
-        t = y | ((int64_t)1 << k);
-        if (t * t <= S) y = t;
+    uint32_t y[6] = {{0, 0, 0, 0, 0, 0}}, s[6];
+    int64_t mx = 0;
+    int i, k;
+    for (i = 0; i < 6; i++) {{
+        SD_OP(SD_mfr32Sqrt);
+        s[i] = (uint32_t)(S[i] < 0 ? 0 : S[i]);
+        if ((int64_t)s[i] > mx) mx = s[i];
     }}
-    dy = S - y * y;
-    dr = (y + 1) * (y + 1) - S;
-    if (dr < dy) y = y + 1;
-    return satw(y, nsat);
+    k = {c['sqrt_bits'] - 1};
+    while (k > 0 && ((int64_t)1 << (2 * k)) > mx) k--;
+    for (; k >= 0; k--) {{
+        for (i = 0; i < 6; i++) {{
+            uint32_t t = y[i] | ((uint32_t)1 << k);
+            y[i] = t * t <= s[i] ? t : y[i];
+        }}
+    }}
+    for (i = 0; i < 6; i++) {{
+        int64_t yy = y[i], dy = (int64_t)s[i] - yy * yy, dr = (yy + 1) * (yy + 1) - (int64_t)s[i];
+        lengths[i] = (sd_word)satw(dr < dy ? yy + 1 : yy, nsat);
+    }}
 }}
 {table}{trig}
 static int ik_core(const sd_word pose[6], sd_word lengths[6], int32_t *trace)
@@ -426,7 +435,7 @@ static int ik_core(const sd_word pose[6], sd_word lengths[6], int32_t *trace)
     int nsat = 0;
     int32_t sx, cx, sy, cy, sz, cz;
     int32_t R00, R01, R02, R10, R11, R12, R20, R21, R22;
-    int64_t sq, v;
+    int64_t sq, v, S[6];
     if (trace) {{ int k; for (k = 0; k < 6; k++) trace[k] = pose[k]; }}
 {chr(10).join(ik_lines)}
     if (trace) {{

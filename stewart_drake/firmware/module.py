@@ -73,6 +73,12 @@ class FirmwareModule:
                              f.from_buffer("int32_t[]", nsat))
         return out.astype(np.int64).reshape(w.shape), nsat.astype(np.int64).reshape(w.shape[:-1])
 
+    def ik_raw(self, words: np.ndarray, out: np.ndarray) -> None:
+        """``sd_ik`` over ``(n, 6)`` C-contiguous ``word_dtype`` pose words into ``out`` (same shape and
+        dtype), no conversions: the batch call the throughput benchmark times."""
+        f = self.ffi
+        self.lib.sd_ik_batch(f.from_buffer(f"{self.word}[]", words), len(words), f.from_buffer(f"{self.word}[]", out), f.NULL)
+
     def ik_trace(self, pose_words) -> np.ndarray:
         """``(TRACE_WORDS,)`` int64 intermediate words of one pose (see ``generate.TRACE_FIELDS``)."""
         p = np.ascontiguousarray(pose_words, dtype=self.word_dtype).reshape(6)
@@ -94,9 +100,9 @@ class FirmwareModule:
             self.lib.sd_op_counts[k] = 0
 
 
-def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O2") -> FirmwareModule:
+def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O3") -> FirmwareModule:
     """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
-    sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c")]
+    sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c", "sd_host_tick.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
     path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt,
                  flags=("-lm",))
@@ -114,10 +120,13 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
         raise FileNotFoundError(f"firmware file {str(path)!r} does not exist")
     sources = [Source(path.name, path=path.resolve()), *library_sources("sd_host.c", "dsp56800e.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
-    lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
     word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
-    ffi, lib = load(lib_path, _cdef(word, False))
-    return FirmwareModule(ffi, lib, lib_path, word)
+    lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
+    m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
+    if m.has_tick:  # then link the tick's host glue too (it calls sd_tick)
+        lib_path = build(sources + library_sources("sd_host_tick.c"), headers=headers, compiler=compiler, flags=("-lm",))
+        m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
+    return m
 
 
 class TickRunner:
