@@ -3,14 +3,13 @@ bit for bit: every edge-case combination and 10^6 random operands per intrinsic;
 words; and the compiled tp17.C against the Python port (the seed table, random poses, op counts)."""
 
 import os
-from collections import Counter
 from itertools import product
 
 import numpy as np
 import pytest
 
 from stewart_drake.firmware import build
-from stewart_drake.firmware.host import BATCH_OPS, frac, host_library, intrinsic, op_counts_tp17, tp17_leg_lengths_c
+from stewart_drake.firmware.host import BATCH_OPS, frac, intrinsic, op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.fixedpoint import q15, scalar, tp17_leg_lengths
 from tests.firmware_cache import firmware_cache  # noqa: F401
 

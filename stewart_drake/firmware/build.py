@@ -56,13 +56,6 @@ class Compiler:
     argv: tuple[str, ...]
     version: str
 
-    def env(self, cache_dir: Path) -> dict:
-        env = dict(os.environ)
-        if "ziglang" in self.argv:  # zig keeps its own cache: keep it beside ours, not in $HOME
-            env.setdefault("ZIG_GLOBAL_CACHE_DIR", str(cache_dir / "zig"))
-            env.setdefault("ZIG_LOCAL_CACHE_DIR", str(cache_dir / "zig"))
-        return env
-
 
 def cache_dir() -> Path:
     """The folder compiled modules are cached in (created on first use)."""
@@ -189,7 +182,7 @@ def build(sources: list[Source], *, headers: list[Source] = (), defines: tuple[s
             files.append(str(s.path if s.path is not None else tmp / s.name))
         target = tmp / "lib.so"
         cmd = [*compiler.argv, *cflags, f"-I{tmp}", f"-I{C_DIR}", "-o", str(target), *files]
-        r = subprocess.run(cmd, capture_output=True, text=True, env=compiler.env(root))
+        r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
             msg = (r.stderr or r.stdout).replace(str(tmp) + os.sep, "")
             raise CompileError(_first_error(msg, compiler))

@@ -2,7 +2,7 @@
 ``fixedpoint.generic`` and the controller tick of ``control._FixedLaw`` (PID, feed-forward word,
 saturation, anti-windup) with the designed gains — bit-identical to the emulation.
 
-ABI (``sd_firmware.h``; ``sd_word`` is ``int16_t`` for word_bits <= 16, else ``int32_t``)::
+ABI (``sd_firmware.h``; ``sd_word`` is ``int16_t``: word_bits 8..16)::
 
     int  sd_ik(const sd_word pose[6], sd_word lengths[6]);     /* returns the saturation count */
     void sd_init(sd_state *s);
@@ -31,7 +31,6 @@ import numpy as np
 
 from ..control import (DIFF_SHIFT, FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG, ControllerConfig, FixedGains,
                        counts_per_lsb)
-from ..fixedpoint import q15
 from ..fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
 from ..fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 from ..geometry import Platform
@@ -120,15 +119,13 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     gains). Raises ValueError if the format cannot be generated (exact trig beyond 16-bit words, a
     sensor resolution that does not divide the length LSB, a platform that does not fit the words)."""
     fmt, conv = config.ik_format, config.convention
-    if fmt.trig == "exact" and fmt.word_bits > 16:
-        raise ValueError(f"--trig exact is generated as a quarter-wave table of 2^(word_bits-2) words; word_bits "
-                         f"{fmt.word_bits} would need {2 ** (fmt.word_bits - 2) + 1} words (use word_bits <= 16 or --trig tfr16)")
+    if fmt.word_bits > 16:
+        raise ValueError(f"generated C takes word_bits 8..16 (16-bit data words, 32-bit accumulators), got {fmt.word_bits}")
     cpl = counts_per_lsb(config)
     gains = FixedGains.from_si(config.gains, config.timing)
     r_T, B = platform_words(platform, fmt)
     f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
-    wide = fmt.word_bits > 16
     acc_hi = (1 << (2 * fmt.word_bits - 1)) - 1
 
     e = _Emitter()
@@ -220,7 +217,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     g = GeneratedFirmware(platform.name, fmt, conv, config, ik_ops=ik_ops, tick_ops=tick_ops)
     ctx = dict(
         name=platform.name, wb=fmt.word_bits, f=f, lo=lo, hi=hi, lsb=fmt.length_lsb, trig=fmt.trig, conv=conv,
-        word="int32_t" if wide else "int16_t", acc_hi=acc_hi, acc_lo=-acc_hi - 1, cpl=cpl, diff_shift=DIFF_SHIFT,
+        word="int16_t", acc_hi=acc_hi, acc_lo=-acc_hi - 1, cpl=cpl, diff_shift=DIFF_SHIFT,
         kp=gains.kp, ki=gains.ki, kd=gains.kd, kv=gains.kv, alpha=gains.alpha, alpha_ff=gains.alpha_ff,
         T=config.timing.sample_period, res=config.timing.sensor_resolution, rng=config.timing.command_range,
         sqrt_bits=fmt.word_bits, trace_words=TRACE_WORDS, ops=OPS, at_sin=TRACE_AT["sin"], at_cos=TRACE_AT["cos"],

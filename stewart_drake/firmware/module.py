@@ -106,7 +106,7 @@ def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, co
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
     path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt,
                  flags=("-lm",))
-    word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
+    word = "int16_t"
     ffi, lib = load(path, _cdef(word, counting))
     return FirmwareModule(ffi, lib, path, word, counting)
 
@@ -120,7 +120,7 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
         raise FileNotFoundError(f"firmware file {str(path)!r} does not exist")
     sources = [Source(path.name, path=path.resolve()), *library_sources("sd_host.c", "dsp56800e.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
-    word = "int16_t" if g.fmt.word_bits <= 16 else "int32_t"
+    word = "int16_t"
     lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
     m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
     if m.has_tick:  # then link the tick's host glue too (it calls sd_tick)
