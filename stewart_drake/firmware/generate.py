@@ -427,7 +427,7 @@ static void isqrt_near6(const int64_t S[6], sd_word lengths[6], int *nsat)
     }}
 }}
 {table}{trig}
-static int ik_core(const sd_word pose[6], sd_word lengths[6], int32_t *trace)
+static inline int ik_core(const sd_word pose[6], sd_word lengths[6], int32_t *trace)
 {{
     int nsat = 0;
     int32_t sx, cx, sy, cy, sz, cz;
