@@ -92,8 +92,9 @@ def _saturation_map(section, quick: bool) -> None:
     ax.set_xlabel("px [m]")
     ax.set_ylabel("pz [m]")
     ax.set_title("utn-dynamic, 16-bit words of 0.1 mm, pitch 20°")
-    section.figure(fig, "firmware_saturation_map", "Where the generated sd_ik saturates (the count it returns): position "
-                   "words clip beyond ±3.28 m, sums and the squared length's accumulator before; the C equals the emulation everywhere")
+    section.figure(fig, "firmware_saturation_map", "Where the generated sd_ik saturates (the count it returns): outside the "
+                   "circle the leg lengths exceed the word (32767 LSB = 3.28 m) and the square root clips; beyond ±3.28 m the position "
+                   "words are already clipped on the way in and the leg-vector sums clip too. The C equals the emulation everywhere")
 
 
 def _instrumented(section, gens) -> None:
