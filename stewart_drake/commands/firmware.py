@@ -51,6 +51,8 @@ def _config(args, platform):
         raise ValueError(f"--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {args.word_bits}")
     if not (args.rate > 0 and args.rate <= 1e6):
         raise ValueError(f"--rate must be a positive number of Hz up to 1e6, got {args.rate:g}")
+    if args.trig == "tfr16" and args.word_bits != 16:
+        raise ValueError(f"--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {args.word_bits} (or use --trig exact)")
     fmt = QFormat(args.word_bits, args.length_lsb, args.trig)
     timing = DspTiming(sample_period=1.0 / args.rate, sensor_resolution=args.sensor_resolution,
                        command_range=float(platform.legs.max_force)).check()

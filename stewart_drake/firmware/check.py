@@ -67,10 +67,11 @@ def check_ik(module, platform: Platform, config: ControllerConfig, n: int, seed:
     """Compare ``module.sd_ik`` with the emulation on ``n`` workspace poses (in chunks)."""
     fmt, conv = config.ik_format, config.convention
     consts = platform_words(platform, fmt)
-    poses = workspace_poses(platform, n, seed)
+    if not (isinstance(n, (int, np.integer)) and 1 <= n <= MAX_POSES):
+        raise ValueError(f"--poses must be an integer in 1..{MAX_POSES}, got {n!r}")
     worst, differing, first = 0, 0, None
-    for a in range(0, len(poses), CHUNK):
-        q = poses[a:a + CHUNK]
+    for a in range(0, n, CHUNK):  # poses drawn chunk by chunk: memory stays bounded whatever n
+        q = workspace_poses(platform, min(CHUNK, n - a), seed * 1_000_003 + a // CHUNK)
         words = pose_words(q, fmt)
         want = leg_length_words(platform, words, fmt, conv, consts)
         got, _ = module.ik(words)
@@ -85,7 +86,7 @@ def check_ik(module, platform: Platform, config: ControllerConfig, n: int, seed:
                      "first_leg": int(np.flatnonzero(d[k])[0]) + 1}
             if trace:
                 first["trace"] = _trace(module, platform, config, words[k])
-    return {"poses": int(len(poses)), "differing_poses": differing, "worst_lsb": worst, "first_difference": first}
+    return {"poses": int(n), "differing_poses": differing, "worst_lsb": worst, "first_difference": first}
 
 
 def _trace(module, platform, config, words) -> dict:
@@ -149,6 +150,8 @@ def check_firmware(path: Path, platform: Platform, config: ControllerConfig, n_p
                    trace: bool = False, duration: float = 0.5, compiler: Compiler | None = None) -> dict:
     """Compile ``path`` against the header generated for ``platform``/``config`` and compare it with the
     emulation; ``{"ik": ..., "tick": ... | None, "identical": bool}``."""
+    if not (isinstance(n_poses, (int, np.integer)) and 1 <= n_poses <= MAX_POSES):
+        raise ValueError(f"--poses must be an integer in 1..{MAX_POSES}, got {n_poses!r}")
     if not (math.isfinite(duration) and 0 < duration <= 60):
         raise ValueError(f"--duration must be in (0, 60] s, got {duration!r}")
     g = generate(platform, config)
