@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.animation import log_saturating, record_animation
 from stewart_drake.control import ControllerConfig, DspTiming, leg_space_inertia, strut_stiffness
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.geometry import load_preset
@@ -161,14 +162,13 @@ def _saturation(section, platform, ranges, duration):
                   caption=f"Command range (Q15 full scale) against saturation, fixed-point controller, seed trajectory, {duration:g} s", fmt="{:.3f}")
 
 
-def _animation(section, platform, duration):
-    from pydrake.geometry import Meshcat, MeshcatParams
-
-    meshcat = Meshcat(MeshcatParams(host="localhost"))
-    build_simulation(platform, SEED, "fixed", meshcat=meshcat).run(duration)
-    html = meshcat.StaticHtml()
-    section.attach("controller_in_the_loop.html", html.encode("utf-8"),
-                   f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, self-contained HTML)")
+def _animation(section, platform, log, duration):
+    """The Meshcat animation of a logged run (the seed trajectory's fixed-point run), thinned to 25 fps."""
+    page = record_animation(platform, log.t, log.pose, log_saturating(log.status), fps=25.0,
+                            title=f"{platform.name}: fixed-point controller, seed trajectory, {duration:g} s")
+    section.attach("controller_in_the_loop.html", page.encode("utf-8"),
+                   f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, "
+                   "25 frames/s, self-contained HTML; legs turn red near a stroke end or when saturating)")
 
 
 def build(section) -> None:
@@ -264,7 +264,7 @@ def build(section) -> None:
         "the legs that carry most of the plate's weight (4 and 5 here) saturate most, the anti-windup holds the "
         "integrator, and tracking degrades by orders of magnitude once the range is below the holding force."
     )
-    _animation(section, platform, 1.0 if quick else 4.0)
+    _animation(section, platform, logs["seed", "fixed"], duration)
 
 
 def main(argv=None):

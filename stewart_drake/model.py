@@ -106,7 +106,7 @@ def _chord(hull: np.ndarray, y: float) -> tuple[float, float]:
     return float(x.min()), float(x.max())
 
 
-def plate_visuals(prefix: str, points, z: float, thickness: float, bar: float, rgba: str, strips: int = 12) -> list[str]:
+def plate_visuals(prefix: str, points, z: float, thickness: float, bar: float, rgba: str, strips: int = 32) -> list[str]:
     """Boxes drawing the convex polygon of ``points`` (n, 2+) as a plate ``thickness`` thick centred at
     height ``z``: ``strips`` slabs across it, each as wide as the polygon along its whole height (so it
     stays inside), and a bar ``bar`` wide along every edge covering the slabs' stepped ends.
