@@ -21,7 +21,7 @@ from .kinematics import leg_lengths
 from .model import build_plant, leg_visual_dimensions, set_pose
 
 WARN_RGBA = (0.9, 0.05, 0.05, 1.0)
-GHOST_RGBA = (0.2, 0.6, 1.0, 0.25)
+GHOST_RGBA = (0.1, 0.85, 0.3, 0.5)
 # A leg within this fraction of its stroke from either end is flagged (5 % of 0.4 m = 20 mm on utn-dynamic).
 WARN_FRACTION = 0.05
 
