@@ -178,11 +178,13 @@ def headline(section) -> str:
     (largest worst/tolerance), else nothing."""
     if getattr(section, "headline_text", ""):
         return section.headline_text
-    ratios = [(c.worst / c.tolerance if c.tolerance > 0 else (0.0 if c.worst <= 0 else math.inf), c) for c in section.checks
+    ratios = [(c.worst / c.tolerance if c.tolerance > 0 else (-1.0 if c.worst <= 0 else math.inf), c) for c in section.checks
               if not math.isnan(c.worst)]
     if not ratios:
         return ""
     _, c = max(ratios, key=lambda rc: rc[0])
+    if c.tolerance <= 0 and c.worst <= 0:
+        return f"{c.what}: {format_number(c.worst)} {c.unit}".rstrip()
     return f"tightest: {c.what}: {format_number(c.worst)} of {format_number(c.tolerance)} {c.unit}".rstrip()
 
 
@@ -221,7 +223,6 @@ def render_html(sections, title: str, meta: dict) -> str:
     checks = [c for s in sections for c in s.checks]
     n_fail = sum(not c.passed for c in checks)
     anchor = {id(s): f"s{i}" for i, s in enumerate(sections)}
-    toc = "".join(f'<li><a href="#s{i}">{html.escape(s.title)}</a></li>' for i, s in enumerate(sections))
     body = "".join(f'<section id="s{i}"><h2>{html.escape(s.title)}</h2>{"".join(s.blocks)}</section>' for i, s in enumerate(sections))
     status = f"<span class='{'fail' if n_fail else 'pass'}'>{len(checks) - n_fail}/{len(checks)} checks passed</span>"
     return (
@@ -229,6 +230,5 @@ def render_html(sections, title: str, meta: dict) -> str:
         f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>"
         f"<h1>{html.escape(title)}</h1>{meta_html(meta)}"
         f"<h2>Verdict</h2><p>{status} in {len(sections)} sections.</p>{verdicts_html(sections, anchor)}"
-        f"<h2>All checks</h2>{checks_html(sections, anchor)}"
-        f"<h2>Contents</h2><nav><ol>{toc}</ol></nav>{body}</body></html>"
+        f"<h2>All checks</h2>{checks_html(sections, anchor)}{body}</body></html>"
     )
