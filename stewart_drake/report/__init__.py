@@ -19,6 +19,7 @@ import importlib.util
 import io
 import json
 import multiprocessing
+import os
 import shlex
 import sys
 import time
@@ -161,6 +162,34 @@ def unlabelled_axes(fig) -> list[str]:
         if missing:
             out.append(f"axes {k} ({ax.get_title() or 'untitled'}) has no {'/'.join(missing)} label")
     return out
+
+
+_MODULES: dict = {}
+
+
+def _call_in_analysis(path: str, name: str, item):
+    """``name(item)`` of the analysis script at ``path`` (loaded once per worker process)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    if path not in _MODULES:
+        spec = importlib.util.spec_from_file_location(f"analyses_{Path(path).stem}", path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        _MODULES[path] = mod
+    return getattr(_MODULES[path], name)(item)
+
+
+def parallel_map(module_file: str, name: str, items: list, jobs: int | None = None) -> list:
+    """``[f(item) for item in items]`` where ``f`` is the function ``name`` of the analysis script
+    ``module_file`` (pass ``__file__``), computed in ``jobs`` worker processes (default: the CPUs).
+    For an analysis's independent heavy cases; ``item`` and the results must be picklable. In order."""
+    jobs = min(len(items), jobs or os.cpu_count() or 1)
+    if jobs <= 1:
+        return [_call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        return list(pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items))
 
 
 def build_section(analysis: Analysis, quick: bool = False) -> Section:

@@ -39,7 +39,7 @@ table{border-collapse:collapse;font-size:90%}td,th{border:1px solid #bbb;padding
 th{background:#eee;font-weight:600}td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
 th.num{text-align:right}.unit{font-weight:normal;color:#555;white-space:nowrap}
 caption{caption-side:top;text-align:left;font-style:italic;padding:4px 0}
-td.na{color:#888;text-align:center}
+td.na{color:#888;text-align:center}td.nw{white-space:nowrap}
 img{max-width:100%;height:auto}figure{margin:1em 0}figcaption{font-style:italic;font-size:90%;max-width:900px}
 .pass{color:#070;font-weight:bold}.fail{color:#b00;font-weight:bold}
 details{margin:.3em 0}summary{cursor:pointer}summary .fail,summary .pass{margin-left:.5em}
@@ -106,7 +106,8 @@ def cell(v, nan_reason: str = "not applicable") -> tuple[str, bool]:
         return f'<td class="num">{html.escape(text.replace("-", "−"))}</td>', True
     if text.strip().lower() == "nan":
         return f'<td class="na" title="{html.escape(nan_reason)}">— <small>({html.escape(nan_reason)})</small></td>', True
-    return f"<td>{html.escape(text)}</td>", False
+    short = len(text) <= 24  # a name or a label: kept on one line
+    return f"<td{' class=nw' if short else ''}>{html.escape(text)}</td>", False
 
 
 def table_html(header: list, rows: list[list], caption: str = "", nan_reason: str = "not applicable") -> str:
