@@ -175,6 +175,7 @@ def build(section) -> None:
         ax.set_box_aspect((1, 1, 1.2))
         ax.set_xlim(-0.35, 0.35), ax.set_ylim(-0.35, 0.35), ax.set_zlim(0, 0.75)
         ax.tick_params(labelsize=6)
+        ax.set_xticks([-0.3, 0, 0.3]), ax.set_yticks([-0.3, 0, 0.3]), ax.set_zticks([0, 0.35, 0.7])  # no overlapping ticks
         ax.set_xlabel("x [m]", fontsize=7, labelpad=-4), ax.set_ylabel("y [m]", fontsize=7, labelpad=-4), ax.set_zlabel("z [m]", fontsize=7, labelpad=-4)
     section.figure(
         fig, "fk_assembly_modes_utn_dynamic",

@@ -86,6 +86,8 @@ class Section:
         import matplotlib.pyplot as plt
 
         self.warnings += [f"figure {name}: {w}" for w in unlabelled_axes(fig)]
+        if fig.get_layout_engine() is None:  # lay labels, titles and legends out without overlaps or clipping
+            fig.set_layout_engine("constrained")
         buf = io.BytesIO()
         fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
         plt.close(fig)
