@@ -52,6 +52,7 @@ def test_unlabelled_axes_lint():
     a.set_xlabel("t [s]")
     b.plot([0, 1], [1, 0])
     b.set_xlabel("t [s]"), b.set_ylabel("L [m]")
+    fig.colorbar(b.scatter([0, 1], [0, 1], c=[0, 1]), ax=b)  # a colorbar's own axes need no label
     problems = unlabelled_axes(fig)
     plt.close(fig)
     assert problems == ["axes 0 (untitled) has no y label"]

@@ -8,7 +8,10 @@ Analyses run in worker processes (``jobs``), each returning its picklable ``Sect
 keeps the analyses' order whatever order they finish in.
 
 An analysis script in ``analyses/`` defines ``TITLE``, ``ORDER`` (position in the report) and
-``build(section)``; its ``main()`` calls ``run_standalone`` so it also runs on its own.
+``build(section)``, optionally ``COST`` (its relative run time: the costliest start first); its ``main()``
+calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
+out with ``parallel_map(__file__, "function_name", items)``. ``section.headline(text)`` sets the figure
+shown beside the section's verdict.
 """
 
 from __future__ import annotations
@@ -151,7 +154,7 @@ def unlabelled_axes(fig) -> list[str]:
     """Axes of a matplotlib figure that show data but lack an axis label (x, y, and z for 3-D)."""
     out = []
     for k, ax in enumerate(fig.axes):
-        if not ax.get_visible() or not ax.axison or not (ax.lines or ax.collections or ax.images or ax.patches):
+        if ax.get_label() == "<colorbar>" or not ax.get_visible() or not ax.axison or not (ax.lines or ax.collections or ax.images or ax.patches):
             continue
         getters = [("x", ax.get_xlabel), ("y", ax.get_ylabel)] + ([("z", ax.get_zlabel)] if hasattr(ax, "get_zlabel") else [])
         missing = [a for a, get in getters if not get().strip()]
