@@ -11,8 +11,9 @@ from stewart_drake.control import ControllerConfig, DspTiming, leg_space_inertia
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.geometry import load_preset
 from stewart_drake.kinematics import leg_lengths
-from stewart_drake.report import parallel_map, run_standalone
+from stewart_drake.report import run_standalone
 from stewart_drake.simulation import ROTATING, SEED, ActuatorModel, build_simulation, design_poses, fit_trajectory, setpoint_step_gain
+from stewart_drake.report import parallel_map
 
 TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
 ORDER = 90
@@ -133,27 +134,20 @@ def _presets(section, duration):
     return rows
 
 
-SWEEP_PLANT_STEP = 2.5e-4
-
-
-def _sweep_case(case):
-    """One (latency model, sample period) of ``_sweep``, in a worker process: its table row."""
-    name, lat, T, duration = case
-    platform = load_preset(name)
-    timing = DspTiming(sample_period=T, latency=lat)
-    cfg = ControllerConfig.for_platform(platform, timing, gains=ControllerConfig.for_platform(platform, poses=design_poses(SEED)).gains)
-    log = build_simulation(platform, SEED, "fixed", cfg, plant_time_step=SWEEP_PLANT_STEP).run(duration)
-    e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
-    return [lat, T * 1e3, timing.output_delay * 1e6, e, int(log.saturations().sum())]
-
-
 def _sweep(section, platform, periods, duration):
     import matplotlib.pyplot as plt
 
-    plant_step = SWEEP_PLANT_STEP
-    cases = [(platform.name, lat, T, duration) for lat in ("computation", "sample") for T in periods]
-    rows = parallel_map(__file__, "_sweep_case", cases)
-    res = {(lat, T): row[3] for (_, lat, T, _), row in zip(cases, rows)}
+    rows = []
+    res = {}
+    plant_step = 2.5e-4
+    for lat in ("computation", "sample"):
+        for T in periods:
+            timing = DspTiming(sample_period=T, latency=lat)
+            cfg = ControllerConfig.for_platform(platform, timing, gains=ControllerConfig.for_platform(platform, poses=design_poses(SEED)).gains)
+            log = build_simulation(platform, SEED, "fixed", cfg, plant_time_step=plant_step).run(duration)
+            e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
+            res[lat, T] = e
+            rows.append([lat, T * 1e3, timing.output_delay * 1e6, e, int(log.saturations().sum())])
     section.table(["latency", "T ms", "output delay µs", "max |leg err| mm", "saturated ticks"], rows,
                   caption=f"Sweep (fixed-point controller, seed trajectory, {duration:g} s, plant step {plant_step * 1e3:g} ms)", fmt="{:.3f}")
     fig, ax = plt.subplots(figsize=(6, 3.5))
