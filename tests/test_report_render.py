@@ -88,3 +88,5 @@ def test_tightest_check_is_the_default_headline():
     s.check("loose", 1.0, 100.0, "mm")
     s.check("tight", 0.9, 1.0, "mm")
     assert render.headline(s) == "tightest: tight: 0.9000 of 1.000 mm"
+    s.check("broken", 2.0, 1.0, "mm")
+    assert render.headline(s) == "FAILED: broken: 2.000 > 1.000 mm"

@@ -175,8 +175,13 @@ def default_meta(sections, command: str | None = None, elapsed: float | None = N
 
 
 def headline(section) -> str:
-    """The section's one headline figure: what the analysis set, else its tightest check
-    (largest worst/tolerance), else nothing."""
+    """The section's one headline figure: its first failed check, else what the analysis set, else its
+    tightest check (largest worst/tolerance), else nothing."""
+    failed = [c for c in section.checks if not c.passed]
+    if failed:
+        c = failed[0]
+        more = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
+        return f"FAILED: {c.what}: {format_number(c.worst)} > {format_number(c.tolerance)} {c.unit}".rstrip() + more
     if getattr(section, "headline_text", ""):
         return section.headline_text
     ratios = [(c.worst / c.tolerance if c.tolerance > 0 else (-1.0 if c.worst <= 0 else math.inf), c) for c in section.checks
