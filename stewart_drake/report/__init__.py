@@ -26,6 +26,7 @@ import os
 import shlex
 import sys
 import time
+import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -89,10 +90,18 @@ class Section:
         import matplotlib.pyplot as plt
 
         self.warnings += [f"figure {name}: {w}" for w in unlabelled_axes(fig)]
+        buf = io.BytesIO()
         if fig.get_layout_engine() is None:  # lay labels, titles and legends out without overlaps or clipping
             fig.set_layout_engine("constrained")
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", UserWarning)  # "constrained_layout not applied": do without
+                    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+            except (ZeroDivisionError, ValueError, UserWarning):  # a layout it cannot solve: the figure as drawn
+                fig.set_layout_engine("none")
+                buf = io.BytesIO()
+        if not buf.getvalue():
+            fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
         plt.close(fig)
         data = buf.getvalue()
         self.files[f"{name}.png"] = data
