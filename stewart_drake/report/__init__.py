@@ -95,7 +95,7 @@ class Section:
             fig.set_layout_engine("constrained")
             try:
                 with warnings.catch_warnings():
-                    warnings.simplefilter("error", UserWarning)  # "constrained_layout not applied": do without
+                    warnings.filterwarnings("error", message=".*constrained_layout not applied")  # then do without
                     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
             except (ZeroDivisionError, ValueError, UserWarning):  # a layout it cannot solve: the figure as drawn
                 fig.set_layout_engine("none")
