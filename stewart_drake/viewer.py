@@ -22,6 +22,7 @@ from .fk import anchor_scale, jacobian_analysis
 from .forward import assembly_modes
 from .geometry import Platform
 from .kinematics import leg_lengths, plate_anchors
+from .model import leg_visual_dimensions
 from .rotations import angle_scale, length_scale, rotation_matrix
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
@@ -174,14 +175,20 @@ class Viewer:
         return r
 
     def _ghost(self, pose) -> None:
-        """A translucent plate and line legs at ``pose`` (None: hide it)."""
-        from pydrake.geometry import Rgba
+        """The platform at ``pose`` as a translucent ghost: a leg rod per leg and the plate (None: hide it)."""
+        from pydrake.geometry import Cylinder, Rgba
+        from pydrake.math import RigidTransform, RotationMatrix
 
         if pose is None:
             self.meshcat.Delete("/ghost")
             return
         top = plate_anchors(self.platform, pose, self.convention)  # (6, 3) per leg
-        self.meshcat.SetLineSegments("/ghost/legs", self.platform.base_anchors.T, top.T, 4.0, Rgba(*GHOST_RGBA[:3], 0.8))
+        r = 0.8 * leg_visual_dimensions(self.platform)["cylinder_radius"]
+        for i, (a, b) in enumerate(zip(self.platform.base_anchors, top)):
+            d = b - a
+            path = f"/ghost/leg_{i + 1}"
+            self.meshcat.SetObject(path, Cylinder(r, float(np.linalg.norm(d))), Rgba(*GHOST_RGBA))
+            self.meshcat.SetTransform(path, RigidTransform(RotationMatrix.MakeFromOneVector(d, 2), (a + b) / 2))
         centre = top.mean(axis=0)
         order = np.argsort(np.arctan2(top[:, 1] - centre[1], top[:, 0] - centre[0]))  # a fan around the centre
         top = top[order]
