@@ -133,6 +133,7 @@ def build(section) -> None:
     }
     for name in ("3d", "top", "front", "side"):
         section.figure(figs[name], f"workspace_{name}", captions[name])
+    section.points3d(w.boundary, "workspace_3d", "The workspace boundary in 3-D, coloured by height", ("X [m]", "Y [m]", "Z [m]"))
 
     # --- mobility
     rows = [[k, m["n"], m["j"], m["sum_f"], m["I_f"], m["m"]] for k in ("SPS", "UPS", "UPU") for m in [ws.stewart_mobility(k)]]

@@ -46,6 +46,8 @@ def _report(tmp_path):
     s.table(["case", "first saturation s", "force (N)", "count"], [["a", float("nan"), 200.0, 1], ["b", 0.286, 3.5e-7, 12]],
             nan_reason="never saturated")
     s.check("a passing check", 0.5, 1.0, "mm")
+    u = np.random.default_rng(0).normal(size=(3000, 3))
+    s.points3d(0.3 * u / np.linalg.norm(u, axis=1, keepdims=True), "sphere", "points on a sphere")
     sections.append(s)
     return write_report(sections, tmp_path / "report", meta=render.default_meta(sections, "pytest", 0.0, ("utn-dynamic",)))
 
@@ -68,6 +70,16 @@ def test_report_renders_cleanly(browser, tmp_path):
     # The header and the verdicts come first; the checks are grouped in collapsible blocks.
     assert browser.evaluate("document.querySelectorAll('details').length") >= 3
     assert "git commit" in text and "command" in text
+    # The rotatable 3-D view draws points, and dragging turns it (the pixels change).
+    pixels = """(() => { const c = document.getElementById('p3d-sphere'); const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let n = 0, h = 0; for (let i = 0; i < d.length; i += 4) { if (d[i] + d[i + 1] + d[i + 2] < 600) { n++; h = (h * 31 + i) % 1000003; } } return [n, h]; })()"""
+    before = browser.evaluate(pixels)
+    assert before[0] > 2000
+    browser.evaluate("""(() => { const c = document.getElementById('p3d-sphere'); const r = c.getBoundingClientRect();
+        const ev = (t, x) => c.dispatchEvent(new PointerEvent(t, {clientX: r.left + x, clientY: r.top + 100, pointerId: 1, bubbles: true}));
+        ev('pointerdown', 100); ev('pointermove', 160); ev('pointerup', 160); return 1; })()""")
+    assert browser.evaluate(pixels) != before
+    assert browser.errors == []
     browser.screenshot(_shot("report_top.png"))
     browser.evaluate("document.querySelector('section').scrollIntoView(); 1")
     browser.screenshot(_shot("report_section.png"))

@@ -113,6 +113,10 @@ class Section:
         alt = html.escape(caption or name)
         self.blocks.append(f'<figure><img alt="{alt}" src="data:image/png;base64,{b64}">{cap}</figure>')
 
+    def points3d(self, points, name: str, caption: str, labels=("x [m]", "y [m]", "z [m]")) -> None:
+        """A rotatable 3-D view of ``(n, 3)`` points in the page (inline script, no file, no library)."""
+        self.blocks.append(render.points3d_html(f"p3d-{name}", points, labels, caption + " (drag to rotate)"))
+
     def attach(self, name: str, data: bytes, text: str) -> None:
         """An extra file in the report folder (e.g. an HTML animation), linked from the section."""
         self.files[name] = data

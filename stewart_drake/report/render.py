@@ -38,7 +38,7 @@ h1{margin-bottom:.2em}h2{border-bottom:1px solid #ccc;padding-bottom:.15em;margi
 table{border-collapse:collapse;font-size:90%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top}
 th{background:#eee;font-weight:600}td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
 th.num{text-align:right}.unit{font-weight:normal;color:#555;white-space:nowrap}
-caption{caption-side:top;text-align:left;font-style:italic;padding:4px 0}
+.tcap{font-style:italic;margin:1em 0 -.6em 0}
 td.na{color:#888;text-align:center}td.nw{white-space:nowrap}
 img{max-width:100%;height:auto}figure{margin:1em 0}figcaption{font-style:italic;font-size:90%;max-width:900px}
 .pass{color:#070;font-weight:bold}.fail{color:#b00;font-weight:bold}
@@ -117,8 +117,9 @@ def table_html(header: list, rows: list[list], caption: str = "", nan_reason: st
     numeric = [bool(cells) and all(c[k][1] for c in cells if k < len(c)) for k in range(len(header))]
     head = "".join(header_cell(h, numeric[k]) for k, h in enumerate(header))
     body = "".join("<tr>" + "".join(c[0] for c in r) + "</tr>" for r in cells)
-    cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
-    return f'<div class="scroll"><table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>'
+    # The caption above the box, not a <caption>: a narrow table would squeeze it into a narrow column.
+    cap = f'<p class="tcap">{html.escape(caption)}</p>' if caption else ""
+    return f'{cap}<div class="scroll"><table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>'
 
 
 # ----------------------------------------------------------------------------------------------
@@ -238,3 +239,57 @@ def render_html(sections, title: str, meta: dict) -> str:
         f"<h2>Verdict</h2><p>{status} in {len(sections)} sections.</p>{verdicts_html(sections, anchor)}"
         f"<h2>All checks</h2>{checks_html(sections, anchor)}{body}</body></html>"
     )
+
+
+_POINTS3D_JS = """
+(function () {
+  const c = document.getElementById(%(id)s), g = c.getContext("2d"), P = %(points)s, L = %(labels)s;
+  let yaw = -0.6, pitch = 0.45, drag = null;
+  const lo = [0, 1, 2].map(k => Math.min(...P.map(p => p[k]))), hi = [0, 1, 2].map(k => Math.max(...P.map(p => p[k])));
+  const mid = lo.map((v, k) => (v + hi[k]) / 2), span = Math.max(...hi.map((v, k) => v - lo[k])) || 1;
+  function proj(p) {
+    const x = (p[0] - mid[0]) / span, y = (p[1] - mid[1]) / span, z = (p[2] - mid[2]) / span;
+    const cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);
+    const x1 = cy * x - sy * y, y1 = sy * x + cy * y;
+    return [x1, cp * z - sp * y1, sp * z + cp * y1];
+  }
+  function draw() {
+    const w = c.width, h = c.height, s = 0.62 * Math.min(w, h);
+    g.fillStyle = "#fff"; g.fillRect(0, 0, w, h);
+    const q = P.map(p => [proj(p), p[2]]).sort((a, b) => b[0][2] - a[0][2]);
+    for (const [r, z] of q) {
+      const t = (z - lo[2]) / ((hi[2] - lo[2]) || 1);
+      g.fillStyle = `hsl(${260 - 200 * t}, 70%%, ${35 + 20 * t}%%)`;
+      g.fillRect(w / 2 + s * r[0] - 1, h / 2 - s * r[1] - 1, 2.2, 2.2);
+    }
+    g.font = "13px sans-serif";
+    [[0, "#c00"], [1, "#080"], [2, "#00c"]].forEach(([k, col]) => {
+      const e = [0, 0, 0]; e[k] = 0.35 * span;
+      const a = proj(mid.map((m, i) => i === k ? m : m)), b = proj(mid.map((m, i) => m + e[i]));
+      const ox = w * 0.12, oy = h * 0.85;
+      g.strokeStyle = col; g.fillStyle = col; g.beginPath(); g.moveTo(ox, oy);
+      g.lineTo(ox + s * (b[0] - a[0]) * 0.6, oy - s * (b[1] - a[1]) * 0.6); g.stroke();
+      g.fillText(L[k], ox + s * (b[0] - a[0]) * 0.7, oy - s * (b[1] - a[1]) * 0.7);
+    });
+  }
+  c.onpointerdown = e => { drag = [e.clientX, e.clientY]; try { c.setPointerCapture(e.pointerId); } catch (_) {} };
+  c.onpointermove = e => { if (!drag) return; yaw += (e.clientX - drag[0]) * 0.01;
+    pitch = Math.max(-1.5, Math.min(1.5, pitch + (e.clientY - drag[1]) * 0.01)); drag = [e.clientX, e.clientY]; draw(); };
+  c.onpointerup = () => { drag = null; };
+  draw();
+})();
+"""
+
+
+def points3d_html(element_id: str, points, labels=("x [m]", "y [m]", "z [m]"), caption: str = "", max_points: int = 4000) -> str:
+    """A rotatable 3-D point cloud (drag to turn) drawn by inline JavaScript on a canvas: no library, so
+    the page stays one self-contained file. ``points`` ``(n, 3)``; at most ``max_points`` kept (seeded)."""
+    import json
+
+    P = np.asarray(points, dtype=float).reshape(-1, 3)
+    if len(P) > max_points:
+        P = P[np.random.default_rng(0).choice(len(P), max_points, replace=False)]
+    js = _POINTS3D_JS % {"id": json.dumps(element_id), "points": json.dumps(np.round(P, 5).tolist()), "labels": json.dumps(list(labels))}
+    cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
+    return (f'<figure><canvas id="{html.escape(element_id)}" width="640" height="480" class="points3d" '
+            f'style="max-width:100%;border:1px solid #ddd;cursor:grab;touch-action:none"></canvas>{cap}<script>{js}</script></figure>')
