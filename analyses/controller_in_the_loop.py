@@ -6,17 +6,23 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.animation import log_saturating, record_animation
 from stewart_drake.control import ControllerConfig, DspTiming, leg_space_inertia, strut_stiffness
+from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.geometry import load_preset
 from stewart_drake.kinematics import leg_lengths
 from stewart_drake.report import run_standalone
 from stewart_drake.simulation import ROTATING, SEED, ActuatorModel, build_simulation, design_poses, fit_trajectory, setpoint_step_gain
+from stewart_drake.report import parallel_map
 
 TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
 ORDER = 90
+COST = 100  # relative run time: the report's workers start the costliest analyses first
 
 PLATFORM = "utn-dynamic"
+# the fixed-point controller's tick as compiled C (bit-identical to the Python engine, several times faster)
+ENGINE = resolve_engine("c", "analysis controller_in_the_loop")
 PRESETS = ("utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009")
 
 
@@ -58,7 +64,7 @@ def _tracking(section, platform, duration):
     for j, traj in enumerate((SEED, ROTATING)):
         cfg = ControllerConfig.for_platform(platform, poses=design_poses(traj, duration))
         for i, kind in enumerate(("float", "fixed")):
-            log = build_simulation(platform, traj, kind, cfg).run(duration)
+            log = build_simulation(platform, traj, kind, cfg, engine=ENGINE).run(duration)
             logs[traj.name, kind] = log
             e = log.length_error(traj, platform)
             pe = log.pose_error(traj)
@@ -87,31 +93,42 @@ def _tracking(section, platform, duration):
     return logs
 
 
+def _preset_case(case):
+    """One (preset, trajectory) of ``_presets``, in a worker process: its checks and its table row."""
+    name, base_name, duration, quick = case
+    platform = load_preset(name)
+    m = np.linalg.eigvalsh(leg_space_inertia(platform))
+    base = {"seed": SEED, "rotating": ROTATING}[base_name]
+    traj = fit_trajectory(base, platform)
+    poses = design_poses(traj, duration)
+    cfg = ControllerConfig.for_platform(platform, poses=poses)
+    g = cfg.gains
+    logs = {kind: build_simulation(platform, traj, kind, cfg, engine=ENGINE).run(duration) for kind in ("float", "fixed")}
+    pid_only = build_simulation(platform, traj, "float", cfg, feedforward=False).run(duration)
+    e = {k: float(np.abs(v.length_error(traj, platform)).max()) for k, v in logs.items()}
+    e_pid = float(np.abs(pid_only.length_error(traj, platform)).max())
+    d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs["float"], duration, cfg)
+    h = _l1_gain(platform, cfg, quick)
+    checks = [(f"{name}, {base.name}: float leg error <= v_max·t_delay", e["float"] * 1e3, v_max * t_delay * 1e3, "mm"),
+              (f"{name}, {base.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r), ‖h‖₁ = {h['coupled']:.2f}", e["fixed"] * 1e3,
+               _fixed_bound(e["float"], d_ik, lsb, r, h["coupled"]) * 1e3, "mm")]
+    row = [name, base.name, f"{m[0]:.2f} … {m[-1]:.1f}", strut_stiffness(platform), float(strut_stiffness(platform, poses).max()), g.kp, g.ki, g.kd,
+           e_pid * 1e3, e["float"] * 1e3, e["fixed"] * 1e3, d_ik * 1e3, v_max * t_delay * 1e3,
+           h["diagonal"], h["coupled"], h["peak"], (e["fixed"] - e["float"]) / (d_ik + lsb + r),
+           int(logs["fixed"].saturations().sum()), float(np.abs(logs["fixed"].force).max())]
+    return checks, row
+
+
 def _presets(section, duration):
     """The default controller (gains designed per platform, force feed-forward) on every preset, the
-    trajectories fitted to each platform's home height and stroke; the same two bounds as above."""
+    trajectories fitted to each platform's home height and stroke; the same two bounds as above. The
+    six cases are independent: they run in worker processes."""
+    cases = [(name, base.name, duration, section.quick) for name in PRESETS for base in (SEED, ROTATING)]
     rows = []
-    for name in PRESETS:
-        platform = load_preset(name)
-        m = np.linalg.eigvalsh(leg_space_inertia(platform))
-        for base in (SEED, ROTATING):
-            traj = fit_trajectory(base, platform)
-            poses = design_poses(traj, duration)
-            cfg = ControllerConfig.for_platform(platform, poses=poses)
-            g = cfg.gains
-            logs = {kind: build_simulation(platform, traj, kind, cfg).run(duration) for kind in ("float", "fixed")}
-            pid_only = build_simulation(platform, traj, "float", cfg, feedforward=False).run(duration)
-            e = {k: float(np.abs(v.length_error(traj, platform)).max()) for k, v in logs.items()}
-            e_pid = float(np.abs(pid_only.length_error(traj, platform)).max())
-            d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs["float"], duration, cfg)
-            section.check(f"{name}, {base.name}: float leg error <= v_max·t_delay", e["float"] * 1e3, v_max * t_delay * 1e3, "mm")
-            h = _l1_gain(platform, cfg, section.quick)
-            section.check(f"{name}, {base.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r), ‖h‖₁ = {h['coupled']:.2f}", e["fixed"] * 1e3,
-                          _fixed_bound(e["float"], d_ik, lsb, r, h["coupled"]) * 1e3, "mm")
-            rows.append([name, base.name, f"{m[0]:.2f} … {m[-1]:.1f}", strut_stiffness(platform), float(strut_stiffness(platform, poses).max()), g.kp, g.ki, g.kd,
-                         e_pid * 1e3, e["float"] * 1e3, e["fixed"] * 1e3, d_ik * 1e3, v_max * t_delay * 1e3,
-                         h["diagonal"], h["coupled"], h["peak"], (e["fixed"] - e["float"]) / (d_ik + lsb + r),
-                         int(logs["fixed"].saturations().sum()), float(np.abs(logs["fixed"].force).max())])
+    for checks, row in parallel_map(__file__, "_preset_case", cases):
+        for c in checks:
+            section.check(*c)
+        rows.append(row)
     section.table(["platform", "trajectory", "leg-space mass kg", "strut stiffness at home N/m", "max along trajectory N/m", "kp N/m", "ki N/(m·s)", "kd N·s/m",
                    "float, PID only mm", "float mm", "fixed mm", "Δ_IK mm", "timing bound mm",
                    "‖h_ii‖₁ own leg", "‖h‖₁ all legs", "step peak", "(fixed − float)/(Δ_IK + LSB + r)", "saturated ticks", "max |force| N"],
@@ -130,7 +147,7 @@ def _sweep(section, platform, periods, duration):
         for T in periods:
             timing = DspTiming(sample_period=T, latency=lat)
             cfg = ControllerConfig.for_platform(platform, timing, gains=ControllerConfig.for_platform(platform, poses=design_poses(SEED)).gains)
-            log = build_simulation(platform, SEED, "fixed", cfg, plant_time_step=plant_step).run(duration)
+            log = build_simulation(platform, SEED, "fixed", cfg, plant_time_step=plant_step, engine=ENGINE).run(duration)
             e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
             res[lat, T] = e
             rows.append([lat, T * 1e3, timing.output_delay * 1e6, e, int(log.saturations().sum())])
@@ -151,24 +168,23 @@ def _saturation(section, platform, ranges, duration):
     rows = []
     for rng in ranges:
         cfg = ControllerConfig.for_platform(platform, DspTiming(command_range=rng), poses=design_poses(SEED))
-        log = build_simulation(platform, SEED, "fixed", cfg).run(duration)
+        log = build_simulation(platform, SEED, "fixed", cfg, engine=ENGINE).run(duration)
         sat = log.saturations().astype(int)
         st = log.status[:, 3]
         first = log.t[np.argmax(st > 0)] if st[-1] > 0 else float("nan")
         e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
         rows.append([rng, " ".join(str(s) for s in sat), first, e])
-    section.table(["command range N", "saturated ticks per leg 1..6", "first saturation s", "max |leg err| mm"], rows,
+    section.table(["command range N", "saturated ticks per leg 1..6", "first saturation s", "max |leg err| mm"], rows, nan_reason="never saturated",
                   caption=f"Command range (Q15 full scale) against saturation, fixed-point controller, seed trajectory, {duration:g} s", fmt="{:.3f}")
 
 
-def _animation(section, platform, duration):
-    from pydrake.geometry import Meshcat, MeshcatParams
-
-    meshcat = Meshcat(MeshcatParams(host="localhost"))
-    build_simulation(platform, SEED, "fixed", meshcat=meshcat).run(duration)
-    html = meshcat.StaticHtml()
-    section.attach("controller_in_the_loop.html", html.encode("utf-8"),
-                   f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, self-contained HTML)")
+def _animation(section, platform, log, duration):
+    """The Meshcat animation of a logged run (the seed trajectory's fixed-point run), thinned to 25 fps."""
+    page = record_animation(platform, log.t, log.pose, log_saturating(log.status), fps=25.0,
+                            title=f"{platform.name}: fixed-point controller, seed trajectory, {duration:g} s")
+    section.attach("controller_in_the_loop.html", page.encode("utf-8"),
+                   f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, "
+                   "25 frames/s, self-contained HTML; legs turn red near a stroke end or when saturating)")
 
 
 def build(section) -> None:
@@ -264,7 +280,7 @@ def build(section) -> None:
         "the legs that carry most of the plate's weight (4 and 5 here) saturate most, the anti-windup holds the "
         "integrator, and tracking degrades by orders of magnitude once the range is below the holding force."
     )
-    _animation(section, platform, 1.0 if quick else 4.0)
+    _animation(section, platform, logs["seed", "fixed"], duration)
 
 
 def main(argv=None):

@@ -90,6 +90,7 @@ def build(section) -> None:
     axes[1].invert_yaxis()
     axes[1].set_xlabel("RMS contribution (mm)")
     axes[1].set_title("by operation")
+    axes[1].set_ylabel("firmware operation")
     section.figure(fig, "fixedpoint_error_hist", "Histogram of the DSP's leg-length error and its RMS contribution per operation")
 
     # Saturation map: where does the firmware clip? Sweep px and pz across the 16-bit range.

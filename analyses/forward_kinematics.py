@@ -23,6 +23,7 @@ from stewart_drake.report import run_standalone
 
 TITLE = "Forward kinematics: round trips, assembly modes, timing"
 ORDER = 30
+COST = 10  # relative run time: the report's workers start the costliest analyses first
 ROUND_TRIP_TOL = 1e-9  # m and rad (issue 3's bound); the pose error is ~ tol_Newton / sigma_min
 
 
@@ -177,6 +178,8 @@ def build(section) -> None:
         ax.set_box_aspect((1, 1, 1.2))
         ax.set_xlim(-0.35, 0.35), ax.set_ylim(-0.35, 0.35), ax.set_zlim(0, 0.75)
         ax.tick_params(labelsize=6)
+        ax.set_xticks([-0.3, 0, 0.3]), ax.set_yticks([-0.3, 0, 0.3]), ax.set_zticks([0, 0.35, 0.7])  # no overlapping ticks
+        ax.set_xlabel("x [m]", fontsize=7, labelpad=-4), ax.set_ylabel("y [m]", fontsize=7, labelpad=-4), ax.set_zlabel("z [m]", fontsize=7, labelpad=-4)
     section.figure(
         fig, "fk_assembly_modes_utn_dynamic",
         "The assembly modes above the base of utn-dynamic at its home lengths (blue: det J⁻¹ > 0, red: < 0); "
@@ -194,7 +197,8 @@ def build(section) -> None:
     ax.scatter(*dp.base_anchors.T, color="k", marker="^", label="base anchors")
     for s, c in ((1, "tab:blue"), (-1, "tab:red")):
         ax.scatter(*P[sgn == s].T, color=c, label=f"plate origin, det J⁻¹ {'>' if s > 0 else '<'} 0")
-    ax.legend(fontsize=7)
+    ax.set_xlabel("x [m]"), ax.set_ylabel("y [m]"), ax.set_zlabel("z [m]")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, 1.08))
     section.figure(
         fig, "fk_assembly_modes_dietmaier",
         f"Dietmaier's 1998 geometry: the plate origin of each of the {len(dm)} real assembly modes found "

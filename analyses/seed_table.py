@@ -141,6 +141,7 @@ def build(section) -> None:
         ax.set_xticks(x[::6] + 2.5, [f"pose {j + 1}" for j in range(4)])
         ax.set_title(f"angles: {name}")
         ax.set_ylabel("difference (mm)")
+        ax.set_xlabel("seed table cell (legs 1–6 of each pose)")
         ax.legend(fontsize=8)
     section.figure(fig, "seed_table_matlab", "IK minus the seed's Matlab and DSP blocks, legs 1–6 per pose, under both readings")
 

@@ -110,8 +110,9 @@ def build(section) -> None:
     ax.plot(x, (emu - fl).ravel(), "k_", ms=14, mew=2, label="DSP − float (total)")
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xticks(x[::6] + 2.5, [f"pose {j + 1}" for j in range(4)])
-    ax.set_ylabel("mm")
-    ax.legend(fontsize=7, ncol=4)
+    ax.set_ylabel("DSP − float leg length (mm)")
+    ax.set_xlabel("seed table cell (legs 1–6 of each pose)")
+    ax.legend(fontsize=7, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.22))  # below the axes, off the bars
     section.figure(fig, "seed_table_dsp_stages", "DSP − float IK per leg (legs 1–6 per pose), stacked by the operation that causes it")
 
 

@@ -96,7 +96,7 @@ def build(section) -> None:
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_aspect("equal")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12))  # below the axes, off the contours
     section.figure(fig, "servo_reachable_xy", "Reachable platform positions (no rotation) at three heights")
 
 

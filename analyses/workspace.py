@@ -21,6 +21,7 @@ from stewart_drake.report import run_standalone
 
 TITLE = "Workspace of the 6-6 platform (González Acuña & Dutra 2009)"
 ORDER = 50
+COST = 30  # relative run time: the report's workers start the costliest analyses first
 
 PRESET = "gonzalez-dutra-2009"
 # Seed 001, section IV: extents at zero orientation (m), and the mid-stroke height.
@@ -132,6 +133,7 @@ def build(section) -> None:
     }
     for name in ("3d", "top", "front", "side"):
         section.figure(figs[name], f"workspace_{name}", captions[name])
+    section.points3d(w.boundary, "workspace_3d", "The workspace boundary in 3-D, coloured by height", ("X [m]", "Y [m]", "Z [m]"))
 
     # --- mobility
     rows = [[k, m["n"], m["j"], m["sum_f"], m["I_f"], m["m"]] for k in ("SPS", "UPS", "UPU") for m in [ws.stewart_mobility(k)]]

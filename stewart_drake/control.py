@@ -540,6 +540,18 @@ class _FloatLaw:
         return u, sp, np.concatenate([integ, m, dfilt, sp, vfilt]), saturated.astype(float)
 
 
+def counts_per_lsb(config: ControllerConfig) -> int:
+    """Sensor counts per length LSB of the fixed-point IK (the set-point's scaling to counts); raises
+    ValueError unless the sensor resolution divides the LSB into a whole number of counts."""
+    r, lsb = config.timing.sensor_resolution, config.ik_format.length_lsb
+    cpl = lsb / r
+    if abs(cpl - round(cpl)) > 1e-9 * cpl or round(cpl) < 1:
+        raise ValueError(
+            f"sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts for the fixed-point controller"
+        )
+    return int(round(cpl))
+
+
 class _FixedLaw:
     """The PID law in the firmware's fixed-point arithmetic (bit-exact Q15/Q31 intrinsics)."""
 
@@ -548,13 +560,7 @@ class _FixedLaw:
 
         self._q = q15
         self.gains = FixedGains.from_si(self.config.gains, self.timing)
-        r, lsb = self.timing.sensor_resolution, self.config.ik_format.length_lsb
-        cpl = lsb / r
-        if abs(cpl - round(cpl)) > 1e-9 * cpl or round(cpl) < 1:
-            raise ValueError(
-                f"sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts for the fixed-point controller"
-            )
-        self._counts_per_lsb = int(round(cpl))
+        self._counts_per_lsb = counts_per_lsb(self.config)
         self._cache: dict[bytes, np.ndarray] = {}
         self.cache_misses = 0
 
@@ -659,8 +665,18 @@ def FixedPointController(platform: Platform, config: ControllerConfig | None = N
     return _cls("FixedPointController", _FixedLaw)(platform, config)
 
 
-def make_controller(kind: str, platform: Platform, config: ControllerConfig | None = None):
-    """``kind`` ``"fixed"`` or ``"float"``."""
+def make_controller(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python", firmware=None):
+    """``kind`` ``"fixed"`` or ``"float"``; for ``fixed``, ``engine`` ``"python"`` (the emulation) or ``"c"``
+    (the compiled firmware, ``firmware.sil``; ``firmware``: a user's C file implementing the ABI). The float
+    twin has no firmware: ``engine`` does not apply to it."""
+    if kind == "fixed" and (engine == "c" or firmware is not None):
+        from .firmware.sil import CFixedPointController  # the firmware package builds on this module
+
+        return CFixedPointController(platform, config, firmware)
+    if engine not in ("python", "c"):
+        raise ValueError(f"engine must be 'python' or 'c', got {engine!r}")
+    if kind != "fixed" and firmware is not None:
+        raise ValueError(f"a firmware file runs the fixed-point controller; controller {kind!r} has no firmware")
     if kind == "fixed":
         return FixedPointController(platform, config)
     if kind == "float":

@@ -53,6 +53,101 @@ def _visual(name, radius, length, z_centre, rgba) -> str:
     )
 
 
+# Display colours (RGBA): a dark base, orange cylinders with steel pistons, black joints, a blue plate.
+BASE_RGBA = "0.3 0.3 0.33 1"
+CYLINDER_RGBA = "0.9 0.5 0.1 1"
+PISTON_RGBA = "0.78 0.8 0.85 1"
+JOINT_RGBA = "0.1 0.1 0.1 1"
+PLATE_RGBA = "0.15 0.35 0.8 1"
+VISUAL_NOTE = (
+    "<!-- Visual geometry is for display only: the cylinder and piston visuals are sized to overlap over the"
+    " whole stroke, joints are spheres and plates their anchor polygons. The <inertial> elements are what the"
+    " dynamics uses (uniform rods of the configured cylinder length; the plate's given mass properties). -->"
+)
+
+
+def _sphere_visual(name, centre, radius, rgba) -> str:
+    return (
+        f'<visual name="{name}"><pose>{_v(*centre, 0, 0, 0)}</pose><geometry><sphere>'
+        f"<radius>{_v(radius)}</radius></sphere></geometry><material><diffuse>{rgba}</diffuse></material></visual>"
+    )
+
+
+def _box_visual(name, centre, size, yaw, rgba) -> str:
+    return (
+        f'<visual name="{name}"><pose>{_v(*centre, 0, 0, yaw)}</pose><geometry><box>'
+        f"<size>{_v(*size)}</size></box></geometry><material><diffuse>{rgba}</diffuse></material></visual>"
+    )
+
+
+def convex_outline(points) -> np.ndarray:
+    """``(m, 2)`` the convex hull of ``(n, 2+)`` points' x, y, counter-clockwise (Andrew's monotone chain);
+    coincident points (legs sharing a joint) count once."""
+    pts = sorted({(round(float(x), 12), round(float(y), 12)) for x, y in np.asarray(points, dtype=float)[:, :2]})
+    if len(pts) < 3:
+        return np.array(pts, dtype=float).reshape(-1, 2)
+
+    def half(seq):
+        h = []
+        for q in seq:
+            while len(h) >= 2 and (h[-1][0] - h[-2][0]) * (q[1] - h[-2][1]) - (h[-1][1] - h[-2][1]) * (q[0] - h[-2][0]) <= 0:
+                h.pop()
+            h.append(q)
+        return h[:-1]
+
+    return np.array(half(pts) + half(pts[::-1]), dtype=float)
+
+
+def _chord(hull: np.ndarray, y: float) -> tuple[float, float]:
+    """The x interval of the convex polygon ``hull`` (m, 2) on the line at height ``y`` (inside it)."""
+    a, b = hull, np.roll(hull, -1, axis=0)
+    dy = b[:, 1] - a[:, 1]
+    ok = (np.minimum(a[:, 1], b[:, 1]) <= y) & (y <= np.maximum(a[:, 1], b[:, 1])) & (np.abs(dy) > 1e-15)
+    x = a[ok, 0] + (y - a[ok, 1]) / dy[ok] * (b[ok, 0] - a[ok, 0])
+    return float(x.min()), float(x.max())
+
+
+def plate_visuals(prefix: str, points, z: float, thickness: float, bar: float, rgba: str, strips: int = 32) -> list[str]:
+    """Boxes drawing the convex polygon of ``points`` (n, 2+) as a plate ``thickness`` thick centred at
+    height ``z``: ``strips`` slabs across it, each as wide as the polygon along its whole height (so it
+    stays inside), and a bar ``bar`` wide along every edge covering the slabs' stepped ends.
+    Fewer than three distinct points: no boxes."""
+    hull = convex_outline(points)
+    if len(hull) < 3:
+        return []
+    out = []
+    y0, y1 = hull[:, 1].min(), hull[:, 1].max()
+    edges = np.linspace(y0, y1, strips + 1)
+    eps = 1e-9 * (y1 - y0)
+    for k in range(strips):
+        lo, hi = _chord(hull, edges[k] + eps), _chord(hull, edges[k + 1] - eps)
+        xa, xb = max(lo[0], hi[0]), min(lo[1], hi[1])
+        if xb - xa > bar:  # narrower slabs lie under the edge bars
+            out.append(_box_visual(f"{prefix}_slab_{k}", ((xa + xb) / 2, (edges[k] + edges[k + 1]) / 2, z),
+                                   (xb - xa, edges[k + 1] - edges[k], thickness), 0.0, rgba))
+    for k, (a, b) in enumerate(zip(hull, np.roll(hull, -1, axis=0))):
+        d = b - a
+        out.append(_box_visual(f"{prefix}_edge_{k}", (*((a + b) / 2), z), (float(np.hypot(*d)) + bar, bar, thickness * 1.2),
+                               float(np.arctan2(d[1], d[0])), rgba))
+    return out
+
+
+def leg_visual_dimensions(platform: Platform) -> dict:
+    """Display lengths (metres) of each leg's cylinder and piston, and the joint sphere radius.
+
+    The cylinder runs from the base joint up ``cylinder_length``; the piston from the top joint down
+    ``piston_length``. They overlap at every leg length L in [L_min, L_max] when their sum exceeds
+    L_max, and neither passes the far joint at L_min when each is at most L_min. Both are
+    L_min/2 + L_max/4: the sum L_min + L_max/2 lies halfway between L_max and 2 L_min, leaving an
+    overlap of (2 L_min − L_max)/2 at full extension. A stroke with L_max >= 2 L_min cannot satisfy
+    both; there each is 0.55 L_max, keeping the overlap (the piston then shows below the base joint)."""
+    lo, hi = platform.L_min, platform.L_max
+    length = lo / 2 + hi / 4 if hi < 2 * lo else 0.55 * hi
+    dims = leg_dimensions(platform)
+    return {"cylinder_length": length, "piston_length": length, "cylinder_radius": dims["cylinder_radius"],
+            "piston_radius": dims["piston_radius"], "joint_radius": 1.6 * dims["cylinder_radius"]}
+
+
 def leg_dimensions(platform: Platform) -> dict:
     """Cylinder/piston radii and lengths (metres), the YAML values or their defaults."""
     legs = platform.legs
@@ -78,6 +173,19 @@ def _rpy(R) -> tuple:
     return tuple(angles_from_matrix(R, "zyx"))
 
 
+def _body_visuals(platform: Platform) -> tuple[str, str]:
+    """The base's and the plate's visual elements: each a plate over its anchor polygon (the base's
+    just below its anchors) and a sphere on every joint."""
+    vis = leg_visual_dimensions(platform)
+    rj = vis["joint_radius"]
+    base_z, top_z = float(platform.base_anchors[:, 2].min()), float(platform.top_anchors[:, 2].mean())
+    base = plate_visuals("base_plate", platform.base_anchors, base_z - rj, rj, rj, BASE_RGBA)
+    base += [_sphere_visual(f"base_joint_{i + 1}", b, rj, JOINT_RGBA) for i, b in enumerate(platform.base_anchors)]
+    top = plate_visuals("top_plate", platform.top_anchors, top_z, rj, rj, PLATE_RGBA)
+    top += [_sphere_visual(f"top_joint_{j + 1}", t, rj, JOINT_RGBA) for j, t in enumerate(platform.top_anchors)]
+    return "".join(base), "".join(top)
+
+
 def sdf_text(platform: Platform) -> str:
     """The SDF (1.9) model of ``platform`` as a string, deterministic for a given platform."""
     dims = leg_dimensions(platform)
@@ -85,19 +193,18 @@ def sdf_text(platform: Platform) -> str:
     R_BC = home_leg_frames(platform)
     home = platform.home_pose()
     p_BT = home[:3] - platform.rotation_centre
-    r_plate = float(np.max(np.linalg.norm(platform.top_anchors[:, :2], axis=1)))
-    r_base = float(np.max(np.linalg.norm(platform.base_anchors[:, :2], axis=1)))
+    base_visuals, top_visuals = _body_visuals(platform)
     out = [
         '<?xml version="1.0"?>',
         f"<!-- Generated by stewart_drake.model from platform {xml_comment(repr(platform.name))}; do not edit. -->",
         '<sdf version="1.9">',
         f'<model name="{xml_attr(model_name(platform))}">',
         f'<link name="base">{_inertial(1.0, (0, 0, 0), np.eye(3) * 0.01)}'
-        f"{_visual('base_plate', r_base * 1.05, r_base * 0.02, -r_base * 0.01, '0.6 0.6 0.6 1')}</link>",
+        f"{base_visuals}</link>",
         '<joint name="base_weld" type="fixed"><parent>world</parent><child>base</child></joint>',
         f'<link name="top"><pose relative_to="base">{_v(*p_BT, 0, 0, 0)}</pose>'
         f"{_inertial(max(platform.mass, 1e-6), platform.com, platform.inertia if platform.mass > 0 else np.eye(3) * 1e-9)}"
-        f"{_visual('top_plate', r_plate * 1.05, r_plate * 0.03, 0.0, '0.2 0.4 0.8 1')}</link>",
+        f"{top_visuals}</link>",
     ]
     for i in range(6):
         n = i + 1
@@ -108,10 +215,11 @@ def sdf_text(platform: Platform) -> str:
         out.append(f'<frame name="top_anchor_{n}" attached_to="top"><pose relative_to="top">{_v(*t, 0, 0, 0)}</pose></frame>')
         cl, cr = dims["cylinder_length"], dims["cylinder_radius"]
         pl, pr = dims["piston_length"], dims["piston_radius"]
+        vis = leg_visual_dimensions(platform)
         out.append(
             f'<link name="cylinder_{n}"><pose relative_to="base">{_v(*b, *rpy)}</pose>'
             f"{_inertial(legs.cylinder_mass, (0, 0, cl / 2), _rod_inertia(legs.cylinder_mass, cr, cl))}"
-            f"{_visual('body', cr, cl, cl / 2, '0.8 0.5 0.2 1')}</link>"
+            f"{_visual('body', cr, vis['cylinder_length'], vis['cylinder_length'] / 2, CYLINDER_RGBA)}</link>"
         )
         out.append(
             f'<joint name="universal_{n}" type="universal"><parent>base</parent><child>cylinder_{n}</child>'
@@ -123,7 +231,7 @@ def sdf_text(platform: Platform) -> str:
         out.append(
             f'<link name="piston_{n}"><pose relative_to="cylinder_{n}">0 0 0 0 0 0</pose>'
             f"{_inertial(legs.piston_mass, (0, 0, -pl / 2), _rod_inertia(legs.piston_mass, pr, pl))}"
-            f"{_visual('rod', pr, pl, -pl / 2, '0.7 0.7 0.7 1')}</link>"
+            f"{_visual('rod', pr, vis['piston_length'], -vis['piston_length'] / 2, PISTON_RGBA)}</link>"
         )
         out.append(
             f'<joint name="prismatic_{n}" type="prismatic"><parent>cylinder_{n}</parent><child>piston_{n}</child>'
@@ -139,7 +247,7 @@ def sdf_text(platform: Platform) -> str:
             f"<drake:ball_constraint_p_BQ>{_v(*t)}</drake:ball_constraint_p_BQ>"
             "</drake:ball_constraint>"
         )
-    out += ["</model>", "</sdf>", ""]
+    out += [VISUAL_NOTE, "</model>", "</sdf>", ""]
     return "\n".join(out)
 
 

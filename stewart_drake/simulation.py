@@ -373,6 +373,8 @@ def build_simulation(
     meshcat=None,
     feedforward: bool = True,
     design_duration: float | None = None,
+    engine: str = "python",
+    firmware=None,
 ) -> Simulation:
     """Assemble the controller-in-the-loop Diagram and its Simulator, with the plant at the reference's
     initial pose, legs at the matching lengths and the controller holding them against gravity.
@@ -382,7 +384,8 @@ def build_simulation(
     actuators' lag); ``plant_time_step`` (s): the discrete plant's step; ``meshcat``: a ``Meshcat`` to
     record an animation; ``feedforward``: connect the model-based force feed-forward table;
     ``design_duration`` (s): the default gains are designed over the reference's poses from 0 to this
-    time (``design_poses``; default the trajectory's duration, else 4 s).
+    time (``design_poses``; default the trajectory's duration, else 4 s); ``engine``: ``python`` or ``c``
+    (the fixed-point tick by compiled C), ``firmware``: a user's C file implementing the firmware ABI.
     """
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
@@ -399,7 +402,7 @@ def build_simulation(
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(platform, plant_time_step, builder)
-    ctrl = builder.AddSystem(make_controller(controller, platform, config))
+    ctrl = builder.AddSystem(make_controller(controller, platform, config, engine, firmware))
     ctrl.set_name(f"{controller}_controller")
     src = builder.AddSystem(pose_source(trajectory))
     src.set_name("reference")

@@ -18,12 +18,16 @@ def register(sub) -> None:
                    help="unit of A B G: 'pi' = a fraction of pi as the firmware takes them (0.1 = 18°, the default), 'deg', 'rad'")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--trace", action="store_true", help="also print the firmware's intermediate words (sin/cos, matrix, plate joints)")
+    p.add_argument("--engine", choices=["python", "c"], default="python",
+                   help="python: the numpy emulation (default); c: tp17.C compiled for the host against the C intrinsics")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     import sys
 
+    from ..firmware.engine import resolve_engine
+    from ..firmware.host import tp17_leg_lengths_c
     from ..fixedpoint.q15 import SaturationCounter
     from ..fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
     from ..rotations import angle_scale
@@ -46,13 +50,15 @@ def run(args) -> int:
         print(f"stewart-drake dsp-ik: warning: the firmware's arithmetic saturated ({dict(sat.counts)}); "
               "its lengths for this pose are clipped, not geometric", file=sys.stderr)
     res = tp17_error_stages(q)
-    dsp = tr.lengths.astype(int)
+    engine = resolve_engine(args.engine, "stewart-drake dsp-ik")
+    dsp = tp17_leg_lengths_c(q) if engine == "c" else tr.lengths.astype(int)
     flt = res["float"]
     out = {
         "pose": {"px_mm": int(np.trunc(q[0])), "py_mm": int(np.trunc(q[1])), "pz_mm": int(np.trunc(q[2])),
                  "alpha_pi": float(q[3]), "beta_pi": float(q[4]), "gamma_pi": float(q[5]),
                  "angle_words": tr.angle_words.tolist()},
         "geometry_mm": {"firmware": dict(TP17_GEOMETRY_MM), "float": {"a": 612.5, "b": 925, "d": 150}},
+        "engine": engine,
         "dsp_lengths_mm": dsp.tolist(),
         "float_lengths_mm": [round(float(v), 4) for v in flt],
         "difference_mm": [round(float(v), 4) for v in dsp - flt],

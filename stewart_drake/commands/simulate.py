@@ -36,6 +36,10 @@ def register(sub) -> None:
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
     p.add_argument("--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin")
+    p.add_argument("--engine", choices=["python", "c"], default="python",
+                   help="fixed-point controller tick: python (the emulation, default) or c (the generated firmware, compiled; bit-identical)")
+    p.add_argument("--firmware", default=None, metavar="FILE.c",
+                   help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`) as the controller tick")
     p.add_argument("--period", type=float, default=1e-3, metavar="S", help="controller sample period, s (default 0.001)")
     p.add_argument("--latency", choices=["sample", "computation", "none"], default="sample",
                    help="when a tick's output is released: one sample later (default), after the cycle model's computation time, or at once")
@@ -57,6 +61,7 @@ def run(args) -> int:
 
     from ..atomic import atomic_folder
     from ..control import ControllerConfig, DspTiming
+    from ..firmware.engine import resolve_engine
     from ..geometry import load_platform
     from ..simulation import ActuatorModel, build_simulation, design_poses, fit_trajectory, get_trajectory, tracking_verdict
 
@@ -86,7 +91,11 @@ def run(args) -> int:
         print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
     # command range and gains designed for the platform over the poses of the run
     config = ControllerConfig.for_platform(platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0)))
-    sim = build_simulation(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward)
+    engine = resolve_engine(args.engine, "stewart-drake simulate") if args.firmware is None else "c"
+    if (engine == "c" or args.firmware) and args.controller != "fixed":
+        raise ValueError(f"--engine c / --firmware run the fixed-point controller; --controller is {args.controller!r}")
+    sim = build_simulation(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward,
+                           engine=engine, firmware=args.firmware)
     log = sim.run(duration, progress=not args.no_progress)
     out = Path(args.out)
     e = log.length_error(traj, platform)
@@ -95,6 +104,8 @@ def run(args) -> int:
         "platform": platform.name,
         "trajectory": traj.name,
         "controller": args.controller,
+        "engine": engine,
+        "firmware": args.firmware,
         "sample_period_s": args.period,
         "latency": args.latency,
         "feedforward": not args.no_feedforward,

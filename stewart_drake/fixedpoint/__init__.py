@@ -31,6 +31,8 @@ Generic fixed-point IK for any Platform — :mod:`.generic`::
     fixed_point_leg_lengths(platform, poses_si, fmt=QFormat(), convention="utn", return_words=False)
         -> (..., 6) metres (integer multiples of length_lsb)
     fixed_point_rotation(angles_rad, fmt, convention) -> (..., 3, 3) Q(word_bits-1) words
+    pose_words(poses_si, fmt) -> (..., 6) words; leg_length_words(platform, words, fmt, convention) -> (..., 6)
+      (the same IK split at the firmware's interface: the C firmware takes pose words; see ``firmware``)
 
 Cycle model (MC56F8367 at 60 MHz) — :mod:`.cycles`::
 

@@ -14,7 +14,8 @@ It follows the firmware's recipe (``tp17.C``) generalised, not its exact instruc
    the nearest LSB); the plate anchor p + R r with each R·r product truncated as in 3 and the sums
    saturated to the word;
 5. the squared length summed in a 2·word_bits accumulator (saturating) and its integer square root
-   rounded to the nearer of y, y + 1 (the mfr32Sqrt rule).
+   rounded to the nearer of y, y + 1 (the mfr32Sqrt rule), saturated to the word (a length beyond the
+   word's range cannot be stored; mfr32Sqrt saturates likewise).
 
 Saturations are recorded in any active :class:`~.q15.SaturationCounter` under ``generic.*`` names.
 """
@@ -107,32 +108,50 @@ def rotation_monomials(convention: str = "utn"):
 # ------------------------------------------------------------------------------------------------
 
 
-def _trig_words(angles: np.ndarray, fmt: QFormat):
+def angle_words(angles, fmt: QFormat) -> np.ndarray:
+    """``(...)`` Q(word_bits-1) words of angles (radians) as fractions of pi: truncated toward zero like
+    FRAC16, saturated. Raises ValueError for |angle| > pi."""
+    angles = np.asarray(angles, dtype=float)
     f = fmt.frac_bits
-    lo, hi = -(1 << f), (1 << f) - 1
     x = angles / np.pi
     if np.any(np.abs(x) > 1.0):
         k = tuple(int(i) for i in np.argwhere(np.abs(x) > 1.0)[0])
         raise ValueError(f"pose {counted(k[:-1])}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
-    w = _sat(np.trunc(x * (1 << f)).astype(np.int64), lo, hi, "generic.angle")
+    return _sat(np.trunc(x * (1 << f)).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.angle")
+
+
+def trig_words(w, fmt: QFormat):
+    """``(sin, cos)`` Q(word_bits-1) words of sin(pi x), cos(pi x) for angle words ``w`` (fractions of pi)."""
+    w = np.asarray(w, dtype=np.int64)
     if fmt.trig == "tfr16":
         return tfr16SinPIx(w), tfr16CosPIx(w)
+    f = fmt.frac_bits
+    lo, hi = -(1 << f), (1 << f) - 1
     t = np.pi * w / (1 << f)
     s = _sat(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
     c = _sat(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
     return s, c
 
 
+def _trig_words(angles: np.ndarray, fmt: QFormat):
+    return trig_words(angle_words(angles, fmt), fmt)
+
+
 def fixed_point_rotation(angles, fmt: QFormat = QFormat(), convention: str = "utn") -> np.ndarray:
     """``(..., 3, 3)`` Q(word_bits-1) words of R_BT for ``(..., 3)`` angles (radians)."""
-    angles = np.asarray(angles, dtype=float)
+    return rotation_from_words(angle_words(angles, fmt), fmt, convention)
+
+
+def rotation_from_words(w, fmt: QFormat = QFormat(), convention: str = "utn") -> np.ndarray:
+    """``(..., 3, 3)`` Q(word_bits-1) words of R_BT for ``(..., 3)`` angle words (see ``angle_words``)."""
+    w = np.asarray(w, dtype=np.int64)
     f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
-    s, c = _trig_words(angles, fmt)
+    s, c = trig_words(w, fmt)
     words = {}
     for k, ax in enumerate("xyz"):
         words[f"s{ax}"], words[f"c{ax}"] = s[..., k], c[..., k]
-    S = angles.shape[:-1]
+    S = w.shape[:-1]
     R = np.zeros(S + (3, 3), dtype=np.int64)
     for i, j in product(range(3), range(3)):
         acc = np.zeros(S, dtype=np.int64)
@@ -157,31 +176,56 @@ def _isqrt_nearest(S: np.ndarray) -> np.ndarray:
     return np.where(np.abs((y + 1) * (y + 1) - S) < np.abs(y * y - S), y + 1, y)
 
 
-def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(), convention: str = "utn",
-                            return_words: bool = False) -> np.ndarray:
-    """``(..., 6)`` leg lengths (metres, integer multiples of ``fmt.length_lsb``) computed in fixed
-    point with ``fmt`` for ``(..., 6)`` SI poses. ``return_words``: the integer length words instead."""
+def length_words(x_m, fmt: QFormat, what: str) -> np.ndarray:
+    """Integer words of lengths ``x_m`` (metres) in units of ``fmt.length_lsb``, rounded to nearest;
+    raises ValueError naming ``what`` if one does not fit the word."""
+    lsb, hi = fmt.length_lsb, (1 << fmt.frac_bits) - 1
+    w = np.round(np.asarray(x_m) / lsb)
+    if np.any(np.abs(w) > hi + 1):
+        raise ValueError(f"{what} {np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())]:.6g} m does not fit a "
+                         f"{fmt.word_bits}-bit word of {lsb:g} m (range ±{fmt.range_m:.6g} m)")
+    return np.clip(w.astype(np.int64), -hi - 1, hi)
+
+
+def platform_words(platform: Platform, fmt: QFormat) -> tuple[np.ndarray, np.ndarray]:
+    """``(r_T, B)``: the ``(6, 3)`` plate-anchor offsets from the rotation centre and the base anchors as
+    length words — the constants of the fixed-point IK (computed once, at generation time in C)."""
+    r_T = length_words(platform.top_anchors_per_leg - platform.rotation_centre, fmt, "a plate anchor offset")
+    B = length_words(platform.base_anchors, fmt, "a base anchor")
+    return r_T, B
+
+
+def check_poses(poses) -> np.ndarray:
+    """``(..., 6)`` finite float poses, or ValueError naming the first bad one."""
     q = np.asarray(poses, dtype=float)
     if q.shape[-1:] != (6,):
         raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
     if not np.all(np.isfinite(q)):
         k = tuple(int(i) for i in np.argwhere(~np.isfinite(q).all(-1))[0])
         raise ValueError(f"pose {counted(k)} is not finite: {q[k].tolist()}")
-    f, lsb = fmt.frac_bits, fmt.length_lsb
+    return q
+
+
+def pose_words(poses, fmt: QFormat = QFormat()) -> np.ndarray:
+    """``(..., 6)`` int64 pose words of ``(..., 6)`` SI poses, as the firmware takes them: positions in
+    length LSBs (rounded to nearest, saturated), angles as Q(word_bits-1) fractions of pi (truncated)."""
+    q = check_poses(poses)
+    f = fmt.frac_bits
+    pos = _sat(np.round(q[..., :3] / fmt.length_lsb).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.position")
+    return np.concatenate([pos, angle_words(q[..., 3:], fmt)], axis=-1)
+
+
+def leg_length_words(platform: Platform, words, fmt: QFormat = QFormat(), convention: str = "utn",
+                     consts: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    """``(..., 6)`` int64 leg-length words from ``(..., 6)`` pose words (``pose_words``): steps 3–5 of
+    the recipe. ``consts``: ``platform_words`` if already computed. A length beyond the word saturates."""
+    w = np.asarray(words, dtype=np.int64)
+    f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
-
-    def words(x_m, what):
-        w = np.round(np.asarray(x_m) / lsb)
-        if np.any(np.abs(w) > hi + 1):
-            raise ValueError(f"{what} {np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())]:.6g} m does not fit a "
-                             f"{fmt.word_bits}-bit word of {lsb:g} m (range ±{fmt.range_m:.6g} m)")
-        return np.clip(w.astype(np.int64), lo, hi)
-
-    r_T = words(platform.top_anchors_per_leg - platform.rotation_centre, "a plate anchor offset")  # (6, 3)
-    B = words(platform.base_anchors, "a base anchor")  # (6, 3)
-    pos = _sat(np.round(q[..., :3] / lsb).astype(np.int64), lo, hi, "generic.position")
-    R = fixed_point_rotation(q[..., 3:], fmt, convention)  # (..., 3, 3)
-    S = q.shape[:-1]
+    r_T, B = platform_words(platform, fmt) if consts is None else consts
+    pos = w[..., :3]
+    R = rotation_from_words(w[..., 3:], fmt, convention)  # (..., 3, 3)
+    S = w.shape[:-1]
     acc_hi = (1 << (2 * fmt.word_bits - 1)) - 1
     out = np.empty(S + (6,), dtype=np.int64)
     for i in range(6):
@@ -193,5 +237,15 @@ def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(),
                     v = _sat(v + ((R[..., r, k] * r_T[i, k]) >> f), lo, hi, "generic.add")
             v = _sat(v - B[i, r], lo, hi, "generic.sub")
             sq = _sat(sq + v * v, -acc_hi - 1, acc_hi, "generic.L_add")
-        out[..., i] = _isqrt_nearest(sq)
-    return out if return_words else out * lsb
+        out[..., i] = _sat(_isqrt_nearest(sq), lo, hi, "generic.sqrt")
+    return out
+
+
+def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(), convention: str = "utn",
+                            return_words: bool = False) -> np.ndarray:
+    """``(..., 6)`` leg lengths (metres, integer multiples of ``fmt.length_lsb``) computed in fixed
+    point with ``fmt`` for ``(..., 6)`` SI poses. ``return_words``: the integer length words instead."""
+    q = check_poses(poses)
+    consts = platform_words(platform, fmt)
+    out = leg_length_words(platform, pose_words(q, fmt), fmt, convention, consts)
+    return out if return_words else out * fmt.length_lsb

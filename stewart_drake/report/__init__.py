@@ -1,9 +1,17 @@
 """Report assembly: analyses add sections (text, tables, figures, checks) to a ``Report``; ``write``
 renders one self-contained HTML file (figures inlined as PNG data URIs, also saved beside it) plus a
-``checks.json``, and replaces the output folder atomically.
+``checks.json``, and replaces the output folder atomically. ``render`` does the HTML: a header (date,
+versions, commit, command line, presets), a verdict per section, the checks grouped by section,
+then the sections; tables format numbers and units alike everywhere.
+
+Analyses run in worker processes (``jobs``), each returning its picklable ``Section``; the report
+keeps the analyses' order whatever order they finish in.
 
 An analysis script in ``analyses/`` defines ``TITLE``, ``ORDER`` (position in the report) and
-``build(section)``; its ``main()`` calls ``run_standalone`` so it also runs on its own.
+``build(section)``, optionally ``COST`` (its relative run time: the costliest start first); its ``main()``
+calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
+out with ``parallel_map(__file__, "function_name", items)``. ``section.headline(text)`` sets the figure
+shown beside the section's verdict.
 """
 
 from __future__ import annotations
@@ -12,13 +20,19 @@ import base64
 import html
 import importlib.util
 import io
+import multiprocessing
+import os
+import shlex
 import sys
 import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..atomic import OutputFolder, atomic_folder
 from ..jsonout import dumps_strict
+from . import render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[2] / "analyses"
 
@@ -47,6 +61,15 @@ class Section:
     blocks: list[str] = field(default_factory=list)
     checks: list[Check] = field(default_factory=list)
     files: dict[str, bytes] = field(default_factory=dict)
+    headline_text: str = ""
+    elapsed: float | None = None  # wall seconds to build
+    cpu: float | None = None  # CPU seconds of the process that built it (not of pools it started)
+    warnings: list[str] = field(default_factory=list)
+
+    def headline(self, text: str) -> None:
+        """The one figure that sums the section up, shown in the report's verdict table (default: the
+        tightest check)."""
+        self.headline_text = text
 
     def text(self, paragraph: str) -> None:
         """A paragraph of plain text (escaped)."""
@@ -56,28 +79,43 @@ class Section:
         """Raw HTML (the caller escapes)."""
         self.blocks.append(fragment)
 
-    def table(self, header: list[str], rows: list[list], caption: str = "", fmt: str = "{:.6g}") -> None:
-        """A table; floats formatted with ``fmt``."""
-        def cell(v):
-            return html.escape(fmt.format(v) if isinstance(v, float) else str(v))
-
-        head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
-        body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in r) + "</tr>" for r in rows)
-        cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
-        self.blocks.append(f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+    def table(self, header: list[str], rows: list[list], caption: str = "", fmt: str | None = None,
+              nan_reason: str = "not applicable") -> None:
+        """A table in a scrolling box. Numbers get the report's significant digits whatever ``fmt``
+        asks (kept for callers; one format for every table), units in headers are written alike, and a
+        NaN shows as an em dash with ``nan_reason``."""
+        self.blocks.append(render.table_html(header, rows, caption, nan_reason))
 
     def figure(self, fig, name: str, caption: str = "") -> None:
         """A matplotlib figure, inlined and saved as ``name.png``; the figure is closed."""
         import matplotlib.pyplot as plt
 
+        self.warnings += [f"figure {name}: {w}" for w in unlabelled_axes(fig)]
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+        if fig.get_layout_engine() is None:  # lay labels, titles and legends out without overlaps or clipping
+            fig.set_layout_engine("constrained")
+            try:
+                with warnings.catch_warnings():
+                    warnings.filterwarnings("error", message=".*constrained_layout not applied")  # then do without
+                    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+            except (ZeroDivisionError, ValueError, UserWarning):  # a layout it cannot solve: the figure as drawn
+                fig.set_layout_engine("none")
+                buf = io.BytesIO()
+        if not buf.getvalue():
+            fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
         plt.close(fig)
         data = buf.getvalue()
         self.files[f"{name}.png"] = data
         b64 = base64.b64encode(data).decode()
         cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
-        self.blocks.append(f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,{b64}">{cap}</figure>')
+        if not caption:
+            self.warnings.append(f"figure {name}: no caption")
+        alt = html.escape(caption or name)
+        self.blocks.append(f'<figure><img alt="{alt}" src="data:image/png;base64,{b64}">{cap}</figure>')
+
+    def points3d(self, points, name: str, caption: str, labels=("x [m]", "y [m]", "z [m]")) -> None:
+        """A rotatable 3-D view of ``(n, 3)`` points in the page (inline script, no file, no library)."""
+        self.blocks.append(render.points3d_html(f"p3d-{name}", points, labels, caption + " (drag to rotate)"))
 
     def attach(self, name: str, data: bytes, text: str) -> None:
         """An extra file in the report folder (e.g. an HTML animation), linked from the section."""
@@ -99,6 +137,8 @@ class Analysis:
     title: str
     order: float
     build: object
+    path: Path | None = None
+    cost: float = 0.0  # the module's optional COST (relative run time): workers take the costliest first
 
 
 def load_analysis(path: Path) -> Analysis:
@@ -108,7 +148,7 @@ def load_analysis(path: Path) -> Analysis:
     for attr in ("TITLE", "ORDER", "build"):
         if not hasattr(mod, attr):
             raise ValueError(f"analysis {path} lacks {attr}")
-    return Analysis(path.stem, mod.TITLE, float(mod.ORDER), mod.build)
+    return Analysis(path.stem, mod.TITLE, float(mod.ORDER), mod.build, path, float(getattr(mod, "COST", 0.0)))
 
 
 def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = None) -> list[Analysis]:
@@ -124,69 +164,123 @@ def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = N
     return sorted(found, key=lambda a: (a.order, a.name))
 
 
-def run_analyses(analyses: list[Analysis], quick: bool = False, log=None) -> list[Section]:
-    """Build each analysis's section, printing progress to ``log`` (default: the current stderr); an
-    analysis that raises becomes a failed check."""
+def unlabelled_axes(fig) -> list[str]:
+    """Axes of a matplotlib figure that show data but lack an axis label (x, y, and z for 3-D)."""
+    out = []
+    for k, ax in enumerate(fig.axes):
+        if ax.get_label() == "<colorbar>" or not ax.get_visible() or not ax.axison or not (ax.lines or ax.collections or ax.images or ax.patches):
+            continue
+        getters = [("x", ax.get_xlabel), ("y", ax.get_ylabel)] + ([("z", ax.get_zlabel)] if hasattr(ax, "get_zlabel") else [])
+        missing = [a for a, get in getters if not get().strip()]
+        shared_x = ax.get_shared_x_axes().get_siblings(ax)
+        if "x" in missing and any(o is not ax and o.get_xlabel().strip() for o in shared_x):
+            missing.remove("x")  # shared x axis labelled on another row
+        shared_y = ax.get_shared_y_axes().get_siblings(ax)
+        if "y" in missing and any(o is not ax and o.get_ylabel().strip() for o in shared_y):
+            missing.remove("y")
+        if missing:
+            out.append(f"axes {k} ({ax.get_title() or 'untitled'}) has no {'/'.join(missing)} label")
+    return out
+
+
+_MODULES: dict = {}
+
+
+def _call_in_analysis(path: str, name: str, item):
+    """``name(item)`` of the analysis script at ``path`` (loaded once per worker process)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    if path not in _MODULES:
+        spec = importlib.util.spec_from_file_location(f"analyses_{Path(path).stem}", path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        _MODULES[path] = mod
+    return getattr(_MODULES[path], name)(item)
+
+
+def parallel_map(module_file: str, name: str, items: list, jobs: int | None = None) -> list:
+    """``[f(item) for item in items]`` where ``f`` is the function ``name`` of the analysis script
+    ``module_file`` (pass ``__file__``), computed in ``jobs`` worker processes (default: the CPUs).
+    For an analysis's independent heavy cases; ``item`` and the results must be picklable. In order."""
+    jobs = min(len(items), jobs or os.cpu_count() or 1)
+    if jobs <= 1:
+        return [_call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        return list(pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items))
+
+
+def build_section(analysis: Analysis, quick: bool = False) -> Section:
+    """Run one analysis into a new ``Section`` (timed); an analysis that raises becomes a failed check."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    s = Section(analysis.title, quick=quick)
+    try:
+        analysis.build(s)
+    except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
+        s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
+        s.check(f"{analysis.name} ran to completion", 1.0, 0.0)
+    s.elapsed, s.cpu = time.perf_counter() - t0, time.process_time() - c0
+    return s
+
+
+def _build_in_worker(path: str, quick: bool) -> Section:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    return build_section(load_analysis(Path(path)), quick)
+
+
+def _progress(k: int, n: int, s: Section, log) -> None:
+    ok = sum(c.passed for c in s.checks)
+    cpu = "" if s.cpu is None else f" (CPU {s.cpu:.1f} s)"
+    print(f"[{k}/{n}] {s.title[:70]}: {ok}/{len(s.checks)} checks passed, {s.elapsed:.1f} s{cpu}", file=log, flush=True)
+    for w in s.warnings:
+        print(f"      warning: {w}", file=log, flush=True)
+
+
+def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1) -> list[Section]:
+    """Build each analysis's section, in ``jobs`` worker processes (1: in this process), printing a
+    line per analysis as it finishes to ``log`` (default: the current stderr); the sections come back
+    in the analyses' order."""
     log = log or sys.stderr
-    sections = []
-    for k, a in enumerate(analyses, 1):
-        print(f"[{k}/{len(analyses)}] {a.title} ...", file=log, flush=True)
-        t0 = time.perf_counter()
-        s = Section(a.title, quick=quick)
-        try:
-            a.build(s)
-        except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
-            s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
-            s.check(f"{a.name} ran to completion", 1.0, 0.0)
-        print(f"      done in {time.perf_counter() - t0:.1f} s", file=log, flush=True)
-        sections.append(s)
+    n = len(analyses)
+    if jobs <= 1 or n <= 1:
+        sections = []
+        for k, a in enumerate(analyses, 1):
+            sections.append(build_section(a, quick))
+            _progress(k, n, sections[-1], log)
+        return sections
+    ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold Drake's threads
+    with ProcessPoolExecutor(max_workers=min(jobs, n), mp_context=ctx) as pool:
+        # The slowest first (ORDER is no guide; COST, when an analysis declares it, is), so that the
+        # workers finish together.
+        order = sorted(range(n), key=lambda i: -getattr(analyses[i], "cost", 0.0))
+        futures = {i: pool.submit(_build_in_worker, str(analyses[i].path), quick) for i in order}
+        done = 0
+        index = {f: i for i, f in futures.items()}
+        sections: list[Section | None] = [None] * n
+        for f in as_completed(futures.values()):
+            i = index[f]
+            try:
+                sections[i] = f.result()
+            except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
+                s = Section(analyses[i].title, quick=quick)
+                s.html(f'<p class="fail">This analysis failed in its worker: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
+                s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
+                s.elapsed = 0.0
+                sections[i] = s
+            done += 1
+            _progress(done, n, sections[i], log)
     return sections
 
 
-_CSS = """
-body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
-table{border-collapse:collapse;margin:1em 0;font-size:90%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}
-th{background:#eee;text-align:left}caption{caption-side:top;text-align:left;font-style:italic;padding:4px 0}
-img{max-width:100%}figure{margin:1em 0}figcaption{font-style:italic;font-size:90%}
-.pass{color:#070;font-weight:bold}.fail{color:#b00;font-weight:bold}
-"""
+def render_html(sections: list[Section], title: str = "stewart-drake report", meta: dict | None = None) -> str:
+    """The report page (see ``render``); ``meta``: the header's fields (default: date, versions, commit)."""
+    return render.render_html(sections, title, meta if meta is not None else render.default_meta(sections))
 
 
-def _versions(sections: list[Section]) -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    def v(pkg):
-        try:
-            return version(pkg)
-        except PackageNotFoundError:
-            return "?"
-
-    mode = "quick mode (small samples)" if any(s.quick for s in sections) else "full mode"
-    return f"stewart-drake {v('stewart-drake')}, drake {v('drake')}, numpy {v('numpy')}, scipy {v('scipy')}; {mode}."
-
-
-def render_html(sections: list[Section], title: str = "stewart-drake report") -> str:
-    checks = [c for s in sections for c in s.checks]
-    n_fail = sum(not c.passed for c in checks)
-    anchor = {s.title: f"s{i}" for i, s in enumerate(sections)}
-    rows = "".join(
-        f"<tr><td style='text-align:left'><a href='#{anchor.get(c.section, '')}'>{html.escape(c.section)}</a></td>"
-        f"<td style='text-align:left'>{html.escape(c.what)}</td>"
-        f"<td>{c.worst:.4g} {html.escape(c.unit)}</td><td>{c.tolerance:.4g} {html.escape(c.unit)}</td>"
-        f"<td class='{'pass' if c.passed else 'fail'}'>{'pass' if c.passed else 'FAIL'}</td></tr>"
-        for c in checks
-    )
-    toc = "".join(f'<li><a href="#s{i}">{html.escape(s.title)}</a></li>' for i, s in enumerate(sections))
-    body = "".join(f'<section id="s{i}"><h2>{html.escape(s.title)}</h2>{"".join(s.blocks)}</section>' for i, s in enumerate(sections))
-    return (
-        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
-        f"<h1>{html.escape(title)}</h1><p>{html.escape(_versions(sections))}</p><h2>Summary of checks</h2><p>{len(checks)} checks, {n_fail} failed.</p>"
-        f"<table><thead><tr><th>section</th><th>what was compared</th><th>worst error</th><th>tolerance</th><th>result</th></tr></thead>"
-        f"<tbody>{rows}</tbody></table><h2>Contents</h2><ol>{toc}</ol>{body}</body></html>"
-    )
-
-
-def write_report(sections: list[Section], out_dir, title: str = "stewart-drake report") -> Path:
+def write_report(sections: list[Section], out_dir, title: str = "stewart-drake report", meta: dict | None = None) -> Path:
     """Write ``index.html``, ``checks.json`` and every section file into ``out_dir``, atomically: the
     report is built in a temporary sibling folder and swapped in only when complete."""
     out = out_dir if isinstance(out_dir, OutputFolder) else OutputFolder(out_dir)
@@ -194,10 +288,17 @@ def write_report(sections: list[Section], out_dir, title: str = "stewart-drake r
         for s in sections:
             for name, data in s.files.items():
                 (tmp / name).write_bytes(data)
-        (tmp / "index.html").write_text(render_html(sections, title), encoding="utf-8")
+        (tmp / "index.html").write_text(render_html(sections, title, meta), encoding="utf-8")
         checks = [dict(c.__dict__, passed=c.passed) for s in sections for c in s.checks]
         (tmp / "checks.json").write_text(dumps_strict(checks), encoding="utf-8")
     return out.path / "index.html"
+
+
+def command_line(argv=None) -> str:
+    """The command as typed (``stewart-drake`` for the CLI module)."""
+    argv = list(sys.argv if argv is None else argv)
+    prog = "stewart-drake" if argv and argv[0].endswith(("cli.py", "stewart-drake", "__main__.py")) else Path(argv[0]).name
+    return shlex.join([prog, *argv[1:]])
 
 
 def run_standalone(module_file: str, argv=None) -> int:
@@ -211,7 +312,9 @@ def run_standalone(module_file: str, argv=None) -> int:
     args = ap.parse_args(argv)
     out = OutputFolder(args.out)
     a = load_analysis(path)
+    t0 = time.perf_counter()
     sections = run_analyses([a], quick=args.quick)
-    index = write_report(sections, out, title=a.title)
+    meta = render.default_meta(sections, command_line([str(path), *(sys.argv[1:] if argv is None else argv)]), time.perf_counter() - t0)
+    index = write_report(sections, out, title=a.title, meta=meta)
     print(index)
     return 0 if all(c.passed for s in sections for c in s.checks) else 1

@@ -1,0 +1,132 @@
+"""Firmware in the loop: what the compiled C engine costs against the Python emulation.
+
+1. Real-time factors at 1 kHz on utn-dynamic (seed trajectory, 1 ms plant step), in one run: the plant
+   alone (zero actuation), the fixed-point controller with the Python engine, and with the C engine
+   (the generated firmware's sd_tick in the LeafSystem); the ratios to the plant alone.
+2. The per-tick cost of the controller's ``compute`` alone (Python law vs one ``sd_tick`` call).
+3. IK throughput, single-threaded batch calls: the generated ``sd_ik`` (poses/s, by wall clock and by the
+   process's CPU time: on a shared machine the latter is the call's own cost), the compiled tp17.C, and
+   the numpy emulations for comparison.
+
+Run by hand:  .venv/bin/python benchmarks/bench_firmware.py [--duration 4] [--poses 2000000]
+Compiled modules are cached (``$STEWART_DRAKE_CACHE``); the first run also compiles them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import numpy as np  # noqa: E402
+
+
+def plant_alone_rtf(p, duration):
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from stewart_drake.model import build_plant, set_pose
+
+    b = DiagramBuilder()
+    plant, _ = build_plant(p, 1e-3, b)
+    src = b.AddSystem(ConstantVectorSource([0.0] * 6))
+    b.Connect(src.get_output_port(), plant.get_actuation_input_port())
+    sim = Simulator(b.Build())
+    set_pose(plant, plant.GetMyMutableContextFromRoot(sim.get_mutable_context()), p, p.home_pose())
+    t0 = time.perf_counter()
+    sim.AdvanceTo(duration)
+    return duration / (time.perf_counter() - t0)
+
+
+def loop_rtf(p, engine, duration):
+    from stewart_drake.simulation import build_simulation
+
+    sim = build_simulation(p, "seed", "fixed", engine=engine)
+    t0 = time.perf_counter()
+    sim.run(duration)
+    return duration / (time.perf_counter() - t0), sim
+
+
+def best_rate(fn, n, repeats=3):
+    return best_rates(fn, n, repeats)[0]
+
+
+def best_rates(fn, n, repeats=3):
+    """Best items/s over ``repeats`` calls, by wall clock and by this process's CPU time (the latter is
+    what a single-threaded call costs on a shared, loaded machine)."""
+    wall = cpu = 0.0
+    for _ in range(repeats):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fn()
+        t1, c1 = time.perf_counter(), time.process_time()
+        wall, cpu = max(wall, n / (t1 - t0)), max(cpu, n / max(c1 - c0, 1e-9))
+    return wall, cpu
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--duration", type=float, default=4.0, help="simulated seconds per closed-loop run (default 4)")
+    ap.add_argument("--poses", type=int, default=2_000_000, help="poses per IK batch (default 2e6)")
+    args = ap.parse_args(argv)
+
+    from stewart_drake.control import ControllerConfig
+    from stewart_drake.firmware.check import workspace_poses
+    from stewart_drake.firmware.generate import generate
+    from stewart_drake.firmware.host import tp17_leg_lengths_c
+    from stewart_drake.firmware.module import compile_generated
+    from stewart_drake.fixedpoint import tp17_leg_lengths
+    from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
+    from stewart_drake.geometry import load_preset
+
+    p = load_preset("utn-dynamic")
+    loop_rtf(p, "c", 0.01)  # compile and cache the module before timing
+    plant = plant_alone_rtf(p, args.duration)
+    py, sim_py = loop_rtf(p, "python", args.duration)
+    c, sim_c = loop_rtf(p, "c", args.duration)
+    print(f"1 kHz, 1 ms plant step, {args.duration:g} s of the seed trajectory on utn-dynamic (real-time factors, one run):")
+    print(f"  plant alone:                         {plant:6.2f}x")
+    print(f"  fixed-point controller, Python engine: {py:6.2f}x  ({py / plant:.2f} × plant alone)")
+    print(f"  fixed-point controller, C engine:      {c:6.2f}x  ({c / plant:.2f} × plant alone; {c / py:.2f} × the Python engine)")
+
+    # the controller's compute alone, on the state and inputs of the last tick
+    for name, sim in (("Python", sim_py), ("C", sim_c)):
+        ctrl = sim.controller
+        ref, L = p.home_pose(), np.full(6, 0.7)
+        pid = ctrl.initial_pid_state(L, np.zeros(6))
+        ff = np.zeros(6)
+        ctrl.prime(ref[None])  # as in the run: the reference's IK / pose words are looked up
+        ctrl.compute(ref, L, pid, ff)
+        n = 3000
+        rate = best_rate(lambda: [ctrl.compute(ref, L, pid, ff) for _ in range(n)], n)
+        print(f"  compute() per tick, {name:6s} engine: {1e6 / rate:7.1f} µs")
+
+    cfg = ControllerConfig.for_platform(p)
+    g = generate(p, cfg)
+    m = compile_generated(g)  # -O3, the default build
+    q = workspace_poses(p, min(args.poses, 200_000), seed=1)
+    w = pose_words(np.resize(q, (args.poses, 6)), cfg.ik_format)
+    w16 = np.ascontiguousarray(w, dtype=m.word_dtype)
+    out = np.empty_like(w16)
+    m.ik_raw(w16[:1000], out[:1000])
+    r_c, r_c_cpu = best_rates(lambda: m.ik_raw(w16, out), len(w16))
+    n_py = min(len(w), 200_000)
+    r_py, _ = best_rates(lambda: leg_length_words(p, w[:n_py], cfg.ik_format, cfg.convention), n_py, repeats=2)
+    print(f"generated sd_ik (utn-dynamic, 16-bit words, tfr16), one thread, batch of {len(w)} poses:")
+    print(f"  {r_c / 1e6:6.2f} M poses/s wall clock, {r_c_cpu / 1e6:6.2f} M poses/s of process CPU time "
+          f"({r_c / r_py:.0f} × the numpy emulation's {r_py / 1e6:.2f} M poses/s, wall)")
+    rng = np.random.default_rng(0)
+    dq = np.c_[rng.integers(-150, 151, (args.poses, 2)), rng.integers(0, 400, args.poses), rng.uniform(-0.3, 0.3, (args.poses, 3))]
+    tp17_leg_lengths_c(dq[:1000])
+    r_t, r_t_cpu = best_rates(lambda: tp17_leg_lengths_c(dq), len(dq))
+    n_py = min(len(dq), 200_000)
+    r_tp, _ = best_rates(lambda: tp17_leg_lengths(dq[:n_py]), n_py, repeats=2)
+    print(f"compiled tp17.C (with validation and conversions), batch of {len(dq)}: {r_t / 1e6:6.2f} M poses/s wall, "
+          f"{r_t_cpu / 1e6:6.2f} M/s CPU ({r_t / r_tp:.1f} × the numpy port's {r_tp / 1e6:.2f} M poses/s)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

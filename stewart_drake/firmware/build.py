@@ -1,0 +1,220 @@
+"""Compiling C for the host: find a compiler, build a shared library, cache it by content hash, load it
+with cffi.
+
+Why cffi's ABI mode (``ffi.dlopen`` of a plain shared library) rather than its API mode (a CPython
+extension): every compiler we fall back to — the system ``cc``/``gcc``/``clang`` and the ``ziglang``
+wheel's ``zig cc`` — builds a shared library with one command and no Python headers or setuptools, the
+library does not depend on the Python version (one cache entry serves every interpreter), and it is
+the very object a user's firmware file compiles to in ``firmware check``. The cost, a libffi call of
+~1 µs, does not matter: the hot loops run inside C batch functions, and the controller in the loop
+makes one call per 1 ms tick.
+
+Compiler order: ``$STEWART_DRAKE_CC`` (a command line, e.g. ``clang`` or ``gcc -m64``), then ``cc``,
+``gcc``, ``clang`` on PATH, then ``python -m ziglang cc`` when the ``ziglang`` wheel is installed.
+Cache: ``$STEWART_DRAKE_CACHE``, else ``$XDG_CACHE_HOME/stewart-drake``, else ``~/.cache/stewart-drake``
+(never the source tree); an entry's name is the SHA-256 of the compiler's identity, the flags and every
+source's bytes, written atomically (compiled in a temporary folder, then renamed).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+from ..errors import StewartError
+
+C_DIR = Path(__file__).resolve().parent.parent / "fixedpoint" / "c"
+CACHE_ENV = "STEWART_DRAKE_CACHE"
+CC_ENV = "STEWART_DRAKE_CC"
+BASE_FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared")
+STRICT_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
+
+
+class CompilerUnavailable(StewartError):
+    """No C compiler could be found (nor the ziglang wheel)."""
+
+
+class CompileError(StewartError):
+    """The compiler rejected a source; the message is the compiler's own (file:line: error ...)."""
+
+
+@dataclass(frozen=True)
+class Compiler:
+    """A C compiler command: ``name`` (gcc, clang, zig cc, ...), ``argv`` the command prefix, ``version``
+    its first ``--version`` line (part of the cache key)."""
+
+    name: str
+    argv: tuple[str, ...]
+    version: str
+
+
+def cache_dir() -> Path:
+    """The folder compiled modules are cached in (created on first use)."""
+    d = os.environ.get(CACHE_ENV)
+    if not d:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        d = os.path.join(base, "stewart-drake")
+    p = Path(d)
+    p.mkdir(parents=True, exist_ok=True)
+    return p
+
+
+def _probe(name: str, argv: tuple[str, ...]) -> Compiler | None:
+    try:
+        r = subprocess.run([*argv, "--version"], capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    if r.returncode != 0:
+        return None
+    first = (r.stdout or r.stderr).strip().splitlines()
+    return Compiler(name, argv, first[0] if first else name)
+
+
+@lru_cache(maxsize=None)
+def _compilers(cc_env: str | None) -> tuple[Compiler, ...]:
+    found = []
+    if cc_env:
+        argv = tuple(shlex.split(cc_env))
+        c = _probe(argv[0], argv) if argv else None
+        if c is None:
+            raise CompilerUnavailable(f"{CC_ENV}={cc_env!r} does not run as a C compiler")
+        return (c,)
+    seen = set()
+    for exe in ("cc", "gcc", "clang"):
+        path = shutil.which(exe)
+        if path and os.path.realpath(path) not in seen:
+            seen.add(os.path.realpath(path))
+            c = _probe(exe, (path,))
+            if c is not None:
+                found.append(c)
+    zig = zig_compiler()
+    if zig is not None:
+        found.append(zig)
+    return tuple(found)
+
+
+@lru_cache(maxsize=None)
+def zig_compiler() -> Compiler | None:
+    """``python -m ziglang cc`` when the ``ziglang`` wheel is installed, else None."""
+    import importlib.util
+
+    if importlib.util.find_spec("ziglang") is None:
+        return None
+    return _probe("zig cc", (sys.executable, "-m", "ziglang", "cc"))
+
+
+def compilers() -> tuple[Compiler, ...]:
+    """Every usable compiler, in the order of preference (see the module docstring)."""
+    return _compilers(os.environ.get(CC_ENV))
+
+
+def default_compiler() -> Compiler:
+    """The preferred compiler; raises CompilerUnavailable if there is none."""
+    cs = compilers()
+    if not cs:
+        raise CompilerUnavailable("no C compiler found (looked for $STEWART_DRAKE_CC, cc, gcc, clang and the ziglang "
+                                  "wheel's zig cc; `pip install ziglang` gives one)")
+    return cs[0]
+
+
+def compiler_by_name(name: str) -> Compiler:
+    """A compiler named ``gcc``, ``clang``, ``cc`` or ``zig`` (raises CompilerUnavailable if absent)."""
+    if name.startswith("zig"):
+        c = zig_compiler()
+    else:
+        path = shutil.which(name)
+        c = _probe(name, (path,)) if path else None
+    if c is None:
+        raise CompilerUnavailable(f"compiler {name!r} is not available")
+    return c
+
+
+@dataclass(frozen=True)
+class Source:
+    """A C source for ``build``: a file on disk (``path``; compiled where it is, so that the compiler's
+    messages name it) or generated text (``name`` + ``text``, written into the build folder)."""
+
+    name: str
+    text: str | None = None
+    path: Path | None = None
+
+    def data(self) -> bytes:
+        return self.path.read_bytes() if self.path is not None else self.text.encode()
+
+
+def library_sources(*names: str) -> list[Source]:
+    """The package's own C files (``fixedpoint/c``) as build sources."""
+    return [Source(n, path=C_DIR / n) for n in names]
+
+
+def build(sources: list[Source], *, headers: list[Source] = (), defines: tuple[str, ...] = (),
+          flags: tuple[str, ...] = (), compiler: Compiler | None = None, strict: bool = False, opt: str = "-O2") -> Path:
+    """Compile ``sources`` (with ``headers`` beside them and the package's ``fixedpoint/c`` on the include
+    path) into a shared library in the cache and return its path; a cached build with the same compiler,
+    flags and bytes is reused. ``strict``: add ``-Wall -Wextra -Werror -pedantic``. Raises CompileError
+    with the compiler's message, CompilerUnavailable without a compiler."""
+    compiler = compiler or default_compiler()
+    cflags = tuple(f for f in BASE_FLAGS if f != "-O2") + (opt,) + (STRICT_FLAGS[1:] if strict else ()) + tuple(f"-D{d}" for d in defines) + tuple(flags)
+    h = hashlib.sha256()
+    h.update("\0".join((compiler.version, *compiler.argv, *cflags)).encode())
+    for s in [*sources, *headers, *library_sources("dsp56800e.h")]:
+        h.update(s.name.encode() + b"\0" + s.data() + b"\0")
+    root = cache_dir()
+    out = root / f"sd-{h.hexdigest()[:32]}.so"
+    if out.exists():
+        return out
+    with tempfile.TemporaryDirectory(prefix="build-", dir=root) as tmp:
+        tmp = Path(tmp)
+        files = []
+        for s in [*sources, *headers]:
+            if s.path is None:
+                (tmp / s.name).write_text(s.text)
+        for s in sources:
+            files.append(str(s.path if s.path is not None else tmp / s.name))
+        target = tmp / "lib.so"
+        cmd = [*compiler.argv, *cflags, f"-I{tmp}", f"-I{C_DIR}", "-o", str(target), *files]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            msg = (r.stderr or r.stdout).replace(str(tmp) + os.sep, "")
+            raise CompileError(_first_error(msg, compiler))
+        os.replace(target, out)
+    return out
+
+
+def _first_error(msg: str, compiler: Compiler) -> str:
+    """The compiler's first error line (file:line:col: error: ...), else the start of its output."""
+    lines = msg.strip().splitlines()
+    for k, line in enumerate(lines):
+        if re.search(r":\d+:(\d+:)? (fatal )?error", line):
+            return line
+    return f"{compiler.name} failed: " + " | ".join(lines[:3])
+
+
+@lru_cache(maxsize=None)
+def _ffi(cdef: str):
+    import cffi
+
+    ffi = cffi.FFI()
+    ffi.cdef(cdef)
+    return ffi
+
+
+_LOADED: dict[tuple[str, str], object] = {}
+
+
+def load(path: Path, cdef: str):
+    """``(ffi, lib)`` for the shared library at ``path`` with the declarations ``cdef`` (loaded once)."""
+    ffi = _ffi(cdef)
+    key = (str(path), cdef)
+    if key not in _LOADED:
+        _LOADED[key] = ffi.dlopen(str(path))
+    return ffi, _LOADED[key]

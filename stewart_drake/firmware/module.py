@@ -1,0 +1,180 @@
+"""A compiled firmware module — generated (``generate``) or a user's C implementing the ABI — loaded
+with cffi: batch IK, traced IK, and the controller tick on an ``sd_state``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .build import Compiler, Source, build, library_sources, load
+from .generate import OPS, TRACE_WORDS, GeneratedFirmware
+
+ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
+
+
+def _cdef(word: str, counting: bool) -> str:
+    s = f"""
+typedef {word} sd_word;
+typedef int32_t sd_count;
+typedef struct {{ int32_t integ[6]; sd_count prev[6]; int16_t dfilt[6]; sd_word setpoint[6]; int16_t vfilt[6]; int16_t saturated[6]; }} sd_state;
+int sd_ik(const sd_word pose[6], sd_word lengths[6]);
+int sd_ik_trace(const sd_word pose[6], int32_t trace[{TRACE_WORDS}]);
+void sd_init(sd_state *s);
+int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], const int16_t feedforward[6], int16_t command[6]);
+void sd_ik_batch(const sd_word *poses, long n, sd_word *lengths, int32_t *nsat);
+int sd_host_tick(sd_state *s, const sd_word pose[6], const double L[6], double res, const double *ff, double range,
+                 double lsb, double state[30], double out[18]);
+"""
+    if counting:
+        s += f"extern long sd_op_counts[{len(OPS)}];\n"
+    return s
+
+
+@dataclass
+class FirmwareModule:
+    """A loaded firmware: ``ffi``, ``lib``, the library ``path``, ``word_dtype`` of ``sd_word`` and which
+    optional ABI functions it defines (``has_tick``, ``has_trace``)."""
+
+    ffi: object
+    lib: object
+    path: Path
+    word: str
+    counting: bool = False
+
+    @property
+    def word_dtype(self):
+        return np.int16 if self.word == "int16_t" else np.int32
+
+    def _has(self, name: str) -> bool:
+        try:
+            getattr(self.lib, name)
+            return True
+        except (AttributeError, NotImplementedError):
+            return False
+
+    @property
+    def has_tick(self) -> bool:
+        return self._has("sd_tick") and self._has("sd_init")
+
+    @property
+    def has_trace(self) -> bool:
+        return self._has("sd_ik_trace")
+
+    def ik(self, words) -> tuple[np.ndarray, np.ndarray]:
+        """``(lengths (..., 6) int64, saturation counts (...) int64)`` of ``(..., 6)`` pose words."""
+        w = np.asarray(words)
+        flat = np.ascontiguousarray(w.reshape(-1, 6), dtype=self.word_dtype)
+        out = np.empty_like(flat)
+        nsat = np.empty(len(flat), dtype=np.int32)
+        f = self.ffi
+        self.lib.sd_ik_batch(f.from_buffer(f"{self.word}[]", flat), len(flat), f.from_buffer(f"{self.word}[]", out),
+                             f.from_buffer("int32_t[]", nsat))
+        return out.astype(np.int64).reshape(w.shape), nsat.astype(np.int64).reshape(w.shape[:-1])
+
+    def ik_raw(self, words: np.ndarray, out: np.ndarray) -> None:
+        """``sd_ik`` over ``(n, 6)`` C-contiguous ``word_dtype`` pose words into ``out`` (same shape and
+        dtype), no conversions: the batch call the throughput benchmark times."""
+        f = self.ffi
+        self.lib.sd_ik_batch(f.from_buffer(f"{self.word}[]", words), len(words), f.from_buffer(f"{self.word}[]", out), f.NULL)
+
+    def ik_trace(self, pose_words) -> np.ndarray:
+        """``(TRACE_WORDS,)`` int64 intermediate words of one pose (see ``generate.TRACE_FIELDS``)."""
+        p = np.ascontiguousarray(pose_words, dtype=self.word_dtype).reshape(6)
+        tr = np.zeros(TRACE_WORDS, dtype=np.int32)
+        self.lib.sd_ik_trace(self.ffi.from_buffer(f"{self.word}[]", p), self.ffi.from_buffer("int32_t[]", tr))
+        return tr.astype(np.int64)
+
+    def new_state(self):
+        s = self.ffi.new("sd_state *")
+        self.lib.sd_init(s)
+        return s
+
+    def op_counts(self) -> dict:
+        """The instrumented build's counters (name -> calls since the last ``reset_op_counts``)."""
+        return {n: int(self.lib.sd_op_counts[k]) for k, n in enumerate(OPS) if self.lib.sd_op_counts[k]}
+
+    def reset_op_counts(self) -> None:
+        for k in range(len(OPS)):
+            self.lib.sd_op_counts[k] = 0
+
+
+def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O3") -> FirmwareModule:
+    """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
+    sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c", "sd_host_tick.c")]
+    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
+    path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt,
+                 flags=("-lm",))
+    word = "int16_t"
+    ffi, lib = load(path, _cdef(word, counting))
+    return FirmwareModule(ffi, lib, path, word, counting)
+
+
+def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = None) -> FirmwareModule:
+    """Compile a user's C file implementing the ABI (``#include "sd_firmware.h"``; the header generated for
+    the same platform and format is on the include path, and so is ``dsp56800e.h``). The compiler's
+    messages name the user's file and line; raises build.CompileError."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"firmware file {str(path)!r} does not exist")
+    sources = [Source(path.name, path=path.resolve()), *library_sources("sd_host.c", "dsp56800e.c")]
+    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
+    word = "int16_t"
+    lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
+    m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
+    if m.has_tick:  # then link the tick's host glue too (it calls sd_tick)
+        lib_path = build(sources + library_sources("sd_host_tick.c"), headers=headers, compiler=compiler, flags=("-lm",))
+        m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
+    return m
+
+
+class TickRunner:
+    """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control._FixedLaw``
+    (integrator, previous measurement, its filtered difference, previous set-point, its filtered
+    difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer."""
+
+    FIELDS = (("integ", np.int32), ("prev", np.int32), ("dfilt", np.int16), ("setpoint", None), ("vfilt", np.int16), ("saturated", np.int16))
+
+    def __init__(self, module: FirmwareModule):
+        if not module.has_tick:
+            raise ValueError(f"firmware {module.path.name} does not define sd_init and sd_tick")
+        self.module = m = module
+        ffi = m.ffi
+        self._buf = bytearray(ffi.sizeof("sd_state"))
+        self._ptr = ffi.from_buffer("sd_state *", self._buf)
+        m.lib.sd_init(self._ptr)
+        self.views = {name: np.frombuffer(self._buf, dtype=dt or m.word_dtype, count=6, offset=ffi.offsetof("sd_state", name))
+                      for name, dt in self.FIELDS}
+        self.pose = np.zeros(6, dtype=m.word_dtype)
+        self.measured = np.zeros(6, dtype=np.int32)
+        self.feedforward = np.zeros(6, dtype=np.int16)
+        self.command = np.zeros(6, dtype=np.int16)
+        self._p = (ffi.from_buffer(f"{m.word}[]", self.pose), ffi.from_buffer("int32_t[]", self.measured),
+                   ffi.from_buffer("int16_t[]", self.feedforward), ffi.from_buffer("int16_t[]", self.command))
+        self._tick = m.lib.sd_tick
+        self._null = ffi.NULL
+
+    def set_state(self, state) -> None:
+        st = np.asarray(state)
+        v = self.views
+        v["integ"][:] = st[0:6]
+        v["prev"][:] = st[6:12]
+        v["dfilt"][:] = st[12:18]
+        v["setpoint"][:] = st[18:24]
+        v["vfilt"][:] = st[24:30]
+
+    def state(self) -> np.ndarray:
+        """The 30-word state vector (int64)."""
+        v = self.views
+        return np.concatenate([v["integ"], v["prev"], v["dfilt"], v["setpoint"], v["vfilt"]]).astype(np.int64)
+
+    def tick(self, pose_words, measured, feedforward_words=None) -> np.ndarray:
+        """One ``sd_tick`` on the held state; returns the six Q15 command words (int16 view, copied)."""
+        self.pose[:] = pose_words
+        self.measured[:] = measured
+        p_pose, p_meas, p_ff, p_cmd = self._p
+        if feedforward_words is not None:
+            self.feedforward[:] = feedforward_words
+        self._tick(self._ptr, p_pose, p_meas, p_ff if feedforward_words is not None else self._null, p_cmd)
+        return self.command.copy()
