@@ -34,7 +34,8 @@ def run(args) -> int:
 
     raw = np.asarray(args.pose, dtype=float)
     q = raw.copy()
-    q[3:] = raw[3:] * angle_scale(args.angle_unit) / np.pi  # -> fractions of pi
+    with np.errstate(over="ignore"):  # 1e308 deg is inf pi: refused just below as beyond ±180°
+        q[3:] = raw[3:] * angle_scale(args.angle_unit) / np.pi  # -> fractions of pi
     for k, name in enumerate(("A", "B", "G")):
         if abs(q[3 + k]) > 1.0:
             raise ValueError(f"angle {name} = {raw[3 + k]:g} {args.angle_unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]")
