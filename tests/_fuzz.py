@@ -1,6 +1,6 @@
 """Shared pieces of the property (fuzz) tests: an in-process CLI runner in a scratch folder, the
 invariants every run must keep, and hypothesis settings for CI (bounded, derandomised) and for the
-long ``-m fuzz`` run (``STEWART_FUZZ_EXAMPLES`` examples per test, default 2500, fixed seed)."""
+long ``-m fuzz`` run (``STEWART_FUZZ_EXAMPLES`` examples per test, default 5000: 20,000 in all; derandomised)."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, settings
 from stewart_drake.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-FUZZ_EXAMPLES = int(os.environ.get("STEWART_FUZZ_EXAMPLES", "2500"))
+FUZZ_EXAMPLES = int(os.environ.get("STEWART_FUZZ_EXAMPLES", "5000"))  # x 4 tests = 20,000
 _HEALTH = list(HealthCheck)
 
 
