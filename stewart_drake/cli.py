@@ -10,6 +10,8 @@ import math
 import pkgutil
 import sys
 
+import numpy as np
+
 from . import __version__, commands
 from .errors import StewartError, UsageError
 
@@ -89,7 +91,10 @@ def main(argv=None) -> int:
         return e.code if isinstance(e.code, int) else 2
     name = args.command + (f" {args.op}" if getattr(args, "op", None) else "")
     try:
-        return int(args.func(args) or 0)
+        # Intermediate overflow/NaN in numpy is not reported as a multi-line RuntimeWarning: every result
+        # is checked (finite inputs and outputs, strict JSON, the sanity checks) before it is printed.
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+            return int(args.func(args) or 0)
     except (StewartError, ValueError) as e:
         print(f"stewart-drake {name}: error: {_one_line(e)}", file=sys.stderr)
         return getattr(e, "exit_code", 2)  # PhysicalLimitError: 1

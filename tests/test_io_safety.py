@@ -504,3 +504,11 @@ def test_servo_write_sdf_json_is_one_document(here, capsys):
     info = json.loads(out)
     assert rc == 0 and info["sdf_file"] == str(here / "s" / "servo-hexapod.sdf") and Path(info["sdf_file"]).is_file()
     assert read_manifest(here / "s") == ["servo-hexapod.sdf"]
+
+
+@pytest.mark.parametrize("argv", [["leg", "ik", "0", "1.6959684595474368e+155", "--gamma", "0", "--l1", "1", "--json"],
+                                  ["dsp-ik", "--pose", "0", "0", "0", "0", "1e308", "0", "--json"]])
+def test_numeric_overflow_is_one_line_not_a_warning(capsys, argv):
+    """Found by the CLI fuzz: an intermediate overflow printed numpy's two-line RuntimeWarning."""
+    rc, out, err = cli(capsys, *argv)
+    assert rc == 2 and out == "" and len(err.splitlines()) == 1 and "RuntimeWarning" not in err
