@@ -401,3 +401,20 @@ def test_dynamics_any_trajectory(tmp_path, samples):
 
 def test_physical_limit_error_exits_1():
     assert PhysicalLimitError.exit_code == 1
+
+
+def test_run_without_plate_computes_no_forces_and_says_so(noplate, tmp_path):
+    f = tmp_path / "p.stw"
+    f.write_text("mover(0, 0, 750, 0, 0, 0) en 1\n")
+    rc, out, _ = cli("run", f, "--platform", noplate, "--out", tmp_path / "o", "--json")
+    s = json.loads(out)
+    assert rc == 0 and s["max_abs_force_N"] is None
+    assert s["notes"] == ["leg forces not computed: platform 'noplate' has no plate mass properties (YAML key 'plate')"]
+
+
+def test_workspace_workers_bounded():
+    import os
+
+    n = 4 * (os.cpu_count() or 1) + 1
+    rc, _, err = cli("workspace", "--workers", n)
+    assert rc == 2 and f"--workers {n} would need {float(n):.2g} worker processes" in err
