@@ -287,7 +287,7 @@ YAML_CASES = [
     ("length_unit: mm\nutn: {b: 1e300, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]", "p.yaml:2: utn.b: 1e300 is too large (at most 100000 mm)"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstrok: [0.5, 0.9]",
      "p.yaml:2: strok: unknown key (did you mean 'stroke'?); valid keys: name, description, length_unit, utn, radial, "
-     "base_anchors, top_anchors, leg_top, stroke, plate, rotation_centre, home_height, legs"),
+     "base_anchors, top_anchors, leg_top, stroke, plate, rotation_centre, home_height, legs, plate_below_base_allowed"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mas: 1}",
      "p.yaml:3: plate: unknown key 'mas' (did you mean 'mass'?); valid keys: mass, com, inertia, thickness, density"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mass: big}", "p.yaml:3: plate.mass: expected a number, got big"),
@@ -491,17 +491,6 @@ def test_ignored_options_and_inputs_echoed_as_written(here, capsys, argv, messag
     rc, out, err = cli(capsys, *argv)
     assert rc == 2 and out == "" and err.strip() == message
     assert sorted(p.name for p in here.iterdir()) == []  # refused before anything was written
-
-
-def test_compile_refuses_python_that_would_not_parse(here, capsys):
-    n = 100  # Python allows 100 indentation levels at most
-    (here / "nest.stw").write_text("x = 1\n" + "IF x > 0 THEN\n" * n + "mover(z = 110) en 1\n" + "END\n" * n)
-    rc, out, err = cli(capsys, "compile", "nest.stw", "--emit", "python")
-    assert rc == 2 and out == "" and err.strip() == ("stewart-drake compile: error: nest.stw: the Python translation does not compile "
-                                                     "(too many levels of indentation); the program nests blocks too deeply for Python")
-    (here / "nest.stw").write_text("x = 1\n" + "IF x > 0 THEN\n" * 20 + "mover(z = 110) en 1\n" + "END\n" * 20)
-    rc, out, _ = cli(capsys, "compile", "nest.stw", "--emit", "python")
-    assert rc == 0 and compile(out, "nest.py", "exec")
 
 
 def test_model_write_inspect_json_is_one_document(here, capsys):

@@ -6,11 +6,9 @@ The program is checked and run first (syntax, variables, argument counts, reacha
 
 from __future__ import annotations
 
-import builtins
 import sys
 
 from ..atomic import check_output_file, write_output_file
-from ..errors import InputError
 from ..rotations import CONVENTIONS
 from ._common import add_platform_arg, platform_from_args
 from .run import read_program
@@ -52,11 +50,6 @@ def run(args) -> int:
         code = emit_matlab(motion)
     else:
         code = emit_python(program, platform=args.platform, convention=args.convention, rate=args.rate)
-        try:
-            builtins.compile(code, f"{args.program} (Python translation)", "exec")
-        except (SyntaxError, RecursionError, MemoryError) as e:
-            raise InputError(f"{args.program}: the Python translation does not compile ({getattr(e, 'msg', type(e).__name__)}); "
-                             "the program nests blocks too deeply for Python") from None
     if args.output:
         write_output_file(args.output, code, option="--output")
     else:
