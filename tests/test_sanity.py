@@ -15,6 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from _fuzz import fuzz
 from stewart_drake.cli import main
 from stewart_drake.errors import PhysicalLimitError
 from stewart_drake.geometry import load_platform
@@ -357,9 +358,22 @@ anything = st.one_of(finite, st.sampled_from([math.nan, math.inf, -math.inf, 1e3
 NUMBER = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)
 
 
+POSE = (st.lists(anything, min_size=6, max_size=6), st.sampled_from(["mm", "m"]))
+
+
 @settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-@given(st.lists(anything, min_size=6, max_size=6), st.sampled_from(["mm", "m"]))
+@given(*POSE)
 def test_ik_any_pose(pose, unit):
+    check_ik_pose(pose, unit)
+
+
+@fuzz
+@given(*POSE)
+def test_ik_any_pose_fuzz(pose, unit):
+    check_ik_pose(pose, unit)
+
+
+def check_ik_pose(pose, unit):
     p = load_platform("utn-kinematic")
     # fixed notation: argparse takes "-1e-05" (and "-inf") for an option (its usage error is exit 2 too)
     rc, out, err = cli("ik", "--pose", *[f"{v:.330f}" if math.isfinite(v) else repr(v) for v in pose], "--length-unit", unit, "--json")
@@ -375,10 +389,23 @@ def test_ik_any_pose(pose, unit):
     assert json.loads(out)["lengths"] == pytest.approx((L * (1e3 if unit == "mm" else 1)).tolist(), rel=1e-12)
 
 
+SAMPLES = st.lists(st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.sampled_from([0.7, 0.6, 0.9, -0.7, 0.0, 7.0, math.nan]),
+                             st.floats(-0.5, 0.5)), min_size=4, max_size=6)
+
+
 @settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-@given(st.lists(st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.sampled_from([0.7, 0.6, 0.9, -0.7, 0.0, 7.0, math.nan]),
-                          st.floats(-0.5, 0.5)), min_size=4, max_size=6))
+@given(SAMPLES)
 def test_dynamics_any_trajectory(tmp_path, samples):
+    check_dynamics_trajectory(tmp_path, samples)
+
+
+@fuzz
+@given(SAMPLES)
+def test_dynamics_any_trajectory_fuzz(tmp_path, samples):
+    check_dynamics_trajectory(tmp_path, samples)
+
+
+def check_dynamics_trajectory(tmp_path, samples):
     """Random 4-6 sample CSV trajectories (positions within, beyond and below the stroke, non-finite):
     exit 0 only when every sample is within stroke and above the base, and then finite forces."""
     p = load_platform("utn-dynamic")
