@@ -445,3 +445,17 @@ def test_workspace_workers_bounded():
     n = 4 * (os.cpu_count() or 1) + 1
     rc, _, err = cli("workspace", "--workers", n)
     assert rc == 2 and f"--workers {n} would need {float(n):.2g} worker processes" in err
+
+
+def test_rotation_limits_stop_at_the_base_plane(utn):
+    """utn-kinematic at home (pz = 100 mm) tilted about X: a plate anchor at y = ±a/2 = ±306.25 mm
+    reaches the base plane when 100 mm + 306.25 mm · sin θ = 0, θ = asin(100 / 306.25) = 19.058°, far
+    before any stroke limit."""
+    from stewart_drake.workspace import orientation_limits
+
+    lim = {(r.axis, r.sign): r for r in orientation_limits(utn)}
+    theta = math.asin(0.1 / (0.6125 / 2))
+    for s in (1, -1):
+        r = lim[("x", s)]
+        assert r.limit == "base" and r.angle == pytest.approx(s * theta, abs=1e-8)
+    assert lim[("z", 1)].limit == "stroke"  # a turn about the vertical never lowers the plate

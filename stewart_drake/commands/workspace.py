@@ -111,7 +111,7 @@ def run(args) -> int:
             print(f"  {n} limit {'binds' if v > 0 else 'does not bind'}: removes {v:.6f} m³")
         print("  rotation limits from the home pose:")
         for r in rot:
-            what = f"{r.limit} leg {r.leg}" if r.leg else (f"{r.limit} legs {r.pair}" if r.pair else (r.limit or "none reached"))
+            what = (f"plate anchor of leg {r.leg} at the base plane" if r.limit == "base" else f"{r.limit} leg {r.leg}") if r.leg else (f"{r.limit} legs {r.pair}" if r.pair else (r.limit or "none reached"))
             print(f"    about {r.axis} {'+' if r.sign > 0 else '-'}: {math.degrees(r.angle):+8.3f} deg  ({what}"
                   f"{', ' + r.side if r.side else ''}); lengths {np.round(r.lengths, 4).tolist()} m")
         if args.out:
