@@ -6,37 +6,123 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import math
 import pkgutil
 import sys
 
 from . import __version__, commands
-from .errors import StewartError
+from .errors import StewartError, UsageError
+
+
+class Number(float):
+    """A float option value that remembers the text the user typed (messages echo it as written)."""
+
+    text: str
+
+    def __new__(cls, text: str):
+        value = super().__new__(cls, text)
+        value.text = text
+        return value
+
+    def __str__(self) -> str:
+        return self.text
+
+    __repr__ = __str__
+
+
+def finite_number(text: str) -> Number:
+    """argparse ``type`` for every float option: a finite number, kept with its text."""
+    try:
+        value = Number(text.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
+
+
+def checked_int(text: str) -> int:
+    """argparse ``type`` for every integer option (at most 18 digits: counts, not big numbers)."""
+    s = text.strip()
+    if len(s.lstrip("+-")) > 18 or not s.lstrip("+-").isdigit():
+        raise argparse.ArgumentTypeError(f"not a whole number (at most 18 digits): {text!r}")
+    return int(s)
+
+
+class Parser(argparse.ArgumentParser):
+    """An ``ArgumentParser`` whose errors are one line (``prog: error: message (see --help)``), exit 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _finite_types(parser: argparse.ArgumentParser) -> None:
+    """Every ``type=float`` option becomes ``finite_number``, every ``type=int`` ``checked_int``, in
+    ``parser`` and its subparsers."""
+    for action in parser._actions:
+        if action.type is float:
+            action.type = finite_number
+        elif action.type is int:
+            action.type = checked_int
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                _finite_types(sub)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="stewart-drake", description=__doc__.split("\n")[0])
+    parser = Parser(prog="stewart-drake", description=__doc__.split("\n")[0])
     parser.add_argument("--version", action="version", version=f"stewart-drake {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
         if not info.name.startswith("_"):
             importlib.import_module(f"{commands.__name__}.{info.name}").register(sub)
+    _finite_types(parser)
     return parser
 
 
 def main(argv=None) -> int:
+    """Run one command; return its exit status (0 ok, 1 a result outside physical limits, 2 bad input)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:  # --help, --version, or a usage error already printed
+        return e.code if isinstance(e.code, int) else 2
+    name = args.command + (f" {args.op}" if getattr(args, "op", None) else "")
     try:
         return int(args.func(args) or 0)
-    except (StewartError, ValueError, FileNotFoundError) as e:
-        print(f"stewart-drake {args.command}: error: {e}", file=sys.stderr)
+    except (StewartError, ValueError) as e:
+        print(f"stewart-drake {name}: error: {_one_line(e)}", file=sys.stderr)
+        return getattr(e, "exit_code", 2)  # PhysicalLimitError: 1
+    except OSError as e:
+        if isinstance(e, BrokenPipeError):  # e.g. `stewart-drake ... | head`
+            sys.stderr.close()
+            return 0
+        print(f"stewart-drake {name}: error: {_os_message(e)}", file=sys.stderr)
         return 2
-    except BrokenPipeError:  # e.g. `stewart-drake ... | head`
-        sys.stderr.close()
-        return 0
     except KeyboardInterrupt:
-        print(f"stewart-drake {args.command}: interrupted", file=sys.stderr)
+        print(f"stewart-drake {name}: interrupted", file=sys.stderr)
         return 130
+    except (MemoryError, RecursionError, OverflowError, TypeError, ArithmeticError, AssertionError, RuntimeError) as e:
+        detail = _one_line(e)
+        print(f"stewart-drake {name}: error: "
+              + UsageError.INTERNAL.format(kind=type(e).__name__, detail=detail[:300]), file=sys.stderr)
+        return 2
+
+
+def _one_line(e: BaseException) -> str:
+    """The message of ``e`` on one line (a multi-line message keeps its first line)."""
+    text = str(e).strip() or type(e).__name__
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    return lines[0] if len(lines) == 1 else f"{lines[0]} ..." if lines else text
+
+
+def _os_message(e: OSError) -> str:
+    """A file-system error as "FILE: reason", with the file name as given."""
+    where = e.filename if e.filename is not None else ""
+    reason = e.strerror or str(e)
+    if where:
+        return f"{where}: {reason}"
+    return reason
 
 
 if __name__ == "__main__":

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import SingularPoseError
+from .errors import SingularPoseError, counted
 from .geometry import SQRT3, Platform
 from .kinematics import _poses, length_jacobian
 from .rotations import angular_velocity_map, check_convention, rotation_matrix
@@ -126,7 +126,7 @@ def _states(q, qd, qdd):
             raise ValueError(f"{name} must have shape (..., 6) like q, got {v.shape}")
         if not np.all(np.isfinite(v)):
             idx = tuple(int(i) for i in np.argwhere(~np.isfinite(v).all(axis=-1))[0])
-            raise ValueError(f"{name} sample {idx} is not finite: {v[idx].tolist()}")
+            raise ValueError(f"{name} sample {counted(idx)} is not finite: {v[idx].tolist()}")
         arrs.append(v)
     q, qd, qdd = np.broadcast_arrays(q, *arrs)
     return q, qd, qdd
@@ -278,7 +278,7 @@ def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.nd
     bad = ~(k <= MAX_CONDITION)
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0]) if np.ndim(k) else ()
-        raise SingularPoseError(SINGULAR_TEMPLATE.format(index=idx, cond=float(k[idx]), limit=MAX_CONDITION))
+        raise SingularPoseError(SINGULAR_TEMPLATE.format(index=counted(idx), cond=float(k[idx]), limit=MAX_CONDITION))
     Q = np.broadcast_to(Q, J.shape[:-1])
     return np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
 

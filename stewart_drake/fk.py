@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ForwardKinematicsError, SingularPoseError, SingularityWarning
+from .errors import ForwardKinematicsError, SingularPoseError, SingularityWarning, counted
 from .geometry import Platform
 from .kinematics import inverse_jacobian
 from .rotations import angles_from_matrix, check_convention, rotation_matrix
@@ -148,7 +148,7 @@ def _report_singular(cond, bad, max_condition, action, what, hint) -> None:
     n = int(np.sum(bad))
     more = f" ({n} samples in all)" if n > 1 else ""
     msg = SINGULAR_TEMPLATE.format(
-        what=what, index=idx, condition=float(np.asarray(cond)[idx]), max_condition=max_condition, hint=hint + more
+        what=what, index=counted(idx), condition=float(np.asarray(cond)[idx]), max_condition=max_condition, hint=hint + more
     )
     if action == "raise":
         raise SingularPoseError(msg)
@@ -197,12 +197,12 @@ class FKResult:
         index = tuple(int(i) for i in np.atleast_1d(index)) if np.ndim(self.converged) else ()
         st = int(self.status[index])
         if st == CONVERGED:
-            return f"lengths sample {index}: converged in {int(self.iterations[index])} iterations, residual {float(self.residual[index]) * 1e3:.3g} mm"
+            return f"lengths sample {counted(index)}: converged in {int(self.iterations[index])} iterations, residual {float(self.residual[index]) * 1e3:.3g} mm"
         hint = ""
         if st in (MAX_ITER, DIVERGED):
             hint = " — the lengths may admit no assembly (legs too long or too short for the geometry), or the initial pose is too far"
         return NOT_CONVERGED_TEMPLATE.format(
-            index=index,
+            index=counted(index),
             lengths_mm=", ".join(f"{v * 1e3:.3f}" for v in self.lengths[index]),
             reason=STATUS_TEXT[st],
             iterations=int(self.iterations[index]),
@@ -228,7 +228,7 @@ def validate_lengths(lengths) -> np.ndarray:
     bad = ~(np.isfinite(L) & (L > 0))
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        raise ValueError(f"lengths sample {idx[:-1]}: leg {idx[-1] + 1} length {float(L[idx])} m is not a positive finite number")
+        raise ValueError(f"lengths sample {counted(idx[:-1])}: leg {idx[-1] + 1} length {float(L[idx])} m is not a positive finite number")
     return L
 
 

@@ -6,7 +6,7 @@ is p_TTj, a plate joint in T; leg i joins base anchor i to top anchor ``leg_top[
 metres and masses kilograms inside the library; YAML files may use millimetres (``length_unit: mm``).
 """
 
-# No "from __future__ import annotations": yaml_load_typed reads the real field types.
+# The YAML schema dataclasses' field types are read by yamlio (typing.get_type_hints).
 
 import dataclasses
 from dataclasses import dataclass, field
@@ -16,8 +16,10 @@ from typing import Optional
 
 import numpy as np
 
-from .errors import GeometryError
+from .errors import GeometryError, YamlError
 from .rotations import length_scale
+from .sanity import check_home
+from .yamlio import Rule, check_rules, load_yaml_typed
 
 SQRT3 = np.sqrt(3.0)
 PRESETS = ("utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009")
@@ -26,7 +28,7 @@ MIN_ANCHOR_SEPARATION = 1e-6
 
 
 # ----------------------------------------------------------------------------------------------
-# YAML schema (edge units), loaded with Drake's yaml_load_typed.
+# YAML schema (edge units), loaded with the safe, bounded yamlio loader.
 
 
 @dataclass
@@ -95,6 +97,7 @@ class PlatformConfig:
     rotation_centre: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     home_height: Optional[float] = None
     legs: LegConfig = field(default_factory=LegConfig)
+    plate_below_base_allowed: bool = False
 
 
 # ----------------------------------------------------------------------------------------------
@@ -129,6 +132,7 @@ class Platform:
     home_height: Optional[float] = None
     legs: LegConfig = field(default_factory=LegConfig)
     description: str = ""
+    plate_below_base_allowed: bool = False  # poses may put plate anchors at or below z = 0 (sanity.above_base)
 
     def __post_init__(self):
         conv = {
@@ -346,6 +350,7 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
         rotation_centre=np.asarray(cfg.rotation_centre, dtype=float) * k,
         home_height=None if cfg.home_height is None else cfg.home_height * k,
         legs=legs,
+        plate_below_base_allowed=bool(cfg.plate_below_base_allowed),
     )
     if cfg.utn is not None:
         return Platform.utn(cfg.utn.b * k, cfg.utn.d * k, cfg.utn.a * k, **common)
@@ -362,26 +367,100 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
     )
 
 
-def load_yaml_config(path, schema, kind: str):
-    """Parse a YAML file into the dataclass ``schema`` with Drake's ``yaml_load_typed``; errors name the
-    file (``kind`` says what it should hold). A config with an empty ``name`` takes the file's stem."""
-    from pydrake.common.yaml import yaml_load_typed
+# Field rules of a platform file (yamlio.Rule): sign, unit and largest magnitude; list sizes.
+PLATFORM_RULES = {
+    **{f"utn.{k}": Rule("pos", "length") for k in "bda"},
+    "radial.base_radius": Rule("pos", "length"),
+    "radial.top_radius": Rule("pos", "length"),
+    "radial.base_angles_deg[*]": Rule("any", "deg", 1e4),
+    "radial.top_angles_deg[*]": Rule("any", "deg", 1e4),
+    "base_anchors[*][*]": Rule("any", "length"),
+    "top_anchors[*][*]": Rule("any", "length"),
+    "leg_top[*]": Rule("nonneg", "", 5),
+    "stroke[*]": Rule("pos", "length"),
+    "plate.mass": Rule("nonneg", "kg", 1e5),
+    "plate.com[*]": Rule("any", "length"),
+    "plate.inertia[*]": Rule("any", "kg·m² (file unit)", 1e12),
+    "plate.thickness": Rule("pos", "length"),
+    "plate.density": Rule("pos", "kg/m³", 1e5),
+    "rotation_centre[*]": Rule("any", "length"),
+    "home_height": Rule("pos", "length"),
+    "legs.cylinder_length": Rule("nonneg", "length"),
+    "legs.cylinder_radius": Rule("nonneg", "length"),
+    "legs.piston_radius": Rule("nonneg", "length"),
+    "legs.cylinder_mass": Rule("pos", "kg", 1e4),
+    "legs.piston_mass": Rule("pos", "kg", 1e4),
+    "legs.max_force": Rule("pos", "N", 1e8),
+}
+PLATFORM_SHAPES = {
+    "radial.base_angles_deg": (6, 6),
+    "radial.top_angles_deg": (6, 6),
+    "base_anchors": (6, 6),
+    "base_anchors[*]": (3, 3),
+    "top_anchors": (3, 6),
+    "top_anchors[*]": (3, 3),
+    "leg_top": (6, 6),
+    "stroke": (2, 2),
+    "plate.com": (3, 3),
+    "plate.inertia": (6, 6),
+    "rotation_centre": (3, 3),
+}
+MAX_NAME_CHARS = 200
 
-    path = Path(path)
-    if not path.is_file():
-        raise GeometryError(f"{kind} file {str(path)!r} does not exist")
-    try:
-        cfg = yaml_load_typed(schema=schema, filename=str(path))
-    except RuntimeError as e:
-        raise GeometryError(f"{path}: {e}") from None
+
+def check_name(cfg, where: dict, shown: str) -> None:
+    """``name``/``description``: printable text (no control characters), ``name`` at most
+    ``MAX_NAME_CHARS`` long; it is used in file names and XML only through safe derivations."""
+    for key, limit in (("name", MAX_NAME_CHARS), ("description", 2000)):
+        text = getattr(cfg, key)
+        w = where.get((key,))
+        line = w.line if w else "?"
+        if len(text) > limit:
+            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=key, value=f"({len(text)} characters)",
+                                                       problem=f"is longer than {limit} characters"))
+        bad = next((c for c in text if not c.isprintable()), None)
+        if bad is not None:
+            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=key, value=repr(text[:60]),
+                                                       problem=f"contains the control character {bad!r}"))
+
+
+def check_length_unit(cfg, where: dict, shown: str) -> float:
+    """The metres per file unit of ``length_unit`` (m or mm)."""
+    if cfg.length_unit not in ("m", "mm"):
+        w = where.get(("length_unit",))
+        raise YamlError(YamlError.UNIT.format(path=shown, line=w.line if w else "?", value=cfg.length_unit))
+    return length_scale(cfg.length_unit)
+
+
+def _check_platform_fields(shown: str):
+    def check(cfg, where):
+        check_name(cfg, where, shown)
+        k = check_length_unit(cfg, where, shown)
+        check_rules(where, PLATFORM_RULES, PLATFORM_SHAPES, cfg, shown, k, cfg.length_unit)
+
+    return check
+
+
+def load_yaml_config(path, schema, kind: str, check=None):
+    """Parse a YAML file into the dataclass ``schema`` with the safe, bounded loader
+    (``yamlio.load_yaml_typed``); errors name the file, line and field (``kind`` says what the file
+    should hold). A config with an empty ``name`` takes the file's stem."""
+    cfg = load_yaml_typed(path, schema, kind, check)
     if not cfg.name:
-        cfg.name = path.stem
+        cfg.name = Path(path).stem
     return cfg
 
 
 def load_platform_yaml(path) -> Platform:
-    """Load one platform from a YAML file (schema: ``PlatformConfig``)."""
-    return platform_from_config(load_yaml_config(path, PlatformConfig, "platform"))
+    """Load one platform from a YAML file (schema: ``PlatformConfig``); every field is checked
+    (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used."""
+    cfg = load_yaml_config(path, PlatformConfig, "platform", _check_platform_fields(str(path)))
+    try:
+        platform = platform_from_config(cfg)
+    except GeometryError as e:
+        raise GeometryError(f"{path}: {e}") from None
+    check_home(platform)  # sanity: a platform singular at its home pose is refused when loaded
+    return platform
 
 
 def preset_path(name: str) -> Path:

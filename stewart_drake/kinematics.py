@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import SingularPoseError, UnreachablePoseError
+from .errors import SingularPoseError, UnreachablePoseError, counted
 from .geometry import Platform
 from .rotations import angular_velocity_map, rotation_matrix
 
@@ -24,7 +24,7 @@ def _poses(poses) -> np.ndarray:
     bad = ~np.isfinite(q).all(axis=-1)
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        raise ValueError(f"pose {idx} is not finite: {q[idx].tolist()}")
+        raise ValueError(f"pose {counted(idx)} is not finite: {q[idx].tolist()}")
     return q
 
 
@@ -115,7 +115,7 @@ def require_nonsingular(platform: Platform, poses, convention: str = "utn", max_
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0]) if np.ndim(k) else ()
         raise SingularPoseError(
-            f"pose {idx} is singular or nearly so: Jacobian condition number {float(k[idx]):.3g} > {max_condition:.3g}"
+            f"pose {counted(idx)} is singular or nearly so: Jacobian condition number {float(k[idx]):.3g} > {max_condition:.3g}"
         )
     return k
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import StewartError
+from .errors import StewartError, counted
 
 ALPHA_SEED = np.radians(134.6 - 180.0)
 BRANCHES = ("a", "b")
@@ -51,7 +51,7 @@ class UnreachableTargetError(StewartError):
 
     def __init__(self, index, distance, r_min, r_max, what="the foot"):
         self.index, self.distance, self.r_min, self.r_max = index, distance, r_min, r_max
-        super().__init__(self.TEMPLATE.format(index=index, what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3, hi_mm=r_max * 1e3))
+        super().__init__(self.TEMPLATE.format(index=counted(index), what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3, hi_mm=r_max * 1e3))
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ flagged per servo and never produce NaN: the angle is then the nearest one (arm 
 the anchor) and the commanded pulse is clamped to the servo's travel.
 """
 
-# No "from __future__ import annotations": yaml_load_typed reads the config dataclasses' real field types.
+# The config dataclasses' field types are read by yamlio (typing.get_type_hints).
 
 import dataclasses
 from dataclasses import dataclass, field
@@ -44,7 +44,7 @@ from typing import Optional
 
 import numpy as np
 
-from .errors import GeometryError, StewartError
+from .errors import GeometryError, StewartError, counted
 from .geometry import load_yaml_config
 from .rotations import length_scale, rotation_matrix
 
@@ -221,7 +221,7 @@ def hobby_servo_hexapod(
 
 
 # ----------------------------------------------------------------------------------------------
-# YAML (edge units: length_unit m|mm, angles in degrees, pulses in µs), loaded with Drake's yaml_load_typed.
+# YAML (edge units: length_unit m|mm, angles in degrees, pulses in µs), loaded with the safe, bounded yamlio loader.
 
 SERVO_PRESETS = ("hobby-servo",)
 _PRESET_FILES = {"hobby-servo": "servo-hobby.yaml"}
@@ -357,7 +357,10 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
 
 def load_servo_yaml(path) -> ServoHexapod:
     """Load a servo hexapod from a YAML file (schema: ``ServoHexapodConfig``)."""
-    return servo_hexapod_from_config(load_yaml_config(path, ServoHexapodConfig, "servo hexapod"))
+    from .geometry import check_name
+
+    return servo_hexapod_from_config(load_yaml_config(path, ServoHexapodConfig, "servo hexapod",
+                                                      lambda cfg, where: check_name(cfg, where, str(path))))
 
 
 def servo_preset_path(name: str) -> Path:
@@ -448,7 +451,7 @@ def check_poses(poses) -> np.ndarray:
     bad = ~np.all(np.isfinite(poses), axis=-1)
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0]) if poses.ndim > 1 else ()
-        raise ServoPoseError(f"pose {idx} has a non-finite number: {poses[idx].tolist()}")
+        raise ServoPoseError(f"pose {counted(idx)} has a non-finite number: {poses[idx].tolist()}")
     return poses
 
 

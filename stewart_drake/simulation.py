@@ -600,3 +600,53 @@ class SimulationLog:
             w.writerow(header)
             w.writerows([[repr(float(v)) for v in r] for r in rows])
         return [npz, path]
+
+
+# ----------------------------------------------------------------------------------------------
+# Verdict.
+
+# Tracking is lost when a leg's length error or the plate's position error exceeds this fraction of the
+# stroke range (20 mm on utn-dynamic's 0.4 m stroke; the seed run's error is ~1 mm).
+TRACKING_LOST_FRACTION = 0.05
+# A leg whose command stays saturated (at the command range) longer than this, in one stretch, has
+# lost authority over its leg.
+MAX_SATURATION_S = 0.05
+
+
+def longest_saturation(log: "SimulationLog") -> np.ndarray:
+    """``(6,)`` the longest stretch (s) over which each leg's command was saturated on every tick."""
+    ticks = log.status[:, STATUS.index("ticks")].astype(int)
+    first = np.r_[True, np.diff(ticks) != 0] & (ticks > 0)
+    counts = log.status[first][:, 4:10]
+    sat = np.diff(np.vstack([np.zeros((1, 6)), counts]), axis=0) > 0  # (ticks, 6) saturated on that tick
+    out = np.zeros(6)
+    for j in range(6):
+        s = np.r_[0, sat[:, j].astype(np.int8), 0]
+        d = np.diff(s)
+        starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+        out[j] = (ends - starts).max() * log.sample_period if len(starts) else 0.0
+    return out
+
+
+def tracking_verdict(platform: Platform, length_error, pose_error, log: "SimulationLog") -> dict:
+    """Whether a run tracked its reference: ``{"tracking_bound_mm", "saturation_bound_s",
+    "longest_saturation_s" (6,), "failures": [messages]}``; a failure is a leg error or plate position
+    error beyond ``TRACKING_LOST_FRACTION`` × the stroke range (lost tracking, with its first time), or a
+    leg saturated for longer than ``MAX_SATURATION_S`` in one stretch."""
+    bound = TRACKING_LOST_FRACTION * float(platform.L_max - platform.L_min)
+    failures = []
+    e = np.abs(np.asarray(length_error))
+    pe = np.linalg.norm(np.asarray(pose_error)[:, :3], axis=1)
+    for name, err, legwise in (("leg length", e, True), ("plate position", pe, False)):
+        bad = (err > bound).reshape(len(err), -1).any(axis=1)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            which = f" of leg {int(np.argmax(err[i])) + 1}" if legwise else ""
+            failures.append(f"tracking lost: the {name} error{which} exceeds {bound * 1e3:.1f} mm ({TRACKING_LOST_FRACTION:g} × the stroke range) "
+                            f"first at t = {log.t[i]:.4f} s, and reaches {err.max() * 1e3:.1f} mm")
+    longest = longest_saturation(log)
+    for j in np.flatnonzero(longest > MAX_SATURATION_S):
+        failures.append(f"leg {j + 1} saturated for {longest[j]:.3f} s in one stretch (longer than {MAX_SATURATION_S:g} s): "
+                        "its actuator cannot follow the reference")
+    return {"tracking_bound_mm": bound * 1e3, "saturation_bound_s": MAX_SATURATION_S,
+            "longest_saturation_s": longest.tolist(), "failures": failures}

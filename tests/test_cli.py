@@ -48,7 +48,7 @@ def test_ik_poses_csv(tmp_path, capsys):
     np.testing.assert_allclose(res[1]["lengths"][0], 638.659, atol=1e-3)
     f.write_text("0,0,100,0,0,0\n0,0,abc,0,0,0\n")
     rc, out, err = run(capsys, "ik", "--poses", str(f))
-    assert rc == 2 and err.strip() == f"stewart-drake ik: error: {f}:2: not a number in ['0', '0', 'abc', '0', '0', '0']"
+    assert rc == 2 and err.strip() == f"stewart-drake ik: error: {f}:2: column 3: not a number: 'abc'"
 
 
 @pytest.mark.parametrize(

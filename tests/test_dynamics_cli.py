@@ -61,4 +61,4 @@ def test_singular_trajectory_exits_2_naming_the_sample(tmp_path, capsys):
     rows = np.c_[t, np.zeros(6), np.zeros(6), np.full(6, 0.7), np.linspace(0, 90, 6), np.zeros(6), np.zeros(6)]
     np.savetxt(path, rows, delimiter=",")
     assert main(["dynamics", "--trajectory", str(path), "--angle-unit", "deg"]) == 2
-    assert "sample (5,)" in capsys.readouterr().err
+    assert "sample 6:" in capsys.readouterr().err

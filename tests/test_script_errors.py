@@ -96,13 +96,14 @@ def test_unreachable_below_the_stroke(utn):
 
 def test_unreachable_only_on_the_way_there(utn):
     """Both poses are within the stroke, but the straight path between them (in pose coordinates)
-    takes a leg past 700 mm: the check is made on every sample, and says the violation is on the way."""
-    a, b = [-51, -21, 135, 8, -40, 20], [-127, -26, 124, 40, -4, 7]
+    takes a leg past 700 mm: the check is made on every sample, and says the violation is on the way.
+    (Poses with every plate anchor above the base plane all along, as ``sanity.above_base`` requires.)"""
+    a, b = [-150, 60, 246, -19, -15, 12], [-85, 75, 181, 23, 9, 13]
     ends = leg_lengths(utn, pose_to_si(np.array([a, b]), "mm", "deg")) * 1e3
     assert np.all((ends > 300) & (ends < 700))
     src = f"mover({', '.join(map(str, a))}) en 1\nmover({', '.join(map(str, b))}) en 1"
     msg = error_of(src, utn)
-    assert msg.startswith("t.stw:2:1: error: mover #2 to (-127, -26, 124 mm; 40, -4, 7 deg) is out of reach")
+    assert msg.startswith("t.stw:2:1: error: mover #2 to (-85, 75, 181 mm; 23, 9, 13 deg) is out of reach")
     assert msg.endswith(", on the way there)")
 
 

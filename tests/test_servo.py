@@ -93,7 +93,7 @@ def test_limits_are_reported_per_servo_never_nan(hexapod):
 
 
 def test_bad_pose_is_named(hexapod):
-    with pytest.raises(ServoPoseError, match=r"pose \(1,\) has a non-finite number"):
+    with pytest.raises(ServoPoseError, match=r"pose 2 has a non-finite number"):
         solve(hexapod, [hexapod.home_pose(), [0, 0, np.nan, 0, 0, 0]])
     with pytest.raises(ServoPoseError, match="needs 6 numbers"):
         solve(hexapod, [0, 0, 0.1])

@@ -22,12 +22,17 @@ def test_simulate_writes_logs_plots_and_summary(tmp_path, capsys):
 
 
 def test_simulate_reads_a_csv_trajectory(tmp_path):
+    """A smooth lift from rest (quintic, 5 mm and 2° in 0.3 s, sampled every 10 ms) is tracked: exit 0."""
     csv = tmp_path / "lift.csv"
-    csv.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.1,0,0,705,0,0,2\n")
+    t = np.linspace(0.0, 0.3, 31)
+    s = (t / 0.3) ** 3 * (10 - 15 * t / 0.3 + 6 * (t / 0.3) ** 2)
+    rows = "".join(f"{a:.6f},0,0,{700 + 5 * b:.6f},0,0,{2 * b:.6f}\n" for a, b in zip(t, s))
+    csv.write_text("t,px,py,pz,ax,ay,az\n" + rows)
     rc = main(["simulate", "--trajectory", str(csv), "--length-unit", "mm", "--angle-unit", "deg", "--out", str(tmp_path / "o"), "--no-progress"])
     assert rc == 0
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
-    assert summary["duration_s"] == 0.1 and summary["controller"] == "fixed"
+    assert summary["duration_s"] == 0.3 and summary["controller"] == "fixed" and summary["failures"] == []
+    assert summary["max_leg_error_mm"] < summary["tracking_bound_mm"]
 
 
 def test_simulate_refuses_infeasible_timing_and_bad_files(tmp_path, capsys):

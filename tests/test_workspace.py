@@ -336,7 +336,7 @@ def test_dask_local_cluster_same_result(gd, ws10):
 def test_errors(gd):
     with pytest.raises(ws.WorkspaceError, match="resolution must be a positive number of metres, got -0.01"):
         ws.constant_orientation_workspace(gd, resolution=-0.01)
-    with pytest.raises(ws.WorkspaceError, match=r"resolution 1e-06 m gives .* grid nodes"):
+    with pytest.raises(ws.WorkspaceError, match=r"resolution 1e-06 m would need .* grid nodes .*; the finest this machine can hold is ~.* mm; use a coarser --resolution"):
         ws.constant_orientation_workspace(gd, resolution=1e-6)
     with pytest.raises(ws.WorkspaceError, match=r"orientation must be 3 finite angles .* got \[0.0, 0.0\]"):
         ws.constant_orientation_workspace(gd, orientation=(0.0, 0.0))

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
-import json
+import math
 import sys
 
 import numpy as np
 
+from ..atomic import OutputFolder
+from ..errors import UsageError
 from ..geometry import PRESETS, Platform, load_platform
+from ..jsonout import dumps_strict
 from ..rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 
 
@@ -30,9 +33,21 @@ def platform_from_args(args) -> Platform:
     return load_platform(args.platform)
 
 
+def add_force_arg(parser) -> None:
+    parser.add_argument("--force", action="store_true",
+                        help="write into an existing folder that holds other files (they are never touched; see README, Output folders)")
+
+
+def output_folder(args, option: str = "--out") -> OutputFolder | None:
+    """The checked ``--out`` destination (``atomic.OutputFolder``), or None when none was given.
+    Call it before any work so that a refused destination costs nothing."""
+    value = getattr(args, option.lstrip("-").replace("-", "_"))
+    return None if value is None else OutputFolder(value, force=getattr(args, "force", False), option=option)
+
+
 def print_json(obj) -> None:
-    json.dump(obj, sys.stdout, indent=2, default=_jsonable)
-    sys.stdout.write("\n")
+    """Print ``obj`` as strict JSON (``dumps_strict``)."""
+    sys.stdout.write(dumps_strict(obj) + "\n")
 
 
 def _jsonable(x):
@@ -41,3 +56,20 @@ def _jsonable(x):
     if isinstance(x, np.generic):
         return x.item()
     raise TypeError(f"not JSON serialisable: {type(x).__name__}")
+
+
+def reject_unused(args, needs: str, applies: bool, **defaults) -> None:
+    """Raise ``UsageError`` when an option was changed from its default (``defaults``: attribute name
+    -> default) although it does not apply (``applies`` false): an ignored option is an error."""
+    if applies:
+        return
+    for name, default in defaults.items():
+        if getattr(args, name) != default:
+            raise UsageError(UsageError.NEEDS.format(option="--" + name.replace("_", "-"), needs=needs))
+
+
+def finite_option(value, option: str) -> float:
+    """``value`` if it is a finite number, else a ``UsageError`` naming the option."""
+    if value is not None and not math.isfinite(value):
+        raise UsageError(UsageError.NOT_FINITE.format(option=option, value=value))
+    return value

@@ -7,8 +7,8 @@ The program is checked and run first (syntax, variables, argument counts, reacha
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
+from ..atomic import check_output_file, write_output_file
 from ..rotations import CONVENTIONS
 from ._common import add_platform_arg, platform_from_args
 from .run import read_program
@@ -31,6 +31,8 @@ def run(args) -> int:
     from ..script.runtime import check_reachable
 
     text = read_program(args.program)
+    if args.output:
+        check_output_file(args.output, option="--output")
     platform = platform_from_args(args)
     try:
         program, motion = compile_program(text, args.program, platform)
@@ -49,7 +51,7 @@ def run(args) -> int:
     else:
         code = emit_python(program, platform=args.platform, convention=args.convention, rate=args.rate)
     if args.output:
-        Path(args.output).write_text(code, encoding="utf-8")
+        write_output_file(args.output, code, option="--output")
     else:
         sys.stdout.write(code)
     return 0

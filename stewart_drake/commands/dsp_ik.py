@@ -39,6 +39,11 @@ def run(args) -> int:
         if abs(q[3 + k]) > 1.0:
             raise ValueError(f"angle {name} = {raw[3 + k]:g} {args.angle_unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]")
     check_dsp_poses(q)
+    # the firmware's platform is utn-kinematic's (a = 612 vs 612.5 mm): its plate must be above its base
+    from ..geometry import load_preset
+    from ..sanity import check_poses
+
+    check_poses(load_preset("utn-kinematic"), np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi], "utn", what="--pose")
     with SaturationCounter() as sat:
         tr = tp17_trace(q)
     if sat.total:

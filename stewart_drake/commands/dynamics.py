@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import csv
+import math
 import sys
 
 import numpy as np
 
 from ..csvio import read_numeric_csv
 from ..rotations import angle_scale, length_scale
-from ._common import add_platform_arg, platform_from_args, print_json
+from ..sanity import check_file_rows, check_finite, check_gravity, check_trajectory, check_work, fmt_value, require_plate
+from ._common import add_platform_arg, platform_from_args, print_json, reject_unused
 
 CSV_HELP = (
     "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
@@ -30,6 +32,8 @@ def register(sub) -> None:
     p.add_argument("--convention", choices=["utn", "zyx"], default="utn", help="Euler convention of the CSV's angles (default utn)")
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV positions (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
+    p.add_argument("--allow-out-of-stroke", action="store_true",
+                   help="compute forces even where a leg leaves the stroke (a warning, also in the JSON 'warnings'); default: exit 1")
     out = p.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON")
     out.add_argument("--csv", action="store_true", help="print CSV: t,F1..F6 (N)")
@@ -38,6 +42,7 @@ def register(sub) -> None:
 
 def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad"):
     """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (see ``CSV_HELP``). Errors name the line."""
+    check_file_rows(path, "--trajectory", BYTES_PER_SAMPLE + 600, 14)
     a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
     width = a.shape[1]
     if len(a) < (2 if width == 19 else 4):
@@ -55,30 +60,56 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     return t, spline(t), spline(t, 1), spline(t, 2)
 
 
+# Memory per trajectory sample while computing forces ((6, 6) Jacobians, mass matrices and their
+# temporaries) and the most samples one run takes (~10 s of vectorised inverse dynamics).
+BYTES_PER_SAMPLE = 4000
+MAX_SAMPLES = 10_000_000
+
+
+def seed_times(t_end: float, dt: float) -> np.ndarray:
+    """``(n,)`` the seed trajectory's sample times 0, dt, ... t_end (s), after checking that both are
+    finite and the sample count fits the memory and sample budget (before allocating)."""
+    check_finite(t_end, "--t-end (s)")
+    check_finite(dt, "--dt (s)")
+    if not (dt > 0 and t_end >= 0):
+        raise ValueError(f"--dt must be > 0 and --t-end >= 0, got dt = {fmt_value(dt)}, t-end = {fmt_value(t_end)}")
+    n = math.floor(t_end / dt + 0.5) + 1
+    check_work("--t-end/--dt", f"{fmt_value(t_end)}/{fmt_value(dt)} s", n, "samples", BYTES_PER_SAMPLE, MAX_SAMPLES,
+               hint="; use a larger --dt or a shorter --t-end")
+    return np.arange(0.0, t_end + dt / 2, dt)
+
+
 def run(args) -> int:
     from ..dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 
+    seed = args.trajectory == "seed"
+    reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
+    reject_unused(args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn")
     platform = platform_from_args(args)
+    require_plate(platform, "dynamics")
+    gravity = check_gravity(args.gravity)
     if args.trajectory == "seed":
-        if not (args.dt > 0 and args.t_end >= 0):
-            raise ValueError(f"--dt must be > 0 and --t-end >= 0, got dt = {args.dt}, t-end = {args.t_end}")
-        t = np.arange(0.0, args.t_end + args.dt / 2, args.dt)
+        t = seed_times(args.t_end, args.dt)
         q, qd, qdd = seed_trajectory(t)
         convention = "utn"
     else:
         t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
         convention = args.convention
+    what = "the seed trajectory" if args.trajectory == "seed" else f"trajectory {args.trajectory}"
+    warnings = check_trajectory(platform, t, q, convention, what, args.allow_out_of_stroke)
+    for w in warnings:
+        print(f"stewart-drake dynamics: warning: {w}", file=sys.stderr)
     if args.legs == "on":
         if args.coriolis == "off":
             raise ValueError("--legs on computes the complete model; it cannot be combined with --coriolis off")
-        F = leg_forces_with_legs(platform, q, qd, qdd, convention, gravity=args.gravity)
+        F = leg_forces_with_legs(platform, q, qd, qdd, convention, gravity=gravity)
     else:
-        F = leg_forces(platform, q, qd, qdd, convention, coriolis=args.coriolis == "on", gravity=args.gravity)
+        F = leg_forces(platform, q, qd, qdd, convention, coriolis=args.coriolis == "on", gravity=gravity)
     if args.json:
         print_json({
             "platform": platform.name, "trajectory": args.trajectory, "coriolis": args.coriolis == "on",
-            "legs": args.legs == "on", "gravity": args.gravity, "unit": "N", "t": t, "forces": F,
-            "max_abs_force": np.abs(F).max(axis=0),
+            "legs": args.legs == "on", "gravity": gravity, "unit": "N", "t": t, "forces": F,
+            "max_abs_force": np.abs(F).max(axis=0), "warnings": warnings,
         })
     elif args.csv:
         w = csv.writer(sys.stdout, lineterminator="\n")

@@ -6,7 +6,9 @@ import sys
 
 import numpy as np
 
+from ..errors import UsageError
 from ..rotations import length_scale, pose_from_si, pose_to_si
+from ..sanity import check_finite, check_positive, check_work
 from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 
 
@@ -47,6 +49,11 @@ def _entry(mode, args, k: float, **extra) -> dict:
     }
     d.update(extra)
     return d
+
+
+# Newton converges quadratically from a good start (< 20 iterations); beyond this many it is not
+# converging, and each iteration costs a Jacobian solve.
+MAX_ITER = 1000
 
 
 def _homotopy_all(platform, L, args, k: float) -> dict:
@@ -91,8 +98,17 @@ def _homotopy_all(platform, L, args, k: float) -> dict:
 def run(args) -> int:
     from ..fk import forward_kinematics
 
+    for i, v in enumerate(args.lengths, 1):
+        if not v > 0:
+            raise UsageError(f"--lengths: leg {i} length {v} {args.length_unit} must be a positive number")
     platform = platform_from_args(args)
     k = length_scale(args.length_unit)
+    check_finite(args.lengths, "--lengths")
+    check_positive(args.tol, "--tol", "metres")
+    if args.max_iter < 1:
+        raise ValueError(f"--max-iter must be >= 1, got {args.max_iter}")
+    check_work("--max-iter", str(args.max_iter), args.max_iter, "Newton iterations", max_count=MAX_ITER,
+               hint="; Newton converges in a few tens of iterations or not at all (without --max-iter, the multi-start search runs)")
     L = np.asarray(args.lengths, dtype=float) * k
     out = {
         "platform": platform.name,
@@ -154,4 +170,6 @@ def run(args) -> int:
         print(f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
               f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})", file=sys.stderr)
         return 1
-    return 0 if all(s["within_stroke"] for s in out["solutions"]) else 1
+    above = [s["above_base"] or platform.plate_below_base_allowed for s in out["solutions"]]
+    physical = any(above) if args.all else all(above)  # --all lists mirror modes too; one valid mode suffices
+    return 0 if all(s["within_stroke"] for s in out["solutions"]) and physical else 1

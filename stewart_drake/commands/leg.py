@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
+from ..atomic import write_output_file
+from ..errors import OutputError
 from ..rotations import angle_scale, length_scale
 from ._common import print_json
 
@@ -12,9 +16,11 @@ def register(sub) -> None:
     p = sub.add_parser("leg", help="3R planar leg (seed 003): DH forward kinematics, geometric inverse kinematics")
     ops = p.add_subparsers(dest="op", required=True, metavar="fk|ik|sdf")
     fk = ops.add_parser("fk", help="foot position and orientation for joint angles q1 q2")
-    fk.add_argument("q", nargs=2, type=float, metavar=("Q1", "Q2"))
+    fk.add_argument("q1", type=float, metavar="Q1", help="hip angle (angle unit)")
+    fk.add_argument("q2", type=float, metavar="Q2", help="knee angle (angle unit)")
     ik = ops.add_parser("ik", help="joint angles (both elbow branches) for a foot position")
-    ik.add_argument("target", nargs=2, type=float, metavar=("PX", "PY"))
+    ik.add_argument("px", type=float, metavar="PX", help="foot x (length unit)")
+    ik.add_argument("py", type=float, metavar="PY", help="foot y (length unit)")
     ik.add_argument("--gamma", type=float, help="also the foot orientation gamma: the seed's 3R method (corrected), returns q3")
     ik.add_argument("--branch", choices=["a", "b", "both"], default="both", help="a: knee angle >= 0, b: <= 0 (default both)")
     sdf = ops.add_parser("sdf", help="print (or --write DIR) the leg's SDF generated from the DH table")
@@ -24,6 +30,7 @@ def register(sub) -> None:
         q.add_argument("--l2", type=float, help="shank length (default 80 mm)")
         q.add_argument("--l3", type=float, help="foot length (default 30 mm)")
         q.add_argument("--length-unit", choices=["m", "mm"], default="mm", help="default mm")
+    for q in (fk, ik):
         q.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="deg", help="default deg")
         q.add_argument("--json", action="store_true", help="JSON output")
     p.set_defaults(func=run)
@@ -41,14 +48,20 @@ def run(args) -> int:
     from ..leg import foot, forward_kinematics, inverse_kinematics, inverse_kinematics_3r, limit_violations, within_limits
 
     leg = _leg(args)
-    k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     if args.op == "sdf":
-        from ..leg_model import sdf_text, write_sdf
+        from ..leg_model import SDF_NAME, sdf_text
 
-        print(write_sdf(leg, args.write) if args.write else sdf_text(leg), end="\n" if args.write else "")
+        if args.write:
+            if os.path.exists(args.write) and not os.path.isdir(args.write):
+                raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
+            print(write_output_file(os.path.join(args.write, f"{SDF_NAME}.sdf"), sdf_text(leg), option="--write"))
+        else:
+            print(sdf_text(leg), end="")
         return 0
+    k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     units = {"length": args.length_unit, "angle": args.angle_unit}
     if args.op == "fk":
+        args.q = [args.q1, args.q2]
         q = np.array(args.q) * ka
         if not np.all(np.isfinite(q)):
             raise ValueError(f"joint angles must be finite, got {args.q}")
@@ -61,7 +74,8 @@ def run(args) -> int:
         else:
             print(f"foot Px = {out['foot'][0]:.6g} {args.length_unit}, Py = {out['foot'][1]:.6g} {args.length_unit}, "
                   f"gamma = {out['gamma']:.6g} {args.angle_unit}" + ("" if out["within_limits"] else "  (outside joint limits)"))
-        return 0
+        return 0 if out["within_limits"] else 1
+    args.target = [args.px, args.py]
     t = np.array(args.target) * k
     if not np.all(np.isfinite(t)):
         raise ValueError(f"target must be finite, got {args.target}")

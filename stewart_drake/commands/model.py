@@ -2,31 +2,42 @@
 
 from __future__ import annotations
 
+import os
+
+from ..atomic import write_output_file
+from ..errors import OutputError, UsageError
 from ._common import add_platform_arg, platform_from_args, print_json
 
 
 def register(sub) -> None:
     p = sub.add_parser("model", help="generate (write) or inspect the SDF model of a platform")
     add_platform_arg(p)
-    p.add_argument("--write", metavar="DIR", help="write <DIR>/<name>.sdf")
+    p.add_argument("--write", metavar="DIR", help="write <DIR>/<name>.sdf (name made file-safe; an existing file is replaced only if stewart-drake wrote it)")
     p.add_argument("--inspect", action="store_true", help="parse into a MultibodyPlant and list bodies, joints, constraints")
     p.add_argument("--json", action="store_true", help="with --inspect: JSON output")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..model import sdf_text, write_sdf
+    from ..model import model_name, sdf_path, sdf_text
     from ..verify import anchor_frames, make_plant
 
+    if args.json and not args.inspect:
+        raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))
     platform = platform_from_args(args)
     if args.write:
-        print(write_sdf(platform, args.write))
+        if os.path.exists(args.write) and not os.path.isdir(args.write):
+            raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
+        target = os.path.join(args.write, sdf_path(platform.name, "").name)
+        written = write_output_file(target, sdf_text(platform), option="--write")
+        if not args.inspect:
+            print(written)
     if args.inspect:
         h = make_plant(platform)
         plant = h.plant
         info = {
             "platform": platform.name,
-            "bodies": [plant.get_body(b).name() for b in plant.GetBodyIndices(plant.GetModelInstanceByName(platform.name))],
+            "bodies": [plant.get_body(b).name() for b in plant.GetBodyIndices(plant.GetModelInstanceByName(model_name(platform)))],
             "joints": {plant.get_joint(j).name(): plant.get_joint(j).type_name() for j in plant.GetJointIndices()},
             "actuators": [plant.get_joint_actuator(a).name() for a in plant.GetJointActuatorIndices()],
             "num_positions": plant.num_positions(),
@@ -35,6 +46,8 @@ def run(args) -> int:
             "time_step_s": plant.time_step(),
         }
         base, top = anchor_frames(h)
+        if args.write:
+            info["sdf_file"] = str(written)
         info["anchor_error_m"] = float(max(abs(base - platform.base_anchors).max(), abs(top - platform.top_anchors_per_leg).max()))
         if args.json:
             print_json(info)

@@ -7,6 +7,9 @@ import sys
 import time
 
 
+from ._common import add_force_arg, output_folder
+
+
 def register(sub) -> None:
     p = sub.add_parser("report", help="run the analyses on the built-in presets and write an HTML report")
     p.add_argument("--out", default="report", help="output folder (default: report/)")
@@ -14,6 +17,7 @@ def register(sub) -> None:
     p.add_argument("--quick", action="store_true", help="smaller samples (smoke test)")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="analyses run in N worker processes (default: the number of CPUs, at most 4; 1: in this process)")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -21,6 +25,7 @@ def run(args) -> int:
     from ..geometry import PRESETS
     from ..report import command_line, discover_analyses, render, run_analyses, write_report
 
+    out = output_folder(args)
     jobs = args.jobs if args.jobs is not None else min(4, os.cpu_count() or 1)
     if not 1 <= jobs <= 64:
         raise ValueError(f"--jobs must be between 1 and 64, got {jobs}")
@@ -30,7 +35,7 @@ def run(args) -> int:
     sections = run_analyses(analyses, quick=args.quick, jobs=jobs)
     elapsed = time.perf_counter() - t0
     meta = render.default_meta(sections, command_line(), elapsed, PRESETS)
-    index = write_report(sections, args.out, meta=meta)
+    index = write_report(sections, out, meta=meta)
     checks = [c for s in sections for c in s.checks]
     failed = [c for c in checks if not c.passed]
     print(f"wrote {index}: {len(checks)} checks, {len(failed)} failed, {elapsed:.0f} s")

@@ -7,15 +7,15 @@ file is written; the output folder is then written in one go.
 from __future__ import annotations
 
 import csv
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from ..atomic import atomic_folder
+from ..errors import InputError
 from ..rotations import CONVENTIONS
-from ._common import _jsonable, add_platform_arg, platform_from_args
+from ._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
 SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)
@@ -34,23 +34,40 @@ def register(sub) -> None:
     p.add_argument("--simulate", action="store_true", help="also run the trajectory through the controller-in-the-loop Drake simulation")
     p.add_argument("--controller", choices=SIMULATE_CONTROLLERS, default="fixed", help="with --simulate: fixed-point (DSP) or float controller (default fixed)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
+MAX_PROGRAM_BYTES = 1_000_000
+
+
 def read_program(path: str) -> str:
+    """The text of a program file (UTF-8, at most ``MAX_PROGRAM_BYTES``); errors name the file."""
     f = Path(path)
+    if not f.exists():
+        raise InputError(f"program file {path!r} does not exist")
     if not f.is_file():
-        raise FileNotFoundError(f"program file {path!r} does not exist")
+        raise InputError(f"program file {path!r} is {'a folder' if f.is_dir() else 'not a regular file'}, not a file")
+    with f.open("rb") as fh:
+        data = fh.read(MAX_PROGRAM_BYTES + 1)
+    if len(data) > MAX_PROGRAM_BYTES:
+        raise InputError(f"{path}: larger than the {MAX_PROGRAM_BYTES}-byte limit for a program")
     try:
-        return f.read_text(encoding="utf-8")
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
-        raise ValueError(f"{path}: not UTF-8 text (byte {e.start})") from None
+        raise InputError(f"{path}: not UTF-8 text (byte {e.start})") from None
+    if "\0" in text:
+        raise InputError(f"{path}:{text[:text.index(chr(0))].count(chr(10)) + 1}: a NUL byte; not a program text file")
+    return text
 
 
 def run(args) -> int:
     from ..script import ScriptError, run_program
 
+    reject_unused(args, "--simulate", args.simulate, controller="fixed")
     text = read_program(args.program)
+    out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
+    out_folder = OutputFolder(str(out), force=args.force)
     platform = platform_from_args(args)
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise ValueError(f"--rate must be a positive number of samples per second, got {args.rate}")
@@ -62,19 +79,20 @@ def run(args) -> int:
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
-    out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
     summary = summarize(result, args.program, platform.stroke)
     if branches is not None:
         summary["branches"] = branches
     if sim is not None:
         summary["simulation"] = sim["summary"]
-    write_outputs(out, result, summary, sim)
+    write_outputs(out_folder, result, summary, sim)
     if args.json:
-        json.dump(summary, sys.stdout, indent=2, default=_jsonable)
-        sys.stdout.write("\n")
+        print_json(summary)
     else:
         print_summary(summary, out)
-    return branch_exit(branches, args)
+    failures = summary.get("simulation", {}).get("failures", [])
+    for f in failures:
+        print(f"stewart-drake run: {f}", file=sys.stderr)
+    return max(branch_exit(branches, args), 1 if failures else 0)
 
 
 BRANCH_DEFAULTS = {"branch_margin": 20.0, "singularity_margin": 0.02, "branch_samples": 200}
@@ -131,8 +149,13 @@ def simulate(platform, result, args) -> dict:
     if traj.duration <= 0:
         raise ValueError("--simulate: the program has no moves or waits (its trajectory lasts 0 s)")
     reference = SimTrajectory(Path(args.program).stem, traj.pose_at, traj.duration)
+    from ..sanity import require_plate
+    from ..simulation import tracking_verdict
+
+    require_plate(platform, "run --simulate")
     log = sim_run(platform, reference, controller=args.controller, duration=traj.duration + SETTLE, progress=True)
     err = log.length_error(reference, platform)
+    verdict = tracking_verdict(platform, err, log.pose_error(reference), log)
     return {
         "log": log,
         "length_error": err,
@@ -142,6 +165,7 @@ def simulate(platform, result, args) -> dict:
             "settle_s": SETTLE,
             "max_abs_length_error_mm": np.abs(err).max(axis=0) * 1e3,
             "max_abs_actuator_force_N": np.abs(log.force).max(axis=0),
+            **verdict,
         },
     }
 
@@ -184,7 +208,7 @@ def summarize(result, program: str, stroke=None) -> dict:
     }
 
 
-def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
+def write_outputs(out, result, summary: dict, sim: dict | None) -> None:
     """Write ``trajectory.csv`` (t, q, q̇, q̈ in SI: readable by ``stewart-drake dynamics --trajectory``),
     ``legs.csv`` (t, L mm, F N), ``summary.json``, ``lengths.png``, ``forces.png`` (and the simulation's
     logs) into ``out``, replacing it atomically."""
@@ -202,7 +226,7 @@ def write_outputs(out: Path, result, summary: dict, sim: dict | None) -> None:
             cols = [traj.t[:, None], result.L * 1e3] + ([result.F] if result.F is not None else [])
             for row in np.concatenate(cols, axis=1):
                 w.writerow([f"{v:.10g}" for v in row])
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2, default=_jsonable), encoding="utf-8")
+        (tmp / "summary.json").write_text(dumps_strict(summary), encoding="utf-8")
         _plots(tmp, result, summary, sim)
         if sim is not None:
             sim["log"].save(tmp / "simulation")

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import os
 
 import numpy as np
 
+from ..atomic import write_output_file
+from ..errors import OutputError
 from ..rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from ..sanity import check_finite
 from ._common import print_json
 
 
@@ -31,13 +35,19 @@ def register(sub) -> None:
 def run(args) -> int:
     from ..servo import load_servo_hexapod, solve
 
+    from ..sanity import check_servo_neutrals
+
     hexapod = load_servo_hexapod(args.platform)
+    check_servo_neutrals(hexapod, f"{args.platform}: servo.neutral_us")
     if args.trim is not None:
+        check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
-        from ..servo_model import write_sdf
+        from ..servo_model import SDF_NAME, sdf_text
 
-        print(write_sdf(hexapod, args.write_sdf))
+        if os.path.exists(args.write_sdf) and not os.path.isdir(args.write_sdf):
+            raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write-sdf", typed=args.write_sdf, part=args.write_sdf))
+        print(write_output_file(os.path.join(args.write_sdf, f"{SDF_NAME}.sdf"), sdf_text(hexapod), option="--write-sdf"))
     k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     scale = np.r_[[k] * 3, [ka] * 3]
     if args.pose is None:

@@ -2,9 +2,27 @@
 
 from __future__ import annotations
 
+import math
+import sys
 from pathlib import Path
 
-from ._common import add_platform_arg, print_json
+import numpy as np
+
+from ..sanity import check_file_rows, check_positive, check_timing, check_trajectory, check_work, fmt_value, require_plate
+from ._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
+
+# Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
+# log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
+# the SAP plant: ~1 ms on one core); a run is refused beyond the memory budget or MAX_RUN_SECONDS.
+BYTES_PER_STEP = 4000
+SECONDS_PER_STEP = 1e-3
+MAX_RUN_SECONDS = 3600.0
+
+
+def check_simulation_size(duration: float, plant_step: float, option: str, value) -> None:
+    """Refuse a simulation whose logs would not fit in memory or that would run for more than an hour."""
+    check_work(option, f"{fmt_value(value)} s", duration / plant_step, f"plant steps of {fmt_value(plant_step)} s", BYTES_PER_STEP,
+               seconds_per=SECONDS_PER_STEP, max_seconds=MAX_RUN_SECONDS, hint=f"; use a shorter {option}")
 
 
 def register(sub) -> None:
@@ -32,30 +50,45 @@ def register(sub) -> None:
     p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds (default: the trajectory's, 4 s for seed)")
     p.add_argument("--out", default="simulation", metavar="DIR", help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--allow-out-of-stroke", action="store_true",
+                   help="simulate even a reference that leaves the stroke (a warning, also in summary.json 'warnings'); default: exit 1")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     import json
 
-    import numpy as np
-
     from ..atomic import atomic_folder
     from ..control import ControllerConfig, DspTiming
     from ..firmware.engine import resolve_engine
     from ..geometry import load_platform
-    from ..simulation import build_simulation, design_poses, fit_trajectory, get_trajectory
+    from ..simulation import ActuatorModel, build_simulation, design_poses, fit_trajectory, get_trajectory, tracking_verdict
 
+    reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
+    out_folder = output_folder(args)
     platform = load_platform(args.platform)
+    require_plate(platform, "simulate")
+    period = check_positive(args.period, "--period", "seconds")
+    plant_step = args.plant_step if args.plant_step is not None else min(period, 1e-3)
+    if args.duration is not None:
+        check_positive(args.duration, "--duration", "seconds")
+    if args.trajectory not in ("seed", "rotating"):
+        check_file_rows(args.trajectory, "--trajectory", 700, 14)
     traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)
     if args.fit:
         traj = fit_trajectory(traj, platform)
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
     if not duration > 0:
         raise ValueError(f"--duration must be a positive number of seconds, got {args.duration}")
-    timing = DspTiming(sample_period=args.period, latency=args.latency, sensor_resolution=args.sensor_resolution,
+    timing = DspTiming(sample_period=period, latency=args.latency, sensor_resolution=args.sensor_resolution,
                        command_range=float(platform.legs.max_force)).check()
-    plant_step = args.plant_step if args.plant_step is not None else min(args.period, 1e-3)
+    check_timing(platform, period, plant_step, ActuatorModel().time_constant, timing.output_delay)
+    check_simulation_size(duration, plant_step, "--duration", args.duration if args.duration is not None else duration)
+    ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
+    warnings = check_trajectory(platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", args.allow_out_of_stroke)
+    for w in warnings:
+        print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
     # command range and gains designed for the platform over the poses of the run
     config = ControllerConfig.for_platform(platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0)))
     engine = resolve_engine(args.engine, "stewart-drake simulate") if args.firmware is None else "c"
@@ -89,11 +122,18 @@ def run(args) -> int:
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
-    with atomic_folder(out) as tmp:
+    verdict = tracking_verdict(platform, e, pe, log)
+    summary.update(verdict)
+    summary["warnings"] = warnings
+    with atomic_folder(out_folder) as tmp:
         written = log.save(tmp) + write_plots(log, e, tmp) + [tmp / "summary.json"]
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
+        (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
+    if verdict["failures"]:
+        for f in verdict["failures"]:
+            print(f"stewart-drake simulate: {f}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -111,7 +151,7 @@ def write_plots(log, length_error, out: Path) -> list[Path]:
     ax[1].plot(log.t, log.force)
     ax[1].set_ylabel("actuator force [N]")
     ax[1].set_xlabel("t [s]")
-    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform}, T = {log.sample_period * 1e3:g} ms")
+    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace("$", r"\$")}, T = {log.sample_period * 1e3:g} ms")
     path = out / "tracking.png"
     fig.savefig(path, dpi=100, bbox_inches="tight")
     plt.close(fig)

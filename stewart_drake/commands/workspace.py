@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -11,7 +11,8 @@ import numpy as np
 
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from ._common import add_platform_arg, platform_from_args, print_json
+from ..sanity import check_centre, check_finite, check_work
+from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
@@ -37,6 +38,7 @@ def register(sub) -> None:
     p.add_argument("--workers", type=int, default=1, metavar="N", help="worker processes for the sweep (default 1)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.add_argument("--out", metavar="DIR", help="write workspace.json, boundary.csv and the views (top, front, side, 3d PNG) into DIR")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -65,9 +67,20 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
 def run(args) -> int:
     from .. import workspace as ws
 
+    names = [n.strip() for n in args.limits.split(",")]
+    reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
+    reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
+    reject_unused(args, "--limits ...,dexterity", "dexterity" in names, max_condition=100.0)
+    reject_unused(args, "--out", args.out is not None, force=False)
+    out = output_folder(args)
     platform = platform_from_args(args)
     if not (args.resolution > 0 and math.isfinite(args.resolution)):
         raise ValueError(f"--resolution must be a positive number of metres, got {args.resolution}")
+    if args.centre is not None:
+        check_centre(platform, args.centre)
+    check_finite(args.orientation, "--orientation")
+    # each worker is a Python process with numpy (~150 MB); more than 4 per CPU only adds overhead
+    check_work("--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1))
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     orientation = to_radians(args.orientation, args.angle_unit)
@@ -82,8 +95,8 @@ def run(args) -> int:
     result["rotation_limits"] = [r.as_dict() for r in rot]
     result["rotation_centre_m"] = list(platform.rotation_centre if args.centre is None else args.centre)
     result["mobility"] = ws.stewart_mobility("SPS")["m"]
-    if args.out:
-        write_outputs(w, result, Path(args.out))
+    if out is not None:
+        write_outputs(w, result, out)
     if args.json:
         print_json(result)
     else:
@@ -98,7 +111,7 @@ def run(args) -> int:
             print(f"  {n} limit {'binds' if v > 0 else 'does not bind'}: removes {v:.6f} m³")
         print("  rotation limits from the home pose:")
         for r in rot:
-            what = f"{r.limit} leg {r.leg}" if r.leg else (f"{r.limit} legs {r.pair}" if r.pair else (r.limit or "none reached"))
+            what = (f"plate anchor of leg {r.leg} at the base plane" if r.limit == "base" else f"{r.limit} leg {r.leg}") if r.leg else (f"{r.limit} legs {r.pair}" if r.pair else (r.limit or "none reached"))
             print(f"    about {r.axis} {'+' if r.sign > 0 else '-'}: {math.degrees(r.angle):+8.3f} deg  ({what}"
                   f"{', ' + r.side if r.side else ''}); lengths {np.round(r.lengths, 4).tolist()} m")
         if args.out:
@@ -106,7 +119,7 @@ def run(args) -> int:
     return 0
 
 
-def write_outputs(w, result: dict, out: Path) -> None:
+def write_outputs(w, result: dict, out) -> None:
     """workspace.json, boundary.csv (metres) and the four views as PNG into ``out``."""
     import matplotlib
 
@@ -116,8 +129,8 @@ def write_outputs(w, result: dict, out: Path) -> None:
     from ..workspace import view_figures
 
     with atomic_folder(out) as tmp:
-        (tmp / "workspace.json").write_text(json.dumps(result, indent=2, default=lambda x: x.tolist() if hasattr(x, "tolist") else str(x)))
+        (tmp / "workspace.json").write_text(dumps_strict(result))
         np.savetxt(tmp / "boundary.csv", w.boundary, delimiter=",", header="x_m,y_m,z_m", comments="", fmt="%.6f")
-        for name, fig in view_figures(w, title=result["platform"]).items():
+        for name, fig in view_figures(w, title=result["platform"].replace("$", r"\$")).items():
             fig.savefig(tmp / f"{name}.png", dpi=110, bbox_inches="tight")
             plt.close(fig)

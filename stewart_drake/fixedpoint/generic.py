@@ -27,6 +27,7 @@ from itertools import product
 
 import numpy as np
 
+from ..errors import counted
 from ..geometry import Platform
 from ..rotations import check_convention
 from .q15 import _sat, tfr16CosPIx, tfr16SinPIx
@@ -115,7 +116,7 @@ def angle_words(angles, fmt: QFormat) -> np.ndarray:
     x = angles / np.pi
     if np.any(np.abs(x) > 1.0):
         k = tuple(int(i) for i in np.argwhere(np.abs(x) > 1.0)[0])
-        raise ValueError(f"pose {k[:-1]}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
+        raise ValueError(f"pose {counted(k[:-1])}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
     return _sat(np.trunc(x * (1 << f)).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.angle")
 
 
@@ -201,7 +202,7 @@ def check_poses(poses) -> np.ndarray:
         raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
     if not np.all(np.isfinite(q)):
         k = tuple(int(i) for i in np.argwhere(~np.isfinite(q).all(-1))[0])
-        raise ValueError(f"pose {k} is not finite: {q[k].tolist()}")
+        raise ValueError(f"pose {counted(k)} is not finite: {q[k].tolist()}")
     return q
 
 

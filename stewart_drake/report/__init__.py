@@ -31,7 +31,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..atomic import atomic_folder
+from ..atomic import OutputFolder, atomic_folder
+from ..jsonout import dumps_strict
 from . import render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[2] / "analyses"
@@ -281,14 +282,15 @@ def render_html(sections: list[Section], title: str = "stewart-drake report", me
 def write_report(sections: list[Section], out_dir, title: str = "stewart-drake report", meta: dict | None = None) -> Path:
     """Write ``index.html``, ``checks.json`` and every section file into ``out_dir``, atomically: the
     report is built in a temporary sibling folder and swapped in only when complete."""
-    with atomic_folder(out_dir) as tmp:
+    out = out_dir if isinstance(out_dir, OutputFolder) else OutputFolder(out_dir)
+    with atomic_folder(out) as tmp:
         for s in sections:
             for name, data in s.files.items():
                 (tmp / name).write_bytes(data)
         (tmp / "index.html").write_text(render_html(sections, title, meta), encoding="utf-8")
         checks = [dict(c.__dict__, passed=c.passed) for s in sections for c in s.checks]
-        (tmp / "checks.json").write_text(json.dumps(checks, indent=2), encoding="utf-8")
-    return Path(out_dir).resolve() / "index.html"
+        (tmp / "checks.json").write_text(dumps_strict(checks), encoding="utf-8")
+    return out.path / "index.html"
 
 
 def command_line(argv=None) -> str:
@@ -307,10 +309,11 @@ def run_standalone(module_file: str, argv=None) -> int:
     ap.add_argument("--out", default=f"report/{path.stem}")
     ap.add_argument("--quick", action="store_true", help="smaller samples, for smoke tests")
     args = ap.parse_args(argv)
+    out = OutputFolder(args.out)
     a = load_analysis(path)
     t0 = time.perf_counter()
     sections = run_analyses([a], quick=args.quick)
     meta = render.default_meta(sections, command_line([str(path), *(sys.argv[1:] if argv is None else argv)]), time.perf_counter() - t0)
-    index = write_report(sections, args.out, title=a.title, meta=meta)
+    index = write_report(sections, out, title=a.title, meta=meta)
     print(index)
     return 0 if all(c.passed for s in sections for c in s.checks) else 1

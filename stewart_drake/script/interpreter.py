@@ -10,7 +10,7 @@ import math
 from . import ast
 from .check import assigned_names
 from .errors import UNDEFINED, ScriptError
-from .runtime import CONSTANTS, FUNCTIONS, Motion, fmt_number, for_range
+from .runtime import CONSTANTS, FUNCTIONS, MAX_SEGMENTS, Motion, fmt_number, for_count, for_range
 
 MAX_STEPS = 1_000_000  # statements executed + loop iterations
 
@@ -40,6 +40,17 @@ class _Interpreter:
                 f"the program ran more than {MAX_STEPS} steps (statements and loop iterations); does a loop never end?", at
             )
 
+    def check_loop(self, s, count: int) -> None:
+        """Refuse, before its first iteration, a FOR loop whose iterations (times the moves and waits its
+        body surely makes, ``static_segments``) would pass ``MAX_STEPS`` or ``MAX_SEGMENTS``."""
+        steps = count * (1 + static_cost(s.body)[0])
+        if self.steps + steps > MAX_STEPS:
+            raise ScriptError(f"this FOR loop would run {count} iterations, at least {steps} steps with its body; a program may run "
+                              f"at most {MAX_STEPS} steps (statements and loop iterations)", s.at)
+        moves = count * static_cost(s.body)[1]
+        if len(self.motion.segments) + moves > MAX_SEGMENTS:
+            raise ScriptError(f"this FOR loop would make {moves} moves and waits; a program may make at most {MAX_SEGMENTS}", s.at)
+
     def block(self, body):
         for s in body:
             self.tick(s.at)
@@ -59,7 +70,9 @@ class _Interpreter:
             self.motion.units(*(n for n, _ in s.names), at=s.at)
         elif isinstance(s, ast.For):
             step = 1.0 if s.step is None else self.eval(s.step)
-            for v in for_range(self.eval(s.start), self.eval(s.stop), step, at=s.at):
+            start, stop = self.eval(s.start), self.eval(s.stop)
+            self.check_loop(s, for_count(start, stop, step, at=s.at))
+            for v in for_range(start, stop, step, at=s.at):
                 self.tick(s.at)
                 self.env[s.var] = v
                 self.block(s.body)
@@ -112,6 +125,26 @@ class _Interpreter:
             a, b = self.eval(e.left), self.eval(e.right)
             return _binary(e.op, a, b, e.at)
         raise TypeError(f"unknown expression {type(e).__name__}")  # pragma: no cover
+
+
+def static_cost(body) -> tuple[int, int]:
+    """Lower bounds ``(steps, segments)`` on what ``body`` does each time it runs: one step per statement
+    and, for nested FOR loops with literal bounds, their iterations times (1 + their bodies' steps);
+    segments are its moves and positive literal waits, likewise multiplied. IF and WHILE bodies may not
+    run, so they count 0: the bounds never refuse a program that would have fitted."""
+    steps = moves = 0
+    for s in body:
+        steps += 1
+        if isinstance(s, ast.Move) or (isinstance(s, ast.Wait) and isinstance(s.duration, ast.Num) and s.duration.value > 0):
+            moves += 1
+        elif isinstance(s, ast.For) and all(isinstance(e, ast.Num) for e in (s.start, s.stop) + ((s.step,) if s.step else ())):
+            step = 1.0 if s.step is None else s.step.value
+            k = (s.stop.value - s.start.value) / step if step else -1.0
+            n = int(math.floor(k + 1e-9)) + 1 if 0 <= k < 1e18 else 0
+            inner_steps, inner_moves = static_cost(s.body)
+            steps += n * (1 + inner_steps)
+            moves += n * inner_moves
+    return steps, moves
 
 
 _COMPARE = {

@@ -20,6 +20,10 @@ from .errors import RESERVED, SYNTAX, Loc, ScriptError
 
 # Deeper nesting than this is refused (later passes recurse over the tree).
 MAX_DEPTH = 100
+# Statement nesting the Python back end can express: Python allows 100 indentation levels (the emitted
+# code adds one) and 20 statically nested loop blocks.
+MAX_STMT_DEPTH = 60
+MAX_LOOP_DEPTH = 16
 
 # Modula-2 keywords the seed's Stewart.g reserved and this language does not (yet) implement.
 # Upper case only, like the seed's (case-sensitive) ANTLR tokens; lower-case spellings are names.
@@ -168,13 +172,13 @@ class _ToAst(Transformer_NonRecursive):
 
     # -- program structure
     def start(self, items):
-        return [s for s in items if s is not None]
+        stmts = [s for s in items if s is not None]
+        _check_nesting(stmts)  # bodies were checked as they were built; the top level here
+        return stmts
 
     def body(self, items):
         stmts = tuple(s for s in items if s is not None)
-        for s in stmts:
-            if _stmt_depth(s) > MAX_DEPTH:
-                raise ScriptError(f"statements nested more than {MAX_DEPTH} levels deep", s.at, kind="syntax error")
+        _check_nesting(stmts)
         return stmts
 
     def assign(self, items):
@@ -275,16 +279,27 @@ def _expr_loc(e) -> Loc:
     return e.at
 
 
-def _stmt_depth(s) -> int:
-    """Statement nesting depth (bodies of FOR/IF/WHILE count one level each); iterative."""
-    best, stack = 0, [(s, 1)]
+def _check_nesting(stmts) -> None:
+    for s in stmts:
+        if _stmt_depth(s) > MAX_STMT_DEPTH:
+            raise ScriptError(f"statements nested more than {MAX_STMT_DEPTH} levels deep", s.at, kind="syntax error")
+        if _stmt_depth(s, loops_only=True) > MAX_LOOP_DEPTH:
+            raise ScriptError(f"loops (FOR, WHILE) nested more than {MAX_LOOP_DEPTH} levels deep", s.at, kind="syntax error")
+
+
+def _stmt_depth(s, loops_only: bool = False) -> int:
+    """Statement nesting depth: the most statements on a path from ``s`` inward (bodies of FOR/IF/WHILE
+    one level each); with ``loops_only``, the most FOR/WHILE statements on such a path. Iterative."""
+    best, stack = 0, [(s, 0)]
     while stack:
         node, d = stack.pop()
+        loop = isinstance(node, (ast.For, ast.While))
+        d += 1 if (loop or not loops_only) else 0
         best = max(best, d)
-        if isinstance(node, (ast.For, ast.While)):
-            stack.extend((c, d + 1) for c in node.body)
+        if loop:
+            stack.extend((c, d) for c in node.body)
         elif isinstance(node, ast.If):
             for _, body in node.branches:
-                stack.extend((c, d + 1) for c in body)
-            stack.extend((c, d + 1) for c in node.orelse or ())
+                stack.extend((c, d) for c in body)
+            stack.extend((c, d) for c in node.orelse or ())
     return best

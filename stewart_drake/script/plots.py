@@ -5,13 +5,17 @@ from __future__ import annotations
 import numpy as np
 
 
+# More move ends than this are not marked one by one (a line each would cost seconds per thousand).
+MAX_MARKS = 200
+
+
 def _move_marks(ax, result):
+    """Grey vertical lines at the ends of the moves, as one collection (none beyond ``MAX_MARKS``)."""
     traj = result.trajectory
-    t0 = 0.0
-    for s in traj.segments:
-        t0 += s.duration
-        if s.kind == "move":
-            ax.axvline(t0, color="0.85", lw=0.8, zorder=0)
+    ends = np.cumsum([s.duration for s in traj.segments])
+    marks = [t for t, s in zip(ends, traj.segments) if s.kind == "move"]
+    if 0 < len(marks) <= MAX_MARKS:
+        ax.vlines(marks, 0, 1, transform=ax.get_xaxis_transform(), color="0.85", lw=0.8, zorder=0)
 
 
 def plot_lengths(result, platform_name: str, stroke_mm=None, ax=None):
@@ -30,8 +34,9 @@ def plot_lengths(result, platform_name: str, stroke_mm=None, ax=None):
     _move_marks(ax, result)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("leg length (mm)")
-    ax.set_title(f"leg lengths, platform {platform_name} (grey: end of each move)")
-    ax.legend(fontsize=8, ncol=6)
+    name = platform_name.replace("$", r"\$")  # a name is text, not mathtext
+    ax.set_title(f"leg lengths, platform {name} (grey: end of each move)")
+    ax.legend(fontsize=8, ncol=6, loc="upper right")
     return fig or ax.figure
 
 
@@ -49,7 +54,7 @@ def plot_forces(result, ax=None):
     ax.set_xlabel("t (s)")
     ax.set_ylabel("leg force (N)")
     ax.set_title("leg forces (inverse dynamics, massless legs)")
-    ax.legend(fontsize=8, ncol=6)
+    ax.legend(fontsize=8, ncol=6, loc="upper right")
     return fig or ax.figure
 
 
@@ -63,5 +68,5 @@ def plot_tracking(log, length_error):
     ax.set_xlabel("t (s)")
     ax.set_ylabel("L − L_ref (mm)")
     ax.set_title(f"controller in the loop ({log.kind}): leg-length tracking error")
-    ax.legend(fontsize=8, ncol=6)
+    ax.legend(fontsize=8, ncol=6, loc="upper right")
     return fig

@@ -35,6 +35,12 @@ DEFAULT_UNITS = ("mm", "deg")
 DEFAULT_DURATION = 1.0  # s, a move without "en"/"in"
 DEFAULT_RATE = 100.0  # Hz, trajectory samples
 MAX_SAMPLES = 2_000_000
+# Moves and waits one program may make: each costs ~0.2 ms to sample, check, evaluate and write, so the
+# limit keeps a run under ~30 s.
+MAX_SEGMENTS = 100_000
+# The shortest move (s): a Stewart platform's actuators cannot resolve a faster one, and the quintic's
+# acceleration (~5.8 Δ / d²) overflows for absurd durations.
+MIN_MOVE_DURATION = 1e-3
 MAX_REPORTED = 10  # unreachable moves listed in one diagnostic batch
 
 # Functions usable in expressions: name -> (number of arguments, implementation, Python spelling).
@@ -220,6 +226,10 @@ class Motion:
         d = self.default_duration if duration is None else _check_finite(duration, f"{keyword} duration", at)
         if d <= 0:
             raise ScriptError(f"{keyword} duration must be positive, got {fmt_number(d)} s", at)
+        if d < MIN_MOVE_DURATION:
+            raise ScriptError(f"{keyword} duration {fmt_number(d)} s is shorter than the shortest move, {fmt_number(MIN_MOVE_DURATION)} s "
+                              "(no actuator follows a faster one)", at)
+        self._check_segments(at)
         q1 = np.array(values) * self._scale()
         self._moves += 1
         seg = Segment("move", self.pose.copy(), q1, d, at, self._moves, keyword, values, (self.length_unit, self.angle_unit))
@@ -239,15 +249,25 @@ class Motion:
             raise ScriptError(f"wait duration must be >= 0, got {fmt_number(d)} s", at)
         if d == 0:
             return None
+        self._check_segments(at)
         seg = Segment("wait", self.pose.copy(), self.pose.copy(), d, at)
         self.segments.append(seg)
         return seg
+
+    def _check_segments(self, at) -> None:
+        if len(self.segments) >= MAX_SEGMENTS:
+            raise ScriptError(f"the program makes more than {MAX_SEGMENTS} moves and waits (the limit); shorten it or use longer moves", at)
 
     # -- result
     def trajectory(self, rate: float = DEFAULT_RATE) -> Trajectory:
         """Sample every segment at ``rate`` Hz (each segment's end is a sample; t = 0 is the start)."""
         if not (math.isfinite(rate) and rate > 0):
             raise ValueError(f"trajectory rate must be a positive number of Hz, got {rate}")
+        for s in self.segments:  # each segment's samples, in floating point first (a huge wait overflows int)
+            if s.duration * rate > MAX_SAMPLES:
+                raise ScriptError(
+                    f"{s.describe()} lasts {fmt_number(s.duration)} s, more than the {MAX_SAMPLES} samples a program may have "
+                    f"at {fmt_number(rate)} Hz ({fmt_number(MAX_SAMPLES / rate)} s)", s.at)
         counts = [max(1, math.ceil(s.duration * rate - 1e-9)) for s in self.segments]
         total = 1 + sum(counts)
         if total > MAX_SAMPLES:
@@ -289,6 +309,7 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
     """``(n, 6)`` leg lengths (m) of every sample; raise ``ScriptError``(s) naming each move whose path
     leaves the stroke: which move, which leg, by how much and when (the worst sample of that move)."""
     L = leg_lengths(platform, traj.q, convention)
+    _check_above_base(platform, traj, convention)
     chk = check_stroke(platform, L)
     bad = ~chk.within
     if not np.any(bad):
@@ -331,6 +352,26 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
     return L  # pragma: no cover
 
 
+def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> None:
+    """``ScriptError`` at the first move whose path puts a plate anchor at or below the base plane
+    (``sanity.above_base``), with the time and the anchor's height."""
+    from ..sanity import above_base, plate_anchor_heights
+
+    ok = above_base(platform, traj.q, convention)
+    if np.all(ok):
+        return
+    n = int(np.argmin(ok))
+    k = traj.segment[n]
+    seg = traj.segments[k] if k >= 0 else None
+    z = plate_anchor_heights(platform, traj.q[n], convention)
+    leg = int(np.argmin(z))
+    what = seg.describe() if seg is not None else "the start pose"
+    raise ScriptError(
+        f"{what} puts the plate {'in' if z[leg] == 0 else 'below'} the base on platform {platform.name}: the plate anchor of leg "
+        f"{leg + 1} is at z = {z[leg] * 1e3:.3f} mm at t = {traj.t[n]:.3f} s (the base plane is z = 0)",
+        seg.at if seg is not None else None)
+
+
 def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) -> ScriptError:
     """A ``SingularPoseError`` from the dynamics, restated at the move whose path crosses the singularity."""
     from ..dynamics import MAX_CONDITION, jacobian_condition
@@ -352,8 +393,13 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
 def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True,
              gravity: float = 9.81) -> Result:
     """Inverse kinematics (with the stroke check) and inverse dynamics on a trajectory."""
+    from ..sanity import has_plate
+
     L = check_reachable(platform, traj, convention)
     notes = []
+    if not has_plate(platform):  # a massless plate would give every force as 0
+        return Result(traj, L, None, platform.name, convention,
+                      (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",))
     try:
         from ..dynamics import leg_forces
     except ImportError:
@@ -365,6 +411,19 @@ def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", cori
         except SingularPoseError as e:
             raise _singular_error(platform, traj, convention, e) from None
     return Result(traj, L, F, platform.name, convention, tuple(notes))
+
+
+def for_count(start, stop, step=1.0, at=None) -> int:
+    """How many values ``for_range`` yields (0 when the loop does not run), without running it."""
+    start = _check_finite(start, "FOR start", at)
+    stop = _check_finite(stop, "FOR limit", at)
+    step = _check_finite(step, "FOR step", at)
+    if step == 0:
+        raise ScriptError("FOR step is 0: the loop would never end", as_loc(at))
+    n = (stop - start) / step
+    if not n > -1e-9:
+        return 0
+    return int(math.floor(n + 1e-9)) + 1 if math.isfinite(n) and n < 1e18 else 10**18
 
 
 def for_range(start, stop, step=1.0, at=None):

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..geometry import Platform
 from ..kinematics import leg_vectors
+from ..sanity import plate_floor
 from .grid import default_bounds
 from .limits import _check_orientation
 
@@ -32,9 +33,12 @@ def stroke_column_lengths(platform: Platform, x, y, orientation=(0.0, 0.0, 0.0),
     return np.sum(np.where(ok, ends[..., 1:] - ends[..., :-1], 0.0), axis=-1)
 
 
-def stroke_volume_columns(platform: Platform, resolution: float, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float = 0.0) -> float:
-    """Volume (m³) of the stroke workspace above ``z_floor``: exact column lengths integrated by the
-    midpoint rule on an (x, y) grid of step ``resolution`` (error O(h^1.5) from the rim)."""
+def stroke_volume_columns(platform: Platform, resolution: float, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float | None = None) -> float:
+    """Volume (m³) of the stroke workspace above ``z_floor`` (default ``sanity.plate_floor``: every plate
+    anchor above the base): exact column lengths integrated by the midpoint rule on an (x, y) grid of
+    step ``resolution`` (error O(h^1.5) from the rim)."""
+    if z_floor is None:
+        z_floor = plate_floor(platform, _check_orientation(orientation), convention)
     b = default_bounds(platform, orientation, convention, z_floor)
     h = float(resolution)
     xs = np.arange(b[0, 0] + h / 2, b[0, 1], h)

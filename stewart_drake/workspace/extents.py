@@ -57,7 +57,8 @@ def _refine_extents(spec: _GridSpec, extents, top, front, side, h, feas_tol: flo
     def margins(p):
         q = np.r_[p, o]
         l = leg_vectors(spec.platform, q, spec.convention)
-        return np.concatenate([m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()])
+        above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
+        return np.concatenate([m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()] + above)
 
     for k, (i_lo, i_hi) in enumerate(_extreme_indices((top, front, side))):
         for side_i, (idx, sign) in enumerate(((i_lo, -1), (i_hi, 1))):

@@ -14,13 +14,48 @@ import numpy as np
 from ..geometry import Platform
 from ..kinematics import leg_vectors
 from ..rotations import check_convention
+from ..sanity import plate_floor
 from .executors import _run_tasks
 from .extents import _extents_from_views, _refine_extents
 from .limits import Limits, WorkspaceError, _check_orientation
 from .slabs import _grid_spec, _slab_task
 
-# Largest grid the sweep accepts (nodes); beyond this the resolution is surely a unit mistake.
-MAX_GRID_NODES = 5e10
+# Largest grid the sweep accepts (nodes): ~10 min of the stroke kernel at ~5e7 nodes/s on one core.
+MAX_GRID_NODES = 3e10
+# Bytes per node of the three views and the boundary points (which scale with the grid's faces, not its
+# volume) and per node of the two x-planes a slab holds at least; see ``grid_memory``.
+BYTES_PER_FACE_NODE = 40
+BYTES_PER_PLANE_NODE = 120
+
+
+def _node_counts(bounds, h) -> tuple:
+    """Nodes per axis ``_grid_axes`` would make, computed without allocating them."""
+    return tuple(math.ceil(hi / h) - math.floor(lo / h) + 3 for lo, hi in bounds)
+
+
+def grid_memory(bounds, h) -> tuple[float, float]:
+    """``(nodes, bytes)`` a sweep at step ``h`` over ``bounds`` would need (views, boundary points, the
+    smallest slab), estimated before anything is allocated."""
+    nx, ny, nz = (float(n) for n in _node_counts(bounds, h))
+    faces = nx * ny + ny * nz + nx * nz
+    return nx * ny * nz, BYTES_PER_FACE_NODE * faces + BYTES_PER_PLANE_NODE * ny * nz + 24 * (nx + ny + nz)
+
+
+def check_grid_size(bounds, h) -> None:
+    """``WorkspaceError`` naming the resolution, the node count, the memory and the finest resolution
+    this machine can hold when the grid is too large (memory budget or ``MAX_GRID_NODES``)."""
+    from ..sanity import human_bytes, memory_budget
+
+    nodes, need = grid_memory(bounds, h)
+    budget = memory_budget()
+    if need <= budget and nodes <= MAX_GRID_NODES:
+        return
+    # memory scales as 1/h² (faces), time as 1/h³ (nodes): the finest step that fits both
+    h_min = max(h * math.sqrt(need / budget), h * (nodes / MAX_GRID_NODES) ** (1 / 3))
+    why = human_bytes(need) if need > budget else f"more than the {MAX_GRID_NODES:.0e} nodes one sweep may take"
+    raise WorkspaceError(
+        f"resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can hold is "
+        f"~{h_min * 1e3:.2g} mm; use a coarser --resolution")
 
 
 @dataclass
@@ -81,14 +116,15 @@ class Workspace:
         }
 
 
-def default_bounds(platform: Platform, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float = 0.0) -> np.ndarray:
+def default_bounds(platform: Platform, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float | None = None) -> np.ndarray:
     """``(3, 2)`` a box that holds the whole stroke workspace: the intersection of the six balls'
-    bounding boxes (|p + l_i(0)| <= L_max), cut below at ``z_floor`` (default: the rotation centre
-    above the base plane, which excludes the mirror-image workspace under the base)."""
-    l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, _check_orientation(orientation)], convention)
+    bounding boxes (|p + l_i(0)| <= L_max), cut below at ``z_floor`` (default ``sanity.plate_floor``:
+    every plate anchor above the base plane, which excludes the mirror-image workspace under the base)."""
+    o = _check_orientation(orientation)
+    l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, o], convention)
     lo = np.max(-l0 - platform.L_max, axis=0)
     hi = np.min(-l0 + platform.L_max, axis=0)
-    lo[2] = max(lo[2], z_floor)
+    lo[2] = max(lo[2], plate_floor(platform, o, convention) if z_floor is None else z_floor)
     if np.any(hi <= lo):
         raise WorkspaceError(f"the stroke workspace at orientation {np.asarray(orientation).tolist()} rad is empty (no common point of the legs' reach)")
     return np.stack([lo, hi], -1)
@@ -131,10 +167,8 @@ def constant_orientation_workspace(
     b = default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
     if b.shape != (3, 2) or not np.all(b[:, 1] > b[:, 0]):
         raise WorkspaceError(f"bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {np.asarray(bounds).tolist()}")
+    check_grid_size(b, h)
     axes = _grid_axes(b, h)
-    n_nodes = math.prod(len(a) for a in axes)
-    if n_nodes > MAX_GRID_NODES:
-        raise WorkspaceError(f"resolution {h} m gives {n_nodes:.3g} grid nodes (> {MAX_GRID_NODES:.0e}); is it in metres?")
     spec = _grid_spec(platform, orientation, convention, limits, axes)
     nx, ny, nz = (len(a) for a in axes)
     per = max(2, int(chunk_nodes) // (ny * nz))  # a slab re-evaluates one plane each side: keep >= 2

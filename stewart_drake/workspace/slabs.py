@@ -14,6 +14,7 @@ import numpy as np
 from ..geometry import Platform
 from ..kinematics import leg_vectors
 from ..rotations import rotation_matrix
+from ..sanity import plate_floor
 from .limits import Limits, _check_orientation, _margins_from_legs
 
 
@@ -28,12 +29,13 @@ class _GridSpec:
     offsets: np.ndarray  # (6, 3) l_i(0, R): leg vectors with the rotation centre at the origin
     R: np.ndarray  # (3, 3)
     axes: tuple  # three 1-D arrays of node coordinates
+    z_floor: float = -np.inf  # nodes count only above it (``sanity.plate_floor``: plate above the base)
 
 
 def _grid_spec(platform, orientation, convention, limits, axes) -> _GridSpec:
     o = _check_orientation(orientation)
     l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, o], convention)
-    return _GridSpec(platform, o, convention, limits, l0, rotation_matrix(o, convention), tuple(axes))
+    return _GridSpec(platform, o, convention, limits, l0, rotation_matrix(o, convention), tuple(axes), plate_floor(platform, o, convention))
 
 
 def _inside_block(spec: _GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
@@ -43,6 +45,7 @@ def _inside_block(spec: _GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
     p = spec.platform
     shape = (len(xs), len(ys), len(zs))
     ok = np.ones(shape, bool)
+    ok &= (np.asarray(zs) > spec.z_floor)[None, None, :]
     lo2, hi2 = p.L_min**2, p.L_max**2
     if spec.limits.stroke:
         for i in range(6):

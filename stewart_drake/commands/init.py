@@ -1,0 +1,25 @@
+"""``stewart-drake init``: print a commented, valid starting file (``--platform-template``)."""
+
+from __future__ import annotations
+
+import sys
+from importlib import resources
+
+TEMPLATES = ("utn", "radial", "explicit")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("init", help="print a commented platform file template to start from (stewart-drake init --platform-template radial > my.yaml)")
+    p.add_argument("--platform-template", choices=TEMPLATES, required=True,
+                   help="utn: the UTN 3-6 family; radial: anchors on two circles; explicit: anchor by anchor")
+    p.set_defaults(func=run)
+
+
+def template_text(kind: str) -> str:
+    """The text of the platform template ``kind`` (one of ``TEMPLATES``)."""
+    return (resources.files("stewart_drake") / "templates" / f"platform-{kind}.yaml").read_text(encoding="utf-8")
+
+
+def run(args) -> int:
+    sys.stdout.write(template_text(args.platform_template))
+    return 0
