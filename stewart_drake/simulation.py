@@ -281,6 +281,7 @@ class Simulation:
     visualizer: object = None
     plant_time_step: float = 1e-3
     feedforward: object = None
+    integrator: str = "sap"
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> "SimulationLog":
@@ -373,6 +374,9 @@ def build_simulation(
     meshcat=None,
     feedforward: bool = True,
     design_duration: float | None = None,
+    integrator: str | None = None,
+    plant_platform: Platform | None = None,
+    sensor=None,
 ) -> Simulation:
     """Assemble the controller-in-the-loop Diagram and its Simulator, with the plant at the reference's
     initial pose, legs at the matching lengths and the controller holding them against gravity.
@@ -382,14 +386,22 @@ def build_simulation(
     actuators' lag); ``plant_time_step`` (s): the discrete plant's step; ``meshcat``: a ``Meshcat`` to
     record an animation; ``feedforward``: connect the model-based force feed-forward table;
     ``design_duration`` (s): the default gains are designed over the reference's poses from 0 to this
-    time (``design_poses``; default the trajectory's duration, else 4 s).
+    time (``design_poses``; default the trajectory's duration, else 4 s); ``integrator``: ``cenic``
+    (default: a continuous plant under Drake's error-controlled CENIC, logged every ``plant_time_step``)
+    or ``sap`` (a discrete plant stepped at ``plant_time_step``); see ``integrators``; ``plant_platform``: the platform the plant is built
+    from (default ``platform``: the controller's model; a perturbed copy models manufacturing errors);
+    ``sensor``: a function ``(plant, D (6, nx)) -> LeafSystem`` (input: plant state, output: the six
+    measured lengths; optional ``initial_reading(L)``) replacing the ideal sensor ``MatrixGain(D)``.
     """
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import LogVectorOutput, MatrixGain
 
+    from .integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
     from .model import build_plant, set_pose
 
+    integrator = check_integrator(integrator or DEFAULT_INTEGRATOR)
+    plant_platform = plant_platform or platform
     if not (math.isfinite(plant_time_step) and plant_time_step > 0):
         raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
     trajectory = get_trajectory(trajectory)
@@ -398,7 +410,7 @@ def build_simulation(
         poses = design_poses(trajectory, design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     builder = DiagramBuilder()
-    plant, scene_graph = build_plant(platform, plant_time_step, builder)
+    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator == "cenic")
     ctrl = builder.AddSystem(make_controller(controller, platform, config))
     ctrl.set_name(f"{controller}_controller")
     src = builder.AddSystem(pose_source(trajectory))
@@ -410,7 +422,7 @@ def build_simulation(
     D = np.zeros((6, nx))
     for i in range(6):
         D[i, plant.GetJointByName(f"prismatic_{i + 1}").position_start()] = 1.0
-    sensor = builder.AddSystem(MatrixGain(D))
+    sensor = builder.AddSystem(MatrixGain(D) if sensor is None else sensor(plant, D))
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
     ff = None
@@ -424,12 +436,14 @@ def build_simulation(
     builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
     builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
     T = config.timing.sample_period
+    # the discrete plant logs at its steps; the continuous one at the same period (not at every integrator step)
+    lp = () if integrator == "sap" else (plant_time_step,)
     loggers = {
-        "state": LogVectorOutput(plant.get_state_output_port(), builder),
-        "command": LogVectorOutput(ctrl.GetOutputPort("command"), builder),
-        "setpoint": LogVectorOutput(ctrl.GetOutputPort("setpoint"), builder),
-        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder),
-        "force": LogVectorOutput(act.get_output_port(), builder),
+        "state": LogVectorOutput(plant.get_state_output_port(), builder, *lp),
+        "command": LogVectorOutput(ctrl.GetOutputPort("command"), builder, *lp),
+        "setpoint": LogVectorOutput(ctrl.GetOutputPort("setpoint"), builder, *lp),
+        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, *lp),
+        "force": LogVectorOutput(act.get_output_port(), builder, *lp),
         "reference": LogVectorOutput(src.get_output_port(), builder, T),
     }
     visualizer = None
@@ -439,12 +453,14 @@ def build_simulation(
         visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32))
     diagram = builder.Build()
     simulator = Simulator(diagram)
+    apply_integrator(simulator, integrator)
     root = simulator.get_mutable_context()
     pose0 = trajectory.pose(0.0)
     pc = plant.GetMyMutableContextFromRoot(root)
-    set_pose(plant, pc, platform, pose0)
-    set_velocity(plant, pc, platform, trajectory, 0.0)
-    L0 = leg_lengths(platform, pose0)
+    set_pose(plant, pc, plant_platform, pose0)
+    set_velocity(plant, pc, plant_platform, trajectory, 0.0)
+    L0 = leg_lengths(plant_platform, pose0)
+    L0 = sensor.initial_reading(L0) if hasattr(sensor, "initial_reading") else L0
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
@@ -452,7 +468,7 @@ def build_simulation(
     if act.state_index is not None:
         act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
     simulator.Initialize()
-    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff)
+    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff, integrator)
 
 
 def setpoint_step_response(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, step: float = 1e-3,
