@@ -13,7 +13,8 @@ What a draw changes (the controller keeps the nominal model: it is what the firm
 - the sensor reads L + offset (``leg_offset``) + white noise σ (``sensor_noise``) − j_k·dL/dt, the
   first-order effect of sampling tick k late by j_k ~ U[0, ``latency_jitter``], then quantises with the
   drawn ``sensor_resolution`` (in the controller);
-- the controller's ``latency`` mode and its gains × ``gain_scale``;
+- the controller's ``latency`` mode, ``sample_period`` and its gains × ``gain_scale`` (the gains are
+  those designed for the nominal timing and actuator lag: what the firmware was built with);
 - the actuators' lag (``actuator_lag``) and force limit (``force_limit``).
 """
 
@@ -30,7 +31,7 @@ from .spec import KEYS, VarySpec
 
 # Nominal values of the keys whose nominal is not the platform's.
 NOMINAL = {"sensor_resolution": 1e-5, "latency": "sample", "actuator_lag": 2e-3, "gain_scale": 1.0,
-           "sensor_noise": 0.0, "latency_jitter": 0.0}
+           "sensor_noise": 0.0, "latency_jitter": 0.0, "sample_period": 1e-3}
 # A run loses tracking when a leg is this far (m) from the reference's IK, or the state is not finite.
 LOST_TRACKING = 5e-3
 AXES = ("x", "y", "z")
@@ -40,7 +41,8 @@ AXES = ("x", "y", "z")
 class Study:
     """A study's fixed settings (picklable). ``trajectory``: ``seed``, ``rotating`` or a CSV path;
     ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
-    the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking."""
+    the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking; ``grid``: one
+    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length)."""
 
     platform: Platform
     spec: VarySpec
@@ -54,6 +56,7 @@ class Study:
     duration: float | None = None
     plant_step: float = 1e-3
     lost_tracking: float = LOST_TRACKING
+    grid: tuple | None = None
     extra: dict = field(default_factory=dict)
 
     def reference(self):
@@ -99,6 +102,7 @@ class Draw:
     payload_mass: float
     payload_com_offset: np.ndarray
     gain_scale: float
+    sample_period: float
 
     def columns(self) -> dict:
         """The drawn parameters as flat ``{column: value}`` (SI, names with their unit)."""
@@ -114,6 +118,7 @@ class Draw:
                     "payload_mass_kg": self.payload_mass})
         out.update({f"payload_com_{a}_m": float(x) for a, x in zip(AXES, self.payload_com_offset)})
         out["gain_scale"] = self.gain_scale
+        out["sample_period_s"] = self.sample_period
         return out
 
 
@@ -161,12 +166,15 @@ def draw(study: Study, index: int) -> tuple[int, Draw]:
             vals[key] = str(_draw_one(rng, law, NOMINAL[key]))
         else:
             vals[key] = float(_draw_one(rng, law, NOMINAL[key]))
+    if study.grid is not None:
+        vals.update(study.grid[index])
     return seed, Draw(
         base_anchor_offset=np.asarray(vals["anchor"][0], float), top_anchor_offset=np.asarray(vals["anchor"][1], float),
         leg_offset=np.asarray(vals["leg_offset"], float), sensor_resolution=vals["sensor_resolution"],
         sensor_noise=vals["sensor_noise"], latency=vals["latency"], latency_jitter=vals["latency_jitter"],
         actuator_lag=vals["actuator_lag"], force_limit=vals["force_limit"], payload_mass=vals["payload_mass"],
         payload_com_offset=np.asarray(vals["payload_com"], float), gain_scale=vals["gain_scale"],
+        sample_period=vals["sample_period"],
     )
 
 
@@ -230,11 +238,12 @@ def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None)
     ref = study.reference()
     duration = study.run_duration(ref)
     p = study.platform
-    timing = DspTiming(latency=d.latency, sensor_resolution=d.sensor_resolution, command_range=float(p.legs.max_force))
-    nominal = ControllerConfig.for_platform(p, timing, poses=design_poses(ref, duration))
-    g = nominal.gains
+    # the gains designed for the nominal timing and actuator lag over the run's poses (as simulate does)
+    g = ControllerConfig.for_platform(p, poses=design_poses(ref, max(duration, ref.duration or 0.0))).gains
     s = d.gain_scale
-    config = replace(nominal, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s))
+    timing = DspTiming(sample_period=d.sample_period, latency=d.latency, sensor_resolution=d.sensor_resolution,
+                       command_range=float(p.legs.max_force))
+    config = ControllerConfig.for_platform(p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s))
     pp = plant_platform(p, d)
     n_ticks = int(math.floor(duration / timing.sample_period + 1e-9)) + 2
     sensor = sensor_factory(d, seed, timing.sample_period, n_ticks)
@@ -257,7 +266,7 @@ def _metrics(log, ref, platform: Platform, lost: float, error: str) -> dict:
     nan = float("nan")
     if log is None:
         return {"max_leg_error_m": nan, "rms_leg_error_m": nan, "max_position_error_m": nan, "rms_position_error_m": nan,
-                "max_angle_error_rad": nan, "rms_angle_error_rad": nan, "saturated_ticks": -1, "lost_tracking": True, "error": error}
+                "max_angle_error_rad": nan, "rms_angle_error_rad": nan, "saturated_ticks": -1, "saturated_leg_ticks": -1, "lost_tracking": True, "error": error}
     e = log.length_error(ref, platform)
     pe = log.pose_error(ref)
     pos = np.linalg.norm(pe[:, :3], axis=1)
@@ -272,6 +281,7 @@ def _metrics(log, ref, platform: Platform, lost: float, error: str) -> dict:
         "max_angle_error_rad": float(ang.max()),
         "rms_angle_error_rad": float(np.sqrt(np.mean(ang**2))),
         "saturated_ticks": int(log.status[-1, 3]),
+        "saturated_leg_ticks": int(log.saturations().sum()),
         "lost_tracking": bool(not finite or max_leg > lost),
         "error": error,
     }

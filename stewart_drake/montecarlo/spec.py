@@ -22,6 +22,7 @@ Keys (nominal in brackets):
     payload_mass       plate mass, kg [the platform's]
     payload_com        plate centre of mass offset, per axis, m [0]
     gain_scale         factor on every PID gain [1]
+    sample_period      controller sample period, s [1e-3] (the gains stay those designed for the nominal)
 
 ``sensor_noise`` and ``latency_jitter`` set the size of per-tick random processes (drawn from the run's
 seed); the other keys are drawn once per run.
@@ -56,6 +57,7 @@ KEYS = {
     "payload_mass": ("mass", 0, False),
     "payload_com": ("length", 3, True),
     "gain_scale": ("ratio", 0, False),
+    "sample_period": ("time", 0, False),
 }
 # Keys that configure a per-tick process: a fixed value only.
 PROCESS_KEYS = ("sensor_noise", "latency_jitter")

@@ -48,7 +48,7 @@ def study_settings(study: Study) -> dict:
         "platform": plat, "vary": study.spec.to_dict(), "seed": study.seed, "trajectory": study.trajectory,
         "program": list(study.program) if study.program else None, "fit": study.fit, "controller": study.controller,
         "integrator": study.integrator, "duration": study.duration, "plant_step": study.plant_step,
-        "lost_tracking": study.lost_tracking, **study.extra,
+        "lost_tracking": study.lost_tracking, "grid": list(study.grid) if study.grid is not None else None, **study.extra,
     }
 
 
@@ -61,12 +61,13 @@ def study_from_settings(settings: dict, runs: int) -> Study:
     plat["legs"] = LegConfig(**plat["legs"])
     plat["leg_top"] = np.asarray(plat["leg_top"], dtype=np.intp)
     fields = {f.name for f in dataclasses.fields(Study)}
-    known = {"platform", "vary", "seed", "trajectory", "program", "fit", "controller", "integrator", "duration", "plant_step", "lost_tracking"}
+    known = {"platform", "vary", "seed", "trajectory", "program", "fit", "controller", "integrator", "duration", "plant_step", "lost_tracking", "grid"}
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(platform=Platform(**plat), spec=spec_from_dict(settings["vary"]), seed=settings["seed"], runs=runs,
                  trajectory=settings["trajectory"], program=tuple(settings["program"]) if settings["program"] else None,
                  fit=settings["fit"], controller=settings["controller"], integrator=settings["integrator"],
                  duration=settings["duration"], plant_step=settings["plant_step"], lost_tracking=settings["lost_tracking"],
+                 grid=tuple(settings["grid"]) if settings.get("grid") is not None else None,
                  extra={k: v for k, v in extra.items() if k not in fields})
 
 
@@ -85,6 +86,8 @@ def check_study(study: Study) -> float:
         raise StudyError(f"--runs must be 1 … {MAX_RUNS}, got {study.runs}")
     if not (isinstance(study.seed, int) and study.seed >= 0):
         raise StudyError(f"--seed must be an integer >= 0, got {study.seed}")
+    if study.grid is not None and len(study.grid) != study.runs:
+        raise StudyError(f"a sweep's runs ({study.runs}) must equal its grid's points ({len(study.grid)})")
     if not (math.isfinite(study.plant_step) and 0 < study.plant_step <= 1e-2):
         raise StudyError(f"plant step must be in (0, 0.01] s, got {study.plant_step}")
     duration = study.run_duration()
@@ -175,13 +178,12 @@ class PartialWriter:
 def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = True) -> list[dict]:
     """Run every run of ``study`` not yet in ``out`` and return all rows in run order. ``workers`` 0
     runs them in this process (no Dask); otherwise a ``LocalCluster`` of ``workers`` processes, or the
-    cluster at ``scheduler``."""
-    out = Path(out)
+    cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume)."""
     check_study(study)
     key = study_key(study)
-    rows = load_partial(out, key)
+    rows = load_partial(Path(out), key) if out is not None else {}
     todo = [i for i in range(study.runs) if i not in rows]
-    writer = PartialWriter(out, key)
+    writer = PartialWriter(Path(out), key) if out is not None else None
     bar = None
     if progress:
         from tqdm import tqdm
@@ -190,11 +192,13 @@ def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None,
     try:
         for row in _results(study, todo, workers, scheduler):
             rows[row["run"]] = row
-            writer.write(row)
+            if writer is not None:
+                writer.write(row)
             if bar is not None:
                 bar.update(1)
     finally:
-        writer.close()
+        if writer is not None:
+            writer.close()
         if bar is not None:
             bar.close()
     return [rows[i] for i in range(study.runs)]

@@ -17,7 +17,7 @@ import numpy as np
 from .spec import LATENCY_MODES
 
 METRICS = ("max_leg_error_m", "rms_leg_error_m", "max_position_error_m", "rms_position_error_m",
-           "max_angle_error_rad", "rms_angle_error_rad", "saturated_ticks")
+           "max_angle_error_rad", "rms_angle_error_rad", "saturated_ticks", "saturated_leg_ticks")
 # Row fields that are not drawn parameters.
 NOT_PARAMETERS = set(METRICS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
 PERCENTILES = (5, 50, 95, 99)
