@@ -88,19 +88,30 @@ def fit_trajectory(trajectory: Trajectory, platform: Platform, home_height: floa
 
 def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
     """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory held constant after the last sample. Errors name the line."""
+    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line."""
     data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
         k = late[0] + 1
         raise ValueError(f"{path}:{lines[k]}: time {data[k, 0]} s is not after the previous sample's {data[k - 1, 0]} s")
-    ts, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+    return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
+
+
+def table_trajectory(name: str, ts, poses) -> Trajectory:
+    """Samples ``ts`` (n,) s, ``poses`` (n, 6) SI as a piecewise-linear Trajectory, held constant after the
+    last sample and continued before the first along the first segment: the differences that start a run
+    at t = 0 (``initial_leg_forces``, ``set_velocity``) then see the reference's initial velocity, not a
+    kink from a pose held before t = 0 (a clamp there read as an acceleration of v/h and threw the plate)."""
+    ts, poses = np.asarray(ts, dtype=float), np.asarray(poses, dtype=float)
+    slope = (poses[1] - poses[0]) / (ts[1] - ts[0]) if len(ts) > 1 else np.zeros(6)
 
     def fn(t):
         t = np.asarray(t, dtype=float)
-        return np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
+        q = np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
+        before = (t < ts[0])[..., None]
+        return np.where(before, poses[0] + (t - ts[0])[..., None] * slope, q)
 
-    return Trajectory(Path(path).stem, fn, float(ts[-1]))
+    return Trajectory(name, fn, float(ts[-1]))
 
 
 def get_trajectory(name_or_path, **units) -> Trajectory:

@@ -177,3 +177,14 @@ def test_replay_is_bit_identical_and_the_check_can_fail(tmp_path, capsys):
     pq.write_table(pa.Table.from_pylist(rows), out / "results.parquet")
     assert main(["montecarlo", "--replay", "1", "--out", str(out), "--no-animation", "--json"]) == 1
     assert json.loads(capsys.readouterr().out)["differing_columns"] == ["max_leg_error_m"]
+
+
+def test_unreachable_program_refused_before_any_run(tmp_path, capsys):
+    """examples/circle.stw is written for utn-kinematic: on utn-dynamic its moves leave the stroke, and the
+    study stops before running anything (the program's diagnostics, exit 2, no folder)."""
+    from pathlib import Path
+
+    program = Path(__file__).resolve().parents[1] / "examples" / "circle.stw"
+    assert main(["montecarlo", "--program", str(program), "--runs", "2", "--out", str(tmp_path / "o"), *SHORT, "--workers", "0"]) == 2
+    assert "out of reach on platform utn-dynamic" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

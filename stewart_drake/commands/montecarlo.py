@@ -15,6 +15,8 @@ def register(sub) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument("--trajectory", default="seed", metavar="seed|rotating|FILE.csv", help="the pose reference (default seed)")
     src.add_argument("--program", metavar="P.stw", help="a motion program as the reference instead")
+    p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
+    p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
     p.add_argument("--fit", action="store_true", help="move and scale the trajectory to the platform's home and stroke")
     p.add_argument("--runs", type=int, default=100, metavar="N", help="number of runs (default 100)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="study seed; run i draws from SeedSequence(S, spawn_key=(i,)) (default 0)")
@@ -42,6 +44,7 @@ def register(sub) -> None:
 def build_study(args):
     from ..geometry import load_platform
     from ..montecarlo.scenario import Study
+    from ..simulation import TRAJECTORIES
     from ..montecarlo.spec import parse_spec
     from .run import read_program
 
@@ -53,11 +56,25 @@ def build_study(args):
     if not args.lost_tracking > 0:
         raise ValueError(f"--lost-tracking must be a positive number of mm, got {args.lost_tracking}")
     trajectory = None if program else args.trajectory
-    if trajectory is not None and trajectory.endswith(".csv"):
-        trajectory = str(Path(trajectory).resolve())
-    return Study(platform=platform, spec=spec, seed=args.seed, runs=args.runs, trajectory=trajectory, program=program,
+    table = None
+    if trajectory is not None and trajectory not in TRAJECTORIES:
+        table = csv_table(trajectory, args.length_unit, args.angle_unit)
+        trajectory = None
+    return Study(platform=platform, spec=spec, seed=args.seed, runs=args.runs, trajectory=trajectory, program=program, table=table,
                  fit=args.fit, controller=args.controller, integrator=args.integrator, duration=args.duration,
                  plant_step=args.plant_step, lost_tracking=args.lost_tracking * 1e-3)
+
+
+def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
+    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
+    (``load_trajectory_csv`` checks it and names a bad line)."""
+    from ..csvio import read_numeric_csv
+    from ..rotations import pose_to_si
+    from ..simulation import load_trajectory_csv
+
+    traj = load_trajectory_csv(path, length_unit, angle_unit)
+    data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
+    return (traj.name, data[:, 0].tolist(), pose_to_si(data[:, 1:], length_unit, angle_unit).tolist())
 
 
 def run(args) -> int:
@@ -66,7 +83,14 @@ def run(args) -> int:
     from ..montecarlo.study import run_study, study_key, study_settings
     from ..montecarlo.summary import write_outputs, summarise
 
+    from ..script import ScriptError
+
     study = build_study(args)
+    try:  # the reference (program compiled, CSV read) checked here, before any run starts
+        study.reference()
+    except ScriptError as e:
+        print(e.render(), file=sys.stderr)
+        return 2
     rows = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
     summary = summarise(rows, study_settings(study), study_key(study))
     summary["files"] = [str(p) for p in write_outputs(args.out, rows, summary)]
@@ -88,7 +112,7 @@ def print_text(summary: dict) -> None:
     for k, scale, unit in (("max_leg_error_m", 1e3, "mm"), ("max_position_error_m", 1e3, "mm"), ("max_angle_error_rad", 57.29577951308232, "deg")):
         s = m[k]
         if s:
-            print(f"  {k[:-2]:22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}")
+            print(f"  {k.rsplit('_', 1)[0]:22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}")
     w = summary["worst_run"]
     print(f"  worst run {w['run']} (seed {w['seed']}): max leg error {w['max_leg_error_m'] * 1e3:.4g} mm")
     for d in summary["sensitivity"]["max_leg_error_m"][:5]:

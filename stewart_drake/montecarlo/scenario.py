@@ -39,8 +39,9 @@ AXES = ("x", "y", "z")
 
 @dataclass(frozen=True)
 class Study:
-    """A study's fixed settings (picklable). ``trajectory``: ``seed``, ``rotating`` or a CSV path;
-    ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
+    """A study's fixed settings (picklable). ``trajectory``: ``seed`` or ``rotating``; ``table``: a CSV
+    reference read on the client, (name, times (n,), poses (n, 6) SI) as lists, so that workers need no
+    file; ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
     the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking; ``grid``: one
     ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length)."""
 
@@ -50,6 +51,7 @@ class Study:
     runs: int
     trajectory: str | None = "seed"
     program: tuple | None = None
+    table: tuple | None = None
     fit: bool = False
     controller: str = "fixed"
     integrator: str | None = None
@@ -61,9 +63,11 @@ class Study:
 
     def reference(self):
         """The pose reference as a ``simulation.Trajectory`` (built on the worker)."""
-        from ..simulation import Trajectory, fit_trajectory, get_trajectory
+        from ..simulation import Trajectory, fit_trajectory, get_trajectory, table_trajectory
 
-        if self.program is not None:
+        if self.table is not None:
+            ref = table_trajectory(*self.table)
+        elif self.program is not None:
             from ..script import run_program
 
             name, text = self.program

@@ -46,7 +46,8 @@ def study_settings(study: Study) -> dict:
     plat = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in plat.items()}
     return {
         "platform": plat, "vary": study.spec.to_dict(), "seed": study.seed, "trajectory": study.trajectory,
-        "program": list(study.program) if study.program else None, "fit": study.fit, "controller": study.controller,
+        "program": list(study.program) if study.program else None,
+        "table": list(study.table) if study.table else None, "fit": study.fit, "controller": study.controller,
         "integrator": study.integrator, "duration": study.duration, "plant_step": study.plant_step,
         "lost_tracking": study.lost_tracking, "grid": list(study.grid) if study.grid is not None else None, **study.extra,
     }
@@ -61,10 +62,11 @@ def study_from_settings(settings: dict, runs: int) -> Study:
     plat["legs"] = LegConfig(**plat["legs"])
     plat["leg_top"] = np.asarray(plat["leg_top"], dtype=np.intp)
     fields = {f.name for f in dataclasses.fields(Study)}
-    known = {"platform", "vary", "seed", "trajectory", "program", "fit", "controller", "integrator", "duration", "plant_step", "lost_tracking", "grid"}
+    known = {"platform", "vary", "seed", "trajectory", "program", "table", "fit", "controller", "integrator", "duration", "plant_step", "lost_tracking", "grid"}
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(platform=Platform(**plat), spec=spec_from_dict(settings["vary"]), seed=settings["seed"], runs=runs,
                  trajectory=settings["trajectory"], program=tuple(settings["program"]) if settings["program"] else None,
+                 table=tuple(settings["table"]) if settings.get("table") else None,
                  fit=settings["fit"], controller=settings["controller"], integrator=settings["integrator"],
                  duration=settings["duration"], plant_step=settings["plant_step"], lost_tracking=settings["lost_tracking"],
                  grid=tuple(settings["grid"]) if settings.get("grid") is not None else None,
@@ -212,11 +214,15 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         for i in todo:
             yield run_row(study, i)
         return
+    import dask
     from distributed import Client, LocalCluster, as_completed
+
+    from ..workspace_dask import WORKER_CONFIG
 
     cluster = None
     if scheduler is None:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        with dask.config.set(WORKER_CONFIG):  # no statistical profiler interrupting the runs
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
     else:
         client = Client(scheduler)
