@@ -25,7 +25,7 @@ def build(section) -> None:
     import matplotlib.pyplot as plt
 
     quick = section.quick
-    runs, duration, workers = (8, 0.5, 0) if quick else (64, 4.0, 2)
+    runs, duration, workers = (8, 0.5, 0) if quick else (40, 4.0, 2)
     platform = load_preset(PLATFORM)
     study = Study(platform, parse_spec(VARY), seed=2026, runs=runs, duration=duration)
     rows = run_study(study, None, workers=workers, progress=False)
