@@ -13,6 +13,10 @@ per platform to the cluster (each evaluation runs single-threaded on its worker)
 
 Where the time went, and what is done about it (``benchmarks/bench_workspace_dask.py`` measures it):
 
+- Dask starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand freed memory back to the OS),
+  which turns off glibc's adaptive mmap threshold: every large numpy temporary of a slab is then a fresh
+  mmap, page-faulted and zeroed. The 2.5 mm workspace sweep took 1.9× the CPU time in a process with
+  that setting, with or without Dask: ``local_client`` starts workers without it (``WORKER_CONFIG``);
 - each worker's statistical profiler interrupts the computing thread every 10 ms to walk its stack,
   taking the GIL from numpy code made of many mid-sized operations: ``local_client`` turns it off
   (``WORKER_CONFIG``);
@@ -37,8 +41,12 @@ import numpy as np
 
 from . import workspace as _ws
 
-# Dask settings for the workers of ``local_client``: no statistical profiler (see the module docstring).
-WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
+# Dask settings for the workers of ``local_client`` (see the module docstring): no statistical profiler,
+# and Dask's default worker environment without MALLOC_TRIM_THRESHOLD_ (numpy temporaries reuse the heap).
+WORKER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ": {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
+}
 # At least this many tasks per worker thread (load balance: the last wave of tasks is a small share).
 TASKS_PER_WORKER = 8
 
