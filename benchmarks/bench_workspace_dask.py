@@ -2,7 +2,10 @@
 time (and the efficiency, ratio / workers) for the constant-orientation workspace and the 6-D reachable
 count, with Dask as it comes ("plain": a LocalCluster, the core functions on its executor) and as
 ``workspace_dask`` runs it ("tuned": no worker profiler, warmed-up workers, tasks sized to the workers).
-Cluster start-up is not timed; every result is checked equal to the serial one.
+Cluster start-up is not timed; every result is checked equal to the serial one. Besides wall time (which
+on a shared machine measures the other users too), the CPU time: this process's plus every worker
+process's (all threads: the task, Dask's event loop, heartbeats) — ``cpu ratio`` = serial CPU / Dask CPU
+is the share of the work that is the sweep itself, whatever the load.
 
     PYTHONPATH=. python benchmarks/bench_workspace_dask.py --workers 1,2 [--resolution 0.0025] [--points 10]
     (on a bigger machine: --workers 1,2,4,8,16 --points 20, the issue's 64 M poses)
@@ -22,13 +25,22 @@ from stewart_drake import workspace_dask as wd
 from stewart_drake.geometry import load_preset
 
 
-def best_of(repeat, fn, *args, **kwargs):
-    best, out = math.inf, None
+def _cpu() -> float:
+    return time.process_time()
+
+
+def best_of(repeat, fn, *args, client=None, **kwargs):
+    """(best wall s, best CPU s, result); CPU: this process's plus the workers' of ``client``."""
+    best, best_cpu, out = math.inf, math.inf, None
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        w0 = sum(client.run(_cpu).values()) if client is not None else 0.0
+        c0, t0 = time.process_time(), time.perf_counter()
         out = fn(*args, **kwargs)
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        if client is not None:
+            cpu += sum(client.run(_cpu).values()) - w0
+        best, best_cpu = min(best, wall), min(best_cpu, cpu)
+    return best, best_cpu, out
 
 
 def six_d_grids(platform, n: int):
@@ -59,31 +71,35 @@ def main(argv=None) -> int:
     p = load_preset(args.platform)
     grids = six_d_grids(p, args.points)
     total = args.points**6
-    t_co, w_ser = best_of(args.repeat, ws.constant_orientation_workspace, p, resolution=args.resolution)
-    t_6d, c_ser = best_of(args.repeat, ws.count_reachable, p, grids)
+    t_co, cpu_co, w_ser = best_of(args.repeat, ws.constant_orientation_workspace, p, resolution=args.resolution)
+    t_6d, cpu_6d, c_ser = best_of(args.repeat, ws.count_reachable, p, grids)
     print(f"{args.platform}: workspace at {args.resolution * 1e3:g} mm ({math.prod(len(a) for a in w_ser.axes):,} nodes), "
           f"6-D count of {total:,} poses")
-    print(f"serial: workspace {t_co:.2f} s, 6-D {t_6d:.2f} s")
-    report = {"serial": {"workspace_s": t_co, "six_d_s": t_6d}}
+    print(f"serial: workspace {t_co:.2f} s (CPU {cpu_co:.2f} s), 6-D {t_6d:.2f} s (CPU {cpu_6d:.2f} s)")
+    report = {"serial": {"workspace_s": t_co, "workspace_cpu_s": cpu_co, "six_d_s": t_6d, "six_d_cpu_s": cpu_6d}}
     for k in (int(x) for x in args.workers.split(",")):
         for mode in args.modes.split(","):
             client = plain_client(k) if mode == "plain" else wd.local_client(n_workers=k)
             try:
                 if mode == "plain":
                     ex = wd.dask_executor(client)
-                    tc, w = best_of(args.repeat, ws.constant_orientation_workspace, p, resolution=args.resolution, executor=ex)
-                    t6, c = best_of(args.repeat, ws.count_reachable, p, grids, executor=ex)
+                    tc, cc, w = best_of(args.repeat, ws.constant_orientation_workspace, p, resolution=args.resolution, executor=ex, client=client)
+                    t6, c6, c = best_of(args.repeat, ws.count_reachable, p, grids, executor=ex, client=client)
                 else:
-                    tc, w = best_of(args.repeat, wd.workspace_on_dask, p, client=client, resolution=args.resolution)
-                    t6, c = best_of(args.repeat, wd.count_reachable_on_dask, p, grids, client=client)
+                    run_co = lambda: wd.workspace_on_dask(p, client=client, resolution=args.resolution)  # noqa: E731
+                    run_6d = lambda: wd.count_reachable_on_dask(p, grids, client=client)  # noqa: E731
+                    tc, cc, w = best_of(args.repeat, run_co, client=client)
+                    t6, c6, c = best_of(args.repeat, run_6d, client=client)
             finally:
                 wd.close_client(client)
             same = w.inside_nodes == w_ser.inside_nodes and np.array_equal(w.extents, w_ser.extents) and c["count"] == c_ser["count"]
-            r = {"workspace_s": tc, "workspace_ratio": t_co / tc, "workspace_efficiency": t_co / tc / k,
-                 "six_d_s": t6, "six_d_ratio": t_6d / t6, "six_d_efficiency": t_6d / t6 / k, "same_result": bool(same)}
+            r = {"workspace_s": tc, "workspace_ratio": t_co / tc, "workspace_efficiency": t_co / tc / k, "workspace_cpu_ratio": cpu_co / cc,
+                 "six_d_s": t6, "six_d_ratio": t_6d / t6, "six_d_efficiency": t_6d / t6 / k, "six_d_cpu_ratio": cpu_6d / c6,
+                 "same_result": bool(same)}
             report[f"{mode}/{k}"] = r
-            print(f"{mode:5s} {k:2d} workers: workspace {tc:6.2f} s ×{r['workspace_ratio']:.2f} (eff {r['workspace_efficiency']:.0%})   "
-                  f"6-D {t6:6.2f} s ×{r['six_d_ratio']:.2f} (eff {r['six_d_efficiency']:.0%})   same result: {same}", flush=True)
+            print(f"{mode:5s} {k:2d} workers: workspace {tc:6.2f} s ×{r['workspace_ratio']:.2f} (eff {r['workspace_efficiency']:.0%}, "
+                  f"cpu ratio {r['workspace_cpu_ratio']:.2f})   6-D {t6:6.2f} s ×{r['six_d_ratio']:.2f} (eff {r['six_d_efficiency']:.0%}, "
+                  f"cpu ratio {r['six_d_cpu_ratio']:.2f})   same result: {same}", flush=True)
     print(json.dumps(report, indent=2))
     return 0
 

@@ -16,7 +16,9 @@ Where the time went, and what is done about it (``benchmarks/bench_workspace_das
 - Dask starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand freed memory back to the OS),
   which turns off glibc's adaptive mmap threshold: every large numpy temporary of a slab is then a fresh
   mmap, page-faulted and zeroed. The 2.5 mm workspace sweep took 1.9× the CPU time in a process with
-  that setting, with or without Dask: ``local_client`` starts workers without it (``WORKER_CONFIG``);
+  that setting, with or without Dask: ``local_cluster`` starts workers without it (``WORKER_CONFIG``;
+  and Dask writes the variable into the spawning process's own environment, where later clusters
+  would inherit it: it is held out of the environment while the workers start);
 - each worker's statistical profiler interrupts the computing thread every 10 ms to walk its stack,
   taking the GIL from numpy code made of many mid-sized operations: ``local_client`` turns it off
   (``WORKER_CONFIG``);
@@ -63,18 +65,31 @@ def local_client(n_workers: int | None = None, threads_per_worker: int = 1, proc
     """A ``distributed.Client`` on a ``LocalCluster`` of ``n_workers`` (default: the usable CPUs) worker
     processes, one thread each (the numpy kernels are single-threaded per slab). Use as a context
     manager; closing the client closes the cluster."""
-    import dask
-
     distributed = _require_distributed()
-    n = n_workers or _ws.default_workers()
-    with dask.config.set(WORKER_CONFIG):
-        cluster = distributed.LocalCluster(
-            n_workers=n, threads_per_worker=threads_per_worker, processes=processes, dashboard_address=None, **kwargs
-        )
+    cluster = local_cluster(n_workers or _ws.default_workers(), threads_per_worker, processes, **kwargs)
     client = distributed.Client(cluster)
     client._stewart_owned_cluster = cluster  # closed with the client (see close_client)
     warm_up(client)
     return client
+
+
+def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool = True, **kwargs):
+    """A ``LocalCluster`` whose workers run with ``WORKER_CONFIG``: no statistical profiler, glibc's
+    adaptive malloc (no ``MALLOC_TRIM_THRESHOLD_``, also when an earlier cluster left it in this
+    process's environment)."""
+    import os
+
+    import dask
+
+    distributed = _require_distributed()
+    held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    try:
+        with dask.config.set(WORKER_CONFIG):
+            return distributed.LocalCluster(n_workers=n_workers, threads_per_worker=threads_per_worker, processes=processes,
+                                            dashboard_address=None, **kwargs)
+    finally:
+        if held is not None:
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = held
 
 
 def _import_kernels() -> bool:

@@ -149,11 +149,14 @@ def test_refuses_a_folder_it_did_not_write(tmp_path, capsys):
 
 
 def test_rows_same_with_one_or_two_dask_workers(tmp_path):
-    """Two LocalClusters (1 and 2 worker processes): the same rows, wall time excluded."""
-    tables = []
-    for k in (1, 2):
-        assert main(_study_args(tmp_path / f"w{k}", 3, "--workers", str(k))) == 0
-        tables.append([{c: v for c, v in r.items() if c != "wall_s"} for r in read_table(tmp_path / f"w{k}")])
+    """``--workers 1`` (the study's own LocalCluster) and ``--scheduler`` of a running 2-worker cluster:
+    the same rows, wall time excluded."""
+    from distributed import LocalCluster
+
+    assert main(_study_args(tmp_path / "w1", 3, "--workers", "1")) == 0
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        assert main(_study_args(tmp_path / "w2", 3, "--scheduler", cluster.scheduler_address)) == 0
+    tables = [[{c: v for c, v in r.items() if c != "wall_s"} for r in read_table(tmp_path / w)] for w in ("w1", "w2")]
     assert tables[0] == tables[1]
     assert len({r["max_leg_error_m"] for r in tables[0]}) == 3  # the runs do differ
 

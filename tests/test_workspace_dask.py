@@ -48,9 +48,18 @@ def test_auto_sized_dask_sweeps_equal_serial():
         assert np.array_equal(a, b)
 
 
-def test_local_client_workers_keep_the_adaptive_malloc():
+def test_local_client_workers_keep_the_adaptive_malloc(monkeypatch):
     """Workers start without Dask's MALLOC_TRIM_THRESHOLD_ (it made every numpy temporary a fresh mmap:
-    1.9× the CPU time of the 2.5 mm sweep), and with single-threaded BLAS as Dask sets it."""
+    1.9× the CPU time of the 2.5 mm sweep), and with single-threaded BLAS as Dask sets it — also after a
+    plain LocalCluster has left the variable in this process's environment."""
+    import os
+
+    from distributed import LocalCluster
+
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)  # this process's environment restored afterwards
+    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None):
+        pass
+    assert os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536"  # Dask's, in this process now
     client = wd.local_client(n_workers=1)
     try:
         env = client.run(lambda: {k: __import__("os").environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")})

@@ -214,15 +214,13 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         for i in todo:
             yield run_row(study, i)
         return
-    import dask
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, as_completed
 
-    from ..workspace_dask import WORKER_CONFIG
+    from ..workspace_dask import local_cluster
 
     cluster = None
     if scheduler is None:
-        with dask.config.set(WORKER_CONFIG):  # no statistical profiler interrupting the runs
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
         client = Client(cluster)
     else:
         client = Client(scheduler)
