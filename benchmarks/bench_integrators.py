@@ -5,7 +5,9 @@ For each integrator: the controller-in-the-loop run (``--trajectory`` on ``--pla
 and the bare plant (no controller: the legs pushed with the static forces of home, so the plate stays
 near home; the integrator is free to take its own steps). Printed per case: wall time, real-time factor
 (simulated s / wall s), the largest ball-constraint gap over every logged state (m), the largest leg
-tracking error, and the largest difference of leg lengths and pose between the two integrators.
+tracking error, the largest difference of leg lengths and pose between the two integrators, and each
+one's distance from a reference run (the float twin under CENIC at accuracy 1e-8: the accuracy, not
+only the agreement).
 
     PYTHONPATH=. python benchmarks/bench_integrators.py [--platform utn-dynamic] [--duration 4]
 """
@@ -18,9 +20,13 @@ import time
 
 import numpy as np
 
+from stewart_drake import integrators
 from stewart_drake.geometry import load_platform
 from stewart_drake.integrators import INTEGRATORS, apply_integrator, constraint_gaps
 from stewart_drake.simulation import build_simulation, get_trajectory
+
+
+REFERENCE_ACCURACY = 1e-8
 
 
 def closed_loop(platform, trajectory, controller, integrator, duration):
@@ -81,6 +87,18 @@ def main(argv=None) -> int:
             "max_leg_length_difference_m": float(np.abs(a.lengths - b.lengths).max()),
             "max_position_difference_m": float(np.abs(a.pose[:, :3] - b.pose[:, :3]).max()),
             "max_angle_difference_rad": float(np.abs(a.pose[:, 3:] - b.pose[:, 3:]).max()),
+        }
+    default = integrators.CENIC_ACCURACY
+    integrators.CENIC_ACCURACY = REFERENCE_ACCURACY
+    try:
+        ref, out["float/reference"] = closed_loop(platform, traj, "float", "cenic", args.duration)
+    finally:
+        integrators.CENIC_ACCURACY = default
+    for integ in INTEGRATORS:
+        log = build_simulation(platform, traj, "float", integrator=integ, design_duration=args.duration).run(args.duration)
+        out[f"float/{integ}_vs_reference"] = {
+            "max_leg_length_difference_m": float(np.abs(log.lengths - ref.lengths).max()),
+            "max_position_difference_m": float(np.abs(log.pose[:, :3] - ref.pose[:, :3]).max()),
         }
     for integ in INTEGRATORS:
         out[f"bare/{integ}"] = bare_plant(platform, integ, args.duration)

@@ -6,6 +6,12 @@
 it (ball constraints supported since Drake 1.56); the controller and the actuators stay discrete
 systems, so the integrator stops exactly at their tick times. ``CENIC_ACCURACY`` is its error-control
 target (Drake's default; ``benchmarks/bench_integrators.py`` measures what it gives).
+
+Measured (``bench_integrators.py``, utn-dynamic, seed, 4 s): the largest ball-constraint gap is
+2.5e-8 m under CENIC and 1.5e-7 m under SAP (fixed-point controller; 7.4e-9 vs 5.6e-8 m with the float
+twin); against CENIC at accuracy 1e-8 the leg lengths of CENIC (1e-4) are within 9 µm, SAP's within
+0.11 mm (its first-order step error); in the loop both run at the same speed (the Python controller
+and the 1 kHz ticks set the pace), so CENIC is the default: accuracy first.
 """
 
 from __future__ import annotations
@@ -30,10 +36,12 @@ def check_integrator(name: str) -> str:
     return name
 
 
-def apply_integrator(simulator, name: str, accuracy: float = CENIC_ACCURACY) -> None:
+def apply_integrator(simulator, name: str, accuracy: float | None = None) -> None:
     """Configure ``simulator`` for ``name``: nothing for ``sap`` (a discrete plant needs no integrator
-    of its own), ``SimulatorConfig(integration_scheme="cenic", accuracy=accuracy)`` for ``cenic``."""
+    of its own), ``SimulatorConfig(integration_scheme="cenic", accuracy=accuracy)`` for ``cenic``
+    (default ``CENIC_ACCURACY``, read at the call)."""
     check_integrator(name)
+    accuracy = CENIC_ACCURACY if accuracy is None else accuracy
     if name == "cenic":
         from pydrake.systems.analysis import ApplySimulatorConfig, SimulatorConfig
 
