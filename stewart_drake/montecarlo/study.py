@@ -74,8 +74,15 @@ def study_from_settings(settings: dict, runs: int) -> Study:
 
 
 def study_key(study: Study) -> str:
-    """A hash of ``study_settings``: two studies with the same key draw and run the same runs."""
-    return hashlib.sha256(json.dumps(study_settings(study), sort_keys=True, default=repr).encode()).hexdigest()[:16]
+    """A hash of ``study_settings`` (settings left at None out, so that a setting added later keeps the
+    keys of studies that do not use it): two studies with the same key draw and run the same runs."""
+    return settings_key(study_settings(study))
+
+
+def settings_key(settings: dict) -> str:
+    """``study_key`` of stored ``study_settings`` (e.g. a finished study's ``study.json``)."""
+    settings = {k: v for k, v in settings.items() if v is not None}
+    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
 
 def check_study(study: Study) -> float:
@@ -130,8 +137,9 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
     previous = out / STUDY_FILE
     if previous.exists():
         old = json.loads(previous.read_text())
-        if old.get("key") != key:
-            raise StudyError(f"--out {str(out)!r} holds another study (key {old.get('key')}, this one {key}); choose another folder")
+        old_key = settings_key(old["settings"]) if "settings" in old else old.get("key")
+        if old_key != key:
+            raise StudyError(f"--out {str(out)!r} holds another study (key {old_key}, this one {key}); choose another folder")
         results = out / "results.parquet"
         if results.exists():
             import pyarrow.parquet as pq

@@ -122,7 +122,7 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
     fig.savefig(paths[-1], dpi=100, bbox_inches="tight")
     plt.close(fig)
     ranking = summary["sensitivity"]["max_leg_error_m"]
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4))
+    fig, ax = plt.subplots(1, 2, figsize=(13, 4), constrained_layout=True)
     if ranking:
         top = ranking[0]["parameter"]
         ax[0].scatter(_numeric(rows, top), _numeric(rows, "max_leg_error_m") * 1e3, s=8)
