@@ -1,4 +1,5 @@
-"""Forward-kinematics throughput: batched Newton, Drake MathematicalProgram, all assembly modes.
+"""Forward-kinematics throughput: batched Newton, Drake MathematicalProgram, all assembly modes
+(multi-start search and the complete parameter homotopy of ``stewart_drake.homotopy``).
 
 Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--quick]``. Pins nothing; prints absolute
 figures for this machine and ratios measured in the same run (the ratios travel between machines,
@@ -82,11 +83,114 @@ def assembly_times() -> list[tuple]:
     return rows
 
 
+# fkSGP (Martyushev et al., elimination templates, Mech. Mach. Theory 2025), published per-case times in
+# Python: ~11-15 ms on Dietmaier's general 6-6, ~5 ms on a planar 6-6; it does not handle the 3-fold
+# symmetric 6-6 (roots at infinity) nor 3-6 platforms. Quoted from its paper, not measured here.
+FKSGP_MS = {"dietmaier-1998": "11-15", "planar": "~5", "gonzalez-dutra-2009": "fails", "utn-dynamic": "fails", "utn-kinematic": "fails"}
+
+
+def homotopy_cases(n_poses: int):
+    """(label, fkSGP key, platform, (k, 6) length sets) for the homotopy benchmark."""
+    from stewart_drake.forward import dietmaier_platform, planar_platform
+
+    p, L = dietmaier_platform()
+    cases = [("dietmaier-1998 (6-6, 40 real)", "dietmaier-1998", p, L[None])]
+    for seed in range(3):
+        p, L = planar_platform(seed)
+        cases.append((f"planar 6-6 seed {seed}", "planar", p, L[None]))
+    rng = np.random.default_rng(0)
+    for name in ("gonzalez-dutra-2009", "utn-dynamic", "utn-kinematic"):
+        p = load_preset(name)
+        q = p.home_pose() + np.c_[rng.uniform(-0.05, 0.05, (n_poses, 3)), rng.uniform(-0.2, 0.2, (n_poses, 3))]
+        cases.append((f"{name} ({n_poses} poses)", name, p, leg_lengths(p, q)))
+    return cases
+
+
+def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tuple]:
+    """Per length set: homotopy median time (stage one cached), its one-time stage-one cost, the
+    multi-start search's time (polish off) on the same sets, and the outcome."""
+    from stewart_drake.forward import assembly_modes
+    from stewart_drake.homotopy import solve
+    from stewart_drake.homotopy.solve import _PLATFORM_STARTS
+
+    rows = []
+    for label, key, p, Ls in homotopy_cases(n_poses):
+        _PLATFORM_STARTS.clear()
+        t0 = time.perf_counter()
+        solve(p, Ls[0])
+        t_first = time.perf_counter() - t0
+        ts, cs, ok, cert, paths = [], [], True, True, None
+        for L in Ls:
+            for _ in range(repeat):
+                t0, c0 = time.perf_counter(), time.process_time()
+                r = solve(p, L)
+                ts.append(time.perf_counter() - t0)
+                cs.append(time.process_time() - c0)
+            ok &= r.complete
+            cert &= all(m.certified for m in r.modes)
+            paths = (r.n_paths, r.max_solutions, r.counts())
+        t_ms, c_ms = [], []
+        if with_multistart:
+            for L in Ls:
+                t0, c0 = time.perf_counter(), time.process_time()
+                assembly_modes(p, L, polish=None)
+                t_ms.append(time.perf_counter() - t0)
+                c_ms.append(time.process_time() - c0)
+        med = float(np.median(ts))
+        nan = float("nan")
+        rows.append((label, key, paths, ok, cert, 1e3 * med, 1e3 * float(np.median(cs)), 1e3 * (t_first - med),
+                     1e3 * float(np.median(t_ms)) if t_ms else nan, 1e3 * float(np.median(c_ms)) if c_ms else nan))
+    return rows
+
+
+def homotopy_batch(n: int) -> list[tuple]:
+    """Batched mode: n length sets of one platform in one call, per-set time."""
+    from stewart_drake.forward import dietmaier_platform, planar_platform
+    from stewart_drake.homotopy import solve_batch
+
+    rows = []
+    rng = np.random.default_rng(1)
+    platforms = {"dietmaier-1998": dietmaier_platform()[0], "planar 6-6 seed 0": planar_platform(0)[0]}
+    platforms.update({name: load_preset(name) for name in ("gonzalez-dutra-2009", "utn-dynamic")})
+    for name, p in platforms.items():
+        q = p.home_pose() + np.c_[rng.uniform(-0.05, 0.05, (n, 3)), rng.uniform(-0.2, 0.2, (n, 3))]
+        L = leg_lengths(p, q)
+        solve_batch(p, L[:1])  # stage one, cached
+        c0 = time.process_time()
+        t, rs = best_of(lambda: solve_batch(p, L), 1)
+        cpu = time.process_time() - c0
+        rows.append((name, n, 1e3 * t / n, 1e3 * cpu / n, sum(r.complete for r in rs), rs[0].timing))
+    return rows
+
+
+def print_homotopy(args) -> None:
+    print("\n# Complete FK by parameter homotopy (all paths, classified, real modes certified) vs multi-start")
+    print(f"{'case':36s} {'paths':>9s} {'complete':>8s} {'cert':>5s} {'hom ms':>7s} {'hom cpu':>7s} {'stage1':>7s} "
+          f"{'multi ms':>9s} {'multi cpu':>9s} {'ratio':>6s} {'fkSGP ms':>9s}  classes")
+    rows = homotopy_times(3 if args.quick else 5, 3 if args.quick else 5, not args.homotopy_only)
+    for label, key, (n2, nmax, counts), ok, cert, med, cpu, first, ms, mcpu in rows:
+        cls = " ".join(f"{k}={v}" for k, v in counts.items() if v)
+        print(f"{label:36s} {n2:4d}/{nmax:<4d} {str(ok):>8s} {str(cert):>5s} {med:7.1f} {cpu:7.1f} {first:7.1f} "
+              f"{ms:9.1f} {mcpu:9.1f} {mcpu / cpu:6.1f} {FKSGP_MS[key]:>9s}  {cls}")
+    print("(hom: median per length set, wall and process CPU time, with the platform's stage one cached; stage1: its")
+    print(" one-time wall cost (ms); ratio: multi-start CPU / homotopy CPU, measured in this run (CPU time because the")
+    print(" machine may be shared: wall time then includes waiting); fkSGP: published, not measured here)")
+    print("\n# Batched homotopy: many length sets of one platform in one call")
+    for name, n, per, cpu, n_ok, timing in homotopy_batch(20 if args.quick else 100):
+        tm = ", ".join(f"{k} {v:.2f} s" for k, v in timing.items())
+        print(f"{name:22s} {n:4d} sets: {per:6.2f} ms wall, {cpu:6.2f} ms CPU per set, {n_ok}/{n} complete ({tm})")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller batches")
+    ap.add_argument("--homotopy", action="store_true", help="only the complete-FK (homotopy vs multi-start) section")
+    ap.add_argument("--homotopy-only", action="store_true", help="only the homotopy timings, without the multi-start comparison")
     args = ap.parse_args(argv)
     n = 20_000 if args.quick else 100_000
+    if args.homotopy or args.homotopy_only:
+        print_homotopy(args)
+        return 0
 
     print(f"\n# Newton FK, batch of {n} poses (best of 3)")
     print(f"{'platform':22s} {'solves/s':>10s} {'no check':>10s} {'tracking':>10s} {'1-call/s':>9s} {'iters':>6s} {'trk it':>6s} {'conv':>6s}")
@@ -107,6 +211,7 @@ def main(argv=None) -> int:
     print(f"{'geometry':28s} {'modes':>5s} {'max':>4s} {'complete':>8s} {'certified':>9s} {'newton s':>9s} {'full s':>7s} {'starts':>7s}")
     for label, k, kmax, comp, cert, tf, tfull, starts in assembly_times():
         print(f"{label:28s} {k:5d} {kmax:4d} {str(comp):>8s} {cert:9d} {tf:9.3f} {tfull:7.3f} {starts:7d}")
+    print_homotopy(args)
     return 0
 
 

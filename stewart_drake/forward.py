@@ -29,8 +29,9 @@ What this guarantees, and what not:
   the number of isolated (complex) solutions: 40 for a general 6-6 platform (Dietmaier 1998 shows all
   40 can be real), 16 when the legs share three plate (or base) joints in pairs (3-6). Then no
   solution was missed. Otherwise the search is probabilistic: a mode whose basin of attraction is tiny may be
-  missed; more starts (``n_starts``, ``max_rounds``) lower that risk but never to zero. Homotopy
-  continuation would be needed for a guarantee.
+  missed; more starts (``n_starts``, ``max_rounds``) lower that risk but never to zero. The complete
+  solver is ``stewart_drake.homotopy`` (parameter homotopy, every path classified, certified modes);
+  this search remains as an independent second method.
 - A platform whose solution set is not finite (an architecturally singular design, self-motions)
   returns finitely many sample points of it.
 """
@@ -136,6 +137,35 @@ def general_platform(seed: int = 0) -> tuple[Platform, np.ndarray]:
         home_height=1.0,
     )
     q = p.home_pose() + np.r_[rng.uniform(-0.1, 0.1, 3), rng.uniform(-0.2, 0.2, 3)]
+    from .kinematics import leg_lengths
+
+    return p, leg_lengths(p, q)
+
+
+def planar_platform(seed: int = 0) -> tuple[Platform, np.ndarray]:
+    """A seeded random planar 6-6 platform (base anchors at z = 0 within 1 m of the axis, plate anchors
+    at z = 0 within 0.6 m, at random angles: no symmetry) and the leg lengths ``(6,)`` of a random pose
+    near its home (±0.1 m, ±0.3 rad). For tests and benchmarks of the complete solvers."""
+    rng = np.random.default_rng(seed)
+
+    def ring(radius, n=6):
+        ang = np.sort(rng.uniform(0, 2 * np.pi, n))
+        r = radius * rng.uniform(0.6, 1.0, n)
+        return np.stack([r * np.cos(ang), r * np.sin(ang), np.zeros(n)], -1)
+
+    p = Platform(
+        name=f"planar-6-6-seed{seed}",
+        description="seeded random planar 6-6 platform",
+        base_anchors=ring(1.0),
+        top_anchors=ring(0.6),
+        leg_top=np.arange(6),
+        stroke=np.array([0.3, 2.5]),
+        mass=0.0,
+        com=np.zeros(3),
+        inertia=np.zeros((3, 3)),
+        home_height=1.0,
+    )
+    q = p.home_pose() + np.r_[rng.uniform(-0.1, 0.1, 3), rng.uniform(-0.3, 0.3, 3)]
     from .kinematics import leg_lengths
 
     return p, leg_lengths(p, q)

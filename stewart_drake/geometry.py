@@ -72,6 +72,9 @@ class LegConfig:
     piston_radius: float = 0.0  # 0: 0.6 x cylinder radius
     piston_mass: float = 0.1
     max_force: float = 1000.0  # N, actuator effort limit
+    max_speed: Optional[float] = None  # length unit per s, actuator speed limit (None: not checked)
+    max_power: Optional[float] = None  # W, actuator mechanical power limit (None: not checked)
+    stiffness: Optional[float] = None  # N per length unit, axial stiffness of a leg (None: unknown)
 
 
 @dataclass
@@ -330,6 +333,8 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
         cylinder_length=cfg.legs.cylinder_length * k,
         cylinder_radius=cfg.legs.cylinder_radius * k,
         piston_radius=cfg.legs.piston_radius * k,
+        max_speed=None if cfg.legs.max_speed is None else cfg.legs.max_speed * k,
+        stiffness=None if cfg.legs.stiffness is None else cfg.legs.stiffness / k,
     )
     common = dict(
         name=cfg.name,

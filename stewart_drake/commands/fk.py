@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from ..rotations import length_scale, pose_from_si, pose_to_si
@@ -14,7 +16,9 @@ def register(sub) -> None:
         help="pose for six leg lengths (forward kinematics); --all: every assembly mode",
         description="Forward kinematics. Without --all: Newton-Raphson from the home pose (or --initial); if it "
         "does not converge, the multi-start search is run and the mode nearest home is returned. With --all: "
-        "every assembly mode found (Newton multi-start, confirmed by a Drake MathematicalProgram), nearest home first.",
+        "every assembly mode, nearest home first: by default the complete parameter homotopy (every path classified, "
+        "each real mode certified by a Krawczyk/Kantorovich test), or --method multi-start (Newton multi-start "
+        "confirmed by a Drake MathematicalProgram).",
     )
     add_platform_arg(p)
     p.add_argument("--lengths", nargs=6, type=float, required=True, metavar=("L1", "L2", "L3", "L4", "L5", "L6"), help="leg lengths in --length-unit")
@@ -23,7 +27,8 @@ def register(sub) -> None:
     p.add_argument("--initial", nargs=6, type=float, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="initial pose for Newton (default: home), in the chosen units")
     p.add_argument("--tol", type=float, default=1e-13, help="Newton tolerance on the leg lengths, metres (default 1e-13)")
     p.add_argument("--max-iter", type=int, default=30, help="Newton iteration limit (default 30)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the multi-start search (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the multi-start search / the homotopy's gamma (default 0)")
+    p.add_argument("--method", choices=("homotopy", "multi-start"), default="homotopy", help="--all: complete homotopy (default) or the multi-start search")
     p.add_argument("--json", action="store_true", help='print JSON: {"solutions": [...], ...}')
     p.set_defaults(func=run)
 
@@ -42,6 +47,45 @@ def _entry(mode, args, k: float, **extra) -> dict:
     }
     d.update(extra)
     return d
+
+
+def _homotopy_all(platform, L, args, k: float) -> dict:
+    """The ``--all`` answer of the complete homotopy solver: solutions nearest home first, each with
+    its certificate; path counts per class; completeness and its guarantee."""
+    from ..forward import modes_from_solutions
+    from ..homotopy import solve
+    from ..rotations import angle_scale
+
+    r = solve(platform, L, seed=args.seed)
+    sols = []
+    for hm in r.modes:
+        mode = modes_from_solutions(platform, hm.position[None], hm.rotation[None], L, np.array([hm.certified]), args.convention)[0]
+        sols.append(
+            _entry(
+                mode, args, k, converged=True, method="homotopy", path=hm.path, certified_radius=hm.radius,
+                uniqueness_radius=hm.uniqueness, position_bound=hm.position_bound / k,
+                angle_bound=hm.angle_bound / angle_scale(args.angle_unit),
+            )
+        )
+    sols.sort(key=lambda d: d["distance_to_home"])
+    return dict(
+        solutions=sols,
+        method="homotopy",
+        modes_found=len(sols),
+        max_solutions=r.max_solutions,
+        complete=r.complete,
+        guarantee=r.guarantee,
+        architecture=r.kind,
+        architecture_text=r.architecture,
+        paths=r.counts(),
+        path_classes=list(r.classes),
+        failed_paths=r.failed_paths,
+        retracked_paths=r.retracked,
+        stage=r.stage,
+        certificate="Krawczyk/Kantorovich existence and uniqueness in Study coordinates (e·e = 1): an exact solution "
+        "lies within certified_radius of the returned point, no other within uniqueness_radius; position_bound / "
+        "angle_bound are the implied pose bounds",
+    )
 
 
 def run(args) -> int:
@@ -67,7 +111,9 @@ def run(args) -> int:
             mode = modes_from_solutions(platform, r.iterate[None, :3], r.rotation[None], L, np.array([False]), args.convention)[0]
             single = _entry(mode, args, k, converged=True, iterations=int(r.iterations), method="newton")
             out.update(solutions=[single], method="newton")
-    if single is None:
+    if single is None and args.all and args.method == "homotopy":
+        out.update(_homotopy_all(platform, L, args, k))
+    elif single is None:
         from ..forward import assembly_modes
 
         am = assembly_modes(platform, L, args.convention, seed=args.seed, tol=min(args.tol, 1e-13))
@@ -87,7 +133,11 @@ def run(args) -> int:
             f"platform {platform.name}, convention {args.convention}, pose in {args.length_unit}/{args.angle_unit}, "
             f"method: {out['method']}"
         )
-        if "modes_found" in out:
+        if "paths" in out:
+            counts = ", ".join(f"{v} {c}" for c, v in out["paths"].items() if v)
+            print(f"architecture {out['architecture']}: {out['max_solutions']} paths ({counts})")
+            print(("complete: " if out["complete"] else "") + out["guarantee"])
+        elif "modes_found" in out:
             print(f"{out['modes_found']} modes found (at most {out['max_solutions']} exist; complete: {out['complete']})")
         for i, s in enumerate(out["solutions"], 1):
             flags = [
@@ -95,6 +145,13 @@ def run(args) -> int:
                 "within stroke" if s["within_stroke"] else "OUTSIDE stroke",
                 f"det {'+' if s['det_sign'] > 0 else '-'}",
                 f"cond {s['condition']:.3g}",
-            ] + (["certified"] if s["certified"] else [])
+            ] + ([f"certified (radius {s['certified_radius']:.1e})" if "certified_radius" in s else "certified"] if s["certified"] else [])
             print(f"{i:3d}", " ".join(f"{x:11.5f}" for x in s["pose"]), f"  residual {s['residual']:.2e}", ", ".join(flags))
+    if out.get("method") == "homotopy" and not out["complete"]:
+        print(f"fk --all: {out['guarantee']}", file=sys.stderr)
+        return 1
+    if out.get("method") == "homotopy" and not out["solutions"]:
+        print(f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
+              f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})", file=sys.stderr)
+        return 1
     return 0 if all(s["within_stroke"] for s in out["solutions"]) else 1

@@ -30,6 +30,7 @@ def register(sub) -> None:
     p.add_argument("--rate", type=float, default=100.0, help="trajectory samples per second (default 100)")
     p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention of alpha, beta, gama (default utn: Ry·Rx·Rz)")
     p.add_argument("--coriolis", choices=["on", "off"], default="on", help="include C(q, q̇) q̇ in the forces (default on; off = the seed's model)")
+    add_branch_args(p)
     p.add_argument("--simulate", action="store_true", help="also run the trajectory through the controller-in-the-loop Drake simulation")
     p.add_argument("--controller", choices=SIMULATE_CONTROLLERS, default="fixed", help="with --simulate: fixed-point (DSP) or float controller (default fixed)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -57,11 +58,14 @@ def run(args) -> int:
         result = run_program(text, args.program, platform, rate=args.rate, convention=args.convention,
                              coriolis=args.coriolis == "on")
         sim = simulate(platform, result, args) if args.simulate else None
+        branches = check_branches(platform, result, args)
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
     out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
     summary = summarize(result, args.program, platform.stroke)
+    if branches is not None:
+        summary["branches"] = branches
     if sim is not None:
         summary["simulation"] = sim["summary"]
     write_outputs(out, result, summary, sim)
@@ -70,7 +74,50 @@ def run(args) -> int:
         sys.stdout.write("\n")
     else:
         print_summary(summary, out)
-    return 0
+    return branch_exit(branches, args)
+
+
+BRANCH_DEFAULTS = {"branch_margin": 20.0, "singularity_margin": 0.02, "branch_samples": 200}
+
+
+def add_branch_args(p) -> None:
+    """``--check-branches`` and its options (``homotopy.branches``)."""
+    p.add_argument("--check-branches", action="store_true", help="check branch safety: the distance from the trajectory to the nearest other assembly mode and to a singularity (complete homotopy FK at sampled poses); exit 1 below a margin")
+    p.add_argument("--branch-margin", type=float, metavar="MM", help="with --check-branches: least allowed distance to another assembly mode, mm at the plate anchors (default 20)")
+    p.add_argument("--singularity-margin", type=float, metavar="SIGMA", help="with --check-branches: least allowed smallest singular value of the scaled inverse Jacobian (default 0.02)")
+    p.add_argument("--branch-samples", type=int, metavar="N", help="with --check-branches: trajectory samples checked, evenly spaced (default 200, at most 5000)")
+
+
+def check_branches(platform, result, args) -> dict | None:
+    """Branch-safety summary of the program's trajectory (``homotopy.branches``), or None without
+    ``--check-branches`` (its options are then refused)."""
+    given = [k for k in BRANCH_DEFAULTS if getattr(args, k) is not None]
+    if not args.check_branches:
+        if given:
+            raise ValueError(f"--{given[0].replace('_', '-')} needs --check-branches")
+        return None
+    for k, v in BRANCH_DEFAULTS.items():
+        if getattr(args, k) is None:
+            setattr(args, k, v)
+    for name, v in (("--branch-margin", args.branch_margin), ("--singularity-margin", args.singularity_margin)):
+        if not (np.isfinite(v) and v >= 0):
+            raise ValueError(f"{name} must be a non-negative number, got {v}")
+    from ..homotopy.branches import branch_safety
+
+    traj = result.trajectory
+    rep = branch_safety(platform, traj.t, traj.q, args.convention, samples=args.branch_samples)
+    return rep.summary(args.branch_margin * 1e-3, args.singularity_margin)
+
+
+def branch_exit(b: dict | None, args) -> int:
+    """Exit status after the outputs are written: 1 (with a one-line reason) when not branch-safe."""
+    if b is None or b["safe"]:
+        return 0
+    print(f"run --check-branches: not branch-safe: nearest other assembly mode {b['min_branch_distance_m'] * 1e3:.3f} mm "
+          f"(margin {args.branch_margin:g} mm) at t = {b['min_branch_distance_t_s']:.3f} s; smallest sigma_min "
+          f"{b['min_sigma_min']:.4g} (margin {args.singularity_margin:g}) at t = {b['min_sigma_min_t_s']:.3f} s"
+          + ("" if b["all_complete"] else f"; FK not complete at samples {b['incomplete_samples']}"), file=sys.stderr)
+    return 1
 
 
 def simulate(platform, result, args) -> dict:
@@ -192,4 +239,9 @@ def print_summary(summary: dict, out: Path) -> None:
     if "simulation" in summary:
         s = summary["simulation"]
         print(f"  simulation ({s['controller']} controller): max |L - L_ref| = {np.max(s['max_abs_length_error_mm']):.3f} mm")
+    if "branches" in summary:
+        b = summary["branches"]
+        print(f"  branches ({b['samples_checked']} samples, {b['modes_min']}-{b['modes_max']} real modes, complete: {b['all_complete']}): "
+              f"nearest other mode {b['min_branch_distance_m'] * 1e3:.3f} mm at t = {b['min_branch_distance_t_s']:.3f} s, "
+              f"smallest sigma_min {b['min_sigma_min']:.4g} at t = {b['min_sigma_min_t_s']:.3f} s -> {'safe' if b['safe'] else 'NOT SAFE'}")
     print(f"wrote {out}/")

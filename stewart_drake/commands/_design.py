@@ -1,0 +1,26 @@
+"""Arguments shared by the design commands (size, stiffness, modes): legs, payload, gravity."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..design.payload import PayloadError, with_payload
+from ..rotations import length_scale
+
+
+def add_payload_args(parser, length_help: str) -> None:
+    parser.add_argument("--legs", choices=["on", "off"], default="off", help="include the legs' masses (cylinder + piston) (default off)")
+    parser.add_argument("--payload", type=float, default=0.0, metavar="KG", help="a point mass carried by the plate (default 0)")
+    parser.add_argument("--payload-com", nargs=3, type=float, default=[0.0, 0.0, 0.0], metavar=("X", "Y", "Z"),
+                        help=f"the payload's centre of mass in the plate frame T, {length_help} (default the T origin)")
+    parser.add_argument("--gravity", type=float, default=9.81, help="m/s² (default 9.81)")
+
+
+def platform_with_payload(platform, args, length_unit: str):
+    """The platform carrying ``--payload`` at ``--payload-com`` (in ``length_unit``); checks ``--gravity``."""
+    if not (np.isfinite(args.gravity) and args.gravity >= 0):
+        raise ValueError(f"--gravity must be a finite number >= 0 m/s², got {args.gravity}")
+    if args.payload_com[2] < 0:
+        raise PayloadError(f"--payload-com: Z = {args.payload_com[2]:g} {length_unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)")
+    p_TP = np.asarray(args.payload_com, dtype=float) * length_scale(length_unit)
+    return with_payload(platform, args.payload, p_TP), p_TP

@@ -1,0 +1,134 @@
+"""``stewart-drake stiffness``: the 6×6 Cartesian stiffness about the rotation centre at a pose, its
+principal stiffnesses and directions, the compliance and the static deflection under a payload."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..rotations import angle_scale, length_scale, pose_to_si
+from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from ._design import add_payload_args, platform_with_payload
+
+NAMES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def add_pose_args(p) -> None:
+    add_platform_arg(p, default="utn-dynamic")
+    p.add_argument("--pose", nargs=6, type=float, required=True, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="the pose, in the chosen units")
+    add_unit_args(p)
+    p.add_argument("--leg-stiffness", type=float, metavar="N/m", help="axial stiffness of every leg (default: legs.stiffness of the platform file)")
+    add_payload_args(p, "in --length-unit")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("stiffness", help="6×6 Cartesian stiffness, compliance and payload deflection at a pose")
+    add_pose_args(p)
+    p.add_argument("--json", action="store_true", help="print JSON (SI units: N/m, N/rad, N·m/rad; deflection in m and rad)")
+    p.add_argument("--map", metavar="DIR", help="also write maps over the x-y slice through the pose (condition number, safe region, "
+                   "assembly mode, minimum stiffness, softest direction, lowest frequency): DIR/maps.png and DIR/maps.npz")
+    p.add_argument("--map-half-width", type=float, default=150.0, help="--map: half-width of the square slice, in --length-unit (default 150)")
+    p.add_argument("--map-n", type=int, default=61, help="--map: nodes per side (default 61)")
+    p.set_defaults(func=run)
+
+
+def prepare(args):
+    """``(platform with payload, pose q (6,) SI, k (6,) N/m, p_TP payload position m)``."""
+    from ..design.stiffness import leg_stiffness_vector
+
+    base = platform_from_args(args)
+    platform, p_TP = platform_with_payload(base, args, args.length_unit)
+    if args.leg_stiffness is not None:
+        k = leg_stiffness_vector(args.leg_stiffness, "--leg-stiffness")
+    else:
+        k = leg_stiffness_vector(base.legs.stiffness, "legs.stiffness")
+    q = pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit)
+    return platform, q, k, p_TP
+
+
+def check_pose(platform, q, convention) -> str | None:
+    """A one-line reason why pose q cannot be analysed (outside the stroke, singular), or None."""
+    from ..errors import StewartError
+    from ..kinematics import inverse_kinematics, require_nonsingular
+
+    try:
+        inverse_kinematics(platform, q, convention)
+        require_nonsingular(platform, q, convention)
+    except StewartError as e:
+        return str(e)
+    return None
+
+
+def run(args) -> int:
+    import sys
+
+    from ..design.payload import payload_wrench
+    from ..design.stiffness import compliance, deflection, principal_stiffness, stiffness_matrix
+    from ..rotations import rotation_matrix
+
+    platform, q, k, p_TP = prepare(args)
+    bad = check_pose(platform, q, args.convention)
+    if bad:
+        print(f"stewart-drake stiffness: {bad}", file=sys.stderr)
+        return 1
+    legs = args.legs == "on"
+    K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)
+    K0 = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs, loaded=False)
+    pr = principal_stiffness(K)
+    w = payload_wrench(platform, rotation_matrix(q[3:], args.convention), args.payload, p_TP, args.gravity)
+    d = deflection(K, w)
+    kl, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
+    out = {
+        "platform": platform.name, "pose": args.pose, "length_unit": args.length_unit, "angle_unit": args.angle_unit,
+        "convention": args.convention, "leg_stiffness_n_per_m": k, "legs_model": legs, "payload_kg": args.payload,
+        "payload_com_m": p_TP, "gravity": args.gravity,
+        "stiffness": K, "stiffness_zero_load": K0, "compliance": compliance(K),
+        "principal_stiffness": {"translational_n_per_m": pr.translational, "translational_directions": pr.translational_dirs.T,
+                                "rotational_nm_per_rad": pr.rotational, "rotational_directions": pr.rotational_dirs.T},
+        "payload_wrench": w, "deflection": d,
+        "deflection_edge_units": np.r_[d[:3] / kl, d[3:] / ka],
+    }
+    if args.map:
+        write_maps(args, platform, q, k)
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"platform {platform.name}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
+          + ("" if np.all(k == k[0]) else " ..."))
+    print("stiffness K about the rotation centre (rows: force N, moment N·m; columns: δp m, δθ rad):")
+    print(f"{'':>4}" + "".join(f"{n:>13}" for n in NAMES))
+    for n, row in zip(("fx", "fy", "fz", "mx", "my", "mz"), K):
+        print(f"{n:>4}" + "".join(f"{v:13.5g}" for v in row))
+    for label, vals, dirs, unit in (("translational", pr.translational, pr.translational_dirs, "N/m"),
+                                    ("rotational", pr.rotational, pr.rotational_dirs, "N·m/rad")):
+        print(f"principal {label} stiffness ({unit}), softest first:")
+        for v, e in zip(vals, dirs.T):
+            print(f"  {v:12.5g}  along [{e[0]:+.4f} {e[1]:+.4f} {e[2]:+.4f}]")
+    print(f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
+          f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}")
+    return 0
+
+
+def write_maps(args, platform, q, k) -> None:
+    """Maps over the x-y slice through pose q, written atomically into ``args.map``."""
+    from ..atomic import atomic_folder
+    from ..design.maps import MAX_POINTS, slice_maps
+    from ..design.plots import plot_slice_maps
+
+    hw = args.map_half_width * length_scale(args.length_unit)
+    if not (np.isfinite(hw) and hw > 0):
+        raise ValueError(f"--map-half-width must be a positive length, got {args.map_half_width}")
+    if not 2 <= args.map_n <= int(np.sqrt(MAX_POINTS)):
+        raise ValueError(f"--map-n must be between 2 and {int(np.sqrt(MAX_POINTS))}, got {args.map_n}")
+    ranges = ((q[0] - hw, q[0] + hw), (q[1] - hw, q[1] + hw))
+    m = slice_maps(platform, (0, 1), ranges, args.map_n, base=q, k=k, gravity=args.gravity, modes=True, convention=args.convention)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with atomic_folder(args.map) as tmp:
+        fig = plot_slice_maps(m, args.length_unit)
+        fig.savefig(tmp / "maps.png", dpi=110, bbox_inches="tight")
+        plt.close(fig)
+        np.savez(tmp / "maps.npz", x_m=m.u, y_m=m.v, base_pose=m.base, within=m.within, condition=m.condition, distance=m.distance,
+                 same_mode=m.same_mode, safe=m.safe, k_min_n_per_m=m.k_min, softest=m.softest, f1_hz=m.f1)
