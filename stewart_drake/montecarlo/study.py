@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import claim_in_manifest
 from ..errors import StewartError
 from .scenario import Study, run_scenario
 
@@ -172,6 +173,7 @@ class PartialWriter:
         self.fh = path.open("a", encoding="utf-8")
         if new:
             self.write({"key": key})
+            claim_in_manifest(out, [PARTIAL])  # the folder stays ours: the final write replaces it
 
     def write(self, obj: dict) -> None:
         self.fh.write(json.dumps(obj) + "\n")

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kinematics import leg_vectors
 from .limits import raw_margins
 from .slabs import _GridSpec
 
@@ -62,7 +63,12 @@ def _refine_extents(spec: _GridSpec, extents, top, front, side, h, feas_tol: flo
         return np.concatenate([m.reshape(len(P), -1) for m in ms.values()] + above, axis=1)
 
     def margins(p):
-        return margins_batch(p)[0]
+        """Every margin at one position ``p`` (3,), through ``leg_vectors``: SLSQP's finite-difference
+        Jacobian of this form converges where the batched one above stalled (gonzalez-dutra-2009, z_min)."""
+        q = np.r_[p, o]
+        l = leg_vectors(spec.platform, q, spec.convention)
+        above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
+        return np.concatenate([m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()] + above)
 
     for k, (i_lo, i_hi) in enumerate(_extreme_indices((top, front, side))):
         for side_i, (idx, sign) in enumerate(((i_lo, -1), (i_hi, 1))):
