@@ -12,6 +12,7 @@ from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.geometry import load_preset
 from stewart_drake.kinematics import leg_lengths
+from stewart_drake.montecarlo.sweep import run_sweep, sweep_study
 from stewart_drake.report import run_standalone
 from stewart_drake.simulation import ROTATING, SEED, ActuatorModel, build_simulation, design_poses, fit_trajectory, setpoint_step_gain
 from stewart_drake.report import parallel_map
@@ -143,14 +144,13 @@ def _sweep(section, platform, periods, duration):
     rows = []
     res = {}
     plant_step = 2.5e-4
-    for lat in ("computation", "sample"):
-        for T in periods:
-            timing = DspTiming(sample_period=T, latency=lat)
-            cfg = ControllerConfig.for_platform(platform, timing, gains=ControllerConfig.for_platform(platform, poses=design_poses(SEED)).gains)
-            log = build_simulation(platform, SEED, "fixed", cfg, plant_time_step=plant_step, engine=ENGINE).run(duration)
-            e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
-            res[lat, T] = e
-            rows.append([lat, T * 1e3, timing.output_delay * 1e6, e, int(log.saturations().sum())])
+    # the Monte Carlo machinery's grid sweep: one run per (latency, T), gains designed for 1 kHz kept fixed
+    study = sweep_study(platform, {"latency": ["computation", "sample"], "sample_period": periods}, duration=duration, plant_step=plant_step, engine=ENGINE)
+    for r in run_sweep(study):
+        lat, T = r["latency"], r["sample_period_s"]
+        e = r["max_leg_error_m"] * 1e3
+        res[lat, T] = e
+        rows.append([lat, T * 1e3, DspTiming(sample_period=T, latency=lat).output_delay * 1e6, e, r["saturated_leg_ticks"]])
     section.table(["latency", "T ms", "output delay µs", "max |leg err| mm", "saturated ticks"], rows,
                   caption=f"Sweep (fixed-point controller, seed trajectory, {duration:g} s, plant step {plant_step * 1e3:g} ms)", fmt="{:.3f}")
     fig, ax = plt.subplots(figsize=(6, 3.5))

@@ -62,6 +62,13 @@ def _write_manifest(folder: Path, files) -> None:
     _write_file_atomic(folder / MANIFEST, text.encode("utf-8"))
 
 
+def claim_in_manifest(folder, names) -> None:
+    """Record ``names`` (relative paths the caller has just written in ``folder``) as the tool's own, so
+    that the folder stays a valid destination for a later ``OutputFolder`` (e.g. a resumable work file)."""
+    folder = Path(folder)
+    _write_manifest(folder, (read_manifest(folder) or []) + list(names))
+
+
 def _is_relative_inside(rel: str) -> bool:
     p = Path(rel)
     return bool(rel) and not p.is_absolute() and ".." not in p.parts and rel != MANIFEST

@@ -281,18 +281,20 @@ def add_platform(plant, platform: Platform):
     return instance
 
 
-def build_plant(platform: Platform, time_step: float = 1e-3, builder=None, gravity: bool = True):
-    """A finalized discrete (SAP) closed-loop ``MultibodyPlant`` of ``platform`` and its ``SceneGraph``,
-    added to ``builder`` (a new ``DiagramBuilder`` if None). ``time_step`` > 0 is required: Drake's ball
-    constraints need a discrete plant."""
+def build_plant(platform: Platform, time_step: float = 1e-3, builder=None, gravity: bool = True, continuous: bool = False):
+    """A finalized closed-loop ``MultibodyPlant`` of ``platform`` and its ``SceneGraph``, added to
+    ``builder`` (a new ``DiagramBuilder`` if None). Discrete (SAP) with ``time_step`` > 0 by default: Drake's
+    ball constraints need a discrete plant, except under the CENIC integrator (``continuous=True``: a
+    continuous plant, time_step 0, for a Simulator configured with ``integration_scheme="cenic"``)."""
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, DiscreteContactApproximation
     from pydrake.systems.framework import DiagramBuilder
 
-    if not time_step > 0:
+    if not (continuous or time_step > 0):
         raise ValueError(f"time_step must be > 0 (ball constraints need a discrete plant), got {time_step}")
     builder = builder or DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step)
-    plant.set_discrete_contact_approximation(DiscreteContactApproximation.kLagged)
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0 if continuous else time_step)
+    if not continuous:
+        plant.set_discrete_contact_approximation(DiscreteContactApproximation.kLagged)
     add_platform(plant, platform)
     if not gravity:
         plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])

@@ -88,19 +88,30 @@ def fit_trajectory(trajectory: Trajectory, platform: Platform, home_height: floa
 
 def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
     """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory held constant after the last sample. Errors name the line."""
+    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line."""
     data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
         k = late[0] + 1
         raise ValueError(f"{path}:{lines[k]}: time {data[k, 0]} s is not after the previous sample's {data[k - 1, 0]} s")
-    ts, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+    return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
+
+
+def table_trajectory(name: str, ts, poses) -> Trajectory:
+    """Samples ``ts`` (n,) s, ``poses`` (n, 6) SI as a piecewise-linear Trajectory, held constant after the
+    last sample and continued before the first along the first segment: the differences that start a run
+    at t = 0 (``initial_leg_forces``, ``set_velocity``) then see the reference's initial velocity, not a
+    kink from a pose held before t = 0 (a clamp there read as an acceleration of v/h and threw the plate)."""
+    ts, poses = np.asarray(ts, dtype=float), np.asarray(poses, dtype=float)
+    slope = (poses[1] - poses[0]) / (ts[1] - ts[0]) if len(ts) > 1 else np.zeros(6)
 
     def fn(t):
         t = np.asarray(t, dtype=float)
-        return np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
+        q = np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
+        before = (t < ts[0])[..., None]
+        return np.where(before, poses[0] + (t - ts[0])[..., None] * slope, q)
 
-    return Trajectory(Path(path).stem, fn, float(ts[-1]))
+    return Trajectory(name, fn, float(ts[-1]))
 
 
 def get_trajectory(name_or_path, **units) -> Trajectory:
@@ -281,6 +292,7 @@ class Simulation:
     visualizer: object = None
     plant_time_step: float = 1e-3
     feedforward: object = None
+    integrator: str = "sap"
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> "SimulationLog":
@@ -375,6 +387,9 @@ def build_simulation(
     design_duration: float | None = None,
     engine: str = "python",
     firmware=None,
+    integrator: str | None = None,
+    plant_platform: Platform | None = None,
+    sensor=None,
 ) -> Simulation:
     """Assemble the controller-in-the-loop Diagram and its Simulator, with the plant at the reference's
     initial pose, legs at the matching lengths and the controller holding them against gravity.
@@ -385,14 +400,23 @@ def build_simulation(
     record an animation; ``feedforward``: connect the model-based force feed-forward table;
     ``design_duration`` (s): the default gains are designed over the reference's poses from 0 to this
     time (``design_poses``; default the trajectory's duration, else 4 s); ``engine``: ``python`` or ``c``
-    (the fixed-point tick by compiled C), ``firmware``: a user's C file implementing the firmware ABI.
+    (the fixed-point tick by compiled C), ``firmware``: a user's C file implementing the firmware ABI;
+    ``integrator``: ``cenic``
+    (default: a continuous plant under Drake's error-controlled CENIC, logged every ``plant_time_step``)
+    or ``sap`` (a discrete plant stepped at ``plant_time_step``); see ``integrators``; ``plant_platform``: the platform the plant is built
+    from (default ``platform``: the controller's model; a perturbed copy models manufacturing errors);
+    ``sensor``: a function ``(plant, D (6, nx)) -> LeafSystem`` (input: plant state, output: the six
+    measured lengths; optional ``initial_reading(L)``) replacing the ideal sensor ``MatrixGain(D)``.
     """
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import LogVectorOutput, MatrixGain
 
+    from .integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
     from .model import build_plant, set_pose
 
+    integrator = check_integrator(integrator or DEFAULT_INTEGRATOR)
+    plant_platform = plant_platform or platform
     if not (math.isfinite(plant_time_step) and plant_time_step > 0):
         raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
     trajectory = get_trajectory(trajectory)
@@ -401,7 +425,7 @@ def build_simulation(
         poses = design_poses(trajectory, design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     builder = DiagramBuilder()
-    plant, scene_graph = build_plant(platform, plant_time_step, builder)
+    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator == "cenic")
     ctrl = builder.AddSystem(make_controller(controller, platform, config, engine, firmware))
     ctrl.set_name(f"{controller}_controller")
     src = builder.AddSystem(pose_source(trajectory))
@@ -413,7 +437,7 @@ def build_simulation(
     D = np.zeros((6, nx))
     for i in range(6):
         D[i, plant.GetJointByName(f"prismatic_{i + 1}").position_start()] = 1.0
-    sensor = builder.AddSystem(MatrixGain(D))
+    sensor = builder.AddSystem(MatrixGain(D) if sensor is None else sensor(plant, D))
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
     ff = None
@@ -427,12 +451,14 @@ def build_simulation(
     builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
     builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
     T = config.timing.sample_period
+    # the discrete plant logs at its steps; the continuous one at the same period (not at every integrator step)
+    lp = () if integrator == "sap" else (plant_time_step,)
     loggers = {
-        "state": LogVectorOutput(plant.get_state_output_port(), builder),
-        "command": LogVectorOutput(ctrl.GetOutputPort("command"), builder),
-        "setpoint": LogVectorOutput(ctrl.GetOutputPort("setpoint"), builder),
-        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder),
-        "force": LogVectorOutput(act.get_output_port(), builder),
+        "state": LogVectorOutput(plant.get_state_output_port(), builder, *lp),
+        "command": LogVectorOutput(ctrl.GetOutputPort("command"), builder, *lp),
+        "setpoint": LogVectorOutput(ctrl.GetOutputPort("setpoint"), builder, *lp),
+        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, *lp),
+        "force": LogVectorOutput(act.get_output_port(), builder, *lp),
         "reference": LogVectorOutput(src.get_output_port(), builder, T),
     }
     visualizer = None
@@ -442,12 +468,14 @@ def build_simulation(
         visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32))
     diagram = builder.Build()
     simulator = Simulator(diagram)
+    apply_integrator(simulator, integrator)
     root = simulator.get_mutable_context()
     pose0 = trajectory.pose(0.0)
     pc = plant.GetMyMutableContextFromRoot(root)
-    set_pose(plant, pc, platform, pose0)
-    set_velocity(plant, pc, platform, trajectory, 0.0)
-    L0 = leg_lengths(platform, pose0)
+    set_pose(plant, pc, plant_platform, pose0)
+    set_velocity(plant, pc, plant_platform, trajectory, 0.0)
+    L0 = leg_lengths(plant_platform, pose0)
+    L0 = sensor.initial_reading(L0) if hasattr(sensor, "initial_reading") else L0
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
@@ -455,7 +483,7 @@ def build_simulation(
     if act.state_index is not None:
         act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
     simulator.Initialize()
-    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff)
+    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff, integrator)
 
 
 def setpoint_step_response(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, step: float = 1e-3,

@@ -74,4 +74,4 @@ def test_fk_outside_stroke_exit_1(capsys):
 
 def test_fk_bad_length(capsys):
     rc, _, err = run(capsys, "fk", "--lengths", "473", "473", "-1", "473", "473", "473")
-    assert rc == 2 and "--lengths: leg 3 length -1 mm must be a positive number" in err  # as typed, in the typed unit
+    assert rc == 2 and "--lengths: leg 3 length -1 mm must be a positive number" in err

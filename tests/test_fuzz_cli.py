@@ -125,6 +125,8 @@ def argv(draw):
         if draw(st.integers(0, 19)) == 0:
             n = max(0, n + draw(st.sampled_from([-1, 1])))  # one value too few or too many
         args += [draw(values_for(a)) for _ in range(n)]
+    if prefix and prefix[0] == "view" and "--duration" not in args:
+        args += ["--duration", "0"]  # the viewer otherwise serves until interrupted
     if prefix and prefix[0] in HEAVY:
         args += ["--out", "userdir"]  # refused before the work (or, with --force, written beside the user's file)
     if draw(st.integers(0, 39)) == 0:

@@ -15,6 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from _fuzz import fuzz
 from stewart_drake.cli import main
 from stewart_drake.errors import PhysicalLimitError
 from stewart_drake.geometry import load_platform
@@ -357,9 +358,22 @@ anything = st.one_of(finite, st.sampled_from([math.nan, math.inf, -math.inf, 1e3
 NUMBER = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)
 
 
+POSE = (st.lists(anything, min_size=6, max_size=6), st.sampled_from(["mm", "m"]))
+
+
 @settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-@given(st.lists(anything, min_size=6, max_size=6), st.sampled_from(["mm", "m"]))
+@given(*POSE)
 def test_ik_any_pose(pose, unit):
+    check_ik_pose(pose, unit)
+
+
+@fuzz
+@given(*POSE)
+def test_ik_any_pose_fuzz(pose, unit):
+    check_ik_pose(pose, unit)
+
+
+def check_ik_pose(pose, unit):
     p = load_platform("utn-kinematic")
     # fixed notation: argparse takes "-1e-05" (and "-inf") for an option (its usage error is exit 2 too)
     rc, out, err = cli("ik", "--pose", *[f"{v:.330f}" if math.isfinite(v) else repr(v) for v in pose], "--length-unit", unit, "--json")
@@ -375,10 +389,23 @@ def test_ik_any_pose(pose, unit):
     assert json.loads(out)["lengths"] == pytest.approx((L * (1e3 if unit == "mm" else 1)).tolist(), rel=1e-12)
 
 
+SAMPLES = st.lists(st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.sampled_from([0.7, 0.6, 0.9, -0.7, 0.0, 7.0, math.nan]),
+                             st.floats(-0.5, 0.5)), min_size=4, max_size=6)
+
+
 @settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-@given(st.lists(st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.sampled_from([0.7, 0.6, 0.9, -0.7, 0.0, 7.0, math.nan]),
-                          st.floats(-0.5, 0.5)), min_size=4, max_size=6))
+@given(SAMPLES)
 def test_dynamics_any_trajectory(tmp_path, samples):
+    check_dynamics_trajectory(tmp_path, samples)
+
+
+@fuzz
+@given(SAMPLES)
+def test_dynamics_any_trajectory_fuzz(tmp_path, samples):
+    check_dynamics_trajectory(tmp_path, samples)
+
+
+def check_dynamics_trajectory(tmp_path, samples):
     """Random 4-6 sample CSV trajectories (positions within, beyond and below the stroke, non-finite):
     exit 0 only when every sample is within stroke and above the base, and then finite forces."""
     p = load_platform("utn-dynamic")
@@ -401,3 +428,34 @@ def test_dynamics_any_trajectory(tmp_path, samples):
 
 def test_physical_limit_error_exits_1():
     assert PhysicalLimitError.exit_code == 1
+
+
+def test_run_without_plate_computes_no_forces_and_says_so(noplate, tmp_path):
+    f = tmp_path / "p.stw"
+    f.write_text("mover(0, 0, 750, 0, 0, 0) en 1\n")
+    rc, out, _ = cli("run", f, "--platform", noplate, "--out", tmp_path / "o", "--json")
+    s = json.loads(out)
+    assert rc == 0 and s["max_abs_force_N"] is None
+    assert s["notes"] == ["leg forces not computed: platform 'noplate' has no plate mass properties (YAML key 'plate')"]
+
+
+def test_workspace_workers_bounded():
+    import os
+
+    n = 4 * (os.cpu_count() or 1) + 1
+    rc, _, err = cli("workspace", "--workers", n)
+    assert rc == 2 and f"--workers {n} would need {float(n):.2g} worker processes" in err
+
+
+def test_rotation_limits_stop_at_the_base_plane(utn):
+    """utn-kinematic at home (pz = 100 mm) tilted about X: a plate anchor at y = ±a/2 = ±306.25 mm
+    reaches the base plane when 100 mm + 306.25 mm · sin θ = 0, θ = asin(100 / 306.25) = 19.058°, far
+    before any stroke limit."""
+    from stewart_drake.workspace import orientation_limits
+
+    lim = {(r.axis, r.sign): r for r in orientation_limits(utn)}
+    theta = math.asin(0.1 / (0.6125 / 2))
+    for s in (1, -1):
+        r = lim[("x", s)]
+        assert r.limit == "base" and r.angle == pytest.approx(s * theta, abs=1e-8)
+    assert lim[("z", 1)].limit == "stroke"  # a turn about the vertical never lowers the plate

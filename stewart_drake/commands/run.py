@@ -89,7 +89,10 @@ def run(args) -> int:
         print_json(summary)
     else:
         print_summary(summary, out)
-    return branch_exit(branches, args)
+    failures = summary.get("simulation", {}).get("failures", [])
+    for f in failures:
+        print(f"stewart-drake run: {f}", file=sys.stderr)
+    return max(branch_exit(branches, args), 1 if failures else 0)
 
 
 BRANCH_DEFAULTS = {"branch_margin": 20.0, "singularity_margin": 0.02, "branch_samples": 200}
@@ -146,8 +149,13 @@ def simulate(platform, result, args) -> dict:
     if traj.duration <= 0:
         raise ValueError("--simulate: the program has no moves or waits (its trajectory lasts 0 s)")
     reference = SimTrajectory(Path(args.program).stem, traj.pose_at, traj.duration)
+    from ..sanity import require_plate
+    from ..simulation import tracking_verdict
+
+    require_plate(platform, "run --simulate")
     log = sim_run(platform, reference, controller=args.controller, duration=traj.duration + SETTLE, progress=True)
     err = log.length_error(reference, platform)
+    verdict = tracking_verdict(platform, err, log.pose_error(reference), log)
     return {
         "log": log,
         "length_error": err,
@@ -157,6 +165,7 @@ def simulate(platform, result, args) -> dict:
             "settle_s": SETTLE,
             "max_abs_length_error_mm": np.abs(err).max(axis=0) * 1e3,
             "max_abs_actuator_force_N": np.abs(log.force).max(axis=0),
+            **verdict,
         },
     }
 

@@ -46,6 +46,9 @@ def register(sub) -> None:
     p.add_argument("--sensor-resolution", type=float, default=1e-5, metavar="M",
                    help="leg-length sensor resolution, m per count (default 1e-5; 1e-3: integer mm as the firmware's words)")
     p.add_argument("--plant-step", type=float, default=None, metavar="S", help="plant time step, s (default: the period, at most 1 ms)")
+    p.add_argument("--integrator", choices=["cenic", "sap"], default=None,
+                   help="plant integrator: cenic (default; error-controlled, continuous plant) or sap (discrete plant at --plant-step); "
+                        "see benchmarks/bench_integrators.py")
     p.add_argument("--no-feedforward", action="store_true", help="no model-based force feed-forward (the PID alone carries the plate)")
     p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds (default: the trajectory's, 4 s for seed)")
     p.add_argument("--out", default="simulation", metavar="DIR", help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)")
@@ -95,7 +98,7 @@ def run(args) -> int:
     if (engine == "c" or args.firmware) and args.controller != "fixed":
         raise ValueError(f"--engine c / --firmware run the fixed-point controller; --controller is {args.controller!r}")
     sim = build_simulation(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward,
-                           engine=engine, firmware=args.firmware)
+                           engine=engine, firmware=args.firmware, integrator=args.integrator)
     log = sim.run(duration, progress=not args.no_progress)
     out = Path(args.out)
     e = log.length_error(traj, platform)
@@ -114,6 +117,7 @@ def run(args) -> int:
         "output_delay_s": timing.output_delay,
         "computation_time_s": timing.computation_time,
         "plant_time_step_s": plant_step,
+        "integrator": sim.integrator,
         "duration_s": duration,
         "ticks": int(len(log.tick_times())),
         "max_leg_error_mm": float(np.abs(e).max() * 1e3),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from ..atomic import atomic_folder
 from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from ..sanity import check_centre, check_finite
+from ..sanity import check_centre, check_finite, check_work
 from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
@@ -78,6 +79,8 @@ def run(args) -> int:
     if args.centre is not None:
         check_centre(platform, args.centre)
     check_finite(args.orientation, "--orientation")
+    # each worker is a Python process with numpy (~150 MB); more than 4 per CPU only adds overhead
+    check_work("--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1))
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     orientation = to_radians(args.orientation, args.angle_unit)
@@ -108,7 +111,7 @@ def run(args) -> int:
             print(f"  {n} limit {'binds' if v > 0 else 'does not bind'}: removes {v:.6f} m³")
         print("  rotation limits from the home pose:")
         for r in rot:
-            what = f"{r.limit} leg {r.leg}" if r.leg else (f"{r.limit} legs {r.pair}" if r.pair else (r.limit or "none reached"))
+            what = (f"plate anchor of leg {r.leg} at the base plane" if r.limit == "base" else f"{r.limit} leg {r.leg}") if r.leg else (f"{r.limit} legs {r.pair}" if r.pair else (r.limit or "none reached"))
             print(f"    about {r.axis} {'+' if r.sign > 0 else '-'}: {math.degrees(r.angle):+8.3f} deg  ({what}"
                   f"{', ' + r.side if r.side else ''}); lengths {np.round(r.lengths, 4).tolist()} m")
         if args.out:

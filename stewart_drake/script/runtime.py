@@ -393,8 +393,13 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
 def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True,
              gravity: float = 9.81) -> Result:
     """Inverse kinematics (with the stroke check) and inverse dynamics on a trajectory."""
+    from ..sanity import has_plate
+
     L = check_reachable(platform, traj, convention)
     notes = []
+    if not has_plate(platform):  # a massless plate would give every force as 0
+        return Result(traj, L, None, platform.name, convention,
+                      (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",))
     try:
         from ..dynamics import leg_forces
     except ImportError:

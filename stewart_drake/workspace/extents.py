@@ -54,7 +54,17 @@ def _refine_extents(spec: _GridSpec, extents, top, front, side, h, feas_tol: flo
     out = extents.copy()
     gaps = []
 
+    def margins_batch(P):
+        """``(m, k)`` every margin at positions ``P`` (m, 3): leg vectors P + l_i(0, R), as in the sweep."""
+        P = np.asarray(P, dtype=float).reshape(-1, 3)
+        q = np.concatenate([P, np.broadcast_to(o, P.shape)], -1)
+        ms = raw_margins(spec.platform, P[:, None, :] + spec.offsets, spec.R, spec.limits, q, spec.convention)
+        above = [P[:, 2:3] - spec.z_floor] if np.isfinite(spec.z_floor) else []  # the half-space above the base
+        return np.concatenate([m.reshape(len(P), -1) for m in ms.values()] + above, axis=1)
+
     def margins(p):
+        """Every margin at one position ``p`` (3,), through ``leg_vectors``: SLSQP's finite-difference
+        Jacobian of this form converges where the batched one above stalled (gonzalez-dutra-2009, z_min)."""
         q = np.r_[p, o]
         l = leg_vectors(spec.platform, q, spec.convention)
         above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
@@ -64,9 +74,9 @@ def _refine_extents(spec: _GridSpec, extents, top, front, side, h, feas_tol: flo
         for side_i, (idx, sign) in enumerate(((i_lo, -1), (i_hi, 1))):
             node_c = axes[k][idx]
             best = node_c
-            cands = [c for c in _extreme_plane_nodes(axes, top, front, side, k, idx) if margins(c).min() >= 0]
-            if cands:
-                cands = np.array(cands)
+            nodes = _extreme_plane_nodes(axes, top, front, side, k, idx)
+            cands = nodes[margins_batch(nodes).min(axis=1) >= 0] if len(nodes) else nodes
+            if len(cands):
                 start = cands[np.argmin(np.linalg.norm(cands - cands.mean(axis=0), axis=1))]
                 res = minimize(lambda p: -sign * p[k], start, jac=lambda p: -sign * np.eye(3)[k], method="SLSQP",
                                constraints={"type": "ineq", "fun": margins}, options={"ftol": 1e-12, "maxiter": 200})

@@ -12,6 +12,7 @@ import numpy as np
 from ..geometry import Platform
 from ..kinematics import leg_lengths, leg_vectors
 from ..rotations import rotation_matrix
+from ..sanity import above_base, plate_anchor_heights
 from .limits import AXES, LIMIT_UNITS, Limits, WorkspaceError, leg_pairs, limit_margins, raw_margins
 
 
@@ -62,7 +63,8 @@ def orientation_limits(
     """Rotate the plate from zero orientation at ``position`` (3,) m (the pose position, default the
     home pose: mid-stroke) about the base X, Y and Z axes through the plate point ``centre`` (p_TC,
     (3,) m in T; default the platform's rotation centre, i.e. the top origin), each way, until a
-    limit is met. The first crossing is found by a scan of ``step`` rad, then bisected to ``tol``.
+    limit is met (the plate reaching the base plane is one: limit ``base``, with the leg whose plate
+    anchor touches it). The first crossing is found by a scan of ``step`` rad, then bisected to ``tol``.
     Returns six ``RotationLimit`` (x+, x-, y+, y-, z+, z-)."""
     pos = platform.home_pose()[:3] if position is None else np.asarray(position, dtype=float)
     if pos.shape != (3,) or not np.all(np.isfinite(pos)):
@@ -88,7 +90,7 @@ def orientation_limits(
         return q
 
     def inside(q):
-        ok = np.ones(q.shape[:-1], bool)
+        ok = above_base(pivot, q)  # the plate stays above its base (sanity.above_base)
         for m, _ in limit_margins(pivot, q, limits).values():
             ok &= m >= 0
         return ok
@@ -108,6 +110,8 @@ def orientation_limits(
     q_lo, q_hi = poses(dirs, lo[:, None])[:, 0], poses(dirs, hi[:, None])[:, 0]
     L = leg_lengths(pivot, q_lo)
     raw_hi = raw_margins(pivot, leg_vectors(pivot, q_hi), rotation_matrix(q_hi[:, 3:]), limits, q_hi)
+    if not pivot.plate_below_base_allowed:
+        raw_hi["base"] = plate_anchor_heights(pivot, q_hi)  # (6, 6) m: the height of each leg's plate anchor
     m_hi = {n: (m.min(axis=-1), m.argmin(axis=-1)) for n, m in raw_hi.items()}
     pairs = leg_pairs(platform)
     out = []

@@ -1,0 +1,179 @@
+"""``stewart-drake montecarlo``: closed-loop runs over drawn tolerances, on Dask; summary, sensitivity, replay."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..firmware.engine import resolve_engine
+from ._common import add_platform_arg, print_json
+
+
+def register(sub) -> None:
+    p = sub.add_parser("montecarlo", help="robustness study: many closed-loop runs with drawn tolerances (Dask), or --replay one of them")
+    add_platform_arg(p, default="utn-dynamic")
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--trajectory", default="seed", metavar="seed|rotating|FILE.csv", help="the pose reference (default seed)")
+    src.add_argument("--program", metavar="P.stw", help="a motion program as the reference instead")
+    p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
+    p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
+    p.add_argument("--fit", action="store_true", help="move and scale the trajectory to the platform's home and stroke")
+    p.add_argument("--runs", type=int, default=100, metavar="N", help="number of runs (default 100)")
+    p.add_argument("--seed", type=int, default=0, metavar="S", help="study seed; run i draws from SeedSequence(S, spawn_key=(i,)) (default 0)")
+    p.add_argument("--vary", nargs="+", default=[], metavar="SPEC",
+                   help="what varies: key=value words or one YAML file (keys: anchor, leg_offset, sensor_resolution, sensor_noise, "
+                        "latency, latency_jitter, actuator_lag, force_limit, payload_mass, payload_com, gain_scale; values X, ±T, ±P%%, A..B, a|b; "
+                        "units m mm um s ms us N kg g)")
+    p.add_argument("--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin")
+    p.add_argument("--engine", choices=["python", "c"], default="python",
+                   help="fixed-point controller engine: python (the emulation) or c (the compiled firmware tick, bit-identical, faster)")
+    p.add_argument("--integrator", choices=["sap", "cenic"], default=None, help="plant integrator (default cenic: see benchmarks/bench_integrators.py)")
+    p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds per run (default the trajectory's)")
+    p.add_argument("--plant-step", type=float, default=1e-3, metavar="S", help="plant step / log period, s (default 0.001)")
+    p.add_argument("--lost-tracking", type=float, default=5.0, metavar="MM", help="leg error that counts as lost tracking, mm (default 5)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=1, metavar="K", help="LocalCluster worker processes, 1 thread each (default 1; 0: in this process, no Dask)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask scheduler instead of a LocalCluster")
+    p.add_argument("--out", default="montecarlo", metavar="DIR", help="output folder (default montecarlo/); a study there with the same settings resumes")
+    p.add_argument("--replay", type=int, default=None, metavar="K", help="re-run run K of the study in --out alone: full log in DIR/replay-K/, checked against its row")
+    p.add_argument("--no-animation", action="store_true", help="with --replay: no Meshcat HTML animation")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+
+def build_study(args):
+    from ..geometry import load_platform
+    from ..montecarlo.scenario import Study
+    from ..simulation import TRAJECTORIES
+    from ..montecarlo.spec import parse_spec
+    from .run import read_program
+
+    platform = load_platform(args.platform)
+    spec = parse_spec(args.vary)
+    program = (args.program, read_program(args.program)) if args.program else None
+    if args.workers is not None and args.workers < 0:
+        raise ValueError(f"--workers must be >= 0, got {args.workers}")
+    if args.engine == "c" and args.controller != "fixed":
+        raise ValueError(f"--engine c runs the fixed-point controller; --controller is {args.controller!r}")
+    engine = resolve_engine(args.engine, "stewart-drake montecarlo")
+    if not args.lost_tracking > 0:
+        raise ValueError(f"--lost-tracking must be a positive number of mm, got {args.lost_tracking}")
+    trajectory = None if program else args.trajectory
+    table = None
+    if trajectory is not None and trajectory not in TRAJECTORIES:
+        table = csv_table(trajectory, args.length_unit, args.angle_unit)
+        trajectory = None
+    return Study(platform=platform, spec=spec, seed=args.seed, runs=args.runs, trajectory=trajectory, program=program, table=table,
+                 fit=args.fit, controller=args.controller, integrator=args.integrator, engine=engine, duration=args.duration,
+                 plant_step=args.plant_step, lost_tracking=args.lost_tracking * 1e-3)
+
+
+def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
+    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
+    (``load_trajectory_csv`` checks it and names a bad line)."""
+    from ..csvio import read_numeric_csv
+    from ..rotations import pose_to_si
+    from ..simulation import load_trajectory_csv
+
+    traj = load_trajectory_csv(path, length_unit, angle_unit)
+    data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
+    return (traj.name, data[:, 0].tolist(), pose_to_si(data[:, 1:], length_unit, angle_unit).tolist())
+
+
+def run(args) -> int:
+    if args.replay is not None:
+        return replay(args)
+    from ..montecarlo.study import run_study, study_key, study_settings
+    from ..montecarlo.summary import write_outputs, summarise
+
+    from ..script import ScriptError
+
+    study = build_study(args)
+    try:  # the reference (program compiled, CSV read) checked here, before any run starts
+        study.reference()
+    except ScriptError as e:
+        print(e.render(), file=sys.stderr)
+        return 2
+    rows = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
+    summary = summarise(rows, study_settings(study), study_key(study))
+    summary["files"] = [str(p) for p in write_outputs(args.out, rows, summary)]
+    if args.json:
+        print_json(summary)
+    else:
+        print_text(summary)
+    lost = summary["lost_tracking_runs"]
+    if lost:
+        print(f"stewart-drake montecarlo: {len(lost)} of {len(rows)} runs lost tracking (leg error > {args.lost_tracking:g} mm or failed): "
+              f"runs {', '.join(map(str, lost[:10]))}{' …' if len(lost) > 10 else ''}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def print_text(summary: dict) -> None:
+    m = summary["metrics"]
+    print(f"{summary['runs']} runs (study {summary['key']})")
+    for k, scale, unit in (("max_leg_error_m", 1e3, "mm"), ("max_position_error_m", 1e3, "mm"), ("max_angle_error_rad", 57.29577951308232, "deg")):
+        s = m[k]
+        if s:
+            print(f"  {k.rsplit('_', 1)[0]:22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}")
+    w = summary["worst_run"]
+    print(f"  worst run {w['run']} (seed {w['seed']}): max leg error {w['max_leg_error_m'] * 1e3:.4g} mm")
+    for d in summary["sensitivity"]["max_leg_error_m"][:5]:
+        print(f"  sensitivity {d['parameter']:24s} ρ = {d['spearman']:+.3f}")
+    print(f"  files: {', '.join(summary['files'])}")
+
+
+def replay(args) -> int:
+    """Re-run one run of the study in ``--out`` and compare its row with the study's."""
+    from ..atomic import atomic_folder
+    from ..montecarlo.scenario import run_scenario
+    from ..montecarlo.study import STUDY_FILE, study_from_settings
+    from ..montecarlo.summary import read_table
+    from .simulate import write_plots
+
+    out = Path(args.out)
+    if not (out / STUDY_FILE).exists():
+        raise ValueError(f"--replay: {str(out)!r} holds no finished study ({STUDY_FILE} missing); run the study first")
+    stored = json.loads((out / STUDY_FILE).read_text())
+    rows = read_table(out)
+    if not 0 <= args.replay < len(rows):
+        raise ValueError(f"--replay {args.replay}: the study in {str(out)!r} has runs 0 … {len(rows) - 1}")
+    study = study_from_settings(stored["settings"], stored["runs"])
+    row = run_scenario(study, args.replay, keep_log=True)
+    log = row.pop("log")
+    want = rows[args.replay]
+    differ = [k for k in want if k != "wall_s" and not _same(want[k], row.get(k))]
+    folder = out / f"replay-{args.replay}"
+    result = {"run": args.replay, "bit_identical": not differ, "differing_columns": differ, "row": row}
+    with atomic_folder(folder) as tmp:
+        files = []
+        if log is not None:
+            ref = study.reference()
+            files += log.save(tmp) + write_plots(log, log.length_error(ref, _plant_platform(study, args.replay)), tmp)
+            if not args.no_animation:
+                from ..montecarlo.animation import write_animation
+
+                files.append(write_animation(_plant_platform(study, args.replay), log, tmp / "animation.html"))
+        (tmp / "row.json").write_text(json.dumps(result, indent=2))
+        result["files"] = [str(folder / p.name) for p in files + [tmp / "row.json"]]
+    if args.json:
+        print_json(result)
+    else:
+        print(f"replay of run {args.replay}: {'bit-identical to its row' if not differ else 'DIFFERS in ' + ', '.join(differ)}; "
+              f"max leg error {row['max_leg_error_m'] * 1e3:.6g} mm; files in {folder}")
+    return 0 if not differ else 1
+
+
+def _plant_platform(study, index):
+    from ..montecarlo.scenario import draw, plant_platform
+
+    return plant_platform(study.platform, draw(study, index)[1])
+
+
+def _same(a, b) -> bool:
+    """Equal values (floats bit for bit: equal, or both NaN)."""
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or (a != a and b != b)
+    return a == b

@@ -1,0 +1,292 @@
+"""One Monte Carlo run as plain, picklable data, and the function that runs it.
+
+Drake objects do not pickle, so a worker receives a ``Study`` (the study's fixed settings: platform,
+reference, controller, integrator, duration, SPEC, seed) and a run index, draws that run's ``Draw`` from
+its own seed and builds its Diagram itself (``run_scenario``). The run's seed is
+``run_seed(study.seed, index)``: the first 64-bit word (its low 63 bits) of ``numpy.random.SeedSequence(S,
+spawn_key=(index,))``, so any run can be re-drawn alone from (S, index) or from its seed.
+
+What a draw changes (the controller keeps the nominal model: it is what the firmware was built for):
+
+- the plant is built from the platform with every anchor moved (``anchor``) and the plate's mass and
+  centre of mass changed (``payload_mass``: the inertia scales with the mass; ``payload_com``);
+- the sensor reads L + offset (``leg_offset``) + white noise σ (``sensor_noise``) − j_k·dL/dt, the
+  first-order effect of sampling tick k late by j_k ~ U[0, ``latency_jitter``], then quantises with the
+  drawn ``sensor_resolution`` (in the controller);
+- the controller's ``latency`` mode, ``sample_period`` and its gains × ``gain_scale`` (the gains are
+  those designed for the nominal timing and actuator lag: what the firmware was built with);
+- the actuators' lag (``actuator_lag``) and force limit (``force_limit``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..geometry import Platform
+from .spec import KEYS, VarySpec
+
+# Nominal values of the keys whose nominal is not the platform's.
+NOMINAL = {"sensor_resolution": 1e-5, "latency": "sample", "actuator_lag": 2e-3, "gain_scale": 1.0,
+           "sensor_noise": 0.0, "latency_jitter": 0.0, "sample_period": 1e-3}
+# A run loses tracking when a leg is this far (m) from the reference's IK, or the state is not finite.
+LOST_TRACKING = 5e-3
+AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class Study:
+    """A study's fixed settings (picklable). ``trajectory``: ``seed`` or ``rotating``; ``table``: a CSV
+    reference read on the client, (name, times (n,), poses (n, 6) SI) as lists, so that workers need no
+    file; ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
+    the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking; ``grid``: one
+    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length)."""
+
+    platform: Platform
+    spec: VarySpec
+    seed: int
+    runs: int
+    trajectory: str | None = "seed"
+    program: tuple | None = None
+    table: tuple | None = None
+    fit: bool = False
+    controller: str = "fixed"
+    integrator: str | None = None
+    engine: str = "python"
+    duration: float | None = None
+    plant_step: float = 1e-3
+    lost_tracking: float = LOST_TRACKING
+    grid: tuple | None = None
+    extra: dict = field(default_factory=dict)
+
+    def reference(self):
+        """The pose reference as a ``simulation.Trajectory`` (built on the worker)."""
+        from ..simulation import Trajectory, fit_trajectory, get_trajectory, table_trajectory
+
+        if self.table is not None:
+            ref = table_trajectory(*self.table)
+        elif self.program is not None:
+            from ..script import run_program
+
+            name, text = self.program
+            traj = run_program(text, name, self.platform).trajectory
+            ref = Trajectory(name.rsplit("/", 1)[-1].removesuffix(".stw"), traj.pose_at, traj.duration)
+        else:
+            ref = get_trajectory(self.trajectory)
+        return fit_trajectory(ref, self.platform) if self.fit else ref
+
+    def run_duration(self, reference=None) -> float:
+        """Simulated seconds per run (given, else the reference's own duration)."""
+        if self.duration is not None:
+            return self.duration
+        ref = reference or self.reference()
+        return ref.duration or 1.0
+
+
+def run_seed(seed: int, index: int) -> int:
+    """The seed (63 bits: a signed 64-bit column holds it) of run ``index`` of a study seeded ``seed``."""
+    return int(np.random.SeedSequence(seed, spawn_key=(index,)).generate_state(1, np.uint64)[0]) & (2**63 - 1)
+
+
+@dataclass(frozen=True)
+class Draw:
+    """One run's parameters (SI). Anchor offsets ``(6, 3)`` base and ``(k, 3)`` plate, in B and T."""
+
+    base_anchor_offset: np.ndarray
+    top_anchor_offset: np.ndarray
+    leg_offset: np.ndarray
+    sensor_resolution: float
+    sensor_noise: float
+    latency: str
+    latency_jitter: float
+    actuator_lag: float
+    force_limit: float
+    payload_mass: float
+    payload_com_offset: np.ndarray
+    gain_scale: float
+    sample_period: float
+
+    def columns(self) -> dict:
+        """The drawn parameters as flat ``{column: value}`` (SI, names with their unit)."""
+        out = {}
+        for i, v in enumerate(self.base_anchor_offset):
+            out.update({f"anchor_base{i + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
+        for j, v in enumerate(self.top_anchor_offset):
+            out.update({f"anchor_top{j + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
+        out.update({f"leg_offset{i + 1}_m": float(x) for i, x in enumerate(self.leg_offset)})
+        out.update({"sensor_resolution_m": self.sensor_resolution, "sensor_noise_m": self.sensor_noise,
+                    "latency": self.latency, "latency_jitter_s": self.latency_jitter,
+                    "actuator_lag_s": self.actuator_lag, "force_limit_N": self.force_limit,
+                    "payload_mass_kg": self.payload_mass})
+        out.update({f"payload_com_{a}_m": float(x) for a, x in zip(AXES, self.payload_com_offset)})
+        out["gain_scale"] = self.gain_scale
+        out["sample_period_s"] = self.sample_period
+        return out
+
+
+def _draw_one(rng, law, nominal, shape=()):
+    """A value of ``law`` (None: ``nominal``) of ``shape`` (components drawn independently)."""
+    if law is None:
+        return np.full(shape, nominal) if shape else nominal
+    if law.kind == "fixed":
+        v = law.values[0]
+        return np.full(shape, v) if shape else v
+    if law.kind == "plusminus":
+        w = law.values[0]
+        return nominal + rng.uniform(-w, w, size=shape or None)
+    if law.kind == "relative":
+        p = law.values[0]
+        return nominal * (1 + rng.uniform(-p, p, size=shape or None))
+    if law.kind == "uniform":
+        return rng.uniform(*law.values, size=shape or None)
+    if law.kind == "choice":
+        return law.values[int(rng.integers(len(law.values)))]
+    raise ValueError(f"unknown law {law.kind!r}")
+
+
+def draw(study: Study, index: int) -> tuple[int, Draw]:
+    """``(run seed, Draw)`` of run ``index``: every key drawn in ``KEYS`` order from the run's own
+    generator (a key left nominal draws nothing)."""
+    seed = run_seed(study.seed, index)
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
+    p, laws = study.platform, study.spec.laws
+    k = len(p.top_anchors)
+    vals = {}
+    for key in KEYS:
+        law = laws.get(key)
+        if key == "anchor":
+            vals[key] = (_draw_one(rng, law, 0.0, (6, 3)), _draw_one(rng, law, 0.0, (k, 3)))
+        elif key == "leg_offset":
+            vals[key] = _draw_one(rng, law, 0.0, (6,))
+        elif key == "payload_com":
+            vals[key] = _draw_one(rng, law, 0.0, (3,))
+        elif key == "force_limit":
+            vals[key] = float(_draw_one(rng, law, float(p.legs.max_force)))
+        elif key == "payload_mass":
+            vals[key] = float(_draw_one(rng, law, float(p.mass)))
+        elif key == "latency":
+            vals[key] = str(_draw_one(rng, law, NOMINAL[key]))
+        else:
+            vals[key] = float(_draw_one(rng, law, NOMINAL[key]))
+    if study.grid is not None:
+        vals.update(study.grid[index])
+    return seed, Draw(
+        base_anchor_offset=np.asarray(vals["anchor"][0], float), top_anchor_offset=np.asarray(vals["anchor"][1], float),
+        leg_offset=np.asarray(vals["leg_offset"], float), sensor_resolution=vals["sensor_resolution"],
+        sensor_noise=vals["sensor_noise"], latency=vals["latency"], latency_jitter=vals["latency_jitter"],
+        actuator_lag=vals["actuator_lag"], force_limit=vals["force_limit"], payload_mass=vals["payload_mass"],
+        payload_com_offset=np.asarray(vals["payload_com"], float), gain_scale=vals["gain_scale"],
+        sample_period=vals["sample_period"],
+    )
+
+
+def plant_platform(platform: Platform, d: Draw) -> Platform:
+    """The platform the plant is built from: anchors moved, plate mass (inertia scaled alike) and centre
+    of mass changed."""
+    scale = d.payload_mass / platform.mass if platform.mass > 0 else 1.0
+    return platform.replace(
+        base_anchors=platform.base_anchors + d.base_anchor_offset,
+        top_anchors=platform.top_anchors + d.top_anchor_offset,
+        mass=d.payload_mass, inertia=platform.inertia * scale, com=platform.com + d.payload_com_offset,
+    )
+
+
+def sensor_factory(d: Draw, seed: int, period: float, n_ticks: int):
+    """A ``build_simulation`` sensor: (plant, D) → the LeafSystem reading L + offset + noise − j·dL/dt.
+    The noise ``(n_ticks, 6)`` and jitter ``(n_ticks,)`` tables come from the run's seed (generator
+    ``spawn_key=(1,)``); tick k reads row k (k = round(t / period))."""
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
+    noise = rng.normal(0.0, 1.0, size=(n_ticks, 6)) * d.sensor_noise
+    jitter = rng.uniform(0.0, 1.0, size=n_ticks) * d.latency_jitter
+
+    def make(plant, D):
+        from pydrake.systems.framework import LeafSystem
+
+        joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
+        pos = np.array([j.position_start() for j in joints])
+        vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
+
+        class Sensor(LeafSystem):
+            def __init__(self):
+                super().__init__()
+                u = self.DeclareVectorInputPort("state", D.shape[1])
+
+                def calc(c, o):
+                    x = u.Eval(c)
+                    k = min(int(round(c.get_time() / period)), n_ticks - 1)
+                    o.SetFromVector(x[pos] + d.leg_offset + noise[k] - jitter[k] * x[vel])
+
+                self.DeclareVectorOutputPort("lengths", 6, calc)
+
+            def initial_reading(self, L):
+                return np.asarray(L, float) + d.leg_offset
+
+        return Sensor()
+
+    return make
+
+
+def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None) -> dict:
+    """Run ``index`` of ``study``: its row (``{"run", "seed", drawn parameters..., metrics...}``) and,
+    with ``keep_log``, the ``SimulationLog`` under ``"log"``. Metrics (SI): leg error = true length −
+    the perturbed plant's IK of the reference; pose error = measured − reference pose. A run whose
+    simulation fails keeps its row, with ``error`` set and ``lost_tracking`` true."""
+    from ..control import ControllerConfig, DspTiming
+    from ..simulation import ActuatorModel, build_simulation, design_poses
+
+    t0 = time.perf_counter()
+    seed, d = draw(study, index)
+    row = {"run": index, "seed": seed, **d.columns()}
+    ref = study.reference()
+    duration = study.run_duration(ref)
+    p = study.platform
+    # the gains designed for the nominal timing and actuator lag over the run's poses (as simulate does)
+    g = ControllerConfig.for_platform(p, poses=design_poses(ref, max(duration, ref.duration or 0.0))).gains
+    s = d.gain_scale
+    timing = DspTiming(sample_period=d.sample_period, latency=d.latency, sensor_resolution=d.sensor_resolution,
+                       command_range=float(p.legs.max_force))
+    config = ControllerConfig.for_platform(p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s))
+    pp = plant_platform(p, d)
+    n_ticks = int(math.floor(duration / timing.sample_period + 1e-9)) + 2
+    sensor = sensor_factory(d, seed, timing.sample_period, n_ticks)
+    log, error = None, ""
+    try:
+        sim = build_simulation(p, ref, study.controller, config, ActuatorModel(d.force_limit, d.actuator_lag),
+                               plant_time_step=study.plant_step, integrator=study.integrator, engine=study.engine,
+                               plant_platform=pp, sensor=sensor, meshcat=meshcat)
+        log = sim.run(duration)
+    except (RuntimeError, ValueError) as e:
+        error = f"{type(e).__name__}: {e}".splitlines()[0][:300]
+    row.update(_metrics(log, ref, pp, study.lost_tracking, error))
+    row["wall_s"] = time.perf_counter() - t0
+    if keep_log:
+        row["log"] = log
+    return row
+
+
+def _metrics(log, ref, platform: Platform, lost: float, error: str) -> dict:
+    nan = float("nan")
+    if log is None:
+        return {"max_leg_error_m": nan, "rms_leg_error_m": nan, "max_position_error_m": nan, "rms_position_error_m": nan,
+                "max_angle_error_rad": nan, "rms_angle_error_rad": nan, "saturated_ticks": -1, "saturated_leg_ticks": -1, "lost_tracking": True, "error": error}
+    e = log.length_error(ref, platform)
+    pe = log.pose_error(ref)
+    pos = np.linalg.norm(pe[:, :3], axis=1)
+    ang = np.abs(pe[:, 3:]).max(axis=1)
+    finite = bool(np.all(np.isfinite(e)) and np.all(np.isfinite(pe)))
+    max_leg = float(np.abs(e).max()) if finite else nan
+    return {
+        "max_leg_error_m": max_leg,
+        "rms_leg_error_m": float(np.sqrt(np.mean(e**2))),
+        "max_position_error_m": float(pos.max()),
+        "rms_position_error_m": float(np.sqrt(np.mean(pos**2))),
+        "max_angle_error_rad": float(ang.max()),
+        "rms_angle_error_rad": float(np.sqrt(np.mean(ang**2))),
+        "saturated_ticks": int(log.status[-1, 3]),
+        "saturated_leg_ticks": int(log.saturations().sum()),
+        "lost_tracking": bool(not finite or max_leg > lost),
+        "error": error,
+    }

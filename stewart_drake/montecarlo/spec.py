@@ -1,0 +1,217 @@
+"""What a Monte Carlo study varies: the ``--vary`` SPEC (a YAML mapping or ``key=value`` words).
+
+Every key takes one value written the same way in both forms (units allowed: ``m mm um µm nm``,
+``s ms us µs``, ``N kN``, ``kg g``, ``%``; a bare number is SI):
+
+    X          fixed at X
+    ±T, +-T    uniform in nominal ± T (per component for the vector keys)
+    ±P%        uniform in nominal × (1 ± P/100) (only keys whose nominal is not zero)
+    A..B       uniform in [A, B]
+    a|b|c      one of the listed values, equally likely
+
+Keys (nominal in brackets):
+
+    anchor             base and plate anchor positions, per axis per anchor [0 offset]
+    leg_offset         the length sensor's zero, per leg [0]
+    sensor_resolution  metres per count [1e-5]
+    sensor_noise       σ of white Gaussian noise on each reading, m [0]
+    latency            sample | computation | none [sample]
+    latency_jitter     the largest lag of a tick's sampling instant, s (per tick uniform in [0, J]) [0]
+    actuator_lag       actuator time constant, s [2e-3]
+    force_limit        actuator force limit, N [the platform's legs.max_force]
+    payload_mass       plate mass, kg [the platform's]
+    payload_com        plate centre of mass offset, per axis, m [0]
+    gain_scale         factor on every PID gain [1]
+    sample_period      controller sample period, s [1e-3] (the gains stay those designed for the nominal)
+
+``sensor_noise`` and ``latency_jitter`` set the size of per-tick random processes (drawn from the run's
+seed); the other keys are drawn once per run.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from decimal import Decimal
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import StewartError
+
+
+class SpecError(StewartError):
+    """A ``--vary`` SPEC that cannot be read: unknown key, bad value, unit or range."""
+
+
+# key: (dimension, vector length or 0 for a scalar, nominal zero?)
+KEYS = {
+    "anchor": ("length", "anchors", True),
+    "leg_offset": ("length", 6, True),
+    "sensor_resolution": ("length", 0, False),
+    "sensor_noise": ("length", 0, True),
+    "latency": ("mode", 0, False),
+    "latency_jitter": ("time", 0, True),
+    "actuator_lag": ("time", 0, False),
+    "force_limit": ("force", 0, False),
+    "payload_mass": ("mass", 0, False),
+    "payload_com": ("length", 3, True),
+    "gain_scale": ("ratio", 0, False),
+    "sample_period": ("time", 0, False),
+}
+# Keys that configure a per-tick process: a fixed value only.
+PROCESS_KEYS = ("sensor_noise", "latency_jitter")
+# Units as powers of ten of the SI unit (exact decimal scaling: 10um reads as 1e-05, not 9.999999999999999e-06).
+UNITS = {
+    "length": {"": 0, "m": 0, "mm": -3, "um": -6, "µm": -6, "nm": -9},
+    "time": {"": 0, "s": 0, "ms": -3, "us": -6, "µs": -6},
+    "force": {"": 0, "N": 0, "kN": 3},
+    "mass": {"": 0, "kg": 0, "g": -3},
+    "ratio": {"": 0},
+}
+LATENCY_MODES = ("sample", "computation", "none")
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+@dataclass(frozen=True)
+class Distribution:
+    """One key's law. ``kind``: ``fixed`` (value), ``plusminus`` (nominal ± half_width), ``relative``
+    (nominal × (1 ± half_width)), ``uniform`` (low..high), ``choice`` (values)."""
+
+    kind: str
+    values: tuple = ()
+    text: str = ""
+
+
+@dataclass(frozen=True)
+class VarySpec:
+    """The parsed SPEC: ``{key: Distribution}`` for the keys given (others stay nominal)."""
+
+    laws: dict = field(default_factory=dict)
+    source: str = ""
+
+    def to_dict(self) -> dict:
+        """``{key: text as the user wrote it}``: the SPEC in a form that ``parse_spec`` reads back."""
+        return {k: d.text for k, d in self.laws.items()}
+
+
+def _where(source: str, line: int | None) -> str:
+    return f"{source}:{line}" if line else source
+
+
+def _number(text: str, key: str, where: str) -> float:
+    dim = KEYS[key][0]
+    m = re.fullmatch(rf"\s*({_NUM})\s*([a-zA-Zµ%]*)\s*", text)
+    units = UNITS.get(dim, {"": 0})
+    if not m or m.group(2) not in units:
+        allowed = ", ".join(u for u in units if u) or "none"
+        raise SpecError(f"{where}: {key}: cannot read {text!r} as a number with a unit ({allowed})")
+    v = float(Decimal(m.group(1)).scaleb(units[m.group(2)]))
+    if not math.isfinite(v):
+        raise SpecError(f"{where}: {key}: {text!r} is not finite")
+    return v
+
+
+def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
+    """The ``Distribution`` of ``key`` written ``text`` (see the module docstring)."""
+    text = str(text).strip()
+    dim, _, zero_nominal = KEYS[key]
+    if dim == "mode":
+        modes = tuple(m.strip() for m in text.split("|"))
+        bad = [m for m in modes if m not in LATENCY_MODES]
+        if bad:
+            raise SpecError(f"{where}: latency: {bad[0]!r} is not one of {', '.join(LATENCY_MODES)}")
+        return Distribution("choice" if len(modes) > 1 else "fixed", modes if len(modes) > 1 else (modes[0],), text)
+    if key in PROCESS_KEYS:
+        v = _number(text, key, where)
+        if v < 0:
+            raise SpecError(f"{where}: {key}: {text!r} must be >= 0 (the size of a per-tick random process)")
+        return Distribution("fixed", (v,), text)
+    if text.startswith(("±", "+-")):
+        body = text[1:] if text.startswith("±") else text[2:]
+        if body.strip().endswith("%"):
+            if zero_nominal:
+                raise SpecError(f"{where}: {key}: {text!r}: a percentage of a zero nominal; give ±value with a unit")
+            p = float(_number(body.strip()[:-1], "gain_scale", where)) / 100
+            if not 0 <= p < 1:
+                raise SpecError(f"{where}: {key}: {text!r}: the percentage must be in [0, 100)")
+            return Distribution("relative", (p,), text)
+        w = _number(body, key, where)
+        if w < 0:
+            raise SpecError(f"{where}: {key}: {text!r}: the half-width must be >= 0")
+        return Distribution("plusminus", (w,), text)
+    if ".." in text:
+        lo, hi = (_number(s, key, where) for s in text.split("..", 1))
+        if not lo <= hi:
+            raise SpecError(f"{where}: {key}: {text!r}: the range's low end is above its high end")
+        return Distribution("uniform", (lo, hi), text)
+    if "|" in text:
+        return Distribution("choice", tuple(_number(s, key, where) for s in text.split("|")), text)
+    return Distribution("fixed", (_number(text, key, where),), text)
+
+
+def _check_key(key: str, where: str) -> None:
+    if key not in KEYS:
+        near = difflib.get_close_matches(key, KEYS, n=1)
+        hint = f" (did you mean {near[0]!r}?)" if near else f" (keys: {', '.join(KEYS)})"
+        raise SpecError(f"{where}: unknown key {key!r}{hint}")
+
+
+def _check_vector(key: str, d: Distribution, where: str) -> None:
+    if KEYS[key][1] and d.kind not in ("plusminus", "fixed"):
+        raise SpecError(f"{where}: {key}: give ±tolerance (per component) or a fixed offset, not {d.text!r}")
+
+
+def parse_spec(words) -> VarySpec:
+    """A ``VarySpec`` from ``key=value`` words (a list of strings, or one string split at whitespace)
+    or, when the only word names an existing ``.yaml``/``.yml`` file, from that YAML mapping."""
+    if isinstance(words, str):
+        words = words.split()
+    words = list(words)
+    if len(words) == 1 and words[0].endswith((".yaml", ".yml")):
+        return _parse_yaml(Path(words[0]))
+    laws = {}
+    for w in words:
+        if "=" not in w:
+            raise SpecError(f"--vary: {w!r} is not key=value")
+        key, value = w.split("=", 1)
+        key = key.strip()
+        _check_key(key, "--vary")
+        d = parse_value(key, value, "--vary")
+        _check_vector(key, d, "--vary")
+        laws[key] = d
+    return VarySpec(laws, " ".join(words))
+
+
+def _parse_yaml(path: Path) -> VarySpec:
+    import yaml
+
+    if not path.is_file():
+        raise SpecError(f"--vary: file {str(path)!r} does not exist")
+    text = path.read_text(encoding="utf-8")
+    try:
+        node = yaml.compose(text)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        raise SpecError(f"{path}:{mark.line + 1 if mark else '?'}: not YAML ({getattr(e, 'problem', e)})") from None
+    if node is None or not isinstance(node, yaml.MappingNode):
+        raise SpecError(f"{path}: the SPEC must be a mapping of key: value")
+    laws = {}
+    for k, v in node.value:
+        where = _where(str(path), k.start_mark.line + 1)
+        if not isinstance(v, yaml.ScalarNode):
+            raise SpecError(f"{where}: {k.value}: the value must be one scalar (e.g. ±0.5mm)")
+        _check_key(k.value, where)
+        d = parse_value(k.value, v.value, where)
+        _check_vector(k.value, d, where)
+        laws[k.value] = d
+    return VarySpec(laws, str(path))
+
+
+def spec_from_dict(d: dict, source: str = "study.json") -> VarySpec:
+    """The ``VarySpec`` of ``VarySpec.to_dict()`` (as stored with a study)."""
+    laws = {}
+    for k, v in d.items():
+        _check_key(k, source)
+        laws[k] = parse_value(k, v, source)
+    return VarySpec(laws, source)

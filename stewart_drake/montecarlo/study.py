@@ -1,0 +1,246 @@
+"""Running a study: runs on Dask (or in this process), streamed back, resumable from the output folder.
+
+The output folder holds, while a study runs, ``montecarlo.partial.jsonl``: a header line with the
+study's key (``study_key``: a hash of every setting except the number of runs) and one JSON row per
+finished run, flushed as each arrives. A study started again with the same settings and ``--out`` reads
+it and runs only the missing indices (JSON keeps every float bit for bit). At the end the folder is
+replaced atomically by the final files (``summary.write_outputs``).
+
+Dask: ``--workers K`` starts a ``LocalCluster`` of K single-threaded worker processes; ``--scheduler``
+connects to an existing one. The ``Study`` is scattered to the workers once; each task is one run index
+(``retries``: a run on a worker that dies is re-run elsewhere). Each run's result depends only on the
+study and its index, so the rows are the same with any number of workers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..atomic import claim_in_manifest
+from ..errors import StewartError
+from .scenario import Study, run_scenario
+
+PARTIAL = "montecarlo.partial.jsonl"
+STUDY_FILE = "study.json"
+# Work bounds, checked before anything runs: runs, simulated seconds per run and in total.
+MAX_RUNS = 100_000
+MAX_RUN_SECONDS = 600.0
+MAX_TOTAL_SECONDS = 500_000.0
+RETRIES = 3
+
+
+class StudyError(StewartError):
+    """A study that cannot start: too large, inconsistent settings, or an output folder that is not its own."""
+
+
+def study_settings(study: Study) -> dict:
+    """The study's settings as JSON-able data (the platform by value), without the number of runs."""
+    p = study.platform
+    plat = {f.name: getattr(p, f.name) for f in dataclasses.fields(p)}
+    plat["legs"] = dataclasses.asdict(p.legs)
+    plat = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in plat.items()}
+    return {
+        "platform": plat, "vary": study.spec.to_dict(), "seed": study.seed, "trajectory": study.trajectory,
+        "program": list(study.program) if study.program else None,
+        "table": list(study.table) if study.table else None, "fit": study.fit, "controller": study.controller,
+        "integrator": study.integrator, "engine": study.engine, "duration": study.duration, "plant_step": study.plant_step,
+        "lost_tracking": study.lost_tracking, "grid": list(study.grid) if study.grid is not None else None, **study.extra,
+    }
+
+
+def study_from_settings(settings: dict, runs: int) -> Study:
+    """The ``Study`` of ``study_settings`` (as stored in ``study.json``)."""
+    from ..geometry import LegConfig, Platform
+    from .spec import spec_from_dict
+
+    plat = dict(settings["platform"])
+    plat["legs"] = LegConfig(**plat["legs"])
+    plat["leg_top"] = np.asarray(plat["leg_top"], dtype=np.intp)
+    fields = {f.name for f in dataclasses.fields(Study)}
+    known = {"platform", "vary", "seed", "trajectory", "program", "table", "fit", "controller", "integrator", "engine", "duration", "plant_step", "lost_tracking", "grid"}
+    extra = {k: v for k, v in settings.items() if k not in known}
+    return Study(platform=Platform(**plat), spec=spec_from_dict(settings["vary"]), seed=settings["seed"], runs=runs,
+                 trajectory=settings["trajectory"], program=tuple(settings["program"]) if settings["program"] else None,
+                 table=tuple(settings["table"]) if settings.get("table") else None,
+                 fit=settings["fit"], controller=settings["controller"], integrator=settings["integrator"], engine=settings.get("engine", "python"),
+                 duration=settings["duration"], plant_step=settings["plant_step"], lost_tracking=settings["lost_tracking"],
+                 grid=tuple(settings["grid"]) if settings.get("grid") is not None else None,
+                 extra={k: v for k, v in extra.items() if k not in fields})
+
+
+def study_key(study: Study) -> str:
+    """A hash of ``study_settings`` (settings left at None out, so that a setting added later keeps the
+    keys of studies that do not use it): two studies with the same key draw and run the same runs."""
+    return settings_key(study_settings(study))
+
+
+def settings_key(settings: dict) -> str:
+    """``study_key`` of stored ``study_settings`` (e.g. a finished study's ``study.json``)."""
+    settings = {k: v for k, v in settings.items() if v is not None}
+    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+
+
+def check_study(study: Study) -> float:
+    """Raise ``StudyError`` if the study is too large or inconsistent; return the seconds per run."""
+    from ..integrators import check_integrator
+
+    if study.integrator is not None:
+        check_integrator(study.integrator)
+    if not (isinstance(study.runs, int) and 1 <= study.runs <= MAX_RUNS):
+        raise StudyError(f"--runs must be 1 … {MAX_RUNS}, got {study.runs}")
+    if not (isinstance(study.seed, int) and study.seed >= 0):
+        raise StudyError(f"--seed must be an integer >= 0, got {study.seed}")
+    if study.grid is not None and len(study.grid) != study.runs:
+        raise StudyError(f"a sweep's runs ({study.runs}) must equal its grid's points ({len(study.grid)})")
+    if not (math.isfinite(study.plant_step) and 0 < study.plant_step <= 1e-2):
+        raise StudyError(f"plant step must be in (0, 0.01] s, got {study.plant_step}")
+    duration = study.run_duration()
+    if not (math.isfinite(duration) and 0 < duration <= MAX_RUN_SECONDS):
+        raise StudyError(f"--duration must be in (0, {MAX_RUN_SECONDS:g}] s per run, got {duration}")
+    if study.runs * duration > MAX_TOTAL_SECONDS:
+        raise StudyError(f"--runs {study.runs} × {duration:g} s = {study.runs * duration:g} simulated s is more than the bound {MAX_TOTAL_SECONDS:g} s")
+    if study.controller == "fixed":
+        law = study.spec.laws.get("sensor_resolution")
+        if law is not None and law.kind not in ("fixed", "choice"):
+            raise StudyError("--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; give a value or a|b|c list, not a range")
+        for r in law.values if law is not None else ():
+            c = 1e-3 / r
+            if not (r > 0 and abs(c - round(c)) <= 1e-9 * c):
+                raise StudyError(f"--vary sensor_resolution: {r:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts")
+    return duration
+
+
+def run_row(study: Study, index: int) -> dict:
+    """The Dask task: run ``index`` of ``study`` and return its row (no log)."""
+    return run_scenario(study, index)
+
+
+# ----------------------------------------------------------------------------------------------
+# The output folder's state.
+
+
+def load_partial(out: Path, key: str) -> dict[int, dict]:
+    """``{run: row}`` of the runs already finished in ``out`` for the study ``key`` (none if ``out`` does
+    not exist). ``StudyError`` if ``out`` holds something else: another study, or files this tool did not
+    write."""
+    if not out.exists():
+        return {}
+    if not out.is_dir():
+        raise StudyError(f"--out {str(out)!r} exists and is not a folder")
+    rows: dict[int, dict] = {}
+    partial = out / PARTIAL
+    previous = out / STUDY_FILE
+    if previous.exists():
+        old = json.loads(previous.read_text())
+        old_key = settings_key(old["settings"]) if "settings" in old else old.get("key")
+        if old_key != key:
+            raise StudyError(f"--out {str(out)!r} holds another study (key {old_key}, this one {key}); choose another folder")
+        results = out / "results.parquet"
+        if results.exists():
+            import pyarrow.parquet as pq
+
+            for r in pq.read_table(results).to_pylist():
+                rows[int(r["run"])] = r
+    elif not partial.exists() and any(out.iterdir()):
+        raise StudyError(f"--out {str(out)!r} is a folder this tool did not write (no {STUDY_FILE} or {PARTIAL}); refusing to overwrite it")
+    if partial.exists():
+        lines = partial.read_text().splitlines()
+        head = json.loads(lines[0]) if lines else {}
+        if head.get("key") != key:
+            raise StudyError(f"--out {str(out)!r} holds a partial study with another key ({head.get('key')}, this one {key}); choose another folder")
+        for line in lines[1:]:
+            try:
+                r = json.loads(line)
+            except json.JSONDecodeError:  # a line cut short by an interruption: that run is re-run
+                continue
+            rows[int(r["run"])] = r
+    return rows
+
+
+class PartialWriter:
+    """Appends finished rows to ``out/montecarlo.partial.jsonl`` (header first), one flushed line each."""
+
+    def __init__(self, out: Path, key: str):
+        out.mkdir(parents=True, exist_ok=True)
+        path = out / PARTIAL
+        new = not path.exists() or path.stat().st_size == 0
+        self.fh = path.open("a", encoding="utf-8")
+        if new:
+            self.write({"key": key})
+            claim_in_manifest(out, [PARTIAL])  # the folder stays ours: the final write replaces it
+
+    def write(self, obj: dict) -> None:
+        self.fh.write(json.dumps(obj) + "\n")
+        self.fh.flush()
+
+    def close(self) -> None:
+        self.fh.close()
+
+
+# ----------------------------------------------------------------------------------------------
+# Running.
+
+
+def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = True) -> list[dict]:
+    """Run every run of ``study`` not yet in ``out`` and return all rows in run order. ``workers`` 0
+    runs them in this process (no Dask); otherwise a ``LocalCluster`` of ``workers`` processes, or the
+    cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume)."""
+    check_study(study)
+    key = study_key(study)
+    rows = load_partial(Path(out), key) if out is not None else {}
+    todo = [i for i in range(study.runs) if i not in rows]
+    writer = PartialWriter(Path(out), key) if out is not None else None
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=study.runs, initial=study.runs - len(todo), desc="montecarlo", unit=" run")
+    try:
+        for row in _results(study, todo, workers, scheduler):
+            rows[row["run"]] = row
+            if writer is not None:
+                writer.write(row)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if writer is not None:
+            writer.close()
+        if bar is not None:
+            bar.close()
+    return [rows[i] for i in range(study.runs)]
+
+
+def _results(study: Study, todo: list[int], workers: int, scheduler: str | None):
+    """Rows of the runs ``todo``, as they finish."""
+    if not todo:
+        return
+    if scheduler is None and workers == 0:
+        for i in todo:
+            yield run_row(study, i)
+        return
+    from distributed import Client, as_completed
+
+    from ..workspace_dask import local_cluster
+
+    cluster = None
+    if scheduler is None:
+        cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    try:
+        s = client.scatter(study, broadcast=True)
+        futures = [client.submit(run_row, s, i, retries=RETRIES, pure=False) for i in todo]
+        for fut in as_completed(futures):
+            yield fut.result()
+            fut.release()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

@@ -1,0 +1,152 @@
+"""A study's summary (percentiles, worst run, sensitivity) and its files (Parquet, CSV, JSON, plots).
+
+Sensitivity: the Spearman rank correlation of each drawn parameter with each error metric over the
+runs (``scipy.stats.spearmanr``; a monotone relation gives ±1 whatever its shape). Parameters that do
+not vary are left out; the ``latency`` mode enters as its index in ``LATENCY_MODES``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .spec import LATENCY_MODES
+
+METRICS = ("max_leg_error_m", "rms_leg_error_m", "max_position_error_m", "rms_position_error_m",
+           "max_angle_error_rad", "rms_angle_error_rad", "saturated_ticks", "saturated_leg_ticks")
+# Row fields that are not drawn parameters.
+NOT_PARAMETERS = set(METRICS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
+PERCENTILES = (5, 50, 95, 99)
+WORST_BY = "max_leg_error_m"
+
+
+def parameter_columns(rows: list[dict]) -> list[str]:
+    """The drawn parameters that vary over ``rows`` (in row order)."""
+    cols = [k for k in rows[0] if k not in NOT_PARAMETERS]
+    return [k for k in cols if len({r[k] for r in rows}) > 1]
+
+
+def _numeric(rows, k) -> np.ndarray:
+    if k == "latency":
+        return np.array([LATENCY_MODES.index(r[k]) for r in rows], float)
+    return np.array([r[k] for r in rows], float)
+
+
+def sensitivity(rows: list[dict], metric: str = WORST_BY) -> list[dict]:
+    """``[{"parameter", "spearman", "p_value"}]`` sorted by |ρ| (largest first), over the runs whose
+    ``metric`` is finite."""
+    from scipy.stats import spearmanr
+
+    ok = [r for r in rows if math.isfinite(float(r[metric]))]
+    if len(ok) < 3:
+        return []
+    y = _numeric(ok, metric)
+    out = []
+    for k in parameter_columns(ok):
+        rho, p = spearmanr(_numeric(ok, k), y)
+        if math.isfinite(rho):
+            out.append({"parameter": k, "spearman": float(rho), "p_value": float(p)})
+    return sorted(out, key=lambda d: -abs(d["spearman"]))
+
+
+def summarise(rows: list[dict], settings: dict, key: str) -> dict:
+    """The study's summary: per metric the percentiles, mean and max; the worst run (largest
+    ``WORST_BY``); lost-tracking and failed counts; the sensitivity ranking per leg and pose metric."""
+    stats = {}
+    for m in METRICS:
+        v = _numeric(rows, m)
+        v = v[np.isfinite(v)]
+        stats[m] = ({f"p{q}": float(np.percentile(v, q)) for q in PERCENTILES} | {"mean": float(v.mean()), "max": float(v.max())}) if v.size else {}
+    finite = [r for r in rows if math.isfinite(float(r[WORST_BY]))]
+    worst = max(finite, key=lambda r: r[WORST_BY]) if finite else rows[0]
+    wall = np.array([r["wall_s"] for r in rows], float)
+    return {
+        "key": key,
+        "runs": len(rows),
+        "settings": settings,
+        "lost_tracking_runs": [r["run"] for r in rows if r["lost_tracking"]],
+        "failed_runs": [r["run"] for r in rows if r["error"]],
+        "metrics": stats,
+        "worst_run": {"run": worst["run"], "seed": worst["seed"], "by": WORST_BY, **{m: worst[m] for m in METRICS}},
+        "sensitivity": {m: sensitivity(rows, m) for m in ("max_leg_error_m", "max_position_error_m")},
+        "varied_parameters": parameter_columns(rows),
+        "run_wall_s": {"sum": float(wall.sum()), "mean": float(wall.mean())},
+    }
+
+
+def write_table(rows: list[dict], folder: Path) -> list[Path]:
+    """``results.parquet`` (pyarrow) and ``results.csv`` (floats as Python's shortest exact repr)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq_path = folder / "results.parquet"
+    pq.write_table(pa.Table.from_pylist(rows), pq_path)
+    csv_path = folder / "results.csv"
+    with csv_path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(list(rows[0]))
+        w.writerows([[repr(v) if isinstance(v, float) else v for v in r.values()] for r in rows])
+    return [pq_path, csv_path]
+
+
+def read_table(folder) -> list[dict]:
+    """The rows of ``folder/results.parquet`` in run order."""
+    import pyarrow.parquet as pq
+
+    return sorted(pq.read_table(Path(folder) / "results.parquet").to_pylist(), key=lambda r: r["run"])
+
+
+def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
+    """``distributions.png`` (histograms of the leg and pose errors) and ``sensitivity.png`` (the leg
+    error against the most influential parameter, and the ranking)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    paths = []
+    fig, ax = plt.subplots(1, 3, figsize=(13, 3.6))
+    for a, (m, scale, label) in zip(ax, [("max_leg_error_m", 1e3, "max leg error [mm]"),
+                                         ("max_position_error_m", 1e3, "max position error [mm]"),
+                                         ("max_angle_error_rad", 180 / np.pi, "max angle error [deg]")]):
+        v = _numeric(rows, m)
+        a.hist(v[np.isfinite(v)] * scale, bins=max(5, min(40, len(rows) // 5)))
+        a.set_xlabel(label)
+    ax[0].set_ylabel("runs")
+    fig.suptitle(f"{len(rows)} runs")
+    paths.append(folder / "distributions.png")
+    fig.savefig(paths[-1], dpi=100, bbox_inches="tight")
+    plt.close(fig)
+    ranking = summary["sensitivity"]["max_leg_error_m"]
+    fig, ax = plt.subplots(1, 2, figsize=(13, 4), constrained_layout=True)
+    if ranking:
+        top = ranking[0]["parameter"]
+        ax[0].scatter(_numeric(rows, top), _numeric(rows, "max_leg_error_m") * 1e3, s=8)
+        ax[0].set_xlabel(top)
+        ax[0].set_ylabel("max leg error [mm]")
+        ax[0].set_title(f"most influential: ρ = {ranking[0]['spearman']:.2f}")
+        shown = ranking[:12][::-1]
+        ax[1].barh([d["parameter"] for d in shown], [d["spearman"] for d in shown])
+        ax[1].set_xlabel("Spearman ρ with max leg error")
+    paths.append(folder / "sensitivity.png")
+    fig.savefig(paths[-1], dpi=100, bbox_inches="tight")
+    plt.close(fig)
+    return paths
+
+
+def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
+    """Replace ``out`` atomically with the table, ``summary.json``, ``study.json`` and the plots."""
+    from ..atomic import atomic_folder
+
+    out = Path(out)
+    with atomic_folder(out) as tmp:
+        written = write_table(rows, tmp) + write_plots(rows, summary, tmp)
+        (tmp / "study.json").write_text(json.dumps({"key": summary["key"], "runs": summary["runs"], "settings": summary["settings"]}, indent=2))
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
+        written += [tmp / "study.json", tmp / "summary.json"]
+        names = [p.name for p in written]
+    return [out / n for n in names]
