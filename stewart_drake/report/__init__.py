@@ -20,7 +20,6 @@ import base64
 import html
 import importlib.util
 import io
-import json
 import multiprocessing
 import os
 import shlex
@@ -240,9 +239,11 @@ def _progress(k: int, n: int, s: Section, log) -> None:
         print(f"      warning: {w}", file=log, flush=True)
 
 
-def run_analyses(analyses: list[Analysis], quick: bool = False, log=sys.stderr, jobs: int = 1) -> list[Section]:
+def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1) -> list[Section]:
     """Build each analysis's section, in ``jobs`` worker processes (1: in this process), printing a
-    line per analysis as it finishes; the sections come back in the analyses' order."""
+    line per analysis as it finishes to ``log`` (default: the current stderr, not the one at import
+    time); the sections come back in the analyses' order."""
+    log = log or sys.stderr
     n = len(analyses)
     if jobs <= 1 or n <= 1:
         sections = []
