@@ -174,11 +174,11 @@ def test_simulate_refuses_out_of_stroke_and_below_base_before_running(tmp_path):
 
 
 def test_simulate_lost_tracking_exits_1(tmp_path):
-    """A piecewise-linear reference that starts moving at once asks for an unbounded acceleration at t = 0:
-    the feed-forward saturates and the legs fall tens of millimetres behind. The summary states the bound
-    and the run exits 1 saying why."""
-    f = tmp_path / "lift.csv"
-    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.1,0,0,705,0,0,2\n")
+    """A reference that jumps 60 mm in 2 ms at t = 0.05 s asks for far more than the actuators' force
+    range: the legs fall tens of millimetres behind. The summary states the bound and the run exits 1
+    saying why."""
+    f = tmp_path / "step.csv"
+    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.05,0,0,700,0,0,0\n0.052,0,0,760,0,0,0\n0.3,0,0,760,0,0,0\n")
     rc, out, err = cli("simulate", "--trajectory", f, "--length-unit", "mm", "--angle-unit", "deg", "--out", tmp_path / "o", "--no-progress")
     summary = json.loads(out)
     assert rc == 1 and summary["tracking_bound_mm"] == pytest.approx(0.05 * 400)
