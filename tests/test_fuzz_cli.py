@@ -3,7 +3,7 @@ with valid, odd and invalid values), keep the invariants of ``_fuzz.check_run``:
 traceback, one-line errors, strict JSON, nothing written outside the outputs, the user's files intact.
 
 Work sizes (resolution, duration, step, loop counts) are drawn from small values so that every
-example is quick; the commands that write folders (workspace, simulate, run, report) are pointed at
+example is quick; the commands that write folders (workspace, simulate, run, report, montecarlo) are pointed at
 the user's folder, which must be refused before any work (or, with --force, kept intact)."""
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ SAFE = {
 }
 # multi-start/homotopy FK, full simulations, Drake linearisation, branch checks and maps: seconds each
 SKIP = {"--all", "--help", "--version", "--simulate", "--drake", "--check-branches", "--map"}
-HEAVY = {"workspace", "simulate", "run", "report"}
+HEAVY = {"workspace", "simulate", "run", "report", "montecarlo"}
 # The Meshcat viewer: run in-process thousands of times it deadlocked (a futex wait in Meshcat's server
 # thread); it has its own tests.
 INTERACTIVE = (["view"],)
@@ -127,8 +127,6 @@ def argv(draw):
         if draw(st.integers(0, 19)) == 0:
             n = max(0, n + draw(st.sampled_from([-1, 1])))  # one value too few or too many
         args += [draw(values_for(a)) for _ in range(n)]
-    if prefix and prefix[0] == "view" and "--duration" not in args:
-        args += ["--duration", "0"]  # the viewer otherwise serves until interrupted
     if prefix and prefix[0] in HEAVY:
         args += ["--out", "userdir"]  # refused before the work (or, with --force, written beside the user's file)
     if draw(st.integers(0, 39)) == 0:
