@@ -199,6 +199,15 @@ def test_cli_stiffness_errors(capsys, args, needle, rc):
     assert needle in err and err.count("\n") == 1
 
 
+@pytest.mark.parametrize("command", ["stiffness", "modes"])
+def test_cli_plate_below_the_base_exits_1(capsys, command):
+    """The mirror image of a reachable pose under the base has legs within the stroke: only the sanity
+    check that every command shares refuses it."""
+    assert main([command, "--pose", "0", "0", "-700", "0", "0", "0", "--length-unit", "mm"]) == 1
+    err = capsys.readouterr().err
+    assert "the plate is below the base" in err and err.count("\n") == 1
+
+
 def test_cli_stiffness_unreachable(capsys):
     assert main(["stiffness", "--pose", "0", "0", "300", "0", "0", "0"]) == 1
     assert "below the stroke minimum" in capsys.readouterr().err

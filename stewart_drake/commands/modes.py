@@ -3,12 +3,10 @@
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 
 from ._common import print_json
-from .stiffness import NAMES, add_pose_args, check_pose, prepare
+from .stiffness import NAMES, add_pose_args, prepare, require_analysable_pose
 
 
 def register(sub) -> None:
@@ -30,10 +28,7 @@ def run(args) -> int:
         raise ValueError(f"--leg-damping must be a finite number >= 0 N·s/m, got {args.leg_damping}")
     if not (np.isfinite(args.sample_rate) and args.sample_rate > 0):
         raise ValueError(f"--sample-rate must be a positive number of Hz, got {args.sample_rate}")
-    bad = check_pose(platform, q, args.convention)
-    if bad:
-        print(f"stewart-drake modes: {bad}", file=sys.stderr)
-        return 1
+    require_analysable_pose(platform, q, args.convention)
     legs = args.legs == "on"
     K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)
     M = spatial_inertia(platform, q, args.convention, legs)

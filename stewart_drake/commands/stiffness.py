@@ -45,31 +45,29 @@ def prepare(args):
     return platform, q, k, p_TP
 
 
-def check_pose(platform, q, convention) -> str | None:
-    """A one-line reason why pose q cannot be analysed (outside the stroke, singular), or None."""
-    from ..errors import StewartError
+def require_analysable_pose(platform, q, convention) -> None:
+    """Refuse a pose that cannot be analysed: the sanity checks every command applies (finite, near the
+    platform, plate above the base), then within the stroke and away from a singularity
+    (``PhysicalLimitError``, exit 1)."""
+    from ..errors import PhysicalLimitError, StewartError
     from ..kinematics import inverse_kinematics, require_nonsingular
+    from ..sanity import check_poses
 
+    check_poses(platform, q, convention, what="--pose")
     try:
         inverse_kinematics(platform, q, convention)
         require_nonsingular(platform, q, convention)
     except StewartError as e:
-        return str(e)
-    return None
+        raise PhysicalLimitError(str(e)) from None
 
 
 def run(args) -> int:
-    import sys
-
     from ..design.payload import payload_wrench
     from ..design.stiffness import compliance, deflection, principal_stiffness, stiffness_matrix
     from ..rotations import rotation_matrix
 
     platform, q, k, p_TP = prepare(args)
-    bad = check_pose(platform, q, args.convention)
-    if bad:
-        print(f"stewart-drake stiffness: {bad}", file=sys.stderr)
-        return 1
+    require_analysable_pose(platform, q, args.convention)
     legs = args.legs == "on"
     K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)
     K0 = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs, loaded=False)
