@@ -269,3 +269,13 @@ def test_cli_size_trajectory_csv(tmp_path, capsys):
     s = size_trajectory(load_platform("utn-dynamic"), t, q, qd, qdd)
     assert np.allclose([r["peak_force_n"] for r in out["legs"]], np.abs(s.force).max(0), rtol=1e-12)
     assert np.allclose([r["peak_speed_m_s"] for r in out["legs"]], np.abs(s.speed).max(0), rtol=1e-12)
+
+
+def test_cli_size_trajectory_below_the_base_exits_1(tmp_path, capsys):
+    """A trajectory mirrored under the base keeps every leg within the stroke; the shared sanity check
+    refuses it, naming the first time."""
+    f = tmp_path / "below.csv"
+    f.write_text("t,px,py,pz,ax,ay,az\n" + "".join(f"{0.1 * i:g},0,0,{-700 - i},0,0,0\n" for i in range(11)))
+    assert main(["size", "--trajectory", str(f), "--length-unit", "mm"]) == 1
+    err = capsys.readouterr().err
+    assert "trajectory at t = 0.0000 s: the plate is below the base" in err and err.count("\n") == 1

@@ -76,7 +76,9 @@ def run(args) -> int:
         print(e.render(), file=sys.stderr)
         return 2
     from ..design.sizing import first_violation, limits_of, size_trajectory
+    from ..sanity import check_poses
 
+    check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
     s = size_trajectory(platform, t, q, qd, qdd, convention, legs, args.gravity)
     limits = limits_of(platform)
     viol = first_violation(limits, {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length})

@@ -32,6 +32,7 @@ from ..errors import StewartError
 from ..geometry import Platform, load_yaml_config
 from ..kinematics import check_stroke, condition_number, leg_lengths
 from ..rotations import angle_scale, angular_velocity_map, check_convention, length_scale, rotation_matrix
+from ..sanity import check_poses
 from .boxquad import box_quadratic_max
 
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
@@ -165,6 +166,10 @@ def load_envelope(path) -> Envelope:
 def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
     """``(n, 6)`` leg lengths of the envelope's poses; ``EnvelopeError`` naming the first pose outside the
     stroke, on (or near) a singularity or at the convention's gimbal lock."""
+    try:
+        check_poses(platform, env.poses, env.convention, what=f"{env.source}: pose")  # finite, near, above the base
+    except StewartError as e:
+        raise EnvelopeError(str(e)) from None
     L = leg_lengths(platform, env.poses, env.convention)
     v = check_stroke(platform, L).violations()
     if v:
