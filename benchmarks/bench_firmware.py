@@ -1,7 +1,7 @@
 """Firmware in the loop: what the compiled C engine costs against the Python emulation.
 
-1. Real-time factors at 1 kHz on utn-dynamic (seed trajectory, 1 ms plant step), in one run: the plant
-   alone (zero actuation), the fixed-point controller with the Python engine, and with the C engine
+1. Real-time factors at 1 kHz on utn-dynamic (seed trajectory, the default integrator), in one run: the plant
+   alone (held at home by its static leg forces), the fixed-point controller with the Python engine, and with the C engine
    (the generated firmware's sd_tick in the LeafSystem); the ratios to the plant alone.
 2. The per-tick cost of the controller's ``compute`` alone (Python law vs one ``sd_tick`` call).
 3. IK throughput, single-threaded batch calls: the generated ``sd_ik`` (poses/s, by wall clock and by the
@@ -21,24 +21,9 @@ import time
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import numpy as np  # noqa: E402
+from bench_integrators import bare_plant  # noqa: E402  (benchmarks/ is the script's folder)
 
-
-def plant_alone_rtf(p, duration):
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import ConstantVectorSource
-
-    from stewart_drake.model import build_plant, set_pose
-
-    b = DiagramBuilder()
-    plant, _ = build_plant(p, 1e-3, b)
-    src = b.AddSystem(ConstantVectorSource([0.0] * 6))
-    b.Connect(src.get_output_port(), plant.get_actuation_input_port())
-    sim = Simulator(b.Build())
-    set_pose(plant, plant.GetMyMutableContextFromRoot(sim.get_mutable_context()), p, p.home_pose())
-    t0 = time.perf_counter()
-    sim.AdvanceTo(duration)
-    return duration / (time.perf_counter() - t0)
+from stewart_drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 
 
 def loop_rtf(p, engine, duration):
@@ -83,10 +68,10 @@ def main(argv=None) -> int:
 
     p = load_preset("utn-dynamic")
     loop_rtf(p, "c", 0.01)  # compile and cache the module before timing
-    plant = plant_alone_rtf(p, args.duration)
+    plant = bare_plant(p, DEFAULT_INTEGRATOR, args.duration)["realtime_factor"]  # the closed loops' integrator
     py, sim_py = loop_rtf(p, "python", args.duration)
     c, sim_c = loop_rtf(p, "c", args.duration)
-    print(f"1 kHz, 1 ms plant step, {args.duration:g} s of the seed trajectory on utn-dynamic (real-time factors, one run):")
+    print(f"1 kHz, plant under {DEFAULT_INTEGRATOR}, {args.duration:g} s of the seed trajectory on utn-dynamic (real-time factors, one run):")
     print(f"  plant alone:                         {plant:6.2f}x")
     print(f"  fixed-point controller, Python engine: {py:6.2f}x  ({py / plant:.2f} × plant alone)")
     print(f"  fixed-point controller, C engine:      {c:6.2f}x  ({c / plant:.2f} × plant alone; {c / py:.2f} × the Python engine)")
