@@ -49,7 +49,7 @@ from .study import (
     pose_from_study,
     study_parameters,
 )
-from .track import DONE, FAILED, STALLED, TrackOptions, track
+from .track import DONE, FAILED, STALLED, TrackOptions, engine_used, track
 
 REAL, COMPLEX, INFINITY, SINGULAR, FAIL = "real", "complex", "infinity", "singular", "failed"
 CLASSES = (REAL, COMPLEX, INFINITY, SINGULAR, FAIL)
@@ -89,7 +89,8 @@ class HomotopyResult:
     """Outcome for one length set. ``classes`` ``(n_paths,)`` per-path class (``CLASSES``); ``modes``
     the real solutions; ``complete`` and ``guarantee`` as in the module docstring; ``failed_paths``
     path indices that failed even after re-tracking; ``retracked`` those re-tracked; ``steps``
-    ``(n_paths,)`` tracker steps; ``attempts`` how many random γ were used."""
+    ``(n_paths,)`` tracker steps; ``attempts`` how many random γ were used; ``engine`` the tracker
+    implementation that ran ("c" or "numpy", ``track.TrackOptions.engine``)."""
 
     kind: str
     architecture: str
@@ -107,6 +108,7 @@ class HomotopyResult:
     dropped: int = 0
     time_s: float = 0.0
     timing: dict = field(default_factory=dict)
+    engine: str = ""
 
     @property
     def n_paths(self) -> int:
@@ -342,7 +344,8 @@ def solve_batch(
         )
     total = time.perf_counter() - t_start
     timing = {"stage1": t_stage1, "track": t_track, "classify": t_class, "certify": total - t_stage1 - t_track - t_class}
-    return [HomotopyResult(**{**r.__dict__, "time_s": total / m, "timing": timing}) for r in results]
+    engine = engine_used(options)
+    return [HomotopyResult(**{**r.__dict__, "time_s": total / m, "timing": timing, "engine": engine}) for r in results]
 
 
 def solve(platform: Platform, lengths, **kwargs) -> HomotopyResult:
