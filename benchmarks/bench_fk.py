@@ -83,10 +83,43 @@ def assembly_times() -> list[tuple]:
     return rows
 
 
-# fkSGP (Martyushev et al., elimination templates, Mech. Mach. Theory 2025), published per-case times in
-# Python: ~11-15 ms on Dietmaier's general 6-6, ~5 ms on a planar 6-6; it does not handle the 3-fold
-# symmetric 6-6 (roots at infinity) nor 3-6 platforms. Quoted from its paper, not measured here.
+# fkSGP (Martyushev, elimination templates, Mech. Mach. Theory 215 (2025) 106170, arXiv 2505.00634), per-case
+# times in Python as quoted by the project's issue 15: ~11-15 ms on Dietmaier's general 6-6, ~5 ms on a planar
+# 6-6; it does not handle the 3-fold symmetric 6-6 (roots at infinity) nor 3-6 platforms. Not measured here
+# unless --fksgp points at a checkout of github.com/martyushev/fkSGP (MIT; not part of this project).
 FKSGP_MS = {"dietmaier-1998": "11-15", "planar": "~5", "gonzalez-dutra-2009": "fails", "utn-dynamic": "fails", "utn-kinematic": "fails"}
+
+
+def fksgp_times(path, cases, repeat: int) -> dict:
+    """{label: (median CPU ms per length set, real postures it returned per set)} of fkSGP's Python solver
+    (``solver66``; ``solver6p6p`` when both plates are planar) on the same cases, from a checkout at
+    ``path``. Its frames put the first base and plate anchors at the origin (a change of pose
+    coordinates only); its squared-length input is L²; its internal random rotations are seeded."""
+    import sys
+
+    sys.path.insert(0, str(path))
+    import python as fk  # the checkout's python/ package
+
+    out = {}
+    for label, _, p, Ls in cases:
+        X = p.base_anchors - p.base_anchors[0]
+        x = p.top_anchors_per_leg - p.top_anchors_per_leg[0]
+        planar = np.all(np.abs(X[:, 2]) < 1e-12) and np.all(np.abs(x[:, 2]) < 1e-12)
+        solver = fk.solver6p6p if planar else fk.solver66
+        np.random.seed(0)
+        cs, n_real = [], []
+        for L in Ls:
+            for _ in range(repeat):
+                c0 = time.process_time()
+                try:
+                    Rt, _ = solver(X, x, L**2, 1)
+                    n = len(Rt)
+                except Exception as err:  # its template assumes 40 finite roots: report how it fails
+                    n = type(err).__name__
+                cs.append(time.process_time() - c0)
+            n_real.append(n)
+        out[label] = (1e3 * float(np.median(cs)), n_real)
+    return out
 
 
 def homotopy_cases(n_poses: int):
@@ -151,8 +184,9 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
                 t_ms.append(time.perf_counter() - t0)
                 c_ms.append(time.process_time() - c0)
         nan = float("nan")
+        n_real = [sum(c == "real" for c in r.classes) for r in outs["c"]]
         rows.append((label, key, per_engine, same, 1e3 * float(np.median(t_ms)) if t_ms else nan,
-                     1e3 * float(np.median(c_ms)) if c_ms else nan))
+                     1e3 * float(np.median(c_ms)) if c_ms else nan, n_real))
     return rows
 
 
@@ -179,24 +213,39 @@ def homotopy_batch(n: int) -> list[tuple]:
     return rows
 
 
+def fksgp_cell(measured, n_real, quoted: str) -> str:
+    """fkSGP's CPU ms when measured ("*" when its real postures differ from the homotopy's), else the quote."""
+    if measured is None:
+        return quoted
+    ms, its = measured
+    return f"{ms:.1f}" + ("" if its == n_real else "*")
+
+
 def print_homotopy(args) -> None:
     print("\n# Complete FK by parameter homotopy (all paths, classified, real modes certified) vs multi-start")
     print("# engines: c = compiled tracker (default), numpy = the vectorised reference tracker")
     print(f"{'case':32s} {'paths':>9s} {'complete':>8s} {'cert':>5s} {'c ms':>6s} {'c cpu':>6s} {'numpy ms':>8s} "
           f"{'np cpu':>6s} {'stage1 c/np':>11s} {'same':>5s} {'multi cpu':>9s} {'multi/c':>7s} {'multi/np':>8s} "
           f"{'np/c':>5s} {'fkSGP ms':>8s}  classes")
-    rows = homotopy_times(3 if args.quick else 5, 3 if args.quick else 5, not args.homotopy_only)
-    for label, key, pe, same, ms, mcpu in rows:
+    n_poses, repeat = (3, 3) if args.quick else (5, 5)
+    rows = homotopy_times(n_poses, repeat, not args.homotopy_only)
+    fk = fksgp_times(args.fksgp, homotopy_cases(n_poses), repeat) if args.fksgp else {}
+    for label, key, pe, same, ms, mcpu, n_real in rows:
         (n2, nmax, counts), ok, cert, med, cpu, first = pe["c"]
         _, ok2, cert2, med2, cpu2, first2 = pe["numpy"]
         cls = " ".join(f"{k}={v}" for k, v in counts.items() if v)
         print(f"{label:32s} {n2:4d}/{nmax:<4d} {str(ok and ok2):>8s} {str(cert and cert2):>5s} {med:6.1f} {cpu:6.1f} "
               f"{med2:8.1f} {cpu2:6.1f} {first:5.0f}/{first2:<5.0f} {str(same):>5s} {mcpu:9.1f} {mcpu / cpu:7.1f} "
-              f"{mcpu / cpu2:8.1f} {cpu2 / cpu:5.1f} {FKSGP_MS[key]:>8s}  {cls}")
+              f"{mcpu / cpu2:8.1f} {cpu2 / cpu:5.1f} {fksgp_cell(fk.get(label), n_real, FKSGP_MS[key]):>8s}  {cls}")
     print("(ms: median per length set, wall and process CPU time, with the platform's stage one cached; stage1: its")
     print(" one-time wall cost (ms); same: both engines gave the same path classes and real modes; ratios: CPU time,")
     print(" measured in this run (CPU because the machine may be shared: wall time then includes waiting); fkSGP:")
-    print(" published, not measured here; complete/cert: for both engines)")
+    print(" " + ("CPU ms measured in this run (--fksgp), * = its real postures differ from the homotopy's" if fk
+                 else "quoted, not measured here") + "; complete/cert: for both engines)")
+    if fk:
+        print("real postures per length set, homotopy vs fkSGP (realOnly; an exception name where it raised):")
+        for label, _, _, _, _, _, n_real in rows:
+            print(f"  {label:32s} homotopy {n_real}  fkSGP {fk[label][1]}")
     print("\n# Batched homotopy: many length sets of one platform in one call")
     for name, engine, n, per, cpu, n_ok, timing in homotopy_batch(20 if args.quick else 100):
         tm = ", ".join(f"{k} {v:.2f} s" for k, v in timing.items())
@@ -208,6 +257,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="smaller batches")
     ap.add_argument("--homotopy", action="store_true", help="only the complete-FK (homotopy vs multi-start) section")
     ap.add_argument("--homotopy-only", action="store_true", help="only the homotopy timings, without the multi-start comparison")
+    ap.add_argument("--fksgp", metavar="DIR", help="a checkout of github.com/martyushev/fkSGP: time its Python solver on the same cases")
     args = ap.parse_args(argv)
     n = 20_000 if args.quick else 100_000
     if args.homotopy or args.homotopy_only:
