@@ -44,7 +44,47 @@ typedef struct {
     const cplx *B0, *dB; /* (6, 4, 4) row-major */
     int fixed;           /* dB == 0: only the lengths move */
     const cplx *v;       /* (8,) chart */
+    double Br[6][4][4];  /* real parts of B0, used when fixed and B0 is real (a real platform's anchors) */
+    int real;
 } System;
+
+/* evaluate() for a fixed real B (the second stage: this platform's own anchors): the products with B
+ * are real × complex, a third of the arithmetic. */
+static void evaluate_real(const System *S, const cplx *s0, const cplx *ds, cplx gamma, const cplx *x, double t,
+                          cplx J[8][8], cplx R[8][2]) {
+    cplx d = gamma * t + (1.0 - t);
+    cplx tau = cdiv(gamma * t, d);
+    cplx dtau = cdiv(gamma, cmul(d, d));
+    const cplx *e = x, *g = x + 4;
+    cplx ee = cmul(e[0], e[0]) + cmul(e[1], e[1]) + cmul(e[2], e[2]) + cmul(e[3], e[3]);
+    for (int i = 0; i < 6; i++) {
+        const double(*B)[4] = S->Br[i];
+        cplx u[4];
+        for (int r = 0; r < 4; r++) u[r] = g[r] + B[r][0] * e[0] + B[r][1] * e[1] + B[r][2] * e[2] + B[r][3] * e[3];
+        cplx s = s0[i] + cmul(tau, ds[i]);
+        cplx uu = cmul(u[0], u[0]) + cmul(u[1], u[1]) + cmul(u[2], u[2]) + cmul(u[3], u[3]);
+        R[i][0] = uu - cmul(s, ee);
+        R[i][1] = cmul(-cmul(ds[i], ee), dtau);
+        for (int c = 0; c < 4; c++) {
+            cplx BTu = B[0][c] * u[0] + B[1][c] * u[1] + B[2][c] * u[2] + B[3][c] * u[3];
+            J[i][c] = 2.0 * (BTu - cmul(s, e[c]));
+            J[i][4 + c] = 2.0 * u[c];
+        }
+    }
+    cplx ge = 0, vx = 0;
+    for (int k = 0; k < 4; k++) {
+        ge += cmul(g[k], e[k]);
+        J[6][k] = g[k];
+        J[6][4 + k] = e[k];
+    }
+    for (int k = 0; k < 8; k++) {
+        vx += cmul(S->v[k], x[k]);
+        J[7][k] = S->v[k];
+    }
+    R[6][0] = ge;
+    R[7][0] = vx - 1.0;
+    R[6][1] = R[7][1] = 0;
+}
 
 /* H_x (8x8, row-major) and the right-hand sides [H | dH/dt] (8x2) at (x, t) for a path with s0, ds (6,)
  * and gamma. */
@@ -148,7 +188,10 @@ static void solve8(cplx J[8][8], cplx R[8][2]) {
 static void newton_tangent(const System *S, const cplx *s0, const cplx *ds, cplx gamma, const cplx *x, double t,
                            cplx *xn, cplx *xd) {
     cplx J[8][8], R[8][2];
-    evaluate(S, s0, ds, gamma, x, t, J, R);
+    if (S->real)
+        evaluate_real(S, s0, ds, gamma, x, t, J, R);
+    else
+        evaluate(S, s0, ds, gamma, x, t, J, R);
     solve8(J, R);
     for (int k = 0; k < 8; k++) {
         xn[k] = x[k] - R[k][0];
@@ -159,7 +202,7 @@ static void newton_tangent(const System *S, const cplx *s0, const cplx *ds, cplx
 static double maxabs(const cplx *z) {
     double m = 0;
     for (int k = 0; k < 8; k++) {
-        double a = hypot(creal(z[k]), cimag(z[k]));
+        double a = sqrt(creal(z[k]) * creal(z[k]) + cimag(z[k]) * cimag(z[k]));
         if (a > m || isnan(a)) m = a;
         if (isnan(m)) return m;
     }
@@ -183,7 +226,11 @@ void sd_track(int64_t n, const double *x0_, const double *B0_, const double *dB_
               int64_t end_newton, double *x_out_, double *t_out, int64_t *state_out, int64_t *steps_out) {
     const cplx *x0 = (const cplx *)x0_, *s0a = (const cplx *)s0_, *dsa = (const cplx *)ds_, *gam = (const cplx *)gamma_;
     cplx *x_out = (cplx *)x_out_;
-    System S = {(const cplx *)B0_, (const cplx *)dB_, fixed, (const cplx *)v_};
+    System S = {(const cplx *)B0_, (const cplx *)dB_, fixed, (const cplx *)v_, {{{0}}}, fixed};
+    for (int k = 0; k < 96; k++) {
+        if (B0_[2 * k + 1] != 0) S.real = 0;
+        S.Br[k / 16][(k / 4) % 4][k % 4] = B0_[2 * k];
+    }
     const double h0 = opts[0], h_max = opts[1], h_min = opts[2], target = opts[3], tol = opts[4], max_jump = opts[5],
                  contraction = opts[6], endgame = opts[7];
     for (int64_t p = 0; p < n; p++) {
