@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..firmware.build import CompilerUnavailable, Source, build, cache_dir, load
+from stewart_drake.firmware.build import CompilerUnavailable, Source, build, cache_dir, load
 
 SOURCE = Path(__file__).with_name("track.c")
 CDEF = """

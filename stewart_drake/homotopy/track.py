@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import ctrack
+from stewart_drake.homotopy import ctrack
 
 ACTIVE, DONE, STALLED, FAILED = 0, 1, 2, 3
 STATE_TEXT = {ACTIVE: "active", DONE: "reached t = 1", STALLED: "stalled at a singular end point", FAILED: "failed"}
