@@ -1,7 +1,9 @@
 """Forward-kinematics throughput: batched Newton, Drake MathematicalProgram, all assembly modes
 (multi-start search and the complete parameter homotopy of ``stewart_drake.homotopy``).
 
-Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--quick]``. Pins nothing; prints absolute
+Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--quick] [--homotopy|--homotopy-only] [--fksgp DIR]``.
+The homotopy section times both path-tracker engines (compiled ``c``, the default, and the ``numpy`` reference)
+in the same run, and, with ``--fksgp``, fkSGP's own Python solver from a checkout of it. Pins nothing; prints absolute
 figures for this machine and ratios measured in the same run (the ratios travel between machines,
 the absolute numbers do not). Single core: set OMP/OPENBLAS threads to 1 before numpy loads.
 """
