@@ -1,4 +1,4 @@
-"""Vectorised path tracking for the parameter homotopy of ``study``.
+"""Path tracking for the parameter homotopy of ``study`` (compiled, with a vectorised numpy reference).
 
 Every path k follows H(x, t) = F(x; P_k(τ(t))) = 0 from t = 0 to t = 1. The parameters move on the
 straight segment P(τ) = P0 + τ (P1 − P0): leg matrices B ``(6, 4, 4)`` shared by all paths (one
@@ -7,7 +7,7 @@ per path (the "gamma trick": the real interval t ∈ [0, 1] becomes a complex ar
 meets the discriminant locus — where two solutions collide — with probability zero, so the paths stay
 non-singular for t < 1 and never cross).
 
-All paths advance together, each with its own t and step h. One step:
+Each path has its own t and step h. One step:
 - predictor: cubic Hermite extrapolation through the last two accepted points and their tangents
   dx/dt = −H_x⁻¹ H_t (Euler on the first step), local error O(h⁴);
 - corrector: two Newton iterations at the new t; each solve also returns the tangent there (one
@@ -25,7 +25,9 @@ root, or a root on the exceptional set e = 0 —, where H_x is singular) or FAIL
 Two implementations of the same algorithm: ``_track_numpy`` (all paths in lockstep, vectorised; the
 reference) and the compiled ``track.c`` (``ctrack``; one path at a time, each for its own number of
 steps). ``TrackOptions.engine`` picks one: "auto" (compiled when a C compiler is available), "c" or
-"numpy".
+"numpy". Why compiled: the lockstep loop costs (steps of the slowest path) × (≈ 20 numpy calls of
+≈ 10 µs), ≈ 80 × 250 µs for a 6-6 length set whose paths average 30 steps; the C loop costs ≈ 1–2 µs
+per step of each path.
 """
 
 from __future__ import annotations
