@@ -356,3 +356,24 @@ def test_tracker_falls_back_to_numpy_without_a_compiler(monkeypatch, tmp_path):
         solve(p, L, options=TrackOptions(engine="c"))
     with pytest.raises(ValueError, match="engine"):
         solve(p, L, options=TrackOptions(engine="fortran"))
+
+
+def test_duplicate_end_points_are_found():
+    """Two end points that are the same pose (equal, or negatives: x and −x are one Study point) closer
+    than DISTINCT_TOL in the max-norm are reported, both of them; points just farther apart are not.
+    Checked against the plain all-pairs comparison on random sets."""
+    from stewart_drake.homotopy.solve import DISTINCT_TOL, _duplicates
+
+    rng = np.random.default_rng(11)
+    for trial in range(50):
+        y = rng.normal(size=(40, 8)) + 1j * rng.normal(size=(40, 8))
+        for _ in range(trial % 4):
+            a, b = rng.choice(40, 2, replace=False)
+            y[b] = rng.choice([-1, 1]) * y[a] + rng.uniform(0, 2 * DISTINCT_TOL) * rng.normal(size=8)
+        idx = np.arange(40)[::-1]
+        z = y[idx]
+        d = np.minimum(np.abs(z[:, None] - z[None]).max(-1), np.abs(z[:, None] + z[None]).max(-1)) + np.diag(np.full(40, np.inf))
+        expected = sorted(int(i) for i in idx[np.any(d <= DISTINCT_TOL * np.maximum(1, np.abs(z).max(-1))[:, None], axis=1)])
+        assert _duplicates(y, idx) == expected
+    y[7] = -y[3]
+    assert {3, 7} <= set(_duplicates(y, np.arange(40)))

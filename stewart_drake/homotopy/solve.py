@@ -166,10 +166,17 @@ def _duplicates(y: np.ndarray, idx: np.ndarray) -> list[int]:
     z = y[idx]
     if len(z) < 2:
         return []
-    d = np.minimum(np.abs(z[:, None] - z[None]).max(-1), np.abs(z[:, None] + z[None]).max(-1))
-    d[np.diag_indices(len(z))] = np.inf
-    close = d <= DISTINCT_TOL * np.maximum(1.0, np.abs(z).max(-1))[:, None]
-    return sorted(int(i) for i in idx[np.any(close, axis=1)])
+    tol = DISTINCT_TOL * np.maximum(1.0, np.abs(z).max(-1))
+    # Exact prefilter: |Σ_k (z_ik ∓ z_jk)| <= 8 max_k |z_ik ∓ z_jk|, so a pair within tol (max-norm) has
+    # its coordinate sums within 8 tol; only such pairs (few) get the full comparison.
+    w = z.sum(-1)
+    near = np.minimum(np.abs(w[:, None] - w[None]), np.abs(w[:, None] + w[None])) <= 8 * tol[:, None] * (1 + 1e-9)
+    near[np.diag_indices(len(z))] = False
+    out = set()
+    for i, j in zip(*np.nonzero(near)):
+        if min(np.abs(z[i] - z[j]).max(), np.abs(z[i] + z[j]).max()) <= tol[i]:
+            out.add(int(idx[i]))
+    return sorted(out)
 
 
 @dataclass(frozen=True)
