@@ -192,10 +192,19 @@ def normalise(obj, tmp: str, repo: str):
 
 
 def _parse(text: str):
+    """``text`` as JSON; else, when its tail from a line opening with ``{`` is JSON (``view`` prints its URL
+    first), ``{"text": head, "json": tail}``; else the text itself."""
     try:
         return json.loads(text)
     except ValueError:
-        return text
+        pass
+    at = text.find("\n{")
+    if at >= 0:
+        try:
+            return {"text": text[: at + 1], "json": json.loads(text[at + 1 :])}
+        except ValueError:
+            pass
+    return text
 
 
 def _sha(data: bytes) -> str:
