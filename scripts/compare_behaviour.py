@@ -106,6 +106,18 @@ def diff(a, b, path: str = "$") -> list[tuple[str, object, object]]:
             else:
                 out.append((f"{path}[{i}]", a[i] if i < len(a) else "<absent>", b[i] if i < len(b) else "<absent>"))
         return out
+    if isinstance(a, str) and a != b and ("\n" in a or "\n" in b):
+        # Multi-line text (a raw stdout): the first differing line, not the whole text.
+        la, lb = a.splitlines(), b.splitlines()
+        bad = [k for k in range(max(len(la), len(lb))) if k >= len(la) or k >= len(lb) or la[k] != lb[k]]
+        i = bad[0]
+        return [
+            (
+                f"{path} line {i + 1} (first of {len(bad)} differing lines)",
+                la[i] if i < len(la) else "<absent>",
+                lb[i] if i < len(lb) else "<absent>",
+            )
+        ]
     return [] if a == b else [(path, a, b)]
 
 
