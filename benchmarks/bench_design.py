@@ -18,8 +18,8 @@ from stewart_drake.design.envelope import Envelope, cartesian_leg_forces, envelo
 from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.modes import analytic_modes, spatial_inertia
 from stewart_drake.design.stiffness import principal_stiffness, stiffness_matrix
-from stewart_drake.design_drake import drake_modes
-from stewart_drake.geometry import load_preset
+from stewart_drake.drake.design_checks import drake_modes
+from stewart_drake.core.geometry import load_preset
 
 
 def grid(n_total: int) -> np.ndarray:
@@ -94,7 +94,7 @@ def main(argv=None) -> int:
 
 def _inertia(p, q):
     from stewart_drake.design.envelope import spatial_inertia_about_C
-    from stewart_drake.rotations import rotation_matrix
+    from stewart_drake.core.rotations import rotation_matrix
 
     return spatial_inertia_about_C(p, rotation_matrix(q[..., 3:]))
 

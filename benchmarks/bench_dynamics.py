@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 
-from stewart_drake import dynamics as D
-from stewart_drake import verify_dynamics as V
-from stewart_drake.geometry import load_preset
+import stewart_drake.core.dynamics as D
+import stewart_drake.drake.verify_dynamics as V
+from stewart_drake.core.geometry import load_preset
 
 
 def rate(fn, n, repeat=3):

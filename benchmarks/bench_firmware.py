@@ -23,11 +23,11 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 import numpy as np  # noqa: E402
 from bench_integrators import bare_plant  # noqa: E402  (benchmarks/ is the script's folder)
 
-from stewart_drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 
 
 def loop_rtf(p, engine, duration):
-    from stewart_drake.simulation import build_simulation
+    from stewart_drake.drake.simulation import build_simulation
 
     sim = build_simulation(p, "seed", "fixed", engine=engine)
     t0 = time.perf_counter()
@@ -57,14 +57,14 @@ def main(argv=None) -> int:
     ap.add_argument("--poses", type=int, default=2_000_000, help="poses per IK batch (default 2e6)")
     args = ap.parse_args(argv)
 
-    from stewart_drake.control import ControllerConfig
+    from stewart_drake.control.controller import ControllerConfig
     from stewart_drake.firmware.check import workspace_poses
     from stewart_drake.firmware.generate import generate
     from stewart_drake.firmware.host import tp17_leg_lengths_c
     from stewart_drake.firmware.module import compile_generated
     from stewart_drake.fixedpoint import tp17_leg_lengths
     from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
-    from stewart_drake.geometry import load_preset
+    from stewart_drake.core.geometry import load_preset
 
     p = load_preset("utn-dynamic")
     loop_rtf(p, "c", 0.01)  # compile and cache the module before timing

@@ -17,9 +17,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from stewart_drake.fk import forward_kinematics, sample_poses  # noqa: E402
-from stewart_drake.geometry import load_preset  # noqa: E402
-from stewart_drake.kinematics import leg_lengths  # noqa: E402
+from stewart_drake.core.newton_fk import forward_kinematics, sample_poses  # noqa: E402
+from stewart_drake.core.geometry import load_preset  # noqa: E402
+from stewart_drake.core.kinematics import leg_lengths  # noqa: E402
 
 
 def best_of(f, repeat=3):
@@ -48,7 +48,7 @@ def newton_rates(n: int) -> list[tuple]:
 
 
 def program_times(repeat: int) -> list[tuple]:
-    from stewart_drake.forward import ProgramFK
+    from stewart_drake.core.assembly_modes import ProgramFK
 
     p = load_preset("gonzalez-dutra-2009")
     q = p.home_pose() + [0.05, -0.03, 0.02, 0.1, -0.05, 0.2]
@@ -67,7 +67,7 @@ def program_times(repeat: int) -> list[tuple]:
 
 
 def assembly_times() -> list[tuple]:
-    from stewart_drake.forward import assembly_modes, dietmaier_platform, general_platform
+    from stewart_drake.core.assembly_modes import assembly_modes, dietmaier_platform, general_platform
 
     cases = [("dietmaier-1998",) + dietmaier_platform()]
     for seed in (0, 4):
@@ -91,7 +91,7 @@ FKSGP_MS = {"dietmaier-1998": "11-15", "planar": "~5", "gonzalez-dutra-2009": "f
 
 def homotopy_cases(n_poses: int):
     """(label, fkSGP key, platform, (k, 6) length sets) for the homotopy benchmark."""
-    from stewart_drake.forward import dietmaier_platform, planar_platform
+    from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
 
     p, L = dietmaier_platform()
     cases = [("dietmaier-1998 (6-6, 40 real)", "dietmaier-1998", p, L[None])]
@@ -109,7 +109,7 @@ def homotopy_cases(n_poses: int):
 def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tuple]:
     """Per length set: homotopy median time (stage one cached), its one-time stage-one cost, the
     multi-start search's time (polish off) on the same sets, and the outcome."""
-    from stewart_drake.forward import assembly_modes
+    from stewart_drake.core.assembly_modes import assembly_modes
     from stewart_drake.homotopy import solve
     from stewart_drake.homotopy.solve import _PLATFORM_STARTS
 
@@ -145,7 +145,7 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
 
 def homotopy_batch(n: int) -> list[tuple]:
     """Batched mode: n length sets of one platform in one call, per-set time."""
-    from stewart_drake.forward import dietmaier_platform, planar_platform
+    from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
     from stewart_drake.homotopy import solve_batch
 
     rows = []

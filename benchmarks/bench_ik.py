@@ -7,9 +7,9 @@ import time
 
 import numpy as np
 
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.sampling import random_poses
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.sampling import random_poses
 
 
 def loop_ik(platform, poses):

@@ -20,10 +20,10 @@ import time
 
 import numpy as np
 
-from stewart_drake import integrators
-from stewart_drake.geometry import load_platform
-from stewart_drake.integrators import INTEGRATORS, apply_integrator, constraint_gaps
-from stewart_drake.simulation import build_simulation, get_trajectory
+import stewart_drake.drake.integrators as integrators
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.drake.integrators import INTEGRATORS, apply_integrator, constraint_gaps
+from stewart_drake.drake.simulation import build_simulation, get_trajectory
 
 
 REFERENCE_ACCURACY = 1e-8
@@ -47,8 +47,8 @@ def bare_plant(platform, integrator, duration):
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
-    from stewart_drake.dynamics import leg_forces_with_legs
-    from stewart_drake.model import build_plant, set_pose
+    from stewart_drake.core.dynamics import leg_forces_with_legs
+    from stewart_drake.drake.platform_model import build_plant, set_pose
 
     builder = DiagramBuilder()
     plant, _ = build_plant(platform, 1e-3, builder, continuous=integrator == "cenic")

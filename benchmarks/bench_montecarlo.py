@@ -16,7 +16,7 @@ import json
 import time
 from pathlib import Path
 
-from stewart_drake.geometry import load_platform
+from stewart_drake.core.geometry import load_platform
 from stewart_drake.montecarlo.scenario import Study
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import run_study, study_key, study_settings

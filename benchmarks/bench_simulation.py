@@ -18,12 +18,12 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 from bench_integrators import bare_plant  # noqa: E402  (benchmarks/ is the script's folder)
 
-from stewart_drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 
 
 def rtf(platform, kind, period, duration, plant_step=None):
-    from stewart_drake.control import ControllerConfig, DspTiming
-    from stewart_drake.simulation import SEED, build_simulation
+    from stewart_drake.control.controller import ControllerConfig, DspTiming
+    from stewart_drake.drake.simulation import SEED, build_simulation
 
     t0 = time.perf_counter()
     sim = build_simulation(platform, SEED, kind, ControllerConfig(timing=DspTiming(sample_period=period)),
@@ -38,7 +38,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--duration", type=float, default=4.0, help="simulated seconds per run (default 4)")
     args = ap.parse_args(argv)
-    from stewart_drake.geometry import load_preset
+    from stewart_drake.core.geometry import load_preset
 
     p = load_preset("utn-dynamic")
     # the plant alone (held at home by its static leg forces), under the closed loops' integrator: the ceiling

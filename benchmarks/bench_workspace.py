@@ -19,7 +19,7 @@ import tracemalloc
 import numpy as np
 
 from stewart_drake import workspace as ws
-from stewart_drake.geometry import load_preset
+from stewart_drake.core.geometry import load_preset
 
 
 def timed(fn, *args, repeat=1, **kwargs):
@@ -112,7 +112,7 @@ def main(argv=None) -> int:
             serial[name] = (fn, a, kw, t1)
             print(f"   {name:32s}: 1 process {t1:6.2f} s, 2 processes {t2:6.2f} s -> speed-up {t1 / t2:.2f}x (incl. pool start)")
         try:
-            from stewart_drake.workspace_dask import close_client, dask_executor, local_client
+            from stewart_drake.workspace.dask_sweep import close_client, dask_executor, local_client
         except ImportError:
             print("   dask: not installed")
         else:

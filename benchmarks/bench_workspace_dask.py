@@ -21,8 +21,8 @@ import time
 import numpy as np
 
 from stewart_drake import workspace as ws
-from stewart_drake import workspace_dask as wd
-from stewart_drake.geometry import load_preset
+import stewart_drake.workspace.dask_sweep as wd
+from stewart_drake.core.geometry import load_preset
 
 
 def _cpu() -> float:

@@ -12,10 +12,10 @@ import argparse
 
 import numpy as np
 
-from stewart_drake.forward import assembly_modes, general_platform, planar_platform
-from stewart_drake.geometry import Platform
+from stewart_drake.core.assembly_modes import assembly_modes, general_platform, planar_platform
+from stewart_drake.core.geometry import Platform
 from stewart_drake.homotopy import solve
-from stewart_drake.kinematics import leg_lengths
+from stewart_drake.core.kinematics import leg_lengths
 
 
 def same_modes(a, b, tol: float = 1e-8) -> bool:

@@ -12,8 +12,8 @@ import sys
 
 import numpy as np
 
-from . import __version__, commands
-from .errors import StewartError, UsageError
+from stewart_drake import __version__, commands
+from stewart_drake.errors import StewartError, UsageError
 
 
 class Number(float):

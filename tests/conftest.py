@@ -11,7 +11,7 @@ if "STEWART_DRAKE_CACHE" not in os.environ:
 
 import pytest  # noqa: E402
 
-from stewart_drake.geometry import PRESETS, load_preset  # noqa: E402
+from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
 
 
 @pytest.fixture(params=PRESETS)

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.browser import Browser, find_chromium
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
+from stewart_drake.report.browser import Browser, find_chromium
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
 
 pytestmark = pytest.mark.skipif(find_chromium() is None, reason="Chromium or websocket-client not installed: run scripts/ensure-chromium")
 
@@ -86,7 +86,7 @@ def test_report_renders_cleanly(browser, tmp_path):
 
 
 def _animation_html(tmp_path):
-    from stewart_drake.animation import record_animation
+    from stewart_drake.drake.animation import record_animation
 
     p = load_preset("utn-dynamic")
     t = np.linspace(0.0, 1.0, 1001)

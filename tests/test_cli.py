@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
 
 
 def run(capsys, *argv):

@@ -9,7 +9,7 @@ other system reads at t; a tick's or release's effect appears in the samples aft
 import numpy as np
 import pytest
 
-from stewart_drake.control import (
+from stewart_drake.control.controller import (
     STATUS,
     ControllerConfig,
     DspTiming,
@@ -21,9 +21,9 @@ from stewart_drake.control import (
     tick_cycles,
 )
 from stewart_drake.fixedpoint import QFormat, fixed_point_leg_lengths, tp17_cycles
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.simulation import ROTATING, SEED, Trajectory, pose_source
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.drake.simulation import ROTATING, SEED, Trajectory, pose_source
 
 PLATFORM = load_preset("utn-dynamic")
 T = 1e-3
@@ -273,9 +273,9 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
     Newton–Euler of ``leg_forces_with_legs``)."""
     from dataclasses import replace
 
-    from stewart_drake.control import leg_space_inertia
-    from stewart_drake.dynamics import mass_matrix
-    from stewart_drake.kinematics import length_jacobian
+    from stewart_drake.control.controller import leg_space_inertia
+    from stewart_drake.core.dynamics import mass_matrix
+    from stewart_drake.core.kinematics import length_jacobian
 
     p = load_preset("utn-kinematic")
     bare = p.replace(legs=replace(p.legs, cylinder_mass=0.0, piston_mass=0.0))
@@ -288,7 +288,7 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
 
 @pytest.mark.parametrize("name", ["utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009"])
 def test_design_gains_follow_the_documented_rules(name):
-    from stewart_drake.control import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
+    from stewart_drake.control.controller import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
                                        UNKNOWN_POSE_STIFFNESS_FACTOR, design_gains, leg_space_inertia, loop_delay,
                                        strut_stiffness)
 
@@ -319,8 +319,8 @@ def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory
     over a full period (2π s) of each trajectory, more and other poses than the design's 64 over 4 s, with
     the pose's own K and heaviest mass. (The home-only design of 6b broke it on utn-kinematic: kp 15.3 kN/m
     against K up to 14.6 kN/m and ki 66 kN/(m·s), ~25 × the limit; the loop grew at ~2 Hz.)"""
-    from stewart_drake.control import design_gains, leg_space_inertia, strut_stiffness
-    from stewart_drake.simulation import design_poses, fit_trajectory, get_trajectory
+    from stewart_drake.control.controller import design_gains, leg_space_inertia, strut_stiffness
+    from stewart_drake.drake.simulation import design_poses, fit_trajectory, get_trajectory
 
     p = load_preset(name)
     traj = fit_trajectory(get_trajectory(base), p)
@@ -334,7 +334,7 @@ def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory
 
 
 def test_strut_stiffness_and_inertia_are_vectorised_over_poses():
-    from stewart_drake.control import leg_space_inertia, strut_stiffness
+    from stewart_drake.control.controller import leg_space_inertia, strut_stiffness
 
     p = load_preset("utn-kinematic")
     q = p.home_pose() + np.array([[0, 0, 0, 0, 0, 0], [0.02, -0.01, 0.01, 0.05, 0.0, 0.2]])
@@ -346,8 +346,8 @@ def test_strut_stiffness_matches_the_open_loop_growth():
     """The negative stiffness K of the struts and the open-loop growth rate λ (``dynamics``) describe the
     same instability: the fastest growth needs λ² ≤ K / m_min (a stiffness K on the lightest mass), and
     the slowest unstable mode at least K / m_max — so λ_max² · m_min <= K <= λ_max² · m_max."""
-    from stewart_drake.control import leg_space_inertia, strut_stiffness
-    from stewart_drake.dynamics import open_loop_growth_rates
+    from stewart_drake.control.controller import leg_space_inertia, strut_stiffness
+    from stewart_drake.core.dynamics import open_loop_growth_rates
 
     for name in ("utn-dynamic", "utn-kinematic"):
         p = load_preset(name)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.geometry import load_platform
-from stewart_drake.simulation import SEED, load_trajectory_csv, simulate
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.drake.simulation import SEED, load_trajectory_csv, simulate
 
 
 def test_sampled_seed_tracks_like_the_closed_form(tmp_path):

@@ -7,8 +7,8 @@ import numpy as np
 from stewart_drake.design.maps import slice_maps
 from stewart_drake.design.modes import analytic_modes, spatial_inertia
 from stewart_drake.design.stiffness import principal_stiffness, stiffness_matrix
-from stewart_drake.geometry import load_platform
-from stewart_drake.kinematics import condition_number
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.kinematics import condition_number
 
 
 def test_slice_maps_match_single_pose_computations():

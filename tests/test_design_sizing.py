@@ -14,8 +14,8 @@ from stewart_drake.design.envelope import Envelope, EnvelopeError, cartesian_leg
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.sizing import leg_motion, rotating_trajectory, size_trajectory
 from stewart_drake.design.verify import newton_euler_fd, sample_box
-from stewart_drake.geometry import load_platform
-from stewart_drake.simulation import ROTATING
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.drake.simulation import ROTATING
 
 @pytest.fixture(scope="module")
 def loaded_platform():
@@ -43,7 +43,7 @@ def test_sizing_equals_newton_euler_by_finite_differences(loaded_platform):
 
 def test_sizing_with_translation_and_rotation(loaded_platform):
     """A trajectory moving every coordinate at once (the rotating one turns about x and z only)."""
-    from stewart_drake.dynamics import harmonic_trajectory
+    from stewart_drake.core.dynamics import harmonic_trajectory
 
     args = ([0.01, -0.02, 0.7, 0.02, -0.03, 0.05], [0.03, 0.02, 0.01, 0.06, 0.05, 0.2], [1.3, 2.1, 2.9, 1.7, 2.3, 3.1], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
     t = np.linspace(0.0, 3.0, 301)

@@ -14,8 +14,8 @@ from stewart_drake.cli import main
 from stewart_drake.design.modes import analytic_modes, damping_matrix, mac, spatial_inertia, subspace_mac
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.stiffness import deflection, principal_stiffness, stiffness_matrix
-from stewart_drake.design_drake import drake_modes
-from stewart_drake.geometry import load_platform
+from stewart_drake.drake.design_checks import drake_modes
+from stewart_drake.core.geometry import load_platform
 
 G = 9.81
 Q_OFF = np.array([0.05, -0.03, 0.72, 0.1, -0.05, 0.2])  # an asymmetric pose: no repeated frequencies
@@ -111,7 +111,7 @@ def test_deflection_solves_the_nonlinear_statics_to_first_order(loaded):
 def test_spatial_inertia_matches_inverse_dynamics(loaded):
     """M_C by formula equals the one read off the toolkit's inverse dynamics (unit accelerations)."""
     from stewart_drake.design.envelope import cartesian_leg_forces
-    from stewart_drake.kinematics import inverse_jacobian
+    from stewart_drake.core.kinematics import inverse_jacobian
 
     A = inverse_jacobian(loaded, Q_OFF)
     F = cartesian_leg_forces(loaded, np.broadcast_to(Q_OFF, (6, 6)), np.zeros((6, 6)), np.eye(6), gravity=0.0)

@@ -4,10 +4,10 @@ seed's printed M(q), finite differences, Christoffel symbols and Drake."""
 import numpy as np
 import pytest
 
-from stewart_drake import dynamics as D
+import stewart_drake.core.dynamics as D
 from stewart_drake.errors import SingularPoseError
-from stewart_drake.geometry import load_preset, triangular_plate
-from stewart_drake.kinematics import leg_lengths, leg_unit_vectors, length_jacobian
+from stewart_drake.core.geometry import load_preset, triangular_plate
+from stewart_drake.core.kinematics import leg_lengths, leg_unit_vectors, length_jacobian
 
 G = 9.81
 
@@ -92,7 +92,7 @@ def test_length_jacobian_against_finite_differences(plat, convention):
 def test_euler_rate_derivative_against_finite_differences(convention):
     rng = np.random.default_rng(3)
     th, thd = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
-    from stewart_drake.rotations import angular_velocity_map
+    from stewart_drake.core.rotations import angular_velocity_map
 
     h = 1e-6
     fd = (angular_velocity_map(th + h * thd, convention) - angular_velocity_map(th - h * thd, convention)) @ thd / (2 * h)

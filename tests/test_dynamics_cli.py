@@ -4,9 +4,9 @@ import json
 
 import numpy as np
 
-from stewart_drake import dynamics as D
+import stewart_drake.core.dynamics as D
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_preset
+from stewart_drake.core.geometry import load_preset
 
 
 def test_seed_json_matches_library(capsys):

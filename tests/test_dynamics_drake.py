@@ -4,9 +4,9 @@ coordinates), the closed-loop model with massive legs, and an open-loop closed-l
 import numpy as np
 import pytest
 
-from stewart_drake import dynamics as D
-from stewart_drake import verify_dynamics as V
-from stewart_drake.geometry import load_preset
+import stewart_drake.core.dynamics as D
+import stewart_drake.drake.verify_dynamics as V
+from stewart_drake.core.geometry import load_preset
 
 # Both sides are double-precision evaluations of the same physics with O(10) operations per term and
 # forces of O(10 N); J is well conditioned (< 100 here). Rounding gives ~1e-14 N; 1e-9 N is the bound.

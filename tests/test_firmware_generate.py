@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
+from stewart_drake.control.controller import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
 from stewart_drake.firmware import build
 from stewart_drake.firmware.check import emulation_trace, trace_names, workspace_poses
 from stewart_drake.firmware.generate import TRACE_WORDS, generate
 from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.fixedpoint import QFormat, SaturationCounter
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
-from stewart_drake.geometry import PRESETS, load_preset
+from stewart_drake.core.geometry import PRESETS, load_preset
 from tests.firmware_cache import firmware_cache  # noqa: F401
 
 
@@ -89,7 +89,7 @@ def test_trace_words_equal_the_emulations():
 def test_tick_equals_the_python_law_on_random_states():
     # sd_tick against control._FixedLaw.compute on random inputs and states (every branch: saturation,
     # anti-windup, with and without feed-forward); the closed-loop runs are in test_firmware_sil
-    from stewart_drake.control import FixedPointController
+    from stewart_drake.control.controller import FixedPointController
 
     p = load_preset("utn-dynamic")
     cfg = ControllerConfig.for_platform(p)

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.geometry import PRESETS, load_preset
-from stewart_drake.simulation import build_simulation, fit_trajectory, get_trajectory
+from stewart_drake.core.geometry import PRESETS, load_preset
+from stewart_drake.drake.simulation import build_simulation, fit_trajectory, get_trajectory
 from tests.firmware_cache import firmware_cache  # noqa: F401
 
 DURATION = 0.12
@@ -36,7 +36,7 @@ def test_closed_loop_logs_bit_identical(name, trajectory):
 
 
 def test_latency_modes_and_no_feedforward_identical():
-    from stewart_drake.control import ControllerConfig, DspTiming
+    from stewart_drake.control.controller import ControllerConfig, DspTiming
 
     p = load_preset("utn-dynamic")
     for latency in ("computation", "none"):

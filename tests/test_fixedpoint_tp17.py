@@ -10,10 +10,10 @@ from stewart_drake.fixedpoint import (CYCLE_TABLE, ERROR_STAGES, QFormat, Satura
                                       dsp_poses_to_si, estimate_cycles, fixed_point_leg_lengths, fixed_point_rotation,
                                       ik_latency_s, tp17_cycles, tp17_error_stages, tp17_leg_lengths, tp17_trace)
 from stewart_drake.fixedpoint import scalar
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.rotations import rotation_matrix
-from stewart_drake.sampling import random_poses
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.sampling import random_poses
 
 # Seed 000 "Tabla comparativa": poses as the firmware takes them (mm; fractions of pi: 18° = 0.1)
 SEED_POSES = np.array([[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]])

@@ -5,9 +5,9 @@ import json
 import numpy as np
 
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.rotations import rotation_matrix
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
 
 
 def run(capsys, *argv):

@@ -4,8 +4,8 @@ multi-start search (``forward.assembly_modes``) and Drake's MathematicalProgram 
 import numpy as np
 import pytest
 
-from stewart_drake.forward import ProgramFK, assembly_modes, dietmaier_platform, planar_platform
-from stewart_drake.geometry import load_preset, load_platform_yaml
+from stewart_drake.core.assembly_modes import ProgramFK, assembly_modes, dietmaier_platform, planar_platform
+from stewart_drake.core.geometry import load_preset, load_platform_yaml
 from stewart_drake.homotopy import architecture, solve, solve_batch
 from stewart_drake.homotopy.certify import certify, newton_real, real_forms
 from stewart_drake.homotopy.start import load_start_system, monodromy_solve
@@ -18,8 +18,8 @@ from stewart_drake.homotopy.study import (
     study_parameters,
 )
 from stewart_drake.homotopy.track import track
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.rotations import rotation_matrix
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
 
 # Two solvers agree on a mode when positions and rotation matrices agree to this: both are
 # Newton-polished to ~1e-15 m leg residual, and the modes are well separated (min distance ~1e-2).
@@ -205,7 +205,7 @@ def test_branch_distance_matches_the_multistart_modes():
     """Branch safety along a short tilt of utn-dynamic: at each sample the distance to the nearest
     other mode equals the one computed from the multi-start's modes at the same lengths (second
     method); the sampled pose is always found among the certified modes."""
-    from stewart_drake.fk import anchor_scale
+    from stewart_drake.core.newton_fk import anchor_scale
     from stewart_drake.homotopy.branches import branch_safety
 
     p = load_preset("utn-dynamic")

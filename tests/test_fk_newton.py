@@ -1,10 +1,10 @@
-"""Batched Newton forward kinematics and Jacobian analysis (``stewart_drake.fk``, plain numpy)."""
+"""Batched Newton forward kinematics and Jacobian analysis (``stewart_drake.core.newton_fk``, plain numpy)."""
 
 import numpy as np
 import pytest
 
 from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError
-from stewart_drake.fk import (
+from stewart_drake.core.newton_fk import (
     CONVERGED,
     check_poses_nonsingular,
     forward_kinematics,
@@ -13,9 +13,9 @@ from stewart_drake.fk import (
     sample_poses,
     validate_lengths,
 )
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import condition_number, inverse_jacobian, leg_lengths
-from stewart_drake.rotations import rotation_matrix
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import condition_number, inverse_jacobian, leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
 
 
 def _exp(w):

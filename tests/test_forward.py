@@ -1,10 +1,10 @@
-"""Drake MathematicalProgram forward kinematics and the assembly-mode search (``stewart_drake.forward``)."""
+"""Drake MathematicalProgram forward kinematics and the assembly-mode search (``stewart_drake.core.assembly_modes``)."""
 
 import numpy as np
 import pytest
 
 from stewart_drake.errors import ForwardKinematicsError
-from stewart_drake.forward import (
+from stewart_drake.core.assembly_modes import (
     ProgramFK,
     assembly_modes,
     best_position,
@@ -13,9 +13,9 @@ from stewart_drake.forward import (
     max_solutions,
     random_rotations,
 )
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths, plate_anchors
-from stewart_drake.rotations import rotation_matrix
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths, plate_anchors
+from stewart_drake.core.rotations import rotation_matrix
 
 MIRROR = np.array([1, 1, -1])
 

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.errors import GeometryError
-from stewart_drake.geometry import (
+from stewart_drake.core.geometry import (
     PRESETS,
     Platform,
     load_platform,

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stewart_drake.geometry import load_platform
-from stewart_drake.integrators import DEFAULT_INTEGRATOR, IntegratorError, constraint_gaps
-from stewart_drake.simulation import build_simulation
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, IntegratorError, constraint_gaps
+from stewart_drake.drake.simulation import build_simulation
 
 DURATION = 0.5
 # The integrators must agree on the legs to well within the fixed-point controller's own set-point

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake import atomic
-from stewart_drake.atomic import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
+import stewart_drake.core.output_folder as atomic
+from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from stewart_drake.cli import main
 from stewart_drake.errors import OutputError
 
@@ -263,8 +263,8 @@ def test_control_character_in_name_refused(here, capsys):
 
 
 def test_preset_sdf_unchanged():
-    from stewart_drake.geometry import PRESETS, load_preset
-    from stewart_drake.model import SDF_DIR, sdf_text
+    from stewart_drake.core.geometry import PRESETS, load_preset
+    from stewart_drake.drake.platform_model import SDF_DIR, sdf_text
 
     for name in PRESETS:
         assert sdf_text(load_preset(name)) == (SDF_DIR / f"{name}.sdf").read_text()
@@ -342,7 +342,7 @@ def test_servo_yaml_uses_the_safe_loader(here, capsys):
 
 @pytest.mark.parametrize("kind", ["utn", "radial", "explicit"])
 def test_platform_templates_load(here, capsys, kind):
-    from stewart_drake.geometry import load_platform
+    from stewart_drake.core.geometry import load_platform
 
     rc, out, _ = cli(capsys, "init", "--platform-template", kind)
     assert rc == 0 and out.startswith("# A stewart-drake platform file")
@@ -356,7 +356,7 @@ def test_platform_templates_load(here, capsys, kind):
 def test_docs_list_every_platform_key():
     import dataclasses
 
-    from stewart_drake.geometry import LegConfig, PlateConfig, PlatformConfig
+    from stewart_drake.core.geometry import LegConfig, PlateConfig, PlatformConfig
 
     doc = (ROOT / "docs" / "platform-file.md").read_text()
     for f in dataclasses.fields(PlatformConfig):

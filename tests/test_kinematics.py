@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from stewart_drake.errors import SingularPoseError, UnreachablePoseError
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import (
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import (
     check_stroke,
     condition_number,
     inverse_jacobian,
@@ -14,8 +14,8 @@ from stewart_drake.kinematics import (
     plate_anchors,
     require_nonsingular,
 )
-from stewart_drake.rotations import rotation_matrix
-from stewart_drake.sampling import random_poses
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.sampling import random_poses
 
 
 def test_utn_home_pose_is_473_2_mm():

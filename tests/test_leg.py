@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from stewart_drake.leg import (
+from stewart_drake.core.leg3r import (
     SEED_FIXES,
     Leg3R,
     UnreachableTargetError,
@@ -118,13 +118,13 @@ def test_seed_ik_is_wrong_and_each_fix_is_needed():
 
 
 def test_sdf_matches_committed_file(tmp_path):
-    from stewart_drake.leg_model import SDF_DIR, write_sdf
+    from stewart_drake.drake.leg_model import SDF_DIR, write_sdf
 
     assert write_sdf(LEG, tmp_path).read_text() == (SDF_DIR / "leg-3r.sdf").read_text()
 
 
 def test_fk_matches_drake():
-    from stewart_drake.leg_model import drake_fk_errors
+    from stewart_drake.drake.leg_model import drake_fk_errors
 
     q = random_configurations(LEG, 200, seed=6)
     assert drake_fk_errors(LEG, q).max() < 1e-14  # every DH frame, 4x4 element-wise
@@ -132,7 +132,7 @@ def test_fk_matches_drake():
 
 @pytest.mark.parametrize("branch", ["a", "b"])
 def test_ik_matches_drake_inverse_kinematics(branch):
-    from stewart_drake.leg_model import drake_ik
+    from stewart_drake.drake.leg_model import drake_ik
 
     q = random_configurations(LEG, 1000, seed=7)
     p = foot(LEG, q)[:, :2]

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from stewart_drake.geometry import PRESETS, load_preset
-from stewart_drake.model import build_plant, leg_joint_positions, sdf_path, sdf_text, set_pose
-from stewart_drake.sampling import random_poses
-from stewart_drake.verify import anchor_frames, drake_fk_tip_errors, drake_ik_lengths, make_plant
-from stewart_drake.kinematics import leg_lengths
+from stewart_drake.core.geometry import PRESETS, load_preset
+from stewart_drake.drake.platform_model import build_plant, leg_joint_positions, sdf_path, sdf_text, set_pose
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.drake.verify_kinematics import anchor_frames, drake_fk_tip_errors, drake_ik_lengths, make_plant
+from stewart_drake.core.kinematics import leg_lengths
 
 # SNOPT closes the ball constraints to its feasibility tolerance (1e-10 m scale); the recovered leg
 # lengths then agree to ~1e-10 m. 1e-8 m leaves margin and is still 100x tighter than the 1e-6 m asked.

@@ -4,8 +4,8 @@ dynamics untouched by it. Measured on the geometry Drake's SceneGraph reports, n
 import numpy as np
 import pytest
 
-from stewart_drake.geometry import load_preset
-from stewart_drake.model import build_plant, convex_outline, leg_dimensions, leg_visual_dimensions
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.drake.platform_model import build_plant, convex_outline, leg_dimensions, leg_visual_dimensions
 
 # Poses and shape sizes come straight from the SDF's 15 significant digits: ~1e-15 m of rounding.
 GEOM_TOL = 1e-12

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_platform
+from stewart_drake.core.geometry import load_platform
 from stewart_drake.montecarlo import study as study_mod
 from stewart_drake.montecarlo.scenario import Study, draw, run_scenario, run_seed
 from stewart_drake.montecarlo.spec import SpecError, parse_spec

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from stewart_drake.rotations import (
+from stewart_drake.core.rotations import (
     angles_from_matrix,
     angular_velocity_map,
     convert_angles,

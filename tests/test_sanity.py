@@ -1,4 +1,4 @@
-"""Physical sanity everywhere (``stewart_drake.sanity``): literal messages and exit codes for every case
+"""Physical sanity everywhere (``stewart_drake.core.sanity``): literal messages and exit codes for every case
 (plate below the base, out of stroke along a trajectory, missing plate, singular home, non-finite or
 absurd options, lost tracking, saturation), checked against independent computations; and property
 tests over random poses and trajectories: exit code in {0, 1, 2}, no traceback, no NaN/inf printed, and
@@ -18,10 +18,10 @@ from hypothesis import strategies as st
 from _fuzz import fuzz
 from stewart_drake.cli import main
 from stewart_drake.errors import PhysicalLimitError
-from stewart_drake.geometry import load_platform
-from stewart_drake.kinematics import leg_lengths, plate_anchors
-from stewart_drake.rotations import pose_to_si
-from stewart_drake.simulation import SEED
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.kinematics import leg_lengths, plate_anchors
+from stewart_drake.core.rotations import pose_to_si
+from stewart_drake.drake.simulation import SEED
 
 NOPLATE = """name: noplate
 length_unit: m
@@ -190,8 +190,8 @@ def test_simulate_lost_tracking_exits_1(tmp_path):
 def test_saturation_verdict_counts_the_longest_stretch():
     """``longest_saturation`` from the cumulative per-leg counters: leg 2 saturated on ticks 3..62 (60
     ticks = 0.060 s at 1 ms) fails; leg 5 saturated on 40 ticks in two stretches of 20 passes."""
-    from stewart_drake.control import STATUS
-    from stewart_drake.simulation import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
+    from stewart_drake.control.controller import STATUS
+    from stewart_drake.drake.simulation import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
 
     n, T = 100, 1e-3
     sat = np.zeros((n, 6), bool)
@@ -233,8 +233,8 @@ def test_singular_home_is_refused_when_loaded_naming_the_anchors(tmp_path):
 
 @pytest.mark.parametrize("name", ["utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009"])
 def test_presets_pass_their_own_sanity(name):
-    from stewart_drake.kinematics import condition_number
-    from stewart_drake.sanity import HOME_MAX_CONDITION, above_base, has_plate
+    from stewart_drake.core.kinematics import condition_number
+    from stewart_drake.core.sanity import HOME_MAX_CONDITION, above_base, has_plate
 
     p = load_platform(name)
     assert has_plate(p) and bool(above_base(p, p.home_pose())) and condition_number(p, p.home_pose()) < HOME_MAX_CONDITION
@@ -275,10 +275,10 @@ def test_bad_options_exit_2_with_the_message(argv, message, tmp_path):
 def test_period_bound_is_the_crossover_margin():
     """The refusal threshold follows from the stated rule: at the largest period the check accepts,
     ω_c = PHASE_BUDGET / (T + T + lag) is at least 2 × the fastest growth rate, and just above it, below."""
-    from stewart_drake.control import PHASE_BUDGET
-    from stewart_drake.dynamics import open_loop_growth_rates
+    from stewart_drake.control.controller import PHASE_BUDGET
+    from stewart_drake.core.dynamics import open_loop_growth_rates
     from stewart_drake.errors import StewartError
-    from stewart_drake.sanity import CROSSOVER_MARGIN, check_timing
+    from stewart_drake.core.sanity import CROSSOVER_MARGIN, check_timing
 
     p = load_platform("utn-dynamic")
     lam = max(open_loop_growth_rates(p, p.home_pose()))
@@ -340,7 +340,7 @@ def test_workspace_resolution_refused_before_allocating(h):
     (("simulate", "--duration", "7200", "--no-progress"), r"--duration 7200 s would need 7.2e\+06 plant steps of 0.001 s \(~2 h\); the limit is ~1 h"),
 ])
 def test_work_is_bounded_before_allocation(argv, pattern, tmp_path, monkeypatch):
-    import stewart_drake.sanity as sanity
+    import stewart_drake.core.sanity as sanity
 
     if "7200" in argv or "1e4" in argv:  # the time and count bounds, whatever this machine's memory
         monkeypatch.setattr(sanity, "memory_budget", lambda: 1 << 50)

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths, leg_unit_vectors
-from stewart_drake.rotations import pose_to_si
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths, leg_unit_vectors
+from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.script import Motion, check, execute, parse, run_program
 from stewart_drake.script.runtime import for_range, quintic
 
@@ -201,7 +201,7 @@ def test_trajectory_velocity_and_acceleration_are_consistent(utn):
 def test_forces_balance_gravity_at_rest(utn):
     """At rest (start and end of a move) the leg forces along the legs add up to the plate's weight,
     Σ F_i u_i = m g e_z (an independent statics check of the inverse dynamics)."""
-    pytest.importorskip("stewart_drake.dynamics")
+    pytest.importorskip("stewart_drake.core.dynamics")
     r = run_program(SEED_PROGRAM, "seed.stw", utn)
     for n in (0, -1):
         u = leg_unit_vectors(utn, r.trajectory.q[n])
@@ -211,7 +211,7 @@ def test_forces_balance_gravity_at_rest(utn):
 
 
 def test_coriolis_switch_changes_only_moving_samples(utn):
-    pytest.importorskip("stewart_drake.dynamics")
+    pytest.importorskip("stewart_drake.core.dynamics")
     on = run_program(SEED_PROGRAM, "s.stw", utn)
     off = run_program(SEED_PROGRAM, "s.stw", utn, coriolis=False)
     np.testing.assert_allclose(on.F[[0, -1]], off.F[[0, -1]], atol=1e-9)

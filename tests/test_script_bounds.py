@@ -9,7 +9,7 @@ import time
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_platform
+from stewart_drake.core.geometry import load_platform
 from stewart_drake.script import ScriptError, compile_program
 from stewart_drake.script.emit import emit_python
 from stewart_drake.script.interpreter import MAX_STEPS, static_cost

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_preset
+from stewart_drake.core.geometry import load_preset
 from stewart_drake.script import compile_program
 from stewart_drake.script.runtime import Motion
 

@@ -5,7 +5,7 @@ import pytest
 from scipy.optimize import brentq
 
 from stewart_drake.errors import GeometryError
-from stewart_drake.servo import (
+from stewart_drake.core.servo import (
     RATE_US_PER_RAD,
     ServoPoseError,
     anchor_positions,
@@ -117,14 +117,14 @@ def test_quantisation_rounds_half_away_from_zero():
 
 
 def test_sdf_matches_committed_file(hexapod, tmp_path):
-    from stewart_drake.servo_model import SDF_DIR, write_sdf
+    from stewart_drake.drake.servo_model import SDF_DIR, write_sdf
 
     path = write_sdf(hexapod, tmp_path)
     assert path.read_text() == (SDF_DIR / "servo-hexapod.sdf").read_text()
 
 
 def test_drake_cross_checks(hexapod):
-    from stewart_drake.servo_model import compare_with_drake
+    from stewart_drake.drake.servo_model import compare_with_drake
 
     poses = random_poses(hexapod, 15, seed=5)
     r = compare_with_drake(hexapod, poses)
@@ -138,7 +138,7 @@ def test_drake_cross_checks(hexapod):
 
 
 def test_controller_quantises_latches_and_delays(hexapod):
-    from stewart_drake.servo_model import run_controller
+    from stewart_drake.drake.servo_model import run_controller
 
     t = np.linspace(0, 0.2, 11)
     poses = np.tile(hexapod.home_pose(), (11, 1))
@@ -157,7 +157,7 @@ def test_controller_quantises_latches_and_delays(hexapod):
 
 def test_yaml_preset_is_the_documented_layout(hexapod):
     """The shipped presets/servo-hobby.yaml (mm, paired layout) builds exactly hobby_servo_hexapod()."""
-    from stewart_drake.servo import load_servo_hexapod
+    from stewart_drake.core.servo import load_servo_hexapod
 
     y = load_servo_hexapod("hobby-servo")
     for name in ("base_pivots", "arm_directions", "platform_anchors", "shaft_directions", "neutral_us"):
@@ -179,7 +179,7 @@ def _explicit_yaml(h, trims):
 
 
 def test_yaml_explicit_layout_round_trip(hexapod, tmp_path):
-    from stewart_drake.servo import load_servo_hexapod
+    from stewart_drake.core.servo import load_servo_hexapod
 
     trims = [1500, 1512, 1490, 1503, 1497, 1521]
     path = tmp_path / "mine.yaml"
@@ -202,7 +202,7 @@ def test_yaml_explicit_layout_round_trip(hexapod, tmp_path):
     (("rod_length: 110.0", "rod_length: 110.0\nrod_colour: red"), "rod_colour"),
 ])
 def test_yaml_errors_name_the_field_and_value(tmp_path, edit, message):
-    from stewart_drake.servo import load_servo_hexapod, servo_preset_path
+    from stewart_drake.core.servo import load_servo_hexapod, servo_preset_path
 
     text = servo_preset_path("hobby-servo").read_text()
     assert edit[0] in text
@@ -213,7 +213,7 @@ def test_yaml_errors_name_the_field_and_value(tmp_path, edit, message):
 
 
 def test_explicit_yaml_missing_fields_and_unknown_names(hexapod, tmp_path):
-    from stewart_drake.servo import load_servo_hexapod
+    from stewart_drake.core.servo import load_servo_hexapod
 
     path = tmp_path / "partial.yaml"
     path.write_text("\n".join(line for line in _explicit_yaml(hexapod, [1500] * 6).splitlines() if not line.startswith("shaft")))
@@ -242,7 +242,7 @@ def test_closed_loop_hold_is_within_quantisation_and_sag(hexapod):
     """A constant offset pose held for 0.4 s: once settled, each arm sits within half a pulse step
     (0.5 µs = 0.056°) plus its static sag (load / kp ≈ 0.02°) of eq. 9, and the platform within the
     Jacobian image of that. A wrong pulse sign, gain or mounting would miss by degrees."""
-    from stewart_drake.servo_model import run_closed_loop, tracking_bounds
+    from stewart_drake.drake.servo_model import run_closed_loop, tracking_bounds
 
     pose = hexapod.home_pose() + [0.003, -0.002, 0.004, 0.05, -0.03, 0.08]
     log = run_closed_loop(hexapod, [0.0, 1.0], [pose, pose], duration=0.4)
@@ -261,7 +261,7 @@ def test_closed_loop_tracks_a_trajectory(hexapod):
     limit adds no lag. Checked per servo and per pose axis on the run's worst case (per sample, the
     reaction of neighbouring servos' frame steps adds ~0.04° blips where an arm reverses, which the
     bound does not model)."""
-    from stewart_drake.servo_model import run_closed_loop, tracking_bounds
+    from stewart_drake.drake.servo_model import run_closed_loop, tracking_bounds
 
     t = np.linspace(0, 1.0, 201)
     traj = np.tile(hexapod.home_pose(), (len(t), 1))

@@ -6,11 +6,11 @@ Short runs (1 s simulated, ~1 s wall each) of the seed trajectory on ``utn-dynam
 import numpy as np
 import pytest
 
-from stewart_drake.control import ControllerConfig, DspTiming, TimingError
+from stewart_drake.control.controller import ControllerConfig, DspTiming, TimingError
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.simulation import (
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.drake.simulation import (
     SEED,
     ActuatorModel,
     SimulationLog,
@@ -116,7 +116,7 @@ def test_saturation_is_counted_in_the_loop():
 def test_anti_windup_stops_the_integrator_at_saturation(kind):
     """One tick computed directly: with an error that drives the output past the positive rail the
     integrator does not grow; with the output inside the range it does."""
-    from stewart_drake.control import make_controller
+    from stewart_drake.control.controller import make_controller
 
     ctrl = make_controller(kind, PLATFORM)
     pose = SEED.pose(0.0)
@@ -203,7 +203,7 @@ def test_other_platforms_track_out_of_the_box(name, base):
     range its actuator force, force feed-forward). The same bounds as on utn-dynamic, for the same
     reasons: the float twin within the timing bound v_max · t_delay, the fixed-point controller within
     float + Δ_IK + LSB + r; no saturation. (Before the design: 40–76 mm on utn-kinematic.)"""
-    from stewart_drake.simulation import fit_trajectory
+    from stewart_drake.drake.simulation import fit_trajectory
 
     platform = load_preset(name)
     traj = fit_trajectory(get_trajectory(base), platform)
@@ -225,8 +225,8 @@ def test_stiffness_floor_is_what_keeps_the_heavy_platform_up():
     kp (3 × the home value) holds the plate within a millimetre."""
     from dataclasses import replace
 
-    from stewart_drake.control import strut_stiffness
-    from stewart_drake.simulation import ROTATING, fit_trajectory
+    from stewart_drake.control.controller import strut_stiffness
+    from stewart_drake.drake.simulation import ROTATING, fit_trajectory
 
     platform = load_preset("utn-kinematic")
     traj = fit_trajectory(ROTATING, platform)
@@ -245,7 +245,7 @@ def test_utn_kinematic_rotating_error_does_not_grow(kind):
     plus one set-point LSB (1 mm: the fixed point's set-point steps can land differently) — the float twin
     plus 0.1 × that. With the home-only design of 6b (kp 15.3 kN/m, ki 66 kN/(m·s)) the fixed-point error
     went 2.3 mm → 30 mm here (the heaviest mode, ~2 Hz, Routh-unstable where kp − K is small)."""
-    from stewart_drake.simulation import ROTATING, fit_trajectory
+    from stewart_drake.drake.simulation import ROTATING, fit_trajectory
 
     platform = load_preset("utn-kinematic")
     traj = fit_trajectory(ROTATING, platform)
@@ -260,8 +260,8 @@ def test_feedforward_table_is_the_inverse_dynamics_ahead_of_time_and_helps():
     """The table holds ``leg_forces_with_legs`` of the reference at t + lead (lead = output delay + T/2 +
     actuator lag, checked against a direct evaluation), and on utn-dynamic it cuts the float twin's error
     several-fold compared with the PID alone."""
-    from stewart_drake.dynamics import leg_forces_with_legs
-    from stewart_drake.simulation import feedforward_lead
+    from stewart_drake.core.dynamics import leg_forces_with_legs
+    from stewart_drake.drake.simulation import feedforward_lead
 
     cfg = ControllerConfig.for_platform(PLATFORM)
     lead = feedforward_lead(cfg, 2e-3)
@@ -287,7 +287,7 @@ def test_setpoint_l1_gain_bounds_the_fixed_point_excess_on_gonzalez():
     (``setpoint_step_gain``): the stepped leg's ‖h_ii‖₁ ≥ 1 (total variation from 0 to the DC gain 1, which
     the integrator restores), > 1 with the overshoot; the six legs' sum is at least that; and the bound
     float + ‖h‖₁·A holds on a 1 s run (both trajectories)."""
-    from stewart_drake.simulation import ROTATING, design_poses, fit_trajectory, setpoint_step_gain
+    from stewart_drake.drake.simulation import ROTATING, design_poses, fit_trajectory, setpoint_step_gain
 
     platform = load_preset("gonzalez-dutra-2009")
     for base in (SEED, ROTATING):
@@ -307,7 +307,7 @@ def test_setpoint_l1_gain_bounds_the_fixed_point_excess_on_gonzalez():
 
 
 def test_setpoint_step_response_is_refused_for_a_bad_leg_or_step():
-    from stewart_drake.simulation import setpoint_step_response
+    from stewart_drake.drake.simulation import setpoint_step_response
 
     with pytest.raises(ValueError, match="leg must be 0 … 5, got 6"):
         setpoint_step_response(PLATFORM, leg=6)

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.animation import _frames, leg_warnings, log_saturating, stroke_margin
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import leg_lengths
-from stewart_drake.viewer import ReplayError, labels, load_replay, nearest_reachable, readout, reachable
+from stewart_drake.drake.animation import _frames, leg_warnings, log_saturating, stroke_margin
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.drake.viewer import ReplayError, labels, load_replay, nearest_reachable, readout, reachable
 
 ROOT = Path(__file__).resolve().parents[1]
 

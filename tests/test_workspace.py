@@ -11,10 +11,10 @@ import pytest
 
 from stewart_drake import workspace as ws
 from stewart_drake.cli import main
-from stewart_drake.geometry import load_preset
-from stewart_drake.kinematics import check_stroke, condition_number, leg_lengths
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
 from stewart_drake.report import ANALYSES_DIR
-from stewart_drake.rotations import rotation_matrix
+from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.workspace.slabs import _grid_spec, _inside_block
 
 DEG = math.pi / 180
@@ -315,7 +315,7 @@ def test_count_reachable_matches_brute_force(gd):
 
 def test_dask_local_cluster_same_result(gd, ws10):
     pytest.importorskip("distributed", reason='the Dask back end needs dask.distributed (pip install "dask[distributed]")')
-    from stewart_drake.workspace_dask import close_client, count_reachable_on_dask, local_client, map_platforms, workspace_on_dask
+    from stewart_drake.workspace.dask_sweep import close_client, count_reachable_on_dask, local_client, map_platforms, workspace_on_dask
 
     client = local_client(n_workers=2)
     try:

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from stewart_drake import workspace as ws
-from stewart_drake.geometry import load_preset
+from stewart_drake.core.geometry import load_preset
 
 pytest.importorskip("distributed", reason='the Dask back end needs dask.distributed (pip install "dask[distributed]")')
 
-from stewart_drake import workspace_dask as wd  # noqa: E402
+import stewart_drake.workspace.dask_sweep as wd  # noqa: E402
 
 
 def test_slab_size_gives_enough_tasks_per_worker():

@@ -7,11 +7,11 @@ import sys
 
 import numpy as np
 
-from ..atomic import OutputFolder
-from ..errors import UsageError
-from ..geometry import PRESETS, Platform, load_platform
-from ..jsonout import dumps_strict
-from ..rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
+from stewart_drake.core.output_folder import OutputFolder
+from stewart_drake.errors import UsageError
+from stewart_drake.core.geometry import PRESETS, Platform, load_platform
+from stewart_drake.core.jsonout import dumps_strict
+from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..design.payload import PayloadError, with_payload
-from ..rotations import length_scale
+from stewart_drake.design.payload import PayloadError, with_payload
+from stewart_drake.core.rotations import length_scale
 
 
 def add_payload_args(parser, length_help: str) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import print_json
+from stewart_drake.commands._common import print_json
 
 ANGLE_UNITS = ("pi", "deg", "rad")
 
@@ -26,11 +26,11 @@ def register(sub) -> None:
 def run(args) -> int:
     import sys
 
-    from ..firmware.engine import resolve_engine
-    from ..firmware.host import tp17_leg_lengths_c
-    from ..fixedpoint.q15 import SaturationCounter
-    from ..fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
-    from ..rotations import angle_scale
+    from stewart_drake.firmware.engine import resolve_engine
+    from stewart_drake.firmware.host import tp17_leg_lengths_c
+    from stewart_drake.fixedpoint.q15 import SaturationCounter
+    from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
+    from stewart_drake.core.rotations import angle_scale
 
     raw = np.asarray(args.pose, dtype=float)
     q = raw.copy()
@@ -41,8 +41,8 @@ def run(args) -> int:
             raise ValueError(f"angle {name} = {raw[3 + k]:g} {args.angle_unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]")
     check_dsp_poses(q)
     # the firmware's platform is utn-kinematic's (a = 612 vs 612.5 mm): its plate must be above its base
-    from ..geometry import load_preset
-    from ..sanity import check_poses
+    from stewart_drake.core.geometry import load_preset
+    from stewart_drake.core.sanity import check_poses
 
     check_poses(load_preset("utn-kinematic"), np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi], "utn", what="--pose")
     with SaturationCounter() as sat:

@@ -8,10 +8,10 @@ import sys
 
 import numpy as np
 
-from ..csvio import read_numeric_csv
-from ..rotations import angle_scale, length_scale
-from ..sanity import check_file_rows, check_finite, check_gravity, check_trajectory, check_work, fmt_value, require_plate
-from ._common import add_platform_arg, platform_from_args, print_json, reject_unused
+from stewart_drake.core.csvio import read_numeric_csv
+from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.core.sanity import check_file_rows, check_finite, check_gravity, check_trajectory, check_work, fmt_value, require_plate
+from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
 
 CSV_HELP = (
     "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
@@ -80,7 +80,7 @@ def seed_times(t_end: float, dt: float) -> np.ndarray:
 
 
 def run(args) -> int:
-    from ..dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
+    from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 
     seed = args.trajectory == "seed"
     reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ._common import add_platform_arg, print_json
+from stewart_drake.commands._common import add_platform_arg, print_json
 
 
 def _format_args(p) -> None:
@@ -44,8 +44,8 @@ def register(sub) -> None:
 
 
 def _config(args, platform):
-    from ..control import ControllerConfig, DspTiming
-    from ..fixedpoint.generic import QFormat
+    from stewart_drake.control.controller import ControllerConfig, DspTiming
+    from stewart_drake.fixedpoint.generic import QFormat
 
     if not 8 <= args.word_bits <= 16:
         raise ValueError(f"--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {args.word_bits}")
@@ -58,18 +58,18 @@ def _config(args, platform):
                        command_range=float(platform.legs.max_force)).check()
     poses = None
     if args.trajectory is not None:
-        from ..simulation import design_poses, get_trajectory
+        from stewart_drake.drake.simulation import design_poses, get_trajectory
 
         poses = design_poses(get_trajectory(args.trajectory))
     return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=args.convention)
 
 
 def run_generate(args) -> int:
-    from ..atomic import atomic_folder
-    from ..firmware.build import compilers
-    from ..firmware.generate import FILES, generate
-    from ..firmware.module import compile_generated
-    from ..geometry import load_platform
+    from stewart_drake.core.output_folder import atomic_folder
+    from stewart_drake.firmware.build import compilers
+    from stewart_drake.firmware.generate import FILES, generate
+    from stewart_drake.firmware.module import compile_generated
+    from stewart_drake.core.geometry import load_platform
 
     platform = load_platform(args.platform)
     config = _config(args, platform)
@@ -114,9 +114,9 @@ def run_generate(args) -> int:
 
 
 def run_check(args) -> int:
-    from ..firmware.build import compiler_by_name
-    from ..firmware.check import check_firmware
-    from ..geometry import load_platform
+    from stewart_drake.firmware.build import compiler_by_name
+    from stewart_drake.firmware.check import check_firmware
+    from stewart_drake.core.geometry import load_platform
 
     platform = load_platform(args.platform)
     config = _config(args, platform)

@@ -7,11 +7,11 @@ import sys
 
 import numpy as np
 
-from ..csvio import read_numeric_csv
-from ..kinematics import check_stroke, leg_lengths
-from ..rotations import length_scale, pose_to_si
-from ..sanity import below_base_message, check_file_rows, check_poses, plate_anchor_heights
-from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from stewart_drake.core.csvio import read_numeric_csv
+from stewart_drake.core.kinematics import check_stroke, leg_lengths
+from stewart_drake.core.rotations import length_scale, pose_to_si
+from stewart_drake.core.sanity import below_base_message, check_file_rows, check_poses, plate_anchor_heights
+from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 
 # Bytes per CSV row while reading (Python lists of floats) and per result printed as JSON (estimates).
 BYTES_PER_ROW = 600

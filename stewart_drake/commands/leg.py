@@ -6,10 +6,10 @@ import os
 
 import numpy as np
 
-from ..atomic import write_output_file
-from ..errors import OutputError
-from ..rotations import angle_scale, length_scale
-from ._common import print_json
+from stewart_drake.core.output_folder import write_output_file
+from stewart_drake.errors import OutputError
+from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.commands._common import print_json
 
 
 def register(sub) -> None:
@@ -37,7 +37,7 @@ def register(sub) -> None:
 
 
 def _leg(args):
-    from ..leg import Leg3R
+    from stewart_drake.core.leg3r import Leg3R
 
     k = length_scale(args.length_unit)
     dims = {n: getattr(args, n) * k for n in ("l1", "l2", "l3") if getattr(args, n) is not None}
@@ -45,11 +45,11 @@ def _leg(args):
 
 
 def run(args) -> int:
-    from ..leg import foot, forward_kinematics, inverse_kinematics, inverse_kinematics_3r, limit_violations, within_limits
+    from stewart_drake.core.leg3r import foot, forward_kinematics, inverse_kinematics, inverse_kinematics_3r, limit_violations, within_limits
 
     leg = _leg(args)
     if args.op == "sdf":
-        from ..leg_model import SDF_NAME, sdf_text
+        from stewart_drake.drake.leg_model import SDF_NAME, sdf_text
 
         if args.write:
             if os.path.exists(args.write) and not os.path.isdir(args.write):

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import os
 
-from ..atomic import write_output_file
-from ..errors import OutputError, UsageError
-from ._common import add_platform_arg, platform_from_args, print_json
+from stewart_drake.core.output_folder import write_output_file
+from stewart_drake.errors import OutputError, UsageError
+from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
 
 
 def register(sub) -> None:
@@ -19,8 +19,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..model import model_name, sdf_path, sdf_text
-    from ..verify import anchor_frames, make_plant
+    from stewart_drake.drake.platform_model import model_name, sdf_path, sdf_text
+    from stewart_drake.drake.verify_kinematics import anchor_frames, make_plant
 
     if args.json and not args.inspect:
         raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))

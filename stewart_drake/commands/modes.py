@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import print_json
-from .stiffness import NAMES, add_pose_args, prepare, require_analysable_pose
+from stewart_drake.commands._common import print_json
+from stewart_drake.commands.stiffness import NAMES, add_pose_args, prepare, require_analysable_pose
 
 
 def register(sub) -> None:
@@ -20,8 +20,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
-    from ..design.stiffness import stiffness_matrix
+    from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
+    from stewart_drake.design.stiffness import stiffness_matrix
 
     platform, q, k, _ = prepare(args)
     if not (np.isfinite(args.leg_damping) and args.leg_damping >= 0):
@@ -44,7 +44,7 @@ def run(args) -> int:
                        "loop_delay_s": delay, "phase_lag_at_lowest_deg": 360.0 * f1 * delay},
     }
     if args.drake:
-        from ..design_drake import drake_modes
+        from stewart_drake.drake.design_checks import drake_modes
 
         d = drake_modes(platform, q, k, args.leg_damping, args.convention, args.gravity, legs)
         md = d["modes"]

@@ -6,8 +6,8 @@ import json
 import sys
 from pathlib import Path
 
-from ..firmware.engine import resolve_engine
-from ._common import add_platform_arg, print_json
+from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.commands._common import add_platform_arg, print_json
 
 
 def register(sub) -> None:
@@ -44,11 +44,11 @@ def register(sub) -> None:
 
 
 def build_study(args):
-    from ..geometry import load_platform
-    from ..montecarlo.scenario import Study
-    from ..simulation import TRAJECTORIES
-    from ..montecarlo.spec import parse_spec
-    from .run import read_program
+    from stewart_drake.core.geometry import load_platform
+    from stewart_drake.montecarlo.scenario import Study
+    from stewart_drake.drake.simulation import TRAJECTORIES
+    from stewart_drake.montecarlo.spec import parse_spec
+    from stewart_drake.commands.run import read_program
 
     platform = load_platform(args.platform)
     spec = parse_spec(args.vary)
@@ -73,9 +73,9 @@ def build_study(args):
 def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
     """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
     (``load_trajectory_csv`` checks it and names a bad line)."""
-    from ..csvio import read_numeric_csv
-    from ..rotations import pose_to_si
-    from ..simulation import load_trajectory_csv
+    from stewart_drake.core.csvio import read_numeric_csv
+    from stewart_drake.core.rotations import pose_to_si
+    from stewart_drake.drake.simulation import load_trajectory_csv
 
     traj = load_trajectory_csv(path, length_unit, angle_unit)
     data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
@@ -85,10 +85,10 @@ def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
 def run(args) -> int:
     if args.replay is not None:
         return replay(args)
-    from ..montecarlo.study import run_study, study_key, study_settings
-    from ..montecarlo.summary import write_outputs, summarise
+    from stewart_drake.montecarlo.study import run_study, study_key, study_settings
+    from stewart_drake.montecarlo.summary import write_outputs, summarise
 
-    from ..script import ScriptError
+    from stewart_drake.script import ScriptError
 
     study = build_study(args)
     try:  # the reference (program compiled, CSV read) checked here, before any run starts
@@ -127,11 +127,11 @@ def print_text(summary: dict) -> None:
 
 def replay(args) -> int:
     """Re-run one run of the study in ``--out`` and compare its row with the study's."""
-    from ..atomic import atomic_folder
-    from ..montecarlo.scenario import run_scenario
-    from ..montecarlo.study import STUDY_FILE, study_from_settings
-    from ..montecarlo.summary import read_table
-    from .simulate import write_plots
+    from stewart_drake.core.output_folder import atomic_folder
+    from stewart_drake.montecarlo.scenario import run_scenario
+    from stewart_drake.montecarlo.study import STUDY_FILE, study_from_settings
+    from stewart_drake.montecarlo.summary import read_table
+    from stewart_drake.commands.simulate import write_plots
 
     out = Path(args.out)
     if not (out / STUDY_FILE).exists():
@@ -153,7 +153,7 @@ def replay(args) -> int:
             ref = study.reference()
             files += log.save(tmp) + write_plots(log, log.length_error(ref, _plant_platform(study, args.replay)), tmp)
             if not args.no_animation:
-                from ..montecarlo.animation import write_animation
+                from stewart_drake.drake.montecarlo_animation import write_animation
 
                 files.append(write_animation(_plant_platform(study, args.replay), log, tmp / "animation.html"))
         (tmp / "row.json").write_text(json.dumps(result, indent=2))
@@ -167,7 +167,7 @@ def replay(args) -> int:
 
 
 def _plant_platform(study, index):
-    from ..montecarlo.scenario import draw, plant_platform
+    from stewart_drake.montecarlo.scenario import draw, plant_platform
 
     return plant_platform(study.platform, draw(study, index)[1])
 

@@ -6,7 +6,7 @@ import os
 import sys
 import time
 
-from ._common import add_force_arg, output_folder
+from stewart_drake.commands._common import add_force_arg, output_folder
 
 
 def register(sub) -> None:
@@ -21,8 +21,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..geometry import PRESETS
-    from ..report import command_line, discover_analyses, render, run_analyses, write_report
+    from stewart_drake.core.geometry import PRESETS
+    from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
 
     out = output_folder(args)
     jobs = args.jobs if args.jobs is not None else min(4, os.cpu_count() or 1)

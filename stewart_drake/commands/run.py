@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_folder
-from ..errors import InputError
-from ..rotations import CONVENTIONS
-from ._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
+from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.errors import InputError
+from stewart_drake.core.rotations import CONVENTIONS
+from stewart_drake.commands._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
 SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)
@@ -62,7 +62,7 @@ def read_program(path: str) -> str:
 
 
 def run(args) -> int:
-    from ..script import ScriptError, run_program
+    from stewart_drake.script import ScriptError, run_program
 
     reject_unused(args, "--simulate", args.simulate, controller="fixed")
     text = read_program(args.program)
@@ -120,7 +120,7 @@ def check_branches(platform, result, args) -> dict | None:
     for name, v in (("--branch-margin", args.branch_margin), ("--singularity-margin", args.singularity_margin)):
         if not (np.isfinite(v) and v >= 0):
             raise ValueError(f"{name} must be a non-negative number, got {v}")
-    from ..homotopy.branches import branch_safety
+    from stewart_drake.homotopy.branches import branch_safety
 
     traj = result.trajectory
     rep = branch_safety(platform, traj.t, traj.q, args.convention, samples=args.branch_samples)
@@ -140,8 +140,8 @@ def branch_exit(b: dict | None, args) -> int:
 
 def simulate(platform, result, args) -> dict:
     """Controller in the loop (issue 6's ``simulation``) along the program's trajectory."""
-    from ..simulation import Trajectory as SimTrajectory
-    from ..simulation import simulate as sim_run
+    from stewart_drake.drake.simulation import Trajectory as SimTrajectory
+    from stewart_drake.drake.simulation import simulate as sim_run
 
     if args.convention != "utn":
         raise ValueError("--simulate drives the plant with utn-convention poses; use --convention utn")
@@ -149,8 +149,8 @@ def simulate(platform, result, args) -> dict:
     if traj.duration <= 0:
         raise ValueError("--simulate: the program has no moves or waits (its trajectory lasts 0 s)")
     reference = SimTrajectory(Path(args.program).stem, traj.pose_at, traj.duration)
-    from ..sanity import require_plate
-    from ..simulation import tracking_verdict
+    from stewart_drake.core.sanity import require_plate
+    from stewart_drake.drake.simulation import tracking_verdict
 
     require_plate(platform, "run --simulate")
     log = sim_run(platform, reference, controller=args.controller, duration=traj.duration + SETTLE, progress=True)
@@ -236,7 +236,7 @@ def _plots(folder: Path, result, summary: dict, sim: dict | None) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    from ..script.plots import plot_forces, plot_lengths, plot_tracking
+    from stewart_drake.script.plots import plot_forces, plot_lengths, plot_tracking
 
     plot_lengths(result, summary["platform"], summary.get("stroke_mm")).savefig(folder / "lengths.png", dpi=110, bbox_inches="tight")
     if result.F is not None:

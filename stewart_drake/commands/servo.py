@@ -7,15 +7,15 @@ import os
 
 import numpy as np
 
-from ..atomic import write_output_file
-from ..errors import OutputError
-from ..rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from ..sanity import check_finite
-from ._common import print_json
+from stewart_drake.core.output_folder import write_output_file
+from stewart_drake.errors import OutputError
+from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from stewart_drake.core.sanity import check_finite
+from stewart_drake.commands._common import print_json
 
 
 def register(sub) -> None:
-    from ..servo import SERVO_PRESETS
+    from stewart_drake.core.servo import SERVO_PRESETS
 
     p = sub.add_parser("servo", help="servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)")
     p.add_argument("--platform", default="hobby-servo", metavar="NAME|FILE",
@@ -33,9 +33,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..servo import load_servo_hexapod, solve
+    from stewart_drake.core.servo import load_servo_hexapod, solve
 
-    from ..sanity import check_servo_neutrals
+    from stewart_drake.core.sanity import check_servo_neutrals
 
     hexapod = load_servo_hexapod(args.platform)
     check_servo_neutrals(hexapod, f"{args.platform}: servo.neutral_us")
@@ -43,7 +43,7 @@ def run(args) -> int:
         check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
-        from ..servo_model import SDF_NAME, sdf_text
+        from stewart_drake.drake.servo_model import SDF_NAME, sdf_text
 
         if os.path.exists(args.write_sdf) and not os.path.isdir(args.write_sdf):
             raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write-sdf", typed=args.write_sdf, part=args.write_sdf))

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..sanity import check_file_rows, check_positive, check_timing, check_trajectory, check_work, fmt_value, require_plate
-from ._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
+from stewart_drake.core.sanity import check_file_rows, check_positive, check_timing, check_trajectory, check_work, fmt_value, require_plate
+from stewart_drake.commands._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -62,11 +62,11 @@ def register(sub) -> None:
 def run(args) -> int:
     import json
 
-    from ..atomic import atomic_folder
-    from ..control import ControllerConfig, DspTiming
-    from ..firmware.engine import resolve_engine
-    from ..geometry import load_platform
-    from ..simulation import ActuatorModel, build_simulation, design_poses, fit_trajectory, get_trajectory, tracking_verdict
+    from stewart_drake.core.output_folder import atomic_folder
+    from stewart_drake.control.controller import ControllerConfig, DspTiming
+    from stewart_drake.firmware.engine import resolve_engine
+    from stewart_drake.core.geometry import load_platform
+    from stewart_drake.drake.simulation import ActuatorModel, build_simulation, design_poses, fit_trajectory, get_trajectory, tracking_verdict
 
     reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
     out_folder = output_folder(args)

@@ -6,9 +6,9 @@ import sys
 
 import numpy as np
 
-from ..rotations import CONVENTIONS
-from ._common import add_platform_arg, platform_from_args, print_json
-from ._design import add_payload_args, platform_with_payload
+from stewart_drake.core.rotations import CONVENTIONS
+from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
+from stewart_drake.commands._design import add_payload_args, platform_with_payload
 
 MAX_LISTED = 10_000  # envelope poses whose allowed accelerations are listed in the JSON
 AXES = ("x", "y", "z", "roll", "pitch", "yaw")
@@ -35,12 +35,12 @@ def register(sub) -> None:
 
 
 def _trajectory(args, platform):
-    from ..design.sizing import rotating_trajectory
-    from ..dynamics import seed_trajectory
+    from stewart_drake.design.sizing import rotating_trajectory
+    from stewart_drake.core.dynamics import seed_trajectory
 
     if args.program is not None:
-        from ..script import run_program
-        from .run import read_program
+        from stewart_drake.script import run_program
+        from stewart_drake.commands.run import read_program
 
         if not (np.isfinite(args.rate) and args.rate > 0):
             raise ValueError(f"--rate must be a positive number of samples per second, got {args.rate}")
@@ -55,14 +55,14 @@ def _trajectory(args, platform):
         t = np.arange(n) * args.dt
         q, qd, qdd = (seed_trajectory if args.trajectory == "seed" else rotating_trajectory)(t)
         return args.trajectory, t, q, qd, qdd, "utn"
-    from .dynamics import read_trajectory_csv
+    from stewart_drake.commands.dynamics import read_trajectory_csv
 
     t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
     return args.trajectory, t, q, qd, qdd, args.convention
 
 
 def run(args) -> int:
-    from ..script import ScriptError
+    from stewart_drake.script import ScriptError
 
     base = platform_from_args(args)
     platform, p_TP = platform_with_payload(base, args, args.length_unit)
@@ -75,8 +75,8 @@ def run(args) -> int:
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
-    from ..design.sizing import first_violation, limits_of, size_trajectory
-    from ..sanity import check_poses
+    from stewart_drake.design.sizing import first_violation, limits_of, size_trajectory
+    from stewart_drake.core.sanity import check_poses
 
     check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
     s = size_trajectory(platform, t, q, qd, qdd, convention, legs, args.gravity)
@@ -126,7 +126,7 @@ def _print_table(legs_json, with_times: bool) -> None:
 def _report_violation(viol, where: str) -> int:
     if viol is None:
         return 0
-    from ..design.sizing import UNITS
+    from stewart_drake.design.sizing import UNITS
 
     name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[viol["quantity"]]
     print(f"stewart-drake size: leg {viol['leg']} {viol['quantity']} {viol['value']:.6g} {UNITS[viol['quantity']]} exceeds "
@@ -135,8 +135,8 @@ def _report_violation(viol, where: str) -> int:
 
 
 def _run_envelope(args, platform, header, legs) -> int:
-    from ..design.envelope import envelope_sizing, load_envelope
-    from ..design.sizing import first_violation, limits_of
+    from stewart_drake.design.envelope import envelope_sizing, load_envelope
+    from stewart_drake.design.sizing import first_violation, limits_of
 
     env = load_envelope(args.envelope)
     es = envelope_sizing(platform, env, legs=legs, gravity=args.gravity)

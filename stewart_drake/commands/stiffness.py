@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rotations import angle_scale, length_scale, pose_to_si
-from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
-from ._design import add_payload_args, platform_with_payload
+from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si
+from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from stewart_drake.commands._design import add_payload_args, platform_with_payload
 
 NAMES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -33,7 +33,7 @@ def register(sub) -> None:
 
 def prepare(args):
     """``(platform with payload, pose q (6,) SI, k (6,) N/m, p_TP payload position m)``."""
-    from ..design.stiffness import leg_stiffness_vector
+    from stewart_drake.design.stiffness import leg_stiffness_vector
 
     base = platform_from_args(args)
     platform, p_TP = platform_with_payload(base, args, args.length_unit)
@@ -49,9 +49,9 @@ def require_analysable_pose(platform, q, convention) -> None:
     """Refuse a pose that cannot be analysed: the sanity checks every command applies (finite, near the
     platform, plate above the base), then within the stroke and away from a singularity
     (``PhysicalLimitError``, exit 1)."""
-    from ..errors import PhysicalLimitError, StewartError
-    from ..kinematics import inverse_kinematics, require_nonsingular
-    from ..sanity import check_poses
+    from stewart_drake.errors import PhysicalLimitError, StewartError
+    from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
+    from stewart_drake.core.sanity import check_poses
 
     check_poses(platform, q, convention, what="--pose")
     try:
@@ -62,9 +62,9 @@ def require_analysable_pose(platform, q, convention) -> None:
 
 
 def run(args) -> int:
-    from ..design.payload import payload_wrench
-    from ..design.stiffness import compliance, deflection, principal_stiffness, stiffness_matrix
-    from ..rotations import rotation_matrix
+    from stewart_drake.design.payload import payload_wrench
+    from stewart_drake.design.stiffness import compliance, deflection, principal_stiffness, stiffness_matrix
+    from stewart_drake.core.rotations import rotation_matrix
 
     platform, q, k, p_TP = prepare(args)
     require_analysable_pose(platform, q, args.convention)
@@ -108,9 +108,9 @@ def run(args) -> int:
 
 def write_maps(args, platform, q, k) -> None:
     """Maps over the x-y slice through pose q, written atomically into ``args.map``."""
-    from ..atomic import atomic_folder
-    from ..design.maps import MAX_POINTS, slice_maps
-    from ..design.plots import plot_slice_maps
+    from stewart_drake.core.output_folder import atomic_folder
+    from stewart_drake.design.maps import MAX_POINTS, slice_maps
+    from stewart_drake.design.plots import plot_slice_maps
 
     hw = args.map_half_width * length_scale(args.length_unit)
     if not (np.isfinite(hw) and hw > 0):

@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-from ._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 
 
 def register(sub) -> None:
@@ -30,8 +30,8 @@ def register(sub) -> None:
 def run(args) -> int:
     from pydrake.geometry import Meshcat, MeshcatParams
 
-    from ..rotations import pose_to_si
-    from ..viewer import Viewer, load_replay
+    from stewart_drake.core.rotations import pose_to_si
+    from stewart_drake.drake.viewer import Viewer, load_replay
 
     platform = platform_from_args(args)
     if args.duration is not None and not (np.isfinite(args.duration) and 0 <= args.duration <= 86400):

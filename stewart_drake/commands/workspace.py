@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_folder
-from ..rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from ..sanity import check_centre, check_finite, check_work
-from ._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
+from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
+from stewart_drake.core.sanity import check_centre, check_finite, check_work
+from stewart_drake.commands._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
@@ -44,7 +44,7 @@ def register(sub) -> None:
 
 def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | None, max_condition: float):
     """A ``workspace.Limits`` from the ``--limits`` list (angles already in radians)."""
-    from ..workspace import Limits
+    from stewart_drake.workspace import Limits
 
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in LIMIT_CHOICES]
@@ -55,7 +55,7 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
         kw["base_cone"] = kw["top_cone"] = joint_cone
     if "collision" in names:
         if leg_diameter is None:
-            from ..model import leg_dimensions
+            from stewart_drake.drake.platform_model import leg_dimensions
 
             leg_diameter = 2 * leg_dimensions(platform)["cylinder_radius"]
         kw["leg_diameter"] = leg_diameter
@@ -65,7 +65,7 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
 
 
 def run(args) -> int:
-    from .. import workspace as ws
+    import stewart_drake.workspace as ws
 
     names = [n.strip() for n in args.limits.split(",")]
     reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
@@ -126,7 +126,7 @@ def write_outputs(w, result: dict, out) -> None:
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    from ..workspace import view_figures
+    from stewart_drake.workspace import view_figures
 
     with atomic_folder(out) as tmp:
         (tmp / "workspace.json").write_text(dumps_strict(result))

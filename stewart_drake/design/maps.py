@@ -15,11 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from ..dynamics import G_EARTH
-from ..geometry import Platform
-from ..kinematics import inverse_jacobian, leg_lengths
-from .modes import spatial_inertia
-from .stiffness import principal_stiffness, stiffness_matrix
+from stewart_drake.core.dynamics import G_EARTH
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import inverse_jacobian, leg_lengths
+from stewart_drake.design.modes import spatial_inertia
+from stewart_drake.design.stiffness import principal_stiffness, stiffness_matrix
 
 MAX_POINTS = 4_000_000  # slice nodes (work bounded before allocating)
 SAFE_CONDITION = 20.0  # default condition-number limit of the safe region
@@ -118,7 +118,7 @@ def slice_maps(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0
 
 
 def _inertia_batch(platform: Platform, q, convention):
-    from ..rotations import rotation_matrix
-    from .envelope import spatial_inertia_about_C
+    from stewart_drake.core.rotations import rotation_matrix
+    from stewart_drake.design.envelope import spatial_inertia_about_C
 
     return spatial_inertia_about_C(platform, rotation_matrix(q[..., 3:], convention))

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from ..geometry import Platform
-from ..kinematics import _poses, inverse_jacobian
-from ..rotations import rotation_matrix
-from .envelope import cartesian_leg_forces, spatial_inertia_about_C
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import _poses, inverse_jacobian
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.design.envelope import cartesian_leg_forces, spatial_inertia_about_C
 
 
 def spatial_inertia(platform: Platform, q, convention: str = "utn", legs: bool = False) -> np.ndarray:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import StewartError
-from ..geometry import Platform
+from stewart_drake.errors import StewartError
+from stewart_drake.core.geometry import Platform
 
 
 class PayloadError(StewartError):

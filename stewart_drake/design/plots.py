@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .maps import AXIS_NAMES, SliceMaps
+from stewart_drake.design.maps import AXIS_NAMES, SliceMaps
 
 
 def plot_slice_maps(m: SliceMaps, length_unit: str = "mm", max_condition: float = 20.0):

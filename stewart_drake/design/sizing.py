@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..dynamics import G_EARTH, leg_forces, leg_forces_with_legs, plate_motion
-from ..errors import GeometryError
-from ..geometry import Platform
+from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs, plate_motion
+from stewart_drake.errors import GeometryError
+from stewart_drake.core.geometry import Platform
 
 QUANTITIES = ("force", "speed", "power", "length")  # order in which violations are reported
 UNITS = {"force": "N", "speed": "m/s", "power": "W", "length": "m"}
@@ -134,6 +134,6 @@ ROTATING_OMEGA = np.array([0.0, 0.0, 0.0, 3.0, 0.0, 2.0])
 def rotating_trajectory(t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(q, q̇, q̈)`` of ``simulation.ROTATING`` with exact derivatives: pz = 0.7 m, 5°·sin 3t about x,
     15°·sin 2t about z (utn convention); each ``t.shape + (6,)``."""
-    from ..dynamics import harmonic_trajectory
+    from stewart_drake.core.dynamics import harmonic_trajectory
 
     return harmonic_trajectory(t, [0.0, 0.0, 0.7, 0.0, 0.0, 0.0], ROTATING_AMPLITUDE, ROTATING_OMEGA)

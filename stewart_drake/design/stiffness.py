@@ -25,12 +25,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..dynamics import G_EARTH, leg_forces, leg_forces_with_legs
-from ..errors import StewartError
-from ..geometry import Platform
-from ..kinematics import _poses, inverse_jacobian
-from ..rotations import angles_from_matrix, rotation_matrix
-from .envelope import _skew
+from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs
+from stewart_drake.errors import StewartError
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import _poses, inverse_jacobian
+from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
+from stewart_drake.design.envelope import _skew
 
 FD_STEP = 1e-6  # m and rad: central-difference step for the legs' weight term (error ~ step²)
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..geometry import Platform
+from stewart_drake.core.geometry import Platform
 
 # Truncation ~ h^8 |q^(9)| (negligible at h = 1e-3 s for smooth trajectories of a few rad/s); rounding
 # ~ 1e-16 |x| / h for a first derivative and / h² for a second: ~1e-10 here.

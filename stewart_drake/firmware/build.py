@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from ..errors import StewartError
+from stewart_drake.errors import StewartError
 
 C_DIR = Path(__file__).resolve().parent.parent / "fixedpoint" / "c"
 CACHE_ENV = "STEWART_DRAKE_CACHE"

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..control import ControllerConfig
-from ..fixedpoint.generic import leg_length_words, platform_words, pose_words, rotation_from_words, trig_words
-from ..geometry import Platform
-from ..sampling import random_poses
-from .build import Compiler
-from .generate import TRACE_FIELDS, generate
-from .module import TickRunner, compile_user
+from stewart_drake.control.controller import ControllerConfig
+from stewart_drake.fixedpoint.generic import leg_length_words, platform_words, pose_words, rotation_from_words, trig_words
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.firmware.build import Compiler
+from stewart_drake.firmware.generate import TRACE_FIELDS, generate
+from stewart_drake.firmware.module import TickRunner, compile_user
 
 MAX_POSES = 100_000_000
 CHUNK = 1 << 18
@@ -107,7 +107,7 @@ def _trace(module, platform, config, words) -> dict:
 def record_closed_loop(platform: Platform, config: ControllerConfig, trajectory="seed", duration: float = 0.5) -> list:
     """The per-tick inputs and outputs of the Python engine's controller in a closed-loop run:
     ``[(pose_words, measured counts, feed-forward words | None, state before, command words, state after)]``."""
-    from ..simulation import build_simulation
+    from stewart_drake.drake.simulation import build_simulation
 
     sim = build_simulation(platform, trajectory, "fixed", config)
     ctrl = sim.controller

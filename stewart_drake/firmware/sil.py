@@ -10,10 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..control import _FixedLaw, _make_class
-from ..fixedpoint.generic import pose_words
-from .generate import generate
-from .module import TickRunner, compile_generated, compile_user
+from stewart_drake.control.controller import _FixedLaw, _make_class
+from stewart_drake.fixedpoint.generic import pose_words
+from stewart_drake.firmware.generate import generate
+from stewart_drake.firmware.module import TickRunner, compile_generated, compile_user
 
 class _CFixedLaw(_FixedLaw):
     """``_FixedLaw`` with ``compute`` done by ``sd_tick`` of a compiled firmware module."""

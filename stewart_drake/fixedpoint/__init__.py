@@ -45,14 +45,14 @@ A pure-Python scalar emulation of the same intrinsics and of tp17.C (independent
 tests, the benchmark and the operation count) is in :mod:`.scalar`.
 """
 
-from .q15 import (FRAC16, FRAC32, MAX16, MAX32, MIN16, MIN32, L_abs, L_add, L_deposit_h, L_deposit_l, L_mac,
+from stewart_drake.fixedpoint.q15 import (FRAC16, FRAC32, MAX16, MAX32, MIN16, MIN32, L_abs, L_add, L_deposit_h, L_deposit_l, L_mac,
                   L_msu, L_mult, L_negate, L_shl, L_shr, L_sub, SaturationCounter, abs_s, add, div_s,
                   extract_h, extract_l, mac_r, mfr32Sqrt, msu_r, mult, mult_r, negate, round_, sat16, sat32,
                   shl, shr, sub, tfr16CosPIx, tfr16SinPIx, to_float16, to_float32, word16, word32)
-from .tp17 import (ERROR_STAGES, TP17_GEOMETRY_MM, Tp17Trace, check_dsp_poses, dsp_poses_from_si, dsp_poses_to_si,
+from stewart_drake.fixedpoint.tp17 import (ERROR_STAGES, TP17_GEOMETRY_MM, Tp17Trace, check_dsp_poses, dsp_poses_from_si, dsp_poses_to_si,
                    tp17_error_stages, tp17_leg_lengths, tp17_trace)
-from .generic import QFormat, fixed_point_leg_lengths, fixed_point_rotation
-from .cycles import CLOCK_HZ, CYCLE_TABLE, CycleEstimate, estimate_cycles, ik_latency_s, tp17_cycles
+from stewart_drake.fixedpoint.generic import QFormat, fixed_point_leg_lengths, fixed_point_rotation
+from stewart_drake.fixedpoint.cycles import CLOCK_HZ, CYCLE_TABLE, CycleEstimate, estimate_cycles, ik_latency_s, tp17_cycles
 
 __all__ = [
     "FRAC16", "FRAC32", "MAX16", "MAX32", "MIN16", "MIN32", "L_abs", "L_add", "L_deposit_h", "L_deposit_l",

@@ -1,4 +1,4 @@
-"""A fixed-point inverse kinematics for any :class:`~stewart_drake.geometry.Platform`, with a chosen
+"""A fixed-point inverse kinematics for any :class:`~stewart_drake.core.geometry.Platform`, with a chosen
 word length, to study word length against leg-length error.
 
 It follows the firmware's recipe (``tp17.C``) generalised, not its exact instruction sequence:
@@ -27,10 +27,10 @@ from itertools import product
 
 import numpy as np
 
-from ..errors import counted
-from ..geometry import Platform
-from ..rotations import check_convention
-from .q15 import _sat, tfr16CosPIx, tfr16SinPIx
+from stewart_drake.errors import counted
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.rotations import check_convention
+from stewart_drake.fixedpoint.q15 import _sat, tfr16CosPIx, tfr16SinPIx
 
 TRIG_MODES = ("exact", "tfr16")
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import q15
-from .q15 import (FRAC16, L_add, L_mult, L_negate, add, extract_h, mfr32Sqrt, negate, tfr16CosPIx,
+from stewart_drake.fixedpoint import q15
+from stewart_drake.fixedpoint.q15 import (FRAC16, L_add, L_mult, L_negate, add, extract_h, mfr32Sqrt, negate, tfr16CosPIx,
                   tfr16SinPIx)
 
 TP17_GEOMETRY_MM = {"a": 1225 // 2, "b": 925, "d": 150}

@@ -3,7 +3,7 @@ solution. numpy only. Modules: ``study`` (the polynomial system, architecture cl
 (start systems by monodromy, shipped in ``data/``), ``track`` (vectorised path tracker), ``solve``
 (path classification, completeness), ``certify`` (Krawczyk/Kantorovich existence-uniqueness test)."""
 
-from .solve import CLASSES, CertifiedMode, HomotopyResult, solve, solve_batch
-from .study import architecture
+from stewart_drake.homotopy.solve import CLASSES, CertifiedMode, HomotopyResult, solve, solve_batch
+from stewart_drake.homotopy.study import architecture
 
 __all__ = ["CLASSES", "CertifiedMode", "HomotopyResult", "architecture", "solve", "solve_batch"]

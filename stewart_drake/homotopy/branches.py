@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fk import anchor_scale, jacobian_analysis
-from ..geometry import Platform
-from ..kinematics import leg_lengths
-from ..rotations import rotation_matrix
-from .solve import solve_batch
+from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.homotopy.solve import solve_batch
 
 MAX_SAMPLES = 5000  # bound on the samples checked (each is one homotopy solve)
 SAME_MODE = 1e-6  # m: the mode the platform is on is found within this of the sampled pose

@@ -36,11 +36,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry import Platform
-from ..fk import _legs, validate_lengths
-from .certify import certify, newton_real, pose_bounds, real_forms
-from .start import load_start_system
-from .study import (
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.newton_fk import _legs, validate_lengths
+from stewart_drake.homotopy.certify import certify, newton_real, pose_bounds, real_forms
+from stewart_drake.homotopy.start import load_start_system
+from stewart_drake.homotopy.study import (
     SIX_THREE,
     architecture,
     evaluate,
@@ -49,7 +49,7 @@ from .study import (
     pose_from_study,
     study_parameters,
 )
-from .track import DONE, FAILED, STALLED, TrackOptions, track
+from stewart_drake.homotopy.track import DONE, FAILED, STALLED, TrackOptions, track
 
 REAL, COMPLEX, INFINITY, SINGULAR, FAIL = "real", "complex", "infinity", "singular", "failed"
 CLASSES = (REAL, COMPLEX, INFINITY, SINGULAR, FAIL)

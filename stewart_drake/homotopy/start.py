@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .study import GENERAL, ROOT_COUNT, SIX_THREE, THREE_SIX, evaluate, leg_matrices
-from .track import DONE, TrackOptions, track
+from stewart_drake.homotopy.study import GENERAL, ROOT_COUNT, SIX_THREE, THREE_SIX, evaluate, leg_matrices
+from stewart_drake.homotopy.track import DONE, TrackOptions, track
 
 DATA = Path(__file__).parent / "data"
 DISTINCT_TOL = 1e-6  # relative distance below which two solutions are one

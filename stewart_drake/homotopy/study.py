@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import Platform
+from stewart_drake.core.geometry import Platform
 
 GENERAL = "6-6"
 THREE_SIX = "3-6"  # plate anchors coincide in three pairs

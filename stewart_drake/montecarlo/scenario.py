@@ -26,8 +26,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..geometry import Platform
-from .spec import KEYS, VarySpec
+from stewart_drake.core.geometry import Platform
+from stewart_drake.montecarlo.spec import KEYS, VarySpec
 
 # Nominal values of the keys whose nominal is not the platform's.
 NOMINAL = {"sensor_resolution": 1e-5, "latency": "sample", "actuator_lag": 2e-3, "gain_scale": 1.0,
@@ -64,12 +64,12 @@ class Study:
 
     def reference(self):
         """The pose reference as a ``simulation.Trajectory`` (built on the worker)."""
-        from ..simulation import Trajectory, fit_trajectory, get_trajectory, table_trajectory
+        from stewart_drake.drake.simulation import Trajectory, fit_trajectory, get_trajectory, table_trajectory
 
         if self.table is not None:
             ref = table_trajectory(*self.table)
         elif self.program is not None:
-            from ..script import run_program
+            from stewart_drake.script import run_program
 
             name, text = self.program
             traj = run_program(text, name, self.platform).trajectory
@@ -234,8 +234,8 @@ def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None)
     with ``keep_log``, the ``SimulationLog`` under ``"log"``. Metrics (SI): leg error = true length −
     the perturbed plant's IK of the reference; pose error = measured − reference pose. A run whose
     simulation fails keeps its row, with ``error`` set and ``lost_tracking`` true."""
-    from ..control import ControllerConfig, DspTiming
-    from ..simulation import ActuatorModel, build_simulation, design_poses
+    from stewart_drake.control.controller import ControllerConfig, DspTiming
+    from stewart_drake.drake.simulation import ActuatorModel, build_simulation, design_poses
 
     t0 = time.perf_counter()
     seed, d = draw(study, index)

@@ -37,7 +37,7 @@ from decimal import Decimal
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import StewartError
+from stewart_drake.errors import StewartError
 
 
 class SpecError(StewartError):

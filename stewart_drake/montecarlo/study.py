@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import claim_in_manifest
-from ..errors import StewartError
-from .scenario import Study, run_scenario
+from stewart_drake.core.output_folder import claim_in_manifest
+from stewart_drake.errors import StewartError
+from stewart_drake.montecarlo.scenario import Study, run_scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -56,8 +56,8 @@ def study_settings(study: Study) -> dict:
 
 def study_from_settings(settings: dict, runs: int) -> Study:
     """The ``Study`` of ``study_settings`` (as stored in ``study.json``)."""
-    from ..geometry import LegConfig, Platform
-    from .spec import spec_from_dict
+    from stewart_drake.core.geometry import LegConfig, Platform
+    from stewart_drake.montecarlo.spec import spec_from_dict
 
     plat = dict(settings["platform"])
     plat["legs"] = LegConfig(**plat["legs"])
@@ -88,7 +88,7 @@ def settings_key(settings: dict) -> str:
 
 def check_study(study: Study) -> float:
     """Raise ``StudyError`` if the study is too large or inconsistent; return the seconds per run."""
-    from ..integrators import check_integrator
+    from stewart_drake.drake.integrators import check_integrator
 
     if study.integrator is not None:
         check_integrator(study.integrator)
@@ -226,7 +226,7 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         return
     from distributed import Client, as_completed
 
-    from ..workspace_dask import local_cluster
+    from stewart_drake.workspace.dask_sweep import local_cluster
 
     cluster = None
     if scheduler is None:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .spec import LATENCY_MODES
+from stewart_drake.montecarlo.spec import LATENCY_MODES
 
 METRICS = ("max_leg_error_m", "rms_leg_error_m", "max_position_error_m", "rms_position_error_m",
            "max_angle_error_rad", "rms_angle_error_rad", "saturated_ticks", "saturated_leg_ticks")
@@ -140,7 +140,7 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
 
 def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
     """Replace ``out`` atomically with the table, ``summary.json``, ``study.json`` and the plots."""
-    from ..atomic import atomic_folder
+    from stewart_drake.core.output_folder import atomic_folder
 
     out = Path(out)
     with atomic_folder(out) as tmp:

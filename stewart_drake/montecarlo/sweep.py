@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import itertools
 
-from ..geometry import Platform
-from .scenario import Study
-from .spec import KEYS, SpecError, VarySpec, _check_key
-from .study import run_study
+from stewart_drake.core.geometry import Platform
+from stewart_drake.montecarlo.scenario import Study
+from stewart_drake.montecarlo.spec import KEYS, SpecError, VarySpec, _check_key
+from stewart_drake.montecarlo.study import run_study
 
 
 def sweep_study(platform: Platform, axes: dict, trajectory: str = "seed", controller: str = "fixed", duration: float | None = None,

@@ -30,11 +30,11 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..atomic import OutputFolder, atomic_folder
-from ..jsonout import dumps_strict
-from . import render
+from stewart_drake.core.output_folder import OutputFolder, atomic_folder
+from stewart_drake.core.jsonout import dumps_strict
+from stewart_drake.report import render
 
-ANALYSES_DIR = Path(__file__).resolve().parents[2] / "analyses"
+ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 
 
 @dataclass
@@ -141,10 +141,20 @@ class Analysis:
     cost: float = 0.0  # the module's optional COST (relative run time): workers take the costliest first
 
 
-def load_analysis(path: Path) -> Analysis:
+def _module_at(path: Path):
+    """The analysis module in file ``path``: imported as ``stewart_drake.analyses.<stem>`` when it is
+    one of the package's own (so an installed package is only read), else loaded from the file."""
+    path = Path(path).resolve()
+    if path.parent == ANALYSES_DIR:
+        return importlib.import_module(f"stewart_drake.analyses.{path.stem}")
     spec = importlib.util.spec_from_file_location(f"analyses_{path.stem}", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
+    return mod
+
+
+def load_analysis(path: Path) -> Analysis:
+    mod = _module_at(path)
     for attr in ("TITLE", "ORDER", "build"):
         if not hasattr(mod, attr):
             raise ValueError(f"analysis {path} lacks {attr}")
@@ -154,7 +164,7 @@ def load_analysis(path: Path) -> Analysis:
 def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = None) -> list[Analysis]:
     """Every ``analyses/*.py`` with TITLE/ORDER/build, in report order; ``only`` filters by file stem."""
     if not directory.is_dir():
-        raise FileNotFoundError(f"analyses folder {str(directory)!r} not found (run from a checkout of stewart-drake)")
+        raise FileNotFoundError(f"analyses folder {str(directory)!r} not found")
     found = [load_analysis(p) for p in sorted(directory.glob("*.py")) if not p.name.startswith("_")]
     if only:
         unknown = sorted(set(only) - {a.name for a in found})
@@ -192,10 +202,7 @@ def _call_in_analysis(path: str, name: str, item):
 
     matplotlib.use("Agg")
     if path not in _MODULES:
-        spec = importlib.util.spec_from_file_location(f"analyses_{Path(path).stem}", path)
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-        _MODULES[path] = mod
+        _MODULES[path] = _module_at(Path(path))
     return getattr(_MODULES[path], name)(item)
 
 

@@ -159,7 +159,7 @@ def meta_html(meta: dict) -> str:
 
 
 def default_meta(sections, command: str | None = None, elapsed: float | None = None, presets=()) -> dict:
-    from ..report import ANALYSES_DIR  # the checkout the analyses came from
+    from stewart_drake.report import ANALYSES_DIR  # the checkout the analyses came from
 
     v = versions()
     mode = "quick (small samples)" if any(s.quick for s in sections) else "full"

@@ -10,12 +10,12 @@ Typical use::
 
 from __future__ import annotations
 
-from ..geometry import Platform
-from .check import check
-from .errors import Loc, ScriptError, ScriptErrors
-from .interpreter import execute
-from .parser import parse
-from .runtime import DEFAULT_RATE, Motion, Result, Trajectory, evaluate
+from stewart_drake.core.geometry import Platform
+from stewart_drake.script.check import check
+from stewart_drake.script.errors import Loc, ScriptError, ScriptErrors
+from stewart_drake.script.interpreter import execute
+from stewart_drake.script.parser import parse
+from stewart_drake.script.runtime import DEFAULT_RATE, Motion, Result, Trajectory, evaluate
 
 __all__ = ["Loc", "Motion", "Result", "ScriptError", "ScriptErrors", "Trajectory", "check", "compile_program",
            "evaluate", "execute", "parse", "run_program"]

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import difflib
 
-from ..rotations import ANGLE_UNITS, LENGTH_UNITS
-from . import ast
-from .errors import (
+from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
+from stewart_drake.script import ast
+from stewart_drake.script.errors import (
     FUNC_ARITY,
     FUNC_UNKNOWN,
     MOVE_ARITY,
@@ -19,7 +19,7 @@ from .errors import (
     ScriptError,
     raise_all,
 )
-from .runtime import ARG_ALIASES, ARG_NAMES, CONSTANTS, FUNCTIONS
+from stewart_drake.script.runtime import ARG_ALIASES, ARG_NAMES, CONSTANTS, FUNCTIONS
 
 NUMBER, CONDITION = "number", "condition"
 

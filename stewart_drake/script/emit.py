@@ -12,9 +12,9 @@ from __future__ import annotations
 import builtins
 import keyword
 
-from . import ast
-from .errors import ScriptError
-from .runtime import CONSTANTS, DEFAULT_RATE, DEFAULT_UNITS, FUNCTIONS, Motion, fmt_number
+from stewart_drake.script import ast
+from stewart_drake.script.errors import ScriptError
+from stewart_drake.script.runtime import CONSTANTS, DEFAULT_RATE, DEFAULT_UNITS, FUNCTIONS, Motion, fmt_number
 
 MATLAB_HEADER = "%%CÓDIGO DE MATLAB"  # the seed's sample output ("Archivo de salida")
 
@@ -68,7 +68,7 @@ unless the program says otherwise (`motion.units`).
 
 import math  # noqa: F401  (used by programs that call functions)
 
-from stewart_drake.geometry import load_platform
+from stewart_drake.core.geometry import load_platform
 from stewart_drake.script.runtime import Motion, evaluate, for_range  # noqa: F401
 
 PLATFORM = {platform!r}
@@ -102,7 +102,7 @@ if __name__ == "__main__":
 
 class _PyEmitter:
     def __init__(self, program: ast.Program):
-        from .check import assigned_names
+        from stewart_drake.script.check import assigned_names
 
         names = set(assigned_names(program.body))
         self.names = {}

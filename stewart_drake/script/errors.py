@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import StewartError
+from stewart_drake.errors import StewartError
 
 SYNTAX = "unexpected {found}; expected {expected}"
 RESERVED = "{word!r} is a reserved word (Modula-2, kept from seed 004's Stewart.g) and cannot be used yet"

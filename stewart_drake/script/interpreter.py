@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import math
 
-from . import ast
-from .check import assigned_names
-from .errors import UNDEFINED, ScriptError
-from .runtime import CONSTANTS, FUNCTIONS, MAX_SEGMENTS, Motion, fmt_number, for_count, for_range
+from stewart_drake.script import ast
+from stewart_drake.script.check import assigned_names
+from stewart_drake.script.errors import UNDEFINED, ScriptError
+from stewart_drake.script.runtime import CONSTANTS, FUNCTIONS, MAX_SEGMENTS, Motion, fmt_number, for_count, for_range
 
 MAX_STEPS = 1_000_000  # statements executed + loop iterations
 

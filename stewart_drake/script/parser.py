@@ -15,8 +15,8 @@ from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken, VisitError
 from lark.visitors import Transformer_NonRecursive
 
-from . import ast
-from .errors import RESERVED, SYNTAX, Loc, ScriptError
+from stewart_drake.script import ast
+from stewart_drake.script.errors import RESERVED, SYNTAX, Loc, ScriptError
 
 # Deeper nesting than this is refused (later passes recurse over the tree).
 MAX_DEPTH = 100

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SingularPoseError
-from ..geometry import Platform
-from ..kinematics import check_stroke, leg_lengths
-from ..rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from .errors import (
+from stewart_drake.errors import SingularPoseError
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import check_stroke, leg_lengths
+from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from stewart_drake.script.errors import (
     MOVE_ARITY,
     MOVE_DUPLICATE_ARG,
     MOVE_UNKNOWN_ARG,
@@ -355,7 +355,7 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
 def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> None:
     """``ScriptError`` at the first move whose path puts a plate anchor at or below the base plane
     (``sanity.above_base``), with the time and the anchor's height."""
-    from ..sanity import above_base, plate_anchor_heights
+    from stewart_drake.core.sanity import above_base, plate_anchor_heights
 
     ok = above_base(platform, traj.q, convention)
     if np.all(ok):
@@ -374,7 +374,7 @@ def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> 
 
 def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) -> ScriptError:
     """A ``SingularPoseError`` from the dynamics, restated at the move whose path crosses the singularity."""
-    from ..dynamics import MAX_CONDITION, jacobian_condition
+    from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition
 
     k = jacobian_condition(platform, traj.q, convention)
     bad = np.flatnonzero(~(k <= MAX_CONDITION))
@@ -393,7 +393,7 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
 def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True,
              gravity: float = 9.81) -> Result:
     """Inverse kinematics (with the stroke check) and inverse dynamics on a trajectory."""
-    from ..sanity import has_plate
+    from stewart_drake.core.sanity import has_plate
 
     L = check_reachable(platform, traj, convention)
     notes = []
@@ -401,10 +401,10 @@ def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", cori
         return Result(traj, L, None, platform.name, convention,
                       (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",))
     try:
-        from ..dynamics import leg_forces
+        from stewart_drake.core.dynamics import leg_forces
     except ImportError:
         F = None
-        notes.append("leg forces not computed: stewart_drake.dynamics.leg_forces is not available in this installation")
+        notes.append("leg forces not computed: stewart_drake.core.dynamics.leg_forces is not available in this installation")
     else:
         try:
             F = np.asarray(leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity))

@@ -6,10 +6,10 @@ run by ``executors``), ``columns`` (exact stroke volume), ``orientation`` (rotat
 is re-exported here.
 """
 
-from .columns import stroke_column_lengths, stroke_volume_columns
-from .executors import default_workers
-from .grid import MAX_GRID_NODES, Workspace, constant_orientation_workspace, default_bounds
-from .limits import (
+from stewart_drake.workspace.columns import stroke_column_lengths, stroke_volume_columns
+from stewart_drake.workspace.executors import default_workers
+from stewart_drake.workspace.grid import MAX_GRID_NODES, Workspace, constant_orientation_workspace, default_bounds
+from stewart_drake.workspace.limits import (
     AXES,
     LIMIT_NAMES,
     LIMIT_UNITS,
@@ -21,10 +21,10 @@ from .limits import (
     raw_margins,
     segment_distances,
 )
-from .maps import count_reachable, dexterity_map
-from .mobility import STEWART_JOINTS, gruebler_mobility, stewart_mobility
-from .orientation import RotationLimit, orientation_limits
-from .views import view_figures
+from stewart_drake.workspace.maps import count_reachable, dexterity_map
+from stewart_drake.workspace.mobility import STEWART_JOINTS, gruebler_mobility, stewart_mobility
+from stewart_drake.workspace.orientation import RotationLimit, orientation_limits
+from stewart_drake.workspace.views import view_figures
 
 __all__ = [
     "AXES",

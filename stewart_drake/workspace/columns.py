@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import Platform
-from ..kinematics import leg_vectors
-from ..sanity import plate_floor
-from .grid import default_bounds
-from .limits import _check_orientation
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.core.sanity import plate_floor
+from stewart_drake.workspace.grid import default_bounds
+from stewart_drake.workspace.limits import _check_orientation
 
 
 def stroke_column_lengths(platform: Platform, x, y, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_bounds=(0.0, np.inf)) -> np.ndarray:

@@ -8,7 +8,7 @@ import os
 import sys
 from concurrent.futures import Executor, ProcessPoolExecutor
 
-from .limits import WorkspaceError
+from stewart_drake.workspace.limits import WorkspaceError
 
 
 def _run_tasks(fn, tasks, executor, workers, progress, desc):

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import leg_vectors
-from .limits import raw_margins
-from .slabs import _GridSpec
+from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.workspace.limits import raw_margins
+from stewart_drake.workspace.slabs import _GridSpec
 
 
 def _extreme_indices(views) -> list:

@@ -11,14 +11,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry import Platform
-from ..kinematics import leg_vectors
-from ..rotations import check_convention
-from ..sanity import plate_floor
-from .executors import _run_tasks
-from .extents import _extents_from_views, _refine_extents
-from .limits import Limits, WorkspaceError, _check_orientation
-from .slabs import _grid_spec, _slab_task
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.core.rotations import check_convention
+from stewart_drake.core.sanity import plate_floor
+from stewart_drake.workspace.executors import _run_tasks
+from stewart_drake.workspace.extents import _extents_from_views, _refine_extents
+from stewart_drake.workspace.limits import Limits, WorkspaceError, _check_orientation
+from stewart_drake.workspace.slabs import _grid_spec, _slab_task
 
 # Largest grid the sweep accepts (nodes): ~10 min of the stroke kernel at ~5e7 nodes/s on one core.
 MAX_GRID_NODES = 3e10
@@ -44,7 +44,7 @@ def grid_memory(bounds, h) -> tuple[float, float]:
 def check_grid_size(bounds, h) -> None:
     """``WorkspaceError`` naming the resolution, the node count, the memory and the finest resolution
     this machine can hold when the grid is too large (memory budget or ``MAX_GRID_NODES``)."""
-    from ..sanity import human_bytes, memory_budget
+    from stewart_drake.core.sanity import human_bytes, memory_budget
 
     nodes, need = grid_memory(bounds, h)
     budget = memory_budget()

@@ -10,10 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import StewartError
-from ..geometry import Platform
-from ..kinematics import condition_number, leg_vectors
-from ..rotations import check_convention, rotation_matrix
+from stewart_drake.errors import StewartError
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import condition_number, leg_vectors
+from stewart_drake.core.rotations import check_convention, rotation_matrix
 
 LIMIT_NAMES = ("stroke", "base_joint", "top_joint", "collision", "dexterity")
 LIMIT_UNITS = {"stroke": "m", "base_joint": "rad", "top_joint": "rad", "collision": "m", "dexterity": "1"}

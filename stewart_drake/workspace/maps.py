@@ -9,11 +9,11 @@ from concurrent.futures import Executor
 
 import numpy as np
 
-from ..geometry import Platform
-from ..kinematics import condition_number
-from .executors import _run_tasks
-from .grid import default_bounds
-from .limits import Limits, WorkspaceError, _check_orientation, classify
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import condition_number
+from stewart_drake.workspace.executors import _run_tasks
+from stewart_drake.workspace.grid import default_bounds
+from stewart_drake.workspace.limits import Limits, WorkspaceError, _check_orientation, classify
 
 
 def dexterity_map(

@@ -4,7 +4,7 @@ m = 6 for SPS legs). Pure arithmetic.
 
 from __future__ import annotations
 
-from .limits import WorkspaceError
+from stewart_drake.workspace.limits import WorkspaceError
 
 
 def gruebler_mobility(n_links: int, joint_dofs, passive_dofs: int = 0, space_dof: int = 6) -> int:

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import Platform
-from ..kinematics import leg_lengths, leg_vectors
-from ..rotations import rotation_matrix
-from ..sanity import above_base, plate_anchor_heights
-from .limits import AXES, LIMIT_UNITS, Limits, WorkspaceError, leg_pairs, limit_margins, raw_margins
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_lengths, leg_vectors
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.sanity import above_base, plate_anchor_heights
+from stewart_drake.workspace.limits import AXES, LIMIT_UNITS, Limits, WorkspaceError, leg_pairs, limit_margins, raw_margins
 
 
 @dataclass(frozen=True)

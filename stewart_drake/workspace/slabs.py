@@ -11,11 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import Platform
-from ..kinematics import leg_vectors
-from ..rotations import rotation_matrix
-from ..sanity import plate_floor
-from .limits import Limits, _check_orientation, _margins_from_legs
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.sanity import plate_floor
+from stewart_drake.workspace.limits import Limits, _check_orientation, _margins_from_legs
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .grid import Workspace
-from .limits import AXES
+from stewart_drake.workspace.grid import Workspace
+from stewart_drake.workspace.limits import AXES
 
 
 def view_figures(ws: Workspace, reference=None, title: str = "") -> dict:

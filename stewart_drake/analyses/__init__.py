@@ -1,0 +1,1 @@
+"""The report's analyses: one module per section (``TITLE``, ``ORDER``, ``build``)."""

@@ -1,0 +1,84 @@
+"""Monte Carlo robustness of the fixed-point controller on utn-dynamic (seed trajectory): the distributions
+of the tracking errors over drawn manufacturing tolerances, sensor, timing and payload, and which
+parameter explains them (Spearman rank correlation)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.montecarlo.scenario import Study, run_scenario
+from stewart_drake.montecarlo.spec import parse_spec
+from stewart_drake.montecarlo.study import run_study
+from stewart_drake.montecarlo.summary import METRICS, sensitivity
+from stewart_drake.report import run_standalone
+
+TITLE = "Robustness: Monte Carlo over tolerances, sensor, timing and payload"
+ORDER = 95
+
+PLATFORM = "utn-dynamic"
+VARY = ["anchor=±0.5mm", "sensor_resolution=10um", "sensor_noise=2um", "latency_jitter=200us", "payload_mass=±20%",
+        "actuator_lag=1.5ms..2.5ms", "gain_scale=±10%"]
+
+
+def build(section) -> None:
+    import matplotlib.pyplot as plt
+
+    quick = section.quick
+    runs, duration, workers = (8, 0.5, 0) if quick else (40, 4.0, 2)
+    platform = load_preset(PLATFORM)
+    study = Study(platform, parse_spec(VARY), seed=2026, runs=runs, duration=duration)
+    rows = run_study(study, None, workers=workers, progress=False)
+    section.text(
+        f"{runs} closed-loop runs of the fixed-point controller on {PLATFORM}, seed trajectory, {duration:g} s each "
+        f"(stewart-drake montecarlo --runs {runs} --seed 2026 --duration {duration:g} --vary {' '.join(VARY)}). Each run "
+        "draws its own parameters from SeedSequence(2026, spawn_key=(run,)): every base and plate anchor moved per axis "
+        "within ±0.5 mm (the plant only: the controller keeps the nominal geometry), a 10 µm sensor with 2 µm of white "
+        "noise, the sampling instant of each tick late by up to 200 µs (first order: L − j·dL/dt), the plate mass ±20 % "
+        "(inertia scaled alike), the actuator lag in 1.5 … 2.5 ms and every gain scaled by ±10 %. Leg error: the true "
+        "leg length minus the perturbed plant's IK of the reference; pose error: the measured plate pose minus the reference."
+    )
+    header = ["metric", "p5", "p50", "p95", "p99", "max"]
+    table = []
+    for m, scale, unit in (("max_leg_error_m", 1e3, "mm"), ("rms_leg_error_m", 1e3, "mm"), ("max_position_error_m", 1e3, "mm"),
+                           ("max_angle_error_rad", 180 / np.pi, "deg")):
+        v = np.array([r[m] for r in rows], float) * scale
+        table.append([f"{m.rsplit('_', 1)[0]} [{unit}]", *[float(np.percentile(v, q)) for q in (5, 50, 95, 99)], float(v.max())])
+    section.table(header, table, caption=f"Distribution over {runs} runs", fmt="{:.4g}")
+    lost = [r["run"] for r in rows if r["lost_tracking"]]
+    section.text(f"Runs that lost tracking (a leg more than 5 mm off, or a failed simulation): {len(lost)} of {runs}"
+                 + (f" ({', '.join(map(str, lost))})." if lost else "."))
+    ranking = {m: sensitivity(rows, m) for m in ("max_leg_error_m", "max_position_error_m")}
+    names = [d["parameter"] for d in ranking["max_leg_error_m"][:10]]
+    rho = {m: {d["parameter"]: d["spearman"] for d in r} for m, r in ranking.items()}
+    section.table(["parameter", "ρ with max leg error", "ρ with max position error"],
+                  [[n, rho["max_leg_error_m"].get(n, float("nan")), rho["max_position_error_m"].get(n, float("nan"))] for n in names],
+                  caption="Sensitivity: Spearman rank correlation of each drawn parameter with the error (ten largest |ρ|)", fmt="{:+.3f}")
+    fig, ax = plt.subplots(1, 3, figsize=(13, 3.5))
+    for a, (m, label) in zip(ax[:2], [("max_leg_error_m", "max leg error [mm]"), ("max_position_error_m", "max position error [mm]")]):
+        a.hist(np.array([r[m] for r in rows]) * 1e3, bins=max(5, runs // 5))
+        a.set_xlabel(label)
+        a.set_ylabel("runs")
+    if names:
+        x = np.array([r[names[0]] for r in rows], float)
+        ax[2].scatter(x, np.array([r["max_leg_error_m"] for r in rows]) * 1e3, s=10)
+        ax[2].set_xlabel(names[0])
+        ax[2].set_ylabel("max leg error [mm]")
+        ax[2].set_title(f"most influential (ρ = {rho['max_leg_error_m'][names[0]]:+.2f})")
+    section.figure(fig, "robustness", "Distributions of the worst leg and position errors, and the leg error against the most influential parameter.")
+    worst = max(rows, key=lambda r: r["max_leg_error_m"])
+    again = run_scenario(study, worst["run"])
+    diff = max(abs(again[m] - worst[m]) for m in METRICS)
+    section.check(f"replay of the worst run ({worst['run']}) reproduces its metrics bit for bit", diff, 0.0)
+    section.text(
+        f"The worst run ({worst['run']}, seed {worst['seed']}) re-run alone from its index gives the same metrics bit for bit "
+        "(the check above): a study's outlier can be replayed and inspected (stewart-drake montecarlo --replay K)."
+    )
+
+
+def main(argv=None):
+    return run_standalone(__file__, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,490 @@
+"""Platform geometry: the typed ``Platform``, its YAML form, constructors and presets.
+
+Frames (Drake monogram notation): B is the base frame (origin at the base centre, Z up), T the top
+(moving plate) frame. ``base_anchors[i]`` is p_BBi, the base joint of leg i in B; ``top_anchors[j]``
+is p_TTj, a plate joint in T; leg i joins base anchor i to top anchor ``leg_top[i]``. All lengths are
+metres and masses kilograms inside the library; YAML files may use millimetres (``length_unit: mm``).
+"""
+
+# The YAML schema dataclasses' field types are read by yamlio (typing.get_type_hints).
+
+import dataclasses
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from stewart_drake.errors import GeometryError, YamlError
+from stewart_drake.core.rotations import length_scale
+from stewart_drake.core.sanity import check_home
+from stewart_drake.core.yamlio import Rule, check_rules, load_yaml_typed
+
+SQRT3 = np.sqrt(3.0)
+PRESETS = ("utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009")
+# Two base anchors closer than this are the same point: a modelling error, not a design.
+MIN_ANCHOR_SEPARATION = 1e-6
+
+
+# ----------------------------------------------------------------------------------------------
+# YAML schema (edge units), loaded with the safe, bounded yamlio loader.
+
+
+@dataclass
+class UtnDims:
+    """The UTN 3-6 family: base hexagon long side ``b``, short side ``d``; top triangle side ``a``."""
+
+    b: float = 0.0
+    d: float = 0.0
+    a: float = 0.0
+
+
+@dataclass
+class RadialDims:
+    """A 6-6 platform with anchors on two circles (z = 0); angles in degrees from the X axis."""
+
+    base_radius: float = 0.0
+    base_angles_deg: list[float] = field(default_factory=list)
+    top_radius: float = 0.0
+    top_angles_deg: list[float] = field(default_factory=list)
+
+
+@dataclass
+class PlateConfig:
+    """The moving plate's mass properties. Either ``mass``/``com``/``inertia`` given directly
+    (inertia about the centre of mass, in T: Ixx Iyy Izz Ixy Ixz Iyz, kg·m²), or a uniform
+    equilateral triangular sheet (UTN family only) from ``thickness`` and ``density``."""
+
+    mass: float = 0.0
+    com: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    inertia: list[float] = field(default_factory=lambda: [0.0] * 6)
+    thickness: Optional[float] = None
+    density: Optional[float] = None
+
+
+@dataclass
+class LegConfig:
+    """Physical legs for the Drake model: a cylinder on a universal joint at the base and a piston
+    on a prismatic joint (lengths in the file's unit, masses kg)."""
+
+    cylinder_length: float = 0.0  # 0: half of the minimum stroke length
+    cylinder_radius: float = 0.0  # 0: 1/40 of the minimum stroke length
+    cylinder_mass: float = 0.2
+    piston_radius: float = 0.0  # 0: 0.6 x cylinder radius
+    piston_mass: float = 0.1
+    max_force: float = 1000.0  # N, actuator effort limit
+    max_speed: Optional[float] = None  # length unit per s, actuator speed limit (None: not checked)
+    max_power: Optional[float] = None  # W, actuator mechanical power limit (None: not checked)
+    stiffness: Optional[float] = None  # N per length unit, axial stiffness of a leg (None: unknown)
+
+
+@dataclass
+class PlatformConfig:
+    """One platform as written in YAML. Exactly one anchor description: ``utn``, ``radial`` or
+    explicit ``base_anchors`` + ``top_anchors`` + ``leg_top``."""
+
+    name: str = ""
+    description: str = ""
+    length_unit: str = "m"
+    utn: Optional[UtnDims] = None
+    radial: Optional[RadialDims] = None
+    base_anchors: list[list[float]] = field(default_factory=list)
+    top_anchors: list[list[float]] = field(default_factory=list)
+    leg_top: list[int] = field(default_factory=list)
+    stroke: list[float] = field(default_factory=list)
+    plate: PlateConfig = field(default_factory=PlateConfig)
+    rotation_centre: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    home_height: Optional[float] = None
+    legs: LegConfig = field(default_factory=LegConfig)
+    plate_below_base_allowed: bool = False
+
+
+# ----------------------------------------------------------------------------------------------
+# The Platform.
+
+
+@dataclass(frozen=True, eq=False)
+class Platform:
+    """A Stewart platform. Arrays are read-only numpy arrays in SI units.
+
+    base_anchors  (6, 3)  p_BBi, metres
+    top_anchors   (k, 3)  p_TTj, metres, 3 <= k <= 6
+    leg_top       (6,)    index into top_anchors for each leg
+    stroke        (2,)    L_min, L_max, metres (joint centre to joint centre)
+    mass          float   plate mass, kg
+    com           (3,)    p_TTcm, plate centre of mass in T, metres
+    inertia       (3, 3)  I_Tcm, plate rotational inertia about its centre of mass, in T, kg·m²
+    rotation_centre (3,)  p_TC: the plate point whose position a pose gives (default the T origin)
+    home_height   float   pz of the home pose [0, 0, h, 0, 0, 0], metres
+    legs          LegConfig in metres
+    """
+
+    name: str
+    base_anchors: np.ndarray
+    top_anchors: np.ndarray
+    leg_top: np.ndarray
+    stroke: np.ndarray
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+    rotation_centre: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    home_height: Optional[float] = None
+    legs: LegConfig = field(default_factory=LegConfig)
+    description: str = ""
+    plate_below_base_allowed: bool = False  # poses may put plate anchors at or below z = 0 (sanity.above_base)
+
+    def __post_init__(self):
+        conv = {
+            "base_anchors": (6, 3),
+            "top_anchors": None,
+            "stroke": (2,),
+            "com": (3,),
+            "inertia": (3, 3),
+            "rotation_centre": (3,),
+        }
+        for name, shape in conv.items():
+            arr = _finite_array(getattr(self, name), name, shape)
+            object.__setattr__(self, name, arr)
+        top = self.top_anchors
+        if top.ndim != 2 or top.shape[1] != 3 or not 3 <= top.shape[0] <= 6:
+            raise GeometryError(f"top_anchors must have shape (k, 3) with 3 <= k <= 6, got {top.shape}")
+        leg_top = np.asarray(self.leg_top)
+        if leg_top.shape != (6,) or not np.issubdtype(leg_top.dtype, np.integer):
+            raise GeometryError(f"leg_top must list 6 integer top-anchor indices (one per leg), got {self.leg_top!r}")
+        bad = [i + 1 for i, j in enumerate(leg_top) if not 0 <= j < top.shape[0]]
+        if bad:
+            raise GeometryError(
+                f"leg_top: leg {bad[0]} refers to top anchor {leg_top[bad[0] - 1]}, but there are {top.shape[0]} top anchors (0..{top.shape[0] - 1})"
+            )
+        unused = sorted(set(range(top.shape[0])) - set(leg_top.tolist()))
+        if unused:
+            raise GeometryError(f"leg_top: top anchor {unused[0]} is used by no leg")
+        leg_top = leg_top.astype(np.intp)
+        leg_top.flags.writeable = False
+        object.__setattr__(self, "leg_top", leg_top)
+        _check_distinct(self.base_anchors, "base anchors")
+        _check_distinct(top, "top anchors")
+        lmin, lmax = self.stroke
+        if not 0 < lmin < lmax:
+            raise GeometryError(f"stroke must satisfy 0 < L_min < L_max, got L_min = {lmin} m, L_max = {lmax} m")
+        if not np.isfinite(self.mass) or self.mass < 0:
+            raise GeometryError(f"plate mass must be finite and >= 0, got {self.mass} kg")
+        if not np.allclose(self.inertia, self.inertia.T, atol=1e-12):
+            raise GeometryError(f"plate inertia must be symmetric, got {self.inertia.tolist()}")
+        if self.mass > 0:
+            eig = np.linalg.eigvalsh(self.inertia)
+            tol = 1e-9 * max(1.0, eig.max())
+            if eig.min() < -tol or any(eig[i] + eig[j] < eig[k] - tol for i, j, k in [(0, 1, 2), (0, 2, 1), (1, 2, 0)]):
+                raise GeometryError(f"plate inertia is not physical (principal moments {eig.tolist()} kg·m²)")
+        if self.home_height is None:
+            object.__setattr__(self, "home_height", _mid_stroke_height(self))
+        elif not np.isfinite(self.home_height) or self.home_height <= 0:
+            raise GeometryError(f"home_height must be a positive number of metres, got {self.home_height}")
+
+    # -- derived quantities -------------------------------------------------------------------
+    @property
+    def top_anchors_per_leg(self) -> np.ndarray:
+        """``(6, 3)`` p_TTi: the plate anchor of each leg, in T (metres)."""
+        return self.top_anchors[self.leg_top]
+
+    @property
+    def L_min(self) -> float:
+        return float(self.stroke[0])
+
+    @property
+    def L_max(self) -> float:
+        return float(self.stroke[1])
+
+    def home_pose(self) -> np.ndarray:
+        """``(6,)`` the home pose [0, 0, home_height, 0, 0, 0] (metres, radians)."""
+        return np.array([0.0, 0.0, self.home_height, 0.0, 0.0, 0.0])
+
+    def replace(self, **changes) -> "Platform":
+        """A copy with some fields changed (validated again)."""
+        return dataclasses.replace(self, **changes)
+
+    # -- constructors --------------------------------------------------------------------------
+    @classmethod
+    def utn(cls, b: float, d: float, a: float, **kwargs) -> "Platform":
+        """The UTN 3-6 platform (SPEC §1): hexagon sides ``b`` (long), ``d`` (short); triangle side ``a``.
+
+        Lengths in metres. Legs 1,2 end at T1; 3,4 at T2; 5,6 at T3.
+        """
+        base, top = utn_anchors(b, d, a)
+        return cls(base_anchors=base, top_anchors=top, leg_top=np.array([0, 0, 1, 1, 2, 2]), **kwargs)
+
+    @classmethod
+    def radial(cls, base_radius, base_angles, top_radius, top_angles, **kwargs) -> "Platform":
+        """A 6-6 platform with anchors on circles (z = 0); angles in radians; leg i joins base i to top i."""
+        return cls(
+            base_anchors=_circle_points(base_radius, base_angles, "base"),
+            top_anchors=_circle_points(top_radius, top_angles, "top"),
+            leg_top=np.arange(6),
+            **kwargs,
+        )
+
+
+def utn_anchors(b: float, d: float, a: float) -> tuple[np.ndarray, np.ndarray]:
+    """SPEC §1 anchors: ``(6, 3)`` base anchors and ``(3, 3)`` top anchors, same unit as b, d, a."""
+    for name, value in (("b", b), ("d", d), ("a", a)):
+        if not np.isfinite(value) or value <= 0:
+            raise GeometryError(f"UTN dimension {name} must be a positive length, got {value}")
+    s = SQRT3 / 6
+    base = np.array(
+        [
+            [s * (2 * b + d), d / 2, 0],
+            [-s * (b - d), (b + d) / 2, 0],
+            [-s * (b + 2 * d), b / 2, 0],
+            [-s * (b + 2 * d), -b / 2, 0],
+            [-s * (b - d), -(b + d) / 2, 0],
+            [s * (2 * b + d), -d / 2, 0],
+        ]
+    )
+    top = np.array([[s * a, a / 2, 0], [-SQRT3 / 3 * a, 0, 0], [s * a, -a / 2, 0]])
+    return base, top
+
+
+def triangular_plate(side: float, thickness: float, density: float) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass properties of a uniform equilateral-triangle sheet occupying 0 <= z <= thickness, centred
+    on the T origin (the triangle's centroid): ``(mass kg, com (3,) m, inertia about com (3, 3) kg·m²)``.
+
+    Closed form: an equilateral lamina of side a has I_xx = I_yy = m a²/24 and I_zz = m a²/12 about its
+    centroid; the thickness adds m t²/12 to the in-plane axes.
+    """
+    area = SQRT3 / 4 * side**2
+    m = density * area * thickness
+    Ixx = m * side**2 / 24 + m * thickness**2 / 12
+    return m, np.array([0.0, 0.0, thickness / 2]), np.diag([Ixx, Ixx, m * side**2 / 12])
+
+
+def _circle_points(radius, angles, what) -> np.ndarray:
+    angles = np.asarray(angles, dtype=float)
+    if angles.shape != (6,):
+        raise GeometryError(f"{what} angles must be 6 numbers, got shape {angles.shape}")
+    if not np.isfinite(radius) or radius <= 0:
+        raise GeometryError(f"{what} radius must be a positive length, got {radius}")
+    return np.stack([radius * np.cos(angles), radius * np.sin(angles), np.zeros(6)], -1)
+
+
+def _finite_array(value, name, shape) -> np.ndarray:
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise GeometryError(f"{name} must be numbers, got {value!r}") from None
+    if shape is not None and arr.shape != shape:
+        raise GeometryError(f"{name} must have shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise GeometryError(f"{name} must be finite, got {arr.tolist()}")
+    arr.flags.writeable = False
+    return arr
+
+
+def _check_distinct(points: np.ndarray, what: str) -> None:
+    diff = np.linalg.norm(points[:, None] - points[None], axis=-1)
+    i, j = np.triu_indices(len(points), 1)
+    close = diff[i, j] < MIN_ANCHOR_SEPARATION
+    if np.any(close):
+        k = int(np.argmax(close))
+        raise GeometryError(
+            f"{what} {i[k] + 1} and {j[k] + 1} coincide at {points[i[k]].tolist()} m (closer than {MIN_ANCHOR_SEPARATION} m)"
+        )
+
+
+def _mid_stroke_height(p: Platform) -> float:
+    """pz at which the mean leg length of the zero-orientation pose is mid-stroke."""
+    target = p.stroke.mean()
+    d_xy = p.top_anchors_per_leg[:, :2] - p.rotation_centre[:2] - p.base_anchors[:, :2]
+    d_z = p.top_anchors_per_leg[:, 2] - p.rotation_centre[2] - p.base_anchors[:, 2]
+    r2 = np.sum(d_xy**2, axis=1)
+    if np.any(r2 >= target**2):
+        raise GeometryError(
+            f"platform too wide for its stroke: a leg spans {np.sqrt(r2.max()):.4f} m horizontally but mid-stroke is {target:.4f} m; give home_height"
+        )
+    return float(np.mean(np.sqrt(target**2 - r2) - d_z))
+
+
+# ----------------------------------------------------------------------------------------------
+# YAML and presets.
+
+
+def platform_from_config(cfg: PlatformConfig) -> Platform:
+    """Build a validated ``Platform`` (SI units) from a parsed YAML ``PlatformConfig``."""
+    try:
+        k = length_scale(cfg.length_unit)
+    except ValueError as e:
+        raise GeometryError(f"length_unit: {e}") from None
+    given = [n for n, v in (("utn", cfg.utn), ("radial", cfg.radial), ("base_anchors", cfg.base_anchors or None)) if v]
+    if len(given) != 1:
+        raise GeometryError(
+            f"platform {cfg.name!r}: give exactly one anchor description (utn, radial, or base_anchors/top_anchors/leg_top), got {given or 'none'}"
+        )
+    plate = cfg.plate
+    if plate.thickness is not None or plate.density is not None:
+        if cfg.utn is None or plate.thickness is None or plate.density is None:
+            raise GeometryError(f"platform {cfg.name!r}: plate thickness+density describe a UTN triangle sheet; give both, with utn dimensions")
+        mass, com, inertia = triangular_plate(cfg.utn.a * k, plate.thickness * k, plate.density)
+    else:
+        if len(plate.inertia) != 6:
+            raise GeometryError(f"plate inertia must be 6 numbers (Ixx Iyy Izz Ixy Ixz Iyz), got {plate.inertia!r}")
+        ixx, iyy, izz, ixy, ixz, iyz = plate.inertia
+        mass, com = plate.mass, np.asarray(plate.com, dtype=float) * k
+        inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float) * k**2
+    if len(cfg.stroke) != 2:
+        raise GeometryError(f"stroke must be [L_min, L_max], got {cfg.stroke!r}")
+    legs = dataclasses.replace(
+        cfg.legs,
+        cylinder_length=cfg.legs.cylinder_length * k,
+        cylinder_radius=cfg.legs.cylinder_radius * k,
+        piston_radius=cfg.legs.piston_radius * k,
+        max_speed=None if cfg.legs.max_speed is None else cfg.legs.max_speed * k,
+        stiffness=None if cfg.legs.stiffness is None else cfg.legs.stiffness / k,
+    )
+    common = dict(
+        name=cfg.name,
+        description=cfg.description,
+        stroke=np.asarray(cfg.stroke, dtype=float) * k,
+        mass=mass,
+        com=com,
+        inertia=inertia,
+        rotation_centre=np.asarray(cfg.rotation_centre, dtype=float) * k,
+        home_height=None if cfg.home_height is None else cfg.home_height * k,
+        legs=legs,
+        plate_below_base_allowed=bool(cfg.plate_below_base_allowed),
+    )
+    if cfg.utn is not None:
+        return Platform.utn(cfg.utn.b * k, cfg.utn.d * k, cfg.utn.a * k, **common)
+    if cfg.radial is not None:
+        r = cfg.radial
+        return Platform.radial(
+            r.base_radius * k, np.radians(r.base_angles_deg), r.top_radius * k, np.radians(r.top_angles_deg), **common
+        )
+    return Platform(
+        base_anchors=np.asarray(cfg.base_anchors, dtype=float) * k,
+        top_anchors=np.asarray(cfg.top_anchors, dtype=float) * k,
+        leg_top=np.asarray(cfg.leg_top),
+        **common,
+    )
+
+
+# Field rules of a platform file (yamlio.Rule): sign, unit and largest magnitude; list sizes.
+PLATFORM_RULES = {
+    **{f"utn.{k}": Rule("pos", "length") for k in "bda"},
+    "radial.base_radius": Rule("pos", "length"),
+    "radial.top_radius": Rule("pos", "length"),
+    "radial.base_angles_deg[*]": Rule("any", "deg", 1e4),
+    "radial.top_angles_deg[*]": Rule("any", "deg", 1e4),
+    "base_anchors[*][*]": Rule("any", "length"),
+    "top_anchors[*][*]": Rule("any", "length"),
+    "leg_top[*]": Rule("nonneg", "", 5),
+    "stroke[*]": Rule("pos", "length"),
+    "plate.mass": Rule("nonneg", "kg", 1e5),
+    "plate.com[*]": Rule("any", "length"),
+    "plate.inertia[*]": Rule("any", "kg·m² (file unit)", 1e12),
+    "plate.thickness": Rule("pos", "length"),
+    "plate.density": Rule("pos", "kg/m³", 1e5),
+    "rotation_centre[*]": Rule("any", "length"),
+    "home_height": Rule("pos", "length"),
+    "legs.cylinder_length": Rule("nonneg", "length"),
+    "legs.cylinder_radius": Rule("nonneg", "length"),
+    "legs.piston_radius": Rule("nonneg", "length"),
+    "legs.cylinder_mass": Rule("pos", "kg", 1e4),
+    "legs.piston_mass": Rule("pos", "kg", 1e4),
+    "legs.max_force": Rule("pos", "N", 1e8),
+    "legs.max_speed": Rule("pos", "length"),
+    "legs.max_power": Rule("pos", "W", 1e9),
+    "legs.stiffness": Rule("pos", "N per length unit", 1e15),
+}
+PLATFORM_SHAPES = {
+    "radial.base_angles_deg": (6, 6),
+    "radial.top_angles_deg": (6, 6),
+    "base_anchors": (6, 6),
+    "base_anchors[*]": (3, 3),
+    "top_anchors": (3, 6),
+    "top_anchors[*]": (3, 3),
+    "leg_top": (6, 6),
+    "stroke": (2, 2),
+    "plate.com": (3, 3),
+    "plate.inertia": (6, 6),
+    "rotation_centre": (3, 3),
+}
+MAX_NAME_CHARS = 200
+
+
+def check_name(cfg, where: dict, shown: str) -> None:
+    """``name``/``description``: printable text (no control characters), ``name`` at most
+    ``MAX_NAME_CHARS`` long; it is used in file names and XML only through safe derivations."""
+    for key, limit in (("name", MAX_NAME_CHARS), ("description", 2000)):
+        text = getattr(cfg, key)
+        w = where.get((key,))
+        line = w.line if w else "?"
+        if len(text) > limit:
+            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=key, value=f"({len(text)} characters)",
+                                                       problem=f"is longer than {limit} characters"))
+        bad = next((c for c in text if not c.isprintable()), None)
+        if bad is not None:
+            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=key, value=repr(text[:60]),
+                                                       problem=f"contains the control character {bad!r}"))
+
+
+def check_length_unit(cfg, where: dict, shown: str) -> float:
+    """The metres per file unit of ``length_unit`` (m or mm)."""
+    if cfg.length_unit not in ("m", "mm"):
+        w = where.get(("length_unit",))
+        raise YamlError(YamlError.UNIT.format(path=shown, line=w.line if w else "?", value=cfg.length_unit))
+    return length_scale(cfg.length_unit)
+
+
+def _check_platform_fields(shown: str):
+    def check(cfg, where):
+        check_name(cfg, where, shown)
+        k = check_length_unit(cfg, where, shown)
+        check_rules(where, PLATFORM_RULES, PLATFORM_SHAPES, cfg, shown, k, cfg.length_unit)
+
+    return check
+
+
+def load_yaml_config(path, schema, kind: str, check=None):
+    """Parse a YAML file into the dataclass ``schema`` with the safe, bounded loader
+    (``yamlio.load_yaml_typed``); errors name the file, line and field (``kind`` says what the file
+    should hold). A config with an empty ``name`` takes the file's stem."""
+    cfg = load_yaml_typed(path, schema, kind, check)
+    if not cfg.name:
+        cfg.name = Path(path).stem
+    return cfg
+
+
+def load_platform_yaml(path) -> Platform:
+    """Load one platform from a YAML file (schema: ``PlatformConfig``); every field is checked
+    (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used."""
+    cfg = load_yaml_config(path, PlatformConfig, "platform", _check_platform_fields(str(path)))
+    try:
+        platform = platform_from_config(cfg)
+    except GeometryError as e:
+        raise GeometryError(f"{path}: {e}") from None
+    check_home(platform)  # sanity: a platform singular at its home pose is refused when loaded
+    return platform
+
+
+def preset_path(name: str) -> Path:
+    """The YAML file of a built-in preset."""
+    if name not in PRESETS:
+        raise GeometryError(f"unknown preset {name!r}; built-in presets: {', '.join(PRESETS)}")
+    return Path(str(resources.files("stewart_drake") / "presets" / f"{name}.yaml"))
+
+
+def load_preset(name: str) -> Platform:
+    """One of the built-in presets (``PRESETS``)."""
+    return load_platform_yaml(preset_path(name))
+
+
+def load_platform(name_or_path) -> Platform:
+    """A preset name or a path to a YAML file."""
+    if isinstance(name_or_path, Platform):
+        return name_or_path
+    s = str(name_or_path)
+    if s in PRESETS:
+        return load_preset(s)
+    if s.endswith((".yaml", ".yml")) or Path(s).exists():
+        return load_platform_yaml(s)
+    raise GeometryError(f"unknown platform {s!r}: not a preset ({', '.join(PRESETS)}) and not a YAML file")

@@ -1,0 +1,175 @@
+"""Closed-form inverse kinematics, vectorised over ``(..., 6)`` poses.
+
+A pose ``q = [px, py, pz, a_x, a_y, a_z]`` (metres, radians, see ``rotations``) places the plate's
+rotation centre C at p_BC = (px, py, pz) with orientation R_BT(a; convention). The plate anchor of
+leg i is then p_BTi = p_BC + R_BT (p_TTi - p_TC), the leg vector l_i = p_BTi - p_BBi and its length
+L_i = |l_i|.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stewart_drake.errors import SingularPoseError, UnreachablePoseError, counted
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+
+
+def _poses(poses) -> np.ndarray:
+    q = np.asarray(poses, dtype=float)
+    if q.shape[-1:] != (6,):
+        raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
+    bad = ~np.isfinite(q).all(axis=-1)
+    if np.any(bad):
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(f"pose {counted(idx)} is not finite: {q[idx].tolist()}")
+    return q
+
+
+def plate_anchors(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6, 3)`` p_BTi: each leg's plate anchor in the base frame (metres)."""
+    q = _poses(poses)
+    R = rotation_matrix(q[..., 3:], convention)
+    r_T = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
+    return q[..., None, :3] + np.einsum("...jk,ik->...ij", R, r_T)
+
+
+def leg_vectors(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6, 3)`` l_i = p_BTi - p_BBi (metres)."""
+    return plate_anchors(platform, poses, convention) - platform.base_anchors
+
+
+CHUNK = 1 << 14  # poses per block in leg_lengths: keeps the temporaries in cache
+
+
+def leg_lengths(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6)`` leg lengths L_i (metres) for ``(..., 6)`` poses.
+
+    The hot path of workspace sweeps: evaluated in blocks of ``CHUNK`` poses, one (n, 6) array per
+    coordinate, accumulated in place.
+    """
+    q = _poses(poses)
+    flat = q.reshape(-1, 6)
+    out = np.empty((flat.shape[0], 6))
+    r_T = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
+    base = platform.base_anchors  # (6, 3)
+    for s in range(0, flat.shape[0], CHUNK):
+        blk = flat[s : s + CHUNK]
+        R = rotation_matrix(blk[:, 3:], convention)  # (n, 3, 3)
+        acc = np.zeros((blk.shape[0], 6))
+        for k in range(3):  # coordinate k of every leg vector: (R r_T)_k + p_k - b_k
+            c = np.multiply.outer(R[:, k, 0], r_T[:, 0])
+            c += np.multiply.outer(R[:, k, 1], r_T[:, 1])
+            c += np.multiply.outer(R[:, k, 2], r_T[:, 2])
+            c += blk[:, k, None] - base[:, k]
+            c *= c
+            acc += c
+        np.sqrt(acc, out=out[s : s + CHUNK])
+    return out.reshape(q.shape)
+
+
+def leg_unit_vectors(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6, 3)`` u_i = l_i / L_i, pointing from base anchor to plate anchor."""
+    l = leg_vectors(platform, poses, convention)
+    return l / np.linalg.norm(l, axis=-1, keepdims=True)
+
+
+def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6, 6)`` J⁻¹ with dL/dt = J⁻¹ · [v_BC; ω_B]: the velocity of the rotation centre and the
+    plate's angular velocity, both in the base frame. Row i is [u_iᵀ, (r_i × u_i)ᵀ], r_i = R (p_TTi - p_TC).
+    """
+    q = _poses(poses)
+    R = rotation_matrix(q[..., 3:], convention)
+    r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
+    l = q[..., None, :3] + r - platform.base_anchors
+    u = l / np.linalg.norm(l, axis=-1, keepdims=True)
+    return np.concatenate([u, np.cross(r, u)], axis=-1)
+
+
+def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6, 6)`` J = ∂L/∂q: leg-length derivatives with respect to the pose coordinates
+    (the seeds' Jacobian, used by the Lagrangian dynamics): J = J⁻¹ · blockdiag(I, E_W(angles))."""
+    q = _poses(poses)
+    Jinv = inverse_jacobian(platform, q, convention)
+    E = angular_velocity_map(q[..., 3:], convention)
+    return np.concatenate([Jinv[..., :3], Jinv[..., 3:] @ E], axis=-1)
+
+
+def condition_number(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(...)`` 2-norm condition number of J⁻¹ (rotation columns scaled by the plate's anchor radius
+    so that both blocks are in metres); inf on a singularity."""
+    Jinv = inverse_jacobian(platform, poses, convention)
+    scale = np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1))
+    Jn = np.concatenate([Jinv[..., :3], Jinv[..., 3:] / scale], axis=-1)
+    s = np.linalg.svd(Jn, compute_uv=False)
+    with np.errstate(divide="ignore"):
+        return np.where(s[..., -1] > 0, s[..., 0] / s[..., -1], np.inf)
+
+
+def require_nonsingular(platform: Platform, poses, convention: str = "utn", max_condition: float = 1e8) -> np.ndarray:
+    """Condition numbers ``(...)``; raise ``SingularPoseError`` naming the first pose above ``max_condition``."""
+    k = condition_number(platform, poses, convention)
+    bad = ~(k <= max_condition)
+    if np.any(bad):
+        idx = tuple(int(i) for i in np.argwhere(bad)[0]) if np.ndim(k) else ()
+        raise SingularPoseError(
+            f"pose {counted(idx)} is singular or nearly so: Jacobian condition number {float(k[idx]):.3g} > {max_condition:.3g}"
+        )
+    return k
+
+
+@dataclass(frozen=True)
+class StrokeCheck:
+    """Per-pose, per-leg stroke check. Arrays ``(..., 6)``: ``below`` / ``above`` are the metres by
+    which a leg is short of L_min / past L_max (0 where within)."""
+
+    lengths: np.ndarray
+    below: np.ndarray
+    above: np.ndarray
+
+    @property
+    def within(self) -> np.ndarray:
+        """``(...)`` True where all six legs are within [L_min, L_max]."""
+        return ~np.any((self.below > 0) | (self.above > 0), axis=-1)
+
+    def violations(self) -> list[dict]:
+        """Every violation as ``{"pose": index, "leg": 1..6, "length_m", "limit_m", "excess_m", "side"}``."""
+        out = []
+        for side, arr, lim in (("min", self.below, -1), ("max", self.above, 1)):
+            for idx in np.argwhere(arr > 0):
+                idx = tuple(int(i) for i in idx)
+                out.append(
+                    {
+                        "pose": list(idx[:-1]),
+                        "leg": idx[-1] + 1,
+                        "length_m": float(self.lengths[idx]),
+                        "limit_m": float(self.lengths[idx] + lim * -arr[idx]),
+                        "excess_m": float(arr[idx]),
+                        "side": side,
+                    }
+                )
+        return sorted(out, key=lambda v: (v["pose"], v["leg"]))
+
+    def raise_first(self) -> None:
+        """Raise ``UnreachablePoseError`` for the first violation, if any."""
+        v = self.violations()
+        if v:
+            v = v[0]
+            raise UnreachablePoseError(tuple(v["pose"]), v["leg"], v["length_m"], v["limit_m"], v["side"])
+
+
+def check_stroke(platform: Platform, lengths) -> StrokeCheck:
+    """Compare ``(..., 6)`` leg lengths (metres) with the platform's stroke."""
+    L = np.asarray(lengths, dtype=float)
+    return StrokeCheck(L, np.maximum(platform.L_min - L, 0.0), np.maximum(L - platform.L_max, 0.0))
+
+
+def inverse_kinematics(platform: Platform, poses, convention: str = "utn", check: bool = True) -> np.ndarray:
+    """``(..., 6)`` leg lengths (metres); with ``check`` raise ``UnreachablePoseError`` naming the first
+    pose and leg outside the stroke and by how much."""
+    L = leg_lengths(platform, poses, convention)
+    if check:
+        check_stroke(platform, L).raise_first()
+    return L

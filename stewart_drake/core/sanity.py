@@ -1,0 +1,431 @@
+"""Physical sanity: the one place that decides whether a pose, a trajectory, a platform or a requested
+amount of work makes sense. Plain numpy (no Drake); metres, radians, seconds, newtons.
+
+Every command calls these checks before it computes or prints anything:
+
+- inputs must be finite (``check_finite``);
+- positions must lie within ``FAR_FACTOR`` × the platform's size (``platform_size``): farther is a unit
+  mistake (a CSV in millimetres read as metres), not a pose;
+- the plate must be above its base: every plate anchor strictly above the base plane z = 0 of B
+  (``above_base``), unless the platform declares ``plate_below_base_allowed: true``;
+- legs must stay within the stroke along a trajectory (``check_trajectory``: the first offending
+  time, leg and amount);
+- dynamics and simulation need the plate's mass properties (``require_plate``);
+- a platform must not be singular at its home pose (``check_home``, called when a platform is loaded);
+- controller periods and plant steps must resolve the dynamics (``check_timing``);
+- user-sized work (grid nodes, samples, steps, rows, iterations) is estimated against a memory and time
+  budget before anything is allocated (``check_work``).
+
+Bad input raises ``StewartError`` subclasses (exit 2); results outside physical limits raise
+``PhysicalLimitError`` (exit 1).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from stewart_drake.errors import (
+    BELOW_BASE,
+    FAR_POSITION,
+    NO_PLATE,
+    NOT_FINITE,
+    OUT_OF_STROKE,
+    SINGULAR_HOME,
+    WORK_TOO_LARGE,
+    GeometryError,
+    PhysicalLimitError,
+    StewartError,
+    WorkTooLargeError,
+)
+
+# Positions farther than this multiple of the platform's size from the base centre are unit mistakes.
+FAR_FACTOR = 10.0
+# A platform whose home pose has a scaled Jacobian condition number above this is singular there
+# (the value ``kinematics.require_nonsingular`` and the dynamics use).
+HOME_MAX_CONDITION = 1e8
+# Fraction of the machine's physical memory one command may plan to use.
+MEMORY_FRACTION = 0.25
+# Fallback when the physical memory cannot be read (bytes).
+DEFAULT_MEMORY = 8 * 2**30
+# The crossover of the leg loops must exceed the platform's fastest open-loop growth rate by this factor:
+# an unstable pole is held only by a loop several times faster than it.
+CROSSOVER_MARGIN = 2.0
+
+
+# ----------------------------------------------------------------------------------------------
+# Values.
+
+
+def fmt_value(v) -> str:
+    """A number as the user would have typed it: ``100``, ``0.001``, ``1e+09``, ``nan``."""
+    v = float(v)
+    if math.isfinite(v) and v == int(v) and abs(v) < 1e15:
+        return str(int(v))
+    return f"{v:.6g}"
+
+
+def check_finite(value, what: str) -> np.ndarray:
+    """``value`` as a float array; ``StewartError`` naming ``what`` if any element is NaN or infinite."""
+    a = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(a)):
+        shown = fmt_value(a) if a.ndim == 0 else "[" + ", ".join(fmt_value(x) for x in a.ravel()[:12]) + "]"
+        raise StewartError(NOT_FINITE.format(what=what, value=shown))
+    return a
+
+
+def check_positive(value, what: str, unit: str = "") -> float:
+    """A finite, strictly positive float, or ``StewartError`` naming ``what``."""
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise StewartError(f"{what} must be a positive number{' of ' + unit if unit else ''}, got {fmt_value(v)}")
+    return v
+
+
+def check_gravity(g: float, option: str = "--gravity") -> float:
+    """Gravity in m/s²: finite and within ±100 m/s² (10 g; larger is a unit mistake)."""
+    v = float(g)
+    if not math.isfinite(v):
+        raise StewartError(NOT_FINITE.format(what=f"{option} (m/s²)", value=fmt_value(v)))
+    if abs(v) > 100.0:
+        raise StewartError(f"{option} {fmt_value(v)} m/s² is beyond ±100 m/s² (10 g); is it in m/s²?")
+    return v
+
+
+# ----------------------------------------------------------------------------------------------
+# Poses.
+
+
+def platform_size(platform) -> float:
+    """A length scale of ``platform`` (m): the largest of L_max and the anchor radii."""
+    r_base = float(np.max(np.linalg.norm(platform.base_anchors, axis=1)))
+    r_top = float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
+    return max(platform.L_max, r_base, r_top)
+
+
+def plate_anchor_heights(platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(..., 6)`` z of each leg's plate anchor in B (m) for ``(..., 6)`` poses."""
+    from stewart_drake.core.kinematics import plate_anchors
+
+    return plate_anchors(platform, poses, convention)[..., 2]
+
+
+def above_base(platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(...)`` True where every plate anchor is strictly above the base plane (z > 0 in B), or the
+    platform allows its plate below the base."""
+    z = plate_anchor_heights(platform, poses, convention)
+    if getattr(platform, "plate_below_base_allowed", False):
+        return np.ones(z.shape[:-1], bool)
+    return np.all(z > 0.0, axis=-1)
+
+
+def _label(what: str, index, times) -> str:
+    if times is not None:
+        return f"{what} at t = {float(times[index]):.4f} s"
+    return f"{what} {index + 1}"
+
+
+def check_poses(platform, poses, convention: str = "utn", what: str = "pose", times=None, lines=None,
+                base: bool = True) -> np.ndarray:
+    """``(n, 6)`` poses (SI) after the checks every pose must pass: finite (``StewartError``), within
+    ``FAR_FACTOR`` × ``platform_size`` of the base centre (``StewartError``: a unit mistake), plate
+    above the base (``PhysicalLimitError``). Errors name the first offending pose as people count
+    (``pose 3``), or its time (``times`` (n,) s) or file line (``lines`` (n,) ints, "line 12").
+    ``base=False`` skips the plate-above-base check (the caller reports ``above_base`` per pose)."""
+    q = np.asarray(poses, dtype=float).reshape(-1, 6)
+
+    def label(i):
+        if len(q) == 1 and times is None and lines is None:
+            return what
+        if lines is not None:
+            return f"{what} on line {int(lines[i])}"
+        return _label(what, i, times)
+
+    finite = np.all(np.isfinite(q), axis=1)
+    if not np.all(finite):
+        i = int(np.argmin(finite))
+        raise StewartError(NOT_FINITE.format(what=label(i), value="[" + ", ".join(fmt_value(x) for x in q[i]) + "]"))
+    size = platform_size(platform)
+    with np.errstate(over="ignore"):  # |p| of 1e308 is inf: far, as it should be
+        r = np.linalg.norm(q[:, :3], axis=1)
+    far = r > FAR_FACTOR * size
+    if np.any(far):
+        i = int(np.argmax(far))
+        raise StewartError(FAR_POSITION.format(what=label(i), pos_m=[float(f"{x:.6g}") for x in q[i, :3]],
+                                               ratio=r[i] / size, size_m=size, limit=FAR_FACTOR))
+    if base and not getattr(platform, "plate_below_base_allowed", False):
+        z = plate_anchor_heights(platform, q, convention)
+        low = ~np.all(z > 0.0, axis=1)
+        if np.any(low):
+            i = int(np.argmax(low))
+            k = int(np.argmin(z[i]))
+            raise PhysicalLimitError(below_base_message(label(i), z[i]))
+    return q
+
+
+def below_base_message(what: str, z) -> str:
+    """``BELOW_BASE`` for one pose whose plate anchors are at heights ``z`` (6,) m."""
+    k = int(np.argmin(z))
+    return BELOW_BASE.format(what=what, where="in" if z[k] == 0 else "below", anchor=f"of leg {k + 1}", z_mm=z[k] * 1e3)
+
+
+# ----------------------------------------------------------------------------------------------
+# Trajectories.
+
+
+def first_stroke_violation(platform, lengths, times=None) -> dict | None:
+    """The first sample (in time order) where a leg leaves the stroke, and its worst leg there:
+    ``{"index", "t_s", "leg" (1-based), "length_m", "limit_m", "excess_m", "side" ("min"|"max")}``;
+    None when every ``(n, 6)`` length is within [L_min, L_max]."""
+    L = np.asarray(lengths, dtype=float).reshape(-1, 6)
+    below = platform.L_min - L
+    above = L - platform.L_max
+    excess = np.maximum(below, above)
+    bad = np.any(excess > 0, axis=1)
+    if not np.any(bad):
+        return None
+    i = int(np.argmax(bad))
+    leg = int(np.argmax(excess[i]))
+    side = "min" if below[i, leg] > 0 else "max"
+    return {
+        "index": i,
+        "t_s": None if times is None else float(times[i]),
+        "leg": leg + 1,
+        "length_m": float(L[i, leg]),
+        "limit_m": platform.L_min if side == "min" else platform.L_max,
+        "excess_m": float(excess[i, leg]),
+        "side": side,
+    }
+
+
+def stroke_message(v: dict, what: str = "the trajectory", hint: str = "") -> str:
+    """``OUT_OF_STROKE`` filled from a ``first_stroke_violation`` dict."""
+    return OUT_OF_STROKE.format(
+        what=what, t=v["t_s"] if v["t_s"] is not None else float(v["index"]), leg=v["leg"],
+        length_mm=v["length_m"] * 1e3, excess_mm=v["excess_m"] * 1e3,
+        side="below" if v["side"] == "min" else "above", bound="minimum" if v["side"] == "min" else "maximum",
+        limit_mm=v["limit_m"] * 1e3, hint=hint,
+    )
+
+
+def check_trajectory(platform, times, poses, convention: str = "utn", what: str = "the trajectory",
+                     allow_out_of_stroke: bool = False) -> list[str]:
+    """Check a sampled trajectory (``times`` (n,) s, ``poses`` (n, 6) SI): every pose passes
+    ``check_poses`` (labelled by its time) and every leg stays within the stroke. A stroke violation
+    raises ``PhysicalLimitError`` naming the first offending time, leg and amount, unless
+    ``allow_out_of_stroke``: then its message is returned as a warning (a list of 0 or 1 strings)."""
+    from stewart_drake.core.kinematics import leg_lengths
+
+    t = np.asarray(times, dtype=float).reshape(-1)
+    q = check_poses(platform, poses, convention, what=what, times=t)
+    v = first_stroke_violation(platform, leg_lengths(platform, q, convention), t)
+    if v is None:
+        return []
+    if not allow_out_of_stroke:
+        raise PhysicalLimitError(stroke_message(v, what, "; --allow-out-of-stroke runs it anyway, with a warning"))
+    return [stroke_message(v, what)]
+
+
+# ----------------------------------------------------------------------------------------------
+# Platforms.
+
+
+def has_plate(platform) -> bool:
+    """True when the plate has a positive mass and a positive definite inertia."""
+    if not platform.mass > 0:
+        return False
+    return bool(np.linalg.eigvalsh(np.asarray(platform.inertia)).min() > 0)
+
+
+def require_plate(platform, command: str) -> None:
+    """``GeometryError`` naming the missing YAML key when ``command`` needs the plate's mass properties
+    (dynamics, simulation) and the platform has none (a massless plate makes every force 0)."""
+    if not has_plate(platform):
+        raise GeometryError(NO_PLATE.format(name=platform.name, command=command))
+
+
+def _collinear(points: np.ndarray, tol: float) -> bool:
+    c = points - points.mean(axis=0)
+    s = np.linalg.svd(c, compute_uv=False)
+    return bool(s[1] <= tol * max(s[0], 1e-300))
+
+
+def check_home(platform) -> None:
+    """``GeometryError`` when ``platform`` is singular at its home pose: its legs cannot hold the plate
+    there (the Jacobian loses rank). Names the anchors when they are collinear (the usual cause)."""
+    from stewart_drake.core.kinematics import condition_number
+
+    home = platform.home_pose()
+    cond = float(condition_number(platform, home))
+    if cond <= HOME_MAX_CONDITION:
+        return
+    tol = 1e-9
+    if _collinear(platform.base_anchors, tol):
+        why = "base anchors 1-6 are collinear (every leg meets one line, so the plate can turn about it)"
+    elif _collinear(platform.top_anchors, tol):
+        n = len(platform.top_anchors)
+        why = f"top anchors 1-{n} are collinear (every leg meets one line, so the plate can turn about it)"
+    else:
+        why = "the six legs' lines are linearly dependent there; move an anchor or give another home_height"
+    raise GeometryError(SINGULAR_HOME.format(name=platform.name, cond=cond, limit=HOME_MAX_CONDITION, why=why))
+
+
+# ----------------------------------------------------------------------------------------------
+# Timing.
+
+
+def check_timing(platform, period: float, plant_step: float, actuator_lag: float, output_delay: float) -> None:
+    """``StewartError`` unless the controller period and the plant step resolve the dynamics:
+
+    - the plant step is at most the controller period (the plant must advance between ticks) and at
+      most the actuator lag (the fastest modelled dynamics: a longer step skips it);
+    - the leg loops' achievable crossover ω_c = PHASE_BUDGET / (output delay + period + actuator lag)
+      (``control.loop_delay``) is at least ``CROSSOVER_MARGIN`` × the platform's fastest open-loop growth
+      rate λ at home (``dynamics.open_loop_growth_rates``): a slower loop cannot hold the plate up.
+    """
+    from stewart_drake.control.controller import PHASE_BUDGET
+
+    T = check_positive(period, "--period", "seconds")
+    h = check_positive(plant_step, "--plant-step", "seconds")
+    if h > T * (1 + 1e-12):
+        raise StewartError(f"--plant-step {fmt_value(h)} s is longer than the controller period {fmt_value(T)} s; "
+                           "the plant step must resolve the period (at most one period)")
+    if actuator_lag > 0 and h > actuator_lag * (1 + 1e-12):
+        raise StewartError(f"--plant-step {fmt_value(h)} s is longer than the actuators' time constant {fmt_value(actuator_lag)} s, "
+                           "the platform's fastest modelled dynamics; use a step of at most that")
+    if has_plate(platform):
+        from stewart_drake.core.dynamics import open_loop_growth_rates
+
+        lam = float(np.max(open_loop_growth_rates(platform, platform.home_pose())))
+        w_c = PHASE_BUDGET / (output_delay + T + actuator_lag)
+        if w_c < CROSSOVER_MARGIN * lam:
+            t_max = PHASE_BUDGET / (CROSSOVER_MARGIN * lam) - actuator_lag
+            raise StewartError(
+                f"--period {fmt_value(T)} s is too slow for platform {platform.name}: its fastest open-loop mode grows at "
+                f"{lam:.3g}/s, and the leg loops' crossover at this period is at most {w_c:.3g} rad/s (< {CROSSOVER_MARGIN:g} × "
+                f"{lam:.3g}); use a period of at most ~{max(t_max / 2, 0):.3g} s")
+
+
+# ----------------------------------------------------------------------------------------------
+# Bounded work.
+
+
+def memory_budget() -> int:
+    """Bytes one command may plan to use: ``MEMORY_FRACTION`` of the machine's physical memory."""
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        total = DEFAULT_MEMORY
+    return int(MEMORY_FRACTION * total)
+
+
+def human_bytes(n: float) -> str:
+    """``512 MB``, ``3.4 GB``, ``~10^19 GB`` for absurd sizes."""
+    n = float(n)
+    if n >= 1e15:
+        return f"~10^{int(math.floor(math.log10(n / 1e9)))} GB"
+    for unit, k in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= k:
+            return f"~{n / k:.3g} {unit}"
+    return f"{n:.0f} B"
+
+
+def human_seconds(s: float) -> str:
+    s = float(s)
+    if s >= 86400 * 365:
+        return f"~{s / (86400 * 365):.2g} years"
+    if s >= 3600:
+        return f"~{s / 3600:.2g} h"
+    if s >= 60:
+        return f"~{s / 60:.2g} min"
+    return f"~{s:.2g} s"
+
+
+def check_work(option: str, value: str, count: float, what: str, bytes_per: float = 0.0, max_count: float | None = None,
+               seconds_per: float = 0.0, max_seconds: float | None = None, hint: str = "") -> None:
+    """Refuse (``WorkTooLargeError``) a request of ``count`` items (``what``: "grid nodes", "samples")
+    whose memory (``bytes_per`` each) exceeds ``memory_budget``, whose count exceeds ``max_count``, or
+    whose time (``seconds_per`` each) exceeds ``max_seconds``. ``option``/``value`` name the user's
+    option as typed; ``hint`` ends the message (e.g. "; use a coarser --resolution")."""
+    count = float(count)
+    if not math.isfinite(count):
+        raise WorkTooLargeError(f"{option} {value} would need unboundedly many {what}{hint}")
+    need = count * bytes_per
+    budget = memory_budget()
+    if bytes_per and need > budget:
+        raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value, estimate=f"{count:.2g} {what} ({human_bytes(need)})",
+                                                      limit=f"{human_bytes(budget).lstrip('~')} on this machine", hint=hint))
+    if max_count is not None and count > max_count:
+        raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value, estimate=f"{count:.2g} {what}",
+                                                      limit=f"{max_count:.2g} {what}", hint=hint))
+    if seconds_per and max_seconds is not None and count * seconds_per > max_seconds:
+        raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value,
+                                                      estimate=f"{count:.2g} {what} ({human_seconds(count * seconds_per)})",
+                                                      limit=human_seconds(max_seconds), hint=hint))
+
+
+def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
+    """A rotation centre ``(3,)`` (m, plate frame): finite and within ``FAR_FACTOR`` × ``platform_size``
+    of the plate's origin (farther is a unit mistake), else ``StewartError``."""
+    c = check_finite(centre, f"{option} (m)")
+    size = platform_size(platform)
+    r = float(np.linalg.norm(c))
+    if r > FAR_FACTOR * size:
+        raise StewartError(f"{option} {' '.join(fmt_value(x) for x in c)} m is {r / size:.3g} × the platform's size ({size:.3f} m) from the plate; "
+                           f"centres beyond {FAR_FACTOR:g} × are surely a unit mistake (the centre is in metres)")
+    return c
+
+
+def check_file_rows(path, option: str, bytes_per_row: float, min_row_bytes: int = 12) -> None:
+    """Refuse a CSV file whose rows could not be held in memory (``bytes_per_row`` each), before reading
+    it: judged first by its size (at most size / ``min_row_bytes`` rows), then, if that is not enough to
+    accept it, by counting its lines. A missing file is left to the reader to report."""
+    try:
+        size = os.path.getsize(path)
+        check_work(option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file")
+    except OSError:
+        return
+    except WorkTooLargeError:
+        if size > memory_budget():
+            raise
+        with open(path, "rb") as fh:  # count the rows (bounded memory, ~1 GB/s) before judging by size
+            rows = sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 24), b"")) + 1
+        check_work(option, repr(str(path)), rows, "rows", bytes_per_row, hint="; split the file")
+
+
+# ----------------------------------------------------------------------------------------------
+# RC servos.
+
+# The pulse widths an RC servo's PWM input accepts (µs): the 50 Hz frame's extreme range that hobby
+# servos take (1000-2000 µs nominal, 500-2500 µs extended); wider pulses are not servo commands.
+SERVO_PULSE_RANGE_US = (500.0, 2500.0)
+
+
+def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
+    """``StewartError`` unless every neutral pulse W0_i (µs) is finite and leaves room for the full travel:
+    W0_i ± travel·rate within ``SERVO_PULSE_RANGE_US``."""
+    w0 = np.asarray(hexapod.neutral_us, dtype=float)
+    check_finite(w0, f"{what} (µs)")
+    swing = float(hexapod.travel_rad * hexapod.rate_us_per_rad)
+    lo, hi = SERVO_PULSE_RANGE_US[0] + swing, SERVO_PULSE_RANGE_US[1] - swing
+    bad = (w0 < lo) | (w0 > hi)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise StewartError(
+            f"{what}: servo {i + 1}'s neutral pulse {fmt_value(w0[i])} µs is outside [{lo:.0f}, {hi:.0f}] µs: with its travel of "
+            f"±{swing:.0f} µs the pulse must stay within an RC servo's {SERVO_PULSE_RANGE_US[0]:.0f}-{SERVO_PULSE_RANGE_US[1]:.0f} µs")
+
+
+def plate_floor(platform, orientation, convention: str = "utn") -> float:
+    """The height (m) the rotation centre must exceed, at ``orientation`` (3,) rad, for every plate
+    anchor to be above the base plane: max_i −(R_BT (p_TTi − p_TC))_z; −inf when the platform allows
+    its plate below the base. Positions above it form the half-space a workspace may count."""
+    from stewart_drake.core.rotations import rotation_matrix
+
+    if getattr(platform, "plate_below_base_allowed", False):
+        return -math.inf
+    R = rotation_matrix(np.asarray(orientation, dtype=float), convention)
+    r = (platform.top_anchors_per_leg - platform.rotation_centre) @ R.T
+    return float(np.max(-r[:, 2]))

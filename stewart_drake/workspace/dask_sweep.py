@@ -1,0 +1,175 @@
+"""The workspace sweeps on Dask (optional: ``pip install "dask[distributed]"``).
+
+Nothing is rescheduled here: Dask's client exposes a ``concurrent.futures.Executor``
+(``Client.get_executor``), and the sweeps in ``workspace`` accept any executor, so the same slab and
+chunk functions run on a laptop's processes or on a cluster. Use:
+
+    from stewart_drake.workspace.dask_sweep import local_client, workspace_on_dask
+    with local_client(n_workers=2) as client:
+        ws = workspace_on_dask(platform, resolution=0.0025, client=client)
+
+For a geometry optimisation over many candidate platforms, ``map_platforms`` sends one evaluation
+per platform to the cluster (each evaluation runs single-threaded on its worker).
+
+Where the time went, and what is done about it (``benchmarks/bench_workspace_dask.py`` measures it):
+
+- Dask starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand freed memory back to the OS),
+  which turns off glibc's adaptive mmap threshold: every large numpy temporary of a slab is then a fresh
+  mmap, page-faulted and zeroed. The 2.5 mm workspace sweep took 1.9× the CPU time in a process with
+  that setting, with or without Dask: ``local_cluster`` starts workers without it (``WORKER_CONFIG``;
+  and Dask writes the variable into the spawning process's own environment, where later clusters
+  would inherit it: it is held out of the environment while the workers start);
+- each worker's statistical profiler interrupts the computing thread every 10 ms to walk its stack,
+  taking the GIL from numpy code made of many mid-sized operations: ``local_client`` turns it off
+  (``WORKER_CONFIG``);
+- the first task on each worker paid the imports (numpy, scipy, the package): ``local_client`` imports
+  them on every worker before any task (``warm_up``);
+- the number of tasks did not follow the number of workers (a 2.5 mm workspace was 46 slabs: 2.9
+  waves on 16 workers, the last one a fifth full): the Dask entry points size the tasks to at least
+  ``TASKS_PER_WORKER`` per worker thread;
+- the extents' refinement after the sweep, serial, checked each candidate node in a Python loop
+  (~7000 margin evaluations at 2.5 mm, ~15 % of the serial time): now one vectorised batch per plane
+  (``workspace.extents``).
+
+What is shipped per task is small (a slab's ``_GridSpec`` ~7 kB, a 6-D chunk's arguments ~2 kB, a
+slab's result ~80 kB), so scattering it once would not change the time.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import stewart_drake.workspace as _ws
+
+# Dask settings for the workers of ``local_client`` (see the module docstring): no statistical profiler,
+# and Dask's default worker environment without MALLOC_TRIM_THRESHOLD_ (numpy temporaries reuse the heap).
+WORKER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ": {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
+}
+# At least this many tasks per worker thread (load balance: the last wave of tasks is a small share).
+TASKS_PER_WORKER = 8
+
+
+def _require_distributed():
+    try:
+        import distributed
+    except ImportError:  # pragma: no cover - exercised only without dask
+        raise ImportError('the Dask back end needs dask.distributed: pip install "dask[distributed]"') from None
+    return distributed
+
+
+def local_client(n_workers: int | None = None, threads_per_worker: int = 1, processes: bool = True, **kwargs):
+    """A ``distributed.Client`` on a ``LocalCluster`` of ``n_workers`` (default: the usable CPUs) worker
+    processes, one thread each (the numpy kernels are single-threaded per slab). Use as a context
+    manager; closing the client closes the cluster."""
+    distributed = _require_distributed()
+    cluster = local_cluster(n_workers or _ws.default_workers(), threads_per_worker, processes, **kwargs)
+    client = distributed.Client(cluster)
+    client._stewart_owned_cluster = cluster  # closed with the client (see close_client)
+    warm_up(client)
+    return client
+
+
+def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool = True, **kwargs):
+    """A ``LocalCluster`` whose workers run with ``WORKER_CONFIG``: no statistical profiler, glibc's
+    adaptive malloc (no ``MALLOC_TRIM_THRESHOLD_``, also when an earlier cluster left it in this
+    process's environment)."""
+    import os
+
+    import dask
+
+    distributed = _require_distributed()
+    held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    try:
+        with dask.config.set(WORKER_CONFIG):
+            return distributed.LocalCluster(n_workers=n_workers, threads_per_worker=threads_per_worker, processes=processes,
+                                            dashboard_address=None, **kwargs)
+    finally:
+        if held is not None:
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = held
+
+
+def _import_kernels() -> bool:
+    import scipy.optimize  # noqa: F401  (the extents' refinement)
+
+    from stewart_drake import workspace  # noqa: F401
+
+    return True
+
+
+def warm_up(client) -> None:
+    """Import the sweep's modules on every worker now, not inside the first timed tasks."""
+    client.run(_import_kernels)
+
+
+def worker_threads(client) -> int:
+    """Threads across the cluster's workers (at least 1)."""
+    return max(1, sum(client.nthreads().values()))
+
+
+def close_client(client) -> None:
+    """Close a client from ``local_client`` and its cluster."""
+    cluster = getattr(client, "_stewart_owned_cluster", None)
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+def dask_executor(client):
+    """The ``concurrent.futures.Executor`` view of a Dask client (tasks are not cached: pure=False)."""
+    _require_distributed()
+    return client.get_executor(pure=False)
+
+
+def slab_nodes(platform, threads: int, orientation=(0.0, 0.0, 0.0), resolution: float = 0.01, convention: str = "utn",
+               bounds=None, chunk_nodes: int = 1 << 21, **_) -> int:
+    """The ``chunk_nodes`` that gives at least ``TASKS_PER_WORKER`` slabs per thread (never more than
+    ``chunk_nodes``; a slab keeps at least two x-planes)."""
+    from stewart_drake.workspace.grid import _grid_axes
+
+    b = _ws.default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
+    nx, ny, nz = (len(a) for a in _grid_axes(b, float(resolution)))
+    planes = max(2, math.ceil(nx / (TASKS_PER_WORKER * threads)))
+    return int(min(chunk_nodes, planes * ny * nz))
+
+
+def workspace_on_dask(platform, client=None, **kwargs):
+    """``workspace.constant_orientation_workspace`` with its slabs on Dask (a temporary local cluster
+    when ``client`` is None). Keyword arguments as in the core function; the result is identical (the
+    slab size only splits the same sweep; at least ``TASKS_PER_WORKER`` slabs per worker thread unless
+    ``chunk_nodes`` is given)."""
+    own = client is None
+    client = local_client() if own else client
+    try:
+        if "chunk_nodes" not in kwargs:
+            kwargs["chunk_nodes"] = slab_nodes(platform, worker_threads(client), **kwargs)
+        return _ws.constant_orientation_workspace(platform, executor=dask_executor(client), **kwargs)
+    finally:
+        if own:
+            close_client(client)
+
+
+def count_reachable_on_dask(platform, grids, client=None, **kwargs):
+    """``workspace.count_reachable`` (a chunked 6-D grid sweep) with its chunks on Dask: at least
+    ``TASKS_PER_WORKER`` chunks per worker thread unless ``chunk`` is given (never more than 2^18 poses)."""
+    own = client is None
+    client = local_client() if own else client
+    try:
+        if "chunk" not in kwargs:
+            total = math.prod(len(np.ravel(g)) for g in grids)
+            kwargs["chunk"] = int(max(1, min(1 << 18, math.ceil(total / (TASKS_PER_WORKER * worker_threads(client))))))
+        return _ws.count_reachable(platform, grids, executor=dask_executor(client), **kwargs)
+    finally:
+        if own:
+            close_client(client)
+
+
+def map_platforms(function, platforms, client, **kwargs) -> list:
+    """``[function(p, **kwargs) for p in platforms]`` evaluated on the cluster, in order. ``function``
+    must be importable by the workers (a module-level function, e.g. ``workspace.stroke_volume_columns``)."""
+    _require_distributed()
+    futures = client.map(function, list(platforms), pure=False, **kwargs)
+    return client.gather(futures)
