@@ -262,14 +262,6 @@ def test_control_character_in_name_refused(here, capsys):
     assert rc == 2 and err.strip() == "stewart-drake ik: error: p.yaml:1: name: 'a\\x00b' contains the control character '\\x00'"
 
 
-def test_preset_sdf_unchanged():
-    from stewart_drake.core.geometry import PRESETS, load_preset
-    from stewart_drake.drake.platform_model import SDF_DIR, sdf_text
-
-    for name in PRESETS:
-        assert sdf_text(load_preset(name)) == (SDF_DIR / f"{name}.sdf").read_text()
-
-
 # ----------------------------------------------------------------------------------------------
 # YAML: safe, bounded, typed; literal messages.
 

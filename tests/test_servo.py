@@ -116,13 +116,6 @@ def test_quantisation_rounds_half_away_from_zero():
 # ---- Drake ----------------------------------------------------------------------------------------
 
 
-def test_sdf_matches_committed_file(hexapod, tmp_path):
-    from stewart_drake.drake.servo_model import SDF_DIR, write_sdf
-
-    path = write_sdf(hexapod, tmp_path)
-    assert path.read_text() == (SDF_DIR / "servo-hexapod.sdf").read_text()
-
-
 def test_drake_cross_checks(hexapod):
     from stewart_drake.drake.servo_model import compare_with_drake
 

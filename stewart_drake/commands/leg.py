@@ -10,6 +10,7 @@ from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.errors import OutputError
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.commands._common import print_json
+from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
 
 
 def register(sub) -> None:
@@ -49,12 +50,10 @@ def run(args) -> int:
 
     leg = _leg(args)
     if args.op == "sdf":
-        from stewart_drake.drake.leg_model import SDF_NAME, sdf_text
-
         if args.write:
             if os.path.exists(args.write) and not os.path.isdir(args.write):
                 raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
-            print(write_output_file(os.path.join(args.write, f"{SDF_NAME}.sdf"), sdf_text(leg), option="--write"))
+            print(write_output_file(os.path.join(args.write, sdf_file_name(leg)), sdf_text(leg), option="--write"))
         else:
             print(sdf_text(leg), end="")
         return 0

@@ -12,6 +12,7 @@ from stewart_drake.errors import OutputError
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
 from stewart_drake.core.sanity import check_finite
 from stewart_drake.commands._common import print_json
+from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
 
 
 def register(sub) -> None:
@@ -43,11 +44,9 @@ def run(args) -> int:
         check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
-        from stewart_drake.drake.servo_model import SDF_NAME, sdf_text
-
         if os.path.exists(args.write_sdf) and not os.path.isdir(args.write_sdf):
             raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write-sdf", typed=args.write_sdf, part=args.write_sdf))
-        sdf_file = write_output_file(os.path.join(args.write_sdf, f"{SDF_NAME}.sdf"), sdf_text(hexapod), option="--write-sdf")
+        sdf_file = write_output_file(os.path.join(args.write_sdf, sdf_file_name(hexapod)), sdf_text(hexapod), option="--write-sdf")
         if not args.json:
             print(sdf_file)
     k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)

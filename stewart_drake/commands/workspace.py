@@ -55,7 +55,7 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
         kw["base_cone"] = kw["top_cone"] = joint_cone
     if "collision" in names:
         if leg_diameter is None:
-            from stewart_drake.drake.platform_model import leg_dimensions
+            from stewart_drake.core.leg_bodies import leg_dimensions
 
             leg_diameter = 2 * leg_dimensions(platform)["cylinder_radius"]
         kw["leg_diameter"] = leg_diameter

@@ -33,6 +33,7 @@ import numpy as np
 from stewart_drake.errors import SingularPoseError, counted
 from stewart_drake.core.geometry import SQRT3, Platform
 from stewart_drake.core.kinematics import _poses, length_jacobian
+from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
 
 G_EARTH = 9.81  # m/s², the seed's Matlab value (its text also quotes 9.8066)
@@ -316,11 +317,9 @@ def coriolis_leg_forces(platform: Platform, q, qd, convention: str = "utn") -> n
 
 def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn", gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) for the plate **and** the legs' cylinders and pistons (masses from
-    ``platform.legs``, uniform rods of ``model.leg_dimensions``; cylinder centre of mass half its length
-    above the base anchor, piston's half its length below the tip), with the universal joints of
-    ``model.py``. Coriolis terms included. See the module docstring for how the legs enter."""
-    from stewart_drake.drake.platform_model import home_leg_frames, leg_dimensions  # numpy only at module level
-
+    ``platform.legs``, uniform rods of ``leg_bodies.leg_dimensions``; cylinder centre of mass half its
+    length above the base anchor, piston's half its length below the tip), with the universal joints of
+    ``leg_bodies.home_leg_frames``. Coriolis terms included. See the module docstring for how the legs enter."""
     check_convention(convention)
     q, qd, qdd = _states(q, qd, qdd)
     mo = plate_motion(platform, q, qd, qdd, convention)

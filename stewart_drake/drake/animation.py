@@ -18,7 +18,8 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.platform_model import build_plant, leg_visual_dimensions, set_pose
+from stewart_drake.core.leg_bodies import leg_visual_dimensions
+from stewart_drake.drake.platform_model import build_plant, set_pose
 
 WARN_RGBA = (0.9, 0.05, 0.05, 1.0)
 GHOST_RGBA = (0.1, 0.85, 0.3, 0.5)

@@ -22,7 +22,7 @@ from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.assembly_modes import assembly_modes
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
-from stewart_drake.drake.platform_model import leg_visual_dimensions
+from stewart_drake.core.leg_bodies import leg_visual_dimensions
 from stewart_drake.core.rotations import angle_scale, length_scale, rotation_matrix
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
