@@ -17,7 +17,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from stewart_drake.core.newton_fk import forward_kinematics, sample_poses  # noqa: E402
+from stewart_drake.core.newton_fk import forward_kinematics  # noqa: E402
+from stewart_drake.core.sampling import random_poses  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.core.kinematics import leg_lengths  # noqa: E402
 
@@ -35,7 +36,7 @@ def newton_rates(n: int) -> list[tuple]:
     rows = []
     for name in ("utn-dynamic", "gonzalez-dutra-2009", "utn-kinematic"):
         p = load_preset(name)
-        q = sample_poses(p, n, seed=1)
+        q = random_poses(p, n, seed=1, region="workspace")
         L = leg_lengths(p, q)
         t_chk, r = best_of(lambda: forward_kinematics(p, L, on_singular="ignore"))
         t_raw, _ = best_of(lambda: forward_kinematics(p, L, check_singularity=False))
@@ -48,7 +49,7 @@ def newton_rates(n: int) -> list[tuple]:
 
 
 def program_times(repeat: int) -> list[tuple]:
-    from stewart_drake.core.assembly_modes import ProgramFK
+    from stewart_drake.drake.program_fk import ProgramFK
 
     p = load_preset("gonzalez-dutra-2009")
     q = p.home_pose() + [0.05, -0.03, 0.02, 0.1, -0.05, 0.2]
@@ -67,7 +68,8 @@ def program_times(repeat: int) -> list[tuple]:
 
 
 def assembly_times() -> list[tuple]:
-    from stewart_drake.core.assembly_modes import assembly_modes, dietmaier_platform, general_platform
+    from stewart_drake.core.reference_platforms import dietmaier_platform, general_platform
+    from stewart_drake.drake.program_fk import assembly_modes
 
     cases = [("dietmaier-1998",) + dietmaier_platform()]
     for seed in (0, 4):
@@ -91,7 +93,7 @@ FKSGP_MS = {"dietmaier-1998": "11-15", "planar": "~5", "gonzalez-dutra-2009": "f
 
 def homotopy_cases(n_poses: int):
     """(label, fkSGP key, platform, (k, 6) length sets) for the homotopy benchmark."""
-    from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
+    from stewart_drake.core.reference_platforms import dietmaier_platform, planar_platform
 
     p, L = dietmaier_platform()
     cases = [("dietmaier-1998 (6-6, 40 real)", "dietmaier-1998", p, L[None])]
@@ -145,7 +147,7 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
 
 def homotopy_batch(n: int) -> list[tuple]:
     """Batched mode: n length sets of one platform in one call, per-set time."""
-    from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
+    from stewart_drake.core.reference_platforms import dietmaier_platform, planar_platform
     from stewart_drake.homotopy import solve_batch
 
     rows = []
