@@ -28,7 +28,8 @@ from scipy.spatial.transform import Rotation
 from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs
 from stewart_drake.errors import StewartError
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import _poses, inverse_jacobian
+from stewart_drake.core.argcheck import as_poses
+from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 from stewart_drake.design.envelope import _skew
 
@@ -61,7 +62,7 @@ def displace(pose, dx, convention: str = "utn") -> np.ndarray:
 
 def static_leg_forces(platform: Platform, q, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) holding the plate at rest at poses q."""
-    q = _poses(q)
+    q = as_poses(q)
     z = np.zeros(q.shape)
     if legs:
         return leg_forces_with_legs(platform, q, z, z, convention, gravity=gravity)
@@ -80,7 +81,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
                      loaded: bool = True) -> np.ndarray:
     """``(..., 6, 6)`` K (N/m, N/rad, N·m/m, N·m/rad) at poses q ``(..., 6)`` for leg stiffnesses k ``(6,)``
     N/m (or one number for all). ``loaded=False`` gives Aᵀ diag(k) A (as does zero gravity, through the full expression)."""
-    q = _poses(q)
+    q = as_poses(q)
     k = np.broadcast_to(np.asarray(k, dtype=float), (6,))
     R = rotation_matrix(q[..., 3:], convention)
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)
@@ -120,7 +121,7 @@ def static_wrench(platform: Platform, q0, dx, k, convention: str = "utn", gravit
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
     L = np.linalg.norm(l, axis=-1)
-    L0 = np.linalg.norm(_poses(q0)[..., None, :3] + np.einsum("...ij,kj->...ki", rotation_matrix(_poses(q0)[..., 3:], convention),
+    L0 = np.linalg.norm(as_poses(q0)[..., None, :3] + np.einsum("...ij,kj->...ki", rotation_matrix(as_poses(q0)[..., 3:], convention),
                                                              platform.top_anchors_per_leg - platform.rotation_centre) - platform.base_anchors, axis=-1)
     u = l / L[..., None]
     F = F0 - np.asarray(k) * (L - L0)

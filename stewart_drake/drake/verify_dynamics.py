@@ -21,7 +21,7 @@ import numpy as np
 
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import _poses
+from stewart_drake.core.argcheck import as_poses as _poses
 from stewart_drake.core.rotations import check_convention, rotation_matrix
 
 # Joints of the Euler chain, outermost first: (name, axis, index in q).

@@ -34,6 +34,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from stewart_drake.errors import FixedPointError
+
 CLOCK_HZ = 60e6
 
 ALU_OPS = ("add", "sub", "negate", "abs_s", "L_add", "L_sub", "L_negate", "L_abs", "L_mult", "extract_h",
@@ -70,13 +72,13 @@ class CycleEstimate:
 
 def estimate_cycles(op_counts: dict, table: dict | None = None, clock_hz: float = CLOCK_HZ, loops: int = 1) -> CycleEstimate:
     """Cycles for a dict of operation -> calls (one evaluation), with one operand move per ALU op.
-    Raises ValueError naming an operation missing from the table."""
+    Raises ``FixedPointError`` naming an operation missing from the table."""
     table = dict(CYCLE_TABLE if table is None else table)
     breakdown = {}
     n_alu = 0
     for op, n in sorted(op_counts.items()):
         if op not in table:
-            raise ValueError(f"operation {op!r} has no entry in the cycle table")
+            raise FixedPointError(FixedPointError.NO_CYCLES.format(op=op))
         breakdown[op] = (int(n), n * table[op])
         if op in ALU_OPS:
             n_alu += n

@@ -58,6 +58,9 @@ from collections import Counter
 
 import numpy as np
 
+from stewart_drake.core.argcheck import first_index
+from stewart_drake.errors import FixedPointError
+
 MIN16, MAX16 = -(1 << 15), (1 << 15) - 1
 MIN32, MAX32 = -(1 << 31), (1 << 31) - 1
 
@@ -124,15 +127,16 @@ def sat32(x, op: str = "sat32") -> np.ndarray:
 
 
 def word16(x, name: str = "value") -> np.ndarray:
-    """Validate and convert to Word16 values: raises ValueError naming ``name`` and the first bad element."""
+    """Validate and convert to Word16 values: raises ``FixedPointError`` naming ``name`` and the first bad element."""
     a = np.asarray(x)
     if not np.issubdtype(a.dtype, np.integer):
         if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
-            raise ValueError(f"{name} must hold integers (Word16), got {a.ravel()[~np.isfinite(a.ravel()) | (a.ravel() != np.round(a.ravel()))][0]!r}")
+            raise FixedPointError(FixedPointError.NOT_INTEGER_16.format(
+                name=name, value=a.ravel()[~np.isfinite(a.ravel()) | (a.ravel() != np.round(a.ravel()))][0]))
     a = a.astype(np.int64)
     bad = (a < MIN16) | (a > MAX16)
     if np.any(bad):
-        raise ValueError(f"{name} = {int(a[bad].ravel()[0])} is outside the 16-bit range [{MIN16}, {MAX16}]")
+        raise FixedPointError(FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=16, lo=MIN16, hi=MAX16))
     return a
 
 
@@ -141,11 +145,11 @@ def word32(x, name: str = "value") -> np.ndarray:
     a = np.asarray(x)
     if not np.issubdtype(a.dtype, np.integer):
         if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
-            raise ValueError(f"{name} must hold integers (Word32)")
+            raise FixedPointError(FixedPointError.NOT_INTEGER_32.format(name=name))
     a = a.astype(np.int64)
     bad = (a < MIN32) | (a > MAX32)
     if np.any(bad):
-        raise ValueError(f"{name} = {int(a[bad].ravel()[0])} is outside the 32-bit range [{MIN32}, {MAX32}]")
+        raise FixedPointError(FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=32, lo=MIN32, hi=MAX32))
     return a
 
 
@@ -158,7 +162,7 @@ def FRAC16(x) -> np.ndarray:
     with x >= 1 -> 32767 and x < -1 -> -32768 (the Freescale macro's saturation)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"FRAC16 of a non-finite value {x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x)!r}")
+        raise FixedPointError(FixedPointError.FRAC16_NOT_FINITE.format(value=x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x)))
     return _sat(np.trunc(x * 32768.0).astype(np.int64), MIN16, MAX16, "FRAC16")
 
 
@@ -166,7 +170,7 @@ def FRAC32(x) -> np.ndarray:
     """Q31 word of a real x: truncation toward zero, saturated to [-2^31, 2^31 - 1]."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError("FRAC32 of a non-finite value")
+        raise FixedPointError(FixedPointError.FRAC32_NOT_FINITE)
     return _sat(np.trunc(np.clip(x, -2.0, 2.0) * 2147483648.0).astype(np.int64), MIN32, MAX32, "FRAC32")
 
 
@@ -317,12 +321,12 @@ def msu_r(acc, a, b) -> np.ndarray:
 
 def div_s(a, b) -> np.ndarray:
     """Q15 quotient a / b for 0 <= a <= b, b > 0: floor(a * 2^15 / b), and 32767 when a == b.
-    Raises ValueError outside that domain (the hardware result is undefined there)."""
+    Raises ``FixedPointError`` outside that domain (the hardware result is undefined there)."""
     a, b = np.broadcast_arrays(_i(a), _i(b))
     bad = (a < 0) | (b <= 0) | (a > b)
-    if np.any(bad):
-        k = np.argwhere(bad)[0] if a.ndim else ()
-        raise ValueError(f"div_s needs 0 <= a <= b and b > 0, got a={int(a[tuple(k)])}, b={int(b[tuple(k)])}")
+    k = first_index(bad)
+    if k is not None:
+        raise FixedPointError(FixedPointError.DIV_S.format(a=int(a[k]), b=int(b[k])))
     return np.where(a == b, MAX16, (a << 15) // np.where(b == 0, 1, b))
 
 
