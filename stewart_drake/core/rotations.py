@@ -182,3 +182,8 @@ def from_drake(rotation, convention: str = "utn") -> np.ndarray:
     if not isinstance(rotation, RotationMatrix):
         raise TypeError(f"expected a Drake RotationMatrix, RollPitchYaw or Quaternion, got {type(rotation).__name__}")
     return angles_from_matrix(rotation.matrix(), convention)
+
+
+def wrap_angle(x) -> np.ndarray:
+    """Angles ``x`` (radians, any shape) wrapped to [-pi, pi)."""
+    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
