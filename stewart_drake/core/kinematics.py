@@ -9,13 +9,16 @@ L_i = |l_i|.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
-from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
+
+if TYPE_CHECKING:  # annotations only: geometry imports sanity, which imports this module
+    from stewart_drake.core.geometry import Platform
 
 
 def plate_anchors(platform: Platform, poses, convention: str = "utn") -> np.ndarray:

@@ -27,8 +27,8 @@ from typing import Optional
 
 import numpy as np
 
-from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces_with_legs
-from stewart_drake.errors import StewartError
+from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces, leg_forces_with_legs
+from stewart_drake.errors import EnvelopeError, StewartError
 from stewart_drake.core.geometry import Platform, load_yaml_config
 from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
 from stewart_drake.core.rotations import angle_scale, angular_velocity_map, check_convention, length_scale, rotation_matrix
@@ -38,10 +38,6 @@ from stewart_drake.design.boxquad import box_quadratic_max
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
 MAX_CONDITION = 1e8  # as dynamics.MAX_CONDITION: leg forces are meaningless beyond it
 CHUNK = 4096
-
-
-class EnvelopeError(StewartError):
-    """An envelope file is malformed or leaves the platform's workspace."""
 
 
 # ----------------------------------------------------------------------------------------------
@@ -260,8 +256,6 @@ def _cartesian_to_euler(q, V, Vd, convention):
 def cartesian_leg_forces(platform: Platform, q, V, Vd, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) at poses q for Cartesian velocity V = [v_C; ω] and acceleration
     [a_C; ω̇] (base frame), by the toolkit's inverse dynamics in Euler coordinates."""
-    from stewart_drake.core.dynamics import leg_forces
-
     q, V, Vd = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (q, V, Vd)))
     qd, qdd = _cartesian_to_euler(q, V, Vd, convention)
     fn = leg_forces_with_legs if legs else leg_forces

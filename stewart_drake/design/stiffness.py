@@ -26,7 +26,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import StiffnessError
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.kinematics import inverse_jacobian
@@ -34,10 +34,6 @@ from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 from stewart_drake.design.envelope import _skew
 
 FD_STEP = 1e-6  # m and rad: central-difference step for the legs' weight term (error ~ step²)
-
-
-class StiffnessError(StewartError):
-    """A leg stiffness is missing or not physical."""
 
 
 def leg_stiffness_vector(value, option: str = "--leg-stiffness") -> np.ndarray:

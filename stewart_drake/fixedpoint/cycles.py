@@ -35,6 +35,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from stewart_drake.errors import FixedPointError
+from stewart_drake.fixedpoint.scalar import tp17_op_counts
 
 CLOCK_HZ = 60e6
 
@@ -90,8 +91,6 @@ def estimate_cycles(op_counts: dict, table: dict | None = None, clock_hz: float 
 
 def tp17_cycles(table: dict | None = None, clock_hz: float = CLOCK_HZ) -> CycleEstimate:
     """Cycle estimate of one pass of tp17.C's loop body (six leg lengths from one pose)."""
-    from stewart_drake.fixedpoint.scalar import tp17_op_counts
-
     return estimate_cycles(tp17_op_counts(), table, clock_hz)
 
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import WorkspaceError
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import condition_number, leg_vectors
 from stewart_drake.core.rotations import check_convention, rotation_matrix
@@ -19,10 +19,6 @@ LIMIT_NAMES = ("stroke", "base_joint", "top_joint", "collision", "dexterity")
 LIMIT_UNITS = {"stroke": "m", "base_joint": "rad", "top_joint": "rad", "collision": "m", "dexterity": "1"}
 AXES = ("x", "y", "z")
 _BLOCK = 4096  # poses per block in the collision kernel
-
-
-class WorkspaceError(StewartError):
-    """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
 
 
 @dataclass(frozen=True)
