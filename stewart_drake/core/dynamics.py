@@ -172,7 +172,7 @@ def velocity_map(platform: Platform, q, convention: str = "utn") -> np.ndarray:
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     A = np.zeros(q.shape[:-1] + (6, 6))
     A[..., :3, :3] = np.eye(3)
-    A[..., :3, 3:] = -_skew(r) @ E
+    A[..., :3, 3:] = -skew(r) @ E
     A[..., 3:, 3:] = np.swapaxes(R, -1, -2) @ E
     return A
 
@@ -365,7 +365,8 @@ def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn"
     return solve_leg_forces(platform, q, Q, convention)
 
 
-def _skew(v) -> np.ndarray:
+def skew(v) -> np.ndarray:
+    """``(..., 3, 3)`` the cross-product matrix [v]× of ``(..., 3)`` vectors: [v]× w = v × w."""
     z = np.zeros_like(v[..., 0])
     return np.stack(
         [np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1), np.stack([-v[..., 1], v[..., 0], z], -1)], -2

@@ -157,7 +157,8 @@ def seed_t03_rotation(gamma) -> np.ndarray:
     return np.stack([np.sin(g), np.cos(g), -np.cos(g), np.sin(g)], -1).reshape(g.shape + (2, 2))
 
 
-def _check_branch(branch: str) -> float:
+def check_branch(branch: str) -> float:
+    """The knee sign of an elbow branch: +1 for 'a' (knee angle >= 0), -1 for 'b'; ``LegError`` otherwise."""
     if branch not in BRANCHES:
         raise LegError(LegError.BRANCH.format(branch=branch))
     return 1.0 if branch == "a" else -1.0
@@ -191,7 +192,7 @@ def inverse_kinematics(leg: Leg3R, target, branch: str = "a") -> np.ndarray:
     l1 and l23 whose elbow is q2 + phi. Raises ``UnreachableTargetError`` naming the first target out
     of reach; joint limits are not applied (see ``within_limits``).
     """
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     t = _check_target(target, 2)
     l23, phi = leg.shank
     q1, elbow = _two_link(-t[..., 1], t[..., 0], leg.l1, l23, sign, "the foot")
@@ -201,7 +202,7 @@ def inverse_kinematics(leg: Leg3R, target, branch: str = "a") -> np.ndarray:
 def inverse_kinematics_3r(leg: Leg3R, target, branch: str = "a") -> np.ndarray:
     """The seed's geometric 3R method, corrected: ``target`` (..., 3) [Px, Py, gamma] ->
     ``(..., 3)`` [q1, q2, q3] with gamma = q1 + q2 + q3 (q3 = alpha when the target came from this leg)."""
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     t = _check_target(target, 3)
     g = t[..., 2]
     x, y = -t[..., 1], t[..., 0]  # the frame "before the -90° rotation"
@@ -224,7 +225,7 @@ def seed_inverse_kinematics(leg: Leg3R, target, branch: str = "a", fixes=()) -> 
     ``SEED_FIXES``, explained in ``SEED_FIX_TEXT``) applied: ``(..., 3)`` [q1, q2, q3]; NaN where the
     formulas have no real value. With every fix this is ``inverse_kinematics_3r`` (without its
     reachability check). For showing the seed's errors, not for control."""
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     unknown = sorted(set(fixes) - set(SEED_FIXES))
     if unknown:
         raise LegError(LegError.SEED_FIX.format(fix=unknown[0], valid=", ".join(SEED_FIXES)))

@@ -31,7 +31,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
-from stewart_drake.design.envelope import _skew
+from stewart_drake.core.dynamics import skew
 
 FD_STEP = 1e-6  # m and rad: central-difference step for the legs' weight term (error ~ step²)
 
@@ -90,7 +90,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
         return K
     F = static_leg_forces(platform, q, convention, legs, gravity)
     P = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
-    Sr, Su = _skew(r), _skew(u)
+    Sr, Su = skew(r), skew(u)
     D = np.zeros(u.shape[:-1] + (6, 6))
     D[..., :3, :3] = P
     D[..., :3, 3:] = -P @ Sr
@@ -99,7 +99,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
     K = K - np.einsum("...k,...kij->...ij", F, D)
     r_cm = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     f_g = np.array([0.0, 0.0, -platform.mass * gravity])
-    K[..., 3:, 3:] -= _skew(np.broadcast_to(f_g, r_cm.shape)) @ _skew(r_cm)
+    K[..., 3:, 3:] -= skew(np.broadcast_to(f_g, r_cm.shape)) @ skew(r_cm)
     if legs:
         h = FD_STEP
         cols = [(legs_weight_wrench(platform, displace(q, h * e, convention), convention, gravity)

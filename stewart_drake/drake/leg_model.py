@@ -127,9 +127,9 @@ def drake_ik(leg: Leg3R, targets, branch: str, tol: float = 1e-14) -> tuple[np.n
     from pydrake.multibody.inverse_kinematics import InverseKinematics
     from pydrake.solvers import SnoptSolver, SolverOptions
 
-    from stewart_drake.core.leg3r import _check_branch
+    from stewart_drake.core.leg3r import check_branch
 
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     _, phi = leg.shank
     h = LegPlant(leg)
     solver, options = SnoptSolver(), SolverOptions()

@@ -30,7 +30,7 @@ import numpy as np
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import check_convention
-from stewart_drake.fixedpoint.q15 import _sat, tfr16CosPIx, tfr16SinPIx
+from stewart_drake.fixedpoint.q15 import saturate, tfr16CosPIx, tfr16SinPIx
 from stewart_drake.errors import FixedPointError, counted
 
 TRIG_MODES = ("exact", "tfr16")
@@ -118,7 +118,7 @@ def angle_words(angles, fmt: QFormat) -> np.ndarray:
     k = first_index(np.abs(x) > 1.0)
     if k is not None:
         raise FixedPointError(FixedPointError.ANGLE.format(index=counted(k[:-1]), angle=angles[k]))
-    return _sat(np.trunc(x * (1 << f)).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.angle")
+    return saturate(np.trunc(x * (1 << f)).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.angle")
 
 
 def trig_words(w, fmt: QFormat):
@@ -129,8 +129,8 @@ def trig_words(w, fmt: QFormat):
     f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
     t = np.pi * w / (1 << f)
-    s = _sat(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
-    c = _sat(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
+    s = saturate(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
+    c = saturate(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
     return s, c
 
 
@@ -162,9 +162,9 @@ def rotation_from_words(w, fmt: QFormat = QFormat(), convention: str = "utn") ->
             else:
                 term = words[factors[0]]
                 for fac in factors[1:]:
-                    term = _sat((term * words[fac]) >> f, lo, hi, "generic.mult")
+                    term = saturate((term * words[fac]) >> f, lo, hi, "generic.mult")
             for _ in range(abs(coef)):
-                acc = _sat(acc + (term if coef > 0 else -term), lo, hi, "generic.add")
+                acc = saturate(acc + (term if coef > 0 else -term), lo, hi, "generic.add")
         R[..., i, j] = acc
     return R
 
@@ -202,7 +202,7 @@ def pose_words(poses, fmt: QFormat = QFormat()) -> np.ndarray:
     length LSBs (rounded to nearest, saturated), angles as Q(word_bits-1) fractions of pi (truncated)."""
     q = as_poses(poses)
     f = fmt.frac_bits
-    pos = _sat(np.round(q[..., :3] / fmt.length_lsb).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.position")
+    pos = saturate(np.round(q[..., :3] / fmt.length_lsb).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.position")
     return np.concatenate([pos, angle_words(q[..., 3:], fmt)], axis=-1)
 
 
@@ -225,10 +225,10 @@ def leg_length_words(platform: Platform, words, fmt: QFormat = QFormat(), conven
             v = pos[..., r]
             for k in range(3):
                 if r_T[i, k]:
-                    v = _sat(v + ((R[..., r, k] * r_T[i, k]) >> f), lo, hi, "generic.add")
-            v = _sat(v - B[i, r], lo, hi, "generic.sub")
-            sq = _sat(sq + v * v, -acc_hi - 1, acc_hi, "generic.L_add")
-        out[..., i] = _sat(_isqrt_nearest(sq), lo, hi, "generic.sqrt")
+                    v = saturate(v + ((R[..., r, k] * r_T[i, k]) >> f), lo, hi, "generic.add")
+            v = saturate(v - B[i, r], lo, hi, "generic.sub")
+            sq = saturate(sq + v * v, -acc_hi - 1, acc_hi, "generic.L_add")
+        out[..., i] = saturate(_isqrt_nearest(sq), lo, hi, "generic.sqrt")
     return out
 
 

@@ -104,7 +104,9 @@ class SaturationCounter:
         _ACTIVE.remove(self)
 
 
-def _sat(x: np.ndarray, lo: int, hi: int, op: str) -> np.ndarray:
+def saturate(x: np.ndarray, lo: int, hi: int, op: str) -> np.ndarray:
+    """``x`` (int64, any shape) clipped to [lo, hi]; the elements that saturated are recorded under the
+    operation name ``op`` by every active ``SaturationCounter``."""
     if _ACTIVE:
         flags = (x < lo) | (x > hi)
         for c in _ACTIVE:
@@ -118,12 +120,12 @@ def _i(x) -> np.ndarray:
 
 def sat16(x, op: str = "sat16") -> np.ndarray:
     """Saturate any integer to the Word16 range."""
-    return _sat(_i(x), MIN16, MAX16, op)
+    return saturate(_i(x), MIN16, MAX16, op)
 
 
 def sat32(x, op: str = "sat32") -> np.ndarray:
     """Saturate any integer to the Word32 range."""
-    return _sat(_i(x), MIN32, MAX32, op)
+    return saturate(_i(x), MIN32, MAX32, op)
 
 
 def word16(x, name: str = "value") -> np.ndarray:
@@ -163,7 +165,7 @@ def FRAC16(x) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
         raise FixedPointError(FixedPointError.FRAC16_NOT_FINITE.format(value=x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x)))
-    return _sat(np.trunc(x * 32768.0).astype(np.int64), MIN16, MAX16, "FRAC16")
+    return saturate(np.trunc(x * 32768.0).astype(np.int64), MIN16, MAX16, "FRAC16")
 
 
 def FRAC32(x) -> np.ndarray:
@@ -171,7 +173,7 @@ def FRAC32(x) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
         raise FixedPointError(FixedPointError.FRAC32_NOT_FINITE)
-    return _sat(np.trunc(np.clip(x, -2.0, 2.0) * 2147483648.0).astype(np.int64), MIN32, MAX32, "FRAC32")
+    return saturate(np.trunc(np.clip(x, -2.0, 2.0) * 2147483648.0).astype(np.int64), MIN32, MAX32, "FRAC32")
 
 
 def to_float16(w) -> np.ndarray:
@@ -190,32 +192,32 @@ def to_float32(w) -> np.ndarray:
 
 def add(a, b) -> np.ndarray:
     """sat16(a + b)."""
-    return _sat(_i(a) + _i(b), MIN16, MAX16, "add")
+    return saturate(_i(a) + _i(b), MIN16, MAX16, "add")
 
 
 def sub(a, b) -> np.ndarray:
     """sat16(a - b)."""
-    return _sat(_i(a) - _i(b), MIN16, MAX16, "sub")
+    return saturate(_i(a) - _i(b), MIN16, MAX16, "sub")
 
 
 def negate(a) -> np.ndarray:
     """sat16(-a); negate(-32768) = 32767."""
-    return _sat(-_i(a), MIN16, MAX16, "negate")
+    return saturate(-_i(a), MIN16, MAX16, "negate")
 
 
 def abs_s(a) -> np.ndarray:
     """sat16(|a|); abs_s(-32768) = 32767."""
-    return _sat(np.abs(_i(a)), MIN16, MAX16, "abs_s")
+    return saturate(np.abs(_i(a)), MIN16, MAX16, "abs_s")
 
 
 def mult(a, b) -> np.ndarray:
     """sat16((a*b) >> 15): Q15 product truncated toward -inf; only -32768*-32768 saturates."""
-    return _sat((_i(a) * _i(b)) >> 15, MIN16, MAX16, "mult")
+    return saturate((_i(a) * _i(b)) >> 15, MIN16, MAX16, "mult")
 
 
 def mult_r(a, b) -> np.ndarray:
     """sat16((a*b + 2^14) >> 15): Q15 product rounded, ties toward +inf."""
-    return _sat((_i(a) * _i(b) + (1 << 14)) >> 15, MIN16, MAX16, "mult_r")
+    return saturate((_i(a) * _i(b) + (1 << 14)) >> 15, MIN16, MAX16, "mult_r")
 
 
 def shl(a, n) -> np.ndarray:
@@ -223,7 +225,7 @@ def shl(a, n) -> np.ndarray:
     a, n = np.broadcast_arrays(_i(a), _i(n))
     left = np.clip(n, 0, 16)
     right = np.clip(-n, 0, 15)
-    return np.where(n >= 0, _sat(a << left, MIN16, MAX16, "shl"), a >> right)
+    return np.where(n >= 0, saturate(a << left, MIN16, MAX16, "shl"), a >> right)
 
 
 def shr(a, n) -> np.ndarray:
@@ -237,27 +239,27 @@ def shr(a, n) -> np.ndarray:
 
 def L_add(a, b) -> np.ndarray:
     """sat32(a + b)."""
-    return _sat(_i(a) + _i(b), MIN32, MAX32, "L_add")
+    return saturate(_i(a) + _i(b), MIN32, MAX32, "L_add")
 
 
 def L_sub(a, b) -> np.ndarray:
     """sat32(a - b)."""
-    return _sat(_i(a) - _i(b), MIN32, MAX32, "L_sub")
+    return saturate(_i(a) - _i(b), MIN32, MAX32, "L_sub")
 
 
 def L_negate(a) -> np.ndarray:
     """sat32(-a); L_negate(-2^31) = 2^31 - 1."""
-    return _sat(-_i(a), MIN32, MAX32, "L_negate")
+    return saturate(-_i(a), MIN32, MAX32, "L_negate")
 
 
 def L_abs(a) -> np.ndarray:
     """sat32(|a|)."""
-    return _sat(np.abs(_i(a)), MIN32, MAX32, "L_abs")
+    return saturate(np.abs(_i(a)), MIN32, MAX32, "L_abs")
 
 
 def L_mult(a, b) -> np.ndarray:
     """sat32(2ab): the Q31 product of two Q15 words; only -32768 * -32768 saturates."""
-    return _sat(2 * _i(a) * _i(b), MIN32, MAX32, "L_mult")
+    return saturate(2 * _i(a) * _i(b), MIN32, MAX32, "L_mult")
 
 
 def L_mac(acc, a, b) -> np.ndarray:
@@ -276,7 +278,7 @@ def L_shl(a, n) -> np.ndarray:
     left = np.clip(n, 0, 32)
     right = np.clip(-n, 0, 31)
     # a << 32 overflows int64 only for |a| >= 2^31, which a Word32 never is.
-    return np.where(n >= 0, _sat(a << left, MIN32, MAX32, "L_shl"), a >> right)
+    return np.where(n >= 0, saturate(a << left, MIN32, MAX32, "L_shl"), a >> right)
 
 
 def L_shr(a, n) -> np.ndarray:
