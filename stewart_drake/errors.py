@@ -62,6 +62,130 @@ class SingularityWarning(UserWarning):
 
 
 # ----------------------------------------------------------------------------------------------
+# Array arguments (``core.argcheck``): shapes and finite values.
+
+
+class ShapeError(StewartError):
+    """An array argument (poses, lengths, vectors) has the wrong shape."""
+
+
+class NotFiniteError(StewartError):
+    """An array argument holds NaN or an infinity; the message names the first such sample."""
+
+
+SHAPE = "Expected {name} to have shape {shape}, got {got}"
+NOT_FINITE_SAMPLE = "{what} {index} is not finite: {values}"
+# The length Jacobian at a trajectory sample is (nearly) singular (``dynamics.solve_leg_forces``).
+SINGULAR_SAMPLE = (
+    "sample {index}: the length Jacobian J = dL/dq is singular or nearly so (condition number {cond:.3g} > "
+    "{limit:.3g}); leg forces are undefined there"
+)
+# A pose whose scaled J⁻¹ condition number exceeds the limit (``kinematics.require_nonsingular``).
+SINGULAR_POSE = "pose {index} is singular or nearly so: Jacobian condition number {cond:.3g} > {limit:.3g}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Mechanisms other than the 6-UPS platform: the 3R leg (``core.leg3r``) and the RC-servo hexapod
+# (``core.servo``).
+
+
+class LegError(StewartError):
+    """A 3R leg's parameters, joint angles or targets are malformed."""
+
+    LENGTH = "leg length {name} must be a positive number of metres, got {value}"
+    ALPHA = "ankle angle alpha must be finite, got {value}"
+    LIMITS = "{name} must be two finite angles (rad) with lower < upper, got {value}"
+    ANGLES_2 = "leg joint angles need 2 numbers (q1, q2), got shape {shape}"
+    ANGLES_2_3 = "leg joint angles need 2 numbers (q1, q2) or 3 (q1, q2, q3), got shape {shape}"
+    BRANCH = "unknown elbow branch {branch!r}; expected 'a' (knee angle >= 0) or 'b' (<= 0)"
+    TARGET = "a leg target needs {n} numbers ({names}), got shape {shape}"
+    SEED_FIX = "unknown seed fix {fix!r}; expected some of {valid}"
+
+
+class UnreachableTargetError(StewartError):
+    """A foot target lies outside the leg's reachable annulus.
+
+    Attributes: ``index`` (tuple, into the batch), ``distance`` (m, hip to target, or to the wrist for the
+    3R solver), ``r_min``, ``r_max`` (m)."""
+
+    TEMPLATE = ("target {index}: {what} is {d_mm:.3f} mm from the hip, outside the reachable range "
+                "[{lo_mm:.3f}, {hi_mm:.3f}] mm")
+
+    def __init__(self, index, distance, r_min, r_max, what="the foot"):
+        self.index, self.distance, self.r_min, self.r_max = index, distance, r_min, r_max
+        super().__init__(self.TEMPLATE.format(index=counted(index), what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3,
+                                              hi_mm=r_max * 1e3))
+
+
+class ServoPoseError(StewartError):
+    """A pose given to the servo hexapod is malformed (shape, non-finite numbers)."""
+
+    SHAPE = "a servo hexapod pose needs 6 numbers (x, y, z, phi, theta, psi), got shape {shape}"
+    NOT_FINITE = "pose {index} has a non-finite number: {values}"
+
+
+SERVO_RESOLUTION = "pulse resolution must be > 0 µs, got {value}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Fixed-point arithmetic (``fixedpoint``): values a word cannot hold, operations outside their domain.
+
+
+class FixedPointError(StewartError):
+    """A value does not fit the fixed-point word it is converted to, or an operation is outside its domain."""
+
+    WORD_BITS = "word_bits must be an integer in 8..31, got {value!r}"
+    LENGTH_LSB = "length_lsb must be a positive number of metres, got {value!r}"
+    TRIG = "trig must be one of {valid}, got {value!r}"
+    TFR16_BITS = "trig='tfr16' is the 16-bit DSP library; it needs word_bits=16, got {value}"
+    ANGLE = "pose {index}: angle {angle:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]"
+    LENGTH_WORD = "{what} {value:.6g} m does not fit a {bits}-bit word of {lsb:g} m (range ±{range_m:.6g} m)"
+    NOT_INTEGER_16 = "{name} must hold integers (Word16), got {value!r}"
+    NOT_INTEGER_32 = "{name} must hold integers (Word32)"
+    RANGE = "{name} = {value} is outside the {bits}-bit range [{lo}, {hi}]"
+    FRAC16_NOT_FINITE = "FRAC16 of a non-finite value {value!r}"
+    FRAC32_NOT_FINITE = "FRAC32 of a non-finite value"
+    DIV_S = "div_s needs 0 <= a <= b and b > 0, got a={a}, b={b}"
+    NO_CYCLES = "operation {op!r} has no entry in the cycle table"
+
+
+class DspPoseError(FixedPointError):
+    """A firmware pose (mm and fractions of pi) is malformed or does not fit the DSP's 16-bit words."""
+
+    NOT_FINITE = "{name} is not finite: {values}"
+    POSITION = "{name}: position {values} mm does not fit a 16-bit word [-32768, 32767]"
+    ANGLES = "{name}: angles {values} (fractions of pi) must lie in [-1, 1]"
+    ANGLE_OPTION = "angle {name} = {value:g} {unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]"
+
+
+# ----------------------------------------------------------------------------------------------
+# Design studies (``design``): envelopes, payloads, stiffness.
+
+
+class EnvelopeError(StewartError):
+    """An envelope file is malformed or leaves the platform's workspace."""
+
+
+class PayloadError(StewartError):
+    """A payload is not physical (negative or non-finite mass, below the plate)."""
+
+
+class StiffnessError(StewartError):
+    """A leg stiffness is missing or not physical."""
+
+
+SLICE_NODES = "slice of {n} x {n} nodes: need 2 <= n and n² <= {limit}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Workspace requests (``workspace``).
+
+
+class WorkspaceError(StewartError):
+    """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
+
+
+# ----------------------------------------------------------------------------------------------
 # Input/output errors and message templates (files, options, output folders).
 
 
@@ -117,6 +241,8 @@ class CsvError(InputError):
     EMPTY = "{path}: no {kind} rows"
     MISSING = "{kind} file {path!r} does not exist"
     IS_FOLDER = "{kind} file {path!r} is a folder, not a file"
+    TOO_FEW = "{path}: need at least {need} samples, got {got}"
+    TIMES = "{path}: times must increase; sample {k} (t = {t} s) does not follow t = {t_prev} s"
 
 
 class UsageError(StewartError):
@@ -125,6 +251,24 @@ class UsageError(StewartError):
     NEEDS = "{option} only applies with {needs}"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     INTERNAL = "internal error ({kind}: {detail}); please report it with the command line"
+    LEGS_CORIOLIS = "--legs on computes the complete model; it cannot be combined with --coriolis off"
+    ENGINE_C = "--engine c runs the fixed-point controller; --controller is {controller!r}"
+
+
+class OptionError(UsageError):
+    """One option's value is outside the range the command accepts; the message names the option and the
+    value as typed."""
+
+    AT_LEAST = "{option} must be >= {min}, got {value}"
+    POSITIVE = "{option} must be a positive number of {unit}, got {value}"
+    POSITIVE_LENGTH = "{option} must be a positive length, got {value}"
+    BETWEEN = "{option} must be between {lo} and {hi}, got {value}"
+    GRAVITY = "{option} must be a finite number >= 0 m/s², got {value}"
+    UNKNOWN_LIMIT = "{option}: unknown limit {value!r}; choose from {valid}"
+    DT = "--dt must be > 0 and --t-end >= 0, got dt = {dt}, t-end = {t_end}"
+    TOO_MANY_SAMPLES = "--t-end / --dt = {n} samples, more than {limit}"
+    NO_STUDY = "--replay: {out!r} holds no finished study ({file} missing); run the study first"
+    NO_RUN = "--replay {run}: the study in {out!r} has runs 0 … {last}"
 
 
 # ----------------------------------------------------------------------------------------------

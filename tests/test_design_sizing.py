@@ -119,9 +119,9 @@ def test_envelope_never_exceeded_and_attained(loaded_platform, legs):
 
 
 def _to_euler(q, V, A):
-    from stewart_drake.design.envelope import _cartesian_to_euler
+    from stewart_drake.design.envelope import cartesian_to_euler
 
-    return _cartesian_to_euler(q, V, A, "utn")
+    return cartesian_to_euler(q, V, A, "utn")
 
 
 def test_allowed_acceleration_is_the_limit(loaded_platform):

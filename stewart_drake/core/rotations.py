@@ -178,3 +178,8 @@ def quaternion_to_matrix(q) -> np.ndarray:
         ],
         axis=-1,
     ).reshape(q.shape[:-1] + (3, 3))
+
+
+def wrap_angle(x) -> np.ndarray:
+    """Angles ``x`` (radians, any shape) wrapped to [-pi, pi)."""
+    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi

@@ -27,6 +27,8 @@ import os
 
 import numpy as np
 
+from stewart_drake.core.kinematics import condition_number, leg_lengths, plate_anchors
+from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import (
     BELOW_BASE,
     FAR_POSITION,
@@ -107,8 +109,6 @@ def platform_size(platform) -> float:
 
 def plate_anchor_heights(platform, poses, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` z of each leg's plate anchor in B (m) for ``(..., 6)`` poses."""
-    from stewart_drake.core.kinematics import plate_anchors
-
     return plate_anchors(platform, poses, convention)[..., 2]
 
 
@@ -216,8 +216,6 @@ def check_trajectory(platform, times, poses, convention: str = "utn", what: str 
     ``check_poses`` (labelled by its time) and every leg stays within the stroke. A stroke violation
     raises ``PhysicalLimitError`` naming the first offending time, leg and amount, unless
     ``allow_out_of_stroke``: then its message is returned as a warning (a list of 0 or 1 strings)."""
-    from stewart_drake.core.kinematics import leg_lengths
-
     t = np.asarray(times, dtype=float).reshape(-1)
     q = check_poses(platform, poses, convention, what=what, times=t)
     v = first_stroke_violation(platform, leg_lengths(platform, q, convention), t)
@@ -255,8 +253,6 @@ def _collinear(points: np.ndarray, tol: float) -> bool:
 def check_home(platform) -> None:
     """``GeometryError`` when ``platform`` is singular at its home pose: its legs cannot hold the plate
     there (the Jacobian loses rank). Names the anchors when they are collinear (the usual cause)."""
-    from stewart_drake.core.kinematics import condition_number
-
     home = platform.home_pose()
     cond = float(condition_number(platform, home))
     if cond <= HOME_MAX_CONDITION:
@@ -422,8 +418,6 @@ def plate_floor(platform, orientation, convention: str = "utn") -> float:
     """The height (m) the rotation centre must exceed, at ``orientation`` (3,) rad, for every plate
     anchor to be above the base plane: max_i −(R_BT (p_TTi − p_TC))_z; −inf when the platform allows
     its plate below the base. Positions above it form the half-space a workspace may count."""
-    from stewart_drake.core.rotations import rotation_matrix
-
     if getattr(platform, "plate_below_base_allowed", False):
         return -math.inf
     R = rotation_matrix(np.asarray(orientation, dtype=float), convention)

@@ -44,9 +44,10 @@ from typing import Optional
 
 import numpy as np
 
-from stewart_drake.errors import GeometryError, StewartError, counted
-from stewart_drake.core.geometry import load_yaml_config
-from stewart_drake.core.rotations import length_scale, rotation_matrix
+from stewart_drake.core.argcheck import first_index
+from stewart_drake.core.geometry import check_name, load_yaml_config
+from stewart_drake.core.rotations import length_scale, rotation_matrix, wrap_angle
+from stewart_drake.errors import SERVO_RESOLUTION, GeometryError, ServoPoseError, StewartError, counted
 
 NEUTRAL_US = 1500.0
 RATE_US_PER_RAD = 400.0 / np.radians(45.0)  # 509.295... µs/rad = 8.888... µs/degree
@@ -59,10 +60,6 @@ SERVO_STALL_TORQUE = 1.0
 SERVO_BAND_RAD = np.radians(2.0)
 # Home heights of the six legs must agree (the seed: "by symmetry eq. 10 gives the same for every leg").
 H0_AGREEMENT_M = 1e-9
-
-
-class ServoPoseError(StewartError):
-    """A pose given to the servo hexapod is malformed (shape, non-finite numbers)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -357,8 +354,6 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
 
 def load_servo_yaml(path) -> ServoHexapod:
     """Load a servo hexapod from a YAML file (schema: ``ServoHexapodConfig``)."""
-    from stewart_drake.core.geometry import check_name
-
     return servo_hexapod_from_config(load_yaml_config(path, ServoHexapodConfig, "servo hexapod",
                                                       lambda cfg, where: check_name(cfg, where, str(path))))
 
@@ -415,11 +410,7 @@ def _alpha(L, M, N):
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(c > 0, L / np.where(c > 0, c, 1.0), np.copysign(np.inf, L))
     alpha = np.arcsin(np.clip(ratio, -1.0, 1.0)) - np.arctan2(N, M)
-    return _wrap(alpha), ratio
-
-
-def _wrap(x):
-    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
+    return wrap_angle(alpha), ratio
 
 
 def home_arm_angles(hexapod: ServoHexapod) -> np.ndarray:
@@ -447,11 +438,10 @@ def check_poses(poses) -> np.ndarray:
     """``poses`` as a float array ``(..., 6)``; raise ``ServoPoseError`` naming a bad shape or pose."""
     poses = np.asarray(poses, dtype=float)
     if poses.shape[-1:] != (6,):
-        raise ServoPoseError(f"a servo hexapod pose needs 6 numbers (x, y, z, phi, theta, psi), got shape {poses.shape}")
-    bad = ~np.all(np.isfinite(poses), axis=-1)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0]) if poses.ndim > 1 else ()
-        raise ServoPoseError(f"pose {counted(idx)} has a non-finite number: {poses[idx].tolist()}")
+        raise ServoPoseError(ServoPoseError.SHAPE.format(shape=poses.shape))
+    idx = first_index(~np.all(np.isfinite(poses), axis=-1))
+    if idx is not None:
+        raise ServoPoseError(ServoPoseError.NOT_FINITE.format(index=counted(idx), values=poses[idx].tolist()))
     return poses
 
 
@@ -514,7 +504,7 @@ def arm_angles(hexapod: ServoHexapod, poses) -> tuple[np.ndarray, np.ndarray]:
 
 def pulse_widths(hexapod: ServoHexapod, alpha) -> np.ndarray:
     """Eqs. 13-14: ``(..., 6)`` pulse widths (µs) for arm angles ``alpha`` (..., 6), without limits."""
-    delta = _wrap(np.asarray(alpha, dtype=float) - hexapod.home_angles)
+    delta = wrap_angle(np.asarray(alpha, dtype=float) - hexapod.home_angles)
     return hexapod.neutral_us + hexapod.pulse_signs * delta * hexapod.rate_us_per_rad
 
 
@@ -527,7 +517,7 @@ def angles_from_pulses(hexapod: ServoHexapod, pulse_us) -> np.ndarray:
 def solve(hexapod: ServoHexapod, poses) -> ServoSolution:
     """The seed's control step for ``(..., 6)`` poses: arm angles, pulse widths, per-servo checks."""
     alpha, ratio = arm_angles(hexapod, poses)
-    delta = _wrap(alpha - hexapod.home_angles)
+    delta = wrap_angle(alpha - hexapod.home_angles)
     raw = hexapod.neutral_us + hexapod.pulse_signs * delta * hexapod.rate_us_per_rad
     lim = hexapod.travel_rad
     pulse = hexapod.neutral_us + hexapod.pulse_signs * np.clip(delta, -lim, lim) * hexapod.rate_us_per_rad
@@ -537,7 +527,7 @@ def solve(hexapod: ServoHexapod, poses) -> ServoSolution:
 def quantise_pulses(pulse_us, resolution_us: float = 1.0) -> np.ndarray:
     """Pulse widths rounded to the driver's resolution (µs), half away from zero like a C ``lround``."""
     if not resolution_us > 0:
-        raise ValueError(f"pulse resolution must be > 0 µs, got {resolution_us}")
+        raise StewartError(SERVO_RESOLUTION.format(value=resolution_us))
     p = np.asarray(pulse_us, dtype=float) / resolution_us
     return np.copysign(np.floor(np.abs(p) + 0.5), p) * resolution_us
 

@@ -27,8 +27,8 @@ from typing import Optional
 
 import numpy as np
 
-from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces_with_legs
-from stewart_drake.errors import StewartError
+from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces, leg_forces_with_legs, skew
+from stewart_drake.errors import EnvelopeError, StewartError
 from stewart_drake.core.geometry import Platform, load_yaml_config
 from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
 from stewart_drake.core.rotations import angle_scale, angular_velocity_map, check_convention, length_scale, rotation_matrix
@@ -38,10 +38,6 @@ from stewart_drake.design.boxquad import box_quadratic_max
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
 MAX_CONDITION = 1e8  # as dynamics.MAX_CONDITION: leg forces are meaningless beyond it
 CHUNK = 4096
-
-
-class EnvelopeError(StewartError):
-    """An envelope file is malformed or leaves the platform's workspace."""
 
 
 # ----------------------------------------------------------------------------------------------
@@ -191,12 +187,6 @@ def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
 # Force terms: F = c + G [a_C; ω̇] + Vᵀ Q V.
 
 
-def _skew(v):
-    z = np.zeros_like(v[..., 0])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
-
-
 def _plate_geometry(platform: Platform, q, convention):
     R = rotation_matrix(q[..., 3:], convention)
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)  # (..., 6, 3)
@@ -212,7 +202,7 @@ def spatial_inertia_about_C(platform: Platform, R) -> np.ndarray:
     (M_C = [[m 1, −m [r]×], [m [r]×, I_C]], r = p_C→cm, I_C the inertia about C)."""
     m = platform.mass
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
-    S = _skew(r)
+    S = skew(r)
     I_W = R @ platform.inertia @ np.swapaxes(R, -1, -2)
     M = np.zeros(r.shape[:-1] + (6, 6))
     M[..., :3, :3] = m * np.eye(3)
@@ -249,7 +239,7 @@ def _plate_terms(platform: Platform, q, convention, gravity):
     return c, G, Q, (R, r_legs, u, L, Jinv)
 
 
-def _cartesian_to_euler(q, V, Vd, convention):
+def cartesian_to_euler(q, V, Vd, convention):
     """q̇, q̈ (..., 6) for Cartesian [v_C; ω], [a_C; ω̇] at poses q."""
     E = angular_velocity_map(q[..., 3:], convention)
     rates = np.linalg.solve(E, V[..., 3:, None])[..., 0]
@@ -260,10 +250,8 @@ def _cartesian_to_euler(q, V, Vd, convention):
 def cartesian_leg_forces(platform: Platform, q, V, Vd, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) at poses q for Cartesian velocity V = [v_C; ω] and acceleration
     [a_C; ω̇] (base frame), by the toolkit's inverse dynamics in Euler coordinates."""
-    from stewart_drake.core.dynamics import leg_forces
-
     q, V, Vd = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (q, V, Vd)))
-    qd, qdd = _cartesian_to_euler(q, V, Vd, convention)
+    qd, qdd = cartesian_to_euler(q, V, Vd, convention)
     fn = leg_forces_with_legs if legs else leg_forces
     return fn(platform, q, qd, qdd, convention, gravity=gravity)
 
@@ -354,7 +342,7 @@ def envelope_sizing(platform: Platform, env: Envelope, legs: bool = False, gravi
         cmax, _ = box_quadratic_max(S, wb)
         cmin_neg, _ = box_quadratic_max(-S, wb)
         P = np.eye(3) - u[..., :, None] * u[..., None, :]
-        B = np.concatenate([P, -P @ _skew(r)], -1) / np.sqrt(L)[..., None, None]  # (..., 6, 3, 6)
+        B = np.concatenate([P, -P @ skew(r)], -1) / np.sqrt(L)[..., None, None]  # (..., 6, 3, 6)
         signs = np.array(np.meshgrid(*[[-1.0, 1.0]] * 6, indexing="ij")).reshape(6, -1).T[:32]  # ±V give the same value
         conv = np.max(np.sum((B @ (signs * env.v_max).T) ** 2, -2), -1)
         alin = np.abs(Jinv) @ env.a_max

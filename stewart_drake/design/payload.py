@@ -4,12 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import PayloadError
 from stewart_drake.core.geometry import Platform
-
-
-class PayloadError(StewartError):
-    """A payload is not physical (negative or non-finite mass, below the plate)."""
 
 
 def with_payload(platform: Platform, mass: float, p_TP=(0.0, 0.0, 0.0), option: str = "--payload") -> Platform:

@@ -13,7 +13,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.solvers import SnoptSolver, SolverOptions
 
-from stewart_drake.core.leg3r import Leg3R, _check_branch, frame_transforms
+from stewart_drake.core.leg3r import Leg3R, check_branch, frame_transforms
 from stewart_drake.core.sdf_models import leg_sdf
 
 # drake_ik accepts a solution whose foot (by Drake's FK) is this close to the target. With tight
@@ -63,7 +63,7 @@ def drake_ik(leg: Leg3R, targets, branch: str, tol: float = 1e-14) -> tuple[np.n
     answer; q1 is boxed to ±180° about that start. Raises ``RuntimeError`` naming the target if the
     foot ends farther than ``GAP_TOL_M`` from it.
     """
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     _, phi = leg.shank
     h = LegPlant(leg)
     solver, options = SnoptSolver(), SolverOptions()

@@ -38,7 +38,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import _poses
+from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.rotations import check_convention, rotation_matrix
 from stewart_drake.drake.platform_model import build_plant, prismatic_positions, set_pose
 
@@ -100,7 +100,7 @@ def drake_dynamics_terms(platform: Platform, q, qd, convention: str = "utn", gra
     """Drake's M(q) ``(n, 6, 6)``, C(q, q̇) q̇ ``(n, 6)`` and G(q) ``(n, 6)`` in pose coordinates (chain plant)."""
     plant, perm = chain_plant(platform, convention, gravity)
     ctx = plant.CreateDefaultContext()
-    q, qd = np.atleast_2d(_poses(q)), np.atleast_2d(qd)
+    q, qd = np.atleast_2d(as_poses(q)), np.atleast_2d(qd)
     n = len(q)
     M, C, G = np.empty((n, 6, 6)), np.empty((n, 6)), np.empty((n, 6))
     inv = np.argsort(perm)  # q index -> drake index

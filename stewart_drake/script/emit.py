@@ -13,6 +13,7 @@ import builtins
 import keyword
 
 from stewart_drake.script import ast
+from stewart_drake.script.check import assigned_names
 from stewart_drake.script.errors import ScriptError
 from stewart_drake.script.runtime import CONSTANTS, DEFAULT_RATE, DEFAULT_UNITS, FUNCTIONS, Motion, fmt_number
 
@@ -102,8 +103,6 @@ if __name__ == "__main__":
 
 class _PyEmitter:
     def __init__(self, program: ast.Program):
-        from stewart_drake.script.check import assigned_names
-
         names = set(assigned_names(program.body))
         self.names = {}
         for n in sorted(names):

@@ -14,10 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import SingularPoseError
+from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition, leg_forces
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from stewart_drake.core.sanity import above_base, has_plate, plate_anchor_heights
+from stewart_drake.errors import OptionError, SingularPoseError
 from stewart_drake.script.errors import (
     MOVE_ARITY,
     MOVE_DUPLICATE_ARG,
@@ -262,7 +264,7 @@ class Motion:
     def trajectory(self, rate: float = DEFAULT_RATE) -> Trajectory:
         """Sample every segment at ``rate`` Hz (each segment's end is a sample; t = 0 is the start)."""
         if not (math.isfinite(rate) and rate > 0):
-            raise ValueError(f"trajectory rate must be a positive number of Hz, got {rate}")
+            raise OptionError(OptionError.POSITIVE.format(option="trajectory rate", unit="Hz", value=rate))
         for s in self.segments:  # each segment's samples, in floating point first (a huge wait overflows int)
             if s.duration * rate > MAX_SAMPLES:
                 raise ScriptError(
@@ -355,8 +357,6 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
 def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> None:
     """``ScriptError`` at the first move whose path puts a plate anchor at or below the base plane
     (``sanity.above_base``), with the time and the anchor's height."""
-    from stewart_drake.core.sanity import above_base, plate_anchor_heights
-
     ok = above_base(platform, traj.q, convention)
     if np.all(ok):
         return
@@ -374,8 +374,6 @@ def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> 
 
 def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) -> ScriptError:
     """A ``SingularPoseError`` from the dynamics, restated at the move whose path crosses the singularity."""
-    from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition
-
     k = jacobian_condition(platform, traj.q, convention)
     bad = np.flatnonzero(~(k <= MAX_CONDITION))
     if not len(bad):
@@ -393,23 +391,15 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
 def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True,
              gravity: float = 9.81) -> Result:
     """Inverse kinematics (with the stroke check) and inverse dynamics on a trajectory."""
-    from stewart_drake.core.sanity import has_plate
-
     L = check_reachable(platform, traj, convention)
     notes = []
     if not has_plate(platform):  # a massless plate would give every force as 0
         return Result(traj, L, None, platform.name, convention,
                       (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",))
     try:
-        from stewart_drake.core.dynamics import leg_forces
-    except ImportError:
-        F = None
-        notes.append("leg forces not computed: stewart_drake.core.dynamics.leg_forces is not available in this installation")
-    else:
-        try:
-            F = np.asarray(leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity))
-        except SingularPoseError as e:
-            raise _singular_error(platform, traj, convention, e) from None
+        F = np.asarray(leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity))
+    except SingularPoseError as e:
+        raise _singular_error(platform, traj, convention, e) from None
     return Result(traj, L, F, platform.name, convention, tuple(notes))
 
 
