@@ -29,7 +29,7 @@ import numpy as np
 
 from stewart_drake.errors import ForwardKinematicsError, SingularPoseError, SingularityWarning, counted
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import inverse_jacobian
+from stewart_drake.core.kinematics import anchor_radius, inverse_jacobian, scaled_jacobian, singular_value_condition
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
 
 # Per-sample status codes (FKResult.status).
@@ -60,9 +60,9 @@ SINGULAR_TEMPLATE = (
 
 
 def anchor_scale(platform: Platform) -> float:
-    """The plate's anchor radius max |p_TTj − p_TC| (metres): the length that makes the rotation
-    columns of J⁻¹ commensurate with the translation columns (as in ``kinematics.condition_number``)."""
-    return float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
+    """The plate's anchor radius max |p_TTj − p_TC| (metres) as a float: ``kinematics.anchor_radius``, the
+    length that makes the rotation columns of J⁻¹ commensurate with the translation columns."""
+    return float(anchor_radius(platform))
 
 
 @dataclass(frozen=True)
@@ -87,26 +87,19 @@ class JacobianAnalysis:
         return ~(self.condition <= max_condition)
 
 
-def _scaled(Jinv: np.ndarray, scale: float) -> np.ndarray:
-    return np.concatenate([Jinv[..., :3], Jinv[..., 3:] / scale], axis=-1)
-
-
 def analyse_inverse_jacobian(Jinv: np.ndarray, scale: float) -> JacobianAnalysis:
     """``JacobianAnalysis`` of ``(..., 6, 6)`` J⁻¹ with its rotation columns divided by ``scale`` (the
     anchor radius, metres)."""
-    Jn = _scaled(Jinv, scale)
+    Jn = scaled_jacobian(Jinv, scale)
     s = np.linalg.svd(Jn, compute_uv=False)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cond = np.where(s[..., -1] > 0, s[..., 0] / s[..., -1], np.inf)
-    return JacobianAnalysis(cond, s[..., -1], np.sign(np.linalg.det(Jn)))
+    return JacobianAnalysis(singular_value_condition(s), s[..., -1], np.sign(np.linalg.det(Jn)))
 
 
 def frobenius_condition(Jinv: np.ndarray, scale: float) -> np.ndarray:
     """``(n,)`` Frobenius-norm condition number ‖A‖_F ‖A⁻¹‖_F of the scaled ``(n, 6, 6)`` J⁻¹ (inf if
     singular). A cheap, conservative stand-in for the 2-norm condition number κ₂ (one batched inverse
     instead of an SVD): κ₂ <= κ_F <= 6 κ₂ for 6x6 matrices."""
-    A = Jinv.copy()
-    A[..., 3:] /= scale
+    A = scaled_jacobian(Jinv, scale)
     try:
         Ainv = np.linalg.inv(A)
     except np.linalg.LinAlgError:  # some sample exactly singular: redo one by one
