@@ -6,6 +6,15 @@ import os
 
 import numpy as np
 
+from stewart_drake.core.leg3r import (
+    Leg3R,
+    foot,
+    forward_kinematics,
+    inverse_kinematics,
+    inverse_kinematics_3r,
+    limit_violations,
+    within_limits,
+)
 from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.errors import OutputError
 from stewart_drake.core.rotations import angle_scale, length_scale
@@ -38,16 +47,12 @@ def register(sub) -> None:
 
 
 def _leg(args):
-    from stewart_drake.core.leg3r import Leg3R
-
     k = length_scale(args.length_unit)
     dims = {n: getattr(args, n) * k for n in ("l1", "l2", "l3") if getattr(args, n) is not None}
     return Leg3R(**dims)
 
 
 def run(args) -> int:
-    from stewart_drake.core.leg3r import foot, forward_kinematics, inverse_kinematics, inverse_kinematics_3r, limit_violations, within_limits
-
     leg = _leg(args)
     if args.op == "sdf":
         if args.write:

@@ -10,14 +10,13 @@ import numpy as np
 from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.errors import OutputError
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from stewart_drake.core.sanity import check_finite
+from stewart_drake.core.sanity import check_finite, check_servo_neutrals
+from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
 
 
 def register(sub) -> None:
-    from stewart_drake.core.servo import SERVO_PRESETS
-
     p = sub.add_parser("servo", help="servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)")
     p.add_argument("--platform", default="hobby-servo", metavar="NAME|FILE",
                    help=f"a servo hexapod preset ({', '.join(SERVO_PRESETS)}) or a servo hexapod YAML file (default hobby-servo)")
@@ -34,10 +33,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.core.servo import load_servo_hexapod, solve
-
-    from stewart_drake.core.sanity import check_servo_neutrals
-
     hexapod = load_servo_hexapod(args.platform)
     check_servo_neutrals(hexapod, f"{args.platform}: servo.neutral_us")
     if args.trim is not None:
