@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import condition_number, inverse_jacobian, leg_lengths
 from stewart_drake.core.newton_fk import (
     CONVERGED,
     check_poses_nonsingular,
@@ -12,10 +13,9 @@ from stewart_drake.core.newton_fk import (
     legs_and_jacobian,
     validate_lengths,
 )
-from stewart_drake.core.geometry import load_preset
-from stewart_drake.core.kinematics import condition_number, inverse_jacobian, leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sampling import random_poses
+from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError
 
 
 def _exp(w):

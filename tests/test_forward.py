@@ -4,13 +4,13 @@
 import numpy as np
 import pytest
 
-from stewart_drake.errors import ForwardKinematicsError
 from stewart_drake.core.assembly_modes import best_position, is_planar, max_solutions, random_rotations
-from stewart_drake.core.reference_platforms import dietmaier_platform
-from stewart_drake.drake.program_fk import ProgramFK, assembly_modes
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
+from stewart_drake.core.reference_platforms import dietmaier_platform
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.drake.program_fk import ProgramFK, assembly_modes
+from stewart_drake.errors import ForwardKinematicsError
 
 MIRROR = np.array([1, 1, -1])
 

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.geometry import load_preset
-from stewart_drake.core.leg_bodies import leg_joint_positions
-from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.core.sampling import random_poses
-from stewart_drake.drake.verify_kinematics import anchor_frames, drake_fk_tip_errors, drake_ik_lengths, make_plant
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.leg_bodies import leg_joint_positions
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.drake.platform_model import build_plant, set_pose
+from stewart_drake.drake.verify_kinematics import anchor_frames, drake_fk_tip_errors, drake_ik_lengths, make_plant
 
 # SNOPT closes the ball constraints to its feasibility tolerance (1e-10 m scale); the recovered leg
 # lengths then agree to ~1e-10 m. 1e-8 m leaves margin and is still 100x tighter than the 1e-6 m asked.

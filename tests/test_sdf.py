@@ -10,7 +10,16 @@ import pytest
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.leg3r import Leg3R
 from stewart_drake.core.rotations import rotation_matrix
-from stewart_drake.core.sdf import box_inertia, cylinder_inertia, header, rpy, visual_xml, xml_attr, xml_comment, xml_vec
+from stewart_drake.core.sdf import (
+    box_inertia,
+    cylinder_inertia,
+    header,
+    rpy,
+    visual_xml,
+    xml_attr,
+    xml_comment,
+    xml_vec,
+)
 from stewart_drake.core.sdf_models import sdf_file_name, sdf_text, write_sdf
 from stewart_drake.core.servo import hobby_servo_hexapod
 

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from stewart_drake.errors import GeometryError
 from stewart_drake.core.servo import (
     RATE_US_PER_RAD,
     ServoPoseError,
@@ -15,6 +14,7 @@ from stewart_drake.core.servo import (
     quantise_pulses,
     solve,
 )
+from stewart_drake.errors import GeometryError
 
 
 @pytest.fixture(scope="module")

@@ -6,12 +6,12 @@ import sys
 
 import numpy as np
 
-from stewart_drake.errors import UsageError
+from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.core.assembly_modes import modes_from_solutions
 from stewart_drake.core.newton_fk import forward_kinematics
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_from_si, pose_to_si
 from stewart_drake.core.sanity import check_finite, check_positive, check_work
-from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from stewart_drake.errors import UsageError
 
 
 def register(sub) -> None:

@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 
+from stewart_drake.commands._common import print_json
 from stewart_drake.core.leg3r import (
     Leg3R,
     foot,
@@ -16,10 +17,9 @@ from stewart_drake.core.leg3r import (
     within_limits,
 )
 from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.errors import OutputError
 from stewart_drake.core.rotations import angle_scale, length_scale
-from stewart_drake.commands._common import print_json
 from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
+from stewart_drake.errors import OutputError
 
 
 def register(sub) -> None:

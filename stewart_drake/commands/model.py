@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import os
 
-from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.errors import OutputError, UsageError
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
+from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.core.sdf_models import platform_model_name, sdf_file_name, sdf_text
+from stewart_drake.errors import OutputError, UsageError
 
 
 def register(sub) -> None:

@@ -7,13 +7,13 @@ import os
 
 import numpy as np
 
+from stewart_drake.commands._common import print_json
 from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.errors import OutputError
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
 from stewart_drake.core.sanity import check_finite, check_servo_neutrals
-from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
-from stewart_drake.commands._common import print_json
 from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
+from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
+from stewart_drake.errors import OutputError
 
 
 def register(sub) -> None:

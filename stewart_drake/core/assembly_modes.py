@@ -40,7 +40,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stewart_drake.errors import ForwardKinematicsError
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import check_stroke, plate_anchors
 from stewart_drake.core.newton_fk import (
     CONVERGED,
     analyse_inverse_jacobian,
@@ -49,9 +50,8 @@ from stewart_drake.core.newton_fk import (
     newton_core,
     validate_lengths,
 )
-from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import check_stroke, plate_anchors
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, quaternion_to_matrix, rotation_matrix
+from stewart_drake.errors import ForwardKinematicsError
 
 CERTIFY_RESIDUAL = 1e-9  # m: a polished solution with a larger leg residual is not a confirmation
 # polish(lengths (6,), p_BC (3,), R_BT (3, 3)) -> (p_BC, R_BT, success, residual m): an independent solve

@@ -27,10 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import ForwardKinematicsError, SingularPoseError, SingularityWarning, counted
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius, inverse_jacobian, scaled_jacobian, singular_value_condition
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
+from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError, counted
 
 # Per-sample status codes (FKResult.status).
 CONVERGED = 0

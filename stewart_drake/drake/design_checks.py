@@ -25,12 +25,12 @@ from pydrake.multibody.tree import LinearSpringDamper, RotationalInertia, RpyFlo
 from pydrake.systems.framework import InputPortSelection, OutputPortSelection
 from pydrake.systems.primitives import Linearize
 
-from stewart_drake.design.modes import analytic_modes, damping_matrix, modes_from_state_eigs
-from stewart_drake.design.stiffness import displace, static_leg_forces
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.design.modes import analytic_modes, damping_matrix, modes_from_state_eigs
+from stewart_drake.design.stiffness import displace, static_leg_forces
 from stewart_drake.drake.platform_model import set_pose
 from stewart_drake.drake.verify_dynamics import ClosedLoopInverseDynamics
 

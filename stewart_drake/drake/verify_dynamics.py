@@ -36,9 +36,9 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
+from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.rotations import check_convention, rotation_matrix
 from stewart_drake.drake.platform_model import build_plant, prismatic_positions, set_pose
 

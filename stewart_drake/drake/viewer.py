@@ -18,14 +18,14 @@ import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, MeshcatParams, Rgba
 from pydrake.math import RigidTransform, RotationMatrix
 
-from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
-from stewart_drake.errors import StewartError
-from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.assembly_modes import assembly_modes
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.leg_bodies import leg_visual_dimensions
+from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length_scale, rotation_matrix
+from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
+from stewart_drake.errors import StewartError
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
 # Above this condition number a pose counts as singular (kinematics.require_nonsingular's default).
