@@ -192,6 +192,12 @@ class WorkspaceError(StewartError):
 class InputError(StewartError):
     """A file or option the user gave is unreadable or malformed (YAML, CSV, a path)."""
 
+    PROGRAM_MISSING = "program file {path!r} does not exist"
+    PROGRAM_NOT_FILE = "program file {path!r} is {what}, not a file"
+    PROGRAM_TOO_LARGE = "{path}: larger than the {limit}-byte limit for a program"
+    PROGRAM_NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
+    PROGRAM_NUL = "{path}:{line}: a NUL byte; not a program text file"
+
 
 class OutputError(StewartError):
     """An output destination is refused by the output policy (``atomic``) or cannot be written."""
