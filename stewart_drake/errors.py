@@ -278,6 +278,26 @@ class OptionError(UsageError):
 
 
 # ----------------------------------------------------------------------------------------------
+# The motion language (``script``): templates of ``script.errors.ScriptError`` messages, which the
+# diagnostics print as ``file:line:column: error: message``.
+
+SCRIPT_SYNTAX = "unexpected {found}; expected {expected}"
+SCRIPT_RESERVED = "{word!r} is a reserved word (Modula-2, kept from seed 004's Stewart.g) and cannot be used yet"
+SCRIPT_UNDEFINED = "undefined variable {name!r}"
+SCRIPT_NEVER_ASSIGNED = "undefined variable {name!r}: it is never assigned in this program"
+SCRIPT_MOVE_ARITY = "{kw} takes 6 arguments (x, y, z, alpha, beta, gama), got {n}"
+SCRIPT_MOVE_UNKNOWN_ARG = "{kw} has no argument {name!r}; its arguments are x, y, z, alpha, beta, gama"
+SCRIPT_MOVE_DUPLICATE_ARG = "{kw}: argument {name!r} given twice"
+SCRIPT_MOVE_POSITIONAL_AFTER_KEYWORD = "{kw}: positional argument after a keyword argument"
+SCRIPT_FUNC_ARITY = "{name}() takes {expected} argument{s}, got {n}"
+SCRIPT_FUNC_UNKNOWN = "unknown function {name!r}; available: {available}"
+SCRIPT_UNREACHABLE = (
+    "{what} is out of reach on platform {platform}: leg {leg} would be {excess:.3f} mm "
+    "{side} the stroke {bound} {limit:.3f} mm (length {length:.3f} mm at t = {t:.3f} s{where})"
+)
+
+
+# ----------------------------------------------------------------------------------------------
 # Physical sanity and bounded work (``sanity``). A ``PhysicalLimitError`` is a result outside the
 # platform's physical limits (exit 1); a ``WorkTooLargeError`` is a request too big to run (exit 2).
 

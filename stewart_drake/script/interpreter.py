@@ -9,7 +9,8 @@ import math
 
 from stewart_drake.script import ast
 from stewart_drake.script.check import assigned_names
-from stewart_drake.script.errors import UNDEFINED, ScriptError
+from stewart_drake.errors import SCRIPT_UNDEFINED
+from stewart_drake.script.errors import ScriptError
 from stewart_drake.script.runtime import CONSTANTS, FUNCTIONS, MAX_SEGMENTS, Motion, fmt_number, for_count, for_range
 
 MAX_STEPS = 1_000_000  # statements executed + loop iterations
@@ -100,7 +101,7 @@ class _Interpreter:
                 return CONSTANTS[e.name][0]
             first = self.assigned.get(e.name)
             hint = f": it is first assigned at line {first.line}, column {first.column}, after this use" if first else ""
-            raise ScriptError(UNDEFINED.format(name=e.name) + hint, e.at)
+            raise ScriptError(SCRIPT_UNDEFINED.format(name=e.name) + hint, e.at)
         if isinstance(e, ast.Unary):
             v = self.eval(e.operand)
             return -v if e.op == "-" else +v

@@ -16,7 +16,8 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 from lark.visitors import Transformer_NonRecursive
 
 from stewart_drake.script import ast
-from stewart_drake.script.errors import RESERVED, SYNTAX, Loc, ScriptError
+from stewart_drake.errors import SCRIPT_RESERVED, SCRIPT_SYNTAX
+from stewart_drake.script.errors import Loc, ScriptError
 
 # Deeper nesting than this is refused (later passes recurse over the tree).
 MAX_DEPTH = 100
@@ -112,7 +113,7 @@ def parse(text: str, filename: str = "<program>") -> ast.Program:
         tree = _lark().parse(text)
     except _ReservedWord as e:
         tok = e.tok
-        raise ScriptError(RESERVED.format(word=tok.value), Loc(filename, tok.line, tok.column), text) from None
+        raise ScriptError(SCRIPT_RESERVED.format(word=tok.value), Loc(filename, tok.line, tok.column), text) from None
     except UnexpectedToken as e:
         tok = e.token
         if tok.type == "$END" or tok.line is None or tok.line < 1:
@@ -120,11 +121,11 @@ def parse(text: str, filename: str = "<program>") -> ast.Program:
         else:
             line, col = tok.line, tok.column
         expected = e.accepts or e.expected
-        msg = SYNTAX.format(found=_describe_token(tok), expected=expected_list(expected))
+        msg = SCRIPT_SYNTAX.format(found=_describe_token(tok), expected=expected_list(expected))
         raise ScriptError(msg, Loc(filename, line, col), text, kind="syntax error") from None
     except UnexpectedCharacters as e:
         found = "end of file" if e.pos_in_stream >= len(text) else f"character {text[e.pos_in_stream]!r}"
-        msg = SYNTAX.format(found=found, expected=expected_list(_accepts_at(text[: e.pos_in_stream])))
+        msg = SCRIPT_SYNTAX.format(found=found, expected=expected_list(_accepts_at(text[: e.pos_in_stream])))
         raise ScriptError(msg, Loc(filename, e.line, e.column), text, kind="syntax error") from None
     except UnexpectedInput as e:  # any other Lark input error
         raise ScriptError(f"cannot parse: {e}", Loc(filename, getattr(e, "line", 1) or 1, getattr(e, "column", 1) or 1),

@@ -19,17 +19,15 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
 from stewart_drake.core.sanity import above_base, has_plate, plate_anchor_heights
-from stewart_drake.errors import OptionError, SingularPoseError
-from stewart_drake.script.errors import (
-    MOVE_ARITY,
-    MOVE_DUPLICATE_ARG,
-    MOVE_UNKNOWN_ARG,
-    UNREACHABLE,
-    Loc,
-    ScriptError,
-    as_loc,
-    raise_all,
+from stewart_drake.errors import (
+    SCRIPT_MOVE_ARITY,
+    SCRIPT_MOVE_DUPLICATE_ARG,
+    SCRIPT_MOVE_UNKNOWN_ARG,
+    SCRIPT_UNREACHABLE,
+    OptionError,
+    SingularPoseError,
 )
+from stewart_drake.script.errors import Loc, ScriptError, as_loc, raise_all
 
 ARG_NAMES = ("x", "y", "z", "alpha", "beta", "gama")
 ARG_ALIASES = {"gamma": "gama"}
@@ -204,7 +202,7 @@ class Motion:
         beta, gama in order, keywords name them; with keywords, omitted coordinates keep their value."""
         at = as_loc(at)
         if len(args) > 6 or (not kwargs and len(args) != 6):
-            raise ScriptError(MOVE_ARITY.format(kw=keyword, n=len(args) + len(kwargs)), at)
+            raise ScriptError(SCRIPT_MOVE_ARITY.format(kw=keyword, n=len(args) + len(kwargs)), at)
         current = self.pose / self._scale()
         values = {n: float(v) for n, v in zip(ARG_NAMES, current)}
         given = {}
@@ -213,9 +211,9 @@ class Motion:
         for name, v in kwargs.items():
             canon = ARG_ALIASES.get(name, name)
             if canon not in ARG_NAMES:
-                raise ScriptError(MOVE_UNKNOWN_ARG.format(kw=keyword, name=name), at)
+                raise ScriptError(SCRIPT_MOVE_UNKNOWN_ARG.format(kw=keyword, name=name), at)
             if canon in given:
-                raise ScriptError(MOVE_DUPLICATE_ARG.format(kw=keyword, name=canon), at)
+                raise ScriptError(SCRIPT_MOVE_DUPLICATE_ARG.format(kw=keyword, name=canon), at)
             given[canon] = v
         for name, v in given.items():
             values[name] = _check_finite(v, f"{keyword} argument {name}", at)
@@ -327,7 +325,7 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
         n = idx[i]
         below = bool(chk.below[n, leg] > 0)
         errors.append(ScriptError(
-            UNREACHABLE.format(
+            SCRIPT_UNREACHABLE.format(
                 what=s.describe(),
                 platform=platform.name,
                 leg=leg + 1,
