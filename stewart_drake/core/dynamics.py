@@ -1,4 +1,4 @@
-"""Inverse dynamics of the moving plate (seed 004 part 2, SPEC §3): the seed's Lagrangian model and the
+"""Inverse dynamics of the moving plate (seed 004 part 2): the seed's Lagrangian model and the
 complete one, vectorised over trajectory samples. Plain numpy, no Drake.
 
 Coordinates ``q = [px, py, pz, a_x, a_y, a_z]`` (metres, radians; ``rotations`` names the Euler

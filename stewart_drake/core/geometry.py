@@ -207,7 +207,7 @@ class Platform:
     # -- constructors --------------------------------------------------------------------------
     @classmethod
     def utn(cls, b: float, d: float, a: float, **kwargs) -> "Platform":
-        """The UTN 3-6 platform (SPEC §1): hexagon sides ``b`` (long), ``d`` (short); triangle side ``a``.
+        """The UTN 3-6 platform: hexagon sides ``b`` (long), ``d`` (short); triangle side ``a``.
 
         Lengths in metres. Legs 1,2 end at T1; 3,4 at T2; 5,6 at T3.
         """
@@ -226,7 +226,7 @@ class Platform:
 
 
 def utn_anchors(b: float, d: float, a: float) -> tuple[np.ndarray, np.ndarray]:
-    """SPEC §1 anchors: ``(6, 3)`` base anchors and ``(3, 3)`` top anchors, same unit as b, d, a."""
+    """The UTN 3-6 anchors: ``(6, 3)`` base anchors and ``(3, 3)`` top anchors, same unit as b, d, a."""
     for name, value in (("b", b), ("d", d), ("a", a)):
         if not np.isfinite(value) or value <= 0:
             raise GeometryError(f"UTN dimension {name} must be a positive length, got {value}")
