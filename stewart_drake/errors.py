@@ -22,6 +22,34 @@ class StewartError(ValueError):
 class GeometryError(StewartError):
     """A platform description is inconsistent (shapes, values, anchors, limits)."""
 
+    TOP_SHAPE = "top_anchors must have shape (k, 3) with 3 <= k <= 6, got {shape}"
+    LEG_TOP = "leg_top must list 6 integer top-anchor indices (one per leg), got {value!r}"
+    LEG_TOP_RANGE = "leg_top: leg {leg} refers to top anchor {anchor}, but there are {n} top anchors (0..{last})"
+    LEG_TOP_UNUSED = "leg_top: top anchor {anchor} is used by no leg"
+    STROKE = "stroke must satisfy 0 < L_min < L_max, got L_min = {lmin} m, L_max = {lmax} m"
+    STROKE_PAIR = "stroke must be [L_min, L_max], got {value!r}"
+    MASS = "plate mass must be finite and >= 0, got {value} kg"
+    INERTIA_SYMMETRIC = "plate inertia must be symmetric, got {value}"
+    INERTIA_PHYSICAL = "plate inertia is not physical (principal moments {moments} kg·m²)"
+    INERTIA_NUMBERS = "plate inertia must be 6 numbers (Ixx Iyy Izz Ixy Ixz Iyz), got {value!r}"
+    HOME_HEIGHT = "home_height must be a positive number of metres, got {value}"
+    UTN_DIMENSION = "UTN dimension {name} must be a positive length, got {value}"
+    CIRCLE_ANGLES = "{what} angles must be 6 numbers, got shape {shape}"
+    CIRCLE_RADIUS = "{what} radius must be a positive length, got {value}"
+    NOT_NUMBERS = "{name} must be numbers, got {value!r}"
+    SHAPE = "{name} must have shape {shape}, got {got}"
+    NOT_FINITE = "{name} must be finite, got {value}"
+    COINCIDE = "{what} {i} and {j} coincide at {at} m (closer than {limit} m)"
+    TOO_WIDE = ("platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is {target:.4f} m; "
+                "give home_height")
+    LENGTH_UNIT = "length_unit: {problem}"
+    ANCHOR_DESCRIPTIONS = ("platform {name!r}: give exactly one anchor description (utn, radial, or "
+                           "base_anchors/top_anchors/leg_top), got {given}")
+    PLATE_SHEET = "platform {name!r}: plate thickness+density describe a UTN triangle sheet; give both, with utn dimensions"
+    IN_FILE = "{path}: {problem}"
+    UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
+    UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
+
 
 class UnreachablePoseError(StewartError):
     """A pose puts a leg outside its stroke (or is otherwise unreachable).
@@ -169,6 +197,9 @@ class EnvelopeError(StewartError):
 class PayloadError(StewartError):
     """A payload is not physical (negative or non-finite mass, below the plate)."""
 
+    BELOW_PLATE = ("--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and "
+                   "its load)")
+
 
 class StiffnessError(StewartError):
     """A leg stiffness is missing or not physical."""
@@ -234,12 +265,14 @@ class YamlError(GeometryError, InputError):
     MISSING = "{kind} file {path!r} does not exist"
     NOT_A_FILE = "{kind} file {path!r} is a folder, not a file"
     UNIT = "{path}:{line}: length_unit: unknown length unit {value!r}; use m or mm"
+    RECURSIVE_ALIAS = "{path}:{line}: an alias refers to the value that contains it"
 
 
 class CsvError(InputError):
     """A CSV file is malformed: messages name the file and the line (counted from 1)."""
 
     FIELD_TOO_LONG = "{path}:{line}: a field is longer than {limit} characters; not a {kind} file?"
+    SYNTAX = "{path}:{line}: {problem}"
     NOT_TEXT = "{path}:{line}: not UTF-8 text"
     NOT_NUMBER = "{path}:{line}: column {column}: not a number: {value!r}"
     WIDTH = "{path}:{line}: expected {expected} values ({columns}), got {got}"
@@ -323,6 +356,16 @@ FAR_POSITION = (
     "{limit:g} × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
 )
 NOT_FINITE = "{what} must be finite, got {value}"
+NOT_POSITIVE = "{what} must be a positive number{unit}, got {value}"
+GRAVITY_RANGE = "{option} {value} m/s² is beyond ±100 m/s² (10 g); is it in m/s²?"
+FAR_CENTRE = (
+    "{option} {centre} m is {ratio:.3g} × the platform's size ({size_m:.3f} m) from the plate; "
+    "centres beyond {limit:g} × are surely a unit mistake (the centre is in metres)"
+)
+SERVO_NEUTRAL = (
+    "{what}: servo {servo}'s neutral pulse {value} µs is outside [{lo:.0f}, {hi:.0f}] µs: with its travel of "
+    "±{swing:.0f} µs the pulse must stay within an RC servo's {range_lo:.0f}-{range_hi:.0f} µs"
+)
 OUT_OF_STROKE = (
     "{what} leaves the stroke: first at t = {t:.4f} s, leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
     "{side} the stroke {bound} {limit_mm:.3f} mm{hint}"
@@ -333,3 +376,4 @@ NO_PLATE = (
 )
 SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
 WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"
+WORK_UNBOUNDED = "{option} {value} would need unboundedly many {what}{hint}"

@@ -22,6 +22,6 @@ def platform_with_payload(platform, args, length_unit: str):
     if not (np.isfinite(args.gravity) and args.gravity >= 0):
         raise OptionError(OptionError.GRAVITY.format(option="--gravity", value=args.gravity))
     if args.payload_com[2] < 0:
-        raise PayloadError(f"--payload-com: Z = {args.payload_com[2]:g} {length_unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)")
+        raise PayloadError(PayloadError.BELOW_PLATE.format(z=args.payload_com[2], unit=length_unit))
     p_TP = np.asarray(args.payload_com, dtype=float) * length_scale(length_unit)
     return with_payload(platform, args.payload, p_TP), p_TP
