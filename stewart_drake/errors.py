@@ -50,6 +50,25 @@ class GeometryError(StewartError):
     UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
     UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
 
+    # a servo hexapod description (``core.servo``)
+    SERVO_SHAPE = "servo hexapod {name} must have shape {shape}, got {got}"
+    SERVO_NOT_FINITE = "servo hexapod {name} has non-finite values: {value}"
+    SERVO_NOT_POSITIVE = "servo hexapod {name} must be a positive number, got {value}"
+    SERVO_ROD = "rod length s = {s} m must exceed the arm length a = {a} m"
+    SERVO_SHAFT = "servo {servo}: shaft direction {shaft} is not perpendicular to its arm plane (beta = {beta:.6g} deg)"
+    SERVO_NO_H0 = "servo {servo}: arm and rod cannot be at right angles over its anchor (eq. 10 has no real h0)"
+    SERVO_ASYMMETRIC = "eq. 10 gives different home heights per servo ({h_mm} mm): the layout is not symmetric"
+    SERVO_FIELD_POSITIVE = "{field} must be a positive number{unit}, got {value!r}"
+    SERVO_FIELD_SHAPE = "{field} must be {shape}, got {value!r}"
+    SERVO_FIELD_FINITE = "{field} must be finite, got {value!r}"
+    SERVO_UNIT = "length_unit must be m or mm, got {value!r}"
+    SERVO_TRAVEL = "servo.travel_deg must be below 90 degrees, got {value!r}"
+    SERVO_BOTH_LAYOUTS = "servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {given})"
+    SERVO_MISSING_LAYOUT = ("servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, platform_anchors, "
+                    "shaft_directions (missing {missing})")
+    SERVO_UNKNOWN_PRESET = "unknown servo hexapod preset {name!r}; available: {presets}"
+    SERVO_UNKNOWN = "unknown servo hexapod {name!r}: not a preset ({presets}) and not a YAML file"
+
 
 class UnreachablePoseError(StewartError):
     """A pose puts a leg outside its stroke (or is otherwise unreachable).
