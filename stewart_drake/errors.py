@@ -64,8 +64,8 @@ class GeometryError(StewartError):
     SERVO_UNIT = "length_unit must be m or mm, got {value!r}"
     SERVO_TRAVEL = "servo.travel_deg must be below 90 degrees, got {value!r}"
     SERVO_BOTH_LAYOUTS = "servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {given})"
-    SERVO_MISSING_LAYOUT = ("servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, platform_anchors, "
-                    "shaft_directions (missing {missing})")
+    SERVO_MISSING_LAYOUT = ("servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, "
+                            "platform_anchors, shaft_directions (missing {missing})")
     SERVO_UNKNOWN_PRESET = "unknown servo hexapod preset {name!r}; available: {presets}"
     SERVO_UNKNOWN = "unknown servo hexapod {name!r}: not a preset ({presets}) and not a YAML file"
 
@@ -233,6 +233,29 @@ SLICE_NODES = "slice of {n} x {n} nodes: need 2 <= n and n² <= {limit}"
 
 class WorkspaceError(StewartError):
     """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
+
+    EXECUTOR = "executor must be a concurrent.futures.Executor (or have submit), got {kind}"
+    GRID_TOO_LARGE = ("resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can hold is "
+                      "~{h_min_mm:.2g} mm; use a coarser --resolution")
+    GRID_NODES = "more than the {limit:.0e} nodes one sweep may take"
+    EMPTY_STROKE = "the stroke workspace at orientation {orientation} rad is empty (no common point of the legs' reach)"
+    RESOLUTION = "resolution must be a positive number of metres, got {value}"
+    BOUNDS = "bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {value}"
+    NOTHING_REACHABLE = "no reachable position at orientation {orientation} rad with limits {limits} at resolution {h} m"
+    CONE = "Limits.{name} must be an angle in (0, pi] rad, got {value}"
+    LEG_DIAMETER = "Limits.leg_diameter must be a positive length in metres, got {value}"
+    MAX_CONDITION = "Limits.max_condition must be > 1, got {value}"
+    AXES = "Limits.{name} must be six non-zero 3-vectors, shape (6, 3), got {shape}"
+    ORIENTATION = "orientation must be 3 finite angles (rad) about X, Y, Z, got {value}"
+    PLANE = "plane must be 'xy', 'xz' or 'yz', got {value!r}"
+    GRIDS = "grids must be six non-empty 1-D arrays (px, py, pz, a_x, a_y, a_z), got {n}"
+    SPACE_DOF = "space_dof (lambda) must be 3 (planar) or 6 (spatial), got {value}"
+    JOINTS = "need n_links >= 1 and every joint freedom in 1..{space_dof}, got n = {n}, f = {f}"
+    LEG_TYPE = "unknown leg type {kind!r}; expected one of {valid}"
+    POSITION = "position must be 3 finite coordinates in metres, got {value}"
+    CENTRE = "rotation centre must be 3 finite coordinates in metres (plate frame), got {value}"
+    STEP = "step must be in (0, max_angle), got step = {step} rad, max_angle = {max_angle} rad"
+    START_OUTSIDE = "start pose {pose} is outside the {limit} limit (margin {margin:.4g} {unit})"
 
 
 # ----------------------------------------------------------------------------------------------
