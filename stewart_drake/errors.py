@@ -49,6 +49,7 @@ class GeometryError(StewartError):
     IN_FILE = "{path}: {problem}"
     UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
     UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
+    LEG_LIMIT = "platform {name!r}: legs.{field} must be a positive number, got {value}"
 
     # a servo hexapod description (``core.servo``)
     SERVO_SHAPE = "servo hexapod {name} must have shape {shape}, got {got}"
@@ -212,9 +213,27 @@ class DspPoseError(FixedPointError):
 class EnvelopeError(StewartError):
     """An envelope file is malformed or leaves the platform's workspace."""
 
+    NOT_NUMBERS = "{where}: expected numbers, got {value!r}"
+    COUNT = "{where}: expected {n} numbers, got {value!r}"
+    NOT_FINITE = "{where}: values must be finite, got {value!r}"
+    NOT_INTEGERS = "{where}: expected integers, got {value!r}"
+    IN_FILE = "{source}: {problem}"
+    ONE_OF = "{source}: give exactly one of poses (a list) or box (a grid)"
+    STEPS = "{source}: box.steps must be >= 1, got {value!r}"
+    BOX_ORDER = "{source}: box.max[{j}] = {hi} is below box.min[{j}] = {lo}"
+    BOX_TOO_LARGE = "{source}: box.steps {steps!r} make {n} poses, more than the limit {limit}"
+    TOO_MANY_POSES = "{source}: {n} poses, more than the limit {limit}"
+    NEGATIVE_BOUND = "{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {value}"
+    OUT_OF_STROKE = "{source}: {pose} leaves the workspace: leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm {side} the stroke"
+    SINGULAR = "{source}: {pose} is singular or nearly so (condition number {cond:.3g})"
+
 
 class PayloadError(StewartError):
     """A payload is not physical (negative or non-finite mass, below the plate)."""
+
+    MASS = "{option}: payload mass must be a finite number >= 0 kg, got {value}"
+    COM_NOT_FINITE = "{option}-com: payload centre of mass must be finite, got {value} m"
+    COM_BELOW = "{option}-com: z = {z:g} m is below the plate (the plate frame's z >= 0 holds the plate and its load)"
 
     BELOW_PLATE = ("--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and "
                    "its load)")
@@ -222,6 +241,9 @@ class PayloadError(StewartError):
 
 class StiffnessError(StewartError):
     """A leg stiffness is missing or not physical."""
+
+    MISSING = "{option}: no leg stiffness given and the platform file has no legs.stiffness"
+    NOT_POSITIVE = "{option}: leg stiffness must be a positive number of N/m, got {value}"
 
 
 SLICE_NODES = "slice of {n} x {n} nodes: need 2 <= n and n² <= {limit}"
