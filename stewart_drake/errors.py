@@ -388,10 +388,65 @@ SCRIPT_MOVE_DUPLICATE_ARG = "{kw}: argument {name!r} given twice"
 SCRIPT_MOVE_POSITIONAL_AFTER_KEYWORD = "{kw}: positional argument after a keyword argument"
 SCRIPT_FUNC_ARITY = "{name}() takes {expected} argument{s}, got {n}"
 SCRIPT_FUNC_UNKNOWN = "unknown function {name!r}; available: {available}"
+# (the messages the motion language's parser, checker, interpreter and runtime raise)
 SCRIPT_UNREACHABLE = (
     "{what} is out of reach on platform {platform}: leg {leg} would be {excess:.3f} mm "
     "{side} the stroke {bound} {limit:.3f} mm (length {length:.3f} mm at t = {t:.3f} s{where})"
 )
+
+
+SCRIPT_EMIT = "the program cannot be translated to valid Python ({kind}: {problem})"
+SCRIPT_TOO_MANY_STEPS = (
+    "the program ran more than {limit} steps (statements and loop iterations); does a loop never end?"
+)
+SCRIPT_LOOP_STEPS = (
+    "this FOR loop would run {count} iterations, at least {steps} steps with its body; a program may run "
+    "at most {limit} steps (statements and loop iterations)"
+)
+SCRIPT_LOOP_MOVES = "this FOR loop would make {moves} moves and waits; a program may make at most {limit}"
+SCRIPT_NO_FINITE_VALUE = "{name}({args}) has no finite value"
+SCRIPT_DIVISION_BY_ZERO = "division by zero ({a} {op} 0)"
+SCRIPT_OVERFLOW = "arithmetic overflow: {a} {op} {b} is not finite"
+SCRIPT_CANNOT_PARSE = "cannot parse: {problem}"
+SCRIPT_EXPRESSION_DEPTH = "expression nested more than {limit} levels deep"
+SCRIPT_NUMBER_TOO_LARGE = "number {text} is too large"
+SCRIPT_STATEMENT_DEPTH = "statements nested more than {limit} levels deep"
+SCRIPT_LOOP_DEPTH = "loops (FOR, WHILE) nested more than {limit} levels deep"
+SCRIPT_NOT_A_NUMBER = "{what} must be a number, got {value!r}"
+SCRIPT_NOT_FINITE = "{what} must be finite, got {value}"
+SCRIPT_UNIT = "units: {name!r} is not a unit; expected {lengths} (length), {angles} (angle)"
+SCRIPT_TWO_UNITS = "units: two {kind} units given"
+SCRIPT_DURATION = "{keyword} duration must be positive, got {value} s"
+SCRIPT_TOO_SHORT = (
+    "{keyword} duration {value} s is shorter than the shortest move, {limit} s (no actuator follows a "
+    "faster one)"
+)
+SCRIPT_WAIT = "wait duration must be >= 0, got {value} s"
+SCRIPT_TOO_MANY_MOVES = (
+    "the program makes more than {limit} moves and waits (the limit); shorten it or use longer moves"
+)
+SCRIPT_SEGMENT_SAMPLES = (
+    "{what} lasts {duration} s, more than the {limit} samples a program may have "
+    "at {rate} Hz ({seconds} s)"
+)
+SCRIPT_TOO_MANY_SAMPLES = (
+    "trajectory too long: {total} samples ({seconds} s at {rate} Hz; the limit is {limit}); lower the "
+    "rate or shorten the program"
+)
+SCRIPT_START_OUT_OF_REACH = (
+    "the start pose is out of reach on platform {platform}: leg {leg} length {length_mm:.3f} mm is "
+    "outside the stroke [{lo_mm:.3f}, {hi_mm:.3f}] mm"
+)
+SCRIPT_MORE_UNREACHABLE = "... and {more} more unreachable moves"
+SCRIPT_BELOW_BASE = (
+    "{what} puts the plate {where} the base on platform {platform}: the plate anchor of leg {leg} "
+    "is at z = {z_mm:.3f} mm at t = {t:.3f} s (the base plane is z = 0)"
+)
+SCRIPT_SINGULAR = (
+    "{what}: the platform is singular or nearly so at t = {t:.3f} s (Jacobian condition number "
+    "{cond:.3g} > {limit:.3g}); leg forces are undefined there"
+)
+SCRIPT_FOR_STEP_ZERO = "FOR step is 0: the loop would never end"
 
 
 # ----------------------------------------------------------------------------------------------
