@@ -1,6 +1,10 @@
-"""The project's exceptions. All derive from ValueError so callers can catch bad input in one place.
+"""The project's one error hierarchy and every message template.
 
-Messages name the offending thing and value; tests match them, so they live here as templates.
+Every error derives from ``StewartError`` (itself a ``ValueError``, so callers can catch bad input in one
+place); the CLI prints it as one line and exits 2, or 1 for a ``PhysicalLimitError``. Messages name the
+offending thing and the value as given; they are templates here, as constants of the class that raises
+them (``GeometryError.STROKE``) or as module constants when several classes share one (``SHAPE``), and
+tests match them: ``pytest.raises(GeometryError, match=re.escape(GeometryError.STROKE.format(...)))``.
 """
 
 from __future__ import annotations
