@@ -498,5 +498,5 @@ NO_PLATE = (
     "'{command}' needs plate.mass and plate.inertia (or plate.thickness and plate.density for a utn platform)"
 )
 SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
-WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"
 WORK_UNBOUNDED = "{option} {value} would need unboundedly many {what}{hint}"
+WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"
