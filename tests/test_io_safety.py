@@ -1,4 +1,4 @@
-"""Output safety, safe input loading and the one-line error path (issue 12, items 1, 5, 6, 7).
+"""Output safety, safe input loading and the one-line error path.
 
 Commands run in-process through ``stewart_drake.cli.main`` in a temporary working directory; the
 SIGKILL test runs real subprocesses.

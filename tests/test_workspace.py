@@ -1,4 +1,4 @@
-"""Workspace analysis (SPEC §5, seed 001): the paper reproduced, the numerics checked against
+"""Workspace analysis (seed 001): the paper reproduced, the numerics checked against
 independent computations, the optional limits binding and not, and the sweep's chunking/back ends."""
 
 import importlib.util

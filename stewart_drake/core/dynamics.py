@@ -1,4 +1,4 @@
-"""Inverse dynamics of the moving plate (seed 004 part 2, SPEC §3): the seed's Lagrangian model and the
+"""Inverse dynamics of the moving plate (seed 004 part 2): the seed's Lagrangian model and the
 complete one, vectorised over trajectory samples. Plain numpy, no Drake.
 
 Coordinates ``q = [px, py, pz, a_x, a_y, a_z]`` (metres, radians; ``rotations`` names the Euler
@@ -20,7 +20,7 @@ between translation and rotation (exact only when the centre of mass is at C). `
 ``coriolis=False`` is the complete model less C q̇ only.
 
 Leg masses (an extension; the seeds neglect them): ``leg_forces_with_legs``. Each leg is a cylinder on
-a universal joint at its base anchor and a piston on the prismatic joint (the bodies of ``model.py``).
+a universal joint at its base anchor and a piston on the prismatic joint (the bodies of the Drake platform model).
 By virtual power each leg adds, at its plate anchor, the force f_i with J_tipᵀ f_i = τ_leg,i, where
 τ_leg,i is the leg's own inverse dynamics in its joint coordinates (two universal-joint angles and the
 length) and J_tip maps those rates to the tip velocity; the actuator force then balances plate + legs.

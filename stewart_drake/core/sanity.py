@@ -31,12 +31,17 @@ from stewart_drake.core.kinematics import condition_number, leg_lengths, plate_a
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import (
     BELOW_BASE,
+    FAR_CENTRE,
     FAR_POSITION,
+    GRAVITY_RANGE,
     NO_PLATE,
     NOT_FINITE,
+    NOT_POSITIVE,
     OUT_OF_STROKE,
+    SERVO_NEUTRAL,
     SINGULAR_HOME,
     WORK_TOO_LARGE,
+    WORK_UNBOUNDED,
     GeometryError,
     PhysicalLimitError,
     StewartError,
@@ -82,7 +87,7 @@ def check_positive(value, what: str, unit: str = "") -> float:
     """A finite, strictly positive float, or ``StewartError`` naming ``what``."""
     v = float(value)
     if not (math.isfinite(v) and v > 0):
-        raise StewartError(f"{what} must be a positive number{' of ' + unit if unit else ''}, got {fmt_value(v)}")
+        raise StewartError(NOT_POSITIVE.format(what=what, unit=" of " + unit if unit else "", value=fmt_value(v)))
     return v
 
 
@@ -92,7 +97,7 @@ def check_gravity(g: float, option: str = "--gravity") -> float:
     if not math.isfinite(v):
         raise StewartError(NOT_FINITE.format(what=f"{option} (m/s²)", value=fmt_value(v)))
     if abs(v) > 100.0:
-        raise StewartError(f"{option} {fmt_value(v)} m/s² is beyond ±100 m/s² (10 g); is it in m/s²?")
+        raise StewartError(GRAVITY_RANGE.format(option=option, value=fmt_value(v)))
     return v
 
 
@@ -347,7 +352,7 @@ def check_work(option: str, value: str, count: float, what: str, bytes_per: floa
     option as typed; ``hint`` ends the message (e.g. "; use a coarser --resolution")."""
     count = float(count)
     if not math.isfinite(count):
-        raise WorkTooLargeError(f"{option} {value} would need unboundedly many {what}{hint}")
+        raise WorkTooLargeError(WORK_UNBOUNDED.format(option=option, value=value, what=what, hint=hint))
     need = count * bytes_per
     budget = memory_budget()
     if bytes_per and need > budget:
@@ -369,8 +374,8 @@ def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
     size = platform_size(platform)
     r = float(np.linalg.norm(c))
     if r > FAR_FACTOR * size:
-        raise StewartError(f"{option} {' '.join(fmt_value(x) for x in c)} m is {r / size:.3g} × the platform's size ({size:.3f} m) from the plate; "
-                           f"centres beyond {FAR_FACTOR:g} × are surely a unit mistake (the centre is in metres)")
+        raise StewartError(FAR_CENTRE.format(option=option, centre=" ".join(fmt_value(x) for x in c), ratio=r / size, size_m=size,
+                                             limit=FAR_FACTOR))
     return c
 
 
@@ -409,9 +414,8 @@ def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
     bad = (w0 < lo) | (w0 > hi)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise StewartError(
-            f"{what}: servo {i + 1}'s neutral pulse {fmt_value(w0[i])} µs is outside [{lo:.0f}, {hi:.0f}] µs: with its travel of "
-            f"±{swing:.0f} µs the pulse must stay within an RC servo's {SERVO_PULSE_RANGE_US[0]:.0f}-{SERVO_PULSE_RANGE_US[1]:.0f} µs")
+        raise StewartError(SERVO_NEUTRAL.format(what=what, servo=i + 1, value=fmt_value(w0[i]), lo=lo, hi=hi, swing=swing,
+                                                range_lo=SERVO_PULSE_RANGE_US[0], range_hi=SERVO_PULSE_RANGE_US[1]))
 
 
 def plate_floor(platform, orientation, convention: str = "utn") -> float:

@@ -100,13 +100,13 @@ def _numbers(values, n, where, integer=False):
     try:
         arr = np.array(values, dtype=float)
     except (TypeError, ValueError):
-        raise EnvelopeError(f"{where}: expected numbers, got {values!r}") from None
+        raise EnvelopeError(EnvelopeError.NOT_NUMBERS.format(where=where, value=values)) from None
     if arr.shape != (n,):
-        raise EnvelopeError(f"{where}: expected {n} numbers, got {values!r}")
+        raise EnvelopeError(EnvelopeError.COUNT.format(where=where, n=n, value=values))
     if not np.all(np.isfinite(arr)):
-        raise EnvelopeError(f"{where}: values must be finite, got {values!r}")
+        raise EnvelopeError(EnvelopeError.NOT_FINITE.format(where=where, value=values))
     if integer and np.any(arr != np.round(arr)):
-        raise EnvelopeError(f"{where}: expected integers, got {values!r}")
+        raise EnvelopeError(EnvelopeError.NOT_INTEGERS.format(where=where, value=values))
     return arr
 
 
@@ -117,27 +117,27 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
         kl, ka = length_scale(cfg.length_unit), angle_scale(cfg.angle_unit)
         check_convention(cfg.convention)
     except ValueError as e:
-        raise EnvelopeError(f"{source}: {e}") from None
+        raise EnvelopeError(EnvelopeError.IN_FILE.format(source=source, problem=e)) from None
     scale = np.r_[np.full(3, kl), np.full(3, ka)]
     if bool(cfg.poses) == (cfg.box is not None):
-        raise EnvelopeError(f"{source}: give exactly one of poses (a list) or box (a grid)")
+        raise EnvelopeError(EnvelopeError.ONE_OF.format(source=source))
     if cfg.box is not None:
         lo = _numbers(cfg.box.min, 6, f"{source}: box.min")
         hi = _numbers(cfg.box.max, 6, f"{source}: box.max")
         steps = _numbers(cfg.box.steps, 6, f"{source}: box.steps", integer=True).astype(int)
         if np.any(steps < 1):
-            raise EnvelopeError(f"{source}: box.steps must be >= 1, got {cfg.box.steps!r}")
+            raise EnvelopeError(EnvelopeError.STEPS.format(source=source, value=cfg.box.steps))
         if np.any(hi < lo):
             j = int(np.argmax(hi < lo))
-            raise EnvelopeError(f"{source}: box.max[{j}] = {cfg.box.max[j]} is below box.min[{j}] = {cfg.box.min[j]}")
+            raise EnvelopeError(EnvelopeError.BOX_ORDER.format(source=source, j=j, hi=cfg.box.max[j], lo=cfg.box.min[j]))
         n = int(np.prod(steps.astype(float)))
         if n > MAX_POSES:
-            raise EnvelopeError(f"{source}: box.steps {cfg.box.steps!r} make {n} poses, more than the limit {MAX_POSES}")
+            raise EnvelopeError(EnvelopeError.BOX_TOO_LARGE.format(source=source, steps=cfg.box.steps, n=n, limit=MAX_POSES))
         axes = [np.linspace(lo[j], hi[j], steps[j]) if steps[j] > 1 else lo[j : j + 1] for j in range(6)]
         poses = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
     else:
         if len(cfg.poses) > MAX_POSES:
-            raise EnvelopeError(f"{source}: {len(cfg.poses)} poses, more than the limit {MAX_POSES}")
+            raise EnvelopeError(EnvelopeError.TOO_MANY_POSES.format(source=source, n=len(cfg.poses), limit=MAX_POSES))
         poses = np.array([_numbers(p, 6, f"{source}: poses (pose {k + 1})") for k, p in enumerate(cfg.poses)])
     bounds = {}
     for name, b in (("velocity", cfg.velocity), ("acceleration", cfg.acceleration)):
@@ -145,7 +145,7 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
         ang = _numbers(b.angular, 3, f"{source}: {name}.angular")
         for part, arr in (("linear", lin), ("angular", ang)):
             if np.any(arr < 0):
-                raise EnvelopeError(f"{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {arr.tolist()}")
+                raise EnvelopeError(EnvelopeError.NEGATIVE_BOUND.format(source=source, name=name, part=part, value=arr.tolist()))
         bounds[name] = np.r_[lin * kl, ang * ka]
     return Envelope(poses * scale, bounds["velocity"], bounds["acceleration"], cfg.convention, source, (cfg.length_unit, cfg.angle_unit))
 
@@ -171,15 +171,15 @@ def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
     if v:
         v = v[0]
         k = v["pose"][0]
-        raise EnvelopeError(
-            f"{env.source}: {env.shown(k)} leaves the workspace: leg {v['leg']} length "
-            f"{v['length_m'] * 1e3:.3f} mm is {v['excess_m'] * 1e3:.3f} mm {'below' if v['side'] == 'min' else 'above'} the stroke")
+        raise EnvelopeError(EnvelopeError.OUT_OF_STROKE.format(source=env.source, pose=env.shown(k), leg=v["leg"],
+                                                               length_mm=v["length_m"] * 1e3, excess_mm=v["excess_m"] * 1e3,
+                                                               side="below" if v["side"] == "min" else "above"))
     for s in range(0, len(env.poses), 1 << 16):
         k = condition_number(platform, env.poses[s : s + (1 << 16)], env.convention)
         bad = ~(k <= MAX_CONDITION)
         if bad.any():
             j = s + int(np.argmax(bad))
-            raise EnvelopeError(f"{env.source}: {env.shown(j)} is singular or nearly so (condition number {k[j - s]:.3g})")
+            raise EnvelopeError(EnvelopeError.SINGULAR.format(source=env.source, pose=env.shown(j), cond=k[j - s]))
     return L
 
 

@@ -95,7 +95,7 @@ def limits_of(platform: Platform) -> dict:
         if value is None:
             continue
         if not (np.isfinite(value) and value > 0):
-            raise GeometryError(f"platform {platform.name!r}: legs.{name} must be a positive number, got {value}")
+            raise GeometryError(GeometryError.LEG_LIMIT.format(name=platform.name, field=name, value=value))
         lim[key] = float(value)
     return lim
 

@@ -40,10 +40,10 @@ def leg_stiffness_vector(value, option: str = "--leg-stiffness") -> np.ndarray:
     """``(6,)`` positive finite leg stiffnesses (N/m) from a number or six numbers; ``StiffnessError``
     naming ``option`` otherwise."""
     if value is None:
-        raise StiffnessError(f"{option}: no leg stiffness given and the platform file has no legs.stiffness")
+        raise StiffnessError(StiffnessError.MISSING.format(option=option))
     k = np.broadcast_to(np.asarray(value, dtype=float), (6,)).copy()
     if not np.all(np.isfinite(k)) or np.any(k <= 0):
-        raise StiffnessError(f"{option}: leg stiffness must be a positive number of N/m, got {np.asarray(value).tolist()}")
+        raise StiffnessError(StiffnessError.NOT_POSITIVE.format(option=option, value=np.asarray(value).tolist()))
     return k
 
 

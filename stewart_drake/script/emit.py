@@ -12,6 +12,7 @@ from __future__ import annotations
 import builtins
 import keyword
 
+from stewart_drake.errors import SCRIPT_EMIT
 from stewart_drake.script import ast
 from stewart_drake.script.check import assigned_names
 from stewart_drake.script.errors import ScriptError
@@ -54,7 +55,7 @@ def emit_python(program: ast.Program, platform: str = "utn-kinematic", conventio
     try:  # the parser's nesting limits keep this valid; checked so that invalid code is never written
         compile(code, f"<{src} as Python>", "exec", dont_inherit=True)
     except (SyntaxError, RecursionError, MemoryError, ValueError) as err:
-        raise ScriptError(f"the program cannot be translated to valid Python ({err.__class__.__name__}: {err})",
+        raise ScriptError(SCRIPT_EMIT.format(kind=err.__class__.__name__, problem=err),
                           program.body[0].at if program.body else None) from None
     return code
 

@@ -26,7 +26,7 @@ def run_tasks(fn, tasks, executor, workers, progress, desc):
                 yield from _drain(ex, fn, tasks, bar, window=4 * workers)
         elif executor is not None:
             if not isinstance(executor, Executor) and not hasattr(executor, "submit"):
-                raise WorkspaceError(f"executor must be a concurrent.futures.Executor (or have submit), got {type(executor).__name__}")
+                raise WorkspaceError(WorkspaceError.EXECUTOR.format(kind=type(executor).__name__))
             yield from _drain(executor, fn, tasks, bar, window=None)
         else:
             for t in tasks:

@@ -50,10 +50,8 @@ def check_grid_size(bounds, h) -> None:
         return
     # memory scales as 1/h² (faces), time as 1/h³ (nodes): the finest step that fits both
     h_min = max(h * math.sqrt(need / budget), h * (nodes / MAX_GRID_NODES) ** (1 / 3))
-    why = human_bytes(need) if need > budget else f"more than the {MAX_GRID_NODES:.0e} nodes one sweep may take"
-    raise WorkspaceError(
-        f"resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can hold is "
-        f"~{h_min * 1e3:.2g} mm; use a coarser --resolution")
+    why = human_bytes(need) if need > budget else WorkspaceError.GRID_NODES.format(limit=MAX_GRID_NODES)
+    raise WorkspaceError(WorkspaceError.GRID_TOO_LARGE.format(h=h, nodes=nodes, why=why, h_min_mm=h_min * 1e3))
 
 
 @dataclass
@@ -124,7 +122,7 @@ def default_bounds(platform: Platform, orientation=(0.0, 0.0, 0.0), convention: 
     hi = np.min(-l0 + platform.L_max, axis=0)
     lo[2] = max(lo[2], plate_floor(platform, o, convention) if z_floor is None else z_floor)
     if np.any(hi <= lo):
-        raise WorkspaceError(f"the stroke workspace at orientation {np.asarray(orientation).tolist()} rad is empty (no common point of the legs' reach)")
+        raise WorkspaceError(WorkspaceError.EMPTY_STROKE.format(orientation=np.asarray(orientation).tolist()))
     return np.stack([lo, hi], -1)
 
 
@@ -163,10 +161,10 @@ def constant_orientation_workspace(
     check_convention(convention)
     h = float(resolution)
     if not (np.isfinite(h) and h > 0):
-        raise WorkspaceError(f"resolution must be a positive number of metres, got {resolution}")
+        raise WorkspaceError(WorkspaceError.RESOLUTION.format(value=resolution))
     b = default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
     if b.shape != (3, 2) or not np.all(b[:, 1] > b[:, 0]):
-        raise WorkspaceError(f"bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {np.asarray(bounds).tolist()}")
+        raise WorkspaceError(WorkspaceError.BOUNDS.format(value=np.asarray(bounds).tolist()))
     check_grid_size(b, h)
     axes = grid_axes(b, h)
     spec = grid_spec(platform, orientation, convention, limits, axes)
@@ -191,7 +189,7 @@ def constant_orientation_workspace(
         boundaries.append(r["boundary"])
     bnd_idx = np.concatenate(boundaries)
     if inside == 0:
-        raise WorkspaceError(f"no reachable position at orientation {spec.orientation.tolist()} rad with limits {list(limits.active)} at resolution {h} m")
+        raise WorkspaceError(WorkspaceError.NOTHING_REACHABLE.format(orientation=spec.orientation.tolist(), limits=list(limits.active), h=h))
     boundary = np.stack([axes[k][bnd_idx[:, k]] for k in range(3)], -1).astype(np.float32)
     h3 = h**3
     vol = inside * h3

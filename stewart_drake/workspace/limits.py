@@ -46,11 +46,11 @@ class Limits:
         for name in ("base_cone", "top_cone"):
             v = getattr(self, name)
             if v is not None and not (0 < v <= math.pi):
-                raise WorkspaceError(f"Limits.{name} must be an angle in (0, pi] rad, got {v}")
+                raise WorkspaceError(WorkspaceError.CONE.format(name=name, value=v))
         if self.leg_diameter is not None and not (np.isfinite(self.leg_diameter) and self.leg_diameter > 0):
-            raise WorkspaceError(f"Limits.leg_diameter must be a positive length in metres, got {self.leg_diameter}")
+            raise WorkspaceError(WorkspaceError.LEG_DIAMETER.format(value=self.leg_diameter))
         if self.max_condition is not None and not (self.max_condition > 1):
-            raise WorkspaceError(f"Limits.max_condition must be > 1, got {self.max_condition}")
+            raise WorkspaceError(WorkspaceError.MAX_CONDITION.format(value=self.max_condition))
         for name in ("base_axes", "top_axes"):
             v = getattr(self, name)
             if v is None:
@@ -58,7 +58,7 @@ class Limits:
             a = np.array(v, dtype=float)
             n = np.linalg.norm(a, axis=-1) if a.shape == (6, 3) else None
             if n is None or not np.all(n > 1e-12):
-                raise WorkspaceError(f"Limits.{name} must be six non-zero 3-vectors, shape (6, 3), got {np.shape(v)}")
+                raise WorkspaceError(WorkspaceError.AXES.format(name=name, shape=np.shape(v)))
             object.__setattr__(self, name, a / n[:, None])
 
     @property
@@ -177,5 +177,5 @@ def check_orientation(orientation) -> np.ndarray:
     """``(3,)`` finite float angles (rad) about X, Y, Z, or ``WorkspaceError`` naming the value."""
     o = np.asarray(orientation, dtype=float)
     if o.shape != (3,) or not np.all(np.isfinite(o)):
-        raise WorkspaceError(f"orientation must be 3 finite angles (rad) about X, Y, Z, got {np.asarray(orientation).tolist()}")
+        raise WorkspaceError(WorkspaceError.ORIENTATION.format(value=np.asarray(orientation).tolist()))
     return o

@@ -31,7 +31,7 @@ def dexterity_map(
     NaN outside the workspace of ``limits``. ``extent``: half-width of the square (default from
     ``default_bounds``)."""
     if plane not in ("xy", "xz", "yz"):
-        raise WorkspaceError(f"plane must be 'xy', 'xz' or 'yz', got {plane!r}")
+        raise WorkspaceError(WorkspaceError.PLANE.format(value=plane))
     o = check_orientation(orientation)
     ku, kv = ("xyz".index(plane[0]), "xyz".index(plane[1]))
     kw = 3 - ku - kv
@@ -74,7 +74,7 @@ def count_reachable(
     ``total``, ``fraction`` and ``marginals`` (per coordinate, the count inside at each grid value)."""
     grids = [np.asarray(g, dtype=float).ravel() for g in grids]
     if len(grids) != 6 or any(len(g) == 0 for g in grids):
-        raise WorkspaceError(f"grids must be six non-empty 1-D arrays (px, py, pz, a_x, a_y, a_z), got {len(grids)}")
+        raise WorkspaceError(WorkspaceError.GRIDS.format(n=len(grids)))
     total = math.prod(len(g) for g in grids)
     tasks = [(platform, grids, limits, convention, s, min(s + chunk, total)) for s in range(0, total, chunk)]
     count, marginals = 0, [np.zeros(len(g), np.int64) for g in grids]
