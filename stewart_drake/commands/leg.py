@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from stewart_drake.commands._common import print_json
@@ -16,10 +14,8 @@ from stewart_drake.core.leg3r import (
     limit_violations,
     within_limits,
 )
-from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.core.rotations import angle_scale, length_scale
-from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
-from stewart_drake.errors import OutputError
+from stewart_drake.core.sdf_models import sdf_text, write_sdf
 
 
 def register(sub) -> None:
@@ -56,9 +52,7 @@ def run(args) -> int:
     leg = _leg(args)
     if args.op == "sdf":
         if args.write:
-            if os.path.exists(args.write) and not os.path.isdir(args.write):
-                raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
-            print(write_output_file(os.path.join(args.write, sdf_file_name(leg)), sdf_text(leg), option="--write"))
+            print(write_sdf(leg, args.write, option="--write"))
         else:
             print(sdf_text(leg), end="")
         return 0

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import os
-
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
-from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.core.sdf_models import platform_model_name, sdf_file_name, sdf_text
-from stewart_drake.errors import OutputError, UsageError
+from stewart_drake.core.sdf_models import platform_model_name, sdf_text, write_sdf
+from stewart_drake.errors import UsageError
 
 
 def register(sub) -> None:
@@ -24,10 +21,7 @@ def run(args) -> int:
         raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))
     platform = platform_from_args(args)
     if args.write:
-        if os.path.exists(args.write) and not os.path.isdir(args.write):
-            raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
-        target = os.path.join(args.write, sdf_file_name(platform))
-        written = write_output_file(target, sdf_text(platform), option="--write")
+        written = write_sdf(platform, args.write, option="--write")
         if not args.inspect:
             print(written)
     if args.inspect:

@@ -3,17 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import os
 
 import numpy as np
 
 from stewart_drake.commands._common import print_json
-from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
 from stewart_drake.core.sanity import check_finite, check_servo_neutrals
-from stewart_drake.core.sdf_models import sdf_file_name, sdf_text
+from stewart_drake.core.sdf_models import write_sdf
 from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
-from stewart_drake.errors import OutputError
 
 
 def register(sub) -> None:
@@ -39,9 +36,7 @@ def run(args) -> int:
         check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
-        if os.path.exists(args.write_sdf) and not os.path.isdir(args.write_sdf):
-            raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write-sdf", typed=args.write_sdf, part=args.write_sdf))
-        sdf_file = write_output_file(os.path.join(args.write_sdf, sdf_file_name(hexapod)), sdf_text(hexapod), option="--write-sdf")
+        sdf_file = write_sdf(hexapod, args.write_sdf, option="--write-sdf")
         if not args.json:
             print(sdf_file)
     k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)

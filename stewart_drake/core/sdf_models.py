@@ -27,6 +27,7 @@ default folder). Names of links, joints and frames are part of the API:
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg3r import Leg3R, dh_rows
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions, leg_visual_dimensions
-from stewart_drake.core.output_folder import safe_file_stem, write_text_atomic
+from stewart_drake.core.output_folder import safe_file_stem, write_output_file
 from stewart_drake.core.sdf import (
     ball_constraint_xml,
     box_inertia,
@@ -47,6 +48,7 @@ from stewart_drake.core.sdf import (
 )
 from stewart_drake.core.servo import ServoHexapod
 from stewart_drake.core.servo_mounting import pivot_frames, rod_frames, servo_joint_home
+from stewart_drake.errors import OutputError
 
 # ----------------------------------------------------------------------------------------------
 # Stewart platform
@@ -328,6 +330,11 @@ def sdf_path(model: Platform | ServoHexapod | Leg3R, directory) -> Path:
     return Path(directory) / sdf_file_name(model)
 
 
-def write_sdf(model: Platform | ServoHexapod | Leg3R, directory) -> Path:
-    """Write ``sdf_path(model, directory)`` atomically (complete or absent); return its path."""
-    return write_text_atomic(sdf_path(model, directory), sdf_text(model))
+def write_sdf(model: Platform | ServoHexapod | Leg3R, folder, *, option: str = "directory") -> Path:
+    """Write ``model``'s SDF as ``sdf_file_name(model)`` into ``folder`` (created if missing) under the
+    output-file policy of ``output_folder.write_output_file``: atomic, recorded in the folder's manifest,
+    and a file the tool did not write is never replaced. ``option`` names the folder in error messages
+    (the CLI passes "--write"); a ``folder`` that exists as a file is refused. Returns the path."""
+    if os.path.exists(folder) and not os.path.isdir(folder):
+        raise OutputError(OutputError.NOT_A_FOLDER.format(option=option, typed=folder, part=folder))
+    return write_output_file(os.path.join(folder, sdf_file_name(model)), sdf_text(model), option=option)
