@@ -127,3 +127,20 @@ def test_models_and_their_commands_need_no_pydrake(tmp_path):
     assert (tmp_path / "a" / "leg-3r.sdf").read_text() == sdf_text(Leg3R())
     assert (tmp_path / "b" / "servo-hexapod.sdf").read_text() == sdf_text(hobby_servo_hexapod())
     assert r.stdout.endswith(sdf_text(load_preset("utn-dynamic")))
+
+
+def test_write_sdf_keeps_the_output_policy(tmp_path):
+    """The one file writer refuses a folder that is a file and never replaces a file it did not write;
+    its own file it replaces (the manifest says it wrote it)."""
+    from stewart_drake.errors import OutputError
+
+    (tmp_path / "f").write_text("x")
+    with pytest.raises(OutputError, match=r"--write-sdf '.*/f': '.*/f' exists and is not a folder"):
+        write_sdf(Leg3R(), str(tmp_path / "f"), option="--write-sdf")
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d" / "leg-3r.sdf").write_text("mine")
+    with pytest.raises(OutputError, match="the file exists and was not written by stewart-drake"):
+        write_sdf(Leg3R(), tmp_path / "d")
+    assert (tmp_path / "d" / "leg-3r.sdf").read_text() == "mine"
+    first = write_sdf(Leg3R(), tmp_path / "e")
+    assert write_sdf(Leg3R(l1=0.09), tmp_path / "e") == first and first.read_text() == sdf_text(Leg3R(l1=0.09))
