@@ -54,10 +54,10 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
     kw = {}
     if "joints" in names:
         kw["base_cone"] = kw["top_cone"] = joint_cone
+    # deferred: only 'collision' without --leg-diameter needs the legs' cylinder (from the platform model's
+    # leg bodies; without that option the workspace command needs no Drake)
     if "collision" in names:
         if leg_diameter is None:
-            # deferred: the leg dimensions live in the Drake model module, and only this option needs them
-            # (the workspace command otherwise runs without pydrake)
             from stewart_drake.drake.platform_model import leg_dimensions
 
             leg_diameter = 2 * leg_dimensions(platform)["cylinder_radius"]
