@@ -165,7 +165,6 @@ def check_poses(platform, poses, convention: str = "utn", what: str = "pose", ti
         low = ~np.all(z > 0.0, axis=1)
         if np.any(low):
             i = int(np.argmax(low))
-            k = int(np.argmin(z[i]))
             raise PhysicalLimitError(below_base_message(label(i), z[i]))
     return q
 
