@@ -361,6 +361,10 @@ class UsageError(StewartError):
 
     NEEDS = "{option} only applies with {needs}"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
+    # argparse prefixes these with "argument --option:" (option values that are not numbers)
+    NOT_A_NUMBER = "not a number: {value!r}"
+    NOT_FINITE_NUMBER = "must be a finite number, got {value!r}"
+    NOT_WHOLE = "not a whole number (at most 18 digits): {value!r}"
     INTERNAL = "internal error ({kind}: {detail}); please report it with the command line"
     LEGS_CORIOLIS = "--legs on computes the complete model; it cannot be combined with --coriolis off"
     ENGINE_C = "--engine c runs the fixed-point controller; --controller is {controller!r}"
