@@ -333,6 +333,7 @@ def human_bytes(n: float) -> str:
 
 
 def human_seconds(s: float) -> str:
+    """A duration in seconds as people read it (s, min, h, days or years), for work estimates."""
     s = float(s)
     if s >= 86400 * 365:
         return f"~{s / (86400 * 365):.2g} years"
