@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, settings
 
 from stewart_drake.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FUZZ_EXAMPLES = int(os.environ.get("STEWART_FUZZ_EXAMPLES", "5000"))  # x 4 tests = 20,000
 _HEALTH = list(HealthCheck)
 

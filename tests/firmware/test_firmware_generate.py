@@ -18,7 +18,7 @@ from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.fixedpoint import QFormat, SaturationCounter
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
 from stewart_drake.core.geometry import PRESETS, load_preset
-from tests.firmware_cache import firmware_cache  # noqa: F401
+from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 
 def second_compiler():

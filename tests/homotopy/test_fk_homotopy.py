@@ -241,7 +241,7 @@ def test_run_check_branches_cli(tmp_path, capsys):
 
     from stewart_drake.cli import main
 
-    prog = str(Path(__file__).resolve().parents[1] / "examples" / "circle.stw")
+    prog = str(Path(__file__).resolve().parents[2] / "examples" / "circle.stw")
     args = ["run", prog, "--platform", "utn-kinematic", "--check-branches", "--branch-samples", "5", "--json"]
     assert main(args + ["--out", str(tmp_path / "a")]) == 0
     b = json.loads(capsys.readouterr().out)["branches"]

@@ -104,14 +104,14 @@ def test_inertias_against_point_clouds():
 
 
 def test_models_and_their_commands_need_no_pydrake(tmp_path):
-    """With pydrake unimportable (``tests/_no_drake.py``), the SDF writer and the modules it stands on
+    """With pydrake unimportable (``tests/cli/_no_drake.py``), the SDF writer and the modules it stands on
     import, and ``leg sdf --write``, ``servo --write-sdf`` and ``model`` (printing the SDF) write the same
     text as the library."""
     import os
     import subprocess
     import sys
 
-    runner = Path(__file__).with_name("_no_drake.py")
+    runner = Path(__file__).resolve().parents[1] / "cli" / "_no_drake.py"
     root = next(d for d in Path(__file__).resolve().parents if (d / "stewart_drake" / "__init__.py").is_file())
     env = dict(os.environ, PYTHONPATH=str(root), MPLBACKEND="Agg")
     code = (

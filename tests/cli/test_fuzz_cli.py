@@ -13,7 +13,7 @@ import argparse
 from hypothesis import given
 from hypothesis import strategies as st
 
-from _fuzz import ci, fuzz, run_and_check
+from tests.cli._fuzz import ci, fuzz, run_and_check
 from stewart_drake.cli import build_parser, checked_int, finite_number
 
 NUMBERS = ["0", "1", "-1", "2.5", "100", "473", "700", "-0.473", "1e308", "-1e308", "1e-300", "nan", "inf", "-inf",

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from _fuzz import fuzz
+from tests.cli._fuzz import fuzz
 from stewart_drake.cli import main
 from stewart_drake.errors import FAR_CENTRE, GRAVITY_RANGE, SERVO_NEUTRAL, PhysicalLimitError, UsageError
 from stewart_drake.core.geometry import load_platform

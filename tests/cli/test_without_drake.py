@@ -14,7 +14,7 @@ import pytest
 
 import stewart_drake
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RUNNER = str(Path(__file__).with_name("_no_drake.py"))
 NUMPY_PACKAGES = ("core", "control", "fixedpoint", "workspace", "script", "homotopy", "design", "firmware")
 

@@ -1,5 +1,5 @@
-"""Run Python with pydrake unimportable: ``python tests/_no_drake.py -c CODE`` or
-``python tests/_no_drake.py cli ARGS...`` (the stewart-drake CLI, exit code passed through)."""
+"""Run Python with pydrake unimportable: ``python tests/cli/_no_drake.py -c CODE`` or
+``python tests/cli/_no_drake.py cli ARGS...`` (the stewart-drake CLI, exit code passed through)."""
 
 import importlib.abc
 import sys

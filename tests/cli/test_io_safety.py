@@ -24,7 +24,7 @@ from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_fold
 from stewart_drake.cli import main
 from stewart_drake.errors import OutputError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "circle.stw"
 PLATFORM = "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.55, 0.95]\nplate: {mass: 1.5, inertia: [0.01, 0.01, 0.02, 0, 0, 0]}\n"
 

@@ -187,7 +187,7 @@ def test_unreachable_program_refused_before_any_run(tmp_path, capsys):
     study stops before running anything (the program's diagnostics, exit 2, no folder)."""
     from pathlib import Path
 
-    program = Path(__file__).resolve().parents[1] / "examples" / "circle.stw"
+    program = Path(__file__).resolve().parents[2] / "examples" / "circle.stw"
     assert main(["montecarlo", "--program", str(program), "--runs", "2", "--out", str(tmp_path / "o"), *SHORT, "--workers", "0"]) == 2
     assert "out of reach on platform utn-dynamic" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()

@@ -1,5 +1,5 @@
 """The viewer's readouts, reachability search, replay loading and CLI, and the animation's helpers —
-without a browser (tests/test_browser.py drives the pages)."""
+without a browser (tests/report/test_browser.py drives the pages)."""
 
 import json
 import os
@@ -15,7 +15,7 @@ from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.drake.viewer import ReplayError, labels, load_replay, nearest_reachable, readout, reachable
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import pytest
 from stewart_drake.firmware import build
 from stewart_drake.firmware.host import BATCH_OPS, frac, intrinsic, op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.fixedpoint import q15, scalar, tp17_leg_lengths
-from tests.firmware_cache import firmware_cache  # noqa: F401
+from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 E16 = [-32768, -32767, -16385, -16384, -2, -1, 0, 1, 2, 16383, 16384, 16385, 32766, 32767]
 E32 = [-(2**31), -(2**31) + 1, -(2**30), -65536, -32769, -32768, -1, 0, 1, 0x7FFF, 0x8000, 65535, 2**30, 2**31 - 2, 2**31 - 1]

@@ -18,7 +18,7 @@ from stewart_drake.core.kinematics import leg_lengths
 
 pytestmark = pytest.mark.skipif(find_chromium() is None, reason="Chromium or websocket-client not installed: run scripts/ensure-chromium")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 WIDTH = 1280
 SHOTS = os.environ.get("STEWART_SCREENSHOTS")  # a folder: also save the screenshots there
 

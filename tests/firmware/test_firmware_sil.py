@@ -11,7 +11,7 @@ import pytest
 from stewart_drake.cli import main
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.drake.simulation import build_simulation, fit_trajectory, get_trajectory
-from tests.firmware_cache import firmware_cache  # noqa: F401
+from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 DURATION = 0.12
 

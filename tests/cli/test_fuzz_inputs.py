@@ -14,7 +14,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 from hypothesis.extra.lark import from_lark
 
-from _fuzz import PLATFORM_TEMPLATE, PROGRAM, ci, fuzz, run_and_check, scratch
+from tests.cli._fuzz import PLATFORM_TEMPLATE, PROGRAM, ci, fuzz, run_and_check, scratch
 from stewart_drake.script.parser import _lark
 
 BASE = yaml.safe_load(PLATFORM_TEMPLATE)

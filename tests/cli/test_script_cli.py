@@ -13,7 +13,7 @@ from stewart_drake.core.geometry import load_preset
 from stewart_drake.script import compile_program
 from stewart_drake.script.runtime import Motion
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 SEED = EXAMPLES / "seed_004.stw"
 
 
