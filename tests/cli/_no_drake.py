@@ -1,5 +1,9 @@
-"""Run Python with pydrake unimportable: ``python tests/cli/_no_drake.py -c CODE`` or
-``python tests/cli/_no_drake.py cli ARGS...`` (the stewart-drake CLI, exit code passed through)."""
+"""Run Python with pydrake unimportable, as on a machine without Drake.
+
+Three ways in: ``python tests/cli/_no_drake.py -c CODE``, ``python tests/cli/_no_drake.py cli ARGS...`` (the
+stewart-drake CLI, exit code passed through), or as a pytest plugin, ``python -m pytest -p tests.cli._no_drake
+tests/core ...``: importing this module installs the blocker before pytest collects a test, so every test module
+and everything it imports sees no pydrake."""
 
 import importlib.abc
 import sys
@@ -15,6 +19,13 @@ class BlockPydrake(importlib.abc.MetaPathFinder):
 
 
 sys.meta_path.insert(0, BlockPydrake())
+
+
+def pytest_report_header(config):
+    """Say in pytest's header that this run has no pydrake (and whether some import slipped in before)."""
+    loaded = sorted(n for n in sys.modules if n == "pydrake" or n.startswith("pydrake."))
+    return f"pydrake blocked (tests/cli/_no_drake.py); already imported before the blocker: {loaded or 'none'}"
+
 
 if __name__ == "__main__":
     if sys.argv[1] == "-c":

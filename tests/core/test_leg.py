@@ -1,8 +1,8 @@
-"""3R planar leg (seed 003): DH FK, both IK branches, the seed's corrections, Drake cross-checks."""
+"""3R planar leg (seed 003): DH FK, both IK branches, the seed's corrections (Drake cross-checks:
+``tests/drake/test_leg_drake.py``)."""
 
 import numpy as np
 import pytest
-
 from stewart_drake.core.leg3r import (
     SEED_FIXES,
     Leg3R,
@@ -112,27 +112,3 @@ def test_seed_ik_is_wrong_and_each_fix_is_needed():
         assert np.nanmax(err) > 1e-2  # centimetres off (or no real solution) until all fixes are in
     full = seed_inverse_kinematics(LEG, f, "a", SEED_FIXES)
     assert np.abs(wrap(full - inverse_kinematics_3r(LEG, f, "a"))).max() < 1e-12
-
-
-# ---- Drake ----------------------------------------------------------------------------------------
-
-
-def test_fk_matches_drake():
-    from stewart_drake.drake.leg_model import drake_fk_errors
-
-    q = random_configurations(LEG, 200, seed=6)
-    assert drake_fk_errors(LEG, q).max() < 1e-14  # every DH frame, 4x4 element-wise
-
-
-@pytest.mark.parametrize("branch", ["a", "b"])
-def test_ik_matches_drake_inverse_kinematics(branch):
-    from stewart_drake.drake.leg_model import drake_ik
-
-    q = random_configurations(LEG, 1000, seed=7)
-    p = foot(LEG, q)[:, :2]
-    qd, gap = drake_ik(LEG, p, branch)
-    qn = inverse_kinematics(LEG, p, branch)
-    d = np.abs(wrap(qd - qn)).max(1)
-    # Drake stops gap metres from the target; to first order that moves the angles by ||J^-1|| gap.
-    bound = np.linalg.norm(np.linalg.inv(foot_jacobian(LEG, qn)), 2, axis=(-2, -1)) * gap
-    assert np.all(d <= 2 * bound + 1e-12)
