@@ -173,40 +173,6 @@ def test_simulate_refuses_out_of_stroke_and_below_base_before_running(tmp_path):
     assert rc == 1 and "the below reference at t = 0.0000 s: the plate is below the base" in err
 
 
-def test_simulate_lost_tracking_exits_1(tmp_path):
-    """A reference that jumps 60 mm in 2 ms at t = 0.05 s asks for far more than the actuators' force
-    range: the legs fall tens of millimetres behind. The summary states the bound and the run exits 1
-    saying why."""
-    f = tmp_path / "step.csv"
-    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.05,0,0,700,0,0,0\n0.052,0,0,760,0,0,0\n0.3,0,0,760,0,0,0\n")
-    rc, out, err = cli("simulate", "--trajectory", f, "--length-unit", "mm", "--angle-unit", "deg", "--out", tmp_path / "o", "--no-progress")
-    summary = json.loads(out)
-    assert rc == 1 and summary["tracking_bound_mm"] == pytest.approx(0.05 * 400)
-    assert summary["max_leg_error_mm"] > summary["tracking_bound_mm"]
-    assert re.search(r"tracking lost: the leg length error of leg \d exceeds 20\.0 mm \(0\.05 × the stroke range\) first at t = ", err)
-    assert json.loads((tmp_path / "o" / "summary.json").read_text())["failures"] == summary["failures"] != []
-
-
-def test_saturation_verdict_counts_the_longest_stretch():
-    """``longest_saturation`` from the cumulative per-leg counters: leg 2 saturated on ticks 3..62 (60
-    ticks = 0.060 s at 1 ms) fails; leg 5 saturated on 40 ticks in two stretches of 20 passes."""
-    from stewart_drake.control.controller import STATUS
-    from stewart_drake.drake.simulation import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
-
-    n, T = 100, 1e-3
-    sat = np.zeros((n, 6), bool)
-    sat[2:62, 1] = True
-    sat[10:30, 4] = sat[50:70, 4] = True
-    status = np.zeros((n, len(STATUS)))
-    status[:, 0] = np.arange(1, n + 1)
-    status[:, 4:10] = np.cumsum(sat, axis=0)
-    z = np.zeros((n, 6))
-    log = SimulationLog("fixed", "p", "seed", T, np.arange(n) * T, z, z, z, z, z, status, np.arange(n) * T, z)
-    assert longest_saturation(log) == pytest.approx([0, 0.060, 0, 0, 0.020, 0])
-    v = tracking_verdict(load_platform("utn-dynamic"), z, z, log)
-    assert v["failures"] == [f"leg 2 saturated for 0.060 s in one stretch (longer than {MAX_SATURATION_S:g} s): its actuator cannot follow the reference"]
-
-
 # ----------------------------------------------------------------------------------------------
 # Required physics, platforms.
 
