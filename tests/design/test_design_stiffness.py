@@ -1,6 +1,6 @@
 """Stiffness and natural frequencies: zero-load stiffness against Aᵀ diag(k) A built from
-the anchors, loaded stiffness against finite differences of the static wrench, frequencies and mode
-shapes against Drake."""
+the anchors, loaded stiffness against finite differences of the static wrench, the inertia against inverse
+dynamics (the modes against Drake: ``tests/drake/test_design_stiffness_drake.py``)."""
 
 from __future__ import annotations
 
@@ -11,11 +11,10 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from stewart_drake.cli import main
-from stewart_drake.design.modes import analytic_modes, damping_matrix, mac, spatial_inertia, subspace_mac
+from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.stiffness import deflection, principal_stiffness, stiffness_matrix
 from stewart_drake.errors import PayloadError, StiffnessError
-from stewart_drake.drake.design_checks import drake_modes
 from stewart_drake.core.geometry import load_platform
 
 G = 9.81
@@ -120,48 +119,6 @@ def test_spatial_inertia_matches_inverse_dynamics(loaded):
     assert np.abs(A.T @ F.T - M).max() <= 1e-12 * np.abs(M).max()
 
 
-@pytest.mark.parametrize("pose", [Q_OFF, np.array([0.0, 0.0, 0.7, 0.0, 0.0, 0.0])])
-def test_drake_linearisation_matches_analytic_plate_only(loaded, pose):
-    K = stiffness_matrix(loaded, pose, K_LEGS)
-    M = spatial_inertia(loaded, pose)
-    a = analytic_modes(K, M)
-    d = drake_modes(loaded, pose, K_LEGS)
-    assert d["residual"] <= 1e-9  # the spring preloads hold the plate in equilibrium
-    assert np.all(np.abs(d["modes"].frequencies_hz / a.frequencies_hz - 1) <= 1e-6)
-    assert np.all(subspace_mac(a.shapes, d["modes"].shapes, a.frequencies_hz) >= 0.999)
-
-
-def test_drake_single_modes_mac(loaded):
-    a = analytic_modes(stiffness_matrix(loaded, Q_OFF, K_LEGS), spatial_inertia(loaded, Q_OFF))
-    assert np.min(np.diff(a.frequencies_hz) / a.frequencies_hz[1:]) > 1e-3  # distinct: plain MAC applies
-    d = drake_modes(loaded, Q_OFF, K_LEGS)
-    assert np.all(mac(a.shapes, d["modes"].shapes) >= 0.999)
-    # a mode against another mode is not a match: the check can fail
-    assert mac(a.shapes[:, :1], d["modes"].shapes[:, 1:2])[0] < 0.5
-
-
-def test_drake_damped(loaded):
-    c = 300.0
-    a = analytic_modes(stiffness_matrix(loaded, Q_OFF, K_LEGS), spatial_inertia(loaded, Q_OFF), damping_matrix(loaded, Q_OFF, c))
-    d = drake_modes(loaded, Q_OFF, K_LEGS, c)
-    assert np.all(np.abs(d["modes"].frequencies_hz / a.frequencies_hz - 1) <= 1e-6)
-    assert np.all(np.abs(d["modes"].damping_ratio - a.damping_ratio) <= 1e-6)
-    assert a.damping_ratio.max() > 0.05
-
-
-def test_drake_closed_loop_with_legs(loaded):
-    """Plate + leg bodies: the analytic model (leg inertia from the numpy inverse dynamics) against the
-    closed-loop Drake plant reduced to the plate's motion (its central differences: ~1e-9)."""
-    K = stiffness_matrix(loaded, Q_OFF, K_LEGS, legs=True)
-    M = spatial_inertia(loaded, Q_OFF, legs=True)
-    a = analytic_modes(K, M)
-    d = drake_modes(loaded, Q_OFF, K_LEGS, legs=True)
-    assert np.all(np.abs(d["modes"].frequencies_hz / a.frequencies_hz - 1) <= 1e-6)
-    assert np.all(mac(a.shapes, d["modes"].shapes) >= 0.999)
-    plate = analytic_modes(stiffness_matrix(loaded, Q_OFF, K_LEGS), spatial_inertia(loaded, Q_OFF))
-    assert np.all(a.frequencies_hz < plate.frequencies_hz)  # the legs' inertia lowers every mode
-
-
 # ----------------------------------------------------------------------------------------------
 # CLI.
 
@@ -177,15 +134,6 @@ def test_cli_stiffness_json(capsys):
     d = np.array(out["deflection"])
     assert d[2] < 0  # the payload pushes the plate down
     assert np.allclose(K @ d, out["payload_wrench"], atol=1e-9)
-
-
-def test_cli_modes_drake_json(capsys):
-    assert main(["modes", "--pose", "50", "-30", "720", "5", "-3", "10", "--drake", "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    f = np.array(out["frequencies_hz"])
-    assert np.all(np.diff(f) >= 0) and len(f) == 6
-    assert max(out["drake"]["relative_difference"]) <= 1e-6 and min(out["drake"]["mac"]) >= 0.999
-    assert out["controller"]["samples_per_lowest_period"] == pytest.approx(1000.0 / f[0])
 
 
 @pytest.mark.parametrize("args, needle, rc", [

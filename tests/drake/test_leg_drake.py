@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.leg3r import Leg3R, foot, foot_jacobian, inverse_kinematics, random_configurations
+from stewart_drake.drake.leg_model import drake_fk_errors, drake_ik
 
 LEG = Leg3R()
 
@@ -14,16 +15,12 @@ def wrap(x):
 
 
 def test_fk_matches_drake():
-    from stewart_drake.drake.leg_model import drake_fk_errors
-
     q = random_configurations(LEG, 200, seed=6)
     assert drake_fk_errors(LEG, q).max() < 1e-14  # every DH frame, 4x4 element-wise
 
 
 @pytest.mark.parametrize("branch", ["a", "b"])
 def test_ik_matches_drake_inverse_kinematics(branch):
-    from stewart_drake.drake.leg_model import drake_ik
-
     q = random_configurations(LEG, 1000, seed=7)
     p = foot(LEG, q)[:, :2]
     qd, gap = drake_ik(LEG, p, branch)

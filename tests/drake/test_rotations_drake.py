@@ -3,20 +3,18 @@ and Quaternion (``drake/conversions``)."""
 
 import numpy as np
 import pytest
+from pydrake.common.eigen_geometry import Quaternion
+from pydrake.math import RollPitchYaw, RotationMatrix
 
 from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
+from stewart_drake.drake.conversions import from_drake, to_drake
 
 RNG = np.random.default_rng(7)
-
-
 # Away from gimbal lock (middle angle ±90°) the inverse is unique; 1e-12 rad is float round-off.
 ANGLES = RNG.uniform([-np.pi, -1.4, -np.pi], [np.pi, 1.4, np.pi], (500, 3))
 
 
 def test_zyx_matches_drake_roll_pitch_yaw():
-    from pydrake.math import RollPitchYaw, RotationMatrix
-    from stewart_drake.drake.conversions import from_drake
-
     for ang in ANGLES[:50]:
         R = RotationMatrix(RollPitchYaw(*ang)).matrix()
         np.testing.assert_allclose(rotation_matrix(ang, "zyx"), R, atol=1e-14)
@@ -24,8 +22,6 @@ def test_zyx_matches_drake_roll_pitch_yaw():
 
 
 def test_drake_round_trip_utn():
-    from stewart_drake.drake.conversions import from_drake, to_drake
-
     ang = np.array([0.2, -0.4, 0.9])
     np.testing.assert_allclose(from_drake(to_drake(ang, "utn"), "utn"), ang, atol=1e-13)
 
@@ -33,10 +29,6 @@ def test_drake_round_trip_utn():
 def test_quaternion_to_matrix_matches_drake():
     """Against Drake's Quaternion -> RotationMatrix (Eigen's formula, written differently): equal to a few
     ulps; q and -q and any positive scaling give the same rotation."""
-    from pydrake.common.eigen_geometry import Quaternion
-    from pydrake.math import RotationMatrix
-    from stewart_drake.drake.conversions import from_drake
-
     q = RNG.normal(size=(40, 4))
     R = quaternion_to_matrix(q)
     for qk, Rk in zip(q / np.linalg.norm(q, axis=-1, keepdims=True), R):

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.servo import hobby_servo_hexapod, quantise_pulses, solve
+from stewart_drake.core.servo_loop import tracking_bounds
+from stewart_drake.drake.servo_model import compare_with_drake, run_closed_loop, run_controller
 
 
 @pytest.fixture(scope="module")
@@ -19,8 +21,6 @@ def random_poses(h, n, seed, dx=0.008, da=np.radians(6)):
 
 
 def test_drake_cross_checks(hexapod):
-    from stewart_drake.drake.servo_model import compare_with_drake
-
     poses = random_poses(hexapod, 15, seed=5)
     r = compare_with_drake(hexapod, poses)
     assert r["frames"] < 1e-15  # the same numbers read back
@@ -33,8 +33,6 @@ def test_drake_cross_checks(hexapod):
 
 
 def test_controller_quantises_latches_and_delays(hexapod):
-    from stewart_drake.drake.servo_model import run_controller
-
     t = np.linspace(0, 0.2, 11)
     poses = np.tile(hexapod.home_pose(), (11, 1))
     poses[:, 3] = np.radians(5) * np.sin(2 * np.pi * 5 * t)
@@ -51,9 +49,6 @@ def test_closed_loop_hold_is_within_quantisation_and_sag(hexapod):
     """A constant offset pose held for 0.4 s: once settled, each arm sits within half a pulse step
     (0.5 µs = 0.056°) plus its static sag (load / kp ≈ 0.02°) of eq. 9, and the platform within the
     Jacobian image of that. A wrong pulse sign, gain or mounting would miss by degrees."""
-    from stewart_drake.core.servo_loop import tracking_bounds
-    from stewart_drake.drake.servo_model import run_closed_loop
-
     pose = hexapod.home_pose() + [0.003, -0.002, 0.004, 0.05, -0.03, 0.08]
     log = run_closed_loop(hexapod, [0.0, 1.0], [pose, pose], duration=0.4)
     b = tracking_bounds(hexapod, log)
@@ -71,9 +66,6 @@ def test_closed_loop_tracks_a_trajectory(hexapod):
     limit adds no lag. Checked per servo and per pose axis on the run's worst case (per sample, the
     reaction of neighbouring servos' frame steps adds ~0.04° blips where an arm reverses, which the
     bound does not model)."""
-    from stewart_drake.core.servo_loop import tracking_bounds
-    from stewart_drake.drake.servo_model import run_closed_loop
-
     t = np.linspace(0, 1.0, 201)
     traj = np.tile(hexapod.home_pose(), (len(t), 1))
     traj[:, 2] += 0.006 * np.sin(np.pi * t)
