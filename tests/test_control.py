@@ -9,21 +9,23 @@ other system reads at t; a tick's or release's effect appears in the samples aft
 import numpy as np
 import pytest
 
-from stewart_drake.control.controller import (
+from stewart_drake.control import (
     STATUS,
     ControllerConfig,
     DspTiming,
     FixedGains,
+    FixedPointLaw,
+    FloatLaw,
     PidGains,
     TimingError,
-    make_controller,
     q15_gain,
     tick_cycles,
 )
 from stewart_drake.fixedpoint import QFormat, fixed_point_leg_lengths, tp17_cycles
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.simulation import ROTATING, SEED, Trajectory, pose_source
+from stewart_drake.core.trajectory import ROTATING, SEED, Trajectory
+from stewart_drake.drake.systems import PoseSource, make_controller
 
 PLATFORM = load_preset("utn-dynamic")
 T = 1e-3
@@ -38,8 +40,8 @@ def run_open_loop(kind, config, reference, measurement, duration, log_period):
 
     b = DiagramBuilder()
     ctrl = b.AddSystem(make_controller(kind, PLATFORM, config))
-    ref = b.AddSystem(pose_source(reference))
-    meas = b.AddSystem(pose_source(measurement))
+    ref = b.AddSystem(PoseSource(reference))
+    meas = b.AddSystem(PoseSource(measurement))
     b.Connect(ref.get_output_port(), ctrl.GetInputPort("reference"))
     b.Connect(meas.get_output_port(), ctrl.GetInputPort("leg_lengths"))
     logs = {name: LogVectorOutput(ctrl.GetOutputPort(name), b, log_period) for name in ("command", "setpoint", "status")}
@@ -197,13 +199,13 @@ def test_fixed_setpoints_equal_the_standalone_fixed_point_ik(latency, lag):
     words = fixed_point_leg_lengths(PLATFORM, ref, QFormat(16, 1e-3, "tfr16"), return_words=True)
     sp = logs["setpoint"]
     np.testing.assert_array_equal(sp[lag:], words[: len(words) - lag] * 1e-3)
-    assert ctrl.cache_misses == len(t) - 1  # one IK per tick (the last sample's tick is not run)
+    assert ctrl.law.cache_misses == len(t) - 1  # one IK per tick (the last sample's tick is not run)
     assert len(np.unique(words, axis=0)) > 40  # the reference moved through many set-points
 
 
 def test_primed_ik_cache_gives_the_same_words():
     config = ControllerConfig()
-    ctrl = make_controller("fixed", PLATFORM, config)
+    ctrl = FixedPointLaw(PLATFORM, config)
     poses = ROTATING.pose(np.arange(200) * 0.01)
     ctrl.prime(poses)
     for q in poses[::17]:
@@ -219,7 +221,7 @@ def test_fixed_pid_tick_matches_a_plain_integer_reimplementation():
     intrinsics): ETSI semantics sat16/sat32, L_mult = sat32(2ab), mult_r = (ab + 2^14) >> 15, shifts
     saturating. Random state and inputs (fixed seed), including saturating ones."""
     rng = np.random.default_rng(6)
-    ctrl = make_controller("fixed", PLATFORM)
+    ctrl = FixedPointLaw(PLATFORM)
     g, cpl = ctrl.gains, 100  # 1 mm IK LSB / 10 µm sensor counts
 
     def s16(x):
@@ -239,7 +241,7 @@ def test_fixed_pid_tick_matches_a_plain_integer_reimplementation():
         pid = np.concatenate([rng.integers(-(2**31), 2**31 - 1, 6), np.round(L / 1e-5) + rng.integers(-300, 300, 6),
                               rng.integers(-5000, 5000, 6), ctrl.setpoint_words(pose) + rng.integers(-3, 3, 6),
                               rng.integers(-5000, 5000, 6)]).astype(float)
-        cmd, sp, new, sat = ctrl.compute(pose, L, pid)
+        cmd, sp, new, sat = ctrl.step(pid, pose, L)
         words = ctrl.setpoint_words(pose)
         for i in range(6):
             integ, prev, df, sprev, vf = (int(pid[6 * j + i]) for j in range(5))
@@ -273,7 +275,7 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
     Newton–Euler of ``leg_forces_with_legs``)."""
     from dataclasses import replace
 
-    from stewart_drake.control.controller import leg_space_inertia
+    from stewart_drake.control import leg_space_inertia
     from stewart_drake.core.dynamics import mass_matrix
     from stewart_drake.core.kinematics import length_jacobian
 
@@ -288,7 +290,7 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
 
 @pytest.mark.parametrize("name", ["utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009"])
 def test_design_gains_follow_the_documented_rules(name):
-    from stewart_drake.control.controller import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
+    from stewart_drake.control import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
                                        UNKNOWN_POSE_STIFFNESS_FACTOR, design_gains, leg_space_inertia, loop_delay,
                                        strut_stiffness)
 
@@ -319,8 +321,8 @@ def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory
     over a full period (2π s) of each trajectory, more and other poses than the design's 64 over 4 s, with
     the pose's own K and heaviest mass. (The home-only design of 6b broke it on utn-kinematic: kp 15.3 kN/m
     against K up to 14.6 kN/m and ki 66 kN/(m·s), ~25 × the limit; the loop grew at ~2 Hz.)"""
-    from stewart_drake.control.controller import design_gains, leg_space_inertia, strut_stiffness
-    from stewart_drake.drake.simulation import design_poses, fit_trajectory, get_trajectory
+    from stewart_drake.control import design_gains, leg_space_inertia, strut_stiffness
+    from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
 
     p = load_preset(name)
     traj = fit_trajectory(get_trajectory(base), p)
@@ -334,7 +336,7 @@ def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory
 
 
 def test_strut_stiffness_and_inertia_are_vectorised_over_poses():
-    from stewart_drake.control.controller import leg_space_inertia, strut_stiffness
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
 
     p = load_preset("utn-kinematic")
     q = p.home_pose() + np.array([[0, 0, 0, 0, 0, 0], [0.02, -0.01, 0.01, 0.05, 0.0, 0.2]])
@@ -346,7 +348,7 @@ def test_strut_stiffness_matches_the_open_loop_growth():
     """The negative stiffness K of the struts and the open-loop growth rate λ (``dynamics``) describe the
     same instability: the fastest growth needs λ² ≤ K / m_min (a stiffness K on the lightest mass), and
     the slowest unstable mode at least K / m_max — so λ_max² · m_min <= K <= λ_max² · m_max."""
-    from stewart_drake.control.controller import leg_space_inertia, strut_stiffness
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
     from stewart_drake.core.dynamics import open_loop_growth_rates
 
     for name in ("utn-dynamic", "utn-kinematic"):
@@ -361,14 +363,14 @@ def test_fixed_feedforward_is_one_saturating_word_added_to_the_sum():
     """The feed-forward enters the fixed-point law as its Q15 table word deposited in the high half and
     added with a saturating L_add; everything else in the tick is unchanged (Python integers)."""
     rng = np.random.default_rng(7)
-    ctrl = make_controller("fixed", PLATFORM)
+    ctrl = FixedPointLaw(PLATFORM)
     for trial in range(60):
         pose = SEED.pose(rng.uniform(0, 4))
         L = leg_lengths(PLATFORM, pose) + rng.normal(0, 1e-3, 6)
         pid = ctrl.initial_pid_state(L, rng.uniform(-50, 50, 6))
         ff = rng.uniform(-300, 300, 6)  # beyond the 200 N range for some legs: the word saturates
-        cmd0, sp0, st0, _ = ctrl.compute(pose, L, pid)
-        cmd, sp, st, sat = ctrl.compute(pose, L, pid, ff)
+        cmd0, sp0, st0, _ = ctrl.step(pid, pose, L)
+        cmd, sp, st, sat = ctrl.step(pid, pose, L, ff)
         np.testing.assert_array_equal(sp, sp0)
         np.testing.assert_array_equal(st[6:], st0[6:])  # filters and memories do not see the feed-forward
         for i in range(6):
@@ -380,12 +382,12 @@ def test_fixed_feedforward_is_one_saturating_word_added_to_the_sum():
 
 
 def test_controller_without_a_feedforward_connection_is_unchanged():
-    """Left unconnected, the feed-forward port is zero: the tick equals ``compute`` without it."""
-    ctrl = make_controller("float", PLATFORM)
+    """Left unconnected, the feed-forward port is zero: the tick equals ``step`` without it."""
+    ctrl = FloatLaw(PLATFORM)
     pose = SEED.pose(0.3)
     L = leg_lengths(PLATFORM, pose)
     pid = ctrl.initial_pid_state(L, np.full(6, 3.0))
-    a = ctrl.compute(pose, L, pid)
-    b = ctrl.compute(pose, L, pid, np.zeros(6))
+    a = ctrl.step(pid, pose, L)
+    b = ctrl.step(pid, pose, L, np.zeros(6))
     for x, y in zip(a, b):
         np.testing.assert_array_equal(x, y)

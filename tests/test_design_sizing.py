@@ -15,7 +15,7 @@ from stewart_drake.design.payload import with_payload
 from stewart_drake.design.sizing import leg_motion, rotating_trajectory, size_trajectory
 from stewart_drake.design.verify import newton_euler_fd, sample_box
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.drake.simulation import ROTATING
+from stewart_drake.core.trajectory import ROTATING
 
 @pytest.fixture(scope="module")
 def loaded_platform():

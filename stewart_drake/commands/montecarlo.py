@@ -46,7 +46,7 @@ def register(sub) -> None:
 def build_study(args):
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.montecarlo.scenario import Study
-    from stewart_drake.drake.simulation import TRAJECTORIES
+    from stewart_drake.core.trajectory import TRAJECTORIES
     from stewart_drake.montecarlo.spec import parse_spec
     from stewart_drake.commands.run import read_program
 
@@ -75,7 +75,7 @@ def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
     (``load_trajectory_csv`` checks it and names a bad line)."""
     from stewart_drake.core.csvio import read_numeric_csv
     from stewart_drake.core.rotations import pose_to_si
-    from stewart_drake.drake.simulation import load_trajectory_csv
+    from stewart_drake.core.trajectory import load_trajectory_csv
 
     traj = load_trajectory_csv(path, length_unit, angle_unit)
     data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")

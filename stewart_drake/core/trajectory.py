@@ -8,6 +8,7 @@ its samples (``t``, ``q``, ``qd``, ``qdd``) and segments.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -134,6 +135,16 @@ def constant_trajectory(name: str, pose, duration: float | None = None) -> Traje
     """The plate held at ``pose`` (6,) for all times."""
     pose = np.asarray(pose, dtype=float).reshape(6)
     return Trajectory(name, lambda t: np.broadcast_to(pose, np.shape(t) + (6,)).copy(), duration)
+
+
+def design_poses(trajectory: Trajectory, duration: float | None = None, n: int = 64) -> np.ndarray:
+    """``(n, 6)`` poses of ``trajectory`` evenly spread over [0, ``duration``] (default the trajectory's
+    duration, else 4 s): what the default gain design (``control.design_gains``) takes as the poses the
+    loop will visit (the struts' stiffness and the leg-space masses vary along the way)."""
+    d = duration if duration is not None else (trajectory.duration or 4.0)
+    if not (math.isfinite(d) and d >= 0):
+        raise ValueError(f"design duration must be a number of seconds >= 0, got {d!r}")
+    return trajectory.pose(np.linspace(0.0, d, n))
 
 
 def get_trajectory(name_or_path, **units) -> Trajectory:

@@ -40,7 +40,7 @@ from stewart_drake.control.laws import STATUS
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
-from stewart_drake.core.trajectory import Trajectory, constant_trajectory, get_trajectory
+from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
 from stewart_drake.drake.platform_model import build_plant, leg_joint_positions, set_pose
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
@@ -362,16 +362,6 @@ def setpoint_step_gain(platform: Platform, config: ControllerConfig | None = Non
     diag = float(tv[leg] + tail)
     coupled = float(tv.sum() - tv[leg] + diag + np.abs(np.delete(s[-1], leg)).sum())
     return {"diagonal": diag, "coupled": coupled, "tail": tail, "peak": float(s[:, leg].max()), "t": t, "s": s}
-
-
-def design_poses(trajectory: Trajectory, duration: float | None = None, n: int = 64) -> np.ndarray:
-    """``(n, 6)`` poses of ``trajectory`` evenly spread over [0, ``duration``] (default the trajectory's
-    duration, else 4 s): what the default gain design (``control.design_gains``) takes as the poses the
-    loop will visit (the struts' stiffness and the leg-space masses vary along the way)."""
-    d = duration if duration is not None else (trajectory.duration or 4.0)
-    if not (math.isfinite(d) and d >= 0):
-        raise ValueError(f"design duration must be a number of seconds >= 0, got {d!r}")
-    return trajectory.pose(np.linspace(0.0, d, n))
 
 
 def simulate(scenario: Scenario, progress: bool = False) -> "SimulationLog":
