@@ -275,10 +275,9 @@ def test_bad_options_exit_2_with_the_message(argv, message, tmp_path):
 def test_period_bound_is_the_crossover_margin():
     """The refusal threshold follows from the stated rule: at the largest period the check accepts,
     ω_c = PHASE_BUDGET / (T + T + lag) is at least 2 × the fastest growth rate, and just above it, below."""
-    from stewart_drake.control import PHASE_BUDGET
+    from stewart_drake.control import CROSSOVER_MARGIN, PHASE_BUDGET, check_timing
     from stewart_drake.core.dynamics import open_loop_growth_rates
     from stewart_drake.errors import StewartError
-    from stewart_drake.core.sanity import CROSSOVER_MARGIN, check_timing
 
     p = load_platform("utn-dynamic")
     lam = max(open_loop_growth_rates(p, p.home_pose()))
