@@ -130,7 +130,7 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
 
 
 class TickRunner:
-    """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control._FixedLaw``
+    """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control.FixedPointLaw``
     (integrator, previous measurement, its filtered difference, previous set-point, its filtered
     difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer."""
 
