@@ -391,3 +391,42 @@ def test_controller_without_a_feedforward_connection_is_unchanged():
     b = ctrl.step(pid, pose, L, np.zeros(6))
     for x, y in zip(a, b):
         np.testing.assert_array_equal(x, y)
+
+
+def test_laws_need_no_drake():
+    """With pydrake unimportable, the control package imports and both laws tick (a fresh interpreter:
+    this one has imported pydrake already); the fixed-point tick equals this process's bit for bit."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import stewart_drake
+
+    code = """
+import sys
+class Block:
+    def find_spec(self, name, path=None, target=None):
+        if name == "pydrake" or name.startswith("pydrake."):
+            raise ImportError("pydrake blocked")
+sys.meta_path.insert(0, Block())
+import numpy as np
+from stewart_drake.control import FixedPointLaw, FloatLaw
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.trajectory import SEED
+p = load_preset("utn-dynamic")
+pose = SEED.pose(0.4)
+L = leg_lengths(p, pose) + 2e-4
+for law in (FixedPointLaw(p), FloatLaw(p)):
+    cmd, sp, st, sat = law.step(law.initial_pid_state(L, np.full(6, 5.0)), pose, L, np.full(6, 3.0))
+    print(repr(cmd.tolist()))
+assert not any(m.startswith("pydrake") for m in sys.modules)
+"""
+    root = Path(stewart_drake.__file__).resolve().parents[1]  # the package importable from the checkout
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=root).stdout.splitlines()
+    law = FixedPointLaw(PLATFORM)
+    pose = SEED.pose(0.4)
+    L = leg_lengths(PLATFORM, pose) + 2e-4
+    cmd = law.step(law.initial_pid_state(L, np.full(6, 5.0)), pose, L, np.full(6, 3.0))[0]
+    assert out[0] == repr(cmd.tolist())
+    assert len(out) == 2

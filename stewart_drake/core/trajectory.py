@@ -3,13 +3,15 @@ sampled tables (a CSV of t, pose rows) and motion programs (their quintic segmen
 
 A trajectory's ``pose(t)`` maps times ``(...)`` (s) to poses ``(..., 6)`` (metres, radians, ``utn``
 convention). The closed-form ones also give exact rates (``derivatives``); a motion program's also carries
-its samples (``t``, ``q``, ``qd``, ``qdd``) and segments.
+its samples (``t``, ``q``, ``qd``, ``qdd``) and segments. Pose functions are module-level functions or
+``functools.partial`` of them, so that a trajectory pickles (a Monte Carlo worker receives its scenario).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Callable
 
@@ -93,13 +95,13 @@ def fit_trajectory(trajectory: Trajectory, platform: Platform, home_height: floa
     s = (platform.stroke[1] - platform.stroke[0]) / stroke
     centre = np.array([0.0, 0.0, home_height])
     home = platform.home_pose()[:3]
+    return Trajectory(trajectory.name, partial(_fitted_pose, trajectory, home, s, centre), trajectory.duration)
 
-    def fn(t):
-        q = trajectory.pose(t).copy()
-        q[..., :3] = home + s * (q[..., :3] - centre)
-        return q
 
-    return Trajectory(trajectory.name, fn, trajectory.duration)
+def _fitted_pose(trajectory: Trajectory, home, s: float, centre, t):
+    q = trajectory.pose(t).copy()
+    q[..., :3] = home + s * (q[..., :3] - centre)
+    return q
 
 
 def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
@@ -121,20 +123,23 @@ def table_trajectory(name: str, ts, poses) -> Trajectory:
     threw the plate)."""
     ts, poses = np.asarray(ts, dtype=float), np.asarray(poses, dtype=float)
     slope = (poses[1] - poses[0]) / (ts[1] - ts[0]) if len(ts) > 1 else np.zeros(6)
+    return Trajectory(name, partial(_table_pose, ts, poses, slope), float(ts[-1]))
 
-    def fn(t):
-        t = np.asarray(t, dtype=float)
-        q = np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
-        before = (t < ts[0])[..., None]
-        return np.where(before, poses[0] + (t - ts[0])[..., None] * slope, q)
 
-    return Trajectory(name, fn, float(ts[-1]))
+def _table_pose(ts, poses, slope, t):
+    t = np.asarray(t, dtype=float)
+    q = np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
+    before = (t < ts[0])[..., None]
+    return np.where(before, poses[0] + (t - ts[0])[..., None] * slope, q)
 
 
 def constant_trajectory(name: str, pose, duration: float | None = None) -> Trajectory:
     """The plate held at ``pose`` (6,) for all times."""
-    pose = np.asarray(pose, dtype=float).reshape(6)
-    return Trajectory(name, lambda t: np.broadcast_to(pose, np.shape(t) + (6,)).copy(), duration)
+    return Trajectory(name, partial(_constant_pose, np.asarray(pose, dtype=float).reshape(6)), duration)
+
+
+def _constant_pose(pose, t):
+    return np.broadcast_to(pose, np.shape(t) + (6,)).copy()
 
 
 def design_poses(trajectory: Trajectory, duration: float | None = None, n: int = 64) -> np.ndarray:
