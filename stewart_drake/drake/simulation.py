@@ -147,6 +147,7 @@ class Simulation:
     plant_time_step: float = 1e-3
     feedforward: object = None
     integrator: str = "sap"
+    source: object = None
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> "SimulationLog":
@@ -159,10 +160,12 @@ class Simulation:
         sim = self.simulator
         T = self.config.timing.sample_period
         n = int(math.floor(duration / T + 1e-9)) + 1
-        if hasattr(self.controller.law, "prime"):  # batch the fixed-point IK of the known reference (speed only)
-            self.controller.law.prime(self.trajectory.pose(np.arange(n) * T))
+        ticks = np.arange(n) * T
+        poses = self.source.prime(ticks)  # the reference at the ticks, in one batch (speed only)
+        if hasattr(self.controller.law, "prime"):  # and the IK of those poses (speed only)
+            self.controller.law.prime(poses)
         if self.feedforward is not None:  # the feed-forward table at the ticks, in one batch
-            self.feedforward.prime(np.arange(n) * T)
+            self.feedforward.prime(ticks)
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
@@ -309,7 +312,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
     simulator.Initialize()
     return Simulation(platform, trajectory, s.controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer,
-                      plant_time_step, ff, integrator)
+                      plant_time_step, ff, integrator, src)
 
 
 def setpoint_step_response(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, step: float = 1e-3,
