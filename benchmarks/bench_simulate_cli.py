@@ -1,11 +1,14 @@
-"""Real-time factor of ``stewart-drake simulate`` as a user runs it (the whole command: imports, gain
-design, Diagram build, run, logs and plots), for both integrators and both fixed-point engines, optionally
-beside another checkout of the project (e.g. an older commit) timed in the same run, interleaved:
+"""Real-time factor of ``stewart-drake simulate``'s closed loop, for both integrators and both fixed-point
+engines, optionally beside another checkout of the project (e.g. an older commit) timed in the same run,
+interleaved so that both see the same machine load:
 
     PYTHONPATH=. python benchmarks/bench_simulate_cli.py [--duration 2] [--repeat 3] [--compare OTHER_CHECKOUT]
 
-The real-time factor is simulated seconds / wall seconds of the command (the best of ``--repeat``); the
-simulated seconds are long enough that the run dominates the fixed costs.
+Two figures per case, each the best of ``--repeat``: ``run``, simulated seconds / wall seconds of the
+Simulator's run alone (the seed trajectory on utn-dynamic, fixed point, 1 kHz, default gains; measured in
+a fresh interpreter of each checkout, through ``build_simulation`` — the scenario dataclass here, the
+keyword arguments of older checkouts), and ``command``, simulated seconds / wall seconds of the whole
+``simulate`` command (imports, gain design, build, run, logs and plots).
 """
 
 from __future__ import annotations
@@ -33,6 +36,29 @@ def wall(checkout: Path, integrator: str, engine: str, duration: float) -> float
         return time.perf_counter() - t0
 
 
+# Times the run alone in a fresh interpreter of a checkout; older checkouts take keyword arguments.
+RUN_ONLY = """
+import sys, time
+from stewart_drake.core.geometry import load_preset
+import stewart_drake.drake.simulation as S
+integrator, engine, duration = sys.argv[1], sys.argv[2], float(sys.argv[3])
+p = load_preset("utn-dynamic")
+kw = dict(integrator=integrator, engine=engine, design_duration=max(duration, 4.0))
+sim = S.build_simulation(S.Scenario(p, "seed", "fixed", **kw)) if hasattr(S, "Scenario") else S.build_simulation(p, "seed", "fixed", **kw)
+t0 = time.perf_counter()
+sim.run(duration)
+print(time.perf_counter() - t0)
+"""
+
+
+def run_only(checkout: Path, integrator: str, engine: str, duration: float) -> float:
+    """Seconds of the Simulator's run alone (build excluded), in a fresh interpreter of ``checkout``."""
+    env = dict(os.environ, PYTHONPATH=str(checkout), MPLBACKEND="Agg")
+    r = subprocess.run([sys.executable, "-c", RUN_ONLY, integrator, engine, str(duration)], env=env, cwd=checkout, check=True,
+                       capture_output=True, text=True)
+    return float(r.stdout.split()[-1])
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--duration", type=float, default=2.0, help="simulated seconds per command (default 2)")
@@ -40,17 +66,20 @@ def main(argv=None) -> int:
     ap.add_argument("--compare", type=Path, default=None, help="another checkout to time alongside this one")
     args = ap.parse_args(argv)
     trees = {"this": ROOT} | ({"other": args.compare.resolve()} if args.compare else {})
-    best = {(name, case): float("inf") for name in trees for case in CASES}
+    best = {(kind, name, case): float("inf") for kind in ("run", "command") for name in trees for case in CASES}
     for _ in range(args.repeat):
         for case in CASES:
             for name, tree in trees.items():  # interleaved: both trees see the same machine load
-                best[name, case] = min(best[name, case], wall(tree, *case, args.duration))
-    print(f"stewart-drake simulate --duration {args.duration:g} (seed on utn-dynamic, fixed point, 1 kHz); "
-          f"real-time factor = simulated s / wall s of the command, best of {args.repeat}:")
-    for case in CASES:
-        cells = "   ".join(f"{name}: {args.duration / best[name, case]:5.3f}x ({best[name, case]:6.2f} s)" for name in trees)
-        ratio = f"   this/other {best['other', case] / best['this', case]:.2f}x" if args.compare else ""
-        print(f"  --integrator {case[0]:5s} --engine {case[1]:6s}  {cells}{ratio}")
+                best["run", name, case] = min(best["run", name, case], run_only(tree, *case, args.duration))
+                best["command", name, case] = min(best["command", name, case], wall(tree, *case, args.duration))
+    print(f"seed on utn-dynamic, fixed point, 1 kHz, {args.duration:g} simulated s; real-time factor = simulated s / wall s, "
+          f"best of {args.repeat}:")
+    for kind in ("run", "command"):
+        print(f"{kind}:")
+        for case in CASES:
+            cells = "   ".join(f"{name}: {args.duration / best[kind, name, case]:5.3f}x ({best[kind, name, case]:6.2f} s)" for name in trees)
+            ratio = f"   this/other {best[kind, 'other', case] / best[kind, 'this', case]:.2f}x" if args.compare else ""
+            print(f"  --integrator {case[0]:5s} --engine {case[1]:6s}  {cells}{ratio}")
     return 0
 
 

@@ -65,9 +65,9 @@ def run(args) -> int:
     from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.control import ControllerConfig, DspTiming, check_timing
     from stewart_drake.core.geometry import load_platform
-    from stewart_drake.core.trajectory import fit_trajectory, get_trajectory
+    from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.drake.simulation import ActuatorModel, Scenario, design_poses, simulate, tracking_verdict
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate, tracking_verdict
     from stewart_drake.firmware.engine import resolve_engine
 
     reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")

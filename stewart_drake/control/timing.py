@@ -18,7 +18,14 @@ import numpy as np
 
 from stewart_drake.core.dynamics import open_loop_growth_rates
 from stewart_drake.core.sanity import check_positive, fmt_value, has_plate
-from stewart_drake.errors import INFEASIBLE_TIMING, PERIOD_TOO_SLOW, PLANT_STEP_ABOVE_LAG, PLANT_STEP_TOO_LONG, StewartError, TimingError
+from stewart_drake.errors import (
+    INFEASIBLE_TIMING,
+    PERIOD_TOO_SLOW,
+    PLANT_STEP_ABOVE_LAG,
+    PLANT_STEP_TOO_LONG,
+    StewartError,
+    TimingError,
+)
 from stewart_drake.fixedpoint import estimate_cycles, tp17_cycles
 
 LATENCY_MODES = ("sample", "computation", "none")
