@@ -2,7 +2,8 @@
 
 Drake objects do not pickle, so a worker receives a ``Study`` (the study's fixed settings: platform,
 reference, controller, integrator, duration, SPEC, seed) and a run index, draws that run's ``Draw`` from
-its own seed and builds its Diagram itself (``run_scenario``). The run's seed is
+its own seed, turns it into a ``drake.simulation.Scenario`` (``scenario``) and builds its Diagram from that
+itself (``run_scenario``). The run's seed is
 ``run_seed(study.seed, index)``: the first 64-bit word (its low 63 bits) of ``numpy.random.SeedSequence(S,
 spawn_key=(index,))``, so any run can be re-drawn alone from (S, index) or from its seed.
 
