@@ -113,7 +113,7 @@ class FixedPointLaw:
         g = self.gains
         self._alphas = np.array([[g.alpha], [g.alpha_ff]], dtype=np.int64)
         self._mantissas = np.array([[k.mantissa] for k in (g.kp, g.kd, g.kv, g.ki)], dtype=np.int64)
-        self._shifts = np.array([[k.shift] for k in (g.kp, g.kd, g.kv, g.ki)], dtype=np.int64)
+        self._shifts = np.array([[k.shift] for k in (g.kp, g.kd, g.kv, g.ki)], dtype=np.int64)  # >= 0 (``q15_gain``)
         self._cache: dict[bytes, np.ndarray] = {}
         self.cache_misses = 0
 
@@ -174,16 +174,18 @@ class FixedPointLaw:
         sp = self.setpoint_words(reference)
         m = self.quantise(measured)
         st = np.asarray(state).astype(np.int64)
-        integ, prev, dfilt, sp_prev, vfilt = np.split(st, 5)
+        integ, prev, dfilt, sp_prev, vfilt = st[:6], st[6:12], st[12:18], st[18:24], st[24:]
         # The same elementwise intrinsics as the firmware's per-leg code, on stacked rows (one numpy call per
         # operation for all rows): row 0 the measurement difference and its filter, row 1 the set-point's.
-        diff = q.shl(q.sat16(np.stack([m - prev, (sp - sp_prev) * self._counts_per_lsb])), DIFF_SHIFT)  # Word16, ·2^DIFF_SHIFT
+        # Every shift here is by a constant n >= 0, where shl(a, n) = sat16(a << n) and L_shl(a, n) =
+        # sat32(a << n) (``q15.shl``, ``q15.L_shl``): written so, without their run-time sign dispatch.
+        diff = q.sat16(q.sat16(np.stack([m - prev, (sp - sp_prev) * self._counts_per_lsb])) << DIFF_SHIFT)  # Word16, ·2^DIFF_SHIFT
         # first-order filters of the differences: f += alpha·(d − f), rounded Q15 multiplies
         filt = np.stack([dfilt, vfilt])
         dfilt, vfilt = q.add(filt, q.mult_r(self._alphas, q.sub(diff, filt)))
         e = q.sat16(sp * self._counts_per_lsb - m)  # Word16 error, counts
         # the P, D, V terms and the integrator's increment: Q31 products shifted by each gain's exponent
-        P, D, V, dI = q.L_shl(q.L_mult(self._mantissas, np.stack([e, dfilt, vfilt, e])), self._shifts)
+        P, D, V, dI = q.sat32(q.L_mult(self._mantissas, np.stack([e, dfilt, vfilt, e])) << self._shifts)
         u32 = q.L_add(q.L_sub(q.L_add(P, integ), D), V)
         if feedforward is not None:
             u32 = q.L_add(u32, q.L_deposit_h(self.feedforward_words(feedforward)))

@@ -201,13 +201,16 @@ class Actuators(LeafSystem):
             self.state_index = None
             self.DeclareVectorOutputPort("force", 6, self._CalcForce)
 
+    def _saturated(self, context) -> np.ndarray:
+        # np.minimum(np.maximum()) is np.clip's result (NaN included), without its per-call overhead
+        return np.minimum(np.maximum(self._u.Eval(context), -self.max_force), self.max_force)
+
     def _Update(self, context, discrete_state):
         F = context.get_discrete_state(self.state_index).value()
-        cmd = np.clip(self._u.Eval(context), -self.max_force, self.max_force)
-        discrete_state.set_value(self.state_index, self._a * F + (1 - self._a) * cmd)
+        discrete_state.set_value(self.state_index, self._a * F + (1 - self._a) * self._saturated(context))
 
     def _CalcForce(self, context, output):
-        output.SetFromVector(np.clip(self._u.Eval(context), -self.max_force, self.max_force))
+        output.SetFromVector(self._saturated(context))
 
 
 class LegLengthSensor(LeafSystem):
