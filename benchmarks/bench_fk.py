@@ -1,7 +1,9 @@
 """Forward-kinematics throughput: batched Newton, Drake MathematicalProgram, all assembly modes
 (multi-start search and the complete parameter homotopy of ``stewart_drake.homotopy``).
 
-Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--quick]``. Pins nothing; prints absolute
+Run by hand: ``.venv/bin/python benchmarks/bench_fk.py [--quick] [--homotopy|--homotopy-only] [--fksgp DIR]``.
+The homotopy section times both path-tracker engines (compiled ``c``, the default, and the ``numpy`` reference)
+in the same run, and, with ``--fksgp``, fkSGP's own Python solver from a checkout of it. Pins nothing; prints absolute
 figures for this machine and ratios measured in the same run (the ratios travel between machines,
 the absolute numbers do not). Single core: set OMP/OPENBLAS threads to 1 before numpy loads.
 """
@@ -83,10 +85,43 @@ def assembly_times() -> list[tuple]:
     return rows
 
 
-# fkSGP (Martyushev et al., elimination templates, Mech. Mach. Theory 2025), published per-case times in
-# Python: ~11-15 ms on Dietmaier's general 6-6, ~5 ms on a planar 6-6; it does not handle the 3-fold
-# symmetric 6-6 (roots at infinity) nor 3-6 platforms. Quoted from its paper, not measured here.
+# fkSGP (Martyushev, elimination templates, Mech. Mach. Theory 215 (2025) 106170, arXiv 2505.00634), per-case
+# times in Python as quoted by the project's issue 15: ~11-15 ms on Dietmaier's general 6-6, ~5 ms on a planar
+# 6-6; it does not handle the 3-fold symmetric 6-6 (roots at infinity) nor 3-6 platforms. Not measured here
+# unless --fksgp points at a checkout of github.com/martyushev/fkSGP (MIT; not part of this project).
 FKSGP_MS = {"dietmaier-1998": "11-15", "planar": "~5", "gonzalez-dutra-2009": "fails", "utn-dynamic": "fails", "utn-kinematic": "fails"}
+
+
+def fksgp_times(path, cases, repeat: int) -> dict:
+    """{label: (median CPU ms per length set, real postures it returned per set)} of fkSGP's Python solver
+    (``solver66``; ``solver6p6p`` when both plates are planar) on the same cases, from a checkout at
+    ``path``. Its frames put the first base and plate anchors at the origin (a change of pose
+    coordinates only); its squared-length input is L²; its internal random rotations are seeded."""
+    import sys
+
+    sys.path.insert(0, str(path))
+    import python as fk  # the checkout's python/ package
+
+    out = {}
+    for label, _, p, Ls in cases:
+        X = p.base_anchors - p.base_anchors[0]
+        x = p.top_anchors_per_leg - p.top_anchors_per_leg[0]
+        planar = np.all(np.abs(X[:, 2]) < 1e-12) and np.all(np.abs(x[:, 2]) < 1e-12)
+        solver = fk.solver6p6p if planar else fk.solver66
+        np.random.seed(0)
+        cs, n_real = [], []
+        for L in Ls:
+            for _ in range(repeat):
+                c0 = time.process_time()
+                try:
+                    Rt, _ = solver(X, x, L**2, 1)
+                    n = len(Rt)
+                except Exception as err:  # its template assumes 40 finite roots: report how it fails
+                    n = type(err).__name__
+                cs.append(time.process_time() - c0)
+            n_real.append(n)
+        out[label] = (1e3 * float(np.median(cs)), n_real)
+    return out
 
 
 def homotopy_cases(n_poses: int):
@@ -106,29 +141,43 @@ def homotopy_cases(n_poses: int):
     return cases
 
 
+ENGINES = ("c", "numpy")  # the compiled tracker (default) and the numpy reference it replaced
+
+
 def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tuple]:
-    """Per length set: homotopy median time (stage one cached), its one-time stage-one cost, the
-    multi-start search's time (polish off) on the same sets, and the outcome."""
+    """Per case, per tracker engine: median time per length set (stage one cached; wall and process CPU),
+    its one-time stage-one cost, the outcome; whether both engines gave the same path classes and modes;
+    the multi-start search's time (polish off) on the same sets."""
     from stewart_drake.core.assembly_modes import assembly_modes
     from stewart_drake.homotopy import solve
     from stewart_drake.homotopy.solve import _PLATFORM_STARTS
+    from stewart_drake.homotopy.track import TrackOptions
 
     rows = []
     for label, key, p, Ls in homotopy_cases(n_poses):
-        _PLATFORM_STARTS.clear()
-        t0 = time.perf_counter()
-        solve(p, Ls[0])
-        t_first = time.perf_counter() - t0
-        ts, cs, ok, cert, paths = [], [], True, True, None
-        for L in Ls:
-            for _ in range(repeat):
-                t0, c0 = time.perf_counter(), time.process_time()
-                r = solve(p, L)
-                ts.append(time.perf_counter() - t0)
-                cs.append(time.process_time() - c0)
-            ok &= r.complete
-            cert &= all(m.certified for m in r.modes)
-            paths = (r.n_paths, r.max_solutions, r.counts())
+        per_engine, outs = {}, {}
+        for engine in ENGINES:
+            o = TrackOptions(engine=engine)
+            _PLATFORM_STARTS.clear()
+            t0 = time.perf_counter()
+            solve(p, Ls[0], options=o)
+            t_first = time.perf_counter() - t0
+            ts, cs, ok, cert, paths, res = [], [], True, True, None, []
+            for L in Ls:
+                for _ in range(repeat):
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    r = solve(p, L, options=o)
+                    ts.append(time.perf_counter() - t0)
+                    cs.append(time.process_time() - c0)
+                ok &= r.complete
+                cert &= all(m.certified for m in r.modes)
+                paths = (r.n_paths, r.max_solutions, r.counts())
+                res.append(r)
+            med = float(np.median(ts))
+            per_engine[engine] = (paths, ok, cert, 1e3 * med, 1e3 * float(np.median(cs)), 1e3 * (t_first - med))
+            outs[engine] = res
+        same = all(a.classes == b.classes and len(a.modes) == len(b.modes) and all(
+            np.abs(m.position - n.position).max() < 1e-9 for m, n in zip(a.modes, b.modes)) for a, b in zip(*outs.values()))
         t_ms, c_ms = [], []
         if with_multistart:
             for L in Ls:
@@ -136,17 +185,18 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
                 assembly_modes(p, L, polish=None)
                 t_ms.append(time.perf_counter() - t0)
                 c_ms.append(time.process_time() - c0)
-        med = float(np.median(ts))
         nan = float("nan")
-        rows.append((label, key, paths, ok, cert, 1e3 * med, 1e3 * float(np.median(cs)), 1e3 * (t_first - med),
-                     1e3 * float(np.median(t_ms)) if t_ms else nan, 1e3 * float(np.median(c_ms)) if c_ms else nan))
+        n_real = [sum(c == "real" for c in r.classes) for r in outs["c"]]
+        rows.append((label, key, per_engine, same, 1e3 * float(np.median(t_ms)) if t_ms else nan,
+                     1e3 * float(np.median(c_ms)) if c_ms else nan, n_real))
     return rows
 
 
 def homotopy_batch(n: int) -> list[tuple]:
-    """Batched mode: n length sets of one platform in one call, per-set time."""
+    """Batched mode: n length sets of one platform in one call, per-set time, per engine."""
     from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
     from stewart_drake.homotopy import solve_batch
+    from stewart_drake.homotopy.track import TrackOptions
 
     rows = []
     rng = np.random.default_rng(1)
@@ -155,30 +205,53 @@ def homotopy_batch(n: int) -> list[tuple]:
     for name, p in platforms.items():
         q = p.home_pose() + np.c_[rng.uniform(-0.05, 0.05, (n, 3)), rng.uniform(-0.2, 0.2, (n, 3))]
         L = leg_lengths(p, q)
-        solve_batch(p, L[:1])  # stage one, cached
-        c0 = time.process_time()
-        t, rs = best_of(lambda: solve_batch(p, L), 1)
-        cpu = time.process_time() - c0
-        rows.append((name, n, 1e3 * t / n, 1e3 * cpu / n, sum(r.complete for r in rs), rs[0].timing))
+        for engine in ENGINES:
+            o = TrackOptions(engine=engine)
+            solve_batch(p, L[:1], options=o)  # stage one, cached
+            c0 = time.process_time()
+            t, rs = best_of(lambda: solve_batch(p, L, options=o), 1)
+            cpu = time.process_time() - c0
+            rows.append((name, engine, n, 1e3 * t / n, 1e3 * cpu / n, sum(r.complete for r in rs), rs[0].timing))
     return rows
+
+
+def fksgp_cell(measured, n_real, quoted: str) -> str:
+    """fkSGP's CPU ms when measured ("*" when its real postures differ from the homotopy's), else the quote."""
+    if measured is None:
+        return quoted
+    ms, its = measured
+    return f"{ms:.1f}" + ("" if its == n_real else "*")
 
 
 def print_homotopy(args) -> None:
     print("\n# Complete FK by parameter homotopy (all paths, classified, real modes certified) vs multi-start")
-    print(f"{'case':36s} {'paths':>9s} {'complete':>8s} {'cert':>5s} {'hom ms':>7s} {'hom cpu':>7s} {'stage1':>7s} "
-          f"{'multi ms':>9s} {'multi cpu':>9s} {'ratio':>6s} {'fkSGP ms':>9s}  classes")
-    rows = homotopy_times(3 if args.quick else 5, 3 if args.quick else 5, not args.homotopy_only)
-    for label, key, (n2, nmax, counts), ok, cert, med, cpu, first, ms, mcpu in rows:
+    print("# engines: c = compiled tracker (default), numpy = the vectorised reference tracker")
+    print(f"{'case':32s} {'paths':>9s} {'complete':>8s} {'cert':>5s} {'c ms':>6s} {'c cpu':>6s} {'numpy ms':>8s} "
+          f"{'np cpu':>6s} {'stage1 c/np':>11s} {'same':>5s} {'multi cpu':>9s} {'multi/c':>7s} {'multi/np':>8s} "
+          f"{'np/c':>5s} {'fkSGP ms':>8s}  classes")
+    n_poses, repeat = (3, 3) if args.quick else (5, 5)
+    rows = homotopy_times(n_poses, repeat, not args.homotopy_only)
+    fk = fksgp_times(args.fksgp, homotopy_cases(n_poses), repeat) if args.fksgp else {}
+    for label, key, pe, same, ms, mcpu, n_real in rows:
+        (n2, nmax, counts), ok, cert, med, cpu, first = pe["c"]
+        _, ok2, cert2, med2, cpu2, first2 = pe["numpy"]
         cls = " ".join(f"{k}={v}" for k, v in counts.items() if v)
-        print(f"{label:36s} {n2:4d}/{nmax:<4d} {str(ok):>8s} {str(cert):>5s} {med:7.1f} {cpu:7.1f} {first:7.1f} "
-              f"{ms:9.1f} {mcpu:9.1f} {mcpu / cpu:6.1f} {FKSGP_MS[key]:>9s}  {cls}")
-    print("(hom: median per length set, wall and process CPU time, with the platform's stage one cached; stage1: its")
-    print(" one-time wall cost (ms); ratio: multi-start CPU / homotopy CPU, measured in this run (CPU time because the")
-    print(" machine may be shared: wall time then includes waiting); fkSGP: published, not measured here)")
+        print(f"{label:32s} {n2:4d}/{nmax:<4d} {str(ok and ok2):>8s} {str(cert and cert2):>5s} {med:6.1f} {cpu:6.1f} "
+              f"{med2:8.1f} {cpu2:6.1f} {first:5.0f}/{first2:<5.0f} {str(same):>5s} {mcpu:9.1f} {mcpu / cpu:7.1f} "
+              f"{mcpu / cpu2:8.1f} {cpu2 / cpu:5.1f} {fksgp_cell(fk.get(label), n_real, FKSGP_MS[key]):>8s}  {cls}")
+    print("(ms: median per length set, wall and process CPU time, with the platform's stage one cached; stage1: its")
+    print(" one-time wall cost (ms); same: both engines gave the same path classes and real modes; ratios: CPU time,")
+    print(" measured in this run (CPU because the machine may be shared: wall time then includes waiting); fkSGP:")
+    print(" " + ("CPU ms measured in this run (--fksgp), * = its real postures differ from the homotopy's" if fk
+                 else "quoted, not measured here") + "; complete/cert: for both engines)")
+    if fk:
+        print("real postures per length set, homotopy vs fkSGP (realOnly; an exception name where it raised):")
+        for label, _, _, _, _, _, n_real in rows:
+            print(f"  {label:32s} homotopy {n_real}  fkSGP {fk[label][1]}")
     print("\n# Batched homotopy: many length sets of one platform in one call")
-    for name, n, per, cpu, n_ok, timing in homotopy_batch(20 if args.quick else 100):
+    for name, engine, n, per, cpu, n_ok, timing in homotopy_batch(20 if args.quick else 100):
         tm = ", ".join(f"{k} {v:.2f} s" for k, v in timing.items())
-        print(f"{name:22s} {n:4d} sets: {per:6.2f} ms wall, {cpu:6.2f} ms CPU per set, {n_ok}/{n} complete ({tm})")
+        print(f"{name:22s} {engine:5s} {n:4d} sets: {per:6.2f} ms wall, {cpu:6.2f} ms CPU per set, {n_ok}/{n} complete ({tm})")
 
 
 def main(argv=None) -> int:
@@ -186,6 +259,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="smaller batches")
     ap.add_argument("--homotopy", action="store_true", help="only the complete-FK (homotopy vs multi-start) section")
     ap.add_argument("--homotopy-only", action="store_true", help="only the homotopy timings, without the multi-start comparison")
+    ap.add_argument("--fksgp", metavar="DIR", help="a checkout of github.com/martyushev/fkSGP: time its Python solver on the same cases")
     args = ap.parse_args(argv)
     n = 20_000 if args.quick else 100_000
     if args.homotopy or args.homotopy_only:

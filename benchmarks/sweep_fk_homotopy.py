@@ -2,7 +2,7 @@
 homotopy (``stewart_drake.homotopy``) and by the multi-start search (``forward.assembly_modes``).
 
 Run by hand: ``PYTHONPATH=. .venv/bin/python benchmarks/sweep_fk_homotopy.py [--planar 100] [--general 40]
-[--three-six 40]``. Prints, per family, how many results are complete, agree with the multi-start (same
+[--three-six 40] [--engine auto|c|numpy]``. Prints, per family, how many results are complete, agree with the multi-start (same
 real modes to 1e-8), have every mode certified, needed re-tracking or a new gamma; lists any exception.
 """
 
@@ -15,6 +15,7 @@ import numpy as np
 from stewart_drake.core.assembly_modes import assembly_modes, general_platform, planar_platform
 from stewart_drake.core.geometry import Platform
 from stewart_drake.homotopy import solve
+from stewart_drake.homotopy.track import ENGINES, TrackOptions
 from stewart_drake.core.kinematics import leg_lengths
 
 
@@ -47,13 +48,15 @@ def main(argv=None) -> int:
     ap.add_argument("--planar", type=int, default=100)
     ap.add_argument("--general", type=int, default=40)
     ap.add_argument("--three-six", type=int, default=40)
+    ap.add_argument("--engine", choices=ENGINES, default="auto", help="path tracker implementation (TrackOptions.engine)")
     args = ap.parse_args(argv)
+    options = TrackOptions(engine=args.engine)
     for family, make, n in (("planar 6-6", planar_platform, args.planar), ("general 6-6", general_platform, args.general),
                             ("3-6", three_six_platform, args.three_six)):
         complete = agree = certified = retracked = regamma = 0
         for seed in range(n):
             p, L = make(seed)
-            r = solve(p, L)
+            r = solve(p, L, options=options)
             ms = assembly_modes(p, L, polish=None)
             ok = same_modes(r.modes, ms.modes)
             complete += r.complete

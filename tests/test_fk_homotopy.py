@@ -1,6 +1,8 @@
 """Complete forward kinematics by parameter homotopy (``stewart_drake.homotopy``), checked against the
 multi-start search (``forward.assembly_modes``) and Drake's MathematicalProgram (``forward.ProgramFK``)."""
 
+import importlib
+
 import numpy as np
 import pytest
 
@@ -17,13 +19,16 @@ from stewart_drake.homotopy.study import (
     study_from_pose,
     study_parameters,
 )
-from stewart_drake.homotopy.track import track
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.homotopy import ctrack
+from stewart_drake.homotopy.solve import _classify
+from stewart_drake.homotopy.track import DONE, STALLED, TrackOptions, track
 
 # Two solvers agree on a mode when positions and rotation matrices agree to this: both are
 # Newton-polished to ~1e-15 m leg residual, and the modes are well separated (min distance ~1e-2).
 SAME_MODE = 1e-8
+solve_module = importlib.import_module("stewart_drake.homotopy.solve")  # the package's ``solve`` is the function
 
 
 def _key(modes):
@@ -148,11 +153,13 @@ def test_presets_at_three_poses_batched(name, kind, n_inf):
     assert direct.counts()["infinity"] == n_inf and _same_sets(direct.modes, rs[2].modes)
 
 
-def test_perturbed_path_is_reported_incomplete():
+@pytest.mark.parametrize("engine", ["c", "numpy"])
+def test_perturbed_path_is_reported_incomplete(engine):
     """Capping one path at 3 steps (in every attempt) makes it fail: the result is not complete and
-    names that path; the other paths are still classified."""
+    names that path; the other paths are still classified (both tracker implementations)."""
     p, L = dietmaier_platform()
-    r = solve(p, L, path_max_steps={17: 3})
+    r = solve(p, L, path_max_steps={17: 3}, options=TrackOptions(engine=engine))
+    assert r.engine == engine
     assert not r.complete
     assert r.failed_paths == [17] and r.classes[17] == "failed"
     assert "17" in r.guarantee and "failed" in r.guarantee
@@ -296,3 +303,77 @@ def test_fk_all_cli_reports_paths_and_certificates(capsys):
     assert main(short) == 1
     err = capsys.readouterr().err
     assert "no real assembly mode" in err and "cannot be assembled" in err
+
+
+@pytest.mark.parametrize("name", ["dietmaier", "gonzalez-dutra-2009", "utn-dynamic"])
+def test_compiled_tracker_matches_numpy(name):
+    """The compiled tracker (track.c) and the numpy reference run the same algorithm: from the shipped
+    start system to the platform (Dietmaier: 40 real; symmetric 6-6: 12 paths to infinity; 3-6), every
+    path ends in the same state, and the paths that reached t = 1 end at the same point. Tolerance
+    1e-9 relative: both end points are Newton-refined roots, so they differ by rounding (1e-16) times
+    the root's condition number (below 1e5 here, Dietmaier's being the worst). The stalled paths
+    approach a root at infinity, where the Jacobian is singular and the iterates are not determined
+    to rounding: both must be classified at infinity."""
+    if name == "dietmaier":
+        p, L = dietmaier_platform()
+    else:
+        p = load_preset(name)
+        L = leg_lengths(p, p.home_pose() + [0.01, 0.02, -0.01, 0.1, 0.05, -0.1])
+    arch = architecture(p)
+    a, b, s, _ = study_parameters(p, L, arch)
+    B1 = leg_matrices(a, b)
+    S = load_start_system(arch.kind)
+    paths = {e: track(S.x, S.B, B1, S.s, s[None], S.v, np.exp(0.3j), TrackOptions(engine=e)) for e in ("c", "numpy")}
+    c, ref = paths["c"], paths["numpy"]
+    np.testing.assert_array_equal(c.state, ref.state)
+    done = ref.state == DONE
+    assert done.sum() == {"dietmaier": 40, "gonzalez-dutra-2009": 28, "utn-dynamic": 16}[name]
+    rel = np.abs(c.x - ref.x).max(1) / np.abs(ref.x).max(1)
+    assert rel[done].max() < 1e-9
+    stalled = ref.state == STALLED
+    for P in (c, ref):
+        cls, _ = _classify(P, B1, np.broadcast_to(s, (len(S.x), 6)), S.v)
+        assert np.all(cls[stalled] == "infinity")
+
+
+def test_tracker_falls_back_to_numpy_without_a_compiler(monkeypatch, tmp_path):
+    """Without a C compiler ($STEWART_DRAKE_CC naming a program that does not exist) and no compiled
+    tracker in the (empty) build cache, "auto" tracks with numpy and gives the compiled tracker's
+    result, and "c" says there is no compiler; an unknown engine name is refused."""
+    from stewart_drake.firmware.build import CompilerUnavailable
+
+    p = load_preset("utn-dynamic")
+    L = leg_lengths(p, p.home_pose() + [0.01, 0.02, -0.01, 0.1, 0.05, -0.1])
+    compiled = solve(p, L, options=TrackOptions(engine="c"))
+    monkeypatch.setenv("STEWART_DRAKE_CC", "/nonexistent/cc")
+    monkeypatch.setenv("STEWART_DRAKE_CACHE", str(tmp_path))
+    monkeypatch.setattr(ctrack, "_LIB", [])
+    monkeypatch.setattr(solve_module, "_PLATFORM_STARTS", {})  # stage one redone (and then forgotten) with numpy
+    fallback = solve(p, L, options=TrackOptions(engine="auto"))
+    assert fallback.engine == "numpy" and compiled.engine == "c" and fallback.complete
+    assert _same_sets(fallback.modes, compiled.modes)
+    with pytest.raises(CompilerUnavailable):
+        solve(p, L, options=TrackOptions(engine="c"))
+    with pytest.raises(ValueError, match="engine"):
+        solve(p, L, options=TrackOptions(engine="fortran"))
+
+
+def test_duplicate_end_points_are_found():
+    """Two end points that are the same pose (equal, or negatives: x and −x are one Study point) closer
+    than DISTINCT_TOL in the max-norm are reported, both of them; points just farther apart are not.
+    Checked against the plain all-pairs comparison on random sets."""
+    from stewart_drake.homotopy.solve import DISTINCT_TOL, _duplicates
+
+    rng = np.random.default_rng(11)
+    for trial in range(50):
+        y = rng.normal(size=(40, 8)) + 1j * rng.normal(size=(40, 8))
+        for _ in range(trial % 4):
+            a, b = rng.choice(40, 2, replace=False)
+            y[b] = rng.choice([-1, 1]) * y[a] + rng.uniform(0, 2 * DISTINCT_TOL) * rng.normal(size=8)
+        idx = np.arange(40)[::-1]
+        z = y[idx]
+        d = np.minimum(np.abs(z[:, None] - z[None]).max(-1), np.abs(z[:, None] + z[None]).max(-1)) + np.diag(np.full(40, np.inf))
+        expected = sorted(int(i) for i in idx[np.any(d <= DISTINCT_TOL * np.maximum(1, np.abs(z).max(-1))[:, None], axis=1)])
+        assert _duplicates(y, idx) == expected
+    y[7] = -y[3]
+    assert {3, 7} <= set(_duplicates(y, np.arange(40)))

@@ -1,4 +1,4 @@
-"""Design analysis (issue 16): actuator sizing for a trajectory, a motion program and a duty envelope;
+"""Design analysis: actuator sizing for a trajectory, a motion program and a duty envelope;
 Cartesian stiffness and its ellipsoids; natural frequencies analytic vs Drake; maps of dexterity,
 stiffness and lowest frequency over a workspace slice; a summary for each preset."""
 

@@ -24,7 +24,7 @@ from stewart_drake.report import run_standalone
 TITLE = "Forward kinematics: round trips, assembly modes, timing"
 ORDER = 30
 COST = 10  # relative run time: the report's workers start the costliest analyses first
-ROUND_TRIP_TOL = 1e-9  # m and rad (issue 3's bound); the pose error is ~ tol_Newton / sigma_min
+ROUND_TRIP_TOL = 1e-9  # m and rad; the pose error is ~ tol_Newton / sigma_min
 
 
 def round_trips(platform, n: int, seed: int = 11) -> dict:

@@ -49,7 +49,7 @@ from stewart_drake.homotopy.study import (
     pose_from_study,
     study_parameters,
 )
-from stewart_drake.homotopy.track import DONE, FAILED, STALLED, TrackOptions, track
+from stewart_drake.homotopy.track import DONE, FAILED, STALLED, TrackOptions, engine_used, track
 
 REAL, COMPLEX, INFINITY, SINGULAR, FAIL = "real", "complex", "infinity", "singular", "failed"
 CLASSES = (REAL, COMPLEX, INFINITY, SINGULAR, FAIL)
@@ -89,7 +89,8 @@ class HomotopyResult:
     """Outcome for one length set. ``classes`` ``(n_paths,)`` per-path class (``CLASSES``); ``modes``
     the real solutions; ``complete`` and ``guarantee`` as in the module docstring; ``failed_paths``
     path indices that failed even after re-tracking; ``retracked`` those re-tracked; ``steps``
-    ``(n_paths,)`` tracker steps; ``attempts`` how many random γ were used."""
+    ``(n_paths,)`` tracker steps; ``attempts`` how many random γ were used; ``engine`` the tracker
+    implementation that ran ("c" or "numpy", ``track.TrackOptions.engine``)."""
 
     kind: str
     architecture: str
@@ -107,6 +108,7 @@ class HomotopyResult:
     dropped: int = 0
     time_s: float = 0.0
     timing: dict = field(default_factory=dict)
+    engine: str = ""
 
     @property
     def n_paths(self) -> int:
@@ -164,10 +166,17 @@ def _duplicates(y: np.ndarray, idx: np.ndarray) -> list[int]:
     z = y[idx]
     if len(z) < 2:
         return []
-    d = np.minimum(np.abs(z[:, None] - z[None]).max(-1), np.abs(z[:, None] + z[None]).max(-1))
-    d[np.diag_indices(len(z))] = np.inf
-    close = d <= DISTINCT_TOL * np.maximum(1.0, np.abs(z).max(-1))[:, None]
-    return sorted(int(i) for i in idx[np.any(close, axis=1)])
+    tol = DISTINCT_TOL * np.maximum(1.0, np.abs(z).max(-1))
+    # Exact prefilter: |Σ_k (z_ik ∓ z_jk)| <= 8 max_k |z_ik ∓ z_jk|, so a pair within tol (max-norm) has
+    # its coordinate sums within 8 tol; only such pairs (few) get the full comparison.
+    w = z.sum(-1)
+    near = np.minimum(np.abs(w[:, None] - w[None]), np.abs(w[:, None] + w[None])) <= 8 * tol[:, None] * (1 + 1e-9)
+    near[np.diag_indices(len(z))] = False
+    out = set()
+    for i, j in zip(*np.nonzero(near)):
+        if min(np.abs(z[i] - z[j]).max(), np.abs(z[i] + z[j]).max()) <= tol[i]:
+            out.add(int(idx[i]))
+    return sorted(out)
 
 
 @dataclass(frozen=True)
@@ -342,7 +351,8 @@ def solve_batch(
         )
     total = time.perf_counter() - t_start
     timing = {"stage1": t_stage1, "track": t_track, "classify": t_class, "certify": total - t_stage1 - t_track - t_class}
-    return [HomotopyResult(**{**r.__dict__, "time_s": total / m, "timing": timing}) for r in results]
+    engine = engine_used(options)
+    return [HomotopyResult(**{**r.__dict__, "time_s": total / m, "timing": timing, "engine": engine}) for r in results]
 
 
 def solve(platform: Platform, lengths, **kwargs) -> HomotopyResult:
