@@ -42,7 +42,8 @@ from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
-from stewart_drake.drake.platform_model import build_plant, leg_joint_positions, set_pose
+from stewart_drake.core.leg_bodies import leg_joint_positions
+from stewart_drake.drake.platform_model import build_plant, set_pose
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
 
 # ----------------------------------------------------------------------------------------------
