@@ -10,7 +10,7 @@ from collections import Counter
 import numpy as np
 
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
-from stewart_drake.firmware.build import compilers
+from stewart_drake.core.c_build import compilers
 from stewart_drake.firmware.check import workspace_poses
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.host import op_counts_tp17, tp17_leg_lengths_c

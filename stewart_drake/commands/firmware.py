@@ -66,7 +66,7 @@ def _config(args, platform):
 
 def run_generate(args) -> int:
     from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.firmware.build import compilers
+    from stewart_drake.core.c_build import compilers
     from stewart_drake.firmware.generate import FILES, generate
     from stewart_drake.firmware.module import compile_generated
     from stewart_drake.core.geometry import load_platform
@@ -114,7 +114,7 @@ def run_generate(args) -> int:
 
 
 def run_check(args) -> int:
-    from stewart_drake.firmware.build import compiler_by_name
+    from stewart_drake.core.c_build import compiler_by_name
     from stewart_drake.drake.firmware_check import check_firmware
     from stewart_drake.core.geometry import load_platform
 

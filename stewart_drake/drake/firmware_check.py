@@ -12,7 +12,7 @@ import numpy as np
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.core.geometry import Platform
 from stewart_drake.drake.simulation import Scenario, build_simulation
-from stewart_drake.firmware.build import Compiler
+from stewart_drake.core.c_build import Compiler
 from stewart_drake.firmware.check import MAX_POSES, check_ik, check_tick
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import compile_user

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.firmware.build import Compiler, Source, build, library_sources, load
+from stewart_drake.core.c_build import Compiler, Source, build, library_sources, load
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
 
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
