@@ -21,7 +21,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 import numpy as np  # noqa: E402
 
 from stewart_drake.control import ControllerConfig  # noqa: E402
-from stewart_drake.firmware.build import compiler_by_name  # noqa: E402
+from stewart_drake.core.c_build import compiler_by_name  # noqa: E402
 from stewart_drake.firmware.check import workspace_poses  # noqa: E402
 from stewart_drake.firmware.generate import generate  # noqa: E402
 from stewart_drake.firmware.host import tp17_leg_lengths_c  # noqa: E402

@@ -11,7 +11,7 @@ import pytest
 
 from stewart_drake.cli import main
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
-from stewart_drake.firmware import build
+from stewart_drake.core import c_build as build
 from stewart_drake.firmware.check import emulation_trace, trace_names, workspace_poses
 from stewart_drake.firmware.generate import TRACE_WORDS, generate
 from stewart_drake.firmware.module import TickRunner, compile_generated
