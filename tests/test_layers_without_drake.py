@@ -1,5 +1,5 @@
-"""The numpy layers' own tests need no Drake: the tests under tests/core, tests/fixedpoint, tests/workspace,
-tests/script and tests/design pass with pydrake unimportable (``tests/cli/_no_drake.py`` loaded as a pytest
+"""The numpy layers' own tests need no Drake: the tests under tests/core, tests/control, tests/fixedpoint,
+tests/workspace, tests/script and tests/design pass with pydrake unimportable (``tests/cli/_no_drake.py`` loaded as a pytest
 plugin), so each layer is checked the way a machine without Drake would run it. The Drake cross-checks of those
 layers live in tests/drake and their Drake-backed commands in tests/cli."""
 
@@ -10,7 +10,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = "tests.cli._no_drake"
-DRAKE_FREE = ("tests/core", "tests/fixedpoint", "tests/workspace", "tests/script", "tests/design")
+DRAKE_FREE = ("tests/core", "tests/control", "tests/fixedpoint", "tests/workspace", "tests/script", "tests/design")
 
 
 def pytest_without_drake(*args):

@@ -1,6 +1,6 @@
 """Physical sanity everywhere (``stewart_drake.core.sanity``): literal messages and exit codes for every case
-(plate below the base, out of stroke along a trajectory, missing plate, singular home, non-finite or
-absurd options, lost tracking, saturation), checked against independent computations; and property
+of the numpy commands (plate below the base, out of stroke along a trajectory, missing plate, singular home,
+non-finite or absurd options), checked against independent computations; and property
 tests over random poses and trajectories: exit code in {0, 1, 2}, no traceback, no NaN/inf printed, and
 exit 0 only for physically valid results."""
 
@@ -21,7 +21,7 @@ from stewart_drake.errors import FAR_CENTRE, GRAVITY_RANGE, SERVO_NEUTRAL, Physi
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.drake.simulation import SEED
+from stewart_drake.core.trajectory import SEED
 
 NOPLATE = """name: noplate
 length_unit: m
@@ -163,29 +163,8 @@ def test_dynamics_csv_first_violation_is_the_first_in_time(tmp_path):
     assert rc == 1 and "trajectory " in err and "at t = 0.2000 s: the plate is below the base" in err
 
 
-def test_simulate_refuses_out_of_stroke_and_below_base_before_running(tmp_path):
-    rc, out, err = cli("simulate", "--platform", "utn-kinematic", "--duration", 0.5, "--out", tmp_path / "o", "--no-progress")
-    assert rc == 1 and out == "" and not (tmp_path / "o").exists()
-    assert "the seed reference leaves the stroke: first at t = 0.0000 s, leg 1 length 891.074 mm" in err
-    f = tmp_path / "below.csv"
-    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,-0.7,0,0,0\n1,0,0,-0.7,0,0,0\n")
-    rc, _, err = cli("simulate", "--trajectory", f, "--out", tmp_path / "o", "--no-progress")
-    assert rc == 1 and "the below reference at t = 0.0000 s: the plate is below the base" in err
-
-
 # ----------------------------------------------------------------------------------------------
 # Required physics, platforms.
-
-
-def test_missing_plate_is_an_error_for_dynamics_and_simulate_only(noplate, tmp_path):
-    msg = ("platform 'noplate' has no plate mass properties (YAML key 'plate' missing, or its mass is 0): '{c}' needs plate.mass "
-           "and plate.inertia (or plate.thickness and plate.density for a utn platform)")
-    rc, out, err = cli("dynamics", "--platform", noplate)
-    assert rc == 2 and out == "" and err.strip() == "stewart-drake dynamics: error: " + msg.format(c="dynamics")
-    rc, _, err = cli("simulate", "--platform", noplate, "--out", tmp_path / "o", "--no-progress")
-    assert rc == 2 and err.strip() == "stewart-drake simulate: error: " + msg.format(c="simulate")
-    assert cli("ik", "--platform", noplate, "--pose", 0, 0, 700, 0, 0, 0)[0] == 0
-    assert cli("workspace", "--platform", noplate, "--resolution", 0.05)[0] == 0
 
 
 def test_singular_home_is_refused_when_loaded_naming_the_anchors(tmp_path):
@@ -222,12 +201,6 @@ def test_presets_pass_their_own_sanity(name):
      "argument --trim: " + UsageError.NOT_FINITE_NUMBER.format(value="nan")),
     (("workspace", "--centre", "100", "0", "0"),
      FAR_CENTRE.format(option="--centre", centre="100 0 0", ratio=105, size_m=0.95, limit=10)),
-    (("simulate", "--plant-step", "1", "--no-progress"),
-     "--plant-step 1 s is longer than the controller period 0.001 s; the plant step must resolve the period (at most one period)"),
-    (("simulate", "--period", "0.004", "--plant-step", "0.004", "--no-progress"),
-     "--plant-step 0.004 s is longer than the actuators' time constant 0.002 s, the platform's fastest modelled dynamics"),
-    (("simulate", "--period", "10", "--no-progress"),
-     "--period 10 s is too slow for platform utn-dynamic: its fastest open-loop mode grows at 7.13/s"),
     (("fk", "--max-iter", "1000000000", "--lengths", "500", "500", "500", "500", "500", "500"),
      "--max-iter 1000000000 would need 1e+09 Newton iterations; the limit is 1e+03 Newton iterations"),
 ])
@@ -242,10 +215,9 @@ def test_bad_options_exit_2_with_the_message(argv, message, tmp_path):
 def test_period_bound_is_the_crossover_margin():
     """The refusal threshold follows from the stated rule: at the largest period the check accepts,
     ω_c = PHASE_BUDGET / (T + T + lag) is at least 2 × the fastest growth rate, and just above it, below."""
-    from stewart_drake.control.controller import PHASE_BUDGET
+    from stewart_drake.control import CROSSOVER_MARGIN, PHASE_BUDGET, check_timing
     from stewart_drake.core.dynamics import open_loop_growth_rates
     from stewart_drake.errors import StewartError
-    from stewart_drake.core.sanity import CROSSOVER_MARGIN, check_timing
 
     p = load_platform("utn-dynamic")
     lam = max(open_loop_growth_rates(p, p.home_pose()))
@@ -302,9 +274,6 @@ def test_workspace_resolution_refused_before_allocating(h):
     (("dynamics", "--t-end", "1e9", "--dt", "1e-6"),
      r"--t-end/--dt 1000000000/1e-06 s would need 1e\+15 samples \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a larger --dt"),
     (("dynamics", "--t-end", "1e4", "--dt", "1e-4"), r"would need 1e\+08 samples; the limit is 1e\+07 samples"),
-    (("simulate", "--duration", "1e9", "--no-progress"),
-     r"--duration 1000000000 s would need 1e\+12 plant steps of 0.001 s \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a shorter --duration"),
-    (("simulate", "--duration", "7200", "--no-progress"), r"--duration 7200 s would need 7.2e\+06 plant steps of 0.001 s \(~2 h\); the limit is ~1 h"),
 ])
 def test_work_is_bounded_before_allocation(argv, pattern, tmp_path, monkeypatch):
     import stewart_drake.core.sanity as sanity
