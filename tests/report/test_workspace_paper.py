@@ -15,6 +15,7 @@ from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.report import ANALYSES_DIR
 
+
 def _paper():
     """The paper's numbers live in the analysis script (one copy of the seed's data)."""
     spec = importlib.util.spec_from_file_location("analysis_workspace", ANALYSES_DIR / "workspace.py")
