@@ -44,6 +44,7 @@ from stewart_drake.core.trajectory import Trajectory, constant_trajectory, desig
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.drake.platform_model import build_plant, set_pose
+from stewart_drake.errors import SimulationError
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
 
 # ----------------------------------------------------------------------------------------------
@@ -61,9 +62,9 @@ class ActuatorModel:
 
     def __post_init__(self):
         if self.max_force is not None and not (math.isfinite(self.max_force) and self.max_force > 0):
-            raise ValueError(f"ActuatorModel.max_force must be a positive number of newtons, got {self.max_force!r}")
+            raise SimulationError(SimulationError.MAX_FORCE.format(value=self.max_force))
         if not (math.isfinite(self.time_constant) and self.time_constant >= 0):
-            raise ValueError(f"ActuatorModel.time_constant must be >= 0 s, got {self.time_constant!r}")
+            raise SimulationError(SimulationError.TIME_CONSTANT.format(value=self.time_constant))
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,7 +155,7 @@ class Simulation:
     def run(self, duration: float, progress: bool = False) -> "SimulationLog":
         """Simulate ``duration`` seconds from t = 0 (once per Simulation) and return the logs."""
         if not (math.isfinite(duration) and duration > 0):
-            raise ValueError(f"duration must be a positive number of seconds, got {duration!r}")
+            raise SimulationError(SimulationError.DURATION.format(value=duration))
         if self._ran:
             raise RuntimeError("a Simulation runs once; build a new one")
         self._ran = True
@@ -241,7 +242,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     plant_platform = s.plant_platform or platform
     plant_time_step = s.plant_time_step
     if not (math.isfinite(plant_time_step) and plant_time_step > 0):
-        raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
+        raise SimulationError(SimulationError.PLANT_STEP.format(value=plant_time_step))
     trajectory = get_trajectory(s.trajectory)
     actuators = s.actuators
     config = s.config
@@ -326,9 +327,9 @@ def setpoint_step_response(platform: Platform, config: ControllerConfig | None =
     chatter to a small-signal measurement). Samples at the plant steps (the controller's period by
     default), so s[n] is the sampled step response of the discrete loop from set-point words to lengths."""
     if not (isinstance(leg, (int, np.integer)) and 0 <= leg < 6):
-        raise ValueError(f"leg must be 0 … 5, got {leg!r}")
+        raise SimulationError(SimulationError.LEG.format(value=leg))
     if not (math.isfinite(step) and step != 0):
-        raise ValueError(f"step must be a non-zero number of metres, got {step!r}")
+        raise SimulationError(SimulationError.STEP.format(value=step))
     cfg = config or ControllerConfig.for_platform(platform)
     cfg = replace(cfg, timing=replace(cfg.timing, sensor_resolution=1e-9))
     rest = constant_trajectory("home", platform.home_pose(), duration)

@@ -25,7 +25,7 @@ from stewart_drake.core.leg_bodies import leg_visual_dimensions
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length_scale, rotation_matrix
 from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import SimulationError, StewartError
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
 # Above this condition number a pose counts as singular (kinematics.require_nonsingular's default).
@@ -141,7 +141,7 @@ def open_meshcat(port: int | None = None) -> Meshcat:
     try:
         return Meshcat(MeshcatParams(host="localhost", port=port))
     except RuntimeError as e:
-        raise ValueError(f"--port {port}: Meshcat could not listen there ({e})") from None
+        raise SimulationError(SimulationError.PORT.format(port=port, reason=e)) from None
 
 
 class Viewer:
