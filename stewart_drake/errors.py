@@ -660,3 +660,4 @@ OPTION_SAMPLE_RATE = "--sample-rate must be a positive number of Hz, got {value}
 OPTION_JOINT_ANGLES = "joint angles must be finite, got {value}"
 OPTION_TARGET = "target must be finite, got {value}"
 OPTION_SERVO_POSE = "--pose has a non-finite number: {value}"
+REPORT_UNKNOWN_ANALYSIS = "unknown analysis {name!r}; available: {available}"

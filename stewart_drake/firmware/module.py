@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.c_build import Compiler, Source, build, library_sources, load
+from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
 
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
@@ -138,7 +139,7 @@ class TickRunner:
 
     def __init__(self, module: FirmwareModule):
         if not module.has_tick:
-            raise ValueError(f"firmware {module.path.name} does not define sd_init and sd_tick")
+            raise FirmwareError(FirmwareError.NO_TICK.format(name=module.path.name))
         self.module = m = module
         ffi = m.ffi
         self._buf = bytearray(ffi.sizeof("sd_state"))
