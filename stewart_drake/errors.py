@@ -638,6 +638,12 @@ class FirmwareError(StewartError):
     SINE_TABLE = "the quarter-wave sine table does not reproduce the exact trig at angle word {index}"
 
 
+class IntegratorError(StewartError):
+    """An unknown integrator name (``drake.integrators``)."""
+
+    UNKNOWN = "integrator must be one of {valid}, got {value!r}"
+
+
 # Command-line options checked by the commands (raised as ``OptionError`` or ``UsageError``).
 OPTION_FIRMWARE_WORD_BITS = "--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {value}"
 OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {value:g}"

@@ -129,7 +129,8 @@ def simulate(platform, result, args) -> dict:
     from dataclasses import replace
 
     from stewart_drake.core.sanity import require_plate
-    from stewart_drake.drake.simulation import Scenario, simulate as sim_run, tracking_verdict
+    from stewart_drake.control.simulation_log import tracking_verdict
+    from stewart_drake.drake.simulation import Scenario, simulate as sim_run
 
     if args.convention != "utn":
         raise UsageError(OPTION_SIMULATE_UTN)

@@ -66,7 +66,8 @@ def run(args) -> int:
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate, tracking_verdict
+    from stewart_drake.control.simulation_log import tracking_verdict
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
     from stewart_drake.firmware.engine import resolve_engine
 
     reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")

@@ -133,7 +133,9 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
 class TickRunner:
     """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control.FixedPointLaw``
     (integrator, previous measurement, its filtered difference, previous set-point, its filtered
-    difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer."""
+    difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer.
+    ``state_ptr`` is the cffi ``sd_state *`` on that buffer, for callers that run the C tick themselves
+    (``firmware.sil``)."""
 
     FIELDS = (("integ", np.int32), ("prev", np.int32), ("dfilt", np.int16), ("setpoint", None), ("vfilt", np.int16), ("saturated", np.int16))
 
@@ -143,8 +145,8 @@ class TickRunner:
         self.module = m = module
         ffi = m.ffi
         self._buf = bytearray(ffi.sizeof("sd_state"))
-        self._ptr = ffi.from_buffer("sd_state *", self._buf)
-        m.lib.sd_init(self._ptr)
+        self.state_ptr = ffi.from_buffer("sd_state *", self._buf)
+        m.lib.sd_init(self.state_ptr)
         self.views = {name: np.frombuffer(self._buf, dtype=dt or m.word_dtype, count=6, offset=ffi.offsetof("sd_state", name))
                       for name, dt in self.FIELDS}
         self.pose = np.zeros(6, dtype=m.word_dtype)
@@ -177,5 +179,5 @@ class TickRunner:
         p_pose, p_meas, p_ff, p_cmd = self._p
         if feedforward_words is not None:
             self.feedforward[:] = feedforward_words
-        self._tick(self._ptr, p_pose, p_meas, p_ff if feedforward_words is not None else self._null, p_cmd)
+        self._tick(self.state_ptr, p_pose, p_meas, p_ff if feedforward_words is not None else self._null, p_cmd)
         return self.command.copy()

@@ -62,7 +62,7 @@ class CFixedPointLaw(FixedPointLaw):
         self._state[:] = state
         if feedforward is not None:
             self._ff[:] = feedforward
-        k = self._host_tick(r._ptr, self._p_pose, self._p_L, self._res, self._p_ff if feedforward is not None else self._null, self._range,
+        k = self._host_tick(r.state_ptr, self._p_pose, self._p_L, self._res, self._p_ff if feedforward is not None else self._null, self._range,
                             self._lsb, self._p_state, self._p_out)
         if k < 0:
             raise FirmwareError(FirmwareError.SENSOR_COUNTS.format(value=np.asarray(measured).tolist()))
