@@ -644,6 +644,62 @@ class IntegratorError(StewartError):
     UNKNOWN = "integrator must be one of {valid}, got {value!r}"
 
 
+class ReplayError(StewartError):
+    """A replay log that cannot be read (``drake.viewer``)."""
+
+    EMPTY_FOLDER = "--replay {path}: no log.npz, simulation/log.npz, trajectory.csv or log.csv in the folder"
+    MISSING = "--replay {path}: no such file"
+    NOT_LOG = "--replay {path}: not a simulate log ({reason})"
+    EMPTY = "--replay {path}: empty file"
+    COLUMNS = ("--replay {path}: line 1: expected the columns of a simulate log.csv or a run trajectory.csv, "
+               "got {got}")
+    ROW = "--replay {path}: line {line}: not a row of numbers"
+    NO_SAMPLES = "--replay {path}: no samples"
+
+
+class SpecError(StewartError):
+    """A ``--vary`` SPEC that cannot be read: unknown key, bad value, unit or range (``montecarlo.spec``)."""
+
+    NUMBER = "{where}: {key}: cannot read {text!r} as a number with a unit ({allowed})"
+    NOT_FINITE = "{where}: {key}: {text!r} is not finite"
+    LATENCY = "{where}: latency: {value!r} is not one of {valid}"
+    NEGATIVE_PROCESS = "{where}: {key}: {text!r} must be >= 0 (the size of a per-tick random process)"
+    PERCENT_OF_ZERO = "{where}: {key}: {text!r}: a percentage of a zero nominal; give ±value with a unit"
+    PERCENT_RANGE = "{where}: {key}: {text!r}: the percentage must be in [0, 100)"
+    HALF_WIDTH = "{where}: {key}: {text!r}: the half-width must be >= 0"
+    RANGE_ORDER = "{where}: {key}: {text!r}: the range's low end is above its high end"
+    UNKNOWN_KEY = "{where}: unknown key {key!r}{hint}"
+    VECTOR_LAW = "{where}: {key}: give ±tolerance (per component) or a fixed offset, not {text!r}"
+    NOT_KEY_VALUE = "--vary: {value!r} is not key=value"
+    MISSING_FILE = "--vary: file {path!r} does not exist"
+    NOT_YAML = "{path}:{line}: not YAML ({problem})"
+    NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
+    NOT_SCALAR = "{where}: {key}: the value must be one scalar (e.g. ±0.5mm)"
+    SWEEP_VECTOR = "sweep: {key} is a per-component key; sweep scalar keys"
+    SWEEP_EMPTY = "sweep: {key} has no values"
+
+
+class StudyError(StewartError):
+    """A study that cannot start: too large, inconsistent settings, or an output folder that is not its own
+    (``montecarlo.study``)."""
+
+    RUNS = "--runs must be 1 … {limit}, got {value}"
+    SEED = "--seed must be an integer >= 0, got {value}"
+    GRID = "a sweep's runs ({runs}) must equal its grid's points ({points})"
+    PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
+    DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
+    TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
+    RESOLUTION_RANGE = ("--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
+                        "give a value or a|b|c list, not a range")
+    RESOLUTION_DIVIDE = ("--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into "
+                         "whole counts")
+    OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
+    OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
+    OUT_NOT_OURS = ("--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to "
+                    "overwrite it")
+    OUT_OTHER_PARTIAL = ("--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose "
+                         "another folder")
+
 # Command-line options checked by the commands (raised as ``OptionError`` or ``UsageError``).
 OPTION_FIRMWARE_WORD_BITS = "--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {value}"
 OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {value:g}"
