@@ -286,6 +286,7 @@ class WorkspaceError(StewartError):
     CENTRE = "rotation centre must be 3 finite coordinates in metres (plate frame), got {value}"
     STEP = "step must be in (0, max_angle), got step = {step} rad, max_angle = {max_angle} rad"
     START_OUTSIDE = "start pose {pose} is outside the {limit} limit (margin {margin:.4g} {unit})"
+    DEXTERITY_POSES = "the dexterity limit needs the poses themselves"
 
 
 # ----------------------------------------------------------------------------------------------
