@@ -10,7 +10,7 @@ def test_saturation_verdict_counts_the_longest_stretch():
     """``longest_saturation`` from the cumulative per-leg counters: leg 2 saturated on ticks 3..62 (60
     ticks = 0.060 s at 1 ms) fails; leg 5 saturated on 40 ticks in two stretches of 20 passes."""
     from stewart_drake.control import STATUS
-    from stewart_drake.drake.simulation import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
+    from stewart_drake.control.simulation_log import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
 
     n, T = 100, 1e-3
     sat = np.zeros((n, 6), bool)
