@@ -287,7 +287,7 @@ YAML_CASES = [
     ("length_unit: mm\nutn: {b: 1e300, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]", "p.yaml:2: utn.b: 1e300 is too large (at most 100000 mm)"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstrok: [0.5, 0.9]",
      "p.yaml:2: strok: unknown key (did you mean 'stroke'?); valid keys: name, description, length_unit, utn, radial, "
-     "base_anchors, top_anchors, leg_top, stroke, plate, rotation_centre, home_height, legs, plate_below_base_allowed"),
+     "base_anchors, top_anchors, leg_top, leg_base, stroke, plate, rotation_centre, home_height, legs, plate_below_base_allowed"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mas: 1}",
      "p.yaml:3: plate: unknown key 'mas' (did you mean 'mass'?); valid keys: mass, com, inertia, thickness, density"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mass: big}", "p.yaml:3: plate.mass: expected a number, got big"),
