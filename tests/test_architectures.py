@@ -115,6 +115,24 @@ def test_file_loads_and_solves_completely(tmp_path, kind, make, seed):
             np.testing.assert_allclose(_lengths_of(p, m.position, m.rotation), L, rtol=0, atol=ROUND_TRIP)
 
 
+def test_three_three_is_solved_in_the_general_family(tmp_path):
+    """A 3-3 (octahedral) platform: shared plate joints (leg_top) and shared base joints (leg_base) in
+    offset pairs. No class of its own: the general 40-path start system, described with its joint counts;
+    its 16 finite solutions found (Nanua, Waldron & Murthy 1990), the other 24 paths at infinity; complete,
+    certified, and the real set equal to the multi-start's."""
+    cfg = dict(name="three-three", base_anchors=[[0.0, 0.5, 0.01], [-0.43, -0.25, 0.0], [0.43, -0.25, -0.01]],
+               leg_base=[0, 0, 1, 1, 2, 2], top_anchors=[[0.0, -0.3, 0.0], [0.26, 0.15, 0.01], [-0.26, 0.15, 0.0]],
+               leg_top=[2, 1, 1, 0, 0, 2], stroke=[0.5, 1.1])
+    p = load_platform_yaml(_write(tmp_path, cfg))
+    arch = architecture(p)
+    assert arch.kind == "6-6" and arch.joints == (3, 3) and "3 base, 3 plate joints" in arch.describe()
+    L = leg_lengths(p, p.home_pose() + POSE_OFFSETS[0])
+    r = solve(p, L)
+    assert r.complete and r.counts()["infinity"] == 24 and r.counts()["real"] + r.counts()["complex"] == 16
+    assert r.modes and all(m.certified for m in r.modes)
+    assert _same_sets(r.modes, assembly_modes(p, L, polish=None).modes)
+
+
 def test_six_three_cli_fk_all_names_architecture_and_engine_and_round_trips(tmp_path, capsys):
     """``fk --all --json`` on a 6-3 file: architecture 6-3, the engine the tracker runs with, complete
     with 16 paths; each listed pose fed back to ``ik`` gives the lengths asked for. The text output
