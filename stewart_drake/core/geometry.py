@@ -109,7 +109,7 @@ class PlatformConfig:
 class Platform:
     """A Stewart platform. Arrays are read-only numpy arrays in SI units.
 
-    base_anchors  (6, 3)  p_BBi, metres
+    base_anchors  (6, 3)  p_BBi, metres; six distinct points, or three pairs (6-3: two legs per base joint)
     top_anchors   (k, 3)  p_TTj, metres, 3 <= k <= 6
     leg_top       (6,)    index into top_anchors for each leg
     stroke        (2,)    L_min, L_max, metres (joint centre to joint centre)
