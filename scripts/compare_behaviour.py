@@ -1,0 +1,165 @@
+"""Compare two recordings of ``scripts/record_behaviour.py``: is the command line's behaviour unchanged?
+
+``python scripts/compare_behaviour.py A B [--paths N]`` prints one line per recorded call (and per report),
+``identical`` or ``differs`` followed by the first ``N`` differing JSON paths with both values, and exits 1 if
+any call differs or is missing from one side (0 otherwise).
+
+Equality is exact: the same JSON types (an int is not a float, a bool is not an int), numbers bit for bit
+(JSON numbers parse to the shortest round-tripping float, so equal text means equal bits), strings and
+list lengths identical. Only the run-dependent fields listed in ``VOLATILE_KEYS``, ``VOLATILE_COLUMNS``,
+``REPORT_IGNORED`` and ``TEXT_SUBSTITUTIONS`` are removed before comparing, each with its reason; nothing
+else. Standard library only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+
+# Dict keys removed wherever they occur (stdout JSON, written JSON/JSON-lines files, report checks).
+VOLATILE_KEYS = {
+    "run_wall_s": "montecarlo summary: sum/mean of the runs' wall-clock times",
+    "wall_s": "montecarlo row (row.json, montecarlo.partial.jsonl): one run's wall-clock time",
+}
+# Columns removed from recorded CSV files (``csv_header``/``csv_rows``) and Parquet tables (``parquet``).
+VOLATILE_COLUMNS = {
+    "wall_s": "montecarlo results.csv / results.parquet: each run's wall-clock time",
+}
+# Fields of the report records (``report-quick``, ``report-full``) not compared.
+REPORT_IGNORED = {
+    "stdout": "the report's summary line carries its wall time",
+    "stderr": "progress lines carry wall/CPU times and arrive in the order the worker processes finish",
+}
+# Regular-expression substitutions applied to every string before comparing.
+TEXT_SUBSTITUTIONS = [
+    (
+        re.compile(r"http://(localhost|127\.0\.0\.1):\d+"),
+        r"http://\1:<PORT>",
+        "view / Meshcat: the port is the first free one from 7000, which depends on other processes",
+    ),
+]
+
+
+def _subst(s: str) -> str:
+    for pattern, repl, _ in TEXT_SUBSTITUTIONS:
+        s = pattern.sub(repl, s)
+    return s
+
+
+def _drop_columns(table: dict) -> dict:
+    """A recorded CSV (header + rows of strings) or Parquet table without the volatile columns."""
+    if "csv_header" in table:
+        keep = [i for i, h in enumerate(table["csv_header"]) if h not in VOLATILE_COLUMNS]
+        return {
+            "csv_header": [table["csv_header"][i] for i in keep],
+            "csv_rows": [[r[i] if i < len(r) else None for i in keep] for r in table["csv_rows"]],
+        }
+    if "parquet" in table and isinstance(table["parquet"], dict):
+        p = table["parquet"]
+        return {
+            "parquet": {
+                "schema": [f for f in p.get("schema", []) if f.split(":")[0] not in VOLATILE_COLUMNS],
+                "columns": {k: v for k, v in p.get("columns", {}).items() if k not in VOLATILE_COLUMNS},
+            }
+        }
+    return table
+
+
+def clean(obj):
+    """``obj`` without the volatile fields (see the module docstring)."""
+    if isinstance(obj, str):
+        return _subst(obj)
+    if isinstance(obj, list):
+        return [clean(v) for v in obj]
+    if isinstance(obj, dict):
+        if "csv_header" in obj or "parquet" in obj:
+            obj = _drop_columns(obj)
+        return {k: clean(v) for k, v in obj.items() if k not in VOLATILE_KEYS}
+    return obj
+
+
+def load(path: Path) -> dict:
+    rec = json.loads(path.read_text(encoding="utf-8"))
+    if path.stem.startswith("report-"):
+        rec = {k: v for k, v in rec.items() if k not in REPORT_IGNORED}
+    return clean(rec)
+
+
+def diff(a, b, path: str = "$") -> list[tuple[str, object, object]]:
+    """Every differing leaf as (JSON path, value in A, value in B); ``<absent>`` for a missing key/item."""
+    if type(a) is not type(b):
+        return [(path, a, b)]
+    if isinstance(a, dict):
+        out = []
+        for k in list(a) + [k for k in b if k not in a]:
+            sub = f"{path}.{k}" if k.isidentifier() else f"{path}[{json.dumps(k, ensure_ascii=False)}]"
+            out += diff(a[k], b[k], sub) if k in a and k in b else [(sub, a.get(k, "<absent>"), b.get(k, "<absent>"))]
+        return out
+    if isinstance(a, list):
+        out = []
+        for i in range(max(len(a), len(b))):
+            if i < len(a) and i < len(b):
+                out += diff(a[i], b[i], f"{path}[{i}]")
+            else:
+                out.append((f"{path}[{i}]", a[i] if i < len(a) else "<absent>", b[i] if i < len(b) else "<absent>"))
+        return out
+    if isinstance(a, str) and a != b and ("\n" in a or "\n" in b):
+        # Multi-line text (a raw stdout): the first differing line, not the whole text.
+        la, lb = a.splitlines(), b.splitlines()
+        bad = [k for k in range(max(len(la), len(lb))) if k >= len(la) or k >= len(lb) or la[k] != lb[k]]
+        i = bad[0]
+        return [
+            (
+                f"{path} line {i + 1} (first of {len(bad)} differing lines)",
+                la[i] if i < len(la) else "<absent>",
+                lb[i] if i < len(lb) else "<absent>",
+            )
+        ]
+    return [] if a == b else [(path, a, b)]
+
+
+def _short(v, n: int = 160) -> str:
+    s = json.dumps(v, ensure_ascii=False) if not isinstance(v, str) or v != "<absent>" else v
+    return s if len(s) <= n else s[: n - 3] + "..."
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("a", type=Path, help="a recording folder (the reference)")
+    ap.add_argument("b", type=Path, help="a recording folder (the one to check)")
+    ap.add_argument("--paths", type=int, default=5, help="differing paths shown per call (default 5)")
+    args = ap.parse_args(argv)
+    for d in (args.a, args.b):
+        if not d.is_dir():
+            print(f"compare_behaviour: {d} is not a folder", file=sys.stderr)
+            return 2
+
+    def names(d: Path) -> set[str]:
+        return {p.name for p in d.glob("*.json") if p.name != "manifest.json"}
+
+    na, nb = names(args.a), names(args.b)
+    bad = 0
+    for name in sorted(na | nb):
+        label = name[:-5]
+        if name not in nb or name not in na:
+            print(f"{label}: missing in {args.b if name not in nb else args.a}")
+            bad += 1
+            continue
+        d = diff(load(args.a / name), load(args.b / name))
+        if not d:
+            print(f"{label}: identical")
+            continue
+        bad += 1
+        print(f"{label}: differs ({len(d)} path{'s' if len(d) != 1 else ''})")
+        for path, va, vb in d[: args.paths]:
+            print(f"    {path}: {_short(va)}  !=  {_short(vb)}")
+    total = len(na | nb)
+    print(f"{total - bad}/{total} identical" + (f", {bad} differ or are missing" if bad else ""))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
