@@ -12,13 +12,16 @@ import yaml
 
 from stewart_drake.cli import main
 from stewart_drake.core.assembly_modes import assembly_modes, modes_from_solutions
+from stewart_drake.core.dynamics import harmonic_trajectory, leg_forces
 from stewart_drake.core.geometry import load_platform_yaml
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.drake.platform_model import set_pose
+from stewart_drake.drake.verify_dynamics import drake_leg_forces
 from stewart_drake.drake.verify_kinematics import anchor_frames, drake_fk_tip_errors, make_plant
 from stewart_drake.errors import GeometryError
 from stewart_drake.homotopy import architecture, solve
 from stewart_drake.homotopy.track import TrackOptions, engine_used
+from stewart_drake.workspace.limits import leg_pairs
 
 # Two solvers agree on a mode when positions and rotation matrices agree to this: both are
 # Newton-polished to ~1e-15 m leg residual and the modes are well separated (min distance ~1e-2).
@@ -207,3 +210,30 @@ def test_repeated_base_anchor_is_still_refused(tmp_path, capsys):
     short["base_anchors"] = short["base_anchors"][:5]
     with pytest.raises(GeometryError, match="base_anchors: 5 points given; give 6"):
         load_platform_yaml(_write(tmp_path, short))
+
+
+def test_six_three_file_through_other_commands(tmp_path, capsys):
+    """Commands other than fk on a 6-3 file: ``model --inspect`` builds the Drake plant with its frames
+    on the file's anchors; ``workspace`` with the collision limit leaves the legs that share a base
+    joint out of the collision pairs (they meet at the joint: counting them would empty the workspace),
+    so the volume stays of the order of the stroke-only volume; the numpy inverse dynamics on the
+    non-planar, shared-joint geometry equals Drake's free-body plant (``drake_leg_forces``)."""
+    f = _write(tmp_path, six_three_config(0))
+    p = load_platform_yaml(f)
+    pairs = {tuple(q) for q in leg_pairs(p).tolist()}
+    assert len(pairs) == 12 and not pairs & {(0, 1), (2, 3), (4, 5)}
+    assert main(["model", "--platform", str(f), "--inspect", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["constraints"] == 6 and d["anchor_error_m"] < 1e-12  # frames: a few float operations
+    volumes = {}
+    for limits in ("stroke", "stroke,collision"):
+        assert main(["workspace", "--platform", str(f), "--resolution", "0.05", "--limits", limits, "--json"]) == 0
+        volumes[limits] = json.loads(capsys.readouterr().out)["volume_m3"]
+    assert volumes["stroke"] > 0.1 and volumes["stroke,collision"] > 0.5 * volumes["stroke"]
+    assert main(["dynamics", "--platform", str(f), "--json"]) == 0
+    assert np.all(np.isfinite(json.loads(capsys.readouterr().out)["forces"]))
+    # As tests/test_dynamics_drake.py: O(10) operations per term on forces of O(10 N), J well conditioned
+    # (< 30 here): rounding gives ~1e-14 N; 1e-9 N is the bound asked of the dynamics everywhere.
+    q, qd, qdd = harmonic_trajectory(np.linspace(0, 2, 7), p.home_pose() + [0.01, -0.01, 0, 0.02, 0.01, 0.03],
+                                     [0.02, 0.02, 0.01, 0.1, 0.1, 0.2], [1.3, 2.1, 1.7, 3.0, 2.5, 3.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    assert np.abs(leg_forces(p, q, qd, qdd, "utn") - drake_leg_forces(p, q, qd, qdd, "utn")).max() <= 1e-9
