@@ -19,7 +19,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from stewart_drake.core.newton_fk import forward_kinematics, sample_poses  # noqa: E402
+from stewart_drake.core.newton_fk import forward_kinematics  # noqa: E402
+from stewart_drake.core.sampling import random_poses  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.core.kinematics import leg_lengths  # noqa: E402
 
@@ -37,7 +38,7 @@ def newton_rates(n: int) -> list[tuple]:
     rows = []
     for name in ("utn-dynamic", "gonzalez-dutra-2009", "utn-kinematic"):
         p = load_preset(name)
-        q = sample_poses(p, n, seed=1)
+        q = random_poses(p, n, seed=1, region="workspace")
         L = leg_lengths(p, q)
         t_chk, r = best_of(lambda: forward_kinematics(p, L, on_singular="ignore"))
         t_raw, _ = best_of(lambda: forward_kinematics(p, L, check_singularity=False))
@@ -50,7 +51,7 @@ def newton_rates(n: int) -> list[tuple]:
 
 
 def program_times(repeat: int) -> list[tuple]:
-    from stewart_drake.core.assembly_modes import ProgramFK
+    from stewart_drake.drake.program_fk import ProgramFK
 
     p = load_preset("gonzalez-dutra-2009")
     q = p.home_pose() + [0.05, -0.03, 0.02, 0.1, -0.05, 0.2]
@@ -69,7 +70,8 @@ def program_times(repeat: int) -> list[tuple]:
 
 
 def assembly_times() -> list[tuple]:
-    from stewart_drake.core.assembly_modes import assembly_modes, dietmaier_platform, general_platform
+    from stewart_drake.core.reference_platforms import dietmaier_platform, general_platform
+    from stewart_drake.drake.program_fk import assembly_modes
 
     cases = [("dietmaier-1998",) + dietmaier_platform()]
     for seed in (0, 4):
@@ -126,7 +128,7 @@ def fksgp_times(path, cases, repeat: int) -> dict:
 
 def homotopy_cases(n_poses: int):
     """(label, fkSGP key, platform, (k, 6) length sets) for the homotopy benchmark."""
-    from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
+    from stewart_drake.core.reference_platforms import dietmaier_platform, planar_platform
 
     p, L = dietmaier_platform()
     cases = [("dietmaier-1998 (6-6, 40 real)", "dietmaier-1998", p, L[None])]
@@ -194,7 +196,7 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
 
 def homotopy_batch(n: int) -> list[tuple]:
     """Batched mode: n length sets of one platform in one call, per-set time, per engine."""
-    from stewart_drake.core.assembly_modes import dietmaier_platform, planar_platform
+    from stewart_drake.core.reference_platforms import dietmaier_platform, planar_platform
     from stewart_drake.homotopy import solve_batch
     from stewart_drake.homotopy.track import TrackOptions
 

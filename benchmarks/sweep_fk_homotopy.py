@@ -12,7 +12,8 @@ import argparse
 
 import numpy as np
 
-from stewart_drake.core.assembly_modes import assembly_modes, general_platform, planar_platform
+from stewart_drake.core.assembly_modes import assembly_modes
+from stewart_drake.core.reference_platforms import general_platform, planar_platform
 from stewart_drake.core.geometry import Platform
 from stewart_drake.homotopy import solve
 from stewart_drake.homotopy.track import ENGINES, TrackOptions

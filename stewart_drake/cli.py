@@ -1,19 +1,49 @@
 """The ``stewart-drake`` command line. Each subcommand lives in ``stewart_drake/commands/<name>.py``
-and defines ``register(subparsers)``, which adds its parser and sets ``func``; this module finds
-them all. Bad input exits with status 2 and one line on stderr, never a traceback."""
+(``COMMANDS`` maps a command to its module) and defines ``register(subparsers)``, which adds its parser and
+sets ``func``. Bad input exits with status 2 and one line on stderr, never a traceback."""
 
 from __future__ import annotations
 
 import argparse
 import importlib
 import math
-import pkgutil
 import sys
 
 import numpy as np
 
 from stewart_drake import __version__, commands
 from stewart_drake.errors import StewartError, UsageError
+
+# Every subcommand: its name -> (its module in ``stewart_drake.commands``, the one-line help that
+# ``stewart-drake --help`` lists; the module's own parser carries the same text, a test keeps them equal).
+# A command's module is imported only when that command runs: the Drake commands import pydrake at
+# their module top, and the numpy commands must work where pydrake is not installed.
+COMMANDS = {
+    "compile": ("compile", "translate a motion program (.stw) to Python (calling this library) "
+                "or Matlab (the seed's output)"),
+    "dsp-ik": ("dsp_ik", "leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK"),
+    "dynamics": ("dynamics", "leg forces along a trajectory (inverse dynamics, with or without Coriolis)"),
+    "firmware": ("firmware", "generate the C firmware (IK + controller tick) or check a C firmware "
+                 "against the emulation"),
+    "fk": ("fk", "pose for six leg lengths (forward kinematics); --all: every assembly mode"),
+    "ik": ("ik", "leg lengths for a pose (closed-form inverse kinematics)"),
+    "init": ("init", "print a commented platform file template to start from "
+             "(stewart-drake init --platform-template radial > my.yaml)"),
+    "leg": ("leg", "3R planar leg (seed 003): DH forward kinematics, geometric inverse kinematics"),
+    "model": ("model", "generate (write) or inspect the SDF model of a platform"),
+    "modes": ("modes", "natural frequencies (Hz) and mode shapes at a pose; --drake checks them against Drake"),
+    "montecarlo": ("montecarlo", "robustness study: many closed-loop runs with drawn tolerances (Dask), "
+                   "or --replay one of them"),
+    "report": ("report", "run the analyses on the built-in presets and write an HTML report"),
+    "run": ("run", "run a motion program (.stw): leg lengths and forces along its trajectory"),
+    "servo": ("servo", "servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)"),
+    "simulate": ("simulate", "run the fixed-point (or float) controller in the loop with the Drake plant"),
+    "size": ("size", "actuator sizing: peak/RMS force, speed, acceleration, power and stroke per leg"),
+    "stiffness": ("stiffness", "6×6 Cartesian stiffness, compliance and payload deflection at a pose"),
+    "view": ("view", "interactive 3-D viewer (Meshcat on localhost): pose sliders, leg lengths, stroke margins, "
+             "singularity distance, assembly modes; or replay a simulate/run log"),
+    "workspace": ("workspace", "reachable positions (extents, volume, views) and rotation limits"),
+}
 
 
 class Number(float):
@@ -71,20 +101,36 @@ def _finite_types(parser: argparse.ArgumentParser) -> None:
                 _finite_types(sub)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_module(name: str):
+    """The module of the subcommand ``name`` (imported now)."""
+    return importlib.import_module(f"{commands.__name__}.{COMMANDS[name][0]}")
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The whole command line. ``only=None``: every command's full parser (imports every command
+    module); otherwise only the command named ``only`` (if it is one) gets its full parser and the others
+    a bare entry with their help, so that only that command's module is imported."""
     parser = Parser(prog="stewart-drake", description=__doc__.split("\n")[0])
     parser.add_argument("--version", action="version", version=f"stewart-drake {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
-        if not info.name.startswith("_"):
-            importlib.import_module(f"{commands.__name__}.{info.name}").register(sub)
+    for name, (_, help_text) in COMMANDS.items():
+        if only is None or name == only:
+            command_module(name).register(sub)
+        else:
+            sub.add_parser(name, help=help_text)
     _finite_types(parser)
     return parser
 
 
+def _command_in(argv: list[str]) -> str:
+    """The subcommand named on the command line: its first word that is not an option ("" if none)."""
+    return next((a for a in argv if not a.startswith("-")), "")
+
+
 def main(argv=None) -> int:
     """Run one command; return its exit status (0 ok, 1 a result outside physical limits, 2 bad input)."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(only=_command_in(argv))
     try:
         args = parser.parse_args(argv)
     except SystemExit as e:  # --help, --version, or a usage error already printed

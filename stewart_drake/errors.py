@@ -1,6 +1,10 @@
-"""The project's exceptions. All derive from ValueError so callers can catch bad input in one place.
+"""The project's one error hierarchy and every message template.
 
-Messages name the offending thing and value; tests match them, so they live here as templates.
+Every error derives from ``StewartError`` (itself a ``ValueError``, so callers can catch bad input in one
+place); the CLI prints it as one line and exits 2, or 1 for a ``PhysicalLimitError``. Messages name the
+offending thing and the value as given; they are templates here, as constants of the class that raises
+them (``GeometryError.STROKE``) or as module constants when several classes share one (``SHAPE``), and
+tests match them: ``pytest.raises(GeometryError, match=re.escape(GeometryError.STROKE.format(...)))``.
 """
 
 from __future__ import annotations
@@ -21,6 +25,54 @@ class StewartError(ValueError):
 
 class GeometryError(StewartError):
     """A platform description is inconsistent (shapes, values, anchors, limits)."""
+
+    TOP_SHAPE = "top_anchors must have shape (k, 3) with 3 <= k <= 6, got {shape}"
+    LEG_TOP = "leg_top must list 6 integer top-anchor indices (one per leg), got {value!r}"
+    LEG_TOP_RANGE = "leg_top: leg {leg} refers to top anchor {anchor}, but there are {n} top anchors (0..{last})"
+    LEG_TOP_UNUSED = "leg_top: top anchor {anchor} is used by no leg"
+    STROKE = "stroke must satisfy 0 < L_min < L_max, got L_min = {lmin} m, L_max = {lmax} m"
+    STROKE_PAIR = "stroke must be [L_min, L_max], got {value!r}"
+    MASS = "plate mass must be finite and >= 0, got {value} kg"
+    INERTIA_SYMMETRIC = "plate inertia must be symmetric, got {value}"
+    INERTIA_PHYSICAL = "plate inertia is not physical (principal moments {moments} kg·m²)"
+    INERTIA_NUMBERS = "plate inertia must be 6 numbers (Ixx Iyy Izz Ixy Ixz Iyz), got {value!r}"
+    HOME_HEIGHT = "home_height must be a positive number of metres, got {value}"
+    UTN_DIMENSION = "UTN dimension {name} must be a positive length, got {value}"
+    CIRCLE_ANGLES = "{what} angles must be 6 numbers, got shape {shape}"
+    CIRCLE_RADIUS = "{what} radius must be a positive length, got {value}"
+    NOT_NUMBERS = "{name} must be numbers, got {value!r}"
+    SHAPE = "{name} must have shape {shape}, got {got}"
+    NOT_FINITE = "{name} must be finite, got {value}"
+    COINCIDE = "{what} {i} and {j} coincide at {at} m (closer than {limit} m)"
+    TOO_WIDE = ("platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is {target:.4f} m; "
+                "give home_height")
+    LENGTH_UNIT = "length_unit: {problem}"
+    ANCHOR_DESCRIPTIONS = ("platform {name!r}: give exactly one anchor description (utn, radial, or "
+                           "base_anchors/top_anchors/leg_top), got {given}")
+    PLATE_SHEET = "platform {name!r}: plate thickness+density describe a UTN triangle sheet; give both, with utn dimensions"
+    IN_FILE = "{path}: {problem}"
+    UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
+    UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
+    LEG_LIMIT = "platform {name!r}: legs.{field} must be a positive number, got {value}"
+
+    # a servo hexapod description (``core.servo``)
+    SERVO_SHAPE = "servo hexapod {name} must have shape {shape}, got {got}"
+    SERVO_NOT_FINITE = "servo hexapod {name} has non-finite values: {value}"
+    SERVO_NOT_POSITIVE = "servo hexapod {name} must be a positive number, got {value}"
+    SERVO_ROD = "rod length s = {s} m must exceed the arm length a = {a} m"
+    SERVO_SHAFT = "servo {servo}: shaft direction {shaft} is not perpendicular to its arm plane (beta = {beta:.6g} deg)"
+    SERVO_NO_H0 = "servo {servo}: arm and rod cannot be at right angles over its anchor (eq. 10 has no real h0)"
+    SERVO_ASYMMETRIC = "eq. 10 gives different home heights per servo ({h_mm} mm): the layout is not symmetric"
+    SERVO_FIELD_POSITIVE = "{field} must be a positive number{unit}, got {value!r}"
+    SERVO_FIELD_SHAPE = "{field} must be {shape}, got {value!r}"
+    SERVO_FIELD_FINITE = "{field} must be finite, got {value!r}"
+    SERVO_UNIT = "length_unit must be m or mm, got {value!r}"
+    SERVO_TRAVEL = "servo.travel_deg must be below 90 degrees, got {value!r}"
+    SERVO_BOTH_LAYOUTS = "servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {given})"
+    SERVO_MISSING_LAYOUT = ("servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, "
+                            "platform_anchors, shaft_directions (missing {missing})")
+    SERVO_UNKNOWN_PRESET = "unknown servo hexapod preset {name!r}; available: {presets}"
+    SERVO_UNKNOWN = "unknown servo hexapod {name!r}: not a preset ({presets}) and not a YAML file"
 
 
 class UnreachablePoseError(StewartError):
@@ -62,11 +114,188 @@ class SingularityWarning(UserWarning):
 
 
 # ----------------------------------------------------------------------------------------------
+# Array arguments (``core.argcheck``): shapes and finite values.
+
+
+class ShapeError(StewartError):
+    """An array argument (poses, lengths, vectors) has the wrong shape."""
+
+
+class NotFiniteError(StewartError):
+    """An array argument holds NaN or an infinity; the message names the first such sample."""
+
+
+SHAPE = "Expected {name} to have shape {shape}, got {got}"
+NOT_FINITE_SAMPLE = "{what} {index} is not finite: {values}"
+# The length Jacobian at a trajectory sample is (nearly) singular (``dynamics.solve_leg_forces``).
+SINGULAR_SAMPLE = (
+    "sample {index}: the length Jacobian J = dL/dq is singular or nearly so (condition number {cond:.3g} > "
+    "{limit:.3g}); leg forces are undefined there"
+)
+# A pose whose scaled J⁻¹ condition number exceeds the limit (``kinematics.require_nonsingular``).
+SINGULAR_POSE = "pose {index} is singular or nearly so: Jacobian condition number {cond:.3g} > {limit:.3g}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Mechanisms other than the 6-UPS platform: the 3R leg (``core.leg3r``) and the RC-servo hexapod
+# (``core.servo``).
+
+
+class LegError(StewartError):
+    """A 3R leg's parameters, joint angles or targets are malformed."""
+
+    LENGTH = "leg length {name} must be a positive number of metres, got {value}"
+    ALPHA = "ankle angle alpha must be finite, got {value}"
+    LIMITS = "{name} must be two finite angles (rad) with lower < upper, got {value}"
+    ANGLES_2 = "leg joint angles need 2 numbers (q1, q2), got shape {shape}"
+    ANGLES_2_3 = "leg joint angles need 2 numbers (q1, q2) or 3 (q1, q2, q3), got shape {shape}"
+    BRANCH = "unknown elbow branch {branch!r}; expected 'a' (knee angle >= 0) or 'b' (<= 0)"
+    TARGET = "a leg target needs {n} numbers ({names}), got shape {shape}"
+    SEED_FIX = "unknown seed fix {fix!r}; expected some of {valid}"
+
+
+class UnreachableTargetError(StewartError):
+    """A foot target lies outside the leg's reachable annulus.
+
+    Attributes: ``index`` (tuple, into the batch), ``distance`` (m, hip to target, or to the wrist for the
+    3R solver), ``r_min``, ``r_max`` (m)."""
+
+    TEMPLATE = ("target {index}: {what} is {d_mm:.3f} mm from the hip, outside the reachable range "
+                "[{lo_mm:.3f}, {hi_mm:.3f}] mm")
+
+    def __init__(self, index, distance, r_min, r_max, what="the foot"):
+        self.index, self.distance, self.r_min, self.r_max = index, distance, r_min, r_max
+        super().__init__(self.TEMPLATE.format(index=counted(index), what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3,
+                                              hi_mm=r_max * 1e3))
+
+
+class ServoPoseError(StewartError):
+    """A pose given to the servo hexapod is malformed (shape, non-finite numbers)."""
+
+    SHAPE = "a servo hexapod pose needs 6 numbers (x, y, z, phi, theta, psi), got shape {shape}"
+    NOT_FINITE = "pose {index} has a non-finite number: {values}"
+
+
+SERVO_RESOLUTION = "pulse resolution must be > 0 µs, got {value}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Fixed-point arithmetic (``fixedpoint``): values a word cannot hold, operations outside their domain.
+
+
+class FixedPointError(StewartError):
+    """A value does not fit the fixed-point word it is converted to, or an operation is outside its domain."""
+
+    WORD_BITS = "word_bits must be an integer in 8..31, got {value!r}"
+    LENGTH_LSB = "length_lsb must be a positive number of metres, got {value!r}"
+    TRIG = "trig must be one of {valid}, got {value!r}"
+    TFR16_BITS = "trig='tfr16' is the 16-bit DSP library; it needs word_bits=16, got {value}"
+    ANGLE = "pose {index}: angle {angle:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]"
+    LENGTH_WORD = "{what} {value:.6g} m does not fit a {bits}-bit word of {lsb:g} m (range ±{range_m:.6g} m)"
+    NOT_INTEGER_16 = "{name} must hold integers (Word16), got {value!r}"
+    NOT_INTEGER_32 = "{name} must hold integers (Word32)"
+    RANGE = "{name} = {value} is outside the {bits}-bit range [{lo}, {hi}]"
+    FRAC16_NOT_FINITE = "FRAC16 of a non-finite value {value!r}"
+    FRAC32_NOT_FINITE = "FRAC32 of a non-finite value"
+    DIV_S = "div_s needs 0 <= a <= b and b > 0, got a={a}, b={b}"
+    NO_CYCLES = "operation {op!r} has no entry in the cycle table"
+
+
+class DspPoseError(FixedPointError):
+    """A firmware pose (mm and fractions of pi) is malformed or does not fit the DSP's 16-bit words."""
+
+    NOT_FINITE = "{name} is not finite: {values}"
+    POSITION = "{name}: position {values} mm does not fit a 16-bit word [-32768, 32767]"
+    ANGLES = "{name}: angles {values} (fractions of pi) must lie in [-1, 1]"
+    ANGLE_OPTION = "angle {name} = {value:g} {unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]"
+
+
+# ----------------------------------------------------------------------------------------------
+# Design studies (``design``): envelopes, payloads, stiffness.
+
+
+class EnvelopeError(StewartError):
+    """An envelope file is malformed or leaves the platform's workspace."""
+
+    NOT_NUMBERS = "{where}: expected numbers, got {value!r}"
+    COUNT = "{where}: expected {n} numbers, got {value!r}"
+    NOT_FINITE = "{where}: values must be finite, got {value!r}"
+    NOT_INTEGERS = "{where}: expected integers, got {value!r}"
+    IN_FILE = "{source}: {problem}"
+    ONE_OF = "{source}: give exactly one of poses (a list) or box (a grid)"
+    STEPS = "{source}: box.steps must be >= 1, got {value!r}"
+    BOX_ORDER = "{source}: box.max[{j}] = {hi} is below box.min[{j}] = {lo}"
+    BOX_TOO_LARGE = "{source}: box.steps {steps!r} make {n} poses, more than the limit {limit}"
+    TOO_MANY_POSES = "{source}: {n} poses, more than the limit {limit}"
+    NEGATIVE_BOUND = "{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {value}"
+    OUT_OF_STROKE = "{source}: {pose} leaves the workspace: leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm {side} the stroke"
+    SINGULAR = "{source}: {pose} is singular or nearly so (condition number {cond:.3g})"
+
+
+class PayloadError(StewartError):
+    """A payload is not physical (negative or non-finite mass, below the plate)."""
+
+    MASS = "{option}: payload mass must be a finite number >= 0 kg, got {value}"
+    COM_NOT_FINITE = "{option}-com: payload centre of mass must be finite, got {value} m"
+    COM_BELOW = "{option}-com: z = {z:g} m is below the plate (the plate frame's z >= 0 holds the plate and its load)"
+
+    BELOW_PLATE = ("--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and "
+                   "its load)")
+
+
+class StiffnessError(StewartError):
+    """A leg stiffness is missing or not physical."""
+
+    MISSING = "{option}: no leg stiffness given and the platform file has no legs.stiffness"
+    NOT_POSITIVE = "{option}: leg stiffness must be a positive number of N/m, got {value}"
+
+
+SLICE_NODES = "slice of {n} x {n} nodes: need 2 <= n and n² <= {limit}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Workspace requests (``workspace``).
+
+
+class WorkspaceError(StewartError):
+    """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
+
+    EXECUTOR = "executor must be a concurrent.futures.Executor (or have submit), got {kind}"
+    GRID_TOO_LARGE = ("resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can hold is "
+                      "~{h_min_mm:.2g} mm; use a coarser --resolution")
+    GRID_NODES = "more than the {limit:.0e} nodes one sweep may take"
+    EMPTY_STROKE = "the stroke workspace at orientation {orientation} rad is empty (no common point of the legs' reach)"
+    RESOLUTION = "resolution must be a positive number of metres, got {value}"
+    BOUNDS = "bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {value}"
+    NOTHING_REACHABLE = "no reachable position at orientation {orientation} rad with limits {limits} at resolution {h} m"
+    CONE = "Limits.{name} must be an angle in (0, pi] rad, got {value}"
+    LEG_DIAMETER = "Limits.leg_diameter must be a positive length in metres, got {value}"
+    MAX_CONDITION = "Limits.max_condition must be > 1, got {value}"
+    AXES = "Limits.{name} must be six non-zero 3-vectors, shape (6, 3), got {shape}"
+    ORIENTATION = "orientation must be 3 finite angles (rad) about X, Y, Z, got {value}"
+    PLANE = "plane must be 'xy', 'xz' or 'yz', got {value!r}"
+    GRIDS = "grids must be six non-empty 1-D arrays (px, py, pz, a_x, a_y, a_z), got {n}"
+    SPACE_DOF = "space_dof (lambda) must be 3 (planar) or 6 (spatial), got {value}"
+    JOINTS = "need n_links >= 1 and every joint freedom in 1..{space_dof}, got n = {n}, f = {f}"
+    LEG_TYPE = "unknown leg type {kind!r}; expected one of {valid}"
+    POSITION = "position must be 3 finite coordinates in metres, got {value}"
+    CENTRE = "rotation centre must be 3 finite coordinates in metres (plate frame), got {value}"
+    STEP = "step must be in (0, max_angle), got step = {step} rad, max_angle = {max_angle} rad"
+    START_OUTSIDE = "start pose {pose} is outside the {limit} limit (margin {margin:.4g} {unit})"
+
+
+# ----------------------------------------------------------------------------------------------
 # Input/output errors and message templates (files, options, output folders).
 
 
 class InputError(StewartError):
     """A file or option the user gave is unreadable or malformed (YAML, CSV, a path)."""
+
+    PROGRAM_MISSING = "program file {path!r} does not exist"
+    PROGRAM_NOT_FILE = "program file {path!r} is {what}, not a file"
+    PROGRAM_TOO_LARGE = "{path}: larger than the {limit}-byte limit for a program"
+    PROGRAM_NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
+    PROGRAM_NUL = "{path}:{line}: a NUL byte; not a program text file"
 
 
 class OutputError(StewartError):
@@ -104,12 +333,14 @@ class YamlError(GeometryError, InputError):
     MISSING = "{kind} file {path!r} does not exist"
     NOT_A_FILE = "{kind} file {path!r} is a folder, not a file"
     UNIT = "{path}:{line}: length_unit: unknown length unit {value!r}; use m or mm"
+    RECURSIVE_ALIAS = "{path}:{line}: an alias refers to the value that contains it"
 
 
 class CsvError(InputError):
     """A CSV file is malformed: messages name the file and the line (counted from 1)."""
 
     FIELD_TOO_LONG = "{path}:{line}: a field is longer than {limit} characters; not a {kind} file?"
+    SYNTAX = "{path}:{line}: {problem}"
     NOT_TEXT = "{path}:{line}: not UTF-8 text"
     NOT_NUMBER = "{path}:{line}: column {column}: not a number: {value!r}"
     WIDTH = "{path}:{line}: expected {expected} values ({columns}), got {got}"
@@ -117,6 +348,8 @@ class CsvError(InputError):
     EMPTY = "{path}: no {kind} rows"
     MISSING = "{kind} file {path!r} does not exist"
     IS_FOLDER = "{kind} file {path!r} is a folder, not a file"
+    TOO_FEW = "{path}: need at least {need} samples, got {got}"
+    TIMES = "{path}: times must increase; sample {k} (t = {t} s) does not follow t = {t_prev} s"
 
 
 class UsageError(StewartError):
@@ -125,6 +358,99 @@ class UsageError(StewartError):
     NEEDS = "{option} only applies with {needs}"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     INTERNAL = "internal error ({kind}: {detail}); please report it with the command line"
+    LEGS_CORIOLIS = "--legs on computes the complete model; it cannot be combined with --coriolis off"
+    ENGINE_C = "--engine c runs the fixed-point controller; --controller is {controller!r}"
+
+
+class OptionError(UsageError):
+    """One option's value is outside the range the command accepts; the message names the option and the
+    value as typed."""
+
+    AT_LEAST = "{option} must be >= {min}, got {value}"
+    POSITIVE = "{option} must be a positive number of {unit}, got {value}"
+    POSITIVE_LENGTH = "{option} must be a positive length, got {value}"
+    BETWEEN = "{option} must be between {lo} and {hi}, got {value}"
+    GRAVITY = "{option} must be a finite number >= 0 m/s², got {value}"
+    UNKNOWN_LIMIT = "{option}: unknown limit {value!r}; choose from {valid}"
+    DT = "--dt must be > 0 and --t-end >= 0, got dt = {dt}, t-end = {t_end}"
+    TOO_MANY_SAMPLES = "--t-end / --dt = {n} samples, more than {limit}"
+    NO_STUDY = "--replay: {out!r} holds no finished study ({file} missing); run the study first"
+    NO_RUN = "--replay {run}: the study in {out!r} has runs 0 … {last}"
+
+
+# ----------------------------------------------------------------------------------------------
+# The motion language (``script``): templates of ``script.errors.ScriptError`` messages, which the
+# diagnostics print as ``file:line:column: error: message``.
+
+SCRIPT_SYNTAX = "unexpected {found}; expected {expected}"
+SCRIPT_RESERVED = "{word!r} is a reserved word (Modula-2, kept from seed 004's Stewart.g) and cannot be used yet"
+SCRIPT_UNDEFINED = "undefined variable {name!r}"
+SCRIPT_NEVER_ASSIGNED = "undefined variable {name!r}: it is never assigned in this program"
+SCRIPT_MOVE_ARITY = "{kw} takes 6 arguments (x, y, z, alpha, beta, gama), got {n}"
+SCRIPT_MOVE_UNKNOWN_ARG = "{kw} has no argument {name!r}; its arguments are x, y, z, alpha, beta, gama"
+SCRIPT_MOVE_DUPLICATE_ARG = "{kw}: argument {name!r} given twice"
+SCRIPT_MOVE_POSITIONAL_AFTER_KEYWORD = "{kw}: positional argument after a keyword argument"
+SCRIPT_FUNC_ARITY = "{name}() takes {expected} argument{s}, got {n}"
+SCRIPT_FUNC_UNKNOWN = "unknown function {name!r}; available: {available}"
+# (the messages the motion language's parser, checker, interpreter and runtime raise)
+SCRIPT_UNREACHABLE = (
+    "{what} is out of reach on platform {platform}: leg {leg} would be {excess:.3f} mm "
+    "{side} the stroke {bound} {limit:.3f} mm (length {length:.3f} mm at t = {t:.3f} s{where})"
+)
+
+
+SCRIPT_EMIT = "the program cannot be translated to valid Python ({kind}: {problem})"
+SCRIPT_TOO_MANY_STEPS = (
+    "the program ran more than {limit} steps (statements and loop iterations); does a loop never end?"
+)
+SCRIPT_LOOP_STEPS = (
+    "this FOR loop would run {count} iterations, at least {steps} steps with its body; a program may run "
+    "at most {limit} steps (statements and loop iterations)"
+)
+SCRIPT_LOOP_MOVES = "this FOR loop would make {moves} moves and waits; a program may make at most {limit}"
+SCRIPT_NO_FINITE_VALUE = "{name}({args}) has no finite value"
+SCRIPT_DIVISION_BY_ZERO = "division by zero ({a} {op} 0)"
+SCRIPT_OVERFLOW = "arithmetic overflow: {a} {op} {b} is not finite"
+SCRIPT_CANNOT_PARSE = "cannot parse: {problem}"
+SCRIPT_EXPRESSION_DEPTH = "expression nested more than {limit} levels deep"
+SCRIPT_NUMBER_TOO_LARGE = "number {text} is too large"
+SCRIPT_STATEMENT_DEPTH = "statements nested more than {limit} levels deep"
+SCRIPT_LOOP_DEPTH = "loops (FOR, WHILE) nested more than {limit} levels deep"
+SCRIPT_NOT_A_NUMBER = "{what} must be a number, got {value!r}"
+SCRIPT_NOT_FINITE = "{what} must be finite, got {value}"
+SCRIPT_UNIT = "units: {name!r} is not a unit; expected {lengths} (length), {angles} (angle)"
+SCRIPT_TWO_UNITS = "units: two {kind} units given"
+SCRIPT_DURATION = "{keyword} duration must be positive, got {value} s"
+SCRIPT_TOO_SHORT = (
+    "{keyword} duration {value} s is shorter than the shortest move, {limit} s (no actuator follows a "
+    "faster one)"
+)
+SCRIPT_WAIT = "wait duration must be >= 0, got {value} s"
+SCRIPT_TOO_MANY_MOVES = (
+    "the program makes more than {limit} moves and waits (the limit); shorten it or use longer moves"
+)
+SCRIPT_SEGMENT_SAMPLES = (
+    "{what} lasts {duration} s, more than the {limit} samples a program may have "
+    "at {rate} Hz ({seconds} s)"
+)
+SCRIPT_TOO_MANY_SAMPLES = (
+    "trajectory too long: {total} samples ({seconds} s at {rate} Hz; the limit is {limit}); lower the "
+    "rate or shorten the program"
+)
+SCRIPT_START_OUT_OF_REACH = (
+    "the start pose is out of reach on platform {platform}: leg {leg} length {length_mm:.3f} mm is "
+    "outside the stroke [{lo_mm:.3f}, {hi_mm:.3f}] mm"
+)
+SCRIPT_MORE_UNREACHABLE = "... and {more} more unreachable moves"
+SCRIPT_BELOW_BASE = (
+    "{what} puts the plate {where} the base on platform {platform}: the plate anchor of leg {leg} "
+    "is at z = {z_mm:.3f} mm at t = {t:.3f} s (the base plane is z = 0)"
+)
+SCRIPT_SINGULAR = (
+    "{what}: the platform is singular or nearly so at t = {t:.3f} s (Jacobian condition number "
+    "{cond:.3g} > {limit:.3g}); leg forces are undefined there"
+)
+SCRIPT_FOR_STEP_ZERO = "FOR step is 0: the loop would never end"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -153,6 +479,16 @@ FAR_POSITION = (
     "{limit:g} × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
 )
 NOT_FINITE = "{what} must be finite, got {value}"
+NOT_POSITIVE = "{what} must be a positive number{unit}, got {value}"
+GRAVITY_RANGE = "{option} {value} m/s² is beyond ±100 m/s² (10 g); is it in m/s²?"
+FAR_CENTRE = (
+    "{option} {centre} m is {ratio:.3g} × the platform's size ({size_m:.3f} m) from the plate; "
+    "centres beyond {limit:g} × are surely a unit mistake (the centre is in metres)"
+)
+SERVO_NEUTRAL = (
+    "{what}: servo {servo}'s neutral pulse {value} µs is outside [{lo:.0f}, {hi:.0f}] µs: with its travel of "
+    "±{swing:.0f} µs the pulse must stay within an RC servo's {range_lo:.0f}-{range_hi:.0f} µs"
+)
 OUT_OF_STROKE = (
     "{what} leaves the stroke: first at t = {t:.4f} s, leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
     "{side} the stroke {bound} {limit_mm:.3f} mm{hint}"
@@ -162,4 +498,5 @@ NO_PLATE = (
     "'{command}' needs plate.mass and plate.inertia (or plate.thickness and plate.density for a utn platform)"
 )
 SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
+WORK_UNBOUNDED = "{option} {value} would need unboundedly many {what}{hint}"
 WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"

@@ -1,4 +1,4 @@
-"""Design maps over a workspace slice (issue 16): each map node equals the single-pose computation."""
+"""Design maps over a workspace slice: each map node equals the single-pose computation."""
 
 from __future__ import annotations
 

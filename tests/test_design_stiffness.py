@@ -1,4 +1,4 @@
-"""Stiffness and natural frequencies (issue 16): zero-load stiffness against Aᵀ diag(k) A built from
+"""Stiffness and natural frequencies: zero-load stiffness against Aᵀ diag(k) A built from
 the anchors, loaded stiffness against finite differences of the static wrench, frequencies and mode
 shapes against Drake."""
 

@@ -1,9 +1,12 @@
 """The DSP IK port (tp17.C), the generic fixed-point IK, the cycle model and ``stewart-drake dsp-ik``."""
 
 import json
+import re
 
 import numpy as np
 import pytest
+
+from stewart_drake.errors import SHAPE, DspPoseError, FixedPointError
 
 from stewart_drake.cli import main
 from stewart_drake.fixedpoint import (CYCLE_TABLE, ERROR_STAGES, QFormat, SaturationCounter, dsp_poses_from_si,
@@ -92,11 +95,11 @@ def test_saturation_counter_through_the_port():
 
 
 def test_pose_validation_messages():
-    with pytest.raises(ValueError, match=r"pose 1: angles \[1.5, 0.0, 0.0\] \(fractions of pi\) must lie in \[-1, 1\]"):
+    with pytest.raises(DspPoseError, match=re.escape(DspPoseError.ANGLES.format(name="pose 1", values=[1.5, 0.0, 0.0]))):
         tp17_leg_lengths([[0, 0, 100, 0, 0, 0], [0, 0, 100, 1.5, 0, 0]])
-    with pytest.raises(ValueError, match="position .* does not fit a 16-bit word"):
+    with pytest.raises(DspPoseError, match=re.escape(DspPoseError.POSITION.format(name="pose", values=[0.0, 0.0, 40000.0]))):
         tp17_leg_lengths([0, 0, 40000, 0, 0, 0])
-    with pytest.raises(ValueError, match=r"shape \(\.\.\., 6\)"):
+    with pytest.raises(DspPoseError, match=re.escape(SHAPE.format(name="DSP poses", shape="(..., 6)", got="(3,)"))):
         tp17_leg_lengths([0, 0, 100])
 
 
@@ -142,12 +145,12 @@ def test_generic_16bit_mm_close_to_the_dsp():
 
 
 def test_generic_qformat_validation():
-    with pytest.raises(ValueError, match="word_bits must be an integer in 8..31, got 40"):
+    with pytest.raises(FixedPointError, match=re.escape(FixedPointError.WORD_BITS.format(value=40))):
         QFormat(word_bits=40)
-    with pytest.raises(ValueError, match="needs word_bits=16"):
+    with pytest.raises(FixedPointError, match=re.escape(FixedPointError.TFR16_BITS.format(value=20))):
         QFormat(word_bits=20, trig="tfr16")
     p = load_preset("utn-kinematic")
-    with pytest.raises(ValueError, match="does not fit a 10-bit word"):
+    with pytest.raises(FixedPointError, match="does not fit a 10-bit word"):  # FixedPointError.LENGTH_WORD
         fixed_point_leg_lengths(p, p.home_pose(), QFormat(10, 1e-3))
 
 
@@ -172,7 +175,7 @@ def test_cycle_estimate():
     assert ik_latency_s(clock_hz=120e6) == pytest.approx(e.seconds / 2)
     cheap = dict(CYCLE_TABLE, mfr32Sqrt=50.0)
     assert tp17_cycles(cheap).cycles == pytest.approx(e.cycles - 6 * 100)
-    with pytest.raises(ValueError, match="'fft' has no entry"):
+    with pytest.raises(FixedPointError, match=re.escape(FixedPointError.NO_CYCLES.format(op="fft"))):
         estimate_cycles({"fft": 1})
 
 

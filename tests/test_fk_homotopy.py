@@ -6,7 +6,9 @@ import importlib
 import numpy as np
 import pytest
 
-from stewart_drake.core.assembly_modes import ProgramFK, assembly_modes, dietmaier_platform, planar_platform
+from stewart_drake.core.assembly_modes import assembly_modes
+from stewart_drake.core.reference_platforms import dietmaier_platform, planar_platform
+from stewart_drake.drake.program_fk import ProgramFK
 from stewart_drake.core.geometry import load_preset, load_platform_yaml
 from stewart_drake.homotopy import architecture, solve, solve_batch
 from stewart_drake.homotopy.certify import certify, newton_real, real_forms

@@ -3,19 +3,19 @@
 import numpy as np
 import pytest
 
-from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import condition_number, inverse_jacobian, leg_lengths
 from stewart_drake.core.newton_fk import (
     CONVERGED,
     check_poses_nonsingular,
     forward_kinematics,
     jacobian_analysis,
     legs_and_jacobian,
-    sample_poses,
     validate_lengths,
 )
-from stewart_drake.core.geometry import load_preset
-from stewart_drake.core.kinematics import condition_number, inverse_jacobian, leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError
 
 
 def _exp(w):
@@ -27,7 +27,7 @@ def _exp(w):
 def test_jacobian_matches_kinematics(preset):
     """The R-based evaluator used by Newton reproduces kinematics.leg_lengths / inverse_jacobian
     (same formulas, other arithmetic order: agreement to a few ulps)."""
-    q = sample_poses(preset, 50, seed=3)
+    q = random_poses(preset, 50, seed=3, region="workspace")
     L, J = legs_and_jacobian(preset, q[:, :3], rotation_matrix(q[:, 3:]))
     np.testing.assert_allclose(L, leg_lengths(preset, q), rtol=1e-14)
     np.testing.assert_allclose(J, inverse_jacobian(preset, q), atol=1e-14)
@@ -37,7 +37,7 @@ def test_jacobian_against_finite_differences():
     """Column j of J⁻¹ is dL/dt along the twist e_j (p += h e_j, or R <- exp(h e_j) R).
     Central differences with h = 1e-6 have truncation error ~h² |L''| ~ 1e-12 and rounding ~1e-16/h."""
     p = load_preset("gonzalez-dutra-2009")
-    q = sample_poses(p, 5, seed=4)
+    q = random_poses(p, 5, seed=4, region="workspace")
     h = 1e-6
     for pose in q:
         P, R = pose[:3], rotation_matrix(pose[3:])
@@ -61,7 +61,7 @@ def test_round_trip_1000_poses_per_preset(preset):
     κ₂ <= 1e4: beyond a singularity the same lengths belong to another assembly mode, which Newton from
     home correctly does not return (see test_round_trip_beyond_singularity). Bound: the pose error is
     about tol/σ_min; with tol = 1e-13 m and σ_min >= ~1e-4 (κ₂ <= 1e4) that is <= 1e-9."""
-    q = sample_poses(preset, 1300, seed=11)
+    q = random_poses(preset, 1300, seed=11, region="workspace")
     a = jacobian_analysis(preset, q)
     home = jacobian_analysis(preset, preset.home_pose())
     q = q[(a.det_sign == home.det_sign) & (a.condition <= 1e4)]
@@ -79,7 +79,7 @@ def test_round_trip_beyond_singularity():
     mostly returns another assembly mode for their lengths (a valid solution, not the sampled pose);
     FK started near the pose (trajectory following) returns the pose itself."""
     p = load_preset("utn-kinematic")
-    q = sample_poses(p, 3000, seed=11)
+    q = random_poses(p, 3000, seed=11, region="workspace")
     a = jacobian_analysis(p, q)
     # κ₂ <= 1e3: nearer the singularity two modes lie within a fraction of a millimetre of each other,
     # and even a close guess may land in the neighbour.
@@ -167,7 +167,7 @@ def test_near_singular_solution_flagged():
 
 def test_jacobian_analysis_consistent_with_kinematics():
     p = load_preset("gonzalez-dutra-2009")
-    q = sample_poses(p, 20, seed=5)
+    q = random_poses(p, 20, seed=5, region="workspace")
     a = jacobian_analysis(p, q)
     np.testing.assert_allclose(a.condition, condition_number(p, q), rtol=1e-10)
     # Frobenius condition used inside Newton brackets the 2-norm one: κ₂ <= κ_F <= 6 κ₂.

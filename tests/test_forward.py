@@ -1,21 +1,16 @@
-"""Drake MathematicalProgram forward kinematics and the assembly-mode search (``stewart_drake.core.assembly_modes``)."""
+"""Drake MathematicalProgram forward kinematics (``drake/program_fk``) and the assembly-mode search
+(``core/assembly_modes``, confirmed by the program)."""
 
 import numpy as np
 import pytest
 
-from stewart_drake.errors import ForwardKinematicsError
-from stewart_drake.core.assembly_modes import (
-    ProgramFK,
-    assembly_modes,
-    best_position,
-    dietmaier_platform,
-    is_planar,
-    max_solutions,
-    random_rotations,
-)
+from stewart_drake.core.assembly_modes import best_position, is_planar, max_solutions, random_rotations
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
+from stewart_drake.core.reference_platforms import dietmaier_platform
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.drake.program_fk import ProgramFK, assembly_modes
+from stewart_drake.errors import ForwardKinematicsError
 
 MIRROR = np.array([1, 1, -1])
 
@@ -129,3 +124,22 @@ def test_bad_arguments():
         ProgramFK(p, rotation="euler")
     with pytest.raises(ValueError, match=r"one length set of shape \(6,\)"):
         assembly_modes(p, np.full((2, 6), 0.7))
+
+
+def test_polish_is_any_callable_and_decides_certification():
+    """The core search takes the polish as a plain callable (no Drake): a mode is certified only when the
+    callable reports success, a residual <= 1e-9 m and the same solution it started from."""
+    from stewart_drake.core.assembly_modes import assembly_modes as search
+
+    p = load_preset("utn-dynamic")
+    L = leg_lengths(p, p.home_pose())
+    kw = dict(n_starts=200, seed=1)
+    agree = search(p, L, polish=lambda L_, p_, R_: (p_, R_, True, 0.0), **kw)
+    assert len(agree) == 16 and all(m.certified for m in agree.modes)
+    failed = search(p, L, polish=lambda L_, p_, R_: (p_, R_, False, 0.0), **kw)
+    elsewhere = search(p, L, polish=lambda L_, p_, R_: (p_ + 1e-3, R_, True, 0.0), **kw)
+    loose = search(p, L, polish=lambda L_, p_, R_: (p_, R_, True, 2e-9), **kw)
+    assert not any(m.certified for am in (failed, elsewhere, loose) for m in am.modes)
+    np.testing.assert_allclose(elsewhere.poses(), agree.poses(), atol=1e-12)  # a rejected polish moves nothing
+    with pytest.raises(TypeError, match="polish must be a callable"):
+        search(p, L, polish="snopt")

@@ -1,4 +1,4 @@
-"""Output safety, safe input loading and the one-line error path (issue 12, items 1, 5, 6, 7).
+"""Output safety, safe input loading and the one-line error path.
 
 Commands run in-process through ``stewart_drake.cli.main`` in a temporary working directory; the
 SIGKILL test runs real subprocesses.
@@ -260,14 +260,6 @@ def test_control_character_in_name_refused(here, capsys):
     (here / "p.yaml").write_text('name: "a\\0b"\n' + PLATFORM)
     rc, _, err = cli(capsys, "ik", "--platform", "p.yaml", "--pose", "0", "0", "700", "0", "0", "0")
     assert rc == 2 and err.strip() == "stewart-drake ik: error: p.yaml:1: name: 'a\\x00b' contains the control character '\\x00'"
-
-
-def test_preset_sdf_unchanged():
-    from stewart_drake.core.geometry import PRESETS, load_preset
-    from stewart_drake.drake.platform_model import SDF_DIR, sdf_text
-
-    for name in PRESETS:
-        assert sdf_text(load_preset(name)) == (SDF_DIR / f"{name}.sdf").read_text()
 
 
 # ----------------------------------------------------------------------------------------------

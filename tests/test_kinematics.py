@@ -1,7 +1,16 @@
+import re
+
 import numpy as np
 import pytest
 
-from stewart_drake.errors import SingularPoseError, UnreachablePoseError
+from stewart_drake.errors import (
+    NOT_FINITE_SAMPLE,
+    SHAPE,
+    NotFiniteError,
+    ShapeError,
+    SingularPoseError,
+    UnreachablePoseError,
+)
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import (
     check_stroke,
@@ -122,10 +131,13 @@ def test_below_minimum_is_reported():
 
 def test_bad_pose_input():
     p = load_preset("utn-dynamic")
-    with pytest.raises(ValueError, match=r"poses must have shape \(\.\.\., 6\)"):
+    # ShapeError and NotFiniteError are ValueErrors too (callers that catch ValueError keep working).
+    with pytest.raises(ShapeError, match=re.escape(SHAPE.format(name="poses", shape="(..., 6)", got="(4, 5)"))):
         leg_lengths(p, np.zeros((4, 5)))
-    with pytest.raises(ValueError, match=r"pose 3 is not finite"):
-        leg_lengths(p, np.r_[[p.home_pose()] * 2, [[0, 0, np.nan, 0, 0, 0]]])
+    bad = [0.0, 0.0, np.nan, 0.0, 0.0, 0.0]
+    with pytest.raises(NotFiniteError, match=re.escape(NOT_FINITE_SAMPLE.format(what="pose", index=3, values=bad))):
+        leg_lengths(p, np.r_[[p.home_pose()] * 2, [bad]])
+    assert issubclass(ShapeError, ValueError) and issubclass(NotFiniteError, ValueError)
 
 
 def test_singular_pose_is_reported():

@@ -117,12 +117,6 @@ def test_seed_ik_is_wrong_and_each_fix_is_needed():
 # ---- Drake ----------------------------------------------------------------------------------------
 
 
-def test_sdf_matches_committed_file(tmp_path):
-    from stewart_drake.drake.leg_model import SDF_DIR, write_sdf
-
-    assert write_sdf(LEG, tmp_path).read_text() == (SDF_DIR / "leg-3r.sdf").read_text()
-
-
 def test_fk_matches_drake():
     from stewart_drake.drake.leg_model import drake_fk_errors
 

@@ -3,23 +3,18 @@
 import numpy as np
 import pytest
 
-from stewart_drake.core.geometry import PRESETS, load_preset
-from stewart_drake.drake.platform_model import build_plant, leg_joint_positions, sdf_path, sdf_text, set_pose
-from stewart_drake.core.sampling import random_poses
-from stewart_drake.drake.verify_kinematics import anchor_frames, drake_fk_tip_errors, drake_ik_lengths, make_plant
+from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.leg_bodies import leg_joint_positions
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.drake.platform_model import build_plant, set_pose
+from stewart_drake.drake.verify_kinematics import anchor_frames, drake_fk_tip_errors, drake_ik_lengths, make_plant
 
 # SNOPT closes the ball constraints to its feasibility tolerance (1e-10 m scale); the recovered leg
 # lengths then agree to ~1e-10 m. 1e-8 m leaves margin and is still 100x tighter than the 1e-6 m asked.
 IK_TOL = 1e-8
 # Frames and forward kinematics are a few float operations on metre-scale numbers: ~1e-15 m.
 FK_TOL = 1e-12
-
-
-@pytest.mark.parametrize("name", PRESETS)
-def test_committed_sdf_is_what_the_generator_writes(name):
-    committed = sdf_path(name).read_text(encoding="utf-8")
-    assert committed == sdf_text(load_preset(name)), f"sdf/{name}.sdf is stale: run `stewart-drake model --platform {name} --write sdf`"
 
 
 def test_plant_structure(preset):

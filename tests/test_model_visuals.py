@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.geometry import load_preset
-from stewart_drake.drake.platform_model import build_plant, convex_outline, leg_dimensions, leg_visual_dimensions
+from stewart_drake.core.leg_bodies import leg_dimensions, leg_visual_dimensions
+from stewart_drake.core.sdf_models import convex_outline
+from stewart_drake.drake.platform_model import build_plant
 
 # Poses and shape sizes come straight from the SDF's 15 significant digits: ~1e-15 m of rounding.
 GEOM_TOL = 1e-12

@@ -5,11 +5,10 @@ from stewart_drake.core.rotations import (
     angles_from_matrix,
     angular_velocity_map,
     convert_angles,
-    from_drake,
     pose_from_si,
     pose_to_si,
+    quaternion_to_matrix,
     rotation_matrix,
-    to_drake,
 )
 
 RNG = np.random.default_rng(7)
@@ -33,6 +32,8 @@ def test_utn_is_ry_rx_rz_written_out_as_in_the_seed():
 def test_zyx_matches_drake_roll_pitch_yaw():
     from pydrake.math import RollPitchYaw, RotationMatrix
 
+    from stewart_drake.drake.conversions import from_drake
+
     for ang in ANGLES[:50]:
         R = RotationMatrix(RollPitchYaw(*ang)).matrix()
         np.testing.assert_allclose(rotation_matrix(ang, "zyx"), R, atol=1e-14)
@@ -54,6 +55,8 @@ def test_convert_between_conventions_keeps_the_rotation():
 
 
 def test_drake_round_trip_utn():
+    from stewart_drake.drake.conversions import from_drake, to_drake
+
     ang = np.array([0.2, -0.4, 0.9])
     np.testing.assert_allclose(from_drake(to_drake(ang, "utn"), "utn"), ang, atol=1e-13)
 
@@ -92,3 +95,22 @@ def test_bad_names_are_reported():
         pose_to_si([0] * 6, "in", "rad")
     with pytest.raises(ValueError, match=r"a pose needs 6 numbers .* got shape \(5,\)"):
         pose_to_si([0] * 5)
+
+
+def test_quaternion_to_matrix_matches_drake():
+    """Against Drake's Quaternion -> RotationMatrix (Eigen's formula, written differently): equal to a few
+    ulps; q and -q and any positive scaling give the same rotation."""
+    from pydrake.common.eigen_geometry import Quaternion
+    from pydrake.math import RotationMatrix
+
+    from stewart_drake.drake.conversions import from_drake
+
+    q = RNG.normal(size=(40, 4))
+    R = quaternion_to_matrix(q)
+    for qk, Rk in zip(q / np.linalg.norm(q, axis=-1, keepdims=True), R):
+        np.testing.assert_allclose(Rk, RotationMatrix(Quaternion(qk)).matrix(), atol=2e-15)  # entries <= 1: a few roundings of 1.1e-16
+    np.testing.assert_allclose(quaternion_to_matrix(-3.0 * q), R, atol=1e-15)
+    np.testing.assert_allclose(quaternion_to_matrix(q.reshape(2, 20, 4)), R.reshape(2, 20, 3, 3), atol=0)
+    np.testing.assert_allclose(from_drake(Quaternion(q[0] / np.linalg.norm(q[0]))), angles_from_matrix(R[0]), atol=1e-13)
+    with pytest.raises(ValueError, match=r"quaternions need 4 numbers \(w, x, y, z\), got shape \(3,\)"):
+        quaternion_to_matrix([1.0, 0.0, 0.0])

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from stewart_drake.errors import GeometryError
 from stewart_drake.core.servo import (
     RATE_US_PER_RAD,
     ServoPoseError,
@@ -15,6 +14,7 @@ from stewart_drake.core.servo import (
     quantise_pulses,
     solve,
 )
+from stewart_drake.errors import GeometryError
 
 
 @pytest.fixture(scope="module")
@@ -114,13 +114,6 @@ def test_quantisation_rounds_half_away_from_zero():
 
 
 # ---- Drake ----------------------------------------------------------------------------------------
-
-
-def test_sdf_matches_committed_file(hexapod, tmp_path):
-    from stewart_drake.drake.servo_model import SDF_DIR, write_sdf
-
-    path = write_sdf(hexapod, tmp_path)
-    assert path.read_text() == (SDF_DIR / "servo-hexapod.sdf").read_text()
 
 
 def test_drake_cross_checks(hexapod):
@@ -242,7 +235,8 @@ def test_closed_loop_hold_is_within_quantisation_and_sag(hexapod):
     """A constant offset pose held for 0.4 s: once settled, each arm sits within half a pulse step
     (0.5 µs = 0.056°) plus its static sag (load / kp ≈ 0.02°) of eq. 9, and the platform within the
     Jacobian image of that. A wrong pulse sign, gain or mounting would miss by degrees."""
-    from stewart_drake.drake.servo_model import run_closed_loop, tracking_bounds
+    from stewart_drake.core.servo_loop import tracking_bounds
+    from stewart_drake.drake.servo_model import run_closed_loop
 
     pose = hexapod.home_pose() + [0.003, -0.002, 0.004, 0.05, -0.03, 0.08]
     log = run_closed_loop(hexapod, [0.0, 1.0], [pose, pose], duration=0.4)
@@ -255,13 +249,14 @@ def test_closed_loop_hold_is_within_quantisation_and_sag(hexapod):
 
 
 def test_closed_loop_tracks_a_trajectory(hexapod):
-    """1 s of heave ±6 mm, roll ±8°, yaw ±15° through the 50 Hz loop. Bound (servo_model.tracking_bounds):
+    """1 s of heave ±6 mm, roll ±8°, yaw ±15° through the 50 Hz loop. Bound (servo_loop.tracking_bounds):
     the reference's change over the loop's latency Λ = 20 ms frame + 2 ms + kd/kp (5.7 ms), plus half a
     pulse step and the sag; the arms' worst speed (2.5 rad/s) is below the servo's 6.2 rad/s, so the speed
     limit adds no lag. Checked per servo and per pose axis on the run's worst case (per sample, the
     reaction of neighbouring servos' frame steps adds ~0.04° blips where an arm reverses, which the
     bound does not model)."""
-    from stewart_drake.drake.servo_model import run_closed_loop, tracking_bounds
+    from stewart_drake.core.servo_loop import tracking_bounds
+    from stewart_drake.drake.servo_model import run_closed_loop
 
     t = np.linspace(0, 1.0, 201)
     traj = np.tile(hexapod.home_pose(), (len(t), 1))

@@ -1,4 +1,4 @@
-"""Workspace analysis (SPEC §5, seed 001): the paper reproduced, the numerics checked against
+"""Workspace analysis (seed 001): the paper reproduced, the numerics checked against
 independent computations, the optional limits binding and not, and the sweep's chunking/back ends."""
 
 import importlib.util
@@ -15,7 +15,7 @@ from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
 from stewart_drake.report import ANALYSES_DIR
 from stewart_drake.core.rotations import rotation_matrix
-from stewart_drake.workspace.slabs import _grid_spec, _inside_block
+from stewart_drake.workspace.slabs import grid_spec, inside_block
 
 DEG = math.pi / 180
 
@@ -102,8 +102,8 @@ def test_grid_classification_equals_leg_lengths(gd, orientation):
     """The grid kernel (translation added to l_i(0)) agrees node by node with kinematics.leg_lengths."""
     rng = np.random.default_rng(1)
     xs, ys, zs = (np.sort(rng.uniform(lo, hi, n)) for (lo, hi), n in zip(ws.default_bounds(gd, orientation), (17, 19, 23)))
-    spec = _grid_spec(gd, orientation, "utn", ws.Limits(), (xs, ys, zs))
-    inside, _ = _inside_block(spec, xs, ys, zs)
+    spec = grid_spec(gd, orientation, "utn", ws.Limits(), (xs, ys, zs))
+    inside, _ = inside_block(spec, xs, ys, zs)
     X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
     q = np.stack([X, Y, Z] + [np.full(X.shape, a) for a in orientation], -1)
     expect = check_stroke(gd, leg_lengths(gd, q)).within

@@ -15,8 +15,10 @@ import time
 
 import numpy as np
 
-from stewart_drake.core.newton_fk import forward_kinematics, jacobian_analysis, sample_poses
-from stewart_drake.core.assembly_modes import ProgramFK, assembly_modes, dietmaier_platform, general_platform
+from stewart_drake.core.newton_fk import forward_kinematics, jacobian_analysis
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.core.reference_platforms import dietmaier_platform, general_platform
+from stewart_drake.drake.program_fk import ProgramFK, assembly_modes
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.report import run_standalone
@@ -29,7 +31,7 @@ ROUND_TRIP_TOL = 1e-9  # m and rad; the pose error is ~ tol_Newton / sigma_min
 
 def round_trips(platform, n: int, seed: int = 11) -> dict:
     """IK -> FK from home for ``n`` sampled poses; split by singularity region."""
-    q = sample_poses(platform, n, seed=seed)
+    q = random_poses(platform, n, seed=seed, region="workspace")
     a = jacobian_analysis(platform, q)
     home = jacobian_analysis(platform, platform.home_pose())
     L = leg_lengths(platform, q)
@@ -77,7 +79,7 @@ def build(section) -> None:
         "sets, iterates on the position and the rotation matrix (no Euler angles inside the loop), and "
         "reports per sample the pose, the leg-length residual, the iteration count and a converged flag; "
         "the Jacobian's condition number is checked at the start and at the solution. The Drake "
-        "MathematicalProgram (stewart_drake.core.assembly_modes.ProgramFK: quaternion or rotation matrix + position, "
+        "MathematicalProgram (stewart_drake.drake.program_fk.ProgramFK: quaternion or rotation matrix + position, "
         "six squared-length equations, SNOPT or IPOPT) polishes and independently confirms solutions. "
         "assembly_modes finds every real solution by seeded multi-start Newton (random orientations, "
         "least-squares positions), deduplication and program confirmation; it is provably complete only "
@@ -210,7 +212,7 @@ def build(section) -> None:
     # ---- timing -----------------------------------------------------------------------------
     nb = 20_000 if section.quick else 100_000
     g = load_preset("gonzalez-dutra-2009")
-    qb = sample_poses(g, nb, seed=2)
+    qb = random_poses(g, nb, seed=2, region="workspace")
     Lb = leg_lengths(g, qb)
     t0 = time.perf_counter()
     forward_kinematics(g, Lb, on_singular="ignore")

@@ -7,15 +7,12 @@ import numpy as np
 
 from stewart_drake.core.leg3r import (SEED_FIXES, SEED_FIX_TEXT, Leg3R, foot, foot_jacobian, inverse_kinematics,
                                inverse_kinematics_3r, joint_points, random_configurations, seed_inverse_kinematics)
+from stewart_drake.core.rotations import wrap_angle
 from stewart_drake.drake.leg_model import drake_fk_errors, drake_ik
 from stewart_drake.report import run_standalone
 
 TITLE = "3R planar leg (seed 003): DH kinematics"
 ORDER = 70
-
-
-def _wrap(x):
-    return (x + np.pi) % (2 * np.pi) - np.pi
 
 
 def build(section) -> None:
@@ -36,7 +33,7 @@ def build(section) -> None:
         qn = inverse_kinematics(leg, p, b)
         rt = np.abs(foot(leg, qn)[:, :2] - p).max()
         qd, gap = drake_ik(leg, p, b)
-        d = np.abs(_wrap(qd - qn)).max(1)
+        d = np.abs(wrap_angle(qd - qn)).max(1)
         bound = np.linalg.norm(np.linalg.inv(foot_jacobian(leg, qn)), 2, axis=(-2, -1)) * gap
         section.check(f"branch {b}: IK → FK round trip ({n} targets)", rt, 1e-12, "m")
         section.check(f"branch {b}: Drake IK angles minus 2·||J⁻¹||·(Drake's foot gap)", float(np.max(d - 2 * bound)), 1e-12, "rad")
@@ -56,7 +53,7 @@ def build(section) -> None:
     section.table(["seed eqs. 13-20", "targets with a real solution", "worst foot error (mm)", "median (mm)"], rows,
                   caption="Branch a, targets from random configurations: each correction is needed", fmt="{:.3g}")
     full = seed_inverse_kinematics(leg, f, "a", SEED_FIXES)
-    section.check("seed IK with every fix = inverse_kinematics_3r", float(np.abs(_wrap(full - inverse_kinematics_3r(leg, f, "a"))).max()), 1e-12, "rad")
+    section.check("seed IK with every fix = inverse_kinematics_3r", float(np.abs(wrap_angle(full - inverse_kinematics_3r(leg, f, "a"))).max()), 1e-12, "rad")
 
     # Workspace.
     m = 60 if section.quick else 200
@@ -64,7 +61,7 @@ def build(section) -> None:
     qq = np.stack([g1.ravel(), g2.ravel()], -1)
     P = foot(leg, qq)
     _, phi = leg.shank
-    a = _wrap(qq[:, 1] + phi) >= 0
+    a = wrap_angle(qq[:, 1] + phi) >= 0
     fig, ax = plt.subplots(figsize=(6, 6))
     ax.scatter(P[a, 0] * 1e3, P[a, 1] * 1e3, s=1, alpha=0.3, label="branch a (knee ≥ 0)")
     ax.scatter(P[~a, 0] * 1e3, P[~a, 1] * 1e3, s=1, alpha=0.3, label="branch b (knee ≤ 0)")

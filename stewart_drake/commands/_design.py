@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.design.payload import PayloadError, with_payload
 from stewart_drake.core.rotations import length_scale
+from stewart_drake.design.payload import with_payload
+from stewart_drake.errors import OptionError, PayloadError
 
 
 def add_payload_args(parser, length_help: str) -> None:
@@ -19,8 +20,8 @@ def add_payload_args(parser, length_help: str) -> None:
 def platform_with_payload(platform, args, length_unit: str):
     """The platform carrying ``--payload`` at ``--payload-com`` (in ``length_unit``); checks ``--gravity``."""
     if not (np.isfinite(args.gravity) and args.gravity >= 0):
-        raise ValueError(f"--gravity must be a finite number >= 0 m/s², got {args.gravity}")
+        raise OptionError(OptionError.GRAVITY.format(option="--gravity", value=args.gravity))
     if args.payload_com[2] < 0:
-        raise PayloadError(f"--payload-com: Z = {args.payload_com[2]:g} {length_unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)")
+        raise PayloadError(PayloadError.BELOW_PLATE.format(z=args.payload_com[2], unit=length_unit))
     p_TP = np.asarray(args.payload_com, dtype=float) * length_scale(length_unit)
     return with_payload(platform, args.payload, p_TP), p_TP

@@ -11,7 +11,10 @@ import sys
 from stewart_drake.core.output_folder import check_output_file, write_output_file
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.commands._common import add_platform_arg, platform_from_args
-from stewart_drake.commands.run import read_program
+from stewart_drake.script import ScriptError, compile_program
+from stewart_drake.script.emit import emit_matlab, emit_python
+from stewart_drake.script.runtime import check_reachable
+from stewart_drake.script.source import read_program
 
 
 def register(sub) -> None:
@@ -26,10 +29,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.script import ScriptError, compile_program
-    from stewart_drake.script.emit import emit_matlab, emit_python
-    from stewart_drake.script.runtime import check_reachable
-
     text = read_program(args.program)
     if args.output:
         check_output_file(args.output, option="--output")

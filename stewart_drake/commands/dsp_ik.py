@@ -3,9 +3,19 @@ computes for a pose, bit-exactly, with the float IK beside them."""
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from stewart_drake.commands._common import print_json
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.rotations import angle_scale
+from stewart_drake.core.sanity import check_poses
+from stewart_drake.errors import DspPoseError
+from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.firmware.host import tp17_leg_lengths_c
+from stewart_drake.fixedpoint.q15 import SaturationCounter
+from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
 
 ANGLE_UNITS = ("pi", "deg", "rad")
 
@@ -24,26 +34,15 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import sys
-
-    from stewart_drake.firmware.engine import resolve_engine
-    from stewart_drake.firmware.host import tp17_leg_lengths_c
-    from stewart_drake.fixedpoint.q15 import SaturationCounter
-    from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
-    from stewart_drake.core.rotations import angle_scale
-
     raw = np.asarray(args.pose, dtype=float)
     q = raw.copy()
     with np.errstate(over="ignore"):  # 1e308 deg is inf pi: refused just below as beyond ±180°
         q[3:] = raw[3:] * angle_scale(args.angle_unit) / np.pi  # -> fractions of pi
     for k, name in enumerate(("A", "B", "G")):
         if abs(q[3 + k]) > 1.0:
-            raise ValueError(f"angle {name} = {raw[3 + k]:g} {args.angle_unit} is beyond ±180°; the firmware takes fractions of pi in [-1, 1]")
+            raise DspPoseError(DspPoseError.ANGLE_OPTION.format(name=name, value=raw[3 + k], unit=args.angle_unit))
     check_dsp_poses(q)
     # the firmware's platform is utn-kinematic's (a = 612 vs 612.5 mm): its plate must be above its base
-    from stewart_drake.core.geometry import load_preset
-    from stewart_drake.core.sanity import check_poses
-
     check_poses(load_preset("utn-kinematic"), np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi], "utn", what="--pose")
     with SaturationCounter() as sat:
         tr = tp17_trace(q)

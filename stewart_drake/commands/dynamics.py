@@ -7,11 +7,14 @@ import math
 import sys
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
+from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
 from stewart_drake.core.csvio import read_numeric_csv
+from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import check_file_rows, check_finite, check_gravity, check_trajectory, check_work, fmt_value, require_plate
-from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
+from stewart_drake.errors import CsvError, OptionError, UsageError
 
 CSV_HELP = (
     "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
@@ -46,16 +49,14 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
     width = a.shape[1]
     if len(a) < (2 if width == 19 else 4):
-        raise ValueError(f"{path}: need at least {2 if width == 19 else 4} samples, got {len(a)}")
+        raise CsvError(CsvError.TOO_FEW.format(path=path, need=2 if width == 19 else 4, got=len(a)))
     t = a[:, 0]
     if np.any(np.diff(t) <= 0):
         k = int(np.argmax(np.diff(t) <= 0))
-        raise ValueError(f"{path}: times must increase; sample {k + 1} (t = {t[k + 1]} s) does not follow t = {t[k]} s")
+        raise CsvError(CsvError.TIMES.format(path=path, k=k + 1, t=t[k + 1], t_prev=t[k]))
     scale = np.r_[np.full(3, length_scale(length_unit)), np.full(3, angle_scale(angle_unit))]
     if width == 19:
         return t, a[:, 1:7] * scale, a[:, 7:13] * scale, a[:, 13:19] * scale
-    from scipy.interpolate import CubicSpline
-
     spline = CubicSpline(t, a[:, 1:7] * scale, axis=0)
     return t, spline(t), spline(t, 1), spline(t, 2)
 
@@ -72,7 +73,7 @@ def seed_times(t_end: float, dt: float) -> np.ndarray:
     check_finite(t_end, "--t-end (s)")
     check_finite(dt, "--dt (s)")
     if not (dt > 0 and t_end >= 0):
-        raise ValueError(f"--dt must be > 0 and --t-end >= 0, got dt = {fmt_value(dt)}, t-end = {fmt_value(t_end)}")
+        raise OptionError(OptionError.DT.format(dt=fmt_value(dt), t_end=fmt_value(t_end)))
     n = math.floor(t_end / dt + 0.5) + 1
     check_work("--t-end/--dt", f"{fmt_value(t_end)}/{fmt_value(dt)} s", n, "samples", BYTES_PER_SAMPLE, MAX_SAMPLES,
                hint="; use a larger --dt or a shorter --t-end")
@@ -80,8 +81,6 @@ def seed_times(t_end: float, dt: float) -> np.ndarray:
 
 
 def run(args) -> int:
-    from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
-
     seed = args.trajectory == "seed"
     reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
     reject_unused(args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn")
@@ -101,7 +100,7 @@ def run(args) -> int:
         print(f"stewart-drake dynamics: warning: {w}", file=sys.stderr)
     if args.legs == "on":
         if args.coriolis == "off":
-            raise ValueError("--legs on computes the complete model; it cannot be combined with --coriolis off")
+            raise UsageError(UsageError.LEGS_CORIOLIS)
         F = leg_forces_with_legs(platform, q, qd, qdd, convention, gravity=gravity)
     else:
         F = leg_forces(platform, q, qd, qdd, convention, coriolis=args.coriolis == "on", gravity=gravity)

@@ -6,10 +6,12 @@ import sys
 
 import numpy as np
 
-from stewart_drake.errors import UsageError
-from stewart_drake.core.rotations import length_scale, pose_from_si, pose_to_si
-from stewart_drake.core.sanity import check_finite, check_positive, check_work
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from stewart_drake.core.assembly_modes import modes_from_solutions
+from stewart_drake.core.newton_fk import forward_kinematics
+from stewart_drake.core.rotations import angle_scale, length_scale, pose_from_si, pose_to_si
+from stewart_drake.core.sanity import check_finite, check_positive, check_work
+from stewart_drake.errors import UsageError
 
 
 def register(sub) -> None:
@@ -59,9 +61,9 @@ MAX_ITER = 1000
 def _homotopy_all(platform, L, args, k: float) -> dict:
     """The ``--all`` answer of the complete homotopy solver: solutions nearest home first, each with
     its certificate; path counts per class; completeness and its guarantee."""
-    from stewart_drake.core.assembly_modes import modes_from_solutions
+    # Deferred: the homotopy solver pulls in scipy (~0.1 s) and cli.py imports every command module at
+    # start-up; only ``--all --method homotopy`` needs it.
     from stewart_drake.homotopy import solve
-    from stewart_drake.core.rotations import angle_scale
 
     r = solve(platform, L, seed=args.seed)
     sols = []
@@ -97,8 +99,6 @@ def _homotopy_all(platform, L, args, k: float) -> dict:
 
 
 def run(args) -> int:
-    from stewart_drake.core.newton_fk import forward_kinematics
-
     for i, v in enumerate(args.lengths, 1):
         if not v > 0:
             raise UsageError(f"--lengths: leg {i} length {v} {args.length_unit} must be a positive number")
@@ -123,15 +123,15 @@ def run(args) -> int:
         initial = None if args.initial is None else pose_to_si(args.initial, args.length_unit, args.angle_unit)
         r = forward_kinematics(platform, L, initial, args.convention, tol=args.tol, max_iter=args.max_iter, on_singular="warn")
         if r.converged:
-            from stewart_drake.core.assembly_modes import modes_from_solutions
-
             mode = modes_from_solutions(platform, r.iterate[None, :3], r.rotation[None], L, np.array([False]), args.convention)[0]
             single = _entry(mode, args, k, converged=True, iterations=int(r.iterations), method="newton")
             out.update(solutions=[single], method="newton")
     if single is None and args.all and args.method == "homotopy":
         out.update(_homotopy_all(platform, L, args, k))
     elif single is None:
-        from stewart_drake.core.assembly_modes import assembly_modes
+        # Deferred: the multi-start search is confirmed by Drake's MathematicalProgram; the Newton and
+        # homotopy paths of this command run without pydrake.
+        from stewart_drake.drake.program_fk import assembly_modes
 
         am = assembly_modes(platform, L, args.convention, seed=args.seed, tol=min(args.tol, 1e-13))
         sols = [_entry(m, args, k, converged=True, method="multi-start") for m in am.modes]

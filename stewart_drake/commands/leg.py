@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
-from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.errors import OutputError
-from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.commands._common import print_json
+from stewart_drake.core.leg3r import (
+    Leg3R,
+    foot,
+    forward_kinematics,
+    inverse_kinematics,
+    inverse_kinematics_3r,
+    limit_violations,
+    within_limits,
+)
+from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.core.sdf_models import sdf_text, write_sdf
 
 
 def register(sub) -> None:
@@ -37,24 +43,16 @@ def register(sub) -> None:
 
 
 def _leg(args):
-    from stewart_drake.core.leg3r import Leg3R
-
     k = length_scale(args.length_unit)
     dims = {n: getattr(args, n) * k for n in ("l1", "l2", "l3") if getattr(args, n) is not None}
     return Leg3R(**dims)
 
 
 def run(args) -> int:
-    from stewart_drake.core.leg3r import foot, forward_kinematics, inverse_kinematics, inverse_kinematics_3r, limit_violations, within_limits
-
     leg = _leg(args)
     if args.op == "sdf":
-        from stewart_drake.drake.leg_model import SDF_NAME, sdf_text
-
         if args.write:
-            if os.path.exists(args.write) and not os.path.isdir(args.write):
-                raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
-            print(write_output_file(os.path.join(args.write, f"{SDF_NAME}.sdf"), sdf_text(leg), option="--write"))
+            print(write_sdf(leg, args.write, option="--write"))
         else:
             print(sdf_text(leg), end="")
         return 0

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import os
-
-from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.errors import OutputError, UsageError
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
+from stewart_drake.core.sdf_models import platform_model_name, sdf_text, write_sdf
+from stewart_drake.errors import UsageError
 
 
 def register(sub) -> None:
@@ -19,25 +17,23 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.drake.platform_model import model_name, sdf_path, sdf_text
-    from stewart_drake.drake.verify_kinematics import anchor_frames, make_plant
-
     if args.json and not args.inspect:
         raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))
     platform = platform_from_args(args)
     if args.write:
-        if os.path.exists(args.write) and not os.path.isdir(args.write):
-            raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write", typed=args.write, part=args.write))
-        target = os.path.join(args.write, sdf_path(platform.name, "").name)
-        written = write_output_file(target, sdf_text(platform), option="--write")
+        written = write_sdf(platform, args.write, option="--write")
         if not args.inspect:
             print(written)
     if args.inspect:
+        # Deferred: only --inspect needs Drake, and cli.py imports every command module at start-up;
+        # writing or printing the SDF works without pydrake.
+        from stewart_drake.drake.verify_kinematics import anchor_frames, make_plant
+
         h = make_plant(platform)
         plant = h.plant
         info = {
             "platform": platform.name,
-            "bodies": [plant.get_body(b).name() for b in plant.GetBodyIndices(plant.GetModelInstanceByName(model_name(platform)))],
+            "bodies": [plant.get_body(b).name() for b in plant.GetBodyIndices(plant.GetModelInstanceByName(platform_model_name(platform)))],
             "joints": {plant.get_joint(j).name(): plant.get_joint(j).type_name() for j in plant.GetJointIndices()},
             "actuators": [plant.get_joint_actuator(a).name() for a in plant.GetJointActuatorIndices()],
             "num_positions": plant.num_positions(),

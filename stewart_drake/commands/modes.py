@@ -20,6 +20,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    # Deferred: these pull in scipy (~0.2 s) and cli.py imports every command module at start-up.
     from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
     from stewart_drake.design.stiffness import stiffness_matrix
 
@@ -44,6 +45,7 @@ def run(args) -> int:
                        "loop_delay_s": delay, "phase_lag_at_lowest_deg": 360.0 * f1 * delay},
     }
     if args.drake:
+        # Deferred: only this check needs Drake; cli.py imports every command module at start-up.
         from stewart_drake.drake.design_checks import drake_modes
 
         d = drake_modes(platform, q, k, args.leg_damping, args.convention, args.gravity, legs)

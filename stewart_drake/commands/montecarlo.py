@@ -6,8 +6,22 @@ import json
 import sys
 from pathlib import Path
 
-from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.commands._common import add_platform_arg, print_json
+from stewart_drake.commands.simulate import write_plots
+from stewart_drake.core.csvio import read_numeric_csv
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.rotations import pose_to_si
+from stewart_drake.drake.montecarlo_animation import write_animation
+from stewart_drake.drake.simulation import TRAJECTORIES, load_trajectory_csv
+from stewart_drake.errors import OptionError, UsageError
+from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
+from stewart_drake.montecarlo.spec import parse_spec
+from stewart_drake.montecarlo.study import STUDY_FILE, run_study, study_from_settings, study_key, study_settings
+from stewart_drake.montecarlo.summary import read_table, summarise, write_outputs
+from stewart_drake.script import ScriptError
+from stewart_drake.script.source import read_program
 
 
 def register(sub) -> None:
@@ -44,22 +58,16 @@ def register(sub) -> None:
 
 
 def build_study(args):
-    from stewart_drake.core.geometry import load_platform
-    from stewart_drake.montecarlo.scenario import Study
-    from stewart_drake.drake.simulation import TRAJECTORIES
-    from stewart_drake.montecarlo.spec import parse_spec
-    from stewart_drake.commands.run import read_program
-
     platform = load_platform(args.platform)
     spec = parse_spec(args.vary)
     program = (args.program, read_program(args.program)) if args.program else None
     if args.workers is not None and args.workers < 0:
-        raise ValueError(f"--workers must be >= 0, got {args.workers}")
+        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=args.workers))
     if args.engine == "c" and args.controller != "fixed":
-        raise ValueError(f"--engine c runs the fixed-point controller; --controller is {args.controller!r}")
+        raise UsageError(UsageError.ENGINE_C.format(controller=args.controller))
     engine = resolve_engine(args.engine, "stewart-drake montecarlo")
     if not args.lost_tracking > 0:
-        raise ValueError(f"--lost-tracking must be a positive number of mm, got {args.lost_tracking}")
+        raise OptionError(OptionError.POSITIVE.format(option="--lost-tracking", unit="mm", value=args.lost_tracking))
     trajectory = None if program else args.trajectory
     table = None
     if trajectory is not None and trajectory not in TRAJECTORIES:
@@ -73,10 +81,6 @@ def build_study(args):
 def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
     """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
     (``load_trajectory_csv`` checks it and names a bad line)."""
-    from stewart_drake.core.csvio import read_numeric_csv
-    from stewart_drake.core.rotations import pose_to_si
-    from stewart_drake.drake.simulation import load_trajectory_csv
-
     traj = load_trajectory_csv(path, length_unit, angle_unit)
     data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
     return (traj.name, data[:, 0].tolist(), pose_to_si(data[:, 1:], length_unit, angle_unit).tolist())
@@ -85,11 +89,6 @@ def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
 def run(args) -> int:
     if args.replay is not None:
         return replay(args)
-    from stewart_drake.montecarlo.study import run_study, study_key, study_settings
-    from stewart_drake.montecarlo.summary import write_outputs, summarise
-
-    from stewart_drake.script import ScriptError
-
     study = build_study(args)
     try:  # the reference (program compiled, CSV read) checked here, before any run starts
         study.reference()
@@ -127,19 +126,13 @@ def print_text(summary: dict) -> None:
 
 def replay(args) -> int:
     """Re-run one run of the study in ``--out`` and compare its row with the study's."""
-    from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.montecarlo.scenario import run_scenario
-    from stewart_drake.montecarlo.study import STUDY_FILE, study_from_settings
-    from stewart_drake.montecarlo.summary import read_table
-    from stewart_drake.commands.simulate import write_plots
-
     out = Path(args.out)
     if not (out / STUDY_FILE).exists():
-        raise ValueError(f"--replay: {str(out)!r} holds no finished study ({STUDY_FILE} missing); run the study first")
+        raise OptionError(OptionError.NO_STUDY.format(out=str(out), file=STUDY_FILE))
     stored = json.loads((out / STUDY_FILE).read_text())
     rows = read_table(out)
     if not 0 <= args.replay < len(rows):
-        raise ValueError(f"--replay {args.replay}: the study in {str(out)!r} has runs 0 … {len(rows) - 1}")
+        raise OptionError(OptionError.NO_RUN.format(run=args.replay, out=str(out), last=len(rows) - 1))
     study = study_from_settings(stored["settings"], stored["runs"])
     row = run_scenario(study, args.replay, keep_log=True)
     log = row.pop("log")
@@ -153,8 +146,6 @@ def replay(args) -> int:
             ref = study.reference()
             files += log.save(tmp) + write_plots(log, log.length_error(ref, _plant_platform(study, args.replay)), tmp)
             if not args.no_animation:
-                from stewart_drake.drake.montecarlo_animation import write_animation
-
                 files.append(write_animation(_plant_platform(study, args.replay), log, tmp / "animation.html"))
         (tmp / "row.json").write_text(json.dumps(result, indent=2))
         result["files"] = [str(folder / p.name) for p in files + [tmp / "row.json"]]
@@ -167,8 +158,6 @@ def replay(args) -> int:
 
 
 def _plant_platform(study, index):
-    from stewart_drake.montecarlo.scenario import draw, plant_platform
-
     return plant_platform(study.platform, draw(study, index)[1])
 
 

@@ -7,6 +7,9 @@ import sys
 import time
 
 from stewart_drake.commands._common import add_force_arg, output_folder
+from stewart_drake.core.geometry import PRESETS
+from stewart_drake.errors import OptionError
+from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
 
 
 def register(sub) -> None:
@@ -21,13 +24,10 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.core.geometry import PRESETS
-    from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
-
     out = output_folder(args)
     jobs = args.jobs if args.jobs is not None else min(4, os.cpu_count() or 1)
     if not 1 <= jobs <= 64:
-        raise ValueError(f"--jobs must be between 1 and 64, got {jobs}")
+        raise OptionError(OptionError.BETWEEN.format(option="--jobs", lo=1, hi=64, value=jobs))
     t0 = time.perf_counter()
     analyses = discover_analyses(only=args.only)
     print(f"running {len(analyses)} analyses in {jobs} process{'es' if jobs > 1 else ''}", file=sys.stderr, flush=True)

@@ -15,6 +15,7 @@ import numpy as np
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.errors import InputError
 from stewart_drake.core.rotations import CONVENTIONS
+from stewart_drake.script.source import read_program
 from stewart_drake.commands._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
@@ -36,29 +37,6 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_force_arg(p)
     p.set_defaults(func=run)
-
-
-MAX_PROGRAM_BYTES = 1_000_000
-
-
-def read_program(path: str) -> str:
-    """The text of a program file (UTF-8, at most ``MAX_PROGRAM_BYTES``); errors name the file."""
-    f = Path(path)
-    if not f.exists():
-        raise InputError(f"program file {path!r} does not exist")
-    if not f.is_file():
-        raise InputError(f"program file {path!r} is {'a folder' if f.is_dir() else 'not a regular file'}, not a file")
-    with f.open("rb") as fh:
-        data = fh.read(MAX_PROGRAM_BYTES + 1)
-    if len(data) > MAX_PROGRAM_BYTES:
-        raise InputError(f"{path}: larger than the {MAX_PROGRAM_BYTES}-byte limit for a program")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        raise InputError(f"{path}: not UTF-8 text (byte {e.start})") from None
-    if "\0" in text:
-        raise InputError(f"{path}:{text[:text.index(chr(0))].count(chr(10)) + 1}: a NUL byte; not a program text file")
-    return text
 
 
 def run(args) -> int:

@@ -3,20 +3,17 @@
 from __future__ import annotations
 
 import argparse
-import os
 
 import numpy as np
 
-from stewart_drake.core.output_folder import write_output_file
-from stewart_drake.errors import OutputError
-from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from stewart_drake.core.sanity import check_finite
 from stewart_drake.commands._common import print_json
+from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
+from stewart_drake.core.sanity import check_finite, check_servo_neutrals
+from stewart_drake.core.sdf_models import write_sdf
+from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
 
 
 def register(sub) -> None:
-    from stewart_drake.core.servo import SERVO_PRESETS
-
     p = sub.add_parser("servo", help="servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)")
     p.add_argument("--platform", default="hobby-servo", metavar="NAME|FILE",
                    help=f"a servo hexapod preset ({', '.join(SERVO_PRESETS)}) or a servo hexapod YAML file (default hobby-servo)")
@@ -33,21 +30,13 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.core.servo import load_servo_hexapod, solve
-
-    from stewart_drake.core.sanity import check_servo_neutrals
-
     hexapod = load_servo_hexapod(args.platform)
     check_servo_neutrals(hexapod, f"{args.platform}: servo.neutral_us")
     if args.trim is not None:
         check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
         hexapod = hexapod.replace(neutral_us=args.trim)
     if args.write_sdf:
-        from stewart_drake.drake.servo_model import SDF_NAME, sdf_text
-
-        if os.path.exists(args.write_sdf) and not os.path.isdir(args.write_sdf):
-            raise OutputError(OutputError.NOT_A_FOLDER.format(option="--write-sdf", typed=args.write_sdf, part=args.write_sdf))
-        sdf_file = write_output_file(os.path.join(args.write_sdf, f"{SDF_NAME}.sdf"), sdf_text(hexapod), option="--write-sdf")
+        sdf_file = write_sdf(hexapod, args.write_sdf, option="--write-sdf")
         if not args.json:
             print(sdf_file)
     k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)

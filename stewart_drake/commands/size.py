@@ -6,11 +6,20 @@ import sys
 
 import numpy as np
 
-from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
 from stewart_drake.commands._design import add_payload_args, platform_with_payload
+from stewart_drake.commands.dynamics import read_trajectory_csv
+from stewart_drake.core.dynamics import seed_trajectory
+from stewart_drake.core.rotations import CONVENTIONS
+from stewart_drake.core.sanity import check_poses
+from stewart_drake.design.envelope import envelope_sizing, load_envelope
+from stewart_drake.design.sizing import UNITS, first_violation, limits_of, rotating_trajectory, size_trajectory
+from stewart_drake.errors import OptionError
+from stewart_drake.script import ScriptError, run_program
+from stewart_drake.script.source import read_program
 
 MAX_LISTED = 10_000  # envelope poses whose allowed accelerations are listed in the JSON
+MAX_SAMPLES = 10_000_000  # samples of a seed/rotating trajectory (--t-end / --dt)
 AXES = ("x", "y", "z", "roll", "pitch", "yaw")
 
 
@@ -35,35 +44,25 @@ def register(sub) -> None:
 
 
 def _trajectory(args, platform):
-    from stewart_drake.design.sizing import rotating_trajectory
-    from stewart_drake.core.dynamics import seed_trajectory
-
     if args.program is not None:
-        from stewart_drake.script import run_program
-        from stewart_drake.commands.run import read_program
-
         if not (np.isfinite(args.rate) and args.rate > 0):
-            raise ValueError(f"--rate must be a positive number of samples per second, got {args.rate}")
+            raise OptionError(OptionError.POSITIVE.format(option="--rate", unit="samples per second", value=args.rate))
         tr = run_program(read_program(args.program), args.program, platform, rate=args.rate, convention=args.convention).trajectory
         return args.program, tr.t, tr.q, tr.qd, tr.qdd, args.convention
     if args.trajectory in ("seed", "rotating"):
         if not (np.isfinite(args.dt) and args.dt > 0 and np.isfinite(args.t_end) and args.t_end >= 0):
-            raise ValueError(f"--dt must be > 0 and --t-end >= 0, got dt = {args.dt}, t-end = {args.t_end}")
+            raise OptionError(OptionError.DT.format(dt=args.dt, t_end=args.t_end))
         n = int(np.floor(args.t_end / args.dt + 0.5)) + 1
-        if n > 10_000_000:
-            raise ValueError(f"--t-end / --dt = {n} samples, more than 10000000")
+        if n > MAX_SAMPLES:
+            raise OptionError(OptionError.TOO_MANY_SAMPLES.format(n=n, limit=MAX_SAMPLES))
         t = np.arange(n) * args.dt
         q, qd, qdd = (seed_trajectory if args.trajectory == "seed" else rotating_trajectory)(t)
         return args.trajectory, t, q, qd, qdd, "utn"
-    from stewart_drake.commands.dynamics import read_trajectory_csv
-
     t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
     return args.trajectory, t, q, qd, qdd, args.convention
 
 
 def run(args) -> int:
-    from stewart_drake.script import ScriptError
-
     base = platform_from_args(args)
     platform, p_TP = platform_with_payload(base, args, args.length_unit)
     legs = args.legs == "on"
@@ -75,9 +74,6 @@ def run(args) -> int:
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
-    from stewart_drake.design.sizing import first_violation, limits_of, size_trajectory
-    from stewart_drake.core.sanity import check_poses
-
     check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
     s = size_trajectory(platform, t, q, qd, qdd, convention, legs, args.gravity)
     limits = limits_of(platform)
@@ -126,8 +122,6 @@ def _print_table(legs_json, with_times: bool) -> None:
 def _report_violation(viol, where: str) -> int:
     if viol is None:
         return 0
-    from stewart_drake.design.sizing import UNITS
-
     name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[viol["quantity"]]
     print(f"stewart-drake size: leg {viol['leg']} {viol['quantity']} {viol['value']:.6g} {UNITS[viol['quantity']]} exceeds "
           f"legs.{name} {viol['limit']:.6g} {UNITS[viol['quantity']]} {where}", file=sys.stderr)
@@ -135,9 +129,6 @@ def _report_violation(viol, where: str) -> int:
 
 
 def _run_envelope(args, platform, header, legs) -> int:
-    from stewart_drake.design.envelope import envelope_sizing, load_envelope
-    from stewart_drake.design.sizing import first_violation, limits_of
-
     env = load_envelope(args.envelope)
     es = envelope_sizing(platform, env, legs=legs, gravity=args.gravity)
     legs_json = []

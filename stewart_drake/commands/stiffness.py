@@ -5,9 +5,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.commands._design import add_payload_args, platform_with_payload
+from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
+from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si, rotation_matrix
+from stewart_drake.core.sanity import check_poses
+from stewart_drake.design.maps import MAX_POINTS, slice_maps
+from stewart_drake.design.payload import payload_wrench
+from stewart_drake.design.plots import plot_slice_maps
+from stewart_drake.design.stiffness import compliance, deflection, leg_stiffness_vector, principal_stiffness, stiffness_matrix
+from stewart_drake.errors import OptionError, PhysicalLimitError, StewartError
 
 NAMES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -33,8 +41,6 @@ def register(sub) -> None:
 
 def prepare(args):
     """``(platform with payload, pose q (6,) SI, k (6,) N/m, p_TP payload position m)``."""
-    from stewart_drake.design.stiffness import leg_stiffness_vector
-
     base = platform_from_args(args)
     platform, p_TP = platform_with_payload(base, args, args.length_unit)
     if args.leg_stiffness is not None:
@@ -49,10 +55,6 @@ def require_analysable_pose(platform, q, convention) -> None:
     """Refuse a pose that cannot be analysed: the sanity checks every command applies (finite, near the
     platform, plate above the base), then within the stroke and away from a singularity
     (``PhysicalLimitError``, exit 1)."""
-    from stewart_drake.errors import PhysicalLimitError, StewartError
-    from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
-    from stewart_drake.core.sanity import check_poses
-
     check_poses(platform, q, convention, what="--pose")
     try:
         inverse_kinematics(platform, q, convention)
@@ -62,10 +64,6 @@ def require_analysable_pose(platform, q, convention) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.design.payload import payload_wrench
-    from stewart_drake.design.stiffness import compliance, deflection, principal_stiffness, stiffness_matrix
-    from stewart_drake.core.rotations import rotation_matrix
-
     platform, q, k, p_TP = prepare(args)
     require_analysable_pose(platform, q, args.convention)
     legs = args.legs == "on"
@@ -108,17 +106,14 @@ def run(args) -> int:
 
 def write_maps(args, platform, q, k) -> None:
     """Maps over the x-y slice through pose q, written atomically into ``args.map``."""
-    from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.design.maps import MAX_POINTS, slice_maps
-    from stewart_drake.design.plots import plot_slice_maps
-
     hw = args.map_half_width * length_scale(args.length_unit)
     if not (np.isfinite(hw) and hw > 0):
-        raise ValueError(f"--map-half-width must be a positive length, got {args.map_half_width}")
+        raise OptionError(OptionError.POSITIVE_LENGTH.format(option="--map-half-width", value=args.map_half_width))
     if not 2 <= args.map_n <= int(np.sqrt(MAX_POINTS)):
-        raise ValueError(f"--map-n must be between 2 and {int(np.sqrt(MAX_POINTS))}, got {args.map_n}")
+        raise OptionError(OptionError.BETWEEN.format(option="--map-n", lo=2, hi=int(np.sqrt(MAX_POINTS)), value=args.map_n))
     ranges = ((q[0] - hw, q[0] + hw), (q[1] - hw, q[1] + hw))
     m = slice_maps(platform, (0, 1), ranges, args.map_n, base=q, k=k, gravity=args.gravity, modes=True, convention=args.convention)
+    # deferred: pyplot is imported only when maps are drawn, after selecting the Agg backend
     import matplotlib
 
     matplotlib.use("Agg")

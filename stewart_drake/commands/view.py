@@ -7,6 +7,7 @@ import sys
 import numpy as np
 
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
+from stewart_drake.core.rotations import pose_to_si
 
 
 def register(sub) -> None:
@@ -28,10 +29,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from pydrake.geometry import Meshcat, MeshcatParams
-
-    from stewart_drake.core.rotations import pose_to_si
-    from stewart_drake.drake.viewer import Viewer, load_replay
+    # Deferred: this command needs Drake (Meshcat), and cli.py imports every command module at start-up,
+    # so a top-level import would make the numpy commands need pydrake too.
+    from stewart_drake.drake.viewer import Viewer, load_replay, open_meshcat
 
     platform = platform_from_args(args)
     if args.duration is not None and not (np.isfinite(args.duration) and 0 <= args.duration <= 86400):
@@ -44,10 +44,7 @@ def run(args) -> int:
     if replay is not None and replay[3] and replay[3] != platform.name:
         print(f"stewart-drake view: note: the log was recorded on platform {replay[3]!r}, shown on {platform.name!r}", file=sys.stderr)
     pose = platform.home_pose() if args.pose is None else pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit)
-    try:
-        meshcat = Meshcat(MeshcatParams(host="localhost", port=args.port))
-    except RuntimeError as e:
-        raise ValueError(f"--port {args.port}: Meshcat could not listen there ({e})") from None
+    meshcat = open_meshcat(args.port)
     viewer = Viewer(platform, meshcat, args.length_unit, args.angle_unit, args.convention, modes=not args.no_modes)
     print(f"stewart-drake view: {platform.name} at {meshcat.web_url()}" + ("" if args.duration is not None else " (Ctrl-C to quit)"), flush=True)
     try:

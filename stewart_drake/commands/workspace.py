@@ -9,10 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
+import stewart_drake.workspace as ws
+from stewart_drake.commands._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
+from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from stewart_drake.core.sanity import check_centre, check_finite, check_work
-from stewart_drake.commands._common import add_force_arg, dumps_strict, reject_unused, add_platform_arg, output_folder, platform_from_args, print_json
+from stewart_drake.errors import OptionError
+from stewart_drake.workspace import Limits, view_figures
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
 
@@ -44,19 +48,15 @@ def register(sub) -> None:
 
 def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | None, max_condition: float):
     """A ``workspace.Limits`` from the ``--limits`` list (angles already in radians)."""
-    from stewart_drake.workspace import Limits
-
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in LIMIT_CHOICES]
     if unknown:
-        raise ValueError(f"--limits: unknown limit {unknown[0]!r}; choose from {', '.join(LIMIT_CHOICES)}")
+        raise OptionError(OptionError.UNKNOWN_LIMIT.format(option="--limits", value=unknown[0], valid=", ".join(LIMIT_CHOICES)))
     kw = {}
     if "joints" in names:
         kw["base_cone"] = kw["top_cone"] = joint_cone
     if "collision" in names:
         if leg_diameter is None:
-            from stewart_drake.drake.platform_model import leg_dimensions
-
             leg_diameter = 2 * leg_dimensions(platform)["cylinder_radius"]
         kw["leg_diameter"] = leg_diameter
     if "dexterity" in names:
@@ -65,8 +65,6 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
 
 
 def run(args) -> int:
-    import stewart_drake.workspace as ws
-
     names = [n.strip() for n in args.limits.split(",")]
     reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
     reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
@@ -75,14 +73,14 @@ def run(args) -> int:
     out = output_folder(args)
     platform = platform_from_args(args)
     if not (args.resolution > 0 and math.isfinite(args.resolution)):
-        raise ValueError(f"--resolution must be a positive number of metres, got {args.resolution}")
+        raise OptionError(OptionError.POSITIVE.format(option="--resolution", unit="metres", value=args.resolution))
     if args.centre is not None:
         check_centre(platform, args.centre)
     check_finite(args.orientation, "--orientation")
     # each worker is a Python process with numpy (~150 MB); more than 4 per CPU only adds overhead
     check_work("--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1))
     if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=1, value=args.workers))
     orientation = to_radians(args.orientation, args.angle_unit)
     cone = float(to_radians(args.joint_cone, args.angle_unit))
     limits = parse_limits(args.limits, platform, cone, args.leg_diameter, args.max_condition)
@@ -121,12 +119,11 @@ def run(args) -> int:
 
 def write_outputs(w, result: dict, out) -> None:
     """workspace.json, boundary.csv (metres) and the four views as PNG into ``out``."""
+    # deferred: pyplot is imported only when views are written, after selecting the Agg backend
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
-
-    from stewart_drake.workspace import view_figures
 
     with atomic_folder(out) as tmp:
         (tmp / "workspace.json").write_text(dumps_strict(result))

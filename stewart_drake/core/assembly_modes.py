@@ -1,23 +1,19 @@
-"""Forward kinematics with Drake's MathematicalProgram, and every assembly mode for a leg-length set.
-
-``ProgramFK`` states the forward kinematics of one platform as a MathematicalProgram: the plate pose
-as decision variables (position p_BC and either a unit quaternion or the first two columns of R_BT
-with orthonormality constraints; the third column is their cross product, so det R = +1), and the six
-leg equations |p_BC + R_BT (p_TTi − p_TC) − p_BBi|² = L_i² as constraints, solved by SNOPT or IPOPT
-from an initial guess. It finds one solution near the guess, like Newton, through a different
-formulation and solver: we use it to polish and independently confirm the Newton solutions.
+"""Every real assembly mode of a Stewart platform for one leg-length set: a seeded multi-start Newton
+search, numpy only, with an optional polish (a callable; ``drake/program_fk`` passes Drake's
+MathematicalProgram) that confirms each mode.
 
 ``assembly_modes`` finds the real solutions ("assembly modes") for one set of lengths:
 
 1. **Generate** — seeded multi-start: random orientations R (uniform on SO(3)) each paired with the
    position that best fits the six leg equations for that R (they are linear in p once the first is
-   subtracted from the others), then the batched Newton of ``fk.newton_core`` from every start.
+   subtracted from the others), then the batched Newton of ``newton_fk.newton_core`` from every start.
    For a platform whose base anchors and plate anchors are both planar (z = 0), the mirror image of
    every solution about the base plane is also a solution; with ``use_symmetry`` it is added directly.
 2. **Deduplicate** — solutions closer than ``dedupe_tol`` (position and rotation matrix) are one.
-3. **Polish and confirm** — each distinct solution is re-solved by ``ProgramFK`` from that point; it is
-   ``certified`` when the program reports success, its leg residual is below 1e-9 m and it lands on the
-   same solution. A final Newton step brings the residual to the rounding floor.
+3. **Polish and confirm** (when a ``polish`` callable is given) — each distinct solution is re-solved
+   from that point by an independent method (``drake/program_fk.program_polish``: a MathematicalProgram
+   with SNOPT or IPOPT); it is ``certified`` when that solve reports success, its leg residual is below
+   1e-9 m and it lands on the same solution. A final Newton step brings the residual to the rounding floor.
 4. Rounds of starts continue until the theoretical maximum number of solutions is found (then the set
    is provably complete), or ``patience`` rounds in a row find nothing new, or ``max_rounds``.
 
@@ -39,111 +35,32 @@ What this guarantees, and what not:
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from stewart_drake.errors import ForwardKinematicsError
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import check_stroke, plate_anchors
 from stewart_drake.core.newton_fk import (
     CONVERGED,
-    _analyse_jinv,
-    _legs,
+    analyse_inverse_jacobian,
     anchor_scale,
     legs_and_jacobian,
     newton_core,
     validate_lengths,
 )
-from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import check_stroke, plate_anchors
-from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
+from stewart_drake.core.rotations import angles_from_matrix, check_convention, quaternion_to_matrix, rotation_matrix
+from stewart_drake.errors import ForwardKinematicsError
 
-SOLVERS = ("snopt", "ipopt")
-ROTATION_PARAMETRISATIONS = ("quaternion", "matrix")
-CERTIFY_RESIDUAL = 1e-9  # m: a program solution with a larger leg residual is not a confirmation
+CERTIFY_RESIDUAL = 1e-9  # m: a polished solution with a larger leg residual is not a confirmation
+# polish(lengths (6,), p_BC (3,), R_BT (3, 3)) -> (p_BC, R_BT, success, residual m): an independent solve
+# started at a Newton solution.
+Polish = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, bool, float]]
 
 
 # ----------------------------------------------------------------------------------------------
-# Dietmaier's 40-real-solution geometry
-
-
-def dietmaier_platform() -> tuple[Platform, np.ndarray]:
-    """Dietmaier's (1998) general 6-6 Stewart–Gough platform with 40 real assembly modes, and its
-    leg lengths ``(6,)``. Dimensionless units read as metres; the anchors are not planar.
-
-    Source of the numbers: we could not read the paper itself; the coordinates below (base anchors,
-    plate anchors, leg lengths) appear in a Stewart-platform example in Drake's C++ sources (a
-    mixed-integer rotation-constraint demo, found by code search; the file does not name Dietmaier)
-    and match the values usually quoted for Dietmaier's example. The result confirms them:
-    ``assembly_modes`` finds 40 real, distinct, non-singular solutions (``tests/test_forward.py``),
-    which only a 40-real-solution geometry can give. The stroke [0.5, 1.6] m is our choice (it holds
-    every leg); the home pose is a placeholder (the geometry has no natural one)."""
-    base = np.array(
-        [
-            [0.0, 0.0, 0.0],
-            [1.107915, 0.0, 0.0],
-            [0.549094, 0.756063, 0.0],
-            [0.735077, -0.223935, 0.525991],
-            [0.514188, -0.526063, -0.368418],
-            [0.590473, 0.094733, -0.205018],
-        ]
-    )
-    top = np.array(
-        [
-            [0.0, 0.0, 0.0],
-            [0.542805, 0.0, 0.0],
-            [0.956919, -0.528915, 0.0],
-            [0.665885, -0.353482, 1.402538],
-            [0.478359, 1.158742, 0.107672],
-            [-0.137087, -0.235121, 0.353913],
-        ]
-    )
-    lengths = np.array([1.0, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071])
-    p = _kinematic_platform("dietmaier-1998", "Dietmaier 1998: general 6-6 platform with 40 real assembly modes", base, top, (0.5, 1.6))
-    return p, lengths
-
-
-def _kinematic_platform(name: str, description: str, p_BBi, p_TTj, stroke) -> Platform:
-    """A massless 6-6 platform (anchors ``(6, 3)`` m, leg i on plate anchor i, stroke ``(2,)`` m, home
-    height 1 m): geometry only, for the FK solvers' reference cases."""
-    return Platform(name=name, description=description, base_anchors=p_BBi, top_anchors=p_TTj, leg_top=np.arange(6),
-                    stroke=np.asarray(stroke, dtype=float), mass=0.0, com=np.zeros(3), inertia=np.zeros((3, 3)), home_height=1.0)
-
-
-def _random_ring(rng, radius: float, dz: float | None, n: int = 6) -> np.ndarray:
-    """``(n, 3)`` anchors at sorted random angles, radii in [0.6, 1] × ``radius``, z uniform in ±``dz``
-    (``None``: z = 0, drawing nothing)."""
-    ang = np.sort(rng.uniform(0, 2 * np.pi, n))
-    r = radius * rng.uniform(0.6, 1.0, n)
-    z = np.zeros(n) if dz is None else rng.uniform(-dz, dz, n)
-    return np.stack([r * np.cos(ang), r * np.sin(ang), z], -1)
-
-
-def _lengths_near_home(p: Platform, rng, angle: float) -> tuple[Platform, np.ndarray]:
-    """``(p, lengths (6,))`` of a random pose within ±0.1 m and ±``angle`` rad of ``p``'s home."""
-    from stewart_drake.core.kinematics import leg_lengths
-
-    q = p.home_pose() + np.r_[rng.uniform(-0.1, 0.1, 3), rng.uniform(-angle, angle, 3)]
-    return p, leg_lengths(p, q)
-
-
-def general_platform(seed: int = 0) -> tuple[Platform, np.ndarray]:
-    """A seeded random general (non-planar, asymmetric) 6-6 platform and the leg lengths ``(6,)`` of a
-    pose near its home: base anchors within 1 m of the axis (z within ±0.2 m), plate anchors within
-    0.6 m (z within ±0.1 m), home height 1 m. For benchmarks and reports."""
-    rng = np.random.default_rng(seed)
-    p = _kinematic_platform(f"general-6-6-seed{seed}", "seeded random general 6-6 platform",
-                            _random_ring(rng, 1.0, 0.2), _random_ring(rng, 0.6, 0.1), (0.5, 2.0))
-    return _lengths_near_home(p, rng, 0.2)
-
-
-def planar_platform(seed: int = 0) -> tuple[Platform, np.ndarray]:
-    """A seeded random planar 6-6 platform (base anchors at z = 0 within 1 m of the axis, plate anchors
-    at z = 0 within 0.6 m, at random angles: no symmetry) and the leg lengths ``(6,)`` of a random pose
-    near its home (±0.1 m, ±0.3 rad). For tests and benchmarks of the complete solvers."""
-    rng = np.random.default_rng(seed)
-    p = _kinematic_platform(f"planar-6-6-seed{seed}", "seeded random planar 6-6 platform",
-                            _random_ring(rng, 1.0, None), _random_ring(rng, 0.6, None), (0.3, 2.5))
-    return _lengths_near_home(p, rng, 0.3)
+# Solution counts
 
 
 def max_solutions(platform: Platform) -> int:
@@ -165,133 +82,6 @@ def is_planar(platform: Platform, tol: float = 1e-12) -> bool:
 
 
 # ----------------------------------------------------------------------------------------------
-# MathematicalProgram
-
-
-@dataclass(frozen=True)
-class ProgramSolution:
-    """One ``ProgramFK.solve`` result. ``residual`` (m) is re-evaluated in numpy from the returned
-    pose, independently of the solver's own report."""
-
-    pose: np.ndarray  # (6,) m, rad, convention
-    position: np.ndarray  # (3,) p_BC
-    rotation: np.ndarray  # (3, 3) R_BT
-    residual: float
-    success: bool
-    solver: str
-    solution_result: str
-    solve_time_s: float
-
-
-class ProgramFK:
-    """Forward kinematics of one platform as a Drake ``MathematicalProgram`` (built once; each
-    ``solve`` only changes the leg lengths and the initial guess).
-
-    rotation  "quaternion" (4 variables + unit-norm constraint) or "matrix" (two columns of R_BT +
-              three orthonormality constraints; third column = their cross product).
-    solver    "snopt" or "ipopt" (both ship in the drake wheel).
-    The squared lengths enter through six auxiliary variables fixed by a bounding box, so that the
-    program is not rebuilt for new lengths.
-    """
-
-    def __init__(self, platform: Platform, rotation: str = "quaternion", solver: str = "snopt", tol: float = 1e-12):
-        from pydrake.solvers import IpoptSolver, MathematicalProgram, SnoptSolver, SolverOptions
-
-        if rotation not in ROTATION_PARAMETRISATIONS:
-            raise ValueError(f"unknown rotation parametrisation {rotation!r}; expected one of {', '.join(ROTATION_PARAMETRISATIONS)}")
-        if solver not in SOLVERS:
-            raise ValueError(f"unknown solver {solver!r}; expected one of {', '.join(SOLVERS)}")
-        self.platform, self.rotation_kind, self.solver_name = platform, rotation, solver
-        prog = MathematicalProgram()
-        self.p = prog.NewContinuousVariables(3, "p")
-        if rotation == "quaternion":
-            self.z = prog.NewContinuousVariables(4, "q")
-            w, x, y, z = self.z
-            R = [
-                [w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                [2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)],
-                [2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z],
-            ]
-            prog.AddConstraint(w * w + x * x + y * y + z * z, 1.0, 1.0)
-        else:
-            self.z = prog.NewContinuousVariables(6, "R")
-            c0, c1 = list(self.z[:3]), list(self.z[3:])
-            c2 = [c0[1] * c1[2] - c0[2] * c1[1], c0[2] * c1[0] - c0[0] * c1[2], c0[0] * c1[1] - c0[1] * c1[0]]
-            R = [[c0[j], c1[j], c2[j]] for j in range(3)]
-            prog.AddConstraint(sum(c * c for c in c0), 1.0, 1.0)
-            prog.AddConstraint(sum(c * c for c in c1), 1.0, 1.0)
-            prog.AddConstraint(sum(a * b for a, b in zip(c0, c1)), 0.0, 0.0)
-        self.s = prog.NewContinuousVariables(6, "s")
-        self._box = prog.AddBoundingBoxConstraint(np.ones(6), np.ones(6), self.s).evaluator()
-        t = platform.top_anchors_per_leg - platform.rotation_centre
-        for i in range(6):  # written out: numpy's object-array matmul warns on symbolic entries
-            e = [
-                self.p[j] + sum(R[j][k] * float(t[i, k]) for k in range(3)) - float(platform.base_anchors[i, j])
-                for j in range(3)
-            ]
-            prog.AddConstraint(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - self.s[i], 0.0, 0.0)
-        self.prog = prog
-        self.solver = SnoptSolver() if solver == "snopt" else IpoptSolver()
-        self.options = SolverOptions()
-        if solver == "snopt":
-            self.options.SetOption(self.solver.solver_id(), "Major feasibility tolerance", tol)
-            self.options.SetOption(self.solver.solver_id(), "Major optimality tolerance", 1e-10)
-        else:
-            self.options.SetOption(self.solver.solver_id(), "tol", tol)
-            self.options.SetOption(self.solver.solver_id(), "constr_viol_tol", tol)
-            self.options.SetOption(self.solver.solver_id(), "print_level", 0)
-        self._vars = np.concatenate([self.p, self.z, self.s])
-
-    def solve(self, lengths, initial=None, convention: str = "utn", initial_rotation=None) -> ProgramSolution:
-        """Solve for ``(6,)`` lengths (m) from ``initial`` (a ``(6,)`` pose, default home) or from
-        ``initial`` = p_BC ``(3,)`` with ``initial_rotation`` = R_BT ``(3, 3)``."""
-        from pydrake.math import RotationMatrix
-
-        check_convention(convention)
-        L = validate_lengths(lengths)
-        if L.shape != (6,):
-            raise ValueError(f"ProgramFK.solve takes one length set of shape (6,), got {L.shape}")
-        if initial_rotation is None:
-            q0 = np.asarray(self.platform.home_pose() if initial is None else initial, dtype=float)
-            if q0.shape != (6,) or not np.all(np.isfinite(q0)):
-                raise ValueError(f"initial pose must be 6 finite numbers, got {q0.tolist()}")
-            p0, R0 = q0[:3], rotation_matrix(q0[3:], convention)
-        else:
-            p0, R0 = np.asarray(initial, dtype=float), np.asarray(initial_rotation, dtype=float)
-        if self.rotation_kind == "quaternion":
-            z0 = RotationMatrix(RotationMatrix.ProjectToRotationMatrix(R0)).ToQuaternion().wxyz()
-        else:
-            z0 = np.concatenate([R0[:, 0], R0[:, 1]])
-        self._box.set_bounds(L**2, L**2)
-        x0 = np.concatenate([p0, z0, L**2])
-        t0 = time.perf_counter()
-        res = self.solver.Solve(self.prog, x0, self.options)
-        dt = time.perf_counter() - t0
-        p = res.GetSolution(self.p)
-        z = res.GetSolution(self.z)
-        if self.rotation_kind == "quaternion":
-            w, x, y, zz = z / np.linalg.norm(z)
-            R = RotationMatrix(_quat(w, x, y, zz)).matrix()
-        else:
-            R = RotationMatrix.ProjectToRotationMatrix(np.column_stack([z[:3], z[3:], np.cross(z[:3], z[3:])])).matrix()
-        _, _, Lp = _legs(self.platform, p[None], R[None])
-        residual = float(np.abs(Lp[0] - L).max())
-        pose = np.concatenate([p, angles_from_matrix(R, convention)])
-        return ProgramSolution(pose, p, R, residual, bool(res.is_success()), self.solver_name, str(res.get_solution_result()), dt)
-
-
-def _quat(w, x, y, z):
-    from pydrake.common.eigen_geometry import Quaternion
-
-    return Quaternion(w, x, y, z)
-
-
-def solve_program(platform: Platform, lengths, initial=None, convention: str = "utn", rotation: str = "quaternion", solver: str = "snopt") -> ProgramSolution:
-    """One-shot ``ProgramFK(platform, rotation, solver).solve(lengths, initial, convention)``."""
-    return ProgramFK(platform, rotation, solver).solve(lengths, initial, convention)
-
-
-# ----------------------------------------------------------------------------------------------
 # All assembly modes
 
 
@@ -303,7 +93,7 @@ class AssemblyMode:
     error; det_sign: sign of det J⁻¹ (the singularity-free region the mode lies in); condition: 2-norm
     condition number of the scaled J⁻¹; sigma_min: its smallest singular value (singularity distance);
     above_base: every plate anchor has z > 0 in B; within_stroke: the lengths are within the stroke (a
-    property of the input, the same for every mode); certified: MathematicalProgram confirmed it;
+    property of the input, the same for every mode); certified: the polish confirmed it;
     distance_to_home: |Δp| / anchor radius + rotation angle (rad) from the home pose.
     """
 
@@ -360,16 +150,7 @@ class AssemblyModes:
 
 def random_rotations(n: int, rng: np.random.Generator) -> np.ndarray:
     """``(n, 3, 3)`` rotation matrices uniform on SO(3) (normalised Gaussian quaternions)."""
-    q = rng.normal(size=(n, 4))
-    w, x, y, z = (q / np.linalg.norm(q, axis=-1, keepdims=True)).T
-    return np.stack(
-        [
-            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
-        ],
-        -1,
-    ).reshape(n, 3, 3)
+    return quaternion_to_matrix(rng.normal(size=(n, 4)))
 
 
 def best_position(platform: Platform, R: np.ndarray, lengths: np.ndarray) -> np.ndarray:
@@ -407,21 +188,21 @@ def assembly_modes(
     max_rounds: int = 10,
     patience: int = 2,
     seed: int = 0,
-    polish: str | None = "snopt",
+    polish: Polish | None = None,
     use_symmetry: bool = True,
     dedupe_tol: float = 1e-6,
     tol: float = 1e-13,
 ) -> AssemblyModes:
     """Every real assembly mode found for one ``(6,)`` leg-length set (metres); see the module
-    docstring for the method and what it guarantees. ``polish`` = "snopt", "ipopt" or None (skip the
-    MathematicalProgram confirmation: faster, ``certified`` is then False). Raises
-    ``ForwardKinematicsError`` if no mode at all is found."""
+    docstring for the method and what it guarantees. ``polish``: the independent solve that confirms
+    each mode (``Polish``; ``drake.program_fk.program_polish``), or None (``certified`` is then False).
+    Raises ``ForwardKinematicsError`` if no mode at all is found."""
     check_convention(convention)
     L = validate_lengths(lengths)
     if L.shape != (6,):
         raise ValueError(f"assembly_modes takes one length set of shape (6,), got {L.shape}")
-    if polish is not None and polish not in SOLVERS:
-        raise ValueError(f"polish must be one of {', '.join(SOLVERS)} or None, got {polish!r}")
+    if polish is not None and not callable(polish):
+        raise TypeError(f"polish must be a callable (lengths, p, R) -> (p, R, success, residual) or None, got {polish!r}")
     t_start = time.perf_counter()
     rng = np.random.default_rng(seed)
     scale = anchor_scale(platform)
@@ -464,13 +245,12 @@ def assembly_modes(
     t0 = time.perf_counter()
     certified = np.zeros(len(P), bool)
     if polish is not None:
-        prog = ProgramFK(platform, "quaternion", polish)
         for k in range(len(P)):
-            sol = prog.solve(L, P[k], convention, initial_rotation=RR[k])
-            same = np.max(np.abs(np.concatenate([(sol.position - P[k]) / size, (sol.rotation - RR[k]).ravel()]))) < 1e-6
-            certified[k] = sol.success and sol.residual <= CERTIFY_RESIDUAL and same
+            p_k, R_k, success, residual = polish(L, P[k], RR[k])
+            same = np.max(np.abs(np.concatenate([(p_k - P[k]) / size, (R_k - RR[k]).ravel()]))) < 1e-6
+            certified[k] = success and residual <= CERTIFY_RESIDUAL and same
             if certified[k]:
-                P[k], RR[k] = sol.position, sol.rotation
+                P[k], RR[k] = p_k, R_k
         # Final Newton polish from the program's point (quadratic convergence: one or two steps).
         P, RR, _, _, _ = newton_core(platform, P, RR, np.broadcast_to(L, (len(P), 6)), 1e-15, 3, 0.25 * size, 0.5)
     t_polish = time.perf_counter() - t0
@@ -482,10 +262,10 @@ def assembly_modes(
 
 def modes_from_solutions(platform, P, RR, L, certified, convention) -> list[AssemblyMode]:
     """``AssemblyMode``s (sorted nearest home first) for solutions p_BC ``(k, 3)``, R_BT ``(k, 3, 3)`` of
-    lengths ``L (6,)``; ``certified`` ``(k,)`` says which the MathematicalProgram confirmed."""
+    lengths ``L (6,)``; ``certified`` ``(k,)`` says which the polish confirmed."""
     Lp, Jinv = legs_and_jacobian(platform, P, RR)
     res = np.abs(Lp - L).max(axis=-1)
-    an = _analyse_jinv(Jinv, anchor_scale(platform))
+    an = analyse_inverse_jacobian(Jinv, anchor_scale(platform))
     poses = np.concatenate([P, angles_from_matrix(RR, convention)], axis=-1)
     above = np.all(plate_anchors(platform, poses, convention)[..., 2] > 0, axis=-1)
     within = bool(check_stroke(platform, L).within)

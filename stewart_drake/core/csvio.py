@@ -71,7 +71,7 @@ def read_numeric_csv(path, kind: str, widths: tuple[int, ...], columns: str) -> 
                 if "field larger than field limit" in str(e):
                     raise CsvError(CsvError.FIELD_TOO_LONG.format(path=path, line=reader.line_num, limit=MAX_FIELD_CHARS,
                                                                   kind=kind)) from None
-                raise CsvError(f"{path}:{reader.line_num}: {e}") from None
+                raise CsvError(CsvError.SYNTAX.format(path=path, line=reader.line_num, problem=e)) from None
             except UnicodeDecodeError:
                 raise CsvError(CsvError.NOT_TEXT.format(path=path, line=reader.line_num + 1)) from None
             lineno = reader.line_num

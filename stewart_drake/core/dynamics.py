@@ -1,4 +1,4 @@
-"""Inverse dynamics of the moving plate (seed 004 part 2, SPEC §3): the seed's Lagrangian model and the
+"""Inverse dynamics of the moving plate (seed 004 part 2): the seed's Lagrangian model and the
 complete one, vectorised over trajectory samples. Plain numpy, no Drake.
 
 Coordinates ``q = [px, py, pz, a_x, a_y, a_z]`` (metres, radians; ``rotations`` names the Euler
@@ -20,7 +20,7 @@ between translation and rotation (exact only when the centre of mass is at C). `
 ``coriolis=False`` is the complete model less C q̇ only.
 
 Leg masses (an extension; the seeds neglect them): ``leg_forces_with_legs``. Each leg is a cylinder on
-a universal joint at its base anchor and a piston on the prismatic joint (the bodies of ``model.py``).
+a universal joint at its base anchor and a piston on the prismatic joint (the bodies of the Drake platform model).
 By virtual power each leg adds, at its plate anchor, the force f_i with J_tipᵀ f_i = τ_leg,i, where
 τ_leg,i is the leg's own inverse dynamics in its joint coordinates (two universal-joint angles and the
 length) and J_tip maps those rates to the tip velocity; the actuator force then balances plate + legs.
@@ -30,17 +30,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.errors import SingularPoseError, counted
+from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import SQRT3, Platform
-from stewart_drake.core.kinematics import _poses, length_jacobian
+from stewart_drake.core.kinematics import length_jacobian, scaled_condition
+from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
+from stewart_drake.errors import SINGULAR_SAMPLE, SingularPoseError, counted
 
 G_EARTH = 9.81  # m/s², the seed's Matlab value (its text also quotes 9.8066)
 SEED_OMEGA = 2.0  # rad/s, the seed's trajectory
 # A Jacobian whose scaled condition number exceeds this is treated as singular: leg forces would carry
 # errors of cond × 1e-16 relative and be enormous anyway.
 MAX_CONDITION = 1e8
-SINGULAR_TEMPLATE = "sample {index}: the length Jacobian J = dL/dq is singular or nearly so (condition number {cond:.3g} > {limit:.3g}); leg forces are undefined there"
 # Order in which the elementary rotations compose (outermost first), as indices into (a_x, a_y, a_z).
 _ORDER = {"utn": (1, 0, 2), "zyx": (2, 1, 0)}
 
@@ -118,16 +119,11 @@ def seed_trajectory(t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _states(q, qd, qdd):
-    q = _poses(q)
+    """``(q, qd, qdd)`` as float arrays ``(..., 6)`` broadcast together; each checked for shape and finite samples."""
+    q = as_poses(q)
     arrs = []
     for name, v in (("qd", qd), ("qdd", qdd)):
-        v = np.asarray(v, dtype=float)
-        if v.shape[-1:] != (6,):
-            raise ValueError(f"{name} must have shape (..., 6) like q, got {v.shape}")
-        if not np.all(np.isfinite(v)):
-            idx = tuple(int(i) for i in np.argwhere(~np.isfinite(v).all(axis=-1))[0])
-            raise ValueError(f"{name} sample {counted(idx)} is not finite: {v[idx].tolist()}")
-        arrs.append(v)
+        arrs.append(as_poses(v, name, f"{name} sample"))
     q, qd, qdd = np.broadcast_arrays(q, *arrs)
     return q, qd, qdd
 
@@ -171,13 +167,13 @@ def plate_motion(platform: Platform, q, qd, qdd, convention: str = "utn") -> dic
 
 def velocity_map(platform: Platform, q, convention: str = "utn") -> np.ndarray:
     """``(..., 6, 6)`` A(q): [v_Tcm in B; ω in the plate frame T] = A(q) · q̇."""
-    q = _poses(q)
+    q = as_poses(q)
     R = rotation_matrix(q[..., 3:], convention)
     E = angular_velocity_map(q[..., 3:], convention)
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     A = np.zeros(q.shape[:-1] + (6, 6))
     A[..., :3, :3] = np.eye(3)
-    A[..., :3, 3:] = -_skew(r) @ E
+    A[..., :3, 3:] = -skew(r) @ E
     A[..., 3:, 3:] = np.swapaxes(R, -1, -2) @ E
     return A
 
@@ -258,27 +254,17 @@ def seed_rotational_mass_matrix(Ix: float, Iy: float, Iz: float, alpha, gamma) -
 def jacobian_condition(platform: Platform, q, convention: str = "utn") -> np.ndarray:
     """``(...)`` 2-norm condition number of J = ∂L/∂q with its angle columns scaled by the plate's anchor
     radius (both blocks in metres); inf on a singularity (platform singularity or Euler gimbal lock)."""
-    return _scaled_condition(platform, length_jacobian(platform, q, convention))
-
-
-def _scaled_condition(platform: Platform, J) -> np.ndarray:
-    scale = np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1))
-    Jn = np.concatenate([J[..., :3], J[..., 3:] / scale], axis=-1)
-    s = np.linalg.svd(Jn, compute_uv=False)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = s[..., 0] / s[..., -1]
-    return np.where(np.isfinite(k), k, np.inf)
+    return scaled_condition(platform, length_jacobian(platform, q, convention))
 
 
 def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` F (N) with Jᵀ(q) F = Q; raises ``SingularPoseError`` naming the first sample whose J
     has a scaled condition number above ``MAX_CONDITION``."""
     J = length_jacobian(platform, q, convention)
-    k = _scaled_condition(platform, J)
-    bad = ~(k <= MAX_CONDITION)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0]) if np.ndim(k) else ()
-        raise SingularPoseError(SINGULAR_TEMPLATE.format(index=counted(idx), cond=float(k[idx]), limit=MAX_CONDITION))
+    k = scaled_condition(platform, J)
+    idx = first_index(~(k <= MAX_CONDITION))
+    if idx is not None:
+        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=float(k[idx]), limit=MAX_CONDITION))
     Q = np.broadcast_to(Q, J.shape[:-1])
     return np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
 
@@ -316,11 +302,9 @@ def coriolis_leg_forces(platform: Platform, q, qd, convention: str = "utn") -> n
 
 def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn", gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) for the plate **and** the legs' cylinders and pistons (masses from
-    ``platform.legs``, uniform rods of ``model.leg_dimensions``; cylinder centre of mass half its length
-    above the base anchor, piston's half its length below the tip), with the universal joints of
-    ``model.py``. Coriolis terms included. See the module docstring for how the legs enter."""
-    from stewart_drake.drake.platform_model import home_leg_frames, leg_dimensions  # numpy only at module level
-
+    ``platform.legs``, uniform rods of ``leg_bodies.leg_dimensions``; cylinder centre of mass half its
+    length above the base anchor, piston's half its length below the tip), with the universal joints of
+    ``leg_bodies.home_leg_frames``. Coriolis terms included. See the module docstring for how the legs enter."""
     check_convention(convention)
     q, qd, qdd = _states(q, qd, qdd)
     mo = plate_motion(platform, q, qd, qdd, convention)
@@ -380,7 +364,8 @@ def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn"
     return solve_leg_forces(platform, q, Q, convention)
 
 
-def _skew(v) -> np.ndarray:
+def skew(v) -> np.ndarray:
+    """``(..., 3, 3)`` the cross-product matrix [v]× of ``(..., 3)`` vectors: [v]× w = v × w."""
     z = np.zeros_like(v[..., 0])
     return np.stack(
         [np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1), np.stack([-v[..., 1], v[..., 0], z], -1)], -2
@@ -395,7 +380,7 @@ def open_loop_growth_rates(platform: Platform, q, convention: str = "utn", legs:
     ∂F_static/∂q from this module's inverse dynamics (central differences, h = 1e-6). λ = √eig > 0 means
     the errors grow like e^{λt}: struts pushing the plate up behave like inverted pendulums.
     """
-    q0 = _poses(q).reshape(6)
+    q0 = as_poses(q).reshape(6)
     z = np.zeros(6)
     if legs:
         def forces(q_, qdd_, g):

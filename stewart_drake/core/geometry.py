@@ -149,18 +149,17 @@ class Platform:
             object.__setattr__(self, name, arr)
         top = self.top_anchors
         if top.ndim != 2 or top.shape[1] != 3 or not 3 <= top.shape[0] <= 6:
-            raise GeometryError(f"top_anchors must have shape (k, 3) with 3 <= k <= 6, got {top.shape}")
+            raise GeometryError(GeometryError.TOP_SHAPE.format(shape=top.shape))
         leg_top = np.asarray(self.leg_top)
         if leg_top.shape != (6,) or not np.issubdtype(leg_top.dtype, np.integer):
-            raise GeometryError(f"leg_top must list 6 integer top-anchor indices (one per leg), got {self.leg_top!r}")
+            raise GeometryError(GeometryError.LEG_TOP.format(value=self.leg_top))
         bad = [i + 1 for i, j in enumerate(leg_top) if not 0 <= j < top.shape[0]]
         if bad:
-            raise GeometryError(
-                f"leg_top: leg {bad[0]} refers to top anchor {leg_top[bad[0] - 1]}, but there are {top.shape[0]} top anchors (0..{top.shape[0] - 1})"
-            )
+            raise GeometryError(GeometryError.LEG_TOP_RANGE.format(leg=bad[0], anchor=leg_top[bad[0] - 1], n=top.shape[0],
+                                                                   last=top.shape[0] - 1))
         unused = sorted(set(range(top.shape[0])) - set(leg_top.tolist()))
         if unused:
-            raise GeometryError(f"leg_top: top anchor {unused[0]} is used by no leg")
+            raise GeometryError(GeometryError.LEG_TOP_UNUSED.format(anchor=unused[0]))
         leg_top = leg_top.astype(np.intp)
         leg_top.flags.writeable = False
         object.__setattr__(self, "leg_top", leg_top)
@@ -168,20 +167,20 @@ class Platform:
         _check_distinct(top, "top anchors")
         lmin, lmax = self.stroke
         if not 0 < lmin < lmax:
-            raise GeometryError(f"stroke must satisfy 0 < L_min < L_max, got L_min = {lmin} m, L_max = {lmax} m")
+            raise GeometryError(GeometryError.STROKE.format(lmin=lmin, lmax=lmax))
         if not np.isfinite(self.mass) or self.mass < 0:
-            raise GeometryError(f"plate mass must be finite and >= 0, got {self.mass} kg")
+            raise GeometryError(GeometryError.MASS.format(value=self.mass))
         if not np.allclose(self.inertia, self.inertia.T, atol=1e-12):
-            raise GeometryError(f"plate inertia must be symmetric, got {self.inertia.tolist()}")
+            raise GeometryError(GeometryError.INERTIA_SYMMETRIC.format(value=self.inertia.tolist()))
         if self.mass > 0:
             eig = np.linalg.eigvalsh(self.inertia)
             tol = 1e-9 * max(1.0, eig.max())
             if eig.min() < -tol or any(eig[i] + eig[j] < eig[k] - tol for i, j, k in [(0, 1, 2), (0, 2, 1), (1, 2, 0)]):
-                raise GeometryError(f"plate inertia is not physical (principal moments {eig.tolist()} kg·m²)")
+                raise GeometryError(GeometryError.INERTIA_PHYSICAL.format(moments=eig.tolist()))
         if self.home_height is None:
             object.__setattr__(self, "home_height", _mid_stroke_height(self))
         elif not np.isfinite(self.home_height) or self.home_height <= 0:
-            raise GeometryError(f"home_height must be a positive number of metres, got {self.home_height}")
+            raise GeometryError(GeometryError.HOME_HEIGHT.format(value=self.home_height))
 
     # -- derived quantities -------------------------------------------------------------------
     @property
@@ -208,7 +207,7 @@ class Platform:
     # -- constructors --------------------------------------------------------------------------
     @classmethod
     def utn(cls, b: float, d: float, a: float, **kwargs) -> "Platform":
-        """The UTN 3-6 platform (SPEC §1): hexagon sides ``b`` (long), ``d`` (short); triangle side ``a``.
+        """The UTN 3-6 platform: hexagon sides ``b`` (long), ``d`` (short); triangle side ``a``.
 
         Lengths in metres. Legs 1,2 end at T1; 3,4 at T2; 5,6 at T3.
         """
@@ -227,10 +226,10 @@ class Platform:
 
 
 def utn_anchors(b: float, d: float, a: float) -> tuple[np.ndarray, np.ndarray]:
-    """SPEC §1 anchors: ``(6, 3)`` base anchors and ``(3, 3)`` top anchors, same unit as b, d, a."""
+    """The UTN 3-6 anchors: ``(6, 3)`` base anchors and ``(3, 3)`` top anchors, same unit as b, d, a."""
     for name, value in (("b", b), ("d", d), ("a", a)):
         if not np.isfinite(value) or value <= 0:
-            raise GeometryError(f"UTN dimension {name} must be a positive length, got {value}")
+            raise GeometryError(GeometryError.UTN_DIMENSION.format(name=name, value=value))
     s = SQRT3 / 6
     base = np.array(
         [
@@ -262,9 +261,9 @@ def triangular_plate(side: float, thickness: float, density: float) -> tuple[flo
 def _circle_points(radius, angles, what) -> np.ndarray:
     angles = np.asarray(angles, dtype=float)
     if angles.shape != (6,):
-        raise GeometryError(f"{what} angles must be 6 numbers, got shape {angles.shape}")
+        raise GeometryError(GeometryError.CIRCLE_ANGLES.format(what=what, shape=angles.shape))
     if not np.isfinite(radius) or radius <= 0:
-        raise GeometryError(f"{what} radius must be a positive length, got {radius}")
+        raise GeometryError(GeometryError.CIRCLE_RADIUS.format(what=what, value=radius))
     return np.stack([radius * np.cos(angles), radius * np.sin(angles), np.zeros(6)], -1)
 
 
@@ -272,11 +271,11 @@ def _finite_array(value, name, shape) -> np.ndarray:
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise GeometryError(f"{name} must be numbers, got {value!r}") from None
+        raise GeometryError(GeometryError.NOT_NUMBERS.format(name=name, value=value)) from None
     if shape is not None and arr.shape != shape:
-        raise GeometryError(f"{name} must have shape {shape}, got {arr.shape}")
+        raise GeometryError(GeometryError.SHAPE.format(name=name, shape=shape, got=arr.shape))
     if not np.all(np.isfinite(arr)):
-        raise GeometryError(f"{name} must be finite, got {arr.tolist()}")
+        raise GeometryError(GeometryError.NOT_FINITE.format(name=name, value=arr.tolist()))
     arr.flags.writeable = False
     return arr
 
@@ -287,9 +286,8 @@ def _check_distinct(points: np.ndarray, what: str) -> None:
     close = diff[i, j] < MIN_ANCHOR_SEPARATION
     if np.any(close):
         k = int(np.argmax(close))
-        raise GeometryError(
-            f"{what} {i[k] + 1} and {j[k] + 1} coincide at {points[i[k]].tolist()} m (closer than {MIN_ANCHOR_SEPARATION} m)"
-        )
+        raise GeometryError(GeometryError.COINCIDE.format(what=what, i=i[k] + 1, j=j[k] + 1, at=points[i[k]].tolist(),
+                                                          limit=MIN_ANCHOR_SEPARATION))
 
 
 def _mid_stroke_height(p: Platform) -> float:
@@ -299,9 +297,7 @@ def _mid_stroke_height(p: Platform) -> float:
     d_z = p.top_anchors_per_leg[:, 2] - p.rotation_centre[2] - p.base_anchors[:, 2]
     r2 = np.sum(d_xy**2, axis=1)
     if np.any(r2 >= target**2):
-        raise GeometryError(
-            f"platform too wide for its stroke: a leg spans {np.sqrt(r2.max()):.4f} m horizontally but mid-stroke is {target:.4f} m; give home_height"
-        )
+        raise GeometryError(GeometryError.TOO_WIDE.format(span=np.sqrt(r2.max()), target=target))
     return float(np.mean(np.sqrt(target**2 - r2) - d_z))
 
 
@@ -314,25 +310,23 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
     try:
         k = length_scale(cfg.length_unit)
     except ValueError as e:
-        raise GeometryError(f"length_unit: {e}") from None
+        raise GeometryError(GeometryError.LENGTH_UNIT.format(problem=e)) from None
     given = [n for n, v in (("utn", cfg.utn), ("radial", cfg.radial), ("base_anchors", cfg.base_anchors or None)) if v]
     if len(given) != 1:
-        raise GeometryError(
-            f"platform {cfg.name!r}: give exactly one anchor description (utn, radial, or base_anchors/top_anchors/leg_top), got {given or 'none'}"
-        )
+        raise GeometryError(GeometryError.ANCHOR_DESCRIPTIONS.format(name=cfg.name, given=given or "none"))
     plate = cfg.plate
     if plate.thickness is not None or plate.density is not None:
         if cfg.utn is None or plate.thickness is None or plate.density is None:
-            raise GeometryError(f"platform {cfg.name!r}: plate thickness+density describe a UTN triangle sheet; give both, with utn dimensions")
+            raise GeometryError(GeometryError.PLATE_SHEET.format(name=cfg.name))
         mass, com, inertia = triangular_plate(cfg.utn.a * k, plate.thickness * k, plate.density)
     else:
         if len(plate.inertia) != 6:
-            raise GeometryError(f"plate inertia must be 6 numbers (Ixx Iyy Izz Ixy Ixz Iyz), got {plate.inertia!r}")
+            raise GeometryError(GeometryError.INERTIA_NUMBERS.format(value=plate.inertia))
         ixx, iyy, izz, ixy, ixz, iyz = plate.inertia
         mass, com = plate.mass, np.asarray(plate.com, dtype=float) * k
         inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float) * k**2
     if len(cfg.stroke) != 2:
-        raise GeometryError(f"stroke must be [L_min, L_max], got {cfg.stroke!r}")
+        raise GeometryError(GeometryError.STROKE_PAIR.format(value=cfg.stroke))
     legs = dataclasses.replace(
         cfg.legs,
         cylinder_length=cfg.legs.cylinder_length * k,
@@ -514,7 +508,7 @@ def load_platform_yaml(path) -> Platform:
     try:
         platform = platform_from_config(cfg)
     except GeometryError as e:
-        raise GeometryError(f"{path}: {e}") from None
+        raise GeometryError(GeometryError.IN_FILE.format(path=path, problem=e)) from None
     check_home(platform)  # sanity: a platform singular at its home pose is refused when loaded
     return platform
 
@@ -522,7 +516,7 @@ def load_platform_yaml(path) -> Platform:
 def preset_path(name: str) -> Path:
     """The YAML file of a built-in preset."""
     if name not in PRESETS:
-        raise GeometryError(f"unknown preset {name!r}; built-in presets: {', '.join(PRESETS)}")
+        raise GeometryError(GeometryError.UNKNOWN_PRESET.format(name=name, presets=", ".join(PRESETS)))
     return Path(str(resources.files("stewart_drake") / "presets" / f"{name}.yaml"))
 
 
@@ -540,4 +534,4 @@ def load_platform(name_or_path) -> Platform:
         return load_preset(s)
     if s.endswith((".yaml", ".yml")) or Path(s).exists():
         return load_platform_yaml(s)
-    raise GeometryError(f"unknown platform {s!r}: not a preset ({', '.join(PRESETS)}) and not a YAML file")
+    raise GeometryError(GeometryError.UNKNOWN_PLATFORM.format(name=s, presets=", ".join(PRESETS)))

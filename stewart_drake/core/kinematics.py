@@ -9,28 +9,21 @@ L_i = |l_i|.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stewart_drake.errors import SingularPoseError, UnreachablePoseError, counted
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
-
-def _poses(poses) -> np.ndarray:
-    q = np.asarray(poses, dtype=float)
-    if q.shape[-1:] != (6,):
-        raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
-    bad = ~np.isfinite(q).all(axis=-1)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        raise ValueError(f"pose {counted(idx)} is not finite: {q[idx].tolist()}")
-    return q
+if TYPE_CHECKING:  # annotations only: geometry imports sanity, which imports this module
+    from stewart_drake.core.geometry import Platform
 
 
 def plate_anchors(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
     """``(..., 6, 3)`` p_BTi: each leg's plate anchor in the base frame (metres)."""
-    q = _poses(poses)
+    q = as_poses(poses)
     R = rotation_matrix(q[..., 3:], convention)
     r_T = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
     return q[..., None, :3] + np.einsum("...jk,ik->...ij", R, r_T)
@@ -50,7 +43,7 @@ def leg_lengths(platform: Platform, poses, convention: str = "utn") -> np.ndarra
     The hot path of workspace sweeps: evaluated in blocks of ``CHUNK`` poses, one (n, 6) array per
     coordinate, accumulated in place.
     """
-    q = _poses(poses)
+    q = as_poses(poses)
     flat = q.reshape(-1, 6)
     out = np.empty((flat.shape[0], 6))
     r_T = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
@@ -80,7 +73,7 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
     """``(..., 6, 6)`` J⁻¹ with dL/dt = J⁻¹ · [v_BC; ω_B]: the velocity of the rotation centre and the
     plate's angular velocity, both in the base frame. Row i is [u_iᵀ, (r_i × u_i)ᵀ], r_i = R (p_TTi - p_TC).
     """
-    q = _poses(poses)
+    q = as_poses(poses)
     R = rotation_matrix(q[..., 3:], convention)
     r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
@@ -91,32 +84,51 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
 def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
     """``(..., 6, 6)`` J = ∂L/∂q: leg-length derivatives with respect to the pose coordinates
     (the seeds' Jacobian, used by the Lagrangian dynamics): J = J⁻¹ · blockdiag(I, E_W(angles))."""
-    q = _poses(poses)
+    q = as_poses(poses)
     Jinv = inverse_jacobian(platform, q, convention)
     E = angular_velocity_map(q[..., 3:], convention)
     return np.concatenate([Jinv[..., :3], Jinv[..., 3:] @ E], axis=-1)
 
 
-def condition_number(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
-    """``(...)`` 2-norm condition number of J⁻¹ (rotation columns scaled by the plate's anchor radius
-    so that both blocks are in metres); inf on a singularity."""
-    Jinv = inverse_jacobian(platform, poses, convention)
-    scale = np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1))
-    Jn = np.concatenate([Jinv[..., :3], Jinv[..., 3:] / scale], axis=-1)
-    s = np.linalg.svd(Jn, compute_uv=False)
-    with np.errstate(divide="ignore"):
+def anchor_radius(platform: Platform) -> float:
+    """The plate's anchor radius max |p_TTj − p_TC| (metres): the length that makes the rotation columns
+    of a Jacobian commensurate with its translation columns."""
+    return np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1))
+
+
+def scaled_jacobian(J, scale: float) -> np.ndarray:
+    """``(..., 6, 6)`` J with its three rotation columns divided by ``scale`` (the anchor radius, m), so
+    that both column blocks are in metres."""
+    return np.concatenate([J[..., :3], J[..., 3:] / scale], axis=-1)
+
+
+def singular_value_condition(s) -> np.ndarray:
+    """``(...)`` σ_max/σ_min from ``(..., n)`` singular values in descending order; inf where σ_min is 0
+    (or the ratio is not finite)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(s[..., -1] > 0, s[..., 0] / s[..., -1], np.inf)
+
+
+def scaled_condition(platform: Platform, J) -> np.ndarray:
+    """``(...)`` 2-norm condition number of a ``(..., 6, 6)`` Jacobian whose last three columns act on
+    rotations (J⁻¹ or ∂L/∂q), those columns scaled by the plate's anchor radius (``scaled_jacobian``);
+    inf on a singularity."""
+    s = np.linalg.svd(scaled_jacobian(J, anchor_radius(platform)), compute_uv=False)
+    return singular_value_condition(s)
+
+
+def condition_number(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(...)`` scaled condition number (``scaled_condition``) of J⁻¹ at ``(..., 6)`` poses (dL/dt =
+    J⁻¹ [v_BC; ω_B]): the platform's own singularities; inf on one."""
+    return scaled_condition(platform, inverse_jacobian(platform, poses, convention))
 
 
 def require_nonsingular(platform: Platform, poses, convention: str = "utn", max_condition: float = 1e8) -> np.ndarray:
     """Condition numbers ``(...)``; raise ``SingularPoseError`` naming the first pose above ``max_condition``."""
     k = condition_number(platform, poses, convention)
-    bad = ~(k <= max_condition)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0]) if np.ndim(k) else ()
-        raise SingularPoseError(
-            f"pose {counted(idx)} is singular or nearly so: Jacobian condition number {float(k[idx]):.3g} > {max_condition:.3g}"
-        )
+    idx = first_index(~(k <= max_condition))
+    if idx is not None:
+        raise SingularPoseError(SINGULAR_POSE.format(index=counted(idx), cond=float(k[idx]), limit=max_condition))
     return k
 
 

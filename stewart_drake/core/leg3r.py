@@ -32,26 +32,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import StewartError, counted
+from stewart_drake.core.argcheck import first_index
+from stewart_drake.core.rotations import wrap_angle
+from stewart_drake.errors import LegError, UnreachableTargetError
 
 ALPHA_SEED = np.radians(134.6 - 180.0)
 BRANCHES = ("a", "b")
 # A target this close (relative) outside the reachable annulus is treated as on its boundary (rounding).
 BOUNDARY_RTOL = 1e-12
-
-
-class UnreachableTargetError(StewartError):
-    """A foot target lies outside the leg's reachable annulus.
-
-    Attributes: ``index`` (tuple, into the batch), ``distance`` (m, hip to target, or to the wrist for the
-    3R solver), ``r_min``, ``r_max`` (m)."""
-
-    TEMPLATE = ("target {index}: {what} is {d_mm:.3f} mm from the hip, outside the reachable range "
-                "[{lo_mm:.3f}, {hi_mm:.3f}] mm")
-
-    def __init__(self, index, distance, r_min, r_max, what="the foot"):
-        self.index, self.distance, self.r_min, self.r_max = index, distance, r_min, r_max
-        super().__init__(self.TEMPLATE.format(index=counted(index), what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3, hi_mm=r_max * 1e3))
 
 
 @dataclass(frozen=True)
@@ -75,13 +63,13 @@ class Leg3R:
         for n in ("l1", "l2", "l3"):
             v = getattr(self, n)
             if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"leg length {n} must be a positive number of metres, got {v}")
+                raise LegError(LegError.LENGTH.format(name=n, value=v))
         if not np.isfinite(self.alpha):
-            raise ValueError(f"ankle angle alpha must be finite, got {self.alpha}")
+            raise LegError(LegError.ALPHA.format(value=self.alpha))
         for n in ("q1_limits", "q2_limits"):
             lo, hi = getattr(self, n)
             if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-                raise ValueError(f"{n} must be two finite angles (rad) with lower < upper, got {getattr(self, n)}")
+                raise LegError(LegError.LIMITS.format(name=n, value=getattr(self, n)))
 
     @property
     def shank(self) -> tuple[float, float]:
@@ -119,7 +107,7 @@ def dh_transform(theta, d, a, alpha) -> np.ndarray:
 def _check_q(q) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     if q.shape[-1:] != (2,):
-        raise ValueError(f"leg joint angles need 2 numbers (q1, q2), got shape {q.shape}")
+        raise LegError(LegError.ANGLES_2.format(shape=q.shape))
     return q
 
 
@@ -145,7 +133,7 @@ def foot(leg: Leg3R, q) -> np.ndarray:
     """
     q = np.asarray(q, dtype=float)
     if q.shape[-1:] not in ((2,), (3,)):
-        raise ValueError(f"leg joint angles need 2 numbers (q1, q2) or 3 (q1, q2, q3), got shape {q.shape}")
+        raise LegError(LegError.ANGLES_2_3.format(shape=q.shape))
     q3 = q[..., 2] if q.shape[-1] == 3 else leg.alpha
     s1, s12, g = q[..., 0], q[..., 0] + q[..., 1], q[..., 0] + q[..., 1] + q3
     px = leg.l1 * np.sin(s1) + leg.l2 * np.sin(s12) + leg.l3 * np.sin(g)
@@ -169,13 +157,10 @@ def seed_t03_rotation(gamma) -> np.ndarray:
     return np.stack([np.sin(g), np.cos(g), -np.cos(g), np.sin(g)], -1).reshape(g.shape + (2, 2))
 
 
-def _wrap(x):
-    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
-
-
-def _check_branch(branch: str) -> float:
+def check_branch(branch: str) -> float:
+    """The knee sign of an elbow branch: +1 for 'a' (knee angle >= 0), -1 for 'b'; ``LegError`` otherwise."""
     if branch not in BRANCHES:
-        raise ValueError(f"unknown elbow branch {branch!r}; expected 'a' (knee angle >= 0) or 'b' (<= 0)")
+        raise LegError(LegError.BRANCH.format(branch=branch))
     return 1.0 if branch == "a" else -1.0
 
 
@@ -185,18 +170,18 @@ def _two_link(x, y, l1, l2, sign, what):
     lo, hi = abs(l1 - l2), l1 + l2
     c = (r**2 - l1**2 - l2**2) / (2 * l1 * l2)
     bad = (r < lo * (1 - BOUNDARY_RTOL)) | (r > hi * (1 + BOUNDARY_RTOL)) | ~np.isfinite(r)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0]) if np.ndim(bad) else ()
+    idx = first_index(bad)
+    if idx is not None:
         raise UnreachableTargetError(idx, float(np.asarray(r)[idx]), lo, hi, what)
     elbow = sign * np.arccos(np.clip(c, -1.0, 1.0))  # eq. 15
     shoulder = np.arctan2(y, x) - np.arctan2(l2 * np.sin(elbow), l1 + l2 * np.cos(elbow))
-    return _wrap(shoulder), elbow
+    return wrap_angle(shoulder), elbow
 
 
 def _check_target(target, n) -> np.ndarray:
     target = np.asarray(target, dtype=float)
     if target.shape[-1:] != (n,):
-        raise ValueError(f"a leg target needs {n} numbers ({'Px, Py' if n == 2 else 'Px, Py, gamma'}), got shape {target.shape}")
+        raise LegError(LegError.TARGET.format(n=n, names="Px, Py" if n == 2 else "Px, Py, gamma", shape=target.shape))
     return target
 
 
@@ -207,23 +192,23 @@ def inverse_kinematics(leg: Leg3R, target, branch: str = "a") -> np.ndarray:
     l1 and l23 whose elbow is q2 + phi. Raises ``UnreachableTargetError`` naming the first target out
     of reach; joint limits are not applied (see ``within_limits``).
     """
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     t = _check_target(target, 2)
     l23, phi = leg.shank
     q1, elbow = _two_link(-t[..., 1], t[..., 0], leg.l1, l23, sign, "the foot")
-    return np.stack([q1, _wrap(elbow - phi)], axis=-1)
+    return np.stack([q1, wrap_angle(elbow - phi)], axis=-1)
 
 
 def inverse_kinematics_3r(leg: Leg3R, target, branch: str = "a") -> np.ndarray:
     """The seed's geometric 3R method, corrected: ``target`` (..., 3) [Px, Py, gamma] ->
     ``(..., 3)`` [q1, q2, q3] with gamma = q1 + q2 + q3 (q3 = alpha when the target came from this leg)."""
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     t = _check_target(target, 3)
     g = t[..., 2]
     x, y = -t[..., 1], t[..., 0]  # the frame "before the -90° rotation"
     xw, yw = x - leg.l3 * np.cos(g), y - leg.l3 * np.sin(g)  # eqs. 13-14, corrected
     q1, q2 = _two_link(xw, yw, leg.l1, leg.l2, sign, "the ankle (wrist)")
-    return np.stack([q1, q2, _wrap(g - q1 - q2)], axis=-1)
+    return np.stack([q1, q2, wrap_angle(g - q1 - q2)], axis=-1)
 
 
 SEED_FIXES = ("frame", "sin14", "elbow18", "atan2")
@@ -240,10 +225,10 @@ def seed_inverse_kinematics(leg: Leg3R, target, branch: str = "a", fixes=()) -> 
     ``SEED_FIXES``, explained in ``SEED_FIX_TEXT``) applied: ``(..., 3)`` [q1, q2, q3]; NaN where the
     formulas have no real value. With every fix this is ``inverse_kinematics_3r`` (without its
     reachability check). For showing the seed's errors, not for control."""
-    sign = _check_branch(branch)
+    sign = check_branch(branch)
     unknown = sorted(set(fixes) - set(SEED_FIXES))
     if unknown:
-        raise ValueError(f"unknown seed fix {unknown[0]!r}; expected some of {', '.join(SEED_FIXES)}")
+        raise LegError(LegError.SEED_FIX.format(fix=unknown[0], valid=", ".join(SEED_FIXES)))
     t = _check_target(target, 3)
     px, py, g = t[..., 0], t[..., 1], t[..., 2]
     x, y = (-py, px) if "frame" in fixes else (px, py)

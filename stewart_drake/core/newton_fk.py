@@ -17,7 +17,7 @@ pose Newton reached may not be the one the trajectory was following.
 
 What Newton guarantees: a converged sample satisfies the six length equations to ``tol``; the pose
 found is *an* assembly mode, normally the one whose basin contains the initial guess (the closest one
-when the guess is close). It does not find all assembly modes (see ``forward.assembly_modes``).
+when the guess is close). It does not find all assembly modes (see ``assembly_modes.assembly_modes``).
 """
 
 from __future__ import annotations
@@ -27,10 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import ForwardKinematicsError, SingularPoseError, SingularityWarning, counted
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import inverse_jacobian
+from stewart_drake.core.kinematics import anchor_radius, inverse_jacobian, scaled_jacobian, singular_value_condition
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
+from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError, counted
 
 # Per-sample status codes (FKResult.status).
 CONVERGED = 0
@@ -60,9 +60,9 @@ SINGULAR_TEMPLATE = (
 
 
 def anchor_scale(platform: Platform) -> float:
-    """The plate's anchor radius max |p_TTj − p_TC| (metres): the length that makes the rotation
-    columns of J⁻¹ commensurate with the translation columns (as in ``kinematics.condition_number``)."""
-    return float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
+    """The plate's anchor radius max |p_TTj − p_TC| (metres) as a float: ``kinematics.anchor_radius``, the
+    length that makes the rotation columns of J⁻¹ commensurate with the translation columns."""
+    return float(anchor_radius(platform))
 
 
 @dataclass(frozen=True)
@@ -87,24 +87,19 @@ class JacobianAnalysis:
         return ~(self.condition <= max_condition)
 
 
-def _scaled(Jinv: np.ndarray, scale: float) -> np.ndarray:
-    return np.concatenate([Jinv[..., :3], Jinv[..., 3:] / scale], axis=-1)
-
-
-def _analyse_jinv(Jinv: np.ndarray, scale: float) -> JacobianAnalysis:
-    Jn = _scaled(Jinv, scale)
+def analyse_inverse_jacobian(Jinv: np.ndarray, scale: float) -> JacobianAnalysis:
+    """``JacobianAnalysis`` of ``(..., 6, 6)`` J⁻¹ with its rotation columns divided by ``scale`` (the
+    anchor radius, metres)."""
+    Jn = scaled_jacobian(Jinv, scale)
     s = np.linalg.svd(Jn, compute_uv=False)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cond = np.where(s[..., -1] > 0, s[..., 0] / s[..., -1], np.inf)
-    return JacobianAnalysis(cond, s[..., -1], np.sign(np.linalg.det(Jn)))
+    return JacobianAnalysis(singular_value_condition(s), s[..., -1], np.sign(np.linalg.det(Jn)))
 
 
 def frobenius_condition(Jinv: np.ndarray, scale: float) -> np.ndarray:
     """``(n,)`` Frobenius-norm condition number ‖A‖_F ‖A⁻¹‖_F of the scaled ``(n, 6, 6)`` J⁻¹ (inf if
     singular). A cheap, conservative stand-in for the 2-norm condition number κ₂ (one batched inverse
     instead of an SVD): κ₂ <= κ_F <= 6 κ₂ for 6x6 matrices."""
-    A = Jinv.copy()
-    A[..., 3:] /= scale
+    A = scaled_jacobian(Jinv, scale)
     try:
         Ainv = np.linalg.inv(A)
     except np.linalg.LinAlgError:  # some sample exactly singular: redo one by one
@@ -121,7 +116,7 @@ def frobenius_condition(Jinv: np.ndarray, scale: float) -> np.ndarray:
 
 def jacobian_analysis(platform: Platform, poses, convention: str = "utn") -> JacobianAnalysis:
     """Condition number, singularity distance and det sign of J⁻¹ at ``(..., 6)`` poses."""
-    return _analyse_jinv(inverse_jacobian(platform, poses, convention), anchor_scale(platform))
+    return analyse_inverse_jacobian(inverse_jacobian(platform, poses, convention), anchor_scale(platform))
 
 
 def check_poses_nonsingular(
@@ -246,15 +241,15 @@ def _exp_so3(w: np.ndarray) -> np.ndarray:
     return np.eye(3) + A[:, None, None] * K + B[:, None, None] * (K @ K)
 
 
-def _legs(platform: Platform, p: np.ndarray, R: np.ndarray):
-    """r_i = R (p_TTi − p_TC) ``(n, 6, 3)``, leg vectors l_i ``(n, 6, 3)`` and lengths ``(n, 6)``."""
+def leg_geometry(platform: Platform, p: np.ndarray, R: np.ndarray):
+    """For ``(n, 3)`` positions p_BC and ``(n, 3, 3)`` orientations R_BT: r_i = R (p_TTi − p_TC) ``(n, 6, 3)``, leg vectors l_i ``(n, 6, 3)`` and lengths ``(n, 6)``."""
     r = np.swapaxes(R @ (platform.top_anchors_per_leg - platform.rotation_centre).T, -1, -2)
     l = p[:, None, :] + r - platform.base_anchors
     return r, l, np.sqrt(np.sum(l * l, axis=-1))
 
 
 def _jinv(r: np.ndarray, l: np.ndarray, L: np.ndarray) -> np.ndarray:
-    """J⁻¹ rows [u_iᵀ, (r_i × u_i)ᵀ] from ``_legs`` output (cross product written out: faster than np.cross)."""
+    """J⁻¹ rows [u_iᵀ, (r_i × u_i)ᵀ] from ``leg_geometry`` output (cross product written out: faster than np.cross)."""
     u = l / L[..., None]
     J = np.empty(L.shape + (6,))
     J[..., :3] = u
@@ -269,7 +264,7 @@ def legs_and_jacobian(platform: Platform, p: np.ndarray, R: np.ndarray):
     """For ``(n, 3)`` positions p_BC and ``(n, 3, 3)`` orientations R_BT: leg lengths ``(n, 6)`` and the
     inverse Jacobian J⁻¹ ``(n, 6, 6)`` (same rows as ``kinematics.inverse_jacobian``, computed from R
     directly so that no Euler angles are involved)."""
-    r, l, L = _legs(platform, p, R)
+    r, l, L = leg_geometry(platform, p, R)
     return L, _jinv(r, l, L)
 
 
@@ -288,7 +283,7 @@ def _solve_batch(J: np.ndarray, e: np.ndarray):
 
 
 def newton_core(platform: Platform, p, R, L_target, tol=1e-12, max_iter=30, max_step_m=0.1, max_step_rad=0.5):
-    """Flat Newton iteration (no validation; used by ``forward_kinematics`` and ``forward``).
+    """Flat Newton iteration (no validation; used by ``forward_kinematics`` and ``assembly_modes``).
 
     ``p (n, 3)``, ``R (n, 3, 3)`` initial iterates (modified copies are returned), ``L_target (n, 6)``.
     Returns ``p, R, residual (n,), iterations (n,), status (n,)``. A step is scaled down (direction kept)
@@ -305,7 +300,7 @@ def newton_core(platform: Platform, p, R, L_target, tol=1e-12, max_iter=30, max_
         if active.size == 0:
             break
         pa, Ra = p[active], R[active]
-        r, l, L = _legs(platform, pa, Ra)
+        r, l, L = leg_geometry(platform, pa, Ra)
         err = L_target[active] - L
         res = np.abs(err).max(axis=-1)
         residual[active] = res
@@ -425,29 +420,3 @@ def forward_kinematics(
             "forward-kinematics solution for lengths sample", "; the pose is poorly determined and may belong to another assembly mode",
         )
     return result
-
-
-def sample_poses(platform: Platform, n: int, seed: int = 0, max_angle: float = np.radians(20.0), convention: str = "utn") -> np.ndarray:
-    """``(n, 6)`` random poses around home for tests, reports and benchmarks: translations within
-    ±0.3 × stroke span of home (pz not below half the home height), each angle within ±max_angle
-    (rad), kept only when every leg is within stroke and every plate anchor lies above the base plane
-    (z > 0). Deterministic for a given seed."""
-    from stewart_drake.core.kinematics import check_stroke, leg_lengths, plate_anchors
-
-    rng = np.random.default_rng(seed)
-    span = 0.3 * (platform.L_max - platform.L_min)
-    h = platform.home_height
-    out, have = [], 0
-    for _ in range(100):
-        m = max(4 * (n - have), 64)
-        q = np.empty((m, 6))
-        q[:, :2] = rng.uniform(-span, span, (m, 2))
-        q[:, 2] = rng.uniform(max(h - span, 0.5 * h), h + span, m)
-        q[:, 3:] = rng.uniform(-max_angle, max_angle, (m, 3))
-        ok = check_stroke(platform, leg_lengths(platform, q, convention)).within
-        ok &= np.all(plate_anchors(platform, q, convention)[..., 2] > 0, axis=-1)
-        out.append(q[ok])
-        have += int(ok.sum())
-        if have >= n:
-            return np.concatenate(out)[:n]
-    raise ValueError(f"platform {platform.name!r}: could not sample {n} reachable poses around home")

@@ -32,6 +32,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
+from stewart_drake import __version__
 from stewart_drake.errors import OutputError
 
 MANIFEST = ".stewart-drake-manifest.json"
@@ -56,8 +57,6 @@ def read_manifest(folder: Path) -> list[str] | None:
 
 
 def _write_manifest(folder: Path, files) -> None:
-    from stewart_drake import __version__
-
     text = json.dumps({"tool": "stewart-drake", "version": __version__, "files": sorted(set(files))}, indent=2) + "\n"
     _write_file_atomic(folder / MANIFEST, text.encode("utf-8"))
 

@@ -162,23 +162,24 @@ def angular_velocity_map(angles, convention: str = "utn") -> np.ndarray:
     return np.concatenate([w_a, w_b, w_g], axis=-1)
 
 
-def to_drake(angles, convention: str = "utn"):
-    """One ``(3,)`` angle triple -> ``pydrake.math.RotationMatrix``."""
-    from pydrake.math import RotationMatrix
+def quaternion_to_matrix(q) -> np.ndarray:
+    """``(..., 4)`` quaternions [w, x, y, z] (normalised here; any non-zero length) -> ``(..., 3, 3)``
+    rotation matrices (Hamilton convention, as Drake's ``Quaternion``)."""
+    q = np.asarray(q, dtype=float)
+    if q.shape[-1:] != (4,):
+        raise ValueError(f"quaternions need 4 numbers (w, x, y, z), got shape {q.shape}")
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    return np.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        axis=-1,
+    ).reshape(q.shape[:-1] + (3, 3))
 
-    R = rotation_matrix(np.asarray(angles, dtype=float).reshape(3), convention)
-    return RotationMatrix(R)
 
-
-def from_drake(rotation, convention: str = "utn") -> np.ndarray:
-    """A Drake ``RotationMatrix``, ``RollPitchYaw`` or ``Quaternion`` -> ``(3,)`` angles (radians)."""
-    from pydrake.common.eigen_geometry import Quaternion
-    from pydrake.math import RollPitchYaw, RotationMatrix
-
-    if isinstance(rotation, RollPitchYaw):
-        rotation = RotationMatrix(rotation)
-    elif isinstance(rotation, Quaternion):
-        rotation = RotationMatrix(rotation)
-    if not isinstance(rotation, RotationMatrix):
-        raise TypeError(f"expected a Drake RotationMatrix, RollPitchYaw or Quaternion, got {type(rotation).__name__}")
-    return angles_from_matrix(rotation.matrix(), convention)
+def wrap_angle(x) -> np.ndarray:
+    """Angles ``x`` (radians, any shape) wrapped to [-pi, pi)."""
+    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi

@@ -27,14 +27,21 @@ import os
 
 import numpy as np
 
+from stewart_drake.core.kinematics import condition_number, leg_lengths, plate_anchors
+from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import (
     BELOW_BASE,
+    FAR_CENTRE,
     FAR_POSITION,
+    GRAVITY_RANGE,
     NO_PLATE,
     NOT_FINITE,
+    NOT_POSITIVE,
     OUT_OF_STROKE,
+    SERVO_NEUTRAL,
     SINGULAR_HOME,
     WORK_TOO_LARGE,
+    WORK_UNBOUNDED,
     GeometryError,
     PhysicalLimitError,
     StewartError,
@@ -80,7 +87,7 @@ def check_positive(value, what: str, unit: str = "") -> float:
     """A finite, strictly positive float, or ``StewartError`` naming ``what``."""
     v = float(value)
     if not (math.isfinite(v) and v > 0):
-        raise StewartError(f"{what} must be a positive number{' of ' + unit if unit else ''}, got {fmt_value(v)}")
+        raise StewartError(NOT_POSITIVE.format(what=what, unit=" of " + unit if unit else "", value=fmt_value(v)))
     return v
 
 
@@ -90,7 +97,7 @@ def check_gravity(g: float, option: str = "--gravity") -> float:
     if not math.isfinite(v):
         raise StewartError(NOT_FINITE.format(what=f"{option} (m/s²)", value=fmt_value(v)))
     if abs(v) > 100.0:
-        raise StewartError(f"{option} {fmt_value(v)} m/s² is beyond ±100 m/s² (10 g); is it in m/s²?")
+        raise StewartError(GRAVITY_RANGE.format(option=option, value=fmt_value(v)))
     return v
 
 
@@ -107,8 +114,6 @@ def platform_size(platform) -> float:
 
 def plate_anchor_heights(platform, poses, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` z of each leg's plate anchor in B (m) for ``(..., 6)`` poses."""
-    from stewart_drake.core.kinematics import plate_anchors
-
     return plate_anchors(platform, poses, convention)[..., 2]
 
 
@@ -216,8 +221,6 @@ def check_trajectory(platform, times, poses, convention: str = "utn", what: str 
     ``check_poses`` (labelled by its time) and every leg stays within the stroke. A stroke violation
     raises ``PhysicalLimitError`` naming the first offending time, leg and amount, unless
     ``allow_out_of_stroke``: then its message is returned as a warning (a list of 0 or 1 strings)."""
-    from stewart_drake.core.kinematics import leg_lengths
-
     t = np.asarray(times, dtype=float).reshape(-1)
     q = check_poses(platform, poses, convention, what=what, times=t)
     v = first_stroke_violation(platform, leg_lengths(platform, q, convention), t)
@@ -255,8 +258,6 @@ def _collinear(points: np.ndarray, tol: float) -> bool:
 def check_home(platform) -> None:
     """``GeometryError`` when ``platform`` is singular at its home pose: its legs cannot hold the plate
     there (the Jacobian loses rank). Names the anchors when they are collinear (the usual cause)."""
-    from stewart_drake.core.kinematics import condition_number
-
     home = platform.home_pose()
     cond = float(condition_number(platform, home))
     if cond <= HOME_MAX_CONDITION:
@@ -351,7 +352,7 @@ def check_work(option: str, value: str, count: float, what: str, bytes_per: floa
     option as typed; ``hint`` ends the message (e.g. "; use a coarser --resolution")."""
     count = float(count)
     if not math.isfinite(count):
-        raise WorkTooLargeError(f"{option} {value} would need unboundedly many {what}{hint}")
+        raise WorkTooLargeError(WORK_UNBOUNDED.format(option=option, value=value, what=what, hint=hint))
     need = count * bytes_per
     budget = memory_budget()
     if bytes_per and need > budget:
@@ -373,8 +374,8 @@ def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
     size = platform_size(platform)
     r = float(np.linalg.norm(c))
     if r > FAR_FACTOR * size:
-        raise StewartError(f"{option} {' '.join(fmt_value(x) for x in c)} m is {r / size:.3g} × the platform's size ({size:.3f} m) from the plate; "
-                           f"centres beyond {FAR_FACTOR:g} × are surely a unit mistake (the centre is in metres)")
+        raise StewartError(FAR_CENTRE.format(option=option, centre=" ".join(fmt_value(x) for x in c), ratio=r / size, size_m=size,
+                                             limit=FAR_FACTOR))
     return c
 
 
@@ -413,17 +414,14 @@ def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
     bad = (w0 < lo) | (w0 > hi)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise StewartError(
-            f"{what}: servo {i + 1}'s neutral pulse {fmt_value(w0[i])} µs is outside [{lo:.0f}, {hi:.0f}] µs: with its travel of "
-            f"±{swing:.0f} µs the pulse must stay within an RC servo's {SERVO_PULSE_RANGE_US[0]:.0f}-{SERVO_PULSE_RANGE_US[1]:.0f} µs")
+        raise StewartError(SERVO_NEUTRAL.format(what=what, servo=i + 1, value=fmt_value(w0[i]), lo=lo, hi=hi, swing=swing,
+                                                range_lo=SERVO_PULSE_RANGE_US[0], range_hi=SERVO_PULSE_RANGE_US[1]))
 
 
 def plate_floor(platform, orientation, convention: str = "utn") -> float:
     """The height (m) the rotation centre must exceed, at ``orientation`` (3,) rad, for every plate
     anchor to be above the base plane: max_i −(R_BT (p_TTi − p_TC))_z; −inf when the platform allows
     its plate below the base. Positions above it form the half-space a workspace may count."""
-    from stewart_drake.core.rotations import rotation_matrix
-
     if getattr(platform, "plate_below_base_allowed", False):
         return -math.inf
     R = rotation_matrix(np.asarray(orientation, dtype=float), convention)

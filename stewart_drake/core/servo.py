@@ -44,9 +44,10 @@ from typing import Optional
 
 import numpy as np
 
-from stewart_drake.errors import GeometryError, StewartError, counted
-from stewart_drake.core.geometry import load_yaml_config
-from stewart_drake.core.rotations import length_scale, rotation_matrix
+from stewart_drake.core.argcheck import first_index
+from stewart_drake.core.geometry import check_name, load_yaml_config
+from stewart_drake.core.rotations import length_scale, rotation_matrix, wrap_angle
+from stewart_drake.errors import SERVO_RESOLUTION, GeometryError, ServoPoseError, StewartError, counted
 
 NEUTRAL_US = 1500.0
 RATE_US_PER_RAD = 400.0 / np.radians(45.0)  # 509.295... µs/rad = 8.888... µs/degree
@@ -59,10 +60,6 @@ SERVO_STALL_TORQUE = 1.0
 SERVO_BAND_RAD = np.radians(2.0)
 # Home heights of the six legs must agree (the seed: "by symmetry eq. 10 gives the same for every leg").
 H0_AGREEMENT_M = 1e-9
-
-
-class ServoPoseError(StewartError):
-    """A pose given to the servo hexapod is malformed (shape, non-finite numbers)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,33 +104,31 @@ class ServoHexapod:
         for name, shape in shapes.items():
             arr = np.array(getattr(self, name), dtype=float)
             if arr.shape != shape:
-                raise GeometryError(f"servo hexapod {name} must have shape {shape}, got {arr.shape}")
+                raise GeometryError(GeometryError.SERVO_SHAPE.format(name=name, shape=shape, got=arr.shape))
             if not np.all(np.isfinite(arr)):
-                raise GeometryError(f"servo hexapod {name} has non-finite values: {arr.tolist()}")
+                raise GeometryError(GeometryError.SERVO_NOT_FINITE.format(name=name, value=arr.tolist()))
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
         for name in ("arm_length", "rod_length", "rate_us_per_rad", "travel_rad", "arm_mass", "rod_mass", "platform_mass",
                      "servo_torque", "servo_speed", "servo_band"):
             v = getattr(self, name)
             if not np.isfinite(v) or v <= 0:
-                raise GeometryError(f"servo hexapod {name} must be a positive number, got {v}")
+                raise GeometryError(GeometryError.SERVO_NOT_POSITIVE.format(name=name, value=v))
         if self.rod_length <= self.arm_length:
-            raise GeometryError(f"rod length s = {self.rod_length} m must exceed the arm length a = {self.arm_length} m")
+            raise GeometryError(GeometryError.SERVO_ROD.format(s=self.rod_length, a=self.arm_length))
         n = np.linalg.norm(self.shaft_directions, axis=1)
         k = self.alpha_axes
         for i in range(6):
             if abs(abs(self.shaft_directions[i] @ k[i]) - n[i]) > 1e-9 * max(n[i], 1.0) or n[i] == 0:
-                raise GeometryError(
-                    f"servo {i + 1}: shaft direction {self.shaft_directions[i].tolist()} is not perpendicular to its arm plane "
-                    f"(beta = {np.degrees(self.arm_directions[i]):.6g} deg)"
-                )
+                raise GeometryError(GeometryError.SERVO_SHAFT.format(servo=i + 1, shaft=self.shaft_directions[i].tolist(),
+                                                                   beta=np.degrees(self.arm_directions[i])))
         object.__setattr__(self, "shaft_directions", _readonly(self.shaft_directions / n[:, None]))
         h = home_heights(self)
         if np.any(~np.isfinite(h)):
             i = int(np.argmax(~np.isfinite(h)))
-            raise GeometryError(f"servo {i + 1}: arm and rod cannot be at right angles over its anchor (eq. 10 has no real h0)")
+            raise GeometryError(GeometryError.SERVO_NO_H0.format(servo=i + 1))
         if np.ptp(h) > H0_AGREEMENT_M:
-            raise GeometryError(f"eq. 10 gives different home heights per servo ({np.round(h * 1e3, 6).tolist()} mm): the layout is not symmetric")
+            raise GeometryError(GeometryError.SERVO_ASYMMETRIC.format(h_mm=np.round(h * 1e3, 6).tolist()))
 
     @property
     def alpha_axes(self) -> np.ndarray:
@@ -281,7 +276,7 @@ class ServoHexapodConfig:
 
 def _positive(field_name: str, value, unit: str = "") -> float:
     if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-        raise GeometryError(f"{field_name} must be a positive number{' of ' + unit if unit else ''}, got {value!r}")
+        raise GeometryError(GeometryError.SERVO_FIELD_POSITIVE.format(field=field_name, unit=" of " + unit if unit else "", value=value))
     return float(value)
 
 
@@ -289,11 +284,11 @@ def _rows(field_name: str, value, shape) -> np.ndarray:
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise GeometryError(f"{field_name} must be {_shape_words(shape)}, got {value!r}") from None
+        raise GeometryError(GeometryError.SERVO_FIELD_SHAPE.format(field=field_name, shape=_shape_words(shape), value=value)) from None
     if arr.shape != shape:
-        raise GeometryError(f"{field_name} must be {_shape_words(shape)}, got {value!r}")
+        raise GeometryError(GeometryError.SERVO_FIELD_SHAPE.format(field=field_name, shape=_shape_words(shape), value=value))
     if not np.all(np.isfinite(arr)):
-        raise GeometryError(f"{field_name} must be finite, got {value!r}")
+        raise GeometryError(GeometryError.SERVO_FIELD_FINITE.format(field=field_name, value=value))
     return arr
 
 
@@ -307,7 +302,7 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
     try:
         k = length_scale(cfg.length_unit)
     except ValueError:
-        raise GeometryError(f"length_unit must be m or mm, got {cfg.length_unit!r}") from None
+        raise GeometryError(GeometryError.SERVO_UNIT.format(value=cfg.length_unit)) from None
     u = cfg.length_unit
     a = _positive("arm_length", cfg.arm_length, u) * k
     s = _positive("rod_length", cfg.rod_length, u) * k
@@ -324,14 +319,14 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
         platform_mass=_positive("masses.platform", m.platform, "kg"),
     )
     if np.degrees(extra["travel_rad"]) >= 90:
-        raise GeometryError(f"servo.travel_deg must be below 90 degrees, got {sv.travel_deg!r}")
+        raise GeometryError(GeometryError.SERVO_TRAVEL.format(value=sv.travel_deg))
     explicit = {"base_pivots": cfg.base_pivots, "arm_directions_deg": cfg.arm_directions_deg,
                 "platform_anchors": cfg.platform_anchors, "shaft_directions": cfg.shaft_directions}
     given = [n for n, v in explicit.items() if len(v)]
     name = cfg.name or "servo-hexapod"
     if cfg.paired is not None:
         if given:
-            raise GeometryError(f"servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {', '.join(given)})")
+            raise GeometryError(GeometryError.SERVO_BOTH_LAYOUTS.format(name=name, given=", ".join(given)))
         p = cfg.paired
         h = hobby_servo_hexapod(
             base_radius=_positive("paired.base_radius", p.base_radius, u) * k,
@@ -343,8 +338,7 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
         return h.replace(name=name, description=cfg.description, **extra)
     missing = [n for n in explicit if n not in given]
     if missing:
-        raise GeometryError(f"servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, platform_anchors, "
-                            f"shaft_directions (missing {', '.join(missing)})")
+        raise GeometryError(GeometryError.SERVO_MISSING_LAYOUT.format(name=name, missing=", ".join(missing)))
     return ServoHexapod(
         name=name, description=cfg.description,
         base_pivots=_rows("base_pivots", cfg.base_pivots, (6, 3)) * k,
@@ -357,8 +351,6 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
 
 def load_servo_yaml(path) -> ServoHexapod:
     """Load a servo hexapod from a YAML file (schema: ``ServoHexapodConfig``)."""
-    from stewart_drake.core.geometry import check_name
-
     return servo_hexapod_from_config(load_yaml_config(path, ServoHexapodConfig, "servo hexapod",
                                                       lambda cfg, where: check_name(cfg, where, str(path))))
 
@@ -366,7 +358,7 @@ def load_servo_yaml(path) -> ServoHexapod:
 def servo_preset_path(name: str) -> Path:
     """The YAML file of a built-in servo hexapod preset."""
     if name not in _PRESET_FILES:
-        raise GeometryError(f"unknown servo hexapod preset {name!r}; available: {', '.join(SERVO_PRESETS)}")
+        raise GeometryError(GeometryError.SERVO_UNKNOWN_PRESET.format(name=name, presets=", ".join(SERVO_PRESETS)))
     return Path(str(resources.files("stewart_drake") / "presets" / _PRESET_FILES[name]))
 
 
@@ -384,7 +376,7 @@ def load_servo_hexapod(name_or_path) -> ServoHexapod:
         return load_servo_preset(text)
     if text.endswith((".yaml", ".yml")) or Path(text).exists():
         return load_servo_yaml(text)
-    raise GeometryError(f"unknown servo hexapod {text!r}: not a preset ({', '.join(SERVO_PRESETS)}) and not a YAML file")
+    raise GeometryError(GeometryError.SERVO_UNKNOWN.format(name=text, presets=", ".join(SERVO_PRESETS)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -415,11 +407,7 @@ def _alpha(L, M, N):
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(c > 0, L / np.where(c > 0, c, 1.0), np.copysign(np.inf, L))
     alpha = np.arcsin(np.clip(ratio, -1.0, 1.0)) - np.arctan2(N, M)
-    return _wrap(alpha), ratio
-
-
-def _wrap(x):
-    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
+    return wrap_angle(alpha), ratio
 
 
 def home_arm_angles(hexapod: ServoHexapod) -> np.ndarray:
@@ -447,11 +435,10 @@ def check_poses(poses) -> np.ndarray:
     """``poses`` as a float array ``(..., 6)``; raise ``ServoPoseError`` naming a bad shape or pose."""
     poses = np.asarray(poses, dtype=float)
     if poses.shape[-1:] != (6,):
-        raise ServoPoseError(f"a servo hexapod pose needs 6 numbers (x, y, z, phi, theta, psi), got shape {poses.shape}")
-    bad = ~np.all(np.isfinite(poses), axis=-1)
-    if np.any(bad):
-        idx = tuple(int(i) for i in np.argwhere(bad)[0]) if poses.ndim > 1 else ()
-        raise ServoPoseError(f"pose {counted(idx)} has a non-finite number: {poses[idx].tolist()}")
+        raise ServoPoseError(ServoPoseError.SHAPE.format(shape=poses.shape))
+    idx = first_index(~np.all(np.isfinite(poses), axis=-1))
+    if idx is not None:
+        raise ServoPoseError(ServoPoseError.NOT_FINITE.format(index=counted(idx), values=poses[idx].tolist()))
     return poses
 
 
@@ -514,7 +501,7 @@ def arm_angles(hexapod: ServoHexapod, poses) -> tuple[np.ndarray, np.ndarray]:
 
 def pulse_widths(hexapod: ServoHexapod, alpha) -> np.ndarray:
     """Eqs. 13-14: ``(..., 6)`` pulse widths (µs) for arm angles ``alpha`` (..., 6), without limits."""
-    delta = _wrap(np.asarray(alpha, dtype=float) - hexapod.home_angles)
+    delta = wrap_angle(np.asarray(alpha, dtype=float) - hexapod.home_angles)
     return hexapod.neutral_us + hexapod.pulse_signs * delta * hexapod.rate_us_per_rad
 
 
@@ -527,7 +514,7 @@ def angles_from_pulses(hexapod: ServoHexapod, pulse_us) -> np.ndarray:
 def solve(hexapod: ServoHexapod, poses) -> ServoSolution:
     """The seed's control step for ``(..., 6)`` poses: arm angles, pulse widths, per-servo checks."""
     alpha, ratio = arm_angles(hexapod, poses)
-    delta = _wrap(alpha - hexapod.home_angles)
+    delta = wrap_angle(alpha - hexapod.home_angles)
     raw = hexapod.neutral_us + hexapod.pulse_signs * delta * hexapod.rate_us_per_rad
     lim = hexapod.travel_rad
     pulse = hexapod.neutral_us + hexapod.pulse_signs * np.clip(delta, -lim, lim) * hexapod.rate_us_per_rad
@@ -537,7 +524,7 @@ def solve(hexapod: ServoHexapod, poses) -> ServoSolution:
 def quantise_pulses(pulse_us, resolution_us: float = 1.0) -> np.ndarray:
     """Pulse widths rounded to the driver's resolution (µs), half away from zero like a C ``lround``."""
     if not resolution_us > 0:
-        raise ValueError(f"pulse resolution must be > 0 µs, got {resolution_us}")
+        raise StewartError(SERVO_RESOLUTION.format(value=resolution_us))
     p = np.asarray(pulse_us, dtype=float) / resolution_us
     return np.copysign(np.floor(np.abs(p) + 0.5), p) * resolution_us
 

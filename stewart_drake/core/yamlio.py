@@ -135,7 +135,7 @@ def _check_size(root, shown: str) -> None:
         if key in sizes:
             return sizes[key]
         if key in busy:
-            raise YamlError(f"{shown}:{node.start_mark.line + 1}: an alias refers to the value that contains it")
+            raise YamlError(YamlError.RECURSIVE_ALIAS.format(path=shown, line=node.start_mark.line + 1))
         busy.add(key)
         if isinstance(node, yaml.SequenceNode):
             n = 1 + sum(size(c) for c in node.value)

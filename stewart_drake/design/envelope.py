@@ -27,8 +27,8 @@ from typing import Optional
 
 import numpy as np
 
-from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces_with_legs
-from stewart_drake.errors import StewartError
+from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces, leg_forces_with_legs, skew
+from stewart_drake.errors import EnvelopeError, StewartError
 from stewart_drake.core.geometry import Platform, load_yaml_config
 from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
 from stewart_drake.core.rotations import angle_scale, angular_velocity_map, check_convention, length_scale, rotation_matrix
@@ -38,10 +38,6 @@ from stewart_drake.design.boxquad import box_quadratic_max
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
 MAX_CONDITION = 1e8  # as dynamics.MAX_CONDITION: leg forces are meaningless beyond it
 CHUNK = 4096
-
-
-class EnvelopeError(StewartError):
-    """An envelope file is malformed or leaves the platform's workspace."""
 
 
 # ----------------------------------------------------------------------------------------------
@@ -104,13 +100,13 @@ def _numbers(values, n, where, integer=False):
     try:
         arr = np.array(values, dtype=float)
     except (TypeError, ValueError):
-        raise EnvelopeError(f"{where}: expected numbers, got {values!r}") from None
+        raise EnvelopeError(EnvelopeError.NOT_NUMBERS.format(where=where, value=values)) from None
     if arr.shape != (n,):
-        raise EnvelopeError(f"{where}: expected {n} numbers, got {values!r}")
+        raise EnvelopeError(EnvelopeError.COUNT.format(where=where, n=n, value=values))
     if not np.all(np.isfinite(arr)):
-        raise EnvelopeError(f"{where}: values must be finite, got {values!r}")
+        raise EnvelopeError(EnvelopeError.NOT_FINITE.format(where=where, value=values))
     if integer and np.any(arr != np.round(arr)):
-        raise EnvelopeError(f"{where}: expected integers, got {values!r}")
+        raise EnvelopeError(EnvelopeError.NOT_INTEGERS.format(where=where, value=values))
     return arr
 
 
@@ -121,27 +117,27 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
         kl, ka = length_scale(cfg.length_unit), angle_scale(cfg.angle_unit)
         check_convention(cfg.convention)
     except ValueError as e:
-        raise EnvelopeError(f"{source}: {e}") from None
+        raise EnvelopeError(EnvelopeError.IN_FILE.format(source=source, problem=e)) from None
     scale = np.r_[np.full(3, kl), np.full(3, ka)]
     if bool(cfg.poses) == (cfg.box is not None):
-        raise EnvelopeError(f"{source}: give exactly one of poses (a list) or box (a grid)")
+        raise EnvelopeError(EnvelopeError.ONE_OF.format(source=source))
     if cfg.box is not None:
         lo = _numbers(cfg.box.min, 6, f"{source}: box.min")
         hi = _numbers(cfg.box.max, 6, f"{source}: box.max")
         steps = _numbers(cfg.box.steps, 6, f"{source}: box.steps", integer=True).astype(int)
         if np.any(steps < 1):
-            raise EnvelopeError(f"{source}: box.steps must be >= 1, got {cfg.box.steps!r}")
+            raise EnvelopeError(EnvelopeError.STEPS.format(source=source, value=cfg.box.steps))
         if np.any(hi < lo):
             j = int(np.argmax(hi < lo))
-            raise EnvelopeError(f"{source}: box.max[{j}] = {cfg.box.max[j]} is below box.min[{j}] = {cfg.box.min[j]}")
+            raise EnvelopeError(EnvelopeError.BOX_ORDER.format(source=source, j=j, hi=cfg.box.max[j], lo=cfg.box.min[j]))
         n = int(np.prod(steps.astype(float)))
         if n > MAX_POSES:
-            raise EnvelopeError(f"{source}: box.steps {cfg.box.steps!r} make {n} poses, more than the limit {MAX_POSES}")
+            raise EnvelopeError(EnvelopeError.BOX_TOO_LARGE.format(source=source, steps=cfg.box.steps, n=n, limit=MAX_POSES))
         axes = [np.linspace(lo[j], hi[j], steps[j]) if steps[j] > 1 else lo[j : j + 1] for j in range(6)]
         poses = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
     else:
         if len(cfg.poses) > MAX_POSES:
-            raise EnvelopeError(f"{source}: {len(cfg.poses)} poses, more than the limit {MAX_POSES}")
+            raise EnvelopeError(EnvelopeError.TOO_MANY_POSES.format(source=source, n=len(cfg.poses), limit=MAX_POSES))
         poses = np.array([_numbers(p, 6, f"{source}: poses (pose {k + 1})") for k, p in enumerate(cfg.poses)])
     bounds = {}
     for name, b in (("velocity", cfg.velocity), ("acceleration", cfg.acceleration)):
@@ -149,7 +145,7 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
         ang = _numbers(b.angular, 3, f"{source}: {name}.angular")
         for part, arr in (("linear", lin), ("angular", ang)):
             if np.any(arr < 0):
-                raise EnvelopeError(f"{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {arr.tolist()}")
+                raise EnvelopeError(EnvelopeError.NEGATIVE_BOUND.format(source=source, name=name, part=part, value=arr.tolist()))
         bounds[name] = np.r_[lin * kl, ang * ka]
     return Envelope(poses * scale, bounds["velocity"], bounds["acceleration"], cfg.convention, source, (cfg.length_unit, cfg.angle_unit))
 
@@ -175,26 +171,20 @@ def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
     if v:
         v = v[0]
         k = v["pose"][0]
-        raise EnvelopeError(
-            f"{env.source}: {env.shown(k)} leaves the workspace: leg {v['leg']} length "
-            f"{v['length_m'] * 1e3:.3f} mm is {v['excess_m'] * 1e3:.3f} mm {'below' if v['side'] == 'min' else 'above'} the stroke")
+        raise EnvelopeError(EnvelopeError.OUT_OF_STROKE.format(source=env.source, pose=env.shown(k), leg=v["leg"],
+                                                               length_mm=v["length_m"] * 1e3, excess_mm=v["excess_m"] * 1e3,
+                                                               side="below" if v["side"] == "min" else "above"))
     for s in range(0, len(env.poses), 1 << 16):
         k = condition_number(platform, env.poses[s : s + (1 << 16)], env.convention)
         bad = ~(k <= MAX_CONDITION)
         if bad.any():
             j = s + int(np.argmax(bad))
-            raise EnvelopeError(f"{env.source}: {env.shown(j)} is singular or nearly so (condition number {k[j - s]:.3g})")
+            raise EnvelopeError(EnvelopeError.SINGULAR.format(source=env.source, pose=env.shown(j), cond=k[j - s]))
     return L
 
 
 # ----------------------------------------------------------------------------------------------
 # Force terms: F = c + G [a_C; ω̇] + Vᵀ Q V.
-
-
-def _skew(v):
-    z = np.zeros_like(v[..., 0])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
 
 
 def _plate_geometry(platform: Platform, q, convention):
@@ -212,7 +202,7 @@ def spatial_inertia_about_C(platform: Platform, R) -> np.ndarray:
     (M_C = [[m 1, −m [r]×], [m [r]×, I_C]], r = p_C→cm, I_C the inertia about C)."""
     m = platform.mass
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
-    S = _skew(r)
+    S = skew(r)
     I_W = R @ platform.inertia @ np.swapaxes(R, -1, -2)
     M = np.zeros(r.shape[:-1] + (6, 6))
     M[..., :3, :3] = m * np.eye(3)
@@ -249,7 +239,7 @@ def _plate_terms(platform: Platform, q, convention, gravity):
     return c, G, Q, (R, r_legs, u, L, Jinv)
 
 
-def _cartesian_to_euler(q, V, Vd, convention):
+def cartesian_to_euler(q, V, Vd, convention):
     """q̇, q̈ (..., 6) for Cartesian [v_C; ω], [a_C; ω̇] at poses q."""
     E = angular_velocity_map(q[..., 3:], convention)
     rates = np.linalg.solve(E, V[..., 3:, None])[..., 0]
@@ -260,10 +250,8 @@ def _cartesian_to_euler(q, V, Vd, convention):
 def cartesian_leg_forces(platform: Platform, q, V, Vd, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) at poses q for Cartesian velocity V = [v_C; ω] and acceleration
     [a_C; ω̇] (base frame), by the toolkit's inverse dynamics in Euler coordinates."""
-    from stewart_drake.core.dynamics import leg_forces
-
     q, V, Vd = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (q, V, Vd)))
-    qd, qdd = _cartesian_to_euler(q, V, Vd, convention)
+    qd, qdd = cartesian_to_euler(q, V, Vd, convention)
     fn = leg_forces_with_legs if legs else leg_forces
     return fn(platform, q, qd, qdd, convention, gravity=gravity)
 
@@ -354,7 +342,7 @@ def envelope_sizing(platform: Platform, env: Envelope, legs: bool = False, gravi
         cmax, _ = box_quadratic_max(S, wb)
         cmin_neg, _ = box_quadratic_max(-S, wb)
         P = np.eye(3) - u[..., :, None] * u[..., None, :]
-        B = np.concatenate([P, -P @ _skew(r)], -1) / np.sqrt(L)[..., None, None]  # (..., 6, 3, 6)
+        B = np.concatenate([P, -P @ skew(r)], -1) / np.sqrt(L)[..., None, None]  # (..., 6, 3, 6)
         signs = np.array(np.meshgrid(*[[-1.0, 1.0]] * 6, indexing="ij")).reshape(6, -1).T[:32]  # ±V give the same value
         conv = np.max(np.sum((B @ (signs * env.v_max).T) ** 2, -2), -1)
         alin = np.abs(Jinv) @ env.a_max

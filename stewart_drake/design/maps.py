@@ -18,8 +18,11 @@ from scipy import ndimage
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import inverse_jacobian, leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.design.envelope import spatial_inertia_about_C
 from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.stiffness import principal_stiffness, stiffness_matrix
+from stewart_drake.errors import SLICE_NODES, StewartError
 
 MAX_POINTS = 4_000_000  # slice nodes (work bounded before allocating)
 SAFE_CONDITION = 20.0  # default condition-number limit of the safe region
@@ -55,7 +58,7 @@ def slice_poses(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 
     """``(u (n,), v (n,), poses (n, n, 6))``: pose coordinates ``axes`` over ``ranges`` (SI), the others
     at ``base`` (default the home pose)."""
     if not (isinstance(n, (int, np.integer)) and 2 <= n and n * n <= MAX_POINTS):
-        raise ValueError(f"slice of {n} x {n} nodes: need 2 <= n and n² <= {MAX_POINTS}")
+        raise StewartError(SLICE_NODES.format(n=n, limit=MAX_POINTS))
     base = platform.home_pose() if base is None else np.asarray(base, dtype=float).reshape(6)
     u = np.linspace(*ranges[0], n)
     v = np.linspace(*ranges[1], n)
@@ -118,7 +121,4 @@ def slice_maps(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0
 
 
 def _inertia_batch(platform: Platform, q, convention):
-    from stewart_drake.core.rotations import rotation_matrix
-    from stewart_drake.design.envelope import spatial_inertia_about_C
-
     return spatial_inertia_about_C(platform, rotation_matrix(q[..., 3:], convention))

@@ -19,14 +19,15 @@ import numpy as np
 import scipy.linalg
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import _poses, inverse_jacobian
+from stewart_drake.core.argcheck import as_poses
+from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.design.envelope import cartesian_leg_forces, spatial_inertia_about_C
 
 
 def spatial_inertia(platform: Platform, q, convention: str = "utn", legs: bool = False) -> np.ndarray:
     """``(6, 6)`` M_C at pose q (6,): kg, kg·m, kg·m². ``legs`` adds the legs' reflected inertia."""
-    q = _poses(q).reshape(6)
+    q = as_poses(q).reshape(6)
     if not legs:
         return spatial_inertia_about_C(platform, rotation_matrix(q[3:], convention))
     A = inverse_jacobian(platform, q, convention)

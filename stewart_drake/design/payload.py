@@ -4,12 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import PayloadError
 from stewart_drake.core.geometry import Platform
-
-
-class PayloadError(StewartError):
-    """A payload is not physical (negative or non-finite mass, below the plate)."""
 
 
 def with_payload(platform: Platform, mass: float, p_TP=(0.0, 0.0, 0.0), option: str = "--payload") -> Platform:
@@ -21,11 +17,11 @@ def with_payload(platform: Platform, mass: float, p_TP=(0.0, 0.0, 0.0), option: 
     """
     p = np.asarray(p_TP, dtype=float).reshape(3)
     if not np.isfinite(mass) or mass < 0:
-        raise PayloadError(f"{option}: payload mass must be a finite number >= 0 kg, got {mass}")
+        raise PayloadError(PayloadError.MASS.format(option=option, value=mass))
     if not np.all(np.isfinite(p)):
-        raise PayloadError(f"{option}-com: payload centre of mass must be finite, got {p.tolist()} m")
+        raise PayloadError(PayloadError.COM_NOT_FINITE.format(option=option, value=p.tolist()))
     if p[2] < 0:
-        raise PayloadError(f"{option}-com: z = {p[2]:g} m is below the plate (the plate frame's z >= 0 holds the plate and its load)")
+        raise PayloadError(PayloadError.COM_BELOW.format(option=option, z=p[2]))
     if mass == 0:
         return platform
     m0, c0 = platform.mass, platform.com

@@ -10,7 +10,7 @@ from stewart_drake.design.maps import AXIS_NAMES, SliceMaps
 def plot_slice_maps(m: SliceMaps, length_unit: str = "mm", max_condition: float = 20.0):
     """One figure: condition number with the safe region and the other assembly mode, minimum
     translational stiffness with the softest direction, and the lowest frequency (when present)."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: importing pyplot picks a backend (commands select Agg first)
 
     scale = [1e3 if length_unit == "mm" else 1.0 if a < 3 else 180 / np.pi for a in m.axes]
     units = [length_unit if a < 3 else "°" for a in m.axes]

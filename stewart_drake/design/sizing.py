@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs, plate_motion
+from stewart_drake.core.argcheck import first_index
+from stewart_drake.core.dynamics import G_EARTH, harmonic_trajectory, leg_forces, leg_forces_with_legs, plate_motion
 from stewart_drake.errors import GeometryError
 from stewart_drake.core.geometry import Platform
 
@@ -94,7 +95,7 @@ def limits_of(platform: Platform) -> dict:
         if value is None:
             continue
         if not (np.isfinite(value) and value > 0):
-            raise GeometryError(f"platform {platform.name!r}: legs.{name} must be a positive number, got {value}")
+            raise GeometryError(GeometryError.LEG_LIMIT.format(name=platform.name, field=name, value=value))
         lim[key] = float(value)
     return lim
 
@@ -117,7 +118,7 @@ def first_violation(limits: dict, peaks: dict) -> dict | None:
             bad = np.abs(arr) > limits[qty]
         if not bad.any():
             continue
-        k, i = (int(x) for x in np.argwhere(bad)[0])
+        k, i = first_index(bad)
         if best is None or k < best["index"]:
             if qty == "length":
                 limit = lo if arr[k, i] < lo else hi
@@ -134,6 +135,4 @@ ROTATING_OMEGA = np.array([0.0, 0.0, 0.0, 3.0, 0.0, 2.0])
 def rotating_trajectory(t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(q, q̇, q̈)`` of ``simulation.ROTATING`` with exact derivatives: pz = 0.7 m, 5°·sin 3t about x,
     15°·sin 2t about z (utn convention); each ``t.shape + (6,)``."""
-    from stewart_drake.core.dynamics import harmonic_trajectory
-
     return harmonic_trajectory(t, [0.0, 0.0, 0.7, 0.0, 0.0, 0.0], ROTATING_AMPLITUDE, ROTATING_OMEGA)

@@ -26,27 +26,24 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import StiffnessError
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import _poses, inverse_jacobian
+from stewart_drake.core.argcheck import as_poses
+from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
-from stewart_drake.design.envelope import _skew
+from stewart_drake.core.dynamics import skew
 
 FD_STEP = 1e-6  # m and rad: central-difference step for the legs' weight term (error ~ step²)
-
-
-class StiffnessError(StewartError):
-    """A leg stiffness is missing or not physical."""
 
 
 def leg_stiffness_vector(value, option: str = "--leg-stiffness") -> np.ndarray:
     """``(6,)`` positive finite leg stiffnesses (N/m) from a number or six numbers; ``StiffnessError``
     naming ``option`` otherwise."""
     if value is None:
-        raise StiffnessError(f"{option}: no leg stiffness given and the platform file has no legs.stiffness")
+        raise StiffnessError(StiffnessError.MISSING.format(option=option))
     k = np.broadcast_to(np.asarray(value, dtype=float), (6,)).copy()
     if not np.all(np.isfinite(k)) or np.any(k <= 0):
-        raise StiffnessError(f"{option}: leg stiffness must be a positive number of N/m, got {np.asarray(value).tolist()}")
+        raise StiffnessError(StiffnessError.NOT_POSITIVE.format(option=option, value=np.asarray(value).tolist()))
     return k
 
 
@@ -61,7 +58,7 @@ def displace(pose, dx, convention: str = "utn") -> np.ndarray:
 
 def static_leg_forces(platform: Platform, q, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
     """``(..., 6)`` leg forces (N) holding the plate at rest at poses q."""
-    q = _poses(q)
+    q = as_poses(q)
     z = np.zeros(q.shape)
     if legs:
         return leg_forces_with_legs(platform, q, z, z, convention, gravity=gravity)
@@ -80,7 +77,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
                      loaded: bool = True) -> np.ndarray:
     """``(..., 6, 6)`` K (N/m, N/rad, N·m/m, N·m/rad) at poses q ``(..., 6)`` for leg stiffnesses k ``(6,)``
     N/m (or one number for all). ``loaded=False`` gives Aᵀ diag(k) A (as does zero gravity, through the full expression)."""
-    q = _poses(q)
+    q = as_poses(q)
     k = np.broadcast_to(np.asarray(k, dtype=float), (6,))
     R = rotation_matrix(q[..., 3:], convention)
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)
@@ -93,7 +90,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
         return K
     F = static_leg_forces(platform, q, convention, legs, gravity)
     P = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
-    Sr, Su = _skew(r), _skew(u)
+    Sr, Su = skew(r), skew(u)
     D = np.zeros(u.shape[:-1] + (6, 6))
     D[..., :3, :3] = P
     D[..., :3, 3:] = -P @ Sr
@@ -102,7 +99,7 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
     K = K - np.einsum("...k,...kij->...ij", F, D)
     r_cm = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     f_g = np.array([0.0, 0.0, -platform.mass * gravity])
-    K[..., 3:, 3:] -= _skew(np.broadcast_to(f_g, r_cm.shape)) @ _skew(r_cm)
+    K[..., 3:, 3:] -= skew(np.broadcast_to(f_g, r_cm.shape)) @ skew(r_cm)
     if legs:
         h = FD_STEP
         cols = [(legs_weight_wrench(platform, displace(q, h * e, convention), convention, gravity)
@@ -120,7 +117,7 @@ def static_wrench(platform: Platform, q0, dx, k, convention: str = "utn", gravit
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
     L = np.linalg.norm(l, axis=-1)
-    L0 = np.linalg.norm(_poses(q0)[..., None, :3] + np.einsum("...ij,kj->...ki", rotation_matrix(_poses(q0)[..., 3:], convention),
+    L0 = np.linalg.norm(as_poses(q0)[..., None, :3] + np.einsum("...ij,kj->...ki", rotation_matrix(as_poses(q0)[..., 3:], convention),
                                                              platform.top_anchors_per_leg - platform.rotation_centre) - platform.base_anchors, axis=-1)
     u = l / L[..., None]
     F = F0 - np.asarray(k) * (L - L0)

@@ -15,10 +15,14 @@ from __future__ import annotations
 import html as _html
 
 import numpy as np
+from pydrake.geometry import Cylinder, Meshcat, MeshcatParams, MeshcatVisualizer, MeshcatVisualizerParams, Rgba
+from pydrake.math import RigidTransform
+from pydrake.systems.framework import DiagramBuilder
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.platform_model import build_plant, leg_visual_dimensions, set_pose
+from stewart_drake.core.leg_bodies import leg_visual_dimensions
+from stewart_drake.drake.platform_model import build_plant, set_pose
 
 WARN_RGBA = (0.9, 0.05, 0.05, 1.0)
 GHOST_RGBA = (0.1, 0.85, 0.3, 0.5)
@@ -57,9 +61,6 @@ class MeshcatScene:
     ghost plate for warnings. Paths: ``/drake/visualizer/<model>/<body>``."""
 
     def __init__(self, platform: Platform, meshcat, publish_period: float = 1 / 25, convention: str = "utn"):
-        from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
-        from pydrake.systems.framework import DiagramBuilder
-
         self.platform, self.meshcat, self.convention = platform, meshcat, convention
         builder = DiagramBuilder()
         self.plant, scene_graph = build_plant(platform, builder=builder)
@@ -79,9 +80,6 @@ class MeshcatScene:
         return [f"{self.prefix}/cylinder_{n}/warning", f"{self.prefix}/piston_{n}/warning"]
 
     def _add_sleeves(self) -> None:
-        from pydrake.geometry import Cylinder, Rgba
-        from pydrake.math import RigidTransform
-
         vis = leg_visual_dimensions(self.platform)
         for i in range(6):
             cyl, pist = self.sleeve_paths(i)
@@ -119,8 +117,6 @@ def record_animation(platform: Platform, t, poses, saturating=None, fps: float =
     ``t`` ``(n,)`` s, thinned to ``fps`` frames per second; legs turn red where ``leg_warnings`` flags
     them (``saturating`` ``(n, 6)`` bool: saturated during that sample, optional; a frame shows a
     saturation of any sample since the previous frame)."""
-    from pydrake.geometry import Meshcat, MeshcatParams
-
     t, poses = np.asarray(t, dtype=float), np.asarray(poses, dtype=float)
     meshcat = Meshcat(MeshcatParams(host="localhost"))
     scene = MeshcatScene(platform, meshcat, publish_period=1.0 / fps)

@@ -19,20 +19,25 @@ enters this reduced model as Aᵀ diag(c) A (only the plate-only path has Drake'
 from __future__ import annotations
 
 import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import LinearSpringDamper, RotationalInertia, RpyFloatingJoint, SpatialInertia
+from pydrake.systems.framework import InputPortSelection, OutputPortSelection
+from pydrake.systems.primitives import Linearize
 
-from stewart_drake.design.modes import analytic_modes, damping_matrix, modes_from_state_eigs
-from stewart_drake.design.stiffness import displace, static_leg_forces
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.design.modes import analytic_modes, damping_matrix, modes_from_state_eigs
+from stewart_drake.design.stiffness import displace, static_leg_forces
+from stewart_drake.drake.platform_model import set_pose
+from stewart_drake.drake.verify_dynamics import ClosedLoopInverseDynamics
 
 FD_STEP = 1e-6  # m and rad: central differences on the constraint manifold (error ~ step² relative)
 
 
 def _spatial_inertia(platform: Platform):
-    from pydrake.multibody.tree import RotationalInertia, SpatialInertia
-
     I = platform.inertia
     return SpatialInertia.MakeFromCentralInertia(platform.mass, platform.com, RotationalInertia(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))
 
@@ -40,10 +45,6 @@ def _spatial_inertia(platform: Platform):
 def spring_plant(platform: Platform, q, k, c=0.0, convention: str = "utn", gravity: float = G_EARTH):
     """``(plant, context, joint)``: the plate on six spring-damper legs (continuous plant, the plate's
     ``RpyFloatingJoint``), at rest in equilibrium at pose q (6,)."""
-    from pydrake.math import RigidTransform, RotationMatrix
-    from pydrake.multibody.plant import MultibodyPlant
-    from pydrake.multibody.tree import LinearSpringDamper, RpyFloatingJoint
-
     q = np.asarray(q, dtype=float).reshape(6)
     k = np.broadcast_to(np.asarray(k, float), (6,))
     c = np.broadcast_to(np.asarray(c, float), (6,))
@@ -84,8 +85,6 @@ def drake_modes(platform: Platform, q, k, c=0.0, convention: str = "utn", gravit
     ``residual`` (the equilibrium's largest |ẋ|, resp. |Nᵀτ|)."""
     if legs:
         return _closed_loop_modes(platform, q, k, c, convention)
-    from pydrake.systems.framework import InputPortSelection, OutputPortSelection
-    from pydrake.systems.primitives import Linearize
 
     plant, ctx, joint = spring_plant(platform, q, k, c, convention, gravity)
     xdot = plant.EvalTimeDerivatives(ctx).CopyToVector()
@@ -101,9 +100,6 @@ def drake_modes(platform: Platform, q, k, c=0.0, convention: str = "utn", gravit
 
 
 def _closed_loop_modes(platform: Platform, q, k, c, convention: str) -> dict:
-    from stewart_drake.drake.platform_model import set_pose
-    from stewart_drake.drake.verify_dynamics import ClosedLoopInverseDynamics
-
     q = np.asarray(q, dtype=float).reshape(6)
     k = np.broadcast_to(np.asarray(k, float), (6,))
     ID = ClosedLoopInverseDynamics(platform, convention)

@@ -5,8 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
+from pydrake.systems.framework import DiagramBuilder
 
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.output_folder import write_text_atomic
+from stewart_drake.drake.platform_model import build_plant, set_pose
 
 FRAME_RATE = 32.0  # frames per second of the animation
 
@@ -14,12 +18,6 @@ FRAME_RATE = 32.0  # frames per second of the animation
 def write_animation(platform: Platform, log, path) -> Path:
     """Write a self-contained Meshcat HTML animation of ``log`` (its plate poses, the legs from the
     closed-form joint positions) on ``platform`` to ``path``; return the path."""
-    from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
-    from pydrake.systems.framework import DiagramBuilder
-
-    from stewart_drake.core.output_folder import write_text_atomic
-    from stewart_drake.drake.platform_model import build_plant, set_pose
-
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(platform, 1e-3, builder)
     meshcat = Meshcat()

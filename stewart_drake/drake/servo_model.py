@@ -1,41 +1,47 @@
-"""The Drake side of the RC-servo hexapod (seed 002): SDF model, plant, cross-checks, and the seed's
-control loop as a discrete system.
+"""The Drake side of the RC-servo hexapod (seed 002): the closed-loop plant of its SDF
+(``core/sdf_models.servo_hexapod_sdf``), cross-checks against the numpy solver, and the seed's control
+loop as discrete systems.
 
-The model ``sdf/servo-hexapod.sdf`` (names are part of the API):
-- ``base`` welded to the world (W = B); ``platform`` a free body whose link frame is P, at the home pose
-  in the file; frames ``pivot_i`` (on base) and ``platform_anchor_i`` (on platform).
-- ``arm_i`` on the actuated revolute joint ``servo_i`` at the pivot. The joint axis is the direction in
-  which an increasing pulse turns the horn (``-shaft_i``: clockwise seen from the horn), so **the joint
-  angle is the servo's mechanical angle**, zero with the arm horizontal along ``beta_i``. Its limits
-  are the ±45° travel about home, its effort the servo's stall torque. Frame ``arm_tip_i`` at (a, 0, 0).
-- ``rod_i`` on the passive ball joint ``rod_joint_i`` at the arm tip, its z axis along the rod at home;
-  a Drake ball constraint closes the rod end (0, 0, s) onto ``platform_anchor_i``. Ball constraints need
-  a discrete SAP plant (DESIGN.md).
-Nothing in the model encodes the seed's odd/even rule: the mirroring has to come out of the mounting.
+Model names: ``base``, ``platform`` (link frame P), frames ``pivot_i``, ``platform_anchor_i`` and
+``arm_tip_i``; ``arm_i`` on the actuated revolute ``servo_i`` whose angle is the servo's mechanical
+angle (``core/servo_mounting``); ``rod_i`` on the ball joint ``rod_joint_i``, a ball constraint closing
+its end onto ``platform_anchor_i`` (a discrete SAP plant, as ball constraints need).
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-from xml.sax.saxutils import escape
-
 import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, DiscreteContactApproximation
+from pydrake.multibody.tree import PdControllerGains
+from pydrake.solvers import SnoptSolver, SolverOptions
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
 
-from stewart_drake.core.output_folder import write_text_atomic
-from stewart_drake.core.servo import FRAME_RATE_HZ, ServoHexapod, angles_from_pulses, quantise_pulses, solve
+from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
+from stewart_drake.core.sdf import rpy
+from stewart_drake.core.sdf_models import SERVO_HEXAPOD_MODEL, servo_hexapod_sdf
+from stewart_drake.core.servo import (
+    FRAME_RATE_HZ,
+    ServoHexapod,
+    angles_from_pulses,
+    quantise_pulses,
+    solve,
+)
+from stewart_drake.core.servo_loop import servo_gains
+from stewart_drake.core.servo_mounting import frame_from_zx, joint_arm_angles, pulse_joint_angles, servo_joint_home
 
-SDF_DIR = Path(__file__).resolve().parents[2] / "sdf"
-SDF_NAME = "servo-hexapod"
 # Drake IK results are accepted when every rod length is this close to s (Drake FK), success flag or not:
 # SNOPT reaches ~1e-9 m on this loop-closure problem before reporting "cannot be improved".
 IK_GAP_TOL_M = 1e-8
-_F = "{:.15g}"
 
 
 def _simulate_and_read_logs(diagram, logs: dict, t_end: float) -> dict:
     """Simulate ``diagram`` to ``t_end``; return ``{"t": sample times, name: (n, k) logged data}``."""
-    from pydrake.systems.analysis import Simulator
-
     sim = Simulator(diagram)
     sim.AdvanceTo(t_end)
     ctx = sim.get_context()
@@ -47,188 +53,16 @@ def _simulate_and_read_logs(diagram, logs: dict, t_end: float) -> dict:
     return out
 
 
-# ----------------------------------------------------------------------------------------------
-# Small SDF writers (shared with leg_model).
-
-
-def xml_attr(text: str) -> str:
-    """``text`` escaped for a double-quoted XML attribute."""
-    return escape(str(text), {'"': "&quot;"})
-
-
-def xml_comment(text: str) -> str:
-    """``text`` made safe inside an XML comment: escaped, and no "--" (which would end it)."""
-    s = escape(str(text))
-    while "--" in s:
-        s = s.replace("--", "-&#45;")
-    return s
-
-
-def xml_vec(*xs) -> str:
-    """Numbers as an SDF vector string, deterministic ("-0" written as "0")."""
-    return " ".join(_F.format(float(x) + 0.0) for x in xs)
-
-
-def inertial_xml(mass, com, inertia) -> str:
-    """An ``<inertial>`` block: mass (kg), centre of mass (m, link frame), 3x3 inertia about it (kg·m²)."""
-    I = np.asarray(inertia, dtype=float)
-    return (
-        f"<inertial><pose>{xml_vec(*com, 0, 0, 0)}</pose><mass>{xml_vec(mass)}</mass><inertia>"
-        f"<ixx>{xml_vec(I[0, 0])}</ixx><ixy>{xml_vec(I[0, 1])}</ixy><ixz>{xml_vec(I[0, 2])}</ixz>"
-        f"<iyy>{xml_vec(I[1, 1])}</iyy><iyz>{xml_vec(I[1, 2])}</iyz><izz>{xml_vec(I[2, 2])}</izz></inertia></inertial>"
-    )
-
-
-def box_inertia(mass, size) -> np.ndarray:
-    x, y, z = size
-    return mass / 12 * np.diag([y * y + z * z, x * x + z * z, x * x + y * y])
-
-
-def cylinder_inertia(mass, radius, length) -> np.ndarray:
-    """About the centre, axis z."""
-    t = mass * (3 * radius**2 + length**2) / 12
-    return np.diag([t, t, mass * radius**2 / 2])
-
-
-def visual_xml(name, pose, geometry, rgba) -> str:
-    """A visual with ``geometry`` = ("box", (x, y, z)) | ("cylinder", (radius, length)) | ("sphere", r)."""
-    kind, dims = geometry
-    if kind == "box":
-        g = f"<box><size>{xml_vec(*dims)}</size></box>"
-    elif kind == "cylinder":
-        g = f"<cylinder><radius>{xml_vec(dims[0])}</radius><length>{xml_vec(dims[1])}</length></cylinder>"
-    else:
-        g = f"<sphere><radius>{xml_vec(dims)}</radius></sphere>"
-    return (f'<visual name="{xml_attr(name)}"><pose>{xml_vec(*pose)}</pose><geometry>{g}</geometry>'
-            f"<material><diffuse>{rgba}</diffuse></material></visual>")
-
-
-def rpy(R) -> tuple:
-    """SDF roll-pitch-yaw of a rotation matrix (R = Rz(yaw) Ry(pitch) Rx(roll))."""
-    from stewart_drake.core.rotations import angles_from_matrix
-
-    return tuple(angles_from_matrix(np.asarray(R), "zyx"))
-
-
-def frame_from_zx(z, x_hint) -> np.ndarray:
-    """A rotation matrix whose z column is ``z`` and x column is ``x_hint`` made orthogonal to it."""
-    z = np.asarray(z, float) / np.linalg.norm(z)
-    x = np.asarray(x_hint, float) - (np.asarray(x_hint, float) @ z) * z
-    if np.linalg.norm(x) < 1e-9:
-        x = np.cross([0.0, 1.0, 0.0], z) if abs(z[1]) < 0.9 else np.cross([1.0, 0.0, 0.0], z)
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z], axis=-1)
-
-
-# ----------------------------------------------------------------------------------------------
-# The model.
-
-
-def pivot_frames(hexapod: ServoHexapod) -> np.ndarray:
-    """``(6, 3, 3)`` R_B,pivot_i: x along the arm at zero angle (beta_i), z = the pulse-increasing axis."""
-    b = hexapod.arm_directions
-    x = np.stack([np.cos(b), np.sin(b), np.zeros(6)], -1)
-    z = -hexapod.shaft_directions
-    return np.stack([x, np.cross(z, x), z], axis=-1)
-
-
-def servo_joint_home(hexapod: ServoHexapod) -> np.ndarray:
-    """``(6,)`` the servo joint angles that put each arm at alpha0 (radians), from the mounting alone."""
-    up = pivot_frames(hexapod)[:, :, 1] @ [0.0, 0.0, 1.0]  # +1 where the joint raises the arm
-    return up * hexapod.home_angles
-
-
-def rod_frames(hexapod: ServoHexapod) -> np.ndarray:
-    """``(6, 3, 3)`` R_B,rod_i at home: z from the arm tip to the anchor."""
-    from stewart_drake.core.servo import arm_tips
-
-    tip = arm_tips(hexapod, hexapod.home_angles)
-    q = hexapod.platform_anchors + [0.0, 0.0, hexapod.home_height]
-    return np.stack([frame_from_zx(q[i] - tip[i], pivot_frames(hexapod)[i][:, 0]) for i in range(6)])
-
-
-def sdf_text(hexapod: ServoHexapod) -> str:
-    """The SDF (1.9) model of the servo hexapod as a string; deterministic."""
-    a, s, h0 = hexapod.arm_length, hexapod.rod_length, hexapod.home_height
-    R_piv, R_rod = pivot_frames(hexapod), rod_frames(hexapod)
-    r_plate = float(np.max(np.linalg.norm(hexapod.platform_anchors[:, :2], axis=1))) * 1.15
-    r_base = float(np.max(np.linalg.norm(hexapod.base_pivots[:, :2], axis=1))) * 1.2
-    mp = hexapod.platform_mass
-    plate_t = 0.005
-    I_plate = np.diag([mp * (3 * r_plate**2 + plate_t**2) / 12] * 2 + [mp * r_plate**2 / 2])
-    arm_w, rod_r = 0.006, 0.0015
-    home = servo_joint_home(hexapod)
-    out = [
-        '<?xml version="1.0"?>',
-        f"<!-- Generated by stewart_drake.drake.servo_model from servo hexapod {xml_comment(repr(hexapod.name))}; do not edit. -->",
-        '<sdf version="1.9">',
-        f'<model name="{SDF_NAME}">',
-        f'<link name="base">{inertial_xml(1.0, (0, 0, 0), np.eye(3) * 0.01)}'
-        f"{visual_xml('base_plate', (0, 0, -0.003, 0, 0, 0), ('cylinder', (r_base, 0.006)), '0.6 0.6 0.6 1')}</link>",
-        '<joint name="base_weld" type="fixed"><parent>world</parent><child>base</child></joint>',
-        f'<link name="platform"><pose relative_to="base">{xml_vec(0, 0, h0, 0, 0, 0)}</pose>'
-        f"{inertial_xml(mp, (0, 0, 0), I_plate)}"
-        f"{visual_xml('plate', (0, 0, plate_t / 2, 0, 0, 0), ('cylinder', (r_plate, plate_t)), '0.2 0.4 0.8 1')}</link>",
-    ]
-    lo, hi = home - hexapod.travel_rad, home + hexapod.travel_rad
-    for i in range(6):
-        n = i + 1
-        b, p = hexapod.base_pivots[i], hexapod.platform_anchors[i]
-        tip = b + a * R_piv[i][:, 0]  # arm tip at zero joint angle
-        out.append(f'<frame name="pivot_{n}" attached_to="base"><pose relative_to="base">{xml_vec(*b, *rpy(R_piv[i]))}</pose></frame>')
-        out.append(f'<frame name="platform_anchor_{n}" attached_to="platform"><pose relative_to="platform">{xml_vec(*p, 0, 0, 0)}</pose></frame>')
-        out.append(
-            f'<link name="arm_{n}"><pose relative_to="pivot_{n}">0 0 0 0 0 0</pose>'
-            f"{inertial_xml(hexapod.arm_mass, (a / 2, 0, 0), box_inertia(hexapod.arm_mass, (a, arm_w, 0.003)))}"
-            f"{visual_xml('horn', (a / 2, 0, 0, 0, 0, 0), ('box', (a + arm_w, arm_w, 0.003)), '0.9 0.9 0.9 1')}</link>"
-        )
-        out.append(
-            f'<joint name="servo_{n}" type="revolute"><parent>base</parent><child>arm_{n}</child>'
-            f"<axis><xyz>0 0 1</xyz><limit><lower>{xml_vec(lo[i])}</lower><upper>{xml_vec(hi[i])}</upper>"
-            f"<effort>{xml_vec(hexapod.servo_torque)}</effort></limit></axis></joint>"
-        )
-        out.append(f'<frame name="arm_tip_{n}" attached_to="arm_{n}"><pose relative_to="arm_{n}">{xml_vec(a, 0, 0, 0, 0, 0)}</pose></frame>')
-        out.append(
-            f'<link name="rod_{n}"><pose relative_to="base">{xml_vec(*tip, *rpy(R_rod[i]))}</pose>'
-            f"{inertial_xml(hexapod.rod_mass, (0, 0, s / 2), cylinder_inertia(hexapod.rod_mass, rod_r, s))}"
-            f"{visual_xml('rod', (0, 0, s / 2, 0, 0, 0), ('cylinder', (rod_r, s)), '0.8 0.5 0.2 1')}</link>"
-        )
-        out.append(
-            f'<joint name="rod_joint_{n}" type="ball"><parent>arm_{n}</parent><child>rod_{n}</child></joint>'
-        )
-        out.append(
-            "<drake:ball_constraint>"
-            f"<drake:ball_constraint_body_A>rod_{n}</drake:ball_constraint_body_A>"
-            "<drake:ball_constraint_body_B>platform</drake:ball_constraint_body_B>"
-            f"<drake:ball_constraint_p_AP>{xml_vec(0, 0, s)}</drake:ball_constraint_p_AP>"
-            f"<drake:ball_constraint_p_BQ>{xml_vec(*p)}</drake:ball_constraint_p_BQ>"
-            "</drake:ball_constraint>"
-        )
-    out += ["</model>", "</sdf>", ""]
-    return "\n".join(out)
-
-
-def write_sdf(hexapod: ServoHexapod, directory=SDF_DIR) -> Path:
-    """Write ``<directory>/servo-hexapod.sdf`` atomically; return its path."""
-    path = Path(directory) / f"{SDF_NAME}.sdf"
-    return write_text_atomic(path, sdf_text(hexapod))
-
-
 def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd_gains=None):
     """A finalized discrete (SAP) closed-loop ``MultibodyPlant`` of the hexapod and its ``SceneGraph``.
     ``pd_gains`` = (kp N·m/rad, kd N·m·s/rad) makes every servo a PD-controlled actuator (Drake's
     implicit PD, clamped to the servo's effort limit, driven by the desired-state input port)."""
-    from pydrake.multibody.parsing import Parser
-    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, DiscreteContactApproximation
-    from pydrake.multibody.tree import PdControllerGains
-    from pydrake.systems.framework import DiagramBuilder
-
     if not time_step > 0:
         raise ValueError(f"time_step must be > 0 (ball constraints need a discrete plant), got {time_step}")
     builder = builder or DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step)
     plant.set_discrete_contact_approximation(DiscreteContactApproximation.kLagged)
-    Parser(plant).AddModelsFromString(sdf_text(hexapod), "sdf")
+    Parser(plant).AddModelsFromString(servo_hexapod_sdf(hexapod), "sdf")
     home = servo_joint_home(hexapod)
     for i in range(6):
         plant.GetJointByName(f"servo_{i + 1}").set_default_angle(home[i])
@@ -259,10 +93,6 @@ class ServoPlant:
 
     def set_platform(self, pose) -> None:
         """Put the platform at a seed-002 pose [x, y, z, phi, theta, psi] (Rz·Ry·Rx)."""
-        from pydrake.math import RigidTransform, RotationMatrix
-
-        from stewart_drake.core.rotations import rotation_matrix
-
         pose = np.asarray(pose, dtype=float)
         X = RigidTransform(RotationMatrix(rotation_matrix(pose[3:], "zyx")), pose[:3])
         self.plant.SetFreeBodyPose(self.context, self.plant.GetBodyByName("platform"), X)
@@ -286,12 +116,6 @@ class ServoPlant:
         return np.array([j.get_angle(self.context) for j in self.servos])
 
 
-def pulse_joint_angles(hexapod: ServoHexapod, pulse_us, joint_home) -> np.ndarray:
-    """Servo joint angles for pulse widths: the horn turns (W - W0)/r from its home angle, in the
-    pulse-increasing sense — the servo's physics, with no odd/even rule."""
-    return np.asarray(joint_home) + (np.asarray(pulse_us) - hexapod.neutral_us) / hexapod.rate_us_per_rad
-
-
 def frame_errors(h: ServoPlant) -> dict:
     """Worst differences (m) between the parsed plant's frames and the geometry: pivots, anchors, arm length."""
     hex_ = h.hexapod
@@ -311,9 +135,6 @@ def drake_home_joint_angles(h: ServoPlant, tol: float = 1e-10) -> np.ndarray:
 def drake_ik_joint_angles(h: ServoPlant, poses, start=None, tol: float = 1e-10) -> np.ndarray:
     """``(n, 6)`` servo joint angles found by Drake's ``InverseKinematics`` with the platform locked at
     each pose; the solver starts from ``start`` (default: the model's home joint angles)."""
-    from pydrake.multibody.inverse_kinematics import InverseKinematics
-    from pydrake.solvers import SnoptSolver, SolverOptions
-
     plant, ctx = h.plant, h.context
     start = servo_joint_home(h.hexapod) if start is None else np.asarray(start, float)
     solver, options = SnoptSolver(), SolverOptions()
@@ -383,11 +204,10 @@ def compare_with_drake(hexapod: ServoHexapod, poses) -> dict:
 # The seed's control loop as a discrete system.
 
 
-def make_servo_controller(hexapod: ServoHexapod, frame_rate_hz: float = FRAME_RATE_HZ, resolution_us: float = 1.0):
-    """A Drake ``LeafSystem``: the seed's loop (read pose → R → l_i → alpha_i → W_i → output) at the
-    servo frame rate.
+class ServoController(LeafSystem):
+    """The seed's loop (read pose → R → l_i → alpha_i → W_i → output) at the servo frame rate.
 
-    Input ``pose`` (6): [x, y, z, phi, theta, psi] (m, rad, Rz·Ry·Rx). Every 1/frame_rate s the system
+    Input ``pose`` (6): [x, y, z, phi, theta, psi] (m, rad, Rz·Ry·Rx). Every 1/frame_rate_hz s the system
     samples the pose and latches, zero-order-hold, these state outputs:
     - ``pulse_us`` (6): eqs. 13-14 clamped to the travel and rounded to ``resolution_us`` (the driver);
     - ``status`` (6): 0 ok, 1 travel limit hit (pulse clamped), 2 unreachable (pulse of the nearest angle);
@@ -395,34 +215,29 @@ def make_servo_controller(hexapod: ServoHexapod, frame_rate_hz: float = FRAME_RA
     Outputs depend on state only (no direct feedthrough): one frame of delay, as on the real loop.
     Initial state: every servo at its neutral pulse (home).
     """
-    from pydrake.systems.framework import BasicVector, LeafSystem
 
-    if not frame_rate_hz > 0:
-        raise ValueError(f"servo frame rate must be > 0 Hz, got {frame_rate_hz}")
+    def __init__(self, hexapod: ServoHexapod, frame_rate_hz: float = FRAME_RATE_HZ, resolution_us: float = 1.0):
+        if not frame_rate_hz > 0:
+            raise ValueError(f"servo frame rate must be > 0 Hz, got {frame_rate_hz}")
+        super().__init__()
+        self.hexapod, self.period, self.resolution_us = hexapod, 1.0 / frame_rate_hz, resolution_us
+        self._pose = self.DeclareVectorInputPort("pose", 6)
+        w0 = quantise_pulses(hexapod.neutral_us, resolution_us)
+        self._pulse = self.DeclareDiscreteState(BasicVector(w0))
+        self._status = self.DeclareDiscreteState(6)
+        self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, self._CalcUpdate)
+        self.DeclareStateOutputPort("pulse_us", self._pulse)
+        self.DeclareStateOutputPort("status", self._status)
+        self.DeclareVectorOutputPort("arm_angle", 6, self._CalcArmAngle, {self.xd_ticket()})
 
-    class ServoController(LeafSystem):
-        def __init__(self):
-            super().__init__()
-            self.hexapod, self.period, self.resolution_us = hexapod, 1.0 / frame_rate_hz, resolution_us
-            self._pose = self.DeclareVectorInputPort("pose", 6)
-            w0 = quantise_pulses(hexapod.neutral_us, resolution_us)
-            self._pulse = self.DeclareDiscreteState(BasicVector(w0))
-            self._status = self.DeclareDiscreteState(6)
-            self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, self._update)
-            self.DeclareStateOutputPort("pulse_us", self._pulse)
-            self.DeclareStateOutputPort("status", self._status)
-            self.DeclareVectorOutputPort("arm_angle", 6, self._arm_angle, {self.xd_ticket()})
+    def _CalcUpdate(self, context, state):
+        sol = solve(self.hexapod, self._pose.Eval(context))
+        status = np.where(~sol.reachable, 2.0, np.where(~sol.within_travel, 1.0, 0.0))
+        state.get_mutable_vector(self._pulse).SetFromVector(quantise_pulses(sol.pulse, self.resolution_us))
+        state.get_mutable_vector(self._status).SetFromVector(status)
 
-        def _update(self, context, state):
-            sol = solve(hexapod, self._pose.Eval(context))
-            status = np.where(~sol.reachable, 2.0, np.where(~sol.within_travel, 1.0, 0.0))
-            state.get_mutable_vector(self._pulse).SetFromVector(quantise_pulses(sol.pulse, resolution_us))
-            state.get_mutable_vector(self._status).SetFromVector(status)
-
-        def _arm_angle(self, context, output):
-            output.SetFromVector(angles_from_pulses(hexapod, context.get_discrete_state(self._pulse).value()))
-
-    return ServoController()
+    def _CalcArmAngle(self, context, output):
+        output.SetFromVector(angles_from_pulses(self.hexapod, context.get_discrete_state(self._pulse).value()))
 
 
 def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None = None,
@@ -432,15 +247,11 @@ def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None =
     logged once per frame. Drake publishes a log sample at t_k before that instant's update, so
     ``pulse_us[k]`` is the pulse held during [t_k - T, t_k), computed from ``pose[k - 1]`` (the one-frame
     delay); ``pulse_us[0]`` is the initial (neutral) state."""
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
-    from pydrake.trajectories import PiecewisePolynomial
-
     times = np.asarray(times, dtype=float)
     poses = np.asarray(poses, dtype=float)
     builder = DiagramBuilder()
     src = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, poses.T)))
-    ctrl = builder.AddSystem(make_servo_controller(hexapod, frame_rate_hz, resolution_us))
+    ctrl = builder.AddSystem(ServoController(hexapod, frame_rate_hz, resolution_us))
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("pose"))
     T = 1.0 / frame_rate_hz
     logs = {name: LogVectorOutput(ctrl.GetOutputPort(name), builder, T) for name in ("pulse_us", "status")}
@@ -453,49 +264,32 @@ def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None =
 # The loop closed: controller → servos → closed-loop plant.
 
 
-def servo_gains(hexapod: ServoHexapod) -> tuple[float, float]:
-    """``(kp, kd)`` of the servo's position loop, from the datasheet numbers (a DC motor behind a
-    proportional position loop): kp = stall torque / ``servo_band`` (full torque that far from the
-    target; 1 N·m / 2° = 28.6 N·m/rad for the preset) and kd = stall torque / no-load speed (the motor's
-    back-EMF damping seen at the horn: 1 N·m / 6.16 rad/s = 0.162 N·m·s/rad)."""
-    return hexapod.servo_torque / hexapod.servo_band, hexapod.servo_torque / hexapod.servo_speed
-
-
-def make_servo_drive(hexapod: ServoHexapod, joint_home, time_step: float):
-    """A Drake ``LeafSystem``: six hobby servos' electronics, pulse width → the plant's PD set-point.
+class ServoDrive(LeafSystem):
+    """Six hobby servos' electronics, pulse width → the plant's PD set-point.
 
     Input ``pulse_us`` (6). Each servo's target is the joint angle ``pulse_joint_angles`` (its physics:
-    (W − W0)/r from home, in the pulse-increasing sense). Every ``time_step`` the set-point moves toward
-    the target by at most ``servo_speed``·time_step (the no-load speed limit); output ``desired_state``
-    (12) = [set-points; their rates], for ``MultibodyPlant``'s desired-state port, whose implicit PD
-    (``servo_gains``) clamps the torque to the stall torque. Initial set-point: ``joint_home``.
+    (W − W0)/r from home, in the pulse-increasing sense). Every ``time_step`` (s) the set-point moves
+    toward the target by at most ``servo_speed``·time_step (the no-load speed limit); output
+    ``desired_state`` (12) = [set-points; their rates], for ``MultibodyPlant``'s desired-state port,
+    whose implicit PD (``servo_gains``) clamps the torque to the stall torque. Initial set-point:
+    ``joint_home`` (6,), radians.
     """
-    from pydrake.systems.framework import BasicVector, LeafSystem
 
-    joint_home = np.asarray(joint_home, dtype=float)
-    step = hexapod.servo_speed * time_step
+    def __init__(self, hexapod: ServoHexapod, joint_home, time_step: float):
+        super().__init__()
+        self.hexapod, self.time_step = hexapod, time_step
+        self.joint_home = np.asarray(joint_home, dtype=float)
+        self.max_step = hexapod.servo_speed * time_step
+        self._pulse = self.DeclareVectorInputPort("pulse_us", 6)
+        self._xd = self.DeclareDiscreteState(BasicVector(np.r_[self.joint_home, np.zeros(6)]))
+        self.DeclarePeriodicDiscreteUpdateEvent(time_step, 0.0, self._CalcUpdate)
+        self.DeclareStateOutputPort("desired_state", self._xd)
 
-    class ServoDrive(LeafSystem):
-        def __init__(self):
-            super().__init__()
-            self._pulse = self.DeclareVectorInputPort("pulse_us", 6)
-            self._xd = self.DeclareDiscreteState(BasicVector(np.r_[joint_home, np.zeros(6)]))
-            self.DeclarePeriodicDiscreteUpdateEvent(time_step, 0.0, self._update)
-            self.DeclareStateOutputPort("desired_state", self._xd)
-
-        def _update(self, context, state):
-            q = context.get_discrete_state(self._xd).value()[:6]
-            target = pulse_joint_angles(hexapod, self._pulse.Eval(context), joint_home)
-            dq = np.clip(target - q, -step, step)
-            state.get_mutable_vector(self._xd).SetFromVector(np.r_[q + dq, dq / time_step])
-
-    return ServoDrive()
-
-
-def joint_arm_angles(hexapod: ServoHexapod, joint_angles) -> np.ndarray:
-    """Arm elevations alpha (..., 6) (radians, eq. 9's angle) from servo joint angles (..., 6)."""
-    up = pivot_frames(hexapod)[:, :, 1] @ [0.0, 0.0, 1.0]
-    return up * np.asarray(joint_angles)
+    def _CalcUpdate(self, context, state):
+        q = context.get_discrete_state(self._xd).value()[:6]
+        target = pulse_joint_angles(self.hexapod, self._pulse.Eval(context), self.joint_home)
+        dq = np.clip(target - q, -self.max_step, self.max_step)
+        state.get_mutable_vector(self._xd).SetFromVector(np.r_[q + dq, dq / self.time_step])
 
 
 def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None = None, time_step: float = 1e-3,
@@ -510,12 +304,6 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     ``arm_angle_ref`` (k, 6), eq. 9 at the reference; ``rod_gap`` (k, 6) | |arm tip − anchor| − s | (m),
     the ball constraints' violation; ``pulse_us`` (k, 6); ``status`` (k, 6).
     """
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
-    from pydrake.trajectories import PiecewisePolynomial
-
-    from stewart_drake.core.rotations import angles_from_matrix
-
     times = np.asarray(times, dtype=float)
     poses = np.asarray(poses, dtype=float)
     if poses.shape != (len(times), 6) or len(times) < 2:
@@ -526,9 +314,9 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     plant, _ = build_plant(hexapod, time_step, builder, pd_gains=servo_gains(hexapod))
     home = servo_joint_home(hexapod)
     src = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, poses.T)))
-    ctrl = builder.AddSystem(make_servo_controller(hexapod, frame_rate_hz, resolution_us))
-    drive = builder.AddSystem(make_servo_drive(hexapod, home, time_step))
-    instance = plant.GetModelInstanceByName(SDF_NAME)
+    ctrl = builder.AddSystem(ServoController(hexapod, frame_rate_hz, resolution_us))
+    drive = builder.AddSystem(ServoDrive(hexapod, home, time_step))
+    instance = plant.GetModelInstanceByName(SERVO_HEXAPOD_MODEL)
     order = [int(plant.get_joint_actuator(a).joint().name().split("_")[1]) - 1 for a in plant.GetJointActuatorIndices(instance)]
     if order != list(range(6)):
         raise RuntimeError(f"servo actuators are not in the order servo_1..servo_6: {order}")
@@ -559,51 +347,3 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     out.update(pose=pose, arm_angle=joint_arm_angles(hexapod, joints), rod_gap=gap,
                arm_angle_ref=solve(hexapod, out["reference"]).angles)
     return out
-
-
-def static_servo_torques(hexapod: ServoHexapod, poses, g: float = 9.81) -> np.ndarray:
-    """``(..., 6)`` the torques (N·m, about alpha) that hold the hexapod still at ``poses`` (..., 6),
-    by virtual work: Jᵀτ = −Q with J = dalpha/dpose and Q = [0, 0, −m g, 0, 0, 0] the gravity force on
-    the platform plus half of each rod (the centre of mass is the platform origin); each servo also
-    carries its arm's weight at a/2 and half its rod at a (cos alpha lever)."""
-    from stewart_drake.core.servo import arm_angles, pose_jacobian
-
-    m = hexapod.platform_mass + 3 * hexapod.rod_mass
-    J = pose_jacobian(hexapod, poses)
-    Q = np.zeros(np.shape(J)[:-2] + (6,))
-    Q[..., 2] = -m * g
-    tau = -np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
-    alpha = arm_angles(hexapod, poses)[0]
-    return tau + (hexapod.arm_mass / 2 + hexapod.rod_mass / 2) * g * hexapod.arm_length * np.cos(alpha)
-
-
-def tracking_bounds(hexapod: ServoHexapod, log: dict, time_step: float = 1e-3, frame_rate_hz: float = FRAME_RATE_HZ,
-                    resolution_us: float = 1.0) -> dict:
-    """Per-sample bounds on the closed-loop tracking error of ``run_closed_loop``'s ``log``, from the
-    loop's arithmetic, valid while every reference arm speed stays below ``servo_speed`` (checked):
-
-    arm (k, 6), radians: |alpha − alpha_ref(t)| <= max over s in [t − Λ, t] |alpha_ref(t) − alpha_ref(s)|
-        + q/2 + sag, where Λ = T (the pose is sampled once per frame and held) + 2 dt (the drive and the
-        plant read their inputs one step late) + kd/kp (the servo's PD lag); q/2 = half the pulse
-        resolution in angle (rounding; 0.056° for 1 µs); sag = static torque / kp (a proportional servo
-        under load). A reference arm speed below the no-load speed means the speed limit adds no lag.
-    pose (k, 6), m and rad: sum_i |J⁻¹_ki| arm_i, the first-order image of the arm bound (J = dalpha/dpose).
-    """
-    from stewart_drake.core.servo import pose_jacobian
-
-    t, ref = log["t"], log["arm_angle_ref"]
-    rate = np.abs(np.diff(ref, axis=0)) / np.diff(t)[:, None]
-    if rate.max() >= hexapod.servo_speed:
-        raise ValueError(f"reference arm speed {rate.max():.3g} rad/s reaches the servo's no-load speed "
-                         f"{hexapod.servo_speed:.3g} rad/s: the tracking bound does not apply")
-    kp, kd = servo_gains(hexapod)
-    lag = 1.0 / frame_rate_hz + 2 * time_step + kd / kp
-    n = int(np.ceil(lag / time_step))
-    padded = np.concatenate([np.repeat(ref[:1], n, axis=0), ref])  # at rest at alpha_ref(0) before t = 0
-    spread = np.max([np.abs(ref - padded[n - j: n - j + len(ref)]) for j in range(n + 1)], axis=0)
-    quant = resolution_us / 2 / hexapod.rate_us_per_rad
-    sag = np.abs(static_servo_torques(hexapod, log["reference"])) / kp
-    arm = spread + quant + sag
-    Jinv = np.linalg.inv(pose_jacobian(hexapod, log["reference"]))
-    return {"arm": arm, "pose": np.einsum("...ki,...i->...k", np.abs(Jinv), arm), "lag": lag, "quantisation": quant,
-            "sag": sag}

@@ -256,7 +256,7 @@ def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: 
     closed-form joint positions, step ``h`` s), so that a run starts on the trajectory, not at rest."""
     from pydrake.multibody.math import SpatialVelocity
 
-    from stewart_drake.drake.platform_model import leg_joint_positions
+    from stewart_drake.core.leg_bodies import leg_joint_positions
 
     qm, qp = trajectory.pose(np.array([t - h, t + h]))
     Rm, Rp = rotation_matrix(qm[3:]), rotation_matrix(qp[3:])

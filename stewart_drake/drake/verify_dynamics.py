@@ -17,12 +17,30 @@
 
 from __future__ import annotations
 
-import numpy as np
+import time
 
+import numpy as np
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import (
+    FixedOffsetFrame,
+    JacobianWrtVariable,
+    MultibodyForces,
+    PrismaticJoint,
+    RevoluteJoint,
+    RotationalInertia,
+    SpatialInertia,
+)
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import _poses
 from stewart_drake.core.rotations import check_convention, rotation_matrix
+from stewart_drake.drake.platform_model import build_plant, prismatic_positions, set_pose
 
 # Joints of the Euler chain, outermost first: (name, axis, index in q).
 _CHAIN = {
@@ -32,8 +50,6 @@ _CHAIN = {
 
 
 def _spatial_inertia(platform: Platform):
-    from pydrake.multibody.tree import RotationalInertia, SpatialInertia
-
     I = platform.inertia
     return SpatialInertia.MakeFromCentralInertia(
         platform.mass, platform.com, RotationalInertia(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
@@ -42,8 +58,6 @@ def _spatial_inertia(platform: Platform):
 
 def free_body_plant(platform: Platform, gravity: float = G_EARTH):
     """A finalized continuous ``MultibodyPlant`` with the plate as the free body ``top`` (frame T)."""
-    from pydrake.multibody.plant import MultibodyPlant
-
     plant = MultibodyPlant(0.0)
     plant.AddRigidBody("top", _spatial_inertia(platform))
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -gravity])
@@ -55,10 +69,6 @@ def chain_plant(platform: Platform, convention: str = "utn", gravity: float = G_
     """A finalized continuous plant whose generalized coordinates are the pose q: prismatic x, y, z then
     revolute joints in the convention's order, the last one's child frame at the rotation centre of
     the plate ``top``. Returns ``(plant, perm)`` with ``v_drake = q̇[perm]``."""
-    from pydrake.math import RigidTransform
-    from pydrake.multibody.plant import MultibodyPlant
-    from pydrake.multibody.tree import PrismaticJoint, RevoluteJoint, SpatialInertia
-
     check_convention(convention)
     plant = MultibodyPlant(0.0)
     parent = plant.world_frame()
@@ -83,8 +93,6 @@ def chain_plant(platform: Platform, convention: str = "utn", gravity: float = G_
 
 
 def _fixed_frame(name, body, X):
-    from pydrake.multibody.tree import FixedOffsetFrame
-
     return FixedOffsetFrame(name, body.body_frame(), X)
 
 
@@ -92,7 +100,7 @@ def drake_dynamics_terms(platform: Platform, q, qd, convention: str = "utn", gra
     """Drake's M(q) ``(n, 6, 6)``, C(q, q̇) q̇ ``(n, 6)`` and G(q) ``(n, 6)`` in pose coordinates (chain plant)."""
     plant, perm = chain_plant(platform, convention, gravity)
     ctx = plant.CreateDefaultContext()
-    q, qd = np.atleast_2d(_poses(q)), np.atleast_2d(qd)
+    q, qd = np.atleast_2d(as_poses(q)), np.atleast_2d(qd)
     n = len(q)
     M, C, G = np.empty((n, 6, 6)), np.empty((n, 6)), np.empty((n, 6))
     inv = np.argsort(perm)  # q index -> drake index
@@ -139,8 +147,6 @@ class DrakeInverseDynamics:
     at T's origin; the leg directions map it to six leg forces."""
 
     def __init__(self, platform: Platform, convention: str = "utn", gravity: float = G_EARTH):
-        from pydrake.multibody.tree import MultibodyForces
-
         self.platform = platform
         self.kinematics = PlateKinematics(platform, convention)
         self.free = free_body_plant(platform, gravity)
@@ -180,10 +186,6 @@ class ClosedLoopInverseDynamics:
     """
 
     def __init__(self, platform: Platform, convention: str = "utn", time_step: float = 1e-3):
-        from pydrake.multibody.tree import MultibodyForces
-
-        from stewart_drake.drake.platform_model import build_plant
-
         self.platform, self.convention = platform, convention
         self.kinematics = PlateKinematics(platform, convention)
         self.plant, _ = build_plant(platform, time_step)
@@ -206,8 +208,6 @@ class ClosedLoopInverseDynamics:
 
     def constraint_jacobian(self) -> tuple[np.ndarray, np.ndarray]:
         """``(18, nv)`` G and ``(18,)`` Ġv: tip − anchor translational velocity/acceleration bias, in W."""
-        from pydrake.multibody.tree import JacobianWrtVariable
-
         plant, ctx, W = self.plant, self.ctx, self.plant.world_frame()
         G, b = [], []
         kV, o = JacobianWrtVariable.kV, np.zeros(3)
@@ -218,8 +218,6 @@ class ClosedLoopInverseDynamics:
 
     def set_state(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """Set the closed-loop state for one sample; returns the constraint Jacobian and bias at it."""
-        from stewart_drake.drake.platform_model import set_pose
-
         _, V_WT, _ = self.kinematics(q, qd)
         set_pose(self.plant, self.ctx, self.platform, q, self.convention)
         v = np.zeros(self.plant.num_velocities())
@@ -259,15 +257,6 @@ def simulate_open_loop(platform: Platform, t, q, qd, forces, time_step: float = 
     R Rᵀ_planned), ``constraint`` (m,) worst |piston tip − plate anchor| (m), ``lengths`` (m, 6) prismatic
     positions, and ``wall_time`` (s).
     """
-    import time as _time
-
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import TrajectorySource
-    from pydrake.trajectories import PiecewisePolynomial
-
-    from stewart_drake.drake.platform_model import build_plant, prismatic_positions
-
     t, q, qd, forces = (np.asarray(a, dtype=float) for a in (t, q, qd, forces))
     ID = ClosedLoopInverseDynamics(platform, convention, time_step)
     ID.set_state(q[0], qd[0])
@@ -290,7 +279,7 @@ def simulate_open_loop(platform: Platform, t, q, qd, forces, time_step: float = 
     anchors = [plant.GetFrameByName(f"top_anchor_{i + 1}") for i in range(6)]
     idx = np.arange(0, len(t), record_every)
     out = {k: [] for k in ("position_error", "angle_error", "constraint", "lengths")}
-    t0 = _time.perf_counter()
+    t0 = time.perf_counter()
     for k in idx:
         if k > 0:  # the first AdvanceTo also fires the update at t[0]; the state then belongs to t[k]
             sim.AdvanceTo(t[k])
@@ -306,5 +295,5 @@ def simulate_open_loop(platform: Platform, t, q, qd, forces, time_step: float = 
         out["lengths"].append(prismatic_positions(plant, pctx))
     res = {k: np.array(v) for k, v in out.items()}
     res["t"] = t[idx]
-    res["wall_time"] = _time.perf_counter() - t0
+    res["wall_time"] = time.perf_counter() - t0
     return res

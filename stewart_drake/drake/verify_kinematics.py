@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.solvers import SnoptSolver, SolverOptions
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
@@ -59,9 +61,6 @@ def drake_ik_lengths(h: PlantHandle, poses, convention: str = "utn", tol: float 
     home configuration (not from the answer) and the solver must close the six ball constraints.
     Raises ``RuntimeError`` naming the pose if the solver fails.
     """
-    from pydrake.multibody.inverse_kinematics import InverseKinematics
-    from pydrake.solvers import SnoptSolver, SolverOptions
-
     plant, ctx, p = h.plant, h.context, h.platform
     poses = np.atleast_2d(poses)
     top = plant.GetJointByName("top")

@@ -15,15 +15,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from pydrake.geometry import Cylinder, Meshcat, MeshcatParams, Rgba
+from pydrake.math import RigidTransform, RotationMatrix
 
-from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
-from stewart_drake.errors import StewartError
-from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.assembly_modes import assembly_modes
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
-from stewart_drake.drake.platform_model import leg_visual_dimensions
-from stewart_drake.core.rotations import angle_scale, length_scale, rotation_matrix
+from stewart_drake.core.leg_bodies import leg_visual_dimensions
+from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
+from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length_scale, rotation_matrix
+from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
+from stewart_drake.errors import StewartError
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
 # Above this condition number a pose counts as singular (kinematics.require_nonsingular's default).
@@ -133,6 +135,15 @@ def labels(r: Readout, length_unit: str = "mm") -> list[str]:
     return out
 
 
+def open_meshcat(port: int | None = None) -> Meshcat:
+    """A Meshcat server on localhost at ``port`` (None: the first free port from 7000). A port that
+    cannot be listened on raises ``ValueError`` naming it (the CLI prints it as one line)."""
+    try:
+        return Meshcat(MeshcatParams(host="localhost", port=port))
+    except RuntimeError as e:
+        raise ValueError(f"--port {port}: Meshcat could not listen there ({e})") from None
+
+
 class Viewer:
     """Pose sliders + readouts on a ``MeshcatScene``. Sliders are in ``length_unit``/``angle_unit`` and
     the Euler ``convention``; internally SI."""
@@ -176,9 +187,6 @@ class Viewer:
 
     def _ghost(self, pose) -> None:
         """The platform at ``pose`` as a translucent ghost: a leg rod per leg and the plate (None: hide it)."""
-        from pydrake.geometry import Cylinder, Rgba
-        from pydrake.math import RigidTransform, RotationMatrix
-
         if pose is None:
             self.meshcat.Delete("/ghost")
             return
@@ -289,8 +297,6 @@ def _load_csv(p: Path):
         platform, convention = str(meta.get("platform", "")), str(meta.get("convention", "utn"))
     poses = data[:, 1:]
     if convention != "utn":  # the viewer's scene takes utn angles
-        from stewart_drake.core.rotations import angles_from_matrix
-
         poses = np.c_[poses[:, :3], angles_from_matrix(rotation_matrix(poses[:, 3:], convention), "utn")]
     return data[:, 0], poses, None, platform
 

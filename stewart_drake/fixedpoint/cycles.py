@@ -34,6 +34,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from stewart_drake.errors import FixedPointError
+from stewart_drake.fixedpoint.scalar import tp17_op_counts
+
 CLOCK_HZ = 60e6
 
 ALU_OPS = ("add", "sub", "negate", "abs_s", "L_add", "L_sub", "L_negate", "L_abs", "L_mult", "extract_h",
@@ -70,13 +73,13 @@ class CycleEstimate:
 
 def estimate_cycles(op_counts: dict, table: dict | None = None, clock_hz: float = CLOCK_HZ, loops: int = 1) -> CycleEstimate:
     """Cycles for a dict of operation -> calls (one evaluation), with one operand move per ALU op.
-    Raises ValueError naming an operation missing from the table."""
+    Raises ``FixedPointError`` naming an operation missing from the table."""
     table = dict(CYCLE_TABLE if table is None else table)
     breakdown = {}
     n_alu = 0
     for op, n in sorted(op_counts.items()):
         if op not in table:
-            raise ValueError(f"operation {op!r} has no entry in the cycle table")
+            raise FixedPointError(FixedPointError.NO_CYCLES.format(op=op))
         breakdown[op] = (int(n), n * table[op])
         if op in ALU_OPS:
             n_alu += n
@@ -88,8 +91,6 @@ def estimate_cycles(op_counts: dict, table: dict | None = None, clock_hz: float 
 
 def tp17_cycles(table: dict | None = None, clock_hz: float = CLOCK_HZ) -> CycleEstimate:
     """Cycle estimate of one pass of tp17.C's loop body (six leg lengths from one pose)."""
-    from stewart_drake.fixedpoint.scalar import tp17_op_counts
-
     return estimate_cycles(tp17_op_counts(), table, clock_hz)
 
 

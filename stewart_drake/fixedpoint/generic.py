@@ -27,10 +27,11 @@ from itertools import product
 
 import numpy as np
 
-from stewart_drake.errors import counted
+from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import check_convention
-from stewart_drake.fixedpoint.q15 import _sat, tfr16CosPIx, tfr16SinPIx
+from stewart_drake.fixedpoint.q15 import saturate, tfr16CosPIx, tfr16SinPIx
+from stewart_drake.errors import FixedPointError, counted
 
 TRIG_MODES = ("exact", "tfr16")
 
@@ -50,13 +51,13 @@ class QFormat:
 
     def __post_init__(self):
         if not (isinstance(self.word_bits, (int, np.integer)) and 8 <= self.word_bits <= 31):
-            raise ValueError(f"word_bits must be an integer in 8..31, got {self.word_bits!r}")
+            raise FixedPointError(FixedPointError.WORD_BITS.format(value=self.word_bits))
         if not (np.isfinite(self.length_lsb) and self.length_lsb > 0):
-            raise ValueError(f"length_lsb must be a positive number of metres, got {self.length_lsb!r}")
+            raise FixedPointError(FixedPointError.LENGTH_LSB.format(value=self.length_lsb))
         if self.trig not in TRIG_MODES:
-            raise ValueError(f"trig must be one of {', '.join(TRIG_MODES)}, got {self.trig!r}")
+            raise FixedPointError(FixedPointError.TRIG.format(valid=", ".join(TRIG_MODES), value=self.trig))
         if self.trig == "tfr16" and self.word_bits != 16:
-            raise ValueError(f"trig='tfr16' is the 16-bit DSP library; it needs word_bits=16, got {self.word_bits}")
+            raise FixedPointError(FixedPointError.TFR16_BITS.format(value=self.word_bits))
 
     @property
     def frac_bits(self) -> int:
@@ -110,14 +111,14 @@ def rotation_monomials(convention: str = "utn"):
 
 def angle_words(angles, fmt: QFormat) -> np.ndarray:
     """``(...)`` Q(word_bits-1) words of angles (radians) as fractions of pi: truncated toward zero like
-    FRAC16, saturated. Raises ValueError for |angle| > pi."""
+    FRAC16, saturated. Raises ``FixedPointError`` for |angle| > pi."""
     angles = np.asarray(angles, dtype=float)
     f = fmt.frac_bits
     x = angles / np.pi
-    if np.any(np.abs(x) > 1.0):
-        k = tuple(int(i) for i in np.argwhere(np.abs(x) > 1.0)[0])
-        raise ValueError(f"pose {counted(k[:-1])}: angle {angles[k]:.6g} rad exceeds ±pi; the DSP takes angles as fractions of pi in [-1, 1]")
-    return _sat(np.trunc(x * (1 << f)).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.angle")
+    k = first_index(np.abs(x) > 1.0)
+    if k is not None:
+        raise FixedPointError(FixedPointError.ANGLE.format(index=counted(k[:-1]), angle=angles[k]))
+    return saturate(np.trunc(x * (1 << f)).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.angle")
 
 
 def trig_words(w, fmt: QFormat):
@@ -128,8 +129,8 @@ def trig_words(w, fmt: QFormat):
     f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
     t = np.pi * w / (1 << f)
-    s = _sat(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
-    c = _sat(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
+    s = saturate(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
+    c = saturate(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
     return s, c
 
 
@@ -161,9 +162,9 @@ def rotation_from_words(w, fmt: QFormat = QFormat(), convention: str = "utn") ->
             else:
                 term = words[factors[0]]
                 for fac in factors[1:]:
-                    term = _sat((term * words[fac]) >> f, lo, hi, "generic.mult")
+                    term = saturate((term * words[fac]) >> f, lo, hi, "generic.mult")
             for _ in range(abs(coef)):
-                acc = _sat(acc + (term if coef > 0 else -term), lo, hi, "generic.add")
+                acc = saturate(acc + (term if coef > 0 else -term), lo, hi, "generic.add")
         R[..., i, j] = acc
     return R
 
@@ -178,12 +179,13 @@ def _isqrt_nearest(S: np.ndarray) -> np.ndarray:
 
 def length_words(x_m, fmt: QFormat, what: str) -> np.ndarray:
     """Integer words of lengths ``x_m`` (metres) in units of ``fmt.length_lsb``, rounded to nearest;
-    raises ValueError naming ``what`` if one does not fit the word."""
+    raises ``FixedPointError`` naming ``what`` if one does not fit the word."""
     lsb, hi = fmt.length_lsb, (1 << fmt.frac_bits) - 1
     w = np.round(np.asarray(x_m) / lsb)
     if np.any(np.abs(w) > hi + 1):
-        raise ValueError(f"{what} {np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())]:.6g} m does not fit a "
-                         f"{fmt.word_bits}-bit word of {lsb:g} m (range ±{fmt.range_m:.6g} m)")
+        raise FixedPointError(FixedPointError.LENGTH_WORD.format(
+            what=what, value=np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())], bits=fmt.word_bits, lsb=lsb,
+            range_m=fmt.range_m))
     return np.clip(w.astype(np.int64), -hi - 1, hi)
 
 
@@ -195,23 +197,12 @@ def platform_words(platform: Platform, fmt: QFormat) -> tuple[np.ndarray, np.nda
     return r_T, B
 
 
-def check_poses(poses) -> np.ndarray:
-    """``(..., 6)`` finite float poses, or ValueError naming the first bad one."""
-    q = np.asarray(poses, dtype=float)
-    if q.shape[-1:] != (6,):
-        raise ValueError(f"poses must have shape (..., 6) [px, py, pz, a_x, a_y, a_z], got {q.shape}")
-    if not np.all(np.isfinite(q)):
-        k = tuple(int(i) for i in np.argwhere(~np.isfinite(q).all(-1))[0])
-        raise ValueError(f"pose {counted(k)} is not finite: {q[k].tolist()}")
-    return q
-
-
 def pose_words(poses, fmt: QFormat = QFormat()) -> np.ndarray:
     """``(..., 6)`` int64 pose words of ``(..., 6)`` SI poses, as the firmware takes them: positions in
     length LSBs (rounded to nearest, saturated), angles as Q(word_bits-1) fractions of pi (truncated)."""
-    q = check_poses(poses)
+    q = as_poses(poses)
     f = fmt.frac_bits
-    pos = _sat(np.round(q[..., :3] / fmt.length_lsb).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.position")
+    pos = saturate(np.round(q[..., :3] / fmt.length_lsb).astype(np.int64), -(1 << f), (1 << f) - 1, "generic.position")
     return np.concatenate([pos, angle_words(q[..., 3:], fmt)], axis=-1)
 
 
@@ -234,10 +225,10 @@ def leg_length_words(platform: Platform, words, fmt: QFormat = QFormat(), conven
             v = pos[..., r]
             for k in range(3):
                 if r_T[i, k]:
-                    v = _sat(v + ((R[..., r, k] * r_T[i, k]) >> f), lo, hi, "generic.add")
-            v = _sat(v - B[i, r], lo, hi, "generic.sub")
-            sq = _sat(sq + v * v, -acc_hi - 1, acc_hi, "generic.L_add")
-        out[..., i] = _sat(_isqrt_nearest(sq), lo, hi, "generic.sqrt")
+                    v = saturate(v + ((R[..., r, k] * r_T[i, k]) >> f), lo, hi, "generic.add")
+            v = saturate(v - B[i, r], lo, hi, "generic.sub")
+            sq = saturate(sq + v * v, -acc_hi - 1, acc_hi, "generic.L_add")
+        out[..., i] = saturate(_isqrt_nearest(sq), lo, hi, "generic.sqrt")
     return out
 
 
@@ -245,7 +236,7 @@ def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(),
                             return_words: bool = False) -> np.ndarray:
     """``(..., 6)`` leg lengths (metres, integer multiples of ``fmt.length_lsb``) computed in fixed
     point with ``fmt`` for ``(..., 6)`` SI poses. ``return_words``: the integer length words instead."""
-    q = check_poses(poses)
+    q = as_poses(poses)
     consts = platform_words(platform, fmt)
     out = leg_length_words(platform, pose_words(q, fmt), fmt, convention, consts)
     return out if return_words else out * fmt.length_lsb

@@ -58,6 +58,9 @@ from collections import Counter
 
 import numpy as np
 
+from stewart_drake.core.argcheck import first_index
+from stewart_drake.errors import FixedPointError
+
 MIN16, MAX16 = -(1 << 15), (1 << 15) - 1
 MIN32, MAX32 = -(1 << 31), (1 << 31) - 1
 
@@ -101,7 +104,9 @@ class SaturationCounter:
         _ACTIVE.remove(self)
 
 
-def _sat(x: np.ndarray, lo: int, hi: int, op: str) -> np.ndarray:
+def saturate(x: np.ndarray, lo: int, hi: int, op: str) -> np.ndarray:
+    """``x`` (int64, any shape) clipped to [lo, hi]; the elements that saturated are recorded under the
+    operation name ``op`` by every active ``SaturationCounter``."""
     if _ACTIVE:
         flags = (x < lo) | (x > hi)
         for c in _ACTIVE:
@@ -115,24 +120,25 @@ def _i(x) -> np.ndarray:
 
 def sat16(x, op: str = "sat16") -> np.ndarray:
     """Saturate any integer to the Word16 range."""
-    return _sat(_i(x), MIN16, MAX16, op)
+    return saturate(_i(x), MIN16, MAX16, op)
 
 
 def sat32(x, op: str = "sat32") -> np.ndarray:
     """Saturate any integer to the Word32 range."""
-    return _sat(_i(x), MIN32, MAX32, op)
+    return saturate(_i(x), MIN32, MAX32, op)
 
 
 def word16(x, name: str = "value") -> np.ndarray:
-    """Validate and convert to Word16 values: raises ValueError naming ``name`` and the first bad element."""
+    """Validate and convert to Word16 values: raises ``FixedPointError`` naming ``name`` and the first bad element."""
     a = np.asarray(x)
     if not np.issubdtype(a.dtype, np.integer):
         if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
-            raise ValueError(f"{name} must hold integers (Word16), got {a.ravel()[~np.isfinite(a.ravel()) | (a.ravel() != np.round(a.ravel()))][0]!r}")
+            raise FixedPointError(FixedPointError.NOT_INTEGER_16.format(
+                name=name, value=a.ravel()[~np.isfinite(a.ravel()) | (a.ravel() != np.round(a.ravel()))][0]))
     a = a.astype(np.int64)
     bad = (a < MIN16) | (a > MAX16)
     if np.any(bad):
-        raise ValueError(f"{name} = {int(a[bad].ravel()[0])} is outside the 16-bit range [{MIN16}, {MAX16}]")
+        raise FixedPointError(FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=16, lo=MIN16, hi=MAX16))
     return a
 
 
@@ -141,11 +147,11 @@ def word32(x, name: str = "value") -> np.ndarray:
     a = np.asarray(x)
     if not np.issubdtype(a.dtype, np.integer):
         if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
-            raise ValueError(f"{name} must hold integers (Word32)")
+            raise FixedPointError(FixedPointError.NOT_INTEGER_32.format(name=name))
     a = a.astype(np.int64)
     bad = (a < MIN32) | (a > MAX32)
     if np.any(bad):
-        raise ValueError(f"{name} = {int(a[bad].ravel()[0])} is outside the 32-bit range [{MIN32}, {MAX32}]")
+        raise FixedPointError(FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=32, lo=MIN32, hi=MAX32))
     return a
 
 
@@ -158,16 +164,16 @@ def FRAC16(x) -> np.ndarray:
     with x >= 1 -> 32767 and x < -1 -> -32768 (the Freescale macro's saturation)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"FRAC16 of a non-finite value {x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x)!r}")
-    return _sat(np.trunc(x * 32768.0).astype(np.int64), MIN16, MAX16, "FRAC16")
+        raise FixedPointError(FixedPointError.FRAC16_NOT_FINITE.format(value=x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x)))
+    return saturate(np.trunc(x * 32768.0).astype(np.int64), MIN16, MAX16, "FRAC16")
 
 
 def FRAC32(x) -> np.ndarray:
     """Q31 word of a real x: truncation toward zero, saturated to [-2^31, 2^31 - 1]."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError("FRAC32 of a non-finite value")
-    return _sat(np.trunc(np.clip(x, -2.0, 2.0) * 2147483648.0).astype(np.int64), MIN32, MAX32, "FRAC32")
+        raise FixedPointError(FixedPointError.FRAC32_NOT_FINITE)
+    return saturate(np.trunc(np.clip(x, -2.0, 2.0) * 2147483648.0).astype(np.int64), MIN32, MAX32, "FRAC32")
 
 
 def to_float16(w) -> np.ndarray:
@@ -186,32 +192,32 @@ def to_float32(w) -> np.ndarray:
 
 def add(a, b) -> np.ndarray:
     """sat16(a + b)."""
-    return _sat(_i(a) + _i(b), MIN16, MAX16, "add")
+    return saturate(_i(a) + _i(b), MIN16, MAX16, "add")
 
 
 def sub(a, b) -> np.ndarray:
     """sat16(a - b)."""
-    return _sat(_i(a) - _i(b), MIN16, MAX16, "sub")
+    return saturate(_i(a) - _i(b), MIN16, MAX16, "sub")
 
 
 def negate(a) -> np.ndarray:
     """sat16(-a); negate(-32768) = 32767."""
-    return _sat(-_i(a), MIN16, MAX16, "negate")
+    return saturate(-_i(a), MIN16, MAX16, "negate")
 
 
 def abs_s(a) -> np.ndarray:
     """sat16(|a|); abs_s(-32768) = 32767."""
-    return _sat(np.abs(_i(a)), MIN16, MAX16, "abs_s")
+    return saturate(np.abs(_i(a)), MIN16, MAX16, "abs_s")
 
 
 def mult(a, b) -> np.ndarray:
     """sat16((a*b) >> 15): Q15 product truncated toward -inf; only -32768*-32768 saturates."""
-    return _sat((_i(a) * _i(b)) >> 15, MIN16, MAX16, "mult")
+    return saturate((_i(a) * _i(b)) >> 15, MIN16, MAX16, "mult")
 
 
 def mult_r(a, b) -> np.ndarray:
     """sat16((a*b + 2^14) >> 15): Q15 product rounded, ties toward +inf."""
-    return _sat((_i(a) * _i(b) + (1 << 14)) >> 15, MIN16, MAX16, "mult_r")
+    return saturate((_i(a) * _i(b) + (1 << 14)) >> 15, MIN16, MAX16, "mult_r")
 
 
 def shl(a, n) -> np.ndarray:
@@ -219,7 +225,7 @@ def shl(a, n) -> np.ndarray:
     a, n = np.broadcast_arrays(_i(a), _i(n))
     left = np.clip(n, 0, 16)
     right = np.clip(-n, 0, 15)
-    return np.where(n >= 0, _sat(a << left, MIN16, MAX16, "shl"), a >> right)
+    return np.where(n >= 0, saturate(a << left, MIN16, MAX16, "shl"), a >> right)
 
 
 def shr(a, n) -> np.ndarray:
@@ -233,27 +239,27 @@ def shr(a, n) -> np.ndarray:
 
 def L_add(a, b) -> np.ndarray:
     """sat32(a + b)."""
-    return _sat(_i(a) + _i(b), MIN32, MAX32, "L_add")
+    return saturate(_i(a) + _i(b), MIN32, MAX32, "L_add")
 
 
 def L_sub(a, b) -> np.ndarray:
     """sat32(a - b)."""
-    return _sat(_i(a) - _i(b), MIN32, MAX32, "L_sub")
+    return saturate(_i(a) - _i(b), MIN32, MAX32, "L_sub")
 
 
 def L_negate(a) -> np.ndarray:
     """sat32(-a); L_negate(-2^31) = 2^31 - 1."""
-    return _sat(-_i(a), MIN32, MAX32, "L_negate")
+    return saturate(-_i(a), MIN32, MAX32, "L_negate")
 
 
 def L_abs(a) -> np.ndarray:
     """sat32(|a|)."""
-    return _sat(np.abs(_i(a)), MIN32, MAX32, "L_abs")
+    return saturate(np.abs(_i(a)), MIN32, MAX32, "L_abs")
 
 
 def L_mult(a, b) -> np.ndarray:
     """sat32(2ab): the Q31 product of two Q15 words; only -32768 * -32768 saturates."""
-    return _sat(2 * _i(a) * _i(b), MIN32, MAX32, "L_mult")
+    return saturate(2 * _i(a) * _i(b), MIN32, MAX32, "L_mult")
 
 
 def L_mac(acc, a, b) -> np.ndarray:
@@ -272,7 +278,7 @@ def L_shl(a, n) -> np.ndarray:
     left = np.clip(n, 0, 32)
     right = np.clip(-n, 0, 31)
     # a << 32 overflows int64 only for |a| >= 2^31, which a Word32 never is.
-    return np.where(n >= 0, _sat(a << left, MIN32, MAX32, "L_shl"), a >> right)
+    return np.where(n >= 0, saturate(a << left, MIN32, MAX32, "L_shl"), a >> right)
 
 
 def L_shr(a, n) -> np.ndarray:
@@ -317,12 +323,12 @@ def msu_r(acc, a, b) -> np.ndarray:
 
 def div_s(a, b) -> np.ndarray:
     """Q15 quotient a / b for 0 <= a <= b, b > 0: floor(a * 2^15 / b), and 32767 when a == b.
-    Raises ValueError outside that domain (the hardware result is undefined there)."""
+    Raises ``FixedPointError`` outside that domain (the hardware result is undefined there)."""
     a, b = np.broadcast_arrays(_i(a), _i(b))
     bad = (a < 0) | (b <= 0) | (a > b)
-    if np.any(bad):
-        k = np.argwhere(bad)[0] if a.ndim else ()
-        raise ValueError(f"div_s needs 0 <= a <= b and b > 0, got a={int(a[tuple(k)])}, b={int(b[tuple(k)])}")
+    k = first_index(bad)
+    if k is not None:
+        raise FixedPointError(FixedPointError.DIV_S.format(a=int(a[k]), b=int(b[k])))
     return np.where(a == b, MAX16, (a << 15) // np.where(b == 0, 1, b))
 
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from collections import Counter
 
+from stewart_drake.errors import FixedPointError
+
 MIN16, MAX16 = -32768, 32767
 MIN32, MAX32 = -(2**31), 2**31 - 1
 
@@ -168,7 +170,7 @@ def msu_r(acc, a, b):
 def div_s(a, b):
     _c("div_s")
     if not (0 <= a <= b and b > 0):
-        raise ValueError(f"div_s needs 0 <= a <= b and b > 0, got a={a}, b={b}")
+        raise FixedPointError(FixedPointError.DIV_S.format(a=a, b=b))
     if a == b:
         return MAX16
     q = 0

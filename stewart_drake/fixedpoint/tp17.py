@@ -20,6 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stewart_drake.core.argcheck import check_shape, first_index
+from stewart_drake.errors import DspPoseError
+
 from stewart_drake.fixedpoint import q15
 from stewart_drake.fixedpoint.q15 import (FRAC16, L_add, L_mult, L_negate, add, extract_h, mfr32Sqrt, negate, tfr16CosPIx,
                   tfr16SinPIx)
@@ -92,25 +95,15 @@ def check_dsp_poses(poses) -> np.ndarray:
     ``Frac16``) and must fit 16 bits; angles must lie in [-1, 1] (one turn). Errors name the pose."""
     q = np.asarray(poses, dtype=float)
 
-    def where(bad):
-        k = tuple(int(i) for i in np.argwhere(bad)[0])
-        return k, ("pose" if k == () else f"pose {k[0] if len(k) == 1 else k}")
-
-    if q.shape[-1:] != (6,):
-        raise ValueError(f"DSP poses must have shape (..., 6) [px, py, pz mm, alpha, beta, gamma pi-fractions], got {q.shape}")
-    bad = ~np.isfinite(q).all(axis=-1)
-    if np.any(bad):
-        k, name = where(bad)
-        raise ValueError(f"{name} is not finite: {q[k].tolist()}")
+    check_shape(q, "DSP poses", (..., 6), DspPoseError)
     pos = np.trunc(q[..., :3])
-    bad = ((pos < q15.MIN16) | (pos > q15.MAX16)).any(axis=-1)
-    if np.any(bad):
-        k, name = where(bad)
-        raise ValueError(f"{name}: position {q[k][:3].tolist()} mm does not fit a 16-bit word [-32768, 32767]")
-    bad = (np.abs(q[..., 3:]) > 1.0).any(axis=-1)
-    if np.any(bad):
-        k, name = where(bad)
-        raise ValueError(f"{name}: angles {q[k][3:].tolist()} (fractions of pi) must lie in [-1, 1]")
+    for bad, template, part in ((~np.isfinite(q).all(axis=-1), DspPoseError.NOT_FINITE, slice(None)),
+                                (((pos < q15.MIN16) | (pos > q15.MAX16)).any(axis=-1), DspPoseError.POSITION, slice(3)),
+                                ((np.abs(q[..., 3:]) > 1.0).any(axis=-1), DspPoseError.ANGLES, slice(3, None))):
+        k = first_index(bad)
+        if k is not None:
+            name = "pose" if k == () else f"pose {k[0] if len(k) == 1 else k}"
+            raise DspPoseError(template.format(name=name, values=q[k][part].tolist()))
     return q
 
 

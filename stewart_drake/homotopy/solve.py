@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.newton_fk import _legs, validate_lengths
+from stewart_drake.core.newton_fk import leg_geometry, validate_lengths
 from stewart_drake.homotopy.certify import certify, newton_real, pose_bounds, real_forms
 from stewart_drake.homotopy.start import load_start_system
 from stewart_drake.homotopy.study import (
@@ -324,7 +324,7 @@ def solve_batch(
         dup = _duplicates(y[sl], np.flatnonzero((cj == REAL) | (cj == COMPLEX) | (cj == SINGULAR)))
         failed = [int(k) for k in np.flatnonzero(cj == FAIL)]
         p_BC, R_BT = pose_from_study(xr, scale, arch.kind)
-        _, _, Lp = _legs(platform, p_BC, R_BT)
+        _, _, Lp = leg_geometry(platform, p_BC, R_BT)
         res = np.abs(Lp - L[j]).max(axis=-1) if len(xr) else np.zeros(0)
         dp, da = pose_bounds(xr, cert.radius)
         if arch.kind == SIX_THREE:  # bounds hold for the inverse motion (R', p'), p = −R'ᵀ p', |p'| = |p|:

@@ -8,17 +8,16 @@ import difflib
 
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
 from stewart_drake.script import ast
-from stewart_drake.script.errors import (
-    FUNC_ARITY,
-    FUNC_UNKNOWN,
-    MOVE_ARITY,
-    MOVE_DUPLICATE_ARG,
-    MOVE_POSITIONAL_AFTER_KEYWORD,
-    MOVE_UNKNOWN_ARG,
-    NEVER_ASSIGNED,
-    ScriptError,
-    raise_all,
+from stewart_drake.errors import (
+    SCRIPT_FUNC_ARITY,
+    SCRIPT_FUNC_UNKNOWN,
+    SCRIPT_MOVE_ARITY,
+    SCRIPT_MOVE_DUPLICATE_ARG,
+    SCRIPT_MOVE_POSITIONAL_AFTER_KEYWORD,
+    SCRIPT_MOVE_UNKNOWN_ARG,
+    SCRIPT_NEVER_ASSIGNED,
 )
+from stewart_drake.script.errors import ScriptError, raise_all
 from stewart_drake.script.runtime import ARG_ALIASES, ARG_NAMES, CONSTANTS, FUNCTIONS
 
 NUMBER, CONDITION = "number", "condition"
@@ -105,17 +104,17 @@ class _Checker:
         seen_kw = False
         for a in s.args:
             if a.name is None and seen_kw:
-                self.err(MOVE_POSITIONAL_AFTER_KEYWORD.format(kw=s.keyword), a.at)
+                self.err(SCRIPT_MOVE_POSITIONAL_AFTER_KEYWORD.format(kw=s.keyword), a.at)
             seen_kw = seen_kw or a.name is not None
         if len(positional) > 6 or (not keywords and len(positional) != 6):
-            self.err(MOVE_ARITY.format(kw=s.keyword, n=len(s.args)), s.at)
+            self.err(SCRIPT_MOVE_ARITY.format(kw=s.keyword, n=len(s.args)), s.at)
         given = set(ARG_NAMES[: len(positional)])
         for a in keywords:
             canon = ARG_ALIASES.get(a.name, a.name)
             if canon not in ARG_NAMES:
-                self.err(MOVE_UNKNOWN_ARG.format(kw=s.keyword, name=a.name) + did_you_mean(a.name, ARG_NAMES), a.at)
+                self.err(SCRIPT_MOVE_UNKNOWN_ARG.format(kw=s.keyword, name=a.name) + did_you_mean(a.name, ARG_NAMES), a.at)
             elif canon in given:
-                self.err(MOVE_DUPLICATE_ARG.format(kw=s.keyword, name=canon), a.at)
+                self.err(SCRIPT_MOVE_DUPLICATE_ARG.format(kw=s.keyword, name=canon), a.at)
             given.add(canon)
         for a in s.args:
             self.number(a.value, f"{s.keyword} argument")
@@ -151,7 +150,7 @@ class _Checker:
             return NUMBER
         if isinstance(e, ast.Var):
             if e.name not in self.assigned and e.name not in CONSTANTS:
-                self.err(NEVER_ASSIGNED.format(name=e.name) + did_you_mean(e.name, set(self.assigned) | set(CONSTANTS)), e.at)
+                self.err(SCRIPT_NEVER_ASSIGNED.format(name=e.name) + did_you_mean(e.name, set(self.assigned) | set(CONSTANTS)), e.at)
             return NUMBER
         if isinstance(e, ast.Unary):
             self.number(e.operand, f"unary {e.op}")
@@ -161,11 +160,11 @@ class _Checker:
             return CONDITION
         if isinstance(e, ast.Call):
             if e.name not in FUNCTIONS:
-                self.err(FUNC_UNKNOWN.format(name=e.name, available=", ".join(sorted(FUNCTIONS))) + did_you_mean(e.name, FUNCTIONS), e.at)
+                self.err(SCRIPT_FUNC_UNKNOWN.format(name=e.name, available=", ".join(sorted(FUNCTIONS))) + did_you_mean(e.name, FUNCTIONS), e.at)
             else:
                 n = FUNCTIONS[e.name][0]
                 if len(e.args) != n:
-                    self.err(FUNC_ARITY.format(name=e.name, expected=n, s="" if n == 1 else "s", n=len(e.args)), e.at)
+                    self.err(SCRIPT_FUNC_ARITY.format(name=e.name, expected=n, s="" if n == 1 else "s", n=len(e.args)), e.at)
             for a in e.args:
                 self.number(a, f"{e.name}()")
             return NUMBER

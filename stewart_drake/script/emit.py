@@ -12,7 +12,9 @@ from __future__ import annotations
 import builtins
 import keyword
 
+from stewart_drake.errors import SCRIPT_EMIT
 from stewart_drake.script import ast
+from stewart_drake.script.check import assigned_names
 from stewart_drake.script.errors import ScriptError
 from stewart_drake.script.runtime import CONSTANTS, DEFAULT_RATE, DEFAULT_UNITS, FUNCTIONS, Motion, fmt_number
 
@@ -53,7 +55,7 @@ def emit_python(program: ast.Program, platform: str = "utn-kinematic", conventio
     try:  # the parser's nesting limits keep this valid; checked so that invalid code is never written
         compile(code, f"<{src} as Python>", "exec", dont_inherit=True)
     except (SyntaxError, RecursionError, MemoryError, ValueError) as err:
-        raise ScriptError(f"the program cannot be translated to valid Python ({err.__class__.__name__}: {err})",
+        raise ScriptError(SCRIPT_EMIT.format(kind=err.__class__.__name__, problem=err),
                           program.body[0].at if program.body else None) from None
     return code
 
@@ -102,8 +104,6 @@ if __name__ == "__main__":
 
 class _PyEmitter:
     def __init__(self, program: ast.Program):
-        from stewart_drake.script.check import assigned_names
-
         names = set(assigned_names(program.body))
         self.names = {}
         for n in sorted(names):

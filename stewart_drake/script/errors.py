@@ -2,8 +2,8 @@
 
 Every problem a program can have (syntax, undefined variable, wrong argument count, unreachable pose,
 arithmetic fault) is a ``ScriptError``; several found together are a ``ScriptErrors``. Both derive from
-``StewartError`` (hence ``ValueError``), so the CLI prints them without a traceback. Message templates
-are module constants; tests match them.
+``StewartError`` (hence ``ValueError``), so the CLI prints them without a traceback. Their message
+templates are constants in ``stewart_drake.errors``; tests match them.
 """
 
 from __future__ import annotations
@@ -11,22 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from stewart_drake.errors import StewartError
-
-SYNTAX = "unexpected {found}; expected {expected}"
-RESERVED = "{word!r} is a reserved word (Modula-2, kept from seed 004's Stewart.g) and cannot be used yet"
-UNDEFINED = "undefined variable {name!r}"
-NEVER_ASSIGNED = "undefined variable {name!r}: it is never assigned in this program"
-MOVE_ARITY = "{kw} takes 6 arguments (x, y, z, alpha, beta, gama), got {n}"
-MOVE_UNKNOWN_ARG = "{kw} has no argument {name!r}; its arguments are x, y, z, alpha, beta, gama"
-MOVE_DUPLICATE_ARG = "{kw}: argument {name!r} given twice"
-MOVE_POSITIONAL_AFTER_KEYWORD = "{kw}: positional argument after a keyword argument"
-FUNC_ARITY = "{name}() takes {expected} argument{s}, got {n}"
-FUNC_UNKNOWN = "unknown function {name!r}; available: {available}"
-UNREACHABLE = (
-    "{what} is out of reach on platform {platform}: leg {leg} would be {excess:.3f} mm "
-    "{side} the stroke {bound} {limit:.3f} mm (length {length:.3f} mm at t = {t:.3f} s{where})"
-)
-
 
 @dataclass(frozen=True)
 class Loc:

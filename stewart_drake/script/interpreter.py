@@ -9,7 +9,16 @@ import math
 
 from stewart_drake.script import ast
 from stewart_drake.script.check import assigned_names
-from stewart_drake.script.errors import UNDEFINED, ScriptError
+from stewart_drake.errors import (
+    SCRIPT_DIVISION_BY_ZERO,
+    SCRIPT_LOOP_MOVES,
+    SCRIPT_LOOP_STEPS,
+    SCRIPT_NO_FINITE_VALUE,
+    SCRIPT_OVERFLOW,
+    SCRIPT_TOO_MANY_STEPS,
+    SCRIPT_UNDEFINED,
+)
+from stewart_drake.script.errors import ScriptError
 from stewart_drake.script.runtime import CONSTANTS, FUNCTIONS, MAX_SEGMENTS, Motion, fmt_number, for_count, for_range
 
 MAX_STEPS = 1_000_000  # statements executed + loop iterations
@@ -36,20 +45,17 @@ class _Interpreter:
     def tick(self, at):
         self.steps += 1
         if self.steps > MAX_STEPS:
-            raise ScriptError(
-                f"the program ran more than {MAX_STEPS} steps (statements and loop iterations); does a loop never end?", at
-            )
+            raise ScriptError(SCRIPT_TOO_MANY_STEPS.format(limit=MAX_STEPS), at)
 
     def check_loop(self, s, count: int) -> None:
         """Refuse, before its first iteration, a FOR loop whose iterations (times the moves and waits its
         body surely makes, ``static_segments``) would pass ``MAX_STEPS`` or ``MAX_SEGMENTS``."""
         steps = count * (1 + static_cost(s.body)[0])
         if self.steps + steps > MAX_STEPS:
-            raise ScriptError(f"this FOR loop would run {count} iterations, at least {steps} steps with its body; a program may run "
-                              f"at most {MAX_STEPS} steps (statements and loop iterations)", s.at)
+            raise ScriptError(SCRIPT_LOOP_STEPS.format(count=count, steps=steps, limit=MAX_STEPS), s.at)
         moves = count * static_cost(s.body)[1]
         if len(self.motion.segments) + moves > MAX_SEGMENTS:
-            raise ScriptError(f"this FOR loop would make {moves} moves and waits; a program may make at most {MAX_SEGMENTS}", s.at)
+            raise ScriptError(SCRIPT_LOOP_MOVES.format(moves=moves, limit=MAX_SEGMENTS), s.at)
 
     def block(self, body):
         for s in body:
@@ -100,7 +106,7 @@ class _Interpreter:
                 return CONSTANTS[e.name][0]
             first = self.assigned.get(e.name)
             hint = f": it is first assigned at line {first.line}, column {first.column}, after this use" if first else ""
-            raise ScriptError(UNDEFINED.format(name=e.name) + hint, e.at)
+            raise ScriptError(SCRIPT_UNDEFINED.format(name=e.name) + hint, e.at)
         if isinstance(e, ast.Unary):
             v = self.eval(e.operand)
             return -v if e.op == "-" else +v
@@ -115,7 +121,7 @@ class _Interpreter:
                 v = math.nan
             if not math.isfinite(v):
                 shown = ", ".join(fmt_number(a) for a in args)
-                raise ScriptError(f"{e.name}({shown}) has no finite value", e.at)
+                raise ScriptError(SCRIPT_NO_FINITE_VALUE.format(name=e.name, args=shown), e.at)
             return float(v)
         if isinstance(e, ast.Binary):
             if e.op == "AND":
@@ -171,11 +177,11 @@ def _binary(op, a, b, at):
     if op in _COMPARE:
         return _COMPARE[op](a, b)
     if op in ("/", "DIV", "MOD") and b == 0:
-        raise ScriptError(f"division by zero ({fmt_number(a)} {op} 0)", at)
+        raise ScriptError(SCRIPT_DIVISION_BY_ZERO.format(a=fmt_number(a), op=op), at)
     try:
         v = _ARITH[op](a, b)
     except OverflowError:
         v = math.inf
     if not math.isfinite(v):
-        raise ScriptError(f"arithmetic overflow: {fmt_number(a)} {op} {fmt_number(b)} is not finite", at)
+        raise ScriptError(SCRIPT_OVERFLOW.format(a=fmt_number(a), op=op, b=fmt_number(b)), at)
     return v

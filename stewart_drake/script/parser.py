@@ -16,7 +16,16 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 from lark.visitors import Transformer_NonRecursive
 
 from stewart_drake.script import ast
-from stewart_drake.script.errors import RESERVED, SYNTAX, Loc, ScriptError
+from stewart_drake.errors import (
+    SCRIPT_CANNOT_PARSE,
+    SCRIPT_EXPRESSION_DEPTH,
+    SCRIPT_LOOP_DEPTH,
+    SCRIPT_NUMBER_TOO_LARGE,
+    SCRIPT_RESERVED,
+    SCRIPT_STATEMENT_DEPTH,
+    SCRIPT_SYNTAX,
+)
+from stewart_drake.script.errors import Loc, ScriptError
 
 # Deeper nesting than this is refused (later passes recurse over the tree).
 MAX_DEPTH = 100
@@ -112,7 +121,7 @@ def parse(text: str, filename: str = "<program>") -> ast.Program:
         tree = _lark().parse(text)
     except _ReservedWord as e:
         tok = e.tok
-        raise ScriptError(RESERVED.format(word=tok.value), Loc(filename, tok.line, tok.column), text) from None
+        raise ScriptError(SCRIPT_RESERVED.format(word=tok.value), Loc(filename, tok.line, tok.column), text) from None
     except UnexpectedToken as e:
         tok = e.token
         if tok.type == "$END" or tok.line is None or tok.line < 1:
@@ -120,14 +129,14 @@ def parse(text: str, filename: str = "<program>") -> ast.Program:
         else:
             line, col = tok.line, tok.column
         expected = e.accepts or e.expected
-        msg = SYNTAX.format(found=_describe_token(tok), expected=expected_list(expected))
+        msg = SCRIPT_SYNTAX.format(found=_describe_token(tok), expected=expected_list(expected))
         raise ScriptError(msg, Loc(filename, line, col), text, kind="syntax error") from None
     except UnexpectedCharacters as e:
         found = "end of file" if e.pos_in_stream >= len(text) else f"character {text[e.pos_in_stream]!r}"
-        msg = SYNTAX.format(found=found, expected=expected_list(_accepts_at(text[: e.pos_in_stream])))
+        msg = SCRIPT_SYNTAX.format(found=found, expected=expected_list(_accepts_at(text[: e.pos_in_stream])))
         raise ScriptError(msg, Loc(filename, e.line, e.column), text, kind="syntax error") from None
     except UnexpectedInput as e:  # any other Lark input error
-        raise ScriptError(f"cannot parse: {e}", Loc(filename, getattr(e, "line", 1) or 1, getattr(e, "column", 1) or 1),
+        raise ScriptError(SCRIPT_CANNOT_PARSE.format(problem=e), Loc(filename, getattr(e, "line", 1) or 1, getattr(e, "column", 1) or 1),
                           text, kind="syntax error") from None
     try:
         body = _ToAst(filename).transform(tree)
@@ -167,7 +176,7 @@ class _ToAst(Transformer_NonRecursive):
 
     def _limit(self, node, at: Loc):
         if getattr(node, "depth", 0) > MAX_DEPTH:
-            raise ScriptError(f"expression nested more than {MAX_DEPTH} levels deep", at, kind="syntax error")
+            raise ScriptError(SCRIPT_EXPRESSION_DEPTH.format(limit=MAX_DEPTH), at, kind="syntax error")
         return node
 
     # -- program structure
@@ -253,7 +262,7 @@ class _ToAst(Transformer_NonRecursive):
         (tok,) = items
         value = float(tok.value)
         if value == float("inf"):
-            raise ScriptError(f"number {tok.value} is too large", self._loc(tok))
+            raise ScriptError(SCRIPT_NUMBER_TOO_LARGE.format(text=tok.value), self._loc(tok))
         return ast.Num(value, tok.value, self._loc(tok))
 
     def var(self, items):
@@ -282,9 +291,9 @@ def _expr_loc(e) -> Loc:
 def _check_nesting(stmts) -> None:
     for s in stmts:
         if _stmt_depth(s) > MAX_STMT_DEPTH:
-            raise ScriptError(f"statements nested more than {MAX_STMT_DEPTH} levels deep", s.at, kind="syntax error")
+            raise ScriptError(SCRIPT_STATEMENT_DEPTH.format(limit=MAX_STMT_DEPTH), s.at, kind="syntax error")
         if _stmt_depth(s, loops_only=True) > MAX_LOOP_DEPTH:
-            raise ScriptError(f"loops (FOR, WHILE) nested more than {MAX_LOOP_DEPTH} levels deep", s.at, kind="syntax error")
+            raise ScriptError(SCRIPT_LOOP_DEPTH.format(limit=MAX_LOOP_DEPTH), s.at, kind="syntax error")
 
 
 def _stmt_depth(s, loops_only: bool = False) -> int:

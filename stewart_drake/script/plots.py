@@ -20,7 +20,7 @@ def _move_marks(ax, result):
 
 def plot_lengths(result, platform_name: str, stroke_mm=None, ax=None):
     """Leg lengths (mm) against time; the stroke limits dashed when given."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: importing pyplot picks a backend (commands select Agg first)
 
     fig = None
     if ax is None:
@@ -42,7 +42,7 @@ def plot_lengths(result, platform_name: str, stroke_mm=None, ax=None):
 
 def plot_forces(result, ax=None):
     """Leg forces (N, > 0 pushes the plate away from the base) against time."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: importing pyplot picks a backend (commands select Agg first)
 
     fig = None
     if ax is None:
@@ -60,7 +60,7 @@ def plot_forces(result, ax=None):
 
 def plot_tracking(log, length_error):
     """Simulated leg-length error (mm) against time."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: importing pyplot picks a backend (commands select Agg first)
 
     fig, ax = plt.subplots(figsize=(8, 3.2))
     for i in range(6):

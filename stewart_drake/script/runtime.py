@@ -14,20 +14,35 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import SingularPoseError
+from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition, leg_forces
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from stewart_drake.script.errors import (
-    MOVE_ARITY,
-    MOVE_DUPLICATE_ARG,
-    MOVE_UNKNOWN_ARG,
-    UNREACHABLE,
-    Loc,
-    ScriptError,
-    as_loc,
-    raise_all,
+from stewart_drake.core.sanity import above_base, has_plate, plate_anchor_heights
+from stewart_drake.errors import (
+    SCRIPT_BELOW_BASE,
+    SCRIPT_DURATION,
+    SCRIPT_FOR_STEP_ZERO,
+    SCRIPT_MORE_UNREACHABLE,
+    SCRIPT_MOVE_ARITY,
+    SCRIPT_MOVE_DUPLICATE_ARG,
+    SCRIPT_MOVE_UNKNOWN_ARG,
+    SCRIPT_NOT_A_NUMBER,
+    SCRIPT_NOT_FINITE,
+    SCRIPT_SEGMENT_SAMPLES,
+    SCRIPT_SINGULAR,
+    SCRIPT_START_OUT_OF_REACH,
+    SCRIPT_TOO_MANY_MOVES,
+    SCRIPT_TOO_MANY_SAMPLES,
+    SCRIPT_TOO_SHORT,
+    SCRIPT_TWO_UNITS,
+    SCRIPT_UNIT,
+    SCRIPT_UNREACHABLE,
+    SCRIPT_WAIT,
+    OptionError,
+    SingularPoseError,
 )
+from stewart_drake.script.errors import Loc, ScriptError, as_loc, raise_all
 
 ARG_NAMES = ("x", "y", "z", "alpha", "beta", "gama")
 ARG_ALIASES = {"gamma": "gama"}
@@ -144,9 +159,9 @@ def _check_finite(value, what: str, at) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ScriptError(f"{what} must be a number, got {value!r}", at) from None
+        raise ScriptError(SCRIPT_NOT_A_NUMBER.format(what=what, value=value), at) from None
     if not math.isfinite(v):
-        raise ScriptError(f"{what} must be finite, got {v}", at)
+        raise ScriptError(SCRIPT_NOT_FINITE.format(what=what, value=v), at)
     return v
 
 
@@ -182,12 +197,11 @@ class Motion:
                 kind = "angle"
             else:
                 raise ScriptError(
-                    f"units: {n!r} is not a unit; expected {' or '.join(LENGTH_UNITS)} (length), "
-                    f"{' or '.join(ANGLE_UNITS)} (angle)",
+                    SCRIPT_UNIT.format(name=n, lengths=" or ".join(LENGTH_UNITS), angles=" or ".join(ANGLE_UNITS)),
                     at,
                 )
             if kind in seen:
-                raise ScriptError(f"units: two {kind} units given", at)
+                raise ScriptError(SCRIPT_TWO_UNITS.format(kind=kind), at)
             seen.add(kind)
             if kind == "length":
                 self.length_unit = n
@@ -202,7 +216,7 @@ class Motion:
         beta, gama in order, keywords name them; with keywords, omitted coordinates keep their value."""
         at = as_loc(at)
         if len(args) > 6 or (not kwargs and len(args) != 6):
-            raise ScriptError(MOVE_ARITY.format(kw=keyword, n=len(args) + len(kwargs)), at)
+            raise ScriptError(SCRIPT_MOVE_ARITY.format(kw=keyword, n=len(args) + len(kwargs)), at)
         current = self.pose / self._scale()
         values = {n: float(v) for n, v in zip(ARG_NAMES, current)}
         given = {}
@@ -211,9 +225,9 @@ class Motion:
         for name, v in kwargs.items():
             canon = ARG_ALIASES.get(name, name)
             if canon not in ARG_NAMES:
-                raise ScriptError(MOVE_UNKNOWN_ARG.format(kw=keyword, name=name), at)
+                raise ScriptError(SCRIPT_MOVE_UNKNOWN_ARG.format(kw=keyword, name=name), at)
             if canon in given:
-                raise ScriptError(MOVE_DUPLICATE_ARG.format(kw=keyword, name=canon), at)
+                raise ScriptError(SCRIPT_MOVE_DUPLICATE_ARG.format(kw=keyword, name=canon), at)
             given[canon] = v
         for name, v in given.items():
             values[name] = _check_finite(v, f"{keyword} argument {name}", at)
@@ -225,10 +239,9 @@ class Motion:
         values = self.resolve(args, kwargs, keyword, at)
         d = self.default_duration if duration is None else _check_finite(duration, f"{keyword} duration", at)
         if d <= 0:
-            raise ScriptError(f"{keyword} duration must be positive, got {fmt_number(d)} s", at)
+            raise ScriptError(SCRIPT_DURATION.format(keyword=keyword, value=fmt_number(d)), at)
         if d < MIN_MOVE_DURATION:
-            raise ScriptError(f"{keyword} duration {fmt_number(d)} s is shorter than the shortest move, {fmt_number(MIN_MOVE_DURATION)} s "
-                              "(no actuator follows a faster one)", at)
+            raise ScriptError(SCRIPT_TOO_SHORT.format(keyword=keyword, value=fmt_number(d), limit=fmt_number(MIN_MOVE_DURATION)), at)
         self._check_segments(at)
         q1 = np.array(values) * self._scale()
         self._moves += 1
@@ -246,7 +259,7 @@ class Motion:
         at = as_loc(at)
         d = _check_finite(duration, "wait duration", at)
         if d < 0:
-            raise ScriptError(f"wait duration must be >= 0, got {fmt_number(d)} s", at)
+            raise ScriptError(SCRIPT_WAIT.format(value=fmt_number(d)), at)
         if d == 0:
             return None
         self._check_segments(at)
@@ -256,25 +269,23 @@ class Motion:
 
     def _check_segments(self, at) -> None:
         if len(self.segments) >= MAX_SEGMENTS:
-            raise ScriptError(f"the program makes more than {MAX_SEGMENTS} moves and waits (the limit); shorten it or use longer moves", at)
+            raise ScriptError(SCRIPT_TOO_MANY_MOVES.format(limit=MAX_SEGMENTS), at)
 
     # -- result
     def trajectory(self, rate: float = DEFAULT_RATE) -> Trajectory:
         """Sample every segment at ``rate`` Hz (each segment's end is a sample; t = 0 is the start)."""
         if not (math.isfinite(rate) and rate > 0):
-            raise ValueError(f"trajectory rate must be a positive number of Hz, got {rate}")
+            raise OptionError(OptionError.POSITIVE.format(option="trajectory rate", unit="Hz", value=rate))
         for s in self.segments:  # each segment's samples, in floating point first (a huge wait overflows int)
             if s.duration * rate > MAX_SAMPLES:
-                raise ScriptError(
-                    f"{s.describe()} lasts {fmt_number(s.duration)} s, more than the {MAX_SAMPLES} samples a program may have "
-                    f"at {fmt_number(rate)} Hz ({fmt_number(MAX_SAMPLES / rate)} s)", s.at)
+                raise ScriptError(SCRIPT_SEGMENT_SAMPLES.format(what=s.describe(), duration=fmt_number(s.duration), limit=MAX_SAMPLES,
+                                                                rate=fmt_number(rate), seconds=fmt_number(MAX_SAMPLES / rate)), s.at)
         counts = [max(1, math.ceil(s.duration * rate - 1e-9)) for s in self.segments]
         total = 1 + sum(counts)
         if total > MAX_SAMPLES:
             seconds = sum(s.duration for s in self.segments)
             raise ScriptError(
-                f"trajectory too long: {total} samples ({fmt_number(seconds)} s at {fmt_number(rate)} Hz; "
-                f"the limit is {MAX_SAMPLES}); lower the rate or shorten the program",
+                SCRIPT_TOO_MANY_SAMPLES.format(total=total, seconds=fmt_number(seconds), rate=fmt_number(rate), limit=MAX_SAMPLES),
                 self.segments[-1].at,
             )
         t, q, qd, qdd, seg = [np.zeros(1)], [self.start[None]], [np.zeros((1, 6))], [np.zeros((1, 6))], [np.array([-1])]
@@ -325,7 +336,7 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
         n = idx[i]
         below = bool(chk.below[n, leg] > 0)
         errors.append(ScriptError(
-            UNREACHABLE.format(
+            SCRIPT_UNREACHABLE.format(
                 what=s.describe(),
                 platform=platform.name,
                 leg=leg + 1,
@@ -341,13 +352,11 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
         ))
     if not errors:  # only the start pose (and waits holding it) is out of stroke
         leg = int(np.argmax(excess[0]))
-        raise ScriptError(
-            f"the start pose is out of reach on platform {platform.name}: leg {leg + 1} length "
-            f"{L[0, leg] * 1e3:.3f} mm is outside the stroke [{platform.L_min * 1e3:.3f}, {platform.L_max * 1e3:.3f}] mm"
-        )
+        raise ScriptError(SCRIPT_START_OUT_OF_REACH.format(platform=platform.name, leg=leg + 1, length_mm=L[0, leg] * 1e3,
+                                                           lo_mm=platform.L_min * 1e3, hi_mm=platform.L_max * 1e3))
     if len(errors) > MAX_REPORTED:
         more = len(errors) - MAX_REPORTED
-        errors = errors[:MAX_REPORTED] + [ScriptError(f"... and {more} more unreachable moves", errors[MAX_REPORTED].at)]
+        errors = errors[:MAX_REPORTED] + [ScriptError(SCRIPT_MORE_UNREACHABLE.format(more=more), errors[MAX_REPORTED].at)]
     raise_all(errors)
     return L  # pragma: no cover
 
@@ -355,8 +364,6 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
 def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> None:
     """``ScriptError`` at the first move whose path puts a plate anchor at or below the base plane
     (``sanity.above_base``), with the time and the anchor's height."""
-    from stewart_drake.core.sanity import above_base, plate_anchor_heights
-
     ok = above_base(platform, traj.q, convention)
     if np.all(ok):
         return
@@ -367,15 +374,13 @@ def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> 
     leg = int(np.argmin(z))
     what = seg.describe() if seg is not None else "the start pose"
     raise ScriptError(
-        f"{what} puts the plate {'in' if z[leg] == 0 else 'below'} the base on platform {platform.name}: the plate anchor of leg "
-        f"{leg + 1} is at z = {z[leg] * 1e3:.3f} mm at t = {traj.t[n]:.3f} s (the base plane is z = 0)",
+        SCRIPT_BELOW_BASE.format(what=what, where="in" if z[leg] == 0 else "below", platform=platform.name, leg=leg + 1,
+                                 z_mm=z[leg] * 1e3, t=traj.t[n]),
         seg.at if seg is not None else None)
 
 
 def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) -> ScriptError:
     """A ``SingularPoseError`` from the dynamics, restated at the move whose path crosses the singularity."""
-    from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition
-
     k = jacobian_condition(platform, traj.q, convention)
     bad = np.flatnonzero(~(k <= MAX_CONDITION))
     if not len(bad):
@@ -384,8 +389,7 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
     seg = traj.segments[traj.segment[n]] if traj.segment[n] >= 0 else None
     what = seg.describe() if seg is not None else "the start pose"
     return ScriptError(
-        f"{what}: the platform is singular or nearly so at t = {traj.t[n]:.3f} s (Jacobian condition number "
-        f"{k[n]:.3g} > {MAX_CONDITION:.3g}); leg forces are undefined there",
+        SCRIPT_SINGULAR.format(what=what, t=traj.t[n], cond=k[n], limit=MAX_CONDITION),
         seg.at if seg is not None else None,
     )
 
@@ -393,23 +397,15 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
 def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True,
              gravity: float = 9.81) -> Result:
     """Inverse kinematics (with the stroke check) and inverse dynamics on a trajectory."""
-    from stewart_drake.core.sanity import has_plate
-
     L = check_reachable(platform, traj, convention)
     notes = []
     if not has_plate(platform):  # a massless plate would give every force as 0
         return Result(traj, L, None, platform.name, convention,
                       (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",))
     try:
-        from stewart_drake.core.dynamics import leg_forces
-    except ImportError:
-        F = None
-        notes.append("leg forces not computed: stewart_drake.core.dynamics.leg_forces is not available in this installation")
-    else:
-        try:
-            F = np.asarray(leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity))
-        except SingularPoseError as e:
-            raise _singular_error(platform, traj, convention, e) from None
+        F = np.asarray(leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity))
+    except SingularPoseError as e:
+        raise _singular_error(platform, traj, convention, e) from None
     return Result(traj, L, F, platform.name, convention, tuple(notes))
 
 
@@ -419,7 +415,7 @@ def for_count(start, stop, step=1.0, at=None) -> int:
     stop = _check_finite(stop, "FOR limit", at)
     step = _check_finite(step, "FOR step", at)
     if step == 0:
-        raise ScriptError("FOR step is 0: the loop would never end", as_loc(at))
+        raise ScriptError(SCRIPT_FOR_STEP_ZERO, as_loc(at))
     n = (stop - start) / step
     if not n > -1e-9:
         return 0
@@ -434,7 +430,7 @@ def for_range(start, stop, step=1.0, at=None):
     stop = _check_finite(stop, "FOR limit", at)
     step = _check_finite(step, "FOR step", at)
     if step == 0:
-        raise ScriptError("FOR step is 0: the loop would never end", as_loc(at))
+        raise ScriptError(SCRIPT_FOR_STEP_ZERO, as_loc(at))
     k = 0
     while (stop - (start + k * step)) / step > -1e-9:
         yield start + k * step

@@ -1,4 +1,4 @@
-"""Workspace of a Stewart platform: which poses every limit allows (SPEC §5, seed 001), in plain numpy
+"""Workspace of a Stewart platform: which poses every limit allows (seed 001), in plain numpy
 (no Drake), metres and radians. Modules: ``limits`` (limits and per-pose margins, ``classify``), ``grid``
 (the constant-orientation workspace, swept in x-slabs by ``slabs``, extents refined by ``extents``, tasks
 run by ``executors``), ``columns`` (exact stroke volume), ``orientation`` (rotation limits), ``maps``

@@ -10,14 +10,14 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_vectors
 from stewart_drake.core.sanity import plate_floor
 from stewart_drake.workspace.grid import default_bounds
-from stewart_drake.workspace.limits import _check_orientation
+from stewart_drake.workspace.limits import check_orientation
 
 
 def stroke_column_lengths(platform: Platform, x, y, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_bounds=(0.0, np.inf)) -> np.ndarray:
     """``(...)`` length (m) of the set of z in ``z_bounds`` with every leg within stroke, for columns at
     ``x``, ``y`` (broadcast, metres). Per leg, L_min² <= ρ² + (z - c_z)² <= L_max² is one or two
     z-intervals; their intersection is measured exactly between sorted interval end points."""
-    l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, _check_orientation(orientation)], convention)
+    l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, check_orientation(orientation)], convention)
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
     rho2 = (x[..., None] + l0[:, 0]) ** 2 + (y[..., None] + l0[:, 1]) ** 2  # (..., 6)
     a = np.sqrt(np.maximum(platform.L_min**2 - rho2, 0.0))
@@ -38,7 +38,7 @@ def stroke_volume_columns(platform: Platform, resolution: float, orientation=(0.
     anchor above the base): exact column lengths integrated by the midpoint rule on an (x, y) grid of
     step ``resolution`` (error O(h^1.5) from the rim)."""
     if z_floor is None:
-        z_floor = plate_floor(platform, _check_orientation(orientation), convention)
+        z_floor = plate_floor(platform, check_orientation(orientation), convention)
     b = default_bounds(platform, orientation, convention, z_floor)
     h = float(resolution)
     xs = np.arange(b[0, 0] + h / 2, b[0, 1], h)

@@ -1,4 +1,4 @@
-"""The workspace sweeps on Dask (optional: ``pip install "dask[distributed]"``).
+"""The workspace sweeps on Dask (``dask[distributed]``, a dependency of the package).
 
 Nothing is rescheduled here: Dask's client exposes a ``concurrent.futures.Executor``
 (``Client.get_executor``), and the sweeps in ``workspace`` accept any executor, so the same slab and
@@ -31,17 +31,21 @@ Where the time went, and what is done about it (``benchmarks/bench_workspace_das
   (~7000 margin evaluations at 2.5 mm, ~15 % of the serial time): now one vectorised batch per plane
   (``workspace.extents``).
 
-What is shipped per task is small (a slab's ``_GridSpec`` ~7 kB, a 6-D chunk's arguments ~2 kB, a
+What is shipped per task is small (a slab's ``GridSpec`` ~7 kB, a 6-D chunk's arguments ~2 kB, a
 slab's result ~80 kB), so scattering it once would not change the time.
 """
 
 from __future__ import annotations
 
 import math
+import os
 
+import dask
+import distributed
 import numpy as np
 
 import stewart_drake.workspace as _ws
+from stewart_drake.workspace.grid import grid_axes
 
 # Dask settings for the workers of ``local_client`` (see the module docstring): no statistical profiler,
 # and Dask's default worker environment without MALLOC_TRIM_THRESHOLD_ (numpy temporaries reuse the heap).
@@ -53,19 +57,10 @@ WORKER_CONFIG = {
 TASKS_PER_WORKER = 8
 
 
-def _require_distributed():
-    try:
-        import distributed
-    except ImportError:  # pragma: no cover - exercised only without dask
-        raise ImportError('the Dask back end needs dask.distributed: pip install "dask[distributed]"') from None
-    return distributed
-
-
 def local_client(n_workers: int | None = None, threads_per_worker: int = 1, processes: bool = True, **kwargs):
     """A ``distributed.Client`` on a ``LocalCluster`` of ``n_workers`` (default: the usable CPUs) worker
     processes, one thread each (the numpy kernels are single-threaded per slab). Use as a context
     manager; closing the client closes the cluster."""
-    distributed = _require_distributed()
     cluster = local_cluster(n_workers or _ws.default_workers(), threads_per_worker, processes, **kwargs)
     client = distributed.Client(cluster)
     client._stewart_owned_cluster = cluster  # closed with the client (see close_client)
@@ -77,11 +72,6 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
     """A ``LocalCluster`` whose workers run with ``WORKER_CONFIG``: no statistical profiler, glibc's
     adaptive malloc (no ``MALLOC_TRIM_THRESHOLD_``, also when an earlier cluster left it in this
     process's environment)."""
-    import os
-
-    import dask
-
-    distributed = _require_distributed()
     held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
     try:
         with dask.config.set(WORKER_CONFIG):
@@ -93,10 +83,8 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
 
 
 def _import_kernels() -> bool:
-    import scipy.optimize  # noqa: F401  (the extents' refinement)
-
-    from stewart_drake import workspace  # noqa: F401
-
+    """Run on each worker: unpickling this function there imports this module and with it the sweep's
+    modules (``workspace``, scipy.optimize), so that the first timed task does not pay for them."""
     return True
 
 
@@ -120,7 +108,6 @@ def close_client(client) -> None:
 
 def dask_executor(client):
     """The ``concurrent.futures.Executor`` view of a Dask client (tasks are not cached: pure=False)."""
-    _require_distributed()
     return client.get_executor(pure=False)
 
 
@@ -128,10 +115,8 @@ def slab_nodes(platform, threads: int, orientation=(0.0, 0.0, 0.0), resolution: 
                bounds=None, chunk_nodes: int = 1 << 21, **_) -> int:
     """The ``chunk_nodes`` that gives at least ``TASKS_PER_WORKER`` slabs per thread (never more than
     ``chunk_nodes``; a slab keeps at least two x-planes)."""
-    from stewart_drake.workspace.grid import _grid_axes
-
     b = _ws.default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
-    nx, ny, nz = (len(a) for a in _grid_axes(b, float(resolution)))
+    nx, ny, nz = (len(a) for a in grid_axes(b, float(resolution)))
     planes = max(2, math.ceil(nx / (TASKS_PER_WORKER * threads)))
     return int(min(chunk_nodes, planes * ny * nz))
 
@@ -170,6 +155,5 @@ def count_reachable_on_dask(platform, grids, client=None, **kwargs):
 def map_platforms(function, platforms, client, **kwargs) -> list:
     """``[function(p, **kwargs) for p in platforms]`` evaluated on the cluster, in order. ``function``
     must be importable by the workers (a module-level function, e.g. ``workspace.stroke_volume_columns``)."""
-    _require_distributed()
     futures = client.map(function, list(platforms), pure=False, **kwargs)
     return client.gather(futures)

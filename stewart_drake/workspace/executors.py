@@ -4,29 +4,29 @@ any ``concurrent.futures.Executor`` (e.g. Dask's, see ``workspace_dask``), with 
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import sys
+from collections import deque
 from concurrent.futures import Executor, ProcessPoolExecutor
+
+from tqdm import tqdm
 
 from stewart_drake.workspace.limits import WorkspaceError
 
 
-def _run_tasks(fn, tasks, executor, workers, progress, desc):
+def run_tasks(fn, tasks, executor, workers, progress, desc):
     """Yield ``fn(*task)`` for every task, in order: in-process, on a process pool of ``workers``, or on a
     given ``concurrent.futures.Executor``. A generator, so that callers merge results as they come
     and memory stays bounded by the slab, not by the number of slabs. Progress with tqdm on stderr."""
-    from tqdm import tqdm
-
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, file=sys.stderr, leave=False)
     try:
         if executor is None and workers > 1 and len(tasks) > 1:
-            import multiprocessing
-
             with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as ex:
                 yield from _drain(ex, fn, tasks, bar, window=4 * workers)
         elif executor is not None:
             if not isinstance(executor, Executor) and not hasattr(executor, "submit"):
-                raise WorkspaceError(f"executor must be a concurrent.futures.Executor (or have submit), got {type(executor).__name__}")
+                raise WorkspaceError(WorkspaceError.EXECUTOR.format(kind=type(executor).__name__))
             yield from _drain(executor, fn, tasks, bar, window=None)
         else:
             for t in tasks:
@@ -38,8 +38,6 @@ def _run_tasks(fn, tasks, executor, workers, progress, desc):
 
 def _drain(executor, fn, tasks, bar, window):
     """Submit tasks (at most ``window`` in flight, None: all) and yield results in order."""
-    from collections import deque
-
     pending, it = deque(), iter(tasks)
     for t in it if window is None else (next(it, None) for _ in range(window)):
         if t is not None:

@@ -5,10 +5,11 @@ extreme refined by a constrained optimisation (SLSQP on the limit margins) with 
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import minimize
 
 from stewart_drake.core.kinematics import leg_vectors
 from stewart_drake.workspace.limits import raw_margins
-from stewart_drake.workspace.slabs import _GridSpec
+from stewart_drake.workspace.slabs import GridSpec
 
 
 def _extreme_indices(views) -> list:
@@ -20,7 +21,7 @@ def _extreme_indices(views) -> list:
     return [(a[0], a[-1]) for a in (ix, iy, iz)]
 
 
-def _extents_from_views(axes, top, front, side, h):
+def extents_from_views(axes, top, front, side, h):
     """Grid-level extents: the true extreme lies within h beyond the extreme inside node."""
     ext = np.array([[axes[k][i0] - h / 2, axes[k][i1] + h / 2] for k, (i0, i1) in enumerate(_extreme_indices((top, front, side)))])
     return ext, h / 2
@@ -42,14 +43,12 @@ def _extreme_plane_nodes(axes, top, front, side, k, idx) -> np.ndarray:
     return pts
 
 
-def _refine_extents(spec: _GridSpec, extents, top, front, side, h, feas_tol: float = 1e-9):
+def refine_extents(spec: GridSpec, extents, top, front, side, h, feas_tol: float = 1e-9):
     """Each extreme found by a constrained optimisation (SLSQP on the per-leg margins, all smooth
     pieces) from the extreme grid node; kept only if the optimum is feasible (every margin >=
     -``feas_tol``) and at least as far out as the node. Returns (extents, error) where error is the
     largest gap between a refined extreme and its grid bracket's far end (node ± h): under the grid
     assumption (the boundary is resolved at h) the true extreme lies in that gap."""
-    from scipy.optimize import minimize
-
     axes, o = spec.axes, spec.orientation
     out = extents.copy()
     gaps = []

@@ -14,11 +14,11 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_vectors
 from stewart_drake.core.rotations import check_convention
-from stewart_drake.core.sanity import plate_floor
-from stewart_drake.workspace.executors import _run_tasks
-from stewart_drake.workspace.extents import _extents_from_views, _refine_extents
-from stewart_drake.workspace.limits import Limits, WorkspaceError, _check_orientation
-from stewart_drake.workspace.slabs import _grid_spec, _slab_task
+from stewart_drake.core.sanity import human_bytes, memory_budget, plate_floor
+from stewart_drake.workspace.executors import run_tasks
+from stewart_drake.workspace.extents import extents_from_views, refine_extents
+from stewart_drake.workspace.limits import Limits, WorkspaceError, check_orientation
+from stewart_drake.workspace.slabs import grid_spec, slab_task
 
 # Largest grid the sweep accepts (nodes): ~10 min of the stroke kernel at ~5e7 nodes/s on one core.
 MAX_GRID_NODES = 3e10
@@ -29,7 +29,7 @@ BYTES_PER_PLANE_NODE = 120
 
 
 def _node_counts(bounds, h) -> tuple:
-    """Nodes per axis ``_grid_axes`` would make, computed without allocating them."""
+    """Nodes per axis ``grid_axes`` would make, computed without allocating them."""
     return tuple(math.ceil(hi / h) - math.floor(lo / h) + 3 for lo, hi in bounds)
 
 
@@ -44,18 +44,14 @@ def grid_memory(bounds, h) -> tuple[float, float]:
 def check_grid_size(bounds, h) -> None:
     """``WorkspaceError`` naming the resolution, the node count, the memory and the finest resolution
     this machine can hold when the grid is too large (memory budget or ``MAX_GRID_NODES``)."""
-    from stewart_drake.core.sanity import human_bytes, memory_budget
-
     nodes, need = grid_memory(bounds, h)
     budget = memory_budget()
     if need <= budget and nodes <= MAX_GRID_NODES:
         return
     # memory scales as 1/h² (faces), time as 1/h³ (nodes): the finest step that fits both
     h_min = max(h * math.sqrt(need / budget), h * (nodes / MAX_GRID_NODES) ** (1 / 3))
-    why = human_bytes(need) if need > budget else f"more than the {MAX_GRID_NODES:.0e} nodes one sweep may take"
-    raise WorkspaceError(
-        f"resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can hold is "
-        f"~{h_min * 1e3:.2g} mm; use a coarser --resolution")
+    why = human_bytes(need) if need > budget else WorkspaceError.GRID_NODES.format(limit=MAX_GRID_NODES)
+    raise WorkspaceError(WorkspaceError.GRID_TOO_LARGE.format(h=h, nodes=nodes, why=why, h_min_mm=h_min * 1e3))
 
 
 @dataclass
@@ -120,17 +116,19 @@ def default_bounds(platform: Platform, orientation=(0.0, 0.0, 0.0), convention: 
     """``(3, 2)`` a box that holds the whole stroke workspace: the intersection of the six balls'
     bounding boxes (|p + l_i(0)| <= L_max), cut below at ``z_floor`` (default ``sanity.plate_floor``:
     every plate anchor above the base plane, which excludes the mirror-image workspace under the base)."""
-    o = _check_orientation(orientation)
+    o = check_orientation(orientation)
     l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, o], convention)
     lo = np.max(-l0 - platform.L_max, axis=0)
     hi = np.min(-l0 + platform.L_max, axis=0)
     lo[2] = max(lo[2], plate_floor(platform, o, convention) if z_floor is None else z_floor)
     if np.any(hi <= lo):
-        raise WorkspaceError(f"the stroke workspace at orientation {np.asarray(orientation).tolist()} rad is empty (no common point of the legs' reach)")
+        raise WorkspaceError(WorkspaceError.EMPTY_STROKE.format(orientation=np.asarray(orientation).tolist()))
     return np.stack([lo, hi], -1)
 
 
-def _grid_axes(bounds, h) -> tuple:
+def grid_axes(bounds, h) -> tuple:
+    """Three 1-D arrays of node coordinates (m), multiples of the step ``h`` covering ``(3, 2)`` bounds
+    with one node beyond each side (outside the workspace by construction)."""
     axes = []
     for lo, hi in bounds:
         k0, k1 = math.floor(lo / h) - 1, math.ceil(hi / h) + 1  # one node beyond each side: outside
@@ -163,13 +161,13 @@ def constant_orientation_workspace(
     check_convention(convention)
     h = float(resolution)
     if not (np.isfinite(h) and h > 0):
-        raise WorkspaceError(f"resolution must be a positive number of metres, got {resolution}")
+        raise WorkspaceError(WorkspaceError.RESOLUTION.format(value=resolution))
     b = default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
     if b.shape != (3, 2) or not np.all(b[:, 1] > b[:, 0]):
-        raise WorkspaceError(f"bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {np.asarray(bounds).tolist()}")
+        raise WorkspaceError(WorkspaceError.BOUNDS.format(value=np.asarray(bounds).tolist()))
     check_grid_size(b, h)
-    axes = _grid_axes(b, h)
-    spec = _grid_spec(platform, orientation, convention, limits, axes)
+    axes = grid_axes(b, h)
+    spec = grid_spec(platform, orientation, convention, limits, axes)
     nx, ny, nz = (len(a) for a in axes)
     per = max(2, int(chunk_nodes) // (ny * nz))  # a slab re-evaluates one plane each side: keep >= 2
     tasks = [(spec, i, min(i + per, nx)) for i in range(0, nx, per)]
@@ -178,7 +176,7 @@ def constant_orientation_workspace(
     removed: dict = {n: 0 for n in limits.active if n != "stroke"}
     edge = False
     boundaries = []
-    for r in _run_tasks(_slab_task, tasks, executor, workers, progress, "workspace slabs"):
+    for r in run_tasks(slab_task, tasks, executor, workers, progress, "workspace slabs"):
         i0 = r["i0"]
         k = len(r["top"])
         top[i0 : i0 + k], front[i0 : i0 + k] = r["top"], r["front"]
@@ -191,14 +189,14 @@ def constant_orientation_workspace(
         boundaries.append(r["boundary"])
     bnd_idx = np.concatenate(boundaries)
     if inside == 0:
-        raise WorkspaceError(f"no reachable position at orientation {spec.orientation.tolist()} rad with limits {list(limits.active)} at resolution {h} m")
+        raise WorkspaceError(WorkspaceError.NOTHING_REACHABLE.format(orientation=spec.orientation.tolist(), limits=list(limits.active), h=h))
     boundary = np.stack([axes[k][bnd_idx[:, k]] for k in range(3)], -1).astype(np.float32)
     h3 = h**3
     vol = inside * h3
     v_lo, v_hi = full * h3, (full + mixed) * h3
-    extents, ext_err = _extents_from_views(axes, top, front, side, h)
+    extents, ext_err = extents_from_views(axes, top, front, side, h)
     if refine:
-        extents, ext_err = _refine_extents(spec, extents, top, front, side, h)
+        extents, ext_err = refine_extents(spec, extents, top, front, side, h)
     return Workspace(
         orientation=spec.orientation,
         limits=limits,

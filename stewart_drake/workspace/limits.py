@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import WorkspaceError
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import condition_number, leg_vectors
 from stewart_drake.core.rotations import check_convention, rotation_matrix
@@ -19,10 +19,6 @@ LIMIT_NAMES = ("stroke", "base_joint", "top_joint", "collision", "dexterity")
 LIMIT_UNITS = {"stroke": "m", "base_joint": "rad", "top_joint": "rad", "collision": "m", "dexterity": "1"}
 AXES = ("x", "y", "z")
 _BLOCK = 4096  # poses per block in the collision kernel
-
-
-class WorkspaceError(StewartError):
-    """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
 
 
 @dataclass(frozen=True)
@@ -50,11 +46,11 @@ class Limits:
         for name in ("base_cone", "top_cone"):
             v = getattr(self, name)
             if v is not None and not (0 < v <= math.pi):
-                raise WorkspaceError(f"Limits.{name} must be an angle in (0, pi] rad, got {v}")
+                raise WorkspaceError(WorkspaceError.CONE.format(name=name, value=v))
         if self.leg_diameter is not None and not (np.isfinite(self.leg_diameter) and self.leg_diameter > 0):
-            raise WorkspaceError(f"Limits.leg_diameter must be a positive length in metres, got {self.leg_diameter}")
+            raise WorkspaceError(WorkspaceError.LEG_DIAMETER.format(value=self.leg_diameter))
         if self.max_condition is not None and not (self.max_condition > 1):
-            raise WorkspaceError(f"Limits.max_condition must be > 1, got {self.max_condition}")
+            raise WorkspaceError(WorkspaceError.MAX_CONDITION.format(value=self.max_condition))
         for name in ("base_axes", "top_axes"):
             v = getattr(self, name)
             if v is None:
@@ -62,7 +58,7 @@ class Limits:
             a = np.array(v, dtype=float)
             n = np.linalg.norm(a, axis=-1) if a.shape == (6, 3) else None
             if n is None or not np.all(n > 1e-12):
-                raise WorkspaceError(f"Limits.{name} must be six non-zero 3-vectors, shape (6, 3), got {np.shape(v)}")
+                raise WorkspaceError(WorkspaceError.AXES.format(name=name, shape=np.shape(v)))
             object.__setattr__(self, name, a / n[:, None])
 
     @property
@@ -151,7 +147,7 @@ def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention
     return out
 
 
-def _margins_from_legs(platform: Platform, l, R, limits: Limits, poses=None, convention="utn") -> dict:
+def margins_from_legs(platform: Platform, l, R, limits: Limits, poses=None, convention="utn") -> dict:
     """``{name: (margin (...), index (...))}``: the worst element of each ``raw_margins`` entry; index is
     the worst leg (0-based) or, for collision, the worst row of ``leg_pairs``."""
     return {n: (m.min(axis=-1), m.argmin(axis=-1)) for n, m in raw_margins(platform, l, R, limits, poses, convention).items()}
@@ -160,12 +156,12 @@ def _margins_from_legs(platform: Platform, l, R, limits: Limits, poses=None, con
 def limit_margins(platform: Platform, poses, limits: Limits = Limits(), convention: str = "utn") -> dict:
     """Signed margins of ``(..., 6)`` poses to each active limit: ``{name: (margin (...), index (...))}``;
     a pose is inside where every margin is >= 0. Units in ``LIMIT_UNITS``; ``index`` as in
-    ``_margins_from_legs`` (worst leg, 0-based, or worst row of ``leg_pairs``)."""
+    ``margins_from_legs`` (worst leg, 0-based, or worst row of ``leg_pairs``)."""
     check_convention(convention)
     q = np.asarray(poses, dtype=float)
     l = leg_vectors(platform, q, convention)
     R = rotation_matrix(q[..., 3:], convention)
-    return _margins_from_legs(platform, l, R, limits, q, convention)
+    return margins_from_legs(platform, l, R, limits, q, convention)
 
 
 def classify(platform: Platform, poses, limits: Limits = Limits(), convention: str = "utn") -> np.ndarray:
@@ -177,8 +173,9 @@ def classify(platform: Platform, poses, limits: Limits = Limits(), convention: s
     return inside
 
 
-def _check_orientation(orientation) -> np.ndarray:
+def check_orientation(orientation) -> np.ndarray:
+    """``(3,)`` finite float angles (rad) about X, Y, Z, or ``WorkspaceError`` naming the value."""
     o = np.asarray(orientation, dtype=float)
     if o.shape != (3,) or not np.all(np.isfinite(o)):
-        raise WorkspaceError(f"orientation must be 3 finite angles (rad) about X, Y, Z, got {np.asarray(orientation).tolist()}")
+        raise WorkspaceError(WorkspaceError.ORIENTATION.format(value=np.asarray(orientation).tolist()))
     return o

@@ -11,9 +11,9 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import condition_number
-from stewart_drake.workspace.executors import _run_tasks
+from stewart_drake.workspace.executors import run_tasks
 from stewart_drake.workspace.grid import default_bounds
-from stewart_drake.workspace.limits import Limits, WorkspaceError, _check_orientation, classify
+from stewart_drake.workspace.limits import Limits, WorkspaceError, check_orientation, classify
 
 
 def dexterity_map(
@@ -31,8 +31,8 @@ def dexterity_map(
     NaN outside the workspace of ``limits``. ``extent``: half-width of the square (default from
     ``default_bounds``)."""
     if plane not in ("xy", "xz", "yz"):
-        raise WorkspaceError(f"plane must be 'xy', 'xz' or 'yz', got {plane!r}")
-    o = _check_orientation(orientation)
+        raise WorkspaceError(WorkspaceError.PLANE.format(value=plane))
+    o = check_orientation(orientation)
     ku, kv = ("xyz".index(plane[0]), "xyz".index(plane[1]))
     kw = 3 - ku - kv
     fixed = platform.home_pose()[kw] if at is None else float(at)
@@ -74,11 +74,11 @@ def count_reachable(
     ``total``, ``fraction`` and ``marginals`` (per coordinate, the count inside at each grid value)."""
     grids = [np.asarray(g, dtype=float).ravel() for g in grids]
     if len(grids) != 6 or any(len(g) == 0 for g in grids):
-        raise WorkspaceError(f"grids must be six non-empty 1-D arrays (px, py, pz, a_x, a_y, a_z), got {len(grids)}")
+        raise WorkspaceError(WorkspaceError.GRIDS.format(n=len(grids)))
     total = math.prod(len(g) for g in grids)
     tasks = [(platform, grids, limits, convention, s, min(s + chunk, total)) for s in range(0, total, chunk)]
     count, marginals = 0, [np.zeros(len(g), np.int64) for g in grids]
-    for c, marg in _run_tasks(_count_task, tasks, executor, workers, progress, "6-D sweep"):
+    for c, marg in run_tasks(_count_task, tasks, executor, workers, progress, "6-D sweep"):
         count += c
         for k in range(6):
             marginals[k] += marg[k]

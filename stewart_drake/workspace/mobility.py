@@ -13,9 +13,9 @@ def gruebler_mobility(n_links: int, joint_dofs, passive_dofs: int = 0, space_dof
     freedoms such as a leg spinning about its own axis), ``space_dof`` λ (6 spatial, 3 planar)."""
     f = [int(x) for x in joint_dofs]
     if space_dof not in (3, 6):
-        raise WorkspaceError(f"space_dof (lambda) must be 3 (planar) or 6 (spatial), got {space_dof}")
+        raise WorkspaceError(WorkspaceError.SPACE_DOF.format(value=space_dof))
     if n_links < 1 or any(not 1 <= x <= space_dof for x in f):
-        raise WorkspaceError(f"need n_links >= 1 and every joint freedom in 1..{space_dof}, got n = {n_links}, f = {f}")
+        raise WorkspaceError(WorkspaceError.JOINTS.format(space_dof=space_dof, n=n_links, f=f))
     return space_dof * (n_links - len(f) - 1) + sum(f) - int(passive_dofs)
 
 
@@ -31,7 +31,7 @@ def stewart_mobility(kind: str = "SPS") -> dict:
     """Grübler's count for a 6-leg platform of joint type ``kind`` ('SPS', 'UPS', 'UPU'): 14 links
     (base, top, two per leg), 18 joints. Returns n, j, joint freedoms, I_f and m."""
     if kind not in STEWART_JOINTS:
-        raise WorkspaceError(f"unknown leg type {kind!r}; expected one of {', '.join(STEWART_JOINTS)}")
+        raise WorkspaceError(WorkspaceError.LEG_TYPE.format(kind=kind, valid=", ".join(STEWART_JOINTS)))
     fb, fp, ft, idle = STEWART_JOINTS[kind]
     dofs = [fb] * 6 + [fp] * 6 + [ft] * 6
     return {"kind": kind, "n": 14, "j": 18, "sum_f": sum(dofs), "I_f": idle, "m": gruebler_mobility(14, dofs, idle)}

@@ -68,19 +68,20 @@ def orientation_limits(
     Returns six ``RotationLimit`` (x+, x-, y+, y-, z+, z-)."""
     pos = platform.home_pose()[:3] if position is None else np.asarray(position, dtype=float)
     if pos.shape != (3,) or not np.all(np.isfinite(pos)):
-        raise WorkspaceError(f"position must be 3 finite coordinates in metres, got {np.asarray(position).tolist()}")
+        raise WorkspaceError(WorkspaceError.POSITION.format(value=np.asarray(position).tolist()))
     c = platform.rotation_centre if centre is None else np.asarray(centre, dtype=float)
     if c.shape != (3,) or not np.all(np.isfinite(c)):
-        raise WorkspaceError(f"rotation centre must be 3 finite coordinates in metres (plate frame), got {np.asarray(centre).tolist()}")
+        raise WorkspaceError(WorkspaceError.CENTRE.format(value=np.asarray(centre).tolist()))
     if not (0 < step < max_angle):
-        raise WorkspaceError(f"step must be in (0, max_angle), got step = {step} rad, max_angle = {max_angle} rad")
+        raise WorkspaceError(WorkspaceError.STEP.format(step=step, max_angle=max_angle))
     pivot = platform.replace(rotation_centre=c)
     p_C = pos - platform.rotation_centre + c  # zero orientation: the pivot point in B
     start = np.r_[p_C, 0.0, 0.0, 0.0]
     m0 = limit_margins(pivot, start, limits)
     bad = [n for n, (m, _) in m0.items() if m < 0]
     if bad:
-        raise WorkspaceError(f"start pose {np.round(np.r_[pos, 0, 0, 0], 6).tolist()} is outside the {bad[0]} limit (margin {float(m0[bad[0]][0]):.4g} {LIMIT_UNITS[bad[0]]})")
+        raise WorkspaceError(WorkspaceError.START_OUTSIDE.format(pose=np.round(np.r_[pos, 0, 0, 0], 6).tolist(), limit=bad[0],
+                                                                 margin=float(m0[bad[0]][0]), unit=LIMIT_UNITS[bad[0]]))
 
     def poses(dirs, angles):  # dirs (k,) 0..5 -> axis, sign; angles (k, n) magnitudes
         q = np.broadcast_to(start, angles.shape + (6,)).copy()

@@ -1,4 +1,4 @@
-"""The grid kernel of the constant-orientation workspace: a small picklable ``_GridSpec`` and the
+"""The grid kernel of the constant-orientation workspace: a small picklable ``GridSpec`` and the
 x-slab worker that classifies nodes, counts cells and finds boundary nodes. Translation enters the
 inverse kinematics additively, l_i(p, R) = p + l_i(0, R), so l_i(0, R) comes from
 ``kinematics.leg_vectors`` once and the grid positions are added (the tests check this node by node).
@@ -15,11 +15,11 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_vectors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import plate_floor
-from stewart_drake.workspace.limits import Limits, _check_orientation, _margins_from_legs
+from stewart_drake.workspace.limits import Limits, check_orientation, margins_from_legs
 
 
 @dataclass(frozen=True)
-class _GridSpec:
+class GridSpec:
     """Everything a slab worker needs (small and picklable)."""
 
     platform: Platform
@@ -32,13 +32,15 @@ class _GridSpec:
     z_floor: float = -np.inf  # nodes count only above it (``sanity.plate_floor``: plate above the base)
 
 
-def _grid_spec(platform, orientation, convention, limits, axes) -> _GridSpec:
-    o = _check_orientation(orientation)
+def grid_spec(platform, orientation, convention, limits, axes) -> GridSpec:
+    """The ``GridSpec`` of a constant-orientation sweep over the node ``axes`` (three 1-D arrays, m) at
+    ``orientation`` (3,) rad."""
+    o = check_orientation(orientation)
     l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, o], convention)
-    return _GridSpec(platform, o, convention, limits, l0, rotation_matrix(o, convention), tuple(axes), plate_floor(platform, o, convention))
+    return GridSpec(platform, o, convention, limits, l0, rotation_matrix(o, convention), tuple(axes), plate_floor(platform, o, convention))
 
 
-def _inside_block(spec: _GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
+def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
     """Classify the grid block xs × ys × zs: ``(inside, removed)`` where ``removed``
     counts, per optional limit, the stroke-feasible nodes it rejects in each x-plane ``(nx,)``.
     ``inside`` is bool ``(nx, ny, nz)``."""
@@ -59,7 +61,7 @@ def _inside_block(spec: _GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
         pos = np.stack([xs[idx[0]], ys[idx[1]], zs[idx[2]]], -1)
         l = pos[:, None, :] + spec.offsets
         poses = np.concatenate([pos, np.broadcast_to(spec.orientation, pos.shape)], -1)
-        margins = _margins_from_legs(p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention)
+        margins = margins_from_legs(p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention)
         keep = np.ones(len(pos), bool)
         for name in others:
             bad = margins[name][0] < 0
@@ -69,11 +71,11 @@ def _inside_block(spec: _GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
     return ok, removed
 
 
-def _slab_task(spec: _GridSpec, i0: int, i1: int) -> dict:
+def slab_task(spec: GridSpec, i0: int, i1: int) -> dict:
     """Sweep the owned x-planes i0..i1-1 (and one neighbour plane each side for cells and boundary)."""
     x, y, z = spec.axes
     lo, hi = max(i0 - 1, 0), min(i1 + 1, len(x))
-    m, removed_all = _inside_block(spec, x[lo:hi], y, z)
+    m, removed_all = inside_block(spec, x[lo:hi], y, z)
     own = slice(i0 - lo, i1 - lo)
     mo = m[own]
     # cells between owned plane p and p+1

@@ -14,7 +14,7 @@ def view_figures(ws: Workspace, reference=None, title: str = "") -> dict:
     """The paper's views of a workspace: ``{"top": X–Y, "front": X–Z, "side": Y–Z, "3d": boundary}``
     matplotlib figures (axes in metres). ``reference``: optional (3, 2) extents drawn dashed (e.g. a
     paper's numbers)."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: importing pyplot picks a backend (commands select Agg first)
 
     x, y, z = ws.axes
     views = {"top": (x, y, ws.top, 0, 1), "front": (x, z, ws.front, 0, 2), "side": (y, z, ws.side, 1, 2)}
