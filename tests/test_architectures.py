@@ -234,6 +234,7 @@ def test_six_three_file_through_other_commands(tmp_path, capsys):
     assert np.all(np.isfinite(json.loads(capsys.readouterr().out)["forces"]))
     # As tests/test_dynamics_drake.py: O(10) operations per term on forces of O(10 N), J well conditioned
     # (< 30 here): rounding gives ~1e-14 N; 1e-9 N is the bound asked of the dynamics everywhere.
-    q, qd, qdd = harmonic_trajectory(np.linspace(0, 2, 7), p.home_pose() + [0.01, -0.01, 0, 0.02, 0.01, 0.03],
-                                     [0.02, 0.02, 0.01, 0.1, 0.1, 0.2], [1.3, 2.1, 1.7, 3.0, 2.5, 3.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    centre, amplitude = p.home_pose() + [0.01, -0.01, 0, 0.02, 0.01, 0.03], [0.02, 0.02, 0.01, 0.1, 0.1, 0.2]
+    q, qd, qdd = harmonic_trajectory(np.linspace(0, 2, 7), centre, amplitude, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5],
+                                     [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
     assert np.abs(leg_forces(p, q, qd, qdd, "utn") - drake_leg_forces(p, q, qd, qdd, "utn")).max() <= 1e-9

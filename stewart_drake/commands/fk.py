@@ -152,7 +152,7 @@ def run(args) -> int:
         )
         if "paths" in out:
             counts = ", ".join(f"{v} {c}" for c, v in out["paths"].items() if v)
-            engine = {"c": "c (the compiled tracker, track.c)", "numpy": "numpy (no C compiler)"}.get(out["engine"], out["engine"])
+            engine = {"c": "c (the compiled tracker, track.c)", "numpy": "numpy (no C compiler)"}[out["engine"]]
             print(f"architecture {out['architecture_text']} ({counts}); tracking engine: {engine}")
             print(("complete: " if out["complete"] else "") + out["guarantee"])
         elif "modes_found" in out:

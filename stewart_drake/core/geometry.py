@@ -442,7 +442,7 @@ def check_base_anchors(points: np.ndarray) -> None:
     try:
         _check_distinct(points, "base anchors")
     except GeometryError as e:
-        raise GeometryError(f"{e}; legs may share base joints only in three pairs (6-3), declared with leg_base") from None
+        raise GeometryError(GeometryError.BASE_PAIRS.format(problem=e)) from None
 
 
 def base_anchors_per_leg(cfg: PlatformConfig) -> np.ndarray:
@@ -451,17 +451,16 @@ def base_anchors_per_leg(cfg: PlatformConfig) -> np.ndarray:
     pts = np.asarray(cfg.base_anchors, dtype=float).reshape(-1, 3)
     if not cfg.leg_base:
         if len(pts) != 6:
-            raise GeometryError(f"base_anchors: {len(pts)} points given; give 6 (one per leg), or list each base joint once "
-                                f"and give leg_base (the base joint of each leg)")
+            raise GeometryError(GeometryError.BASE_COUNT.format(n=len(pts)))
         return pts
     idx = np.asarray(cfg.leg_base)
     bad = [i for i, j in enumerate(idx) if not 0 <= j < len(pts)]
     if bad:
-        raise GeometryError(f"leg_base: leg {bad[0] + 1} refers to base anchor {idx[bad[0]]}, but there are {len(pts)} "
-                            f"base anchors (0..{len(pts) - 1})")
+        raise GeometryError(GeometryError.LEG_BASE_RANGE.format(leg=bad[0] + 1, anchor=idx[bad[0]], n=len(pts),
+                                                                last=len(pts) - 1))
     unused = sorted(set(range(len(pts))) - set(idx.tolist()))
     if unused:
-        raise GeometryError(f"leg_base: base anchor {unused[0]} is used by no leg")
+        raise GeometryError(GeometryError.LEG_BASE_UNUSED.format(anchor=unused[0]))
     return pts[idx]
 
 
@@ -477,8 +476,7 @@ def check_shared_base(cfg: PlatformConfig, where: dict, shown: str, k: float) ->
         w = where.get(("base_anchors", b, 0))
         raise YamlError(YamlError.BAD_VALUE.format(
             path=shown, line=w.line if w else "?", field=f"base_anchors item {b + 1}", value=cfg.base_anchors[b],
-            problem=f"repeats item {a + 1} (closer than {MIN_ANCHOR_SEPARATION} m); legs sharing a base joint list it "
-                    f"once and give leg_base (the base joint of each leg)"))
+            problem=GeometryError.BASE_REPEATED.format(first=a + 1, limit=MIN_ANCHOR_SEPARATION)))
 
 
 def _check_platform_fields(shown: str):
