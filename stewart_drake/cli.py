@@ -67,9 +67,9 @@ def finite_number(text: str) -> Number:
     try:
         value = Number(text.strip())
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        raise argparse.ArgumentTypeError(UsageError.NOT_A_NUMBER.format(value=text)) from None
     if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+        raise argparse.ArgumentTypeError(UsageError.NOT_FINITE_NUMBER.format(value=text))
     return value
 
 
@@ -77,7 +77,7 @@ def checked_int(text: str) -> int:
     """argparse ``type`` for every integer option (at most 18 digits: counts, not big numbers)."""
     s = text.strip()
     if len(s.lstrip("+-")) > 18 or not s.lstrip("+-").isdigit():
-        raise argparse.ArgumentTypeError(f"not a whole number (at most 18 digits): {text!r}")
+        raise argparse.ArgumentTypeError(UsageError.NOT_WHOLE.format(value=text))
     return int(s)
 
 

@@ -44,12 +44,13 @@ class GeometryError(StewartError):
     SHAPE = "{name} must have shape {shape}, got {got}"
     NOT_FINITE = "{name} must be finite, got {value}"
     COINCIDE = "{what} {i} and {j} coincide at {at} m (closer than {limit} m)"
-    TOO_WIDE = ("platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is {target:.4f} m; "
-                "give home_height")
+    TOO_WIDE = ("platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is "
+                "{target:.4f} m; give home_height")
     LENGTH_UNIT = "length_unit: {problem}"
     ANCHOR_DESCRIPTIONS = ("platform {name!r}: give exactly one anchor description (utn, radial, or "
                            "base_anchors/top_anchors/leg_top), got {given}")
-    PLATE_SHEET = "platform {name!r}: plate thickness+density describe a UTN triangle sheet; give both, with utn dimensions"
+    PLATE_SHEET = ("platform {name!r}: plate thickness+density describe a UTN triangle sheet; give both, "
+                   "with utn dimensions")
     IN_FILE = "{path}: {problem}"
     UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
     UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
@@ -76,7 +77,8 @@ class GeometryError(StewartError):
     SERVO_FIELD_FINITE = "{field} must be finite, got {value!r}"
     SERVO_UNIT = "length_unit must be m or mm, got {value!r}"
     SERVO_TRAVEL = "servo.travel_deg must be below 90 degrees, got {value!r}"
-    SERVO_BOTH_LAYOUTS = "servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {given})"
+    SERVO_BOTH_LAYOUTS = ("servo hexapod {name!r}: give either paired or the explicit layout, not both "
+                          "(also got {given})")
     SERVO_MISSING_LAYOUT = ("servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, "
                             "platform_anchors, shaft_directions (missing {missing})")
     SERVO_UNKNOWN_PRESET = "unknown servo hexapod preset {name!r}; available: {presets}"
@@ -236,7 +238,8 @@ class EnvelopeError(StewartError):
     BOX_TOO_LARGE = "{source}: box.steps {steps!r} make {n} poses, more than the limit {limit}"
     TOO_MANY_POSES = "{source}: {n} poses, more than the limit {limit}"
     NEGATIVE_BOUND = "{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {value}"
-    OUT_OF_STROKE = "{source}: {pose} leaves the workspace: leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm {side} the stroke"
+    OUT_OF_STROKE = ("{source}: {pose} leaves the workspace: leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
+                     "{side} the stroke")
     SINGULAR = "{source}: {pose} is singular or nearly so (condition number {cond:.3g})"
 
 
@@ -269,13 +272,14 @@ class WorkspaceError(StewartError):
     """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
 
     EXECUTOR = "executor must be a concurrent.futures.Executor (or have submit), got {kind}"
-    GRID_TOO_LARGE = ("resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can hold is "
-                      "~{h_min_mm:.2g} mm; use a coarser --resolution")
+    GRID_TOO_LARGE = ("resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can "
+                      "hold is ~{h_min_mm:.2g} mm; use a coarser --resolution")
     GRID_NODES = "more than the {limit:.0e} nodes one sweep may take"
     EMPTY_STROKE = "the stroke workspace at orientation {orientation} rad is empty (no common point of the legs' reach)"
     RESOLUTION = "resolution must be a positive number of metres, got {value}"
     BOUNDS = "bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {value}"
-    NOTHING_REACHABLE = "no reachable position at orientation {orientation} rad with limits {limits} at resolution {h} m"
+    NOTHING_REACHABLE = ("no reachable position at orientation {orientation} rad with limits {limits} "
+                         "at resolution {h} m")
     CONE = "Limits.{name} must be an angle in (0, pi] rad, got {value}"
     LEG_DIAMETER = "Limits.leg_diameter must be a positive length in metres, got {value}"
     MAX_CONDITION = "Limits.max_condition must be > 1, got {value}"
@@ -365,6 +369,10 @@ class UsageError(StewartError):
 
     NEEDS = "{option} only applies with {needs}"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
+    # argparse prefixes these with "argument --option:" (option values that are not numbers)
+    NOT_A_NUMBER = "not a number: {value!r}"
+    NOT_FINITE_NUMBER = "must be a finite number, got {value!r}"
+    NOT_WHOLE = "not a whole number (at most 18 digits): {value!r}"
     INTERNAL = "internal error ({kind}: {detail}); please report it with the command line"
     LEGS_CORIOLIS = "--legs on computes the complete model; it cannot be combined with --coriolis off"
     ENGINE_C = "--engine c runs the fixed-point controller; --controller is {controller!r}"

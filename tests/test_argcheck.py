@@ -33,7 +33,8 @@ def test_check_shape_messages():
 def test_non_finite_sample_is_named_counted_from_one():
     q = np.zeros((2, 3, 6))
     q[1, 2, 4] = np.inf
-    with pytest.raises(NotFiniteError, match=re.escape(NOT_FINITE_SAMPLE.format(what="pose", index="2,3", values=q[1, 2].tolist()))):
+    message = NOT_FINITE_SAMPLE.format(what="pose", index="2,3", values=q[1, 2].tolist())
+    with pytest.raises(NotFiniteError, match=re.escape(message)):
         as_poses(q)
     with pytest.raises(NotFiniteError, match=re.escape("x 4 is not finite: nan")):
         check_finite_samples([0.0, 1.0, 2.0, np.nan], "x", sample_ndim=0)

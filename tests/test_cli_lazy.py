@@ -19,8 +19,10 @@ import json, sys
 sys.modules["pydrake"] = None
 from stewart_drake.cli import main
 rc = main(sys.argv[1:])
-loaded = sorted(m for m in sys.modules if m.startswith("stewart_drake.commands.") and not m.split(".")[-1].startswith("_"))
-print(json.dumps({"rc": rc, "commands": loaded, "pydrake": any(m.startswith("pydrake.") for m in sys.modules)}), file=sys.stderr)
+loaded = sorted(m for m in sys.modules
+                if m.startswith("stewart_drake.commands.") and not m.split(".")[-1].startswith("_"))
+drake = any(m.startswith("pydrake.") for m in sys.modules)
+print(json.dumps({"rc": rc, "commands": loaded, "pydrake": drake}), file=sys.stderr)
 """
 
 

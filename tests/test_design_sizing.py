@@ -14,6 +14,7 @@ from stewart_drake.design.envelope import Envelope, EnvelopeError, cartesian_leg
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.sizing import leg_motion, rotating_trajectory, size_trajectory
 from stewart_drake.design.verify import newton_euler_fd, sample_box
+from stewart_drake.errors import OptionError, PayloadError
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.drake.simulation import ROTATING
 
@@ -228,9 +229,9 @@ def test_cli_envelope_errors(tmp_path, capsys, text, needle):
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["--payload", "-1"], "--payload: payload mass must be"),
-    (["--payload", "2", "--payload-com", "0", "0", "-0.01"], "--payload-com: Z = -0.01 m is below the plate"),
-    (["--gravity", "-1"], "--gravity must be"),
+    (["--payload", "-1"], PayloadError.MASS.format(option="--payload", value="-1")),
+    (["--payload", "2", "--payload-com", "0", "0", "-0.01"], PayloadError.BELOW_PLATE.format(z=-0.01, unit="m")),
+    (["--gravity", "-1"], OptionError.GRAVITY.format(option="--gravity", value="-1")),
 ])
 def test_cli_size_bad_payload(capsys, args, needle):
     assert main(["size", "--trajectory", "seed", "--dt", "0.1"] + args) == 2

@@ -14,6 +14,7 @@ from stewart_drake.cli import main
 from stewart_drake.design.modes import analytic_modes, damping_matrix, mac, spatial_inertia, subspace_mac
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.stiffness import deflection, principal_stiffness, stiffness_matrix
+from stewart_drake.errors import PayloadError, StiffnessError
 from stewart_drake.drake.design_checks import drake_modes
 from stewart_drake.core.geometry import load_platform
 
@@ -188,10 +189,10 @@ def test_cli_modes_drake_json(capsys):
 
 
 @pytest.mark.parametrize("args, needle, rc", [
-    (["--leg-stiffness", "-5"], "--leg-stiffness: leg stiffness must be a positive number of N/m, got -5.0", 2),
+    (["--leg-stiffness", "-5"], StiffnessError.NOT_POSITIVE.format(option="--leg-stiffness", value=-5.0), 2),
     (["--leg-stiffness", "nan"], "--leg-stiffness", 2),
-    (["--payload", "2", "--payload-com", "0", "0", "-5"], "--payload-com: Z = -5 mm is below the plate", 2),
-    (["--platform", "utn-kinematic"], "legs.stiffness: no leg stiffness given", 2),
+    (["--payload", "2", "--payload-com", "0", "0", "-5"], PayloadError.BELOW_PLATE.format(z=-5.0, unit="mm"), 2),
+    (["--platform", "utn-kinematic"], StiffnessError.MISSING.format(option="legs.stiffness"), 2),
 ])
 def test_cli_stiffness_errors(capsys, args, needle, rc):
     assert main(["stiffness", "--pose", "0", "0", "700", "0", "0", "0"] + args) == rc

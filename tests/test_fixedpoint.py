@@ -12,7 +12,7 @@ from stewart_drake.errors import FixedPointError
 
 from stewart_drake.fixedpoint import q15
 from stewart_drake.fixedpoint import scalar as s
-from stewart_drake.fixedpoint.q15 import (FRAC16, MAX16, MAX32, MIN16, MIN32, L_add, L_deposit_h, L_mult,
+from stewart_drake.fixedpoint.q15 import (FRAC16, MAX16, MAX32, MIN16, MIN32, L_add, L_mult,
                                           L_negate, L_shl, L_shr, L_sub, SaturationCounter, abs_s, add, div_s,
                                           extract_h, extract_l, mac_r, mfr32Sqrt, mult, mult_r, negate, round_,
                                           shl, shr, sub, tfr16CosPIx, tfr16SinPIx)

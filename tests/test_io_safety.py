@@ -20,7 +20,6 @@ from pathlib import Path
 
 import pytest
 
-import stewart_drake.core.output_folder as atomic
 from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from stewart_drake.cli import main
 from stewart_drake.errors import OutputError

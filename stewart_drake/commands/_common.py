@@ -15,6 +15,7 @@ from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
+    """``--platform NAME|FILE``: a built-in preset or a platform YAML file."""
     parser.add_argument(
         "--platform",
         default=default,
@@ -24,16 +25,19 @@ def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
 
 
 def add_unit_args(parser, length_default: str = "mm", angle_default: str = "deg") -> None:
+    """``--length-unit`` and ``--angle-unit``: the units of the pose values on the command line."""
     parser.add_argument("--length-unit", choices=list(LENGTH_UNITS), default=length_default, help=f"default {length_default}")
     parser.add_argument("--angle-unit", choices=list(ANGLE_UNITS), default=angle_default, help=f"default {angle_default} ('pi': a fraction of pi)")
     parser.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention (default utn: Ry·Rx·Rz)")
 
 
 def platform_from_args(args) -> Platform:
+    """The platform named by ``--platform`` (a preset or a YAML file), validated."""
     return load_platform(args.platform)
 
 
 def add_force_arg(parser) -> None:
+    """``--force``: write into an existing folder that holds files stewart-drake did not write."""
     parser.add_argument("--force", action="store_true",
                         help="write into an existing folder that holds other files (they are never touched; see README, Output folders)")
 

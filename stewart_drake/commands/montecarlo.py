@@ -58,6 +58,8 @@ def register(sub) -> None:
 
 
 def build_study(args):
+    """The ``Study`` the options describe (platform, tolerance spec, reference, controller, integrator);
+    the options are checked here."""
     platform = load_platform(args.platform)
     spec = parse_spec(args.vary)
     program = (args.program, read_program(args.program)) if args.program else None
@@ -111,6 +113,7 @@ def run(args) -> int:
 
 
 def print_text(summary: dict) -> None:
+    """The study summary as text: error percentiles (mm, deg), the worst run, the strongest sensitivities, the files."""
     m = summary["metrics"]
     print(f"{summary['runs']} runs (study {summary['key']})")
     for k, scale, unit in (("max_leg_error_m", 1e3, "mm"), ("max_position_error_m", 1e3, "mm"), ("max_angle_error_rad", 57.29577951308232, "deg")):

@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.output_folder import atomic_folder
-from stewart_drake.errors import InputError
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.script.source import read_program
 from stewart_drake.commands._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json

@@ -21,6 +21,7 @@ NAMES = ("x", "y", "z", "rx", "ry", "rz")
 
 
 def add_pose_args(p) -> None:
+    """The arguments ``stiffness`` and ``modes`` share: platform, pose and its units, leg stiffness, payload."""
     add_platform_arg(p, default="utn-dynamic")
     p.add_argument("--pose", nargs=6, type=float, required=True, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="the pose, in the chosen units")
     add_unit_args(p)

@@ -165,7 +165,6 @@ def check_poses(platform, poses, convention: str = "utn", what: str = "pose", ti
         low = ~np.all(z > 0.0, axis=1)
         if np.any(low):
             i = int(np.argmax(low))
-            k = int(np.argmin(z[i]))
             raise PhysicalLimitError(below_base_message(label(i), z[i]))
     return q
 
@@ -334,6 +333,7 @@ def human_bytes(n: float) -> str:
 
 
 def human_seconds(s: float) -> str:
+    """A duration in seconds as people read it (s, min, h, days or years), for work estimates."""
     s = float(s)
     if s >= 86400 * 365:
         return f"~{s / (86400 * 365):.2g} years"

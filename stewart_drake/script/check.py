@@ -24,6 +24,7 @@ NUMBER, CONDITION = "number", "condition"
 
 
 def did_you_mean(name: str, candidates) -> str:
+    """" (did you mean 'x'?)" with the candidate closest to ``name`` (difflib), or "" when none is close."""
     close = difflib.get_close_matches(name, sorted(candidates), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 

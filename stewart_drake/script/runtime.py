@@ -116,6 +116,7 @@ def fmt_number(v: float) -> str:
 
 
 def pose_text(values, units) -> str:
+    """Six pose values as the program wrote them: "x, y, z <length unit>; a, b, g <angle unit>"."""
     v = [fmt_number(x) for x in values]
     return f"{', '.join(v[:3])} {units[0]}; {', '.join(v[3:])} {units[1]}"
 

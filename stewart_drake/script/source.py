@@ -16,7 +16,8 @@ def read_program(path: str) -> str:
     if not f.exists():
         raise InputError(InputError.PROGRAM_MISSING.format(path=path))
     if not f.is_file():
-        raise InputError(InputError.PROGRAM_NOT_FILE.format(path=path, what="a folder" if f.is_dir() else "not a regular file"))
+        what = "a folder" if f.is_dir() else "not a regular file"
+        raise InputError(InputError.PROGRAM_NOT_FILE.format(path=path, what=what))
     with f.open("rb") as fh:
         data = fh.read(MAX_PROGRAM_BYTES + 1)
     if len(data) > MAX_PROGRAM_BYTES:
