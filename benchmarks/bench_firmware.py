@@ -27,9 +27,9 @@ from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 
 
 def loop_rtf(p, engine, duration):
-    from stewart_drake.drake.simulation import build_simulation
+    from stewart_drake.drake.simulation import Scenario, build_simulation
 
-    sim = build_simulation(p, "seed", "fixed", engine=engine)
+    sim = build_simulation(Scenario(p, "seed", "fixed", engine=engine))
     t0 = time.perf_counter()
     sim.run(duration)
     return duration / (time.perf_counter() - t0), sim
@@ -57,7 +57,7 @@ def main(argv=None) -> int:
     ap.add_argument("--poses", type=int, default=2_000_000, help="poses per IK batch (default 2e6)")
     args = ap.parse_args(argv)
 
-    from stewart_drake.control.controller import ControllerConfig
+    from stewart_drake.control import ControllerConfig
     from stewart_drake.firmware.check import workspace_poses
     from stewart_drake.firmware.generate import generate
     from stewart_drake.firmware.host import tp17_leg_lengths_c
@@ -78,15 +78,15 @@ def main(argv=None) -> int:
 
     # the controller's compute alone, on the state and inputs of the last tick
     for name, sim in (("Python", sim_py), ("C", sim_c)):
-        ctrl = sim.controller
+        ctrl = sim.controller.law
         ref, L = p.home_pose(), np.full(6, 0.7)
         pid = ctrl.initial_pid_state(L, np.zeros(6))
         ff = np.zeros(6)
         ctrl.prime(ref[None])  # as in the run: the reference's IK / pose words are looked up
-        ctrl.compute(ref, L, pid, ff)
+        ctrl.step(pid, ref, L, ff)
         n = 3000
-        rate = best_rate(lambda: [ctrl.compute(ref, L, pid, ff) for _ in range(n)], n)
-        print(f"  compute() per tick, {name:6s} engine: {1e6 / rate:7.1f} µs")
+        rate = best_rate(lambda: [ctrl.step(pid, ref, L, ff) for _ in range(n)], n)
+        print(f"  law.step() per tick, {name:6s} engine: {1e6 / rate:7.1f} µs")
 
     cfg = ControllerConfig.for_platform(p)
     g = generate(p, cfg)

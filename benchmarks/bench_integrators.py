@@ -23,14 +23,15 @@ import numpy as np
 import stewart_drake.drake.integrators as integrators
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.drake.integrators import INTEGRATORS, apply_integrator, constraint_gaps
-from stewart_drake.drake.simulation import build_simulation, get_trajectory
+from stewart_drake.core.trajectory import get_trajectory
+from stewart_drake.drake.simulation import Scenario, build_simulation
 
 
 REFERENCE_ACCURACY = 1e-8
 
 
 def closed_loop(platform, trajectory, controller, integrator, duration):
-    sim = build_simulation(platform, trajectory, controller, integrator=integrator, design_duration=duration)
+    sim = build_simulation(Scenario(platform, trajectory, controller, integrator=integrator, design_duration=duration))
     t0 = time.perf_counter()
     log = sim.run(duration)
     wall = time.perf_counter() - t0
@@ -95,7 +96,7 @@ def main(argv=None) -> int:
     finally:
         integrators.CENIC_ACCURACY = default
     for integ in INTEGRATORS:
-        log = build_simulation(platform, traj, "float", integrator=integ, design_duration=args.duration).run(args.duration)
+        log = build_simulation(Scenario(platform, traj, "float", integrator=integ, design_duration=args.duration)).run(args.duration)
         out[f"float/{integ}_vs_reference"] = {
             "max_leg_length_difference_m": float(np.abs(log.lengths - ref.lengths).max()),
             "max_position_difference_m": float(np.abs(log.pose[:, :3] - ref.pose[:, :3]).max()),

@@ -22,12 +22,13 @@ from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 
 
 def rtf(platform, kind, period, duration, plant_step=None):
-    from stewart_drake.control.controller import ControllerConfig, DspTiming
-    from stewart_drake.drake.simulation import SEED, build_simulation
+    from stewart_drake.control import ControllerConfig, DspTiming
+    from stewart_drake.core.trajectory import SEED
+    from stewart_drake.drake.simulation import Scenario, build_simulation
 
     t0 = time.perf_counter()
-    sim = build_simulation(platform, SEED, kind, ControllerConfig(timing=DspTiming(sample_period=period)),
-                           plant_time_step=plant_step or min(period, 1e-3))
+    sim = build_simulation(Scenario(platform, SEED, kind, ControllerConfig(timing=DspTiming(sample_period=period)),
+                                    plant_time_step=plant_step or min(period, 1e-3)))
     t1 = time.perf_counter()
     sim.run(duration)
     t2 = time.perf_counter()

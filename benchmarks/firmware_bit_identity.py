@@ -20,8 +20,8 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 import numpy as np  # noqa: E402
 
-from stewart_drake.control.controller import ControllerConfig  # noqa: E402
-from stewart_drake.firmware.build import compiler_by_name  # noqa: E402
+from stewart_drake.control import ControllerConfig  # noqa: E402
+from stewart_drake.core.c_build import compiler_by_name  # noqa: E402
 from stewart_drake.firmware.check import workspace_poses  # noqa: E402
 from stewart_drake.firmware.generate import generate  # noqa: E402
 from stewart_drake.firmware.host import tp17_leg_lengths_c  # noqa: E402
@@ -29,7 +29,8 @@ from stewart_drake.firmware.module import compile_generated  # noqa: E402
 from stewart_drake.fixedpoint import tp17_leg_lengths  # noqa: E402
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words  # noqa: E402
 from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
-from stewart_drake.drake.simulation import build_simulation, fit_trajectory, get_trajectory  # noqa: E402
+from stewart_drake.core.trajectory import fit_trajectory, get_trajectory  # noqa: E402
+from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -64,7 +65,7 @@ def main(argv=None) -> int:
             if name != "utn-dynamic":
                 traj = fit_trajectory(traj, p)
             d = traj.duration or 4.0
-            logs = {e: build_simulation(p, traj, "fixed", engine=e).run(d) for e in ("python", "c")}
+            logs = {e: build_simulation(Scenario(p, traj, "fixed", engine=e)).run(d) for e in ("python", "c")}
             arrays = [f.name for f in dataclasses.fields(logs["c"]) if isinstance(getattr(logs["c"], f.name), np.ndarray)]
             same = all(np.array_equal(getattr(logs["python"], a), getattr(logs["c"], a)) for a in arrays)
             ok &= same

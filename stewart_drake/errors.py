@@ -516,3 +516,23 @@ NO_PLATE = (
 SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
 WORK_UNBOUNDED = "{option} {value} would need unboundedly many {what}{hint}"
 WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"
+
+
+# --- control
+class TimingError(StewartError):
+    """A DSP timing configuration that cannot run (the computation does not fit in the sample period)."""
+
+
+INFEASIBLE_TIMING = (
+    "infeasible DSP timing: one controller tick needs {cycles} cycles = {t_comp_us:.3f} µs at {clock_mhz:g} MHz, "
+    "longer than the sample period {period_us:.3f} µs"
+)
+PLANT_STEP_TOO_LONG = ("--plant-step {step} s is longer than the controller period {period} s; "
+                       "the plant step must resolve the period (at most one period)")
+PLANT_STEP_ABOVE_LAG = ("--plant-step {step} s is longer than the actuators' time constant {lag} s, "
+                        "the platform's fastest modelled dynamics; use a step of at most that")
+PERIOD_TOO_SLOW = (
+    "--period {period} s is too slow for platform {name}: its fastest open-loop mode grows at "
+    "{lam:.3g}/s, and the leg loops' crossover at this period is at most {w_c:.3g} rad/s (< {margin:g} × "
+    "{lam:.3g}); use a period of at most ~{t_max:.3g} s"
+)

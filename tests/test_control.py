@@ -1,81 +1,28 @@
-"""The DSP controller LeafSystems on their own (no plant): timing, causality, bit-exact set-points.
-
-The controller is driven by time functions (a pose reference, a leg-length "measurement"), and its
-held outputs are logged finely between ticks, so what is checked is what the plant would see. Drake
-publishes (logs) at time t *before* the discrete updates scheduled at t: a sample at t shows what every
-other system reads at t; a tick's or release's effect appears in the samples after it.
-"""
+"""The DSP controller without Drake: timing and cycle model, gain design and Q15 encoding, and single
+ticks of the float and fixed-point laws against independent computations (plain Python integers). The
+controller as a Drake system is tested in ``test_controller_system.py``."""
 
 import numpy as np
 import pytest
 
-from stewart_drake.control.controller import (
-    STATUS,
+from stewart_drake.control import (
     ControllerConfig,
     DspTiming,
     FixedGains,
+    FixedPointLaw,
+    FloatLaw,
     PidGains,
     TimingError,
-    make_controller,
     q15_gain,
     tick_cycles,
 )
-from stewart_drake.fixedpoint import QFormat, fixed_point_leg_lengths, tp17_cycles
+from stewart_drake.fixedpoint import fixed_point_leg_lengths, tp17_cycles
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.simulation import ROTATING, SEED, Trajectory, pose_source
+from stewart_drake.core.trajectory import ROTATING, SEED
 
 PLATFORM = load_preset("utn-dynamic")
 T = 1e-3
-
-
-def run_open_loop(kind, config, reference, measurement, duration, log_period):
-    """Controller alone: reference and measurement from time functions; returns the logs (times, command,
-    setpoint, status, reference) sampled every ``log_period`` and the controller."""
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import LogVectorOutput
-
-    b = DiagramBuilder()
-    ctrl = b.AddSystem(make_controller(kind, PLATFORM, config))
-    ref = b.AddSystem(pose_source(reference))
-    meas = b.AddSystem(pose_source(measurement))
-    b.Connect(ref.get_output_port(), ctrl.GetInputPort("reference"))
-    b.Connect(meas.get_output_port(), ctrl.GetInputPort("leg_lengths"))
-    logs = {name: LogVectorOutput(ctrl.GetOutputPort(name), b, log_period) for name in ("command", "setpoint", "status")}
-    logs["reference"] = LogVectorOutput(ref.get_output_port(), b, log_period)
-    d = b.Build()
-    sim = Simulator(d)
-    ctx = sim.get_mutable_context()
-    L0 = measurement.pose(0.0)
-    ctrl.initialize(ctrl.GetMyMutableContextFromRoot(ctx), L0, np.full(6, 5.0))
-    sim.Initialize()
-    sim.AdvanceTo(duration)
-    out = {k: v.FindLog(sim.get_context()) for k, v in logs.items()}
-    t = out["command"].sample_times()
-    return t, {k: v.data().T for k, v in out.items()}, ctrl
-
-
-def _fast(t):
-    """Every pose coordinate moving quickly, so that 60 ticks visit many set-points."""
-    t = np.asarray(t, dtype=float)[..., None]
-    amp = np.array([0.03, 0.03, 0.03, 0.15, 0.15, 0.3])
-    return np.array([0.0, 0.0, 0.7, 0, 0, 0]) + amp * np.sin(np.array([31.0, 37, 41, 43, 47, 53]) * t)
-
-
-FAST = Trajectory("fast", _fast, None)
-HOME = Trajectory("home", lambda t: SEED.pose(np.zeros_like(t)), None)
-L_HOME = leg_lengths(PLATFORM, SEED.pose(0.0))
-
-
-def step_measurement(t_step, delta):
-    """Leg lengths L_HOME, plus ``delta`` on every leg from ``t_step`` on."""
-
-    def fn(t):
-        t = np.asarray(t, dtype=float)
-        return L_HOME + delta * (t >= t_step)[..., None]
-
-    return Trajectory("step", fn, None)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -97,7 +44,7 @@ def test_infeasible_timing_is_refused_with_both_numbers():
     with pytest.raises(TimingError, match=rf"{n} cycles = {n / 60:.3f} µs at 60 MHz, longer than the sample period 50\.000 µs"):
         DspTiming(sample_period=50e-6).check()
     with pytest.raises(TimingError, match=r"5000 cycles = 500\.000 µs at 10 MHz.*400\.000 µs"):
-        make_controller("fixed", PLATFORM, ControllerConfig(timing=DspTiming(clock_hz=10e6, sample_period=400e-6, computation_cycles=5000)))
+        FixedPointLaw(PLATFORM, ControllerConfig(timing=DspTiming(clock_hz=10e6, sample_period=400e-6, computation_cycles=5000)))
     DspTiming(sample_period=n / 60e6).check()  # exactly fits: accepted
 
 
@@ -115,15 +62,13 @@ def test_bad_timing_values_are_named(kwargs, match):
         DspTiming(**kwargs)
 
 
-def test_bad_gains_and_controller_kind_are_named():
+def test_bad_gains_and_sensor_resolution_are_named():
     with pytest.raises(ValueError, match="PidGains.kd must be a finite number >= 0, got -1"):
         PidGains(kd=-1)
     with pytest.raises(ValueError, match=r"PidGains.feedforward_filter must be in \(0, 1\], got 0"):
         PidGains(feedforward_filter=0)
-    with pytest.raises(ValueError, match="controller must be 'fixed' or 'float', got 'analog'"):
-        make_controller("analog", PLATFORM)
     with pytest.raises(ValueError, match="sensor_resolution 0.0003 m must divide the IK's length LSB 0.001 m"):
-        make_controller("fixed", PLATFORM, ControllerConfig(timing=DspTiming(sensor_resolution=3e-4)))
+        FixedPointLaw(PLATFORM, ControllerConfig(timing=DspTiming(sensor_resolution=3e-4)))
 
 
 def test_q15_gains_are_within_half_an_lsb():
@@ -141,69 +86,9 @@ def test_q15_gains_are_within_half_an_lsb():
 # Timing in a Diagram
 
 
-@pytest.mark.parametrize("kind", ["fixed", "float"])
-def test_ticks_happen_exactly_at_k_T(kind):
-    T2 = 2e-3  # a period other than the plant's usual step
-    config = ControllerConfig(timing=DspTiming(sample_period=T2))
-    t, logs, _ = run_open_loop(kind, config, HOME, step_measurement(0.01, 1e-3), 0.05, T2 / 4)
-    st = logs["status"]
-    ticks = st[:, STATUS.index("ticks")]
-    tick_time = st[:, STATUS.index("last_tick_time")]
-    # one tick per period: a sample at t has seen the ticks strictly before t
-    k = np.ceil(t / T2 - 1e-9)
-    np.testing.assert_array_equal(ticks, k)
-    first = np.r_[False, np.diff(ticks) > 0]
-    # the logged tick times are k·T exactly (bit for bit: Drake schedules offset + k·period)
-    np.testing.assert_array_equal(tick_time[first], np.arange(first.sum()) * T2)
-
-
-@pytest.mark.parametrize(
-    "latency, cycles, delay",
-    [("sample", None, T), ("computation", 15000, 15000 / 60e6), ("none", None, 0.0)],
-)
-@pytest.mark.parametrize("kind", ["fixed", "float"])
-def test_output_depends_only_on_measurements_before_the_release(kind, latency, cycles, delay):
-    """A measurement step at tick 5 changes the output first at 5T + delay: with the default latency
-    ("sample") the output at tick k depends only on measurements up to tick k−1."""
-    config = ControllerConfig(timing=DspTiming(latency=latency, computation_cycles=cycles))
-    t_step, dt = 5 * T, T / 8
-    t, base, _ = run_open_loop(kind, config, HOME, step_measurement(1.0, 0.0), 0.012, dt)
-    t, step, _ = run_open_loop(kind, config, HOME, step_measurement(t_step, 1e-3), 0.012, dt)
-    changed = np.any(step["command"] != base["command"], axis=1)
-    assert changed.any()
-    t_first = t[np.argmax(changed)]
-    assert t_first == pytest.approx(t_step + delay + dt, abs=1e-12)  # the first sample after the release
-    # held between releases (zero-order hold): the command changes only at release instants k·T + delay
-    moves = t[1:][np.any(np.diff(step["command"], axis=0) != 0, axis=1)]
-    phase = np.mod(moves - dt - delay + 1e-12, T)
-    assert len(moves) > 3 and np.all(phase < 1e-9), moves
-
-
-# ----------------------------------------------------------------------------------------------
-# Bit-exact set-points
-
-
-@pytest.mark.parametrize("latency, lag", [("none", 1), ("sample", 2)])
-def test_fixed_setpoints_equal_the_standalone_fixed_point_ik(latency, lag):
-    """The set-points the controller releases are, bit for bit, ``fixed_point_leg_lengths`` of the
-    reference it read (16-bit words, integer mm, the tfr16 sine/cosine). Not primed: every tick
-    computes the IK itself. Logged at k·T (before tick k), so the sample at k·T shows the set-point of
-    tick k − 1 (latency none) or k − 2 (one full sample)."""
-    config = ControllerConfig(timing=DspTiming(latency=latency))
-    meas = Trajectory("L", lambda t: leg_lengths(PLATFORM, FAST.pose(t)), None)
-    t, logs, ctrl = run_open_loop("fixed", config, FAST, meas, 0.06, T)
-    ref = logs["reference"]  # the reference at each tick, as the controller read it
-    np.testing.assert_array_equal(t, np.arange(len(t)) * T)
-    words = fixed_point_leg_lengths(PLATFORM, ref, QFormat(16, 1e-3, "tfr16"), return_words=True)
-    sp = logs["setpoint"]
-    np.testing.assert_array_equal(sp[lag:], words[: len(words) - lag] * 1e-3)
-    assert ctrl.cache_misses == len(t) - 1  # one IK per tick (the last sample's tick is not run)
-    assert len(np.unique(words, axis=0)) > 40  # the reference moved through many set-points
-
-
 def test_primed_ik_cache_gives_the_same_words():
     config = ControllerConfig()
-    ctrl = make_controller("fixed", PLATFORM, config)
+    ctrl = FixedPointLaw(PLATFORM, config)
     poses = ROTATING.pose(np.arange(200) * 0.01)
     ctrl.prime(poses)
     for q in poses[::17]:
@@ -219,7 +104,7 @@ def test_fixed_pid_tick_matches_a_plain_integer_reimplementation():
     intrinsics): ETSI semantics sat16/sat32, L_mult = sat32(2ab), mult_r = (ab + 2^14) >> 15, shifts
     saturating. Random state and inputs (fixed seed), including saturating ones."""
     rng = np.random.default_rng(6)
-    ctrl = make_controller("fixed", PLATFORM)
+    ctrl = FixedPointLaw(PLATFORM)
     g, cpl = ctrl.gains, 100  # 1 mm IK LSB / 10 µm sensor counts
 
     def s16(x):
@@ -239,7 +124,7 @@ def test_fixed_pid_tick_matches_a_plain_integer_reimplementation():
         pid = np.concatenate([rng.integers(-(2**31), 2**31 - 1, 6), np.round(L / 1e-5) + rng.integers(-300, 300, 6),
                               rng.integers(-5000, 5000, 6), ctrl.setpoint_words(pose) + rng.integers(-3, 3, 6),
                               rng.integers(-5000, 5000, 6)]).astype(float)
-        cmd, sp, new, sat = ctrl.compute(pose, L, pid)
+        cmd, sp, new, sat = ctrl.step(pid, pose, L)
         words = ctrl.setpoint_words(pose)
         for i in range(6):
             integ, prev, df, sprev, vf = (int(pid[6 * j + i]) for j in range(5))
@@ -273,7 +158,7 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
     Newton–Euler of ``leg_forces_with_legs``)."""
     from dataclasses import replace
 
-    from stewart_drake.control.controller import leg_space_inertia
+    from stewart_drake.control import leg_space_inertia
     from stewart_drake.core.dynamics import mass_matrix
     from stewart_drake.core.kinematics import length_jacobian
 
@@ -288,7 +173,7 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
 
 @pytest.mark.parametrize("name", ["utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009"])
 def test_design_gains_follow_the_documented_rules(name):
-    from stewart_drake.control.controller import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
+    from stewart_drake.control import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
                                        UNKNOWN_POSE_STIFFNESS_FACTOR, design_gains, leg_space_inertia, loop_delay,
                                        strut_stiffness)
 
@@ -319,8 +204,8 @@ def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory
     over a full period (2π s) of each trajectory, more and other poses than the design's 64 over 4 s, with
     the pose's own K and heaviest mass. (The home-only design of 6b broke it on utn-kinematic: kp 15.3 kN/m
     against K up to 14.6 kN/m and ki 66 kN/(m·s), ~25 × the limit; the loop grew at ~2 Hz.)"""
-    from stewart_drake.control.controller import design_gains, leg_space_inertia, strut_stiffness
-    from stewart_drake.drake.simulation import design_poses, fit_trajectory, get_trajectory
+    from stewart_drake.control import design_gains, leg_space_inertia, strut_stiffness
+    from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
 
     p = load_preset(name)
     traj = fit_trajectory(get_trajectory(base), p)
@@ -334,7 +219,7 @@ def test_designed_gains_keep_the_heaviest_mode_routh_stable_along_the_trajectory
 
 
 def test_strut_stiffness_and_inertia_are_vectorised_over_poses():
-    from stewart_drake.control.controller import leg_space_inertia, strut_stiffness
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
 
     p = load_preset("utn-kinematic")
     q = p.home_pose() + np.array([[0, 0, 0, 0, 0, 0], [0.02, -0.01, 0.01, 0.05, 0.0, 0.2]])
@@ -346,7 +231,7 @@ def test_strut_stiffness_matches_the_open_loop_growth():
     """The negative stiffness K of the struts and the open-loop growth rate λ (``dynamics``) describe the
     same instability: the fastest growth needs λ² ≤ K / m_min (a stiffness K on the lightest mass), and
     the slowest unstable mode at least K / m_max — so λ_max² · m_min <= K <= λ_max² · m_max."""
-    from stewart_drake.control.controller import leg_space_inertia, strut_stiffness
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
     from stewart_drake.core.dynamics import open_loop_growth_rates
 
     for name in ("utn-dynamic", "utn-kinematic"):
@@ -361,14 +246,14 @@ def test_fixed_feedforward_is_one_saturating_word_added_to_the_sum():
     """The feed-forward enters the fixed-point law as its Q15 table word deposited in the high half and
     added with a saturating L_add; everything else in the tick is unchanged (Python integers)."""
     rng = np.random.default_rng(7)
-    ctrl = make_controller("fixed", PLATFORM)
+    ctrl = FixedPointLaw(PLATFORM)
     for trial in range(60):
         pose = SEED.pose(rng.uniform(0, 4))
         L = leg_lengths(PLATFORM, pose) + rng.normal(0, 1e-3, 6)
         pid = ctrl.initial_pid_state(L, rng.uniform(-50, 50, 6))
         ff = rng.uniform(-300, 300, 6)  # beyond the 200 N range for some legs: the word saturates
-        cmd0, sp0, st0, _ = ctrl.compute(pose, L, pid)
-        cmd, sp, st, sat = ctrl.compute(pose, L, pid, ff)
+        cmd0, sp0, st0, _ = ctrl.step(pid, pose, L)
+        cmd, sp, st, sat = ctrl.step(pid, pose, L, ff)
         np.testing.assert_array_equal(sp, sp0)
         np.testing.assert_array_equal(st[6:], st0[6:])  # filters and memories do not see the feed-forward
         for i in range(6):
@@ -380,12 +265,51 @@ def test_fixed_feedforward_is_one_saturating_word_added_to_the_sum():
 
 
 def test_controller_without_a_feedforward_connection_is_unchanged():
-    """Left unconnected, the feed-forward port is zero: the tick equals ``compute`` without it."""
-    ctrl = make_controller("float", PLATFORM)
+    """Left unconnected, the feed-forward port is zero: the tick equals ``step`` without it."""
+    ctrl = FloatLaw(PLATFORM)
     pose = SEED.pose(0.3)
     L = leg_lengths(PLATFORM, pose)
     pid = ctrl.initial_pid_state(L, np.full(6, 3.0))
-    a = ctrl.compute(pose, L, pid)
-    b = ctrl.compute(pose, L, pid, np.zeros(6))
+    a = ctrl.step(pid, pose, L)
+    b = ctrl.step(pid, pose, L, np.zeros(6))
     for x, y in zip(a, b):
         np.testing.assert_array_equal(x, y)
+
+
+def test_laws_need_no_drake():
+    """With pydrake unimportable, the control package imports and both laws tick (in a fresh interpreter,
+    whatever this one has imported); the fixed-point tick equals this process's bit for bit."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import stewart_drake
+
+    code = """
+import sys
+class Block:
+    def find_spec(self, name, path=None, target=None):
+        if name == "pydrake" or name.startswith("pydrake."):
+            raise ImportError("pydrake blocked")
+sys.meta_path.insert(0, Block())
+import numpy as np
+from stewart_drake.control import FixedPointLaw, FloatLaw
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.trajectory import SEED
+p = load_preset("utn-dynamic")
+pose = SEED.pose(0.4)
+L = leg_lengths(p, pose) + 2e-4
+for law in (FixedPointLaw(p), FloatLaw(p)):
+    cmd, sp, st, sat = law.step(law.initial_pid_state(L, np.full(6, 5.0)), pose, L, np.full(6, 3.0))
+    print(repr(cmd.tolist()))
+assert not any(m.startswith("pydrake") for m in sys.modules)
+"""
+    root = Path(stewart_drake.__file__).resolve().parents[1]  # the package importable from the checkout
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=root).stdout.splitlines()
+    law = FixedPointLaw(PLATFORM)
+    pose = SEED.pose(0.4)
+    L = leg_lengths(PLATFORM, pose) + 2e-4
+    cmd = law.step(law.initial_pid_state(L, np.full(6, 5.0)), pose, L, np.full(6, 3.0))[0]
+    assert out[0] == repr(cmd.tolist())
+    assert len(out) == 2

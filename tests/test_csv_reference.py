@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.drake.simulation import SEED, load_trajectory_csv, simulate
+from stewart_drake.core.trajectory import SEED, load_trajectory_csv
+from stewart_drake.drake.simulation import Scenario, simulate
 
 
 def test_sampled_seed_tracks_like_the_closed_form(tmp_path):
@@ -20,6 +21,6 @@ def test_sampled_seed_tracks_like_the_closed_form(tmp_path):
     before = csv_ref.pose(np.array([-0.01]))[0]
     assert np.allclose(before, 2 * SEED.pose(0.0) - SEED.pose(0.01))  # continued along the first segment
     p = load_platform("utn-dynamic")
-    a = simulate(p, csv_ref, "float", duration=0.3)
-    b = simulate(p, SEED, "float", duration=0.3)
+    a = simulate(Scenario(p, csv_ref, "float", duration=0.3))
+    b = simulate(Scenario(p, SEED, "float", duration=0.3))
     assert np.abs(a.lengths - b.lengths).max() < 1e-4

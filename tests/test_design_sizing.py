@@ -16,7 +16,7 @@ from stewart_drake.design.sizing import leg_motion, rotating_trajectory, size_tr
 from stewart_drake.design.verify import newton_euler_fd, sample_box
 from stewart_drake.errors import OptionError, PayloadError
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.drake.simulation import ROTATING
+from stewart_drake.core.trajectory import ROTATING
 
 @pytest.fixture(scope="module")
 def loaded_platform():

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.control.controller import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
-from stewart_drake.firmware import build
+from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
+from stewart_drake.core import c_build as build
 from stewart_drake.firmware.check import emulation_trace, trace_names, workspace_poses
 from stewart_drake.firmware.generate import TRACE_WORDS, generate
 from stewart_drake.firmware.module import TickRunner, compile_generated
@@ -87,13 +87,13 @@ def test_trace_words_equal_the_emulations():
 
 
 def test_tick_equals_the_python_law_on_random_states():
-    # sd_tick against control._FixedLaw.compute on random inputs and states (every branch: saturation,
+    # sd_tick against control.FixedPointLaw.step on random inputs and states (every branch: saturation,
     # anti-windup, with and without feed-forward); the closed-loop runs are in test_firmware_sil
-    from stewart_drake.control.controller import FixedPointController
+    from stewart_drake.control import FixedPointLaw
 
     p = load_preset("utn-dynamic")
     cfg = ControllerConfig.for_platform(p)
-    ctrl = FixedPointController(p, cfg)
+    ctrl = FixedPointLaw(p, cfg)
     r = TickRunner(compile_generated(generate(p, cfg)))
     rng = np.random.default_rng(5)
     home = p.home_pose()
@@ -104,7 +104,7 @@ def test_tick_equals_the_python_law_on_random_states():
         state = np.r_[rng.integers(-(2**31), 2**31, 6), np.round(L0 / 1e-5) + rng.integers(-3000, 3000, 6),
                       rng.integers(-32768, 32768, 6), ctrl.ik_words(home) + rng.integers(-5, 6, 6), rng.integers(-32768, 32768, 6)]
         ff = rng.normal(0, 300, 6) if k % 3 else None
-        command, sp, new_state, saturated = ctrl.compute(ref, L, state.astype(float), ff)
+        command, sp, new_state, saturated = ctrl.step(state.astype(float), ref, L, ff)
         r.set_state(state)
         cmd = r.tick(pose_words(ref, cfg.ik_format), ctrl.quantise(L), None if ff is None else ctrl.feedforward_words(ff))
         assert np.array_equal(cmd / 32768.0 * cfg.timing.command_range, command)

@@ -8,7 +8,7 @@ from itertools import product
 import numpy as np
 import pytest
 
-from stewart_drake.firmware import build
+from stewart_drake.core import c_build as build
 from stewart_drake.firmware.host import BATCH_OPS, frac, intrinsic, op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.fixedpoint import q15, scalar, tp17_leg_lengths
 from tests.firmware_cache import firmware_cache  # noqa: F401

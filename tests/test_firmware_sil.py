@@ -10,7 +10,8 @@ import pytest
 
 from stewart_drake.cli import main
 from stewart_drake.core.geometry import PRESETS, load_preset
-from stewart_drake.drake.simulation import build_simulation, fit_trajectory, get_trajectory
+from stewart_drake.core.trajectory import fit_trajectory, get_trajectory
+from stewart_drake.drake.simulation import Scenario, build_simulation
 from tests.firmware_cache import firmware_cache  # noqa: F401
 
 DURATION = 0.12
@@ -30,20 +31,20 @@ def test_closed_loop_logs_bit_identical(name, trajectory):
     traj = get_trajectory(trajectory)
     if name != "utn-dynamic":  # the references are made for utn-dynamic: move them into this platform's stroke
         traj = fit_trajectory(traj, p)
-    logs = {eng: build_simulation(p, traj, "fixed", engine=eng).run(DURATION) for eng in ("python", "c")}
+    logs = {eng: build_simulation(Scenario(p, traj, "fixed", engine=eng)).run(DURATION) for eng in ("python", "c")}
     _logs_equal(logs["python"], logs["c"])
     assert len(logs["c"].tick_times()) == round(DURATION / 1e-3)
 
 
 def test_latency_modes_and_no_feedforward_identical():
-    from stewart_drake.control.controller import ControllerConfig, DspTiming
+    from stewart_drake.control import ControllerConfig, DspTiming
 
     p = load_preset("utn-dynamic")
     for latency in ("computation", "none"):
         timing = DspTiming(latency=latency, command_range=float(p.legs.max_force))
         cfg = ControllerConfig.for_platform(p, timing)
-        a = build_simulation(p, "seed", "fixed", cfg, feedforward=False, engine="python").run(0.06)
-        b = build_simulation(p, "seed", "fixed", cfg, feedforward=False, engine="c").run(0.06)
+        a = build_simulation(Scenario(p, "seed", "fixed", cfg, feedforward=False, engine="python")).run(0.06)
+        b = build_simulation(Scenario(p, "seed", "fixed", cfg, feedforward=False, engine="c")).run(0.06)
         _logs_equal(a, b)
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, IntegratorError, constraint_gaps
-from stewart_drake.drake.simulation import build_simulation
+from stewart_drake.drake.simulation import Scenario, build_simulation
 
 DURATION = 0.5
 # The integrators must agree on the legs to well within the fixed-point controller's own set-point
@@ -23,7 +23,7 @@ def runs():
     p = load_platform("utn-dynamic")
     out = {}
     for integ in ("sap", "cenic"):
-        sim = build_simulation(p, "seed", "fixed", integrator=integ, design_duration=4.0)
+        sim = build_simulation(Scenario(p, "seed", "fixed", integrator=integ, design_duration=4.0))
         log = sim.run(DURATION)
         X = sim.loggers["state"].FindLog(sim.simulator.get_context()).data().T
         out[integ] = (sim, log, constraint_gaps(sim.plant, X))
@@ -51,4 +51,4 @@ def test_ball_constraints_hold_and_cenic_holds_them_tighter(runs):
 
 def test_unknown_integrator_refused():
     with pytest.raises(IntegratorError, match="integrator must be one of sap, cenic, got 'rk4'"):
-        build_simulation(load_platform("utn-dynamic"), "seed", "float", integrator="rk4")
+        build_simulation(Scenario(load_platform("utn-dynamic"), "seed", "float", integrator="rk4"))

@@ -191,3 +191,22 @@ def test_unreachable_program_refused_before_any_run(tmp_path, capsys):
     assert main(["montecarlo", "--program", str(program), "--runs", "2", "--out", str(tmp_path / "o"), *SHORT, "--workers", "0"]) == 2
     assert "out of reach on platform utn-dynamic" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_pickled_run_scenario_builds_the_same_diagram(platform):
+    """Workers build their Diagram from a pickled ``Scenario``: run 1 of a study (perturbed plant, drawn
+    sensor noise and jitter, scaled gains) simulated from its unpickled scenario gives the same logs, bit
+    for bit, as from the original object."""
+    import pickle
+
+    from stewart_drake.drake.simulation import build_simulation
+    from stewart_drake.montecarlo.scenario import scenario
+
+    study = Study(platform=platform, spec=parse_spec(VARY + ["sensor_noise=5um", "gain_scale=±10%"]), seed=11, runs=2, duration=0.05)
+    _, d, sc = scenario(study, 1)
+    back = pickle.loads(pickle.dumps(sc))
+    assert back.plant_platform.mass == sc.plant_platform.mass != platform.mass  # the draw reaches the plant
+    assert np.abs(back.sensor.noise).max() > 0 and back.sensor.jitter.max() > 0  # ... and the sensor
+    a, b = (build_simulation(s).run(0.05) for s in (sc, back))
+    for k in a.ARRAYS:
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k))

@@ -21,7 +21,7 @@ from stewart_drake.errors import FAR_CENTRE, GRAVITY_RANGE, SERVO_NEUTRAL, Physi
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.drake.simulation import SEED
+from stewart_drake.core.trajectory import SEED
 
 NOPLATE = """name: noplate
 length_unit: m
@@ -190,7 +190,7 @@ def test_simulate_lost_tracking_exits_1(tmp_path):
 def test_saturation_verdict_counts_the_longest_stretch():
     """``longest_saturation`` from the cumulative per-leg counters: leg 2 saturated on ticks 3..62 (60
     ticks = 0.060 s at 1 ms) fails; leg 5 saturated on 40 ticks in two stretches of 20 passes."""
-    from stewart_drake.control.controller import STATUS
+    from stewart_drake.control import STATUS
     from stewart_drake.drake.simulation import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
 
     n, T = 100, 1e-3
@@ -276,10 +276,9 @@ def test_bad_options_exit_2_with_the_message(argv, message, tmp_path):
 def test_period_bound_is_the_crossover_margin():
     """The refusal threshold follows from the stated rule: at the largest period the check accepts,
     ω_c = PHASE_BUDGET / (T + T + lag) is at least 2 × the fastest growth rate, and just above it, below."""
-    from stewart_drake.control.controller import PHASE_BUDGET
+    from stewart_drake.control import CROSSOVER_MARGIN, PHASE_BUDGET, check_timing
     from stewart_drake.core.dynamics import open_loop_growth_rates
     from stewart_drake.errors import StewartError
-    from stewart_drake.core.sanity import CROSSOVER_MARGIN, check_timing
 
     p = load_platform("utn-dynamic")
     lam = max(open_loop_growth_rates(p, p.home_pose()))

@@ -6,19 +6,13 @@ Short runs (1 s simulated, ~1 s wall each) of the seed trajectory on ``utn-dynam
 import numpy as np
 import pytest
 
-from stewart_drake.control.controller import ControllerConfig, DspTiming, TimingError
+from stewart_drake.control import ControllerConfig, DspTiming, TimingError
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.simulation import (
-    SEED,
-    ActuatorModel,
-    SimulationLog,
-    actuator_system,
-    build_simulation,
-    get_trajectory,
-    load_trajectory_csv,
-)
+from stewart_drake.core.trajectory import SEED, fit_trajectory, get_trajectory, load_trajectory_csv
+from stewart_drake.drake.simulation import ActuatorModel, Scenario, SimulationLog, build_simulation
+from stewart_drake.drake.systems import Actuators
 
 PLATFORM = load_preset("utn-dynamic")
 DURATION = 1.0
@@ -27,7 +21,7 @@ DURATION = 1.0
 @pytest.fixture(scope="module")
 def runs():
     """One float and one fixed run of the seed trajectory with the default (DSP) configuration."""
-    return {kind: build_simulation(PLATFORM, SEED, kind).run(DURATION) for kind in ("float", "fixed")}
+    return {kind: build_simulation(Scenario(PLATFORM, SEED, kind)).run(DURATION) for kind in ("float", "fixed")}
 
 
 def test_run_starts_on_the_reference(runs):
@@ -92,22 +86,38 @@ def test_seed_trajectory_tracks_within_the_quantisation_and_timing_bound(runs):
 
 
 def test_two_identical_runs_give_identical_logs(runs):
-    again = build_simulation(PLATFORM, SEED, "fixed").run(DURATION)
+    again = build_simulation(Scenario(PLATFORM, SEED, "fixed")).run(DURATION)
     first = runs["fixed"]
     for name in SimulationLog.ARRAYS:
         np.testing.assert_array_equal(getattr(again, name), getattr(first, name), err_msg=name)
 
 
+@pytest.mark.parametrize("kind", ["float", "fixed"])
+def test_primed_tables_change_no_bit(kind):
+    """The reference, IK and feed-forward tables primed at the ticks are a speed-up only: with every
+    table left empty (each tick computes its own pose, IK and forces) the logs are the same bit for bit."""
+    traj = fit_trajectory(get_trajectory("rotating"), PLATFORM)
+    primed = build_simulation(Scenario(PLATFORM, traj, kind)).run(0.1)
+    sim = build_simulation(Scenario(PLATFORM, traj, kind))
+    sim.source.prime = lambda times: traj.pose(np.asarray(times, dtype=float))  # nothing remembered
+    sim.controller.law.prime = lambda poses: None
+    sim.feedforward.prime = lambda times: None
+    bare = sim.run(0.1)
+    assert sim.source._table == {} and sim.controller.law._cache == {} and sim.feedforward.table == {}
+    for name in SimulationLog.ARRAYS:
+        np.testing.assert_array_equal(getattr(bare, name), getattr(primed, name), err_msg=name)
+
+
 def test_infeasible_timing_is_refused_by_the_diagram():
     with pytest.raises(TimingError, match=r"longer than the sample period 40\.000 µs"):
-        build_simulation(PLATFORM, SEED, "fixed", ControllerConfig(timing=DspTiming(sample_period=40e-6)))
+        build_simulation(Scenario(PLATFORM, SEED, "fixed", ControllerConfig(timing=DspTiming(sample_period=40e-6))))
 
 
 def test_saturation_is_counted_in_the_loop():
     """A command range of 3 N cannot hold the plate (≈13 N of weight on six legs, 2–5 N each): the
     controller saturates and says so; the command never exceeds the range."""
     cfg = ControllerConfig(timing=DspTiming(command_range=3.0))
-    log = build_simulation(PLATFORM, SEED, "fixed", cfg).run(0.2)
+    log = build_simulation(Scenario(PLATFORM, SEED, "fixed", cfg)).run(0.2)
     assert log.saturations().sum() > 0
     assert np.all(np.abs(log.command) <= 3.0)
 
@@ -116,18 +126,18 @@ def test_saturation_is_counted_in_the_loop():
 def test_anti_windup_stops_the_integrator_at_saturation(kind):
     """One tick computed directly: with an error that drives the output past the positive rail the
     integrator does not grow; with the output inside the range it does."""
-    from stewart_drake.control.controller import make_controller
+    from stewart_drake.drake.systems import make_law
 
-    ctrl = make_controller(kind, PLATFORM)
+    ctrl = make_law(kind, PLATFORM)
     pose = SEED.pose(0.0)
     L = leg_lengths(PLATFORM, pose)
     pid = ctrl.initial_pid_state(L, np.full(6, 5.0))
     # legs 0.3 m short of their set-points: the P term alone is 900 N > 200 N
-    u, _, pid_new, sat = ctrl.compute(pose, L - 0.3, pid)
+    u, _, pid_new, sat = ctrl.step(pid, pose, L - 0.3)
     assert np.all(sat == 1) and np.allclose(u, 200.0, rtol=1e-3)
     np.testing.assert_array_equal(pid_new[:6], pid[:6])
     # 1 mm short: unsaturated, the integrator grows by ki·T·e (float) or its Q31 word (fixed)
-    u, _, pid_new, sat = ctrl.compute(pose, L - 1e-3, pid)
+    u, _, pid_new, sat = ctrl.step(pid, pose, L - 1e-3)
     assert np.all(sat == 0) and np.all(pid_new[:6] > pid[:6])
 
 
@@ -167,7 +177,7 @@ def test_actuator_saturates_and_lags():
     from pydrake.systems.analysis import Simulator
 
     dt, tau = 1e-3, 4e-3
-    act = actuator_system(50.0, tau, dt)
+    act = Actuators(50.0, tau, dt)
     sim = Simulator(act)
     ctx = sim.get_mutable_context()
     act.get_input_port().FixValue(ctx, np.full(6, 500.0))  # beyond the 50 N limit
@@ -203,11 +213,11 @@ def test_other_platforms_track_out_of_the_box(name, base):
     range its actuator force, force feed-forward). The same bounds as on utn-dynamic, for the same
     reasons: the float twin within the timing bound v_max · t_delay, the fixed-point controller within
     float + Δ_IK + LSB + r; no saturation. (Before the design: 40–76 mm on utn-kinematic.)"""
-    from stewart_drake.drake.simulation import fit_trajectory
+    from stewart_drake.core.trajectory import fit_trajectory
 
     platform = load_preset(name)
     traj = fit_trajectory(get_trajectory(base), platform)
-    logs = {kind: build_simulation(platform, traj, kind).run(0.5) for kind in ("float", "fixed")}
+    logs = {kind: build_simulation(Scenario(platform, traj, kind)).run(0.5) for kind in ("float", "fixed")}
     cfg = ControllerConfig.for_platform(platform)
     e_float = np.abs(logs["float"].length_error(traj, platform)).max()
     e_fixed = np.abs(logs["fixed"].length_error(traj, platform)).max()
@@ -225,15 +235,15 @@ def test_stiffness_floor_is_what_keeps_the_heavy_platform_up():
     kp (3 × the home value) holds the plate within a millimetre."""
     from dataclasses import replace
 
-    from stewart_drake.control.controller import strut_stiffness
-    from stewart_drake.drake.simulation import ROTATING, fit_trajectory
+    from stewart_drake.control import strut_stiffness
+    from stewart_drake.core.trajectory import ROTATING, fit_trajectory
 
     platform = load_preset("utn-kinematic")
     traj = fit_trajectory(ROTATING, platform)
     cfg = ControllerConfig.for_platform(platform)
     weak = replace(cfg, gains=replace(cfg.gains, kp=0.9 * strut_stiffness(platform)))
-    e_weak = np.abs(build_simulation(platform, traj, "float", weak).run(1.0).length_error(traj, platform)).max()
-    e_design = np.abs(build_simulation(platform, traj, "float", cfg).run(1.0).length_error(traj, platform)).max()
+    e_weak = np.abs(build_simulation(Scenario(platform, traj, "float", weak)).run(1.0).length_error(traj, platform)).max()
+    e_design = np.abs(build_simulation(Scenario(platform, traj, "float", cfg)).run(1.0).length_error(traj, platform)).max()
     assert e_weak > 5e-3 and e_design < 1e-3, (e_weak, e_design)
 
 
@@ -245,11 +255,11 @@ def test_utn_kinematic_rotating_error_does_not_grow(kind):
     plus one set-point LSB (1 mm: the fixed point's set-point steps can land differently) — the float twin
     plus 0.1 × that. With the home-only design of 6b (kp 15.3 kN/m, ki 66 kN/(m·s)) the fixed-point error
     went 2.3 mm → 30 mm here (the heaviest mode, ~2 Hz, Routh-unstable where kp − K is small)."""
-    from stewart_drake.drake.simulation import ROTATING, fit_trajectory
+    from stewart_drake.core.trajectory import ROTATING, fit_trajectory
 
     platform = load_preset("utn-kinematic")
     traj = fit_trajectory(ROTATING, platform)
-    log = build_simulation(platform, traj, kind).run(1.5)
+    log = build_simulation(Scenario(platform, traj, kind)).run(1.5)
     e = np.abs(log.length_error(traj, platform)).max(axis=1)
     first, last = e[log.t < 0.5].max(), e[log.t >= 1.25].max()
     slack = 1e-3 if kind == "fixed" else 1e-4
@@ -261,12 +271,12 @@ def test_feedforward_table_is_the_inverse_dynamics_ahead_of_time_and_helps():
     actuator lag, checked against a direct evaluation), and on utn-dynamic it cuts the float twin's error
     several-fold compared with the PID alone."""
     from stewart_drake.core.dynamics import leg_forces_with_legs
-    from stewart_drake.drake.simulation import feedforward_lead
+    from stewart_drake.control import feedforward_lead
 
     cfg = ControllerConfig.for_platform(PLATFORM)
     lead = feedforward_lead(cfg, 2e-3)
     assert lead == pytest.approx(1e-3 + 0.5e-3 + 2e-3)
-    sim = build_simulation(PLATFORM, SEED, "float")
+    sim = build_simulation(Scenario(PLATFORM, SEED, "float"))
     t = 0.25
     q = SEED.pose(t + lead)  # analytic rates of the seed trajectory: py = 0.1 sin 2t
     qd = np.array([0, 0.2 * np.cos(2 * (t + lead)), 0, 0, 0, 0])
@@ -275,7 +285,7 @@ def test_feedforward_table_is_the_inverse_dynamics_ahead_of_time_and_helps():
     np.testing.assert_allclose(sim.feedforward.force(t), leg_forces_with_legs(PLATFORM, q, qd, qdd), atol=1e-5)
     log = sim.run(0.6)
     e_ff = np.abs(log.length_error(SEED, PLATFORM)).max()
-    e_pid = np.abs(build_simulation(PLATFORM, SEED, "float", feedforward=False).run(0.6).length_error(SEED, PLATFORM)).max()
+    e_pid = np.abs(build_simulation(Scenario(PLATFORM, SEED, "float", feedforward=False)).run(0.6).length_error(SEED, PLATFORM)).max()
     assert e_ff < e_pid / 4, (e_ff, e_pid)
 
 
@@ -287,7 +297,8 @@ def test_setpoint_l1_gain_bounds_the_fixed_point_excess_on_gonzalez():
     (``setpoint_step_gain``): the stepped leg's ‖h_ii‖₁ ≥ 1 (total variation from 0 to the DC gain 1, which
     the integrator restores), > 1 with the overshoot; the six legs' sum is at least that; and the bound
     float + ‖h‖₁·A holds on a 1 s run (both trajectories)."""
-    from stewart_drake.drake.simulation import ROTATING, design_poses, fit_trajectory, setpoint_step_gain
+    from stewart_drake.core.trajectory import ROTATING, design_poses, fit_trajectory
+    from stewart_drake.drake.simulation import setpoint_step_gain
 
     platform = load_preset("gonzalez-dutra-2009")
     for base in (SEED, ROTATING):
@@ -298,7 +309,7 @@ def test_setpoint_l1_gain_bounds_the_fixed_point_excess_on_gonzalez():
         assert abs(s[-1] - 1.0) < 0.02, s[-1]  # DC gain 1: the integrator removes the static error
         assert g["peak"] > 1.1 and g["diagonal"] >= 2 * g["peak"] - 1 - 1e-9, g  # overshoot: up, back down
         assert g["coupled"] >= g["diagonal"] >= 1.0
-        logs = {kind: build_simulation(platform, traj, kind, cfg).run(1.0) for kind in ("float", "fixed")}
+        logs = {kind: build_simulation(Scenario(platform, traj, kind, cfg)).run(1.0) for kind in ("float", "fixed")}
         e_float, e_fixed = (np.abs(logs[k].length_error(traj, platform)).max() for k in ("float", "fixed"))
         ticks = traj.pose(np.arange(1000) * 1e-3)
         d_ik = np.abs(fixed_point_leg_lengths(platform, ticks, cfg.ik_format) - leg_lengths(platform, ticks)).max()

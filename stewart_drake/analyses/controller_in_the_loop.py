@@ -7,14 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.drake.animation import log_saturating, record_animation
-from stewart_drake.control.controller import ControllerConfig, DspTiming, leg_space_inertia, strut_stiffness
+from stewart_drake.control import ControllerConfig, DspTiming, leg_space_inertia, strut_stiffness
 from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.montecarlo.sweep import run_sweep, sweep_study
 from stewart_drake.report import run_standalone
-from stewart_drake.drake.simulation import ROTATING, SEED, ActuatorModel, build_simulation, design_poses, fit_trajectory, setpoint_step_gain
+from stewart_drake.core.trajectory import ROTATING, SEED, design_poses, fit_trajectory
+from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation, setpoint_step_gain
 from stewart_drake.report import parallel_map
 
 TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
@@ -65,7 +66,7 @@ def _tracking(section, platform, duration):
     for j, traj in enumerate((SEED, ROTATING)):
         cfg = ControllerConfig.for_platform(platform, poses=design_poses(traj, duration))
         for i, kind in enumerate(("float", "fixed")):
-            log = build_simulation(platform, traj, kind, cfg, engine=ENGINE).run(duration)
+            log = build_simulation(Scenario(platform, traj, kind, cfg, engine=ENGINE)).run(duration)
             logs[traj.name, kind] = log
             e = log.length_error(traj, platform)
             pe = log.pose_error(traj)
@@ -104,8 +105,8 @@ def _preset_case(case):
     poses = design_poses(traj, duration)
     cfg = ControllerConfig.for_platform(platform, poses=poses)
     g = cfg.gains
-    logs = {kind: build_simulation(platform, traj, kind, cfg, engine=ENGINE).run(duration) for kind in ("float", "fixed")}
-    pid_only = build_simulation(platform, traj, "float", cfg, feedforward=False).run(duration)
+    logs = {kind: build_simulation(Scenario(platform, traj, kind, cfg, engine=ENGINE)).run(duration) for kind in ("float", "fixed")}
+    pid_only = build_simulation(Scenario(platform, traj, "float", cfg, feedforward=False)).run(duration)
     e = {k: float(np.abs(v.length_error(traj, platform)).max()) for k, v in logs.items()}
     e_pid = float(np.abs(pid_only.length_error(traj, platform)).max())
     d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs["float"], duration, cfg)
@@ -168,7 +169,7 @@ def _saturation(section, platform, ranges, duration):
     rows = []
     for rng in ranges:
         cfg = ControllerConfig.for_platform(platform, DspTiming(command_range=rng), poses=design_poses(SEED))
-        log = build_simulation(platform, SEED, "fixed", cfg, engine=ENGINE).run(duration)
+        log = build_simulation(Scenario(platform, SEED, "fixed", cfg, engine=ENGINE)).run(duration)
         sat = log.saturations().astype(int)
         st = log.status[:, 3]
         first = log.t[np.argmax(st > 0)] if st[-1] > 0 else float("nan")

@@ -9,8 +9,8 @@ from collections import Counter
 
 import numpy as np
 
-from stewart_drake.control.controller import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
-from stewart_drake.firmware.build import compilers
+from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
+from stewart_drake.core.c_build import compilers
 from stewart_drake.firmware.check import workspace_poses
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.host import op_counts_tp17, tp17_leg_lengths_c
@@ -20,7 +20,7 @@ from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.report import run_standalone
-from stewart_drake.drake.simulation import build_simulation
+from stewart_drake.drake.simulation import Scenario, build_simulation
 
 TITLE = "Firmware equivalence: the C compiled, generated and run in the loop"
 ORDER = 95
@@ -139,7 +139,7 @@ def _sil(section, quick: bool) -> None:
     duration = 0.3 if quick else 4.0
     logs, wall = {}, {}
     for eng in ("python", "c"):
-        sim = build_simulation(p, "seed", "fixed", engine=eng)
+        sim = build_simulation(Scenario(p, "seed", "fixed", engine=eng))
         t0 = time.perf_counter()
         logs[eng] = sim.run(duration)
         wall[eng] = time.perf_counter() - t0
@@ -162,7 +162,7 @@ def _sil(section, quick: bool) -> None:
 
 
 def _traj():
-    from stewart_drake.drake.simulation import get_trajectory
+    from stewart_drake.core.trajectory import get_trajectory
 
     return get_trajectory("seed")
 

@@ -44,7 +44,7 @@ def register(sub) -> None:
 
 
 def _config(args, platform):
-    from stewart_drake.control.controller import ControllerConfig, DspTiming
+    from stewart_drake.control import ControllerConfig, DspTiming
     from stewart_drake.fixedpoint.generic import QFormat
 
     if not 8 <= args.word_bits <= 16:
@@ -58,7 +58,7 @@ def _config(args, platform):
                        command_range=float(platform.legs.max_force)).check()
     poses = None
     if args.trajectory is not None:
-        from stewart_drake.drake.simulation import design_poses, get_trajectory
+        from stewart_drake.core.trajectory import design_poses, get_trajectory
 
         poses = design_poses(get_trajectory(args.trajectory))
     return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=args.convention)
@@ -66,7 +66,7 @@ def _config(args, platform):
 
 def run_generate(args) -> int:
     from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.firmware.build import compilers
+    from stewart_drake.core.c_build import compilers
     from stewart_drake.firmware.generate import FILES, generate
     from stewart_drake.firmware.module import compile_generated
     from stewart_drake.core.geometry import load_platform
@@ -114,8 +114,8 @@ def run_generate(args) -> int:
 
 
 def run_check(args) -> int:
-    from stewart_drake.firmware.build import compiler_by_name
-    from stewart_drake.firmware.check import check_firmware
+    from stewart_drake.core.c_build import compiler_by_name
+    from stewart_drake.drake.firmware_check import check_firmware
     from stewart_drake.core.geometry import load_platform
 
     platform = load_platform(args.platform)

@@ -13,7 +13,7 @@ from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.drake.montecarlo_animation import write_animation
-from stewart_drake.drake.simulation import TRAJECTORIES, load_trajectory_csv
+from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
 from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario

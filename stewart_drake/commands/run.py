@@ -116,21 +116,20 @@ def branch_exit(b: dict | None, args) -> int:
 
 
 def simulate(platform, result, args) -> dict:
-    """Controller in the loop (issue 6's ``simulation``) along the program's trajectory."""
-    from stewart_drake.drake.simulation import Trajectory as SimTrajectory
-    from stewart_drake.drake.simulation import simulate as sim_run
+    """Controller in the loop (``drake.simulation``) along the program's trajectory."""
+    from dataclasses import replace
+
+    from stewart_drake.core.sanity import require_plate
+    from stewart_drake.drake.simulation import Scenario, simulate as sim_run, tracking_verdict
 
     if args.convention != "utn":
         raise ValueError("--simulate drives the plant with utn-convention poses; use --convention utn")
     traj = result.trajectory
     if traj.duration <= 0:
         raise ValueError("--simulate: the program has no moves or waits (its trajectory lasts 0 s)")
-    reference = SimTrajectory(Path(args.program).stem, traj.pose_at, traj.duration)
-    from stewart_drake.core.sanity import require_plate
-    from stewart_drake.drake.simulation import tracking_verdict
-
+    reference = replace(traj, name=Path(args.program).stem)
     require_plate(platform, "run --simulate")
-    log = sim_run(platform, reference, controller=args.controller, duration=traj.duration + SETTLE, progress=True)
+    log = sim_run(Scenario(platform, reference, args.controller, duration=traj.duration + SETTLE), progress=True)
     err = log.length_error(reference, platform)
     verdict = tracking_verdict(platform, err, log.pose_error(reference), log)
     return {

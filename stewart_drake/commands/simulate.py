@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.sanity import check_file_rows, check_positive, check_timing, check_trajectory, check_work, fmt_value, require_plate
+from stewart_drake.core.sanity import check_file_rows, check_positive, check_trajectory, check_work, fmt_value, require_plate
 from stewart_drake.commands._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
@@ -63,10 +63,12 @@ def run(args) -> int:
     import json
 
     from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.control.controller import ControllerConfig, DspTiming
-    from stewart_drake.firmware.engine import resolve_engine
+    from stewart_drake.control import ControllerConfig, DspTiming, check_timing
     from stewart_drake.core.geometry import load_platform
-    from stewart_drake.drake.simulation import ActuatorModel, build_simulation, design_poses, fit_trajectory, get_trajectory, tracking_verdict
+    from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
+    from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate, tracking_verdict
+    from stewart_drake.firmware.engine import resolve_engine
 
     reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
     out_folder = output_folder(args)
@@ -97,9 +99,9 @@ def run(args) -> int:
     engine = resolve_engine(args.engine, "stewart-drake simulate") if args.firmware is None else "c"
     if (engine == "c" or args.firmware) and args.controller != "fixed":
         raise ValueError(f"--engine c / --firmware run the fixed-point controller; --controller is {args.controller!r}")
-    sim = build_simulation(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward,
-                           engine=engine, firmware=args.firmware, integrator=args.integrator)
-    log = sim.run(duration, progress=not args.no_progress)
+    scenario = Scenario(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward,
+                        engine=engine, firmware=args.firmware, integrator=args.integrator or DEFAULT_INTEGRATOR, duration=duration)
+    log = simulate(scenario, progress=not args.no_progress)
     out = Path(args.out)
     e = log.length_error(traj, platform)
     pe = log.pose_error(traj)
@@ -117,7 +119,7 @@ def run(args) -> int:
         "output_delay_s": timing.output_delay,
         "computation_time_s": timing.computation_time,
         "plant_time_step_s": plant_step,
-        "integrator": sim.integrator,
+        "integrator": scenario.integrator,
         "duration_s": duration,
         "ticks": int(len(log.tick_times())),
         "max_leg_error_mm": float(np.abs(e).max() * 1e3),

@@ -12,7 +12,6 @@ Every command calls these checks before it computes or prints anything:
   time, leg and amount);
 - dynamics and simulation need the plate's mass properties (``require_plate``);
 - a platform must not be singular at its home pose (``check_home``, called when a platform is loaded);
-- controller periods and plant steps must resolve the dynamics (``check_timing``);
 - user-sized work (grid nodes, samples, steps, rows, iterations) is estimated against a memory and time
   budget before anything is allocated (``check_work``).
 
@@ -57,9 +56,6 @@ HOME_MAX_CONDITION = 1e8
 MEMORY_FRACTION = 0.25
 # Fallback when the physical memory cannot be read (bytes).
 DEFAULT_MEMORY = 8 * 2**30
-# The crossover of the leg loops must exceed the platform's fastest open-loop growth rate by this factor:
-# an unstable pole is held only by a loop several times faster than it.
-CROSSOVER_MARGIN = 2.0
 
 
 # ----------------------------------------------------------------------------------------------
@@ -270,42 +266,6 @@ def check_home(platform) -> None:
     else:
         why = "the six legs' lines are linearly dependent there; move an anchor or give another home_height"
     raise GeometryError(SINGULAR_HOME.format(name=platform.name, cond=cond, limit=HOME_MAX_CONDITION, why=why))
-
-
-# ----------------------------------------------------------------------------------------------
-# Timing.
-
-
-def check_timing(platform, period: float, plant_step: float, actuator_lag: float, output_delay: float) -> None:
-    """``StewartError`` unless the controller period and the plant step resolve the dynamics:
-
-    - the plant step is at most the controller period (the plant must advance between ticks) and at
-      most the actuator lag (the fastest modelled dynamics: a longer step skips it);
-    - the leg loops' achievable crossover ω_c = PHASE_BUDGET / (output delay + period + actuator lag)
-      (``control.loop_delay``) is at least ``CROSSOVER_MARGIN`` × the platform's fastest open-loop growth
-      rate λ at home (``dynamics.open_loop_growth_rates``): a slower loop cannot hold the plate up.
-    """
-    from stewart_drake.control.controller import PHASE_BUDGET
-
-    T = check_positive(period, "--period", "seconds")
-    h = check_positive(plant_step, "--plant-step", "seconds")
-    if h > T * (1 + 1e-12):
-        raise StewartError(f"--plant-step {fmt_value(h)} s is longer than the controller period {fmt_value(T)} s; "
-                           "the plant step must resolve the period (at most one period)")
-    if actuator_lag > 0 and h > actuator_lag * (1 + 1e-12):
-        raise StewartError(f"--plant-step {fmt_value(h)} s is longer than the actuators' time constant {fmt_value(actuator_lag)} s, "
-                           "the platform's fastest modelled dynamics; use a step of at most that")
-    if has_plate(platform):
-        from stewart_drake.core.dynamics import open_loop_growth_rates
-
-        lam = float(np.max(open_loop_growth_rates(platform, platform.home_pose())))
-        w_c = PHASE_BUDGET / (output_delay + T + actuator_lag)
-        if w_c < CROSSOVER_MARGIN * lam:
-            t_max = PHASE_BUDGET / (CROSSOVER_MARGIN * lam) - actuator_lag
-            raise StewartError(
-                f"--period {fmt_value(T)} s is too slow for platform {platform.name}: its fastest open-loop mode grows at "
-                f"{lam:.3g}/s, and the leg loops' crossover at this period is at most {w_c:.3g} rad/s (< {CROSSOVER_MARGIN:g} × "
-                f"{lam:.3g}); use a period of at most ~{max(t_max / 2, 0):.3g} s")
 
 
 # ----------------------------------------------------------------------------------------------

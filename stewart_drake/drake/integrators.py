@@ -17,6 +17,7 @@ and the 1 kHz ticks set the pace), so CENIC is the default: accuracy first.
 from __future__ import annotations
 
 import numpy as np
+from pydrake.systems.analysis import ApplySimulatorConfig, SimulatorConfig
 
 from stewart_drake.errors import StewartError
 
@@ -43,8 +44,6 @@ def apply_integrator(simulator, name: str, accuracy: float | None = None) -> Non
     check_integrator(name)
     accuracy = CENIC_ACCURACY if accuracy is None else accuracy
     if name == "cenic":
-        from pydrake.systems.analysis import ApplySimulatorConfig, SimulatorConfig
-
         ApplySimulatorConfig(SimulatorConfig(integration_scheme="cenic", accuracy=accuracy), simulator)
 
 

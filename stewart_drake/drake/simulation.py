@@ -1,13 +1,14 @@
 """Controller-in-the-loop simulation: trajectory source → DSP controller → actuators → closed-loop plant.
 
-The Diagram (``build_simulation``)::
+One typed, picklable ``Scenario`` describes a run (platform, reference, controller kind and engine, timing
+and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram::
 
-    PoseSource ──reference──▶ controller (fixed | float, discrete, period T) ──command──▶ Actuators
-        ▲  FeedforwardTable ──▶    ▲ leg_lengths                                           │ force
-        │                          └──────── MatrixGain (prismatic positions) ◀── plant ◀──┘
-        └ (trajectory: seed, rotating, or a (t, pose) CSV)
+    PoseSource ──reference──▶ ControllerSystem (fixed | float law, discrete, period T) ──command──▶ Actuators
+        ▲  FeedforwardSource ──▶    ▲ leg_lengths                                                 │ force
+        │                           └──────── sensor (prismatic positions) ◀──── plant ◀──────────┘
+        └ (core.trajectory: seed, rotating, a (t, pose) CSV, a motion program)
 
-The feed-forward table (``feedforward_forces``) holds, per tick, the leg forces of the inverse dynamics
+The feed-forward table (``control.feedforward``) holds, per tick, the leg forces of the inverse dynamics
 (plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
 with the pose table and download to the DSP. Without it (``feedforward=False``) the PID alone carries
 the plate.
@@ -22,112 +23,31 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
+from pydrake.multibody.math import SpatialVelocity
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput, MatrixGain
+from tqdm import tqdm
 
-from stewart_drake.control.controller import STATUS, ControllerConfig, make_controller
-from stewart_drake.core.csvio import read_numeric_csv
+from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
+from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.control.laws import STATUS
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.core.rotations import angles_from_matrix, pose_to_si, rotation_matrix
+from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
+from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
+from stewart_drake.core.leg_bodies import leg_joint_positions
+from stewart_drake.drake.platform_model import build_plant, set_pose
+from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
 
 # ----------------------------------------------------------------------------------------------
-# Trajectories: pose(t) for a scalar or an array of times, (..., 6) metres/radians, utn convention.
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A pose reference. ``pose(t)``: ``(..., 6)`` for times ``(...)`` (s); ``duration`` the natural
-    length in seconds (None: unbounded)."""
-
-    name: str
-    fn: object
-    duration: float | None = None
-
-    def pose(self, t) -> np.ndarray:
-        return self.fn(np.asarray(t, dtype=float))
-
-
-def _seed_pose(t):
-    """SPEC §3: px = −0.1 m, py = 0.1·sin(2t) m, pz = 0.7 m, no rotation."""
-    t = np.asarray(t, dtype=float)
-    z = np.zeros_like(t)
-    return np.stack([z - 0.1, 0.1 * np.sin(2.0 * t), z + 0.7, z, z, z], axis=-1)
-
-
-def _rotating_pose(t):
-    """The plate at pz = 0.7 m turning about Z by 15°·sin(2t) while tilting 5°·sin(3t) about X."""
-    t = np.asarray(t, dtype=float)
-    z = np.zeros_like(t)
-    return np.stack([z, z, z + 0.7, np.radians(5.0) * np.sin(3.0 * t), z, np.radians(15.0) * np.sin(2.0 * t)], axis=-1)
-
-
-SEED = Trajectory("seed", _seed_pose, 4.0)
-ROTATING = Trajectory("rotating", _rotating_pose, 4.0)
-TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
-
-
-def fit_trajectory(trajectory: Trajectory, platform: Platform, home_height: float = 0.7, stroke: float = 0.4) -> Trajectory:
-    """``trajectory`` (made for a platform whose home is pz = ``home_height`` with a stroke of ``stroke``
-    metres, as ``SEED`` and ``ROTATING`` are for utn-dynamic) moved to ``platform``'s home and its
-    positions scaled by the ratio of the strokes (angles unchanged): the same motion, relative to the
-    platform's size."""
-    s = (platform.stroke[1] - platform.stroke[0]) / stroke
-    centre = np.array([0.0, 0.0, home_height])
-    home = platform.home_pose()[:3]
-
-    def fn(t):
-        q = trajectory.pose(t).copy()
-        q[..., :3] = home + s * (q[..., :3] - centre)
-        return q
-
-    return Trajectory(trajectory.name, fn, trajectory.duration)
-
-
-def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
-    """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line."""
-    data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
-    late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
-    if late.size:
-        k = late[0] + 1
-        raise ValueError(f"{path}:{lines[k]}: time {data[k, 0]} s is not after the previous sample's {data[k - 1, 0]} s")
-    return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
-
-
-def table_trajectory(name: str, ts, poses) -> Trajectory:
-    """Samples ``ts`` (n,) s, ``poses`` (n, 6) SI as a piecewise-linear Trajectory, held constant after the
-    last sample and continued before the first along the first segment: the differences that start a run
-    at t = 0 (``initial_leg_forces``, ``set_velocity``) then see the reference's initial velocity, not a
-    kink from a pose held before t = 0 (a clamp there read as an acceleration of v/h and threw the plate)."""
-    ts, poses = np.asarray(ts, dtype=float), np.asarray(poses, dtype=float)
-    slope = (poses[1] - poses[0]) / (ts[1] - ts[0]) if len(ts) > 1 else np.zeros(6)
-
-    def fn(t):
-        t = np.asarray(t, dtype=float)
-        q = np.stack([np.interp(t, ts, poses[:, j]) for j in range(6)], axis=-1)
-        before = (t < ts[0])[..., None]
-        return np.where(before, poses[0] + (t - ts[0])[..., None] * slope, q)
-
-    return Trajectory(name, fn, float(ts[-1]))
-
-
-def get_trajectory(name_or_path, **units) -> Trajectory:
-    """``seed``, ``rotating`` or a CSV file path."""
-    if isinstance(name_or_path, Trajectory):
-        return name_or_path
-    s = str(name_or_path)
-    if s in TRAJECTORIES:
-        return TRAJECTORIES[s]
-    if s.endswith(".csv") or Path(s).exists():
-        return load_trajectory_csv(s, **units)
-    raise ValueError(f"unknown trajectory {s!r}: not one of {', '.join(TRAJECTORIES)} and not a CSV file")
-
-
-# ----------------------------------------------------------------------------------------------
-# Actuators.
+# The scenario: what a run is, as plain data.
 
 
 @dataclass(frozen=True)
@@ -146,118 +66,53 @@ class ActuatorModel:
             raise ValueError(f"ActuatorModel.time_constant must be >= 0 s, got {self.time_constant!r}")
 
 
-def _systems():
-    """LeafSystem classes, built on first use (keeps pydrake out of import time)."""
-    global _SYS
-    if _SYS is not None:
-        return _SYS
-    from pydrake.systems.framework import LeafSystem
+@dataclass(frozen=True, eq=False)
+class SensorModel:
+    """A leg-length sensor that is not ideal: it reads L + ``offset`` (6,) m + ``noise[k]`` − ``jitter[k]``·dL/dt
+    at tick k = round(t / ``period``) (``noise`` ``(n_ticks, 6)`` m, ``jitter`` ``(n_ticks,)`` s: a sample
+    taken that late); the controller then quantises the reading."""
 
-    class PoseSource(LeafSystem):
-        """Output ``pose`` (6) = trajectory.pose(t)."""
-
-        def __init__(self, trajectory: Trajectory):
-            super().__init__()
-            self.trajectory = trajectory
-            # evaluated on a 1-element array, the same code path as a batch of times
-            self.DeclareVectorOutputPort("pose", 6, lambda c, o: o.SetFromVector(trajectory.pose(np.array([c.get_time()]))[0]))
-
-    class Actuators(LeafSystem):
-        """Input ``command`` (6, N) → output ``force`` (6, N): saturation at ±max_force, then a first-order
-        lag discretised exactly at ``period`` (the plant's step), F ← a·F + (1−a)·u, a = exp(−period/τ)."""
-
-        def __init__(self, max_force: float, time_constant: float, period: float):
-            super().__init__()
-            self.max_force = max_force
-            u = self.DeclareVectorInputPort("command", 6)
-            if time_constant > 0:
-                a = math.exp(-period / time_constant)
-                s = self.DeclareDiscreteState(6)
-
-                def update(context, xd):
-                    F = context.get_discrete_state(s).value()
-                    cmd = np.clip(u.Eval(context), -max_force, max_force)
-                    xd.set_value(s, a * F + (1 - a) * cmd)
-
-                self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, update)
-                self.DeclareStateOutputPort("force", s)
-                self.state_index = s
-            else:
-                self.state_index = None
-                self.DeclareVectorOutputPort("force", 6, lambda c, o: o.SetFromVector(np.clip(u.Eval(c), -max_force, max_force)))
-
-    class FeedforwardTable(LeafSystem):
-        """Output ``force`` (6, N) = ``feedforward_forces`` at the context's time, from a table filled in
-        one batch by ``prime(times)`` (a time not in the table is computed on its own: same numbers)."""
-
-        def __init__(self, platform: Platform, trajectory: Trajectory, lead: float, h: float):
-            super().__init__()
-            self.args = (platform, trajectory, lead, h)
-            self.table: dict[float, np.ndarray] = {}
-            self.DeclareVectorOutputPort("force", 6, lambda c, o: o.SetFromVector(self.force(c.get_time())))
-
-        def prime(self, times) -> None:
-            times = np.asarray(times, dtype=float)
-            for t, F in zip(times, feedforward_forces(*self.args[:2], times, *self.args[2:])):
-                self.table[float(t)] = F
-
-        def force(self, t: float) -> np.ndarray:
-            F = self.table.get(float(t))
-            return F if F is not None else feedforward_forces(*self.args[:2], [t], *self.args[2:])[0]
-
-    _SYS = {"PoseSource": PoseSource, "Actuators": Actuators, "FeedforwardTable": FeedforwardTable}
-    return _SYS
+    offset: np.ndarray
+    noise: np.ndarray
+    jitter: np.ndarray
+    period: float
 
 
-_SYS = None
+@dataclass(frozen=True)
+class Scenario:
+    """One controller-in-the-loop run, as plain (picklable) data.
 
+    ``platform``: the controller's model (and the plant's unless ``plant_platform``: a perturbed copy models
+    manufacturing errors); ``trajectory``: ``seed``, ``rotating``, a CSV path or a ``Trajectory``;
+    ``controller``: ``fixed`` or ``float``; ``engine``: ``python`` or ``c`` (the fixed-point tick by
+    compiled C; ``firmware``: a user's C file implementing the firmware ABI); ``config``: timing and gains
+    (refused if infeasible; None: ``ControllerConfig.for_platform`` with the actuators' lag over the
+    reference's poses from 0 to ``design_duration`` s, ``design_poses``); ``actuators``; ``plant_time_step``
+    (s): the discrete plant's step, or the continuous plant's logging period; ``integrator``: ``cenic`` or
+    ``sap`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect the model-based force
+    feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
+    runs (None: the trajectory's own duration, else 1 s).
+    """
 
-def pose_source(trajectory: Trajectory):
-    """A LeafSystem with one output ``pose`` (6) = ``trajectory.pose(t)`` (any 6-vector function of time)."""
-    return _systems()["PoseSource"](trajectory)
-
-
-def actuator_system(max_force: float, time_constant: float, period: float):
-    """The actuator LeafSystem: input ``command`` (6, N) → output ``force`` (6, N); see ``ActuatorModel``."""
-    return _systems()["Actuators"](max_force, time_constant, period)
-
-
-def initial_leg_forces(platform: Platform, trajectory: Trajectory, t: float = 0.0, h: float = 1e-4) -> np.ndarray:
-    """``(6,)`` leg forces (N) that move plate and legs along the reference at time ``t``
-    (``dynamics.leg_forces_with_legs`` with central-difference rates): where the controller's integrator
-    starts, so a run begins in equilibrium instead of with a gravity sag."""
-    from stewart_drake.core.dynamics import leg_forces_with_legs
-
-    qm, q0, qp = trajectory.pose(np.array([t - h, t, t + h]))
-    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
-
-
-def feedforward_lead(config: ControllerConfig, actuator_lag: float) -> float:
-    """Seconds by which the feed-forward table leads the reference: a force computed at tick k is
-    released after the output delay, held for a sample (on average half of it) and reaches the plate
-    through the actuator lag (a first-order lag τ delays slow signals by τ)."""
-    return config.timing.output_delay + config.timing.sample_period / 2 + actuator_lag
-
-
-def feedforward_forces(platform: Platform, trajectory: Trajectory, times, lead: float, h: float) -> np.ndarray:
-    """``(n, 6)`` feed-forward leg forces (N) at ``times`` (n,): ``dynamics.leg_forces_with_legs`` at the
-    reference pose of t + ``lead``, with its rates from central differences of step ``h`` (the sample
-    period: the second difference of the sampled reference, bounded also for piecewise-linear CSV
-    references)."""
-    from stewart_drake.core.dynamics import leg_forces_with_legs
-
-    t = np.asarray(times, dtype=float).reshape(-1) + lead
-    qm, q0, qp = trajectory.pose(t - h), trajectory.pose(t), trajectory.pose(t + h)
-    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
+    platform: Platform
+    trajectory: object = "seed"
+    controller: str = "fixed"
+    config: ControllerConfig | None = None
+    actuators: ActuatorModel = field(default_factory=ActuatorModel)
+    plant_time_step: float = 1e-3
+    feedforward: bool = True
+    design_duration: float | None = None
+    engine: str = "python"
+    firmware: str | None = None
+    integrator: str | None = None
+    plant_platform: Platform | None = None
+    sensor: SensorModel | None = None
+    duration: float | None = None
 
 
 def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: float, h: float = 1e-6) -> None:
     """Set every velocity in ``context`` to the reference's at time ``t`` (central differences of the
     closed-form joint positions, step ``h`` s), so that a run starts on the trajectory, not at rest."""
-    from pydrake.multibody.math import SpatialVelocity
-
-    from stewart_drake.core.leg_bodies import leg_joint_positions
-
     qm, qp = trajectory.pose(np.array([t - h, t + h]))
     Rm, Rp = rotation_matrix(qm[3:]), rotation_matrix(qp[3:])
     W = (Rp - Rm) / (2 * h) @ rotation_matrix(trajectory.pose(t)[3:]).T  # [ω]×
@@ -293,6 +148,7 @@ class Simulation:
     plant_time_step: float = 1e-3
     feedforward: object = None
     integrator: str = "sap"
+    source: object = None
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> "SimulationLog":
@@ -305,15 +161,15 @@ class Simulation:
         sim = self.simulator
         T = self.config.timing.sample_period
         n = int(math.floor(duration / T + 1e-9)) + 1
-        if hasattr(self.controller, "prime"):  # batch the fixed-point IK of the known reference (speed only)
-            self.controller.prime(self.trajectory.pose(np.arange(n) * T))
+        ticks = np.arange(n) * T
+        poses = self.source.prime(ticks)  # the reference at the ticks, in one batch (speed only)
+        if hasattr(self.controller.law, "prime"):  # and the IK of those poses (speed only)
+            self.controller.law.prime(poses)
         if self.feedforward is not None:  # the feed-forward table at the ticks, in one batch
-            self.feedforward.prime(np.arange(n) * T)
+            self.feedforward.prime(ticks)
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
-            from tqdm import tqdm
-
             steps = max(1, int(round(duration / 0.05)))
             with tqdm(total=steps, desc=f"simulate {self.kind} {duration:g} s", unit=" × 50 ms", leave=False) as bar:
                 for k in range(1, steps + 1):
@@ -375,77 +231,52 @@ def _quat_to_matrix(q) -> np.ndarray:
     ).reshape(-1, 3, 3)
 
 
-def build_simulation(
-    platform: Platform,
-    trajectory="seed",
-    controller: str = "fixed",
-    config: ControllerConfig | None = None,
-    actuators: ActuatorModel | None = None,
-    plant_time_step: float = 1e-3,
-    meshcat=None,
-    feedforward: bool = True,
-    design_duration: float | None = None,
-    engine: str = "python",
-    firmware=None,
-    integrator: str | None = None,
-    plant_platform: Platform | None = None,
-    sensor=None,
-) -> Simulation:
-    """Assemble the controller-in-the-loop Diagram and its Simulator, with the plant at the reference's
-    initial pose, legs at the matching lengths and the controller holding them against gravity.
-
-    ``controller``: ``fixed`` or ``float``; ``config``: timing and gains (refused if infeasible; default
-    ``ControllerConfig.for_platform``: command range and gains designed for ``platform`` and the
-    actuators' lag); ``plant_time_step`` (s): the discrete plant's step; ``meshcat``: a ``Meshcat`` to
-    record an animation; ``feedforward``: connect the model-based force feed-forward table;
-    ``design_duration`` (s): the default gains are designed over the reference's poses from 0 to this
-    time (``design_poses``; default the trajectory's duration, else 4 s); ``engine``: ``python`` or ``c``
-    (the fixed-point tick by compiled C), ``firmware``: a user's C file implementing the firmware ABI;
-    ``integrator``: ``cenic``
-    (default: a continuous plant under Drake's error-controlled CENIC, logged every ``plant_time_step``)
-    or ``sap`` (a discrete plant stepped at ``plant_time_step``); see ``integrators``; ``plant_platform``: the platform the plant is built
-    from (default ``platform``: the controller's model; a perturbed copy models manufacturing errors);
-    ``sensor``: a function ``(plant, D (6, nx)) -> LeafSystem`` (input: plant state, output: the six
-    measured lengths; optional ``initial_reading(L)``) replacing the ideal sensor ``MatrixGain(D)``.
-    """
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import LogVectorOutput, MatrixGain
-
-    from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
-    from stewart_drake.drake.platform_model import build_plant, set_pose
-
-    integrator = check_integrator(integrator or DEFAULT_INTEGRATOR)
-    plant_platform = plant_platform or platform
+def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
+    """Assemble ``scenario``'s controller-in-the-loop Diagram and its Simulator, with the plant at the
+    reference's initial pose, legs at the matching lengths and the controller holding them against
+    gravity. ``meshcat``: a ``Meshcat`` to record an animation (not part of the scenario: it does not pickle)."""
+    s = scenario
+    platform = s.platform
+    integrator = check_integrator(s.integrator or DEFAULT_INTEGRATOR)
+    plant_platform = s.plant_platform or platform
+    plant_time_step = s.plant_time_step
     if not (math.isfinite(plant_time_step) and plant_time_step > 0):
         raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
-    trajectory = get_trajectory(trajectory)
-    actuators = actuators or ActuatorModel()
+    trajectory = get_trajectory(s.trajectory)
+    actuators = s.actuators
+    config = s.config
     if config is None:
-        poses = design_poses(trajectory, design_duration)
+        poses = design_poses(trajectory, s.design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator == "cenic")
-    ctrl = builder.AddSystem(make_controller(controller, platform, config, engine, firmware))
-    ctrl.set_name(f"{controller}_controller")
-    src = builder.AddSystem(pose_source(trajectory))
+    ctrl = builder.AddSystem(make_controller(s.controller, platform, config, s.engine, s.firmware))
+    ctrl.set_name(f"{s.controller}_controller")
+    src = builder.AddSystem(PoseSource(trajectory))
     src.set_name("reference")
     max_force = actuators.max_force or float(platform.legs.max_force)
-    act = builder.AddSystem(actuator_system(max_force, actuators.time_constant, plant_time_step))
+    act = builder.AddSystem(Actuators(max_force, actuators.time_constant, plant_time_step))
     act.set_name("actuators")
     nx = plant.num_multibody_states()
-    D = np.zeros((6, nx))
-    for i in range(6):
-        D[i, plant.GetJointByName(f"prismatic_{i + 1}").position_start()] = 1.0
-    sensor = builder.AddSystem(MatrixGain(D) if sensor is None else sensor(plant, D))
+    joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
+    if s.sensor is None:
+        D = np.zeros((6, nx))
+        for i in range(6):
+            D[i, joints[i].position_start()] = 1.0
+        sensor = builder.AddSystem(MatrixGain(D))
+    else:
+        pos = np.array([j.position_start() for j in joints])
+        vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
+        sensor = builder.AddSystem(LegLengthSensor(nx, pos, vel, s.sensor.offset, s.sensor.noise, s.sensor.jitter, s.sensor.period))
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
     ff = None
-    if feedforward:
+    if s.feedforward:
         T = config.timing.sample_period
-        ff = builder.AddSystem(_systems()["FeedforwardTable"](platform, trajectory, feedforward_lead(config, actuators.time_constant), T))
-        ff.set_name("feedforward_table")
-        builder.Connect(ff.get_output_port(), ctrl.GetInputPort("feedforward"))
+        ff = FeedforwardTable(platform, trajectory, feedforward_lead(config, actuators.time_constant), T)
+        ffs = builder.AddSystem(FeedforwardSource(ff))
+        ffs.set_name("feedforward_table")
+        builder.Connect(ffs.get_output_port(), ctrl.GetInputPort("feedforward"))
     builder.Connect(plant.get_state_output_port(), sensor.get_input_port())
     builder.Connect(sensor.get_output_port(), ctrl.GetInputPort("leg_lengths"))
     builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
@@ -463,8 +294,6 @@ def build_simulation(
     }
     visualizer = None
     if meshcat is not None:
-        from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
-
         visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32))
     diagram = builder.Build()
     simulator = Simulator(diagram)
@@ -483,7 +312,8 @@ def build_simulation(
     if act.state_index is not None:
         act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
     simulator.Initialize()
-    return Simulation(platform, trajectory, controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer, plant_time_step, ff, integrator)
+    return Simulation(platform, trajectory, s.controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer,
+                      plant_time_step, ff, integrator, src)
 
 
 def setpoint_step_response(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, step: float = 1e-3,
@@ -495,22 +325,19 @@ def setpoint_step_response(platform: Platform, config: ControllerConfig | None =
     1 nm: the sensor's counts are a separate term of the bounds, and a 10 µm quantiser would add its own
     chatter to a small-signal measurement). Samples at the plant steps (the controller's period by
     default), so s[n] is the sampled step response of the discrete loop from set-point words to lengths."""
-    from dataclasses import replace
-
     if not (isinstance(leg, (int, np.integer)) and 0 <= leg < 6):
         raise ValueError(f"leg must be 0 … 5, got {leg!r}")
     if not (math.isfinite(step) and step != 0):
         raise ValueError(f"step must be a non-zero number of metres, got {step!r}")
     cfg = config or ControllerConfig.for_platform(platform)
     cfg = replace(cfg, timing=replace(cfg.timing, sensor_resolution=1e-9))
-    home = platform.home_pose()
-    rest = Trajectory("home", lambda t: np.broadcast_to(home, np.shape(t) + (6,)).copy(), duration)
+    rest = constant_trajectory("home", platform.home_pose(), duration)
     runs = []
     for delta in (0.0, step):
-        sim = build_simulation(platform, rest, "float", cfg, actuators)
+        sim = build_simulation(Scenario(platform, rest, "float", config=cfg, actuators=actuators or ActuatorModel()))
         off = np.zeros(6)
         off[leg] = delta
-        sim.controller.setpoint_offset = off
+        sim.controller.law.setpoint_offset = off
         runs.append(sim.run(duration))
     return runs[1].t, (runs[1].lengths - runs[0].lengths) / step
 
@@ -541,24 +368,14 @@ def setpoint_step_gain(platform: Platform, config: ControllerConfig | None = Non
     return {"diagonal": diag, "coupled": coupled, "tail": tail, "peak": float(s[:, leg].max()), "t": t, "s": s}
 
 
-def design_poses(trajectory: Trajectory, duration: float | None = None, n: int = 64) -> np.ndarray:
-    """``(n, 6)`` poses of ``trajectory`` evenly spread over [0, ``duration``] (default the trajectory's
-    duration, else 4 s): what the default gain design (``control.design_gains``) takes as the poses the
-    loop will visit (the struts' stiffness and the leg-space masses vary along the way)."""
-    d = duration if duration is not None else (trajectory.duration or 4.0)
-    if not (math.isfinite(d) and d >= 0):
-        raise ValueError(f"design duration must be a number of seconds >= 0, got {d!r}")
-    return trajectory.pose(np.linspace(0.0, d, n))
-
-
-def simulate(platform: Platform, trajectory="seed", controller: str = "fixed", duration: float | None = None, progress=False, **kwargs) -> "SimulationLog":
-    """Build and run: the logs of ``duration`` seconds (default the trajectory's own duration); the
-    default gains are designed over the poses of the run."""
-    traj = get_trajectory(trajectory)
-    duration = duration if duration is not None else (traj.duration or 1.0)
-    if kwargs.get("config") is None:
-        kwargs.setdefault("design_duration", max(duration, traj.duration or 0.0))
-    return build_simulation(platform, traj, controller, **kwargs).run(duration, progress=progress)
+def simulate(scenario: Scenario, progress: bool = False) -> "SimulationLog":
+    """Build ``scenario``'s Diagram and run it: the logs of ``scenario.duration`` seconds (default the
+    trajectory's own duration, else 1 s); default gains are designed over the poses of the whole run."""
+    traj = get_trajectory(scenario.trajectory)
+    duration = scenario.duration if scenario.duration is not None else (traj.duration or 1.0)
+    if scenario.config is None and scenario.design_duration is None:
+        scenario = replace(scenario, design_duration=max(duration, traj.duration or 0.0))
+    return build_simulation(replace(scenario, trajectory=traj)).run(duration, progress=progress)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -1,20 +1,17 @@
-"""Checking a firmware C file against the emulation: its ``sd_ik`` over workspace poses and, when it has
-one, its ``sd_tick`` over the input stream of a closed-loop run (Python engine), word for word."""
+"""Checking a firmware C file against the emulation, word for word: its ``sd_ik`` over workspace poses
+(``check_ik``) and its ``sd_tick`` over a recorded input stream (``check_tick``; the stream of a closed-loop
+run is recorded by ``drake.firmware_check``)."""
 
 from __future__ import annotations
 
-import math
-from pathlib import Path
-
 import numpy as np
 
-from stewart_drake.control.controller import ControllerConfig
+from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.fixedpoint.generic import leg_length_words, platform_words, pose_words, rotation_from_words, trig_words
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.sampling import random_poses
-from stewart_drake.firmware.build import Compiler
-from stewart_drake.firmware.generate import TRACE_FIELDS, generate
-from stewart_drake.firmware.module import TickRunner, compile_user
+from stewart_drake.firmware.generate import TRACE_FIELDS
+from stewart_drake.firmware.module import TickRunner
 
 MAX_POSES = 100_000_000
 CHUNK = 1 << 18
@@ -104,29 +101,6 @@ def _trace(module, platform, config, words) -> dict:
     return out
 
 
-def record_closed_loop(platform: Platform, config: ControllerConfig, trajectory="seed", duration: float = 0.5) -> list:
-    """The per-tick inputs and outputs of the Python engine's controller in a closed-loop run:
-    ``[(pose_words, measured counts, feed-forward words | None, state before, command words, state after)]``."""
-    from stewart_drake.drake.simulation import build_simulation
-
-    sim = build_simulation(platform, trajectory, "fixed", config)
-    ctrl = sim.controller
-    fmt = config.ik_format
-    records = []
-    orig = ctrl.compute
-
-    def compute(ref, L, pid, ff=None):
-        out = orig(ref, L, pid, ff)
-        cmd_words = np.round(out[0] / ctrl.timing.command_range * 32768.0).astype(np.int64)
-        records.append((pose_words(np.asarray(ref, float), fmt), ctrl.quantise(L), None if ff is None else ctrl.feedforward_words(ff),
-                        np.asarray(pid).astype(np.int64), cmd_words, np.asarray(out[2]).astype(np.int64)))
-        return out
-
-    ctrl.compute = compute
-    sim.run(duration)
-    return records
-
-
 def check_tick(module, records: list) -> dict:
     """Run ``module.sd_tick`` from the first recorded state on the recorded inputs (its own state from
     then on) and compare its commands and state with the emulation's, tick by tick."""
@@ -144,21 +118,3 @@ def check_tick(module, records: list) -> dict:
                 first = {"tick": k, "emulation_command": cmd.tolist(), "firmware_command": c.tolist(),
                          "emulation_state": state.tolist(), "firmware_state": st.tolist()}
     return {"ticks": len(records), "differing_ticks": differing, "worst_command_lsb": worst, "first_difference": first}
-
-
-def check_firmware(path: Path, platform: Platform, config: ControllerConfig, n_poses: int = 100_000, seed: int = 0,
-                   trace: bool = False, duration: float = 0.5, compiler: Compiler | None = None) -> dict:
-    """Compile ``path`` against the header generated for ``platform``/``config`` and compare it with the
-    emulation; ``{"ik": ..., "tick": ... | None, "identical": bool}``."""
-    if not (isinstance(n_poses, (int, np.integer)) and 1 <= n_poses <= MAX_POSES):
-        raise ValueError(f"--poses must be an integer in 1..{MAX_POSES}, got {n_poses!r}")
-    if not (math.isfinite(duration) and 0 < duration <= 60):
-        raise ValueError(f"--duration must be in (0, 60] s, got {duration!r}")
-    g = generate(platform, config)
-    m = compile_user(path, g, compiler)
-    if not m._has("sd_ik"):
-        raise ValueError(f"{path}: defines no sd_ik (the firmware ABI: int sd_ik(const sd_word pose[6], sd_word lengths[6]))")
-    ik = check_ik(m, platform, config, n_poses, seed, trace)
-    tick = check_tick(m, record_closed_loop(platform, config, duration=duration)) if m.has_tick else None
-    same = ik["differing_poses"] == 0 and (tick is None or tick["differing_ticks"] == 0)
-    return {"file": str(path), "platform": platform.name, "ik": ik, "tick": tick, "identical": same}

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from stewart_drake.firmware.build import CompilerUnavailable, default_compiler
+from stewart_drake.core.c_build import CompilerUnavailable, default_compiler
 
 ENGINES = ("python", "c")
 

@@ -1,5 +1,5 @@
 """C generation: a self-contained C99 firmware module for any platform — the fixed-point IK of
-``fixedpoint.generic`` and the controller tick of ``control._FixedLaw`` (PID, feed-forward word,
+``fixedpoint.generic`` and the controller tick of ``control.FixedPointLaw`` (PID, feed-forward word,
 saturation, anti-windup) with the designed gains — bit-identical to the emulation.
 
 ABI (``sd_firmware.h``; ``sd_word`` is ``int16_t``: word_bits 8..16)::
@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.control.controller import (DIFF_SHIFT, FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG, ControllerConfig, FixedGains,
-                       counts_per_lsb)
+from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
+from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG
 from stewart_drake.fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
 from stewart_drake.fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 from stewart_drake.core.geometry import Platform

@@ -14,7 +14,7 @@ from collections import Counter
 import numpy as np
 
 from stewart_drake.fixedpoint.tp17 import check_dsp_poses
-from stewart_drake.firmware.build import Compiler, build, library_sources, load
+from stewart_drake.core.c_build import Compiler, build, library_sources, load
 
 # The order of the B_* enum in dsp_batch.c.
 BATCH_OPS = ("add", "sub", "negate", "abs_s", "mult", "mult_r", "shl", "shr", "L_add", "L_sub", "L_negate", "L_abs",

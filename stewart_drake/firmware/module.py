@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.firmware.build import Compiler, Source, build, library_sources, load
+from stewart_drake.core.c_build import Compiler, Source, build, library_sources, load
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
 
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
@@ -130,7 +130,7 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
 
 
 class TickRunner:
-    """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control._FixedLaw``
+    """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control.FixedPointLaw``
     (integrator, previous measurement, its filtered difference, previous set-point, its filtered
     difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer."""
 

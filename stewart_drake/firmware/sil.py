@@ -1,8 +1,7 @@
-"""Software in the loop: the fixed-point controller LeafSystem with its tick computed by compiled C —
-the module generated for the platform and the controller's configuration, or a user's C file that
-implements the ABI (``sd_firmware.h``). Same ports, timing, zero-order hold and logs as the Python
-engine (``control.FixedPointController``): only ``compute`` changes, and its numbers are the same bit
-for bit (the tests compare whole closed-loop logs)."""
+"""Software in the loop: the fixed-point law with its tick computed by compiled C — the module generated
+for the platform and the controller's configuration, or a user's C file that implements the ABI
+(``sd_firmware.h``). Same interface as the Python law (``control.FixedPointLaw``): only ``step`` changes,
+and its numbers are the same bit for bit (the tests compare whole closed-loop logs)."""
 
 from __future__ import annotations
 
@@ -10,25 +9,29 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.control.controller import _FixedLaw, _make_class
-from stewart_drake.fixedpoint.generic import pose_words
+from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.control.laws import FixedPointLaw
+from stewart_drake.core.geometry import Platform
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import TickRunner, compile_generated, compile_user
+from stewart_drake.fixedpoint.generic import pose_words
 
-class _CFixedLaw(_FixedLaw):
-    """``_FixedLaw`` with ``compute`` done by ``sd_tick`` of a compiled firmware module."""
 
-    firmware: Path | None = None  # set on the per-file subclass
+class CFixedPointLaw(FixedPointLaw):
+    """``FixedPointLaw`` with ``step`` done by ``sd_tick`` of a compiled firmware module: the generated
+    module for ``platform`` and ``config`` or, with ``firmware``, a user's C file implementing the ABI
+    (compiled against the header generated for the same platform and format)."""
 
-    def _setup(self):
-        super()._setup()
+    def __init__(self, platform: Platform, config: ControllerConfig | None = None, firmware: str | Path | None = None):
+        super().__init__(platform, config)
+        self.firmware = None if firmware is None else Path(firmware).resolve()
         self.generated = generate(self.platform, self.config)
         m = compile_user(self.firmware, self.generated) if self.firmware is not None else compile_generated(self.generated)
         self.module = m
         self.runner = TickRunner(m)
         self._words: dict[bytes, np.ndarray] = {}
         # the host's side of one tick (quantising, feed-forward words, state vector) runs in C too
-        # (sd_host.c: the same IEEE operations as _FixedLaw's numpy code), one call per tick
+        # (sd_host.c: the same IEEE operations as FixedPointLaw's numpy code), one call per tick
         ffi = m.ffi
         self._L, self._ff, self._state, self._out = np.zeros(6), np.zeros(6), np.zeros(30), np.zeros(18)
         self._p_pose = ffi.from_buffer(f"{m.word}[]", self.runner.pose)
@@ -44,37 +47,23 @@ class _CFixedLaw(_FixedLaw):
         for q, w in zip(poses, pose_words(poses, self.config.ik_format)):
             self._words[q.tobytes()] = w
 
-    def compute(self, ref, L, pid, ff=None):
-        """One tick by the compiled ``sd_tick`` (see ``_FixedLaw.compute``): the PID state words go into
-        the C ``sd_state`` and come back out, so the LeafSystem's discrete state and logs are unchanged."""
-        ref = np.ascontiguousarray(ref, dtype=float)
+    def step(self, state, reference, measured, feedforward=None):
+        """One tick by the compiled ``sd_tick`` (see ``FixedPointLaw.step``): the PID state words go into
+        the C ``sd_state`` and come back out, so the state and the logs are unchanged."""
+        ref = np.ascontiguousarray(reference, dtype=float)
         w = self._words.get(ref.tobytes())
         if w is None:
             self.cache_misses += 1
             w = pose_words(ref, self.config.ik_format)
         r = self.runner
         r.pose[:] = w
-        self._L[:] = L
-        self._state[:] = pid
-        if ff is not None:
-            self._ff[:] = ff
-        k = self._host_tick(r._ptr, self._p_pose, self._p_L, self._res, self._p_ff if ff is not None else self._null, self._range,
+        self._L[:] = measured
+        self._state[:] = state
+        if feedforward is not None:
+            self._ff[:] = feedforward
+        k = self._host_tick(r._ptr, self._p_pose, self._p_L, self._res, self._p_ff if feedforward is not None else self._null, self._range,
                             self._lsb, self._p_state, self._p_out)
         if k < 0:
-            raise ValueError(f"measured leg lengths {np.asarray(L).tolist()} m do not fit the firmware's 32-bit sensor counts")
+            raise ValueError(f"measured leg lengths {np.asarray(measured).tolist()} m do not fit the firmware's 32-bit sensor counts")
         o = self._out
         return o[:6].copy(), o[6:12].copy(), self._state.copy(), o[12:].copy()
-
-
-_CLASSES: dict[str, type] = {}
-
-
-def CFixedPointController(platform, config=None, firmware: str | Path | None = None):
-    """The fixed-point controller LeafSystem running compiled C: the generated module for ``platform`` and
-    ``config`` or, with ``firmware``, a user's C file implementing the ABI (compiled against the header
-    generated for the same platform and format)."""
-    key = "" if firmware is None else str(Path(firmware).resolve())
-    if key not in _CLASSES:
-        law = type("_CFixedLawFile", (_CFixedLaw,), {"firmware": None if firmware is None else Path(key)})
-        _CLASSES[key] = _make_class("CFixedPointController", law)
-    return _CLASSES[key](platform, config)

@@ -2,7 +2,8 @@
 
 Drake objects do not pickle, so a worker receives a ``Study`` (the study's fixed settings: platform,
 reference, controller, integrator, duration, SPEC, seed) and a run index, draws that run's ``Draw`` from
-its own seed and builds its Diagram itself (``run_scenario``). The run's seed is
+its own seed, turns it into a ``drake.simulation.Scenario`` (``scenario``) and builds its Diagram from that
+itself (``run_scenario``). The run's seed is
 ``run_seed(study.seed, index)``: the first 64-bit word (its low 63 bits) of ``numpy.random.SeedSequence(S,
 spawn_key=(index,))``, so any run can be re-drawn alone from (S, index) or from its seed.
 
@@ -26,8 +27,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
+from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.montecarlo.spec import KEYS, VarySpec
+from stewart_drake.script import run_program
 
 # Nominal values of the keys whose nominal is not the platform's.
 NOMINAL = {"sensor_resolution": 1e-5, "latency": "sample", "actuator_lag": 2e-3, "gain_scale": 1.0,
@@ -62,18 +67,13 @@ class Study:
     grid: tuple | None = None
     extra: dict = field(default_factory=dict)
 
-    def reference(self):
-        """The pose reference as a ``simulation.Trajectory`` (built on the worker)."""
-        from stewart_drake.drake.simulation import Trajectory, fit_trajectory, get_trajectory, table_trajectory
-
+    def reference(self) -> Trajectory:
+        """The pose reference (built on the worker)."""
         if self.table is not None:
             ref = table_trajectory(*self.table)
         elif self.program is not None:
-            from stewart_drake.script import run_program
-
             name, text = self.program
-            traj = run_program(text, name, self.platform).trajectory
-            ref = Trajectory(name.rsplit("/", 1)[-1].removesuffix(".stw"), traj.pose_at, traj.duration)
+            ref = replace(run_program(text, name, self.platform).trajectory, name=name.rsplit("/", 1)[-1].removesuffix(".stw"))
         else:
             ref = get_trajectory(self.trajectory)
         return fit_trajectory(ref, self.platform) if self.fit else ref
@@ -194,39 +194,33 @@ def plant_platform(platform: Platform, d: Draw) -> Platform:
     )
 
 
-def sensor_factory(d: Draw, seed: int, period: float, n_ticks: int):
-    """A ``build_simulation`` sensor: (plant, D) → the LeafSystem reading L + offset + noise − j·dL/dt.
-    The noise ``(n_ticks, 6)`` and jitter ``(n_ticks,)`` tables come from the run's seed (generator
-    ``spawn_key=(1,)``); tick k reads row k (k = round(t / period))."""
+def sensor_model(d: Draw, seed: int, period: float, n_ticks: int) -> SensorModel:
+    """The run's sensor: L + offset + noise − j·dL/dt. The noise ``(n_ticks, 6)`` and jitter ``(n_ticks,)``
+    tables come from the run's seed (generator ``spawn_key=(1,)``); tick k reads row k (k = round(t / period))."""
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
     noise = rng.normal(0.0, 1.0, size=(n_ticks, 6)) * d.sensor_noise
     jitter = rng.uniform(0.0, 1.0, size=n_ticks) * d.latency_jitter
+    return SensorModel(d.leg_offset, noise, jitter, period)
 
-    def make(plant, D):
-        from pydrake.systems.framework import LeafSystem
 
-        joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
-        pos = np.array([j.position_start() for j in joints])
-        vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
-
-        class Sensor(LeafSystem):
-            def __init__(self):
-                super().__init__()
-                u = self.DeclareVectorInputPort("state", D.shape[1])
-
-                def calc(c, o):
-                    x = u.Eval(c)
-                    k = min(int(round(c.get_time() / period)), n_ticks - 1)
-                    o.SetFromVector(x[pos] + d.leg_offset + noise[k] - jitter[k] * x[vel])
-
-                self.DeclareVectorOutputPort("lengths", 6, calc)
-
-            def initial_reading(self, L):
-                return np.asarray(L, float) + d.leg_offset
-
-        return Sensor()
-
-    return make
+def scenario(study: Study, index: int, reference: Trajectory | None = None) -> tuple[int, Draw, Scenario]:
+    """``(run seed, Draw, Scenario)`` of run ``index``: the controller keeps the nominal model with the
+    gains designed for the nominal timing and actuator lag over the run's poses (as ``simulate`` does),
+    scaled by the draw's ``gain_scale``; the plant and sensor are the draw's."""
+    seed, d = draw(study, index)
+    ref = reference or study.reference()
+    duration = study.run_duration(ref)
+    p = study.platform
+    g = ControllerConfig.for_platform(p, poses=design_poses(ref, max(duration, ref.duration or 0.0))).gains
+    s = d.gain_scale
+    timing = DspTiming(sample_period=d.sample_period, latency=d.latency, sensor_resolution=d.sensor_resolution,
+                       command_range=float(p.legs.max_force))
+    config = ControllerConfig.for_platform(p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s))
+    n_ticks = int(math.floor(duration / timing.sample_period + 1e-9)) + 2
+    return seed, d, Scenario(p, ref, study.controller, config, ActuatorModel(d.force_limit, d.actuator_lag),
+                             plant_time_step=study.plant_step, integrator=study.integrator, engine=study.engine,
+                             plant_platform=plant_platform(p, d), sensor=sensor_model(d, seed, timing.sample_period, n_ticks),
+                             duration=duration)
 
 
 def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None) -> dict:
@@ -234,33 +228,16 @@ def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None)
     with ``keep_log``, the ``SimulationLog`` under ``"log"``. Metrics (SI): leg error = true length −
     the perturbed plant's IK of the reference; pose error = measured − reference pose. A run whose
     simulation fails keeps its row, with ``error`` set and ``lost_tracking`` true."""
-    from stewart_drake.control.controller import ControllerConfig, DspTiming
-    from stewart_drake.drake.simulation import ActuatorModel, build_simulation, design_poses
-
     t0 = time.perf_counter()
-    seed, d = draw(study, index)
-    row = {"run": index, "seed": seed, **d.columns()}
     ref = study.reference()
-    duration = study.run_duration(ref)
-    p = study.platform
-    # the gains designed for the nominal timing and actuator lag over the run's poses (as simulate does)
-    g = ControllerConfig.for_platform(p, poses=design_poses(ref, max(duration, ref.duration or 0.0))).gains
-    s = d.gain_scale
-    timing = DspTiming(sample_period=d.sample_period, latency=d.latency, sensor_resolution=d.sensor_resolution,
-                       command_range=float(p.legs.max_force))
-    config = ControllerConfig.for_platform(p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s))
-    pp = plant_platform(p, d)
-    n_ticks = int(math.floor(duration / timing.sample_period + 1e-9)) + 2
-    sensor = sensor_factory(d, seed, timing.sample_period, n_ticks)
+    seed, d, sc = scenario(study, index, ref)
+    row = {"run": index, "seed": seed, **d.columns()}
     log, error = None, ""
     try:
-        sim = build_simulation(p, ref, study.controller, config, ActuatorModel(d.force_limit, d.actuator_lag),
-                               plant_time_step=study.plant_step, integrator=study.integrator, engine=study.engine,
-                               plant_platform=pp, sensor=sensor, meshcat=meshcat)
-        log = sim.run(duration)
+        log = build_simulation(sc, meshcat=meshcat).run(sc.duration)
     except (RuntimeError, ValueError) as e:
         error = f"{type(e).__name__}: {e}".splitlines()[0][:300]
-    row.update(_metrics(log, ref, pp, study.lost_tracking, error))
+    row.update(_metrics(log, ref, sc.plant_platform, study.lost_tracking, error))
     row["wall_s"] = time.perf_counter() - t0
     if keep_log:
         row["log"] = log

@@ -150,7 +150,7 @@ def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
     return Distribution("fixed", (_number(text, key, where),), text)
 
 
-def _check_key(key: str, where: str) -> None:
+def check_key(key: str, where: str) -> None:
     if key not in KEYS:
         near = difflib.get_close_matches(key, KEYS, n=1)
         hint = f" (did you mean {near[0]!r}?)" if near else f" (keys: {', '.join(KEYS)})"
@@ -176,7 +176,7 @@ def parse_spec(words) -> VarySpec:
             raise SpecError(f"--vary: {w!r} is not key=value")
         key, value = w.split("=", 1)
         key = key.strip()
-        _check_key(key, "--vary")
+        check_key(key, "--vary")
         d = parse_value(key, value, "--vary")
         _check_vector(key, d, "--vary")
         laws[key] = d
@@ -201,7 +201,7 @@ def _parse_yaml(path: Path) -> VarySpec:
         where = _where(str(path), k.start_mark.line + 1)
         if not isinstance(v, yaml.ScalarNode):
             raise SpecError(f"{where}: {k.value}: the value must be one scalar (e.g. ±0.5mm)")
-        _check_key(k.value, where)
+        check_key(k.value, where)
         d = parse_value(k.value, v.value, where)
         _check_vector(k.value, d, where)
         laws[k.value] = d
@@ -212,6 +212,6 @@ def spec_from_dict(d: dict, source: str = "study.json") -> VarySpec:
     """The ``VarySpec`` of ``VarySpec.to_dict()`` (as stored with a study)."""
     laws = {}
     for k, v in d.items():
-        _check_key(k, source)
+        check_key(k, source)
         laws[k] = parse_value(k, v, source)
     return VarySpec(laws, source)

@@ -8,7 +8,7 @@ import itertools
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.montecarlo.scenario import Study
-from stewart_drake.montecarlo.spec import KEYS, SpecError, VarySpec, _check_key
+from stewart_drake.montecarlo.spec import KEYS, SpecError, VarySpec, check_key
 from stewart_drake.montecarlo.study import run_study
 
 
@@ -17,7 +17,7 @@ def sweep_study(platform: Platform, axes: dict, trajectory: str = "seed", contro
     """The ``Study`` of the cartesian product of ``axes`` (``{key: [SI values]}``, keys of ``spec.KEYS``;
     the first key varies slowest): point i is run i."""
     for k, values in axes.items():
-        _check_key(k, "sweep")
+        check_key(k, "sweep")
         if KEYS[k][1]:
             raise SpecError(f"sweep: {k} is a per-component key; sweep scalar keys")
         if not len(values):

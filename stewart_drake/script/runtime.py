@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition, leg_forces
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
+from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
 from stewart_drake.core.sanity import above_base, has_plate, plate_anchor_heights
 from stewart_drake.errors import (
@@ -121,39 +123,20 @@ def pose_text(values, units) -> str:
     return f"{', '.join(v[:3])} {units[0]}; {', '.join(v[3:])} {units[1]}"
 
 
-@dataclass(frozen=True)
-class Trajectory:
-    """Sampled trajectory: ``t`` (n,) s; ``q``, ``qd``, ``qdd`` (n, 6) in m, rad and their rates;
-    ``segment`` (n,) index into ``segments`` of the piece each sample ends (−1: the start pose)."""
-
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    segment: np.ndarray
-    segments: tuple
-
-    @property
-    def moves(self) -> list[Segment]:
-        return [s for s in self.segments if s.kind == "move"]
-
-    @property
-    def duration(self) -> float:
-        return float(self.t[-1])
-
-    def pose_at(self, t) -> np.ndarray:
-        """``(..., 6)`` pose at any times ``(...)`` (s), from the segments' quintics (not the samples);
-        the start pose before 0 and the final pose after the end."""
-        t = np.asarray(t, dtype=float)
-        if not self.segments:
-            return np.broadcast_to(self.q[0], t.shape + (6,)).copy()
-        d = np.array([s.duration for s in self.segments])
-        ends = np.cumsum(d)
-        k = np.clip(np.searchsorted(ends, t, side="left"), 0, len(d) - 1)
-        tau = np.clip((t - (ends[k] - d[k])) / d[k], 0.0, 1.0)
-        q0 = np.array([s.q0 for s in self.segments])[k]
-        q1 = np.array([s.q1 for s in self.segments])[k]
-        return q0 + quintic(tau)[0][..., None] * (q1 - q0)
+def segments_pose(segments: tuple, start, t) -> np.ndarray:
+    """``(..., 6)`` pose at any times ``(...)`` (s) along a program's ``segments`` (their quintics, not
+    samples): ``start`` (6,) before the first segment's start and without segments, the final pose after
+    the end."""
+    t = np.asarray(t, dtype=float)
+    if not segments:
+        return np.broadcast_to(start, t.shape + (6,)).copy()
+    d = np.array([s.duration for s in segments])
+    ends = np.cumsum(d)
+    k = np.clip(np.searchsorted(ends, t, side="left"), 0, len(d) - 1)
+    tau = np.clip((t - (ends[k] - d[k])) / d[k], 0.0, 1.0)
+    q0 = np.array([s.q0 for s in segments])[k]
+    q1 = np.array([s.q1 for s in segments])[k]
+    return q0 + quintic(tau)[0][..., None] * (q1 - q0)
 
 
 def _check_finite(value, what: str, at) -> float:
@@ -301,7 +284,10 @@ class Motion:
             qdd.append(ddp[:, None] * delta / s.duration**2)
             seg.append(np.full(n, k))
             t0 += s.duration
-        return Trajectory(np.concatenate(t), np.vstack(q), np.vstack(qd), np.vstack(qdd), np.concatenate(seg), tuple(self.segments))
+        t, q = np.concatenate(t), np.vstack(q)
+        segments = tuple(self.segments)
+        return Trajectory("program", partial(segments_pose, segments, q[0].copy()), float(t[-1]), t=t, q=q, qd=np.vstack(qd),
+                          qdd=np.vstack(qdd), segment=np.concatenate(seg), segments=segments)
 
 
 @dataclass(frozen=True)

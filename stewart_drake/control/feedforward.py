@@ -1,0 +1,63 @@
+"""The model-based force feed-forward: the leg forces of the inverse dynamics (plate and legs) along the
+reference, sampled at the controller's ticks and advanced by the loop's known delays.
+
+On the DSP it is a table (six Q15 words per tick, written by the host with the pose table: 12 bytes per
+tick, 12 kB per second at 1 kHz) and costs one ``L_deposit_h`` and one ``L_add`` per leg
+(``timing.FEEDFORWARD_OPS_PER_LEG``, in the cycle model). Computing it on the DSP instead would take the
+inverse dynamics per tick (``timing.ONLINE_FEEDFORWARD_OPS``: a linearised model F = F_home + M_L·L̈_ref,
+36 multiply-accumulates and the second differences, is ~150 cycles; the full model with the Jacobian solve
+is several thousand cycles, more than the IK).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.core.dynamics import leg_forces_with_legs
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.trajectory import Trajectory
+
+
+def feedforward_lead(config: ControllerConfig, actuator_lag: float) -> float:
+    """Seconds by which the feed-forward table leads the reference: a force computed at tick k is
+    released after the output delay, held for a sample (on average half of it) and reaches the plate
+    through the actuator lag (a first-order lag τ delays slow signals by τ)."""
+    return config.timing.output_delay + config.timing.sample_period / 2 + actuator_lag
+
+
+def feedforward_forces(platform: Platform, trajectory: Trajectory, times, lead: float, h: float) -> np.ndarray:
+    """``(n, 6)`` feed-forward leg forces (N) at ``times`` (n,): ``dynamics.leg_forces_with_legs`` at the
+    reference pose of t + ``lead``, with its rates from central differences of step ``h`` (the sample
+    period: the second difference of the sampled reference, bounded also for piecewise-linear CSV
+    references)."""
+    t = np.asarray(times, dtype=float).reshape(-1) + lead
+    qm, q0, qp = trajectory.pose(t - h), trajectory.pose(t), trajectory.pose(t + h)
+    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
+
+
+class FeedforwardTable:
+    """``feedforward_forces`` of ``trajectory`` at tick times, filled in one batch by ``prime(times)``; a
+    time not in the table is computed on its own (same numbers)."""
+
+    def __init__(self, platform: Platform, trajectory: Trajectory, lead: float, h: float):
+        self.platform, self.trajectory, self.lead, self.h = platform, trajectory, lead, h
+        self.table: dict[float, np.ndarray] = {}
+
+    def prime(self, times) -> None:
+        times = np.asarray(times, dtype=float)
+        for t, F in zip(times, feedforward_forces(self.platform, self.trajectory, times, self.lead, self.h)):
+            self.table[float(t)] = F
+
+    def force(self, t: float) -> np.ndarray:
+        """``(6,)`` N at time ``t`` (s)."""
+        F = self.table.get(float(t))
+        return F if F is not None else feedforward_forces(self.platform, self.trajectory, [t], self.lead, self.h)[0]
+
+
+def initial_leg_forces(platform: Platform, trajectory: Trajectory, t: float = 0.0, h: float = 1e-4) -> np.ndarray:
+    """``(6,)`` leg forces (N) that move plate and legs along the reference at time ``t``
+    (``dynamics.leg_forces_with_legs`` with central-difference rates): where the controller's integrator
+    starts, so a run begins in equilibrium instead of with a gravity sag."""
+    qm, q0, qp = trajectory.pose(np.array([t - h, t, t + h]))
+    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)

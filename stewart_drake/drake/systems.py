@@ -1,0 +1,237 @@
+"""Drake systems of the controller-in-the-loop Diagram, each a thin ``LeafSystem`` around numpy code:
+
+- ``ControllerSystem``: a control law (``control.FloatLaw``, ``control.FixedPointLaw`` or the compiled
+  ``firmware.sil.CFixedPointLaw``) ticking at exactly t = k·T, with the DSP's output latency and a
+  zero-order hold on its outputs;
+- ``PoseSource``: a ``core.trajectory.Trajectory`` as an output port;
+- ``FeedforwardSource``: the feed-forward table (``control.FeedforwardTable``) as an output port;
+- ``Actuators``: saturation and a first-order lag, discretised exactly at the plant's step;
+- ``LegLengthSensor``: the plant state's leg lengths plus an offset, white noise and the first-order
+  effect of a late sample (a Monte Carlo draw's sensor).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from pydrake.systems.framework import LeafSystem
+
+from stewart_drake.control.feedforward import FeedforwardTable
+from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.control.laws import CONTROLLER_KINDS, STATUS, FixedPointLaw, FloatLaw
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.firmware.sil import CFixedPointLaw
+
+ENGINES = ("python", "c")
+
+
+class ControllerSystem(LeafSystem):
+    """A leg controller: ``law`` ticking every ``law.timing.sample_period`` seconds at t = k·T.
+
+    Inputs ``reference`` (6: pose, metres/radians, the law's convention), ``leg_lengths`` (6: metres, the
+    true prismatic positions: the law quantises them) and the optional ``feedforward`` (6: leg forces,
+    newtons; left unconnected it is zero). Outputs ``command`` (6: leg forces, N), ``setpoint`` (6: m) and
+    ``status`` (``control.STATUS``). A tick's result is released after the output delay
+    (``DspTiming.latency``): ``sample`` at (k+1)·T, ``computation`` at k·T + t_comp, ``none`` at k·T; the
+    outputs read discrete state, so between releases the command is held (zero-order hold).
+
+    Discrete state groups: ``held`` (12: released command N, released set-point m), ``pending`` (12: the
+    same, computed but not yet released), ``pid`` (30: the law's state), ``status`` (``STATUS``).
+    """
+
+    def __init__(self, law):
+        super().__init__()
+        self.law = law
+        self.platform, self.config, self.timing = law.platform, law.config, law.timing
+        T = self.timing.sample_period
+        self.DeclareVectorInputPort("reference", 6)
+        self.DeclareVectorInputPort("leg_lengths", 6)
+        self._ff_port = self.DeclareVectorInputPort("feedforward", 6)
+        self._held = self.DeclareDiscreteState(12)
+        self._pending = self.DeclareDiscreteState(12)
+        self._pid = self.DeclareDiscreteState(30)
+        self._status = self.DeclareDiscreteState(len(STATUS))
+        self.DeclareVectorOutputPort("command", 6, self._CalcCommand)
+        self.DeclareVectorOutputPort("setpoint", 6, self._CalcSetpoint)
+        self.DeclareStateOutputPort("status", self._status)
+        self.DeclarePeriodicDiscreteUpdateEvent(T, 0.0, self._Tick)
+        d = self.timing.output_delay
+        self._release_separately = 0.0 < d < T
+        if self._release_separately:
+            self.DeclarePeriodicDiscreteUpdateEvent(T, d, self._Release)
+
+    def _CalcCommand(self, context, output):
+        output.SetFromVector(context.get_discrete_state(self._held).value()[:6])
+
+    def _CalcSetpoint(self, context, output):
+        output.SetFromVector(context.get_discrete_state(self._held).value()[6:])
+
+    def _Tick(self, context, discrete_state):
+        ref = self.get_input_port(0).Eval(context)
+        L = self.get_input_port(1).Eval(context)
+        ff = self._ff_port.Eval(context) if self._ff_port.HasValue(context) else None
+        pid = context.get_discrete_state(self._pid).value()
+        command, setpoint, pid_new, saturated = self.law.step(pid, ref, L, ff)
+        st = context.get_discrete_state(self._status).value().copy()
+        t = context.get_time()
+        st[0] += 1
+        st[1] = t
+        st[3] += float(np.any(saturated))
+        st[4:10] += saturated
+        out = np.concatenate([command, setpoint])
+        if self.timing.latency == "none":
+            discrete_state.set_value(self._held, out)
+            st[2] = t
+        elif self.timing.latency == "sample" or not self._release_separately:
+            # release the previous tick's result now, (k+1)·T, then compute the next one
+            if st[0] > 1:
+                discrete_state.set_value(self._held, context.get_discrete_state(self._pending).value())
+                st[2] = t
+        discrete_state.set_value(self._pending, out)
+        discrete_state.set_value(self._pid, pid_new)
+        discrete_state.set_value(self._status, st)
+
+    def _Release(self, context, discrete_state):
+        st = context.get_discrete_state(self._status).value().copy()
+        if st[0] < 1:
+            return
+        discrete_state.set_value(self._held, context.get_discrete_state(self._pending).value())
+        st[2] = context.get_time()
+        discrete_state.set_value(self._status, st)
+
+    def initialize(self, context, lengths, hold_forces=None, feedforward=None, rates=None) -> None:
+        """Set the controller's state (in its own ``context``) as if it had been holding ``lengths``
+        (6, metres) with ``hold_forces`` (6, newtons; e.g. the static forces against gravity) for a while;
+        with a ``feedforward`` (6, N) the integrator holds only the difference hold − feed-forward; with
+        ``rates`` (6, m/s) as if the legs had been moving at those rates (the difference filters start
+        there: no start-up kick from a derivative that sees the motion but a feed-forward that does not)."""
+        lengths = np.asarray(lengths, dtype=float).reshape(6)
+        F = np.zeros(6) if hold_forces is None else np.asarray(hold_forces, dtype=float).reshape(6)
+        ff = np.zeros(6) if feedforward is None else np.asarray(feedforward, dtype=float).reshape(6)
+        pid = self.law.initial_pid_state(lengths, F - ff, rates)
+        context.SetDiscreteState(self._pid, pid)
+        held = np.concatenate([self.law.command_from_integrator(pid[:6], ff), lengths])
+        context.SetDiscreteState(self._held, held)
+        context.SetDiscreteState(self._pending, held)
+        context.SetDiscreteState(self._status, np.zeros(len(STATUS)))
+
+
+def make_law(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python",
+             firmware: str | Path | None = None):
+    """The law of controller ``kind`` (``"fixed"`` or ``"float"``); for ``fixed``, ``engine`` ``"python"``
+    (the emulation) or ``"c"`` (the compiled firmware; ``firmware``: a user's C file implementing the ABI).
+    The float twin has no firmware: ``engine`` does not apply to it."""
+    if kind == "fixed" and (engine == "c" or firmware is not None):
+        return CFixedPointLaw(platform, config, firmware)
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be 'python' or 'c', got {engine!r}")
+    if kind != "fixed" and firmware is not None:
+        raise ValueError(f"a firmware file runs the fixed-point controller; controller {kind!r} has no firmware")
+    if kind == "fixed":
+        return FixedPointLaw(platform, config)
+    if kind == "float":
+        return FloatLaw(platform, config)
+    raise ValueError(f"controller must be {' or '.join(repr(k) for k in CONTROLLER_KINDS)}, got {kind!r}")
+
+
+def make_controller(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python",
+                    firmware: str | Path | None = None) -> ControllerSystem:
+    """``ControllerSystem`` of ``make_law(kind, platform, config, engine, firmware)``."""
+    return ControllerSystem(make_law(kind, platform, config, engine, firmware))
+
+
+class PoseSource(LeafSystem):
+    """Output ``pose`` (6) = ``trajectory.pose(t)`` (any 6-vector function of time: also leg lengths);
+    ``prime(times)`` evaluates the times a run will ask for (the ticks) in one batch beforehand."""
+
+    def __init__(self, trajectory: Trajectory):
+        super().__init__()
+        self.trajectory = trajectory
+        self._table: dict[float, np.ndarray] = {}
+        self.DeclareVectorOutputPort("pose", 6, self._CalcPose)
+
+    def prime(self, times) -> np.ndarray:
+        """Remember (and return, ``(n, 6)``) the poses at ``times`` (n,) s, computed in one batch (the pose
+        functions are elementwise over times: the same numbers as one at a time). A speed-up only; other
+        times are computed."""
+        times = np.asarray(times, dtype=float).reshape(-1)
+        poses = self.trajectory.pose(times)
+        for t, q in zip(times, poses):
+            self._table[float(t)] = q
+        return poses
+
+    def _CalcPose(self, context, output):
+        t = context.get_time()
+        q = self._table.get(t)
+        # evaluated on a 1-element array, the same code path as a batch of times
+        output.SetFromVector(q if q is not None else self.trajectory.pose(np.array([t]))[0])
+
+
+class FeedforwardSource(LeafSystem):
+    """Output ``force`` (6, N) = ``table.force(t)`` at the context's time."""
+
+    def __init__(self, table: FeedforwardTable):
+        super().__init__()
+        self.table = table
+        self.DeclareVectorOutputPort("force", 6, self._CalcForce)
+
+    def _CalcForce(self, context, output):
+        output.SetFromVector(self.table.force(context.get_time()))
+
+
+class Actuators(LeafSystem):
+    """Input ``command`` (6, N) → output ``force`` (6, N): saturation at ±``max_force``, then a first-order
+    lag with time constant ``time_constant`` (s) discretised exactly at ``period`` (the plant's step),
+    F ← a·F + (1−a)·u, a = exp(−period/τ); with τ = 0 the saturated command passes straight through.
+    ``state_index``: the discrete state of the lag (None without one)."""
+
+    def __init__(self, max_force: float, time_constant: float, period: float):
+        super().__init__()
+        self.max_force = max_force
+        self._u = self.DeclareVectorInputPort("command", 6)
+        if time_constant > 0:
+            self._a = math.exp(-period / time_constant)
+            self.state_index = self.DeclareDiscreteState(6)
+            self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._Update)
+            self.DeclareStateOutputPort("force", self.state_index)
+        else:
+            self.state_index = None
+            self.DeclareVectorOutputPort("force", 6, self._CalcForce)
+
+    def _saturated(self, context) -> np.ndarray:
+        # np.minimum(np.maximum()) is np.clip's result (NaN included), without its per-call overhead
+        return np.minimum(np.maximum(self._u.Eval(context), -self.max_force), self.max_force)
+
+    def _Update(self, context, discrete_state):
+        F = context.get_discrete_state(self.state_index).value()
+        discrete_state.set_value(self.state_index, self._a * F + (1 - self._a) * self._saturated(context))
+
+    def _CalcForce(self, context, output):
+        output.SetFromVector(self._saturated(context))
+
+
+class LegLengthSensor(LeafSystem):
+    """Input ``state`` (the plant's state) → output ``lengths`` (6, m) = L + ``offset`` + ``noise[k]`` −
+    ``jitter[k]``·dL/dt at tick k = round(t / ``period``) (rows ``(n_ticks, 6)`` m and ``(n_ticks,)`` s,
+    the last row reused beyond the table). ``positions``, ``velocities``: indices of the six prismatic
+    joints' positions and rates in the state."""
+
+    def __init__(self, n_state: int, positions, velocities, offset, noise, jitter, period: float):
+        super().__init__()
+        self._pos, self._vel = np.asarray(positions), np.asarray(velocities)
+        self._offset, self._noise, self._jitter = np.asarray(offset, float), np.asarray(noise, float), np.asarray(jitter, float)
+        self._period = period
+        self._u = self.DeclareVectorInputPort("state", n_state)
+        self.DeclareVectorOutputPort("lengths", 6, self._CalcLengths)
+
+    def _CalcLengths(self, context, output):
+        x = self._u.Eval(context)
+        k = min(int(round(context.get_time() / self._period)), len(self._jitter) - 1)
+        output.SetFromVector(x[self._pos] + self._offset + self._noise[k] - self._jitter[k] * x[self._vel])
+
+    def initial_reading(self, L):
+        """The reading of true lengths ``L`` (6, m) at rest before t = 0: L + offset."""
+        return np.asarray(L, float) + self._offset
