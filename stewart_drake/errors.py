@@ -294,6 +294,7 @@ class WorkspaceError(StewartError):
     CENTRE = "rotation centre must be 3 finite coordinates in metres (plate frame), got {value}"
     STEP = "step must be in (0, max_angle), got step = {step} rad, max_angle = {max_angle} rad"
     START_OUTSIDE = "start pose {pose} is outside the {limit} limit (margin {margin:.4g} {unit})"
+    DEXTERITY_POSES = "the dexterity limit needs the poses themselves"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -536,3 +537,198 @@ PERIOD_TOO_SLOW = (
     "{lam:.3g}/s, and the leg loops' crossover at this period is at most {w_c:.3g} rad/s (< {margin:g} × "
     "{lam:.3g}); use a period of at most ~{t_max:.3g} s"
 )
+
+
+# --- remaining modules: rotations, Newton FK, gains, simulation, firmware, command options
+class RotationError(StewartError):
+    """An unknown rotation convention or unit, or an angle/pose/quaternion array of the wrong shape
+    (``core.rotations``)."""
+
+    CONVENTION = "unknown rotation convention {value!r}; expected one of {valid}"
+    ANGLE_UNIT = "unknown angle unit {value!r}; expected one of {valid}"
+    LENGTH_UNIT = "unknown length unit {value!r}; expected one of {valid}"
+    POSE_SHAPE = "a pose needs 6 numbers (px, py, pz, a_x, a_y, a_z), got shape {shape}"
+    ANGLES_SHAPE = "angles need 3 numbers (about X, Y, Z), got shape {shape}"
+    QUATERNION_SHAPE = "quaternions need 4 numbers (w, x, y, z), got shape {shape}"
+
+
+class FkInputError(StewartError):
+    """Forward kinematics was given malformed lengths, initial poses or solver options (``core.newton_fk``,
+    ``core.assembly_modes``, ``drake.program_fk``)."""
+
+    ON_SINGULAR = "on_singular must be 'raise', 'warn' or 'ignore', got {value!r}"
+    LENGTHS_SHAPE = "leg lengths must have shape (..., 6), one per leg, got {shape}"
+    LENGTH_VALUE = "lengths sample {index}: leg {leg} length {value} m is not a positive finite number"
+    POSITIVE = "{name} must be a positive finite number, got {value!r}"
+    MAX_ITER = "max_iter must be a positive integer, got {value!r}"
+    INITIAL_SHAPE = "initial pose must have shape (6,) or (..., 6), got {shape}"
+    INITIAL_NOT_FINITE = "initial pose must be finite, got {value}"
+    INITIAL_BROADCAST = "initial poses of shape {shape} do not match lengths of shape {lengths_shape}"
+    INITIAL_SIX = "initial pose must be 6 finite numbers, got {value}"
+    ONE_SET = "{what} takes one length set of shape (6,), got {shape}"
+    ROTATION = "unknown rotation parametrisation {value!r}; expected one of {valid}"
+    SOLVER = "unknown solver {value!r}; expected one of {valid}"
+    POLISH = "polish must be one of {valid} or None, got {value!r}"
+
+
+class SamplingError(StewartError):
+    """A pose-sampling request that names an unknown region or finds too few reachable poses (``core.sampling``)."""
+
+    REGION = "unknown pose region {value!r}; expected one of {valid}"
+    TOO_FEW = "platform {name!r}: could not sample {n} reachable poses around home ({region!r} region)"
+
+
+class GainError(StewartError):
+    """Controller gains or their design inputs are not usable (``control.gains``)."""
+
+    PID_NEGATIVE = "PidGains.{name} must be a finite number >= 0, got {value!r}"
+    PID_FILTER = "PidGains.{name} must be in (0, 1], got {value!r}"
+    ACTUATOR_LAG = "actuator_lag must be >= 0 s, got {value!r}"
+    INERTIA = ("platform {name!r}: the leg-space inertia is not positive definite (smallest eigenvalue "
+               "{m_min:.3g} kg)")
+    DESIGN_POSE = "design pose {index} is not finite: {value!r}"
+    GAIN = "a gain must be a finite number >= 0, got {value!r}"
+    Q15_RANGE = "gain {value!r} is too large for a Q15 mantissa with a 32-bit shift"
+    SENSOR_COUNTS = ("sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts "
+                     "for the fixed-point controller")
+
+
+# DspTiming fields (``control.timing``), raised as ``TimingError``.
+TIMING_POSITIVE = "DspTiming.{name} must be a positive number, got {value!r}"
+TIMING_LATENCY = "DspTiming.latency must be one of {valid}, got {value!r}"
+TIMING_CYCLES = "DspTiming.computation_cycles must be a positive integer, got {value!r}"
+
+
+class TrajectoryError(InputError):
+    """A reference trajectory that cannot be built: unknown name, bad CSV times, a bad design duration
+    (``core.trajectory``)."""
+
+    NO_RATES = "trajectory {name!r} has no closed-form rates"
+    TIME_ORDER = "{path}:{line}: time {t} s is not after the previous sample's {t_prev} s"
+    DESIGN_DURATION = "design duration must be a number of seconds >= 0, got {value!r}"
+    UNKNOWN = "unknown trajectory {value!r}: not one of {valid} and not a CSV file"
+
+
+class SimulationError(StewartError):
+    """A simulation or Drake model request with values outside what it accepts (``drake.simulation``,
+    ``drake.systems``, ``drake.*_model``)."""
+
+    MAX_FORCE = "ActuatorModel.max_force must be a positive number of newtons, got {value!r}"
+    TIME_CONSTANT = "ActuatorModel.time_constant must be >= 0 s, got {value!r}"
+    DURATION = "duration must be a positive number of seconds, got {value!r}"
+    PLANT_STEP = "plant_time_step must be a positive number of seconds, got {value!r}"
+    LEG = "leg must be 0 … 5, got {value!r}"
+    STEP = "step must be a non-zero number of metres, got {value!r}"
+    ENGINE = "engine must be 'python' or 'c', got {value!r}"
+    FIRMWARE_LAW = "a firmware file runs the fixed-point controller; controller {kind!r} has no firmware"
+    CONTROLLER = "controller must be {valid}, got {value!r}"
+    DISCRETE_STEP = "time_step must be > 0 (ball constraints need a discrete plant), got {value}"
+    TIME_STEP = "time_step must be > 0, got {value}"
+    SERVO_POSES = "compare_with_drake needs reachable in-travel poses; pose {index} is not: {why}"
+    FRAME_RATE = "servo frame rate must be > 0 Hz, got {value}"
+    CLOSED_LOOP_SHAPES = ("run_closed_loop needs times (n,) and poses (n, 6) with n >= 2, got {times_shape} and "
+                          "{poses_shape}")
+    SPRING = "leg {leg}: static force {force:.6g} N compresses a {k:.6g} N/m spring past zero length"
+    SERVO_SPEED = ("reference arm speed {rate:.3g} rad/s reaches the servo's no-load speed "
+                   "{speed:.3g} rad/s: the tracking bound does not apply")
+    PORT = "--port {port}: Meshcat could not listen there ({reason})"
+
+
+class FirmwareError(StewartError):
+    """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
+
+    POSES = "--poses must be an integer in 1..{limit}, got {value!r}"
+    DURATION = "--duration must be in (0, 60] s, got {value!r}"
+    NO_IK = "{path}: defines no sd_ik (the firmware ABI: int sd_ik(const sd_word pose[6], sd_word lengths[6]))"
+    NO_TICK = "firmware {name} does not define sd_init and sd_tick"
+    SENSOR_COUNTS = "measured leg lengths {value} m do not fit the firmware's 32-bit sensor counts"
+    ENGINE = "--engine must be one of {valid}, got {value!r}"
+    WORD_BITS = "generated C takes word_bits 8..16 (16-bit data words, 32-bit accumulators), got {value}"
+    SINE_TABLE = "the quarter-wave sine table does not reproduce the exact trig at angle word {index}"
+
+
+class IntegratorError(StewartError):
+    """An unknown integrator name (``drake.integrators``)."""
+
+    UNKNOWN = "integrator must be one of {valid}, got {value!r}"
+
+
+class ReplayError(StewartError):
+    """A replay log that cannot be read (``drake.viewer``)."""
+
+    EMPTY_FOLDER = "--replay {path}: no log.npz, simulation/log.npz, trajectory.csv or log.csv in the folder"
+    MISSING = "--replay {path}: no such file"
+    NOT_LOG = "--replay {path}: not a simulate log ({reason})"
+    EMPTY = "--replay {path}: empty file"
+    COLUMNS = ("--replay {path}: line 1: expected the columns of a simulate log.csv or a run trajectory.csv, "
+               "got {got}")
+    ROW = "--replay {path}: line {line}: not a row of numbers"
+    NO_SAMPLES = "--replay {path}: no samples"
+
+
+class SpecError(StewartError):
+    """A ``--vary`` SPEC that cannot be read: unknown key, bad value, unit or range (``montecarlo.spec``)."""
+
+    NUMBER = "{where}: {key}: cannot read {text!r} as a number with a unit ({allowed})"
+    NOT_FINITE = "{where}: {key}: {text!r} is not finite"
+    LATENCY = "{where}: latency: {value!r} is not one of {valid}"
+    NEGATIVE_PROCESS = "{where}: {key}: {text!r} must be >= 0 (the size of a per-tick random process)"
+    PERCENT_OF_ZERO = "{where}: {key}: {text!r}: a percentage of a zero nominal; give ±value with a unit"
+    PERCENT_RANGE = "{where}: {key}: {text!r}: the percentage must be in [0, 100)"
+    HALF_WIDTH = "{where}: {key}: {text!r}: the half-width must be >= 0"
+    RANGE_ORDER = "{where}: {key}: {text!r}: the range's low end is above its high end"
+    UNKNOWN_KEY = "{where}: unknown key {key!r}{hint}"
+    VECTOR_LAW = "{where}: {key}: give ±tolerance (per component) or a fixed offset, not {text!r}"
+    NOT_KEY_VALUE = "--vary: {value!r} is not key=value"
+    MISSING_FILE = "--vary: file {path!r} does not exist"
+    NOT_YAML = "{path}:{line}: not YAML ({problem})"
+    NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
+    NOT_SCALAR = "{where}: {key}: the value must be one scalar (e.g. ±0.5mm)"
+    SWEEP_VECTOR = "sweep: {key} is a per-component key; sweep scalar keys"
+    SWEEP_EMPTY = "sweep: {key} has no values"
+
+
+class StudyError(StewartError):
+    """A study that cannot start: too large, inconsistent settings, or an output folder that is not its own
+    (``montecarlo.study``)."""
+
+    RUNS = "--runs must be 1 … {limit}, got {value}"
+    SEED = "--seed must be an integer >= 0, got {value}"
+    GRID = "a sweep's runs ({runs}) must equal its grid's points ({points})"
+    PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
+    DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
+    TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
+    RESOLUTION_RANGE = ("--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
+                        "give a value or a|b|c list, not a range")
+    RESOLUTION_DIVIDE = ("--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into "
+                         "whole counts")
+    OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
+    OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
+    OUT_NOT_OURS = ("--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to "
+                    "overwrite it")
+    OUT_OTHER_PARTIAL = ("--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose "
+                         "another folder")
+
+# Command-line options checked by the commands (raised as ``OptionError`` or ``UsageError``).
+OPTION_FIRMWARE_WORD_BITS = "--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {value}"
+OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {value:g}"
+OPTION_FIRMWARE_TFR16 = ("--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {value} "
+                         "(or use --trig exact)")
+OPTION_OUT_NOT_FOLDER = "--out {out}: exists and is not a folder"
+OPTION_OUT_FOREIGN = "--out {out}: holds files this command did not write ({names}); choose another folder"
+OPTION_RUN_RATE = "--rate must be a positive number of samples per second, got {value}"
+OPTION_NEEDS_BRANCHES = "--{option} needs --check-branches"
+OPTION_NON_NEGATIVE = "{name} must be a non-negative number, got {value}"
+OPTION_SIMULATE_UTN = "--simulate drives the plant with utn-convention poses; use --convention utn"
+OPTION_SIMULATE_EMPTY = "--simulate: the program has no moves or waits (its trajectory lasts 0 s)"
+OPTION_DURATION_POSITIVE = "--duration must be a positive number of seconds, got {value}"
+OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
+OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
+OPTION_SPEED = "--speed must be a positive number, got {value!r}"
+OPTION_PORT = "--port must be in 1..65535, got {value}"
+OPTION_LEG_DAMPING = "--leg-damping must be a finite number >= 0 N·s/m, got {value}"
+OPTION_SAMPLE_RATE = "--sample-rate must be a positive number of Hz, got {value}"
+OPTION_JOINT_ANGLES = "joint angles must be finite, got {value}"
+OPTION_TARGET = "target must be finite, got {value}"
+OPTION_SERVO_POSE = "--pose has a non-finite number: {value}"
+REPORT_UNKNOWN_ANALYSIS = "unknown analysis {name!r}; available: {available}"

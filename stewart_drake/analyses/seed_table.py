@@ -58,7 +58,7 @@ def poses_si(reading: str) -> np.ndarray:
     elif reading == "pi-fraction-as-radians":
         q[:, 3:] = q[:, 3:] / 180.0
     else:
-        raise ValueError(f"unknown reading {reading!r}")
+        raise ValueError(f"unknown reading {reading!r}")  # internal: the analyses pass one of the two readings
     return q
 
 

@@ -7,6 +7,16 @@ import sys
 from pathlib import Path
 
 from stewart_drake.commands._common import add_platform_arg, print_json
+from stewart_drake.errors import (
+    OPTION_FIRMWARE_RATE,
+    OPTION_FIRMWARE_TFR16,
+    OPTION_FIRMWARE_WORD_BITS,
+    OPTION_OUT_FOREIGN,
+    OPTION_OUT_NOT_FOLDER,
+    OptionError,
+    OutputError,
+    UsageError,
+)
 
 
 def _format_args(p) -> None:
@@ -48,11 +58,11 @@ def _config(args, platform):
     from stewart_drake.fixedpoint.generic import QFormat
 
     if not 8 <= args.word_bits <= 16:
-        raise ValueError(f"--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {args.word_bits}")
+        raise OptionError(OPTION_FIRMWARE_WORD_BITS.format(value=args.word_bits))
     if not (args.rate > 0 and args.rate <= 1e6):
-        raise ValueError(f"--rate must be a positive number of Hz up to 1e6, got {args.rate:g}")
+        raise OptionError(OPTION_FIRMWARE_RATE.format(value=args.rate))
     if args.trig == "tfr16" and args.word_bits != 16:
-        raise ValueError(f"--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {args.word_bits} (or use --trig exact)")
+        raise UsageError(OPTION_FIRMWARE_TFR16.format(value=args.word_bits))
     fmt = QFormat(args.word_bits, args.length_lsb, args.trig)
     timing = DspTiming(sample_period=1.0 / args.rate, sensor_resolution=args.sensor_resolution,
                        command_range=float(platform.legs.max_force)).check()
@@ -76,10 +86,10 @@ def run_generate(args) -> int:
     out = Path(args.out)
     if out.exists():
         if not out.is_dir():
-            raise ValueError(f"--out {args.out}: exists and is not a folder")
+            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=args.out))
         foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
         if foreign:
-            raise ValueError(f"--out {args.out}: holds files this command did not write ({', '.join(foreign[:3])}); choose another folder")
+            raise OutputError(OPTION_OUT_FOREIGN.format(out=args.out, names=", ".join(foreign[:3])))
     g = generate(platform, config)
     compiled = []
     if not args.no_compile:

@@ -16,6 +16,7 @@ from stewart_drake.core.leg3r import (
 )
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sdf_models import sdf_text, write_sdf
+from stewart_drake.errors import OPTION_JOINT_ANGLES, OPTION_TARGET, LegError
 
 
 def register(sub) -> None:
@@ -62,7 +63,7 @@ def run(args) -> int:
         args.q = [args.q1, args.q2]
         q = np.array(args.q) * ka
         if not np.all(np.isfinite(q)):
-            raise ValueError(f"joint angles must be finite, got {args.q}")
+            raise LegError(OPTION_JOINT_ANGLES.format(value=args.q))
         f = foot(leg, q)
         out = {"q": list(args.q), "foot": [f[0] / k, f[1] / k], "gamma": f[2] / ka, "units": units,
                "T03": forward_kinematics(leg, q).tolist(), "within_limits": bool(within_limits(leg, q)),
@@ -76,7 +77,7 @@ def run(args) -> int:
     args.target = [args.px, args.py]
     t = np.array(args.target) * k
     if not np.all(np.isfinite(t)):
-        raise ValueError(f"target must be finite, got {args.target}")
+        raise LegError(OPTION_TARGET.format(value=args.target))
     sols = {}
     for b in (("a", "b") if args.branch == "both" else (args.branch,)):
         if args.gamma is None:

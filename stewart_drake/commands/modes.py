@@ -7,6 +7,7 @@ import numpy as np
 
 from stewart_drake.commands._common import print_json
 from stewart_drake.commands.stiffness import NAMES, add_pose_args, prepare, require_analysable_pose
+from stewart_drake.errors import OPTION_LEG_DAMPING, OPTION_SAMPLE_RATE, OptionError
 
 
 def register(sub) -> None:
@@ -26,9 +27,9 @@ def run(args) -> int:
 
     platform, q, k, _ = prepare(args)
     if not (np.isfinite(args.leg_damping) and args.leg_damping >= 0):
-        raise ValueError(f"--leg-damping must be a finite number >= 0 N·s/m, got {args.leg_damping}")
+        raise OptionError(OPTION_LEG_DAMPING.format(value=args.leg_damping))
     if not (np.isfinite(args.sample_rate) and args.sample_rate > 0):
-        raise ValueError(f"--sample-rate must be a positive number of Hz, got {args.sample_rate}")
+        raise OptionError(OPTION_SAMPLE_RATE.format(value=args.sample_rate))
     require_analysable_pose(platform, q, args.convention)
     legs = args.legs == "on"
     K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)

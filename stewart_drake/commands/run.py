@@ -14,6 +14,15 @@ import numpy as np
 
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import CONVENTIONS
+from stewart_drake.errors import (
+    OPTION_NEEDS_BRANCHES,
+    OPTION_NON_NEGATIVE,
+    OPTION_RUN_RATE,
+    OPTION_SIMULATE_EMPTY,
+    OPTION_SIMULATE_UTN,
+    OptionError,
+    UsageError,
+)
 from stewart_drake.script.source import read_program
 from stewart_drake.commands._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
 
@@ -47,7 +56,7 @@ def run(args) -> int:
     out_folder = OutputFolder(str(out), force=args.force)
     platform = platform_from_args(args)
     if not (np.isfinite(args.rate) and args.rate > 0):
-        raise ValueError(f"--rate must be a positive number of samples per second, got {args.rate}")
+        raise OptionError(OPTION_RUN_RATE.format(value=args.rate))
     try:
         result = run_program(text, args.program, platform, rate=args.rate, convention=args.convention,
                              coriolis=args.coriolis == "on")
@@ -89,14 +98,14 @@ def check_branches(platform, result, args) -> dict | None:
     given = [k for k in BRANCH_DEFAULTS if getattr(args, k) is not None]
     if not args.check_branches:
         if given:
-            raise ValueError(f"--{given[0].replace('_', '-')} needs --check-branches")
+            raise UsageError(OPTION_NEEDS_BRANCHES.format(option=given[0].replace("_", "-")))
         return None
     for k, v in BRANCH_DEFAULTS.items():
         if getattr(args, k) is None:
             setattr(args, k, v)
     for name, v in (("--branch-margin", args.branch_margin), ("--singularity-margin", args.singularity_margin)):
         if not (np.isfinite(v) and v >= 0):
-            raise ValueError(f"{name} must be a non-negative number, got {v}")
+            raise OptionError(OPTION_NON_NEGATIVE.format(name=name, value=v))
     from stewart_drake.homotopy.branches import branch_safety
 
     traj = result.trajectory
@@ -120,13 +129,14 @@ def simulate(platform, result, args) -> dict:
     from dataclasses import replace
 
     from stewart_drake.core.sanity import require_plate
-    from stewart_drake.drake.simulation import Scenario, simulate as sim_run, tracking_verdict
+    from stewart_drake.control.simulation_log import tracking_verdict
+    from stewart_drake.drake.simulation import Scenario, simulate as sim_run
 
     if args.convention != "utn":
-        raise ValueError("--simulate drives the plant with utn-convention poses; use --convention utn")
+        raise UsageError(OPTION_SIMULATE_UTN)
     traj = result.trajectory
     if traj.duration <= 0:
-        raise ValueError("--simulate: the program has no moves or waits (its trajectory lasts 0 s)")
+        raise UsageError(OPTION_SIMULATE_EMPTY)
     reference = replace(traj, name=Path(args.program).stem)
     require_plate(platform, "run --simulate")
     log = sim_run(Scenario(platform, reference, args.controller, duration=traj.duration + SETTLE), progress=True)

@@ -11,6 +11,7 @@ from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale,
 from stewart_drake.core.sanity import check_finite, check_servo_neutrals
 from stewart_drake.core.sdf_models import write_sdf
 from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
+from stewart_drake.errors import OPTION_SERVO_POSE, ServoPoseError
 
 
 def register(sub) -> None:
@@ -46,7 +47,7 @@ def run(args) -> int:
     else:
         raw = np.array(args.pose, dtype=float)
         if not np.all(np.isfinite(raw)):
-            raise ValueError(f"--pose has a non-finite number: {raw.tolist()}")
+            raise ServoPoseError(OPTION_SERVO_POSE.format(value=raw.tolist()))
     pose = raw * scale
     if args.from_home:
         pose[2] += hexapod.home_height

@@ -10,6 +10,7 @@ import numpy as np
 
 from stewart_drake.core.sanity import check_file_rows, check_positive, check_trajectory, check_work, fmt_value, require_plate
 from stewart_drake.commands._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
+from stewart_drake.errors import OPTION_DURATION_POSITIVE, OPTION_ENGINE_FIXED, OptionError, UsageError
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -60,14 +61,13 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import json
-
     from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.control import ControllerConfig, DspTiming, check_timing
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate, tracking_verdict
+    from stewart_drake.control.simulation_log import tracking_verdict
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
     from stewart_drake.firmware.engine import resolve_engine
 
     reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
@@ -85,7 +85,7 @@ def run(args) -> int:
         traj = fit_trajectory(traj, platform)
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
     if not duration > 0:
-        raise ValueError(f"--duration must be a positive number of seconds, got {args.duration}")
+        raise OptionError(OPTION_DURATION_POSITIVE.format(value=args.duration))
     timing = DspTiming(sample_period=period, latency=args.latency, sensor_resolution=args.sensor_resolution,
                        command_range=float(platform.legs.max_force)).check()
     check_timing(platform, period, plant_step, ActuatorModel().time_constant, timing.output_delay)
@@ -98,7 +98,7 @@ def run(args) -> int:
     config = ControllerConfig.for_platform(platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0)))
     engine = resolve_engine(args.engine, "stewart-drake simulate") if args.firmware is None else "c"
     if (engine == "c" or args.firmware) and args.controller != "fixed":
-        raise ValueError(f"--engine c / --firmware run the fixed-point controller; --controller is {args.controller!r}")
+        raise UsageError(OPTION_ENGINE_FIXED.format(controller=args.controller))
     scenario = Scenario(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward,
                         engine=engine, firmware=args.firmware, integrator=args.integrator or DEFAULT_INTEGRATOR, duration=duration)
     log = simulate(scenario, progress=not args.no_progress)

@@ -8,6 +8,7 @@ import numpy as np
 
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.core.rotations import pose_to_si
+from stewart_drake.errors import OPTION_PORT, OPTION_SPEED, OPTION_VIEW_DURATION, OptionError
 
 
 def register(sub) -> None:
@@ -35,11 +36,11 @@ def run(args) -> int:
 
     platform = platform_from_args(args)
     if args.duration is not None and not (np.isfinite(args.duration) and 0 <= args.duration <= 86400):
-        raise ValueError(f"--duration must be between 0 and 86400 s, got {args.duration!r}")
+        raise OptionError(OPTION_VIEW_DURATION.format(value=args.duration))
     if not (np.isfinite(args.speed) and args.speed > 0):
-        raise ValueError(f"--speed must be a positive number, got {args.speed!r}")
+        raise OptionError(OPTION_SPEED.format(value=args.speed))
     if args.port is not None and not 1 <= args.port <= 65535:
-        raise ValueError(f"--port must be in 1..65535, got {args.port}")
+        raise OptionError(OPTION_PORT.format(value=args.port))
     replay = load_replay(args.replay) if args.replay else None
     if replay is not None and replay[3] and replay[3] != platform.name:
         print(f"stewart-drake view: note: the log was recorded on platform {replay[3]!r}, shown on {platform.name!r}", file=sys.stderr)

@@ -24,6 +24,7 @@ from stewart_drake.control.timing import PHASE_BUDGET, DspTiming, loop_delay
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import length_jacobian
+from stewart_drake.errors import GainError
 from stewart_drake.fixedpoint import QFormat
 
 # The measurement difference is scaled up by 2^DIFF_SHIFT before its 16-bit filter, so that a
@@ -55,11 +56,11 @@ class PidGains:
         for name in ("kp", "ki", "kd", "kv"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"PidGains.{name} must be a finite number >= 0, got {v!r}")
+                raise GainError(GainError.PID_NEGATIVE.format(name=name, value=v))
         for name in ("derivative_filter", "feedforward_filter"):
             v = getattr(self, name)
             if not 0 < v <= 1:
-                raise ValueError(f"PidGains.{name} must be in (0, 1], got {v!r}")
+                raise GainError(GainError.PID_FILTER.format(name=name, value=v))
 
 
 @dataclass(frozen=True)
@@ -157,13 +158,13 @@ def design_gains(platform: Platform, timing: DspTiming | None = None, actuator_l
     """
     timing = timing or DspTiming()
     if not (math.isfinite(actuator_lag) and actuator_lag >= 0):
-        raise ValueError(f"actuator_lag must be >= 0 s, got {actuator_lag!r}")
+        raise GainError(GainError.ACTUATOR_LAG.format(value=actuator_lag))
     q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float).reshape(6)
     visited = np.concatenate([q0[None], design_pose_subset(poses)])
     m = np.linalg.eigvalsh(leg_space_inertia(platform, visited))
     m_min, m_max = float(m[:, 0].min()), float(m[:, -1].max())
     if not m_min > 0:
-        raise ValueError(f"platform {platform.name!r}: the leg-space inertia is not positive definite (smallest eigenvalue {m_min:.3g} kg)")
+        raise GainError(GainError.INERTIA.format(name=platform.name, m_min=m_min))
     K = float(strut_stiffness(platform, visited).max())
     if poses is None:
         K *= UNKNOWN_POSE_STIFFNESS_FACTOR
@@ -183,7 +184,7 @@ def design_pose_subset(poses) -> np.ndarray:
     poses = np.asarray(poses, dtype=float).reshape(-1, 6)
     if not np.all(np.isfinite(poses)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(poses), axis=1))[0])
-        raise ValueError(f"design pose {bad} is not finite: {poses[bad]!r}")
+        raise GainError(GainError.DESIGN_POSE.format(index=bad, value=poses[bad]))
     if len(poses) > DESIGN_POSES:
         poses = poses[np.unique(np.round(np.linspace(0, len(poses) - 1, DESIGN_POSES)).astype(int))]
     return poses
@@ -208,12 +209,12 @@ class Q15Gain:
 def q15_gain(x: float) -> Q15Gain:
     """The Q15 mantissa and smallest shift >= 0 representing ``x`` >= 0 (rounded to nearest)."""
     if not (math.isfinite(x) and x >= 0):
-        raise ValueError(f"a gain must be a finite number >= 0, got {x!r}")
+        raise GainError(GainError.GAIN.format(value=x))
     shift = 0
     while round(x / 2.0**shift * 32768.0) > 32767:
         shift += 1
     if shift > 30:
-        raise ValueError(f"gain {x!r} is too large for a Q15 mantissa with a 32-bit shift")
+        raise GainError(GainError.Q15_RANGE.format(value=x))
     return Q15Gain(int(round(x / 2.0**shift * 32768.0)), shift)
 
 
@@ -254,7 +255,5 @@ def counts_per_lsb(config: ControllerConfig) -> int:
     r, lsb = config.timing.sensor_resolution, config.ik_format.length_lsb
     cpl = lsb / r
     if abs(cpl - round(cpl)) > 1e-9 * cpl or round(cpl) < 1:
-        raise ValueError(
-            f"sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts for the fixed-point controller"
-        )
+        raise GainError(GainError.SENSOR_COUNTS.format(r=r, lsb=lsb))
     return int(round(cpl))

@@ -23,6 +23,9 @@ from stewart_drake.errors import (
     PERIOD_TOO_SLOW,
     PLANT_STEP_ABOVE_LAG,
     PLANT_STEP_TOO_LONG,
+    TIMING_CYCLES,
+    TIMING_LATENCY,
+    TIMING_POSITIVE,
     StewartError,
     TimingError,
 )
@@ -75,11 +78,11 @@ class DspTiming:
         for name in ("clock_hz", "sample_period", "sensor_resolution", "command_range"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"DspTiming.{name} must be a positive number, got {v!r}")
+                raise TimingError(TIMING_POSITIVE.format(name=name, value=v))
         if self.latency not in LATENCY_MODES:
-            raise ValueError(f"DspTiming.latency must be one of {', '.join(LATENCY_MODES)}, got {self.latency!r}")
+            raise TimingError(TIMING_LATENCY.format(valid=", ".join(LATENCY_MODES), value=self.latency))
         if self.computation_cycles is not None and not (int(self.computation_cycles) == self.computation_cycles and self.computation_cycles > 0):
-            raise ValueError(f"DspTiming.computation_cycles must be a positive integer, got {self.computation_cycles!r}")
+            raise TimingError(TIMING_CYCLES.format(value=self.computation_cycles))
 
     def cycles(self) -> int:
         """Cycles of one controller tick (given, or from the cycle model: IK + 6 PIDs + ISR overhead)."""

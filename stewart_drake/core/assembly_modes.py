@@ -51,7 +51,7 @@ from stewart_drake.core.newton_fk import (
     validate_lengths,
 )
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, quaternion_to_matrix, rotation_matrix
-from stewart_drake.errors import ForwardKinematicsError
+from stewart_drake.errors import FkInputError, ForwardKinematicsError
 
 CERTIFY_RESIDUAL = 1e-9  # m: a polished solution with a larger leg residual is not a confirmation
 # polish(lengths (6,), p_BC (3,), R_BT (3, 3)) -> (p_BC, R_BT, success, residual m): an independent solve
@@ -200,7 +200,7 @@ def assembly_modes(
     check_convention(convention)
     L = validate_lengths(lengths)
     if L.shape != (6,):
-        raise ValueError(f"assembly_modes takes one length set of shape (6,), got {L.shape}")
+        raise FkInputError(FkInputError.ONE_SET.format(what="assembly_modes", shape=L.shape))
     if polish is not None and not callable(polish):
         raise TypeError(f"polish must be a callable (lengths, p, R) -> (p, R, success, residual) or None, got {polish!r}")
     t_start = time.perf_counter()

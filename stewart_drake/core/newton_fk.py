@@ -30,7 +30,7 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius, inverse_jacobian, scaled_jacobian, singular_value_condition
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
-from stewart_drake.errors import ForwardKinematicsError, SingularityWarning, SingularPoseError, counted
+from stewart_drake.errors import FkInputError, ForwardKinematicsError, SingularityWarning, SingularPoseError, counted
 
 # Per-sample status codes (FKResult.status).
 CONVERGED = 0
@@ -132,7 +132,7 @@ def check_poses_nonsingular(
 
 def _check_action(action: str) -> str:
     if action not in ("raise", "warn", "ignore"):
-        raise ValueError(f"on_singular must be 'raise', 'warn' or 'ignore', got {action!r}")
+        raise FkInputError(FkInputError.ON_SINGULAR.format(value=action))
     return action
 
 
@@ -216,14 +216,14 @@ class FKResult:
 
 
 def validate_lengths(lengths) -> np.ndarray:
-    """``(..., 6)`` leg lengths as a float array; ValueError naming the sample and leg if not finite and > 0."""
+    """``(..., 6)`` leg lengths as a float array; FkInputError naming the sample and leg if not finite and > 0."""
     L = np.asarray(lengths, dtype=float)
     if L.shape[-1:] != (6,):
-        raise ValueError(f"leg lengths must have shape (..., 6), one per leg, got {L.shape}")
+        raise FkInputError(FkInputError.LENGTHS_SHAPE.format(shape=L.shape))
     bad = ~(np.isfinite(L) & (L > 0))
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        raise ValueError(f"lengths sample {counted(idx[:-1])}: leg {idx[-1] + 1} length {float(L[idx])} m is not a positive finite number")
+        raise FkInputError(FkInputError.LENGTH_VALUE.format(index=counted(idx[:-1]), leg=idx[-1] + 1, value=float(L[idx])))
     return L
 
 
@@ -329,9 +329,9 @@ def newton_core(platform: Platform, p, R, L_target, tol=1e-12, max_iter=30, max_
 def _check_options(tol, max_iter, max_step_m, max_step_rad, max_condition):
     for name, v in (("tol", tol), ("max_step_m", max_step_m), ("max_step_rad", max_step_rad), ("max_condition", max_condition)):
         if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+            raise FkInputError(FkInputError.POSITIVE.format(name=name, value=v))
     if int(max_iter) != max_iter or max_iter < 1:
-        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
+        raise FkInputError(FkInputError.MAX_ITER.format(value=max_iter))
 
 
 def forward_kinematics(
@@ -372,13 +372,13 @@ def forward_kinematics(
     batch = L_target.shape[:-1]
     q0 = np.asarray(platform.home_pose() if initial is None else initial, dtype=float)
     if q0.shape[-1:] != (6,):
-        raise ValueError(f"initial pose must have shape (6,) or (..., 6), got {q0.shape}")
+        raise FkInputError(FkInputError.INITIAL_SHAPE.format(shape=q0.shape))
     if not np.all(np.isfinite(q0)):
-        raise ValueError(f"initial pose must be finite, got {q0.tolist()}")
+        raise FkInputError(FkInputError.INITIAL_NOT_FINITE.format(value=q0.tolist()))
     try:
         np.broadcast_shapes(q0.shape, batch + (6,))
     except ValueError:
-        raise ValueError(f"initial poses of shape {q0.shape} do not match lengths of shape {L_target.shape}") from None
+        raise FkInputError(FkInputError.INITIAL_BROADCAST.format(shape=q0.shape, lengths_shape=L_target.shape)) from None
     scale = anchor_scale(platform)
     if check_singularity:  # on the distinct initial poses, before broadcasting
         qi = q0.reshape(-1, 6)

@@ -21,7 +21,7 @@ def dietmaier_platform() -> tuple[Platform, np.ndarray]:
     mixed-integer rotation-constraint demo, found by code search; the file does not name Dietmaier)
     and match the values usually quoted for Dietmaier's example. The result confirms them:
     ``assembly_modes.assembly_modes`` finds 40 real, distinct, non-singular solutions
-    (``tests/test_forward.py``),
+    (``tests/drake/test_forward_drake.py``),
     which only a 40-real-solution geometry can give. The stroke [0.5, 1.6] m is our choice (it holds
     every leg); the home pose is a placeholder (the geometry has no natural one)."""
     base = np.array(

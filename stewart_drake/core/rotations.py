@@ -16,15 +16,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.errors import RotationError
+
 CONVENTIONS = ("utn", "zyx")
 ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "pi": np.pi}
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 
 
 def check_convention(convention: str) -> str:
-    """Return ``convention`` if it is known, else raise ValueError naming it."""
+    """Return ``convention`` if it is known, else raise RotationError naming it."""
     if convention not in CONVENTIONS:
-        raise ValueError(f"unknown rotation convention {convention!r}; expected one of {', '.join(CONVENTIONS)}")
+        raise RotationError(RotationError.CONVENTION.format(value=convention, valid=", ".join(CONVENTIONS)))
     return convention
 
 
@@ -33,7 +35,7 @@ def angle_scale(unit: str) -> float:
     try:
         return ANGLE_UNITS[unit]
     except KeyError:
-        raise ValueError(f"unknown angle unit {unit!r}; expected one of {', '.join(ANGLE_UNITS)}") from None
+        raise RotationError(RotationError.ANGLE_UNIT.format(value=unit, valid=", ".join(ANGLE_UNITS))) from None
 
 
 def length_scale(unit: str) -> float:
@@ -41,7 +43,7 @@ def length_scale(unit: str) -> float:
     try:
         return LENGTH_UNITS[unit]
     except KeyError:
-        raise ValueError(f"unknown length unit {unit!r}; expected one of {', '.join(LENGTH_UNITS)}") from None
+        raise RotationError(RotationError.LENGTH_UNIT.format(value=unit, valid=", ".join(LENGTH_UNITS))) from None
 
 
 def to_radians(angles, unit: str) -> np.ndarray:
@@ -58,7 +60,7 @@ def pose_to_si(pose, length_unit: str = "m", angle_unit: str = "rad") -> np.ndar
     """A ``(..., 6)`` pose in edge units -> metres and radians."""
     pose = np.asarray(pose, dtype=float)
     if pose.shape[-1:] != (6,):
-        raise ValueError(f"a pose needs 6 numbers (px, py, pz, a_x, a_y, a_z), got shape {pose.shape}")
+        raise RotationError(RotationError.POSE_SHAPE.format(shape=pose.shape))
     scale = np.r_[np.full(3, length_scale(length_unit)), np.full(3, angle_scale(angle_unit))]
     return pose * scale
 
@@ -89,7 +91,7 @@ def rotation_matrix(angles, convention: str = "utn") -> np.ndarray:
     check_convention(convention)
     angles = np.asarray(angles, dtype=float)
     if angles.shape[-1:] != (3,):
-        raise ValueError(f"angles need 3 numbers (about X, Y, Z), got shape {angles.shape}")
+        raise RotationError(RotationError.ANGLES_SHAPE.format(shape=angles.shape))
     ca, cb, cg = np.moveaxis(np.cos(angles), -1, 0)
     sa, sb, sg = np.moveaxis(np.sin(angles), -1, 0)
     if convention == "utn":  # Ry(beta) Rx(alpha) Rz(gamma), the seeds' TTB written out
@@ -167,7 +169,7 @@ def quaternion_to_matrix(q) -> np.ndarray:
     rotation matrices (Hamilton convention, as Drake's ``Quaternion``)."""
     q = np.asarray(q, dtype=float)
     if q.shape[-1:] != (4,):
-        raise ValueError(f"quaternions need 4 numbers (w, x, y, z), got shape {q.shape}")
+        raise RotationError(RotationError.QUATERNION_SHAPE.format(shape=q.shape))
     q = q / np.linalg.norm(q, axis=-1, keepdims=True)
     w, x, y, z = np.moveaxis(q, -1, 0)
     return np.stack(

@@ -17,6 +17,7 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths, plate_anchors
+from stewart_drake.errors import SamplingError
 
 REGIONS = ("box", "workspace")
 MAX_ROUNDS = 100  # draws before giving up: a region with (almost) no acceptable pose fails, not spins
@@ -30,7 +31,7 @@ def random_poses(platform: Platform, n: int, seed: int = 0, translation: float |
     "box" only ("workspace" always requires it). Raises ValueError when ``MAX_ROUNDS`` draws do not
     give ``n`` acceptable poses."""
     if region not in REGIONS:
-        raise ValueError(f"unknown pose region {region!r}; expected one of {', '.join(REGIONS)}")
+        raise SamplingError(SamplingError.REGION.format(value=region, valid=", ".join(REGIONS)))
     rng = np.random.default_rng(seed)
     span = platform.L_max - platform.L_min
     home = platform.home_pose()
@@ -56,4 +57,4 @@ def random_poses(platform: Platform, n: int, seed: int = 0, translation: float |
         have += int(ok.sum())
         if have >= n:
             return np.concatenate(out)[:n]
-    raise ValueError(f"platform {platform.name!r}: could not sample {n} reachable poses around home ({region!r} region)")
+    raise SamplingError(SamplingError.TOO_FEW.format(name=platform.name, n=n, region=region))

@@ -83,6 +83,7 @@ def visual_xml(name, pose, geometry, rgba) -> str:
     elif kind == "sphere":
         g = f"<sphere><radius>{xml_vec(dims)}</radius></sphere>"
     else:
+        # internal: the model writers pass one of these kinds; no user input reaches here
         raise ValueError(f"unknown SDF visual geometry {kind!r}; expected box, cylinder or sphere")
     return (f'<visual name="{xml_attr(name)}"><pose>{xml_vec(*pose)}</pose><geometry>{g}</geometry>'
             f"<material><diffuse>{rgba}</diffuse></material></visual>")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.core.servo import FRAME_RATE_HZ, ServoHexapod, arm_angles, pose_jacobian
+from stewart_drake.errors import SimulationError
 
 
 def servo_gains(hexapod: ServoHexapod) -> tuple[float, float]:
@@ -48,8 +49,7 @@ def tracking_bounds(hexapod: ServoHexapod, log: dict, time_step: float = 1e-3, f
     t, ref = log["t"], log["arm_angle_ref"]
     rate = np.abs(np.diff(ref, axis=0)) / np.diff(t)[:, None]
     if rate.max() >= hexapod.servo_speed:
-        raise ValueError(f"reference arm speed {rate.max():.3g} rad/s reaches the servo's no-load speed "
-                         f"{hexapod.servo_speed:.3g} rad/s: the tracking bound does not apply")
+        raise SimulationError(SimulationError.SERVO_SPEED.format(rate=rate.max(), speed=hexapod.servo_speed))
     kp, kd = servo_gains(hexapod)
     lag = 1.0 / frame_rate_hz + 2 * time_step + kd / kp
     n = int(np.ceil(lag / time_step))

@@ -21,6 +21,7 @@ from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import pose_to_si
+from stewart_drake.errors import TrajectoryError
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,7 +57,7 @@ class Trajectory:
     def derivatives(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(q, qd, qdd)`` at times ``(...)``, each ``(..., 6)``, exact; ValueError if not known."""
         if self.exact is None:
-            raise ValueError(f"trajectory {self.name!r} has no closed-form rates")
+            raise TrajectoryError(TrajectoryError.NO_RATES.format(name=self.name))
         return self.exact(np.asarray(t, dtype=float))
 
     @property
@@ -111,7 +112,7 @@ def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
         k = late[0] + 1
-        raise ValueError(f"{path}:{lines[k]}: time {data[k, 0]} s is not after the previous sample's {data[k - 1, 0]} s")
+        raise TrajectoryError(TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0]))
     return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
 
 
@@ -148,7 +149,7 @@ def design_poses(trajectory: Trajectory, duration: float | None = None, n: int =
     loop will visit (the struts' stiffness and the leg-space masses vary along the way)."""
     d = duration if duration is not None else (trajectory.duration or 4.0)
     if not (math.isfinite(d) and d >= 0):
-        raise ValueError(f"design duration must be a number of seconds >= 0, got {d!r}")
+        raise TrajectoryError(TrajectoryError.DESIGN_DURATION.format(value=d))
     return trajectory.pose(np.linspace(0.0, d, n))
 
 
@@ -161,4 +162,4 @@ def get_trajectory(name_or_path, **units) -> Trajectory:
         return TRAJECTORIES[s]
     if s.endswith(".csv") or Path(s).exists():
         return load_trajectory_csv(s, **units)
-    raise ValueError(f"unknown trajectory {s!r}: not one of {', '.join(TRAJECTORIES)} and not a CSV file")
+    raise TrajectoryError(TrajectoryError.UNKNOWN.format(value=s, valid=", ".join(TRAJECTORIES)))

@@ -174,6 +174,7 @@ def _with_time_control(page: str, duration: float, title: str, warned: int, fram
                               pct=WARN_FRACTION * 100, warned=warned, frames=frames)
     head, sep, tail = page.rpartition("</body>")
     if not sep:
+        # internal: Meshcat's own page always has one; its absence is a pydrake change, not bad input
         raise ValueError("Meshcat's StaticHtml has no </body>")
     return head + overlay + sep + tail
 

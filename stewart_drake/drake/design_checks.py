@@ -33,6 +33,7 @@ from stewart_drake.design.modes import analytic_modes, damping_matrix, modes_fro
 from stewart_drake.design.stiffness import displace, static_leg_forces
 from stewart_drake.drake.platform_model import set_pose
 from stewart_drake.drake.verify_dynamics import ClosedLoopInverseDynamics
+from stewart_drake.errors import SimulationError
 
 FD_STEP = 1e-6  # m and rad: central differences on the constraint manifold (error ~ step² relative)
 
@@ -56,7 +57,7 @@ def spring_plant(platform: Platform, q, k, c=0.0, convention: str = "utn", gravi
     free = L + F0 / k
     if np.any(free <= 0):
         i = int(np.argmax(free <= 0))
-        raise ValueError(f"leg {i + 1}: static force {F0[i]:.6g} N compresses a {k[i]:.6g} N/m spring past zero length")
+        raise SimulationError(SimulationError.SPRING.format(leg=i + 1, force=F0[i], k=k[i]))
     for i in range(6):
         plant.AddForceElement(LinearSpringDamper(plant.world_body(), platform.base_anchors[i], top, platform.top_anchors_per_leg[i],
                                                  float(free[i]), float(k[i]), float(c[i])))

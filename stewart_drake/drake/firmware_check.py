@@ -16,6 +16,7 @@ from stewart_drake.core.c_build import Compiler
 from stewart_drake.firmware.check import MAX_POSES, check_ik, check_tick
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import compile_user
+from stewart_drake.errors import FirmwareError
 from stewart_drake.fixedpoint.generic import pose_words
 
 
@@ -45,13 +46,13 @@ def check_firmware(path: Path, platform: Platform, config: ControllerConfig, n_p
     """Compile ``path`` against the header generated for ``platform``/``config`` and compare it with the
     emulation; ``{"ik": ..., "tick": ... | None, "identical": bool}``."""
     if not (isinstance(n_poses, (int, np.integer)) and 1 <= n_poses <= MAX_POSES):
-        raise ValueError(f"--poses must be an integer in 1..{MAX_POSES}, got {n_poses!r}")
+        raise FirmwareError(FirmwareError.POSES.format(limit=MAX_POSES, value=n_poses))
     if not (math.isfinite(duration) and 0 < duration <= 60):
-        raise ValueError(f"--duration must be in (0, 60] s, got {duration!r}")
+        raise FirmwareError(FirmwareError.DURATION.format(value=duration))
     g = generate(platform, config)
     m = compile_user(path, g, compiler)
     if not m._has("sd_ik"):
-        raise ValueError(f"{path}: defines no sd_ik (the firmware ABI: int sd_ik(const sd_word pose[6], sd_word lengths[6]))")
+        raise FirmwareError(FirmwareError.NO_IK.format(path=path))
     ik = check_ik(m, platform, config, n_poses, seed, trace)
     tick = check_tick(m, record_closed_loop(platform, config, duration=duration)) if m.has_tick else None
     same = ik["differing_poses"] == 0 and (tick is None or tick["differing_ticks"] == 0)

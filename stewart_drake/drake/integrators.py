@@ -19,21 +19,17 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, SimulatorConfig
 
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import IntegratorError
 
 INTEGRATORS = ("sap", "cenic")
 DEFAULT_INTEGRATOR = "cenic"
 CENIC_ACCURACY = 1e-4
 
 
-class IntegratorError(StewartError):
-    """An unknown integrator name."""
-
-
 def check_integrator(name: str) -> str:
     """``name`` if it is one of ``INTEGRATORS``, else ``IntegratorError``."""
     if name not in INTEGRATORS:
-        raise IntegratorError(f"integrator must be one of {', '.join(INTEGRATORS)}, got {name!r}")
+        raise IntegratorError(IntegratorError.UNKNOWN.format(valid=", ".join(INTEGRATORS), value=name))
     return name
 
 

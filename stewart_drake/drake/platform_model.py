@@ -19,6 +19,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sdf_models import platform_sdf
+from stewart_drake.errors import SimulationError
 
 
 def add_platform(plant, platform: Platform):
@@ -37,7 +38,7 @@ def build_plant(platform: Platform, time_step: float = 1e-3, builder=None, gravi
     ball constraints need a discrete plant, except under the CENIC integrator (``continuous=True``: a
     continuous plant, time_step 0, for a Simulator configured with ``integration_scheme="cenic"``)."""
     if not (continuous or time_step > 0):
-        raise ValueError(f"time_step must be > 0 (ball constraints need a discrete plant), got {time_step}")
+        raise SimulationError(SimulationError.DISCRETE_STEP.format(value=time_step))
     builder = builder or DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0 if continuous else time_step)
     if not continuous:

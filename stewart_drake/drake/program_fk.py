@@ -23,6 +23,7 @@ from stewart_drake.core import assembly_modes as search
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.newton_fk import leg_geometry, validate_lengths
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
+from stewart_drake.errors import FkInputError
 
 SOLVERS = ("snopt", "ipopt")
 ROTATION_PARAMETRISATIONS = ("quaternion", "matrix")
@@ -56,9 +57,9 @@ class ProgramFK:
 
     def __init__(self, platform: Platform, rotation: str = "quaternion", solver: str = "snopt", tol: float = 1e-12):
         if rotation not in ROTATION_PARAMETRISATIONS:
-            raise ValueError(f"unknown rotation parametrisation {rotation!r}; expected one of {', '.join(ROTATION_PARAMETRISATIONS)}")
+            raise FkInputError(FkInputError.ROTATION.format(value=rotation, valid=", ".join(ROTATION_PARAMETRISATIONS)))
         if solver not in SOLVERS:
-            raise ValueError(f"unknown solver {solver!r}; expected one of {', '.join(SOLVERS)}")
+            raise FkInputError(FkInputError.SOLVER.format(value=solver, valid=", ".join(SOLVERS)))
         self.platform, self.rotation_kind, self.solver_name = platform, rotation, solver
         prog = MathematicalProgram()
         self.p = prog.NewContinuousVariables(3, "p")
@@ -106,11 +107,11 @@ class ProgramFK:
         check_convention(convention)
         L = validate_lengths(lengths)
         if L.shape != (6,):
-            raise ValueError(f"ProgramFK.solve takes one length set of shape (6,), got {L.shape}")
+            raise FkInputError(FkInputError.ONE_SET.format(what="ProgramFK.solve", shape=L.shape))
         if initial_rotation is None:
             q0 = np.asarray(self.platform.home_pose() if initial is None else initial, dtype=float)
             if q0.shape != (6,) or not np.all(np.isfinite(q0)):
-                raise ValueError(f"initial pose must be 6 finite numbers, got {q0.tolist()}")
+                raise FkInputError(FkInputError.INITIAL_SIX.format(value=q0.tolist()))
             p0, R0 = q0[:3], rotation_matrix(q0[3:], convention)
         else:
             p0, R0 = np.asarray(initial, dtype=float), np.asarray(initial_rotation, dtype=float)
@@ -160,6 +161,6 @@ def assembly_modes(platform: Platform, lengths, convention: str = "utn", *, poli
     ``core.assembly_modes.assembly_modes`` (``options``: its keyword arguments), each confirmed by a
     ``ProgramFK`` solved with ``polish`` ("snopt", "ipopt"; None: no confirmation, ``certified`` False)."""
     if polish is not None and polish not in SOLVERS:
-        raise ValueError(f"polish must be one of {', '.join(SOLVERS)} or None, got {polish!r}")
+        raise FkInputError(FkInputError.POLISH.format(valid=", ".join(SOLVERS), value=polish))
     fn = None if polish is None else program_polish(platform, polish, convention)
     return search.assembly_modes(platform, lengths, convention, polish=fn, **options)

@@ -33,6 +33,7 @@ from stewart_drake.core.servo import (
     solve,
 )
 from stewart_drake.core.servo_loop import servo_gains
+from stewart_drake.errors import SimulationError
 from stewart_drake.core.servo_mounting import frame_from_zx, joint_arm_angles, pulse_joint_angles, servo_joint_home
 
 # Drake IK results are accepted when every rod length is this close to s (Drake FK), success flag or not:
@@ -58,7 +59,7 @@ def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd
     ``pd_gains`` = (kp N·m/rad, kd N·m·s/rad) makes every servo a PD-controlled actuator (Drake's
     implicit PD, clamped to the servo's effort limit, driven by the desired-state input port)."""
     if not time_step > 0:
-        raise ValueError(f"time_step must be > 0 (ball constraints need a discrete plant), got {time_step}")
+        raise SimulationError(SimulationError.DISCRETE_STEP.format(value=time_step))
     builder = builder or DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step)
     plant.set_discrete_contact_approximation(DiscreteContactApproximation.kLagged)
@@ -189,7 +190,7 @@ def compare_with_drake(hexapod: ServoHexapod, poses) -> dict:
     sol = solve(hexapod, poses)
     if not np.all(sol.ok):
         bad = int(np.argmin(sol.ok))
-        raise ValueError(f"compare_with_drake needs reachable in-travel poses; pose {bad} is not: {sol.violations()[0]}")
+        raise SimulationError(SimulationError.SERVO_POSES.format(index=bad, why=sol.violations()[0]))
     home = drake_home_joint_angles(h)
     res = {"frames": max(frame_errors(h).values()), "home": float(np.abs(home - servo_joint_home(hexapod)).max())}
     res["fk"] = float(drake_rod_length_errors(h, poses, sol.pulse_raw, home).max())
@@ -218,7 +219,7 @@ class ServoController(LeafSystem):
 
     def __init__(self, hexapod: ServoHexapod, frame_rate_hz: float = FRAME_RATE_HZ, resolution_us: float = 1.0):
         if not frame_rate_hz > 0:
-            raise ValueError(f"servo frame rate must be > 0 Hz, got {frame_rate_hz}")
+            raise SimulationError(SimulationError.FRAME_RATE.format(value=frame_rate_hz))
         super().__init__()
         self.hexapod, self.period, self.resolution_us = hexapod, 1.0 / frame_rate_hz, resolution_us
         self._pose = self.DeclareVectorInputPort("pose", 6)
@@ -307,9 +308,9 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     times = np.asarray(times, dtype=float)
     poses = np.asarray(poses, dtype=float)
     if poses.shape != (len(times), 6) or len(times) < 2:
-        raise ValueError(f"run_closed_loop needs times (n,) and poses (n, 6) with n >= 2, got {times.shape} and {poses.shape}")
+        raise SimulationError(SimulationError.CLOSED_LOOP_SHAPES.format(times_shape=times.shape, poses_shape=poses.shape))
     if not time_step > 0:
-        raise ValueError(f"time_step must be > 0, got {time_step}")
+        raise SimulationError(SimulationError.TIME_STEP.format(value=time_step))
     builder = DiagramBuilder()
     plant, _ = build_plant(hexapod, time_step, builder, pd_gains=servo_gains(hexapod))
     home = servo_joint_home(hexapod)

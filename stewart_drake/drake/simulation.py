@@ -21,10 +21,8 @@ same inputs give the same logs bit for bit (no randomness, no threads in the loo
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
@@ -36,14 +34,15 @@ from tqdm import tqdm
 
 from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
 from stewart_drake.control.gains import ControllerConfig
-from stewart_drake.control.laws import STATUS
+from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
+from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.drake.platform_model import build_plant, set_pose
+from stewart_drake.errors import SimulationError
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
 
 # ----------------------------------------------------------------------------------------------
@@ -61,9 +60,9 @@ class ActuatorModel:
 
     def __post_init__(self):
         if self.max_force is not None and not (math.isfinite(self.max_force) and self.max_force > 0):
-            raise ValueError(f"ActuatorModel.max_force must be a positive number of newtons, got {self.max_force!r}")
+            raise SimulationError(SimulationError.MAX_FORCE.format(value=self.max_force))
         if not (math.isfinite(self.time_constant) and self.time_constant >= 0):
-            raise ValueError(f"ActuatorModel.time_constant must be >= 0 s, got {self.time_constant!r}")
+            raise SimulationError(SimulationError.TIME_CONSTANT.format(value=self.time_constant))
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,10 +150,10 @@ class Simulation:
     source: object = None
     _ran: bool = False
 
-    def run(self, duration: float, progress: bool = False) -> "SimulationLog":
+    def run(self, duration: float, progress: bool = False) -> SimulationLog:
         """Simulate ``duration`` seconds from t = 0 (once per Simulation) and return the logs."""
         if not (math.isfinite(duration) and duration > 0):
-            raise ValueError(f"duration must be a positive number of seconds, got {duration!r}")
+            raise SimulationError(SimulationError.DURATION.format(value=duration))
         if self._ran:
             raise RuntimeError("a Simulation runs once; build a new one")
         self._ran = True
@@ -182,7 +181,7 @@ class Simulation:
             self.visualizer.PublishRecording()
         return self._collect()
 
-    def _collect(self) -> "SimulationLog":
+    def _collect(self) -> SimulationLog:
         ctx = self.simulator.get_context()
         logs = {k: lg.FindLog(ctx) for k, lg in self.loggers.items()}
         x = logs["state"]
@@ -192,7 +191,7 @@ class Simulation:
         i0 = top.floating_positions_start()
         quat = X[:, i0 : i0 + 4]
         p_WT = X[:, i0 + 4 : i0 + 7]
-        R = _quat_to_matrix(quat)
+        R = quaternion_to_matrix(quat)
         angles = angles_from_matrix(R, "utn")
         p_WC = p_WT + np.einsum("nij,j->ni", R, self.platform.rotation_centre)
         pose = np.concatenate([p_WC, angles], axis=1)
@@ -217,20 +216,6 @@ class Simulation:
         )
 
 
-def _quat_to_matrix(q) -> np.ndarray:
-    """``(n, 4)`` unit quaternions [w, x, y, z] → ``(n, 3, 3)``."""
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    w, x, y, z = q.T
-    return np.stack(
-        [
-            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
-        ],
-        axis=-1,
-    ).reshape(-1, 3, 3)
-
-
 def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     """Assemble ``scenario``'s controller-in-the-loop Diagram and its Simulator, with the plant at the
     reference's initial pose, legs at the matching lengths and the controller holding them against
@@ -241,7 +226,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     plant_platform = s.plant_platform or platform
     plant_time_step = s.plant_time_step
     if not (math.isfinite(plant_time_step) and plant_time_step > 0):
-        raise ValueError(f"plant_time_step must be a positive number of seconds, got {plant_time_step!r}")
+        raise SimulationError(SimulationError.PLANT_STEP.format(value=plant_time_step))
     trajectory = get_trajectory(s.trajectory)
     actuators = s.actuators
     config = s.config
@@ -326,9 +311,9 @@ def setpoint_step_response(platform: Platform, config: ControllerConfig | None =
     chatter to a small-signal measurement). Samples at the plant steps (the controller's period by
     default), so s[n] is the sampled step response of the discrete loop from set-point words to lengths."""
     if not (isinstance(leg, (int, np.integer)) and 0 <= leg < 6):
-        raise ValueError(f"leg must be 0 … 5, got {leg!r}")
+        raise SimulationError(SimulationError.LEG.format(value=leg))
     if not (math.isfinite(step) and step != 0):
-        raise ValueError(f"step must be a non-zero number of metres, got {step!r}")
+        raise SimulationError(SimulationError.STEP.format(value=step))
     cfg = config or ControllerConfig.for_platform(platform)
     cfg = replace(cfg, timing=replace(cfg.timing, sensor_resolution=1e-9))
     rest = constant_trajectory("home", platform.home_pose(), duration)
@@ -368,7 +353,7 @@ def setpoint_step_gain(platform: Platform, config: ControllerConfig | None = Non
     return {"diagonal": diag, "coupled": coupled, "tail": tail, "peak": float(s[:, leg].max()), "t": t, "s": s}
 
 
-def simulate(scenario: Scenario, progress: bool = False) -> "SimulationLog":
+def simulate(scenario: Scenario, progress: bool = False) -> SimulationLog:
     """Build ``scenario``'s Diagram and run it: the logs of ``scenario.duration`` seconds (default the
     trajectory's own duration, else 1 s); default gains are designed over the poses of the whole run."""
     traj = get_trajectory(scenario.trajectory)
@@ -376,122 +361,3 @@ def simulate(scenario: Scenario, progress: bool = False) -> "SimulationLog":
     if scenario.config is None and scenario.design_duration is None:
         scenario = replace(scenario, design_duration=max(duration, traj.duration or 0.0))
     return build_simulation(replace(scenario, trajectory=traj)).run(duration, progress=progress)
-
-
-# ----------------------------------------------------------------------------------------------
-# Logs.
-
-
-@dataclass
-class SimulationLog:
-    """The logs of one run, numpy arrays in SI units.
-
-    ``t`` (n,) plant-step times; ``pose`` (n, 6) measured plate pose (utn); ``lengths`` (n, 6) true leg
-    lengths; ``command`` (n, 6) held controller output (N); ``setpoint`` (n, 6) held set-points (m);
-    ``force`` (n, 6) actuator forces (N); ``status`` (n, len(STATUS)); ``t_ref`` (m,), ``reference``
-    (m, 6) the pose reference at the controller's ticks.
-    """
-
-    kind: str
-    platform: str
-    trajectory: str
-    sample_period: float
-    t: np.ndarray
-    pose: np.ndarray
-    lengths: np.ndarray
-    command: np.ndarray
-    setpoint: np.ndarray
-    force: np.ndarray
-    status: np.ndarray
-    t_ref: np.ndarray
-    reference: np.ndarray
-
-    ARRAYS = ("t", "pose", "lengths", "command", "setpoint", "force", "status", "t_ref", "reference")
-
-    def tick_times(self) -> np.ndarray:
-        """The controller's tick times read from the logged status (one per tick, in order)."""
-        ticks = self.status[:, STATUS.index("ticks")].astype(int)
-        times = self.status[:, STATUS.index("last_tick_time")]
-        first = np.r_[True, np.diff(ticks) != 0] & (ticks > 0)
-        return times[first]
-
-    def saturations(self) -> np.ndarray:
-        """``(6,)`` saturated ticks per leg over the run."""
-        return self.status[-1, 4:10].copy()
-
-    def length_error(self, trajectory: Trajectory, platform: Platform) -> np.ndarray:
-        """``(n, 6)`` true leg length − the exact IK of the reference at the same time (m)."""
-        return self.lengths - leg_lengths(platform, trajectory.pose(self.t))
-
-    def pose_error(self, trajectory: Trajectory) -> np.ndarray:
-        """``(n, 6)`` measured pose − reference pose at the same time (m, rad)."""
-        return self.pose - trajectory.pose(self.t)
-
-    def save(self, directory) -> list[Path]:
-        """Write ``log.npz`` (every array) and ``log.csv`` (one row per plant step); return the paths."""
-        d = Path(directory)
-        d.mkdir(parents=True, exist_ok=True)
-        npz = d / "log.npz"
-        np.savez(npz, **{k: getattr(self, k) for k in self.ARRAYS}, kind=self.kind, platform=self.platform, trajectory=self.trajectory, sample_period=self.sample_period)
-        header = (
-            ["t"] + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")]
-            + [f"L{i}" for i in range(1, 7)] + [f"setpoint{i}" for i in range(1, 7)]
-            + [f"command{i}" for i in range(1, 7)] + [f"force{i}" for i in range(1, 7)] + list(STATUS)
-        )
-        rows = np.concatenate([self.t[:, None], self.pose, self.lengths, self.setpoint, self.command, self.force, self.status], axis=1)
-        path = d / "log.csv"
-        with path.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            w.writerows([[repr(float(v)) for v in r] for r in rows])
-        return [npz, path]
-
-
-# ----------------------------------------------------------------------------------------------
-# Verdict.
-
-# Tracking is lost when a leg's length error or the plate's position error exceeds this fraction of the
-# stroke range (20 mm on utn-dynamic's 0.4 m stroke; the seed run's error is ~1 mm).
-TRACKING_LOST_FRACTION = 0.05
-# A leg whose command stays saturated (at the command range) longer than this, in one stretch, has
-# lost authority over its leg.
-MAX_SATURATION_S = 0.05
-
-
-def longest_saturation(log: "SimulationLog") -> np.ndarray:
-    """``(6,)`` the longest stretch (s) over which each leg's command was saturated on every tick."""
-    ticks = log.status[:, STATUS.index("ticks")].astype(int)
-    first = np.r_[True, np.diff(ticks) != 0] & (ticks > 0)
-    counts = log.status[first][:, 4:10]
-    sat = np.diff(np.vstack([np.zeros((1, 6)), counts]), axis=0) > 0  # (ticks, 6) saturated on that tick
-    out = np.zeros(6)
-    for j in range(6):
-        s = np.r_[0, sat[:, j].astype(np.int8), 0]
-        d = np.diff(s)
-        starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
-        out[j] = (ends - starts).max() * log.sample_period if len(starts) else 0.0
-    return out
-
-
-def tracking_verdict(platform: Platform, length_error, pose_error, log: "SimulationLog") -> dict:
-    """Whether a run tracked its reference: ``{"tracking_bound_mm", "saturation_bound_s",
-    "longest_saturation_s" (6,), "failures": [messages]}``; a failure is a leg error or plate position
-    error beyond ``TRACKING_LOST_FRACTION`` × the stroke range (lost tracking, with its first time), or a
-    leg saturated for longer than ``MAX_SATURATION_S`` in one stretch."""
-    bound = TRACKING_LOST_FRACTION * float(platform.L_max - platform.L_min)
-    failures = []
-    e = np.abs(np.asarray(length_error))
-    pe = np.linalg.norm(np.asarray(pose_error)[:, :3], axis=1)
-    for name, err, legwise in (("leg length", e, True), ("plate position", pe, False)):
-        bad = (err > bound).reshape(len(err), -1).any(axis=1)
-        if np.any(bad):
-            i = int(np.argmax(bad))
-            which = f" of leg {int(np.argmax(err[i])) + 1}" if legwise else ""
-            failures.append(f"tracking lost: the {name} error{which} exceeds {bound * 1e3:.1f} mm ({TRACKING_LOST_FRACTION:g} × the stroke range) "
-                            f"first at t = {log.t[i]:.4f} s, and reaches {err.max() * 1e3:.1f} mm")
-    longest = longest_saturation(log)
-    for j in np.flatnonzero(longest > MAX_SATURATION_S):
-        failures.append(f"leg {j + 1} saturated for {longest[j]:.3f} s in one stretch (longer than {MAX_SATURATION_S:g} s): "
-                        "its actuator cannot follow the reference")
-    return {"tracking_bound_mm": bound * 1e3, "saturation_bound_s": MAX_SATURATION_S,
-            "longest_saturation_s": longest.tolist(), "failures": failures}

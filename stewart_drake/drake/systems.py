@@ -23,6 +23,7 @@ from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.laws import CONTROLLER_KINDS, STATUS, FixedPointLaw, FloatLaw
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.errors import SimulationError
 from stewart_drake.firmware.sil import CFixedPointLaw
 
 ENGINES = ("python", "c")
@@ -127,14 +128,14 @@ def make_law(kind: str, platform: Platform, config: ControllerConfig | None = No
     if kind == "fixed" and (engine == "c" or firmware is not None):
         return CFixedPointLaw(platform, config, firmware)
     if engine not in ENGINES:
-        raise ValueError(f"engine must be 'python' or 'c', got {engine!r}")
+        raise SimulationError(SimulationError.ENGINE.format(value=engine))
     if kind != "fixed" and firmware is not None:
-        raise ValueError(f"a firmware file runs the fixed-point controller; controller {kind!r} has no firmware")
+        raise SimulationError(SimulationError.FIRMWARE_LAW.format(kind=kind))
     if kind == "fixed":
         return FixedPointLaw(platform, config)
     if kind == "float":
         return FloatLaw(platform, config)
-    raise ValueError(f"controller must be {' or '.join(repr(k) for k in CONTROLLER_KINDS)}, got {kind!r}")
+    raise SimulationError(SimulationError.CONTROLLER.format(valid=" or ".join(repr(k) for k in CONTROLLER_KINDS), value=kind))
 
 
 def make_controller(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python",

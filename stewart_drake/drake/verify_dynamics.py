@@ -192,6 +192,7 @@ class ClosedLoopInverseDynamics:
         plant = self.plant
         g = np.linalg.norm(plant.gravity_field().gravity_vector())
         if abs(g - G_EARTH) > 1e-12:
+            # internal: build_plant sets the gravity; a different value is a bug here, not bad input
             raise ValueError(f"the closed-loop plant's gravity is {g} m/s², expected {G_EARTH}")
         self.ctx = plant.CreateDefaultContext()
         self.top = plant.GetBodyByName("top")

@@ -25,17 +25,13 @@ from stewart_drake.core.leg_bodies import leg_visual_dimensions
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length_scale, rotation_matrix
 from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import ReplayError, SimulationError, StewartError
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
 # Above this condition number a pose counts as singular (kinematics.require_nonsingular's default).
 MAX_CONDITION = 1e8
 # Assembly modes closer than this (|Δp| / anchor radius + rotation angle in rad) count as "near" the pose.
 NEAR_MODE = 0.5
-
-
-class ReplayError(StewartError):
-    """A replay log that cannot be read."""
 
 
 @dataclass
@@ -141,7 +137,7 @@ def open_meshcat(port: int | None = None) -> Meshcat:
     try:
         return Meshcat(MeshcatParams(host="localhost", port=port))
     except RuntimeError as e:
-        raise ValueError(f"--port {port}: Meshcat could not listen there ({e})") from None
+        raise SimulationError(SimulationError.PORT.format(port=port, reason=e)) from None
 
 
 class Viewer:
@@ -258,15 +254,15 @@ def load_replay(path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str]:
         for name in ("log.npz", "simulation/log.npz", "trajectory.csv", "log.csv"):
             if (p / name).exists():
                 return load_replay(p / name)
-        raise ReplayError(f"--replay {path}: no log.npz, simulation/log.npz, trajectory.csv or log.csv in the folder")
+        raise ReplayError(ReplayError.EMPTY_FOLDER.format(path=path))
     if not p.exists():
-        raise ReplayError(f"--replay {path}: no such file")
+        raise ReplayError(ReplayError.MISSING.format(path=path))
     if p.suffix == ".npz":
         try:
             with np.load(p, allow_pickle=False) as z:
                 return np.asarray(z["t"], float), np.asarray(z["pose"], float), log_saturating(z["status"]), str(z["platform"])
         except (KeyError, ValueError, OSError) as e:
-            raise ReplayError(f"--replay {path}: not a simulate log ({e})") from None
+            raise ReplayError(ReplayError.NOT_LOG.format(path=path, reason=e)) from None
     return _load_csv(p)
 
 
@@ -274,22 +270,22 @@ def _load_csv(p: Path):
     with p.open(newline="") as fh:
         rows = list(csv.reader(fh))
     if not rows:
-        raise ReplayError(f"--replay {p}: empty file")
+        raise ReplayError(ReplayError.EMPTY.format(path=p))
     header = rows[0]
     for cols in (["t"] + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")],
                  ["t", "px", "py", "pz", "alpha", "beta", "gama"]):
         if all(c in header for c in cols):
             break
     else:
-        raise ReplayError(f"--replay {p}: line 1: expected the columns of a simulate log.csv or a run trajectory.csv, got {', '.join(header[:8])}")
+        raise ReplayError(ReplayError.COLUMNS.format(path=p, got=", ".join(header[:8])))
     idx = [header.index(c) for c in cols]
     try:
         data = np.array([[float(r[i]) for i in idx] for r in rows[1:]])
     except (ValueError, IndexError):
         bad = next(k for k, r in enumerate(rows[1:], 2) if len(r) <= max(idx) or not _floats(r, idx))
-        raise ReplayError(f"--replay {p}: line {bad}: not a row of numbers") from None
+        raise ReplayError(ReplayError.ROW.format(path=p, line=bad)) from None
     if len(data) == 0:
-        raise ReplayError(f"--replay {p}: no samples")
+        raise ReplayError(ReplayError.NO_SAMPLES.format(path=p))
     platform, convention = "", "utn"
     summary = p.parent / "summary.json"
     if cols[1] == "px" and summary.exists():

@@ -12,6 +12,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.firmware.generate import TRACE_FIELDS
 from stewart_drake.firmware.module import TickRunner
+from stewart_drake.errors import FirmwareError
 
 MAX_POSES = 100_000_000
 CHUNK = 1 << 18
@@ -56,7 +57,7 @@ def emulation_trace(platform: Platform, words, config: ControllerConfig) -> np.n
 def workspace_poses(platform: Platform, n: int, seed: int = 0) -> np.ndarray:
     """``(n, 6)`` SI poses within stroke around home (``sampling.random_poses``: ±10 % of the stroke, ±15°)."""
     if not (isinstance(n, (int, np.integer)) and 1 <= n <= MAX_POSES):
-        raise ValueError(f"--poses must be an integer in 1..{MAX_POSES}, got {n!r}")
+        raise FirmwareError(FirmwareError.POSES.format(limit=MAX_POSES, value=n))
     return random_poses(platform, int(n), seed=seed)
 
 
@@ -65,7 +66,7 @@ def check_ik(module, platform: Platform, config: ControllerConfig, n: int, seed:
     fmt, conv = config.ik_format, config.convention
     consts = platform_words(platform, fmt)
     if not (isinstance(n, (int, np.integer)) and 1 <= n <= MAX_POSES):
-        raise ValueError(f"--poses must be an integer in 1..{MAX_POSES}, got {n!r}")
+        raise FirmwareError(FirmwareError.POSES.format(limit=MAX_POSES, value=n))
     worst, differing, first = 0, 0, None
     for a in range(0, n, CHUNK):  # poses drawn chunk by chunk: memory stays bounded whatever n
         q = workspace_poses(platform, min(CHUNK, n - a), seed * 1_000_003 + a // CHUNK)

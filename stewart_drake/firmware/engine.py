@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 
 from stewart_drake.core.c_build import CompilerUnavailable, default_compiler
+from stewart_drake.errors import FirmwareError
 
 ENGINES = ("python", "c")
 
@@ -14,7 +15,7 @@ def resolve_engine(engine: str, what: str = "stewart-drake") -> str:
     """``engine`` if it can run here: ``"c"`` needs a C compiler; without one the notice says so on
     stderr and ``"python"`` is returned (same numbers, bit for bit, only slower)."""
     if engine not in ENGINES:
-        raise ValueError(f"--engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+        raise FirmwareError(FirmwareError.ENGINE.format(valid=", ".join(ENGINES), value=engine))
     if engine == "c":
         try:
             default_compiler()

@@ -34,6 +34,7 @@ from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_C
 from stewart_drake.fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
 from stewart_drake.fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 from stewart_drake.core.geometry import Platform
+from stewart_drake.errors import FirmwareError
 
 # Operation names the generated code counts (the instrumented build's order).
 OPS = ("add", "sub", "negate", "mult", "L_mult", "L_add", "L_sub", "L_shl", "shl", "mult_r", "extract_h",
@@ -120,7 +121,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     sensor resolution that does not divide the length LSB, a platform that does not fit the words)."""
     fmt, conv = config.ik_format, config.convention
     if fmt.word_bits > 16:
-        raise ValueError(f"generated C takes word_bits 8..16 (16-bit data words, 32-bit accumulators), got {fmt.word_bits}")
+        raise FirmwareError(FirmwareError.WORD_BITS.format(value=fmt.word_bits))
     cpl = counts_per_lsb(config)
     gains = FixedGains.from_si(config.gains, config.timing)
     r_T, B = platform_words(platform, fmt)
@@ -241,7 +242,7 @@ def _verify_table(U: np.ndarray, fmt: QFormat) -> None:
     cc = np.clip(np.where(a <= H, U[np.clip(H - a, 0, H)], -U[np.clip(a - H, 0, H)]), lo, hi)
     if np.any(ss != s) or np.any(cc != c):
         bad = int(w[np.flatnonzero((ss != s) | (cc != c))[0]])
-        raise ValueError(f"the quarter-wave sine table does not reproduce the exact trig at angle word {bad}")
+        raise FirmwareError(FirmwareError.SINE_TABLE.format(index=bad))
 
 
 def _header(c: dict, config: ControllerConfig) -> str:

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.c_build import Compiler, Source, build, library_sources, load
+from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
 
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
@@ -132,18 +133,20 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
 class TickRunner:
     """Calls ``sd_tick`` with the controller's state held as the 30-word vector of ``control.FixedPointLaw``
     (integrator, previous measurement, its filtered difference, previous set-point, its filtered
-    difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer."""
+    difference): the vector goes into a C ``sd_state`` and comes back out, with numpy views on one buffer.
+    ``state_ptr`` is the cffi ``sd_state *`` on that buffer, for callers that run the C tick themselves
+    (``firmware.sil``)."""
 
     FIELDS = (("integ", np.int32), ("prev", np.int32), ("dfilt", np.int16), ("setpoint", None), ("vfilt", np.int16), ("saturated", np.int16))
 
     def __init__(self, module: FirmwareModule):
         if not module.has_tick:
-            raise ValueError(f"firmware {module.path.name} does not define sd_init and sd_tick")
+            raise FirmwareError(FirmwareError.NO_TICK.format(name=module.path.name))
         self.module = m = module
         ffi = m.ffi
         self._buf = bytearray(ffi.sizeof("sd_state"))
-        self._ptr = ffi.from_buffer("sd_state *", self._buf)
-        m.lib.sd_init(self._ptr)
+        self.state_ptr = ffi.from_buffer("sd_state *", self._buf)
+        m.lib.sd_init(self.state_ptr)
         self.views = {name: np.frombuffer(self._buf, dtype=dt or m.word_dtype, count=6, offset=ffi.offsetof("sd_state", name))
                       for name, dt in self.FIELDS}
         self.pose = np.zeros(6, dtype=m.word_dtype)
@@ -176,5 +179,5 @@ class TickRunner:
         p_pose, p_meas, p_ff, p_cmd = self._p
         if feedforward_words is not None:
             self.feedforward[:] = feedforward_words
-        self._tick(self._ptr, p_pose, p_meas, p_ff if feedforward_words is not None else self._null, p_cmd)
+        self._tick(self.state_ptr, p_pose, p_meas, p_ff if feedforward_words is not None else self._null, p_cmd)
         return self.command.copy()

@@ -14,6 +14,7 @@ from stewart_drake.control.laws import FixedPointLaw
 from stewart_drake.core.geometry import Platform
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import TickRunner, compile_generated, compile_user
+from stewart_drake.errors import FirmwareError
 from stewart_drake.fixedpoint.generic import pose_words
 
 
@@ -61,9 +62,9 @@ class CFixedPointLaw(FixedPointLaw):
         self._state[:] = state
         if feedforward is not None:
             self._ff[:] = feedforward
-        k = self._host_tick(r._ptr, self._p_pose, self._p_L, self._res, self._p_ff if feedforward is not None else self._null, self._range,
+        k = self._host_tick(r.state_ptr, self._p_pose, self._p_L, self._res, self._p_ff if feedforward is not None else self._null, self._range,
                             self._lsb, self._p_state, self._p_out)
         if k < 0:
-            raise ValueError(f"measured leg lengths {np.asarray(measured).tolist()} m do not fit the firmware's 32-bit sensor counts")
+            raise FirmwareError(FirmwareError.SENSOR_COUNTS.format(value=np.asarray(measured).tolist()))
         o = self._out
         return o[:6].copy(), o[6:12].copy(), self._state.copy(), o[12:].copy()

@@ -144,7 +144,7 @@ def _draw_one(rng, law, nominal, shape=()):
         return rng.uniform(*law.values, size=shape or None)
     if law.kind == "choice":
         return law.values[int(rng.integers(len(law.values)))]
-    raise ValueError(f"unknown law {law.kind!r}")
+    raise ValueError(f"unknown law {law.kind!r}")  # internal: the study loader accepts only the kinds above
 
 
 def draw(study: Study, index: int) -> tuple[int, Draw]:

@@ -37,11 +37,7 @@ from decimal import Decimal
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from stewart_drake.errors import StewartError
-
-
-class SpecError(StewartError):
-    """A ``--vary`` SPEC that cannot be read: unknown key, bad value, unit or range."""
+from stewart_drake.errors import SpecError
 
 
 # key: (dimension, vector length or 0 for a scalar, nominal zero?)
@@ -105,10 +101,10 @@ def _number(text: str, key: str, where: str) -> float:
     units = UNITS.get(dim, {"": 0})
     if not m or m.group(2) not in units:
         allowed = ", ".join(u for u in units if u) or "none"
-        raise SpecError(f"{where}: {key}: cannot read {text!r} as a number with a unit ({allowed})")
+        raise SpecError(SpecError.NUMBER.format(where=where, key=key, text=text, allowed=allowed))
     v = float(Decimal(m.group(1)).scaleb(units[m.group(2)]))
     if not math.isfinite(v):
-        raise SpecError(f"{where}: {key}: {text!r} is not finite")
+        raise SpecError(SpecError.NOT_FINITE.format(where=where, key=key, text=text))
     return v
 
 
@@ -120,30 +116,30 @@ def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
         modes = tuple(m.strip() for m in text.split("|"))
         bad = [m for m in modes if m not in LATENCY_MODES]
         if bad:
-            raise SpecError(f"{where}: latency: {bad[0]!r} is not one of {', '.join(LATENCY_MODES)}")
+            raise SpecError(SpecError.LATENCY.format(where=where, value=bad[0], valid=", ".join(LATENCY_MODES)))
         return Distribution("choice" if len(modes) > 1 else "fixed", modes if len(modes) > 1 else (modes[0],), text)
     if key in PROCESS_KEYS:
         v = _number(text, key, where)
         if v < 0:
-            raise SpecError(f"{where}: {key}: {text!r} must be >= 0 (the size of a per-tick random process)")
+            raise SpecError(SpecError.NEGATIVE_PROCESS.format(where=where, key=key, text=text))
         return Distribution("fixed", (v,), text)
     if text.startswith(("±", "+-")):
         body = text[1:] if text.startswith("±") else text[2:]
         if body.strip().endswith("%"):
             if zero_nominal:
-                raise SpecError(f"{where}: {key}: {text!r}: a percentage of a zero nominal; give ±value with a unit")
+                raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=where, key=key, text=text))
             p = float(_number(body.strip()[:-1], "gain_scale", where)) / 100
             if not 0 <= p < 1:
-                raise SpecError(f"{where}: {key}: {text!r}: the percentage must be in [0, 100)")
+                raise SpecError(SpecError.PERCENT_RANGE.format(where=where, key=key, text=text))
             return Distribution("relative", (p,), text)
         w = _number(body, key, where)
         if w < 0:
-            raise SpecError(f"{where}: {key}: {text!r}: the half-width must be >= 0")
+            raise SpecError(SpecError.HALF_WIDTH.format(where=where, key=key, text=text))
         return Distribution("plusminus", (w,), text)
     if ".." in text:
         lo, hi = (_number(s, key, where) for s in text.split("..", 1))
         if not lo <= hi:
-            raise SpecError(f"{where}: {key}: {text!r}: the range's low end is above its high end")
+            raise SpecError(SpecError.RANGE_ORDER.format(where=where, key=key, text=text))
         return Distribution("uniform", (lo, hi), text)
     if "|" in text:
         return Distribution("choice", tuple(_number(s, key, where) for s in text.split("|")), text)
@@ -154,12 +150,12 @@ def check_key(key: str, where: str) -> None:
     if key not in KEYS:
         near = difflib.get_close_matches(key, KEYS, n=1)
         hint = f" (did you mean {near[0]!r}?)" if near else f" (keys: {', '.join(KEYS)})"
-        raise SpecError(f"{where}: unknown key {key!r}{hint}")
+        raise SpecError(SpecError.UNKNOWN_KEY.format(where=where, key=key, hint=hint))
 
 
 def _check_vector(key: str, d: Distribution, where: str) -> None:
     if KEYS[key][1] and d.kind not in ("plusminus", "fixed"):
-        raise SpecError(f"{where}: {key}: give ±tolerance (per component) or a fixed offset, not {d.text!r}")
+        raise SpecError(SpecError.VECTOR_LAW.format(where=where, key=key, text=d.text))
 
 
 def parse_spec(words) -> VarySpec:
@@ -173,7 +169,7 @@ def parse_spec(words) -> VarySpec:
     laws = {}
     for w in words:
         if "=" not in w:
-            raise SpecError(f"--vary: {w!r} is not key=value")
+            raise SpecError(SpecError.NOT_KEY_VALUE.format(value=w))
         key, value = w.split("=", 1)
         key = key.strip()
         check_key(key, "--vary")
@@ -187,20 +183,21 @@ def _parse_yaml(path: Path) -> VarySpec:
     import yaml
 
     if not path.is_file():
-        raise SpecError(f"--vary: file {str(path)!r} does not exist")
+        raise SpecError(SpecError.MISSING_FILE.format(path=str(path)))
     text = path.read_text(encoding="utf-8")
     try:
         node = yaml.compose(text)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
-        raise SpecError(f"{path}:{mark.line + 1 if mark else '?'}: not YAML ({getattr(e, 'problem', e)})") from None
+        raise SpecError(SpecError.NOT_YAML.format(path=path, line=mark.line + 1 if mark else "?",
+                                                  problem=getattr(e, "problem", e))) from None
     if node is None or not isinstance(node, yaml.MappingNode):
-        raise SpecError(f"{path}: the SPEC must be a mapping of key: value")
+        raise SpecError(SpecError.NOT_MAPPING.format(path=path))
     laws = {}
     for k, v in node.value:
         where = _where(str(path), k.start_mark.line + 1)
         if not isinstance(v, yaml.ScalarNode):
-            raise SpecError(f"{where}: {k.value}: the value must be one scalar (e.g. ±0.5mm)")
+            raise SpecError(SpecError.NOT_SCALAR.format(where=where, key=k.value))
         check_key(k.value, where)
         d = parse_value(k.value, v.value, where)
         _check_vector(k.value, d, where)

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.output_folder import claim_in_manifest
-from stewart_drake.errors import StewartError
+from stewart_drake.errors import StudyError
 from stewart_drake.montecarlo.scenario import Study, run_scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
@@ -33,10 +33,6 @@ MAX_RUNS = 100_000
 MAX_RUN_SECONDS = 600.0
 MAX_TOTAL_SECONDS = 500_000.0
 RETRIES = 3
-
-
-class StudyError(StewartError):
-    """A study that cannot start: too large, inconsistent settings, or an output folder that is not its own."""
 
 
 def study_settings(study: Study) -> dict:
@@ -93,26 +89,27 @@ def check_study(study: Study) -> float:
     if study.integrator is not None:
         check_integrator(study.integrator)
     if not (isinstance(study.runs, int) and 1 <= study.runs <= MAX_RUNS):
-        raise StudyError(f"--runs must be 1 … {MAX_RUNS}, got {study.runs}")
+        raise StudyError(StudyError.RUNS.format(limit=MAX_RUNS, value=study.runs))
     if not (isinstance(study.seed, int) and study.seed >= 0):
-        raise StudyError(f"--seed must be an integer >= 0, got {study.seed}")
+        raise StudyError(StudyError.SEED.format(value=study.seed))
     if study.grid is not None and len(study.grid) != study.runs:
-        raise StudyError(f"a sweep's runs ({study.runs}) must equal its grid's points ({len(study.grid)})")
+        raise StudyError(StudyError.GRID.format(runs=study.runs, points=len(study.grid)))
     if not (math.isfinite(study.plant_step) and 0 < study.plant_step <= 1e-2):
-        raise StudyError(f"plant step must be in (0, 0.01] s, got {study.plant_step}")
+        raise StudyError(StudyError.PLANT_STEP.format(value=study.plant_step))
     duration = study.run_duration()
     if not (math.isfinite(duration) and 0 < duration <= MAX_RUN_SECONDS):
-        raise StudyError(f"--duration must be in (0, {MAX_RUN_SECONDS:g}] s per run, got {duration}")
+        raise StudyError(StudyError.DURATION.format(limit=MAX_RUN_SECONDS, value=duration))
     if study.runs * duration > MAX_TOTAL_SECONDS:
-        raise StudyError(f"--runs {study.runs} × {duration:g} s = {study.runs * duration:g} simulated s is more than the bound {MAX_TOTAL_SECONDS:g} s")
+        raise StudyError(StudyError.TOTAL.format(runs=study.runs, duration=duration, total=study.runs * duration,
+                                                 limit=MAX_TOTAL_SECONDS))
     if study.controller == "fixed":
         law = study.spec.laws.get("sensor_resolution")
         if law is not None and law.kind not in ("fixed", "choice"):
-            raise StudyError("--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; give a value or a|b|c list, not a range")
+            raise StudyError(StudyError.RESOLUTION_RANGE)
         for r in law.values if law is not None else ():
             c = 1e-3 / r
             if not (r > 0 and abs(c - round(c)) <= 1e-9 * c):
-                raise StudyError(f"--vary sensor_resolution: {r:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts")
+                raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r))
     return duration
 
 
@@ -132,7 +129,7 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
     if not out.exists():
         return {}
     if not out.is_dir():
-        raise StudyError(f"--out {str(out)!r} exists and is not a folder")
+        raise StudyError(StudyError.OUT_NOT_FOLDER.format(out=str(out)))
     rows: dict[int, dict] = {}
     partial = out / PARTIAL
     previous = out / STUDY_FILE
@@ -140,7 +137,7 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
         old = json.loads(previous.read_text())
         old_key = settings_key(old["settings"]) if "settings" in old else old.get("key")
         if old_key != key:
-            raise StudyError(f"--out {str(out)!r} holds another study (key {old_key}, this one {key}); choose another folder")
+            raise StudyError(StudyError.OUT_OTHER_STUDY.format(out=str(out), old_key=old_key, key=key))
         results = out / "results.parquet"
         if results.exists():
             import pyarrow.parquet as pq
@@ -148,12 +145,12 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
             for r in pq.read_table(results).to_pylist():
                 rows[int(r["run"])] = r
     elif not partial.exists() and any(out.iterdir()):
-        raise StudyError(f"--out {str(out)!r} is a folder this tool did not write (no {STUDY_FILE} or {PARTIAL}); refusing to overwrite it")
+        raise StudyError(StudyError.OUT_NOT_OURS.format(out=str(out), study_file=STUDY_FILE, partial=PARTIAL))
     if partial.exists():
         lines = partial.read_text().splitlines()
         head = json.loads(lines[0]) if lines else {}
         if head.get("key") != key:
-            raise StudyError(f"--out {str(out)!r} holds a partial study with another key ({head.get('key')}, this one {key}); choose another folder")
+            raise StudyError(StudyError.OUT_OTHER_PARTIAL.format(out=str(out), old_key=head.get("key"), key=key))
         for line in lines[1:]:
             try:
                 r = json.loads(line)

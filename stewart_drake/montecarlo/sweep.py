@@ -19,9 +19,9 @@ def sweep_study(platform: Platform, axes: dict, trajectory: str = "seed", contro
     for k, values in axes.items():
         check_key(k, "sweep")
         if KEYS[k][1]:
-            raise SpecError(f"sweep: {k} is a per-component key; sweep scalar keys")
+            raise SpecError(SpecError.SWEEP_VECTOR.format(key=k))
         if not len(values):
-            raise SpecError(f"sweep: {k} has no values")
+            raise SpecError(SpecError.SWEEP_EMPTY.format(key=k))
     keys = list(axes)
     grid = tuple(dict(zip(keys, point)) for point in itertools.product(*(axes[k] for k in keys)))
     return Study(platform, VarySpec({}, "sweep"), seed=0, runs=len(grid), trajectory=trajectory, controller=controller,

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.jsonout import dumps_strict
+from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
 from stewart_drake.report import render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
@@ -157,7 +158,7 @@ def load_analysis(path: Path) -> Analysis:
     mod = _module_at(path)
     for attr in ("TITLE", "ORDER", "build"):
         if not hasattr(mod, attr):
-            raise ValueError(f"analysis {path} lacks {attr}")
+            raise ValueError(f"analysis {path} lacks {attr}")  # internal: the analyses are package modules
     return Analysis(path.stem, mod.TITLE, float(mod.ORDER), mod.build, path, float(getattr(mod, "COST", 0.0)))
 
 
@@ -169,7 +170,7 @@ def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = N
     if only:
         unknown = sorted(set(only) - {a.name for a in found})
         if unknown:
-            raise ValueError(f"unknown analysis {unknown[0]!r}; available: {', '.join(a.name for a in found)}")
+            raise UsageError(REPORT_UNKNOWN_ANALYSIS.format(name=unknown[0], available=", ".join(a.name for a in found)))
         found = [a for a in found if a.name in only]
     return sorted(found, key=lambda a: (a.order, a.name))
 

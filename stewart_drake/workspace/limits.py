@@ -142,7 +142,7 @@ def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention
             out["collision"] = np.full(L.shape[:-1] + (1,), np.inf)
     if limits.max_condition is not None:
         if poses is None:
-            raise WorkspaceError("the dexterity limit needs the poses themselves")
+            raise WorkspaceError(WorkspaceError.DEXTERITY_POSES)
         out["dexterity"] = (limits.max_condition - condition_number(platform, poses, convention))[..., None]
     return out
 

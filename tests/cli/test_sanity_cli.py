@@ -1,0 +1,107 @@
+"""Physical-limit checks of the ``simulate`` command, which runs a Drake simulation: a trajectory out of stroke or
+below the base refused before running, a platform without plate mass refused, absurd --plant-step/--period/--duration
+refused before any work, and a reference the actuators cannot follow exits 1 saying why (the numpy commands' checks:
+``tests/core/test_sanity.py``)."""
+
+import contextlib
+import io
+import json
+import re
+
+import pytest
+
+from stewart_drake.cli import main
+
+
+def cli(*argv):
+    """``(exit code, stdout, stderr)`` of the CLI run in-process; an exception other than SystemExit
+    (a traceback) fails the test."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main([str(a) for a in argv])
+        except SystemExit as e:  # argparse
+            rc = e.code
+    return rc, out.getvalue(), err.getvalue()
+
+
+NOPLATE = """name: noplate
+length_unit: m
+utn: {b: 0.4, d: 0.1, a: 0.2}
+stroke: [0.55, 0.95]
+home_height: 0.7
+"""
+
+
+@pytest.fixture
+def noplate(tmp_path):
+    f = tmp_path / "noplate.yaml"
+    f.write_text(NOPLATE)
+    return f
+
+
+def test_simulate_lost_tracking_exits_1(tmp_path):
+    """A reference that jumps 60 mm in 2 ms at t = 0.05 s asks for far more than the actuators' force
+    range: the legs fall tens of millimetres behind. The summary states the bound and the run exits 1
+    saying why."""
+    f = tmp_path / "step.csv"
+    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.05,0,0,700,0,0,0\n0.052,0,0,760,0,0,0\n0.3,0,0,760,0,0,0\n")
+    rc, out, err = cli("simulate", "--trajectory", f, "--length-unit", "mm", "--angle-unit", "deg", "--out", tmp_path / "o", "--no-progress")
+    summary = json.loads(out)
+    assert rc == 1 and summary["tracking_bound_mm"] == pytest.approx(0.05 * 400)
+    assert summary["max_leg_error_mm"] > summary["tracking_bound_mm"]
+    assert re.search(r"tracking lost: the leg length error of leg \d exceeds 20\.0 mm \(0\.05 × the stroke range\) first at t = ", err)
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["failures"] == summary["failures"] != []
+
+
+def test_simulate_refuses_out_of_stroke_and_below_base_before_running(tmp_path):
+    rc, out, err = cli("simulate", "--platform", "utn-kinematic", "--duration", 0.5, "--out", tmp_path / "o", "--no-progress")
+    assert rc == 1 and out == "" and not (tmp_path / "o").exists()
+    assert "the seed reference leaves the stroke: first at t = 0.0000 s, leg 1 length 891.074 mm" in err
+    f = tmp_path / "below.csv"
+    f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,-0.7,0,0,0\n1,0,0,-0.7,0,0,0\n")
+    rc, _, err = cli("simulate", "--trajectory", f, "--out", tmp_path / "o", "--no-progress")
+    assert rc == 1 and "the below reference at t = 0.0000 s: the plate is below the base" in err
+
+
+def test_missing_plate_is_an_error_for_dynamics_and_simulate_only(noplate, tmp_path):
+    msg = ("platform 'noplate' has no plate mass properties (YAML key 'plate' missing, or its mass is 0): '{c}' needs plate.mass "
+           "and plate.inertia (or plate.thickness and plate.density for a utn platform)")
+    rc, out, err = cli("dynamics", "--platform", noplate)
+    assert rc == 2 and out == "" and err.strip() == "stewart-drake dynamics: error: " + msg.format(c="dynamics")
+    rc, _, err = cli("simulate", "--platform", noplate, "--out", tmp_path / "o", "--no-progress")
+    assert rc == 2 and err.strip() == "stewart-drake simulate: error: " + msg.format(c="simulate")
+    assert cli("ik", "--platform", noplate, "--pose", 0, 0, 700, 0, 0, 0)[0] == 0
+    assert cli("workspace", "--platform", noplate, "--resolution", 0.05)[0] == 0
+
+
+@pytest.mark.parametrize("argv, message", [
+    (("simulate", "--plant-step", "1", "--no-progress"),
+     "--plant-step 1 s is longer than the controller period 0.001 s; the plant step must resolve the period (at most one period)"),
+    (("simulate", "--period", "0.004", "--plant-step", "0.004", "--no-progress"),
+     "--plant-step 0.004 s is longer than the actuators' time constant 0.002 s, the platform's fastest modelled dynamics"),
+    (("simulate", "--period", "10", "--no-progress"),
+     "--period 10 s is too slow for platform utn-dynamic: its fastest open-loop mode grows at 7.13/s"),
+])
+def test_simulate_bad_options_exit_2_with_the_message(argv, message, tmp_path):
+    if argv[0] == "simulate":
+        argv = argv + ("--out", str(tmp_path / "o"))
+    rc, out, err = cli(*argv)
+    assert rc == 2 and out == "" and message in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("argv, pattern", [
+    (("simulate", "--duration", "1e9", "--no-progress"),
+     r"--duration 1000000000 s would need 1e\+12 plant steps of 0.001 s \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a shorter --duration"),
+    (("simulate", "--duration", "7200", "--no-progress"), r"--duration 7200 s would need 7.2e\+06 plant steps of 0.001 s \(~2 h\); the limit is ~1 h"),
+])
+def test_simulate_work_is_bounded_before_allocation(argv, pattern, tmp_path, monkeypatch):
+    import stewart_drake.core.sanity as sanity
+
+    if "7200" in argv or "1e4" in argv:  # the time and count bounds, whatever this machine's memory
+        monkeypatch.setattr(sanity, "memory_budget", lambda: 1 << 50)
+    if argv[0] == "simulate":
+        argv = argv + ("--out", str(tmp_path / "o"))
+    rc, out, err = cli(*argv)
+    assert rc == 2 and out == "" and re.search(pattern, err), err
