@@ -14,18 +14,20 @@ import time
 
 import numpy as np
 
+from stewart_drake.core.geometry import load_preset
 from stewart_drake.design.envelope import Envelope, cartesian_leg_forces, envelope_sizing
 from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.modes import analytic_modes, spatial_inertia
 from stewart_drake.design.stiffness import principal_stiffness, stiffness_matrix
 from stewart_drake.drake.design_checks import drake_modes
-from stewart_drake.core.geometry import load_preset
 
 
 def grid(n_total: int) -> np.ndarray:
     """About ``n_total`` poses on a 6-D grid around home (±50 mm, 680–720 mm, ±5°)."""
     m = max(2, int(round(n_total ** (1 / 6))))
-    axes = [np.linspace(-0.05, 0.05, m), np.linspace(-0.05, 0.05, m), np.linspace(0.68, 0.72, m)] + [np.radians(np.linspace(-5, 5, m))] * 3
+    axes = [np.linspace(-0.05, 0.05, m), np.linspace(-0.05, 0.05, m), np.linspace(0.68, 0.72, m)] + [
+        np.radians(np.linspace(-5, 5, m))
+    ] * 3
     return np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
 
 
@@ -80,21 +82,35 @@ def main(argv=None) -> int:
     print(f"platform {p.name}")
     r_env = len(poses) / t_env
     r_brute = len(sub) / t_brute
-    print(f"envelope sizing, {len(poses):,} poses (worst case per pose and leg, exact):  {t_env:7.2f} s  {r_env:12,.0f} poses/s")
-    print(f"  brute force over 512 vertex samples per pose ({len(sub)} poses):           {t_brute:7.2f} s  {r_brute:12,.0f} poses/s  -> {r_env / r_brute:,.0f}x")
+    print(
+        f"envelope sizing, {len(poses):,} poses (worst case per pose and leg, exact):  {t_env:7.2f} s  {r_env:12,.0f} poses/s"
+    )
+    print(
+        f"  brute force over 512 vertex samples per pose ({len(sub)} poses):           {t_brute:7.2f} s  {r_brute:12,.0f} poses/s  -> {r_env / r_brute:,.0f}x"
+    )
     print(f"  brute force never beats the worst case: max(brute - worst) = {gap:.2e} N (<= 0 expected)")
     r_map = len(mp) / t_map
-    print(f"stiffness map, {len(mp):,} poses (K under load + principal stiffnesses):     {t_map:7.2f} s  {r_map:12,.0f} poses/s")
-    print(f"  per-pose loop ({n_loop} poses):                                          {t_loop:7.2f} s  {n_loop / t_loop:12,.0f} poses/s  -> {r_map / (n_loop / t_loop):,.0f}x")
-    print(f"lowest-frequency map, {len(mp):,} poses (K, M_C, batched Cholesky + eigvalsh): {t_f1:7.2f} s  {len(mp) / t_f1:12,.0f} poses/s")
-    print(f"  analytic modes per pose ({n_dk}):                                          {t_an:7.2f} s  {n_dk / t_an:12,.0f} poses/s")
-    print(f"  Drake Linearize per pose ({n_dk}):                                         {t_dk:7.2f} s  {n_dk / t_dk:12,.1f} poses/s  -> batched {len(mp) / t_f1 / (n_dk / t_dk):,.0f}x")
+    print(
+        f"stiffness map, {len(mp):,} poses (K under load + principal stiffnesses):     {t_map:7.2f} s  {r_map:12,.0f} poses/s"
+    )
+    print(
+        f"  per-pose loop ({n_loop} poses):                                          {t_loop:7.2f} s  {n_loop / t_loop:12,.0f} poses/s  -> {r_map / (n_loop / t_loop):,.0f}x"
+    )
+    print(
+        f"lowest-frequency map, {len(mp):,} poses (K, M_C, batched Cholesky + eigvalsh): {t_f1:7.2f} s  {len(mp) / t_f1:12,.0f} poses/s"
+    )
+    print(
+        f"  analytic modes per pose ({n_dk}):                                          {t_an:7.2f} s  {n_dk / t_an:12,.0f} poses/s"
+    )
+    print(
+        f"  Drake Linearize per pose ({n_dk}):                                         {t_dk:7.2f} s  {n_dk / t_dk:12,.1f} poses/s  -> batched {len(mp) / t_f1 / (n_dk / t_dk):,.0f}x"
+    )
     return 0
 
 
 def _inertia(p, q):
-    from stewart_drake.design.envelope import spatial_inertia_about_C
     from stewart_drake.core.rotations import rotation_matrix
+    from stewart_drake.design.envelope import spatial_inertia_about_C
 
     return spatial_inertia_about_C(p, rotation_matrix(q[..., 3:]))
 

@@ -28,11 +28,15 @@ def rate(fn, n, repeat=3):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=20000, help="samples for the numpy model (default 20000)")
-    ap.add_argument("--drake-samples", type=int, default=500, help="samples for the per-sample Drake loop (default 500)")
+    ap.add_argument(
+        "--drake-samples", type=int, default=500, help="samples for the per-sample Drake loop (default 500)"
+    )
     args = ap.parse_args(argv)
     p = load_preset("utn-dynamic")
     amp = np.array([0.02, 0.03, 0.015, 0.3, 0.3, 0.3])
-    traj = lambda n: D.harmonic_trajectory(np.linspace(0, 10, n), [-0.02, 0.01, 0.7, 0, 0, 0], amp, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5])  # noqa: E731
+    traj = lambda n: D.harmonic_trajectory(
+        np.linspace(0, 10, n), [-0.02, 0.01, 0.7, 0, 0, 0], amp, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5]
+    )  # noqa: E731
     q, qd, qdd = traj(args.samples)
     qs, qds, qdds = traj(args.drake_samples)
     r_np, _ = rate(lambda: D.leg_forces(p, q, qd, qdd), args.samples)

@@ -58,23 +58,27 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     from stewart_drake.control import ControllerConfig
+    from stewart_drake.core.geometry import load_preset
     from stewart_drake.firmware.check import workspace_poses
     from stewart_drake.firmware.generate import generate
     from stewart_drake.firmware.host import tp17_leg_lengths_c
     from stewart_drake.firmware.module import compile_generated
     from stewart_drake.fixedpoint import tp17_leg_lengths
     from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
-    from stewart_drake.core.geometry import load_preset
 
     p = load_preset("utn-dynamic")
     loop_rtf(p, "c", 0.01)  # compile and cache the module before timing
     plant = bare_plant(p, DEFAULT_INTEGRATOR, args.duration)["realtime_factor"]  # the closed loops' integrator
     py, sim_py = loop_rtf(p, "python", args.duration)
     c, sim_c = loop_rtf(p, "c", args.duration)
-    print(f"1 kHz, plant under {DEFAULT_INTEGRATOR}, {args.duration:g} s of the seed trajectory on utn-dynamic (real-time factors, one run):")
+    print(
+        f"1 kHz, plant under {DEFAULT_INTEGRATOR}, {args.duration:g} s of the seed trajectory on utn-dynamic (real-time factors, one run):"
+    )
     print(f"  plant alone:                         {plant:6.2f}x")
     print(f"  fixed-point controller, Python engine: {py:6.2f}x  ({py / plant:.2f} × plant alone)")
-    print(f"  fixed-point controller, C engine:      {c:6.2f}x  ({c / plant:.2f} × plant alone; {c / py:.2f} × the Python engine)")
+    print(
+        f"  fixed-point controller, C engine:      {c:6.2f}x  ({c / plant:.2f} × plant alone; {c / py:.2f} × the Python engine)"
+    )
 
     # the controller's compute alone, on the state and inputs of the last tick
     for name, sim in (("Python", sim_py), ("C", sim_c)):
@@ -100,16 +104,24 @@ def main(argv=None) -> int:
     n_py = min(len(w), 200_000)
     r_py, _ = best_rates(lambda: leg_length_words(p, w[:n_py], cfg.ik_format, cfg.convention), n_py, repeats=2)
     print(f"generated sd_ik (utn-dynamic, 16-bit words, tfr16), one thread, batch of {len(w)} poses:")
-    print(f"  {r_c / 1e6:6.2f} M poses/s wall clock, {r_c_cpu / 1e6:6.2f} M poses/s of process CPU time "
-          f"({r_c / r_py:.0f} × the numpy emulation's {r_py / 1e6:.2f} M poses/s, wall)")
+    print(
+        f"  {r_c / 1e6:6.2f} M poses/s wall clock, {r_c_cpu / 1e6:6.2f} M poses/s of process CPU time "
+        f"({r_c / r_py:.0f} × the numpy emulation's {r_py / 1e6:.2f} M poses/s, wall)"
+    )
     rng = np.random.default_rng(0)
-    dq = np.c_[rng.integers(-150, 151, (args.poses, 2)), rng.integers(0, 400, args.poses), rng.uniform(-0.3, 0.3, (args.poses, 3))]
+    dq = np.c_[
+        rng.integers(-150, 151, (args.poses, 2)),
+        rng.integers(0, 400, args.poses),
+        rng.uniform(-0.3, 0.3, (args.poses, 3)),
+    ]
     tp17_leg_lengths_c(dq[:1000])
     r_t, r_t_cpu = best_rates(lambda: tp17_leg_lengths_c(dq), len(dq))
     n_py = min(len(dq), 200_000)
     r_tp, _ = best_rates(lambda: tp17_leg_lengths(dq[:n_py]), n_py, repeats=2)
-    print(f"compiled tp17.C (with validation and conversions), batch of {len(dq)}: {r_t / 1e6:6.2f} M poses/s wall, "
-          f"{r_t_cpu / 1e6:6.2f} M/s CPU ({r_t / r_tp:.1f} × the numpy port's {r_tp / 1e6:.2f} M poses/s)")
+    print(
+        f"compiled tp17.C (with validation and conversions), batch of {len(dq)}: {r_t / 1e6:6.2f} M poses/s wall, "
+        f"{r_t_cpu / 1e6:6.2f} M/s CPU ({r_t / r_tp:.1f} × the numpy port's {r_tp / 1e6:.2f} M poses/s)"
+    )
     return 0
 
 

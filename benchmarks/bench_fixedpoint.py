@@ -11,11 +11,10 @@ import time
 
 import numpy as np
 
-from stewart_drake.fixedpoint import QFormat, fixed_point_leg_lengths, tp17_leg_lengths
-from stewart_drake.fixedpoint import scalar
-from stewart_drake.fixedpoint.q15 import L_mult, mfr32Sqrt
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.fixedpoint import fixed_point_leg_lengths, scalar, tp17_leg_lengths
+from stewart_drake.fixedpoint.q15 import L_mult, mfr32Sqrt
 
 
 def best_rate(fn, n, repeats=3):

@@ -19,10 +19,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from stewart_drake.core.newton_fk import forward_kinematics  # noqa: E402
-from stewart_drake.core.sampling import random_poses  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.core.kinematics import leg_lengths  # noqa: E402
+from stewart_drake.core.newton_fk import forward_kinematics  # noqa: E402
+from stewart_drake.core.sampling import random_poses  # noqa: E402
 
 
 def best_of(f, repeat=3):
@@ -46,7 +46,19 @@ def newton_rates(n: int) -> list[tuple]:
         t_trk, r2 = best_of(lambda: forward_kinematics(p, L, q + 1e-3, check_singularity=False))
         one = L[0]
         t_one, _ = best_of(lambda: [forward_kinematics(p, one, check_singularity=False) for _ in range(200)])
-        rows.append((name, n, n / t_chk, n / t_raw, n / t_trk, 200 / t_one, r.iterations.mean(), r2.iterations.mean(), r.converged.mean()))
+        rows.append(
+            (
+                name,
+                n,
+                n / t_chk,
+                n / t_raw,
+                n / t_trk,
+                200 / t_one,
+                r.iterations.mean(),
+                r2.iterations.mean(),
+                r.converged.mean(),
+            )
+        )
     return rows
 
 
@@ -83,7 +95,9 @@ def assembly_times() -> list[tuple]:
     for label, p, L in cases:
         t_fast, a = best_of(lambda: assembly_modes(p, L, polish=None), 2)
         t_full, b = best_of(lambda: assembly_modes(p, L), 2)
-        rows.append((label, len(b), b.max_solutions, b.complete, sum(m.certified for m in b.modes), t_fast, t_full, b.starts))
+        rows.append(
+            (label, len(b), b.max_solutions, b.complete, sum(m.certified for m in b.modes), t_fast, t_full, b.starts)
+        )
     return rows
 
 
@@ -91,7 +105,13 @@ def assembly_times() -> list[tuple]:
 # times in Python as quoted by the project's issue 15: ~11-15 ms on Dietmaier's general 6-6, ~5 ms on a planar
 # 6-6; it does not handle the 3-fold symmetric 6-6 (roots at infinity) nor 3-6 platforms. Not measured here
 # unless --fksgp points at a checkout of github.com/martyushev/fkSGP (MIT; not part of this project).
-FKSGP_MS = {"dietmaier-1998": "11-15", "planar": "~5", "gonzalez-dutra-2009": "fails", "utn-dynamic": "fails", "utn-kinematic": "fails"}
+FKSGP_MS = {
+    "dietmaier-1998": "11-15",
+    "planar": "~5",
+    "gonzalez-dutra-2009": "fails",
+    "utn-dynamic": "fails",
+    "utn-kinematic": "fails",
+}
 
 
 def fksgp_times(path, cases, repeat: int) -> dict:
@@ -178,8 +198,12 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
             med = float(np.median(ts))
             per_engine[engine] = (paths, ok, cert, 1e3 * med, 1e3 * float(np.median(cs)), 1e3 * (t_first - med))
             outs[engine] = res
-        same = all(a.classes == b.classes and len(a.modes) == len(b.modes) and all(
-            np.abs(m.position - n.position).max() < 1e-9 for m, n in zip(a.modes, b.modes)) for a, b in zip(*outs.values()))
+        same = all(
+            a.classes == b.classes
+            and len(a.modes) == len(b.modes)
+            and all(np.abs(m.position - n.position).max() < 1e-9 for m, n in zip(a.modes, b.modes))
+            for a, b in zip(*outs.values())
+        )
         t_ms, c_ms = [], []
         if with_multistart:
             for L in Ls:
@@ -189,8 +213,17 @@ def homotopy_times(n_poses: int, repeat: int, with_multistart: bool) -> list[tup
                 c_ms.append(time.process_time() - c0)
         nan = float("nan")
         n_real = [sum(c == "real" for c in r.classes) for r in outs["c"]]
-        rows.append((label, key, per_engine, same, 1e3 * float(np.median(t_ms)) if t_ms else nan,
-                     1e3 * float(np.median(c_ms)) if c_ms else nan, n_real))
+        rows.append(
+            (
+                label,
+                key,
+                per_engine,
+                same,
+                1e3 * float(np.median(t_ms)) if t_ms else nan,
+                1e3 * float(np.median(c_ms)) if c_ms else nan,
+                n_real,
+            )
+        )
     return rows
 
 
@@ -228,9 +261,11 @@ def fksgp_cell(measured, n_real, quoted: str) -> str:
 def print_homotopy(args) -> None:
     print("\n# Complete FK by parameter homotopy (all paths, classified, real modes certified) vs multi-start")
     print("# engines: c = compiled tracker (default), numpy = the vectorised reference tracker")
-    print(f"{'case':32s} {'paths':>9s} {'complete':>8s} {'cert':>5s} {'c ms':>6s} {'c cpu':>6s} {'numpy ms':>8s} "
-          f"{'np cpu':>6s} {'stage1 c/np':>11s} {'same':>5s} {'multi cpu':>9s} {'multi/c':>7s} {'multi/np':>8s} "
-          f"{'np/c':>5s} {'fkSGP ms':>8s}  classes")
+    print(
+        f"{'case':32s} {'paths':>9s} {'complete':>8s} {'cert':>5s} {'c ms':>6s} {'c cpu':>6s} {'numpy ms':>8s} "
+        f"{'np cpu':>6s} {'stage1 c/np':>11s} {'same':>5s} {'multi cpu':>9s} {'multi/c':>7s} {'multi/np':>8s} "
+        f"{'np/c':>5s} {'fkSGP ms':>8s}  classes"
+    )
     n_poses, repeat = (3, 3) if args.quick else (5, 5)
     rows = homotopy_times(n_poses, repeat, not args.homotopy_only)
     fk = fksgp_times(args.fksgp, homotopy_cases(n_poses), repeat) if args.fksgp else {}
@@ -238,14 +273,23 @@ def print_homotopy(args) -> None:
         (n2, nmax, counts), ok, cert, med, cpu, first = pe["c"]
         _, ok2, cert2, med2, cpu2, first2 = pe["numpy"]
         cls = " ".join(f"{k}={v}" for k, v in counts.items() if v)
-        print(f"{label:32s} {n2:4d}/{nmax:<4d} {str(ok and ok2):>8s} {str(cert and cert2):>5s} {med:6.1f} {cpu:6.1f} "
-              f"{med2:8.1f} {cpu2:6.1f} {first:5.0f}/{first2:<5.0f} {str(same):>5s} {mcpu:9.1f} {mcpu / cpu:7.1f} "
-              f"{mcpu / cpu2:8.1f} {cpu2 / cpu:5.1f} {fksgp_cell(fk.get(label), n_real, FKSGP_MS[key]):>8s}  {cls}")
+        print(
+            f"{label:32s} {n2:4d}/{nmax:<4d} {str(ok and ok2):>8s} {str(cert and cert2):>5s} {med:6.1f} {cpu:6.1f} "
+            f"{med2:8.1f} {cpu2:6.1f} {first:5.0f}/{first2:<5.0f} {str(same):>5s} {mcpu:9.1f} {mcpu / cpu:7.1f} "
+            f"{mcpu / cpu2:8.1f} {cpu2 / cpu:5.1f} {fksgp_cell(fk.get(label), n_real, FKSGP_MS[key]):>8s}  {cls}"
+        )
     print("(ms: median per length set, wall and process CPU time, with the platform's stage one cached; stage1: its")
     print(" one-time wall cost (ms); same: both engines gave the same path classes and real modes; ratios: CPU time,")
     print(" measured in this run (CPU because the machine may be shared: wall time then includes waiting); fkSGP:")
-    print(" " + ("CPU ms measured in this run (--fksgp), * = its real postures differ from the homotopy's" if fk
-                 else "quoted, not measured here") + "; complete/cert: for both engines)")
+    print(
+        " "
+        + (
+            "CPU ms measured in this run (--fksgp), * = its real postures differ from the homotopy's"
+            if fk
+            else "quoted, not measured here"
+        )
+        + "; complete/cert: for both engines)"
+    )
     if fk:
         print("real postures per length set, homotopy vs fkSGP (realOnly; an exception name where it raised):")
         for label, _, _, _, _, _, n_real in rows:
@@ -253,15 +297,23 @@ def print_homotopy(args) -> None:
     print("\n# Batched homotopy: many length sets of one platform in one call")
     for name, engine, n, per, cpu, n_ok, timing in homotopy_batch(20 if args.quick else 100):
         tm = ", ".join(f"{k} {v:.2f} s" for k, v in timing.items())
-        print(f"{name:22s} {engine:5s} {n:4d} sets: {per:6.2f} ms wall, {cpu:6.2f} ms CPU per set, {n_ok}/{n} complete ({tm})")
+        print(
+            f"{name:22s} {engine:5s} {n:4d} sets: {per:6.2f} ms wall, {cpu:6.2f} ms CPU per set, {n_ok}/{n} complete ({tm})"
+        )
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller batches")
     ap.add_argument("--homotopy", action="store_true", help="only the complete-FK (homotopy vs multi-start) section")
-    ap.add_argument("--homotopy-only", action="store_true", help="only the homotopy timings, without the multi-start comparison")
-    ap.add_argument("--fksgp", metavar="DIR", help="a checkout of github.com/martyushev/fkSGP: time its Python solver on the same cases")
+    ap.add_argument(
+        "--homotopy-only", action="store_true", help="only the homotopy timings, without the multi-start comparison"
+    )
+    ap.add_argument(
+        "--fksgp",
+        metavar="DIR",
+        help="a checkout of github.com/martyushev/fkSGP: time its Python solver on the same cases",
+    )
     args = ap.parse_args(argv)
     n = 20_000 if args.quick else 100_000
     if args.homotopy or args.homotopy_only:
@@ -269,12 +321,16 @@ def main(argv=None) -> int:
         return 0
 
     print(f"\n# Newton FK, batch of {n} poses (best of 3)")
-    print(f"{'platform':22s} {'solves/s':>10s} {'no check':>10s} {'tracking':>10s} {'1-call/s':>9s} {'iters':>6s} {'trk it':>6s} {'conv':>6s}")
+    print(
+        f"{'platform':22s} {'solves/s':>10s} {'no check':>10s} {'tracking':>10s} {'1-call/s':>9s} {'iters':>6s} {'trk it':>6s} {'conv':>6s}"
+    )
     rows = newton_rates(n)
     for name, _, chk, raw, trk, one, it, it2, conv in rows:
         print(f"{name:22s} {chk:10.3g} {raw:10.3g} {trk:10.3g} {one:9.3g} {it:6.2f} {it2:6.2f} {conv:6.3f}")
     r0 = rows[0]
-    print(f"ratio batch/single-call (utn-dynamic): {r0[2] / r0[5]:.0f}x; singularity check costs {100 * (1 - r0[2] / r0[3]):.0f}% of the rate")
+    print(
+        f"ratio batch/single-call (utn-dynamic): {r0[2] / r0[5]:.0f}x; singularity check costs {100 * (1 - r0[2] / r0[3]):.0f}% of the rate"
+    )
 
     print("\n# MathematicalProgram FK, one solve from a guess 2 cm / 0.1 rad off (gonzalez-dutra-2009)")
     prog_rows = program_times(20 if args.quick else 100)
@@ -284,7 +340,9 @@ def main(argv=None) -> int:
     print(f"ratio SNOPT solve / Newton batch solve (gonzalez-dutra): {snopt_ms * 1e-3 * rows[1][2]:.0f}x")
 
     print("\n# All assembly modes (Newton multi-start; 'full' adds the SNOPT confirmation)")
-    print(f"{'geometry':28s} {'modes':>5s} {'max':>4s} {'complete':>8s} {'certified':>9s} {'newton s':>9s} {'full s':>7s} {'starts':>7s}")
+    print(
+        f"{'geometry':28s} {'modes':>5s} {'max':>4s} {'complete':>8s} {'certified':>9s} {'newton s':>9s} {'full s':>7s} {'starts':>7s}"
+    )
     for label, k, kmax, comp, cert, tf, tfull, starts in assembly_times():
         print(f"{label:28s} {k:5d} {kmax:4d} {str(comp):>8s} {cert:9d} {tf:9.3f} {tfull:7.3f} {starts:7d}")
     print_homotopy(args)

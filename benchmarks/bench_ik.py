@@ -19,8 +19,11 @@ def loop_ik(platform, poses):
     out = []
     for px, py, pz, a, b, g in poses.tolist():
         ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
-        R = ((cb * cg + sa * sb * sg, -cb * sg + sa * sb * cg, ca * sb), (ca * sg, ca * cg, -sa),
-             (-sb * cg + sa * cb * sg, sb * sg + sa * cb * cg, ca * cb))
+        R = (
+            (cb * cg + sa * sb * sg, -cb * sg + sa * sb * cg, ca * sb),
+            (ca * sg, ca * cg, -sa),
+            (-sb * cg + sa * cb * sg, sb * sg + sa * cb * cg, ca * cb),
+        )
         row = []
         for (bx, by, bz), (tx, ty, tz) in zip(base, top):
             x = px + R[0][0] * tx + R[0][1] * ty + R[0][2] * tz - bx
@@ -53,7 +56,9 @@ def main(argv=None):
     vec_rate, loop_rate, each_rate = args.n / t_vec, m / t_loop, k / t_each
     print(f"vectorised leg_lengths: {args.n} poses, {vec_rate:.3g} poses/s")
     print(f"per-pose loop calling leg_lengths: {k} poses, {each_rate:.3g} poses/s -> ratio {vec_rate / each_rate:.0f}x")
-    print(f"per-pose pure-Python scalar formula: {m} poses, {loop_rate:.3g} poses/s -> ratio {vec_rate / loop_rate:.0f}x")
+    print(
+        f"per-pose pure-Python scalar formula: {m} poses, {loop_rate:.3g} poses/s -> ratio {vec_rate / loop_rate:.0f}x"
+    )
 
 
 if __name__ == "__main__":

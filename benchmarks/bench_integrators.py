@@ -22,10 +22,9 @@ import numpy as np
 
 import stewart_drake.drake.integrators as integrators
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.drake.integrators import INTEGRATORS, apply_integrator, constraint_gaps
 from stewart_drake.core.trajectory import get_trajectory
+from stewart_drake.drake.integrators import INTEGRATORS, apply_integrator, constraint_gaps
 from stewart_drake.drake.simulation import Scenario, build_simulation
-
 
 REFERENCE_ACCURACY = 1e-8
 
@@ -38,8 +37,13 @@ def closed_loop(platform, trajectory, controller, integrator, duration):
     X = sim.loggers["state"].FindLog(sim.simulator.get_context()).data().T
     gap = constraint_gaps(sim.plant, X)
     err = log.length_error(sim.trajectory, platform)
-    return log, {"wall_s": wall, "realtime_factor": duration / wall, "max_constraint_gap_m": float(gap.max()),
-                 "max_leg_error_m": float(np.abs(err).max()), "plant_samples": len(log.t)}
+    return log, {
+        "wall_s": wall,
+        "realtime_factor": duration / wall,
+        "max_constraint_gap_m": float(gap.max()),
+        "max_leg_error_m": float(np.abs(err).max()),
+        "plant_samples": len(log.t),
+    }
 
 
 def bare_plant(platform, integrator, duration):
@@ -66,7 +70,11 @@ def bare_plant(platform, integrator, duration):
     sim.AdvanceTo(duration)
     wall = time.perf_counter() - t0
     X = logger.FindLog(sim.get_context()).data().T
-    return {"wall_s": wall, "realtime_factor": duration / wall, "max_constraint_gap_m": float(constraint_gaps(plant, X).max())}
+    return {
+        "wall_s": wall,
+        "realtime_factor": duration / wall,
+        "max_constraint_gap_m": float(constraint_gaps(plant, X).max()),
+    }
 
 
 def main(argv=None) -> int:
@@ -96,7 +104,9 @@ def main(argv=None) -> int:
     finally:
         integrators.CENIC_ACCURACY = default
     for integ in INTEGRATORS:
-        log = build_simulation(Scenario(platform, traj, "float", integrator=integ, design_duration=args.duration)).run(args.duration)
+        log = build_simulation(Scenario(platform, traj, "float", integrator=integ, design_duration=args.duration)).run(
+            args.duration
+        )
         out[f"float/{integ}_vs_reference"] = {
             "max_leg_length_difference_m": float(np.abs(log.lengths - ref.lengths).max()),
             "max_position_difference_m": float(np.abs(log.pose[:, :3] - ref.pose[:, :3]).max()),

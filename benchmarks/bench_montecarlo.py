@@ -31,12 +31,23 @@ def main(argv=None) -> int:
     ap.add_argument("--runs", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--duration", type=float, default=None)
-    ap.add_argument("--vary", nargs="+", default=["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "payload_mass=±20%"])
+    ap.add_argument(
+        "--vary",
+        nargs="+",
+        default=["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "payload_mass=±20%"],
+    )
     ap.add_argument("--workers", default="1,2", help="comma-separated worker counts")
     ap.add_argument("--out", required=True, help="a new folder; one study folder per worker count inside")
     args = ap.parse_args(argv)
-    study = Study(load_platform(args.platform), parse_spec(args.vary), args.seed, args.runs, trajectory=args.trajectory,
-                  controller=args.controller, duration=args.duration)
+    study = Study(
+        load_platform(args.platform),
+        parse_spec(args.vary),
+        args.seed,
+        args.runs,
+        trajectory=args.trajectory,
+        controller=args.controller,
+        duration=args.duration,
+    )
     counts = [int(k) for k in args.workers.split(",")]
     base, first, report = Path(args.out), None, {}
     if base.exists():
@@ -50,17 +61,25 @@ def main(argv=None) -> int:
         write_outputs(out, rows, summary)
         same = [{c: v for c, v in r.items() if c != "wall_s"} for r in rows]
         first = first or same
-        report[k] = {"wall_s": wall, "runs_per_s": len(rows) / wall, "rows_equal_first": _equal(same, first),
-                     "worst_run": summary["worst_run"]["run"]}
-        print(f"workers {k:2d}: {wall:8.1f} s  {len(rows) / wall:7.3f} runs/s  ×{report[counts[0]]['wall_s'] / wall:.2f}  "
-              f"rows equal to workers {counts[0]}: {report[k]['rows_equal_first']}", flush=True)
+        report[k] = {
+            "wall_s": wall,
+            "runs_per_s": len(rows) / wall,
+            "rows_equal_first": _equal(same, first),
+            "worst_run": summary["worst_run"]["run"],
+        }
+        print(
+            f"workers {k:2d}: {wall:8.1f} s  {len(rows) / wall:7.3f} runs/s  ×{report[counts[0]]['wall_s'] / wall:.2f}  "
+            f"rows equal to workers {counts[0]}: {report[k]['rows_equal_first']}",
+            flush=True,
+        )
     print(json.dumps(report, indent=2))
     return 0 if all(r["rows_equal_first"] for r in report.values()) else 1
 
 
 def _equal(a, b) -> bool:
     return len(a) == len(b) and all(
-        x.keys() == y.keys() and all(x[c] == y[c] or (x[c] != x[c] and y[c] != y[c]) for c in x) for x, y in zip(a, b))
+        x.keys() == y.keys() and all(x[c] == y[c] or (x[c] != x[c] and y[c] != y[c]) for c in x) for x, y in zip(a, b)
+    )
 
 
 if __name__ == "__main__":

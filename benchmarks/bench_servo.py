@@ -27,8 +27,10 @@ def main(argv=None):
     t_each = time.perf_counter() - t0
     assert np.array_equal(np.array([s.pulse for s in each]), sol.pulse[:k])
     vec_rate, each_rate = args.n / t_vec, k / t_each
-    print(f"vectorised solve (arm angles + pulses + checks): {args.n} poses, {vec_rate:.3g} poses/s "
-          f"({sol.ok.mean() * 100:.0f}% reachable within travel)")
+    print(
+        f"vectorised solve (arm angles + pulses + checks): {args.n} poses, {vec_rate:.3g} poses/s "
+        f"({sol.ok.mean() * 100:.0f}% reachable within travel)"
+    )
     print(f"per-pose loop calling solve: {k} poses, {each_rate:.3g} poses/s -> ratio {vec_rate / each_rate:.0f}x")
 
 

@@ -29,8 +29,21 @@ def wall(checkout: Path, integrator: str, engine: str, duration: float) -> float
     """Seconds of one ``simulate`` command run from ``checkout``."""
     env = dict(os.environ, PYTHONPATH=str(checkout), MPLBACKEND="Agg")
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [sys.executable, "-m", "stewart_drake.cli", "simulate", "--duration", str(duration), "--no-progress",
-               "--integrator", integrator, "--engine", engine, "--out", str(Path(tmp) / "out")]
+        cmd = [
+            sys.executable,
+            "-m",
+            "stewart_drake.cli",
+            "simulate",
+            "--duration",
+            str(duration),
+            "--no-progress",
+            "--integrator",
+            integrator,
+            "--engine",
+            engine,
+            "--out",
+            str(Path(tmp) / "out"),
+        ]
         t0 = time.perf_counter()
         subprocess.run(cmd, env=env, cwd=checkout, check=True, capture_output=True)
         return time.perf_counter() - t0
@@ -54,8 +67,14 @@ print(time.perf_counter() - t0)
 def run_only(checkout: Path, integrator: str, engine: str, duration: float) -> float:
     """Seconds of the Simulator's run alone (build excluded), in a fresh interpreter of ``checkout``."""
     env = dict(os.environ, PYTHONPATH=str(checkout), MPLBACKEND="Agg")
-    r = subprocess.run([sys.executable, "-c", RUN_ONLY, integrator, engine, str(duration)], env=env, cwd=checkout, check=True,
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-c", RUN_ONLY, integrator, engine, str(duration)],
+        env=env,
+        cwd=checkout,
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     return float(r.stdout.split()[-1])
 
 
@@ -72,12 +91,17 @@ def main(argv=None) -> int:
             for name, tree in trees.items():  # interleaved: both trees see the same machine load
                 best["run", name, case] = min(best["run", name, case], run_only(tree, *case, args.duration))
                 best["command", name, case] = min(best["command", name, case], wall(tree, *case, args.duration))
-    print(f"seed on utn-dynamic, fixed point, 1 kHz, {args.duration:g} simulated s; real-time factor = simulated s / wall s, "
-          f"best of {args.repeat}:")
+    print(
+        f"seed on utn-dynamic, fixed point, 1 kHz, {args.duration:g} simulated s; real-time factor = simulated s / wall s, "
+        f"best of {args.repeat}:"
+    )
     for kind in ("run", "command"):
         print(f"{kind}:")
         for case in CASES:
-            cells = "   ".join(f"{name}: {args.duration / best[kind, name, case]:5.3f}x ({best[kind, name, case]:6.2f} s)" for name in trees)
+            cells = "   ".join(
+                f"{name}: {args.duration / best[kind, name, case]:5.3f}x ({best[kind, name, case]:6.2f} s)"
+                for name in trees
+            )
             ratio = f"   this/other {best[kind, 'other', case] / best[kind, 'this', case]:.2f}x" if args.compare else ""
             print(f"  --integrator {case[0]:5s} --engine {case[1]:6s}  {cells}{ratio}")
     return 0

@@ -27,8 +27,15 @@ def rtf(platform, kind, period, duration, plant_step=None):
     from stewart_drake.drake.simulation import Scenario, build_simulation
 
     t0 = time.perf_counter()
-    sim = build_simulation(Scenario(platform, SEED, kind, ControllerConfig(timing=DspTiming(sample_period=period)),
-                                    plant_time_step=plant_step or min(period, 1e-3)))
+    sim = build_simulation(
+        Scenario(
+            platform,
+            SEED,
+            kind,
+            ControllerConfig(timing=DspTiming(sample_period=period)),
+            plant_time_step=plant_step or min(period, 1e-3),
+        )
+    )
     t1 = time.perf_counter()
     sim.run(duration)
     t2 = time.perf_counter()

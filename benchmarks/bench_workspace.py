@@ -74,8 +74,10 @@ def main(argv=None) -> int:
     print("2. the paper's analysis at 2.5 mm (workspace + extents refinement + six rotation limits)")
     t_ws, w = timed(ws.constant_orientation_workspace, p, resolution=0.0025)
     t_rot, _ = timed(ws.orientation_limits, p)
-    print(f"   workspace {t_ws:.2f} s ({nodes(w):,} nodes, volume {w.volume * 1e3:.3f} ± {w.volume_error * 1e3:.3f} L), "
-          f"rotation limits {t_rot * 1e3:.1f} ms, total {t_ws + t_rot:.2f} s")
+    print(
+        f"   workspace {t_ws:.2f} s ({nodes(w):,} nodes, volume {w.volume * 1e3:.3f} ± {w.volume_error * 1e3:.3f} L), "
+        f"rotation limits {t_rot * 1e3:.1f} ms, total {t_ws + t_rot:.2f} s"
+    )
 
     print("3. time and peak memory against resolution (slab 2^21 nodes)")
     print(f"   {'h (mm)':>7} {'nodes':>12} {'time (s)':>9} {'peak (MiB)':>10} {'time ratio':>10} {'memory ratio':>12}")
@@ -96,21 +98,40 @@ def main(argv=None) -> int:
     if not args.no_parallel:
         import os
 
-        print(f"4. back ends: 1 vs 2 worker processes (load average now {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs)")
+        print(
+            f"4. back ends: 1 vs 2 worker processes (load average now {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs)"
+        )
         lim = ws.Limits(base_cone=0.9, top_cone=0.9, leg_diameter=0.1)
         h = p.home_pose()
         grids = [np.linspace(-0.3, 0.3, 13)] * 2 + [h[2] + np.linspace(-0.2, 0.2, 9)] + [np.linspace(-0.4, 0.4, 9)] * 3
         jobs = [
-            ("stroke grid, 2.5 mm", ws.constant_orientation_workspace, (p,), dict(resolution=0.0025, chunk_nodes=1 << 19, refine=False)),
-            ("joints + collision grid, 5 mm", ws.constant_orientation_workspace, (p,), dict(resolution=0.005, limits=lim, chunk_nodes=1 << 18, refine=False)),
-            (f"6-D sweep, {math.prod(len(g) for g in grids):,} poses", ws.count_reachable, (p, grids), dict(chunk=1 << 16)),
+            (
+                "stroke grid, 2.5 mm",
+                ws.constant_orientation_workspace,
+                (p,),
+                dict(resolution=0.0025, chunk_nodes=1 << 19, refine=False),
+            ),
+            (
+                "joints + collision grid, 5 mm",
+                ws.constant_orientation_workspace,
+                (p,),
+                dict(resolution=0.005, limits=lim, chunk_nodes=1 << 18, refine=False),
+            ),
+            (
+                f"6-D sweep, {math.prod(len(g) for g in grids):,} poses",
+                ws.count_reachable,
+                (p, grids),
+                dict(chunk=1 << 16),
+            ),
         ]
         serial = {}
         for name, fn, a, kw in jobs:
             t1, _ = timed(fn, *a, **kw)
             t2, _ = timed(fn, *a, workers=2, **kw)
             serial[name] = (fn, a, kw, t1)
-            print(f"   {name:32s}: 1 process {t1:6.2f} s, 2 processes {t2:6.2f} s -> speed-up {t1 / t2:.2f}x (incl. pool start)")
+            print(
+                f"   {name:32s}: 1 process {t1:6.2f} s, 2 processes {t2:6.2f} s -> speed-up {t1 / t2:.2f}x (incl. pool start)"
+            )
         try:
             from stewart_drake.workspace.dask_sweep import close_client, dask_executor, local_client
         except ImportError:
@@ -125,7 +146,9 @@ def main(argv=None) -> int:
                     ex = dask_executor(client)
                     for name, (fn, a, kw, t1) in serial.items():
                         td, _ = timed(fn, *a, executor=ex, **kw)
-                        print(f"   {name:32s}: dask LocalCluster (2 workers) {td:6.2f} s -> {t1 / td:.2f}x the single process")
+                        print(
+                            f"   {name:32s}: dask LocalCluster (2 workers) {td:6.2f} s -> {t1 / td:.2f}x the single process"
+                        )
                 finally:
                     close_client(client)
     return 0

@@ -20,8 +20,8 @@ import time
 
 import numpy as np
 
-from stewart_drake import workspace as ws
 import stewart_drake.workspace.dask_sweep as wd
+from stewart_drake import workspace as ws
 from stewart_drake.core.geometry import load_preset
 
 
@@ -73,8 +73,10 @@ def main(argv=None) -> int:
     total = args.points**6
     t_co, cpu_co, w_ser = best_of(args.repeat, ws.constant_orientation_workspace, p, resolution=args.resolution)
     t_6d, cpu_6d, c_ser = best_of(args.repeat, ws.count_reachable, p, grids)
-    print(f"{args.platform}: workspace at {args.resolution * 1e3:g} mm ({math.prod(len(a) for a in w_ser.axes):,} nodes), "
-          f"6-D count of {total:,} poses")
+    print(
+        f"{args.platform}: workspace at {args.resolution * 1e3:g} mm ({math.prod(len(a) for a in w_ser.axes):,} nodes), "
+        f"6-D count of {total:,} poses"
+    )
     print(f"serial: workspace {t_co:.2f} s (CPU {cpu_co:.2f} s), 6-D {t_6d:.2f} s (CPU {cpu_6d:.2f} s)")
     report = {"serial": {"workspace_s": t_co, "workspace_cpu_s": cpu_co, "six_d_s": t_6d, "six_d_cpu_s": cpu_6d}}
     for k in (int(x) for x in args.workers.split(",")):
@@ -83,7 +85,14 @@ def main(argv=None) -> int:
             try:
                 if mode == "plain":
                     ex = wd.dask_executor(client)
-                    tc, cc, w = best_of(args.repeat, ws.constant_orientation_workspace, p, resolution=args.resolution, executor=ex, client=client)
+                    tc, cc, w = best_of(
+                        args.repeat,
+                        ws.constant_orientation_workspace,
+                        p,
+                        resolution=args.resolution,
+                        executor=ex,
+                        client=client,
+                    )
                     t6, c6, c = best_of(args.repeat, ws.count_reachable, p, grids, executor=ex, client=client)
                 else:
                     run_co = lambda: wd.workspace_on_dask(p, client=client, resolution=args.resolution)  # noqa: E731
@@ -92,14 +101,29 @@ def main(argv=None) -> int:
                     t6, c6, c = best_of(args.repeat, run_6d, client=client)
             finally:
                 wd.close_client(client)
-            same = w.inside_nodes == w_ser.inside_nodes and np.array_equal(w.extents, w_ser.extents) and c["count"] == c_ser["count"]
-            r = {"workspace_s": tc, "workspace_ratio": t_co / tc, "workspace_efficiency": t_co / tc / k, "workspace_cpu_ratio": cpu_co / cc,
-                 "six_d_s": t6, "six_d_ratio": t_6d / t6, "six_d_efficiency": t_6d / t6 / k, "six_d_cpu_ratio": cpu_6d / c6,
-                 "same_result": bool(same)}
+            same = (
+                w.inside_nodes == w_ser.inside_nodes
+                and np.array_equal(w.extents, w_ser.extents)
+                and c["count"] == c_ser["count"]
+            )
+            r = {
+                "workspace_s": tc,
+                "workspace_ratio": t_co / tc,
+                "workspace_efficiency": t_co / tc / k,
+                "workspace_cpu_ratio": cpu_co / cc,
+                "six_d_s": t6,
+                "six_d_ratio": t_6d / t6,
+                "six_d_efficiency": t_6d / t6 / k,
+                "six_d_cpu_ratio": cpu_6d / c6,
+                "same_result": bool(same),
+            }
             report[f"{mode}/{k}"] = r
-            print(f"{mode:5s} {k:2d} workers: workspace {tc:6.2f} s ×{r['workspace_ratio']:.2f} (eff {r['workspace_efficiency']:.0%}, "
-                  f"cpu ratio {r['workspace_cpu_ratio']:.2f})   6-D {t6:6.2f} s ×{r['six_d_ratio']:.2f} (eff {r['six_d_efficiency']:.0%}, "
-                  f"cpu ratio {r['six_d_cpu_ratio']:.2f})   same result: {same}", flush=True)
+            print(
+                f"{mode:5s} {k:2d} workers: workspace {tc:6.2f} s ×{r['workspace_ratio']:.2f} (eff {r['workspace_efficiency']:.0%}, "
+                f"cpu ratio {r['workspace_cpu_ratio']:.2f})   6-D {t6:6.2f} s ×{r['six_d_ratio']:.2f} (eff {r['six_d_efficiency']:.0%}, "
+                f"cpu ratio {r['six_d_cpu_ratio']:.2f})   same result: {same}",
+                flush=True,
+            )
     print(json.dumps(report, indent=2))
     return 0
 

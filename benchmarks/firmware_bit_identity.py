@@ -22,15 +22,15 @@ import numpy as np  # noqa: E402
 
 from stewart_drake.control import ControllerConfig  # noqa: E402
 from stewart_drake.core.c_build import compiler_by_name  # noqa: E402
+from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
+from stewart_drake.core.trajectory import fit_trajectory, get_trajectory  # noqa: E402
+from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 from stewart_drake.firmware.check import workspace_poses  # noqa: E402
 from stewart_drake.firmware.generate import generate  # noqa: E402
 from stewart_drake.firmware.host import tp17_leg_lengths_c  # noqa: E402
 from stewart_drake.firmware.module import compile_generated  # noqa: E402
 from stewart_drake.fixedpoint import tp17_leg_lengths  # noqa: E402
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words  # noqa: E402
-from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
-from stewart_drake.core.trajectory import fit_trajectory, get_trajectory  # noqa: E402
-from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -49,8 +49,10 @@ def main(argv=None) -> int:
         cfg = ControllerConfig.for_platform(p)
         g = generate(p, cfg)
         f = cfg.ik_format.frac_bits
-        sets = {"workspace poses": pose_words(workspace_poses(p, n, seed=7), cfg.ik_format),
-                "random words": rng.integers(-(1 << f), 1 << f, (n, 6))}
+        sets = {
+            "workspace poses": pose_words(workspace_poses(p, n, seed=7), cfg.ik_format),
+            "random words": rng.integers(-(1 << f), 1 << f, (n, 6)),
+        }
         want = {k: leg_length_words(p, w, cfg.ik_format, cfg.convention) for k, w in sets.items()}
         for cc in ("gcc", "zig"):
             m = compile_generated(g, compiler=compiler_by_name(cc))
@@ -66,10 +68,15 @@ def main(argv=None) -> int:
                 traj = fit_trajectory(traj, p)
             d = traj.duration or 4.0
             logs = {e: build_simulation(Scenario(p, traj, "fixed", engine=e)).run(d) for e in ("python", "c")}
-            arrays = [f.name for f in dataclasses.fields(logs["c"]) if isinstance(getattr(logs["c"], f.name), np.ndarray)]
+            arrays = [
+                f.name for f in dataclasses.fields(logs["c"]) if isinstance(getattr(logs["c"], f.name), np.ndarray)
+            ]
             same = all(np.array_equal(getattr(logs["python"], a), getattr(logs["c"], a)) for a in arrays)
             ok &= same
-            print(f"closed loop {name}, {tr}, {d:g} s ({len(logs['c'].tick_times())} ticks): C vs Python logs bit-identical: {same}", flush=True)
+            print(
+                f"closed loop {name}, {tr}, {d:g} s ({len(logs['c'].tick_times())} ticks): C vs Python logs bit-identical: {same}",
+                flush=True,
+            )
     return 0 if ok else 1
 
 

@@ -27,7 +27,9 @@ def main(argv=None) -> int:
         S = monodromy_solve(kind, seed=args.seed)
         path = args.out / f"start_{kind}.npz"
         S.save(path)
-        print(f"{kind}: {len(S.x)} solutions, max residual {S.residual():.2e}, {time.perf_counter() - t0:.2f} s -> {path}")
+        print(
+            f"{kind}: {len(S.x)} solutions, max residual {S.residual():.2e}, {time.perf_counter() - t0:.2f} s -> {path}"
+        )
     return 0
 
 

@@ -19,29 +19,41 @@ from stewart_drake.errors import StewartError, UsageError
 # A command's module is imported only when that command runs: the Drake commands import pydrake at
 # their module top, and the numpy commands must work where pydrake is not installed.
 COMMANDS = {
-    "compile": ("compile", "translate a motion program (.stw) to Python (calling this library) "
-                "or Matlab (the seed's output)"),
+    "compile": (
+        "compile",
+        "translate a motion program (.stw) to Python (calling this library) or Matlab (the seed's output)",
+    ),
     "dsp-ik": ("dsp_ik", "leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK"),
     "dynamics": ("dynamics", "leg forces along a trajectory (inverse dynamics, with or without Coriolis)"),
-    "firmware": ("firmware", "generate the C firmware (IK + controller tick) or check a C firmware "
-                 "against the emulation"),
+    "firmware": (
+        "firmware",
+        "generate the C firmware (IK + controller tick) or check a C firmware against the emulation",
+    ),
     "fk": ("fk", "pose for six leg lengths (forward kinematics); --all: every assembly mode"),
     "ik": ("ik", "leg lengths for a pose (closed-form inverse kinematics)"),
-    "init": ("init", "print a commented platform file template to start from "
-             "(stewart-drake init --platform-template radial > my.yaml)"),
+    "init": (
+        "init",
+        "print a commented platform file template to start from "
+        "(stewart-drake init --platform-template radial > my.yaml)",
+    ),
     "leg": ("leg", "3R planar leg (seed 003): DH forward kinematics, geometric inverse kinematics"),
     "model": ("model", "generate (write) or inspect the SDF model of a platform"),
     "modes": ("modes", "natural frequencies (Hz) and mode shapes at a pose; --drake checks them against Drake"),
-    "montecarlo": ("montecarlo", "robustness study: many closed-loop runs with drawn tolerances (Dask), "
-                   "or --replay one of them"),
+    "montecarlo": (
+        "montecarlo",
+        "robustness study: many closed-loop runs with drawn tolerances (Dask), or --replay one of them",
+    ),
     "report": ("report", "run the analyses on the built-in presets and write an HTML report"),
     "run": ("run", "run a motion program (.stw): leg lengths and forces along its trajectory"),
     "servo": ("servo", "servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)"),
     "simulate": ("simulate", "run the fixed-point (or float) controller in the loop with the Drake plant"),
     "size": ("size", "actuator sizing: peak/RMS force, speed, acceleration, power and stroke per leg"),
     "stiffness": ("stiffness", "6×6 Cartesian stiffness, compliance and payload deflection at a pose"),
-    "view": ("view", "interactive 3-D viewer (Meshcat on localhost): pose sliders, leg lengths, stroke margins, "
-             "singularity distance, assembly modes; or replay a simulate/run log"),
+    "view": (
+        "view",
+        "interactive 3-D viewer (Meshcat on localhost): pose sliders, leg lengths, stroke margins, "
+        "singularity distance, assembly modes; or replay a simulate/run log",
+    ),
     "workspace": ("workspace", "reachable positions (extents, volume, views) and rotation limits"),
 }
 
@@ -155,8 +167,10 @@ def main(argv=None) -> int:
         return 130
     except (MemoryError, RecursionError, OverflowError, TypeError, ArithmeticError, AssertionError, RuntimeError) as e:
         detail = _one_line(e)
-        print(f"stewart-drake {name}: error: "
-              + UsageError.INTERNAL.format(kind=type(e).__name__, detail=detail[:300]), file=sys.stderr)
+        print(
+            f"stewart-drake {name}: error: " + UsageError.INTERNAL.format(kind=type(e).__name__, detail=detail[:300]),
+            file=sys.stderr,
+        )
         return 2
 
 

@@ -44,25 +44,34 @@ class GeometryError(StewartError):
     SHAPE = "{name} must have shape {shape}, got {got}"
     NOT_FINITE = "{name} must be finite, got {value}"
     COINCIDE = "{what} {i} and {j} coincide at {at} m (closer than {limit} m)"
-    TOO_WIDE = ("platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is "
-                "{target:.4f} m; give home_height")
+    TOO_WIDE = (
+        "platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is "
+        "{target:.4f} m; give home_height"
+    )
     LENGTH_UNIT = "length_unit: {problem}"
-    ANCHOR_DESCRIPTIONS = ("platform {name!r}: give exactly one anchor description (utn, radial, or "
-                           "base_anchors/top_anchors/leg_top), got {given}")
-    PLATE_SHEET = ("platform {name!r}: plate thickness+density describe a UTN triangle sheet; give both, "
-                   "with utn dimensions")
+    ANCHOR_DESCRIPTIONS = (
+        "platform {name!r}: give exactly one anchor description (utn, radial, or "
+        "base_anchors/top_anchors/leg_top), got {given}"
+    )
+    PLATE_SHEET = (
+        "platform {name!r}: plate thickness+density describe a UTN triangle sheet; give both, with utn dimensions"
+    )
     IN_FILE = "{path}: {problem}"
     UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
     UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
     LEG_LIMIT = "platform {name!r}: legs.{field} must be a positive number, got {value}"
     # shared base joints (6-3 platforms, ``leg_base``)
     BASE_PAIRS = "{problem}; legs may share base joints only in three pairs (6-3), declared with leg_base"
-    BASE_COUNT = ("base_anchors: {n} points given; give 6 (one per leg), or list each base joint once and give leg_base "
-                  "(the base joint of each leg)")
+    BASE_COUNT = (
+        "base_anchors: {n} points given; give 6 (one per leg), or list each base joint once and give leg_base "
+        "(the base joint of each leg)"
+    )
     LEG_BASE_RANGE = "leg_base: leg {leg} refers to base anchor {anchor}, but there are {n} base anchors (0..{last})"
     LEG_BASE_UNUSED = "leg_base: base anchor {anchor} is used by no leg"
-    BASE_REPEATED = ("repeats item {first} (closer than {limit} m); legs sharing a base joint list it once and give "
-                     "leg_base (the base joint of each leg)")
+    BASE_REPEATED = (
+        "repeats item {first} (closer than {limit} m); legs sharing a base joint list it once and give "
+        "leg_base (the base joint of each leg)"
+    )
 
     # a servo hexapod description (``core.servo``)
     SERVO_SHAPE = "servo hexapod {name} must have shape {shape}, got {got}"
@@ -77,10 +86,13 @@ class GeometryError(StewartError):
     SERVO_FIELD_FINITE = "{field} must be finite, got {value!r}"
     SERVO_UNIT = "length_unit must be m or mm, got {value!r}"
     SERVO_TRAVEL = "servo.travel_deg must be below 90 degrees, got {value!r}"
-    SERVO_BOTH_LAYOUTS = ("servo hexapod {name!r}: give either paired or the explicit layout, not both "
-                          "(also got {given})")
-    SERVO_MISSING_LAYOUT = ("servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, "
-                            "platform_anchors, shaft_directions (missing {missing})")
+    SERVO_BOTH_LAYOUTS = (
+        "servo hexapod {name!r}: give either paired or the explicit layout, not both (also got {given})"
+    )
+    SERVO_MISSING_LAYOUT = (
+        "servo hexapod {name!r}: give paired, or all of base_pivots, arm_directions_deg, "
+        "platform_anchors, shaft_directions (missing {missing})"
+    )
     SERVO_UNKNOWN_PRESET = "unknown servo hexapod preset {name!r}; available: {presets}"
     SERVO_UNKNOWN = "unknown servo hexapod {name!r}: not a preset ({presets}) and not a YAML file"
 
@@ -170,13 +182,18 @@ class UnreachableTargetError(StewartError):
     Attributes: ``index`` (tuple, into the batch), ``distance`` (m, hip to target, or to the wrist for the
     3R solver), ``r_min``, ``r_max`` (m)."""
 
-    TEMPLATE = ("target {index}: {what} is {d_mm:.3f} mm from the hip, outside the reachable range "
-                "[{lo_mm:.3f}, {hi_mm:.3f}] mm")
+    TEMPLATE = (
+        "target {index}: {what} is {d_mm:.3f} mm from the hip, outside the reachable range "
+        "[{lo_mm:.3f}, {hi_mm:.3f}] mm"
+    )
 
     def __init__(self, index, distance, r_min, r_max, what="the foot"):
         self.index, self.distance, self.r_min, self.r_max = index, distance, r_min, r_max
-        super().__init__(self.TEMPLATE.format(index=counted(index), what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3,
-                                              hi_mm=r_max * 1e3))
+        super().__init__(
+            self.TEMPLATE.format(
+                index=counted(index), what=what, d_mm=distance * 1e3, lo_mm=r_min * 1e3, hi_mm=r_max * 1e3
+            )
+        )
 
 
 class ServoPoseError(StewartError):
@@ -238,8 +255,10 @@ class EnvelopeError(StewartError):
     BOX_TOO_LARGE = "{source}: box.steps {steps!r} make {n} poses, more than the limit {limit}"
     TOO_MANY_POSES = "{source}: {n} poses, more than the limit {limit}"
     NEGATIVE_BOUND = "{source}: {name}.{part} bounds are magnitudes and must be >= 0, got {value}"
-    OUT_OF_STROKE = ("{source}: {pose} leaves the workspace: leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
-                     "{side} the stroke")
+    OUT_OF_STROKE = (
+        "{source}: {pose} leaves the workspace: leg {leg} length {length_mm:.3f} mm is {excess_mm:.3f} mm "
+        "{side} the stroke"
+    )
     SINGULAR = "{source}: {pose} is singular or nearly so (condition number {cond:.3g})"
 
 
@@ -250,8 +269,9 @@ class PayloadError(StewartError):
     COM_NOT_FINITE = "{option}-com: payload centre of mass must be finite, got {value} m"
     COM_BELOW = "{option}-com: z = {z:g} m is below the plate (the plate frame's z >= 0 holds the plate and its load)"
 
-    BELOW_PLATE = ("--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and "
-                   "its load)")
+    BELOW_PLATE = (
+        "--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)"
+    )
 
 
 class StiffnessError(StewartError):
@@ -272,14 +292,17 @@ class WorkspaceError(StewartError):
     """A workspace request that cannot be answered (bad resolution, start pose outside the limits, ...)."""
 
     EXECUTOR = "executor must be a concurrent.futures.Executor (or have submit), got {kind}"
-    GRID_TOO_LARGE = ("resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can "
-                      "hold is ~{h_min_mm:.2g} mm; use a coarser --resolution")
+    GRID_TOO_LARGE = (
+        "resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can "
+        "hold is ~{h_min_mm:.2g} mm; use a coarser --resolution"
+    )
     GRID_NODES = "more than the {limit:.0e} nodes one sweep may take"
     EMPTY_STROKE = "the stroke workspace at orientation {orientation} rad is empty (no common point of the legs' reach)"
     RESOLUTION = "resolution must be a positive number of metres, got {value}"
     BOUNDS = "bounds must be [[xmin, xmax], [ymin, ymax], [zmin, zmax]] metres with min < max, got {value}"
-    NOTHING_REACHABLE = ("no reachable position at orientation {orientation} rad with limits {limits} "
-                         "at resolution {h} m")
+    NOTHING_REACHABLE = (
+        "no reachable position at orientation {orientation} rad with limits {limits} at resolution {h} m"
+    )
     CONE = "Limits.{name} must be an angle in (0, pi] rad, got {value}"
     LEG_DIAMETER = "Limits.leg_diameter must be a positive length in metres, got {value}"
     MAX_CONDITION = "Limits.max_condition must be > 1, got {value}"
@@ -317,15 +340,19 @@ class OutputError(StewartError):
     REFUSED_PLACE = "{option} {typed!r}: refusing to write into {what}; give a new folder name"
     NOT_A_FOLDER = "{option} {typed!r}: {part!r} exists and is not a folder"
     SYMLINK = "{option} {typed!r}: is a symbolic link; give the real folder"
-    NOT_OURS = ("{option} {typed!r}: the folder {why} (e.g. {example!r}, {count} file(s)); give a new or empty "
-                "folder, or --force to write beside them (files not written by stewart-drake are never touched)")
+    NOT_OURS = (
+        "{option} {typed!r}: the folder {why} (e.g. {example!r}, {count} file(s)); give a new or empty "
+        "folder, or --force to write beside them (files not written by stewart-drake are never touched)"
+    )
     UNWRITABLE = "{option} {typed!r}: cannot write there ({reason})"
     BAD_PATH = "{option} {typed!r}: not a usable path"
     CLASH = "{option} {typed!r}: {name!r} exists and was not written by stewart-drake; nothing was written"
     FILE_IS_FOLDER = "{option} {typed!r}: is a folder; give a file name"
     FILE_NOT_REGULAR = "{option} {typed!r}: exists and is not a regular file"
-    FILE_NOT_OURS = ("{option} {typed!r}: the file exists and was not written by stewart-drake; "
-                     "remove it or choose another name (it is never overwritten)")
+    FILE_NOT_OURS = (
+        "{option} {typed!r}: the file exists and was not written by stewart-drake; "
+        "remove it or choose another name (it is never overwritten)"
+    )
 
 
 class YamlError(GeometryError, InputError):
@@ -439,16 +466,14 @@ SCRIPT_UNIT = "units: {name!r} is not a unit; expected {lengths} (length), {angl
 SCRIPT_TWO_UNITS = "units: two {kind} units given"
 SCRIPT_DURATION = "{keyword} duration must be positive, got {value} s"
 SCRIPT_TOO_SHORT = (
-    "{keyword} duration {value} s is shorter than the shortest move, {limit} s (no actuator follows a "
-    "faster one)"
+    "{keyword} duration {value} s is shorter than the shortest move, {limit} s (no actuator follows a faster one)"
 )
 SCRIPT_WAIT = "wait duration must be >= 0, got {value} s"
 SCRIPT_TOO_MANY_MOVES = (
     "the program makes more than {limit} moves and waits (the limit); shorten it or use longer moves"
 )
 SCRIPT_SEGMENT_SAMPLES = (
-    "{what} lasts {duration} s, more than the {limit} samples a program may have "
-    "at {rate} Hz ({seconds} s)"
+    "{what} lasts {duration} s, more than the {limit} samples a program may have at {rate} Hz ({seconds} s)"
 )
 SCRIPT_TOO_MANY_SAMPLES = (
     "trajectory too long: {total} samples ({seconds} s at {rate} Hz; the limit is {limit}); lower the "
@@ -514,7 +539,9 @@ NO_PLATE = (
     "platform {name!r} has no plate mass properties (YAML key 'plate' missing, or its mass is 0): "
     "'{command}' needs plate.mass and plate.inertia (or plate.thickness and plate.density for a utn platform)"
 )
-SINGULAR_HOME = "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
+SINGULAR_HOME = (
+    "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"
+)
 WORK_UNBOUNDED = "{option} {value} would need unboundedly many {what}{hint}"
 WORK_TOO_LARGE = "{option} {value} would need {estimate}; the limit is {limit}{hint}"
 
@@ -528,10 +555,14 @@ INFEASIBLE_TIMING = (
     "infeasible DSP timing: one controller tick needs {cycles} cycles = {t_comp_us:.3f} µs at {clock_mhz:g} MHz, "
     "longer than the sample period {period_us:.3f} µs"
 )
-PLANT_STEP_TOO_LONG = ("--plant-step {step} s is longer than the controller period {period} s; "
-                       "the plant step must resolve the period (at most one period)")
-PLANT_STEP_ABOVE_LAG = ("--plant-step {step} s is longer than the actuators' time constant {lag} s, "
-                        "the platform's fastest modelled dynamics; use a step of at most that")
+PLANT_STEP_TOO_LONG = (
+    "--plant-step {step} s is longer than the controller period {period} s; "
+    "the plant step must resolve the period (at most one period)"
+)
+PLANT_STEP_ABOVE_LAG = (
+    "--plant-step {step} s is longer than the actuators' time constant {lag} s, "
+    "the platform's fastest modelled dynamics; use a step of at most that"
+)
 PERIOD_TOO_SLOW = (
     "--period {period} s is too slow for platform {name}: its fastest open-loop mode grows at "
     "{lam:.3g}/s, and the leg loops' crossover at this period is at most {w_c:.3g} rad/s (< {margin:g} × "
@@ -584,13 +615,14 @@ class GainError(StewartError):
     PID_NEGATIVE = "PidGains.{name} must be a finite number >= 0, got {value!r}"
     PID_FILTER = "PidGains.{name} must be in (0, 1], got {value!r}"
     ACTUATOR_LAG = "actuator_lag must be >= 0 s, got {value!r}"
-    INERTIA = ("platform {name!r}: the leg-space inertia is not positive definite (smallest eigenvalue "
-               "{m_min:.3g} kg)")
+    INERTIA = "platform {name!r}: the leg-space inertia is not positive definite (smallest eigenvalue {m_min:.3g} kg)"
     DESIGN_POSE = "design pose {index} is not finite: {value!r}"
     GAIN = "a gain must be a finite number >= 0, got {value!r}"
     Q15_RANGE = "gain {value!r} is too large for a Q15 mantissa with a 32-bit shift"
-    SENSOR_COUNTS = ("sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts "
-                     "for the fixed-point controller")
+    SENSOR_COUNTS = (
+        "sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts "
+        "for the fixed-point controller"
+    )
 
 
 # DspTiming fields (``control.timing``), raised as ``TimingError``.
@@ -626,11 +658,14 @@ class SimulationError(StewartError):
     TIME_STEP = "time_step must be > 0, got {value}"
     SERVO_POSES = "compare_with_drake needs reachable in-travel poses; pose {index} is not: {why}"
     FRAME_RATE = "servo frame rate must be > 0 Hz, got {value}"
-    CLOSED_LOOP_SHAPES = ("run_closed_loop needs times (n,) and poses (n, 6) with n >= 2, got {times_shape} and "
-                          "{poses_shape}")
+    CLOSED_LOOP_SHAPES = (
+        "run_closed_loop needs times (n,) and poses (n, 6) with n >= 2, got {times_shape} and {poses_shape}"
+    )
     SPRING = "leg {leg}: static force {force:.6g} N compresses a {k:.6g} N/m spring past zero length"
-    SERVO_SPEED = ("reference arm speed {rate:.3g} rad/s reaches the servo's no-load speed "
-                   "{speed:.3g} rad/s: the tracking bound does not apply")
+    SERVO_SPEED = (
+        "reference arm speed {rate:.3g} rad/s reaches the servo's no-load speed "
+        "{speed:.3g} rad/s: the tracking bound does not apply"
+    )
     PORT = "--port {port}: Meshcat could not listen there ({reason})"
 
 
@@ -660,8 +695,7 @@ class ReplayError(StewartError):
     MISSING = "--replay {path}: no such file"
     NOT_LOG = "--replay {path}: not a simulate log ({reason})"
     EMPTY = "--replay {path}: empty file"
-    COLUMNS = ("--replay {path}: line 1: expected the columns of a simulate log.csv or a run trajectory.csv, "
-               "got {got}")
+    COLUMNS = "--replay {path}: line 1: expected the columns of a simulate log.csv or a run trajectory.csv, got {got}"
     ROW = "--replay {path}: line {line}: not a row of numbers"
     NO_SAMPLES = "--replay {path}: no samples"
 
@@ -698,22 +732,29 @@ class StudyError(StewartError):
     PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
     DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
     TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
-    RESOLUTION_RANGE = ("--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
-                        "give a value or a|b|c list, not a range")
-    RESOLUTION_DIVIDE = ("--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into "
-                         "whole counts")
+    RESOLUTION_RANGE = (
+        "--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
+        "give a value or a|b|c list, not a range"
+    )
+    RESOLUTION_DIVIDE = (
+        "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
+    )
     OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
     OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
-    OUT_NOT_OURS = ("--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to "
-                    "overwrite it")
-    OUT_OTHER_PARTIAL = ("--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose "
-                         "another folder")
+    OUT_NOT_OURS = (
+        "--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to overwrite it"
+    )
+    OUT_OTHER_PARTIAL = (
+        "--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose another folder"
+    )
+
 
 # Command-line options checked by the commands (raised as ``OptionError`` or ``UsageError``).
 OPTION_FIRMWARE_WORD_BITS = "--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {value}"
 OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {value:g}"
-OPTION_FIRMWARE_TFR16 = ("--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {value} "
-                         "(or use --trig exact)")
+OPTION_FIRMWARE_TFR16 = (
+    "--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {value} (or use --trig exact)"
+)
 OPTION_OUT_NOT_FOLDER = "--out {out}: exists and is not a folder"
 OPTION_OUT_FOREIGN = "--out {out}: holds files this command did not write ({names}); choose another folder"
 OPTION_RUN_RATE = "--rate must be a positive number of samples per second, got {value}"

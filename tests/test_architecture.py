@@ -50,7 +50,12 @@ def top_level_nodes(tree: ast.Module) -> set[int]:
         if isinstance(n, (ast.Import, ast.ImportFrom)):
             out.add(id(n))
         elif isinstance(n, (ast.If, ast.Try)):
-            stack.extend(n.body + n.orelse + getattr(n, "finalbody", []) + [h for x in getattr(n, "handlers", []) for h in x.body])
+            stack.extend(
+                n.body
+                + n.orelse
+                + getattr(n, "finalbody", [])
+                + [h for x in getattr(n, "handlers", []) for h in x.body]
+            )
     return out
 
 
@@ -91,6 +96,11 @@ def test_module_respects_its_layer(path):
         if private:
             problems.append(f"line {node.lineno}: imports private {private} from {name}")
     for node in ast.walk(tree):
-        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "type" and len(node.args) == 3:
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id == "type"
+            and len(node.args) == 3
+        ):
             problems.append(f"line {node.lineno}: class built with type(name, bases, dict)")
     assert not problems, "\n".join(problems)

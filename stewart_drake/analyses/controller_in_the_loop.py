@@ -6,17 +6,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.drake.animation import log_saturating, record_animation
 from stewart_drake.control import ControllerConfig, DspTiming, leg_space_inertia, strut_stiffness
-from stewart_drake.firmware.engine import resolve_engine
-from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.montecarlo.sweep import run_sweep, sweep_study
-from stewart_drake.report import run_standalone
 from stewart_drake.core.trajectory import ROTATING, SEED, design_poses, fit_trajectory
+from stewart_drake.drake.animation import log_saturating, record_animation
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation, setpoint_step_gain
-from stewart_drake.report import parallel_map
+from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.fixedpoint import fixed_point_leg_lengths
+from stewart_drake.montecarlo.sweep import run_sweep, sweep_study
+from stewart_drake.report import parallel_map, run_standalone
 
 TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
 ORDER = 90
@@ -70,9 +69,18 @@ def _tracking(section, platform, duration):
             logs[traj.name, kind] = log
             e = log.length_error(traj, platform)
             pe = log.pose_error(traj)
-            rows.append([traj.name, kind, float(np.abs(e).max() * 1e3), float(np.sqrt(np.mean(e**2)) * 1e3),
-                         float(np.abs(pe[:, :3]).max() * 1e3), float(np.degrees(np.abs(pe[:, 3:]).max())),
-                         int(log.saturations().sum()), float(np.abs(log.force).max())])
+            rows.append(
+                [
+                    traj.name,
+                    kind,
+                    float(np.abs(e).max() * 1e3),
+                    float(np.sqrt(np.mean(e**2)) * 1e3),
+                    float(np.abs(pe[:, :3]).max() * 1e3),
+                    float(np.degrees(np.abs(pe[:, 3:]).max())),
+                    int(log.saturations().sum()),
+                    float(np.abs(log.force).max()),
+                ]
+            )
             ax = axes[i, j]
             ax.plot(log.t, e * 1e3, lw=0.8)
             ax.set_title(f"{traj.name} trajectory, {kind} controller", fontsize=9)
@@ -80,18 +88,41 @@ def _tracking(section, platform, duration):
         d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs[traj.name, "float"], duration, cfg)
         e_float = np.abs(logs[traj.name, "float"].length_error(traj, platform)).max()
         e_fixed = np.abs(logs[traj.name, "fixed"].length_error(traj, platform)).max()
-        section.check(f"{traj.name}: float twin's leg error <= v_max·t_delay (timing bound, {v_max * 1e3:.0f} mm/s × {t_delay * 1e3:.0f} ms)",
-                      e_float * 1e3, v_max * t_delay * 1e3, "mm")
+        section.check(
+            f"{traj.name}: float twin's leg error <= v_max·t_delay (timing bound, {v_max * 1e3:.0f} mm/s × {t_delay * 1e3:.0f} ms)",
+            e_float * 1e3,
+            v_max * t_delay * 1e3,
+            "mm",
+        )
         g = _l1_gain(platform, cfg, section.quick)
-        section.check(f"{traj.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r) (quantisation bound, ‖h‖₁ = {g['coupled']:.2f})",
-                      e_fixed * 1e3, _fixed_bound(e_float, d_ik, lsb, r, g["coupled"]) * 1e3, "mm")
+        section.check(
+            f"{traj.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r) (quantisation bound, ‖h‖₁ = {g['coupled']:.2f})",
+            e_fixed * 1e3,
+            _fixed_bound(e_float, d_ik, lsb, r, g["coupled"]) * 1e3,
+            "mm",
+        )
         rows[-1].append(f"Δ_IK {d_ik * 1e3:.2f} mm, ‖h‖₁ {g['coupled']:.2f} (own leg {g['diagonal']:.2f})")
     for ax in axes[-1]:
         ax.set_xlabel("t [s]")
-    section.table(["trajectory", "controller", "max |leg err| mm", "rms leg err mm", "max |pos err| mm",
-                   "max |angle err| deg", "saturated ticks", "max |force| N", "note"],
-                  [r + [""] * (9 - len(r)) for r in rows], caption=f"Tracking over {duration:g} s, T = 1 ms, one sample of output delay", fmt="{:.3f}")
-    section.figure(fig, "cil_tracking", "Leg-length tracking error (true length − exact IK of the reference), six legs.")
+    section.table(
+        [
+            "trajectory",
+            "controller",
+            "max |leg err| mm",
+            "rms leg err mm",
+            "max |pos err| mm",
+            "max |angle err| deg",
+            "saturated ticks",
+            "max |force| N",
+            "note",
+        ],
+        [r + [""] * (9 - len(r)) for r in rows],
+        caption=f"Tracking over {duration:g} s, T = 1 ms, one sample of output delay",
+        fmt="{:.3f}",
+    )
+    section.figure(
+        fig, "cil_tracking", "Leg-length tracking error (true length − exact IK of the reference), six legs."
+    )
     return logs
 
 
@@ -105,19 +136,45 @@ def _preset_case(case):
     poses = design_poses(traj, duration)
     cfg = ControllerConfig.for_platform(platform, poses=poses)
     g = cfg.gains
-    logs = {kind: build_simulation(Scenario(platform, traj, kind, cfg, engine=ENGINE)).run(duration) for kind in ("float", "fixed")}
+    logs = {
+        kind: build_simulation(Scenario(platform, traj, kind, cfg, engine=ENGINE)).run(duration)
+        for kind in ("float", "fixed")
+    }
     pid_only = build_simulation(Scenario(platform, traj, "float", cfg, feedforward=False)).run(duration)
     e = {k: float(np.abs(v.length_error(traj, platform)).max()) for k, v in logs.items()}
     e_pid = float(np.abs(pid_only.length_error(traj, platform)).max())
     d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs["float"], duration, cfg)
     h = _l1_gain(platform, cfg, quick)
-    checks = [(f"{name}, {base.name}: float leg error <= v_max·t_delay", e["float"] * 1e3, v_max * t_delay * 1e3, "mm"),
-              (f"{name}, {base.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r), ‖h‖₁ = {h['coupled']:.2f}", e["fixed"] * 1e3,
-               _fixed_bound(e["float"], d_ik, lsb, r, h["coupled"]) * 1e3, "mm")]
-    row = [name, base.name, f"{m[0]:.2f} … {m[-1]:.1f}", strut_stiffness(platform), float(strut_stiffness(platform, poses).max()), g.kp, g.ki, g.kd,
-           e_pid * 1e3, e["float"] * 1e3, e["fixed"] * 1e3, d_ik * 1e3, v_max * t_delay * 1e3,
-           h["diagonal"], h["coupled"], h["peak"], (e["fixed"] - e["float"]) / (d_ik + lsb + r),
-           int(logs["fixed"].saturations().sum()), float(np.abs(logs["fixed"].force).max())]
+    checks = [
+        (f"{name}, {base.name}: float leg error <= v_max·t_delay", e["float"] * 1e3, v_max * t_delay * 1e3, "mm"),
+        (
+            f"{name}, {base.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r), ‖h‖₁ = {h['coupled']:.2f}",
+            e["fixed"] * 1e3,
+            _fixed_bound(e["float"], d_ik, lsb, r, h["coupled"]) * 1e3,
+            "mm",
+        ),
+    ]
+    row = [
+        name,
+        base.name,
+        f"{m[0]:.2f} … {m[-1]:.1f}",
+        strut_stiffness(platform),
+        float(strut_stiffness(platform, poses).max()),
+        g.kp,
+        g.ki,
+        g.kd,
+        e_pid * 1e3,
+        e["float"] * 1e3,
+        e["fixed"] * 1e3,
+        d_ik * 1e3,
+        v_max * t_delay * 1e3,
+        h["diagonal"],
+        h["coupled"],
+        h["peak"],
+        (e["fixed"] - e["float"]) / (d_ik + lsb + r),
+        int(logs["fixed"].saturations().sum()),
+        float(np.abs(logs["fixed"].force).max()),
+    ]
     return checks, row
 
 
@@ -131,11 +188,33 @@ def _presets(section, duration):
         for c in checks:
             section.check(*c)
         rows.append(row)
-    section.table(["platform", "trajectory", "leg-space mass kg", "strut stiffness at home N/m", "max along trajectory N/m", "kp N/m", "ki N/(m·s)", "kd N·s/m",
-                   "float, PID only mm", "float mm", "fixed mm", "Δ_IK mm", "timing bound mm",
-                   "‖h_ii‖₁ own leg", "‖h‖₁ all legs", "step peak", "(fixed − float)/(Δ_IK + LSB + r)", "saturated ticks", "max |force| N"],
-                  rows, caption=f"Default controller on every preset, {duration:g} s, T = 1 ms, one sample of output delay "
-                  "(max |leg length − IK(reference)|)", fmt="{:.3f}")
+    section.table(
+        [
+            "platform",
+            "trajectory",
+            "leg-space mass kg",
+            "strut stiffness at home N/m",
+            "max along trajectory N/m",
+            "kp N/m",
+            "ki N/(m·s)",
+            "kd N·s/m",
+            "float, PID only mm",
+            "float mm",
+            "fixed mm",
+            "Δ_IK mm",
+            "timing bound mm",
+            "‖h_ii‖₁ own leg",
+            "‖h‖₁ all legs",
+            "step peak",
+            "(fixed − float)/(Δ_IK + LSB + r)",
+            "saturated ticks",
+            "max |force| N",
+        ],
+        rows,
+        caption=f"Default controller on every preset, {duration:g} s, T = 1 ms, one sample of output delay "
+        "(max |leg length − IK(reference)|)",
+        fmt="{:.3f}",
+    )
     return rows
 
 
@@ -146,14 +225,26 @@ def _sweep(section, platform, periods, duration):
     res = {}
     plant_step = 2.5e-4
     # the Monte Carlo machinery's grid sweep: one run per (latency, T), gains designed for 1 kHz kept fixed
-    study = sweep_study(platform, {"latency": ["computation", "sample"], "sample_period": periods}, duration=duration, plant_step=plant_step, engine=ENGINE)
+    study = sweep_study(
+        platform,
+        {"latency": ["computation", "sample"], "sample_period": periods},
+        duration=duration,
+        plant_step=plant_step,
+        engine=ENGINE,
+    )
     for r in run_sweep(study):
         lat, T = r["latency"], r["sample_period_s"]
         e = r["max_leg_error_m"] * 1e3
         res[lat, T] = e
-        rows.append([lat, T * 1e3, DspTiming(sample_period=T, latency=lat).output_delay * 1e6, e, r["saturated_leg_ticks"]])
-    section.table(["latency", "T ms", "output delay µs", "max |leg err| mm", "saturated ticks"], rows,
-                  caption=f"Sweep (fixed-point controller, seed trajectory, {duration:g} s, plant step {plant_step * 1e3:g} ms)", fmt="{:.3f}")
+        rows.append(
+            [lat, T * 1e3, DspTiming(sample_period=T, latency=lat).output_delay * 1e6, e, r["saturated_leg_ticks"]]
+        )
+    section.table(
+        ["latency", "T ms", "output delay µs", "max |leg err| mm", "saturated ticks"],
+        rows,
+        caption=f"Sweep (fixed-point controller, seed trajectory, {duration:g} s, plant step {plant_step * 1e3:g} ms)",
+        fmt="{:.3f}",
+    )
     fig, ax = plt.subplots(figsize=(6, 3.5))
     for lat in ("computation", "sample"):
         ax.semilogy([T * 1e3 for T in periods], [res[lat, T] for T in periods], "o-", label=f"latency: {lat}")
@@ -175,17 +266,31 @@ def _saturation(section, platform, ranges, duration):
         first = log.t[np.argmax(st > 0)] if st[-1] > 0 else float("nan")
         e = float(np.abs(log.length_error(SEED, platform)).max() * 1e3)
         rows.append([rng, " ".join(str(s) for s in sat), first, e])
-    section.table(["command range N", "saturated ticks per leg 1..6", "first saturation s", "max |leg err| mm"], rows, nan_reason="never saturated",
-                  caption=f"Command range (Q15 full scale) against saturation, fixed-point controller, seed trajectory, {duration:g} s", fmt="{:.3f}")
+    section.table(
+        ["command range N", "saturated ticks per leg 1..6", "first saturation s", "max |leg err| mm"],
+        rows,
+        nan_reason="never saturated",
+        caption=f"Command range (Q15 full scale) against saturation, fixed-point controller, seed trajectory, {duration:g} s",
+        fmt="{:.3f}",
+    )
 
 
 def _animation(section, platform, log, duration):
     """The Meshcat animation of a logged run (the seed trajectory's fixed-point run), thinned to 25 fps."""
-    page = record_animation(platform, log.t, log.pose, log_saturating(log.status), fps=25.0,
-                            title=f"{platform.name}: fixed-point controller, seed trajectory, {duration:g} s")
-    section.attach("controller_in_the_loop.html", page.encode("utf-8"),
-                   f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, "
-                   "25 frames/s, self-contained HTML; legs turn red near a stroke end or when saturating)")
+    page = record_animation(
+        platform,
+        log.t,
+        log.pose,
+        log_saturating(log.status),
+        fps=25.0,
+        title=f"{platform.name}: fixed-point controller, seed trajectory, {duration:g} s",
+    )
+    section.attach(
+        "controller_in_the_loop.html",
+        page.encode("utf-8"),
+        f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, "
+        "25 frames/s, self-contained HTML; legs turn red near a stroke end or when saturating)",
+    )
 
 
 def build(section) -> None:
@@ -255,6 +360,7 @@ def build(section) -> None:
     )
     periods = [5e-4, 1e-3, 2e-3] if quick else [2.5e-4, 5e-4, 1e-3, 1.5e-3, 2e-3]
     res = _sweep(section, platform, periods, 0.5 if quick else 1.5)
+
     def longest(lat):
         ok = [T for T in periods if res[lat, T] < 5.0]
         if not ok:

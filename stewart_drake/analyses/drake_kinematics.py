@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from stewart_drake.core.geometry import PRESETS, load_preset
-from stewart_drake.report import run_standalone
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.drake.verify_kinematics import compare_ik_with_drake
+from stewart_drake.report import run_standalone
 
 TITLE = "Inverse kinematics vs Drake"
 ORDER = 5
@@ -25,16 +23,30 @@ def build(section) -> None:
         err = compare_ik_with_drake(p, random_poses(p, n, seed=1))
         rows.append([name, n, err["anchors"], err["ik"], err["fk"]])
         section.check(f"{name}: anchor frames read back from the parsed plant", err["anchors"], FRAME_TOL_M, "m")
-        section.check(f"{name}: Drake InverseKinematics prismatic positions vs closed-form lengths ({n} poses)", err["ik"], IK_TOL_M, "m")
-        section.check(f"{name}: Drake FK piston tip vs plate anchor at the closed-form joints ({n} poses)", err["fk"], FRAME_TOL_M, "m")
+        section.check(
+            f"{name}: Drake InverseKinematics prismatic positions vs closed-form lengths ({n} poses)",
+            err["ik"],
+            IK_TOL_M,
+            "m",
+        )
+        section.check(
+            f"{name}: Drake FK piston tip vs plate anchor at the closed-form joints ({n} poses)",
+            err["fk"],
+            FRAME_TOL_M,
+            "m",
+        )
     section.text(
         "For each preset the SDF is generated from the Platform and parsed into a discrete MultibodyPlant with six "
         "ball constraints. (a) the anchor frames read back from the plant; (b) Drake's InverseKinematics with the "
         "plate's floating joint locked at a random in-stroke pose, legs starting from the home configuration; "
         "(c) Drake's forward kinematics with the joints set to the closed-form solution."
     )
-    section.table(["preset", "poses", "anchor frames (m)", "IK lengths (m)", "FK tip gap (m)"], rows,
-                  caption="Worst absolute errors", fmt="{:.3g}")
+    section.table(
+        ["preset", "poses", "anchor frames (m)", "IK lengths (m)", "FK tip gap (m)"],
+        rows,
+        caption="Worst absolute errors",
+        fmt="{:.3g}",
+    )
 
 
 def main(argv=None):

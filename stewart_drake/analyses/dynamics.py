@@ -20,18 +20,32 @@ def rotating_trajectory(t, omega=3.0, amplitude=np.radians(20)):
     """About the seed's pose: ±``amplitude`` rad about X, Y and Z at ``omega`` rad/s (phases 0, 2π/3, 4π/3)
     plus the seed's py motion. ``(q, qd, qdd)``."""
     return D.harmonic_trajectory(
-        t, [-0.1, 0, 0.7, 0, 0, 0], [0, 0.1, 0, amplitude, amplitude, amplitude],
-        [0, D.SEED_OMEGA, 0, omega, omega, omega], [0, 0, 0, 0, 2 * np.pi / 3, 4 * np.pi / 3],
+        t,
+        [-0.1, 0, 0.7, 0, 0, 0],
+        [0, 0.1, 0, amplitude, amplitude, amplitude],
+        [0, D.SEED_OMEGA, 0, omega, omega, omega],
+        [0, 0, 0, 0, 2 * np.pi / 3, 4 * np.pi / 3],
     )
 
 
 def comparison_trajectories(t):
     """Named trajectories for the Drake table: the seed's, and rotations about X, Y, Z and all axes."""
     out = {"seed (no rotation)": D.seed_trajectory(t)}
-    for name, axes in (("rotation about X", [3]), ("rotation about Y", [4]), ("rotation about Z", [5]), ("rotation about X, Y, Z", [3, 4, 5])):
+    for name, axes in (
+        ("rotation about X", [3]),
+        ("rotation about Y", [4]),
+        ("rotation about Z", [5]),
+        ("rotation about X, Y, Z", [3, 4, 5]),
+    ):
         amp = np.array([0.02, 0.03, 0.015, 0, 0, 0])
         amp[axes] = np.radians(20)
-        out[name] = D.harmonic_trajectory(t, [-0.02, 0.01, 0.7, 0.03, -0.02, 0.05], amp, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+        out[name] = D.harmonic_trajectory(
+            t,
+            [-0.02, 0.01, 0.7, 0.03, -0.02, 0.05],
+            amp,
+            [1.3, 2.1, 1.7, 3.0, 2.5, 3.5],
+            [0.1, 0.2, 0.3, 0.4, 0.5, 0.6],
+        )
     return out
 
 
@@ -58,13 +72,22 @@ def build(section) -> None:
             ["mass (kg)", m, quad["mass"], "1.36"],
             ["centre of mass z (mm)", com[2] * 1e3, quad["com"][2] * 1e3, "—"],
             ["Ixx = Iyy about the centre of mass (kg·m²)", I_cm[0, 0], quad["inertia_cm"][0, 0], "—"],
-            ["Ixx = Iyy about T (the seed's integral) (kg·m²)", D.inertia_about(p, [0, 0, 0])[0, 0], quad["inertia_T"][0, 0], "not printed"],
+            [
+                "Ixx = Iyy about T (the seed's integral) (kg·m²)",
+                D.inertia_about(p, [0, 0, 0])[0, 0],
+                quad["inertia_T"][0, 0],
+                "not printed",
+            ],
             ["Izz (kg·m²)", I_cm[2, 2], quad["inertia_cm"][2, 2], "not printed"],
         ],
         caption="Plate mass properties",
         fmt="{:.8g}",
     )
-    section.check("plate inertia: quadrature vs closed form (relative)", np.abs(quad["inertia_cm"] - I_cm).max() / I_cm.max(), 1e-12)
+    section.check(
+        "plate inertia: quadrature vs closed form (relative)",
+        np.abs(quad["inertia_cm"] - I_cm).max() / I_cm.max(),
+        1e-12,
+    )
     section.check("plate mass vs the seed's 1.36 kg (printed to 2 decimals)", abs(quad["mass"] - 1.36), 0.005, "kg")
 
     # 2. The seed's six-force plot -----------------------------------------------------------------
@@ -77,7 +100,7 @@ def build(section) -> None:
     d_com = np.abs(D.seed_leg_forces(p, qf, qddf) - F_full).max()
     fig, ax = plt.subplots(figsize=(8, 4))
     for i in range(6):
-        line, = ax.plot(t_fine, F_full[:, i], lw=1.2, label=f"leg {i + 1}")
+        (line,) = ax.plot(t_fine, F_full[:, i], lw=1.2, label=f"leg {i + 1}")
         ax.plot(t_seed, F_seed_pts[:, i], "o", ms=3, color=line.get_color())
     ax.set_ylim(-2, 6)
     ax.set_xlim(0, 4)
@@ -85,9 +108,12 @@ def build(section) -> None:
     ax.set_ylabel("leg force (N)")
     ax.legend(ncol=3, fontsize=8)
     ax.grid(alpha=0.3)
-    section.figure(fig, "dynamics_seed_forces",
-                   "The seed's trajectory (px = −0.1 m, py = 0.1 sin 2t m, pz = 0.7 m): dots, the seed's model at its 0.1 s "
-                   "samples (Generador.m); lines, the complete model. Axis −2…6 N as in the seed's figure.")
+    section.figure(
+        fig,
+        "dynamics_seed_forces",
+        "The seed's trajectory (px = −0.1 m, py = 0.1 sin 2t m, pz = 0.7 m): dots, the seed's model at its 0.1 s "
+        "samples (Generador.m); lines, the complete model. Axis −2…6 N as in the seed's figure.",
+    )
     section.text(
         f"The six forces stay within {F_full.min():.2f} … {F_full.max():.2f} N, inside the seed's −2…6 N axis; at rest they "
         f"sum (vertically) to the weight m g = {p.mass * D.G_EARTH:.3f} N. The trajectory does not rotate, so C(q, q̇)q̇ is "
@@ -103,7 +129,7 @@ def build(section) -> None:
     F_off = D.leg_forces(p, qr, qdr, qddr, coriolis=False)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     for i in range(6):
-        line, = ax1.plot(t_rot, F_on[:, i], lw=1.2, label=f"leg {i + 1}")
+        (line,) = ax1.plot(t_rot, F_on[:, i], lw=1.2, label=f"leg {i + 1}")
         ax1.plot(t_rot, F_off[:, i], "--", lw=0.8, color=line.get_color())
         ax2.plot(t_rot, (F_on - F_off)[:, i] * 1e3, lw=1, color=line.get_color())
     w_norm = np.linalg.norm(np.einsum("nij,nj->ni", D.plate_motion(p, qr, qdr, qddr)["E"], qdr[:, 3:]), axis=1)
@@ -114,18 +140,32 @@ def build(section) -> None:
     ax1.legend(ncol=3, fontsize=8)
     ax2.set_ylabel("Coriolis part (mN)")
     ax2.set_xlabel("t (s)")
-    section.figure(fig, "dynamics_coriolis_rotating",
-                   "A rotating trajectory (±20° about X, Y and Z at 3 rad/s, phases 120° apart, plus the seed's py motion): "
-                   "complete model (solid) vs the seed's model without Coriolis (dashed), and their difference J⁻ᵀ C q̇.")
+    section.figure(
+        fig,
+        "dynamics_coriolis_rotating",
+        "A rotating trajectory (±20° about X, Y and Z at 3 rad/s, phases 120° apart, plus the seed's py motion): "
+        "complete model (solid) vs the seed's model without Coriolis (dashed), and their difference J⁻ᵀ C q̇.",
+    )
     omegas = np.array([0.5, 1, 2, 3, 5, 8]) if not quick else np.array([1, 3, 8])
     rows = []
     for om in omegas:
         qo, qdo, qddo = rotating_trajectory(t_rot, omega=om)
         Fc = D.coriolis_leg_forces(p, qo, qdo)
         Ft = D.leg_forces(p, qo, qdo, qddo)
-        rows.append([f"{om:g}", np.abs(Fc).max() * 1e3, np.abs(Ft).max(), 100 * np.abs(Fc).max() / np.abs(Ft - D.leg_forces(p, qo, 0 * qdo, 0 * qddo)).max()])
-    section.table(["ω (rad/s)", "max |J⁻ᵀ C q̇| (mN)", "max |F| (N)", "Coriolis / dynamic part of F (%)"], rows,
-                  caption="How much the Coriolis term matters (±20° about all three axes)", fmt="{:.4g}")
+        rows.append(
+            [
+                f"{om:g}",
+                np.abs(Fc).max() * 1e3,
+                np.abs(Ft).max(),
+                100 * np.abs(Fc).max() / np.abs(Ft - D.leg_forces(p, qo, 0 * qdo, 0 * qddo)).max(),
+            ]
+        )
+    section.table(
+        ["ω (rad/s)", "max |J⁻ᵀ C q̇| (mN)", "max |F| (N)", "Coriolis / dynamic part of F (%)"],
+        rows,
+        caption="How much the Coriolis term matters (±20° about all three axes)",
+        fmt="{:.4g}",
+    )
     c3 = rows[list(omegas).index(3)][1] if 3 in omegas else rows[-1][1]
     section.text(
         "The Coriolis term (centripetal, gyroscopic ω × Iω and the Euler-rate term Ė θ̇) grows as ω²: "
@@ -150,8 +190,16 @@ def build(section) -> None:
         worst_c, worst_s = max(worst_c, e_c), max(worst_s, e_nc)
         rows.append([name, len(t_cmp), e_c, e_n, e_nc, np.abs(D.seed_leg_forces(p, qc, qddc) - Fd).max()])
     section.table(
-        ["trajectory", "samples", "complete − Drake (N)", "no Coriolis − Drake (N)", "no Coriolis + J⁻ᵀCq̇ − Drake (N)", "seed as printed − Drake (N)"],
-        rows, caption="Leg forces vs Drake (the plate as a free body; CalcInverseDynamics with gravity, mapped through the leg directions)",
+        [
+            "trajectory",
+            "samples",
+            "complete − Drake (N)",
+            "no Coriolis − Drake (N)",
+            "no Coriolis + J⁻ᵀCq̇ − Drake (N)",
+            "seed as printed − Drake (N)",
+        ],
+        rows,
+        caption="Leg forces vs Drake (the plate as a free body; CalcInverseDynamics with gravity, mapped through the leg directions)",
         fmt="{:.3g}",
     )
     section.text(
@@ -181,18 +229,30 @@ def build(section) -> None:
     for dt in steps:
         t = np.arange(0, T + dt / 2, dt)
         q, qd, qdd = D.seed_trajectory(t)
-        r = V.simulate_open_loop(p, t, q, qd, D.leg_forces_with_legs(p, q, qd, qdd), dt, record_every=int(round(0.01 / dt)))
+        r = V.simulate_open_loop(
+            p, t, q, qd, D.leg_forces_with_legs(p, q, qd, qdd), dt, record_every=int(round(0.01 / dt))
+        )
         runs[dt] = r
         ax1.semilogy(r["t"][1:], r["position_error"][1:], label=f"dt = {dt * 1e3:g} ms")
         ax2.semilogy(r["t"][1:], r["constraint"][1:], label=f"dt = {dt * 1e3:g} ms")
         k1 = np.searchsorted(r["t"], 1.0)
         over = np.nonzero(r["position_error"] > 1e-3)[0]
-        rows.append([f"{dt * 1e3:g}", r["position_error"][k1] * 1e6, np.degrees(r["angle_error"][k1]),
-                     r["t"][over[0]] if len(over) else f"> {T:g}", r["constraint"][: k1 + 1].max() * 1e6, r["wall_time"]])
+        rows.append(
+            [
+                f"{dt * 1e3:g}",
+                r["position_error"][k1] * 1e6,
+                np.degrees(r["angle_error"][k1]),
+                r["t"][over[0]] if len(over) else f"> {T:g}",
+                r["constraint"][: k1 + 1].max() * 1e6,
+                r["wall_time"],
+            ]
+        )
     t = np.arange(0, T + 5e-4, 1e-3)
     q, qd, qdd = D.seed_trajectory(t)
     r_plate = V.simulate_open_loop(p, t, q, qd, D.leg_forces(p, q, qd, qdd), 1e-3, record_every=10)
-    ax1.semilogy(r_plate["t"][1:], r_plate["position_error"][1:], "k--", lw=0.8, label="plate-only forces (legs ignored)")
+    ax1.semilogy(
+        r_plate["t"][1:], r_plate["position_error"][1:], "k--", lw=0.8, label="plate-only forces (legs ignored)"
+    )
     lam = D.open_loop_growth_rates(p, [-0.1, 0, 0.7, 0, 0, 0])
     r = runs[1e-3]
     # The growth rate the simulation shows: fit log(error) where it is between 0.1 mm and 10 mm.
@@ -201,19 +261,38 @@ def build(section) -> None:
     if win.sum() > 3:
         tt = r["t"][win]
         t_a = tt[0]
-        ax1.semilogy(tt, np.exp(c0 + lam_sim * t_a) * np.exp(lam[0] * (tt - t_a)), "r:", lw=1.2, label=f"slope λ = {lam[0]:.1f}/s (linearised)")
+        ax1.semilogy(
+            tt,
+            np.exp(c0 + lam_sim * t_a) * np.exp(lam[0] * (tt - t_a)),
+            "r:",
+            lw=1.2,
+            label=f"slope λ = {lam[0]:.1f}/s (linearised)",
+        )
     ax1.set_xlabel("t (s)")
     ax1.set_ylabel("|p_C − p_C planned| (m)")
     ax1.legend(fontsize=7)
     ax2.set_xlabel("t (s)")
     ax2.set_ylabel("worst ball-constraint violation (m)")
     ax2.legend(fontsize=7)
-    section.figure(fig, "dynamics_closed_loop_drift",
-                   "Forces of the complete model with leg masses applied open loop to the closed-loop Drake plant (SAP, "
-                   "ball constraints) on the seed's trajectory: drift of the plate and constraint violation.")
-    section.table(["dt (ms)", "position error at 1 s (µm)", "angle error at 1 s (°)", "drift exceeds 1 mm at t (s)",
-                   "max constraint violation to 1 s (µm)", "wall time (s)"], rows,
-                  caption="Open-loop drift on the closed-loop model", fmt="{:.3g}")
+    section.figure(
+        fig,
+        "dynamics_closed_loop_drift",
+        "Forces of the complete model with leg masses applied open loop to the closed-loop Drake plant (SAP, "
+        "ball constraints) on the seed's trajectory: drift of the plate and constraint violation.",
+    )
+    section.table(
+        [
+            "dt (ms)",
+            "position error at 1 s (µm)",
+            "angle error at 1 s (°)",
+            "drift exceeds 1 mm at t (s)",
+            "max constraint violation to 1 s (µm)",
+            "wall time (s)",
+        ],
+        rows,
+        caption="Open-loop drift on the closed-loop model",
+        fmt="{:.3g}",
+    )
     dt_err = [runs[dt]["position_error"][np.searchsorted(runs[dt]["t"], 1.0)] for dt in steps]
     section.text(
         f"The plate follows the trajectory: at 1 s the drift is {rows[-1][1]:.3g}–{rows[0][1]:.3g} µm and halves with the time "
@@ -228,10 +307,19 @@ def build(section) -> None:
         "controller sections."
     )
     if np.isfinite(lam_sim):
-        section.check("open-loop drift growth rate: simulation vs linearised model (relative)", abs(lam_sim / lam[0] - 1), 0.2)
+        section.check(
+            "open-loop drift growth rate: simulation vs linearised model (relative)", abs(lam_sim / lam[0] - 1), 0.2
+        )
     if len(dt_err) >= 2:
-        section.check("closed-loop drift at 1 s halves with the time step (ratio 2 ± 0.4)", abs(dt_err[0] / dt_err[1] - 2), 0.4)
-    section.check("closed-loop drift at 1 s (dt = 1 ms), open loop", runs[1e-3]["position_error"][np.searchsorted(runs[1e-3]["t"], 1.0)], 1e-4, "m")
+        section.check(
+            "closed-loop drift at 1 s halves with the time step (ratio 2 ± 0.4)", abs(dt_err[0] / dt_err[1] - 2), 0.4
+        )
+    section.check(
+        "closed-loop drift at 1 s (dt = 1 ms), open loop",
+        runs[1e-3]["position_error"][np.searchsorted(runs[1e-3]["t"], 1.0)],
+        1e-4,
+        "m",
+    )
 
 
 def main(argv=None):

@@ -11,38 +11,54 @@ import numpy as np
 
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
 from stewart_drake.core.c_build import compilers
+from stewart_drake.core.geometry import PRESETS, load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.drake.simulation import Scenario, build_simulation
 from stewart_drake.firmware.check import workspace_poses
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.host import op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.fixedpoint import QFormat, scalar
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
-from stewart_drake.core.geometry import PRESETS, load_preset
-from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.report import run_standalone
-from stewart_drake.drake.simulation import Scenario, build_simulation
 
 TITLE = "Firmware equivalence: the C compiled, generated and run in the loop"
 ORDER = 95
 
-SEED_POSES = np.array([[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]])
-SEED_DSP_MM = np.array([[475, 471, 473, 473, 471, 475], [504, 515, 477, 477, 469, 458],
-                        [523, 548, 480, 480, 478, 449], [638, 521, 547, 391, 608, 325]])
+SEED_POSES = np.array(
+    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]]
+)
+SEED_DSP_MM = np.array(
+    [
+        [475, 471, 473, 473, 471, 475],
+        [504, 515, 477, 477, 469, 458],
+        [523, 548, 480, 480, 478, 449],
+        [638, 521, 547, 391, 608, 325],
+    ]
+)
 
 
 def _seed_table(section) -> None:
     c = tp17_leg_lengths_c(SEED_POSES)
     rows = []
     for k, q in enumerate(SEED_POSES):
-        rows.append([f"{q[0]:g}, {q[1]:g}, {q[2]:g} mm; {q[3]:g}π, {q[4]:g}π, {q[5]:g}π", "seed DSP"] + [int(v) for v in SEED_DSP_MM[k]])
+        rows.append(
+            [f"{q[0]:g}, {q[1]:g}, {q[2]:g} mm; {q[3]:g}π, {q[4]:g}π, {q[5]:g}π", "seed DSP"]
+            + [int(v) for v in SEED_DSP_MM[k]]
+        )
         rows.append(["", "tp17.C compiled (host)"] + [int(v) for v in c[k]])
-    section.table(["pose", "row"] + [f"L{i}" for i in range(1, 7)], rows,
-                  caption="The seed table's DSP block from the compiled tp17.C (fixedpoint/c/tp17.c with dsp56800e.h)")
+    section.table(
+        ["pose", "row"] + [f"L{i}" for i in range(1, 7)],
+        rows,
+        caption="The seed table's DSP block from the compiled tp17.C (fixedpoint/c/tp17.c with dsp56800e.h)",
+    )
     section.check("seed DSP block: 24 values vs compiled tp17.C", np.abs(c - SEED_DSP_MM).max(), 0.0, "mm")
     counts = op_counts_tp17()
     model = scalar.tp17_op_counts()
     diff = sum(abs(counts[k] - model[k]) for k in set(counts) | set(model))
-    section.check("tp17.C instrumented intrinsic calls per pass vs the cycle model's counts (sum of |Δ|)", diff, 0, "calls")
+    section.check(
+        "tp17.C instrumented intrinsic calls per pass vs the cycle model's counts (sum of |Δ|)", diff, 0, "calls"
+    )
 
 
 def _workspace(section, n: int) -> list:
@@ -59,13 +75,32 @@ def _workspace(section, n: int) -> list:
         c, nsat = compile_generated(g).ik(w)
         d_ce = np.abs(c - emu).max()
         err = c * cfg.ik_format.length_lsb - leg_lengths(p, q)
-        rows.append([name, n, int(np.any(c != emu, axis=1).sum()), int(d_ce), f"{np.abs(err).max() * 1e3:.3f}",
-                     f"{np.sqrt(np.mean(err**2)) * 1e3:.3f}", int((nsat > 0).sum())])
+        rows.append(
+            [
+                name,
+                n,
+                int(np.any(c != emu, axis=1).sum()),
+                int(d_ce),
+                f"{np.abs(err).max() * 1e3:.3f}",
+                f"{np.sqrt(np.mean(err**2)) * 1e3:.3f}",
+                int((nsat > 0).sum()),
+            ]
+        )
         section.check(f"{name}: generated sd_ik vs emulation, {n} workspace poses (worst LSB)", d_ce, 0, "LSB")
-    section.table(["preset", "poses", "differing", "worst C − emulation (LSB)", "max |C − float| (mm)", "RMS C − float (mm)",
-                   "poses with saturation"], rows,
-                  caption="The generated firmware's sd_ik (16-bit words, 1 mm LSB, tfr16) over random workspace poses "
-                          "(within stroke, ±10 % of the stroke, ±15°): bit-identical with the emulation; its error against the float IK")
+    section.table(
+        [
+            "preset",
+            "poses",
+            "differing",
+            "worst C − emulation (LSB)",
+            "max |C − float| (mm)",
+            "RMS C − float (mm)",
+            "poses with saturation",
+        ],
+        rows,
+        caption="The generated firmware's sd_ik (16-bit words, 1 mm LSB, tfr16) over random workspace poses "
+        "(within stroke, ±10 % of the stroke, ±15°): bit-identical with the emulation; its error against the float IK",
+    )
     return gens
 
 
@@ -85,16 +120,25 @@ def _saturation_map(section, quick: bool) -> None:
     w = pose_words(q, fmt)
     c, nsat = m.ik(w)
     emu = leg_length_words(p, w, fmt, cfg.convention)
-    section.check("saturation map: sd_ik vs emulation on the grid, saturating poses included (worst LSB)", np.abs(c - emu).max(), 0, "LSB")
+    section.check(
+        "saturation map: sd_ik vs emulation on the grid, saturating poses included (worst LSB)",
+        np.abs(c - emu).max(),
+        0,
+        "LSB",
+    )
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     im = ax.pcolormesh(X, Z, nsat, shading="auto", cmap="magma_r")
     fig.colorbar(im, ax=ax, label="saturations in one sd_ik")
     ax.set_xlabel("px [m]")
     ax.set_ylabel("pz [m]")
     ax.set_title("utn-dynamic, 16-bit words of 0.1 mm, pitch 20°")
-    section.figure(fig, "firmware_saturation_map", "Where the generated sd_ik saturates (the count it returns): outside the "
-                   "circle the leg lengths exceed the word (32767 LSB = 3.28 m) and the square root clips; beyond ±3.28 m the position "
-                   "words are already clipped on the way in and the leg-vector sums clip too. The C equals the emulation everywhere")
+    section.figure(
+        fig,
+        "firmware_saturation_map",
+        "Where the generated sd_ik saturates (the count it returns): outside the "
+        "circle the leg lengths exceed the word (32767 LSB = 3.28 m) and the square root clips; beyond ±3.28 m the position "
+        "words are already clipped on the way in and the leg-vector sums clip too. The C equals the emulation everywhere",
+    )
 
 
 def _instrumented(section, gens) -> None:
@@ -111,10 +155,18 @@ def _instrumented(section, gens) -> None:
     for ops in (PID_OPS_PER_LEG, FEEDFORWARD_OPS_PER_LEG):
         for k, v in ops.items():
             model[k] += 6 * v
-    section.check(f"{p.name}: instrumented sd_ik operation counts vs the README's cycle model (sum of |Δ|)",
-                  sum(abs(ik[k] - g.ik_ops[k]) for k in set(ik) | set(g.ik_ops)), 0, "calls")
-    section.check(f"{p.name}: instrumented sd_tick operations beyond the IK vs control.PID_OPS_PER_LEG + FEEDFORWARD_OPS_PER_LEG (sum of |Δ|)",
-                  sum(abs(tick[k] - model[k]) for k in set(tick) | set(model)), 0, "calls")
+    section.check(
+        f"{p.name}: instrumented sd_ik operation counts vs the README's cycle model (sum of |Δ|)",
+        sum(abs(ik[k] - g.ik_ops[k]) for k in set(ik) | set(g.ik_ops)),
+        0,
+        "calls",
+    )
+    section.check(
+        f"{p.name}: instrumented sd_tick operations beyond the IK vs control.PID_OPS_PER_LEG + FEEDFORWARD_OPS_PER_LEG (sum of |Δ|)",
+        sum(abs(tick[k] - model[k]) for k in set(tick) | set(model)),
+        0,
+        "calls",
+    )
 
 
 def _files(section, gens) -> None:
@@ -122,14 +174,26 @@ def _files(section, gens) -> None:
     for p, cfg, g in gens:
         ik = g.ik_cycles
         sizes = ", ".join(f"{k} {len(v.encode())} B" for k, v in g.files.items())
-        rows.append([p.name, sizes, f"{ik.cycles:.0f} ({ik.microseconds:.1f} µs)",
-                     f"{g.tick_cycles:.0f} ({g.tick_cycles / cfg.timing.clock_hz * 1e6:.1f} µs)",
-                     f"kp {cfg.gains.kp:.4g}, ki {cfg.gains.ki:.4g}, kd {cfg.gains.kd:.4g}"])
-    section.table(["preset", "generated files", "sd_ik cycles", "sd_tick cycles", "designed gains (SI)"], rows,
-                  caption="`stewart-drake firmware generate --platform NAME`: the files, and the cycle estimates (MC56F8367 at 60 MHz, "
-                          "fixedpoint.cycles table; the generated IK skips the firmware's run-time double conversions and dead anchors)")
-    section.text("Each module compiles warning-free with -std=c99 -Wall -Wextra -Werror -pedantic under: "
-                 + ", ".join(f"{c.name} ({c.version})" for c in compilers()) + ".")
+        rows.append(
+            [
+                p.name,
+                sizes,
+                f"{ik.cycles:.0f} ({ik.microseconds:.1f} µs)",
+                f"{g.tick_cycles:.0f} ({g.tick_cycles / cfg.timing.clock_hz * 1e6:.1f} µs)",
+                f"kp {cfg.gains.kp:.4g}, ki {cfg.gains.ki:.4g}, kd {cfg.gains.kd:.4g}",
+            ]
+        )
+    section.table(
+        ["preset", "generated files", "sd_ik cycles", "sd_tick cycles", "designed gains (SI)"],
+        rows,
+        caption="`stewart-drake firmware generate --platform NAME`: the files, and the cycle estimates (MC56F8367 at 60 MHz, "
+        "fixedpoint.cycles table; the generated IK skips the firmware's run-time double conversions and dead anchors)",
+    )
+    section.text(
+        "Each module compiles warning-free with -std=c99 -Wall -Wextra -Werror -pedantic under: "
+        + ", ".join(f"{c.name} ({c.version})" for c in compilers())
+        + "."
+    )
 
 
 def _sil(section, quick: bool) -> None:
@@ -144,13 +208,26 @@ def _sil(section, quick: bool) -> None:
         logs[eng] = sim.run(duration)
         wall[eng] = time.perf_counter() - t0
     a, b = logs["python"], logs["c"]
-    worst = max(float(np.abs(getattr(a, k) - getattr(b, k)).max()) for k in ("lengths", "command", "setpoint", "force", "pose"))
-    section.check(f"closed loop, seed trajectory {duration:g} s: C engine logs vs Python engine logs (worst |Δ|)", worst, 0.0)
-    section.table(["engine", "wall time (s)", "real-time factor", "max leg error (mm)"],
-                  [[eng, f"{wall[eng]:.2f}", f"{duration / wall[eng]:.2f}",
-                    f"{np.abs(lg.length_error(_traj(), p)).max() * 1e3:.3f}"] for eng, lg in logs.items()],
-                  caption="The fixed-point controller at 1 kHz driving the Drake plant: the Python law vs the generated firmware's sd_tick "
-                          "(same LeafSystem ports, timing and logs); times from this run")
+    worst = max(
+        float(np.abs(getattr(a, k) - getattr(b, k)).max()) for k in ("lengths", "command", "setpoint", "force", "pose")
+    )
+    section.check(
+        f"closed loop, seed trajectory {duration:g} s: C engine logs vs Python engine logs (worst |Δ|)", worst, 0.0
+    )
+    section.table(
+        ["engine", "wall time (s)", "real-time factor", "max leg error (mm)"],
+        [
+            [
+                eng,
+                f"{wall[eng]:.2f}",
+                f"{duration / wall[eng]:.2f}",
+                f"{np.abs(lg.length_error(_traj(), p)).max() * 1e3:.3f}",
+            ]
+            for eng, lg in logs.items()
+        ],
+        caption="The fixed-point controller at 1 kHz driving the Drake plant: the Python law vs the generated firmware's sd_tick "
+        "(same LeafSystem ports, timing and logs); times from this run",
+    )
     fig, ax = plt.subplots(figsize=(8, 3))
     ea, eb = a.length_error(_traj(), p), b.length_error(_traj(), p)
     ax.plot(a.t, ea * 1e3, lw=2.5, alpha=0.4)
@@ -158,7 +235,11 @@ def _sil(section, quick: bool) -> None:
     ax.plot(b.t, eb * 1e3, "--", lw=0.8)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("leg error [mm]")
-    section.figure(fig, "firmware_sil", "Leg-length errors with the Python engine (wide, faint) and the C engine (dashed): the same curves, bit for bit")
+    section.figure(
+        fig,
+        "firmware_sil",
+        "Leg-length errors with the Python engine (wide, faint) and the C engine (dashed): the same curves, bit for bit",
+    )
 
 
 def _traj():

@@ -15,12 +15,12 @@ import time
 
 import numpy as np
 
-from stewart_drake.core.newton_fk import forward_kinematics, jacobian_analysis
-from stewart_drake.core.sampling import random_poses
-from stewart_drake.core.reference_platforms import dietmaier_platform, general_platform
-from stewart_drake.drake.program_fk import ProgramFK, assembly_modes
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
+from stewart_drake.core.newton_fk import forward_kinematics, jacobian_analysis
+from stewart_drake.core.reference_platforms import dietmaier_platform, general_platform
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.drake.program_fk import ProgramFK, assembly_modes
 from stewart_drake.report import run_standalone
 
 TITLE = "Forward kinematics: round trips, assembly modes, timing"
@@ -109,22 +109,35 @@ def build(section) -> None:
         )
         section.check(
             f"{name}: IK→FK from home, {int(m.sum())} poses in home's singularity-free region, position error",
-            res["pos_err"][m].max(), ROUND_TRIP_TOL, "m",
+            res["pos_err"][m].max(),
+            ROUND_TRIP_TOL,
+            "m",
         )
         section.check(f"{name}: IK→FK from home, angle error", res["ang_err"][m].max(), ROUND_TRIP_TOL, "rad")
         section.check(f"{name}: Newton failures in home's region", int((~res["converged"][m]).sum()), 0)
         if res["beyond_near_err"] is not None:
             section.check(
                 f"{name}: poses across a singularity, FK started 0.1 mm / 0.1 mrad away, pose error",
-                res["beyond_near_err"].max(), ROUND_TRIP_TOL, "m|rad",
+                res["beyond_near_err"].max(),
+                ROUND_TRIP_TOL,
+                "m|rad",
             )
     section.table(
-        ["preset", "poses", "in home region", "max pos err (m)", "max angle err (rad)", "mean iters",
-         "across a singularity (κ₂ ≤ 1e3)", "→ FK from home gave another mode", "err when started nearby",
-         "near a singularity (not checked)"],
+        [
+            "preset",
+            "poses",
+            "in home region",
+            "max pos err (m)",
+            "max angle err (rad)",
+            "mean iters",
+            "across a singularity (κ₂ ≤ 1e3)",
+            "→ FK from home gave another mode",
+            "err when started nearby",
+            "near a singularity (not checked)",
+        ],
         rows,
-        caption=f"IK→FK round trips: poses sampled around home (±0.3 stroke span, angles ±20°), within stroke, "
-        f"plate above the base; Newton tol 1e-13 m. 'Home region': same sign of det J⁻¹ as home and κ₂ ≤ 1e4.",
+        caption="IK→FK round trips: poses sampled around home (±0.3 stroke span, angles ±20°), within stroke, "
+        "plate above the base; Newton tol 1e-13 m. 'Home region': same sign of det J⁻¹ as home and κ₂ ≤ 1e4.",
     )
     section.text(
         "The wide, low utn-kinematic platform (home height 100 mm, plate side 612.5 mm) has sampled poses "
@@ -144,7 +157,9 @@ def build(section) -> None:
         ax.set_xlabel(unit)
         ax.set_ylabel("poses")
         ax.legend(fontsize=7)
-    section.figure(fig, "fk_round_trip_hist", "IK→FK round-trip error per preset (poses in home's singularity-free region)")
+    section.figure(
+        fig, "fk_round_trip_hist", "IK→FK round-trip error per preset (poses in home's singularity-free region)"
+    )
 
     # ---- assembly modes ---------------------------------------------------------------------
     p = load_preset("utn-dynamic")
@@ -152,18 +167,33 @@ def build(section) -> None:
     am = assembly_modes(p, L)
     M = np.array([1.0, 1.0, -1.0])
     mirror_gap = max(
-        min(np.abs(o.position - m.position * M).max() + np.abs(o.rotation - m.rotation * M[:, None] * M).max() for o in am.modes)
+        min(
+            np.abs(o.position - m.position * M).max() + np.abs(o.rotation - m.rotation * M[:, None] * M).max()
+            for o in am.modes
+        )
         for m in am.modes
     )
     ik_err = np.abs(leg_lengths(p, am.poses()) - L).max()
-    section.check("utn-dynamic at home lengths: assembly modes found vs the 3-6 bound of 16", am.max_solutions - len(am), 0, "modes")
+    section.check(
+        "utn-dynamic at home lengths: assembly modes found vs the 3-6 bound of 16",
+        am.max_solutions - len(am),
+        0,
+        "modes",
+    )
     section.check("utn-dynamic modes: set closed under the mirror about the base plane", mirror_gap, 1e-9)
     section.check("utn-dynamic modes: IK of every mode vs the input lengths", ik_err, 1e-12, "m")
     section.table(
         ["#", "px (m)", "py (m)", "pz (m)", "α (°)", "β (°)", "γ (°)", "det J⁻¹", "κ₂", "above base", "certified"],
         [
-            [k + 1, *[f"{v:.4f}" for v in m.pose[:3]], *[f"{v:.2f}" for v in np.degrees(m.pose[3:])],
-             "+" if m.det_sign > 0 else "−", f"{m.condition:.3g}", "yes" if m.above_base else "no", "yes" if m.certified else "no"]
+            [
+                k + 1,
+                *[f"{v:.4f}" for v in m.pose[:3]],
+                *[f"{v:.2f}" for v in np.degrees(m.pose[3:])],
+                "+" if m.det_sign > 0 else "−",
+                f"{m.condition:.3g}",
+                "yes" if m.above_base else "no",
+                "yes" if m.certified else "no",
+            ]
             for k, m in enumerate(am.modes)
         ],
         caption=f"utn-dynamic, all legs {L[0]:.4f} m (home): {len(am)} modes of at most {am.max_solutions} "
@@ -180,10 +210,19 @@ def build(section) -> None:
         ax.set_box_aspect((1, 1, 1.2))
         ax.set_xlim(-0.35, 0.35), ax.set_ylim(-0.35, 0.35), ax.set_zlim(0, 0.75)
         ax.tick_params(labelsize=6)
-        ax.set_xticks([-0.3, 0, 0.3]), ax.set_yticks([-0.3, 0, 0.3]), ax.set_zticks([0, 0.35, 0.7])  # no overlapping ticks
-        ax.set_xlabel("x [m]", fontsize=7, labelpad=-4), ax.set_ylabel("y [m]", fontsize=7, labelpad=-4), ax.set_zlabel("z [m]", fontsize=7, labelpad=-4)
+        (
+            ax.set_xticks([-0.3, 0, 0.3]),
+            ax.set_yticks([-0.3, 0, 0.3]),
+            ax.set_zticks([0, 0.35, 0.7]),
+        )  # no overlapping ticks
+        (
+            ax.set_xlabel("x [m]", fontsize=7, labelpad=-4),
+            ax.set_ylabel("y [m]", fontsize=7, labelpad=-4),
+            ax.set_zlabel("z [m]", fontsize=7, labelpad=-4),
+        )
     section.figure(
-        fig, "fk_assembly_modes_utn_dynamic",
+        fig,
+        "fk_assembly_modes_utn_dynamic",
         "The assembly modes above the base of utn-dynamic at its home lengths (blue: det J⁻¹ > 0, red: < 0); "
         "each has a mirror image below the base plane.",
     )
@@ -202,7 +241,8 @@ def build(section) -> None:
     ax.set_xlabel("x [m]"), ax.set_ylabel("y [m]"), ax.set_zlabel("z [m]")
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, 1.08))
     section.figure(
-        fig, "fk_assembly_modes_dietmaier",
+        fig,
+        "fk_assembly_modes_dietmaier",
         f"Dietmaier's 1998 geometry: the plate origin of each of the {len(dm)} real assembly modes found "
         f"(SNOPT-confirmed: {sum(m.certified for m in dm.modes)}).",
     )
@@ -229,12 +269,37 @@ def build(section) -> None:
     section.table(
         ["operation", "time", "per solve", "notes"],
         [
-            ["Newton FK, batch", f"{t_newton:.3f} s for {nb}", f"{1e6 * t_newton / nb:.1f} µs", f"{nb / t_newton:.3g} solves/s, gonzalez-dutra-2009"],
-            ["MathematicalProgram, SNOPT (quaternion)", "", f"{1e3 * t_prog:.2f} ms", "from a guess 2 cm / 0.1 rad off"],
+            [
+                "Newton FK, batch",
+                f"{t_newton:.3f} s for {nb}",
+                f"{1e6 * t_newton / nb:.1f} µs",
+                f"{nb / t_newton:.3g} solves/s, gonzalez-dutra-2009",
+            ],
+            [
+                "MathematicalProgram, SNOPT (quaternion)",
+                "",
+                f"{1e3 * t_prog:.2f} ms",
+                "from a guess 2 cm / 0.1 rad off",
+            ],
             ["MathematicalProgram, IPOPT (quaternion)", "", f"{1e3 * t_ipopt:.2f} ms", "same"],
-            ["all modes, utn-dynamic home", f"{am.elapsed_s:.3f} s", "", f"{len(am)}/{am.max_solutions} modes, {am.starts} starts"],
-            ["all modes, Dietmaier 1998", f"{dm.elapsed_s:.3f} s", "", f"{len(dm)}/{dm.max_solutions} modes, {dm.starts} starts"],
-            ["all modes, general 6-6 (seed 4)", f"{t_gen:.3f} s", "", f"{len(ga)} real modes found (not provably complete)"],
+            [
+                "all modes, utn-dynamic home",
+                f"{am.elapsed_s:.3f} s",
+                "",
+                f"{len(am)}/{am.max_solutions} modes, {am.starts} starts",
+            ],
+            [
+                "all modes, Dietmaier 1998",
+                f"{dm.elapsed_s:.3f} s",
+                "",
+                f"{len(dm)}/{dm.max_solutions} modes, {dm.starts} starts",
+            ],
+            [
+                "all modes, general 6-6 (seed 4)",
+                f"{t_gen:.3f} s",
+                "",
+                f"{len(ga)} real modes found (not provably complete)",
+            ],
         ],
         caption="Timing on this machine, one core (absolute figures vary between machines; see benchmarks/bench_fk.py)",
     )
@@ -282,16 +347,44 @@ def homotopy_section(section, known) -> None:
         c = r.counts()
         gap = _mode_gap(r.modes, am.modes)
         n_cert = sum(m.certified for m in r.modes)
-        rows.append([label, r.kind, r.max_solutions, c["real"], c["complex"], c["infinity"], c["singular"], c["failed"],
-                     "yes" if r.complete else "NO", f"{n_cert}/{len(r.modes)}",
-                     f"{max([m.radius for m in r.modes] + [0.0]):.1e}", f"{max([m.position_bound for m in r.modes] + [0.0]):.1e}",
-                     len(am), f"{1e3 * dt:.0f}"])
+        rows.append(
+            [
+                label,
+                r.kind,
+                r.max_solutions,
+                c["real"],
+                c["complex"],
+                c["infinity"],
+                c["singular"],
+                c["failed"],
+                "yes" if r.complete else "NO",
+                f"{n_cert}/{len(r.modes)}",
+                f"{max([m.radius for m in r.modes] + [0.0]):.1e}",
+                f"{max([m.position_bound for m in r.modes] + [0.0]):.1e}",
+                len(am),
+                f"{1e3 * dt:.0f}",
+            ]
+        )
         section.check(f"homotopy, {label}: failed paths", c["failed"], 0, "paths")
         section.check(f"homotopy, {label}: real modes vs the multi-start's (largest mismatch)", gap, 1e-8)
         section.check(f"homotopy, {label}: uncertified real modes", len(r.modes) - n_cert, 0, "modes")
     section.table(
-        ["case", "class", "paths", "real", "complex", "infinity", "singular", "failed", "complete", "certified",
-         "max radius", "max position bound (m)", "multi-start modes", "time (ms)"],
+        [
+            "case",
+            "class",
+            "paths",
+            "real",
+            "complex",
+            "infinity",
+            "singular",
+            "failed",
+            "complete",
+            "certified",
+            "max radius",
+            "max position bound (m)",
+            "multi-start modes",
+            "time (ms)",
+        ],
         rows,
         caption="Path classification of the complete homotopy solver; radius: Krawczyk existence radius in Study "
         "coordinates (e·e = 1); position bound: the implied bound on the plate position; time includes the "

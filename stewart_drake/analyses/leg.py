@@ -5,8 +5,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.leg3r import (SEED_FIXES, SEED_FIX_TEXT, Leg3R, foot, foot_jacobian, inverse_kinematics,
-                               inverse_kinematics_3r, joint_points, random_configurations, seed_inverse_kinematics)
+from stewart_drake.core.leg3r import (
+    SEED_FIX_TEXT,
+    SEED_FIXES,
+    Leg3R,
+    foot,
+    foot_jacobian,
+    inverse_kinematics,
+    inverse_kinematics_3r,
+    joint_points,
+    random_configurations,
+    seed_inverse_kinematics,
+)
 from stewart_drake.core.rotations import wrap_angle
 from stewart_drake.drake.leg_model import drake_fk_errors, drake_ik
 from stewart_drake.report import run_standalone
@@ -36,10 +46,19 @@ def build(section) -> None:
         d = np.abs(wrap_angle(qd - qn)).max(1)
         bound = np.linalg.norm(np.linalg.inv(foot_jacobian(leg, qn)), 2, axis=(-2, -1)) * gap
         section.check(f"branch {b}: IK → FK round trip ({n} targets)", rt, 1e-12, "m")
-        section.check(f"branch {b}: Drake IK angles minus 2·||J⁻¹||·(Drake's foot gap)", float(np.max(d - 2 * bound)), 1e-12, "rad")
+        section.check(
+            f"branch {b}: Drake IK angles minus 2·||J⁻¹||·(Drake's foot gap)",
+            float(np.max(d - 2 * bound)),
+            1e-12,
+            "rad",
+        )
         rows.append([b, rt, d.max(), gap.max()])
-    section.table(["branch", "IK→FK (m)", "|q_Drake − q_ours| (rad)", "Drake foot gap (m)"], rows,
-                  caption="Geometric IK vs Drake's InverseKinematics (SNOPT, knee boxed to the branch)", fmt="{:.3g}")
+    section.table(
+        ["branch", "IK→FK (m)", "|q_Drake − q_ours| (rad)", "Drake foot gap (m)"],
+        rows,
+        caption="Geometric IK vs Drake's InverseKinematics (SNOPT, knee boxed to the branch)",
+        fmt="{:.3g}",
+    )
 
     # The seed's inverse kinematics, fix by fix.
     f = foot(leg, q)
@@ -48,12 +67,27 @@ def build(section) -> None:
         s = seed_inverse_kinematics(leg, f, "a", SEED_FIXES[:k])
         ok = np.all(np.isfinite(s), axis=1)
         err = np.hypot(*(foot(leg, s[ok]) - f[ok])[:, :2].T)
-        rows.append(["as printed" if k == 0 else "+ " + SEED_FIX_TEXT[SEED_FIXES[k - 1]], f"{ok.mean() * 100:.0f}%",
-                     float(err.max() * 1e3) if ok.any() else float("nan"), float(np.median(err) * 1e3) if ok.any() else float("nan")])
-    section.table(["seed eqs. 13-20", "targets with a real solution", "worst foot error (mm)", "median (mm)"], rows,
-                  caption="Branch a, targets from random configurations: each correction is needed", fmt="{:.3g}")
+        rows.append(
+            [
+                "as printed" if k == 0 else "+ " + SEED_FIX_TEXT[SEED_FIXES[k - 1]],
+                f"{ok.mean() * 100:.0f}%",
+                float(err.max() * 1e3) if ok.any() else float("nan"),
+                float(np.median(err) * 1e3) if ok.any() else float("nan"),
+            ]
+        )
+    section.table(
+        ["seed eqs. 13-20", "targets with a real solution", "worst foot error (mm)", "median (mm)"],
+        rows,
+        caption="Branch a, targets from random configurations: each correction is needed",
+        fmt="{:.3g}",
+    )
     full = seed_inverse_kinematics(leg, f, "a", SEED_FIXES)
-    section.check("seed IK with every fix = inverse_kinematics_3r", float(np.abs(wrap_angle(full - inverse_kinematics_3r(leg, f, "a"))).max()), 1e-12, "rad")
+    section.check(
+        "seed IK with every fix = inverse_kinematics_3r",
+        float(np.abs(wrap_angle(full - inverse_kinematics_3r(leg, f, "a"))).max()),
+        1e-12,
+        "rad",
+    )
 
     # Workspace.
     m = 60 if section.quick else 200
@@ -74,7 +108,9 @@ def build(section) -> None:
     ax.set_xlabel("Px (mm)")
     ax.set_ylabel("Py (mm)")
     ax.legend(fontsize=8, markerscale=6)
-    section.figure(fig, "leg_workspace", "Foot workspace within the joint limits; dotted: the reach annulus without limits")
+    section.figure(
+        fig, "leg_workspace", "Foot workspace within the joint limits; dotted: the reach annulus without limits"
+    )
 
 
 def main(argv=None):

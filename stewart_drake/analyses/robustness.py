@@ -17,8 +17,15 @@ TITLE = "Robustness: Monte Carlo over tolerances, sensor, timing and payload"
 ORDER = 95
 
 PLATFORM = "utn-dynamic"
-VARY = ["anchor=±0.5mm", "sensor_resolution=10um", "sensor_noise=2um", "latency_jitter=200us", "payload_mass=±20%",
-        "actuator_lag=1.5ms..2.5ms", "gain_scale=±10%"]
+VARY = [
+    "anchor=±0.5mm",
+    "sensor_resolution=10um",
+    "sensor_noise=2um",
+    "latency_jitter=200us",
+    "payload_mass=±20%",
+    "actuator_lag=1.5ms..2.5ms",
+    "gain_scale=±10%",
+]
 
 
 def build(section) -> None:
@@ -40,22 +47,38 @@ def build(section) -> None:
     )
     header = ["metric", "p5", "p50", "p95", "p99", "max"]
     table = []
-    for m, scale, unit in (("max_leg_error_m", 1e3, "mm"), ("rms_leg_error_m", 1e3, "mm"), ("max_position_error_m", 1e3, "mm"),
-                           ("max_angle_error_rad", 180 / np.pi, "deg")):
+    for m, scale, unit in (
+        ("max_leg_error_m", 1e3, "mm"),
+        ("rms_leg_error_m", 1e3, "mm"),
+        ("max_position_error_m", 1e3, "mm"),
+        ("max_angle_error_rad", 180 / np.pi, "deg"),
+    ):
         v = np.array([r[m] for r in rows], float) * scale
-        table.append([f"{m.rsplit('_', 1)[0]} [{unit}]", *[float(np.percentile(v, q)) for q in (5, 50, 95, 99)], float(v.max())])
+        table.append(
+            [f"{m.rsplit('_', 1)[0]} [{unit}]", *[float(np.percentile(v, q)) for q in (5, 50, 95, 99)], float(v.max())]
+        )
     section.table(header, table, caption=f"Distribution over {runs} runs", fmt="{:.4g}")
     lost = [r["run"] for r in rows if r["lost_tracking"]]
-    section.text(f"Runs that lost tracking (a leg more than 5 mm off, or a failed simulation): {len(lost)} of {runs}"
-                 + (f" ({', '.join(map(str, lost))})." if lost else "."))
+    section.text(
+        f"Runs that lost tracking (a leg more than 5 mm off, or a failed simulation): {len(lost)} of {runs}"
+        + (f" ({', '.join(map(str, lost))})." if lost else ".")
+    )
     ranking = {m: sensitivity(rows, m) for m in ("max_leg_error_m", "max_position_error_m")}
     names = [d["parameter"] for d in ranking["max_leg_error_m"][:10]]
     rho = {m: {d["parameter"]: d["spearman"] for d in r} for m, r in ranking.items()}
-    section.table(["parameter", "ρ with max leg error", "ρ with max position error"],
-                  [[n, rho["max_leg_error_m"].get(n, float("nan")), rho["max_position_error_m"].get(n, float("nan"))] for n in names],
-                  caption="Sensitivity: Spearman rank correlation of each drawn parameter with the error (ten largest |ρ|)", fmt="{:+.3f}")
+    section.table(
+        ["parameter", "ρ with max leg error", "ρ with max position error"],
+        [
+            [n, rho["max_leg_error_m"].get(n, float("nan")), rho["max_position_error_m"].get(n, float("nan"))]
+            for n in names
+        ],
+        caption="Sensitivity: Spearman rank correlation of each drawn parameter with the error (ten largest |ρ|)",
+        fmt="{:+.3f}",
+    )
     fig, ax = plt.subplots(1, 3, figsize=(13, 3.5))
-    for a, (m, label) in zip(ax[:2], [("max_leg_error_m", "max leg error [mm]"), ("max_position_error_m", "max position error [mm]")]):
+    for a, (m, label) in zip(
+        ax[:2], [("max_leg_error_m", "max leg error [mm]"), ("max_position_error_m", "max position error [mm]")]
+    ):
         a.hist(np.array([r[m] for r in rows]) * 1e3, bins=max(5, runs // 5))
         a.set_xlabel(label)
         a.set_ylabel("runs")
@@ -65,7 +88,11 @@ def build(section) -> None:
         ax[2].set_xlabel(names[0])
         ax[2].set_ylabel("max leg error [mm]")
         ax[2].set_title(f"most influential (ρ = {rho['max_leg_error_m'][names[0]]:+.2f})")
-    section.figure(fig, "robustness", "Distributions of the worst leg and position errors, and the leg error against the most influential parameter.")
+    section.figure(
+        fig,
+        "robustness",
+        "Distributions of the worst leg and position errors, and the leg error against the most influential parameter.",
+    )
     worst = max(rows, key=lambda r: r["max_leg_error_m"])
     again = run_scenario(study, worst["run"])
     diff = max(abs(again[m] - worst[m]) for m in METRICS)

@@ -143,7 +143,9 @@ def build(section) -> None:
         ax.set_ylabel("difference (mm)")
         ax.set_xlabel("seed table cell (legs 1–6 of each pose)")
         ax.legend(fontsize=8)
-    section.figure(fig, "seed_table_matlab", "IK minus the seed's Matlab and DSP blocks, legs 1–6 per pose, under both readings")
+    section.figure(
+        fig, "seed_table_matlab", "IK minus the seed's Matlab and DSP blocks, legs 1–6 per pose, under both readings"
+    )
 
 
 def main(argv=None):

@@ -3,8 +3,6 @@ the float IK and the Matlab block beside it, and the DSP's differences traced to
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from stewart_drake.analyses import seed_table
@@ -28,9 +26,17 @@ def dsp_block() -> dict:
     q[:, 3:] /= 180.0  # 18° -> 0.1 (of pi), as in tp17.C
     emu = tp17_leg_lengths(q)
     stages = tp17_error_stages(q)
-    return {"poses": q, "emulated": emu, "seed_dsp": st.SEED_DSP_MM, "seed_matlab": st.SEED_MATLAB_MM,
-            "float_deg": stages["float"], "float_pi_as_rad": st.matlab_block_model()["pi-fraction-as-radians"]["lengths_mm"],
-            "stages": stages["stages"], "trace": tp17_trace(q), "labels": st.SEED_POSES_MM_DEG}
+    return {
+        "poses": q,
+        "emulated": emu,
+        "seed_dsp": st.SEED_DSP_MM,
+        "seed_matlab": st.SEED_MATLAB_MM,
+        "float_deg": stages["float"],
+        "float_pi_as_rad": st.matlab_block_model()["pi-fraction-as-radians"]["lengths_mm"],
+        "stages": stages["stages"],
+        "trace": tp17_trace(q),
+        "labels": st.SEED_POSES_MM_DEG,
+    }
 
 
 def build(section) -> None:
@@ -55,7 +61,9 @@ def build(section) -> None:
         rows.append(["", "float IK, angles in degrees (a = 612.5)"] + [f"{v:.2f}" for v in fl[k]])
         rows.append(["", "seed Matlab"] + [f"{v:.0f}" for v in r["seed_matlab"][k]])
         rows.append(["", "float IK, π-fraction read as rad"] + [f"{v:.2f}" for v in r["float_pi_as_rad"][k]])
-    section.table(header, rows, caption="The seed table's two blocks, the emulation and the float IK under both readings (mm)")
+    section.table(
+        header, rows, caption="The seed table's two blocks, the emulation and the float IK under both readings (mm)"
+    )
     section.check("seed DSP block: the 24 values vs the bit-exact emulation of tp17.C", np.abs(diff).max(), 0.0, "mm")
     worst = np.abs(emu - fl).max()
     section.check("emulated DSP vs float IK with the angles in degrees (fixed-point error)", worst, 6.3, "mm")
@@ -109,7 +117,11 @@ def build(section) -> None:
     ax.set_ylabel("DSP − float leg length (mm)")
     ax.set_xlabel("seed table cell (legs 1–6 of each pose)")
     ax.legend(fontsize=7, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.22))  # below the axes, off the bars
-    section.figure(fig, "seed_table_dsp_stages", "DSP − float IK per leg (legs 1–6 per pose), stacked by the operation that causes it")
+    section.figure(
+        fig,
+        "seed_table_dsp_stages",
+        "DSP − float IK per leg (legs 1–6 per pose), stacked by the operation that causes it",
+    )
 
 
 def main(argv=None):

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.report import run_standalone
 from stewart_drake.core.servo import load_servo_hexapod, solve
 from stewart_drake.core.servo_loop import servo_gains, tracking_bounds
 from stewart_drake.drake.servo_model import IK_GAP_TOL_M, compare_with_drake, run_closed_loop, run_controller
+from stewart_drake.report import run_standalone
 
 TITLE = "RC-servo hexapod (seed 002): arm angles and PWM"
 ORDER = 60
@@ -43,11 +43,24 @@ def build(section) -> None:
     section.check("servo SDF frames read back (pivots, anchors, arm length)", r["frames"], 1e-15, "m")
     section.check("Drake IK home joint angles vs eq. 12 alpha0 through the mounting", r["home"], 1e-6, "rad")
     section.check(f"Drake FK rod length at eq. 13-14 pulses ({len(poses)} poses)", r["fk"], 1e-12, "m")
-    section.check(f"Drake InverseKinematics servo angles vs eq. 9 ({len(poses)} poses)", r["ik"], 2 * IK_GAP_TOL_M / (0.5 * h.arm_length), "rad")
-    section.table(["check", "worst"], [["frames (m)", r["frames"]], ["home angles (rad)", r["home"]], ["FK rod length (m)", r["fk"]],
-                                       ["IK angles (rad)", r["ik"]], ["FK with the odd/even sign ignored (m)", r["mirror_fk"]]],
-                  caption="Drake cross-checks; the last row shows the check can fail: without the mirroring the rods are off by millimetres",
-                  fmt="{:.3g}")
+    section.check(
+        f"Drake InverseKinematics servo angles vs eq. 9 ({len(poses)} poses)",
+        r["ik"],
+        2 * IK_GAP_TOL_M / (0.5 * h.arm_length),
+        "rad",
+    )
+    section.table(
+        ["check", "worst"],
+        [
+            ["frames (m)", r["frames"]],
+            ["home angles (rad)", r["home"]],
+            ["FK rod length (m)", r["fk"]],
+            ["IK angles (rad)", r["ik"]],
+            ["FK with the odd/even sign ignored (m)", r["mirror_fk"]],
+        ],
+        caption="Drake cross-checks; the last row shows the check can fail: without the mirroring the rods are off by millimetres",
+        fmt="{:.3g}",
+    )
 
     # A trajectory through the 50 Hz controller with 1 µs quantisation.
     T = 1.0 if section.quick else 4.0
@@ -66,10 +79,16 @@ def build(section) -> None:
     ax[0].legend(ncol=3, fontsize=8)
     ax[1].set_ylabel("pulse (µs), 50 Hz, 1 µs")
     ax[1].set_xlabel("t (s)")
-    section.figure(fig, "servo_trajectory", "Heave ±6 mm, roll ±8°, yaw ±15°: eq. 9 arm angles (top) and the controller's latched pulses (bottom)")
+    section.figure(
+        fig,
+        "servo_trajectory",
+        "Heave ±6 mm, roll ±8°, yaw ±15°: eq. 9 arm angles (top) and the controller's latched pulses (bottom)",
+    )
     sat = int(np.sum(log["status"] > 0))
-    section.text(f"{len(log['t'])} frames logged, {sat} servo-frames clamped or unreachable; pulses span "
-                 f"{log['pulse_us'].min():.0f}–{log['pulse_us'].max():.0f} µs.")
+    section.text(
+        f"{len(log['t'])} frames logged, {sat} servo-frames clamped or unreachable; pulses span "
+        f"{log['pulse_us'].min():.0f}–{log['pulse_us'].max():.0f} µs."
+    )
 
     # The same trajectory with the loop closed: controller → servos (PD, speed limit) → closed-loop plant.
     closed_loop(section, h, t, traj)
@@ -83,7 +102,12 @@ def build(section) -> None:
         plus, minus = axis_limits(h, d, hi), axis_limits(h, -d, hi)
         s = 1e3 if k < 3 else np.degrees(1.0)
         rows.append([AXES[k], -minus * s, plus * s])
-    section.table(["axis", "min", "max"], rows, caption="Reachable range along each axis from home (all servos reachable and within ±45°)", fmt="{:.2f}")
+    section.table(
+        ["axis", "min", "max"],
+        rows,
+        caption="Reachable range along each axis from home (all servos reachable and within ±45°)",
+        fmt="{:.2f}",
+    )
     m = 41 if section.quick else 121
     xs = np.linspace(-0.04, 0.04, m)
     X, Y = np.meshgrid(xs, xs)
@@ -120,12 +144,33 @@ def closed_loop(section, h, t, traj) -> None:
         f"{b['lag'] * 1e3:.1f} ms (20 ms frame + 2 steps + kd/kp) + half a pulse step ({np.degrees(b['quantisation']):.3f}°) + "
         f"sag under load (≤ {np.degrees(b['sag'].max()):.3f}°); on the pose: its Jacobian image."
     )
-    rows = [[AXES[k], abs(err[:, k]).max() * (1e3 if k < 3 else np.degrees(1)), b["pose"][:, k].max() * (1e3 if k < 3 else np.degrees(1))]
-            for k in range(6)]
+    rows = [
+        [
+            AXES[k],
+            abs(err[:, k]).max() * (1e3 if k < 3 else np.degrees(1)),
+            b["pose"][:, k].max() * (1e3 if k < 3 else np.degrees(1)),
+        ]
+        for k in range(6)
+    ]
     rows.append(["arm angle (deg)", np.degrees(arm.max()), np.degrees(b["arm"].max())])
-    section.table(["quantity", "worst error", "worst bound"], rows, caption="Closed-loop tracking, worst over the run", fmt="{:.3f}")
-    section.check("closed-loop arm angle error / its bound (per servo, worst over the run)", (arm.max(0) / b["arm"].max(0)).max(), 1.0, "ratio")
-    section.check("closed-loop pose error / its bound (per axis, worst over the run)", (np.abs(err).max(0) / b["pose"].max(0)).max(), 1.0, "ratio")
+    section.table(
+        ["quantity", "worst error", "worst bound"],
+        rows,
+        caption="Closed-loop tracking, worst over the run",
+        fmt="{:.3f}",
+    )
+    section.check(
+        "closed-loop arm angle error / its bound (per servo, worst over the run)",
+        (arm.max(0) / b["arm"].max(0)).max(),
+        1.0,
+        "ratio",
+    )
+    section.check(
+        "closed-loop pose error / its bound (per axis, worst over the run)",
+        (np.abs(err).max(0) / b["pose"].max(0)).max(),
+        1.0,
+        "ratio",
+    )
     section.check("closed-loop rod constraint violation (t >= 0.1 s)", log["rod_gap"][settled].max(), 1e-5, "m")
     fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     for k, lab in ((0, "x"), (1, "y"), (2, "z")):
@@ -138,9 +183,15 @@ def closed_loop(section, h, t, traj) -> None:
     ax[1].set_ylabel("angle error (deg); dotted: bound")
     ax[1].set_xlabel("t (s)")
     ax[1].legend(fontsize=8)
-    section.figure(fig, "servo_closed_loop", "Closed loop: platform pose (Drake) minus the reference; the 20 ms frame latency dominates")
-    section.text(f"Rod constraint violation: ≤ {log['rod_gap'][settled].max():.2g} m after 0.1 s (start-up kick "
-                 f"{log['rod_gap'].max():.2g} m in the first steps); no servo clamped ({int(np.sum(log['status'] > 0))} servo-samples).")
+    section.figure(
+        fig,
+        "servo_closed_loop",
+        "Closed loop: platform pose (Drake) minus the reference; the 20 ms frame latency dominates",
+    )
+    section.text(
+        f"Rod constraint violation: ≤ {log['rod_gap'][settled].max():.2g} m after 0.1 s (start-up kick "
+        f"{log['rod_gap'].max():.2g} m in the first steps); no servo clamped ({int(np.sum(log['status'] > 0))} servo-samples)."
+    )
 
 
 def main(argv=None):

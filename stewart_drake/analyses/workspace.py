@@ -28,7 +28,14 @@ PRESET = "gonzalez-dutra-2009"
 PAPER_EXTENTS_M = np.array([[-0.391, 0.391], [-0.451, 0.451], [0.394, 0.87]])
 PAPER_HOME_Z_M = 0.644
 # Section V: rotation limits (deg) about the top centroid at mid-stroke, (axis, sign) -> angle.
-PAPER_ROTATION_DEG = {("x", 1): 36.1, ("x", -1): -41.8, ("y", 1): 32.9, ("y", -1): -32.9, ("z", 1): 47.3, ("z", -1): -47.3}
+PAPER_ROTATION_DEG = {
+    ("x", 1): 36.1,
+    ("x", -1): -41.8,
+    ("y", 1): 32.9,
+    ("y", -1): -32.9,
+    ("z", 1): 47.3,
+    ("z", -1): -47.3,
+}
 # Tables 1-3: final leg lengths L1..L6 (m) at the limit.
 PAPER_LENGTHS_M = {
     ("x", 1): [0.641, 0.698, 0.95, 0.95, 0.698, 0.641],
@@ -72,11 +79,24 @@ def build(section) -> None:
             d = w.extents[k, s] - PAPER_EXTENTS_M[k, s]
             worst_ext = max(worst_ext, abs(d))
             rows.append([f"{a} {lab}", PAPER_EXTENTS_M[k, s], round(w.extents[k, s], 4), round(d * 1e3, 2)])
-    rows.append(["Z at L_i = 0.75 m (home)", PAPER_HOME_Z_M, round(p.home_height, 4), round((p.home_height - PAPER_HOME_Z_M) * 1e3, 2)])
-    section.table(["quantity", "paper (m)", "ours (m)", "ours − paper (mm)"], rows, caption="Extents of the workspace at zero orientation")
+    rows.append(
+        [
+            "Z at L_i = 0.75 m (home)",
+            PAPER_HOME_Z_M,
+            round(p.home_height, 4),
+            round((p.home_height - PAPER_HOME_Z_M) * 1e3, 2),
+        ]
+    )
+    section.table(
+        ["quantity", "paper (m)", "ours (m)", "ours − paper (mm)"],
+        rows,
+        caption="Extents of the workspace at zero orientation",
+    )
     section.check("workspace extents X, Y, Z vs the paper (seed 001 §IV)", worst_ext, TOL_EXTENT_M, "m")
     section.check("home pose: every leg 0.75 m at the mid-stroke height", float(np.abs(home - 0.75).max()), 1e-9, "m")
-    section.check("mid-stroke height vs the paper's Z = 0.644 m", abs(p.home_height - PAPER_HOME_Z_M), TOL_EXTENT_M, "m")
+    section.check(
+        "mid-stroke height vs the paper's Z = 0.644 m", abs(p.home_height - PAPER_HOME_Z_M), TOL_EXTENT_M, "m"
+    )
 
     # --- rotation limits and the final lengths
     rows, worst_ang, worst_len = [], 0.0, 0.0
@@ -85,9 +105,20 @@ def build(section) -> None:
         d = math.degrees(r.angle) - ang
         worst_ang = max(worst_ang, abs(d))
         legs = ", ".join(f"L{i}" for i in r.at_limit)
-        rows.append([f"about {key[0].upper()} {'+' if key[1] > 0 else '−'}", ang, round(math.degrees(r.angle), 3), round(d, 3), f"{legs} at L_{r.side}"])
-    section.table(["rotation", "paper (°)", "ours (°)", "ours − paper (°)", "limited by"], rows,
-                  caption="Largest rotation from the mid-stroke pose about the top centroid, each way")
+        rows.append(
+            [
+                f"about {key[0].upper()} {'+' if key[1] > 0 else '−'}",
+                ang,
+                round(math.degrees(r.angle), 3),
+                round(d, 3),
+                f"{legs} at L_{r.side}",
+            ]
+        )
+    section.table(
+        ["rotation", "paper (°)", "ours (°)", "ours − paper (°)", "limited by"],
+        rows,
+        caption="Largest rotation from the mid-stroke pose about the top centroid, each way",
+    )
     section.check("rotation limits about X, Y, Z (±) vs the paper (seed 001 §V)", worst_ang, TOL_ANGLE_DEG, "deg")
     rows = []
     for key, Lp in PAPER_LENGTHS_M.items():
@@ -96,7 +127,11 @@ def build(section) -> None:
         name = f"{key[0].upper()} {PAPER_ROTATION_DEG[key]:+.1f}°"
         rows.append([name, "paper"] + [f"{v:.3f}" for v in Lp])
         rows.append(["", "ours"] + [f"{v:.4f}" for v in L])
-    section.table(["rotation", "source"] + [f"L{i} (m)" for i in range(1, 7)], rows, caption="Final leg lengths at the limit (paper Tables 1–3)")
+    section.table(
+        ["rotation", "source"] + [f"L{i} (m)" for i in range(1, 7)],
+        rows,
+        caption="Final leg lengths at the limit (paper Tables 1–3)",
+    )
     section.check("final leg lengths of the rotation tables vs the paper (Tables 1-3)", worst_len, TOL_LENGTH_M, "m")
     section.text(
         "The paper prints three decimals and truncates (0.949 where the leg is at L_max = 0.95 m). Our limits are "
@@ -109,19 +144,36 @@ def build(section) -> None:
     conv = [(hh, ws.constant_orientation_workspace(p, resolution=hh, refine=False)) for hh in levels] + [(h, w)]
     h_col = 0.004 if quick else 0.001
     v_col = ws.stroke_volume_columns(p, h_col)
-    rows = [[f"{hh * 1e3:g}", round(x.volume * 1e3, 4), round(x.volume_error * 1e3, 4), f"{x.volume_change_2h * 1e3:.2e}",
-             f"{(x.volume - v_col) * 1e3:+.2e}"] for hh, x in conv]
-    section.table(["grid step (mm)", "volume (L)", "error bound (L)", "|V(h) − V(2h)| (L)", "V − V_columns (L)"], rows,
-                  caption=f"Volume under refinement (1 L = 1e-3 m³); V_columns = {v_col * 1e3:.4f} L from exact z-intervals per "
-                          f"(x, y) column on a {h_col * 1e3:g} mm grid")
+    rows = [
+        [
+            f"{hh * 1e3:g}",
+            round(x.volume * 1e3, 4),
+            round(x.volume_error * 1e3, 4),
+            f"{x.volume_change_2h * 1e3:.2e}",
+            f"{(x.volume - v_col) * 1e3:+.2e}",
+        ]
+        for hh, x in conv
+    ]
+    section.table(
+        ["grid step (mm)", "volume (L)", "error bound (L)", "|V(h) − V(2h)| (L)", "V − V_columns (L)"],
+        rows,
+        caption=f"Volume under refinement (1 L = 1e-3 m³); V_columns = {v_col * 1e3:.4f} L from exact z-intervals per "
+        f"(x, y) column on a {h_col * 1e3:g} mm grid",
+    )
     section.text(
         "The paper gives no volume. The error bound is the volume of the cells whose corners disagree (it shrinks "
         "like h); the two independent estimates agree far better than that bound."
     )
-    section.check("grid volume vs the column integral, within the grid's error bound", abs(w.volume - v_col), w.volume_error, "m³")
+    section.check(
+        "grid volume vs the column integral, within the grid's error bound", abs(w.volume - v_col), w.volume_error, "m³"
+    )
     errs = [x.volume_error for _, x in conv]
-    section.check("volume error bound halves with the grid step (ratio of successive bounds vs 0.5)",
-                  max(abs(a / b - 2.0) / 2.0 for a, b in zip(errs[:-1], errs[1:])), 0.1, "")
+    section.check(
+        "volume error bound halves with the grid step (ratio of successive bounds vs 0.5)",
+        max(abs(a / b - 2.0) / 2.0 for a, b in zip(errs[:-1], errs[1:])),
+        0.1,
+        "",
+    )
 
     # --- figures redrawn
     figs = ws.view_figures(w, reference=PAPER_EXTENTS_M, title=PRESET)
@@ -133,18 +185,33 @@ def build(section) -> None:
     }
     for name in ("3d", "top", "front", "side"):
         section.figure(figs[name], f"workspace_{name}", captions[name])
-    section.points3d(w.boundary, "workspace_3d", "The workspace boundary in 3-D, coloured by height", ("X [m]", "Y [m]", "Z [m]"))
+    section.points3d(
+        w.boundary, "workspace_3d", "The workspace boundary in 3-D, coloured by height", ("X [m]", "Y [m]", "Z [m]")
+    )
 
     # --- mobility
-    rows = [[k, m["n"], m["j"], m["sum_f"], m["I_f"], m["m"]] for k in ("SPS", "UPS", "UPU") for m in [ws.stewart_mobility(k)]]
-    section.table(["legs", "n", "j", "Σ f_i", "I_f", "m"], rows, caption="Grübler: m = 6 (n − j − 1) + Σ f_i − I_f; the paper's count is the SPS row")
+    rows = [
+        [k, m["n"], m["j"], m["sum_f"], m["I_f"], m["m"]]
+        for k in ("SPS", "UPS", "UPU")
+        for m in [ws.stewart_mobility(k)]
+    ]
+    section.table(
+        ["legs", "n", "j", "Σ f_i", "I_f", "m"],
+        rows,
+        caption="Grübler: m = 6 (n − j − 1) + Σ f_i − I_f; the paper's count is the SPS row",
+    )
     section.text(
         "The paper calls its legs UPU but counts twelve 3-freedom joints and subtracts I_f = 6 idle spins (legs "
         "spinning about their own axes): that is the SPS count. UPS gives m = 6 with no idle freedom. A strict UPU "
         "count gives m = 0 (each U-P-U leg has only 5 freedoms and locks one plate freedom); UPU hexapods move because "
         "the actuator rod can also turn about its axis (a cylindrical pair), which restores 6."
     )
-    section.check("Grübler mobility of the paper's count (n = 14, j = 18, I_f = 6) = 6", abs(ws.stewart_mobility("SPS")["m"] - 6), 0, "")
+    section.check(
+        "Grübler mobility of the paper's count (n = 14, j = 18, I_f = 6) = 6",
+        abs(ws.stewart_mobility("SPS")["m"] - 6),
+        0,
+        "",
+    )
 
     beyond(section, p, 0.02 if quick else 0.01)
 
@@ -164,11 +231,35 @@ def beyond(section, p, h) -> None:
         removed[name] = w.removed_m3
         rot = ws.orientation_limits(p, limits=lim)
         binding = ", ".join(f"{n} (−{v * 1e3:.2f} L)" for n, v in w.removed_m3.items() if v > 0) or "—"
-        rots = " ".join(f"{r.axis}{'+' if r.sign > 0 else '−'}{abs(math.degrees(r.angle)):.1f}" + ("" if r.limit in (None, "stroke") else f"[{r.limit}]") for r in rot)
-        rows.append([name, round(w.volume * 1e3, 2), f"±{w.extents[0, 1]:.3f}", f"±{w.extents[1, 1]:.3f}",
-                     f"{w.extents[2, 0]:.3f}…{w.extents[2, 1]:.3f}", binding, rots])
-    section.table(["limits", "volume (L)", "X (m)", "Y (m)", "Z (m)", "binding (volume removed)", "rotation limits (°) [limit if not stroke]"],
-                  rows, caption=f"Beyond the paper: optional limits at zero orientation ({h * 1e3:g} mm grid); the stroke always applies")
+        rots = " ".join(
+            f"{r.axis}{'+' if r.sign > 0 else '−'}{abs(math.degrees(r.angle)):.1f}"
+            + ("" if r.limit in (None, "stroke") else f"[{r.limit}]")
+            for r in rot
+        )
+        rows.append(
+            [
+                name,
+                round(w.volume * 1e3, 2),
+                f"±{w.extents[0, 1]:.3f}",
+                f"±{w.extents[1, 1]:.3f}",
+                f"{w.extents[2, 0]:.3f}…{w.extents[2, 1]:.3f}",
+                binding,
+                rots,
+            ]
+        )
+    section.table(
+        [
+            "limits",
+            "volume (L)",
+            "X (m)",
+            "Y (m)",
+            "Z (m)",
+            "binding (volume removed)",
+            "rotation limits (°) [limit if not stroke]",
+        ],
+        rows,
+        caption=f"Beyond the paper: optional limits at zero orientation ({h * 1e3:g} mm grid); the stroke always applies",
+    )
 
     # the largest leg diameter that never collides at zero orientation: min leg-leg distance over the workspace
     b = ws.default_bounds(p)
@@ -187,9 +278,18 @@ def beyond(section, p, h) -> None:
         "at the base the nearest anchors are 151.4 mm apart. The joint cones bind first: a 40° cone removes most of the "
         "rotation range, since at home every leg already leans 30.7° from the normals."
     )
-    section.check("leg collision at Ø 0.10 m removes no volume (non-binding)", removed["leg collision, Ø 0.10 m"]["collision"], 0.0, "m³")
-    section.check("leg collision at Ø 0.145 m binds (removes volume: 1 = it did not), as the minimum leg distance predicts",
-                  float(not (removed["leg collision, Ø 0.145 m"]["collision"] > 0 and 0.10 < dist[0][k] < 0.145)), 0.0, "")
+    section.check(
+        "leg collision at Ø 0.10 m removes no volume (non-binding)",
+        removed["leg collision, Ø 0.10 m"]["collision"],
+        0.0,
+        "m³",
+    )
+    section.check(
+        "leg collision at Ø 0.145 m binds (removes volume: 1 = it did not), as the minimum leg distance predicts",
+        float(not (removed["leg collision, Ø 0.145 m"]["collision"] > 0 and 0.10 < dist[0][k] < 0.145)),
+        0.0,
+        "",
+    )
 
     u, v, kappa = ws.dexterity_map(p, resolution=h)
     import matplotlib.pyplot as plt
@@ -201,7 +301,11 @@ def beyond(section, p, h) -> None:
     ax.set_ylabel("Y (m)")
     ax.set_aspect("equal")
     ax.set_title(f"dexterity at Z = {p.home_height:.3f} m, zero orientation", fontsize=9)
-    section.figure(fig, "workspace_dexterity", "Dexterity map: Jacobian condition number over the workspace slice through the home pose")
+    section.figure(
+        fig,
+        "workspace_dexterity",
+        "Dexterity map: Jacobian condition number over the workspace slice through the home pose",
+    )
 
 
 def main(argv=None):

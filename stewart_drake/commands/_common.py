@@ -7,11 +7,11 @@ import sys
 
 import numpy as np
 
-from stewart_drake.core.output_folder import OutputFolder
-from stewart_drake.errors import UsageError
 from stewart_drake.core.geometry import PRESETS, Platform, load_platform
 from stewart_drake.core.jsonout import dumps_strict
+from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
+from stewart_drake.errors import UsageError
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
@@ -26,9 +26,18 @@ def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
 
 def add_unit_args(parser, length_default: str = "mm", angle_default: str = "deg") -> None:
     """``--length-unit`` and ``--angle-unit``: the units of the pose values on the command line."""
-    parser.add_argument("--length-unit", choices=list(LENGTH_UNITS), default=length_default, help=f"default {length_default}")
-    parser.add_argument("--angle-unit", choices=list(ANGLE_UNITS), default=angle_default, help=f"default {angle_default} ('pi': a fraction of pi)")
-    parser.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention (default utn: Ry·Rx·Rz)")
+    parser.add_argument(
+        "--length-unit", choices=list(LENGTH_UNITS), default=length_default, help=f"default {length_default}"
+    )
+    parser.add_argument(
+        "--angle-unit",
+        choices=list(ANGLE_UNITS),
+        default=angle_default,
+        help=f"default {angle_default} ('pi': a fraction of pi)",
+    )
+    parser.add_argument(
+        "--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention (default utn: Ry·Rx·Rz)"
+    )
 
 
 def platform_from_args(args) -> Platform:
@@ -38,8 +47,11 @@ def platform_from_args(args) -> Platform:
 
 def add_force_arg(parser) -> None:
     """``--force``: write into an existing folder that holds files stewart-drake did not write."""
-    parser.add_argument("--force", action="store_true",
-                        help="write into an existing folder that holds other files (they are never touched; see README, Output folders)")
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="write into an existing folder that holds other files (they are never touched; see README, Output folders)",
+    )
 
 
 def output_folder(args, option: str = "--out") -> OutputFolder | None:

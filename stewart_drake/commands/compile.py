@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import sys
 
+from stewart_drake.commands._common import add_platform_arg, platform_from_args
 from stewart_drake.core.output_folder import check_output_file, write_output_file
 from stewart_drake.core.rotations import CONVENTIONS
-from stewart_drake.commands._common import add_platform_arg, platform_from_args
 from stewart_drake.script import ScriptError, compile_program
 from stewart_drake.script.emit import emit_matlab, emit_python
 from stewart_drake.script.runtime import check_reachable
@@ -18,7 +18,10 @@ from stewart_drake.script.source import read_program
 
 
 def register(sub) -> None:
-    p = sub.add_parser("compile", help="translate a motion program (.stw) to Python (calling this library) or Matlab (the seed's output)")
+    p = sub.add_parser(
+        "compile",
+        help="translate a motion program (.stw) to Python (calling this library) or Matlab (the seed's output)",
+    )
     p.add_argument("program", metavar="PROGRAM.stw", help="motion-language source file")
     p.add_argument("--emit", choices=["python", "matlab"], required=True, help="back end")
     p.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")

@@ -21,15 +21,35 @@ ANGLE_UNITS = ("pi", "deg", "rad")
 
 
 def register(sub) -> None:
-    p = sub.add_parser("dsp-ik", help="leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK")
-    p.add_argument("--pose", nargs=6, type=float, required=True, metavar=("PX", "PY", "PZ", "A", "B", "G"),
-                   help="position in mm (truncated to whole mm, as the firmware stores it) and the angles alpha, beta, gamma")
-    p.add_argument("--angle-unit", choices=ANGLE_UNITS, default="pi",
-                   help="unit of A B G: 'pi' = a fraction of pi as the firmware takes them (0.1 = 18°, the default), 'deg', 'rad'")
+    p = sub.add_parser(
+        "dsp-ik", help="leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK"
+    )
+    p.add_argument(
+        "--pose",
+        nargs=6,
+        type=float,
+        required=True,
+        metavar=("PX", "PY", "PZ", "A", "B", "G"),
+        help="position in mm (truncated to whole mm, as the firmware stores it) and the angles alpha, beta, gamma",
+    )
+    p.add_argument(
+        "--angle-unit",
+        choices=ANGLE_UNITS,
+        default="pi",
+        help="unit of A B G: 'pi' = a fraction of pi as the firmware takes them (0.1 = 18°, the default), 'deg', 'rad'",
+    )
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    p.add_argument("--trace", action="store_true", help="also print the firmware's intermediate words (sin/cos, matrix, plate joints)")
-    p.add_argument("--engine", choices=["python", "c"], default="python",
-                   help="python: the numpy emulation (default); c: tp17.C compiled for the host against the C intrinsics")
+    p.add_argument(
+        "--trace",
+        action="store_true",
+        help="also print the firmware's intermediate words (sin/cos, matrix, plate joints)",
+    )
+    p.add_argument(
+        "--engine",
+        choices=["python", "c"],
+        default="python",
+        help="python: the numpy emulation (default); c: tp17.C compiled for the host against the C intrinsics",
+    )
     p.set_defaults(func=run)
 
 
@@ -47,16 +67,25 @@ def run(args) -> int:
     with SaturationCounter() as sat:
         tr = tp17_trace(q)
     if sat.total:
-        print(f"stewart-drake dsp-ik: warning: the firmware's arithmetic saturated ({dict(sat.counts)}); "
-              "its lengths for this pose are clipped, not geometric", file=sys.stderr)
+        print(
+            f"stewart-drake dsp-ik: warning: the firmware's arithmetic saturated ({dict(sat.counts)}); "
+            "its lengths for this pose are clipped, not geometric",
+            file=sys.stderr,
+        )
     res = tp17_error_stages(q)
     engine = resolve_engine(args.engine, "stewart-drake dsp-ik")
     dsp = tp17_leg_lengths_c(q) if engine == "c" else tr.lengths.astype(int)
     flt = res["float"]
     out = {
-        "pose": {"px_mm": int(np.trunc(q[0])), "py_mm": int(np.trunc(q[1])), "pz_mm": int(np.trunc(q[2])),
-                 "alpha_pi": float(q[3]), "beta_pi": float(q[4]), "gamma_pi": float(q[5]),
-                 "angle_words": tr.angle_words.tolist()},
+        "pose": {
+            "px_mm": int(np.trunc(q[0])),
+            "py_mm": int(np.trunc(q[1])),
+            "pz_mm": int(np.trunc(q[2])),
+            "alpha_pi": float(q[3]),
+            "beta_pi": float(q[4]),
+            "gamma_pi": float(q[5]),
+            "angle_words": tr.angle_words.tolist(),
+        },
         "geometry_mm": {"firmware": dict(TP17_GEOMETRY_MM), "float": {"a": 612.5, "b": 925, "d": 150}},
         "engine": engine,
         "dsp_lengths_mm": dsp.tolist(),
@@ -65,15 +94,23 @@ def run(args) -> int:
         "saturations": dict(sat.counts),
     }
     if args.trace:
-        out["trace"] = {"sin_q15": tr.sin.tolist(), "cos_q15": tr.cos.tolist(), "R_q15": tr.R.tolist(),
-                        "plate_joints_T_mm": tr.top_T.tolist(), "plate_joints_B_mm": tr.top_B.tolist(),
-                        "leg_vectors_mm": tr.leg.tolist(), "L32": tr.L32.tolist()}
+        out["trace"] = {
+            "sin_q15": tr.sin.tolist(),
+            "cos_q15": tr.cos.tolist(),
+            "R_q15": tr.R.tolist(),
+            "plate_joints_T_mm": tr.top_T.tolist(),
+            "plate_joints_B_mm": tr.top_B.tolist(),
+            "leg_vectors_mm": tr.leg.tolist(),
+            "L32": tr.L32.tolist(),
+        }
     if args.json:
         print_json(out)
         return 0
     p = out["pose"]
-    print(f"pose: px={p['px_mm']} py={p['py_mm']} pz={p['pz_mm']} mm; alpha={p['alpha_pi']:g}π beta={p['beta_pi']:g}π "
-          f"gamma={p['gamma_pi']:g}π (FRAC16 words {p['angle_words']})")
+    print(
+        f"pose: px={p['px_mm']} py={p['py_mm']} pz={p['pz_mm']} mm; alpha={p['alpha_pi']:g}π beta={p['beta_pi']:g}π "
+        f"gamma={p['gamma_pi']:g}π (FRAC16 words {p['angle_words']})"
+    )
     print("firmware geometry a=612 b=925 d=150 mm (float IK: a=612.5)")
     print(f"{'leg':>4} {'DSP mm':>8} {'float mm':>10} {'DSP-float':>10}")
     for i in range(6):

@@ -13,7 +13,15 @@ from stewart_drake.commands._common import add_platform_arg, platform_from_args,
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 from stewart_drake.core.rotations import angle_scale, length_scale
-from stewart_drake.core.sanity import check_file_rows, check_finite, check_gravity, check_trajectory, check_work, fmt_value, require_plate
+from stewart_drake.core.sanity import (
+    check_file_rows,
+    check_finite,
+    check_gravity,
+    check_trajectory,
+    check_work,
+    fmt_value,
+    require_plate,
+)
 from stewart_drake.errors import CsvError, OptionError, UsageError
 
 CSV_HELP = (
@@ -25,18 +33,34 @@ CSV_HELP = (
 def register(sub) -> None:
     p = sub.add_parser("dynamics", help="leg forces along a trajectory (inverse dynamics, with or without Coriolis)")
     add_platform_arg(p, default="utn-dynamic")
-    p.add_argument("--trajectory", default="seed", metavar="seed|FILE.csv",
-                   help="'seed' (px = -0.1 m, py = 0.1 sin(2t) m, pz = 0.7 m) or a CSV file: " + CSV_HELP)
+    p.add_argument(
+        "--trajectory",
+        default="seed",
+        metavar="seed|FILE.csv",
+        help="'seed' (px = -0.1 m, py = 0.1 sin(2t) m, pz = 0.7 m) or a CSV file: " + CSV_HELP,
+    )
     p.add_argument("--t-end", type=float, default=4.0, help="seed trajectory: last time in s (default 4)")
     p.add_argument("--dt", type=float, default=0.1, help="seed trajectory: time step in s (default 0.1, as the seed)")
-    p.add_argument("--coriolis", choices=["on", "off"], default="on", help="include C(q, q̇) q̇ (default on; off = the seed's model)")
-    p.add_argument("--legs", choices=["on", "off"], default="off", help="include the legs' masses (cylinder + piston, from the platform) (default off, as the seed)")
+    p.add_argument(
+        "--coriolis", choices=["on", "off"], default="on", help="include C(q, q̇) q̇ (default on; off = the seed's model)"
+    )
+    p.add_argument(
+        "--legs",
+        choices=["on", "off"],
+        default="off",
+        help="include the legs' masses (cylinder + piston, from the platform) (default off, as the seed)",
+    )
     p.add_argument("--gravity", type=float, default=9.81, help="m/s² (default 9.81)")
-    p.add_argument("--convention", choices=["utn", "zyx"], default="utn", help="Euler convention of the CSV's angles (default utn)")
+    p.add_argument(
+        "--convention", choices=["utn", "zyx"], default="utn", help="Euler convention of the CSV's angles (default utn)"
+    )
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV positions (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
-    p.add_argument("--allow-out-of-stroke", action="store_true",
-                   help="compute forces even where a leg leaves the stroke (a warning, also in the JSON 'warnings'); default: exit 1")
+    p.add_argument(
+        "--allow-out-of-stroke",
+        action="store_true",
+        help="compute forces even where a leg leaves the stroke (a warning, also in the JSON 'warnings'); default: exit 1",
+    )
     out = p.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print JSON")
     out.add_argument("--csv", action="store_true", help="print CSV: t,F1..F6 (N)")
@@ -75,8 +99,15 @@ def seed_times(t_end: float, dt: float) -> np.ndarray:
     if not (dt > 0 and t_end >= 0):
         raise OptionError(OptionError.DT.format(dt=fmt_value(dt), t_end=fmt_value(t_end)))
     n = math.floor(t_end / dt + 0.5) + 1
-    check_work("--t-end/--dt", f"{fmt_value(t_end)}/{fmt_value(dt)} s", n, "samples", BYTES_PER_SAMPLE, MAX_SAMPLES,
-               hint="; use a larger --dt or a shorter --t-end")
+    check_work(
+        "--t-end/--dt",
+        f"{fmt_value(t_end)}/{fmt_value(dt)} s",
+        n,
+        "samples",
+        BYTES_PER_SAMPLE,
+        MAX_SAMPLES,
+        hint="; use a larger --dt or a shorter --t-end",
+    )
     return np.arange(0.0, t_end + dt / 2, dt)
 
 
@@ -105,18 +136,29 @@ def run(args) -> int:
     else:
         F = leg_forces(platform, q, qd, qdd, convention, coriolis=args.coriolis == "on", gravity=gravity)
     if args.json:
-        print_json({
-            "platform": platform.name, "trajectory": args.trajectory, "coriolis": args.coriolis == "on",
-            "legs": args.legs == "on", "gravity": gravity, "unit": "N", "t": t, "forces": F,
-            "max_abs_force": np.abs(F).max(axis=0), "warnings": warnings,
-        })
+        print_json(
+            {
+                "platform": platform.name,
+                "trajectory": args.trajectory,
+                "coriolis": args.coriolis == "on",
+                "legs": args.legs == "on",
+                "gravity": gravity,
+                "unit": "N",
+                "t": t,
+                "forces": F,
+                "max_abs_force": np.abs(F).max(axis=0),
+                "warnings": warnings,
+            }
+        )
     elif args.csv:
         w = csv.writer(sys.stdout, lineterminator="\n")
         w.writerow(["t"] + [f"F{i}" for i in range(1, 7)])
         for tk, Fk in zip(t, F):
             w.writerow([f"{tk:.9g}"] + [f"{x:.12g}" for x in Fk])
     else:
-        print(f"platform {platform.name}, trajectory {args.trajectory}, Coriolis {args.coriolis}, legs {args.legs}; forces in N")
+        print(
+            f"platform {platform.name}, trajectory {args.trajectory}, Coriolis {args.coriolis}, legs {args.legs}; forces in N"
+        )
         print(f"{'t (s)':>8} " + " ".join(f"{'F' + str(i):>10}" for i in range(1, 7)))
         for tk, Fk in zip(t, F):
             print(f"{tk:8.3f} " + " ".join(f"{x:10.4f}" for x in Fk))

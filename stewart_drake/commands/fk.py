@@ -25,14 +25,36 @@ def register(sub) -> None:
         "confirmed by a Drake MathematicalProgram).",
     )
     add_platform_arg(p)
-    p.add_argument("--lengths", nargs=6, type=float, required=True, metavar=("L1", "L2", "L3", "L4", "L5", "L6"), help="leg lengths in --length-unit")
+    p.add_argument(
+        "--lengths",
+        nargs=6,
+        type=float,
+        required=True,
+        metavar=("L1", "L2", "L3", "L4", "L5", "L6"),
+        help="leg lengths in --length-unit",
+    )
     add_unit_args(p)
     p.add_argument("--all", action="store_true", help="every assembly mode, not just one")
-    p.add_argument("--initial", nargs=6, type=float, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="initial pose for Newton (default: home), in the chosen units")
-    p.add_argument("--tol", type=float, default=1e-13, help="Newton tolerance on the leg lengths, metres (default 1e-13)")
+    p.add_argument(
+        "--initial",
+        nargs=6,
+        type=float,
+        metavar=("PX", "PY", "PZ", "A", "B", "G"),
+        help="initial pose for Newton (default: home), in the chosen units",
+    )
+    p.add_argument(
+        "--tol", type=float, default=1e-13, help="Newton tolerance on the leg lengths, metres (default 1e-13)"
+    )
     p.add_argument("--max-iter", type=int, default=30, help="Newton iteration limit (default 30)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the multi-start search / the homotopy's gamma (default 0)")
-    p.add_argument("--method", choices=("homotopy", "multi-start"), default="homotopy", help="--all: complete homotopy (default) or the multi-start search")
+    p.add_argument(
+        "--seed", type=int, default=0, help="random seed of the multi-start search / the homotopy's gamma (default 0)"
+    )
+    p.add_argument(
+        "--method",
+        choices=("homotopy", "multi-start"),
+        default="homotopy",
+        help="--all: complete homotopy (default) or the multi-start search",
+    )
     p.add_argument("--json", action="store_true", help='print JSON: {"solutions": [...], ...}')
     p.set_defaults(func=run)
 
@@ -68,11 +90,20 @@ def _homotopy_all(platform, L, args, k: float) -> dict:
     r = solve(platform, L, seed=args.seed)
     sols = []
     for hm in r.modes:
-        mode = modes_from_solutions(platform, hm.position[None], hm.rotation[None], L, np.array([hm.certified]), args.convention)[0]
+        mode = modes_from_solutions(
+            platform, hm.position[None], hm.rotation[None], L, np.array([hm.certified]), args.convention
+        )[0]
         sols.append(
             _entry(
-                mode, args, k, converged=True, method="homotopy", path=hm.path, certified_radius=hm.radius,
-                uniqueness_radius=hm.uniqueness, position_bound=hm.position_bound / k,
+                mode,
+                args,
+                k,
+                converged=True,
+                method="homotopy",
+                path=hm.path,
+                certified_radius=hm.radius,
+                uniqueness_radius=hm.uniqueness,
+                position_bound=hm.position_bound / k,
                 angle_bound=hm.angle_bound / angle_scale(args.angle_unit),
             )
         )
@@ -108,8 +139,14 @@ def run(args) -> int:
     check_positive(args.tol, "--tol", "metres")
     if args.max_iter < 1:
         raise ValueError(f"--max-iter must be >= 1, got {args.max_iter}")
-    check_work("--max-iter", str(args.max_iter), args.max_iter, "Newton iterations", max_count=MAX_ITER,
-               hint="; Newton converges in a few tens of iterations or not at all (without --max-iter, the multi-start search runs)")
+    check_work(
+        "--max-iter",
+        str(args.max_iter),
+        args.max_iter,
+        "Newton iterations",
+        max_count=MAX_ITER,
+        hint="; Newton converges in a few tens of iterations or not at all (without --max-iter, the multi-start search runs)",
+    )
     L = np.asarray(args.lengths, dtype=float) * k
     out = {
         "platform": platform.name,
@@ -121,9 +158,13 @@ def run(args) -> int:
     single = None
     if not args.all:
         initial = None if args.initial is None else pose_to_si(args.initial, args.length_unit, args.angle_unit)
-        r = forward_kinematics(platform, L, initial, args.convention, tol=args.tol, max_iter=args.max_iter, on_singular="warn")
+        r = forward_kinematics(
+            platform, L, initial, args.convention, tol=args.tol, max_iter=args.max_iter, on_singular="warn"
+        )
         if r.converged:
-            mode = modes_from_solutions(platform, r.iterate[None, :3], r.rotation[None], L, np.array([False]), args.convention)[0]
+            mode = modes_from_solutions(
+                platform, r.iterate[None, :3], r.rotation[None], L, np.array([False]), args.convention
+            )[0]
             single = _entry(mode, args, k, converged=True, iterations=int(r.iterations), method="newton")
             out.update(solutions=[single], method="newton")
     if single is None and args.all and args.method == "homotopy":
@@ -156,21 +197,35 @@ def run(args) -> int:
             print(f"architecture {out['architecture_text']} ({counts}); tracking engine: {engine}")
             print(("complete: " if out["complete"] else "") + out["guarantee"])
         elif "modes_found" in out:
-            print(f"{out['modes_found']} modes found (at most {out['max_solutions']} exist; complete: {out['complete']})")
+            print(
+                f"{out['modes_found']} modes found (at most {out['max_solutions']} exist; complete: {out['complete']})"
+            )
         for i, s in enumerate(out["solutions"], 1):
             flags = [
                 "above base" if s["above_base"] else "BELOW base",
                 "within stroke" if s["within_stroke"] else "OUTSIDE stroke",
                 f"det {'+' if s['det_sign'] > 0 else '-'}",
                 f"cond {s['condition']:.3g}",
-            ] + ([f"certified (radius {s['certified_radius']:.1e})" if "certified_radius" in s else "certified"] if s["certified"] else [])
-            print(f"{i:3d}", " ".join(f"{x:11.5f}" for x in s["pose"]), f"  residual {s['residual']:.2e}", ", ".join(flags))
+            ] + (
+                [f"certified (radius {s['certified_radius']:.1e})" if "certified_radius" in s else "certified"]
+                if s["certified"]
+                else []
+            )
+            print(
+                f"{i:3d}",
+                " ".join(f"{x:11.5f}" for x in s["pose"]),
+                f"  residual {s['residual']:.2e}",
+                ", ".join(flags),
+            )
     if out.get("method") == "homotopy" and not out["complete"]:
         print(f"fk --all: {out['guarantee']}", file=sys.stderr)
         return 1
     if out.get("method") == "homotopy" and not out["solutions"]:
-        print(f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
-              f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})", file=sys.stderr)
+        print(
+            f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
+            f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})",
+            file=sys.stderr,
+        )
         return 1
     above = [s["above_base"] or platform.plate_below_base_allowed for s in out["solutions"]]
     physical = any(above) if args.all else all(above)  # --all lists mirror modes too; one valid mode suffices

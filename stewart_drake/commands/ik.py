@@ -7,11 +7,11 @@ import sys
 
 import numpy as np
 
+from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.rotations import length_scale, pose_to_si
 from stewart_drake.core.sanity import below_base_message, check_file_rows, check_poses, plate_anchor_heights
-from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 
 # Bytes per CSV row while reading (Python lists of floats) and per result printed as JSON (estimates).
 BYTES_PER_ROW = 600
@@ -23,8 +23,12 @@ def register(sub) -> None:
     p = sub.add_parser("ik", help="leg lengths for a pose (closed-form inverse kinematics)")
     add_platform_arg(p)
     g = p.add_mutually_exclusive_group(required=True)
-    g.add_argument("--pose", nargs=6, type=float, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="one pose in the chosen units")
-    g.add_argument("--poses", metavar="FILE.csv", help="CSV with columns px,py,pz,a,b,g (header optional), one pose per row")
+    g.add_argument(
+        "--pose", nargs=6, type=float, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="one pose in the chosen units"
+    )
+    g.add_argument(
+        "--poses", metavar="FILE.csv", help="CSV with columns px,py,pz,a,b,g (header optional), one pose per row"
+    )
     add_unit_args(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=run)
@@ -43,7 +47,9 @@ def run(args) -> int:
         check_file_rows(args.poses, "--poses", BYTES_PER_ROW + (BYTES_PER_JSON_ROW if args.json else 0), MIN_ROW_BYTES)
         raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g")
     q = pose_to_si(raw, args.length_unit, args.angle_unit)
-    check_poses(platform, q, args.convention, what="--pose" if lines is None else f"{args.poses}: pose", lines=lines, base=False)
+    check_poses(
+        platform, q, args.convention, what="--pose" if lines is None else f"{args.poses}: pose", lines=lines, base=False
+    )
     L = leg_lengths(platform, q, args.convention)
     check = check_stroke(platform, L)
     within = check.within
@@ -58,8 +64,15 @@ def run(args) -> int:
     for side, arr, lim in (("min", check.below, platform.L_min), ("max", check.above, platform.L_max)):
         for i, leg in np.argwhere(arr[bad] > 0):
             n = int(bad[i])
-            viol[n].append({"leg": int(leg) + 1, "side": side, "length": float(Lu[n, leg]), "limit": lim / k,
-                            "excess": float(arr[n, leg]) / k})
+            viol[n].append(
+                {
+                    "leg": int(leg) + 1,
+                    "side": side,
+                    "length": float(Lu[n, leg]),
+                    "limit": lim / k,
+                    "excess": float(arr[n, leg]) / k,
+                }
+            )
     for v in viol.values():
         v.sort(key=lambda d: d["leg"])
     notes = {int(i): below_base_message("pose", z[i]) for i in np.flatnonzero(~above)}
@@ -67,22 +80,37 @@ def run(args) -> int:
         rows = raw.tolist()
         lengths = Lu.tolist()
         results = [
-            {"pose": rows[i], "lengths": lengths[i], "length_unit": args.length_unit, "within_stroke": bool(within[i]),
-             "above_base": bool(above[i]), "violations": viol.get(i, [])}
+            {
+                "pose": rows[i],
+                "lengths": lengths[i],
+                "length_unit": args.length_unit,
+                "within_stroke": bool(within[i]),
+                "above_base": bool(above[i]),
+                "violations": viol.get(i, []),
+            }
             for i in range(len(q))
         ]
         if args.pose is not None:
             print_json(results[0])
         else:  # compact, one result per line: the C encoder (indent= is pure Python, ~50 µs a row)
-            sys.stdout.write('{"platform": ' + json.dumps(platform.name) + ', "results": [\n'
-                             + ",\n".join(json.dumps(r, allow_nan=False) for r in results) + "\n]}\n")
+            sys.stdout.write(
+                '{"platform": '
+                + json.dumps(platform.name)
+                + ', "results": [\n'
+                + ",\n".join(json.dumps(r, allow_nan=False) for r in results)
+                + "\n]}\n"
+            )
     else:
         print(f"platform {platform.name}, convention {args.convention}, lengths in {args.length_unit}")
         flags = np.full(len(q), "ok", dtype=object)
         for i, vs in viol.items():
-            flags[i] = "; ".join(([notes[i]] if i in notes else []) + [
-                f"leg {v['leg']} {v['excess']:.3f} {args.length_unit} {'below L_min' if v['side'] == 'min' else 'above L_max'}"
-                for v in vs])
+            flags[i] = "; ".join(
+                ([notes[i]] if i in notes else [])
+                + [
+                    f"leg {v['leg']} {v['excess']:.3f} {args.length_unit} {'below L_min' if v['side'] == 'min' else 'above L_max'}"
+                    for v in vs
+                ]
+            )
         cells = np.empty((len(q), 7), dtype=object)
         cells[:, :6], cells[:, 6] = Lu, flags
         # one formatting pass over all rows (a Python loop per row costs ~10 µs a row)

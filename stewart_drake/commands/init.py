@@ -9,9 +9,16 @@ TEMPLATES = ("utn", "radial", "explicit")
 
 
 def register(sub) -> None:
-    p = sub.add_parser("init", help="print a commented platform file template to start from (stewart-drake init --platform-template radial > my.yaml)")
-    p.add_argument("--platform-template", choices=TEMPLATES, required=True,
-                   help="utn: the UTN 3-6 family; radial: anchors on two circles; explicit: anchor by anchor")
+    p = sub.add_parser(
+        "init",
+        help="print a commented platform file template to start from (stewart-drake init --platform-template radial > my.yaml)",
+    )
+    p.add_argument(
+        "--platform-template",
+        choices=TEMPLATES,
+        required=True,
+        help="utn: the UTN 3-6 family; radial: anchors on two circles; explicit: anchor by anchor",
+    )
     p.set_defaults(func=run)
 
 

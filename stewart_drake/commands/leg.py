@@ -28,8 +28,12 @@ def register(sub) -> None:
     ik = ops.add_parser("ik", help="joint angles (both elbow branches) for a foot position")
     ik.add_argument("px", type=float, metavar="PX", help="foot x (length unit)")
     ik.add_argument("py", type=float, metavar="PY", help="foot y (length unit)")
-    ik.add_argument("--gamma", type=float, help="also the foot orientation gamma: the seed's 3R method (corrected), returns q3")
-    ik.add_argument("--branch", choices=["a", "b", "both"], default="both", help="a: knee angle >= 0, b: <= 0 (default both)")
+    ik.add_argument(
+        "--gamma", type=float, help="also the foot orientation gamma: the seed's 3R method (corrected), returns q3"
+    )
+    ik.add_argument(
+        "--branch", choices=["a", "b", "both"], default="both", help="a: knee angle >= 0, b: <= 0 (default both)"
+    )
     sdf = ops.add_parser("sdf", help="print (or --write DIR) the leg's SDF generated from the DH table")
     sdf.add_argument("--write", metavar="DIR")
     for q in (fk, ik, sdf):
@@ -65,21 +69,30 @@ def run(args) -> int:
         if not np.all(np.isfinite(q)):
             raise LegError(OPTION_JOINT_ANGLES.format(value=args.q))
         f = foot(leg, q)
-        out = {"q": list(args.q), "foot": [f[0] / k, f[1] / k], "gamma": f[2] / ka, "units": units,
-               "T03": forward_kinematics(leg, q).tolist(), "within_limits": bool(within_limits(leg, q)),
-               "limit_violations": limit_violations(leg, q)}
+        out = {
+            "q": list(args.q),
+            "foot": [f[0] / k, f[1] / k],
+            "gamma": f[2] / ka,
+            "units": units,
+            "T03": forward_kinematics(leg, q).tolist(),
+            "within_limits": bool(within_limits(leg, q)),
+            "limit_violations": limit_violations(leg, q),
+        }
         if args.json:
             print_json(out)
         else:
-            print(f"foot Px = {out['foot'][0]:.6g} {args.length_unit}, Py = {out['foot'][1]:.6g} {args.length_unit}, "
-                  f"gamma = {out['gamma']:.6g} {args.angle_unit}" + ("" if out["within_limits"] else "  (outside joint limits)"))
+            print(
+                f"foot Px = {out['foot'][0]:.6g} {args.length_unit}, Py = {out['foot'][1]:.6g} {args.length_unit}, "
+                f"gamma = {out['gamma']:.6g} {args.angle_unit}"
+                + ("" if out["within_limits"] else "  (outside joint limits)")
+            )
         return 0 if out["within_limits"] else 1
     args.target = [args.px, args.py]
     t = np.array(args.target) * k
     if not np.all(np.isfinite(t)):
         raise LegError(OPTION_TARGET.format(value=args.target))
     sols = {}
-    for b in (("a", "b") if args.branch == "both" else (args.branch,)):
+    for b in ("a", "b") if args.branch == "both" else (args.branch,):
         if args.gamma is None:
             q = inverse_kinematics(leg, t, b)
         else:
@@ -91,6 +104,9 @@ def run(args) -> int:
     else:
         for b, s in sols.items():
             names = ["q1", "q2", "q3"][: len(s["q"])]
-            print(f"branch {b}: " + ", ".join(f"{n} = {v:.6g} {args.angle_unit}" for n, v in zip(names, s["q"]))
-                  + ("" if s["within_limits"] else "  (outside joint limits)"))
+            print(
+                f"branch {b}: "
+                + ", ".join(f"{n} = {v:.6g} {args.angle_unit}" for n, v in zip(names, s["q"]))
+                + ("" if s["within_limits"] else "  (outside joint limits)")
+            )
     return 0 if any(s["within_limits"] for s in sols.values()) else 1

@@ -10,8 +10,14 @@ from stewart_drake.errors import UsageError
 def register(sub) -> None:
     p = sub.add_parser("model", help="generate (write) or inspect the SDF model of a platform")
     add_platform_arg(p)
-    p.add_argument("--write", metavar="DIR", help="write <DIR>/<name>.sdf (name made file-safe; an existing file is replaced only if stewart-drake wrote it)")
-    p.add_argument("--inspect", action="store_true", help="parse into a MultibodyPlant and list bodies, joints, constraints")
+    p.add_argument(
+        "--write",
+        metavar="DIR",
+        help="write <DIR>/<name>.sdf (name made file-safe; an existing file is replaced only if stewart-drake wrote it)",
+    )
+    p.add_argument(
+        "--inspect", action="store_true", help="parse into a MultibodyPlant and list bodies, joints, constraints"
+    )
     p.add_argument("--json", action="store_true", help="with --inspect: JSON output")
     p.set_defaults(func=run)
 
@@ -33,7 +39,10 @@ def run(args) -> int:
         plant = h.plant
         info = {
             "platform": platform.name,
-            "bodies": [plant.get_body(b).name() for b in plant.GetBodyIndices(plant.GetModelInstanceByName(platform_model_name(platform)))],
+            "bodies": [
+                plant.get_body(b).name()
+                for b in plant.GetBodyIndices(plant.GetModelInstanceByName(platform_model_name(platform)))
+            ],
             "joints": {plant.get_joint(j).name(): plant.get_joint(j).type_name() for j in plant.GetJointIndices()},
             "actuators": [plant.get_joint_actuator(a).name() for a in plant.GetJointActuatorIndices()],
             "num_positions": plant.num_positions(),
@@ -44,7 +53,9 @@ def run(args) -> int:
         base, top = anchor_frames(h)
         if args.write:
             info["sdf_file"] = str(written)
-        info["anchor_error_m"] = float(max(abs(base - platform.base_anchors).max(), abs(top - platform.top_anchors_per_leg).max()))
+        info["anchor_error_m"] = float(
+            max(abs(base - platform.base_anchors).max(), abs(top - platform.top_anchors_per_leg).max())
+        )
         if args.json:
             print_json(info)
         else:

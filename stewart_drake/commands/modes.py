@@ -11,11 +11,25 @@ from stewart_drake.errors import OPTION_LEG_DAMPING, OPTION_SAMPLE_RATE, OptionE
 
 
 def register(sub) -> None:
-    p = sub.add_parser("modes", help="natural frequencies (Hz) and mode shapes at a pose; --drake checks them against Drake")
+    p = sub.add_parser(
+        "modes", help="natural frequencies (Hz) and mode shapes at a pose; --drake checks them against Drake"
+    )
     add_pose_args(p)
-    p.add_argument("--leg-damping", type=float, default=0.0, metavar="N·s/m", help="axial damping of every leg (default 0)")
-    p.add_argument("--drake", action="store_true", help="also linearise the Drake plant (legs off: springs + Linearize; on: closed-loop plant)")
-    p.add_argument("--sample-rate", type=float, default=1000.0, metavar="HZ", help="controller sample rate to compare with (default 1000, the DSP's)")
+    p.add_argument(
+        "--leg-damping", type=float, default=0.0, metavar="N·s/m", help="axial damping of every leg (default 0)"
+    )
+    p.add_argument(
+        "--drake",
+        action="store_true",
+        help="also linearise the Drake plant (legs off: springs + Linearize; on: closed-loop plant)",
+    )
+    p.add_argument(
+        "--sample-rate",
+        type=float,
+        default=1000.0,
+        metavar="HZ",
+        help="controller sample rate to compare with (default 1000, the DSP's)",
+    )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
 
@@ -40,10 +54,20 @@ def run(args) -> int:
     T = 1.0 / args.sample_rate
     delay = 1.5 * T  # one sample of output delay + half a sample of zero-order hold
     out = {
-        "platform": platform.name, "pose": args.pose, "legs_model": legs, "leg_stiffness_n_per_m": k, "leg_damping_ns_per_m": args.leg_damping,
-        "frequencies_hz": m.frequencies_hz, "damping_ratio": m.damping_ratio, "mode_shapes": m.shapes.T.real if C is None else None,
-        "controller": {"sample_rate_hz": args.sample_rate, "samples_per_lowest_period": args.sample_rate / f1 if f1 > 0 else None,
-                       "loop_delay_s": delay, "phase_lag_at_lowest_deg": 360.0 * f1 * delay},
+        "platform": platform.name,
+        "pose": args.pose,
+        "legs_model": legs,
+        "leg_stiffness_n_per_m": k,
+        "leg_damping_ns_per_m": args.leg_damping,
+        "frequencies_hz": m.frequencies_hz,
+        "damping_ratio": m.damping_ratio,
+        "mode_shapes": m.shapes.T.real if C is None else None,
+        "controller": {
+            "sample_rate_hz": args.sample_rate,
+            "samples_per_lowest_period": args.sample_rate / f1 if f1 > 0 else None,
+            "loop_delay_s": delay,
+            "phase_lag_at_lowest_deg": 360.0 * f1 * delay,
+        },
     }
     if args.drake:
         # Deferred: only this check needs Drake; cli.py imports every command module at start-up.
@@ -51,19 +75,34 @@ def run(args) -> int:
 
         d = drake_modes(platform, q, k, args.leg_damping, args.convention, args.gravity, legs)
         md = d["modes"]
-        out["drake"] = {"frequencies_hz": md.frequencies_hz, "damping_ratio": md.damping_ratio,
-                        "relative_difference": np.abs(md.frequencies_hz / m.frequencies_hz - 1),
-                        "mac": subspace_mac(m.shapes, md.shapes, m.frequencies_hz), "equilibrium_residual": d["residual"],
-                        "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize"}
+        out["drake"] = {
+            "frequencies_hz": md.frequencies_hz,
+            "damping_ratio": md.damping_ratio,
+            "relative_difference": np.abs(md.frequencies_hz / m.frequencies_hz - 1),
+            "mac": subspace_mac(m.shapes, md.shapes, m.frequencies_hz),
+            "equilibrium_residual": d["residual"],
+            "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize",
+        }
     if args.json:
         print_json(out)
         return 0
-    print(f"platform {platform.name}, pose {args.pose}; legs {'with' if legs else 'without'} mass, k = {k[0]:.6g} N/m, c = {args.leg_damping} N·s/m")
-    print(f"{'mode':>4} {'f (Hz)':>11} {'ζ':>8}  shape [" + " ".join(NAMES) + "] (largest component = 1)" + ("   Drake f (Hz)   MAC" if args.drake else ""))
+    print(
+        f"platform {platform.name}, pose {args.pose}; legs {'with' if legs else 'without'} mass, k = {k[0]:.6g} N/m, c = {args.leg_damping} N·s/m"
+    )
+    print(
+        f"{'mode':>4} {'f (Hz)':>11} {'ζ':>8}  shape ["
+        + " ".join(NAMES)
+        + "] (largest component = 1)"
+        + ("   Drake f (Hz)   MAC" if args.drake else "")
+    )
     for i in range(6):
         s = m.shapes[:, i].real
         s = s / s[np.argmax(np.abs(s))]
-        line = f"{i + 1:4d} {m.frequencies_hz[i]:11.5f} {m.damping_ratio[i]:8.4f}  [" + " ".join(f"{v:+.3f}" for v in s) + "]"
+        line = (
+            f"{i + 1:4d} {m.frequencies_hz[i]:11.5f} {m.damping_ratio[i]:8.4f}  ["
+            + " ".join(f"{v:+.3f}" for v in s)
+            + "]"
+        )
         if args.drake:
             line += f"   {out['drake']['frequencies_hz'][i]:12.6f}  {out['drake']['mac'][i]:.6f}"
         print(line)
@@ -71,6 +110,8 @@ def run(args) -> int:
     if c["samples_per_lowest_period"] is None:  # f1 = 0: nothing oscillates to be sampled
         print(f"lowest mode {f1:.4g} Hz: it does not oscillate (neutral or unstable at this leg stiffness)")
     else:
-        print(f"lowest mode {f1:.4g} Hz: {c['samples_per_lowest_period']:.4g} controller samples per period at {args.sample_rate:g} Hz; "
-              f"a {delay * 1e3:.3g} ms loop delay lags it by {c['phase_lag_at_lowest_deg']:.3g}°")
+        print(
+            f"lowest mode {f1:.4g} Hz: {c['samples_per_lowest_period']:.4g} controller samples per period at {args.sample_rate:g} Hz; "
+            f"a {delay * 1e3:.3g} ms loop delay lags it by {c['phase_lag_at_lowest_deg']:.3g}°"
+        )
     return 0

@@ -12,8 +12,8 @@ from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
+from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
@@ -25,32 +25,88 @@ from stewart_drake.script.source import read_program
 
 
 def register(sub) -> None:
-    p = sub.add_parser("montecarlo", help="robustness study: many closed-loop runs with drawn tolerances (Dask), or --replay one of them")
+    p = sub.add_parser(
+        "montecarlo",
+        help="robustness study: many closed-loop runs with drawn tolerances (Dask), or --replay one of them",
+    )
     add_platform_arg(p, default="utn-dynamic")
     src = p.add_mutually_exclusive_group()
-    src.add_argument("--trajectory", default="seed", metavar="seed|rotating|FILE.csv", help="the pose reference (default seed)")
+    src.add_argument(
+        "--trajectory", default="seed", metavar="seed|rotating|FILE.csv", help="the pose reference (default seed)"
+    )
     src.add_argument("--program", metavar="P.stw", help="a motion program as the reference instead")
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
     p.add_argument("--fit", action="store_true", help="move and scale the trajectory to the platform's home and stroke")
     p.add_argument("--runs", type=int, default=100, metavar="N", help="number of runs (default 100)")
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="study seed; run i draws from SeedSequence(S, spawn_key=(i,)) (default 0)")
-    p.add_argument("--vary", nargs="+", default=[], metavar="SPEC",
-                   help="what varies: key=value words or one YAML file (keys: anchor, leg_offset, sensor_resolution, sensor_noise, "
-                        "latency, latency_jitter, actuator_lag, force_limit, payload_mass, payload_com, gain_scale; values X, ±T, ±P%%, A..B, a|b; "
-                        "units m mm um s ms us N kg g)")
-    p.add_argument("--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin")
-    p.add_argument("--engine", choices=["python", "c"], default="python",
-                   help="fixed-point controller engine: python (the emulation) or c (the compiled firmware tick, bit-identical, faster)")
-    p.add_argument("--integrator", choices=["sap", "cenic"], default=None, help="plant integrator (default cenic: see benchmarks/bench_integrators.py)")
-    p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds per run (default the trajectory's)")
-    p.add_argument("--plant-step", type=float, default=1e-3, metavar="S", help="plant step / log period, s (default 0.001)")
-    p.add_argument("--lost-tracking", type=float, default=5.0, metavar="MM", help="leg error that counts as lost tracking, mm (default 5)")
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        metavar="S",
+        help="study seed; run i draws from SeedSequence(S, spawn_key=(i,)) (default 0)",
+    )
+    p.add_argument(
+        "--vary",
+        nargs="+",
+        default=[],
+        metavar="SPEC",
+        help="what varies: key=value words or one YAML file (keys: anchor, leg_offset, sensor_resolution, sensor_noise, "
+        "latency, latency_jitter, actuator_lag, force_limit, payload_mass, payload_com, gain_scale; values X, ±T, ±P%%, A..B, a|b; "
+        "units m mm um s ms us N kg g)",
+    )
+    p.add_argument(
+        "--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin"
+    )
+    p.add_argument(
+        "--engine",
+        choices=["python", "c"],
+        default="python",
+        help="fixed-point controller engine: python (the emulation) or c (the compiled firmware tick, bit-identical, faster)",
+    )
+    p.add_argument(
+        "--integrator",
+        choices=["sap", "cenic"],
+        default=None,
+        help="plant integrator (default cenic: see benchmarks/bench_integrators.py)",
+    )
+    p.add_argument(
+        "--duration", type=float, default=None, metavar="S", help="simulated seconds per run (default the trajectory's)"
+    )
+    p.add_argument(
+        "--plant-step", type=float, default=1e-3, metavar="S", help="plant step / log period, s (default 0.001)"
+    )
+    p.add_argument(
+        "--lost-tracking",
+        type=float,
+        default=5.0,
+        metavar="MM",
+        help="leg error that counts as lost tracking, mm (default 5)",
+    )
     where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, default=1, metavar="K", help="LocalCluster worker processes, 1 thread each (default 1; 0: in this process, no Dask)")
-    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask scheduler instead of a LocalCluster")
-    p.add_argument("--out", default="montecarlo", metavar="DIR", help="output folder (default montecarlo/); a study there with the same settings resumes")
-    p.add_argument("--replay", type=int, default=None, metavar="K", help="re-run run K of the study in --out alone: full log in DIR/replay-K/, checked against its row")
+    where.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        metavar="K",
+        help="LocalCluster worker processes, 1 thread each (default 1; 0: in this process, no Dask)",
+    )
+    where.add_argument(
+        "--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask scheduler instead of a LocalCluster"
+    )
+    p.add_argument(
+        "--out",
+        default="montecarlo",
+        metavar="DIR",
+        help="output folder (default montecarlo/); a study there with the same settings resumes",
+    )
+    p.add_argument(
+        "--replay",
+        type=int,
+        default=None,
+        metavar="K",
+        help="re-run run K of the study in --out alone: full log in DIR/replay-K/, checked against its row",
+    )
     p.add_argument("--no-animation", action="store_true", help="with --replay: no Meshcat HTML animation")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -75,9 +131,22 @@ def build_study(args):
     if trajectory is not None and trajectory not in TRAJECTORIES:
         table = csv_table(trajectory, args.length_unit, args.angle_unit)
         trajectory = None
-    return Study(platform=platform, spec=spec, seed=args.seed, runs=args.runs, trajectory=trajectory, program=program, table=table,
-                 fit=args.fit, controller=args.controller, integrator=args.integrator, engine=engine, duration=args.duration,
-                 plant_step=args.plant_step, lost_tracking=args.lost_tracking * 1e-3)
+    return Study(
+        platform=platform,
+        spec=spec,
+        seed=args.seed,
+        runs=args.runs,
+        trajectory=trajectory,
+        program=program,
+        table=table,
+        fit=args.fit,
+        controller=args.controller,
+        integrator=args.integrator,
+        engine=engine,
+        duration=args.duration,
+        plant_step=args.plant_step,
+        lost_tracking=args.lost_tracking * 1e-3,
+    )
 
 
 def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
@@ -106,8 +175,11 @@ def run(args) -> int:
         print_text(summary)
     lost = summary["lost_tracking_runs"]
     if lost:
-        print(f"stewart-drake montecarlo: {len(lost)} of {len(rows)} runs lost tracking (leg error > {args.lost_tracking:g} mm or failed): "
-              f"runs {', '.join(map(str, lost[:10]))}{' …' if len(lost) > 10 else ''}", file=sys.stderr)
+        print(
+            f"stewart-drake montecarlo: {len(lost)} of {len(rows)} runs lost tracking (leg error > {args.lost_tracking:g} mm or failed): "
+            f"runs {', '.join(map(str, lost[:10]))}{' …' if len(lost) > 10 else ''}",
+            file=sys.stderr,
+        )
         return 1
     return 0
 
@@ -116,10 +188,16 @@ def print_text(summary: dict) -> None:
     """The study summary as text: error percentiles (mm, deg), the worst run, the strongest sensitivities, the files."""
     m = summary["metrics"]
     print(f"{summary['runs']} runs (study {summary['key']})")
-    for k, scale, unit in (("max_leg_error_m", 1e3, "mm"), ("max_position_error_m", 1e3, "mm"), ("max_angle_error_rad", 57.29577951308232, "deg")):
+    for k, scale, unit in (
+        ("max_leg_error_m", 1e3, "mm"),
+        ("max_position_error_m", 1e3, "mm"),
+        ("max_angle_error_rad", 57.29577951308232, "deg"),
+    ):
         s = m[k]
         if s:
-            print(f"  {k.rsplit('_', 1)[0]:22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}")
+            print(
+                f"  {k.rsplit('_', 1)[0]:22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}"
+            )
     w = summary["worst_run"]
     print(f"  worst run {w['run']} (seed {w['seed']}): max leg error {w['max_leg_error_m'] * 1e3:.4g} mm")
     for d in summary["sensitivity"]["max_leg_error_m"][:5]:
@@ -155,8 +233,10 @@ def replay(args) -> int:
     if args.json:
         print_json(result)
     else:
-        print(f"replay of run {args.replay}: {'bit-identical to its row' if not differ else 'DIFFERS in ' + ', '.join(differ)}; "
-              f"max leg error {row['max_leg_error_m'] * 1e3:.6g} mm; files in {folder}")
+        print(
+            f"replay of run {args.replay}: {'bit-identical to its row' if not differ else 'DIFFERS in ' + ', '.join(differ)}; "
+            f"max leg error {row['max_leg_error_m'] * 1e3:.6g} mm; files in {folder}"
+        )
     return 0 if not differ else 1
 
 

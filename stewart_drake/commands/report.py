@@ -17,8 +17,13 @@ def register(sub) -> None:
     p.add_argument("--out", default="report", help="output folder (default: report/)")
     p.add_argument("--only", nargs="+", metavar="ANALYSIS", help="run only these analyses (file names in analyses/)")
     p.add_argument("--quick", action="store_true", help="smaller samples (smoke test)")
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="analyses run in N worker processes (default: the number of CPUs, at most 4; 1: in this process)")
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        metavar="N",
+        help="analyses run in N worker processes (default: the number of CPUs, at most 4; 1: in this process)",
+    )
     add_force_arg(p)
     p.set_defaults(func=run)
 

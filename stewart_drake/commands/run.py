@@ -12,6 +12,15 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.commands._common import (
+    OutputFolder,
+    add_force_arg,
+    add_platform_arg,
+    dumps_strict,
+    platform_from_args,
+    print_json,
+    reject_unused,
+)
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.errors import (
@@ -24,7 +33,6 @@ from stewart_drake.errors import (
     UsageError,
 )
 from stewart_drake.script.source import read_program
-from stewart_drake.commands._common import OutputFolder, add_force_arg, reject_unused, add_platform_arg, dumps_strict, platform_from_args, print_json
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
 SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)
@@ -37,11 +45,30 @@ def register(sub) -> None:
     add_platform_arg(p)
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<program name>)")
     p.add_argument("--rate", type=float, default=100.0, help="trajectory samples per second (default 100)")
-    p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention of alpha, beta, gama (default utn: Ry·Rx·Rz)")
-    p.add_argument("--coriolis", choices=["on", "off"], default="on", help="include C(q, q̇) q̇ in the forces (default on; off = the seed's model)")
+    p.add_argument(
+        "--convention",
+        choices=list(CONVENTIONS),
+        default="utn",
+        help="Euler convention of alpha, beta, gama (default utn: Ry·Rx·Rz)",
+    )
+    p.add_argument(
+        "--coriolis",
+        choices=["on", "off"],
+        default="on",
+        help="include C(q, q̇) q̇ in the forces (default on; off = the seed's model)",
+    )
     add_branch_args(p)
-    p.add_argument("--simulate", action="store_true", help="also run the trajectory through the controller-in-the-loop Drake simulation")
-    p.add_argument("--controller", choices=SIMULATE_CONTROLLERS, default="fixed", help="with --simulate: fixed-point (DSP) or float controller (default fixed)")
+    p.add_argument(
+        "--simulate",
+        action="store_true",
+        help="also run the trajectory through the controller-in-the-loop Drake simulation",
+    )
+    p.add_argument(
+        "--controller",
+        choices=SIMULATE_CONTROLLERS,
+        default="fixed",
+        help="with --simulate: fixed-point (DSP) or float controller (default fixed)",
+    )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_force_arg(p)
     p.set_defaults(func=run)
@@ -58,8 +85,9 @@ def run(args) -> int:
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise OptionError(OPTION_RUN_RATE.format(value=args.rate))
     try:
-        result = run_program(text, args.program, platform, rate=args.rate, convention=args.convention,
-                             coriolis=args.coriolis == "on")
+        result = run_program(
+            text, args.program, platform, rate=args.rate, convention=args.convention, coriolis=args.coriolis == "on"
+        )
         sim = simulate(platform, result, args) if args.simulate else None
         branches = check_branches(platform, result, args)
     except ScriptError as e:
@@ -86,10 +114,29 @@ BRANCH_DEFAULTS = {"branch_margin": 20.0, "singularity_margin": 0.02, "branch_sa
 
 def add_branch_args(p) -> None:
     """``--check-branches`` and its options (``homotopy.branches``)."""
-    p.add_argument("--check-branches", action="store_true", help="check branch safety: the distance from the trajectory to the nearest other assembly mode and to a singularity (complete homotopy FK at sampled poses); exit 1 below a margin")
-    p.add_argument("--branch-margin", type=float, metavar="MM", help="with --check-branches: least allowed distance to another assembly mode, mm at the plate anchors (default 20)")
-    p.add_argument("--singularity-margin", type=float, metavar="SIGMA", help="with --check-branches: least allowed smallest singular value of the scaled inverse Jacobian (default 0.02)")
-    p.add_argument("--branch-samples", type=int, metavar="N", help="with --check-branches: trajectory samples checked, evenly spaced (default 200, at most 5000)")
+    p.add_argument(
+        "--check-branches",
+        action="store_true",
+        help="check branch safety: the distance from the trajectory to the nearest other assembly mode and to a singularity (complete homotopy FK at sampled poses); exit 1 below a margin",
+    )
+    p.add_argument(
+        "--branch-margin",
+        type=float,
+        metavar="MM",
+        help="with --check-branches: least allowed distance to another assembly mode, mm at the plate anchors (default 20)",
+    )
+    p.add_argument(
+        "--singularity-margin",
+        type=float,
+        metavar="SIGMA",
+        help="with --check-branches: least allowed smallest singular value of the scaled inverse Jacobian (default 0.02)",
+    )
+    p.add_argument(
+        "--branch-samples",
+        type=int,
+        metavar="N",
+        help="with --check-branches: trajectory samples checked, evenly spaced (default 200, at most 5000)",
+    )
 
 
 def check_branches(platform, result, args) -> dict | None:
@@ -117,10 +164,13 @@ def branch_exit(b: dict | None, args) -> int:
     """Exit status after the outputs are written: 1 (with a one-line reason) when not branch-safe."""
     if b is None or b["safe"]:
         return 0
-    print(f"run --check-branches: not branch-safe: nearest other assembly mode {b['min_branch_distance_m'] * 1e3:.3f} mm "
-          f"(margin {args.branch_margin:g} mm) at t = {b['min_branch_distance_t_s']:.3f} s; smallest sigma_min "
-          f"{b['min_sigma_min']:.4g} (margin {args.singularity_margin:g}) at t = {b['min_sigma_min_t_s']:.3f} s"
-          + ("" if b["all_complete"] else f"; FK not complete at samples {b['incomplete_samples']}"), file=sys.stderr)
+    print(
+        f"run --check-branches: not branch-safe: nearest other assembly mode {b['min_branch_distance_m'] * 1e3:.3f} mm "
+        f"(margin {args.branch_margin:g} mm) at t = {b['min_branch_distance_t_s']:.3f} s; smallest sigma_min "
+        f"{b['min_sigma_min']:.4g} (margin {args.singularity_margin:g}) at t = {b['min_sigma_min_t_s']:.3f} s"
+        + ("" if b["all_complete"] else f"; FK not complete at samples {b['incomplete_samples']}"),
+        file=sys.stderr,
+    )
     return 1
 
 
@@ -128,9 +178,10 @@ def simulate(platform, result, args) -> dict:
     """Controller in the loop (``drake.simulation``) along the program's trajectory."""
     from dataclasses import replace
 
-    from stewart_drake.core.sanity import require_plate
     from stewart_drake.control.simulation_log import tracking_verdict
-    from stewart_drake.drake.simulation import Scenario, simulate as sim_run
+    from stewart_drake.core.sanity import require_plate
+    from stewart_drake.drake.simulation import Scenario
+    from stewart_drake.drake.simulation import simulate as sim_run
 
     if args.convention != "utn":
         raise UsageError(OPTION_SIMULATE_UTN)
@@ -170,15 +221,17 @@ def summarize(result, program: str, stroke=None) -> dict:
             continue
         n = ends[k]
         mask = traj.segment == k
-        moves.append({
-            "move": s.ordinal,
-            "at": str(s.at) if s.at else None,
-            "target": list(s.values),
-            "units": list(s.units),
-            "t_end_s": float(traj.t[n]),
-            "lengths_mm": L[n] * 1e3,
-            "max_abs_force_N": None if F is None else np.abs(F[mask]).max(axis=0),
-        })
+        moves.append(
+            {
+                "move": s.ordinal,
+                "at": str(s.at) if s.at else None,
+                "target": list(s.values),
+                "units": list(s.units),
+                "t_end_s": float(traj.t[n]),
+                "lengths_mm": L[n] * 1e3,
+                "max_abs_force_N": None if F is None else np.abs(F[mask]).max(axis=0),
+            }
+        )
     return {
         "program": program,
         "platform": result.platform,
@@ -208,7 +261,11 @@ def write_outputs(out, result, summary: dict, sim: dict | None) -> None:
                 w.writerow([repr(float(v)) for v in row])
         with (tmp / "legs.csv").open("w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["t_s"] + [f"L{i}_mm" for i in range(1, 7)] + ([f"F{i}_N" for i in range(1, 7)] if result.F is not None else []))
+            w.writerow(
+                ["t_s"]
+                + [f"L{i}_mm" for i in range(1, 7)]
+                + ([f"F{i}_N" for i in range(1, 7)] if result.F is not None else [])
+            )
             cols = [traj.t[:, None], result.L * 1e3] + ([result.F] if result.F is not None else [])
             for row in np.concatenate(cols, axis=1):
                 w.writerow([f"{v:.10g}" for v in row])
@@ -224,7 +281,9 @@ def _plots(folder: Path, result, summary: dict, sim: dict | None) -> None:
     matplotlib.use("Agg")
     from stewart_drake.script.plots import plot_forces, plot_lengths, plot_tracking
 
-    plot_lengths(result, summary["platform"], summary.get("stroke_mm")).savefig(folder / "lengths.png", dpi=110, bbox_inches="tight")
+    plot_lengths(result, summary["platform"], summary.get("stroke_mm")).savefig(
+        folder / "lengths.png", dpi=110, bbox_inches="tight"
+    )
     if result.F is not None:
         plot_forces(result).savefig(folder / "forces.png", dpi=110, bbox_inches="tight")
     if sim is not None:
@@ -235,8 +294,10 @@ def _plots(folder: Path, result, summary: dict, sim: dict | None) -> None:
 
 
 def print_summary(summary: dict, out: Path) -> None:
-    print(f"{summary['program']}: {len(summary['moves'])} moves, {summary['duration_s']:.3f} s, "
-          f"{summary['samples']} samples, platform {summary['platform']}")
+    print(
+        f"{summary['program']}: {len(summary['moves'])} moves, {summary['duration_s']:.3f} s, "
+        f"{summary['samples']} samples, platform {summary['platform']}"
+    )
     shown = summary["moves"][:MAX_PRINTED]
     for m in shown:
         L = " ".join(f"{v:8.2f}" for v in m["lengths_mm"])
@@ -248,10 +309,14 @@ def print_summary(summary: dict, out: Path) -> None:
         print(f"  note: {note}")
     if "simulation" in summary:
         s = summary["simulation"]
-        print(f"  simulation ({s['controller']} controller): max |L - L_ref| = {np.max(s['max_abs_length_error_mm']):.3f} mm")
+        print(
+            f"  simulation ({s['controller']} controller): max |L - L_ref| = {np.max(s['max_abs_length_error_mm']):.3f} mm"
+        )
     if "branches" in summary:
         b = summary["branches"]
-        print(f"  branches ({b['samples_checked']} samples, {b['modes_min']}-{b['modes_max']} real modes, complete: {b['all_complete']}): "
-              f"nearest other mode {b['min_branch_distance_m'] * 1e3:.3f} mm at t = {b['min_branch_distance_t_s']:.3f} s, "
-              f"smallest sigma_min {b['min_sigma_min']:.4g} at t = {b['min_sigma_min_t_s']:.3f} s -> {'safe' if b['safe'] else 'NOT SAFE'}")
+        print(
+            f"  branches ({b['samples_checked']} samples, {b['modes_min']}-{b['modes_max']} real modes, complete: {b['all_complete']}): "
+            f"nearest other mode {b['min_branch_distance_m'] * 1e3:.3f} mm at t = {b['min_branch_distance_t_s']:.3f} s, "
+            f"smallest sigma_min {b['min_sigma_min']:.4g} at t = {b['min_sigma_min_t_s']:.3f} s -> {'safe' if b['safe'] else 'NOT SAFE'}"
+        )
     print(f"wrote {out}/")

@@ -16,13 +16,24 @@ from stewart_drake.errors import OPTION_SERVO_POSE, ServoPoseError
 
 def register(sub) -> None:
     p = sub.add_parser("servo", help="servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)")
-    p.add_argument("--platform", default="hobby-servo", metavar="NAME|FILE",
-                   help=f"a servo hexapod preset ({', '.join(SERVO_PRESETS)}) or a servo hexapod YAML file (default hobby-servo)")
+    p.add_argument(
+        "--platform",
+        default="hobby-servo",
+        metavar="NAME|FILE",
+        help=f"a servo hexapod preset ({', '.join(SERVO_PRESETS)}) or a servo hexapod YAML file (default hobby-servo)",
+    )
     p.add_argument("--preset", dest="platform", help=argparse.SUPPRESS)  # the option's earlier name
-    p.add_argument("--pose", nargs=6, type=float, metavar=("X", "Y", "Z", "PHI", "THETA", "PSI"),
-                   help="platform pose, R = Rz(psi)·Ry(theta)·Rx(phi) (default: home)")
+    p.add_argument(
+        "--pose",
+        nargs=6,
+        type=float,
+        metavar=("X", "Y", "Z", "PHI", "THETA", "PSI"),
+        help="platform pose, R = Rz(psi)·Ry(theta)·Rx(phi) (default: home)",
+    )
     p.add_argument("--from-home", action="store_true", help="Z is the offset from the home height h0")
-    p.add_argument("--trim", nargs=6, type=float, metavar="W0", help="per-servo neutral pulses W0_i in µs (default 1500)")
+    p.add_argument(
+        "--trim", nargs=6, type=float, metavar="W0", help="per-servo neutral pulses W0_i in µs (default 1500)"
+    )
     p.add_argument("--length-unit", choices=list(LENGTH_UNITS), default="mm", help="default mm")
     p.add_argument("--angle-unit", choices=list(ANGLE_UNITS), default="deg", help="default deg")
     p.add_argument("--write-sdf", metavar="DIR", help="also write DIR/servo-hexapod.sdf")
@@ -69,7 +80,9 @@ def run(args) -> int:
     if args.json:
         print_json(result)
     else:
-        print(f"{hexapod.name}: h0 = {result['home_height']:.3f} {args.length_unit}, alpha0 = {result['alpha0_deg'][0]:.3f} deg")
+        print(
+            f"{hexapod.name}: h0 = {result['home_height']:.3f} {args.length_unit}, alpha0 = {result['alpha0_deg'][0]:.3f} deg"
+        )
         print("servo   angle (deg)   pulse (us)")
         for i in range(6):
             print(f"{i + 1:5d}   {result['angles_deg'][i]:11.3f}   {result['pulse_us'][i]:10.1f}")
@@ -77,5 +90,7 @@ def run(args) -> int:
             if v["kind"] == "unreachable":
                 print(f"servo {v['servo']}: unreachable (|L/sqrt(M^2+N^2)| = {abs(v['ratio']):.4f} > 1)")
             else:
-                print(f"servo {v['servo']}: travel limit, {v['angle_deg']:.3f} deg from home, {v['excess_deg']:.3f} deg beyond ±{abs(v['limit_deg']):.0f}")
+                print(
+                    f"servo {v['servo']}: travel limit, {v['angle_deg']:.3f} deg from home, {v['excess_deg']:.3f} deg beyond ±{abs(v['limit_deg']):.0f}"
+                )
     return 0 if sol.ok else 1

@@ -8,8 +8,22 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.sanity import check_file_rows, check_positive, check_trajectory, check_work, fmt_value, require_plate
-from stewart_drake.commands._common import add_force_arg, add_platform_arg, reject_unused, dumps_strict, output_folder, print_json
+from stewart_drake.commands._common import (
+    add_force_arg,
+    add_platform_arg,
+    dumps_strict,
+    output_folder,
+    print_json,
+    reject_unused,
+)
+from stewart_drake.core.sanity import (
+    check_file_rows,
+    check_positive,
+    check_trajectory,
+    check_work,
+    fmt_value,
+    require_plate,
+)
 from stewart_drake.errors import OPTION_DURATION_POSITIVE, OPTION_ENGINE_FIXED, OptionError, UsageError
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
@@ -22,55 +36,121 @@ MAX_RUN_SECONDS = 3600.0
 
 def check_simulation_size(duration: float, plant_step: float, option: str, value) -> None:
     """Refuse a simulation whose logs would not fit in memory or that would run for more than an hour."""
-    check_work(option, f"{fmt_value(value)} s", duration / plant_step, f"plant steps of {fmt_value(plant_step)} s", BYTES_PER_STEP,
-               seconds_per=SECONDS_PER_STEP, max_seconds=MAX_RUN_SECONDS, hint=f"; use a shorter {option}")
+    check_work(
+        option,
+        f"{fmt_value(value)} s",
+        duration / plant_step,
+        f"plant steps of {fmt_value(plant_step)} s",
+        BYTES_PER_STEP,
+        seconds_per=SECONDS_PER_STEP,
+        max_seconds=MAX_RUN_SECONDS,
+        hint=f"; use a shorter {option}",
+    )
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run the fixed-point (or float) controller in the loop with the Drake plant")
     add_platform_arg(p, default="utn-dynamic")
-    p.add_argument("--trajectory", default="seed", metavar="seed|rotating|FILE.csv",
-                   help="the pose reference: the seed's (px=-0.1, py=0.1 sin 2t, pz=0.7 m), a rotating one, or a CSV "
-                        "of t,px,py,pz,ax,ay,az rows (SI unless --length-unit/--angle-unit)")
-    p.add_argument("--fit", action="store_true",
-                   help="move and scale the trajectory (made for utn-dynamic: pz 0.7 m, 0.4 m stroke) to the platform's home height and stroke")
+    p.add_argument(
+        "--trajectory",
+        default="seed",
+        metavar="seed|rotating|FILE.csv",
+        help="the pose reference: the seed's (px=-0.1, py=0.1 sin 2t, pz=0.7 m), a rotating one, or a CSV "
+        "of t,px,py,pz,ax,ay,az rows (SI unless --length-unit/--angle-unit)",
+    )
+    p.add_argument(
+        "--fit",
+        action="store_true",
+        help="move and scale the trajectory (made for utn-dynamic: pz 0.7 m, 0.4 m stroke) to the platform's home height and stroke",
+    )
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
-    p.add_argument("--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin")
-    p.add_argument("--engine", choices=["python", "c"], default="python",
-                   help="fixed-point controller tick: python (the emulation, default) or c (the generated firmware, compiled; bit-identical)")
-    p.add_argument("--firmware", default=None, metavar="FILE.c",
-                   help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`) as the controller tick")
-    p.add_argument("--period", type=float, default=1e-3, metavar="S", help="controller sample period, s (default 0.001)")
-    p.add_argument("--latency", choices=["sample", "computation", "none"], default="sample",
-                   help="when a tick's output is released: one sample later (default), after the cycle model's computation time, or at once")
-    p.add_argument("--sensor-resolution", type=float, default=1e-5, metavar="M",
-                   help="leg-length sensor resolution, m per count (default 1e-5; 1e-3: integer mm as the firmware's words)")
-    p.add_argument("--plant-step", type=float, default=None, metavar="S", help="plant time step, s (default: the period, at most 1 ms)")
-    p.add_argument("--integrator", choices=["cenic", "sap"], default=None,
-                   help="plant integrator: cenic (default; error-controlled, continuous plant) or sap (discrete plant at --plant-step); "
-                        "see benchmarks/bench_integrators.py")
-    p.add_argument("--no-feedforward", action="store_true", help="no model-based force feed-forward (the PID alone carries the plate)")
-    p.add_argument("--duration", type=float, default=None, metavar="S", help="simulated seconds (default: the trajectory's, 4 s for seed)")
-    p.add_argument("--out", default="simulation", metavar="DIR", help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)")
+    p.add_argument(
+        "--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin"
+    )
+    p.add_argument(
+        "--engine",
+        choices=["python", "c"],
+        default="python",
+        help="fixed-point controller tick: python (the emulation, default) or c (the generated firmware, compiled; bit-identical)",
+    )
+    p.add_argument(
+        "--firmware",
+        default=None,
+        metavar="FILE.c",
+        help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`) as the controller tick",
+    )
+    p.add_argument(
+        "--period", type=float, default=1e-3, metavar="S", help="controller sample period, s (default 0.001)"
+    )
+    p.add_argument(
+        "--latency",
+        choices=["sample", "computation", "none"],
+        default="sample",
+        help="when a tick's output is released: one sample later (default), after the cycle model's computation time, or at once",
+    )
+    p.add_argument(
+        "--sensor-resolution",
+        type=float,
+        default=1e-5,
+        metavar="M",
+        help="leg-length sensor resolution, m per count (default 1e-5; 1e-3: integer mm as the firmware's words)",
+    )
+    p.add_argument(
+        "--plant-step",
+        type=float,
+        default=None,
+        metavar="S",
+        help="plant time step, s (default: the period, at most 1 ms)",
+    )
+    p.add_argument(
+        "--integrator",
+        choices=["cenic", "sap"],
+        default=None,
+        help="plant integrator: cenic (default; error-controlled, continuous plant) or sap (discrete plant at --plant-step); "
+        "see benchmarks/bench_integrators.py",
+    )
+    p.add_argument(
+        "--no-feedforward",
+        action="store_true",
+        help="no model-based force feed-forward (the PID alone carries the plate)",
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="S",
+        help="simulated seconds (default: the trajectory's, 4 s for seed)",
+    )
+    p.add_argument(
+        "--out",
+        default="simulation",
+        metavar="DIR",
+        help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--allow-out-of-stroke", action="store_true",
-                   help="simulate even a reference that leaves the stroke (a warning, also in summary.json 'warnings'); default: exit 1")
+    p.add_argument(
+        "--allow-out-of-stroke",
+        action="store_true",
+        help="simulate even a reference that leaves the stroke (a warning, also in summary.json 'warnings'); default: exit 1",
+    )
     add_force_arg(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.control import ControllerConfig, DspTiming, check_timing
+    from stewart_drake.control.simulation_log import tracking_verdict
     from stewart_drake.core.geometry import load_platform
+    from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.control.simulation_log import tracking_verdict
     from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
     from stewart_drake.firmware.engine import resolve_engine
 
-    reject_unused(args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad")
+    reject_unused(
+        args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
+    )
     out_folder = output_folder(args)
     platform = load_platform(args.platform)
     require_plate(platform, "simulate")
@@ -86,21 +166,39 @@ def run(args) -> int:
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
     if not duration > 0:
         raise OptionError(OPTION_DURATION_POSITIVE.format(value=args.duration))
-    timing = DspTiming(sample_period=period, latency=args.latency, sensor_resolution=args.sensor_resolution,
-                       command_range=float(platform.legs.max_force)).check()
+    timing = DspTiming(
+        sample_period=period,
+        latency=args.latency,
+        sensor_resolution=args.sensor_resolution,
+        command_range=float(platform.legs.max_force),
+    ).check()
     check_timing(platform, period, plant_step, ActuatorModel().time_constant, timing.output_delay)
     check_simulation_size(duration, plant_step, "--duration", args.duration if args.duration is not None else duration)
     ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
-    warnings = check_trajectory(platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", args.allow_out_of_stroke)
+    warnings = check_trajectory(
+        platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", args.allow_out_of_stroke
+    )
     for w in warnings:
         print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
     # command range and gains designed for the platform over the poses of the run
-    config = ControllerConfig.for_platform(platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0)))
+    config = ControllerConfig.for_platform(
+        platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0))
+    )
     engine = resolve_engine(args.engine, "stewart-drake simulate") if args.firmware is None else "c"
     if (engine == "c" or args.firmware) and args.controller != "fixed":
         raise UsageError(OPTION_ENGINE_FIXED.format(controller=args.controller))
-    scenario = Scenario(platform, traj, args.controller, config, plant_time_step=plant_step, feedforward=not args.no_feedforward,
-                        engine=engine, firmware=args.firmware, integrator=args.integrator or DEFAULT_INTEGRATOR, duration=duration)
+    scenario = Scenario(
+        platform,
+        traj,
+        args.controller,
+        config,
+        plant_time_step=plant_step,
+        feedforward=not args.no_feedforward,
+        engine=engine,
+        firmware=args.firmware,
+        integrator=args.integrator or DEFAULT_INTEGRATOR,
+        duration=duration,
+    )
     log = simulate(scenario, progress=not args.no_progress)
     out = Path(args.out)
     e = log.length_error(traj, platform)
@@ -157,7 +255,9 @@ def write_plots(log, length_error, out: Path) -> list[Path]:
     ax[1].plot(log.t, log.force)
     ax[1].set_ylabel("actuator force [N]")
     ax[1].set_xlabel("t [s]")
-    fig.suptitle(f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace("$", r"\$")}, T = {log.sample_period * 1e3:g} ms")
+    fig.suptitle(
+        f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace('$', r'\$')}, T = {log.sample_period * 1e3:g} ms"
+    )
     path = out / "tracking.png"
     fig.savefig(path, dpi=100, bbox_inches="tight")
     plt.close(fig)

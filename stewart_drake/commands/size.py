@@ -28,16 +28,28 @@ def register(sub) -> None:
     add_platform_arg(p, default="utn-dynamic")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--program", metavar="P.stw", help="a motion program (sampled at --rate)")
-    src.add_argument("--trajectory", metavar="seed|rotating|FILE.csv",
-                     help="'seed' (px = -0.1 m, py = 0.1 sin 2t m, pz = 0.7 m), 'rotating' (15° sin 2t about z, 5° sin 3t about x at "
-                          "pz = 0.7 m), or a CSV as for `dynamics` (t + 6 pose columns, or t, q, q̇, q̈)")
-    src.add_argument("--envelope", metavar="FILE.yaml", help="a duty envelope: poses + Cartesian velocity and acceleration bounds")
+    src.add_argument(
+        "--trajectory",
+        metavar="seed|rotating|FILE.csv",
+        help="'seed' (px = -0.1 m, py = 0.1 sin 2t m, pz = 0.7 m), 'rotating' (15° sin 2t about z, 5° sin 3t about x at "
+        "pz = 0.7 m), or a CSV as for `dynamics` (t + 6 pose columns, or t, q, q̇, q̈)",
+    )
+    src.add_argument(
+        "--envelope", metavar="FILE.yaml", help="a duty envelope: poses + Cartesian velocity and acceleration bounds"
+    )
     add_payload_args(p, "in --length-unit")
     p.add_argument("--rate", type=float, default=100.0, help="--program: samples per second (default 100)")
     p.add_argument("--t-end", type=float, default=4.0, help="seed/rotating: duration in s (default 4)")
     p.add_argument("--dt", type=float, default=0.001, help="seed/rotating: time step in s (default 0.001)")
-    p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention of program/CSV angles (default utn)")
-    p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV positions and --payload-com (default m)")
+    p.add_argument(
+        "--convention",
+        choices=list(CONVENTIONS),
+        default="utn",
+        help="Euler convention of program/CSV angles (default utn)",
+    )
+    p.add_argument(
+        "--length-unit", choices=["m", "mm"], default="m", help="CSV positions and --payload-com (default m)"
+    )
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
@@ -47,7 +59,9 @@ def _trajectory(args, platform):
     if args.program is not None:
         if not (np.isfinite(args.rate) and args.rate > 0):
             raise OptionError(OptionError.POSITIVE.format(option="--rate", unit="samples per second", value=args.rate))
-        tr = run_program(read_program(args.program), args.program, platform, rate=args.rate, convention=args.convention).trajectory
+        tr = run_program(
+            read_program(args.program), args.program, platform, rate=args.rate, convention=args.convention
+        ).trajectory
         return args.program, tr.t, tr.q, tr.qd, tr.qdd, args.convention
     if args.trajectory in ("seed", "rotating"):
         if not (np.isfinite(args.dt) and args.dt > 0 and np.isfinite(args.t_end) and args.t_end >= 0):
@@ -66,7 +80,13 @@ def run(args) -> int:
     base = platform_from_args(args)
     platform, p_TP = platform_with_payload(base, args, args.length_unit)
     legs = args.legs == "on"
-    header = {"platform": base.name, "legs_model": legs, "payload_kg": args.payload, "payload_com_m": p_TP, "gravity": args.gravity}
+    header = {
+        "platform": base.name,
+        "legs_model": legs,
+        "payload_kg": args.payload,
+        "payload_com_m": p_TP,
+        "gravity": args.gravity,
+    }
     if args.envelope is not None:
         return _run_envelope(args, platform, header, legs)
     try:
@@ -79,21 +99,46 @@ def run(args) -> int:
     limits = limits_of(platform)
     viol = first_violation(limits, {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length})
     rows = s.legs()
-    legs_json = [{
-        "leg": r["leg"], "peak_force_n": r["force"]["peak"], "peak_force_t_s": r["force"]["t"], "peak_force_pose": r["force"]["pose"],
-        "rms_force_n": r["rms_force"], "peak_speed_m_s": r["speed"]["peak"], "peak_speed_t_s": r["speed"]["t"],
-        "peak_speed_pose": r["speed"]["pose"], "peak_accel_m_s2": r["accel"]["peak"], "peak_accel_t_s": r["accel"]["t"],
-        "peak_accel_pose": r["accel"]["pose"], "peak_power_w": r["power"]["peak"], "peak_power_t_s": r["power"]["t"],
-        "peak_power_pose": r["power"]["pose"], "min_length_m": r["min_length"], "max_length_m": r["max_length"],
-    } for r in rows]
+    legs_json = [
+        {
+            "leg": r["leg"],
+            "peak_force_n": r["force"]["peak"],
+            "peak_force_t_s": r["force"]["t"],
+            "peak_force_pose": r["force"]["pose"],
+            "rms_force_n": r["rms_force"],
+            "peak_speed_m_s": r["speed"]["peak"],
+            "peak_speed_t_s": r["speed"]["t"],
+            "peak_speed_pose": r["speed"]["pose"],
+            "peak_accel_m_s2": r["accel"]["peak"],
+            "peak_accel_t_s": r["accel"]["t"],
+            "peak_accel_pose": r["accel"]["pose"],
+            "peak_power_w": r["power"]["peak"],
+            "peak_power_t_s": r["power"]["t"],
+            "peak_power_pose": r["power"]["pose"],
+            "min_length_m": r["min_length"],
+            "max_length_m": r["max_length"],
+        }
+        for r in rows
+    ]
     if viol is not None:
         viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]])
-    out = dict(header, source=source, samples=len(t), duration_s=float(t[-1] - t[0]) if len(t) else 0.0, convention=convention,
-               legs=legs_json, set=_set_summary(legs_json), limits=limits, violation=viol)
+    out = dict(
+        header,
+        source=source,
+        samples=len(t),
+        duration_s=float(t[-1] - t[0]) if len(t) else 0.0,
+        convention=convention,
+        legs=legs_json,
+        set=_set_summary(legs_json),
+        limits=limits,
+        violation=viol,
+    )
     if args.json:
         print_json(out)
     else:
-        print(f"platform {base.name}, {source}: {len(t)} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg")
+        print(
+            f"platform {base.name}, {source}: {len(t)} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
+        )
         _print_table(legs_json, with_times=True)
     return _report_violation(viol, "at t = {t:.4f} s".format(t=viol["t_s"]) if viol else "")
 
@@ -112,19 +157,28 @@ def _set_summary(legs_json) -> dict:
 
 
 def _print_table(legs_json, with_times: bool) -> None:
-    print(f"{'leg':>3} {'peak|F| N':>10} {'RMS F N':>9} {'|L̇| m/s':>9} {'|L̈| m/s²':>10} {'|P| W':>9} {'L min mm':>9} {'L max mm':>9}" + ("   t(peak F) s" if with_times else ""))
+    print(
+        f"{'leg':>3} {'peak|F| N':>10} {'RMS F N':>9} {'|L̇| m/s':>9} {'|L̈| m/s²':>10} {'|P| W':>9} {'L min mm':>9} {'L max mm':>9}"
+        + ("   t(peak F) s" if with_times else "")
+    )
     for r in legs_json:
         rms = "—" if r["rms_force_n"] is None else f"{r['rms_force_n']:9.3f}"
-        print(f"{r['leg']:3d} {r['peak_force_n']:10.3f} {rms:>9} {r['peak_speed_m_s']:9.4f} {r['peak_accel_m_s2']:10.4f} {r['peak_power_w']:9.3f} "
-              f"{r['min_length_m'] * 1e3:9.2f} {r['max_length_m'] * 1e3:9.2f}" + (f"   {r['peak_force_t_s']:.4f}" if with_times else ""))
+        print(
+            f"{r['leg']:3d} {r['peak_force_n']:10.3f} {rms:>9} {r['peak_speed_m_s']:9.4f} {r['peak_accel_m_s2']:10.4f} {r['peak_power_w']:9.3f} "
+            f"{r['min_length_m'] * 1e3:9.2f} {r['max_length_m'] * 1e3:9.2f}"
+            + (f"   {r['peak_force_t_s']:.4f}" if with_times else "")
+        )
 
 
 def _report_violation(viol, where: str) -> int:
     if viol is None:
         return 0
     name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[viol["quantity"]]
-    print(f"stewart-drake size: leg {viol['leg']} {viol['quantity']} {viol['value']:.6g} {UNITS[viol['quantity']]} exceeds "
-          f"legs.{name} {viol['limit']:.6g} {UNITS[viol['quantity']]} {where}", file=sys.stderr)
+    print(
+        f"stewart-drake size: leg {viol['leg']} {viol['quantity']} {viol['value']:.6g} {UNITS[viol['quantity']]} exceeds "
+        f"legs.{name} {viol['limit']:.6g} {UNITS[viol['quantity']]} {where}",
+        file=sys.stderr,
+    )
     return 1
 
 
@@ -137,33 +191,68 @@ def _run_envelope(args, platform, header, legs) -> int:
         ks = int(np.argmax(es.peak_speed[:, i]))
         ka = int(np.argmax(es.peak_accel[:, i]))
         kp = int(np.argmax(es.peak_power[:, i]))
-        legs_json.append({
-            "leg": i + 1, "peak_force_n": w["peak"], "peak_force_pose": w["pose"], "peak_force_pose_index": w["index"],
-            "peak_force_accel": w["accel"], "peak_force_velocity": w["velocity"], "rms_force_n": None,
-            "peak_speed_m_s": float(es.peak_speed[ks, i]), "peak_speed_pose": env.poses[ks],
-            "peak_accel_m_s2": float(es.peak_accel[ka, i]), "peak_accel_pose": env.poses[ka],
-            "peak_power_w": float(es.peak_power[kp, i]), "peak_power_pose": env.poses[kp],
-            "min_length_m": float(es.length[:, i].min()), "max_length_m": float(es.length[:, i].max()),
-        })
+        legs_json.append(
+            {
+                "leg": i + 1,
+                "peak_force_n": w["peak"],
+                "peak_force_pose": w["pose"],
+                "peak_force_pose_index": w["index"],
+                "peak_force_accel": w["accel"],
+                "peak_force_velocity": w["velocity"],
+                "rms_force_n": None,
+                "peak_speed_m_s": float(es.peak_speed[ks, i]),
+                "peak_speed_pose": env.poses[ks],
+                "peak_accel_m_s2": float(es.peak_accel[ka, i]),
+                "peak_accel_pose": env.poses[ka],
+                "peak_power_w": float(es.peak_power[kp, i]),
+                "peak_power_pose": env.poses[kp],
+                "min_length_m": float(es.length[:, i].min()),
+                "max_length_m": float(es.length[:, i].max()),
+            }
+        )
     limits = limits_of(platform)
     viol = first_violation(limits, {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power})
     if viol is not None:
         viol = dict(viol, pose_index=viol["index"], pose=env.poses[viol["index"]])
-    allowed = {"axes": list(AXES), "units": ["m/s²"] * 3 + ["rad/s²"] * 3, "min_over_poses": es.allowed_accel.min(axis=0)}
+    allowed = {
+        "axes": list(AXES),
+        "units": ["m/s²"] * 3 + ["rad/s²"] * 3,
+        "min_over_poses": es.allowed_accel.min(axis=0),
+    }
     if len(env.poses) <= MAX_LISTED:
         allowed["per_pose"] = es.allowed_accel
-    out = dict(header, source=args.envelope, poses=len(env.poses), convention=env.convention, v_max=env.v_max, a_max=env.a_max,
-               legs=legs_json, set=_set_summary(legs_json), limits=limits, violation=viol, allowed_acceleration=allowed,
-               bounds={"peak_force_n": "exact worst case", "peak_speed_m_s": "exact worst case",
-                       "peak_accel_m_s2": "upper bound", "peak_power_w": "upper bound (peak |F| x peak |L̇|)", "rms_force_n": "undefined for an envelope"})
+    out = dict(
+        header,
+        source=args.envelope,
+        poses=len(env.poses),
+        convention=env.convention,
+        v_max=env.v_max,
+        a_max=env.a_max,
+        legs=legs_json,
+        set=_set_summary(legs_json),
+        limits=limits,
+        violation=viol,
+        allowed_acceleration=allowed,
+        bounds={
+            "peak_force_n": "exact worst case",
+            "peak_speed_m_s": "exact worst case",
+            "peak_accel_m_s2": "upper bound",
+            "peak_power_w": "upper bound (peak |F| x peak |L̇|)",
+            "rms_force_n": "undefined for an envelope",
+        },
+    )
     if args.json:
         print_json(out)
     else:
-        print(f"platform {platform.name}, envelope {args.envelope}: {len(env.poses)} poses, legs model {args.legs}, payload {args.payload} kg")
+        print(
+            f"platform {platform.name}, envelope {args.envelope}: {len(env.poses)} poses, legs model {args.legs}, payload {args.payload} kg"
+        )
         _print_table(legs_json, with_times=False)
         a = allowed["min_over_poses"]
-        print("largest acceleration per axis the actuators allow at every pose (others zero, worst velocity): "
-              + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, allowed["units"])))
+        print(
+            "largest acceleration per axis the actuators allow at every pose (others zero, worst velocity): "
+            + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, allowed["units"]))
+        )
     where = ""
     if viol:
         where = f"at envelope {env.shown(viol['index'])}"

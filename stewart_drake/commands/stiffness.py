@@ -14,7 +14,13 @@ from stewart_drake.core.sanity import check_poses
 from stewart_drake.design.maps import MAX_POINTS, slice_maps
 from stewart_drake.design.payload import payload_wrench
 from stewart_drake.design.plots import plot_slice_maps
-from stewart_drake.design.stiffness import compliance, deflection, leg_stiffness_vector, principal_stiffness, stiffness_matrix
+from stewart_drake.design.stiffness import (
+    compliance,
+    deflection,
+    leg_stiffness_vector,
+    principal_stiffness,
+    stiffness_matrix,
+)
 from stewart_drake.errors import OptionError, PhysicalLimitError, StewartError
 
 NAMES = ("x", "y", "z", "rx", "ry", "rz")
@@ -23,19 +29,42 @@ NAMES = ("x", "y", "z", "rx", "ry", "rz")
 def add_pose_args(p) -> None:
     """The arguments ``stiffness`` and ``modes`` share: platform, pose and its units, leg stiffness, payload."""
     add_platform_arg(p, default="utn-dynamic")
-    p.add_argument("--pose", nargs=6, type=float, required=True, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="the pose, in the chosen units")
+    p.add_argument(
+        "--pose",
+        nargs=6,
+        type=float,
+        required=True,
+        metavar=("PX", "PY", "PZ", "A", "B", "G"),
+        help="the pose, in the chosen units",
+    )
     add_unit_args(p)
-    p.add_argument("--leg-stiffness", type=float, metavar="N/m", help="axial stiffness of every leg (default: legs.stiffness of the platform file)")
+    p.add_argument(
+        "--leg-stiffness",
+        type=float,
+        metavar="N/m",
+        help="axial stiffness of every leg (default: legs.stiffness of the platform file)",
+    )
     add_payload_args(p, "in --length-unit")
 
 
 def register(sub) -> None:
     p = sub.add_parser("stiffness", help="6×6 Cartesian stiffness, compliance and payload deflection at a pose")
     add_pose_args(p)
-    p.add_argument("--json", action="store_true", help="print JSON (SI units: N/m, N/rad, N·m/rad; deflection in m and rad)")
-    p.add_argument("--map", metavar="DIR", help="also write maps over the x-y slice through the pose (condition number, safe region, "
-                   "assembly mode, minimum stiffness, softest direction, lowest frequency): DIR/maps.png and DIR/maps.npz")
-    p.add_argument("--map-half-width", type=float, default=150.0, help="--map: half-width of the square slice, in --length-unit (default 150)")
+    p.add_argument(
+        "--json", action="store_true", help="print JSON (SI units: N/m, N/rad, N·m/rad; deflection in m and rad)"
+    )
+    p.add_argument(
+        "--map",
+        metavar="DIR",
+        help="also write maps over the x-y slice through the pose (condition number, safe region, "
+        "assembly mode, minimum stiffness, softest direction, lowest frequency): DIR/maps.png and DIR/maps.npz",
+    )
+    p.add_argument(
+        "--map-half-width",
+        type=float,
+        default=150.0,
+        help="--map: half-width of the square slice, in --length-unit (default 150)",
+    )
     p.add_argument("--map-n", type=int, default=61, help="--map: nodes per side (default 61)")
     p.set_defaults(func=run)
 
@@ -75,13 +104,27 @@ def run(args) -> int:
     d = deflection(K, w)
     kl, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     out = {
-        "platform": platform.name, "pose": args.pose, "length_unit": args.length_unit, "angle_unit": args.angle_unit,
-        "convention": args.convention, "leg_stiffness_n_per_m": k, "legs_model": legs, "payload_kg": args.payload,
-        "payload_com_m": p_TP, "gravity": args.gravity,
-        "stiffness": K, "stiffness_zero_load": K0, "compliance": compliance(K),
-        "principal_stiffness": {"translational_n_per_m": pr.translational, "translational_directions": pr.translational_dirs.T,
-                                "rotational_nm_per_rad": pr.rotational, "rotational_directions": pr.rotational_dirs.T},
-        "payload_wrench": w, "deflection": d,
+        "platform": platform.name,
+        "pose": args.pose,
+        "length_unit": args.length_unit,
+        "angle_unit": args.angle_unit,
+        "convention": args.convention,
+        "leg_stiffness_n_per_m": k,
+        "legs_model": legs,
+        "payload_kg": args.payload,
+        "payload_com_m": p_TP,
+        "gravity": args.gravity,
+        "stiffness": K,
+        "stiffness_zero_load": K0,
+        "compliance": compliance(K),
+        "principal_stiffness": {
+            "translational_n_per_m": pr.translational,
+            "translational_directions": pr.translational_dirs.T,
+            "rotational_nm_per_rad": pr.rotational,
+            "rotational_directions": pr.rotational_dirs.T,
+        },
+        "payload_wrench": w,
+        "deflection": d,
         "deflection_edge_units": np.r_[d[:3] / kl, d[3:] / ka],
     }
     if args.map:
@@ -89,19 +132,25 @@ def run(args) -> int:
     if args.json:
         print_json(out)
         return 0
-    print(f"platform {platform.name}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
-          + ("" if np.all(k == k[0]) else " ..."))
+    print(
+        f"platform {platform.name}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
+        + ("" if np.all(k == k[0]) else " ...")
+    )
     print("stiffness K about the rotation centre (rows: force N, moment N·m; columns: δp m, δθ rad):")
     print(f"{'':>4}" + "".join(f"{n:>13}" for n in NAMES))
     for n, row in zip(("fx", "fy", "fz", "mx", "my", "mz"), K):
         print(f"{n:>4}" + "".join(f"{v:13.5g}" for v in row))
-    for label, vals, dirs, unit in (("translational", pr.translational, pr.translational_dirs, "N/m"),
-                                    ("rotational", pr.rotational, pr.rotational_dirs, "N·m/rad")):
+    for label, vals, dirs, unit in (
+        ("translational", pr.translational, pr.translational_dirs, "N/m"),
+        ("rotational", pr.rotational, pr.rotational_dirs, "N·m/rad"),
+    ):
         print(f"principal {label} stiffness ({unit}), softest first:")
         for v, e in zip(vals, dirs.T):
             print(f"  {v:12.5g}  along [{e[0]:+.4f} {e[1]:+.4f} {e[2]:+.4f}]")
-    print(f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
-          f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}")
+    print(
+        f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
+        f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}"
+    )
     return 0
 
 
@@ -111,9 +160,13 @@ def write_maps(args, platform, q, k) -> None:
     if not (np.isfinite(hw) and hw > 0):
         raise OptionError(OptionError.POSITIVE_LENGTH.format(option="--map-half-width", value=args.map_half_width))
     if not 2 <= args.map_n <= int(np.sqrt(MAX_POINTS)):
-        raise OptionError(OptionError.BETWEEN.format(option="--map-n", lo=2, hi=int(np.sqrt(MAX_POINTS)), value=args.map_n))
+        raise OptionError(
+            OptionError.BETWEEN.format(option="--map-n", lo=2, hi=int(np.sqrt(MAX_POINTS)), value=args.map_n)
+        )
     ranges = ((q[0] - hw, q[0] + hw), (q[1] - hw, q[1] + hw))
-    m = slice_maps(platform, (0, 1), ranges, args.map_n, base=q, k=k, gravity=args.gravity, modes=True, convention=args.convention)
+    m = slice_maps(
+        platform, (0, 1), ranges, args.map_n, base=q, k=k, gravity=args.gravity, modes=True, convention=args.convention
+    )
     # deferred: pyplot is imported only when maps are drawn, after selecting the Agg backend
     import matplotlib
 
@@ -124,5 +177,17 @@ def write_maps(args, platform, q, k) -> None:
         fig = plot_slice_maps(m, args.length_unit)
         fig.savefig(tmp / "maps.png", dpi=110, bbox_inches="tight")
         plt.close(fig)
-        np.savez(tmp / "maps.npz", x_m=m.u, y_m=m.v, base_pose=m.base, within=m.within, condition=m.condition, distance=m.distance,
-                 same_mode=m.same_mode, safe=m.safe, k_min_n_per_m=m.k_min, softest=m.softest, f1_hz=m.f1)
+        np.savez(
+            tmp / "maps.npz",
+            x_m=m.u,
+            y_m=m.v,
+            base_pose=m.base,
+            within=m.within,
+            condition=m.condition,
+            distance=m.distance,
+            same_mode=m.same_mode,
+            safe=m.safe,
+            k_min_n_per_m=m.k_min,
+            softest=m.softest,
+            f1_hz=m.f1,
+        )

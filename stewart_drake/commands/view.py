@@ -12,18 +12,41 @@ from stewart_drake.errors import OPTION_PORT, OPTION_SPEED, OPTION_VIEW_DURATION
 
 
 def register(sub) -> None:
-    p = sub.add_parser("view", help="interactive 3-D viewer (Meshcat on localhost): pose sliders, leg lengths, "
-                       "stroke margins, singularity distance, assembly modes; or replay a simulate/run log")
+    p = sub.add_parser(
+        "view",
+        help="interactive 3-D viewer (Meshcat on localhost): pose sliders, leg lengths, "
+        "stroke margins, singularity distance, assembly modes; or replay a simulate/run log",
+    )
     add_platform_arg(p, default="utn-dynamic")
     add_unit_args(p)
-    p.add_argument("--port", type=int, default=None, metavar="P", help="Meshcat port on localhost (default: the first free from 7000)")
-    p.add_argument("--pose", type=float, nargs=6, metavar=("PX", "PY", "PZ", "A", "B", "G"),
-                   help="initial pose in --length-unit/--angle-unit/--convention (default: home)")
-    p.add_argument("--replay", metavar="LOG", help="replay a simulate log (log.npz, log.csv), a run output (trajectory.csv) or their folder")
+    p.add_argument(
+        "--port",
+        type=int,
+        default=None,
+        metavar="P",
+        help="Meshcat port on localhost (default: the first free from 7000)",
+    )
+    p.add_argument(
+        "--pose",
+        type=float,
+        nargs=6,
+        metavar=("PX", "PY", "PZ", "A", "B", "G"),
+        help="initial pose in --length-unit/--angle-unit/--convention (default: home)",
+    )
+    p.add_argument(
+        "--replay",
+        metavar="LOG",
+        help="replay a simulate log (log.npz, log.csv), a run output (trajectory.csv) or their folder",
+    )
     p.add_argument("--speed", type=float, default=1.0, help="replay speed factor (default 1)")
     p.add_argument("--loop", action="store_true", help="replay in a loop")
-    p.add_argument("--duration", type=float, default=None, metavar="S",
-                   help="exit after S wall seconds (non-interactive use, tests); 0: draw once and exit")
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="S",
+        help="exit after S wall seconds (non-interactive use, tests); 0: draw once and exit",
+    )
     p.add_argument("--no-modes", action="store_true", help="do not count assembly modes (faster updates)")
     p.add_argument("--json", action="store_true", help="print the last readout as JSON on exit")
     p.set_defaults(func=run)
@@ -43,11 +66,22 @@ def run(args) -> int:
         raise OptionError(OPTION_PORT.format(value=args.port))
     replay = load_replay(args.replay) if args.replay else None
     if replay is not None and replay[3] and replay[3] != platform.name:
-        print(f"stewart-drake view: note: the log was recorded on platform {replay[3]!r}, shown on {platform.name!r}", file=sys.stderr)
-    pose = platform.home_pose() if args.pose is None else pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit)
+        print(
+            f"stewart-drake view: note: the log was recorded on platform {replay[3]!r}, shown on {platform.name!r}",
+            file=sys.stderr,
+        )
+    pose = (
+        platform.home_pose()
+        if args.pose is None
+        else pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit)
+    )
     meshcat = open_meshcat(args.port)
     viewer = Viewer(platform, meshcat, args.length_unit, args.angle_unit, args.convention, modes=not args.no_modes)
-    print(f"stewart-drake view: {platform.name} at {meshcat.web_url()}" + ("" if args.duration is not None else " (Ctrl-C to quit)"), flush=True)
+    print(
+        f"stewart-drake view: {platform.name} at {meshcat.web_url()}"
+        + ("" if args.duration is not None else " (Ctrl-C to quit)"),
+        flush=True,
+    )
     try:
         if replay is not None:
             t, poses, sat, _ = replay

@@ -74,7 +74,9 @@ class ControllerConfig:
     convention: str = "utn"
 
     @classmethod
-    def for_platform(cls, platform: Platform, timing: DspTiming | None = None, actuator_lag: float = 2e-3, poses=None, **kwargs) -> "ControllerConfig":
+    def for_platform(
+        cls, platform: Platform, timing: DspTiming | None = None, actuator_lag: float = 2e-3, poses=None, **kwargs
+    ) -> ControllerConfig:
         """The configuration designed for ``platform``: ``timing`` (default ``DspTiming()`` with its
         command range the platform's actuator force ``legs.max_force``; a given timing is used as is) and
         the gains of ``design_gains`` for that timing, an actuator lag ``actuator_lag`` (s) and the poses
@@ -127,13 +129,22 @@ def strut_stiffness(platform: Platform, pose=None, h: float = 1e-6):
     differences of step ``h``."""
     q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float)
     z = np.zeros_like(q0)
-    dFdq = np.stack([(leg_forces_with_legs(platform, q0 + h * e, z, z) - leg_forces_with_legs(platform, q0 - h * e, z, z)) / (2 * h) for e in np.eye(6)], -1)
+    dFdq = np.stack(
+        [
+            (leg_forces_with_legs(platform, q0 + h * e, z, z) - leg_forces_with_legs(platform, q0 - h * e, z, z))
+            / (2 * h)
+            for e in np.eye(6)
+        ],
+        -1,
+    )
     K = dFdq @ np.linalg.inv(length_jacobian(platform, q0))
     k = np.maximum(0.0, np.linalg.eigvalsh(-(K + np.swapaxes(K, -1, -2)) / 2)[..., -1])
     return float(k) if k.ndim == 0 else k
 
 
-def design_gains(platform: Platform, timing: DspTiming | None = None, actuator_lag: float = 2e-3, pose=None, poses=None) -> PidGains:
+def design_gains(
+    platform: Platform, timing: DspTiming | None = None, actuator_lag: float = 2e-3, pose=None, poses=None
+) -> PidGains:
     """Leg PID gains for ``platform`` from its leg-space inertia (``leg_space_inertia``: lightest mode
     m_min, heaviest m_max), the struts' negative stiffness K (``strut_stiffness``) and the loop delay t_d
     (``loop_delay``). The extremes are taken over ``pose`` (default home) and ``poses`` (``(n, 6)``, the
@@ -235,7 +246,7 @@ class FixedGains:
     alpha_ff: int
 
     @classmethod
-    def from_si(cls, gains: PidGains, timing: DspTiming) -> "FixedGains":
+    def from_si(cls, gains: PidGains, timing: DspTiming) -> FixedGains:
         # command fraction per error fraction: k_phys · (2^15 counts · resolution) / command_range
         scale = 32768.0 * timing.sensor_resolution / timing.command_range
         T = timing.sample_period

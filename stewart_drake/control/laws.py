@@ -27,7 +27,9 @@ from stewart_drake.fixedpoint import fixed_point_leg_lengths, q15
 
 # Layout of a controller's ``status``: tick count, time of the last tick, time of the last release of a
 # command, saturated ticks in total, then per leg (6) saturated ticks.
-STATUS = ("ticks", "last_tick_time", "last_release_time", "saturations") + tuple(f"saturations_{i}" for i in range(1, 7))
+STATUS = ("ticks", "last_tick_time", "last_release_time", "saturations") + tuple(
+    f"saturations_{i}" for i in range(1, 7)
+)
 CONTROLLER_KINDS = ("fixed", "float")
 
 
@@ -128,7 +130,9 @@ class FixedPointLaw:
 
     def ik_words(self, poses) -> np.ndarray:
         """``(..., 6)`` int64 set-point words (units of the IK's length LSB) for ``(..., 6)`` poses."""
-        return fixed_point_leg_lengths(self.platform, poses, self.config.ik_format, self.config.convention, return_words=True)
+        return fixed_point_leg_lengths(
+            self.platform, poses, self.config.ik_format, self.config.convention, return_words=True
+        )
 
     def quantise(self, L) -> np.ndarray:
         """Sensor counts (int64) of true lengths ``L`` (metres), rounded to nearest."""
@@ -179,7 +183,9 @@ class FixedPointLaw:
         # operation for all rows): row 0 the measurement difference and its filter, row 1 the set-point's.
         # Every shift here is by a constant n >= 0, where shl(a, n) = sat16(a << n) and L_shl(a, n) =
         # sat32(a << n) (``q15.shl``, ``q15.L_shl``): written so, without their run-time sign dispatch.
-        diff = q.sat16(q.sat16(np.stack([m - prev, (sp - sp_prev) * self._counts_per_lsb])) << DIFF_SHIFT)  # Word16, ·2^DIFF_SHIFT
+        diff = q.sat16(
+            q.sat16(np.stack([m - prev, (sp - sp_prev) * self._counts_per_lsb])) << DIFF_SHIFT
+        )  # Word16, ·2^DIFF_SHIFT
         # first-order filters of the differences: f += alpha·(d − f), rounded Q15 multiplies
         filt = np.stack([dfilt, vfilt])
         dfilt, vfilt = q.add(filt, q.mult_r(self._alphas, q.sub(diff, filt)))

@@ -66,13 +66,26 @@ class SimulationLog:
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
         npz = d / "log.npz"
-        np.savez(npz, **{k: getattr(self, k) for k in self.ARRAYS}, kind=self.kind, platform=self.platform, trajectory=self.trajectory, sample_period=self.sample_period)
-        header = (
-            ["t"] + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")]
-            + [f"L{i}" for i in range(1, 7)] + [f"setpoint{i}" for i in range(1, 7)]
-            + [f"command{i}" for i in range(1, 7)] + [f"force{i}" for i in range(1, 7)] + list(STATUS)
+        np.savez(
+            npz,
+            **{k: getattr(self, k) for k in self.ARRAYS},
+            kind=self.kind,
+            platform=self.platform,
+            trajectory=self.trajectory,
+            sample_period=self.sample_period,
         )
-        rows = np.concatenate([self.t[:, None], self.pose, self.lengths, self.setpoint, self.command, self.force, self.status], axis=1)
+        header = (
+            ["t"]
+            + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")]
+            + [f"L{i}" for i in range(1, 7)]
+            + [f"setpoint{i}" for i in range(1, 7)]
+            + [f"command{i}" for i in range(1, 7)]
+            + [f"force{i}" for i in range(1, 7)]
+            + list(STATUS)
+        )
+        rows = np.concatenate(
+            [self.t[:, None], self.pose, self.lengths, self.setpoint, self.command, self.force, self.status], axis=1
+        )
         path = d / "log.csv"
         with path.open("w", newline="") as fh:
             w = csv.writer(fh)
@@ -118,11 +131,19 @@ def tracking_verdict(platform: Platform, length_error, pose_error, log: Simulati
         if np.any(bad):
             i = int(np.argmax(bad))
             which = f" of leg {int(np.argmax(err[i])) + 1}" if legwise else ""
-            failures.append(f"tracking lost: the {name} error{which} exceeds {bound * 1e3:.1f} mm ({TRACKING_LOST_FRACTION:g} × the stroke range) "
-                            f"first at t = {log.t[i]:.4f} s, and reaches {err.max() * 1e3:.1f} mm")
+            failures.append(
+                f"tracking lost: the {name} error{which} exceeds {bound * 1e3:.1f} mm ({TRACKING_LOST_FRACTION:g} × the stroke range) "
+                f"first at t = {log.t[i]:.4f} s, and reaches {err.max() * 1e3:.1f} mm"
+            )
     longest = longest_saturation(log)
     for j in np.flatnonzero(longest > MAX_SATURATION_S):
-        failures.append(f"leg {j + 1} saturated for {longest[j]:.3f} s in one stretch (longer than {MAX_SATURATION_S:g} s): "
-                        "its actuator cannot follow the reference")
-    return {"tracking_bound_mm": bound * 1e3, "saturation_bound_s": MAX_SATURATION_S,
-            "longest_saturation_s": longest.tolist(), "failures": failures}
+        failures.append(
+            f"leg {j + 1} saturated for {longest[j]:.3f} s in one stretch (longer than {MAX_SATURATION_S:g} s): "
+            "its actuator cannot follow the reference"
+        )
+    return {
+        "tracking_bound_mm": bound * 1e3,
+        "saturation_bound_s": MAX_SATURATION_S,
+        "longest_saturation_s": longest.tolist(),
+        "failures": failures,
+    }

@@ -37,7 +37,17 @@ LATENCY_MODES = ("sample", "computation", "none")
 # measurement and set-point differences and their filters (sub ×5, shl ×2, mult_r ×2, add ×2), P, I, D, V
 # terms (L_mult ×4, L_shl ×4), the sums (L_add ×3, L_sub), the command word (extract_h), the set-point
 # scalings to counts (L_mult ×2).
-PID_OPS_PER_LEG = {"sub": 5, "add": 2, "shl": 2, "mult_r": 2, "L_mult": 6, "extract_h": 1, "L_shl": 4, "L_add": 3, "L_sub": 1}
+PID_OPS_PER_LEG = {
+    "sub": 5,
+    "add": 2,
+    "shl": 2,
+    "mult_r": 2,
+    "L_mult": 6,
+    "extract_h": 1,
+    "L_shl": 4,
+    "L_add": 3,
+    "L_sub": 1,
+}
 # The force feed-forward from its table: the word to the high half of a long (L_deposit_h), added to the sum.
 FEEDFORWARD_OPS_PER_LEG = {"L_deposit_h": 1, "L_add": 1}
 # The alternative, not implemented: a linearised feed-forward computed on the DSP per tick,
@@ -81,7 +91,9 @@ class DspTiming:
                 raise TimingError(TIMING_POSITIVE.format(name=name, value=v))
         if self.latency not in LATENCY_MODES:
             raise TimingError(TIMING_LATENCY.format(valid=", ".join(LATENCY_MODES), value=self.latency))
-        if self.computation_cycles is not None and not (int(self.computation_cycles) == self.computation_cycles and self.computation_cycles > 0):
+        if self.computation_cycles is not None and not (
+            int(self.computation_cycles) == self.computation_cycles and self.computation_cycles > 0
+        ):
             raise TimingError(TIMING_CYCLES.format(value=self.computation_cycles))
 
     def cycles(self) -> int:
@@ -100,7 +112,7 @@ class DspTiming:
         """Seconds from a tick to the release of its command."""
         return {"sample": self.sample_period, "computation": self.computation_time, "none": 0.0}[self.latency]
 
-    def check(self) -> "DspTiming":
+    def check(self) -> DspTiming:
         """Return self, or raise ``TimingError`` if a tick's computation is longer than the sample period."""
         n = self.cycles()
         t = n / self.clock_hz
@@ -151,5 +163,13 @@ def check_timing(platform, period: float, plant_step: float, actuator_lag: float
         w_c = PHASE_BUDGET / (output_delay + T + actuator_lag)
         if w_c < CROSSOVER_MARGIN * lam:
             t_max = PHASE_BUDGET / (CROSSOVER_MARGIN * lam) - actuator_lag
-            raise StewartError(PERIOD_TOO_SLOW.format(period=fmt_value(T), name=platform.name, lam=lam, w_c=w_c,
-                                                      margin=CROSSOVER_MARGIN, t_max=max(t_max / 2, 0)))
+            raise StewartError(
+                PERIOD_TOO_SLOW.format(
+                    period=fmt_value(T),
+                    name=platform.name,
+                    lam=lam,
+                    w_c=w_c,
+                    margin=CROSSOVER_MARGIN,
+                    t_max=max(t_max / 2, 0),
+                )
+            )

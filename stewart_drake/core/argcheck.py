@@ -35,7 +35,7 @@ def check_shape(value, name: str, shape, error: type[Exception] = ShapeError) ->
     shape = tuple(shape)
     if shape[:1] == (...,):
         tail = shape[1:]
-        ok = a.shape[a.ndim - len(tail):] == tail if a.ndim >= len(tail) else False
+        ok = a.shape[a.ndim - len(tail) :] == tail if a.ndim >= len(tail) else False
     else:
         ok = a.shape == shape
     if not ok:

@@ -202,7 +202,9 @@ def assembly_modes(
     if L.shape != (6,):
         raise FkInputError(FkInputError.ONE_SET.format(what="assembly_modes", shape=L.shape))
     if polish is not None and not callable(polish):
-        raise TypeError(f"polish must be a callable (lengths, p, R) -> (p, R, success, residual) or None, got {polish!r}")
+        raise TypeError(
+            f"polish must be a callable (lengths, p, R) -> (p, R, success, residual) or None, got {polish!r}"
+        )
     t_start = time.perf_counter()
     rng = np.random.default_rng(seed)
     scale = anchor_scale(platform)
@@ -223,9 +225,7 @@ def assembly_modes(
             R0 = np.concatenate([rotation_matrix(h[3:], "utn")[None], R0])
             p0 = np.concatenate([h[None, :3], p0])
         starts += len(p0)
-        p, R, _, _, status = newton_core(
-            platform, p0, R0, np.broadcast_to(L, (len(p0), 6)), tol, 40, 0.25 * size, 0.5
-        )
+        p, R, _, _, status = newton_core(platform, p0, R0, np.broadcast_to(L, (len(p0), 6)), tol, 40, 0.25 * size, 0.5)
         ok = status == CONVERGED
         p, R = p[ok], R[ok]
         if mirror and len(p):

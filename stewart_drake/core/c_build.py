@@ -27,7 +27,7 @@ import subprocess
 import sys
 import tempfile
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 from stewart_drake.errors import StewartError
@@ -79,7 +79,7 @@ def _probe(name: str, argv: tuple[str, ...]) -> Compiler | None:
     return Compiler(name, argv, first[0] if first else name)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _compilers(cc_env: str | None) -> tuple[Compiler, ...]:
     found = []
     if cc_env:
@@ -102,7 +102,7 @@ def _compilers(cc_env: str | None) -> tuple[Compiler, ...]:
     return tuple(found)
 
 
-@lru_cache(maxsize=None)
+@cache
 def zig_compiler() -> Compiler | None:
     """``python -m ziglang cc`` when the ``ziglang`` wheel is installed, else None."""
     import importlib.util
@@ -121,8 +121,10 @@ def default_compiler() -> Compiler:
     """The preferred compiler; raises CompilerUnavailable if there is none."""
     cs = compilers()
     if not cs:
-        raise CompilerUnavailable("no C compiler found (looked for $STEWART_DRAKE_CC, cc, gcc, clang and the ziglang "
-                                  "wheel's zig cc; `pip install ziglang` gives one)")
+        raise CompilerUnavailable(
+            "no C compiler found (looked for $STEWART_DRAKE_CC, cc, gcc, clang and the ziglang "
+            "wheel's zig cc; `pip install ziglang` gives one)"
+        )
     return cs[0]
 
 
@@ -156,14 +158,28 @@ def library_sources(*names: str) -> list[Source]:
     return [Source(n, path=C_DIR / n) for n in names]
 
 
-def build(sources: list[Source], *, headers: list[Source] = (), defines: tuple[str, ...] = (),
-          flags: tuple[str, ...] = (), compiler: Compiler | None = None, strict: bool = False, opt: str = "-O2") -> Path:
+def build(
+    sources: list[Source],
+    *,
+    headers: list[Source] = (),
+    defines: tuple[str, ...] = (),
+    flags: tuple[str, ...] = (),
+    compiler: Compiler | None = None,
+    strict: bool = False,
+    opt: str = "-O2",
+) -> Path:
     """Compile ``sources`` (with ``headers`` beside them and the package's ``fixedpoint/c`` on the include
     path) into a shared library in the cache and return its path; a cached build with the same compiler,
     flags and bytes is reused. ``strict``: add ``-Wall -Wextra -Werror -pedantic``. Raises CompileError
     with the compiler's message, CompilerUnavailable without a compiler."""
     compiler = compiler or default_compiler()
-    cflags = tuple(f for f in BASE_FLAGS if f != "-O2") + (opt,) + (STRICT_FLAGS[1:] if strict else ()) + tuple(f"-D{d}" for d in defines) + tuple(flags)
+    cflags = (
+        tuple(f for f in BASE_FLAGS if f != "-O2")
+        + (opt,)
+        + (STRICT_FLAGS[1:] if strict else ())
+        + tuple(f"-D{d}" for d in defines)
+        + tuple(flags)
+    )
     h = hashlib.sha256()
     h.update("\0".join((compiler.version, *compiler.argv, *cflags)).encode())
     for s in [*sources, *headers, *library_sources("dsp56800e.h")]:
@@ -199,7 +215,7 @@ def _first_error(msg: str, compiler: Compiler) -> str:
     return f"{compiler.name} failed: " + " | ".join(lines[:3])
 
 
-@lru_cache(maxsize=None)
+@cache
 def _ffi(cdef: str):
     import cffi
 

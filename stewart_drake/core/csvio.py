@@ -69,8 +69,11 @@ def read_numeric_csv(path, kind: str, widths: tuple[int, ...], columns: str) -> 
                 break
             except csv.Error as e:
                 if "field larger than field limit" in str(e):
-                    raise CsvError(CsvError.FIELD_TOO_LONG.format(path=path, line=reader.line_num, limit=MAX_FIELD_CHARS,
-                                                                  kind=kind)) from None
+                    raise CsvError(
+                        CsvError.FIELD_TOO_LONG.format(
+                            path=path, line=reader.line_num, limit=MAX_FIELD_CHARS, kind=kind
+                        )
+                    ) from None
                 raise CsvError(CsvError.SYNTAX.format(path=path, line=reader.line_num, problem=e)) from None
             except UnicodeDecodeError:
                 raise CsvError(CsvError.NOT_TEXT.format(path=path, line=reader.line_num + 1)) from None
@@ -85,15 +88,21 @@ def read_numeric_csv(path, kind: str, widths: tuple[int, ...], columns: str) -> 
                     if lineno == 1:
                         values = None
                         break
-                    raise CsvError(CsvError.NOT_NUMBER.format(path=path, line=lineno, column=col, value=_short(c))) from None
+                    raise CsvError(
+                        CsvError.NOT_NUMBER.format(path=path, line=lineno, column=col, value=_short(c))
+                    ) from None
             if values is None:
                 continue  # header
             if len(values) not in widths or (width is not None and len(values) != width):
                 expected = width or " or ".join(map(str, widths))
-                raise CsvError(CsvError.WIDTH.format(path=path, line=lineno, expected=expected, columns=columns, got=len(values)))
+                raise CsvError(
+                    CsvError.WIDTH.format(path=path, line=lineno, expected=expected, columns=columns, got=len(values))
+                )
             bad = next((i for i, v in enumerate(values) if not math.isfinite(v)), None)
             if bad is not None:
-                raise CsvError(CsvError.NOT_FINITE.format(path=path, line=lineno, column=bad + 1, value=_short(row[bad])))
+                raise CsvError(
+                    CsvError.NOT_FINITE.format(path=path, line=lineno, column=bad + 1, value=_short(row[bad]))
+                )
             width = len(values)
             rows.append(values)
             lines.append(lineno)

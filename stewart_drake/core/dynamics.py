@@ -100,7 +100,9 @@ def harmonic_trajectory(t, mean, amplitude, omega, phase=0.0) -> tuple[np.ndarra
     Returns ``(q, qd, qdd)``, each ``t.shape + (6,)`` in metres/radians and their time derivatives.
     """
     t = np.asarray(t, dtype=float)[..., None]
-    mean, amplitude, omega, phase = (np.broadcast_to(np.asarray(v, dtype=float), (6,)) for v in (mean, amplitude, omega, phase))
+    mean, amplitude, omega, phase = (
+        np.broadcast_to(np.asarray(v, dtype=float), (6,)) for v in (mean, amplitude, omega, phase)
+    )
     arg = omega * t + phase
     s, c = np.sin(arg), np.cos(arg)
     return mean + amplitude * s, amplitude * omega * c, -amplitude * omega**2 * s
@@ -158,7 +160,16 @@ def plate_motion(platform: Platform, q, qd, qdd, convention: str = "utn") -> dic
     centripetal = np.cross(w, np.cross(w, r))
     a_bias = np.cross(wd_bias, r) + centripetal
     a = qdd[..., :3] + np.cross(wd, r) + centripetal
-    return {"R": R, "E": E, "omega": w, "omega_dot": wd, "omega_dot_bias": wd_bias, "r_cm": r, "a_cm": a, "a_cm_bias": a_bias}
+    return {
+        "R": R,
+        "E": E,
+        "omega": w,
+        "omega_dot": wd,
+        "omega_dot_bias": wd_bias,
+        "r_cm": r,
+        "a_cm": a,
+        "a_cm_bias": a_bias,
+    }
 
 
 # ----------------------------------------------------------------------------------------------
@@ -197,7 +208,9 @@ def gravity_vector(platform: Platform, q, convention: str = "utn", gravity: floa
 def coriolis_vector(platform: Platform, q, qd, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` C(q, q̇) q̇ (N, N·m): the generalized force the plate needs at q̈ = 0 without gravity,
     by Newton–Euler: f = m a_cm, τ_cm = I ω̇ + ω × I ω, projected on q as [f; E_Wᵀ (τ_cm + r_cm × f)]."""
-    return _generalized_force(platform, plate_motion(platform, q, qd, np.zeros_like(np.asarray(qd, float)), convention), 0.0)
+    return _generalized_force(
+        platform, plate_motion(platform, q, qd, np.zeros_like(np.asarray(qd, float)), convention), 0.0
+    )
 
 
 def _generalized_force(platform: Platform, mo: dict, gravity: float, bias_only: bool = False) -> np.ndarray:
@@ -211,7 +224,9 @@ def _generalized_force(platform: Platform, mo: dict, gravity: float, bias_only: 
     return np.concatenate([f, np.einsum("...ji,...j->...i", mo["E"], tau_C)], axis=-1)
 
 
-def generalized_force(platform: Platform, q, qd, qdd, convention: str = "utn", coriolis: bool = True, gravity: float = G_EARTH) -> np.ndarray:
+def generalized_force(
+    platform: Platform, q, qd, qdd, convention: str = "utn", coriolis: bool = True, gravity: float = G_EARTH
+) -> np.ndarray:
     """``(..., 6)`` Q = M q̈ + C q̇ + G (the last two optional): what Jᵀ F must equal (N, N·m)."""
     mo = plate_motion(platform, q, qd, qdd, convention)
     Q = _generalized_force(platform, mo, gravity)
@@ -269,7 +284,9 @@ def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.nd
     return np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
 
 
-def leg_forces(platform: Platform, q, qd, qdd, convention: str = "utn", coriolis: bool = True, gravity: float = G_EARTH) -> np.ndarray:
+def leg_forces(
+    platform: Platform, q, qd, qdd, convention: str = "utn", coriolis: bool = True, gravity: float = G_EARTH
+) -> np.ndarray:
     """``(..., 6)`` leg forces F (N, > 0 pushes the plate away from the base) that move the plate along
     ``(..., 6)`` q, q̇, q̈ (metres, radians and their time derivatives): Jᵀ F = M q̈ + C q̇ + G.
 
@@ -300,7 +317,9 @@ def coriolis_leg_forces(platform: Platform, q, qd, convention: str = "utn") -> n
 # Leg masses (extension).
 
 
-def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn", gravity: float = G_EARTH) -> np.ndarray:
+def leg_forces_with_legs(
+    platform: Platform, q, qd, qdd, convention: str = "utn", gravity: float = G_EARTH
+) -> np.ndarray:
     """``(..., 6)`` leg forces (N) for the plate **and** the legs' cylinders and pistons (masses from
     ``platform.legs``, uniform rods of ``leg_bodies.leg_dimensions``; cylinder centre of mass half its
     length above the base anchor, piston's half its length below the tip), with the universal joints of
@@ -309,7 +328,9 @@ def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn"
     q, qd, qdd = _states(q, qd, qdd)
     mo = plate_motion(platform, q, qd, qdd, convention)
     w, wd = mo["omega"][..., None, :], mo["omega_dot"][..., None, :]
-    r = np.einsum("...ij,kj->...ki", mo["R"], platform.top_anchors_per_leg - platform.rotation_centre)  # (...,6,3) p_CTi
+    r = np.einsum(
+        "...ij,kj->...ki", mo["R"], platform.top_anchors_per_leg - platform.rotation_centre
+    )  # (...,6,3) p_CTi
     # Leg vectors base anchor -> plate anchor and their first two time derivatives.
     l = q[..., None, :3] + r - platform.base_anchors
     ld = qd[..., None, :3] + np.cross(w, r)
@@ -350,7 +371,9 @@ def leg_forces_with_legs(platform: Platform, q, qd, qdd, convention: str = "utn"
             e, ed, edd = L - length / 2, Ld, Ldd
         a_cm = edd * u + 2 * ed * ud + e * udd
         f = mass * (a_cm + g_vec)
-        tau = np.einsum("...ij,...j->...i", I_W, omega_c_dot) + np.cross(omega_c, np.einsum("...ij,...j->...i", I_W, omega_c))
+        tau = np.einsum("...ij,...j->...i", I_W, omega_c_dot) + np.cross(
+            omega_c, np.einsum("...ij,...j->...i", I_W, omega_c)
+        )
         M_B = M_B + tau + np.cross(e * u, f)
         f_piston = f
     tau_leg = np.stack([np.sum(a1 * M_B, -1), np.sum(a2 * M_B, -1), np.sum(u * f_piston, -1)], -1)
@@ -368,11 +391,18 @@ def skew(v) -> np.ndarray:
     """``(..., 3, 3)`` the cross-product matrix [v]× of ``(..., 3)`` vectors: [v]× w = v × w."""
     z = np.zeros_like(v[..., 0])
     return np.stack(
-        [np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1), np.stack([-v[..., 1], v[..., 0], z], -1)], -2
+        [
+            np.stack([z, -v[..., 2], v[..., 1]], -1),
+            np.stack([v[..., 2], z, -v[..., 0]], -1),
+            np.stack([-v[..., 1], v[..., 0], z], -1),
+        ],
+        -2,
     )
 
 
-def open_loop_growth_rates(platform: Platform, q, convention: str = "utn", legs: bool = True, gravity: float = G_EARTH) -> np.ndarray:
+def open_loop_growth_rates(
+    platform: Platform, q, convention: str = "utn", legs: bool = True, gravity: float = G_EARTH
+) -> np.ndarray:
     """``(6,)`` exponential rates λ (1/s, real part, descending) of small errors about the static pose
     ``q`` (6,) when the static leg forces are applied open loop (constant forces, no feedback).
 
@@ -383,11 +413,14 @@ def open_loop_growth_rates(platform: Platform, q, convention: str = "utn", legs:
     q0 = as_poses(q).reshape(6)
     z = np.zeros(6)
     if legs:
+
         def forces(q_, qdd_, g):
             return leg_forces_with_legs(platform, q_, z, qdd_, convention, gravity=g)
     else:
+
         def forces(q_, qdd_, g):
             return leg_forces(platform, q_, z, qdd_, convention, gravity=g)
+
     J = length_jacobian(platform, q0, convention)
     M_eff = J.T @ np.stack([forces(q0, e, 0.0) for e in np.eye(6)], -1)
     h = 1e-6

@@ -12,14 +12,13 @@ import dataclasses
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
-from stewart_drake.errors import GeometryError, YamlError
 from stewart_drake.core.rotations import length_scale
 from stewart_drake.core.sanity import check_home
 from stewart_drake.core.yamlio import Rule, check_rules, load_yaml_typed
+from stewart_drake.errors import GeometryError, YamlError
 
 SQRT3 = np.sqrt(3.0)
 PRESETS = ("utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009")
@@ -59,8 +58,8 @@ class PlateConfig:
     mass: float = 0.0
     com: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     inertia: list[float] = field(default_factory=lambda: [0.0] * 6)
-    thickness: Optional[float] = None
-    density: Optional[float] = None
+    thickness: float | None = None
+    density: float | None = None
 
 
 @dataclass
@@ -74,9 +73,9 @@ class LegConfig:
     piston_radius: float = 0.0  # 0: 0.6 x cylinder radius
     piston_mass: float = 0.1
     max_force: float = 1000.0  # N, actuator effort limit
-    max_speed: Optional[float] = None  # length unit per s, actuator speed limit (None: not checked)
-    max_power: Optional[float] = None  # W, actuator mechanical power limit (None: not checked)
-    stiffness: Optional[float] = None  # N per length unit, axial stiffness of a leg (None: unknown)
+    max_speed: float | None = None  # length unit per s, actuator speed limit (None: not checked)
+    max_power: float | None = None  # W, actuator mechanical power limit (None: not checked)
+    stiffness: float | None = None  # N per length unit, axial stiffness of a leg (None: unknown)
 
 
 @dataclass
@@ -87,8 +86,8 @@ class PlatformConfig:
     name: str = ""
     description: str = ""
     length_unit: str = "m"
-    utn: Optional[UtnDims] = None
-    radial: Optional[RadialDims] = None
+    utn: UtnDims | None = None
+    radial: RadialDims | None = None
     base_anchors: list[list[float]] = field(default_factory=list)
     top_anchors: list[list[float]] = field(default_factory=list)
     leg_top: list[int] = field(default_factory=list)
@@ -96,7 +95,7 @@ class PlatformConfig:
     stroke: list[float] = field(default_factory=list)
     plate: PlateConfig = field(default_factory=PlateConfig)
     rotation_centre: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    home_height: Optional[float] = None
+    home_height: float | None = None
     legs: LegConfig = field(default_factory=LegConfig)
     plate_below_base_allowed: bool = False
 
@@ -130,7 +129,7 @@ class Platform:
     com: np.ndarray
     inertia: np.ndarray
     rotation_centre: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    home_height: Optional[float] = None
+    home_height: float | None = None
     legs: LegConfig = field(default_factory=LegConfig)
     description: str = ""
     plate_below_base_allowed: bool = False  # poses may put plate anchors at or below z = 0 (sanity.above_base)
@@ -155,8 +154,11 @@ class Platform:
             raise GeometryError(GeometryError.LEG_TOP.format(value=self.leg_top))
         bad = [i + 1 for i, j in enumerate(leg_top) if not 0 <= j < top.shape[0]]
         if bad:
-            raise GeometryError(GeometryError.LEG_TOP_RANGE.format(leg=bad[0], anchor=leg_top[bad[0] - 1], n=top.shape[0],
-                                                                   last=top.shape[0] - 1))
+            raise GeometryError(
+                GeometryError.LEG_TOP_RANGE.format(
+                    leg=bad[0], anchor=leg_top[bad[0] - 1], n=top.shape[0], last=top.shape[0] - 1
+                )
+            )
         unused = sorted(set(range(top.shape[0])) - set(leg_top.tolist()))
         if unused:
             raise GeometryError(GeometryError.LEG_TOP_UNUSED.format(anchor=unused[0]))
@@ -286,8 +288,11 @@ def _check_distinct(points: np.ndarray, what: str) -> None:
     close = diff[i, j] < MIN_ANCHOR_SEPARATION
     if np.any(close):
         k = int(np.argmax(close))
-        raise GeometryError(GeometryError.COINCIDE.format(what=what, i=i[k] + 1, j=j[k] + 1, at=points[i[k]].tolist(),
-                                                          limit=MIN_ANCHOR_SEPARATION))
+        raise GeometryError(
+            GeometryError.COINCIDE.format(
+                what=what, i=i[k] + 1, j=j[k] + 1, at=points[i[k]].tolist(), limit=MIN_ANCHOR_SEPARATION
+            )
+        )
 
 
 def _mid_stroke_height(p: Platform) -> float:
@@ -416,12 +421,26 @@ def check_name(cfg, where: dict, shown: str) -> None:
         w = where.get((key,))
         line = w.line if w else "?"
         if len(text) > limit:
-            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=key, value=f"({len(text)} characters)",
-                                                       problem=f"is longer than {limit} characters"))
+            raise YamlError(
+                YamlError.BAD_VALUE.format(
+                    path=shown,
+                    line=line,
+                    field=key,
+                    value=f"({len(text)} characters)",
+                    problem=f"is longer than {limit} characters",
+                )
+            )
         bad = next((c for c in text if not c.isprintable()), None)
         if bad is not None:
-            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=key, value=repr(text[:60]),
-                                                       problem=f"contains the control character {bad!r}"))
+            raise YamlError(
+                YamlError.BAD_VALUE.format(
+                    path=shown,
+                    line=line,
+                    field=key,
+                    value=repr(text[:60]),
+                    problem=f"contains the control character {bad!r}",
+                )
+            )
 
 
 def check_length_unit(cfg, where: dict, shown: str) -> float:
@@ -456,8 +475,9 @@ def base_anchors_per_leg(cfg: PlatformConfig) -> np.ndarray:
     idx = np.asarray(cfg.leg_base)
     bad = [i for i, j in enumerate(idx) if not 0 <= j < len(pts)]
     if bad:
-        raise GeometryError(GeometryError.LEG_BASE_RANGE.format(leg=bad[0] + 1, anchor=idx[bad[0]], n=len(pts),
-                                                                last=len(pts) - 1))
+        raise GeometryError(
+            GeometryError.LEG_BASE_RANGE.format(leg=bad[0] + 1, anchor=idx[bad[0]], n=len(pts), last=len(pts) - 1)
+        )
     unused = sorted(set(range(len(pts))) - set(idx.tolist()))
     if unused:
         raise GeometryError(GeometryError.LEG_BASE_UNUSED.format(anchor=unused[0]))
@@ -474,9 +494,15 @@ def check_shared_base(cfg: PlatformConfig, where: dict, shown: str, k: float) ->
     if np.any(close):
         a, b = int(i[np.argmax(close)]), int(j[np.argmax(close)])
         w = where.get(("base_anchors", b, 0))
-        raise YamlError(YamlError.BAD_VALUE.format(
-            path=shown, line=w.line if w else "?", field=f"base_anchors item {b + 1}", value=cfg.base_anchors[b],
-            problem=GeometryError.BASE_REPEATED.format(first=a + 1, limit=MIN_ANCHOR_SEPARATION)))
+        raise YamlError(
+            YamlError.BAD_VALUE.format(
+                path=shown,
+                line=w.line if w else "?",
+                field=f"base_anchors item {b + 1}",
+                value=cfg.base_anchors[b],
+                problem=GeometryError.BASE_REPEATED.format(first=a + 1, limit=MIN_ANCHOR_SEPARATION),
+            )
+        )
 
 
 def _check_platform_fields(shown: str):

@@ -263,7 +263,15 @@ def limit_violations(leg: Leg3R, q) -> list[dict]:
             idx = tuple(int(i) for i in idx)
             val = float(v[idx])
             lim = lo if val < lo else hi
-            out.append({"index": list(idx), "joint": f"q{j + 1}", "value_rad": val, "limit_rad": lim, "excess_rad": abs(val - lim)})
+            out.append(
+                {
+                    "index": list(idx),
+                    "joint": f"q{j + 1}",
+                    "value_rad": val,
+                    "limit_rad": lim,
+                    "excess_rad": abs(val - lim),
+                }
+            )
     return out
 
 

@@ -37,8 +37,13 @@ def leg_visual_dimensions(platform: Platform) -> dict:
     lo, hi = platform.L_min, platform.L_max
     length = lo / 2 + hi / 4 if hi < 2 * lo else 0.55 * hi
     dims = leg_dimensions(platform)
-    return {"cylinder_length": length, "piston_length": length, "cylinder_radius": dims["cylinder_radius"],
-            "piston_radius": dims["piston_radius"], "joint_radius": 1.6 * dims["cylinder_radius"]}
+    return {
+        "cylinder_length": length,
+        "piston_length": length,
+        "cylinder_radius": dims["cylinder_radius"],
+        "piston_radius": dims["piston_radius"],
+        "joint_radius": 1.6 * dims["cylinder_radius"],
+    }
 
 
 def home_leg_frames(platform: Platform) -> np.ndarray:

@@ -143,7 +143,11 @@ def _report_singular(cond, bad, max_condition, action, what, hint) -> None:
     n = int(np.sum(bad))
     more = f" ({n} samples in all)" if n > 1 else ""
     msg = SINGULAR_TEMPLATE.format(
-        what=what, index=counted(idx), condition=float(np.asarray(cond)[idx]), max_condition=max_condition, hint=hint + more
+        what=what,
+        index=counted(idx),
+        condition=float(np.asarray(cond)[idx]),
+        max_condition=max_condition,
+        hint=hint + more,
     )
     if action == "raise":
         raise SingularPoseError(msg)
@@ -206,7 +210,7 @@ class FKResult:
             hint=hint,
         )
 
-    def raise_if_failed(self) -> "FKResult":
+    def raise_if_failed(self) -> FKResult:
         """Raise ``ForwardKinematicsError`` for the first sample that did not converge; else return self."""
         bad = self.failures()
         if bad:
@@ -223,7 +227,9 @@ def validate_lengths(lengths) -> np.ndarray:
     bad = ~(np.isfinite(L) & (L > 0))
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        raise FkInputError(FkInputError.LENGTH_VALUE.format(index=counted(idx[:-1]), leg=idx[-1] + 1, value=float(L[idx])))
+        raise FkInputError(
+            FkInputError.LENGTH_VALUE.format(index=counted(idx[:-1]), leg=idx[-1] + 1, value=float(L[idx]))
+        )
     return L
 
 
@@ -291,7 +297,9 @@ def newton_core(platform: Platform, p, R, L_target, tol=1e-12, max_iter=30, max_
     """
     p, R = np.array(p, dtype=float), np.array(R, dtype=float)
     n = len(p)
-    size = max(np.abs(platform.base_anchors).max(), np.abs(platform.top_anchors).max(), float(np.max(L_target, initial=0)))
+    size = max(
+        np.abs(platform.base_anchors).max(), np.abs(platform.top_anchors).max(), float(np.max(L_target, initial=0))
+    )
     residual = np.full(n, np.inf)
     iterations = np.zeros(n, dtype=np.intp)
     status = np.full(n, MAX_ITER, dtype=np.intp)
@@ -319,7 +327,9 @@ def newton_core(platform: Platform, p, R, L_target, tol=1e-12, max_iter=30, max_
             active, pa, Ra, d = active[ok], pa[ok], Ra[ok], d[ok]
         dp, w = d[:, :3], d[:, 3:]
         with np.errstate(divide="ignore"):
-            s = np.minimum(1.0, np.minimum(max_step_m / np.linalg.norm(dp, axis=-1), max_step_rad / np.linalg.norm(w, axis=-1)))
+            s = np.minimum(
+                1.0, np.minimum(max_step_m / np.linalg.norm(dp, axis=-1), max_step_rad / np.linalg.norm(w, axis=-1))
+            )
         p[active] = pa + s[:, None] * dp
         R[active] = _exp_so3(s[:, None] * w) @ Ra
         iterations[active] += 1
@@ -327,7 +337,12 @@ def newton_core(platform: Platform, p, R, L_target, tol=1e-12, max_iter=30, max_
 
 
 def _check_options(tol, max_iter, max_step_m, max_step_rad, max_condition):
-    for name, v in (("tol", tol), ("max_step_m", max_step_m), ("max_step_rad", max_step_rad), ("max_condition", max_condition)):
+    for name, v in (
+        ("tol", tol),
+        ("max_step_m", max_step_m),
+        ("max_step_rad", max_step_rad),
+        ("max_condition", max_condition),
+    ):
         if not (np.isfinite(v) and v > 0):
             raise FkInputError(FkInputError.POSITIVE.format(name=name, value=v))
     if int(max_iter) != max_iter or max_iter < 1:
@@ -378,15 +393,21 @@ def forward_kinematics(
     try:
         np.broadcast_shapes(q0.shape, batch + (6,))
     except ValueError:
-        raise FkInputError(FkInputError.INITIAL_BROADCAST.format(shape=q0.shape, lengths_shape=L_target.shape)) from None
+        raise FkInputError(
+            FkInputError.INITIAL_BROADCAST.format(shape=q0.shape, lengths_shape=L_target.shape)
+        ) from None
     scale = anchor_scale(platform)
     if check_singularity:  # on the distinct initial poses, before broadcasting
         qi = q0.reshape(-1, 6)
         _, J0 = legs_and_jacobian(platform, qi[:, :3], rotation_matrix(qi[:, 3:], convention))
         c0 = frobenius_condition(J0, scale).reshape(q0.shape[:-1])
         _report_singular(
-            c0, ~(c0 <= max_condition), max_condition, on_singular,
-            "initial pose", "; Newton's first step there is unreliable: start from another pose",
+            c0,
+            ~(c0 <= max_condition),
+            max_condition,
+            on_singular,
+            "initial pose",
+            "; Newton's first step there is unreliable: start from another pose",
         )
     q0 = np.broadcast_to(q0, batch + (6,)).reshape(-1, 6)
     R0 = rotation_matrix(q0[:, 3:], convention)
@@ -416,7 +437,11 @@ def forward_kinematics(
     )
     if check_singularity:
         _report_singular(
-            result.condition, result.near_singular, max_condition, on_singular,
-            "forward-kinematics solution for lengths sample", "; the pose is poorly determined and may belong to another assembly mode",
+            result.condition,
+            result.near_singular,
+            max_condition,
+            on_singular,
+            "forward-kinematics solution for lengths sample",
+            "; the pose is poorly determined and may belong to another assembly mode",
         )
     return result

@@ -28,9 +28,9 @@ import os
 import re
 import secrets
 import shutil
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
 
 from stewart_drake import __version__
 from stewart_drake.errors import OutputError
@@ -104,8 +104,17 @@ def _refused_location(path: Path, typed: str, option: str) -> None:
         cwd = Path(path.anchor)
     home = Path.home().resolve()
     if path == Path(path.anchor) or path == home or path == cwd or path in cwd.parents:
-        what = "the root folder" if path == Path(path.anchor) else ("your home folder" if path == home else
-                                                                    "the working directory" if path == cwd else "a parent of the working directory")
+        what = (
+            "the root folder"
+            if path == Path(path.anchor)
+            else (
+                "your home folder"
+                if path == home
+                else "the working directory"
+                if path == cwd
+                else "a parent of the working directory"
+            )
+        )
         raise OutputError(OutputError.REFUSED_PLACE.format(option=option, typed=typed, what=what))
 
 
@@ -123,7 +132,9 @@ def _probe_writable(path: Path, typed: str, option: str) -> None:
         os.mkdir(probe)
         os.rmdir(probe)
     except OSError as e:
-        raise OutputError(OutputError.UNWRITABLE.format(option=option, typed=typed, reason=e.strerror or str(e))) from None
+        raise OutputError(
+            OutputError.UNWRITABLE.format(option=option, typed=typed, reason=e.strerror or str(e))
+        ) from None
 
 
 def clean_stale_temps(path: Path) -> list[Path]:
@@ -195,12 +206,21 @@ class OutputFolder:
             try:
                 present = _files_under(path)
             except OSError as e:
-                raise OutputError(OutputError.UNWRITABLE.format(option=option, typed=typed, reason=e.strerror or str(e))) from None
+                raise OutputError(
+                    OutputError.UNWRITABLE.format(option=option, typed=typed, reason=e.strerror or str(e))
+                ) from None
             foreign = [f for f in present if f not in set(ours or [])]
             if foreign and not self.force:
-                why = "was not written by stewart-drake (no manifest)" if ours is None else "holds files stewart-drake did not write"
-                raise OutputError(OutputError.NOT_OURS.format(option=option, typed=typed, why=why, example=foreign[0],
-                                                              count=len(foreign)))
+                why = (
+                    "was not written by stewart-drake (no manifest)"
+                    if ours is None
+                    else "holds files stewart-drake did not write"
+                )
+                raise OutputError(
+                    OutputError.NOT_OURS.format(
+                        option=option, typed=typed, why=why, example=foreign[0], count=len(foreign)
+                    )
+                )
             if not os.access(path, os.W_OK | os.X_OK):
                 raise OutputError(OutputError.UNWRITABLE.format(option=option, typed=typed, reason="permission denied"))
         _probe_writable(path, typed, option)
@@ -243,7 +263,9 @@ class OutputFolder:
             shutil.rmtree(tmp, ignore_errors=True)  # the previous result (only files we wrote)
             return
         # --force into a folder with other files: put ours beside them, file by file.
-        clash = [f for f in new if f in set(foreign) or any(f.startswith(g + "/") or g.startswith(f + "/") for g in foreign)]
+        clash = [
+            f for f in new if f in set(foreign) or any(f.startswith(g + "/") or g.startswith(f + "/") for g in foreign)
+        ]
         if clash:
             raise OutputError(OutputError.CLASH.format(option=self.option, typed=self.typed, name=clash[0]))
         for rel in ours or []:
@@ -364,5 +386,7 @@ def write_output_file(typed, text: str, *, option: str) -> Path:
         _write_file_atomic(path, text.encode("utf-8"))
         _write_manifest(path.parent, (read_manifest(path.parent) or []) + [path.name])
     except OSError as e:
-        raise OutputError(OutputError.UNWRITABLE.format(option=option, typed=typed, reason=e.strerror or str(e))) from None
+        raise OutputError(
+            OutputError.UNWRITABLE.format(option=option, typed=typed, reason=e.strerror or str(e))
+        ) from None
     return path

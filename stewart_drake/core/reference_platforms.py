@@ -45,15 +45,27 @@ def dietmaier_platform() -> tuple[Platform, np.ndarray]:
         ]
     )
     lengths = np.array([1.0, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071])
-    p = _kinematic_platform("dietmaier-1998", "Dietmaier 1998: general 6-6 platform with 40 real assembly modes", base, top, (0.5, 1.6))
+    p = _kinematic_platform(
+        "dietmaier-1998", "Dietmaier 1998: general 6-6 platform with 40 real assembly modes", base, top, (0.5, 1.6)
+    )
     return p, lengths
 
 
 def _kinematic_platform(name: str, description: str, p_BBi, p_TTj, stroke) -> Platform:
     """A massless 6-6 platform (anchors ``(6, 3)`` m, leg i on plate anchor i, stroke ``(2,)`` m, home
     height 1 m): geometry only, for the FK solvers' reference cases."""
-    return Platform(name=name, description=description, base_anchors=p_BBi, top_anchors=p_TTj, leg_top=np.arange(6),
-                    stroke=np.asarray(stroke, dtype=float), mass=0.0, com=np.zeros(3), inertia=np.zeros((3, 3)), home_height=1.0)
+    return Platform(
+        name=name,
+        description=description,
+        base_anchors=p_BBi,
+        top_anchors=p_TTj,
+        leg_top=np.arange(6),
+        stroke=np.asarray(stroke, dtype=float),
+        mass=0.0,
+        com=np.zeros(3),
+        inertia=np.zeros((3, 3)),
+        home_height=1.0,
+    )
 
 
 def _random_ring(rng, radius: float, dz: float | None, n: int = 6) -> np.ndarray:
@@ -76,8 +88,13 @@ def general_platform(seed: int = 0) -> tuple[Platform, np.ndarray]:
     pose near its home: base anchors within 1 m of the axis (z within ±0.2 m), plate anchors within
     0.6 m (z within ±0.1 m), home height 1 m. For benchmarks and reports."""
     rng = np.random.default_rng(seed)
-    p = _kinematic_platform(f"general-6-6-seed{seed}", "seeded random general 6-6 platform",
-                            _random_ring(rng, 1.0, 0.2), _random_ring(rng, 0.6, 0.1), (0.5, 2.0))
+    p = _kinematic_platform(
+        f"general-6-6-seed{seed}",
+        "seeded random general 6-6 platform",
+        _random_ring(rng, 1.0, 0.2),
+        _random_ring(rng, 0.6, 0.1),
+        (0.5, 2.0),
+    )
     return _lengths_near_home(p, rng, 0.2)
 
 
@@ -86,6 +103,11 @@ def planar_platform(seed: int = 0) -> tuple[Platform, np.ndarray]:
     at z = 0 within 0.6 m, at random angles: no symmetry) and the leg lengths ``(6,)`` of a random pose
     near its home (±0.1 m, ±0.3 rad). For tests and benchmarks of the complete solvers."""
     rng = np.random.default_rng(seed)
-    p = _kinematic_platform(f"planar-6-6-seed{seed}", "seeded random planar 6-6 platform",
-                            _random_ring(rng, 1.0, None), _random_ring(rng, 0.6, None), (0.3, 2.5))
+    p = _kinematic_platform(
+        f"planar-6-6-seed{seed}",
+        "seeded random planar 6-6 platform",
+        _random_ring(rng, 1.0, None),
+        _random_ring(rng, 0.6, None),
+        (0.3, 2.5),
+    )
     return _lengths_near_home(p, rng, 0.3)

@@ -95,13 +95,29 @@ def rotation_matrix(angles, convention: str = "utn") -> np.ndarray:
     ca, cb, cg = np.moveaxis(np.cos(angles), -1, 0)
     sa, sb, sg = np.moveaxis(np.sin(angles), -1, 0)
     if convention == "utn":  # Ry(beta) Rx(alpha) Rz(gamma), the seeds' TTB written out
-        rows = (cb * cg + sa * sb * sg, sa * sb * cg - cb * sg, ca * sb,
-                ca * sg, ca * cg, -sa,
-                sa * cb * sg - sb * cg, sb * sg + sa * cb * cg, ca * cb)
+        rows = (
+            cb * cg + sa * sb * sg,
+            sa * sb * cg - cb * sg,
+            ca * sb,
+            ca * sg,
+            ca * cg,
+            -sa,
+            sa * cb * sg - sb * cg,
+            sb * sg + sa * cb * cg,
+            ca * cb,
+        )
     else:  # Rz(psi) Ry(theta) Rx(phi) with (phi, theta, psi) = (a_x, a_y, a_z)
-        rows = (cb * cg, sa * sb * cg - ca * sg, ca * sb * cg + sa * sg,
-                cb * sg, sa * sb * sg + ca * cg, ca * sb * sg - sa * cg,
-                -sb, sa * cb, ca * cb)
+        rows = (
+            cb * cg,
+            sa * sb * cg - ca * sg,
+            ca * sb * cg + sa * sg,
+            cb * sg,
+            sa * sb * sg + ca * cg,
+            ca * sb * sg - sa * cg,
+            -sb,
+            sa * cb,
+            ca * cb,
+        )
     return np.stack(rows, -1).reshape(angles.shape[:-1] + (3, 3))
 
 
@@ -174,9 +190,15 @@ def quaternion_to_matrix(q) -> np.ndarray:
     w, x, y, z = np.moveaxis(q, -1, 0)
     return np.stack(
         [
-            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+            1 - 2 * (y * y + z * z),
+            2 * (x * y - w * z),
+            2 * (x * z + w * y),
+            2 * (x * y + w * z),
+            1 - 2 * (x * x + z * z),
+            2 * (y * z - w * x),
+            2 * (x * z - w * y),
+            2 * (y * z + w * x),
+            1 - 2 * (x * x + y * y),
         ],
         axis=-1,
     ).reshape(q.shape[:-1] + (3, 3))

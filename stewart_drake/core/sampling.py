@@ -23,9 +23,17 @@ REGIONS = ("box", "workspace")
 MAX_ROUNDS = 100  # draws before giving up: a region with (almost) no acceptable pose fails, not spins
 
 
-def random_poses(platform: Platform, n: int, seed: int = 0, translation: float | None = None,
-                 rotation: float | None = None, within_stroke: bool = True, *, region: str = "box",
-                 convention: str = "utn") -> np.ndarray:
+def random_poses(
+    platform: Platform,
+    n: int,
+    seed: int = 0,
+    translation: float | None = None,
+    rotation: float | None = None,
+    within_stroke: bool = True,
+    *,
+    region: str = "box",
+    convention: str = "utn",
+) -> np.ndarray:
     """``(n, 6)`` seeded poses (m, rad, ``convention``) around home in ``region`` (see the module
     docstring; ``translation`` m and ``rotation`` rad default per region). ``within_stroke`` applies to
     "box" only ("workspace" always requires it). Raises ValueError when ``MAX_ROUNDS`` draws do not
@@ -41,7 +49,11 @@ def random_poses(platform: Platform, n: int, seed: int = 0, translation: float |
             t = 0.1 * span if translation is None else translation
             r = np.radians(15) if rotation is None else rotation
             q = home + np.c_[rng.uniform(-t, t, (2 * n, 3)), rng.uniform(-r, r, (2 * n, 3))]
-            ok = check_stroke(platform, leg_lengths(platform, q, convention)).within if within_stroke else np.ones(len(q), bool)
+            ok = (
+                check_stroke(platform, leg_lengths(platform, q, convention)).within
+                if within_stroke
+                else np.ones(len(q), bool)
+            )
         else:
             t = 0.3 * span if translation is None else translation
             r = np.radians(20.0) if rotation is None else rotation

@@ -128,8 +128,9 @@ def _label(what: str, index, times) -> str:
     return f"{what} {index + 1}"
 
 
-def check_poses(platform, poses, convention: str = "utn", what: str = "pose", times=None, lines=None,
-                base: bool = True) -> np.ndarray:
+def check_poses(
+    platform, poses, convention: str = "utn", what: str = "pose", times=None, lines=None, base: bool = True
+) -> np.ndarray:
     """``(n, 6)`` poses (SI) after the checks every pose must pass: finite (``StewartError``), within
     ``FAR_FACTOR`` × ``platform_size`` of the base centre (``StewartError``: a unit mistake), plate
     above the base (``PhysicalLimitError``). Errors name the first offending pose as people count
@@ -154,8 +155,15 @@ def check_poses(platform, poses, convention: str = "utn", what: str = "pose", ti
     far = r > FAR_FACTOR * size
     if np.any(far):
         i = int(np.argmax(far))
-        raise StewartError(FAR_POSITION.format(what=label(i), pos_m=[float(f"{x:.6g}") for x in q[i, :3]],
-                                               ratio=r[i] / size, size_m=size, limit=FAR_FACTOR))
+        raise StewartError(
+            FAR_POSITION.format(
+                what=label(i),
+                pos_m=[float(f"{x:.6g}") for x in q[i, :3]],
+                ratio=r[i] / size,
+                size_m=size,
+                limit=FAR_FACTOR,
+            )
+        )
     if base and not getattr(platform, "plate_below_base_allowed", False):
         z = plate_anchor_heights(platform, q, convention)
         low = ~np.all(z > 0.0, axis=1)
@@ -203,15 +211,21 @@ def first_stroke_violation(platform, lengths, times=None) -> dict | None:
 def stroke_message(v: dict, what: str = "the trajectory", hint: str = "") -> str:
     """``OUT_OF_STROKE`` filled from a ``first_stroke_violation`` dict."""
     return OUT_OF_STROKE.format(
-        what=what, t=v["t_s"] if v["t_s"] is not None else float(v["index"]), leg=v["leg"],
-        length_mm=v["length_m"] * 1e3, excess_mm=v["excess_m"] * 1e3,
-        side="below" if v["side"] == "min" else "above", bound="minimum" if v["side"] == "min" else "maximum",
-        limit_mm=v["limit_m"] * 1e3, hint=hint,
+        what=what,
+        t=v["t_s"] if v["t_s"] is not None else float(v["index"]),
+        leg=v["leg"],
+        length_mm=v["length_m"] * 1e3,
+        excess_mm=v["excess_m"] * 1e3,
+        side="below" if v["side"] == "min" else "above",
+        bound="minimum" if v["side"] == "min" else "maximum",
+        limit_mm=v["limit_m"] * 1e3,
+        hint=hint,
     )
 
 
-def check_trajectory(platform, times, poses, convention: str = "utn", what: str = "the trajectory",
-                     allow_out_of_stroke: bool = False) -> list[str]:
+def check_trajectory(
+    platform, times, poses, convention: str = "utn", what: str = "the trajectory", allow_out_of_stroke: bool = False
+) -> list[str]:
     """Check a sampled trajectory (``times`` (n,) s, ``poses`` (n, 6) SI): every pose passes
     ``check_poses`` (labelled by its time) and every leg stays within the stroke. A stroke violation
     raises ``PhysicalLimitError`` naming the first offending time, leg and amount, unless
@@ -304,8 +318,17 @@ def human_seconds(s: float) -> str:
     return f"~{s:.2g} s"
 
 
-def check_work(option: str, value: str, count: float, what: str, bytes_per: float = 0.0, max_count: float | None = None,
-               seconds_per: float = 0.0, max_seconds: float | None = None, hint: str = "") -> None:
+def check_work(
+    option: str,
+    value: str,
+    count: float,
+    what: str,
+    bytes_per: float = 0.0,
+    max_count: float | None = None,
+    seconds_per: float = 0.0,
+    max_seconds: float | None = None,
+    hint: str = "",
+) -> None:
     """Refuse (``WorkTooLargeError``) a request of ``count`` items (``what``: "grid nodes", "samples")
     whose memory (``bytes_per`` each) exceeds ``memory_budget``, whose count exceeds ``max_count``, or
     whose time (``seconds_per`` each) exceeds ``max_seconds``. ``option``/``value`` name the user's
@@ -316,15 +339,31 @@ def check_work(option: str, value: str, count: float, what: str, bytes_per: floa
     need = count * bytes_per
     budget = memory_budget()
     if bytes_per and need > budget:
-        raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value, estimate=f"{count:.2g} {what} ({human_bytes(need)})",
-                                                      limit=f"{human_bytes(budget).lstrip('~')} on this machine", hint=hint))
+        raise WorkTooLargeError(
+            WORK_TOO_LARGE.format(
+                option=option,
+                value=value,
+                estimate=f"{count:.2g} {what} ({human_bytes(need)})",
+                limit=f"{human_bytes(budget).lstrip('~')} on this machine",
+                hint=hint,
+            )
+        )
     if max_count is not None and count > max_count:
-        raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value, estimate=f"{count:.2g} {what}",
-                                                      limit=f"{max_count:.2g} {what}", hint=hint))
+        raise WorkTooLargeError(
+            WORK_TOO_LARGE.format(
+                option=option, value=value, estimate=f"{count:.2g} {what}", limit=f"{max_count:.2g} {what}", hint=hint
+            )
+        )
     if seconds_per and max_seconds is not None and count * seconds_per > max_seconds:
-        raise WorkTooLargeError(WORK_TOO_LARGE.format(option=option, value=value,
-                                                      estimate=f"{count:.2g} {what} ({human_seconds(count * seconds_per)})",
-                                                      limit=human_seconds(max_seconds), hint=hint))
+        raise WorkTooLargeError(
+            WORK_TOO_LARGE.format(
+                option=option,
+                value=value,
+                estimate=f"{count:.2g} {what} ({human_seconds(count * seconds_per)})",
+                limit=human_seconds(max_seconds),
+                hint=hint,
+            )
+        )
 
 
 def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
@@ -334,8 +373,11 @@ def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
     size = platform_size(platform)
     r = float(np.linalg.norm(c))
     if r > FAR_FACTOR * size:
-        raise StewartError(FAR_CENTRE.format(option=option, centre=" ".join(fmt_value(x) for x in c), ratio=r / size, size_m=size,
-                                             limit=FAR_FACTOR))
+        raise StewartError(
+            FAR_CENTRE.format(
+                option=option, centre=" ".join(fmt_value(x) for x in c), ratio=r / size, size_m=size, limit=FAR_FACTOR
+            )
+        )
     return c
 
 
@@ -345,7 +387,9 @@ def check_file_rows(path, option: str, bytes_per_row: float, min_row_bytes: int 
     accept it, by counting its lines. A missing file is left to the reader to report."""
     try:
         size = os.path.getsize(path)
-        check_work(option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file")
+        check_work(
+            option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file"
+        )
     except OSError:
         return
     except WorkTooLargeError:
@@ -374,8 +418,18 @@ def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
     bad = (w0 < lo) | (w0 > hi)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise StewartError(SERVO_NEUTRAL.format(what=what, servo=i + 1, value=fmt_value(w0[i]), lo=lo, hi=hi, swing=swing,
-                                                range_lo=SERVO_PULSE_RANGE_US[0], range_hi=SERVO_PULSE_RANGE_US[1]))
+        raise StewartError(
+            SERVO_NEUTRAL.format(
+                what=what,
+                servo=i + 1,
+                value=fmt_value(w0[i]),
+                lo=lo,
+                hi=hi,
+                swing=swing,
+                range_lo=SERVO_PULSE_RANGE_US[0],
+                range_hi=SERVO_PULSE_RANGE_US[1],
+            )
+        )
 
 
 def plate_floor(platform, orientation, convention: str = "utn") -> float:

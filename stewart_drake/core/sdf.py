@@ -85,8 +85,10 @@ def visual_xml(name, pose, geometry, rgba) -> str:
     else:
         # internal: the model writers pass one of these kinds; no user input reaches here
         raise ValueError(f"unknown SDF visual geometry {kind!r}; expected box, cylinder or sphere")
-    return (f'<visual name="{xml_attr(name)}"><pose>{xml_vec(*pose)}</pose><geometry>{g}</geometry>'
-            f"<material><diffuse>{rgba}</diffuse></material></visual>")
+    return (
+        f'<visual name="{xml_attr(name)}"><pose>{xml_vec(*pose)}</pose><geometry>{g}</geometry>'
+        f"<material><diffuse>{rgba}</diffuse></material></visual>"
+    )
 
 
 def ball_constraint_xml(body_a: str, p_AP, body_b: str, p_BQ) -> str:
@@ -105,6 +107,15 @@ def ball_constraint_xml(body_a: str, p_AP, body_b: str, p_BQ) -> str:
 def document(source: str, model_name: str, elements: list[str]) -> str:
     """A whole SDF file: the declaration, ``header(source)``, one ``<model>`` holding ``elements``
     (one per line) and a final newline."""
-    return "\n".join([XML_DECLARATION, header(source), SDF_OPEN, f'<model name="{xml_attr(model_name)}">',
-                      *elements, "</model>", SDF_CLOSE, ""])
-
+    return "\n".join(
+        [
+            XML_DECLARATION,
+            header(source),
+            SDF_OPEN,
+            f'<model name="{xml_attr(model_name)}">',
+            *elements,
+            "</model>",
+            SDF_CLOSE,
+            "",
+        ]
+    )

@@ -76,7 +76,10 @@ def convex_outline(points) -> np.ndarray:
     def half(seq):
         h = []
         for q in seq:
-            while len(h) >= 2 and (h[-1][0] - h[-2][0]) * (q[1] - h[-2][1]) - (h[-1][1] - h[-2][1]) * (q[0] - h[-2][0]) <= 0:
+            while (
+                len(h) >= 2
+                and (h[-1][0] - h[-2][0]) * (q[1] - h[-2][1]) - (h[-1][1] - h[-2][1]) * (q[0] - h[-2][0]) <= 0
+            ):
                 h.pop()
             h.append(q)
         return h[:-1]
@@ -97,7 +100,9 @@ def _box(name, centre, size, yaw, rgba) -> str:
     return visual_xml(name, (*centre, 0, 0, yaw), ("box", size), rgba)
 
 
-def plate_visuals(prefix: str, points, z: float, thickness: float, bar: float, rgba: str, strips: int = 32) -> list[str]:
+def plate_visuals(
+    prefix: str, points, z: float, thickness: float, bar: float, rgba: str, strips: int = 32
+) -> list[str]:
     """Boxes drawing the convex polygon of ``points`` (n, 2+) as a plate ``thickness`` thick centred at
     height ``z``: ``strips`` slabs across it, each as wide as the polygon along its whole height (so it
     stays inside), and a bar ``bar`` wide along every edge covering the slabs' stepped ends.
@@ -113,12 +118,26 @@ def plate_visuals(prefix: str, points, z: float, thickness: float, bar: float, r
         lo, hi = _chord(hull, edges[k] + eps), _chord(hull, edges[k + 1] - eps)
         xa, xb = max(lo[0], hi[0]), min(lo[1], hi[1])
         if xb - xa > bar:  # narrower slabs lie under the edge bars
-            out.append(_box(f"{prefix}_slab_{k}", ((xa + xb) / 2, (edges[k] + edges[k + 1]) / 2, z),
-                            (xb - xa, edges[k + 1] - edges[k], thickness), 0.0, rgba))
+            out.append(
+                _box(
+                    f"{prefix}_slab_{k}",
+                    ((xa + xb) / 2, (edges[k] + edges[k + 1]) / 2, z),
+                    (xb - xa, edges[k + 1] - edges[k], thickness),
+                    0.0,
+                    rgba,
+                )
+            )
     for k, (a, b) in enumerate(zip(hull, np.roll(hull, -1, axis=0))):
         d = b - a
-        out.append(_box(f"{prefix}_edge_{k}", (*((a + b) / 2), z), (float(np.hypot(*d)) + bar, bar, thickness * 1.2),
-                        float(np.arctan2(d[1], d[0])), rgba))
+        out.append(
+            _box(
+                f"{prefix}_edge_{k}",
+                (*((a + b) / 2), z),
+                (float(np.hypot(*d)) + bar, bar, thickness * 1.2),
+                float(np.arctan2(d[1], d[0])),
+                rgba,
+            )
+        )
     return out
 
 
@@ -129,11 +148,15 @@ def _body_visuals(platform: Platform) -> tuple[str, str]:
     rj = vis["joint_radius"]
     base_z, top_z = float(platform.base_anchors[:, 2].min()), float(platform.top_anchors[:, 2].mean())
     base = plate_visuals("base_plate", platform.base_anchors, base_z - rj, rj, rj, BASE_RGBA)
-    base += [visual_xml(f"base_joint_{i + 1}", (*b, 0, 0, 0), ("sphere", rj), JOINT_RGBA)
-             for i, b in enumerate(platform.base_anchors)]
+    base += [
+        visual_xml(f"base_joint_{i + 1}", (*b, 0, 0, 0), ("sphere", rj), JOINT_RGBA)
+        for i, b in enumerate(platform.base_anchors)
+    ]
     top = plate_visuals("top_plate", platform.top_anchors, top_z, rj, rj, PLATE_RGBA)
-    top += [visual_xml(f"top_joint_{j + 1}", (*t, 0, 0, 0), ("sphere", rj), JOINT_RGBA)
-            for j, t in enumerate(platform.top_anchors)]
+    top += [
+        visual_xml(f"top_joint_{j + 1}", (*t, 0, 0, 0), ("sphere", rj), JOINT_RGBA)
+        for j, t in enumerate(platform.top_anchors)
+    ]
     return "".join(base), "".join(top)
 
 
@@ -165,8 +188,12 @@ def platform_sdf(platform: Platform) -> str:
         n = i + 1
         b = platform.base_anchors[i]
         t = platform.top_anchors_per_leg[i]
-        out.append(f'<frame name="base_anchor_{n}" attached_to="base"><pose relative_to="base">{xml_vec(*b, 0, 0, 0)}</pose></frame>')
-        out.append(f'<frame name="top_anchor_{n}" attached_to="top"><pose relative_to="top">{xml_vec(*t, 0, 0, 0)}</pose></frame>')
+        out.append(
+            f'<frame name="base_anchor_{n}" attached_to="base"><pose relative_to="base">{xml_vec(*b, 0, 0, 0)}</pose></frame>'
+        )
+        out.append(
+            f'<frame name="top_anchor_{n}" attached_to="top"><pose relative_to="top">{xml_vec(*t, 0, 0, 0)}</pose></frame>'
+        )
         out.append(
             f'<link name="cylinder_{n}"><pose relative_to="base">{xml_vec(*b, *rpy(R_BC[i]))}</pose>'
             f"{inertial_xml(legs.cylinder_mass, (0, 0, cl / 2), cylinder_inertia(legs.cylinder_mass, cr, cl))}"
@@ -227,8 +254,12 @@ def servo_hexapod_sdf(hexapod: ServoHexapod) -> str:
         n = i + 1
         b, p = hexapod.base_pivots[i], hexapod.platform_anchors[i]
         tip = b + a * R_piv[i][:, 0]  # arm tip at zero joint angle
-        out.append(f'<frame name="pivot_{n}" attached_to="base"><pose relative_to="base">{xml_vec(*b, *rpy(R_piv[i]))}</pose></frame>')
-        out.append(f'<frame name="platform_anchor_{n}" attached_to="platform"><pose relative_to="platform">{xml_vec(*p, 0, 0, 0)}</pose></frame>')
+        out.append(
+            f'<frame name="pivot_{n}" attached_to="base"><pose relative_to="base">{xml_vec(*b, *rpy(R_piv[i]))}</pose></frame>'
+        )
+        out.append(
+            f'<frame name="platform_anchor_{n}" attached_to="platform"><pose relative_to="platform">{xml_vec(*p, 0, 0, 0)}</pose></frame>'
+        )
         out.append(
             f'<link name="arm_{n}"><pose relative_to="pivot_{n}">0 0 0 0 0 0</pose>'
             f"{inertial_xml(hexapod.arm_mass, (a / 2, 0, 0), box_inertia(hexapod.arm_mass, (a, arm_w, 0.003)))}"
@@ -239,7 +270,9 @@ def servo_hexapod_sdf(hexapod: ServoHexapod) -> str:
             f"<axis><xyz>0 0 1</xyz><limit><lower>{xml_vec(lo[i])}</lower><upper>{xml_vec(hi[i])}</upper>"
             f"<effort>{xml_vec(hexapod.servo_torque)}</effort></limit></axis></joint>"
         )
-        out.append(f'<frame name="arm_tip_{n}" attached_to="arm_{n}"><pose relative_to="arm_{n}">{xml_vec(a, 0, 0, 0, 0, 0)}</pose></frame>')
+        out.append(
+            f'<frame name="arm_tip_{n}" attached_to="arm_{n}"><pose relative_to="arm_{n}">{xml_vec(a, 0, 0, 0, 0, 0)}</pose></frame>'
+        )
         out.append(
             f'<link name="rod_{n}"><pose relative_to="base">{xml_vec(*tip, *rpy(R_rod[i]))}</pose>'
             f"{inertial_xml(hexapod.rod_mass, (0, 0, s / 2), cylinder_inertia(hexapod.rod_mass, rod_r, s))}"
@@ -289,10 +322,12 @@ def leg_sdf(leg: Leg3R) -> str:
                 f"<effort>{xml_vec(JOINT_TORQUE)}</effort></limit></axis></joint>"
             )
         else:
-            out.append(f'<joint name="{row["joint"]}" type="fixed"><parent>{parent}</parent><child>{row["link"]}</child></joint>')
+            out.append(
+                f'<joint name="{row["joint"]}" type="fixed"><parent>{parent}</parent><child>{row["link"]}</child></joint>'
+            )
         out.append(
             f'<frame name="dh_{i}" attached_to="{row["link"]}"><pose relative_to="{row["link"]}">'
-            f'{xml_vec(a, 0, row["d"], row["alpha"], 0, 0)}</pose></frame>'
+            f"{xml_vec(a, 0, row['d'], row['alpha'], 0, 0)}</pose></frame>"
         )
         parent = row["link"]
     return document(f"leg {leg.name!r} (DH table of seed 003)", LEG_MODEL, out)

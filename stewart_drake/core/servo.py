@@ -40,7 +40,6 @@ import dataclasses
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 
@@ -99,8 +98,13 @@ class ServoHexapod:
     servo_band: float = SERVO_BAND_RAD  # position error at which the servo gives its stall torque
 
     def __post_init__(self):
-        shapes = {"base_pivots": (6, 3), "arm_directions": (6,), "platform_anchors": (6, 3),
-                  "shaft_directions": (6, 3), "neutral_us": (6,)}
+        shapes = {
+            "base_pivots": (6, 3),
+            "arm_directions": (6,),
+            "platform_anchors": (6, 3),
+            "shaft_directions": (6, 3),
+            "neutral_us": (6,),
+        }
         for name, shape in shapes.items():
             arr = np.array(getattr(self, name), dtype=float)
             if arr.shape != shape:
@@ -109,8 +113,18 @@ class ServoHexapod:
                 raise GeometryError(GeometryError.SERVO_NOT_FINITE.format(name=name, value=arr.tolist()))
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
-        for name in ("arm_length", "rod_length", "rate_us_per_rad", "travel_rad", "arm_mass", "rod_mass", "platform_mass",
-                     "servo_torque", "servo_speed", "servo_band"):
+        for name in (
+            "arm_length",
+            "rod_length",
+            "rate_us_per_rad",
+            "travel_rad",
+            "arm_mass",
+            "rod_mass",
+            "platform_mass",
+            "servo_torque",
+            "servo_speed",
+            "servo_band",
+        ):
             v = getattr(self, name)
             if not np.isfinite(v) or v <= 0:
                 raise GeometryError(GeometryError.SERVO_NOT_POSITIVE.format(name=name, value=v))
@@ -120,8 +134,11 @@ class ServoHexapod:
         k = self.alpha_axes
         for i in range(6):
             if abs(abs(self.shaft_directions[i] @ k[i]) - n[i]) > 1e-9 * max(n[i], 1.0) or n[i] == 0:
-                raise GeometryError(GeometryError.SERVO_SHAFT.format(servo=i + 1, shaft=self.shaft_directions[i].tolist(),
-                                                                   beta=np.degrees(self.arm_directions[i])))
+                raise GeometryError(
+                    GeometryError.SERVO_SHAFT.format(
+                        servo=i + 1, shaft=self.shaft_directions[i].tolist(), beta=np.degrees(self.arm_directions[i])
+                    )
+                )
         object.__setattr__(self, "shaft_directions", _readonly(self.shaft_directions / n[:, None]))
         h = home_heights(self)
         if np.any(~np.isfinite(h)):
@@ -265,7 +282,7 @@ class ServoHexapodConfig:
     length_unit: str = "m"
     arm_length: float = 0.0
     rod_length: float = 0.0
-    paired: Optional[PairedLayoutConfig] = None
+    paired: PairedLayoutConfig | None = None
     base_pivots: list[list[float]] = field(default_factory=list)
     arm_directions_deg: list[float] = field(default_factory=list)
     platform_anchors: list[list[float]] = field(default_factory=list)
@@ -276,7 +293,9 @@ class ServoHexapodConfig:
 
 def _positive(field_name: str, value, unit: str = "") -> float:
     if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-        raise GeometryError(GeometryError.SERVO_FIELD_POSITIVE.format(field=field_name, unit=" of " + unit if unit else "", value=value))
+        raise GeometryError(
+            GeometryError.SERVO_FIELD_POSITIVE.format(field=field_name, unit=" of " + unit if unit else "", value=value)
+        )
     return float(value)
 
 
@@ -284,9 +303,13 @@ def _rows(field_name: str, value, shape) -> np.ndarray:
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise GeometryError(GeometryError.SERVO_FIELD_SHAPE.format(field=field_name, shape=_shape_words(shape), value=value)) from None
+        raise GeometryError(
+            GeometryError.SERVO_FIELD_SHAPE.format(field=field_name, shape=_shape_words(shape), value=value)
+        ) from None
     if arr.shape != shape:
-        raise GeometryError(GeometryError.SERVO_FIELD_SHAPE.format(field=field_name, shape=_shape_words(shape), value=value))
+        raise GeometryError(
+            GeometryError.SERVO_FIELD_SHAPE.format(field=field_name, shape=_shape_words(shape), value=value)
+        )
     if not np.all(np.isfinite(arr)):
         raise GeometryError(GeometryError.SERVO_FIELD_FINITE.format(field=field_name, value=value))
     return arr
@@ -309,7 +332,8 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
     sv, m = cfg.servo, cfg.masses
     extra = dict(
         neutral_us=_rows("servo.neutral_us", sv.neutral_us, (6,)),
-        rate_us_per_rad=_positive("servo.rate_us", sv.rate_us, "µs") / np.radians(_positive("servo.rate_deg", sv.rate_deg, "degrees")),
+        rate_us_per_rad=_positive("servo.rate_us", sv.rate_us, "µs")
+        / np.radians(_positive("servo.rate_deg", sv.rate_deg, "degrees")),
         travel_rad=np.radians(_positive("servo.travel_deg", sv.travel_deg, "degrees")),
         servo_torque=_positive("servo.stall_torque", sv.stall_torque, "N·m"),
         servo_speed=np.radians(60.0) / _positive("servo.speed_s_per_60deg", sv.speed_s_per_60deg, "seconds"),
@@ -320,8 +344,12 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
     )
     if np.degrees(extra["travel_rad"]) >= 90:
         raise GeometryError(GeometryError.SERVO_TRAVEL.format(value=sv.travel_deg))
-    explicit = {"base_pivots": cfg.base_pivots, "arm_directions_deg": cfg.arm_directions_deg,
-                "platform_anchors": cfg.platform_anchors, "shaft_directions": cfg.shaft_directions}
+    explicit = {
+        "base_pivots": cfg.base_pivots,
+        "arm_directions_deg": cfg.arm_directions_deg,
+        "platform_anchors": cfg.platform_anchors,
+        "shaft_directions": cfg.shaft_directions,
+    }
     given = [n for n, v in explicit.items() if len(v)]
     name = cfg.name or "servo-hexapod"
     if cfg.paired is not None:
@@ -333,26 +361,33 @@ def servo_hexapod_from_config(cfg: ServoHexapodConfig) -> ServoHexapod:
             pair_spacing=_positive("paired.pair_spacing", p.pair_spacing, u) * k,
             platform_radius=_positive("paired.platform_radius", p.platform_radius, u) * k,
             anchor_half_angle_deg=float(p.anchor_half_angle_deg),
-            arm_length=a, rod_length=s,
+            arm_length=a,
+            rod_length=s,
         )
         return h.replace(name=name, description=cfg.description, **extra)
     missing = [n for n in explicit if n not in given]
     if missing:
         raise GeometryError(GeometryError.SERVO_MISSING_LAYOUT.format(name=name, missing=", ".join(missing)))
     return ServoHexapod(
-        name=name, description=cfg.description,
+        name=name,
+        description=cfg.description,
         base_pivots=_rows("base_pivots", cfg.base_pivots, (6, 3)) * k,
         arm_directions=np.radians(_rows("arm_directions_deg", cfg.arm_directions_deg, (6,))),
         platform_anchors=_rows("platform_anchors", cfg.platform_anchors, (6, 3)) * k,
         shaft_directions=_rows("shaft_directions", cfg.shaft_directions, (6, 3)),
-        arm_length=a, rod_length=s, **extra,
+        arm_length=a,
+        rod_length=s,
+        **extra,
     )
 
 
 def load_servo_yaml(path) -> ServoHexapod:
     """Load a servo hexapod from a YAML file (schema: ``ServoHexapodConfig``)."""
-    return servo_hexapod_from_config(load_yaml_config(path, ServoHexapodConfig, "servo hexapod",
-                                                      lambda cfg, where: check_name(cfg, where, str(path))))
+    return servo_hexapod_from_config(
+        load_yaml_config(
+            path, ServoHexapodConfig, "servo hexapod", lambda cfg, where: check_name(cfg, where, str(path))
+        )
+    )
 
 
 def servo_preset_path(name: str) -> Path:
@@ -483,13 +518,23 @@ class ServoSolution:
         reach = self.reachable
         for idx in np.argwhere(~reach):
             idx = tuple(int(i) for i in idx)
-            out.append({"pose": list(idx[:-1]), "servo": idx[-1] + 1, "kind": "unreachable", "ratio": float(self.ratio[idx])})
+            out.append(
+                {"pose": list(idx[:-1]), "servo": idx[-1] + 1, "kind": "unreachable", "ratio": float(self.ratio[idx])}
+            )
         lim = np.degrees(self.hexapod.travel_rad)
         for idx in np.argwhere(reach & ~self.within_travel):
             idx = tuple(int(i) for i in idx)
             d = float(np.degrees(self.delta[idx]))
-            out.append({"pose": list(idx[:-1]), "servo": idx[-1] + 1, "kind": "travel", "angle_deg": d,
-                        "limit_deg": float(np.copysign(lim, d)), "excess_deg": abs(d) - lim})
+            out.append(
+                {
+                    "pose": list(idx[:-1]),
+                    "servo": idx[-1] + 1,
+                    "kind": "travel",
+                    "angle_deg": d,
+                    "limit_deg": float(np.copysign(lim, d)),
+                    "excess_deg": abs(d) - lim,
+                }
+            )
         out.sort(key=lambda v: (v["pose"], v["servo"]))
         return out
 

@@ -34,8 +34,13 @@ def static_servo_torques(hexapod: ServoHexapod, poses, g: float = 9.81) -> np.nd
     return tau + (hexapod.arm_mass / 2 + hexapod.rod_mass / 2) * g * hexapod.arm_length * np.cos(alpha)
 
 
-def tracking_bounds(hexapod: ServoHexapod, log: dict, time_step: float = 1e-3, frame_rate_hz: float = FRAME_RATE_HZ,
-                    resolution_us: float = 1.0) -> dict:
+def tracking_bounds(
+    hexapod: ServoHexapod,
+    log: dict,
+    time_step: float = 1e-3,
+    frame_rate_hz: float = FRAME_RATE_HZ,
+    resolution_us: float = 1.0,
+) -> dict:
     """Per-sample bounds on the closed-loop tracking error of ``run_closed_loop``'s ``log``, from the
     loop's arithmetic, valid while every reference arm speed stays below ``servo_speed`` (checked):
 
@@ -54,10 +59,15 @@ def tracking_bounds(hexapod: ServoHexapod, log: dict, time_step: float = 1e-3, f
     lag = 1.0 / frame_rate_hz + 2 * time_step + kd / kp
     n = int(np.ceil(lag / time_step))
     padded = np.concatenate([np.repeat(ref[:1], n, axis=0), ref])  # at rest at alpha_ref(0) before t = 0
-    spread = np.max([np.abs(ref - padded[n - j: n - j + len(ref)]) for j in range(n + 1)], axis=0)
+    spread = np.max([np.abs(ref - padded[n - j : n - j + len(ref)]) for j in range(n + 1)], axis=0)
     quant = resolution_us / 2 / hexapod.rate_us_per_rad
     sag = np.abs(static_servo_torques(hexapod, log["reference"])) / kp
     arm = spread + quant + sag
     Jinv = np.linalg.inv(pose_jacobian(hexapod, log["reference"]))
-    return {"arm": arm, "pose": np.einsum("...ki,...i->...k", np.abs(Jinv), arm), "lag": lag, "quantisation": quant,
-            "sag": sag}
+    return {
+        "arm": arm,
+        "pose": np.einsum("...ki,...i->...k", np.abs(Jinv), arm),
+        "lag": lag,
+        "quantisation": quant,
+        "sag": sag,
+    }

@@ -10,10 +10,10 @@ its samples (``t``, ``q``, ``qd``, ``qdd``) and segments. Pose functions are mod
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -71,7 +71,11 @@ def _seed_pose(t):
 
 
 # The rotating reference: the plate at pz = 0.7 m turning about Z by 15°·sin(2t) while tilting 5°·sin(3t) about X.
-_ROTATING = ([0.0, 0.0, 0.7, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, np.radians(5.0), 0.0, np.radians(15.0)], [0.0, 0.0, 0.0, 3.0, 0.0, 2.0])
+_ROTATING = (
+    [0.0, 0.0, 0.7, 0.0, 0.0, 0.0],
+    [0.0, 0.0, 0.0, np.radians(5.0), 0.0, np.radians(15.0)],
+    [0.0, 0.0, 0.0, 3.0, 0.0, 2.0],
+)
 
 
 def _rotating_exact(t):
@@ -88,7 +92,9 @@ ROTATING = Trajectory("rotating", _rotating_pose, 4.0, _rotating_exact)
 TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
 
 
-def fit_trajectory(trajectory: Trajectory, platform: Platform, home_height: float = 0.7, stroke: float = 0.4) -> Trajectory:
+def fit_trajectory(
+    trajectory: Trajectory, platform: Platform, home_height: float = 0.7, stroke: float = 0.4
+) -> Trajectory:
     """``trajectory`` (made for a platform whose home is pz = ``home_height`` with a stroke of ``stroke``
     metres, as ``SEED`` and ``ROTATING`` are for utn-dynamic) moved to ``platform``'s home and its
     positions scaled by the ratio of the strokes (angles unchanged): the same motion, relative to the
@@ -112,7 +118,9 @@ def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
         k = late[0] + 1
-        raise TrajectoryError(TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0]))
+        raise TrajectoryError(
+            TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0])
+        )
     return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
 
 

@@ -15,9 +15,10 @@ import difflib
 import math
 import types
 import typing
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import yaml
 
@@ -109,7 +110,9 @@ def compose(text: str, shown: str):
         loader = _Loader(text)
     except yaml.reader.ReaderError as e:
         line = text[: max(e.position, 0)].count("\n") + 1
-        raise YamlError(YamlError.SYNTAX.format(path=shown, line=line, problem=f"{e.reason} (character #x{e.character:04x})")) from None
+        raise YamlError(
+            YamlError.SYNTAX.format(path=shown, line=line, problem=f"{e.reason} (character #x{e.character:04x})")
+        ) from None
     loader.path = shown
     try:
         return loader.get_single_node()
@@ -166,12 +169,17 @@ def _line(node) -> int:
 
 def _check_tag(node, shown: str) -> None:
     if node.tag not in _SAFE_TAGS:
-        raise YamlError(YamlError.TAG.format(path=shown, line=_line(node), tag=node.tag.replace("tag:yaml.org,2002:", "!!")))
+        raise YamlError(
+            YamlError.TAG.format(path=shown, line=_line(node), tag=node.tag.replace("tag:yaml.org,2002:", "!!"))
+        )
 
 
 def _wrong(node, path, shown, expected: str) -> YamlError:
-    return YamlError(YamlError.WRONG_TYPE.format(path=shown, line=_line(node), field=field_name(path), expected=expected,
-                                                 value=_describe(node)))
+    return YamlError(
+        YamlError.WRONG_TYPE.format(
+            path=shown, line=_line(node), field=field_name(path), expected=expected, value=_describe(node)
+        )
+    )
 
 
 def _convert(node, tp, path: tuple, shown: str, where: dict):
@@ -231,8 +239,14 @@ def _number(node, path, shown) -> float:
         value = float(_integer(node, path, shown))
     else:
         try:
-            value = float(text.replace(".inf", "inf").replace(".Inf", "inf").replace(".INF", "inf")
-                          .replace(".nan", "nan").replace(".NaN", "nan").replace(".NAN", "nan"))
+            value = float(
+                text.replace(".inf", "inf")
+                .replace(".Inf", "inf")
+                .replace(".INF", "inf")
+                .replace(".nan", "nan")
+                .replace(".NaN", "nan")
+                .replace(".NAN", "nan")
+            )
         except ValueError:
             raise _wrong(node, path, shown, "a number") from None
     if not math.isfinite(value):
@@ -241,8 +255,11 @@ def _number(node, path, shown) -> float:
 
 
 def _bad(node, path, shown, problem: str) -> YamlError:
-    return YamlError(YamlError.BAD_VALUE.format(path=shown, line=_line(node), field=field_name(path), value=_describe(node),
-                                                problem=problem))
+    return YamlError(
+        YamlError.BAD_VALUE.format(
+            path=shown, line=_line(node), field=field_name(path), value=_describe(node), problem=problem
+        )
+    )
 
 
 def _dataclass(node, tp, path, shown, where):
@@ -257,17 +274,28 @@ def _dataclass(node, tp, path, shown, where):
     for knode, vnode in node.value:
         _check_tag(knode, shown)
         if not isinstance(knode, yaml.ScalarNode):
-            raise YamlError(YamlError.UNKNOWN_KEY.format(path=shown, line=_line(knode), field=field_name(path), hint="",
-                                                         valid=", ".join(fields)))
+            raise YamlError(
+                YamlError.UNKNOWN_KEY.format(
+                    path=shown, line=_line(knode), field=field_name(path), hint="", valid=", ".join(fields)
+                )
+            )
         key = knode.value
         if key not in hints:
             close = difflib.get_close_matches(key, fields, n=1, cutoff=0.6)
             hint = f" {key!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
-            raise YamlError(YamlError.UNKNOWN_KEY.format(path=shown, line=_line(knode), field=field_name(path) if path else key,
-                                                         hint=hint if path else (f" (did you mean {close[0]!r}?)" if close else ""),
-                                                         valid=", ".join(fields)))
+            raise YamlError(
+                YamlError.UNKNOWN_KEY.format(
+                    path=shown,
+                    line=_line(knode),
+                    field=field_name(path) if path else key,
+                    hint=hint if path else (f" (did you mean {close[0]!r}?)" if close else ""),
+                    valid=", ".join(fields),
+                )
+            )
         if key in seen:
-            raise YamlError(YamlError.DUPLICATE_KEY.format(path=shown, line=_line(knode), field=field_name(path + (key,))))
+            raise YamlError(
+                YamlError.DUPLICATE_KEY.format(path=shown, line=_line(knode), field=field_name(path + (key,)))
+            )
         seen.add(key)
         setattr(obj, key, _convert(vnode, hints[key], path + (key,), shown, where))
         where.setdefault(path + (key,), Where(_line(vnode), _describe(vnode)))
@@ -311,14 +339,21 @@ def check_rules(where: dict, rules: dict, shapes: dict, cfg, shown: str, length_
             continue
         name = field_name(path)
         if rule.sign == "pos" and not value > 0:
-            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=w.line, field=name, value=w.text, problem="must be > 0"))
+            raise YamlError(
+                YamlError.BAD_VALUE.format(path=shown, line=w.line, field=name, value=w.text, problem="must be > 0")
+            )
         if rule.sign == "nonneg" and not value >= 0:
-            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=w.line, field=name, value=w.text, problem="must be >= 0"))
+            raise YamlError(
+                YamlError.BAD_VALUE.format(path=shown, line=w.line, field=name, value=w.text, problem="must be >= 0")
+            )
         scale, limit, unit = (length_scale, MAX_LENGTH_M, "m") if rule.unit == "length" else (1.0, rule.max, rule.unit)
         if abs(value) * scale > limit:
             shown_limit = f"{limit / scale:g} {unit_name}" if rule.unit == "length" else f"{limit:g} {unit}"
-            raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=w.line, field=name, value=w.text,
-                                                       problem=f"is too large (at most {shown_limit})"))
+            raise YamlError(
+                YamlError.BAD_VALUE.format(
+                    path=shown, line=w.line, field=name, value=w.text, problem=f"is too large (at most {shown_limit})"
+                )
+            )
     for pattern, (lo, hi) in shapes.items():
         for path, value in _lists(cfg, pattern):
             if value is None or (not value and lo > 0 and path not in where and not _given(where, path)):
@@ -327,8 +362,15 @@ def check_rules(where: dict, rules: dict, shapes: dict, cfg, shown: str, length_
                 w = where.get(path)
                 count = f"{lo}" if lo == hi else f"{lo} to {hi}"
                 line = f"{w.line}" if w else "?"
-                raise YamlError(YamlError.BAD_VALUE.format(path=shown, line=line, field=field_name(path),
-                                                           value=f"({len(value)} items)", problem=f"must have {count} items"))
+                raise YamlError(
+                    YamlError.BAD_VALUE.format(
+                        path=shown,
+                        line=line,
+                        field=field_name(path),
+                        value=f"({len(value)} items)",
+                        problem=f"must have {count} items",
+                    )
+                )
 
 
 def _given(where: dict, path: tuple) -> bool:

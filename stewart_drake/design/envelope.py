@@ -23,17 +23,22 @@ envelope, the largest |Ȧ_j| for which every leg stays within ±max_force (0 whe
 """
 
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 
 from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces, leg_forces_with_legs, skew
-from stewart_drake.errors import EnvelopeError, StewartError
 from stewart_drake.core.geometry import Platform, load_yaml_config
 from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
-from stewart_drake.core.rotations import angle_scale, angular_velocity_map, check_convention, length_scale, rotation_matrix
+from stewart_drake.core.rotations import (
+    angle_scale,
+    angular_velocity_map,
+    check_convention,
+    length_scale,
+    rotation_matrix,
+)
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.design.boxquad import box_quadratic_max
+from stewart_drake.errors import EnvelopeError, StewartError
 
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
 MAX_CONDITION = 1e8  # as dynamics.MAX_CONDITION: leg forces are meaningless beyond it
@@ -72,7 +77,7 @@ class EnvelopeConfig:
     angle_unit: str = "rad"
     convention: str = "utn"
     poses: list[list[float]] = field(default_factory=list)
-    box: Optional[BoxConfig] = None
+    box: BoxConfig | None = None
     velocity: BoundsConfig = field(default_factory=BoundsConfig)
     acceleration: BoundsConfig = field(default_factory=BoundsConfig)
 
@@ -129,10 +134,14 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
             raise EnvelopeError(EnvelopeError.STEPS.format(source=source, value=cfg.box.steps))
         if np.any(hi < lo):
             j = int(np.argmax(hi < lo))
-            raise EnvelopeError(EnvelopeError.BOX_ORDER.format(source=source, j=j, hi=cfg.box.max[j], lo=cfg.box.min[j]))
+            raise EnvelopeError(
+                EnvelopeError.BOX_ORDER.format(source=source, j=j, hi=cfg.box.max[j], lo=cfg.box.min[j])
+            )
         n = int(np.prod(steps.astype(float)))
         if n > MAX_POSES:
-            raise EnvelopeError(EnvelopeError.BOX_TOO_LARGE.format(source=source, steps=cfg.box.steps, n=n, limit=MAX_POSES))
+            raise EnvelopeError(
+                EnvelopeError.BOX_TOO_LARGE.format(source=source, steps=cfg.box.steps, n=n, limit=MAX_POSES)
+            )
         axes = [np.linspace(lo[j], hi[j], steps[j]) if steps[j] > 1 else lo[j : j + 1] for j in range(6)]
         poses = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
     else:
@@ -145,9 +154,18 @@ def envelope_from_config(cfg: EnvelopeConfig, source: str = "envelope") -> Envel
         ang = _numbers(b.angular, 3, f"{source}: {name}.angular")
         for part, arr in (("linear", lin), ("angular", ang)):
             if np.any(arr < 0):
-                raise EnvelopeError(EnvelopeError.NEGATIVE_BOUND.format(source=source, name=name, part=part, value=arr.tolist()))
+                raise EnvelopeError(
+                    EnvelopeError.NEGATIVE_BOUND.format(source=source, name=name, part=part, value=arr.tolist())
+                )
         bounds[name] = np.r_[lin * kl, ang * ka]
-    return Envelope(poses * scale, bounds["velocity"], bounds["acceleration"], cfg.convention, source, (cfg.length_unit, cfg.angle_unit))
+    return Envelope(
+        poses * scale,
+        bounds["velocity"],
+        bounds["acceleration"],
+        cfg.convention,
+        source,
+        (cfg.length_unit, cfg.angle_unit),
+    )
 
 
 def load_envelope(path) -> Envelope:
@@ -171,9 +189,16 @@ def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
     if v:
         v = v[0]
         k = v["pose"][0]
-        raise EnvelopeError(EnvelopeError.OUT_OF_STROKE.format(source=env.source, pose=env.shown(k), leg=v["leg"],
-                                                               length_mm=v["length_m"] * 1e3, excess_mm=v["excess_m"] * 1e3,
-                                                               side="below" if v["side"] == "min" else "above"))
+        raise EnvelopeError(
+            EnvelopeError.OUT_OF_STROKE.format(
+                source=env.source,
+                pose=env.shown(k),
+                leg=v["leg"],
+                length_mm=v["length_m"] * 1e3,
+                excess_mm=v["excess_m"] * 1e3,
+                side="below" if v["side"] == "min" else "above",
+            )
+        )
     for s in range(0, len(env.poses), 1 << 16):
         k = condition_number(platform, env.poses[s : s + (1 << 16)], env.convention)
         bad = ~(k <= MAX_CONDITION)
@@ -247,7 +272,9 @@ def cartesian_to_euler(q, V, Vd, convention):
     return np.concatenate([V[..., :3], rates], -1), np.concatenate([Vd[..., :3], acc], -1)
 
 
-def cartesian_leg_forces(platform: Platform, q, V, Vd, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
+def cartesian_leg_forces(
+    platform: Platform, q, V, Vd, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH
+) -> np.ndarray:
     """``(..., 6)`` leg forces (N) at poses q for Cartesian velocity V = [v_C; ω] and acceleration
     [a_C; ω̇] (base frame), by the toolkit's inverse dynamics in Euler coordinates."""
     q, V, Vd = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (q, V, Vd)))
@@ -262,7 +289,9 @@ def _generic_terms(platform: Platform, q, convention, gravity):
     E = np.eye(6)
 
     def F(V, Vd):
-        return cartesian_leg_forces(platform, q, np.broadcast_to(V, q.shape), np.broadcast_to(Vd, q.shape), convention, True, gravity)
+        return cartesian_leg_forces(
+            platform, q, np.broadcast_to(V, q.shape), np.broadcast_to(Vd, q.shape), convention, True, gravity
+        )
 
     c = F(z, z)
     G = np.stack([F(z, E[j]) - c for j in range(6)], -1)
@@ -311,12 +340,17 @@ def _allowed(c, G, qmax, qmin, fmax):
     return np.where(infeasible, 0.0, np.maximum(out, 0.0))
 
 
-def envelope_sizing(platform: Platform, env: Envelope, legs: bool = False, gravity: float = G_EARTH, chunk: int = CHUNK) -> EnvelopeSizing:
+def envelope_sizing(
+    platform: Platform, env: Envelope, legs: bool = False, gravity: float = G_EARTH, chunk: int = CHUNK
+) -> EnvelopeSizing:
     """Worst case over the envelope (see the module docstring). Raises ``EnvelopeError`` if a pose leaves
     the workspace. Work is chunked over poses."""
     L_all = check_in_workspace(platform, env)
     n = len(env.poses)
-    out = {k: np.empty((n, 6)) for k in ("force_max", "force_min", "peak_force", "peak_speed", "peak_accel", "allowed_accel")}
+    out = {
+        k: np.empty((n, 6))
+        for k in ("force_max", "force_min", "peak_force", "peak_speed", "peak_accel", "allowed_accel")
+    }
     worst = [{"peak": -1.0} for _ in range(6)]
     vel_axes = np.flatnonzero(env.v_max > 0) if legs else 3 + np.flatnonzero(env.v_max[3:] > 0)
     b = env.v_max[vel_axes]
@@ -337,7 +371,9 @@ def envelope_sizing(platform: Platform, env: Envelope, legs: bool = False, gravi
         out["peak_force"][s : s + chunk] = peak
         out["peak_speed"][s : s + chunk] = np.abs(Jinv) @ env.v_max
         # Leg acceleration bound: linear + centripetal (ω-quadratic, exact max) + convex transverse term.
-        S = 0.5 * (r[..., :, None] * u[..., None, :] + u[..., :, None] * r[..., None, :]) - np.sum(r * u, -1)[..., None, None] * np.eye(3)
+        S = 0.5 * (r[..., :, None] * u[..., None, :] + u[..., :, None] * r[..., None, :]) - np.sum(r * u, -1)[
+            ..., None, None
+        ] * np.eye(3)
         wb = env.v_max[3:]
         cmax, _ = box_quadratic_max(S, wb)
         cmin_neg, _ = box_quadratic_max(-S, wb)
@@ -356,8 +392,24 @@ def envelope_sizing(platform: Platform, env: Envelope, legs: bool = False, gravi
                 acc = sign * np.sign(G[k, i]) * env.a_max
                 V = np.zeros(6)
                 V[vel_axes] = (xmax if upper else xmin)[k, i]
-                worst[i] = {"peak": float(peak[k, i]), "force": float(fmax[k, i] if upper else fmin[k, i]),
-                            "index": s + k, "pose": env.poses[s + k], "accel": acc, "velocity": V}
+                worst[i] = {
+                    "peak": float(peak[k, i]),
+                    "force": float(fmax[k, i] if upper else fmin[k, i]),
+                    "index": s + k,
+                    "pose": env.poses[s + k],
+                    "accel": acc,
+                    "velocity": V,
+                }
     power = out["peak_force"] * out["peak_speed"]
-    return EnvelopeSizing(env, out["force_max"], out["force_min"], out["peak_force"], out["peak_speed"], out["peak_accel"],
-                          power, L_all, out["allowed_accel"], worst)
+    return EnvelopeSizing(
+        env,
+        out["force_max"],
+        out["force_min"],
+        out["peak_force"],
+        out["peak_speed"],
+        out["peak_accel"],
+        power,
+        L_all,
+        out["allowed_accel"],
+        worst,
+    )

@@ -54,7 +54,9 @@ class SliceMaps:
     f1: np.ndarray | None = None
 
 
-def slice_poses(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0.15)), n: int = 61, base=None) -> tuple:
+def slice_poses(
+    platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0.15)), n: int = 61, base=None
+) -> tuple:
     """``(u (n,), v (n,), poses (n, n, 6))``: pose coordinates ``axes`` over ``ranges`` (SI), the others
     at ``base`` (default the home pose)."""
     if not (isinstance(n, (int, np.integer)) and 2 <= n and n * n <= MAX_POINTS):
@@ -77,9 +79,18 @@ def lowest_frequency(K, M) -> np.ndarray:
     return np.sqrt(np.maximum(w2, 0.0)) / (2 * np.pi)
 
 
-def slice_maps(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0.15)), n: int = 61, base=None,
-               k=None, gravity: float = G_EARTH, modes: bool = False, max_condition: float = SAFE_CONDITION,
-               convention: str = "utn") -> SliceMaps:
+def slice_maps(
+    platform: Platform,
+    axes=(0, 1),
+    ranges=((-0.15, 0.15), (-0.15, 0.15)),
+    n: int = 61,
+    base=None,
+    k=None,
+    gravity: float = G_EARTH,
+    modes: bool = False,
+    max_condition: float = SAFE_CONDITION,
+    convention: str = "utn",
+) -> SliceMaps:
     """Maps over the slice (see ``SliceMaps``, ``slice_poses``); stiffness maps when leg stiffness ``k``
     (N/m) is given, and the lowest frequency too with ``modes`` (plate only). The safe region is the
     connected part holding the node nearest to the home pose's coordinates, of the nodes within
@@ -101,8 +112,17 @@ def slice_maps(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0
     i0 = (int(np.argmin(np.abs(x - home[0]))), int(np.argmin(np.abs(y - home[1]))))
     safe = ok & (labels == labels[i0]) if ok[i0] else np.zeros_like(ok)
     nan = np.where(within, 1.0, np.nan)
-    out = dict(u=x, v=y, axes=tuple(axes), base=q[0, 0].copy(), within=within,
-               condition=cond * nan, distance=np.where(np.isfinite(cond), 1 / cond, 0.0) * nan, same_mode=same, safe=safe)
+    out = dict(
+        u=x,
+        v=y,
+        axes=tuple(axes),
+        base=q[0, 0].copy(),
+        within=within,
+        condition=cond * nan,
+        distance=np.where(np.isfinite(cond), 1 / cond, 0.0) * nan,
+        same_mode=same,
+        safe=safe,
+    )
     if k is not None:
         kmin = np.full(within.shape, np.nan)
         soft = np.full(within.shape + (3,), np.nan)
@@ -114,7 +134,11 @@ def slice_maps(platform: Platform, axes=(0, 1), ranges=((-0.15, 0.15), (-0.15, 0
         out.update(k_min=kmin, softest=soft)
         if modes:
             f1 = np.full(within.shape, np.nan)
-            M = np.stack([spatial_inertia(platform, qq, convention) for qq in q[good]]) if good.sum() < 64 else _inertia_batch(platform, q[good], convention)
+            M = (
+                np.stack([spatial_inertia(platform, qq, convention) for qq in q[good]])
+                if good.sum() < 64
+                else _inertia_batch(platform, q[good], convention)
+            )
             f1[good] = lowest_frequency(K, M)
             out["f1"] = f1
     return SliceMaps(**out)

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from stewart_drake.core.geometry import Platform
 from stewart_drake.core.argcheck import as_poses
+from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.design.envelope import cartesian_leg_forces, spatial_inertia_about_C
@@ -32,7 +32,9 @@ def spatial_inertia(platform: Platform, q, convention: str = "utn", legs: bool =
         return spatial_inertia_about_C(platform, rotation_matrix(q[3:], convention))
     A = inverse_jacobian(platform, q, convention)
     E = np.eye(6)
-    F = cartesian_leg_forces(platform, np.broadcast_to(q, (6, 6)), np.zeros((6, 6)), E, convention, legs=True, gravity=0.0)
+    F = cartesian_leg_forces(
+        platform, np.broadcast_to(q, (6, 6)), np.zeros((6, 6)), E, convention, legs=True, gravity=0.0
+    )
     M = A.T @ F.T
     return 0.5 * (M + M.T)
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.errors import PayloadError
 from stewart_drake.core.geometry import Platform
+from stewart_drake.errors import PayloadError
 
 
 def with_payload(platform: Platform, mass: float, p_TP=(0.0, 0.0, 0.0), option: str = "--payload") -> Platform:

@@ -31,7 +31,9 @@ def plot_slice_maps(m: SliceMaps, length_unit: str = "mm", max_condition: float 
         c = axes[k].pcolormesh(U, V, m.k_min / 1e3, shading="auto", cmap="magma")
         s = slice(None, None, max(1, len(m.u) // 15))
         d = m.softest[..., list(m.axes)] if max(m.axes) < 3 else m.softest[..., :2]
-        axes[k].quiver(U[s, s], V[s, s], d[s, s, 0], d[s, s, 1], color="c", pivot="mid", headwidth=1, headlength=0, scale=25)
+        axes[k].quiver(
+            U[s, s], V[s, s], d[s, s, 0], d[s, s, 1], color="c", pivot="mid", headwidth=1, headlength=0, scale=25
+        )
         axes[k].set_title("min translational stiffness (kN/m), softest direction", fontsize=8)
         fig.colorbar(c, ax=axes[k])
         k += 1

@@ -19,8 +19,8 @@ import numpy as np
 
 from stewart_drake.core.argcheck import first_index
 from stewart_drake.core.dynamics import G_EARTH, harmonic_trajectory, leg_forces, leg_forces_with_legs, plate_motion
-from stewart_drake.errors import GeometryError
 from stewart_drake.core.geometry import Platform
+from stewart_drake.errors import GeometryError
 
 QUANTITIES = ("force", "speed", "power", "length")  # order in which violations are reported
 UNITS = {"force": "N", "speed": "m/s", "power": "W", "length": "m"}
@@ -63,9 +63,20 @@ class TrajectorySizing:
         n = len(self.t)
         for i in range(6):
             d = {"leg": i + 1}
-            for key, arr in (("force", self.force), ("speed", self.speed), ("accel", self.accel), ("power", self.power)):
+            for key, arr in (
+                ("force", self.force),
+                ("speed", self.speed),
+                ("accel", self.accel),
+                ("power", self.power),
+            ):
                 k = int(np.argmax(np.abs(arr[:, i])))
-                d[key] = {"peak": float(abs(arr[k, i])), "value": float(arr[k, i]), "index": k, "t": float(self.t[k]), "pose": self.q[k]}
+                d[key] = {
+                    "peak": float(abs(arr[k, i])),
+                    "value": float(arr[k, i]),
+                    "index": k,
+                    "t": float(self.t[k]),
+                    "pose": self.q[k],
+                }
             d["rms_force"] = float(np.sqrt(np.mean(self.force[:, i] ** 2))) if n else 0.0
             d["min_length"] = float(self.length[:, i].min())
             d["max_length"] = float(self.length[:, i].max())
@@ -73,8 +84,9 @@ class TrajectorySizing:
         return out
 
 
-def size_trajectory(platform: Platform, t, q, qd, qdd, convention: str = "utn", legs: bool = False,
-                    gravity: float = G_EARTH) -> TrajectorySizing:
+def size_trajectory(
+    platform: Platform, t, q, qd, qdd, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH
+) -> TrajectorySizing:
     """Leg forces and motion along a trajectory: ``t`` (n,) s, ``q, q̇, q̈`` (n, 6) SI. ``legs`` adds the
     leg bodies' inertia and weight to the forces (``leg_forces_with_legs``)."""
     t = np.asarray(t, dtype=float)

@@ -25,13 +25,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs
-from stewart_drake.errors import StiffnessError
-from stewart_drake.core.geometry import Platform
 from stewart_drake.core.argcheck import as_poses
+from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs, skew
+from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
-from stewart_drake.core.dynamics import skew
+from stewart_drake.errors import StiffnessError
 
 FD_STEP = 1e-6  # m and rad: central-difference step for the legs' weight term (error ~ step²)
 
@@ -52,11 +51,15 @@ def displace(pose, dx, convention: str = "utn") -> np.ndarray:
     pose = np.asarray(pose, dtype=float)
     dx = np.asarray(dx, dtype=float)
     pose, dx = np.broadcast_arrays(pose, dx)
-    R = Rotation.from_rotvec(dx[..., 3:].reshape(-1, 3)).as_matrix().reshape(dx.shape[:-1] + (3, 3)) @ rotation_matrix(pose[..., 3:], convention)
+    R = Rotation.from_rotvec(dx[..., 3:].reshape(-1, 3)).as_matrix().reshape(dx.shape[:-1] + (3, 3)) @ rotation_matrix(
+        pose[..., 3:], convention
+    )
     return np.concatenate([pose[..., :3] + dx[..., :3], angles_from_matrix(R, convention)], -1)
 
 
-def static_leg_forces(platform: Platform, q, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH) -> np.ndarray:
+def static_leg_forces(
+    platform: Platform, q, convention: str = "utn", legs: bool = False, gravity: float = G_EARTH
+) -> np.ndarray:
     """``(..., 6)`` leg forces (N) holding the plate at rest at poses q."""
     q = as_poses(q)
     z = np.zeros(q.shape)
@@ -69,12 +72,15 @@ def legs_weight_wrench(platform: Platform, q, convention: str = "utn", gravity: 
     """``(..., 6)`` the wrench [f; m about C] (base frame) the legs' weight applies to the plate at its
     anchors when at rest at q: −Aᵀ (F_with legs − F_plate alone)."""
     A = inverse_jacobian(platform, q, convention)
-    dF = static_leg_forces(platform, q, convention, True, gravity) - static_leg_forces(platform, q, convention, False, gravity)
+    dF = static_leg_forces(platform, q, convention, True, gravity) - static_leg_forces(
+        platform, q, convention, False, gravity
+    )
     return -np.einsum("...ji,...j->...i", A, dF)
 
 
-def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False,
-                     loaded: bool = True) -> np.ndarray:
+def stiffness_matrix(
+    platform: Platform, q, k, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False, loaded: bool = True
+) -> np.ndarray:
     """``(..., 6, 6)`` K (N/m, N/rad, N·m/m, N·m/rad) at poses q ``(..., 6)`` for leg stiffnesses k ``(6,)``
     N/m (or one number for all). ``loaded=False`` gives Aᵀ diag(k) A (as does zero gravity, through the full expression)."""
     q = as_poses(q)
@@ -102,8 +108,14 @@ def stiffness_matrix(platform: Platform, q, k, convention: str = "utn", gravity:
     K[..., 3:, 3:] -= skew(np.broadcast_to(f_g, r_cm.shape)) @ skew(r_cm)
     if legs:
         h = FD_STEP
-        cols = [(legs_weight_wrench(platform, displace(q, h * e, convention), convention, gravity)
-                 - legs_weight_wrench(platform, displace(q, -h * e, convention), convention, gravity)) / (2 * h) for e in np.eye(6)]
+        cols = [
+            (
+                legs_weight_wrench(platform, displace(q, h * e, convention), convention, gravity)
+                - legs_weight_wrench(platform, displace(q, -h * e, convention), convention, gravity)
+            )
+            / (2 * h)
+            for e in np.eye(6)
+        ]
         K = K - np.stack(cols, -1)
     return K
 
@@ -117,8 +129,16 @@ def static_wrench(platform: Platform, q0, dx, k, convention: str = "utn", gravit
     r = np.einsum("...ij,kj->...ki", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
     L = np.linalg.norm(l, axis=-1)
-    L0 = np.linalg.norm(as_poses(q0)[..., None, :3] + np.einsum("...ij,kj->...ki", rotation_matrix(as_poses(q0)[..., 3:], convention),
-                                                             platform.top_anchors_per_leg - platform.rotation_centre) - platform.base_anchors, axis=-1)
+    L0 = np.linalg.norm(
+        as_poses(q0)[..., None, :3]
+        + np.einsum(
+            "...ij,kj->...ki",
+            rotation_matrix(as_poses(q0)[..., 3:], convention),
+            platform.top_anchors_per_leg - platform.rotation_centre,
+        )
+        - platform.base_anchors,
+        axis=-1,
+    )
     u = l / L[..., None]
     F = F0 - np.asarray(k) * (L - L0)
     w = np.einsum("...k,...ki->...i", F, np.concatenate([u, np.cross(r, u)], -1))

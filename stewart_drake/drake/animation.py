@@ -47,8 +47,12 @@ def camera_pose(platform: Platform) -> tuple[np.ndarray, np.ndarray]:
     """Camera position and target (world, metres) framing the platform at home: looking at the middle
     of its height from the front-right, above, far enough that it fills ~70 % of Meshcat's 75° view."""
     home = platform.home_pose()
-    radius = float(max(np.linalg.norm(platform.base_anchors[:, :2], axis=1).max(),
-                       np.linalg.norm(platform.top_anchors[:, :2], axis=1).max()))
+    radius = float(
+        max(
+            np.linalg.norm(platform.base_anchors[:, :2], axis=1).max(),
+            np.linalg.norm(platform.top_anchors[:, :2], axis=1).max(),
+        )
+    )
     height = float(home[2])
     target = np.array([0.0, 0.0, 0.5 * height])
     size = max(height, 2 * radius)
@@ -64,12 +68,16 @@ class MeshcatScene:
         self.platform, self.meshcat, self.convention = platform, meshcat, convention
         builder = DiagramBuilder()
         self.plant, scene_graph = build_plant(platform, builder=builder)
-        self.visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=publish_period))
+        self.visualizer = MeshcatVisualizer.AddToBuilder(
+            builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=publish_period)
+        )
         self.diagram = builder.Build()
         self.context = self.diagram.CreateDefaultContext()
         self.plant_context = self.plant.GetMyMutableContextFromRoot(self.context)
         self.visualizer_context = self.visualizer.GetMyContextFromRoot(self.context)
-        self.prefix = f"/drake/visualizer/{self.plant.GetModelInstanceName(self.plant.GetBodyByName('top').model_instance())}"
+        self.prefix = (
+            f"/drake/visualizer/{self.plant.GetModelInstanceName(self.plant.GetBodyByName('top').model_instance())}"
+        )
         self.visualizer.ForcedPublish(self.visualizer_context)
         self._add_sleeves()
         eye, target = camera_pose(platform)
@@ -83,9 +91,13 @@ class MeshcatScene:
         vis = leg_visual_dimensions(self.platform)
         for i in range(6):
             cyl, pist = self.sleeve_paths(i)
-            self.meshcat.SetObject(cyl, Cylinder(1.2 * vis["cylinder_radius"], 1.01 * vis["cylinder_length"]), Rgba(*WARN_RGBA))
+            self.meshcat.SetObject(
+                cyl, Cylinder(1.2 * vis["cylinder_radius"], 1.01 * vis["cylinder_length"]), Rgba(*WARN_RGBA)
+            )
             self.meshcat.SetTransform(cyl, RigidTransform([0, 0, vis["cylinder_length"] / 2]))
-            self.meshcat.SetObject(pist, Cylinder(1.25 * vis["piston_radius"], 1.01 * vis["piston_length"]), Rgba(*WARN_RGBA))
+            self.meshcat.SetObject(
+                pist, Cylinder(1.25 * vis["piston_radius"], 1.01 * vis["piston_length"]), Rgba(*WARN_RGBA)
+            )
             self.meshcat.SetTransform(pist, RigidTransform([0, 0, -vis["piston_length"] / 2]))
             for p in (cyl, pist):
                 self.meshcat.SetProperty(p, "visible", False)
@@ -170,8 +182,13 @@ _OVERLAY = """
 
 def _with_time_control(page: str, duration: float, title: str, warned: int, frames: int) -> str:
     """``page`` with a panel (title, play/pause, a time slider and readout, the colour legend) before </body>."""
-    overlay = _OVERLAY.format(title=_html.escape(title or "stewart-drake animation"), duration=duration,
-                              pct=WARN_FRACTION * 100, warned=warned, frames=frames)
+    overlay = _OVERLAY.format(
+        title=_html.escape(title or "stewart-drake animation"),
+        duration=duration,
+        pct=WARN_FRACTION * 100,
+        warned=warned,
+        frames=frames,
+    )
     head, sep, tail = page.rpartition("</body>")
     if not sep:
         # internal: Meshcat's own page always has one; its absence is a pydrake change, not bad input

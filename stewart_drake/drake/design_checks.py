@@ -40,7 +40,9 @@ FD_STEP = 1e-6  # m and rad: central differences on the constraint manifold (err
 
 def _spatial_inertia(platform: Platform):
     I = platform.inertia
-    return SpatialInertia.MakeFromCentralInertia(platform.mass, platform.com, RotationalInertia(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))
+    return SpatialInertia.MakeFromCentralInertia(
+        platform.mass, platform.com, RotationalInertia(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
+    )
 
 
 def spring_plant(platform: Platform, q, k, c=0.0, convention: str = "utn", gravity: float = G_EARTH):
@@ -59,8 +61,17 @@ def spring_plant(platform: Platform, q, k, c=0.0, convention: str = "utn", gravi
         i = int(np.argmax(free <= 0))
         raise SimulationError(SimulationError.SPRING.format(leg=i + 1, force=F0[i], k=k[i]))
     for i in range(6):
-        plant.AddForceElement(LinearSpringDamper(plant.world_body(), platform.base_anchors[i], top, platform.top_anchors_per_leg[i],
-                                                 float(free[i]), float(k[i]), float(c[i])))
+        plant.AddForceElement(
+            LinearSpringDamper(
+                plant.world_body(),
+                platform.base_anchors[i],
+                top,
+                platform.top_anchors_per_leg[i],
+                float(free[i]),
+                float(k[i]),
+                float(c[i]),
+            )
+        )
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -gravity])
     plant.Finalize()
     ctx = plant.CreateDefaultContext()
@@ -80,7 +91,9 @@ def _to_C(platform: Platform, R, v_drake) -> np.ndarray:
     return np.concatenate([vC, w], 0)
 
 
-def drake_modes(platform: Platform, q, k, c=0.0, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False) -> dict:
+def drake_modes(
+    platform: Platform, q, k, c=0.0, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False
+) -> dict:
     """Natural frequencies and mode shapes by Drake about the static equilibrium at pose q (6,), leg
     stiffnesses k (N/m) and damping c (N·s/m). Returns ``modes`` (``Modes``; shapes in [δp; δθ]) and
     ``residual`` (the equilibrium's largest |ẋ|, resp. |Nᵀτ|)."""
@@ -89,7 +102,9 @@ def drake_modes(platform: Platform, q, k, c=0.0, convention: str = "utn", gravit
 
     plant, ctx, joint = spring_plant(platform, q, k, c, convention, gravity)
     xdot = plant.EvalTimeDerivatives(ctx).CopyToVector()
-    lin = Linearize(plant, ctx, InputPortSelection.kNoInput, OutputPortSelection.kNoOutput, equilibrium_check_tolerance=1e-6)
+    lin = Linearize(
+        plant, ctx, InputPortSelection.kNoInput, OutputPortSelection.kNoOutput, equilibrium_check_tolerance=1e-6
+    )
     lam, vec = np.linalg.eig(lin.A())
     nq = plant.num_positions()
     vs = joint.velocity_start()
@@ -134,4 +149,3 @@ def _closed_loop_modes(platform: Platform, q, k, c, convention: str) -> dict:
     K = -np.stack([(reduced(h * e)[1] - reduced(-h * e)[1]) / (2 * h) for e in np.eye(6)], -1)
     C_d = damping_matrix(platform, q, c, convention) if np.any(np.asarray(c) != 0) else None
     return {"modes": analytic_modes(K, M, C_d), "residual": float(np.abs(res).max()), "K": K, "M": M}
-

@@ -10,13 +10,13 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.core.c_build import Compiler
 from stewart_drake.core.geometry import Platform
 from stewart_drake.drake.simulation import Scenario, build_simulation
-from stewart_drake.core.c_build import Compiler
+from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.check import MAX_POSES, check_ik, check_tick
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import compile_user
-from stewart_drake.errors import FirmwareError
 from stewart_drake.fixedpoint.generic import pose_words
 
 
@@ -32,8 +32,16 @@ def record_closed_loop(platform: Platform, config: ControllerConfig, trajectory=
     def step(pid, ref, L, ff=None):
         out = orig(pid, ref, L, ff)
         cmd_words = np.round(out[0] / law.timing.command_range * 32768.0).astype(np.int64)
-        records.append((pose_words(np.asarray(ref, float), fmt), law.quantise(L), None if ff is None else law.feedforward_words(ff),
-                        np.asarray(pid).astype(np.int64), cmd_words, np.asarray(out[2]).astype(np.int64)))
+        records.append(
+            (
+                pose_words(np.asarray(ref, float), fmt),
+                law.quantise(L),
+                None if ff is None else law.feedforward_words(ff),
+                np.asarray(pid).astype(np.int64),
+                cmd_words,
+                np.asarray(out[2]).astype(np.int64),
+            )
+        )
         return out
 
     law.step = step  # the system calls law.step at every tick: record each call
@@ -41,8 +49,16 @@ def record_closed_loop(platform: Platform, config: ControllerConfig, trajectory=
     return records
 
 
-def check_firmware(path: Path, platform: Platform, config: ControllerConfig, n_poses: int = 100_000, seed: int = 0,
-                   trace: bool = False, duration: float = 0.5, compiler: Compiler | None = None) -> dict:
+def check_firmware(
+    path: Path,
+    platform: Platform,
+    config: ControllerConfig,
+    n_poses: int = 100_000,
+    seed: int = 0,
+    trace: bool = False,
+    duration: float = 0.5,
+    compiler: Compiler | None = None,
+) -> dict:
     """Compile ``path`` against the header generated for ``platform``/``config`` and compare it with the
     emulation; ``{"ik": ..., "tick": ... | None, "identical": bool}``."""
     if not (isinstance(n_poses, (int, np.integer)) and 1 <= n_poses <= MAX_POSES):

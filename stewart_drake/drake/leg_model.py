@@ -41,7 +41,9 @@ class LegPlant:
     def frame_transforms(self, q) -> np.ndarray:
         """``(4, 4, 4)`` X_{dh_0, dh_i} computed by Drake at joint angles ``q`` (2,)."""
         self.set_q(q)
-        return np.stack([self.plant.CalcRelativeTransform(self.context, self.frames[0], f).GetAsMatrix4() for f in self.frames])
+        return np.stack(
+            [self.plant.CalcRelativeTransform(self.context, self.frames[0], f).GetAsMatrix4() for f in self.frames]
+        )
 
 
 def drake_fk_errors(leg: Leg3R, q) -> np.ndarray:
@@ -84,7 +86,9 @@ def drake_ik(leg: Leg3R, targets, branch: str, tol: float = 1e-14) -> tuple[np.n
         qk = result.GetSolution(ik.q())
         gap = np.linalg.norm(h.frame_transforms(qk)[3][:2, 3] - t) if np.all(np.isfinite(qk)) else np.inf
         if not gap <= GAP_TOL_M:
-            raise RuntimeError(f"Drake InverseKinematics failed at target {k} {t.tolist()} (branch {branch}): "
-                               f"foot {gap:.3g} m from the target ({result.get_solution_result()})")
+            raise RuntimeError(
+                f"Drake InverseKinematics failed at target {k} {t.tolist()} (branch {branch}): "
+                f"foot {gap:.3g} m from the target ({result.get_solution_result()})"
+            )
         out[k], gaps[k] = qk, gap
     return out, gaps

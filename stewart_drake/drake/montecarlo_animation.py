@@ -21,7 +21,9 @@ def write_animation(platform: Platform, log, path) -> Path:
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(platform, 1e-3, builder)
     meshcat = Meshcat()
-    vis = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / FRAME_RATE))
+    vis = MeshcatVisualizer.AddToBuilder(
+        builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / FRAME_RATE)
+    )
     diagram = builder.Build()
     ctx = diagram.CreateDefaultContext()
     pc = plant.GetMyMutableContextFromRoot(ctx)

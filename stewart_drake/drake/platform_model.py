@@ -32,7 +32,9 @@ def add_platform(plant, platform: Platform):
     return instance
 
 
-def build_plant(platform: Platform, time_step: float = 1e-3, builder=None, gravity: bool = True, continuous: bool = False):
+def build_plant(
+    platform: Platform, time_step: float = 1e-3, builder=None, gravity: bool = True, continuous: bool = False
+):
     """A finalized closed-loop ``MultibodyPlant`` of ``platform`` and its ``SceneGraph``, added to
     ``builder`` (a new ``DiagramBuilder`` if None). Discrete (SAP) with ``time_step`` > 0 by default: Drake's
     ball constraints need a discrete plant, except under the CENIC integrator (``continuous=True``: a

@@ -134,10 +134,19 @@ class ProgramFK:
         _, _, Lp = leg_geometry(self.platform, p[None], R[None])
         residual = float(np.abs(Lp[0] - L).max())
         pose = np.concatenate([p, angles_from_matrix(R, convention)])
-        return ProgramSolution(pose, p, R, residual, bool(res.is_success()), self.solver_name, str(res.get_solution_result()), dt)
+        return ProgramSolution(
+            pose, p, R, residual, bool(res.is_success()), self.solver_name, str(res.get_solution_result()), dt
+        )
 
 
-def solve_program(platform: Platform, lengths, initial=None, convention: str = "utn", rotation: str = "quaternion", solver: str = "snopt") -> ProgramSolution:
+def solve_program(
+    platform: Platform,
+    lengths,
+    initial=None,
+    convention: str = "utn",
+    rotation: str = "quaternion",
+    solver: str = "snopt",
+) -> ProgramSolution:
     """One-shot ``ProgramFK(platform, rotation, solver).solve(lengths, initial, convention)``."""
     return ProgramFK(platform, rotation, solver).solve(lengths, initial, convention)
 
@@ -155,8 +164,9 @@ def program_polish(platform: Platform, solver: str = "snopt", convention: str = 
     return polish
 
 
-def assembly_modes(platform: Platform, lengths, convention: str = "utn", *, polish: str | None = "snopt",
-                   **options) -> search.AssemblyModes:
+def assembly_modes(
+    platform: Platform, lengths, convention: str = "utn", *, polish: str | None = "snopt", **options
+) -> search.AssemblyModes:
     """Every real assembly mode found for one ``(6,)`` leg-length set (metres) by
     ``core.assembly_modes.assembly_modes`` (``options``: its keyword arguments), each confirmed by a
     ``ProgramFK`` solved with ``polish`` ("snopt", "ipopt"; None: no confirmation, ``certified`` False)."""

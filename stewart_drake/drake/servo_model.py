@@ -33,8 +33,8 @@ from stewart_drake.core.servo import (
     solve,
 )
 from stewart_drake.core.servo_loop import servo_gains
-from stewart_drake.errors import SimulationError
 from stewart_drake.core.servo_mounting import frame_from_zx, joint_arm_angles, pulse_joint_angles, servo_joint_home
+from stewart_drake.errors import SimulationError
 
 # Drake IK results are accepted when every rod length is this close to s (Drake FK), success flag or not:
 # SNOPT reaches ~1e-9 m on this loop-closure problem before reporting "cannot be improved".
@@ -68,7 +68,9 @@ def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd
     for i in range(6):
         plant.GetJointByName(f"servo_{i + 1}").set_default_angle(home[i])
         if pd_gains is not None:
-            plant.GetJointActuatorByName(f"servo_{i + 1}").set_controller_gains(PdControllerGains(p=pd_gains[0], d=pd_gains[1]))
+            plant.GetJointActuatorByName(f"servo_{i + 1}").set_controller_gains(
+                PdControllerGains(p=pd_gains[0], d=pd_gains[1])
+            )
     plant.Finalize()
     return plant, scene_graph
 
@@ -121,10 +123,20 @@ def frame_errors(h: ServoPlant) -> dict:
     """Worst differences (m) between the parsed plant's frames and the geometry: pivots, anchors, arm length."""
     hex_ = h.hexapod
     piv = np.array([h.plant.GetFrameByName(f"pivot_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)])
-    anc = np.array([h.plant.GetFrameByName(f"platform_anchor_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)])
-    arm = np.array([np.linalg.norm(h.plant.GetFrameByName(f"arm_tip_{i + 1}").GetFixedPoseInBodyFrame().translation()) for i in range(6)])
-    return {"pivots": float(np.abs(piv - hex_.base_pivots).max()), "anchors": float(np.abs(anc - hex_.platform_anchors).max()),
-            "arm_length": float(np.abs(arm - hex_.arm_length).max())}
+    anc = np.array(
+        [h.plant.GetFrameByName(f"platform_anchor_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)]
+    )
+    arm = np.array(
+        [
+            np.linalg.norm(h.plant.GetFrameByName(f"arm_tip_{i + 1}").GetFixedPoseInBodyFrame().translation())
+            for i in range(6)
+        ]
+    )
+    return {
+        "pivots": float(np.abs(piv - hex_.base_pivots).max()),
+        "anchors": float(np.abs(anc - hex_.platform_anchors).max()),
+        "arm_length": float(np.abs(arm - hex_.arm_length).max()),
+    }
 
 
 def drake_home_joint_angles(h: ServoPlant, tol: float = 1e-10) -> np.ndarray:
@@ -157,11 +169,18 @@ def drake_ik_joint_angles(h: ServoPlant, poses, start=None, tol: float = 1e-10) 
         # SNOPT sometimes stops with "cannot be improved" at a point that already closes the loops far
         # below any mechanical tolerance: judge by Drake's own forward kinematics instead.
         h.set_servos(out[k])
-        gap = max(abs(np.linalg.norm(h.frame_pose(f"platform_anchor_{i + 1}") - h.frame_pose(f"arm_tip_{i + 1}")) - h.hexapod.rod_length)
-                  for i in range(6))
+        gap = max(
+            abs(
+                np.linalg.norm(h.frame_pose(f"platform_anchor_{i + 1}") - h.frame_pose(f"arm_tip_{i + 1}"))
+                - h.hexapod.rod_length
+            )
+            for i in range(6)
+        )
         if not (result.is_success() or gap <= IK_GAP_TOL_M):
-            raise RuntimeError(f"Drake InverseKinematics failed at pose {k} {np.asarray(pose).tolist()}: "
-                               f"rod length off by {gap:.3g} m ({result.get_solution_result()})")
+            raise RuntimeError(
+                f"Drake InverseKinematics failed at pose {k} {np.asarray(pose).tolist()}: "
+                f"rod length off by {gap:.3g} m ({result.get_solution_result()})"
+            )
     return out
 
 
@@ -241,8 +260,14 @@ class ServoController(LeafSystem):
         output.SetFromVector(angles_from_pulses(self.hexapod, context.get_discrete_state(self._pulse).value()))
 
 
-def run_controller(hexapod: ServoHexapod, times, poses, duration: float | None = None,
-                   frame_rate_hz: float = FRAME_RATE_HZ, resolution_us: float = 1.0) -> dict:
+def run_controller(
+    hexapod: ServoHexapod,
+    times,
+    poses,
+    duration: float | None = None,
+    frame_rate_hz: float = FRAME_RATE_HZ,
+    resolution_us: float = 1.0,
+) -> dict:
     """Drive the controller in a Diagram with a first-order-hold pose trajectory through ``(times,
     poses)`` (n,), (n, 6); return ``t`` (k,), ``pulse_us`` (k, 6), ``status`` (k, 6) and ``pose`` (k, 6)
     logged once per frame. Drake publishes a log sample at t_k before that instant's update, so
@@ -293,8 +318,15 @@ class ServoDrive(LeafSystem):
         state.get_mutable_vector(self._xd).SetFromVector(np.r_[q + dq, dq / self.time_step])
 
 
-def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None = None, time_step: float = 1e-3,
-                    frame_rate_hz: float = FRAME_RATE_HZ, resolution_us: float = 1.0) -> dict:
+def run_closed_loop(
+    hexapod: ServoHexapod,
+    times,
+    poses,
+    duration: float | None = None,
+    time_step: float = 1e-3,
+    frame_rate_hz: float = FRAME_RATE_HZ,
+    resolution_us: float = 1.0,
+) -> dict:
     """The seed's control loop closed in simulation, one Diagram::
 
         TrajectorySource(pose ref) → ServoController (50 Hz, 1 µs) → ServoDrive (speed limit) → plant (PD servos)
@@ -308,7 +340,9 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     times = np.asarray(times, dtype=float)
     poses = np.asarray(poses, dtype=float)
     if poses.shape != (len(times), 6) or len(times) < 2:
-        raise SimulationError(SimulationError.CLOSED_LOOP_SHAPES.format(times_shape=times.shape, poses_shape=poses.shape))
+        raise SimulationError(
+            SimulationError.CLOSED_LOOP_SHAPES.format(times_shape=times.shape, poses_shape=poses.shape)
+        )
     if not time_step > 0:
         raise SimulationError(SimulationError.TIME_STEP.format(value=time_step))
     builder = DiagramBuilder()
@@ -318,16 +352,21 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
     ctrl = builder.AddSystem(ServoController(hexapod, frame_rate_hz, resolution_us))
     drive = builder.AddSystem(ServoDrive(hexapod, home, time_step))
     instance = plant.GetModelInstanceByName(SERVO_HEXAPOD_MODEL)
-    order = [int(plant.get_joint_actuator(a).joint().name().split("_")[1]) - 1 for a in plant.GetJointActuatorIndices(instance)]
+    order = [
+        int(plant.get_joint_actuator(a).joint().name().split("_")[1]) - 1
+        for a in plant.GetJointActuatorIndices(instance)
+    ]
     if order != list(range(6)):
         raise RuntimeError(f"servo actuators are not in the order servo_1..servo_6: {order}")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("pose"))
     builder.Connect(ctrl.GetOutputPort("pulse_us"), drive.GetInputPort("pulse_us"))
     builder.Connect(drive.GetOutputPort("desired_state"), plant.get_desired_state_input_port(instance))
-    logs = {"reference": LogVectorOutput(src.get_output_port(), builder, time_step),
-            "state": LogVectorOutput(plant.get_state_output_port(), builder, time_step),
-            "pulse_us": LogVectorOutput(ctrl.GetOutputPort("pulse_us"), builder, time_step),
-            "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, time_step)}
+    logs = {
+        "reference": LogVectorOutput(src.get_output_port(), builder, time_step),
+        "state": LogVectorOutput(plant.get_state_output_port(), builder, time_step),
+        "pulse_us": LogVectorOutput(ctrl.GetOutputPort("pulse_us"), builder, time_step),
+        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, time_step),
+    }
     out = _simulate_and_read_logs(builder.Build(), logs, float(times[-1] if duration is None else duration))
     # Kinematics of the logged states.
     pc = plant.CreateDefaultContext()
@@ -343,8 +382,17 @@ def run_closed_loop(hexapod: ServoHexapod, times, poses, duration: float | None 
         X = plant.EvalBodyPoseInWorld(pc, body)
         pose[j] = np.r_[X.translation(), angles_from_matrix(X.rotation().matrix(), "zyx")]
         joints[j] = [sj.get_angle(pc) for sj in servos]
-        gap[j] = [abs(np.linalg.norm(anchors[i].CalcPoseInWorld(pc).translation() - tips[i].CalcPoseInWorld(pc).translation())
-                      - hexapod.rod_length) for i in range(6)]
-    out.update(pose=pose, arm_angle=joint_arm_angles(hexapod, joints), rod_gap=gap,
-               arm_angle_ref=solve(hexapod, out["reference"]).angles)
+        gap[j] = [
+            abs(
+                np.linalg.norm(anchors[i].CalcPoseInWorld(pc).translation() - tips[i].CalcPoseInWorld(pc).translation())
+                - hexapod.rod_length
+            )
+            for i in range(6)
+        ]
+    out.update(
+        pose=pose,
+        arm_angle=joint_arm_angles(hexapod, joints),
+        rod_gap=gap,
+        arm_angle_ref=solve(hexapod, out["reference"]).angles,
+    )
     return out

@@ -37,13 +37,13 @@ from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
-from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.errors import SimulationError
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
+from stewart_drake.errors import SimulationError
 
 # ----------------------------------------------------------------------------------------------
 # The scenario: what a run is, as plain data.
@@ -252,7 +252,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     else:
         pos = np.array([j.position_start() for j in joints])
         vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
-        sensor = builder.AddSystem(LegLengthSensor(nx, pos, vel, s.sensor.offset, s.sensor.noise, s.sensor.jitter, s.sensor.period))
+        sensor = builder.AddSystem(
+            LegLengthSensor(nx, pos, vel, s.sensor.offset, s.sensor.noise, s.sensor.jitter, s.sensor.period)
+        )
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
     ff = None
@@ -279,7 +281,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     }
     visualizer = None
     if meshcat is not None:
-        visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32))
+        visualizer = MeshcatVisualizer.AddToBuilder(
+            builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32)
+        )
     diagram = builder.Build()
     simulator = Simulator(diagram)
     apply_integrator(simulator, integrator)
@@ -297,12 +301,33 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     if act.state_index is not None:
         act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
     simulator.Initialize()
-    return Simulation(platform, trajectory, s.controller, config, diagram, plant, ctrl, loggers, simulator, meshcat, visualizer,
-                      plant_time_step, ff, integrator, src)
+    return Simulation(
+        platform,
+        trajectory,
+        s.controller,
+        config,
+        diagram,
+        plant,
+        ctrl,
+        loggers,
+        simulator,
+        meshcat,
+        visualizer,
+        plant_time_step,
+        ff,
+        integrator,
+        src,
+    )
 
 
-def setpoint_step_response(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, step: float = 1e-3,
-                           duration: float = 0.3, actuators: ActuatorModel | None = None) -> tuple[np.ndarray, np.ndarray]:
+def setpoint_step_response(
+    platform: Platform,
+    config: ControllerConfig | None = None,
+    leg: int = 0,
+    step: float = 1e-3,
+    duration: float = 0.3,
+    actuators: ActuatorModel | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """The float twin's closed-loop response, on the actual plant at home, to a set-point step of ``step``
     metres on leg ``leg`` (0-based) at t = 0: ``(t (n,), s (n, 6))``, s = (L(t) − L_rest(t)) / step for
     all six legs, L_rest a run without the step (removes any residual drift of the equilibrium). The

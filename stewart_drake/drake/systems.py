@@ -120,8 +120,13 @@ class ControllerSystem(LeafSystem):
         context.SetDiscreteState(self._status, np.zeros(len(STATUS)))
 
 
-def make_law(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python",
-             firmware: str | Path | None = None):
+def make_law(
+    kind: str,
+    platform: Platform,
+    config: ControllerConfig | None = None,
+    engine: str = "python",
+    firmware: str | Path | None = None,
+):
     """The law of controller ``kind`` (``"fixed"`` or ``"float"``); for ``fixed``, ``engine`` ``"python"``
     (the emulation) or ``"c"`` (the compiled firmware; ``firmware``: a user's C file implementing the ABI).
     The float twin has no firmware: ``engine`` does not apply to it."""
@@ -135,11 +140,18 @@ def make_law(kind: str, platform: Platform, config: ControllerConfig | None = No
         return FixedPointLaw(platform, config)
     if kind == "float":
         return FloatLaw(platform, config)
-    raise SimulationError(SimulationError.CONTROLLER.format(valid=" or ".join(repr(k) for k in CONTROLLER_KINDS), value=kind))
+    raise SimulationError(
+        SimulationError.CONTROLLER.format(valid=" or ".join(repr(k) for k in CONTROLLER_KINDS), value=kind)
+    )
 
 
-def make_controller(kind: str, platform: Platform, config: ControllerConfig | None = None, engine: str = "python",
-                    firmware: str | Path | None = None) -> ControllerSystem:
+def make_controller(
+    kind: str,
+    platform: Platform,
+    config: ControllerConfig | None = None,
+    engine: str = "python",
+    firmware: str | Path | None = None,
+) -> ControllerSystem:
     """``ControllerSystem`` of ``make_law(kind, platform, config, engine, firmware)``."""
     return ControllerSystem(make_law(kind, platform, config, engine, firmware))
 
@@ -223,7 +235,11 @@ class LegLengthSensor(LeafSystem):
     def __init__(self, n_state: int, positions, velocities, offset, noise, jitter, period: float):
         super().__init__()
         self._pos, self._vel = np.asarray(positions), np.asarray(velocities)
-        self._offset, self._noise, self._jitter = np.asarray(offset, float), np.asarray(noise, float), np.asarray(jitter, float)
+        self._offset, self._noise, self._jitter = (
+            np.asarray(offset, float),
+            np.asarray(noise, float),
+            np.asarray(jitter, float),
+        )
         self._period = period
         self._u = self.DeclareVectorInputPort("state", n_state)
         self.DeclareVectorOutputPort("lengths", 6, self._CalcLengths)

@@ -76,7 +76,9 @@ def chain_plant(platform: Platform, convention: str = "utn", gravity: float = G_
     chain = _CHAIN[convention]
     for k, (name, axis, index) in enumerate(chain):
         last = k == len(chain) - 1
-        body = plant.AddRigidBody("top" if last else f"link_{name}", _spatial_inertia(platform) if last else SpatialInertia.Zero())
+        body = plant.AddRigidBody(
+            "top" if last else f"link_{name}", _spatial_inertia(platform) if last else SpatialInertia.Zero()
+        )
         child = body.body_frame()
         if last:
             child = plant.AddFrame(_fixed_frame("C", body, RigidTransform(platform.rotation_centre)))
@@ -137,7 +139,9 @@ class PlateKinematics:
         V = self.plant.EvalBodySpatialVelocityInWorld(self.ctx, self.top)
         if qdd is None:
             return X, V, None
-        A = self.plant.CalcSpatialAccelerationsFromVdot(self.ctx, np.asarray(qdd, dtype=float)[self.perm])[int(self.top.index())]
+        A = self.plant.CalcSpatialAccelerationsFromVdot(self.ctx, np.asarray(qdd, dtype=float)[self.perm])[
+            int(self.top.index())
+        ]
         return X, V, A
 
 
@@ -201,7 +205,9 @@ class ClosedLoopInverseDynamics:
         self.i_top = np.arange(self.top.floating_velocities_start_in_v(), self.top.floating_velocities_start_in_v() + 6)
         self.i_legs = np.setdiff1d(np.arange(nv), self.i_top)
         B = plant.MakeActuationMatrix()  # (nv, n_actuators), columns in actuator order
-        order = [int(np.argmax(np.abs(B[plant.GetJointByName(f"prismatic_{i + 1}").velocity_start()]))) for i in range(6)]
+        order = [
+            int(np.argmax(np.abs(B[plant.GetJointByName(f"prismatic_{i + 1}").velocity_start()]))) for i in range(6)
+        ]
         self.order = order  # actuator index of leg i
         self.B = B[:, order]  # columns in leg order
         self.tips = [plant.GetFrameByName(f"piston_{i + 1}") for i in range(6)]
@@ -213,8 +219,14 @@ class ClosedLoopInverseDynamics:
         G, b = [], []
         kV, o = JacobianWrtVariable.kV, np.zeros(3)
         for tip, anchor in zip(self.tips, self.anchors):
-            G.append(plant.CalcJacobianTranslationalVelocity(ctx, kV, tip, o, W, W) - plant.CalcJacobianTranslationalVelocity(ctx, kV, anchor, o, W, W))
-            b.append(plant.CalcBiasTranslationalAcceleration(ctx, kV, tip, o, W, W) - plant.CalcBiasTranslationalAcceleration(ctx, kV, anchor, o, W, W))
+            G.append(
+                plant.CalcJacobianTranslationalVelocity(ctx, kV, tip, o, W, W)
+                - plant.CalcJacobianTranslationalVelocity(ctx, kV, anchor, o, W, W)
+            )
+            b.append(
+                plant.CalcBiasTranslationalAcceleration(ctx, kV, tip, o, W, W)
+                - plant.CalcBiasTranslationalAcceleration(ctx, kV, anchor, o, W, W)
+            )
         return np.vstack(G), np.concatenate([x.ravel() for x in b])
 
     def set_state(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
@@ -248,8 +260,9 @@ def constrained_leg_forces(platform: Platform, q, qd, qdd, convention: str = "ut
     return np.array([ID(q[k], qd[k], qdd[k]) for k in range(len(q))])
 
 
-def simulate_open_loop(platform: Platform, t, q, qd, forces, time_step: float = 1e-3, convention: str = "utn",
-                       record_every: int = 10) -> dict:
+def simulate_open_loop(
+    platform: Platform, t, q, qd, forces, time_step: float = 1e-3, convention: str = "utn", record_every: int = 10
+) -> dict:
     """Apply ``(n, 6)`` leg forces (N, at times ``t`` (n,), first-order hold) open loop to the closed-loop
     plant of ``model.build_plant``, starting on the trajectory at (q[0], q̇[0]); compare the plate with
     the planned ``(n, 6)`` poses q every ``record_every`` samples.
@@ -291,8 +304,12 @@ def simulate_open_loop(platform: Platform, t, q, qd, forces, time_step: float = 
         out["position_error"].append(np.linalg.norm(p_C - q[k, :3]))
         c = np.clip((np.trace(R @ R_plan.T) - 1) / 2, -1.0, 1.0)
         out["angle_error"].append(np.arccos(c))
-        out["constraint"].append(max(np.linalg.norm(a.CalcPoseInWorld(pctx).translation() - b.CalcPoseInWorld(pctx).translation())
-                                     for a, b in zip(tips, anchors)))
+        out["constraint"].append(
+            max(
+                np.linalg.norm(a.CalcPoseInWorld(pctx).translation() - b.CalcPoseInWorld(pctx).translation())
+                for a, b in zip(tips, anchors)
+            )
+        )
         out["lengths"].append(prismatic_positions(plant, pctx))
     res = {k: np.array(v) for k, v in out.items()}
     res["t"] = t[idx]

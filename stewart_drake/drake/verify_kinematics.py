@@ -36,8 +36,12 @@ def make_plant(platform: Platform) -> PlantHandle:
 
 def anchor_frames(h: PlantHandle) -> tuple[np.ndarray, np.ndarray]:
     """``(6, 3)`` p_BBi and ``(6, 3)`` p_TTi as read from the plant's frames ``base_anchor_i``/``top_anchor_i``."""
-    base = np.array([h.plant.GetFrameByName(f"base_anchor_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)])
-    top = np.array([h.plant.GetFrameByName(f"top_anchor_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)])
+    base = np.array(
+        [h.plant.GetFrameByName(f"base_anchor_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)]
+    )
+    top = np.array(
+        [h.plant.GetFrameByName(f"top_anchor_{i + 1}").GetFixedPoseInBodyFrame().translation() for i in range(6)]
+    )
     return base, top
 
 
@@ -77,14 +81,18 @@ def drake_ik_lengths(h: PlantHandle, poses, convention: str = "utn", tol: float 
         ik = InverseKinematics(plant, ctx)
         q = ik.q()
         guess = plant.GetPositions(ctx).copy()
-        leg_idx = np.r_[[plant.GetJointByName(f"universal_{i + 1}").position_start() + j for i in range(6) for j in range(2)],
-                        [plant.GetJointByName(f"prismatic_{i + 1}").position_start() for i in range(6)]]
+        leg_idx = np.r_[
+            [plant.GetJointByName(f"universal_{i + 1}").position_start() + j for i in range(6) for j in range(2)],
+            [plant.GetJointByName(f"prismatic_{i + 1}").position_start() for i in range(6)],
+        ]
         guess[leg_idx] = q_home[leg_idx]
         ik.get_mutable_prog().AddQuadraticErrorCost(np.eye(len(leg_idx)) * 1e-6, q_home[leg_idx], q[leg_idx])
         result = solver.Solve(ik.prog(), guess, options)
         top.Unlock(ctx)
         if not result.is_success():
-            raise RuntimeError(f"Drake InverseKinematics failed at pose {k} {pose.tolist()}: {result.get_solution_result()}")
+            raise RuntimeError(
+                f"Drake InverseKinematics failed at pose {k} {pose.tolist()}: {result.get_solution_result()}"
+            )
         plant.SetPositions(ctx, result.GetSolution(q))
         out[k] = prismatic_positions(plant, ctx)
     return out

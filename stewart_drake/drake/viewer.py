@@ -55,10 +55,18 @@ class Readout:
     warnings: np.ndarray = field(default_factory=lambda: np.zeros(6, bool))
 
     def to_dict(self) -> dict:
-        return {"pose": self.pose.tolist(), "lengths_m": self.lengths.tolist(), "stroke_margin_m": self.margin.tolist(),
-                "condition": self.condition, "sigma_min": self.sigma_min, "reachable": self.reachable,
-                "nearest_reachable_pose": self.nearest.tolist(), "fraction_from_home": self.fraction,
-                "assembly_modes": self.modes, "assembly_modes_near": self.modes_near}
+        return {
+            "pose": self.pose.tolist(),
+            "lengths_m": self.lengths.tolist(),
+            "stroke_margin_m": self.margin.tolist(),
+            "condition": self.condition,
+            "sigma_min": self.sigma_min,
+            "reachable": self.reachable,
+            "nearest_reachable_pose": self.nearest.tolist(),
+            "fraction_from_home": self.fraction,
+            "assembly_modes": self.modes,
+            "assembly_modes_near": self.modes_near,
+        }
 
 
 def reachable(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
@@ -67,7 +75,9 @@ def reachable(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
     return ok & (jacobian_analysis(platform, poses, convention).condition < MAX_CONDITION)
 
 
-def nearest_reachable(platform: Platform, pose, convention: str = "utn", iterations: int = 40) -> tuple[np.ndarray, float]:
+def nearest_reachable(
+    platform: Platform, pose, convention: str = "utn", iterations: int = 40
+) -> tuple[np.ndarray, float]:
     """The last reachable pose on the straight line (in pose coordinates) from home to ``pose`` (6,),
     by bisection on the fraction s in [0, 1], and s. ``pose`` itself when reachable; home (s = 0) when
     home is the only reachable point found."""
@@ -93,8 +103,17 @@ def readout(platform: Platform, pose, convention: str = "utn", modes: bool = Tru
     jac = jacobian_analysis(platform, pose, convention)
     ok = bool(reachable(platform, pose, convention))
     nearest, s = nearest_reachable(platform, pose, convention)
-    r = Readout(pose, L, stroke_margin(platform, L), float(jac.condition), float(jac.sigma_min), ok, nearest, s,
-                warnings=leg_warnings(platform, L))
+    r = Readout(
+        pose,
+        L,
+        stroke_margin(platform, L),
+        float(jac.condition),
+        float(jac.sigma_min),
+        ok,
+        nearest,
+        s,
+        warnings=leg_warnings(platform, L),
+    )
     if modes:
         r.modes, r.modes_near = count_modes(platform, pose, L, convention)
     return r
@@ -144,8 +163,15 @@ class Viewer:
     """Pose sliders + readouts on a ``MeshcatScene``. Sliders are in ``length_unit``/``angle_unit`` and
     the Euler ``convention``; internally SI."""
 
-    def __init__(self, platform: Platform, meshcat, length_unit: str = "mm", angle_unit: str = "deg",
-                 convention: str = "utn", modes: bool = True):
+    def __init__(
+        self,
+        platform: Platform,
+        meshcat,
+        length_unit: str = "mm",
+        angle_unit: str = "deg",
+        convention: str = "utn",
+        modes: bool = True,
+    ):
         self.platform, self.meshcat, self.convention, self.modes = platform, meshcat, convention, modes
         self.length_unit = length_unit
         self.lk, self.ak = length_scale(length_unit), angle_scale(angle_unit)
@@ -227,7 +253,9 @@ class Viewer:
                 counted = True
         return self.readout
 
-    def replay(self, t, poses, saturating=None, speed: float = 1.0, loop: bool = False, duration: float | None = None) -> Readout:
+    def replay(
+        self, t, poses, saturating=None, speed: float = 1.0, loop: bool = False, duration: float | None = None
+    ) -> Readout:
         """Play ``poses`` ``(n, 6)`` SI at times ``t`` ``(n,)`` s in real time × ``speed`` (25 frames/s),
         once or in a loop, until ``duration`` wall seconds if given."""
         t = np.asarray(t, dtype=float) - t[0]
@@ -260,7 +288,12 @@ def load_replay(path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str]:
     if p.suffix == ".npz":
         try:
             with np.load(p, allow_pickle=False) as z:
-                return np.asarray(z["t"], float), np.asarray(z["pose"], float), log_saturating(z["status"]), str(z["platform"])
+                return (
+                    np.asarray(z["t"], float),
+                    np.asarray(z["pose"], float),
+                    log_saturating(z["status"]),
+                    str(z["platform"]),
+                )
         except (KeyError, ValueError, OSError) as e:
             raise ReplayError(ReplayError.NOT_LOG.format(path=path, reason=e)) from None
     return _load_csv(p)
@@ -272,8 +305,10 @@ def _load_csv(p: Path):
     if not rows:
         raise ReplayError(ReplayError.EMPTY.format(path=p))
     header = rows[0]
-    for cols in (["t"] + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")],
-                 ["t", "px", "py", "pz", "alpha", "beta", "gama"]):
+    for cols in (
+        ["t"] + [f"pose_{c}" for c in ("px", "py", "pz", "ax", "ay", "az")],
+        ["t", "px", "py", "pz", "alpha", "beta", "gama"],
+    ):
         if all(c in header for c in cols):
             break
     else:

@@ -7,12 +7,18 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
-from stewart_drake.fixedpoint.generic import leg_length_words, platform_words, pose_words, rotation_from_words, trig_words
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.sampling import random_poses
+from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import TRACE_FIELDS
 from stewart_drake.firmware.module import TickRunner
-from stewart_drake.errors import FirmwareError
+from stewart_drake.fixedpoint.generic import (
+    leg_length_words,
+    platform_words,
+    pose_words,
+    rotation_from_words,
+    trig_words,
+)
 
 MAX_POSES = 100_000_000
 CHUNK = 1 << 18
@@ -79,9 +85,14 @@ def check_ik(module, platform: Platform, config: ControllerConfig, n: int, seed:
         worst = max(worst, int(np.abs(d).max()))
         if bad.size and first is None:
             k = int(bad[0])
-            first = {"index": a + k, "pose_si": q[k].tolist(), "pose_words": words[k].tolist(),
-                     "emulation_lengths": want[k].tolist(), "firmware_lengths": got[k].tolist(),
-                     "first_leg": int(np.flatnonzero(d[k])[0]) + 1}
+            first = {
+                "index": a + k,
+                "pose_si": q[k].tolist(),
+                "pose_words": words[k].tolist(),
+                "emulation_lengths": want[k].tolist(),
+                "firmware_lengths": got[k].tolist(),
+                "first_leg": int(np.flatnonzero(d[k])[0]) + 1,
+            }
             if trace:
                 first["trace"] = _trace(module, platform, config, words[k])
     return {"poses": int(n), "differing_poses": differing, "worst_lsb": worst, "first_difference": first}
@@ -116,6 +127,11 @@ def check_tick(module, records: list) -> dict:
             differing += 1
             worst = max(worst, int(d.max()))
             if first is None:
-                first = {"tick": k, "emulation_command": cmd.tolist(), "firmware_command": c.tolist(),
-                         "emulation_state": state.tolist(), "firmware_state": st.tolist()}
+                first = {
+                    "tick": k,
+                    "emulation_command": cmd.tolist(),
+                    "firmware_command": c.tolist(),
+                    "emulation_state": state.tolist(),
+                    "firmware_state": st.tolist(),
+                }
     return {"ticks": len(records), "differing_ticks": differing, "worst_command_lsb": worst, "first_difference": first}

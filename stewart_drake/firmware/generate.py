@@ -31,14 +31,30 @@ import numpy as np
 
 from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
 from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG
-from stewart_drake.fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
-from stewart_drake.fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import FirmwareError
+from stewart_drake.fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
+from stewart_drake.fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 
 # Operation names the generated code counts (the instrumented build's order).
-OPS = ("add", "sub", "negate", "mult", "L_mult", "L_add", "L_sub", "L_shl", "shl", "mult_r", "extract_h",
-       "L_deposit_h", "mfr32Sqrt", "tfr16SinPIx", "tfr16CosPIx", "table")
+OPS = (
+    "add",
+    "sub",
+    "negate",
+    "mult",
+    "L_mult",
+    "L_add",
+    "L_sub",
+    "L_shl",
+    "shl",
+    "mult_r",
+    "extract_h",
+    "L_deposit_h",
+    "mfr32Sqrt",
+    "tfr16SinPIx",
+    "tfr16CosPIx",
+    "table",
+)
 # cycles of a quarter-wave table look-up (fold, index, load, sign): exact trig only
 TABLE_CYCLES = 6.0
 # trace layout of sd_ik_trace (int32 words)
@@ -68,7 +84,9 @@ class GeneratedFirmware:
     @property
     def tick_cycles(self) -> float:
         """Cycles of one controller tick: IK + PIDs with feed-forward + ISR overhead."""
-        return self.ik_cycles.cycles + estimate_cycles(self.tick_ops, _cycle_table(), loops=0).cycles + ISR_OVERHEAD_CYCLES
+        return (
+            self.ik_cycles.cycles + estimate_cycles(self.tick_ops, _cycle_table(), loops=0).cycles + ISR_OVERHEAD_CYCLES
+        )
 
     @property
     def digest(self) -> str:
@@ -170,10 +188,16 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
                         e.op("add" if coef > 0 else "sub")
             if first:
                 e.emit(f"{target} = 0;")
-    e.emit("if (trace) { " + " ".join(f"trace[{TRACE_AT['R'] + 3 * i + j}] = R{i}{j};" for i in range(3) for j in range(3)) + " }")
+    e.emit(
+        "if (trace) { "
+        + " ".join(f"trace[{TRACE_AT['R'] + 3 * i + j}] = R{i}{j};" for i in range(3) for j in range(3))
+        + " }"
+    )
     # -- legs
     for i in range(6):
-        e.emit(f"/* leg {i + 1}: plate anchor offset ({', '.join(str(int(v)) for v in r_T[i])}), base anchor ({', '.join(str(int(v)) for v in B[i])}) LSB */")
+        e.emit(
+            f"/* leg {i + 1}: plate anchor offset ({', '.join(str(int(v)) for v in r_T[i])}), base anchor ({', '.join(str(int(v)) for v in B[i])}) LSB */"
+        )
         e.emit("sq = 0;")
         for r in range(3):
             e.emit(f"v = pose[{r}];")
@@ -202,11 +226,14 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
         k = np.arange(H + 1)
         U = np.round(np.sin(np.pi * k / (1 << f)) * (1 << f)).astype(np.int64)
         _verify_table(U, fmt)
-        rows = [", ".join(str(int(v)) for v in U[a:a + 16]) for a in range(0, H + 1, 16)]
+        rows = [", ".join(str(int(v)) for v in U[a : a + 16]) for a in range(0, H + 1, 16)]
         ttype = "uint16_t" if f <= 15 else "uint32_t"
-        table = (f"/* U[k] = round(2^{f} sin(pi k / 2^{f})), k = 0..2^{f - 1}, unsaturated (verified at generation against\n"
-                 f"   the emulation on all {2 ** fmt.word_bits} angle words) */\nstatic const {ttype} SIN_TABLE[{H + 1}] = {{\n    "
-                 + ",\n    ".join(rows) + "\n};\n")
+        table = (
+            f"/* U[k] = round(2^{f} sin(pi k / 2^{f})), k = 0..2^{f - 1}, unsaturated (verified at generation against\n"
+            f"   the emulation on all {2**fmt.word_bits} angle words) */\nstatic const {ttype} SIN_TABLE[{H + 1}] = {{\n    "
+            + ",\n    ".join(rows)
+            + "\n};\n"
+        )
 
     # the controller tick's operations beyond the IK: the cycle model's (control.PID_OPS_PER_LEG and
     # FEEDFORWARD_OPS_PER_LEG, six legs); the emitted sd_tick below performs exactly these (a test counts them)
@@ -217,11 +244,33 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
 
     g = GeneratedFirmware(platform.name, fmt, conv, config, ik_ops=ik_ops, tick_ops=tick_ops)
     ctx = dict(
-        name=platform.name, wb=fmt.word_bits, f=f, lo=lo, hi=hi, lsb=fmt.length_lsb, trig=fmt.trig, conv=conv,
-        word="int16_t", acc_hi=acc_hi, acc_lo=-acc_hi - 1, cpl=cpl, diff_shift=DIFF_SHIFT,
-        kp=gains.kp, ki=gains.ki, kd=gains.kd, kv=gains.kv, alpha=gains.alpha, alpha_ff=gains.alpha_ff,
-        T=config.timing.sample_period, res=config.timing.sensor_resolution, rng=config.timing.command_range,
-        sqrt_bits=fmt.word_bits, trace_words=TRACE_WORDS, ops=OPS, at_sin=TRACE_AT["sin"], at_cos=TRACE_AT["cos"],
+        name=platform.name,
+        wb=fmt.word_bits,
+        f=f,
+        lo=lo,
+        hi=hi,
+        lsb=fmt.length_lsb,
+        trig=fmt.trig,
+        conv=conv,
+        word="int16_t",
+        acc_hi=acc_hi,
+        acc_lo=-acc_hi - 1,
+        cpl=cpl,
+        diff_shift=DIFF_SHIFT,
+        kp=gains.kp,
+        ki=gains.ki,
+        kd=gains.kd,
+        kv=gains.kv,
+        alpha=gains.alpha,
+        alpha_ff=gains.alpha_ff,
+        T=config.timing.sample_period,
+        res=config.timing.sensor_resolution,
+        rng=config.timing.command_range,
+        sqrt_bits=fmt.word_bits,
+        trace_words=TRACE_WORDS,
+        ops=OPS,
+        at_sin=TRACE_AT["sin"],
+        at_cos=TRACE_AT["cos"],
         at_len=TRACE_AT["lengths"],
     )
     g.files["sd_firmware.h"] = _header(ctx, config)
@@ -246,36 +295,36 @@ def _verify_table(U: np.ndarray, fmt: QFormat) -> None:
 
 
 def _header(c: dict, config: ControllerConfig) -> str:
-    return f"""/* sd_firmware.h -- generated by `stewart-drake firmware generate` for platform {c['name']!r}; do not edit.
- * Fixed-point IK ({c['wb']}-bit words, length LSB {c['lsb']:g} m, trig {c['trig']}, convention {c['conv']}) and the
- * controller tick (PID + feed-forward word + saturation + anti-windup) at {1 / c['T']:g} Hz. C99, no floating point.
+    return f"""/* sd_firmware.h -- generated by `stewart-drake firmware generate` for platform {c["name"]!r}; do not edit.
+ * Fixed-point IK ({c["wb"]}-bit words, length LSB {c["lsb"]:g} m, trig {c["trig"]}, convention {c["conv"]}) and the
+ * controller tick (PID + feed-forward word + saturation + anti-windup) at {1 / c["T"]:g} Hz. C99, no floating point.
  * Bit-identical to stewart_drake.fixedpoint.generic / control (FixedPointController). See README.md. */
 #ifndef SD_FIRMWARE_H
 #define SD_FIRMWARE_H
 
 #include <stdint.h>
 
-typedef {c['word']} sd_word;   /* a {c['wb']}-bit data word */
-typedef int32_t sd_count;   /* a leg-length sensor reading, counts of {c['res']:g} m */
+typedef {c["word"]} sd_word;   /* a {c["wb"]}-bit data word */
+typedef int32_t sd_count;   /* a leg-length sensor reading, counts of {c["res"]:g} m */
 
-#define SD_WORD_BITS {c['wb']}
-#define SD_FRAC_BITS {c['f']}
-#define SD_TRACE_WORDS {c['trace_words']}
+#define SD_WORD_BITS {c["wb"]}
+#define SD_FRAC_BITS {c["f"]}
+#define SD_TRACE_WORDS {c["trace_words"]}
 
 /* The controller's state (sd_init zeroes it; the host may set it to hold a pose). */
 typedef struct {{
     int32_t integ[6];     /* integrator, Q31 fraction of the command range */
     sd_count prev[6];     /* previous measurement, counts */
-    int16_t dfilt[6];     /* filtered measurement difference, counts * 2^{c['diff_shift']} */
+    int16_t dfilt[6];     /* filtered measurement difference, counts * 2^{c["diff_shift"]} */
     sd_word setpoint[6];  /* the set-point of the last tick, length LSBs */
-    int16_t vfilt[6];     /* filtered set-point difference, counts * 2^{c['diff_shift']} */
+    int16_t vfilt[6];     /* filtered set-point difference, counts * 2^{c["diff_shift"]} */
     int16_t saturated[6]; /* 1 where the last tick's command saturated */
 }} sd_state;
 
-/* six leg lengths (length LSBs) of a pose (positions in length LSBs, angles Q{c['f']} fractions of pi);
+/* six leg lengths (length LSBs) of a pose (positions in length LSBs, angles Q{c["f"]} fractions of pi);
    returns the number of saturations in the arithmetic (0 on a geometric pose) */
 int sd_ik(const sd_word pose[6], sd_word lengths[6]);
-/* sd_ik that also writes every intermediate word: pose 6, sin 3, cos 3, R 9 (row-major, Q{c['f']}),
+/* sd_ik that also writes every intermediate word: pose 6, sin 3, cos 3, R 9 (row-major, Q{c["f"]}),
    leg vectors 18 (LSB), squared lengths 6 (capped at 2^31 - 1), lengths 6 */
 int sd_ik_trace(const sd_word pose[6], int32_t trace[SD_TRACE_WORDS]);
 void sd_init(sd_state *s);
@@ -285,8 +334,8 @@ int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], cons
 
 #ifdef SD_COUNT_OPS
 /* instrumented build: operations executed, in the order of SD_OP_NAMES */
-#define SD_OP_N {len(c['ops'])}
-#define SD_OP_NAMES "{' '.join(c['ops'])}"
+#define SD_OP_N {len(c["ops"])}
+#define SD_OP_NAMES "{" ".join(c["ops"])}"
 extern long sd_op_counts[SD_OP_N];
 #endif
 
@@ -358,7 +407,7 @@ def _source(c: dict, ik_lines: list[str], table: str) -> str:
     kp, ki, kd, kv = c["kp"], c["ki"], c["kd"], c["kv"]
     enum = ", ".join(f"SD_{n}" for n in c["ops"])
     trig = TFR16 if c["trig"] == "tfr16" else TABLE_TRIG
-    return f"""/* sd_firmware.c -- generated by `stewart-drake firmware generate` for platform {c['name']!r}; do not edit.
+    return f"""/* sd_firmware.c -- generated by `stewart-drake firmware generate` for platform {c["name"]!r}; do not edit.
  * The fixed-point IK of stewart_drake.fixedpoint.generic, operation by operation, and the controller tick
  * of stewart_drake.control.controller (FixedPointController), with every constant computed at generation time. */
 #include "sd_firmware.h"
@@ -371,11 +420,11 @@ long sd_op_counts[SD_OP_N];
 #define SD_OP(k) ((void)0)
 #endif
 
-#define SD_LO ({c['lo']}L)
-#define SD_HI {c['hi']}L
-#define SD_HALF {c['hi'] // 2 + 1}L
-#define SD_ACC_LO ({c['acc_lo']}LL)
-#define SD_ACC_HI {c['acc_hi']}LL
+#define SD_LO ({c["lo"]}L)
+#define SD_HI {c["hi"]}L
+#define SD_HALF {c["hi"] // 2 + 1}L
+#define SD_ACC_LO ({c["acc_lo"]}LL)
+#define SD_ACC_HI {c["acc_hi"]}LL
 
 /* floor(x / 2^n): the arithmetic right shift without implementation-defined behaviour */
 static int64_t asr(int64_t x, int n) {{ return x >= 0 ? (x >> n) : (-((-(x + 1)) >> n) - 1); }}
@@ -385,14 +434,14 @@ static int32_t satw(int64_t x, int *nsat)
     if (x < SD_LO) {{ ++*nsat; return (int32_t)SD_LO; }}
     return (int32_t)x;
 }}
-/* Q{c['f']} product truncated toward -inf, saturated (the extract_h(L_mult) idiom) */
-static int32_t mulq(int32_t a, int32_t b, int *nsat) {{ SD_OP(SD_mult); return satw(asr((int64_t)a * b, {c['f']}), nsat); }}
+/* Q{c["f"]} product truncated toward -inf, saturated (the extract_h(L_mult) idiom) */
+static int32_t mulq(int32_t a, int32_t b, int *nsat) {{ SD_OP(SD_mult); return satw(asr((int64_t)a * b, {c["f"]}), nsat); }}
 /* the same product, unsaturated (the sum it feeds saturates) */
-static int64_t mulr(int32_t a, int64_t b) {{ SD_OP(SD_mult); return asr((int64_t)a * b, {c['f']}); }}
+static int64_t mulr(int32_t a, int64_t b) {{ SD_OP(SD_mult); return asr((int64_t)a * b, {c["f"]}); }}
 static int32_t addw(int64_t a, int64_t b, int *nsat) {{ SD_OP(SD_add); return satw(a + b, nsat); }}
 static int32_t subw(int64_t a, int64_t b, int *nsat) {{ SD_OP(SD_sub); return satw(a - b, nsat); }}
 static int32_t negw(int64_t a, int *nsat) {{ SD_OP(SD_negate); return satw(-a, nsat); }}
-/* sq + v^2 in the {2 * c['wb']}-bit accumulator, saturating */
+/* sq + v^2 in the {2 * c["wb"]}-bit accumulator, saturating */
 static int64_t sqacc(int64_t sq, int64_t v, int *nsat)
 {{
     int64_t x = sq + v * v;
@@ -401,9 +450,9 @@ static int64_t sqacc(int64_t sq, int64_t v, int *nsat)
     if (x > SD_ACC_HI) {{ ++*nsat; return SD_ACC_HI; }}
     return x;
 }}
-/* lengths[i] = the nearer of y, y + 1 to sqrt(S[i]) (y the largest with y^2 <= S[i]: a {c['sqrt_bits']}-step bit search,
+/* lengths[i] = the nearer of y, y + 1 to sqrt(S[i]) (y the largest with y^2 <= S[i]: a {c["sqrt_bits"]}-step bit search,
    skipping the trial bits above the largest root, which stay 0), saturated to the word; the six searches
-   run side by side (independent: the same results, scheduled in parallel). S[i] < 2^{2 * c['wb'] - 1}: 32-bit words. */
+   run side by side (independent: the same results, scheduled in parallel). S[i] < 2^{2 * c["wb"] - 1}: 32-bit words. */
 static void isqrt_near6(const int64_t S[6], sd_word lengths[6], int *nsat)
 {{
     uint32_t y[6] = {{0, 0, 0, 0, 0, 0}}, s[6];
@@ -414,7 +463,7 @@ static void isqrt_near6(const int64_t S[6], sd_word lengths[6], int *nsat)
         s[i] = (uint32_t)(S[i] < 0 ? 0 : S[i]);
         if ((int64_t)s[i] > mx) mx = s[i];
     }}
-    k = {c['sqrt_bits'] - 1};
+    k = {c["sqrt_bits"] - 1};
     while (k > 0 && ((int64_t)1 << (2 * k)) > mx) k--;
     for (; k >= 0; k--) {{
         for (i = 0; i < 6; i++) {{
@@ -438,9 +487,9 @@ static inline int ik_core(const sd_word pose[6], sd_word lengths[6], int32_t *tr
 {chr(10).join(ik_lines)}
     if (trace) {{
         int k;
-        trace[{c['at_sin']}] = sx; trace[{c['at_sin']} + 1] = sy; trace[{c['at_sin']} + 2] = sz;
-        trace[{c['at_cos']}] = cx; trace[{c['at_cos']} + 1] = cy; trace[{c['at_cos']} + 2] = cz;
-        for (k = 0; k < 6; k++) trace[{c['at_len']} + k] = lengths[k];
+        trace[{c["at_sin"]}] = sx; trace[{c["at_sin"]} + 1] = sy; trace[{c["at_sin"]} + 2] = sz;
+        trace[{c["at_cos"]}] = cx; trace[{c["at_cos"]} + 1] = cy; trace[{c["at_cos"]} + 2] = cz;
+        for (k = 0; k < 6; k++) trace[{c["at_len"]} + k] = lengths[k];
     }}
     return nsat;
 }}
@@ -469,7 +518,7 @@ static int32_t i_extract_h(int32_t a) {{ SD_OP(SD_extract_h); return (int32_t)as
 static int32_t i_L_deposit_h(int32_t a) {{ SD_OP(SD_L_deposit_h); return a * 65536; }}
 
 /* gains (generation time): kp {kp.mantissa}/2^15 << {kp.shift}, ki {ki.mantissa}/2^15 << {ki.shift} (per tick),
-   kd {kd.mantissa}/2^15 << {kd.shift}, kv {kv.mantissa}/2^15 << {kv.shift} (per tick, on differences * 2^{c['diff_shift']}) */
+   kd {kd.mantissa}/2^15 << {kd.shift}, kv {kv.mantissa}/2^15 << {kv.shift} (per tick, on differences * 2^{c["diff_shift"]}) */
 #define KP_M {kp.mantissa}
 #define KP_S {kp.shift}
 #define KI_M {ki.mantissa}
@@ -478,10 +527,10 @@ static int32_t i_L_deposit_h(int32_t a) {{ SD_OP(SD_L_deposit_h); return a * 655
 #define KD_S {kd.shift}
 #define KV_M {kv.mantissa}
 #define KV_S {kv.shift}
-#define ALPHA {c['alpha']}
-#define ALPHA_FF {c['alpha_ff']}
-#define COUNTS_PER_LSB {c['cpl']}
-#define DIFF_SHIFT {c['diff_shift']}
+#define ALPHA {c["alpha"]}
+#define ALPHA_FF {c["alpha_ff"]}
+#define COUNTS_PER_LSB {c["cpl"]}
+#define DIFF_SHIFT {c["diff_shift"]}
 
 void sd_init(sd_state *s)
 {{
@@ -535,7 +584,7 @@ def _readme(c: dict, g: GeneratedFirmware, config: ControllerConfig, r_T, B) -> 
     ops = ", ".join(f"{k} ×{v}" for k, v in sorted(g.ik_ops.items()))
     tops = ", ".join(f"{k} ×{v}" for k, v in sorted(g.tick_ops.items()))
     gains = config.gains
-    return f"""# Firmware module for platform `{c['name']}`
+    return f"""# Firmware module for platform `{c["name"]}`
 
 Generated by `stewart-drake firmware generate`. Files: `sd_firmware.h` (the ABI), `sd_firmware.c` (C99, no
 floating point, no library calls). Compile with any C99 compiler, e.g.
@@ -546,23 +595,23 @@ variant that counts the operations below as they execute.
 
 | word | type | meaning |
 | --- | --- | --- |
-| `pose[0..2]` | `sd_word` ({c['wb']}-bit) | position px, py, pz of the plate's rotation centre in the base frame, in length LSBs of {c['lsb']:g} m (round to nearest when converting) |
-| `pose[3..5]` | `sd_word` | angles a_x, a_y, a_z (convention `{c['conv']}`) as Q{c['f']} fractions of π: word = trunc(angle / π · 2^{c['f']}) |
-| `lengths[i]` | `sd_word` | leg i + 1 length in length LSBs ({c['lsb']:g} m) |
-| `measured[i]` | `sd_count` (int32) | leg i + 1 measured length in sensor counts of {c['res']:g} m |
-| `feedforward[i]` | `int16_t` | feed-forward force of leg i + 1, Q15 fraction of the command range {c['rng']:g} N (NULL: none) |
-| `command[i]` | `int16_t` | commanded force of leg i + 1, Q15 fraction of {c['rng']:g} N |
-| `sd_state` | struct | integrator (Q31), previous measurement (counts), filtered differences (counts · 2^{c['diff_shift']}), last set-point (LSB), saturation flags |
+| `pose[0..2]` | `sd_word` ({c["wb"]}-bit) | position px, py, pz of the plate's rotation centre in the base frame, in length LSBs of {c["lsb"]:g} m (round to nearest when converting) |
+| `pose[3..5]` | `sd_word` | angles a_x, a_y, a_z (convention `{c["conv"]}`) as Q{c["f"]} fractions of π: word = trunc(angle / π · 2^{c["f"]}) |
+| `lengths[i]` | `sd_word` | leg i + 1 length in length LSBs ({c["lsb"]:g} m) |
+| `measured[i]` | `sd_count` (int32) | leg i + 1 measured length in sensor counts of {c["res"]:g} m |
+| `feedforward[i]` | `int16_t` | feed-forward force of leg i + 1, Q15 fraction of the command range {c["rng"]:g} N (NULL: none) |
+| `command[i]` | `int16_t` | commanded force of leg i + 1, Q15 fraction of {c["rng"]:g} N |
+| `sd_state` | struct | integrator (Q31), previous measurement (counts), filtered differences (counts · 2^{c["diff_shift"]}), last set-point (LSB), saturation flags |
 
-sin/cos: {'the DSP library polynomial (Motorola tfr16.c)' if c['trig'] == 'tfr16' else 'a quarter-wave table of correctly rounded words'}.
-Rotation R = {'Ry(a_y) Rx(a_x) Rz(a_z)' if c['conv'] == 'utn' else 'Rz(a_z) Ry(a_y) Rx(a_x)'}, each entry a sum of products truncated to Q{c['f']}.
+sin/cos: {"the DSP library polynomial (Motorola tfr16.c)" if c["trig"] == "tfr16" else "a quarter-wave table of correctly rounded words"}.
+Rotation R = {"Ry(a_y) Rx(a_x) Rz(a_z)" if c["conv"] == "utn" else "Rz(a_z) Ry(a_y) Rx(a_x)"}, each entry a sum of products truncated to Q{c["f"]}.
 Constants (length LSBs): plate anchor offsets from the rotation centre {r_T.tolist()}; base anchors {B.tolist()}.
 
 ## Controller
 
-Sample rate {1 / c['T']:g} Hz; designed gains kp {gains.kp:.6g} N/m, ki {gains.ki:.6g} N/(m·s), kd {gains.kd:.6g} N·s/m,
-kv {gains.kv:.6g} N·s/m; as words: kp {c['kp'].mantissa}·2^{c['kp'].shift}/2^15, ki {c['ki'].mantissa}·2^{c['ki'].shift}/2^15, kd {c['kd'].mantissa}·2^{c['kd'].shift}/2^15,
-kv {c['kv'].mantissa}·2^{c['kv'].shift}/2^15, filters α {c['alpha']}, α_ff {c['alpha_ff']} (Q15); {c['cpl']} counts per length LSB.
+Sample rate {1 / c["T"]:g} Hz; designed gains kp {gains.kp:.6g} N/m, ki {gains.ki:.6g} N/(m·s), kd {gains.kd:.6g} N·s/m,
+kv {gains.kv:.6g} N·s/m; as words: kp {c["kp"].mantissa}·2^{c["kp"].shift}/2^15, ki {c["ki"].mantissa}·2^{c["ki"].shift}/2^15, kd {c["kd"].mantissa}·2^{c["kd"].shift}/2^15,
+kv {c["kv"].mantissa}·2^{c["kv"].shift}/2^15, filters α {c["alpha"]}, α_ff {c["alpha_ff"]} (Q15); {c["cpl"]} counts per length LSB.
 
 ## Cycle estimate (MC56F8367 cycle model, {clock / 1e6:g} MHz)
 
@@ -570,5 +619,5 @@ kv {c['kv'].mantissa}·2^{c['kv'].shift}/2^15, filters α {c['alpha']}, α_ff {c
 - `sd_tick`: {tick:.0f} cycles = {tick / clock * 1e6:.1f} µs (the IK, then per tick {tops}, and {ISR_OVERHEAD_CYCLES} cycles of interrupt overhead)
 
 The per-operation cycles are those of `stewart_drake.fixedpoint.cycles.CYCLE_TABLE` (estimates), with the
-{c['sqrt_bits']}-step square root costed as `mfr32Sqrt`{' and a table look-up as 6 cycles' if c['trig'] == 'exact' else ''}.
+{c["sqrt_bits"]}-step square root costed as `mfr32Sqrt`{" and a table look-up as 6 cycles" if c["trig"] == "exact" else ""}.
 """

@@ -70,15 +70,21 @@ class FirmwareModule:
         out = np.empty_like(flat)
         nsat = np.empty(len(flat), dtype=np.int32)
         f = self.ffi
-        self.lib.sd_ik_batch(f.from_buffer(f"{self.word}[]", flat), len(flat), f.from_buffer(f"{self.word}[]", out),
-                             f.from_buffer("int32_t[]", nsat))
+        self.lib.sd_ik_batch(
+            f.from_buffer(f"{self.word}[]", flat),
+            len(flat),
+            f.from_buffer(f"{self.word}[]", out),
+            f.from_buffer("int32_t[]", nsat),
+        )
         return out.astype(np.int64).reshape(w.shape), nsat.astype(np.int64).reshape(w.shape[:-1])
 
     def ik_raw(self, words: np.ndarray, out: np.ndarray) -> None:
         """``sd_ik`` over ``(n, 6)`` C-contiguous ``word_dtype`` pose words into ``out`` (same shape and
         dtype), no conversions: the batch call the throughput benchmark times."""
         f = self.ffi
-        self.lib.sd_ik_batch(f.from_buffer(f"{self.word}[]", words), len(words), f.from_buffer(f"{self.word}[]", out), f.NULL)
+        self.lib.sd_ik_batch(
+            f.from_buffer(f"{self.word}[]", words), len(words), f.from_buffer(f"{self.word}[]", out), f.NULL
+        )
 
     def ik_trace(self, pose_words) -> np.ndarray:
         """``(TRACE_WORDS,)`` int64 intermediate words of one pose (see ``generate.TRACE_FIELDS``)."""
@@ -101,12 +107,21 @@ class FirmwareModule:
             self.lib.sd_op_counts[k] = 0
 
 
-def compile_generated(g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O3") -> FirmwareModule:
+def compile_generated(
+    g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O3"
+) -> FirmwareModule:
     """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
     sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c", "sd_host_tick.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
-    path = build(sources, headers=headers, compiler=compiler, strict=True, defines=("SD_COUNT_OPS",) if counting else (), opt=opt,
-                 flags=("-lm",))
+    path = build(
+        sources,
+        headers=headers,
+        compiler=compiler,
+        strict=True,
+        defines=("SD_COUNT_OPS",) if counting else (),
+        opt=opt,
+        flags=("-lm",),
+    )
     word = "int16_t"
     ffi, lib = load(path, _cdef(word, counting))
     return FirmwareModule(ffi, lib, path, word, counting)
@@ -125,7 +140,9 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
     lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
     m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
     if m.has_tick:  # then link the tick's host glue too (it calls sd_tick)
-        lib_path = build(sources + library_sources("sd_host_tick.c"), headers=headers, compiler=compiler, flags=("-lm",))
+        lib_path = build(
+            sources + library_sources("sd_host_tick.c"), headers=headers, compiler=compiler, flags=("-lm",)
+        )
         m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
     return m
 
@@ -137,7 +154,14 @@ class TickRunner:
     ``state_ptr`` is the cffi ``sd_state *`` on that buffer, for callers that run the C tick themselves
     (``firmware.sil``)."""
 
-    FIELDS = (("integ", np.int32), ("prev", np.int32), ("dfilt", np.int16), ("setpoint", None), ("vfilt", np.int16), ("saturated", np.int16))
+    FIELDS = (
+        ("integ", np.int32),
+        ("prev", np.int32),
+        ("dfilt", np.int16),
+        ("setpoint", None),
+        ("vfilt", np.int16),
+        ("saturated", np.int16),
+    )
 
     def __init__(self, module: FirmwareModule):
         if not module.has_tick:
@@ -147,14 +171,20 @@ class TickRunner:
         self._buf = bytearray(ffi.sizeof("sd_state"))
         self.state_ptr = ffi.from_buffer("sd_state *", self._buf)
         m.lib.sd_init(self.state_ptr)
-        self.views = {name: np.frombuffer(self._buf, dtype=dt or m.word_dtype, count=6, offset=ffi.offsetof("sd_state", name))
-                      for name, dt in self.FIELDS}
+        self.views = {
+            name: np.frombuffer(self._buf, dtype=dt or m.word_dtype, count=6, offset=ffi.offsetof("sd_state", name))
+            for name, dt in self.FIELDS
+        }
         self.pose = np.zeros(6, dtype=m.word_dtype)
         self.measured = np.zeros(6, dtype=np.int32)
         self.feedforward = np.zeros(6, dtype=np.int16)
         self.command = np.zeros(6, dtype=np.int16)
-        self._p = (ffi.from_buffer(f"{m.word}[]", self.pose), ffi.from_buffer("int32_t[]", self.measured),
-                   ffi.from_buffer("int16_t[]", self.feedforward), ffi.from_buffer("int16_t[]", self.command))
+        self._p = (
+            ffi.from_buffer(f"{m.word}[]", self.pose),
+            ffi.from_buffer("int32_t[]", self.measured),
+            ffi.from_buffer("int16_t[]", self.feedforward),
+            ffi.from_buffer("int16_t[]", self.command),
+        )
         self._tick = m.lib.sd_tick
         self._null = ffi.NULL
 

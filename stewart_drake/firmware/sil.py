@@ -12,9 +12,9 @@ import numpy as np
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.laws import FixedPointLaw
 from stewart_drake.core.geometry import Platform
+from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import TickRunner, compile_generated, compile_user
-from stewart_drake.errors import FirmwareError
 from stewart_drake.fixedpoint.generic import pose_words
 
 
@@ -27,7 +27,11 @@ class CFixedPointLaw(FixedPointLaw):
         super().__init__(platform, config)
         self.firmware = None if firmware is None else Path(firmware).resolve()
         self.generated = generate(self.platform, self.config)
-        m = compile_user(self.firmware, self.generated) if self.firmware is not None else compile_generated(self.generated)
+        m = (
+            compile_user(self.firmware, self.generated)
+            if self.firmware is not None
+            else compile_generated(self.generated)
+        )
         self.module = m
         self.runner = TickRunner(m)
         self._words: dict[bytes, np.ndarray] = {}
@@ -36,7 +40,9 @@ class CFixedPointLaw(FixedPointLaw):
         ffi = m.ffi
         self._L, self._ff, self._state, self._out = np.zeros(6), np.zeros(6), np.zeros(30), np.zeros(18)
         self._p_pose = ffi.from_buffer(f"{m.word}[]", self.runner.pose)
-        self._p_L, self._p_ff, self._p_state, self._p_out = (ffi.from_buffer("double[]", a) for a in (self._L, self._ff, self._state, self._out))
+        self._p_L, self._p_ff, self._p_state, self._p_out = (
+            ffi.from_buffer("double[]", a) for a in (self._L, self._ff, self._state, self._out)
+        )
         self._null = ffi.NULL
         self._host_tick = m.lib.sd_host_tick
         self._res, self._range = float(self.timing.sensor_resolution), float(self.timing.command_range)
@@ -62,8 +68,17 @@ class CFixedPointLaw(FixedPointLaw):
         self._state[:] = state
         if feedforward is not None:
             self._ff[:] = feedforward
-        k = self._host_tick(r.state_ptr, self._p_pose, self._p_L, self._res, self._p_ff if feedforward is not None else self._null, self._range,
-                            self._lsb, self._p_state, self._p_out)
+        k = self._host_tick(
+            r.state_ptr,
+            self._p_pose,
+            self._p_L,
+            self._res,
+            self._p_ff if feedforward is not None else self._null,
+            self._range,
+            self._lsb,
+            self._p_state,
+            self._p_out,
+        )
         if k < 0:
             raise FirmwareError(FirmwareError.SENSOR_COUNTS.format(value=np.asarray(measured).tolist()))
         o = self._out

@@ -39,8 +39,28 @@ from stewart_drake.fixedpoint.scalar import tp17_op_counts
 
 CLOCK_HZ = 60e6
 
-ALU_OPS = ("add", "sub", "negate", "abs_s", "L_add", "L_sub", "L_negate", "L_abs", "L_mult", "extract_h",
-           "extract_l", "L_deposit_h", "L_deposit_l", "round", "mult", "mult_r", "shl", "shr", "L_shl", "L_shr")
+ALU_OPS = (
+    "add",
+    "sub",
+    "negate",
+    "abs_s",
+    "L_add",
+    "L_sub",
+    "L_negate",
+    "L_abs",
+    "L_mult",
+    "extract_h",
+    "extract_l",
+    "L_deposit_h",
+    "L_deposit_l",
+    "round",
+    "mult",
+    "mult_r",
+    "shl",
+    "shr",
+    "L_shl",
+    "L_shr",
+)
 
 CYCLE_TABLE: dict[str, float] = {
     **{op: 1.0 for op in ALU_OPS},
@@ -71,7 +91,9 @@ class CycleEstimate:
         return self.seconds * 1e6
 
 
-def estimate_cycles(op_counts: dict, table: dict | None = None, clock_hz: float = CLOCK_HZ, loops: int = 1) -> CycleEstimate:
+def estimate_cycles(
+    op_counts: dict, table: dict | None = None, clock_hz: float = CLOCK_HZ, loops: int = 1
+) -> CycleEstimate:
     """Cycles for a dict of operation -> calls (one evaluation), with one operand move per ALU op.
     Raises ``FixedPointError`` naming an operation missing from the table."""
     table = dict(CYCLE_TABLE if table is None else table)

@@ -30,8 +30,8 @@ import numpy as np
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import check_convention
-from stewart_drake.fixedpoint.q15 import saturate, tfr16CosPIx, tfr16SinPIx
 from stewart_drake.errors import FixedPointError, counted
+from stewart_drake.fixedpoint.q15 import saturate, tfr16CosPIx, tfr16SinPIx
 
 TRIG_MODES = ("exact", "tfr16")
 
@@ -183,9 +183,15 @@ def length_words(x_m, fmt: QFormat, what: str) -> np.ndarray:
     lsb, hi = fmt.length_lsb, (1 << fmt.frac_bits) - 1
     w = np.round(np.asarray(x_m) / lsb)
     if np.any(np.abs(w) > hi + 1):
-        raise FixedPointError(FixedPointError.LENGTH_WORD.format(
-            what=what, value=np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())], bits=fmt.word_bits, lsb=lsb,
-            range_m=fmt.range_m))
+        raise FixedPointError(
+            FixedPointError.LENGTH_WORD.format(
+                what=what,
+                value=np.asarray(x_m).ravel()[np.argmax(np.abs(w).ravel())],
+                bits=fmt.word_bits,
+                lsb=lsb,
+                range_m=fmt.range_m,
+            )
+        )
     return np.clip(w.astype(np.int64), -hi - 1, hi)
 
 
@@ -206,8 +212,13 @@ def pose_words(poses, fmt: QFormat = QFormat()) -> np.ndarray:
     return np.concatenate([pos, angle_words(q[..., 3:], fmt)], axis=-1)
 
 
-def leg_length_words(platform: Platform, words, fmt: QFormat = QFormat(), convention: str = "utn",
-                     consts: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+def leg_length_words(
+    platform: Platform,
+    words,
+    fmt: QFormat = QFormat(),
+    convention: str = "utn",
+    consts: tuple[np.ndarray, np.ndarray] | None = None,
+) -> np.ndarray:
     """``(..., 6)`` int64 leg-length words from ``(..., 6)`` pose words (``pose_words``): steps 3–5 of
     the recipe. ``consts``: ``platform_words`` if already computed. A length beyond the word saturates."""
     w = np.asarray(words, dtype=np.int64)
@@ -232,8 +243,9 @@ def leg_length_words(platform: Platform, words, fmt: QFormat = QFormat(), conven
     return out
 
 
-def fixed_point_leg_lengths(platform: Platform, poses, fmt: QFormat = QFormat(), convention: str = "utn",
-                            return_words: bool = False) -> np.ndarray:
+def fixed_point_leg_lengths(
+    platform: Platform, poses, fmt: QFormat = QFormat(), convention: str = "utn", return_words: bool = False
+) -> np.ndarray:
     """``(..., 6)`` leg lengths (metres, integer multiples of ``fmt.length_lsb``) computed in fixed
     point with ``fmt`` for ``(..., 6)`` SI poses. ``return_words``: the integer length words instead."""
     q = as_poses(poses)

@@ -64,7 +64,7 @@ from stewart_drake.errors import FixedPointError
 MIN16, MAX16 = -(1 << 15), (1 << 15) - 1
 MIN32, MAX32 = -(1 << 31), (1 << 31) - 1
 
-_ACTIVE: list["SaturationCounter"] = []
+_ACTIVE: list[SaturationCounter] = []
 
 
 class SaturationCounter:
@@ -96,7 +96,7 @@ class SaturationCounter:
                 except ValueError:
                     pass
 
-    def __enter__(self) -> "SaturationCounter":
+    def __enter__(self) -> SaturationCounter:
         _ACTIVE.append(self)
         return self
 
@@ -133,12 +133,17 @@ def word16(x, name: str = "value") -> np.ndarray:
     a = np.asarray(x)
     if not np.issubdtype(a.dtype, np.integer):
         if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
-            raise FixedPointError(FixedPointError.NOT_INTEGER_16.format(
-                name=name, value=a.ravel()[~np.isfinite(a.ravel()) | (a.ravel() != np.round(a.ravel()))][0]))
+            raise FixedPointError(
+                FixedPointError.NOT_INTEGER_16.format(
+                    name=name, value=a.ravel()[~np.isfinite(a.ravel()) | (a.ravel() != np.round(a.ravel()))][0]
+                )
+            )
     a = a.astype(np.int64)
     bad = (a < MIN16) | (a > MAX16)
     if np.any(bad):
-        raise FixedPointError(FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=16, lo=MIN16, hi=MAX16))
+        raise FixedPointError(
+            FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=16, lo=MIN16, hi=MAX16)
+        )
     return a
 
 
@@ -151,7 +156,9 @@ def word32(x, name: str = "value") -> np.ndarray:
     a = a.astype(np.int64)
     bad = (a < MIN32) | (a > MAX32)
     if np.any(bad):
-        raise FixedPointError(FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=32, lo=MIN32, hi=MAX32))
+        raise FixedPointError(
+            FixedPointError.RANGE.format(name=name, value=int(a[bad].ravel()[0]), bits=32, lo=MIN32, hi=MAX32)
+        )
     return a
 
 
@@ -164,7 +171,9 @@ def FRAC16(x) -> np.ndarray:
     with x >= 1 -> 32767 and x < -1 -> -32768 (the Freescale macro's saturation)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise FixedPointError(FixedPointError.FRAC16_NOT_FINITE.format(value=x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x)))
+        raise FixedPointError(
+            FixedPointError.FRAC16_NOT_FINITE.format(value=x[~np.isfinite(x)].ravel()[0] if x.ndim else float(x))
+        )
     return saturate(np.trunc(x * 32768.0).astype(np.int64), MIN16, MAX16, "FRAC16")
 
 
@@ -350,8 +359,15 @@ def mfr32Sqrt(L) -> np.ndarray:
     return np.where(use_r, yr, y)
 
 
-_SINE_COEFS = (0.39269908169872, -0.64596409750625, 0.31877050498467, -0.07446482317004,
-               0.01026823582639, -0.00092130386821, 0.00005828785072)
+_SINE_COEFS = (
+    0.39269908169872,
+    -0.64596409750625,
+    0.31877050498467,
+    -0.07446482317004,
+    0.01026823582639,
+    -0.00092130386821,
+    0.00005828785072,
+)
 
 
 def _sinpix_poly(x) -> np.ndarray:
@@ -413,8 +429,34 @@ TFR1_tfr16SinPIx = tfr16SinPIx
 TFR1_tfr16CosPIx = tfr16CosPIx
 
 INTRINSICS = (
-    "FRAC16", "FRAC32", "add", "sub", "negate", "abs_s", "mult", "mult_r", "shl", "shr",
-    "L_add", "L_sub", "L_negate", "L_abs", "L_mult", "L_mac", "L_msu", "L_shl", "L_shr",
-    "extract_h", "extract_l", "L_deposit_h", "L_deposit_l", "round_", "mac_r", "msu_r", "div_s",
-    "mfr32Sqrt", "tfr16SinPIx", "tfr16CosPIx",
+    "FRAC16",
+    "FRAC32",
+    "add",
+    "sub",
+    "negate",
+    "abs_s",
+    "mult",
+    "mult_r",
+    "shl",
+    "shr",
+    "L_add",
+    "L_sub",
+    "L_negate",
+    "L_abs",
+    "L_mult",
+    "L_mac",
+    "L_msu",
+    "L_shl",
+    "L_shr",
+    "extract_h",
+    "extract_l",
+    "L_deposit_h",
+    "L_deposit_l",
+    "round_",
+    "mac_r",
+    "msu_r",
+    "div_s",
+    "mfr32Sqrt",
+    "tfr16SinPIx",
+    "tfr16CosPIx",
 )

@@ -196,8 +196,15 @@ def mfr32Sqrt(L):
     return yr if abs(2 * yr * yr - L) < abs(2 * y * y - L) else y
 
 
-SINE_COEFS = (0.39269908169872, -0.64596409750625, 0.31877050498467, -0.07446482317004,
-              0.01026823582639, -0.00092130386821, 0.00005828785072)
+SINE_COEFS = (
+    0.39269908169872,
+    -0.64596409750625,
+    0.31877050498467,
+    -0.07446482317004,
+    0.01026823582639,
+    -0.00092130386821,
+    0.00005828785072,
+)
 _SC = [int(c * 32768.0) for c in SINE_COEFS]  # FRAC16 of the tfr16.c table (compile-time)
 
 
@@ -299,16 +306,32 @@ def tp17_loop(px, py, pz, alpha, beta, gama, a=612, b=925, d=150, consts=None):
         return mfr32Sqrt(L32)
 
     h, t, half = FRAC16(0.2886), FRAC16(0.5773), FRAC16(0.5)
-    L1 = length(L_add(L_negate(L_mult(d, h)), L_negate(L_mult(b, t))), Xt1,
-                [lambda: negate(extract_h(L_mult(half, d)))], Yt1, Zt1)
-    L2 = length(L_add(L_negate(L_mult(d, h)), L_mult(b, h)), Xt1,
-                [lambda: negate(extract_h(L_mult(half, d))), lambda: negate(extract_h(L_mult(half, b)))], Yt1, Zt1)
+    L1 = length(
+        L_add(L_negate(L_mult(d, h)), L_negate(L_mult(b, t))),
+        Xt1,
+        [lambda: negate(extract_h(L_mult(half, d)))],
+        Yt1,
+        Zt1,
+    )
+    L2 = length(
+        L_add(L_negate(L_mult(d, h)), L_mult(b, h)),
+        Xt1,
+        [lambda: negate(extract_h(L_mult(half, d))), lambda: negate(extract_h(L_mult(half, b)))],
+        Yt1,
+        Zt1,
+    )
     L3 = length(L_add(L_mult(d, t), L_mult(b, h)), Xt2, [lambda: negate(extract_h(L_mult(half, b)))], Yt2, Zt2)
     L4 = length(L_add(L_mult(d, t), L_mult(b, h)), Xt2, [lambda: extract_h(L_mult(half, b))], Yt2, Zt2)
-    L5 = length(L_add(L_negate(L_mult(d, h)), L_mult(b, h)), Xt3,
-                [lambda: extract_h(L_mult(half, d)), lambda: extract_h(L_mult(half, b))], Yt3, Zt3)
-    L6 = length(L_add(L_negate(L_mult(d, h)), L_negate(L_mult(b, t))), Xt3,
-                [lambda: extract_h(L_mult(half, d))], Yt3, Zt3)
+    L5 = length(
+        L_add(L_negate(L_mult(d, h)), L_mult(b, h)),
+        Xt3,
+        [lambda: extract_h(L_mult(half, d)), lambda: extract_h(L_mult(half, b))],
+        Yt3,
+        Zt3,
+    )
+    L6 = length(
+        L_add(L_negate(L_mult(d, h)), L_negate(L_mult(b, t))), Xt3, [lambda: extract_h(L_mult(half, d))], Yt3, Zt3
+    )
     return [L1, L2, L3, L4, L5, L6]
 
 

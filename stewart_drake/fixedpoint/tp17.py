@@ -22,10 +22,19 @@ import numpy as np
 
 from stewart_drake.core.argcheck import check_shape, first_index
 from stewart_drake.errors import DspPoseError
-
 from stewart_drake.fixedpoint import q15
-from stewart_drake.fixedpoint.q15 import (FRAC16, L_add, L_mult, L_negate, add, extract_h, mfr32Sqrt, negate, tfr16CosPIx,
-                  tfr16SinPIx)
+from stewart_drake.fixedpoint.q15 import (
+    FRAC16,
+    L_add,
+    L_mult,
+    L_negate,
+    add,
+    extract_h,
+    mfr32Sqrt,
+    negate,
+    tfr16CosPIx,
+    tfr16SinPIx,
+)
 
 TP17_GEOMETRY_MM = {"a": 1225 // 2, "b": 925, "d": 150}
 # The firmware's literal constants (their FRAC16 words are 9456, 18916, 16384).
@@ -81,7 +90,9 @@ def tp17_base_offsets(b: int = 925, d: int = 150) -> np.ndarray:
     hd = extract_h(L_mult(half, d))
     hb = extract_h(L_mult(half, b))
     # y offsets are applied as successive saturating adds in tp17_trace (order matters only on saturation)
-    return np.array([[o1, -hd, 0], [o2, -hd - hb, 0], [o3, -hb, 0], [o3, hb, 0], [o2, hd + hb, 0], [o1, hd, 0]], dtype=np.int64)
+    return np.array(
+        [[o1, -hd, 0], [o2, -hd - hb, 0], [o3, -hb, 0], [o3, hb, 0], [o2, hd + hb, 0], [o1, hd, 0]], dtype=np.int64
+    )
 
 
 # leg i ends at plate joint LEG_JOINT[i]; its y offset is built from these terms, added in order
@@ -97,9 +108,11 @@ def check_dsp_poses(poses) -> np.ndarray:
 
     check_shape(q, "DSP poses", (..., 6), DspPoseError)
     pos = np.trunc(q[..., :3])
-    for bad, template, part in ((~np.isfinite(q).all(axis=-1), DspPoseError.NOT_FINITE, slice(None)),
-                                (((pos < q15.MIN16) | (pos > q15.MAX16)).any(axis=-1), DspPoseError.POSITION, slice(3)),
-                                ((np.abs(q[..., 3:]) > 1.0).any(axis=-1), DspPoseError.ANGLES, slice(3, None))):
+    for bad, template, part in (
+        (~np.isfinite(q).all(axis=-1), DspPoseError.NOT_FINITE, slice(None)),
+        (((pos < q15.MIN16) | (pos > q15.MAX16)).any(axis=-1), DspPoseError.POSITION, slice(3)),
+        ((np.abs(q[..., 3:]) > 1.0).any(axis=-1), DspPoseError.ANGLES, slice(3, None)),
+    ):
         k = first_index(bad)
         if k is not None:
             name = "pose" if k == () else f"pose {k[0] if len(k) == 1 else k}"
@@ -129,8 +142,16 @@ def _tp17_core(q: np.ndarray, a: int, b: int, d: int, trace: bool) -> dict:
     ]
     p = (px, py, pz)
     top_T = tp17_plate_words(a)
-    top_B = [[add(add(add(m(co[r][0], int(top_T[j, 0])), m(co[r][1], int(top_T[j, 1]))), m(co[r][2], int(top_T[j, 2]))), p[r])
-              for r in range(3)] for j in range(3)]
+    top_B = [
+        [
+            add(
+                add(add(m(co[r][0], int(top_T[j, 0])), m(co[r][1], int(top_T[j, 1]))), m(co[r][2], int(top_T[j, 2]))),
+                p[r],
+            )
+            for r in range(3)
+        ]
+        for j in range(3)
+    ]
 
     half = FRAC16(C_HALF)
     hd, hb = extract_h(L_mult(half, d)), extract_h(L_mult(half, b))
@@ -147,14 +168,20 @@ def _tp17_core(q: np.ndarray, a: int, b: int, d: int, trace: bool) -> dict:
     L32 = np.stack(L32, -1)
     out = {"lengths": mfr32Sqrt(L32)}
     if trace:
+
         def full(x):
             return np.broadcast_to(x, S)
 
         out.update(
-            angle_words=w, sin=np.stack([sinA, sinB, sinG], -1), cos=np.stack([cosA, cosB, cosG], -1),
-            R=np.stack([np.stack([full(c) for c in row], -1) for row in co], -2), top_T=top_T,
-            top_B=np.stack([np.stack([full(c) for c in row], -1) for row in top_B], -2), base_offset=offsets,
-            leg=np.stack([np.stack([full(c) for c in v], -1) for v in legs], -2), L32=L32,
+            angle_words=w,
+            sin=np.stack([sinA, sinB, sinG], -1),
+            cos=np.stack([cosA, cosB, cosG], -1),
+            R=np.stack([np.stack([full(c) for c in row], -1) for row in co], -2),
+            top_T=top_T,
+            top_B=np.stack([np.stack([full(c) for c in row], -1) for row in top_B], -2),
+            base_offset=offsets,
+            leg=np.stack([np.stack([full(c) for c in v], -1) for v in legs], -2),
+            L32=L32,
         )
     return out
 
@@ -167,7 +194,9 @@ def tp17_trace(poses, a: int = 612, b: int = 925, d: int = 150) -> Tp17Trace:
     return Tp17Trace(**_tp17_core(check_dsp_poses(poses), a, b, d, trace=True))
 
 
-def tp17_leg_lengths(poses, a: int = 612, b: int = 925, d: int = 150, counter: q15.SaturationCounter | None = None) -> np.ndarray:
+def tp17_leg_lengths(
+    poses, a: int = 612, b: int = 925, d: int = 150, counter: q15.SaturationCounter | None = None
+) -> np.ndarray:
     """``(..., 6)`` integer leg lengths (mm) the DSP computes for ``(..., 6)`` poses
     [px, py, pz mm; alpha, beta, gamma fractions of pi]. ``counter``: a
     :class:`~.q15.SaturationCounter` to record saturations in (entered for the call; its ``mask``,
@@ -181,7 +210,7 @@ def tp17_leg_lengths(poses, a: int = 612, b: int = 925, d: int = 150, counter: q
         return _tp17_core(q, a, b, d, trace=False)["lengths"]
     out = np.empty((len(flat), 6), dtype=np.int64)
     for k in range(0, len(flat), CHUNK):
-        out[k:k + CHUNK] = _tp17_core(flat[k:k + CHUNK], a, b, d, trace=False)["lengths"]
+        out[k : k + CHUNK] = _tp17_core(flat[k : k + CHUNK], a, b, d, trace=False)["lengths"]
     return out.reshape(q.shape)
 
 
@@ -207,7 +236,10 @@ def dsp_poses_to_si(poses_dsp) -> np.ndarray:
 
 ERROR_STAGES = (
     ("a = 612", "the plate side a = 1225/2 = 612 mm (C integer division) instead of 612.5 mm"),
-    ("anchor words", "anchors as the firmware's integer-mm words: FRAC16(0.2886), FRAC16(0.5773) and extract_h truncation"),
+    (
+        "anchor words",
+        "anchors as the firmware's integer-mm words: FRAC16(0.2886), FRAC16(0.5773) and extract_h truncation",
+    ),
     ("angle words", "the angles truncated to Q15 words by FRAC16 (sin/cos still exact)"),
     ("sin/cos library", "tfr16SinPIx/tfr16CosPIx instead of the exact sine and cosine of the angle words"),
     ("matrix products", "co11..co33: products of sines and cosines truncated by extract_h(L_mult)"),
@@ -227,11 +259,14 @@ def _rot_utn_from_sc(s, c):
     """R = Ry(b) Rx(a) Rz(g) from float sines/cosines (..., 3) of (a, b, g)."""
     sA, sB, sG = s[..., 0], s[..., 1], s[..., 2]
     cA, cB, cG = c[..., 0], c[..., 1], c[..., 2]
-    return np.stack([
-        np.stack([cB * cG + sA * sB * sG, -cB * sG + sA * sB * cG, cA * sB], -1),
-        np.stack([cA * sG, cA * cG, -sA], -1),
-        np.stack([-sB * cG + sA * cB * sG, sB * sG + sA * cB * cG, cA * cB], -1),
-    ], -2)
+    return np.stack(
+        [
+            np.stack([cB * cG + sA * sB * sG, -cB * sG + sA * sB * cG, cA * sB], -1),
+            np.stack([cA * sG, cA * cG, -sA], -1),
+            np.stack([-sB * cG + sA * cB * sG, sB * sG + sA * cB * cG, cA * cB], -1),
+        ],
+        -2,
+    )
 
 
 def tp17_error_stages(poses, a: int = 612, b: int = 925, d: int = 150) -> dict:
@@ -251,9 +286,16 @@ def tp17_error_stages(poses, a: int = 612, b: int = 925, d: int = 150) -> dict:
 
     def exact_geometry(a_mm):
         top = np.array([[s3 / 6 * a_mm, a_mm / 2, 0], [-s3 / 3 * a_mm, 0, 0], [s3 / 6 * a_mm, -a_mm / 2, 0]])
-        base = np.array([[s3 / 6 * (2 * b + d), d / 2, 0], [-s3 / 6 * (b - d), (b + d) / 2, 0],
-                         [-s3 / 6 * (b + 2 * d), b / 2, 0], [-s3 / 6 * (b + 2 * d), -b / 2, 0],
-                         [-s3 / 6 * (b - d), -(b + d) / 2, 0], [s3 / 6 * (2 * b + d), -d / 2, 0]])
+        base = np.array(
+            [
+                [s3 / 6 * (2 * b + d), d / 2, 0],
+                [-s3 / 6 * (b - d), (b + d) / 2, 0],
+                [-s3 / 6 * (b + 2 * d), b / 2, 0],
+                [-s3 / 6 * (b + 2 * d), -b / 2, 0],
+                [-s3 / 6 * (b - d), -(b + d) / 2, 0],
+                [s3 / 6 * (2 * b + d), -d / 2, 0],
+            ]
+        )
         return top, -base
 
     R_exact = _rot_utn_from_sc(np.sin(ang), np.cos(ang))

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.homotopy.solve import solve_batch
 
@@ -61,8 +61,12 @@ class BranchReport:
             "all_complete": bool(self.complete.all()),
             "incomplete_samples": [int(i) for i in self.index[~self.complete]],
             "pose_found_at_every_sample": bool(self.on_mode.all()),
-            "safe": bool(self.branch_distance[kb] >= branch_margin and self.sigma_min[ks] >= singularity_margin
-                         and self.complete.all() and self.on_mode.all()),
+            "safe": bool(
+                self.branch_distance[kb] >= branch_margin
+                and self.sigma_min[ks] >= singularity_margin
+                and self.complete.all()
+                and self.on_mode.all()
+            ),
         }
 
 
@@ -73,7 +77,9 @@ def sample_indices(n: int, samples: int) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, n - 1, min(n, samples))).astype(int))
 
 
-def branch_safety(platform: Platform, t: np.ndarray, poses: np.ndarray, convention: str, samples: int = 200, seed: int = 0) -> BranchReport:
+def branch_safety(
+    platform: Platform, t: np.ndarray, poses: np.ndarray, convention: str, samples: int = 200, seed: int = 0
+) -> BranchReport:
     """Check ``samples`` evenly spaced poses of a trajectory (t ``(n,)`` s, poses ``(n, 6)`` m/rad in
     ``convention``); see the module docstring."""
     idx = sample_indices(len(poses), samples)
@@ -96,5 +102,12 @@ def branch_safety(platform: Platform, t: np.ndarray, poses: np.ndarray, conventi
         others = np.delete(d, me)
         dist[k] = others.min() if len(others) else np.inf
     sig = jacobian_analysis(platform, q, convention).sigma_min
-    return BranchReport(idx, np.asarray(t)[idx], dist, sig, np.array([len(r.modes) for r in results]),
-                        np.array([r.complete for r in results]), on)
+    return BranchReport(
+        idx,
+        np.asarray(t)[idx],
+        dist,
+        sig,
+        np.array([len(r.modes) for r in results]),
+        np.array([r.complete for r in results]),
+        on,
+    )

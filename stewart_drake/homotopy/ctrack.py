@@ -88,7 +88,22 @@ def track_c(x0, B0, dB, fixed: bool, s0, ds, v, gamma, cap, opts, end_newton: in
     state = np.empty(n, np.int64)
     steps = np.empty(n, np.int64)
     d = [_ptr(ffi, a, "double *") for a in c]
-    lib.sd_track(n, d[0], d[1], d[2], int(fixed), d[3], d[4], d[5], d[6], _ptr(ffi, cap, "int64_t *"),
-                 _ptr(ffi, opts, "double *"), end_newton, _ptr(ffi, x, "double *"), _ptr(ffi, t, "double *"),
-                 _ptr(ffi, state, "int64_t *"), _ptr(ffi, steps, "int64_t *"))
+    lib.sd_track(
+        n,
+        d[0],
+        d[1],
+        d[2],
+        int(fixed),
+        d[3],
+        d[4],
+        d[5],
+        d[6],
+        _ptr(ffi, cap, "int64_t *"),
+        _ptr(ffi, opts, "double *"),
+        end_newton,
+        _ptr(ffi, x, "double *"),
+        _ptr(ffi, t, "double *"),
+        _ptr(ffi, state, "int64_t *"),
+        _ptr(ffi, steps, "int64_t *"),
+    )
     return x, t, state, steps

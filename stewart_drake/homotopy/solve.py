@@ -200,7 +200,9 @@ _PLATFORM_STARTS: dict = {}
 MAX_CACHED_PLATFORMS = 32  # stage-one results kept (oldest dropped first)
 
 
-def platform_start(platform: Platform, arch, scale: float, B1: np.ndarray, seed: int = 0, options: TrackOptions = TrackOptions()) -> Start | None:
+def platform_start(
+    platform: Platform, arch, scale: float, B1: np.ndarray, seed: int = 0, options: TrackOptions = TrackOptions()
+) -> Start | None:
     """Stage one of the two-stage homotopy, cached per platform: track the shipped start system of the
     class to this platform's anchors at random complex squared lengths s* (mid-stroke ± 30 %, complex).
     Every path must end at infinity or at a finite non-singular root, the finite ones distinct; then
@@ -208,8 +210,14 @@ def platform_start(platform: Platform, arch, scale: float, B1: np.ndarray, seed:
     length space, and tracking them to any real lengths (stage two) reaches every isolated solution
     there (parameter homotopy over the six squared lengths). Returns None when stage one is not
     clean after three random s*."""
-    key = (platform.base_anchors.tobytes(), platform.top_anchors_per_leg.tobytes(), platform.rotation_centre.tobytes(),
-           platform.stroke.tobytes(), seed, options)
+    key = (
+        platform.base_anchors.tobytes(),
+        platform.top_anchors_per_leg.tobytes(),
+        platform.rotation_centre.tobytes(),
+        platform.stroke.tobytes(),
+        seed,
+        options,
+    )
     if key in _PLATFORM_STARTS:
         return _PLATFORM_STARTS[key]
     S = load_start_system(arch.kind)
@@ -284,7 +292,17 @@ def solve_batch(
         paths = track(x0[rows], st.B, B1, s0[rows], s1[rows], st.v, g_rows, options, cap[rows])
         bad = np.flatnonzero(paths.state == FAILED)
         if retrack and len(bad):
-            again = track(x0[rows][bad], st.B, B1, s0[rows][bad], s1[rows][bad], st.v, g_rows[bad], options.tighter(), cap[rows][bad])
+            again = track(
+                x0[rows][bad],
+                st.B,
+                B1,
+                s0[rows][bad],
+                s1[rows][bad],
+                st.v,
+                g_rows[bad],
+                options.tighter(),
+                cap[rows][bad],
+            )
             paths.x[bad], paths.state[bad], paths.t[bad] = again.x, again.state, again.t
             paths.steps[bad] += again.steps
         return paths, rows[bad] if retrack else np.zeros(0, int)
@@ -330,27 +348,72 @@ def solve_batch(
         if arch.kind == SIX_THREE:  # bounds hold for the inverse motion (R', p'), p = −R'ᵀ p', |p'| = |p|:
             dp = dp + (np.linalg.norm(p_BC, axis=1) / scale + dp) * da  # |δp| <= |δp'| + (|p'| + |δp'|) θ
         modes = [
-            CertifiedMode(p_BC[k], R_BT[k], float(res[k]), bool(cert.certified[k]), float(cert.radius[k]),
-                          float(cert.uniqueness[k]), float(dp[k] * scale), float(da[k]), int(ridx[k]))
+            CertifiedMode(
+                p_BC[k],
+                R_BT[k],
+                float(res[k]),
+                bool(cert.certified[k]),
+                float(cert.radius[k]),
+                float(cert.uniqueness[k]),
+                float(dp[k] * scale),
+                float(da[k]),
+                int(ridx[k]),
+            )
             for k in range(len(ridx))
         ]
         complete = not failed and not dup
-        what = f"{st.total} paths" if st.stage == "direct" else (
-            f"two stages: {st.total} paths once to this platform at random complex lengths ({st.dropped} went to "
-            f"infinity), then {N} paths per length set")
-        guarantee = COMPLETE_TEXT.format(kind=arch.kind, what=what) if complete else (
-            "not complete: " + "; ".join(
-                ([f"path(s) {', '.join(map(str, failed))} failed even after re-tracking with tighter steps and new gamma"] if failed else [])
-                + ([f"paths {', '.join(map(str, dup))} reached the same finite end point"] if dup else [])
-            ) + " — an isolated solution may be missing"
+        what = (
+            f"{st.total} paths"
+            if st.stage == "direct"
+            else (
+                f"two stages: {st.total} paths once to this platform at random complex lengths ({st.dropped} went to "
+                f"infinity), then {N} paths per length set"
+            )
+        )
+        guarantee = (
+            COMPLETE_TEXT.format(kind=arch.kind, what=what)
+            if complete
+            else (
+                "not complete: "
+                + "; ".join(
+                    (
+                        [
+                            f"path(s) {', '.join(map(str, failed))} failed even after re-tracking with tighter steps and new gamma"
+                        ]
+                        if failed
+                        else []
+                    )
+                    + ([f"paths {', '.join(map(str, dup))} reached the same finite end point"] if dup else [])
+                )
+                + " — an isolated solution may be missing"
+            )
         )
         rt = [int(k - j * N) for k in retracked if j * N <= k < (j + 1) * N]
         results.append(
-            HomotopyResult(arch.kind, arch.describe(), L[j], tuple(cj.tolist()), modes, complete, guarantee, failed, rt, dup,
-                           paths.steps[sl].copy(), int(attempts[j]), st.stage, st.dropped)
+            HomotopyResult(
+                arch.kind,
+                arch.describe(),
+                L[j],
+                tuple(cj.tolist()),
+                modes,
+                complete,
+                guarantee,
+                failed,
+                rt,
+                dup,
+                paths.steps[sl].copy(),
+                int(attempts[j]),
+                st.stage,
+                st.dropped,
+            )
         )
     total = time.perf_counter() - t_start
-    timing = {"stage1": t_stage1, "track": t_track, "classify": t_class, "certify": total - t_stage1 - t_track - t_class}
+    timing = {
+        "stage1": t_stage1,
+        "track": t_track,
+        "classify": t_class,
+        "certify": total - t_stage1 - t_track - t_class,
+    }
     engine = engine_used(options)
     return [HomotopyResult(**{**r.__dict__, "time_s": total / m, "timing": timing, "engine": engine}) for r in results]
 

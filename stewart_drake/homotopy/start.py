@@ -19,7 +19,7 @@ x (complex (n, 8)), kind, seed. Regenerate with ``scripts/make_fk_start_systems.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -82,7 +82,9 @@ def _distinct(x: np.ndarray, known: np.ndarray) -> np.ndarray:
     return keep
 
 
-def monodromy_solve(kind: str, seed: int = 0, max_loops: int = 200, options: TrackOptions = TrackOptions(), verbose: bool = False) -> StartSystem:
+def monodromy_solve(
+    kind: str, seed: int = 0, max_loops: int = 200, options: TrackOptions = TrackOptions(), verbose: bool = False
+) -> StartSystem:
     """All ``ROOT_COUNT[kind]`` solutions of a random complex parameter point of class ``kind`` by
     monodromy (see the module docstring). Raises RuntimeError when ``max_loops`` loops do not find
     them all."""
@@ -124,7 +126,7 @@ def monodromy_solve(kind: str, seed: int = 0, max_loops: int = 200, options: Tra
     return StartSystem(kind, a, b, s, v, sols, seed)
 
 
-@lru_cache(maxsize=None)
+@cache
 def load_start_system(kind: str) -> StartSystem:
     """The shipped start system of class ``kind`` (6-3 uses the 3-6 one)."""
     kind = THREE_SIX if kind == SIX_THREE else kind

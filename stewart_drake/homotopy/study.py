@@ -42,7 +42,12 @@ def left_matrix(q: np.ndarray) -> np.ndarray:
     """``(..., 4, 4)`` L(q) with q*r = L(q) r (Hamilton product, q = (w, x, y, z) ``(..., 4)``)."""
     w, x, y, z = np.moveaxis(np.asarray(q), -1, 0)
     return np.stack(
-        [np.stack([w, -x, -y, -z], -1), np.stack([x, w, -z, y], -1), np.stack([y, z, w, -x], -1), np.stack([z, -y, x, w], -1)],
+        [
+            np.stack([w, -x, -y, -z], -1),
+            np.stack([x, w, -z, y], -1),
+            np.stack([y, z, w, -x], -1),
+            np.stack([z, -y, x, w], -1),
+        ],
         -2,
     )
 
@@ -51,7 +56,12 @@ def right_matrix(q: np.ndarray) -> np.ndarray:
     """``(..., 4, 4)`` R(q) with r*q = R(q) r."""
     w, x, y, z = np.moveaxis(np.asarray(q), -1, 0)
     return np.stack(
-        [np.stack([w, -x, -y, -z], -1), np.stack([x, w, z, -y], -1), np.stack([y, -z, w, x], -1), np.stack([z, y, -x, w], -1)],
+        [
+            np.stack([w, -x, -y, -z], -1),
+            np.stack([x, w, z, -y], -1),
+            np.stack([y, -z, w, x], -1),
+            np.stack([z, y, -x, w], -1),
+        ],
         -2,
     )
 
@@ -234,7 +244,12 @@ def quaternion_from_matrix(R: np.ndarray) -> np.ndarray:
     for i, Ri in enumerate(R):
         if k[i] == 0:
             w = np.sqrt(1 + tr[i]) / 2
-            q[i] = [w, (Ri[2, 1] - Ri[1, 2]) / (4 * w), (Ri[0, 2] - Ri[2, 0]) / (4 * w), (Ri[1, 0] - Ri[0, 1]) / (4 * w)]
+            q[i] = [
+                w,
+                (Ri[2, 1] - Ri[1, 2]) / (4 * w),
+                (Ri[0, 2] - Ri[2, 0]) / (4 * w),
+                (Ri[1, 0] - Ri[0, 1]) / (4 * w),
+            ]
         else:
             j = k[i] - 1
             a, b = (j + 1) % 3, (j + 2) % 3

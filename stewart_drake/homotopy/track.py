@@ -59,10 +59,18 @@ class TrackOptions:
     endgame: float = 1e-2
     engine: str = "auto"
 
-    def tighter(self) -> "TrackOptions":
+    def tighter(self) -> TrackOptions:
         """Options for re-tracking failed paths: smaller steps, more of them, a stricter corrector."""
-        return replace(self, h0=self.h0 / 10, h_max=self.h_max / 5, h_min=self.h_min / 100, max_steps=self.max_steps * 10,
-                       target=self.target / 10, tol=self.tol / 10, max_jump=self.max_jump / 4)
+        return replace(
+            self,
+            h0=self.h0 / 10,
+            h_max=self.h_max / 5,
+            h_min=self.h_min / 100,
+            max_steps=self.max_steps * 10,
+            target=self.target / 10,
+            tol=self.tol / 10,
+            max_jump=self.max_jump / 4,
+        )
 
 
 @dataclass
@@ -80,7 +88,7 @@ def _block_diagonal(B: np.ndarray) -> np.ndarray:
     """``(24, 24)`` block-diagonal matrix of the six ``(4, 4)`` blocks B_i: u_flat @ it = [u_iᵀ B_i]_i."""
     D = np.zeros((24, 24), complex)
     for i in range(6):
-        D[4 * i:4 * i + 4, 4 * i:4 * i + 4] = B[i]
+        D[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] = B[i]
     return D
 
 
@@ -163,7 +171,7 @@ ENGINES = ("auto", "c", "numpy")
 
 
 def engine_used(options: TrackOptions) -> str:
-    """"c" or "numpy": the implementation ``track`` runs with these options ("c" raises
+    """ "c" or "numpy": the implementation ``track`` runs with these options ("c" raises
     CompilerUnavailable when there is no C compiler; "auto" then falls back to numpy)."""
     if options.engine not in ENGINES:
         raise ValueError(f"TrackOptions.engine must be one of {ENGINES}, got {options.engine!r}")
@@ -228,7 +236,18 @@ def _track_numpy(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOpti
                     break
                 k = np.flatnonzero(live)
                 idx, x, t, xd, xp, tp, xdp, h, steps, state, capw = (
-                    idx[k], x[k], t[k], xd[k], xp[k], tp[k], xdp[k], h[k], steps[k], state[k], capw[k])
+                    idx[k],
+                    x[k],
+                    t[k],
+                    xd[k],
+                    xp[k],
+                    tp[k],
+                    xdp[k],
+                    h[k],
+                    steps[k],
+                    state[k],
+                    capw[k],
+                )
                 live = np.ones(len(idx), bool)
                 hom.bind(idx)
             ha = np.where(live, np.minimum(h, 1 - t), 0.0)
@@ -238,7 +257,12 @@ def _track_numpy(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOpti
             sg = (ha[:, None] + D) / D
             sg2 = sg * sg
             sg3 = sg2 * sg
-            xhat = (2 * sg3 - 3 * sg2 + 1) * xp + (sg3 - 2 * sg2 + sg) * D * xdp + (3 * sg2 - 2 * sg3) * x + (sg3 - sg2) * D * xd
+            xhat = (
+                (2 * sg3 - 3 * sg2 + 1) * xp
+                + (sg3 - 2 * sg2 + sg) * D * xdp
+                + (3 * sg2 - 2 * sg3) * x
+                + (sg3 - sg2) * D * xd
+            )
             x1, _ = _newton_tangent(hom, xhat, tn)
             x2, xd2 = _newton_tangent(hom, x1, tn)
             norm = np.maximum(_norm(x), 1.0)
@@ -256,7 +280,11 @@ def _track_numpy(x0, B0, B1, s0, s1, v, gamma, options: TrackOptions = TrackOpti
             x = np.where(g2, x2, x)
             xd = np.where(g2, xd2, xd)
             t = np.where(good, np.where(1 - tn <= 1e-14, 1.0, tn), t)
-            h = np.where(good, np.minimum(ha * np.clip(0.8 * ratio, 0.5, 2.0), o.h_max), np.where(bad, ha * np.clip(0.8 * ratio, 0.1, 0.5), h))
+            h = np.where(
+                good,
+                np.minimum(ha * np.clip(0.8 * ratio, 0.5, 2.0), o.h_max),
+                np.where(bad, ha * np.clip(0.8 * ratio, 0.1, 0.5), h),
+            )
             state[good & (t >= 1.0)] = DONE
             small = bad & (h < o.h_min)
             state[small] = np.where(1 - t[small] <= o.endgame, STALLED, FAILED)

@@ -35,8 +35,15 @@ from stewart_drake.montecarlo.spec import KEYS, VarySpec
 from stewart_drake.script import run_program
 
 # Nominal values of the keys whose nominal is not the platform's.
-NOMINAL = {"sensor_resolution": 1e-5, "latency": "sample", "actuator_lag": 2e-3, "gain_scale": 1.0,
-           "sensor_noise": 0.0, "latency_jitter": 0.0, "sample_period": 1e-3}
+NOMINAL = {
+    "sensor_resolution": 1e-5,
+    "latency": "sample",
+    "actuator_lag": 2e-3,
+    "gain_scale": 1.0,
+    "sensor_noise": 0.0,
+    "latency_jitter": 0.0,
+    "sample_period": 1e-3,
+}
 # A run loses tracking when a leg is this far (m) from the reference's IK, or the state is not finite.
 LOST_TRACKING = 5e-3
 AXES = ("x", "y", "z")
@@ -73,7 +80,9 @@ class Study:
             ref = table_trajectory(*self.table)
         elif self.program is not None:
             name, text = self.program
-            ref = replace(run_program(text, name, self.platform).trajectory, name=name.rsplit("/", 1)[-1].removesuffix(".stw"))
+            ref = replace(
+                run_program(text, name, self.platform).trajectory, name=name.rsplit("/", 1)[-1].removesuffix(".stw")
+            )
         else:
             ref = get_trajectory(self.trajectory)
         return fit_trajectory(ref, self.platform) if self.fit else ref
@@ -117,10 +126,17 @@ class Draw:
         for j, v in enumerate(self.top_anchor_offset):
             out.update({f"anchor_top{j + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
         out.update({f"leg_offset{i + 1}_m": float(x) for i, x in enumerate(self.leg_offset)})
-        out.update({"sensor_resolution_m": self.sensor_resolution, "sensor_noise_m": self.sensor_noise,
-                    "latency": self.latency, "latency_jitter_s": self.latency_jitter,
-                    "actuator_lag_s": self.actuator_lag, "force_limit_N": self.force_limit,
-                    "payload_mass_kg": self.payload_mass})
+        out.update(
+            {
+                "sensor_resolution_m": self.sensor_resolution,
+                "sensor_noise_m": self.sensor_noise,
+                "latency": self.latency,
+                "latency_jitter_s": self.latency_jitter,
+                "actuator_lag_s": self.actuator_lag,
+                "force_limit_N": self.force_limit,
+                "payload_mass_kg": self.payload_mass,
+            }
+        )
         out.update({f"payload_com_{a}_m": float(x) for a, x in zip(AXES, self.payload_com_offset)})
         out["gain_scale"] = self.gain_scale
         out["sample_period_s"] = self.sample_period
@@ -174,11 +190,18 @@ def draw(study: Study, index: int) -> tuple[int, Draw]:
     if study.grid is not None:
         vals.update(study.grid[index])
     return seed, Draw(
-        base_anchor_offset=np.asarray(vals["anchor"][0], float), top_anchor_offset=np.asarray(vals["anchor"][1], float),
-        leg_offset=np.asarray(vals["leg_offset"], float), sensor_resolution=vals["sensor_resolution"],
-        sensor_noise=vals["sensor_noise"], latency=vals["latency"], latency_jitter=vals["latency_jitter"],
-        actuator_lag=vals["actuator_lag"], force_limit=vals["force_limit"], payload_mass=vals["payload_mass"],
-        payload_com_offset=np.asarray(vals["payload_com"], float), gain_scale=vals["gain_scale"],
+        base_anchor_offset=np.asarray(vals["anchor"][0], float),
+        top_anchor_offset=np.asarray(vals["anchor"][1], float),
+        leg_offset=np.asarray(vals["leg_offset"], float),
+        sensor_resolution=vals["sensor_resolution"],
+        sensor_noise=vals["sensor_noise"],
+        latency=vals["latency"],
+        latency_jitter=vals["latency_jitter"],
+        actuator_lag=vals["actuator_lag"],
+        force_limit=vals["force_limit"],
+        payload_mass=vals["payload_mass"],
+        payload_com_offset=np.asarray(vals["payload_com"], float),
+        gain_scale=vals["gain_scale"],
         sample_period=vals["sample_period"],
     )
 
@@ -190,7 +213,9 @@ def plant_platform(platform: Platform, d: Draw) -> Platform:
     return platform.replace(
         base_anchors=platform.base_anchors + d.base_anchor_offset,
         top_anchors=platform.top_anchors + d.top_anchor_offset,
-        mass=d.payload_mass, inertia=platform.inertia * scale, com=platform.com + d.payload_com_offset,
+        mass=d.payload_mass,
+        inertia=platform.inertia * scale,
+        com=platform.com + d.payload_com_offset,
     )
 
 
@@ -213,14 +238,33 @@ def scenario(study: Study, index: int, reference: Trajectory | None = None) -> t
     p = study.platform
     g = ControllerConfig.for_platform(p, poses=design_poses(ref, max(duration, ref.duration or 0.0))).gains
     s = d.gain_scale
-    timing = DspTiming(sample_period=d.sample_period, latency=d.latency, sensor_resolution=d.sensor_resolution,
-                       command_range=float(p.legs.max_force))
-    config = ControllerConfig.for_platform(p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s))
+    timing = DspTiming(
+        sample_period=d.sample_period,
+        latency=d.latency,
+        sensor_resolution=d.sensor_resolution,
+        command_range=float(p.legs.max_force),
+    )
+    config = ControllerConfig.for_platform(
+        p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s)
+    )
     n_ticks = int(math.floor(duration / timing.sample_period + 1e-9)) + 2
-    return seed, d, Scenario(p, ref, study.controller, config, ActuatorModel(d.force_limit, d.actuator_lag),
-                             plant_time_step=study.plant_step, integrator=study.integrator, engine=study.engine,
-                             plant_platform=plant_platform(p, d), sensor=sensor_model(d, seed, timing.sample_period, n_ticks),
-                             duration=duration)
+    return (
+        seed,
+        d,
+        Scenario(
+            p,
+            ref,
+            study.controller,
+            config,
+            ActuatorModel(d.force_limit, d.actuator_lag),
+            plant_time_step=study.plant_step,
+            integrator=study.integrator,
+            engine=study.engine,
+            plant_platform=plant_platform(p, d),
+            sensor=sensor_model(d, seed, timing.sample_period, n_ticks),
+            duration=duration,
+        ),
+    )
 
 
 def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None) -> dict:
@@ -247,8 +291,18 @@ def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None)
 def _metrics(log, ref, platform: Platform, lost: float, error: str) -> dict:
     nan = float("nan")
     if log is None:
-        return {"max_leg_error_m": nan, "rms_leg_error_m": nan, "max_position_error_m": nan, "rms_position_error_m": nan,
-                "max_angle_error_rad": nan, "rms_angle_error_rad": nan, "saturated_ticks": -1, "saturated_leg_ticks": -1, "lost_tracking": True, "error": error}
+        return {
+            "max_leg_error_m": nan,
+            "rms_leg_error_m": nan,
+            "max_position_error_m": nan,
+            "rms_position_error_m": nan,
+            "max_angle_error_rad": nan,
+            "rms_angle_error_rad": nan,
+            "saturated_ticks": -1,
+            "saturated_leg_ticks": -1,
+            "lost_tracking": True,
+            "error": error,
+        }
     e = log.length_error(ref, platform)
     pe = log.pose_error(ref)
     pos = np.linalg.norm(pe[:, :3], axis=1)

@@ -33,12 +33,11 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from decimal import Decimal
 from dataclasses import dataclass, field
+from decimal import Decimal
 from pathlib import Path
 
 from stewart_drake.errors import SpecError
-
 
 # key: (dimension, vector length or 0 for a scalar, nominal zero?)
 KEYS = {
@@ -189,8 +188,9 @@ def _parse_yaml(path: Path) -> VarySpec:
         node = yaml.compose(text)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
-        raise SpecError(SpecError.NOT_YAML.format(path=path, line=mark.line + 1 if mark else "?",
-                                                  problem=getattr(e, "problem", e))) from None
+        raise SpecError(
+            SpecError.NOT_YAML.format(path=path, line=mark.line + 1 if mark else "?", problem=getattr(e, "problem", e))
+        ) from None
     if node is None or not isinstance(node, yaml.MappingNode):
         raise SpecError(SpecError.NOT_MAPPING.format(path=path))
     laws = {}

@@ -42,11 +42,21 @@ def study_settings(study: Study) -> dict:
     plat["legs"] = dataclasses.asdict(p.legs)
     plat = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in plat.items()}
     return {
-        "platform": plat, "vary": study.spec.to_dict(), "seed": study.seed, "trajectory": study.trajectory,
+        "platform": plat,
+        "vary": study.spec.to_dict(),
+        "seed": study.seed,
+        "trajectory": study.trajectory,
         "program": list(study.program) if study.program else None,
-        "table": list(study.table) if study.table else None, "fit": study.fit, "controller": study.controller,
-        "integrator": study.integrator, "engine": study.engine, "duration": study.duration, "plant_step": study.plant_step,
-        "lost_tracking": study.lost_tracking, "grid": list(study.grid) if study.grid is not None else None, **study.extra,
+        "table": list(study.table) if study.table else None,
+        "fit": study.fit,
+        "controller": study.controller,
+        "integrator": study.integrator,
+        "engine": study.engine,
+        "duration": study.duration,
+        "plant_step": study.plant_step,
+        "lost_tracking": study.lost_tracking,
+        "grid": list(study.grid) if study.grid is not None else None,
+        **study.extra,
     }
 
 
@@ -59,15 +69,41 @@ def study_from_settings(settings: dict, runs: int) -> Study:
     plat["legs"] = LegConfig(**plat["legs"])
     plat["leg_top"] = np.asarray(plat["leg_top"], dtype=np.intp)
     fields = {f.name for f in dataclasses.fields(Study)}
-    known = {"platform", "vary", "seed", "trajectory", "program", "table", "fit", "controller", "integrator", "engine", "duration", "plant_step", "lost_tracking", "grid"}
+    known = {
+        "platform",
+        "vary",
+        "seed",
+        "trajectory",
+        "program",
+        "table",
+        "fit",
+        "controller",
+        "integrator",
+        "engine",
+        "duration",
+        "plant_step",
+        "lost_tracking",
+        "grid",
+    }
     extra = {k: v for k, v in settings.items() if k not in known}
-    return Study(platform=Platform(**plat), spec=spec_from_dict(settings["vary"]), seed=settings["seed"], runs=runs,
-                 trajectory=settings["trajectory"], program=tuple(settings["program"]) if settings["program"] else None,
-                 table=tuple(settings["table"]) if settings.get("table") else None,
-                 fit=settings["fit"], controller=settings["controller"], integrator=settings["integrator"], engine=settings.get("engine", "python"),
-                 duration=settings["duration"], plant_step=settings["plant_step"], lost_tracking=settings["lost_tracking"],
-                 grid=tuple(settings["grid"]) if settings.get("grid") is not None else None,
-                 extra={k: v for k, v in extra.items() if k not in fields})
+    return Study(
+        platform=Platform(**plat),
+        spec=spec_from_dict(settings["vary"]),
+        seed=settings["seed"],
+        runs=runs,
+        trajectory=settings["trajectory"],
+        program=tuple(settings["program"]) if settings["program"] else None,
+        table=tuple(settings["table"]) if settings.get("table") else None,
+        fit=settings["fit"],
+        controller=settings["controller"],
+        integrator=settings["integrator"],
+        engine=settings.get("engine", "python"),
+        duration=settings["duration"],
+        plant_step=settings["plant_step"],
+        lost_tracking=settings["lost_tracking"],
+        grid=tuple(settings["grid"]) if settings.get("grid") is not None else None,
+        extra={k: v for k, v in extra.items() if k not in fields},
+    )
 
 
 def study_key(study: Study) -> str:
@@ -100,8 +136,11 @@ def check_study(study: Study) -> float:
     if not (math.isfinite(duration) and 0 < duration <= MAX_RUN_SECONDS):
         raise StudyError(StudyError.DURATION.format(limit=MAX_RUN_SECONDS, value=duration))
     if study.runs * duration > MAX_TOTAL_SECONDS:
-        raise StudyError(StudyError.TOTAL.format(runs=study.runs, duration=duration, total=study.runs * duration,
-                                                 limit=MAX_TOTAL_SECONDS))
+        raise StudyError(
+            StudyError.TOTAL.format(
+                runs=study.runs, duration=duration, total=study.runs * duration, limit=MAX_TOTAL_SECONDS
+            )
+        )
     if study.controller == "fixed":
         law = study.spec.laws.get("sensor_resolution")
         if law is not None and law.kind not in ("fixed", "choice"):

@@ -16,8 +16,16 @@ import numpy as np
 
 from stewart_drake.montecarlo.spec import LATENCY_MODES
 
-METRICS = ("max_leg_error_m", "rms_leg_error_m", "max_position_error_m", "rms_position_error_m",
-           "max_angle_error_rad", "rms_angle_error_rad", "saturated_ticks", "saturated_leg_ticks")
+METRICS = (
+    "max_leg_error_m",
+    "rms_leg_error_m",
+    "max_position_error_m",
+    "rms_position_error_m",
+    "max_angle_error_rad",
+    "rms_angle_error_rad",
+    "saturated_ticks",
+    "saturated_leg_ticks",
+)
 # Row fields that are not drawn parameters.
 NOT_PARAMETERS = set(METRICS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
 PERCENTILES = (5, 50, 95, 99)
@@ -60,7 +68,14 @@ def summarise(rows: list[dict], settings: dict, key: str) -> dict:
     for m in METRICS:
         v = _numeric(rows, m)
         v = v[np.isfinite(v)]
-        stats[m] = ({f"p{q}": float(np.percentile(v, q)) for q in PERCENTILES} | {"mean": float(v.mean()), "max": float(v.max())}) if v.size else {}
+        stats[m] = (
+            (
+                {f"p{q}": float(np.percentile(v, q)) for q in PERCENTILES}
+                | {"mean": float(v.mean()), "max": float(v.max())}
+            )
+            if v.size
+            else {}
+        )
     finite = [r for r in rows if math.isfinite(float(r[WORST_BY]))]
     worst = max(finite, key=lambda r: r[WORST_BY]) if finite else rows[0]
     wall = np.array([r["wall_s"] for r in rows], float)
@@ -110,9 +125,14 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
 
     paths = []
     fig, ax = plt.subplots(1, 3, figsize=(13, 3.6))
-    for a, (m, scale, label) in zip(ax, [("max_leg_error_m", 1e3, "max leg error [mm]"),
-                                         ("max_position_error_m", 1e3, "max position error [mm]"),
-                                         ("max_angle_error_rad", 180 / np.pi, "max angle error [deg]")]):
+    for a, (m, scale, label) in zip(
+        ax,
+        [
+            ("max_leg_error_m", 1e3, "max leg error [mm]"),
+            ("max_position_error_m", 1e3, "max position error [mm]"),
+            ("max_angle_error_rad", 180 / np.pi, "max angle error [deg]"),
+        ],
+    ):
         v = _numeric(rows, m)
         a.hist(v[np.isfinite(v)] * scale, bins=max(5, min(40, len(rows) // 5)))
         a.set_xlabel(label)
@@ -145,7 +165,9 @@ def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
     out = Path(out)
     with atomic_folder(out) as tmp:
         written = write_table(rows, tmp) + write_plots(rows, summary, tmp)
-        (tmp / "study.json").write_text(json.dumps({"key": summary["key"], "runs": summary["runs"], "settings": summary["settings"]}, indent=2))
+        (tmp / "study.json").write_text(
+            json.dumps({"key": summary["key"], "runs": summary["runs"], "settings": summary["settings"]}, indent=2)
+        )
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
         written += [tmp / "study.json", tmp / "summary.json"]
         names = [p.name for p in written]

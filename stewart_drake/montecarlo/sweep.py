@@ -12,8 +12,16 @@ from stewart_drake.montecarlo.spec import KEYS, SpecError, VarySpec, check_key
 from stewart_drake.montecarlo.study import run_study
 
 
-def sweep_study(platform: Platform, axes: dict, trajectory: str = "seed", controller: str = "fixed", duration: float | None = None,
-                plant_step: float = 1e-3, integrator: str | None = None, engine: str = "python") -> Study:
+def sweep_study(
+    platform: Platform,
+    axes: dict,
+    trajectory: str = "seed",
+    controller: str = "fixed",
+    duration: float | None = None,
+    plant_step: float = 1e-3,
+    integrator: str | None = None,
+    engine: str = "python",
+) -> Study:
     """The ``Study`` of the cartesian product of ``axes`` (``{key: [SI values]}``, keys of ``spec.KEYS``;
     the first key varies slowest): point i is run i."""
     for k, values in axes.items():
@@ -24,8 +32,19 @@ def sweep_study(platform: Platform, axes: dict, trajectory: str = "seed", contro
             raise SpecError(SpecError.SWEEP_EMPTY.format(key=k))
     keys = list(axes)
     grid = tuple(dict(zip(keys, point)) for point in itertools.product(*(axes[k] for k in keys)))
-    return Study(platform, VarySpec({}, "sweep"), seed=0, runs=len(grid), trajectory=trajectory, controller=controller,
-                 duration=duration, plant_step=plant_step, integrator=integrator, engine=engine, grid=grid)
+    return Study(
+        platform,
+        VarySpec({}, "sweep"),
+        seed=0,
+        runs=len(grid),
+        trajectory=trajectory,
+        controller=controller,
+        duration=duration,
+        plant_step=plant_step,
+        integrator=integrator,
+        engine=engine,
+        grid=grid,
+    )
 
 
 def run_sweep(study: Study, workers: int = 0, out=None, progress: bool = False) -> list[dict]:

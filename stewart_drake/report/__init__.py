@@ -30,8 +30,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.jsonout import dumps_strict
+from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
 from stewart_drake.report import render
 
@@ -80,8 +80,14 @@ class Section:
         """Raw HTML (the caller escapes)."""
         self.blocks.append(fragment)
 
-    def table(self, header: list[str], rows: list[list], caption: str = "", fmt: str | None = None,
-              nan_reason: str = "not applicable") -> None:
+    def table(
+        self,
+        header: list[str],
+        rows: list[list],
+        caption: str = "",
+        fmt: str | None = None,
+        nan_reason: str = "not applicable",
+    ) -> None:
         """A table in a scrolling box. Numbers get the report's significant digits whatever ``fmt``
         asks (kept for callers; one format for every table), units in headers are written alike, and a
         NaN shows as an em dash with ``nan_reason``."""
@@ -170,7 +176,9 @@ def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = N
     if only:
         unknown = sorted(set(only) - {a.name for a in found})
         if unknown:
-            raise UsageError(REPORT_UNKNOWN_ANALYSIS.format(name=unknown[0], available=", ".join(a.name for a in found)))
+            raise UsageError(
+                REPORT_UNKNOWN_ANALYSIS.format(name=unknown[0], available=", ".join(a.name for a in found))
+            )
         found = [a for a in found if a.name in only]
     return sorted(found, key=lambda a: (a.order, a.name))
 
@@ -179,9 +187,16 @@ def unlabelled_axes(fig) -> list[str]:
     """Axes of a matplotlib figure that show data but lack an axis label (x, y, and z for 3-D)."""
     out = []
     for k, ax in enumerate(fig.axes):
-        if ax.get_label() == "<colorbar>" or not ax.get_visible() or not ax.axison or not (ax.lines or ax.collections or ax.images or ax.patches):
+        if (
+            ax.get_label() == "<colorbar>"
+            or not ax.get_visible()
+            or not ax.axison
+            or not (ax.lines or ax.collections or ax.images or ax.patches)
+        ):
             continue
-        getters = [("x", ax.get_xlabel), ("y", ax.get_ylabel)] + ([("z", ax.get_zlabel)] if hasattr(ax, "get_zlabel") else [])
+        getters = [("x", ax.get_xlabel), ("y", ax.get_ylabel)] + (
+            [("z", ax.get_zlabel)] if hasattr(ax, "get_zlabel") else []
+        )
         missing = [a for a, get in getters if not get().strip()]
         shared_x = ax.get_shared_x_axes().get_siblings(ax)
         if "x" in missing and any(o is not ax and o.get_xlabel().strip() for o in shared_x):
@@ -216,7 +231,9 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
         return [_call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
     ctx = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-        return list(pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items))
+        return list(
+            pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
+        )
 
 
 def build_section(analysis: Analysis, quick: bool = False) -> Section:
@@ -274,7 +291,9 @@ def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: 
                 sections[i] = f.result()
             except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
                 s = Section(analyses[i].title, quick=quick)
-                s.html(f'<p class="fail">This analysis failed in its worker: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
+                s.html(
+                    f'<p class="fail">This analysis failed in its worker: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>'
+                )
                 s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
                 s.elapsed = 0.0
                 sections[i] = s
@@ -288,7 +307,9 @@ def render_html(sections: list[Section], title: str = "stewart-drake report", me
     return render.render_html(sections, title, meta if meta is not None else render.default_meta(sections))
 
 
-def write_report(sections: list[Section], out_dir, title: str = "stewart-drake report", meta: dict | None = None) -> Path:
+def write_report(
+    sections: list[Section], out_dir, title: str = "stewart-drake report", meta: dict | None = None
+) -> Path:
     """Write ``index.html``, ``checks.json`` and every section file into ``out_dir``, atomically: the
     report is built in a temporary sibling folder and swapped in only when complete."""
     out = out_dir if isinstance(out_dir, OutputFolder) else OutputFolder(out_dir)
@@ -305,7 +326,9 @@ def write_report(sections: list[Section], out_dir, title: str = "stewart-drake r
 def command_line(argv=None) -> str:
     """The command as typed (``stewart-drake`` for the CLI module)."""
     argv = list(sys.argv if argv is None else argv)
-    prog = "stewart-drake" if argv and argv[0].endswith(("cli.py", "stewart-drake", "__main__.py")) else Path(argv[0]).name
+    prog = (
+        "stewart-drake" if argv and argv[0].endswith(("cli.py", "stewart-drake", "__main__.py")) else Path(argv[0]).name
+    )
     return shlex.join([prog, *argv[1:]])
 
 
@@ -322,7 +345,9 @@ def run_standalone(module_file: str, argv=None) -> int:
     a = load_analysis(path)
     t0 = time.perf_counter()
     sections = run_analyses([a], quick=args.quick)
-    meta = render.default_meta(sections, command_line([str(path), *(sys.argv[1:] if argv is None else argv)]), time.perf_counter() - t0)
+    meta = render.default_meta(
+        sections, command_line([str(path), *(sys.argv[1:] if argv is None else argv)]), time.perf_counter() - t0
+    )
     index = write_report(sections, out, title=a.title, meta=meta)
     print(index)
     return 0 if all(c.passed for s in sections for c in s.checks) else 1

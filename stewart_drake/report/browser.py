@@ -22,11 +22,20 @@ import numpy as np
 
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "chrome")
 FLAGS = (
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-    "--disable-default-apps", "--mute-audio", "--hide-scrollbars",
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-default-apps",
+    "--mute-audio",
+    "--hide-scrollbars",
     # WebGL on the CPU (SwiftShader) for Meshcat's canvas: Chromium no longer falls back to it silently.
-    "--enable-unsafe-swiftshader", "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--use-angle=swiftshader",
 )
 
 
@@ -47,20 +56,31 @@ class Browser:
     def __init__(self, width: int = 1280, height: int = 900, executable: str | None = None, timeout: float = 30.0):
         self.executable = executable or find_chromium()
         if self.executable is None:
-            raise RuntimeError("Chromium (or the websocket-client package) is not installed; run scripts/ensure-chromium")
+            raise RuntimeError(
+                "Chromium (or the websocket-client package) is not installed; run scripts/ensure-chromium"
+            )
         self.width, self.height, self.timeout = width, height, timeout
         self.errors: list[str] = []
         self._id = 0
         self._events: list[dict] = []
 
-    def __enter__(self) -> "Browser":
+    def __enter__(self) -> Browser:
         import websocket
 
         self._dir = tempfile.TemporaryDirectory(prefix="stewart-chromium-")
         self._proc = subprocess.Popen(
-            [self.executable, *FLAGS, f"--user-data-dir={self._dir.name}", "--remote-debugging-port=0",
-             "--remote-allow-origins=*", f"--window-size={self.width},{self.height}", "about:blank"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            [
+                self.executable,
+                *FLAGS,
+                f"--user-data-dir={self._dir.name}",
+                "--remote-debugging-port=0",
+                "--remote-allow-origins=*",
+                f"--window-size={self.width},{self.height}",
+                "about:blank",
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         port_file = Path(self._dir.name) / "DevToolsActivePort"
         deadline = time.monotonic() + self.timeout
         while not (port_file.exists() and port_file.read_text().strip()):
@@ -74,7 +94,13 @@ class Browser:
         self._ws = websocket.create_connection(page["webSocketDebuggerUrl"], timeout=self.timeout, suppress_origin=True)
         for domain in ("Page", "Runtime", "Log"):
             self.send(f"{domain}.enable")
-        self.send("Emulation.setDeviceMetricsOverride", width=self.width, height=self.height, deviceScaleFactor=1, mobile=False)
+        self.send(
+            "Emulation.setDeviceMetricsOverride",
+            width=self.width,
+            height=self.height,
+            deviceScaleFactor=1,
+            mobile=False,
+        )
         return self
 
     def __exit__(self, *exc) -> None:
@@ -145,7 +171,9 @@ class Browser:
         """The value of a JavaScript expression in the page (promises awaited)."""
         r = self.send("Runtime.evaluate", expression=expression, returnByValue=True, awaitPromise=True)
         if "exceptionDetails" in r:
-            raise RuntimeError(f"JavaScript error: {r['exceptionDetails'].get('exception', {}).get('description', r['exceptionDetails'])}")
+            raise RuntimeError(
+                f"JavaScript error: {r['exceptionDetails'].get('exception', {}).get('description', r['exceptionDetails'])}"
+            )
         return r["result"].get("value")
 
     def wait_for(self, expression: str, timeout: float = 20.0, interval: float = 0.2):
@@ -167,7 +195,10 @@ class Browser:
         params = {"format": "png"}
         if full_page:
             m = self.send("Page.getLayoutMetrics")["cssContentSize"]
-            params.update(captureBeyondViewport=True, clip={"x": 0, "y": 0, "width": m["width"], "height": min(m["height"], 16000), "scale": 1})
+            params.update(
+                captureBeyondViewport=True,
+                clip={"x": 0, "y": 0, "width": m["width"], "height": min(m["height"], 16000), "scale": 1},
+            )
         data = base64.b64decode(self.send("Page.captureScreenshot", **params)["data"])
         if path is not None:
             Path(path).parent.mkdir(parents=True, exist_ok=True)

@@ -13,19 +13,45 @@ import html
 import math
 import re
 import subprocess
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
 DIGITS = 4
 # Units recognised at the end of a header without brackets ("max |leg err| mm").
-BARE_UNITS = ("mm", "m", "s", "ms", "µs", "us", "N", "N/m", "N·s/m", "N/(m·s)", "deg", "rad", "kg", "Hz", "%",
-              "mm/s", "m/s", "kg·m²", "kN/m", "V", "A", "W", "cycles", "µm", "nm")
+BARE_UNITS = (
+    "mm",
+    "m",
+    "s",
+    "ms",
+    "µs",
+    "us",
+    "N",
+    "N/m",
+    "N·s/m",
+    "N/(m·s)",
+    "deg",
+    "rad",
+    "kg",
+    "Hz",
+    "%",
+    "mm/s",
+    "m/s",
+    "kg·m²",
+    "kN/m",
+    "V",
+    "A",
+    "W",
+    "cycles",
+    "µm",
+    "nm",
+)
 _BRACKET_UNIT = r"[A-Za-zµ°·/²³%0-9^⁻¹()\-−]{1,12}"
 _UNIT_RE = re.compile(
     rf"^(?P<name>.*?)\s*(?:\[(?P<b>{_BRACKET_UNIT})\]|\((?P<p>[A-Za-zµ°·/²³%0-9^⁻¹\-−]{{1,12}})\)|\s(?P<u>"
-    + "|".join(re.escape(u) for u in sorted(BARE_UNITS, key=len, reverse=True)) + r"))$"
+    + "|".join(re.escape(u) for u in sorted(BARE_UNITS, key=len, reverse=True))
+    + r"))$"
 )
 
 _NUMERIC_TEXT = re.compile(r"^\s*[-+−]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*$")
@@ -91,7 +117,7 @@ def split_unit(header: str) -> tuple[str, str]:
 def header_cell(h: str, numeric: bool) -> str:
     name, unit = split_unit(h)
     u = f' <span class="unit">[{html.escape(unit)}]</span>' if unit else ""
-    return f'<th{" class=num" if numeric else ""}>{html.escape(name)}{u}</th>'
+    return f"<th{' class=num' if numeric else ''}>{html.escape(name)}{u}</th>"
 
 
 def cell(v, nan_reason: str = "not applicable") -> tuple[str, bool]:
@@ -99,13 +125,19 @@ def cell(v, nan_reason: str = "not applicable") -> tuple[str, bool]:
     if is_number(v):
         v = v.item() if hasattr(v, "item") else v
         if isinstance(v, float) and math.isnan(v):
-            return f'<td class="na" title="{html.escape(nan_reason)}">— <small>({html.escape(nan_reason)})</small></td>', True
+            return (
+                f'<td class="na" title="{html.escape(nan_reason)}">— <small>({html.escape(nan_reason)})</small></td>',
+                True,
+            )
         return f'<td class="num">{format_number(v)}</td>', True
     text = str(v)
     if _NUMERIC_TEXT.match(text):  # a number the analysis formatted itself: aligned as a number
         return f'<td class="num">{html.escape(text.replace("-", "−"))}</td>', True
     if text.strip().lower() == "nan":
-        return f'<td class="na" title="{html.escape(nan_reason)}">— <small>({html.escape(nan_reason)})</small></td>', True
+        return (
+            f'<td class="na" title="{html.escape(nan_reason)}">— <small>({html.escape(nan_reason)})</small></td>',
+            True,
+        )
     short = len(text) <= 24  # a name or a label: kept on one line
     return f"<td{' class=nw' if short else ''}>{html.escape(text)}</td>", False
 
@@ -154,7 +186,11 @@ def git_commit(directory: Path) -> str | None:
 
 def meta_html(meta: dict) -> str:
     """The header block: a two-column table of ``meta`` (keys in insertion order)."""
-    rows = "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in meta.items() if v not in (None, ""))
+    rows = "".join(
+        f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>"
+        for k, v in meta.items()
+        if v not in (None, "")
+    )
     return f'<div class="scroll meta"><table>{rows}</table></div>'
 
 
@@ -164,7 +200,7 @@ def default_meta(sections, command: str | None = None, elapsed: float | None = N
     v = versions()
     mode = "quick (small samples)" if any(s.quick for s in sections) else "full"
     return {
-        "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "toolkit": f"stewart-drake {v.pop('stewart-drake')}",
         "dependencies": ", ".join(f"{k} {x}" for k, x in v.items()),
         "git commit": git_commit(ANALYSES_DIR) or "not a git checkout",
@@ -185,8 +221,11 @@ def headline(section) -> str:
         return f"FAILED: {c.what}: {format_number(c.worst)} > {format_number(c.tolerance)} {c.unit}".rstrip() + more
     if getattr(section, "headline_text", ""):
         return section.headline_text
-    ratios = [(c.worst / c.tolerance if c.tolerance > 0 else (-1.0 if c.worst <= 0 else math.inf), c) for c in section.checks
-              if not math.isnan(c.worst)]
+    ratios = [
+        (c.worst / c.tolerance if c.tolerance > 0 else (-1.0 if c.worst <= 0 else math.inf), c)
+        for c in section.checks
+        if not math.isnan(c.worst)
+    ]
     if not ratios:
         return ""
     _, c = max(ratios, key=lambda rc: rc[0])
@@ -201,11 +240,16 @@ def verdicts_html(sections, anchor: dict) -> str:
         n, ok = len(s.checks), sum(c.passed for c in s.checks)
         cls = "pass" if ok == n else "fail"
         t = getattr(s, "elapsed", None)
-        rows.append(f'<tr><td><a href="#{anchor[id(s)]}">{html.escape(s.title)}</a></td><td class="num {cls}">{ok}/{n}</td>'
-                    f"<td>{html.escape(headline(s))}</td><td class=num>{'' if t is None else f'{t:.1f}'}</td></tr>")
-    return ('<div class="scroll"><table class="verdicts"><thead><tr><th>section</th><th class=num>checks passed</th>'
-            '<th>headline</th><th class=num>time <span class="unit">[s]</span></th></tr></thead><tbody>'
-            + "".join(rows) + "</tbody></table></div>")
+        rows.append(
+            f'<tr><td><a href="#{anchor[id(s)]}">{html.escape(s.title)}</a></td><td class="num {cls}">{ok}/{n}</td>'
+            f"<td>{html.escape(headline(s))}</td><td class=num>{'' if t is None else f'{t:.1f}'}</td></tr>"
+        )
+    return (
+        '<div class="scroll"><table class="verdicts"><thead><tr><th>section</th><th class=num>checks passed</th>'
+        '<th>headline</th><th class=num>time <span class="unit">[s]</span></th></tr></thead><tbody>'
+        + "".join(rows)
+        + "</tbody></table></div>"
+    )
 
 
 def checks_html(sections, anchor: dict) -> str:
@@ -217,12 +261,15 @@ def checks_html(sections, anchor: dict) -> str:
         n, ok = len(s.checks), sum(c.passed for c in s.checks)
         rows = "".join(
             f"<tr><td>{html.escape(c.what)}</td>{cell(c.worst, 'not measured')[0]}{cell(c.tolerance)[0]}<td>{html.escape(c.unit)}</td>"
-            f"<td class='{'pass' if c.passed else 'fail'}'>{'pass' if c.passed else 'FAIL'}</td></tr>" for c in s.checks)
+            f"<td class='{'pass' if c.passed else 'fail'}'>{'pass' if c.passed else 'FAIL'}</td></tr>"
+            for c in s.checks
+        )
         out.append(
             f"<details{' open' if ok < n else ''}><summary><a href='#{anchor[id(s)]}'>{html.escape(s.title)}</a>"
             f"<span class='{'pass' if ok == n else 'fail'}'>{ok}/{n}</span></summary>"
             '<div class="scroll"><table><thead><tr><th>what was compared</th><th class=num>worst</th><th class=num>tolerance</th>'
-            f"<th>unit</th><th>result</th></tr></thead><tbody>{rows}</tbody></table></div></details>")
+            f"<th>unit</th><th>result</th></tr></thead><tbody>{rows}</tbody></table></div></details>"
+        )
     return "".join(out)
 
 
@@ -230,7 +277,10 @@ def render_html(sections, title: str, meta: dict) -> str:
     checks = [c for s in sections for c in s.checks]
     n_fail = sum(not c.passed for c in checks)
     anchor = {id(s): f"s{i}" for i, s in enumerate(sections)}
-    body = "".join(f'<section id="s{i}"><h2>{html.escape(s.title)}</h2>{"".join(s.blocks)}</section>' for i, s in enumerate(sections))
+    body = "".join(
+        f'<section id="s{i}"><h2>{html.escape(s.title)}</h2>{"".join(s.blocks)}</section>'
+        for i, s in enumerate(sections)
+    )
     status = f"<span class='{'fail' if n_fail else 'pass'}'>{len(checks) - n_fail}/{len(checks)} checks passed</span>"
     return (
         f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><meta name='viewport' content='width=device-width'>"
@@ -281,7 +331,9 @@ _POINTS3D_JS = """
 """
 
 
-def points3d_html(element_id: str, points, labels=("x [m]", "y [m]", "z [m]"), caption: str = "", max_points: int = 4000) -> str:
+def points3d_html(
+    element_id: str, points, labels=("x [m]", "y [m]", "z [m]"), caption: str = "", max_points: int = 4000
+) -> str:
     """A rotatable 3-D point cloud (drag to turn) drawn by inline JavaScript on a canvas: no library, so
     the page stays one self-contained file. ``points`` ``(n, 3)``; at most ``max_points`` kept (seeded)."""
     import json
@@ -289,7 +341,13 @@ def points3d_html(element_id: str, points, labels=("x [m]", "y [m]", "z [m]"), c
     P = np.asarray(points, dtype=float).reshape(-1, 3)
     if len(P) > max_points:
         P = P[np.random.default_rng(0).choice(len(P), max_points, replace=False)]
-    js = _POINTS3D_JS % {"id": json.dumps(element_id), "points": json.dumps(np.round(P, 5).tolist()), "labels": json.dumps(list(labels))}
+    js = _POINTS3D_JS % {
+        "id": json.dumps(element_id),
+        "points": json.dumps(np.round(P, 5).tolist()),
+        "labels": json.dumps(list(labels)),
+    }
     cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
-    return (f'<figure><canvas id="{html.escape(element_id)}" width="640" height="480" class="points3d" '
-            f'style="max-width:100%;border:1px solid #ddd;cursor:grab;touch-action:none"></canvas>{cap}<script>{js}</script></figure>')
+    return (
+        f'<figure><canvas id="{html.escape(element_id)}" width="640" height="480" class="points3d" '
+        f'style="max-width:100%;border:1px solid #ddd;cursor:grab;touch-action:none"></canvas>{cap}<script>{js}</script></figure>'
+    )

@@ -17,8 +17,20 @@ from stewart_drake.script.interpreter import execute
 from stewart_drake.script.parser import parse
 from stewart_drake.script.runtime import DEFAULT_RATE, Motion, Result, Trajectory, evaluate
 
-__all__ = ["Loc", "Motion", "Result", "ScriptError", "ScriptErrors", "Trajectory", "check", "compile_program",
-           "evaluate", "execute", "parse", "run_program"]
+__all__ = [
+    "Loc",
+    "Motion",
+    "Result",
+    "ScriptError",
+    "ScriptErrors",
+    "Trajectory",
+    "check",
+    "compile_program",
+    "evaluate",
+    "execute",
+    "parse",
+    "run_program",
+]
 
 
 def compile_program(text: str, filename: str, platform: Platform):
@@ -31,8 +43,14 @@ def compile_program(text: str, filename: str, platform: Platform):
     return program, motion
 
 
-def run_program(text: str, filename: str, platform: Platform, rate: float = DEFAULT_RATE, convention: str = "utn",
-                coriolis: bool = True) -> Result:
+def run_program(
+    text: str,
+    filename: str,
+    platform: Platform,
+    rate: float = DEFAULT_RATE,
+    convention: str = "utn",
+    coriolis: bool = True,
+) -> Result:
     """Everything ``stewart-drake run`` computes, before writing anything: parse, check, execute,
     sample the trajectory, IK with stroke check, inverse dynamics."""
     program, motion = compile_program(text, filename, platform)

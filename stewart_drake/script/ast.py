@@ -7,7 +7,7 @@ instead of overflowing Python's stack.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Union
+from typing import Union
 
 from stewart_drake.script.errors import Loc
 
@@ -32,7 +32,7 @@ class Var:
 @dataclass(frozen=True)
 class Unary:
     op: str  # "-" or "+"
-    operand: "Expr"
+    operand: Expr
     at: Loc
     depth: int = 1
 
@@ -43,15 +43,15 @@ class Binary:
     ``at`` is the operator's position."""
 
     op: str
-    left: "Expr"
-    right: "Expr"
+    left: Expr
+    right: Expr
     at: Loc
     depth: int = 1
 
 
 @dataclass(frozen=True)
 class Not:
-    operand: "Expr"
+    operand: Expr
     at: Loc
     depth: int = 1
 
@@ -82,7 +82,7 @@ class Assign:
 
 @dataclass(frozen=True)
 class Arg:
-    name: Optional[str]  # None for a positional argument
+    name: str | None  # None for a positional argument
     value: Expr
     at: Loc
 
@@ -91,7 +91,7 @@ class Arg:
 class Move:
     keyword: str  # as written: "mover" or "move"
     args: tuple  # of Arg
-    duration: Optional[Expr]
+    duration: Expr | None
     at: Loc
 
 
@@ -112,7 +112,7 @@ class For:
     var: str
     start: Expr
     stop: Expr
-    step: Optional[Expr]
+    step: Expr | None
     body: tuple
     at: Loc
     var_at: Loc
@@ -121,7 +121,7 @@ class For:
 @dataclass(frozen=True)
 class If:
     branches: tuple  # of (condition, body)
-    orelse: Optional[tuple]
+    orelse: tuple | None
     at: Loc
 
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 import difflib
 
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
-from stewart_drake.script import ast
 from stewart_drake.errors import (
     SCRIPT_FUNC_ARITY,
     SCRIPT_FUNC_UNKNOWN,
@@ -17,6 +16,7 @@ from stewart_drake.errors import (
     SCRIPT_MOVE_UNKNOWN_ARG,
     SCRIPT_NEVER_ASSIGNED,
 )
+from stewart_drake.script import ast
 from stewart_drake.script.errors import ScriptError, raise_all
 from stewart_drake.script.runtime import ARG_ALIASES, ARG_NAMES, CONSTANTS, FUNCTIONS
 
@@ -24,7 +24,7 @@ NUMBER, CONDITION = "number", "condition"
 
 
 def did_you_mean(name: str, candidates) -> str:
-    """" (did you mean 'x'?)" with the candidate closest to ``name`` (difflib), or "" when none is close."""
+    """ " (did you mean 'x'?)" with the candidate closest to ``name`` (difflib), or "" when none is close."""
     close = difflib.get_close_matches(name, sorted(candidates), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
@@ -113,7 +113,9 @@ class _Checker:
         for a in keywords:
             canon = ARG_ALIASES.get(a.name, a.name)
             if canon not in ARG_NAMES:
-                self.err(SCRIPT_MOVE_UNKNOWN_ARG.format(kw=s.keyword, name=a.name) + did_you_mean(a.name, ARG_NAMES), a.at)
+                self.err(
+                    SCRIPT_MOVE_UNKNOWN_ARG.format(kw=s.keyword, name=a.name) + did_you_mean(a.name, ARG_NAMES), a.at
+                )
             elif canon in given:
                 self.err(SCRIPT_MOVE_DUPLICATE_ARG.format(kw=s.keyword, name=canon), a.at)
             given.add(canon)
@@ -151,7 +153,11 @@ class _Checker:
             return NUMBER
         if isinstance(e, ast.Var):
             if e.name not in self.assigned and e.name not in CONSTANTS:
-                self.err(SCRIPT_NEVER_ASSIGNED.format(name=e.name) + did_you_mean(e.name, set(self.assigned) | set(CONSTANTS)), e.at)
+                self.err(
+                    SCRIPT_NEVER_ASSIGNED.format(name=e.name)
+                    + did_you_mean(e.name, set(self.assigned) | set(CONSTANTS)),
+                    e.at,
+                )
             return NUMBER
         if isinstance(e, ast.Unary):
             self.number(e.operand, f"unary {e.op}")
@@ -161,11 +167,17 @@ class _Checker:
             return CONDITION
         if isinstance(e, ast.Call):
             if e.name not in FUNCTIONS:
-                self.err(SCRIPT_FUNC_UNKNOWN.format(name=e.name, available=", ".join(sorted(FUNCTIONS))) + did_you_mean(e.name, FUNCTIONS), e.at)
+                self.err(
+                    SCRIPT_FUNC_UNKNOWN.format(name=e.name, available=", ".join(sorted(FUNCTIONS)))
+                    + did_you_mean(e.name, FUNCTIONS),
+                    e.at,
+                )
             else:
                 n = FUNCTIONS[e.name][0]
                 if len(e.args) != n:
-                    self.err(SCRIPT_FUNC_ARITY.format(name=e.name, expected=n, s="" if n == 1 else "s", n=len(e.args)), e.at)
+                    self.err(
+                        SCRIPT_FUNC_ARITY.format(name=e.name, expected=n, s="" if n == 1 else "s", n=len(e.args)), e.at
+                    )
             for a in e.args:
                 self.number(a, f"{e.name}()")
             return NUMBER

@@ -21,12 +21,41 @@ from stewart_drake.script.runtime import CONSTANTS, DEFAULT_RATE, DEFAULT_UNITS,
 MATLAB_HEADER = "%%CÓDIGO DE MATLAB"  # the seed's sample output ("Archivo de salida")
 
 # Python precedence levels of our operators (higher binds tighter).
-_PREC = {"OR": 1, "AND": 2, "NOT": 3, "=": 4, "<>": 4, "<": 4, "<=": 4, ">": 4, ">=": 4,
-         "+": 5, "-": 5, "*": 6, "/": 6, "DIV": 6, "MOD": 6}
+_PREC = {
+    "OR": 1,
+    "AND": 2,
+    "NOT": 3,
+    "=": 4,
+    "<>": 4,
+    "<": 4,
+    "<=": 4,
+    ">": 4,
+    ">=": 4,
+    "+": 5,
+    "-": 5,
+    "*": 6,
+    "/": 6,
+    "DIV": 6,
+    "MOD": 6,
+}
 _PY_OP = {"OR": "or", "AND": "and", "=": "==", "<>": "!=", "DIV": "//", "MOD": "%"}
 # Names the generated module defines or imports; program variables that clash get a trailing "_".
-_TAKEN = {"math", "motion", "for_range", "Motion", "evaluate", "load_platform", "program", "main",
-          "PLATFORM", "CONVENTION", "RATE", "result", "platform", "np"}
+_TAKEN = {
+    "math",
+    "motion",
+    "for_range",
+    "Motion",
+    "evaluate",
+    "load_platform",
+    "program",
+    "main",
+    "PLATFORM",
+    "CONVENTION",
+    "RATE",
+    "result",
+    "platform",
+    "np",
+}
 
 
 def emit_matlab(motion: Motion) -> str:
@@ -45,8 +74,9 @@ def emit_matlab(motion: Motion) -> str:
     return "\n".join(lines) + "\n"
 
 
-def emit_python(program: ast.Program, platform: str = "utn-kinematic", convention: str = "utn",
-                rate: float = DEFAULT_RATE) -> str:
+def emit_python(
+    program: ast.Program, platform: str = "utn-kinematic", convention: str = "utn", rate: float = DEFAULT_RATE
+) -> str:
     """A Python module equivalent to ``stewart-drake run`` on ``program``."""
     e = _PyEmitter(program)
     body = e.block(program.body, 1)
@@ -55,8 +85,9 @@ def emit_python(program: ast.Program, platform: str = "utn-kinematic", conventio
     try:  # the parser's nesting limits keep this valid; checked so that invalid code is never written
         compile(code, f"<{src} as Python>", "exec", dont_inherit=True)
     except (SyntaxError, RecursionError, MemoryError, ValueError) as err:
-        raise ScriptError(SCRIPT_EMIT.format(kind=err.__class__.__name__, problem=err),
-                          program.body[0].at if program.body else None) from None
+        raise ScriptError(
+            SCRIPT_EMIT.format(kind=err.__class__.__name__, problem=err), program.body[0].at if program.body else None
+        ) from None
     return code
 
 
@@ -108,7 +139,13 @@ class _PyEmitter:
         self.names = {}
         for n in sorted(names):
             m = n
-            while keyword.iskeyword(m) or keyword.issoftkeyword(m) or m in _TAKEN or hasattr(builtins, m) or (m != n and m in names):
+            while (
+                keyword.iskeyword(m)
+                or keyword.issoftkeyword(m)
+                or m in _TAKEN
+                or hasattr(builtins, m)
+                or (m != n and m in names)
+            ):
                 m += "_"
             self.names[n] = m
 
@@ -134,7 +171,9 @@ class _PyEmitter:
             return f"{pad}motion.units({', '.join(repr(n) for n, _ in s.names)}, {at})"
         if isinstance(s, ast.For):
             step = "1" if s.step is None else self.expr(s.step)
-            head = f"{pad}for {self.names[s.var]} in for_range({self.expr(s.start)}, {self.expr(s.stop)}, {step}, {at}):"
+            head = (
+                f"{pad}for {self.names[s.var]} in for_range({self.expr(s.start)}, {self.expr(s.stop)}, {step}, {at}):"
+            )
             return f"{head}\n{self.block(s.body, indent + 1)}"
         if isinstance(s, ast.If):
             out = []

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from stewart_drake.errors import StewartError
 
+
 @dataclass(frozen=True)
 class Loc:
     """A place in a program: file name, 1-based line and column."""

@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import math
 
-from stewart_drake.script import ast
-from stewart_drake.script.check import assigned_names
 from stewart_drake.errors import (
     SCRIPT_DIVISION_BY_ZERO,
     SCRIPT_LOOP_MOVES,
@@ -18,6 +16,8 @@ from stewart_drake.errors import (
     SCRIPT_TOO_MANY_STEPS,
     SCRIPT_UNDEFINED,
 )
+from stewart_drake.script import ast
+from stewart_drake.script.check import assigned_names
 from stewart_drake.script.errors import ScriptError
 from stewart_drake.script.runtime import CONSTANTS, FUNCTIONS, MAX_SEGMENTS, Motion, fmt_number, for_count, for_range
 
@@ -105,7 +105,9 @@ class _Interpreter:
             if e.name in CONSTANTS:
                 return CONSTANTS[e.name][0]
             first = self.assigned.get(e.name)
-            hint = f": it is first assigned at line {first.line}, column {first.column}, after this use" if first else ""
+            hint = (
+                f": it is first assigned at line {first.line}, column {first.column}, after this use" if first else ""
+            )
             raise ScriptError(SCRIPT_UNDEFINED.format(name=e.name) + hint, e.at)
         if isinstance(e, ast.Unary):
             v = self.eval(e.operand)
@@ -141,9 +143,13 @@ def static_cost(body) -> tuple[int, int]:
     steps = moves = 0
     for s in body:
         steps += 1
-        if isinstance(s, ast.Move) or (isinstance(s, ast.Wait) and isinstance(s.duration, ast.Num) and s.duration.value > 0):
+        if isinstance(s, ast.Move) or (
+            isinstance(s, ast.Wait) and isinstance(s.duration, ast.Num) and s.duration.value > 0
+        ):
             moves += 1
-        elif isinstance(s, ast.For) and all(isinstance(e, ast.Num) for e in (s.start, s.stop) + ((s.step,) if s.step else ())):
+        elif isinstance(s, ast.For) and all(
+            isinstance(e, ast.Num) for e in (s.start, s.stop) + ((s.step,) if s.step else ())
+        ):
             step = 1.0 if s.step is None else s.step.value
             k = (s.stop.value - s.start.value) / step if step else -1.0
             n = int(math.floor(k + 1e-9)) + 1 if 0 <= k < 1e18 else 0

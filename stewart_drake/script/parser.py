@@ -8,14 +8,13 @@ positions and turns every Lark exception into a ``ScriptError`` of the form
 from __future__ import annotations
 
 import functools
-from typing import NamedTuple
 from importlib import resources
+from typing import NamedTuple
 
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken, VisitError
 from lark.visitors import Transformer_NonRecursive
 
-from stewart_drake.script import ast
 from stewart_drake.errors import (
     SCRIPT_CANNOT_PARSE,
     SCRIPT_EXPRESSION_DEPTH,
@@ -25,6 +24,7 @@ from stewart_drake.errors import (
     SCRIPT_STATEMENT_DEPTH,
     SCRIPT_SYNTAX,
 )
+from stewart_drake.script import ast
 from stewart_drake.script.errors import Loc, ScriptError
 
 # Deeper nesting than this is refused (later passes recurse over the tree).
@@ -41,8 +41,27 @@ RESERVED_WORDS = frozenset(
     "MODULE OF OPAQUE POINTER PROCEDURE RECORD REPEAT RETURN SET TYPE UNTIL VAR VARIADIC".split()
 )
 # Terminals that are words (shown as keywords in messages); matched case-insensitively.
-KEYWORDS = ("MOVE", "_DURATION", "WAIT", "UNITS", "FOR", "TO", "BY", "DO", "END", "IF", "THEN", "ELSIF",
-            "ELSE", "WHILE", "OR", "AND", "NOT", "DIV", "MOD")
+KEYWORDS = (
+    "MOVE",
+    "_DURATION",
+    "WAIT",
+    "UNITS",
+    "FOR",
+    "TO",
+    "BY",
+    "DO",
+    "END",
+    "IF",
+    "THEN",
+    "ELSIF",
+    "ELSE",
+    "WHILE",
+    "OR",
+    "AND",
+    "NOT",
+    "DIV",
+    "MOD",
+)
 _KEYWORD_SPELLING = {"MOVE": "mover", "_DURATION": "en", "WAIT": "wait", "UNITS": "units"}
 _DESCRIBE = {
     "NAME": "a name",
@@ -59,8 +78,9 @@ _CMP = {"==": "=", "=": "=", "<>": "<>", "#": "<>", "!=": "<>", "<": "<", "<=": 
 @functools.cache
 def _lark() -> Lark:
     grammar = resources.files(__package__).joinpath("stewart.lark").read_text(encoding="utf-8")
-    return Lark(grammar, parser="lalr", lexer="basic", maybe_placeholders=True,
-                lexer_callbacks={"NAME": _check_reserved})
+    return Lark(
+        grammar, parser="lalr", lexer="basic", maybe_placeholders=True, lexer_callbacks={"NAME": _check_reserved}
+    )
 
 
 def _check_reserved(tok: Token) -> Token:
@@ -136,8 +156,12 @@ def parse(text: str, filename: str = "<program>") -> ast.Program:
         msg = SCRIPT_SYNTAX.format(found=found, expected=expected_list(_accepts_at(text[: e.pos_in_stream])))
         raise ScriptError(msg, Loc(filename, e.line, e.column), text, kind="syntax error") from None
     except UnexpectedInput as e:  # any other Lark input error
-        raise ScriptError(SCRIPT_CANNOT_PARSE.format(problem=e), Loc(filename, getattr(e, "line", 1) or 1, getattr(e, "column", 1) or 1),
-                          text, kind="syntax error") from None
+        raise ScriptError(
+            SCRIPT_CANNOT_PARSE.format(problem=e),
+            Loc(filename, getattr(e, "line", 1) or 1, getattr(e, "column", 1) or 1),
+            text,
+            kind="syntax error",
+        ) from None
     try:
         body = _ToAst(filename).transform(tree)
     except VisitError as e:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 # More move ends than this are not marked one by one (a line each would cost seconds per thousand).
 MAX_MARKS = 200
 

@@ -18,9 +18,9 @@ import numpy as np
 from stewart_drake.core.dynamics import MAX_CONDITION, jacobian_condition, leg_forces
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
-from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
 from stewart_drake.core.sanity import above_base, has_plate, plate_anchor_heights
+from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.errors import (
     SCRIPT_BELOW_BASE,
     SCRIPT_DURATION,
@@ -165,7 +165,7 @@ class Motion:
         self._moves = 0
 
     @classmethod
-    def at_home(cls, platform: Platform, **kw) -> "Motion":
+    def at_home(cls, platform: Platform, **kw) -> Motion:
         """A motion starting at the platform's home pose."""
         return cls(platform.home_pose(), **kw)
 
@@ -225,11 +225,15 @@ class Motion:
         if d <= 0:
             raise ScriptError(SCRIPT_DURATION.format(keyword=keyword, value=fmt_number(d)), at)
         if d < MIN_MOVE_DURATION:
-            raise ScriptError(SCRIPT_TOO_SHORT.format(keyword=keyword, value=fmt_number(d), limit=fmt_number(MIN_MOVE_DURATION)), at)
+            raise ScriptError(
+                SCRIPT_TOO_SHORT.format(keyword=keyword, value=fmt_number(d), limit=fmt_number(MIN_MOVE_DURATION)), at
+            )
         self._check_segments(at)
         q1 = np.array(values) * self._scale()
         self._moves += 1
-        seg = Segment("move", self.pose.copy(), q1, d, at, self._moves, keyword, values, (self.length_unit, self.angle_unit))
+        seg = Segment(
+            "move", self.pose.copy(), q1, d, at, self._moves, keyword, values, (self.length_unit, self.angle_unit)
+        )
         self.segments.append(seg)
         self.pose = q1
         return seg
@@ -262,14 +266,24 @@ class Motion:
             raise OptionError(OptionError.POSITIVE.format(option="trajectory rate", unit="Hz", value=rate))
         for s in self.segments:  # each segment's samples, in floating point first (a huge wait overflows int)
             if s.duration * rate > MAX_SAMPLES:
-                raise ScriptError(SCRIPT_SEGMENT_SAMPLES.format(what=s.describe(), duration=fmt_number(s.duration), limit=MAX_SAMPLES,
-                                                                rate=fmt_number(rate), seconds=fmt_number(MAX_SAMPLES / rate)), s.at)
+                raise ScriptError(
+                    SCRIPT_SEGMENT_SAMPLES.format(
+                        what=s.describe(),
+                        duration=fmt_number(s.duration),
+                        limit=MAX_SAMPLES,
+                        rate=fmt_number(rate),
+                        seconds=fmt_number(MAX_SAMPLES / rate),
+                    ),
+                    s.at,
+                )
         counts = [max(1, math.ceil(s.duration * rate - 1e-9)) for s in self.segments]
         total = 1 + sum(counts)
         if total > MAX_SAMPLES:
             seconds = sum(s.duration for s in self.segments)
             raise ScriptError(
-                SCRIPT_TOO_MANY_SAMPLES.format(total=total, seconds=fmt_number(seconds), rate=fmt_number(rate), limit=MAX_SAMPLES),
+                SCRIPT_TOO_MANY_SAMPLES.format(
+                    total=total, seconds=fmt_number(seconds), rate=fmt_number(rate), limit=MAX_SAMPLES
+                ),
                 self.segments[-1].at,
             )
         t, q, qd, qdd, seg = [np.zeros(1)], [self.start[None]], [np.zeros((1, 6))], [np.zeros((1, 6))], [np.array([-1])]
@@ -286,8 +300,17 @@ class Motion:
             t0 += s.duration
         t, q = np.concatenate(t), np.vstack(q)
         segments = tuple(self.segments)
-        return Trajectory("program", partial(segments_pose, segments, q[0].copy()), float(t[-1]), t=t, q=q, qd=np.vstack(qd),
-                          qdd=np.vstack(qdd), segment=np.concatenate(seg), segments=segments)
+        return Trajectory(
+            "program",
+            partial(segments_pose, segments, q[0].copy()),
+            float(t[-1]),
+            t=t,
+            q=q,
+            qd=np.vstack(qd),
+            qdd=np.vstack(qdd),
+            segment=np.concatenate(seg),
+            segments=segments,
+        )
 
 
 @dataclass(frozen=True)
@@ -322,28 +345,39 @@ def check_reachable(platform: Platform, traj: Trajectory, convention: str = "utn
         i, leg = np.unravel_index(np.argmax(excess[idx]), (len(idx), 6))
         n = idx[i]
         below = bool(chk.below[n, leg] > 0)
-        errors.append(ScriptError(
-            SCRIPT_UNREACHABLE.format(
-                what=s.describe(),
-                platform=platform.name,
-                leg=leg + 1,
-                excess=excess[n, leg] * 1e3,
-                side="below" if below else "above",
-                bound="minimum" if below else "maximum",
-                limit=(platform.L_min if below else platform.L_max) * 1e3,
-                length=L[n, leg] * 1e3,
-                t=traj.t[n],
-                where="" if n == np.flatnonzero(traj.segment == k)[-1] else ", on the way there",
-            ),
-            s.at,
-        ))
+        errors.append(
+            ScriptError(
+                SCRIPT_UNREACHABLE.format(
+                    what=s.describe(),
+                    platform=platform.name,
+                    leg=leg + 1,
+                    excess=excess[n, leg] * 1e3,
+                    side="below" if below else "above",
+                    bound="minimum" if below else "maximum",
+                    limit=(platform.L_min if below else platform.L_max) * 1e3,
+                    length=L[n, leg] * 1e3,
+                    t=traj.t[n],
+                    where="" if n == np.flatnonzero(traj.segment == k)[-1] else ", on the way there",
+                ),
+                s.at,
+            )
+        )
     if not errors:  # only the start pose (and waits holding it) is out of stroke
         leg = int(np.argmax(excess[0]))
-        raise ScriptError(SCRIPT_START_OUT_OF_REACH.format(platform=platform.name, leg=leg + 1, length_mm=L[0, leg] * 1e3,
-                                                           lo_mm=platform.L_min * 1e3, hi_mm=platform.L_max * 1e3))
+        raise ScriptError(
+            SCRIPT_START_OUT_OF_REACH.format(
+                platform=platform.name,
+                leg=leg + 1,
+                length_mm=L[0, leg] * 1e3,
+                lo_mm=platform.L_min * 1e3,
+                hi_mm=platform.L_max * 1e3,
+            )
+        )
     if len(errors) > MAX_REPORTED:
         more = len(errors) - MAX_REPORTED
-        errors = errors[:MAX_REPORTED] + [ScriptError(SCRIPT_MORE_UNREACHABLE.format(more=more), errors[MAX_REPORTED].at)]
+        errors = errors[:MAX_REPORTED] + [
+            ScriptError(SCRIPT_MORE_UNREACHABLE.format(more=more), errors[MAX_REPORTED].at)
+        ]
     raise_all(errors)
     return L  # pragma: no cover
 
@@ -361,9 +395,16 @@ def _check_above_base(platform: Platform, traj: Trajectory, convention: str) -> 
     leg = int(np.argmin(z))
     what = seg.describe() if seg is not None else "the start pose"
     raise ScriptError(
-        SCRIPT_BELOW_BASE.format(what=what, where="in" if z[leg] == 0 else "below", platform=platform.name, leg=leg + 1,
-                                 z_mm=z[leg] * 1e3, t=traj.t[n]),
-        seg.at if seg is not None else None)
+        SCRIPT_BELOW_BASE.format(
+            what=what,
+            where="in" if z[leg] == 0 else "below",
+            platform=platform.name,
+            leg=leg + 1,
+            z_mm=z[leg] * 1e3,
+            t=traj.t[n],
+        ),
+        seg.at if seg is not None else None,
+    )
 
 
 def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) -> ScriptError:
@@ -381,16 +422,25 @@ def _singular_error(platform: Platform, traj: Trajectory, convention: str, err) 
     )
 
 
-def evaluate(platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True,
-             gravity: float = 9.81) -> Result:
+def evaluate(
+    platform: Platform, traj: Trajectory, convention: str = "utn", coriolis: bool = True, gravity: float = 9.81
+) -> Result:
     """Inverse kinematics (with the stroke check) and inverse dynamics on a trajectory."""
     L = check_reachable(platform, traj, convention)
     notes = []
     if not has_plate(platform):  # a massless plate would give every force as 0
-        return Result(traj, L, None, platform.name, convention,
-                      (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",))
+        return Result(
+            traj,
+            L,
+            None,
+            platform.name,
+            convention,
+            (f"leg forces not computed: platform {platform.name!r} has no plate mass properties (YAML key 'plate')",),
+        )
     try:
-        F = np.asarray(leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity))
+        F = np.asarray(
+            leg_forces(platform, traj.q, traj.qd, traj.qdd, convention=convention, coriolis=coriolis, gravity=gravity)
+        )
     except SingularPoseError as e:
         raise _singular_error(platform, traj, convention, e) from None
     return Result(traj, L, F, platform.name, convention, tuple(notes))

@@ -13,7 +13,9 @@ from stewart_drake.workspace.grid import default_bounds
 from stewart_drake.workspace.limits import check_orientation
 
 
-def stroke_column_lengths(platform: Platform, x, y, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_bounds=(0.0, np.inf)) -> np.ndarray:
+def stroke_column_lengths(
+    platform: Platform, x, y, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_bounds=(0.0, np.inf)
+) -> np.ndarray:
     """``(...)`` length (m) of the set of z in ``z_bounds`` with every leg within stroke, for columns at
     ``x``, ``y`` (broadcast, metres). Per leg, L_min² <= ρ² + (z - c_z)² <= L_max² is one or two
     z-intervals; their intersection is measured exactly between sorted interval end points."""
@@ -33,7 +35,13 @@ def stroke_column_lengths(platform: Platform, x, y, orientation=(0.0, 0.0, 0.0),
     return np.sum(np.where(ok, ends[..., 1:] - ends[..., :-1], 0.0), axis=-1)
 
 
-def stroke_volume_columns(platform: Platform, resolution: float, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float | None = None) -> float:
+def stroke_volume_columns(
+    platform: Platform,
+    resolution: float,
+    orientation=(0.0, 0.0, 0.0),
+    convention: str = "utn",
+    z_floor: float | None = None,
+) -> float:
     """Volume (m³) of the stroke workspace above ``z_floor`` (default ``sanity.plate_floor``: every plate
     anchor above the base): exact column lengths integrated by the midpoint rule on an (x, y) grid of
     step ``resolution`` (error O(h^1.5) from the rim)."""

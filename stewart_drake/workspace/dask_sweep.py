@@ -75,8 +75,13 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
     held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
     try:
         with dask.config.set(WORKER_CONFIG):
-            return distributed.LocalCluster(n_workers=n_workers, threads_per_worker=threads_per_worker, processes=processes,
-                                            dashboard_address=None, **kwargs)
+            return distributed.LocalCluster(
+                n_workers=n_workers,
+                threads_per_worker=threads_per_worker,
+                processes=processes,
+                dashboard_address=None,
+                **kwargs,
+            )
     finally:
         if held is not None:
             os.environ["MALLOC_TRIM_THRESHOLD_"] = held
@@ -111,8 +116,16 @@ def dask_executor(client):
     return client.get_executor(pure=False)
 
 
-def slab_nodes(platform, threads: int, orientation=(0.0, 0.0, 0.0), resolution: float = 0.01, convention: str = "utn",
-               bounds=None, chunk_nodes: int = 1 << 21, **_) -> int:
+def slab_nodes(
+    platform,
+    threads: int,
+    orientation=(0.0, 0.0, 0.0),
+    resolution: float = 0.01,
+    convention: str = "utn",
+    bounds=None,
+    chunk_nodes: int = 1 << 21,
+    **_,
+) -> int:
     """The ``chunk_nodes`` that gives at least ``TASKS_PER_WORKER`` slabs per thread (never more than
     ``chunk_nodes``; a slab keeps at least two x-planes)."""
     b = _ws.default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)

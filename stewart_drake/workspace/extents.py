@@ -23,7 +23,9 @@ def _extreme_indices(views) -> list:
 
 def extents_from_views(axes, top, front, side, h):
     """Grid-level extents: the true extreme lies within h beyond the extreme inside node."""
-    ext = np.array([[axes[k][i0] - h / 2, axes[k][i1] + h / 2] for k, (i0, i1) in enumerate(_extreme_indices((top, front, side)))])
+    ext = np.array(
+        [[axes[k][i0] - h / 2, axes[k][i1] + h / 2] for k, (i0, i1) in enumerate(_extreme_indices((top, front, side)))]
+    )
     return ext, h / 2
 
 
@@ -67,7 +69,9 @@ def refine_extents(spec: GridSpec, extents, top, front, side, h, feas_tol: float
         q = np.r_[p, o]
         l = leg_vectors(spec.platform, q, spec.convention)
         above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
-        return np.concatenate([m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()] + above)
+        return np.concatenate(
+            [m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()] + above
+        )
 
     for k, (i_lo, i_hi) in enumerate(_extreme_indices((top, front, side))):
         for side_i, (idx, sign) in enumerate(((i_lo, -1), (i_hi, 1))):
@@ -77,8 +81,14 @@ def refine_extents(spec: GridSpec, extents, top, front, side, h, feas_tol: float
             cands = nodes[margins_batch(nodes).min(axis=1) >= 0] if len(nodes) else nodes
             if len(cands):
                 start = cands[np.argmin(np.linalg.norm(cands - cands.mean(axis=0), axis=1))]
-                res = minimize(lambda p: -sign * p[k], start, jac=lambda p: -sign * np.eye(3)[k], method="SLSQP",
-                               constraints={"type": "ineq", "fun": margins}, options={"ftol": 1e-12, "maxiter": 200})
+                res = minimize(
+                    lambda p: -sign * p[k],
+                    start,
+                    jac=lambda p: -sign * np.eye(3)[k],
+                    method="SLSQP",
+                    constraints={"type": "ineq", "fun": margins},
+                    options={"ftol": 1e-12, "maxiter": 200},
+                )
                 if margins(res.x).min() >= -feas_tol and sign * res.x[k] >= sign * node_c:
                     best = float(res.x[k])
             out[k, side_i] = best

@@ -112,7 +112,9 @@ class Workspace:
         }
 
 
-def default_bounds(platform: Platform, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float | None = None) -> np.ndarray:
+def default_bounds(
+    platform: Platform, orientation=(0.0, 0.0, 0.0), convention: str = "utn", z_floor: float | None = None
+) -> np.ndarray:
     """``(3, 2)`` a box that holds the whole stroke workspace: the intersection of the six balls'
     bounding boxes (|p + l_i(0)| <= L_max), cut below at ``z_floor`` (default ``sanity.plate_floor``:
     every plate anchor above the base plane, which excludes the mirror-image workspace under the base)."""
@@ -189,7 +191,11 @@ def constant_orientation_workspace(
         boundaries.append(r["boundary"])
     bnd_idx = np.concatenate(boundaries)
     if inside == 0:
-        raise WorkspaceError(WorkspaceError.NOTHING_REACHABLE.format(orientation=spec.orientation.tolist(), limits=list(limits.active), h=h))
+        raise WorkspaceError(
+            WorkspaceError.NOTHING_REACHABLE.format(
+                orientation=spec.orientation.tolist(), limits=list(limits.active), h=h
+            )
+        )
     boundary = np.stack([axes[k][bnd_idx[:, k]] for k in range(3)], -1).astype(np.float32)
     h3 = h**3
     vol = inside * h3

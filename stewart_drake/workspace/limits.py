@@ -10,10 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.errors import WorkspaceError
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import condition_number, leg_vectors
 from stewart_drake.core.rotations import check_convention, rotation_matrix
+from stewart_drake.errors import WorkspaceError
 
 LIMIT_NAMES = ("stroke", "base_joint", "top_joint", "collision", "dexterity")
 LIMIT_UNITS = {"stroke": "m", "base_joint": "rad", "top_joint": "rad", "collision": "m", "dexterity": "1"}
@@ -80,7 +80,9 @@ def segment_distances(P1, Q1, P2, Q2) -> np.ndarray:
     Clamped closest-point parameters (Ericson, *Real-Time Collision Detection* §5.1.9); parallel
     segments take s = 0. Segments must have non-zero length.
     """
-    P1, Q1, P2, Q2 = (np.moveaxis(v, -1, 0) for v in np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (P1, Q1, P2, Q2))))
+    P1, Q1, P2, Q2 = (
+        np.moveaxis(v, -1, 0) for v in np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (P1, Q1, P2, Q2)))
+    )
     d1, d2, r = Q1 - P1, Q2 - P2, P1 - P2  # (3, ...) components first: cheaper than einsum on a length-3 axis
 
     def dot(u, v):
@@ -136,7 +138,9 @@ def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention
             d = np.empty((len(P), len(pairs)))
             for k in range(0, len(P), _BLOCK):  # blocks that stay in cache: ~6x faster than one pass
                 Pk = P[k : k + _BLOCK]
-                d[k : k + _BLOCK] = segment_distances(B[pairs[:, 0]], Pk[:, pairs[:, 0]], B[pairs[:, 1]], Pk[:, pairs[:, 1]])
+                d[k : k + _BLOCK] = segment_distances(
+                    B[pairs[:, 0]], Pk[:, pairs[:, 0]], B[pairs[:, 1]], Pk[:, pairs[:, 1]]
+                )
             out["collision"] = d.reshape(L.shape[:-1] + (len(pairs),)) - limits.leg_diameter
         else:
             out["collision"] = np.full(L.shape[:-1] + (1,), np.inf)
@@ -150,7 +154,10 @@ def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention
 def margins_from_legs(platform: Platform, l, R, limits: Limits, poses=None, convention="utn") -> dict:
     """``{name: (margin (...), index (...))}``: the worst element of each ``raw_margins`` entry; index is
     the worst leg (0-based) or, for collision, the worst row of ``leg_pairs``."""
-    return {n: (m.min(axis=-1), m.argmin(axis=-1)) for n, m in raw_margins(platform, l, R, limits, poses, convention).items()}
+    return {
+        n: (m.min(axis=-1), m.argmin(axis=-1))
+        for n, m in raw_margins(platform, l, R, limits, poses, convention).items()
+    }
 
 
 def limit_margins(platform: Platform, poses, limits: Limits = Limits(), convention: str = "utn") -> dict:

@@ -13,7 +13,15 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, leg_vectors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import above_base, plate_anchor_heights
-from stewart_drake.workspace.limits import AXES, LIMIT_UNITS, Limits, WorkspaceError, leg_pairs, limit_margins, raw_margins
+from stewart_drake.workspace.limits import (
+    AXES,
+    LIMIT_UNITS,
+    Limits,
+    WorkspaceError,
+    leg_pairs,
+    limit_margins,
+    raw_margins,
+)
 
 
 @dataclass(frozen=True)
@@ -80,8 +88,14 @@ def orientation_limits(
     m0 = limit_margins(pivot, start, limits)
     bad = [n for n, (m, _) in m0.items() if m < 0]
     if bad:
-        raise WorkspaceError(WorkspaceError.START_OUTSIDE.format(pose=np.round(np.r_[pos, 0, 0, 0], 6).tolist(), limit=bad[0],
-                                                                 margin=float(m0[bad[0]][0]), unit=LIMIT_UNITS[bad[0]]))
+        raise WorkspaceError(
+            WorkspaceError.START_OUTSIDE.format(
+                pose=np.round(np.r_[pos, 0, 0, 0], 6).tolist(),
+                limit=bad[0],
+                margin=float(m0[bad[0]][0]),
+                unit=LIMIT_UNITS[bad[0]],
+            )
+        )
 
     def poses(dirs, angles):  # dirs (k,) 0..5 -> axis, sign; angles (k, n) magnitudes
         q = np.broadcast_to(start, angles.shape + (6,)).copy()
@@ -133,5 +147,7 @@ def orientation_limits(
                 at_limit = tuple(int(j) + 1 for j in crossing)
             if name == "stroke":
                 side = "max" if L[d, idx] > platform.stroke.mean() else "min"
-        out.append(RotationLimit(AXES[d // 2], sign, sign * float(lo[d]), L[d], name, leg, pair, side, bool(reached), at_limit))
+        out.append(
+            RotationLimit(AXES[d // 2], sign, sign * float(lo[d]), L[d], name, leg, pair, side, bool(reached), at_limit)
+        )
     return out

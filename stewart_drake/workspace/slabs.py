@@ -37,7 +37,16 @@ def grid_spec(platform, orientation, convention, limits, axes) -> GridSpec:
     ``orientation`` (3,) rad."""
     o = check_orientation(orientation)
     l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, o], convention)
-    return GridSpec(platform, o, convention, limits, l0, rotation_matrix(o, convention), tuple(axes), plate_floor(platform, o, convention))
+    return GridSpec(
+        platform,
+        o,
+        convention,
+        limits,
+        l0,
+        rotation_matrix(o, convention),
+        tuple(axes),
+        plate_floor(platform, o, convention),
+    )
 
 
 def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
@@ -52,7 +61,11 @@ def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
     if spec.limits.stroke:
         for i in range(6):
             c = spec.offsets[i]
-            d2 = ((xs + c[0]) ** 2)[:, None, None] + ((ys + c[1]) ** 2)[None, :, None] + ((zs + c[2]) ** 2)[None, None, :]
+            d2 = (
+                ((xs + c[0]) ** 2)[:, None, None]
+                + ((ys + c[1]) ** 2)[None, :, None]
+                + ((zs + c[2]) ** 2)[None, None, :]
+            )
             ok &= (d2 >= lo2) & (d2 <= hi2)
     removed = {}
     others = [n for n in spec.limits.active if n != "stroke"]
@@ -61,7 +74,9 @@ def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
         pos = np.stack([xs[idx[0]], ys[idx[1]], zs[idx[2]]], -1)
         l = pos[:, None, :] + spec.offsets
         poses = np.concatenate([pos, np.broadcast_to(spec.orientation, pos.shape)], -1)
-        margins = margins_from_legs(p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention)
+        margins = margins_from_legs(
+            p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention
+        )
         keep = np.ones(len(pos), bool)
         for name in others:
             bad = margins[name][0] < 0
@@ -89,7 +104,14 @@ def slab_task(spec: GridSpec, i0: int, i1: int) -> dict:
         full, mixed = int(np.count_nonzero(s == 8)), int(np.count_nonzero((s > 0) & (s < 8)))
     # boundary: inside nodes with an outside (or off-grid) face neighbour
     pad = np.pad(m, 1, constant_values=False)
-    nb = pad[:-2, 1:-1, 1:-1] & pad[2:, 1:-1, 1:-1] & pad[1:-1, :-2, 1:-1] & pad[1:-1, 2:, 1:-1] & pad[1:-1, 1:-1, :-2] & pad[1:-1, 1:-1, 2:]
+    nb = (
+        pad[:-2, 1:-1, 1:-1]
+        & pad[2:, 1:-1, 1:-1]
+        & pad[1:-1, :-2, 1:-1]
+        & pad[1:-1, 2:, 1:-1]
+        & pad[1:-1, 1:-1, :-2]
+        & pad[1:-1, 1:-1, 2:]
+    )
     bnd = np.argwhere(mo & ~nb[own]).astype(np.int32)
     bnd[:, 0] += i0
     return {
@@ -102,6 +124,11 @@ def slab_task(spec: GridSpec, i0: int, i1: int) -> dict:
         "side": mo.any(axis=0),
         "boundary": bnd,
         "removed": {n: int(v[own].sum()) for n, v in removed_all.items()},
-        "edge": bool((i0 == 0 and mo[0].any()) or (i1 == len(x) and mo[-1].any()) or mo[:, [0, -1], :].any() or mo[:, :, [0, -1]].any()),
+        "edge": bool(
+            (i0 == 0 and mo[0].any())
+            or (i1 == len(x) and mo[-1].any())
+            or mo[:, [0, -1], :].any()
+            or mo[:, :, [0, -1]].any()
+        ),
         "inside_2h": int(np.count_nonzero(mo[(np.arange(i0, i1) % 2) == 0][:, ::2, ::2])),
     }

@@ -30,8 +30,9 @@ def ci(n: int):
 
 def fuzz(fn):
     """Mark a long property test: ``pytest -m fuzz``; ``FUZZ_EXAMPLES`` examples, derandomised."""
-    fn = settings(max_examples=FUZZ_EXAMPLES, derandomize=True, deadline=None, database=None,
-                  suppress_health_check=_HEALTH)(fn)
+    fn = settings(
+        max_examples=FUZZ_EXAMPLES, derandomize=True, deadline=None, database=None, suppress_health_check=_HEALTH
+    )(fn)
     return pytest.mark.fuzz(fn)
 
 

@@ -24,8 +24,26 @@ def test_ik_json(capsys):
 
 
 def test_ik_units_and_convention(capsys):
-    rc, out, _ = run(capsys, "ik", "--platform", "utn-dynamic", "--pose", "-0.1", "0.05", "0.7", "0.1", "0.05", "-0.1",
-                     "--length-unit", "m", "--angle-unit", "pi", "--convention", "zyx", "--json")
+    rc, out, _ = run(
+        capsys,
+        "ik",
+        "--platform",
+        "utn-dynamic",
+        "--pose",
+        "-0.1",
+        "0.05",
+        "0.7",
+        "0.1",
+        "0.05",
+        "-0.1",
+        "--length-unit",
+        "m",
+        "--angle-unit",
+        "pi",
+        "--convention",
+        "zyx",
+        "--json",
+    )
     p = load_preset("utn-dynamic")
     expect = leg_lengths(p, [-0.1, 0.05, 0.7, 0.1 * np.pi, 0.05 * np.pi, -0.1 * np.pi], "zyx")
     np.testing.assert_allclose(json.loads(out)["lengths"], expect, rtol=1e-14)
@@ -64,8 +82,25 @@ def test_bad_arguments_one_line(capsys, argv, message):
 
 
 def test_console_script_bad_unit_exits_2():
-    r = subprocess.run([sys.executable, "-m", "stewart_drake.cli", "ik", "--pose", "0", "0", "0", "0", "0", "0", "--angle-unit", "grad"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "stewart_drake.cli",
+            "ik",
+            "--pose",
+            "0",
+            "0",
+            "0",
+            "0",
+            "0",
+            "0",
+            "--angle-unit",
+            "grad",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 2 and "invalid choice: 'grad'" in r.stderr and "Traceback" not in r.stderr
 
 

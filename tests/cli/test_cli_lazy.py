@@ -54,15 +54,18 @@ def test_one_command_parser_imports_only_that_command():
     assert any(a.dest == "lengths" for a in full_sub.choices["fk"]._actions)
 
 
-@pytest.mark.parametrize("argv, command", [
-    (["ik", "--pose", "0", "0", "100", "0", "0", "0", "--json"], "ik"),
-    (["fk", "--lengths", "473", "473", "473", "473", "473", "473", "--json"], "fk"),
-    (["dynamics", "--platform", "utn-dynamic", "--t-end", "0.2", "--json"], "dynamics"),
-    (["dsp-ik", "--pose", "0", "0", "100", "0.1", "0", "0", "--json"], "dsp_ik"),
-    (["workspace", "--resolution", "0.02", "--json"], "workspace"),
-    (["servo", "--pose", "0", "0", "0", "0", "0", "0", "--from-home", "--json"], "servo"),
-    (["leg", "fk", "0.1", "0.2"], "leg"),
-])
+@pytest.mark.parametrize(
+    "argv, command",
+    [
+        (["ik", "--pose", "0", "0", "100", "0", "0", "0", "--json"], "ik"),
+        (["fk", "--lengths", "473", "473", "473", "473", "473", "473", "--json"], "fk"),
+        (["dynamics", "--platform", "utn-dynamic", "--t-end", "0.2", "--json"], "dynamics"),
+        (["dsp-ik", "--pose", "0", "0", "100", "0.1", "0", "0", "--json"], "dsp_ik"),
+        (["workspace", "--resolution", "0.02", "--json"], "workspace"),
+        (["servo", "--pose", "0", "0", "0", "0", "0", "0", "--from-home", "--json"], "servo"),
+        (["leg", "fk", "0.1", "0.2"], "leg"),
+    ],
+)
 def test_numpy_commands_run_without_pydrake(argv, command):
     status, out, err = run_blocked(*argv)
     assert status["rc"] == 0, err

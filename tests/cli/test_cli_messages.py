@@ -18,30 +18,58 @@ def short_csv(tmp_path):
 @pytest.fixture
 def repeated_time_csv(tmp_path):
     f = tmp_path / "times.csv"
-    f.write_text("t,px,py,pz,a,b,g\n0,0,0,0.7,0,0,0\n0,0.001,0,0.7,0,0,0\n"
-                 "0.2,0.002,0,0.7,0,0,0\n0.3,0.003,0,0.7,0,0,0\n")
+    f.write_text(
+        "t,px,py,pz,a,b,g\n0,0,0,0.7,0,0,0\n0,0.001,0,0.7,0,0,0\n0.2,0.002,0,0.7,0,0,0\n0.3,0.003,0,0.7,0,0,0\n"
+    )
     return f
 
 
-STIFFNESS = ["stiffness", "--platform", "utn-dynamic", "--pose", "0", "0", "0.7", "0", "0", "0", "--length-unit", "m",
-             "--angle-unit", "rad", "--leg-stiffness", "1e7"]
+STIFFNESS = [
+    "stiffness",
+    "--platform",
+    "utn-dynamic",
+    "--pose",
+    "0",
+    "0",
+    "0.7",
+    "0",
+    "0",
+    "0",
+    "--length-unit",
+    "m",
+    "--angle-unit",
+    "rad",
+    "--leg-stiffness",
+    "1e7",
+]
 CASES = [
     (["dynamics", "--platform", "utn-dynamic", "--legs", "on", "--coriolis", "off"], UsageError.LEGS_CORIOLIS),
-    (["dynamics", "--platform", "utn-dynamic", "--dt", "0", "--t-end", "1"],
-     OptionError.DT.format(dt="0", t_end="1")),
-    (["workspace", "--resolution", "-1"],
-     OptionError.POSITIVE.format(option="--resolution", unit="metres", value="-1")),
+    (["dynamics", "--platform", "utn-dynamic", "--dt", "0", "--t-end", "1"], OptionError.DT.format(dt="0", t_end="1")),
+    (
+        ["workspace", "--resolution", "-1"],
+        OptionError.POSITIVE.format(option="--resolution", unit="metres", value="-1"),
+    ),
     (["workspace", "--workers", "0"], OptionError.AT_LEAST.format(option="--workers", min=1, value=0)),
-    (["workspace", "--limits", "stroke,bogus"],
-     OptionError.UNKNOWN_LIMIT.format(option="--limits", value="bogus", valid="stroke, joints, collision, dexterity")),
-    (["size", "--platform", "utn-dynamic", "--trajectory", "seed", "--dt", "0"],
-     OptionError.DT.format(dt="0", t_end="4.0")),
+    (
+        ["workspace", "--limits", "stroke,bogus"],
+        OptionError.UNKNOWN_LIMIT.format(
+            option="--limits", value="bogus", valid="stroke, joints, collision, dexterity"
+        ),
+    ),
+    (
+        ["size", "--platform", "utn-dynamic", "--trajectory", "seed", "--dt", "0"],
+        OptionError.DT.format(dt="0", t_end="4.0"),
+    ),
     (STIFFNESS + ["--gravity", "-1"], OptionError.GRAVITY.format(option="--gravity", value="-1")),
-    (STIFFNESS + ["--map", "maps", "--map-n", "1"],
-     OptionError.BETWEEN.format(option="--map-n", lo=2, hi=int(MAX_POINTS**0.5), value=1)),
+    (
+        STIFFNESS + ["--map", "maps", "--map-n", "1"],
+        OptionError.BETWEEN.format(option="--map-n", lo=2, hi=int(MAX_POINTS**0.5), value=1),
+    ),
     (["report", "--jobs", "0"], OptionError.BETWEEN.format(option="--jobs", lo=1, hi=64, value=0)),
-    (["dsp-ik", "--pose", "0", "0", "100", "200", "0", "0", "--angle-unit", "deg"],
-     DspPoseError.ANGLE_OPTION.format(name="A", value=200.0, unit="deg")),
+    (
+        ["dsp-ik", "--pose", "0", "0", "100", "200", "0", "0", "--angle-unit", "deg"],
+        DspPoseError.ANGLE_OPTION.format(name="A", value=200.0, unit="deg"),
+    ),
 ]
 
 

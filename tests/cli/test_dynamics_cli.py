@@ -26,7 +26,23 @@ def test_csv_file_in_degrees_and_csv_out(tmp_path, capsys):
     path = tmp_path / "traj.csv"
     rows = np.c_[t, q[:, :3] * 1e3, np.degrees(q[:, 3:])]
     path.write_text("t,px,py,pz,a,b,g\n" + "\n".join(",".join(f"{v:.12g}" for v in r) for r in rows))
-    assert main(["dynamics", "--trajectory", str(path), "--length-unit", "mm", "--angle-unit", "deg", "--csv", "--coriolis", "off"]) == 0
+    assert (
+        main(
+            [
+                "dynamics",
+                "--trajectory",
+                str(path),
+                "--length-unit",
+                "mm",
+                "--angle-unit",
+                "deg",
+                "--csv",
+                "--coriolis",
+                "off",
+            ]
+        )
+        == 0
+    )
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines[0] == "t,F1,F2,F3,F4,F5,F6" and len(lines) == 202
     F = np.array([[float(x) for x in ln.split(",")[1:]] for ln in lines[1:]])
@@ -42,7 +58,9 @@ def test_19_column_file_is_exact(tmp_path, capsys):
     np.savetxt(path, np.c_[t, q, qd, qdd], delimiter=",")
     assert main(["dynamics", "--trajectory", str(path), "--json", "--legs", "on"]) == 0
     out = json.loads(capsys.readouterr().out)
-    np.testing.assert_allclose(out["forces"], D.leg_forces_with_legs(load_preset("utn-dynamic"), q, qd, qdd), rtol=1e-12)
+    np.testing.assert_allclose(
+        out["forces"], D.leg_forces_with_legs(load_preset("utn-dynamic"), q, qd, qdd), rtol=1e-12
+    )
 
 
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys):

@@ -36,16 +36,33 @@ def test_fk_convention_and_units(capsys):
     p = load_preset("utn-dynamic")
     q = np.array([0.02, 0.01, 0.68, 0.1, -0.05, 0.2])  # zyx angles
     L = leg_lengths(p, q, "zyx")
-    rc, out, _ = run(capsys, "fk", "--platform", "utn-dynamic", "--lengths", *(repr(float(v)) for v in L), "--length-unit", "m",
-                     "--angle-unit", "rad", "--convention", "zyx", "--json")
+    rc, out, _ = run(
+        capsys,
+        "fk",
+        "--platform",
+        "utn-dynamic",
+        "--lengths",
+        *(repr(float(v)) for v in L),
+        "--length-unit",
+        "m",
+        "--angle-unit",
+        "rad",
+        "--convention",
+        "zyx",
+        "--json",
+    )
     np.testing.assert_allclose(json.loads(out)["solutions"][0]["pose"], q, atol=1e-12)
-    assert np.allclose(rotation_matrix(q[3:], "zyx"), rotation_matrix(json.loads(out)["solutions"][0]["pose"][3:], "zyx"))
+    assert np.allclose(
+        rotation_matrix(q[3:], "zyx"), rotation_matrix(json.loads(out)["solutions"][0]["pose"][3:], "zyx")
+    )
 
 
 def test_fk_all_modes(capsys):
     p = load_preset("utn-dynamic")
     L = leg_lengths(p, p.home_pose()) * 1e3
-    rc, out, _ = run(capsys, "fk", "--platform", "utn-dynamic", "--lengths", *(repr(float(v)) for v in L), "--all", "--json")
+    rc, out, _ = run(
+        capsys, "fk", "--platform", "utn-dynamic", "--lengths", *(repr(float(v)) for v in L), "--all", "--json"
+    )
     d = json.loads(out)
     assert rc == 0 and len(d["solutions"]) == 16 and d["complete"] and d["max_solutions"] == 16
     np.testing.assert_allclose(d["solutions"][0]["pose"], [0, 0, 700, 0, 0, 0], atol=1e-9)  # nearest home first

@@ -13,15 +13,62 @@ import argparse
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tests.cli._fuzz import ci, fuzz, run_and_check
 from stewart_drake.cli import build_parser, checked_int, finite_number
+from tests.cli._fuzz import ci, fuzz, run_and_check
 
-NUMBERS = ["0", "1", "-1", "2.5", "100", "473", "700", "-0.473", "1e308", "-1e308", "1e-300", "nan", "inf", "-inf",
-           "abc", "", "0x10", "1_000", "1e", "--", " 5", "45", "90", "180", "-180", "1000"]
+NUMBERS = [
+    "0",
+    "1",
+    "-1",
+    "2.5",
+    "100",
+    "473",
+    "700",
+    "-0.473",
+    "1e308",
+    "-1e308",
+    "1e-300",
+    "nan",
+    "inf",
+    "-inf",
+    "abc",
+    "",
+    "0x10",
+    "1_000",
+    "1e",
+    "--",
+    " 5",
+    "45",
+    "90",
+    "180",
+    "-180",
+    "1000",
+]
 INTS = ["0", "1", "-1", "5", "30", "abc", "1e9", "9" * 30, "", "2"]
-PATHS = ["good.yaml", "bad.yaml", "poses.csv", "traj.csv", "prog.stw", "missing.yaml", "missing.csv", "emptydir", "userdir",
-         "afile.txt", "", "/proc/x", "..", ".", "new_out", "seed", "rotating", "utn-kinematic", "utn-dynamic",
-         "gonzalez-dutra-2009", "hobby-servo", "userdir/new.m"]
+PATHS = [
+    "good.yaml",
+    "bad.yaml",
+    "poses.csv",
+    "traj.csv",
+    "prog.stw",
+    "missing.yaml",
+    "missing.csv",
+    "emptydir",
+    "userdir",
+    "afile.txt",
+    "",
+    "/proc/x",
+    "..",
+    ".",
+    "new_out",
+    "seed",
+    "rotating",
+    "utn-kinematic",
+    "utn-dynamic",
+    "gonzalez-dutra-2009",
+    "hobby-servo",
+    "userdir/new.m",
+]
 # Work sizes: small values only (bounding big ones is another test's business), and invalid ones.
 SAFE = {
     "--resolution": ["0.05", "0.1", "0", "-0.01", "abc"],
@@ -90,8 +137,11 @@ def values_for(action):
         invalid = st.sampled_from(["x", "", "MM"])
     elif action.type is finite_number:
         valid = st.sampled_from(PLAUSIBLE)
-        invalid = st.one_of(st.sampled_from(NUMBERS), st.floats(allow_nan=True, allow_infinity=True).map(repr),
-                            st.integers(-10**6, 10**6).map(str))
+        invalid = st.one_of(
+            st.sampled_from(NUMBERS),
+            st.floats(allow_nan=True, allow_infinity=True).map(repr),
+            st.integers(-(10**6), 10**6).map(str),
+        )
     elif action.type is checked_int:
         valid, invalid = st.sampled_from(["0", "1", "5"]), st.sampled_from(INTS)
     else:
@@ -110,7 +160,9 @@ def nargs_count(action) -> int | None:
 def argv(draw):
     prefix, parser = draw(st.sampled_from(COMMANDS))
     args = list(prefix)
-    actions = [a for a in parser._actions if not isinstance(a, argparse._HelpAction) and a.option_strings[:1] != ["--version"]]
+    actions = [
+        a for a in parser._actions if not isinstance(a, argparse._HelpAction) and a.option_strings[:1] != ["--version"]
+    ]
     for a in actions:
         if a.option_strings and set(a.option_strings) & SKIP:
             continue
@@ -154,5 +206,20 @@ def test_cli_vectors_fuzz(vector):
 
 def test_every_subcommand_is_generated():
     names = {" ".join(p) for p, _ in COMMANDS}
-    assert names >= {"compile", "dsp-ik", "dynamics", "fk", "ik", "init", "leg fk", "leg ik", "leg sdf", "model", "report",
-                     "run", "servo", "simulate", "workspace"}
+    assert names >= {
+        "compile",
+        "dsp-ik",
+        "dynamics",
+        "fk",
+        "ik",
+        "init",
+        "leg fk",
+        "leg ik",
+        "leg sdf",
+        "model",
+        "report",
+        "run",
+        "servo",
+        "simulate",
+        "workspace",
+    }

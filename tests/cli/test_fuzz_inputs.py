@@ -14,8 +14,8 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 from hypothesis.extra.lark import from_lark
 
-from tests.cli._fuzz import PLATFORM_TEMPLATE, PROGRAM, ci, fuzz, run_and_check, scratch
 from stewart_drake.script.parser import _lark
+from tests.cli._fuzz import PLATFORM_TEMPLATE, PROGRAM, ci, fuzz, run_and_check, scratch
 
 BASE = yaml.safe_load(PLATFORM_TEMPLATE)
 
@@ -25,8 +25,33 @@ BASE = yaml.safe_load(PLATFORM_TEMPLATE)
 LEAVES = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.integers(min_value=-(10**400), max_value=10**400),
-    st.sampled_from([0, -1, 1e300, -1e-300, 1e6, 0.5, 700.0, 2**63, True, False, None, "", "big", "nan", "1e3", "../../x",
-                     'evil"><!--', "a::b", "m", "mm", "inch", "\u00e9", "x" * 300]),
+    st.sampled_from(
+        [
+            0,
+            -1,
+            1e300,
+            -1e-300,
+            1e6,
+            0.5,
+            700.0,
+            2**63,
+            True,
+            False,
+            None,
+            "",
+            "big",
+            "nan",
+            "1e3",
+            "../../x",
+            'evil"><!--',
+            "a::b",
+            "m",
+            "mm",
+            "inch",
+            "\u00e9",
+            "x" * 300,
+        ]
+    ),
     st.text(max_size=20),
 )
 
@@ -111,7 +136,9 @@ def check_platform(text: str, extra: bytes = b"") -> None:
     d = scratch()
     try:
         (d / "p.yaml").write_bytes(text.encode("utf-8", "surrogatepass") + extra)
-        rc, out, err = run_and_check(["ik", "--platform", "p.yaml", "--pose", "0", "0", "700", "0", "0", "0", "--json"], d)
+        rc, out, err = run_and_check(
+            ["ik", "--platform", "p.yaml", "--pose", "0", "0", "700", "0", "0", "0", "--json"], d
+        )
         if rc == 2:
             assert err.startswith("stewart-drake ik: error: p.yaml") or "pose" in err or "platform" in err, err
         else:
@@ -122,7 +149,9 @@ def check_platform(text: str, extra: bytes = b"") -> None:
         shutil.rmtree(d, ignore_errors=True)
 
 
-yaml_inputs = st.tuples(platform_trees(), st.sampled_from(range(len(TEXT_TWEAKS))), st.sampled_from([b"", b"\0", b"\xff\xfe", b"\x1b[0m"]))
+yaml_inputs = st.tuples(
+    platform_trees(), st.sampled_from(range(len(TEXT_TWEAKS))), st.sampled_from([b"", b"\0", b"\xff\xfe", b"\x1b[0m"])
+)
 
 
 @ci(60)
@@ -142,9 +171,11 @@ def test_platform_yaml_fuzz(case):
 # ----------------------------------------------------------------------------------------------
 # CSV files.
 
-CELLS = st.one_of(st.sampled_from(["0", "100", "0.7", "-5", "1e3", "nan", "inf", "", " ", "abc", '"1,2"', "1e400", "0x1"]),
-                  st.floats(allow_nan=False, allow_infinity=False, min_value=-1e3, max_value=1e3).map(repr),
-                  st.text(max_size=5))
+CELLS = st.one_of(
+    st.sampled_from(["0", "100", "0.7", "-5", "1e3", "nan", "inf", "", " ", "abc", '"1,2"', "1e400", "0x1"]),
+    st.floats(allow_nan=False, allow_infinity=False, min_value=-1e3, max_value=1e3).map(repr),
+    st.text(max_size=5),
+)
 
 
 @st.composite
@@ -162,9 +193,11 @@ def check_csv(data: bytes, command: str) -> None:
     d = scratch()
     try:
         (d / "f.csv").write_bytes(data)
-        argv = {"ik": ["ik", "--poses", "f.csv", "--json"],
-                "dynamics": ["dynamics", "--trajectory", "f.csv", "--json"],
-                "simulate": ["simulate", "--trajectory", "f.csv", "--out", "userdir"]}[command]
+        argv = {
+            "ik": ["ik", "--poses", "f.csv", "--json"],
+            "dynamics": ["dynamics", "--trajectory", "f.csv", "--json"],
+            "simulate": ["simulate", "--trajectory", "f.csv", "--out", "userdir"],
+        }[command]
         rc, out, err = run_and_check(argv, d)
         if rc == 2 and command != "simulate":
             assert "f.csv" in err or "pose" in err or "sample" in err or "trajectory" in err, err
@@ -209,8 +242,31 @@ def programs(draw):
         for _ in range(draw(st.integers(1, 4))):
             i = draw(st.integers(0, len(text)))
             j = draw(st.integers(i, min(len(text), i + 8)))
-            text = text[:i] + draw(st.sampled_from(["", "(", ")", "END", "mover(", "x", "1e999", "/", ";", "\0", "IF",
-                                                     "units m, rad\n", "FOR i := 1 TO 2 DO", "*)", "(*"])) + text[j:]
+            text = (
+                text[:i]
+                + draw(
+                    st.sampled_from(
+                        [
+                            "",
+                            "(",
+                            ")",
+                            "END",
+                            "mover(",
+                            "x",
+                            "1e999",
+                            "/",
+                            ";",
+                            "\0",
+                            "IF",
+                            "units m, rad\n",
+                            "FOR i := 1 TO 2 DO",
+                            "*)",
+                            "(*",
+                        ]
+                    )
+                )
+                + text[j:]
+            )
         assume("while" not in text.lower())
     return text
 
@@ -219,9 +275,11 @@ def check_program(text: str, command: str) -> None:
     d = scratch()
     try:
         (d / "p.stw").write_bytes(text.encode("utf-8", "surrogatepass"))
-        argv = {"compile": ["compile", "p.stw", "--emit", "python"],
-                "matlab": ["compile", "p.stw", "--emit", "matlab", "-o", "out.m"],
-                "run": ["run", "p.stw", "--out", "runout", "--json"]}[command]
+        argv = {
+            "compile": ["compile", "p.stw", "--emit", "python"],
+            "matlab": ["compile", "p.stw", "--emit", "matlab", "-o", "out.m"],
+            "run": ["run", "p.stw", "--out", "runout", "--json"],
+        }[command]
         run_and_check(argv, d)
     finally:
         shutil.rmtree(d, ignore_errors=True)

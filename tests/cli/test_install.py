@@ -23,7 +23,9 @@ def skip(folder: str, names: list[str]) -> set[str]:
 
 def snapshot(folder: Path) -> dict[str, tuple[int, int]]:
     """Every file under ``folder``: (size, mtime in ns)."""
-    return {str(p.relative_to(folder)): (p.stat().st_size, p.stat().st_mtime_ns) for p in folder.rglob("*") if p.is_file()}
+    return {
+        str(p.relative_to(folder)): (p.stat().st_size, p.stat().st_mtime_ns) for p in folder.rglob("*") if p.is_file()
+    }
 
 
 def test_installed_package_writes_the_report_from_anywhere(tmp_path):
@@ -32,7 +34,11 @@ def test_installed_package_writes_the_report_from_anywhere(tmp_path):
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     python = venv / "bin" / "python"
-    pip = subprocess.run([python, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", str(source)], capture_output=True, text=True)
+    pip = subprocess.run(
+        [python, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", str(source)],
+        capture_output=True,
+        text=True,
+    )
     assert pip.returncode == 0, pip.stderr[-3000:]
     shutil.rmtree(source)  # the installed package cannot lean on the copy
 
@@ -40,13 +46,27 @@ def test_installed_package_writes_the_report_from_anywhere(tmp_path):
     elsewhere.mkdir()
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     env.update(MPLBACKEND="Agg", PATH=f"{venv / 'bin'}{os.pathsep}{env.get('PATH', '')}")
-    where = subprocess.run([python, "-c", "import stewart_drake; print(stewart_drake.__file__)"], capture_output=True, text=True, cwd=elsewhere, env=env, check=True)
+    where = subprocess.run(
+        [python, "-c", "import stewart_drake; print(stewart_drake.__file__)"],
+        capture_output=True,
+        text=True,
+        cwd=elsewhere,
+        env=env,
+        check=True,
+    )
     package = Path(where.stdout.strip()).parent
     assert venv in package.parents, f"imported from {package}, not the fresh venv"
     before = snapshot(package)
 
     out = elsewhere / "X"
-    run = subprocess.run([venv / "bin" / "stewart-drake", "report", "--quick", "--out", "X"], capture_output=True, text=True, cwd=elsewhere, env=env, timeout=900)
+    run = subprocess.run(
+        [venv / "bin" / "stewart-drake", "report", "--quick", "--out", "X"],
+        capture_output=True,
+        text=True,
+        cwd=elsewhere,
+        env=env,
+        timeout=900,
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     checks = json.loads((out / "checks.json").read_text())
     rows = checks["checks"] if isinstance(checks, dict) else checks

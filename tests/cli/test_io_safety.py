@@ -20,13 +20,15 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from stewart_drake.cli import main
+from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from stewart_drake.errors import OutputError
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "circle.stw"
-PLATFORM = "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.55, 0.95]\nplate: {mass: 1.5, inertia: [0.01, 0.01, 0.02, 0, 0, 0]}\n"
+PLATFORM = (
+    "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.55, 0.95]\nplate: {mass: 1.5, inertia: [0.01, 0.01, 0.02, 0, 0, 0]}\n"
+)
 
 
 def cli(capsys, *argv):
@@ -71,9 +73,11 @@ def test_user_folder_refused_and_kept(here, capsys, argv):
     t0 = time.perf_counter()
     rc, out, err = cli(capsys, *argv, "u")
     assert rc == 2
-    assert err.strip() == (f"stewart-drake {argv[0]}: error: --out 'u': the folder was not written by stewart-drake (no manifest) "
-                           "(e.g. 'notes.txt', 1 file(s)); give a new or empty folder, or --force to write beside them "
-                           "(files not written by stewart-drake are never touched)")
+    assert err.strip() == (
+        f"stewart-drake {argv[0]}: error: --out 'u': the folder was not written by stewart-drake (no manifest) "
+        "(e.g. 'notes.txt', 1 file(s)); give a new or empty folder, or --force to write beside them "
+        "(files not written by stewart-drake are never touched)"
+    )
     assert time.perf_counter() - t0 < 2.0  # refused before the analyses/simulation ran
     assert sorted(p.name for p in u.iterdir()) == ["notes.txt"] and (u / "notes.txt").read_text() == "mine"
     assert no_litter(here) == []
@@ -91,7 +95,10 @@ def test_out_existing_file_refused(here, capsys):
     (here / "existing_file.txt").write_text("data")
     rc, _, err = cli(capsys, "workspace", "--out", "existing_file.txt")
     assert rc == 2
-    assert err.strip() == "stewart-drake workspace: error: --out 'existing_file.txt': 'existing_file.txt' exists and is not a folder"
+    assert (
+        err.strip()
+        == "stewart-drake workspace: error: --out 'existing_file.txt': 'existing_file.txt' exists and is not a folder"
+    )
     assert (here / "existing_file.txt").read_text() == "data"
     assert sorted(p.name for p in here.iterdir()) == ["existing_file.txt"]
 
@@ -145,7 +152,9 @@ def test_clash_with_foreign_file_refused_under_force(here):
     u = user_folder(here / "u")
     (u / "a.txt").write_text("user's")
     out = OutputFolder("u", force=True)
-    with pytest.raises(OutputError, match=r"^--out 'u': 'a.txt' exists and was not written by stewart-drake; nothing was written$"):
+    with pytest.raises(
+        OutputError, match=r"^--out 'u': 'a.txt' exists and was not written by stewart-drake; nothing was written$"
+    ):
         with atomic_folder(out) as tmp:
             (tmp / "a.txt").write_text("ours")
             (tmp / "b.txt").write_text("ours")
@@ -201,8 +210,10 @@ def test_model_write_policy(here, capsys):
     assert cli(capsys, "model", "--write", "m")[0] == 0  # ours: replaced
     (here / "m" / "gonzalez-dutra-2009.sdf").write_text("user's model")
     rc, _, err = cli(capsys, "model", "--platform", "gonzalez-dutra-2009", "--write", "m")
-    assert rc == 2 and err.strip() == ("stewart-drake model: error: --write 'm/gonzalez-dutra-2009.sdf': the file exists and "
-                                       "was not written by stewart-drake; remove it or choose another name (it is never overwritten)")
+    assert rc == 2 and err.strip() == (
+        "stewart-drake model: error: --write 'm/gonzalez-dutra-2009.sdf': the file exists and "
+        "was not written by stewart-drake; remove it or choose another name (it is never overwritten)"
+    )
     assert (here / "m" / "gonzalez-dutra-2009.sdf").read_text() == "user's model"
     (here / "file").write_text("x")
     rc, _, err = cli(capsys, "model", "--write", "file")
@@ -225,7 +236,11 @@ def test_compile_output_policy(here, capsys):
     assert rc == 2 and err.strip() == "stewart-drake compile: error: --output 'd': is a folder; give a file name"
     (here / "prog.m").write_text("user")
     rc, _, err = cli(capsys, "compile", EXAMPLE, "--emit", "matlab", "-o", "prog.m")
-    assert rc == 2 and "the file exists and was not written by stewart-drake" in err and (here / "prog.m").read_text() == "user"
+    assert (
+        rc == 2
+        and "the file exists and was not written by stewart-drake" in err
+        and (here / "prog.m").read_text() == "user"
+    )
     assert cli(capsys, "compile", EXAMPLE, "--emit", "matlab", "-o", "new.m")[0] == 0
     assert cli(capsys, "compile", EXAMPLE, "--emit", "matlab", "-o", "new.m")[0] == 0
     assert (here / "new.m").read_text().strip()
@@ -241,8 +256,16 @@ def well_formed(text: str) -> bool:
     return True
 
 
-@pytest.mark.parametrize("name,file", [("../../escaped", "escaped.sdf"), ("/abs/x", "abs_x.sdf"),
-                                       ('evil"><!--', "evil_--.sdf"), ("a::b", "a_b.sdf"), ("&amp;", "amp.sdf")])
+@pytest.mark.parametrize(
+    "name,file",
+    [
+        ("../../escaped", "escaped.sdf"),
+        ("/abs/x", "abs_x.sdf"),
+        ('evil"><!--', "evil_--.sdf"),
+        ("a::b", "a_b.sdf"),
+        ("&amp;", "amp.sdf"),
+    ],
+)
 def test_platform_name_never_a_path_or_markup(here, capsys, name, file):
     (here / "p.yaml").write_text(f"name: {json.dumps(name)}\n" + PLATFORM)
     (here / "w" / "a").mkdir(parents=True)
@@ -258,7 +281,10 @@ def test_platform_name_never_a_path_or_markup(here, capsys, name, file):
 def test_control_character_in_name_refused(here, capsys):
     (here / "p.yaml").write_text('name: "a\\0b"\n' + PLATFORM)
     rc, _, err = cli(capsys, "ik", "--platform", "p.yaml", "--pose", "0", "0", "700", "0", "0", "0")
-    assert rc == 2 and err.strip() == "stewart-drake ik: error: p.yaml:1: name: 'a\\x00b' contains the control character '\\x00'"
+    assert (
+        rc == 2
+        and err.strip() == "stewart-drake ik: error: p.yaml:1: name: 'a\\x00b' contains the control character '\\x00'"
+    )
 
 
 # ----------------------------------------------------------------------------------------------
@@ -266,35 +292,76 @@ def test_control_character_in_name_refused(here, capsys):
 
 YAML_CASES = [
     ("[1, 2", "p.yaml:1: YAML syntax error: expected ',' or ']', but got '<stream end>'"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\n\0", "p.yaml:3: YAML syntax error: special characters are not allowed (character #x0000)"),
-    ("!!python/object/apply:os.system ['echo hi']", "p.yaml:1: tag '!!python/object/apply:os.system' is not allowed (plain YAML values only)"),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\n\0",
+        "p.yaml:3: YAML syntax error: special characters are not allowed (character #x0000)",
+    ),
+    (
+        "!!python/object/apply:os.system ['echo hi']",
+        "p.yaml:1: tag '!!python/object/apply:os.system' is not allowed (plain YAML values only)",
+    ),
     ("stroke: 5", "p.yaml:1: stroke: expected a list [...], got 5"),
     ("utn: 5", "p.yaml:1: utn: expected a mapping of keys to values, got 5"),
     ("plate: [1, 2]", "p.yaml:1: plate: expected a mapping of keys to values, got a list"),
     ("- 1\n- 2", "p.yaml: a platform file must be a mapping of keys to values, got a list"),
-    ("utn: {b: 4000000000000000000000000000000000000000000000000, d: 0.1, a: 0.2}",
-     "p.yaml:1: utn.b: 4000000000000000000000000000000000000000000000000 has more than 30 digits"),
+    (
+        "utn: {b: 4000000000000000000000000000000000000000000000000, d: 0.1, a: 0.2}",
+        "p.yaml:1: utn.b: 4000000000000000000000000000000000000000000000000 has more than 30 digits",
+    ),
     ("utn: {b: 1e300, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]", "p.yaml:1: utn.b: 1e300 is too large (at most 100 m)"),
-    ("length_unit: mm\nutn: {b: 1e300, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]", "p.yaml:2: utn.b: 1e300 is too large (at most 100000 mm)"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstrok: [0.5, 0.9]",
-     "p.yaml:2: strok: unknown key (did you mean 'stroke'?); valid keys: name, description, length_unit, utn, radial, "
-     "base_anchors, top_anchors, leg_top, leg_base, stroke, plate, rotation_centre, home_height, legs, plate_below_base_allowed"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mas: 1}",
-     "p.yaml:3: plate: unknown key 'mas' (did you mean 'mass'?); valid keys: mass, com, inertia, thickness, density"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mass: big}", "p.yaml:3: plate.mass: expected a number, got big"),
+    (
+        "length_unit: mm\nutn: {b: 1e300, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]",
+        "p.yaml:2: utn.b: 1e300 is too large (at most 100000 mm)",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstrok: [0.5, 0.9]",
+        "p.yaml:2: strok: unknown key (did you mean 'stroke'?); valid keys: name, description, length_unit, utn, radial, "
+        "base_anchors, top_anchors, leg_top, leg_base, stroke, plate, rotation_centre, home_height, legs, plate_below_base_allowed",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mas: 1}",
+        "p.yaml:3: plate: unknown key 'mas' (did you mean 'mass'?); valid keys: mass, com, inertia, thickness, density",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mass: big}",
+        "p.yaml:3: plate.mass: expected a number, got big",
+    ),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mass: -3}", "p.yaml:3: plate.mass: -3 must be >= 0"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {cylinder_mass: .nan}", "p.yaml:3: legs.cylinder_mass: .nan is not a finite number"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {max_force: .inf}", "p.yaml:3: legs.max_force: .inf is not a finite number"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {piston_radius: -0.01}", "p.yaml:3: legs.piston_radius: -0.01 must be >= 0"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {piston_mass: 0}", "p.yaml:3: legs.piston_mass: 0 must be > 0"),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {cylinder_mass: .nan}",
+        "p.yaml:3: legs.cylinder_mass: .nan is not a finite number",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {max_force: .inf}",
+        "p.yaml:3: legs.max_force: .inf is not a finite number",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {piston_radius: -0.01}",
+        "p.yaml:3: legs.piston_radius: -0.01 must be >= 0",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlegs: {piston_mass: 0}",
+        "p.yaml:3: legs.piston_mass: 0 must be > 0",
+    ),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9, 1.0]", "p.yaml:2: stroke: (3 items) must have 2 items"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, '0.9']", "p.yaml:2: stroke item 2: expected a number, got '0.9'"),
     ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nstroke: [0.5, 0.9]", "p.yaml:3: stroke: key given twice"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlength_unit: inch", "p.yaml:3: length_unit: unknown length unit 'inch'; use m or mm"),
-    ("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nhome_height: true", "p.yaml:3: home_height: expected a number, got true"),
-    ("a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + "".join(f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
-                                                         for p, c in zip("abcdefgh", "bcdefghi")),
-     "p.yaml: more than 100000 values after expanding aliases (an alias bomb?)"),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlength_unit: inch",
+        "p.yaml:3: length_unit: unknown length unit 'inch'; use m or mm",
+    ),
+    (
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nhome_height: true",
+        "p.yaml:3: home_height: expected a number, got true",
+    ),
+    (
+        "a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n"
+        + "".join(
+            f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+            for p, c in zip("abcdefgh", "bcdefghi")
+        ),
+        "p.yaml: more than 100000 values after expanding aliases (an alias bomb?)",
+    ),
     ("x: " + "[" * 40 + "]" * 40, "p.yaml:1: nesting deeper than 32 levels"),
 ]
 
@@ -311,7 +378,11 @@ def test_yaml_literal_messages(here, capsys, text, message):
 def test_yaml_size_limit(here, capsys):
     (here / "big.yaml").write_bytes(b"#" * 1_000_001)
     rc, _, err = cli(capsys, "fk", "--platform", "big.yaml", "--lengths", *["700"] * 6)
-    assert rc == 2 and err.strip() == "stewart-drake fk: error: big.yaml: 1000001 bytes is larger than the 1000000-byte limit for a platform file"
+    assert (
+        rc == 2
+        and err.strip()
+        == "stewart-drake fk: error: big.yaml: 1000001 bytes is larger than the 1000000-byte limit for a platform file"
+    )
 
 
 def test_yaml_folder_and_missing(here, capsys):
@@ -325,7 +396,11 @@ def test_yaml_folder_and_missing(here, capsys):
 def test_servo_yaml_uses_the_safe_loader(here, capsys):
     (here / "s.yaml").write_text("!!python/name:os.system")
     rc, _, err = cli(capsys, "servo", "--platform", "s.yaml", "--pose", "0", "0", "0", "0", "0", "0")
-    assert rc == 2 and err.strip() == "stewart-drake servo: error: s.yaml:1: tag '!!python/name:os.system' is not allowed (plain YAML values only)"
+    assert (
+        rc == 2
+        and err.strip()
+        == "stewart-drake servo: error: s.yaml:1: tag '!!python/name:os.system' is not allowed (plain YAML values only)"
+    )
     (here / "s.yaml").write_text("arm_lenght: 25")
     rc, _, err = cli(capsys, "servo", "--platform", "s.yaml", "--pose", "0", "0", "0", "0", "0", "0")
     assert rc == 2 and "s.yaml:1: arm_lenght: unknown key (did you mean 'arm_length'?)" in err
@@ -340,7 +415,9 @@ def test_platform_templates_load(here, capsys, kind):
     (here / "my.yaml").write_text(out)
     p = load_platform("my.yaml")
     assert p.mass > 0 and p.name == f"my-{kind}-platform"
-    rc, out, _ = cli(capsys, "ik", "--platform", "my.yaml", "--pose", "0", "0", f"{p.home_height * 1e3}", "0", "0", "0", "--json")
+    rc, out, _ = cli(
+        capsys, "ik", "--platform", "my.yaml", "--pose", "0", "0", f"{p.home_height * 1e3}", "0", "0", "0", "--json"
+    )
     assert rc == 0 and json.loads(out)
 
 
@@ -370,7 +447,11 @@ def test_csv_bom_keeps_first_row(here, capsys):
 def test_csv_huge_field(here, capsys):
     (here / "p.csv").write_text("0,0,100,0,0,0\n" + "1" * 200_000 + ",0,0,0,0,0\n")
     rc, _, err = cli(capsys, "ik", "--poses", "p.csv")
-    assert rc == 2 and err.strip() == "stewart-drake ik: error: p.csv:2: a field is longer than 131072 characters; not a poses file?"
+    assert (
+        rc == 2
+        and err.strip()
+        == "stewart-drake ik: error: p.csv:2: a field is longer than 131072 characters; not a poses file?"
+    )
 
 
 def test_csv_folder_and_nonfinite(here, capsys):
@@ -386,16 +467,34 @@ def test_csv_folder_and_nonfinite(here, capsys):
 # One error path: argparse, options, JSON.
 
 
-@pytest.mark.parametrize("argv,message", [
-    (["leg", "fk"], "stewart-drake leg fk: error: the following arguments are required: Q1, Q2 (see stewart-drake leg fk --help)"),
-    (["leg", "fk", "10"], "stewart-drake leg fk: error: the following arguments are required: Q2 (see stewart-drake leg fk --help)"),
-    (["leg", "ik", "1"], "stewart-drake leg ik: error: the following arguments are required: PY (see stewart-drake leg ik --help)"),
-    (["model", "--json"], "stewart-drake model: error: --json only applies with --inspect"),
-    (["leg", "fk", "nan", "1"], "stewart-drake leg fk: error: argument Q1: must be a finite number, got 'nan' (see stewart-drake leg fk --help)"),
-    (["workspace", "--workers", "1" * 30], "stewart-drake workspace: error: argument --workers: not a whole number (at most 18 digits): "
-                                           f"'{'1' * 30}' (see stewart-drake workspace --help)"),
-    (["nonsense"], None),
-])
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (
+            ["leg", "fk"],
+            "stewart-drake leg fk: error: the following arguments are required: Q1, Q2 (see stewart-drake leg fk --help)",
+        ),
+        (
+            ["leg", "fk", "10"],
+            "stewart-drake leg fk: error: the following arguments are required: Q2 (see stewart-drake leg fk --help)",
+        ),
+        (
+            ["leg", "ik", "1"],
+            "stewart-drake leg ik: error: the following arguments are required: PY (see stewart-drake leg ik --help)",
+        ),
+        (["model", "--json"], "stewart-drake model: error: --json only applies with --inspect"),
+        (
+            ["leg", "fk", "nan", "1"],
+            "stewart-drake leg fk: error: argument Q1: must be a finite number, got 'nan' (see stewart-drake leg fk --help)",
+        ),
+        (
+            ["workspace", "--workers", "1" * 30],
+            "stewart-drake workspace: error: argument --workers: not a whole number (at most 18 digits): "
+            f"'{'1' * 30}' (see stewart-drake workspace --help)",
+        ),
+        (["nonsense"], None),
+    ],
+)
 def test_one_line_errors(here, capsys, argv, message):
     rc, out, err = cli(capsys, *argv)
     assert rc == 2 and len(err.strip().splitlines()) == 1
@@ -430,8 +529,11 @@ def test_program_file_errors(here, capsys):
 
 def _complete(folder: Path) -> bool:
     listed = read_manifest(folder)
-    return (listed is not None and all((folder / f).is_file() for f in listed)
-            and any(n in listed for n in ("checks.json", "summary.json")))
+    return (
+        listed is not None
+        and all((folder / f).is_file() for f in listed)
+        and any(n in listed for n in ("checks.json", "summary.json"))
+    )
 
 
 KILL_RUNS = [
@@ -464,20 +566,48 @@ def test_sigkill_never_leaves_partial_output_or_litter(tmp_path, name, argv):
     assert sorted(os.listdir(tmp_path)) == ["dest"]
 
 
-@pytest.mark.parametrize("argv,message", [
-    (["workspace", "--joint-cone", "30"], "stewart-drake workspace: error: --joint-cone only applies with --limits ...,joints"),
-    (["workspace", "--leg-diameter", "0.05"], "stewart-drake workspace: error: --leg-diameter only applies with --limits ...,collision"),
-    (["workspace", "--max-condition", "50"], "stewart-drake workspace: error: --max-condition only applies with --limits ...,dexterity"),
-    (["workspace", "--force"], "stewart-drake workspace: error: --force only applies with --out"),
-    (["run", str(EXAMPLE), "--controller", "float"], "stewart-drake run: error: --controller only applies with --simulate"),
-    (["simulate", "--length-unit", "mm"], "stewart-drake simulate: error: --length-unit only applies with --trajectory FILE.csv"),
-    (["dynamics", "--trajectory", "t.csv", "--t-end", "2"], "stewart-drake dynamics: error: --t-end only applies with --trajectory seed"),
-    (["dynamics", "--angle-unit", "deg"], "stewart-drake dynamics: error: --angle-unit only applies with --trajectory FILE.csv"),
-    (["fk", "--lengths", "473", "473", "473", "473", "473", "-473"],
-     "stewart-drake fk: error: --lengths: leg 6 length -473 mm must be a positive number"),
-    (["fk", "--length-unit", "m", "--lengths", "0.473", "0.473", "0.473", "0.473", "0.473", "-0.473"],
-     "stewart-drake fk: error: --lengths: leg 6 length -0.473 m must be a positive number"),
-])
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (
+            ["workspace", "--joint-cone", "30"],
+            "stewart-drake workspace: error: --joint-cone only applies with --limits ...,joints",
+        ),
+        (
+            ["workspace", "--leg-diameter", "0.05"],
+            "stewart-drake workspace: error: --leg-diameter only applies with --limits ...,collision",
+        ),
+        (
+            ["workspace", "--max-condition", "50"],
+            "stewart-drake workspace: error: --max-condition only applies with --limits ...,dexterity",
+        ),
+        (["workspace", "--force"], "stewart-drake workspace: error: --force only applies with --out"),
+        (
+            ["run", str(EXAMPLE), "--controller", "float"],
+            "stewart-drake run: error: --controller only applies with --simulate",
+        ),
+        (
+            ["simulate", "--length-unit", "mm"],
+            "stewart-drake simulate: error: --length-unit only applies with --trajectory FILE.csv",
+        ),
+        (
+            ["dynamics", "--trajectory", "t.csv", "--t-end", "2"],
+            "stewart-drake dynamics: error: --t-end only applies with --trajectory seed",
+        ),
+        (
+            ["dynamics", "--angle-unit", "deg"],
+            "stewart-drake dynamics: error: --angle-unit only applies with --trajectory FILE.csv",
+        ),
+        (
+            ["fk", "--lengths", "473", "473", "473", "473", "473", "-473"],
+            "stewart-drake fk: error: --lengths: leg 6 length -473 mm must be a positive number",
+        ),
+        (
+            ["fk", "--length-unit", "m", "--lengths", "0.473", "0.473", "0.473", "0.473", "0.473", "-0.473"],
+            "stewart-drake fk: error: --lengths: leg 6 length -0.473 m must be a positive number",
+        ),
+    ],
+)
 def test_ignored_options_and_inputs_echoed_as_written(here, capsys, argv, message):
     rc, out, err = cli(capsys, *argv)
     assert rc == 2 and out == "" and err.strip() == message
@@ -497,8 +627,13 @@ def test_servo_write_sdf_json_is_one_document(here, capsys):
     assert read_manifest(here / "s") == ["servo-hexapod.sdf"]
 
 
-@pytest.mark.parametrize("argv", [["leg", "ik", "0", "1.6959684595474368e+155", "--gamma", "0", "--l1", "1", "--json"],
-                                  ["dsp-ik", "--pose", "0", "0", "0", "0", "1e308", "0", "--json"]])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["leg", "ik", "0", "1.6959684595474368e+155", "--gamma", "0", "--l1", "1", "--json"],
+        ["dsp-ik", "--pose", "0", "0", "0", "0", "1e308", "0", "--json"],
+    ],
+)
 def test_numeric_overflow_is_one_line_not_a_warning(capsys, argv):
     """Found by the CLI fuzz: an intermediate overflow printed numpy's two-line RuntimeWarning."""
     rc, out, err = cli(capsys, *argv)

@@ -46,16 +46,32 @@ def test_simulate_lost_tracking_exits_1(tmp_path):
     saying why."""
     f = tmp_path / "step.csv"
     f.write_text("t,px,py,pz,ax,ay,az\n0,0,0,700,0,0,0\n0.05,0,0,700,0,0,0\n0.052,0,0,760,0,0,0\n0.3,0,0,760,0,0,0\n")
-    rc, out, err = cli("simulate", "--trajectory", f, "--length-unit", "mm", "--angle-unit", "deg", "--out", tmp_path / "o", "--no-progress")
+    rc, out, err = cli(
+        "simulate",
+        "--trajectory",
+        f,
+        "--length-unit",
+        "mm",
+        "--angle-unit",
+        "deg",
+        "--out",
+        tmp_path / "o",
+        "--no-progress",
+    )
     summary = json.loads(out)
     assert rc == 1 and summary["tracking_bound_mm"] == pytest.approx(0.05 * 400)
     assert summary["max_leg_error_mm"] > summary["tracking_bound_mm"]
-    assert re.search(r"tracking lost: the leg length error of leg \d exceeds 20\.0 mm \(0\.05 × the stroke range\) first at t = ", err)
+    assert re.search(
+        r"tracking lost: the leg length error of leg \d exceeds 20\.0 mm \(0\.05 × the stroke range\) first at t = ",
+        err,
+    )
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["failures"] == summary["failures"] != []
 
 
 def test_simulate_refuses_out_of_stroke_and_below_base_before_running(tmp_path):
-    rc, out, err = cli("simulate", "--platform", "utn-kinematic", "--duration", 0.5, "--out", tmp_path / "o", "--no-progress")
+    rc, out, err = cli(
+        "simulate", "--platform", "utn-kinematic", "--duration", 0.5, "--out", tmp_path / "o", "--no-progress"
+    )
     assert rc == 1 and out == "" and not (tmp_path / "o").exists()
     assert "the seed reference leaves the stroke: first at t = 0.0000 s, leg 1 length 891.074 mm" in err
     f = tmp_path / "below.csv"
@@ -65,8 +81,10 @@ def test_simulate_refuses_out_of_stroke_and_below_base_before_running(tmp_path):
 
 
 def test_missing_plate_is_an_error_for_dynamics_and_simulate_only(noplate, tmp_path):
-    msg = ("platform 'noplate' has no plate mass properties (YAML key 'plate' missing, or its mass is 0): '{c}' needs plate.mass "
-           "and plate.inertia (or plate.thickness and plate.density for a utn platform)")
+    msg = (
+        "platform 'noplate' has no plate mass properties (YAML key 'plate' missing, or its mass is 0): '{c}' needs plate.mass "
+        "and plate.inertia (or plate.thickness and plate.density for a utn platform)"
+    )
     rc, out, err = cli("dynamics", "--platform", noplate)
     assert rc == 2 and out == "" and err.strip() == "stewart-drake dynamics: error: " + msg.format(c="dynamics")
     rc, _, err = cli("simulate", "--platform", noplate, "--out", tmp_path / "o", "--no-progress")
@@ -75,14 +93,23 @@ def test_missing_plate_is_an_error_for_dynamics_and_simulate_only(noplate, tmp_p
     assert cli("workspace", "--platform", noplate, "--resolution", 0.05)[0] == 0
 
 
-@pytest.mark.parametrize("argv, message", [
-    (("simulate", "--plant-step", "1", "--no-progress"),
-     "--plant-step 1 s is longer than the controller period 0.001 s; the plant step must resolve the period (at most one period)"),
-    (("simulate", "--period", "0.004", "--plant-step", "0.004", "--no-progress"),
-     "--plant-step 0.004 s is longer than the actuators' time constant 0.002 s, the platform's fastest modelled dynamics"),
-    (("simulate", "--period", "10", "--no-progress"),
-     "--period 10 s is too slow for platform utn-dynamic: its fastest open-loop mode grows at 7.13/s"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (
+            ("simulate", "--plant-step", "1", "--no-progress"),
+            "--plant-step 1 s is longer than the controller period 0.001 s; the plant step must resolve the period (at most one period)",
+        ),
+        (
+            ("simulate", "--period", "0.004", "--plant-step", "0.004", "--no-progress"),
+            "--plant-step 0.004 s is longer than the actuators' time constant 0.002 s, the platform's fastest modelled dynamics",
+        ),
+        (
+            ("simulate", "--period", "10", "--no-progress"),
+            "--period 10 s is too slow for platform utn-dynamic: its fastest open-loop mode grows at 7.13/s",
+        ),
+    ],
+)
 def test_simulate_bad_options_exit_2_with_the_message(argv, message, tmp_path):
     if argv[0] == "simulate":
         argv = argv + ("--out", str(tmp_path / "o"))
@@ -91,11 +118,19 @@ def test_simulate_bad_options_exit_2_with_the_message(argv, message, tmp_path):
     assert not (tmp_path / "o").exists()
 
 
-@pytest.mark.parametrize("argv, pattern", [
-    (("simulate", "--duration", "1e9", "--no-progress"),
-     r"--duration 1000000000 s would need 1e\+12 plant steps of 0.001 s \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a shorter --duration"),
-    (("simulate", "--duration", "7200", "--no-progress"), r"--duration 7200 s would need 7.2e\+06 plant steps of 0.001 s \(~2 h\); the limit is ~1 h"),
-])
+@pytest.mark.parametrize(
+    "argv, pattern",
+    [
+        (
+            ("simulate", "--duration", "1e9", "--no-progress"),
+            r"--duration 1000000000 s would need 1e\+12 plant steps of 0.001 s \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a shorter --duration",
+        ),
+        (
+            ("simulate", "--duration", "7200", "--no-progress"),
+            r"--duration 7200 s would need 7.2e\+06 plant steps of 0.001 s \(~2 h\); the limit is ~1 h",
+        ),
+    ],
+)
 def test_simulate_work_is_bounded_before_allocation(argv, pattern, tmp_path, monkeypatch):
     import stewart_drake.core.sanity as sanity
 

@@ -80,9 +80,17 @@ def test_run_writes_lengths_forces_and_plots(tmp_path, capsys):
     out = tmp_path / "seed"
     assert main(["run", str(SEED), "--out", str(out), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
-    assert sorted(p.name for p in out.iterdir() if p.name != ".stewart-drake-manifest.json") == ["forces.png", "legs.csv", "lengths.png", "summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir() if p.name != ".stewart-drake-manifest.json") == [
+        "forces.png",
+        "legs.csv",
+        "lengths.png",
+        "summary.json",
+        "trajectory.csv",
+    ]
     assert summary["platform"] == "utn-kinematic" and summary["samples"] == 101
-    np.testing.assert_allclose(summary["moves"][0]["lengths_mm"], [583.334, 669.133, 508.944, 693.559, 624.865, 364.708], atol=1e-3)
+    np.testing.assert_allclose(
+        summary["moves"][0]["lengths_mm"], [583.334, 669.133, 508.944, 693.559, 624.865, 364.708], atol=1e-3
+    )
     rows = list(csv.reader((out / "legs.csv").open()))
     assert rows[0] == ["t_s"] + [f"L{i}_mm" for i in range(1, 7)] + [f"F{i}_N" for i in range(1, 7)]
     assert len(rows) == 102 and float(rows[1][1]) == pytest.approx(473.1873, abs=1e-4)

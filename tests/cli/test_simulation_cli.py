@@ -9,7 +9,20 @@ from stewart_drake.cli import main
 
 def test_simulate_writes_logs_plots_and_summary(tmp_path, capsys):
     out = tmp_path / "run"
-    rc = main(["simulate", "--trajectory", "rotating", "--controller", "float", "--duration", "0.1", "--out", str(out), "--no-progress"])
+    rc = main(
+        [
+            "simulate",
+            "--trajectory",
+            "rotating",
+            "--controller",
+            "float",
+            "--duration",
+            "0.1",
+            "--out",
+            str(out),
+            "--no-progress",
+        ]
+    )
     assert rc == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["ticks"] == 100 and summary["controller"] == "float" and summary["trajectory"] == "rotating"
@@ -28,7 +41,20 @@ def test_simulate_reads_a_csv_trajectory(tmp_path):
     s = (t / 0.3) ** 3 * (10 - 15 * t / 0.3 + 6 * (t / 0.3) ** 2)
     rows = "".join(f"{a:.6f},0,0,{700 + 5 * b:.6f},0,0,{2 * b:.6f}\n" for a, b in zip(t, s))
     csv.write_text("t,px,py,pz,ax,ay,az\n" + rows)
-    rc = main(["simulate", "--trajectory", str(csv), "--length-unit", "mm", "--angle-unit", "deg", "--out", str(tmp_path / "o"), "--no-progress"])
+    rc = main(
+        [
+            "simulate",
+            "--trajectory",
+            str(csv),
+            "--length-unit",
+            "mm",
+            "--angle-unit",
+            "deg",
+            "--out",
+            str(tmp_path / "o"),
+            "--no-progress",
+        ]
+    )
     assert rc == 0
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["duration_s"] == 0.3 and summary["controller"] == "fixed" and summary["failures"] == []

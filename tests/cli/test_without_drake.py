@@ -21,7 +21,9 @@ NUMPY_PACKAGES = ("core", "control", "fixedpoint", "workspace", "script", "homot
 
 def run(*args, cwd):
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
-    return subprocess.run([sys.executable, RUNNER, *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+    return subprocess.run(
+        [sys.executable, RUNNER, *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=300
+    )
 
 
 def test_blocker_blocks():
@@ -31,18 +33,41 @@ def test_blocker_blocks():
 
 
 def test_every_numpy_module_imports_without_pydrake():
-    names = [m.name for pkg in NUMPY_PACKAGES for m in pkgutil.walk_packages([str(Path(stewart_drake.__file__).parent / pkg)], f"stewart_drake.{pkg}.")]
+    names = [
+        m.name
+        for pkg in NUMPY_PACKAGES
+        for m in pkgutil.walk_packages([str(Path(stewart_drake.__file__).parent / pkg)], f"stewart_drake.{pkg}.")
+    ]
     names += [f"stewart_drake.{pkg}" for pkg in NUMPY_PACKAGES]
     assert len(names) > 40
     code = "import importlib, sys\nfor n in sys.argv[3:]: importlib.import_module(n)\nprint('ok', len(sys.argv[3:]))"
-    r = subprocess.run([sys.executable, RUNNER, "-c", code, *names], capture_output=True, text=True, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=300)
+    r = subprocess.run(
+        [sys.executable, RUNNER, "-c", code, *names],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr[-2000:]
     assert "pydrake" not in r.stderr
 
 
 COMMANDS = {
     "ik": ["ik", "--platform", "utn-dynamic", "--pose", "5", "-3", "720", "2", "-1", "3", "--json"],
-    "fk": ["fk", "--platform", "utn-dynamic", "--lengths", "753.9", "753.8", "750.2", "745.4", "749.4", "744.6", "--json"],
+    "fk": [
+        "fk",
+        "--platform",
+        "utn-dynamic",
+        "--lengths",
+        "753.9",
+        "753.8",
+        "750.2",
+        "745.4",
+        "749.4",
+        "744.6",
+        "--json",
+    ],
     "dynamics": ["dynamics", "--platform", "utn-dynamic", "--trajectory", "seed", "--json"],
     "dsp-ik": ["dsp-ik", "--pose", "0", "0", "100", "0.1", "0", "0", "--json"],
     "workspace": ["workspace", "--platform", "utn-kinematic", "--resolution", "0.05", "--json", "--out", "ws"],
@@ -59,7 +84,14 @@ def test_numpy_command_runs_without_pydrake_and_agrees(name, tmp_path):
     blocked = run("cli", *COMMANDS[name], cwd=tmp_path / "a")
     assert blocked.returncode == 0, blocked.stderr[-2000:]
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
-    normal = subprocess.run([sys.executable, "-m", "stewart_drake.cli", *COMMANDS[name]], capture_output=True, text=True, cwd=tmp_path / "b", env=env, timeout=300)
+    normal = subprocess.run(
+        [sys.executable, "-m", "stewart_drake.cli", *COMMANDS[name]],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path / "b",
+        env=env,
+        timeout=300,
+    )
     assert normal.returncode == 0, normal.stderr[-2000:]
     drop = {"wall_time_s", "elapsed_s", "out"}
     a, b = json.loads(blocked.stdout), json.loads(normal.stdout)

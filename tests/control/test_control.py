@@ -16,10 +16,10 @@ from stewart_drake.control import (
     q15_gain,
     tick_cycles,
 )
-from stewart_drake.fixedpoint import fixed_point_leg_lengths, tp17_cycles
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import ROTATING, SEED
+from stewart_drake.fixedpoint import fixed_point_leg_lengths, tp17_cycles
 
 PLATFORM = load_preset("utn-dynamic")
 T = 1e-3
@@ -41,10 +41,14 @@ def test_cycle_model_is_ik_plus_pid_plus_isr():
 
 def test_infeasible_timing_is_refused_with_both_numbers():
     n = tick_cycles()
-    with pytest.raises(TimingError, match=rf"{n} cycles = {n / 60:.3f} µs at 60 MHz, longer than the sample period 50\.000 µs"):
+    with pytest.raises(
+        TimingError, match=rf"{n} cycles = {n / 60:.3f} µs at 60 MHz, longer than the sample period 50\.000 µs"
+    ):
         DspTiming(sample_period=50e-6).check()
     with pytest.raises(TimingError, match=r"5000 cycles = 500\.000 µs at 10 MHz.*400\.000 µs"):
-        FixedPointLaw(PLATFORM, ControllerConfig(timing=DspTiming(clock_hz=10e6, sample_period=400e-6, computation_cycles=5000)))
+        FixedPointLaw(
+            PLATFORM, ControllerConfig(timing=DspTiming(clock_hz=10e6, sample_period=400e-6, computation_cycles=5000))
+        )
     DspTiming(sample_period=n / 60e6).check()  # exactly fits: accepted
 
 
@@ -95,7 +99,9 @@ def test_primed_ik_cache_gives_the_same_words():
         np.testing.assert_array_equal(ctrl.setpoint_words(q), ctrl.ik_words(q))
     assert ctrl.cache_misses == 0
     q = poses[3] + 1e-9  # not primed: computed, same function
-    np.testing.assert_array_equal(ctrl.setpoint_words(q), fixed_point_leg_lengths(PLATFORM, q, config.ik_format, return_words=True))
+    np.testing.assert_array_equal(
+        ctrl.setpoint_words(q), fixed_point_leg_lengths(PLATFORM, q, config.ik_format, return_words=True)
+    )
     assert ctrl.cache_misses == 1
 
 
@@ -121,9 +127,15 @@ def test_fixed_pid_tick_matches_a_plain_integer_reimplementation():
         pose = SEED.pose(rng.uniform(0, 4))
         scale = 1e-3 if trial % 2 else 0.3  # small errors, or saturating ones
         L = leg_lengths(PLATFORM, pose) + rng.normal(0, scale, 6)
-        pid = np.concatenate([rng.integers(-(2**31), 2**31 - 1, 6), np.round(L / 1e-5) + rng.integers(-300, 300, 6),
-                              rng.integers(-5000, 5000, 6), ctrl.setpoint_words(pose) + rng.integers(-3, 3, 6),
-                              rng.integers(-5000, 5000, 6)]).astype(float)
+        pid = np.concatenate(
+            [
+                rng.integers(-(2**31), 2**31 - 1, 6),
+                np.round(L / 1e-5) + rng.integers(-300, 300, 6),
+                rng.integers(-5000, 5000, 6),
+                ctrl.setpoint_words(pose) + rng.integers(-3, 3, 6),
+                rng.integers(-5000, 5000, 6),
+            ]
+        ).astype(float)
         cmd, sp, new, sat = ctrl.step(pid, pose, L)
         words = ctrl.setpoint_words(pose)
         for i in range(6):
@@ -173,9 +185,17 @@ def test_leg_space_inertia_without_legs_is_the_plate_mass_matrix_in_leg_coordina
 
 @pytest.mark.parametrize("name", ["utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009"])
 def test_design_gains_follow_the_documented_rules(name):
-    from stewart_drake.control import (HEAVY_MODE_DAMPING, PHASE_BUDGET, ROUTH_FRACTION, STIFFNESS_MARGIN,
-                                       UNKNOWN_POSE_STIFFNESS_FACTOR, design_gains, leg_space_inertia, loop_delay,
-                                       strut_stiffness)
+    from stewart_drake.control import (
+        HEAVY_MODE_DAMPING,
+        PHASE_BUDGET,
+        ROUTH_FRACTION,
+        STIFFNESS_MARGIN,
+        UNKNOWN_POSE_STIFFNESS_FACTOR,
+        design_gains,
+        leg_space_inertia,
+        loop_delay,
+        strut_stiffness,
+    )
 
     p = load_preset(name)
     cfg = ControllerConfig.for_platform(p)
@@ -306,7 +326,9 @@ for law in (FixedPointLaw(p), FloatLaw(p)):
 assert not any(m.startswith("pydrake") for m in sys.modules)
 """
     root = Path(stewart_drake.__file__).resolve().parents[1]  # the package importable from the checkout
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=root).stdout.splitlines()
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=root
+    ).stdout.splitlines()
     law = FixedPointLaw(PLATFORM)
     pose = SEED.pose(0.4)
     L = leg_lengths(PLATFORM, pose) + 2e-4

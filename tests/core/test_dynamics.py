@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import stewart_drake.core.dynamics as D
-from stewart_drake.errors import NOT_FINITE_SAMPLE, SHAPE, NotFiniteError, ShapeError, SingularPoseError
 from stewart_drake.core.geometry import load_preset, triangular_plate
 from stewart_drake.core.kinematics import leg_lengths, leg_unit_vectors, length_jacobian
+from stewart_drake.errors import NOT_FINITE_SAMPLE, SHAPE, NotFiniteError, ShapeError, SingularPoseError
 
 G = 9.81
 
@@ -27,7 +27,9 @@ def rotating(t, axis=None, seed=0):
         amp[3:] = rng.uniform(0.15, 0.35, 3)
     else:
         amp[3 + axis] = 0.35
-    return D.harmonic_trajectory(t, [-0.02, 0.01, 0.7, 0.02, -0.03, 0.05], amp, rng.uniform(1.5, 4.0, 6), rng.uniform(0, 6.3, 6))
+    return D.harmonic_trajectory(
+        t, [-0.02, 0.01, 0.7, 0.02, -0.03, 0.05], amp, rng.uniform(1.5, 4.0, 6), rng.uniform(0, 6.3, 6)
+    )
 
 
 # --- 1. plate inertia ------------------------------------------------------------------------------
@@ -86,7 +88,13 @@ def test_length_jacobian_against_finite_differences(plat, convention):
     rng = np.random.default_rng(2)
     q = plat.home_pose() + np.c_[rng.uniform(-0.05, 0.05, (10, 3)), rng.uniform(-0.5, 0.5, (10, 3))]
     h = 1e-6  # central differences: truncation ~h² L''' ~ 1e-12, rounding ~1e-16 / h ~ 1e-10
-    fd = np.stack([(leg_lengths(plat, q + h * e, convention) - leg_lengths(plat, q - h * e, convention)) / (2 * h) for e in np.eye(6)], -1)
+    fd = np.stack(
+        [
+            (leg_lengths(plat, q + h * e, convention) - leg_lengths(plat, q - h * e, convention)) / (2 * h)
+            for e in np.eye(6)
+        ],
+        -1,
+    )
     np.testing.assert_allclose(length_jacobian(plat, q, convention), fd, atol=1e-8)
 
 
@@ -97,7 +105,11 @@ def test_euler_rate_derivative_against_finite_differences(convention):
     from stewart_drake.core.rotations import angular_velocity_map
 
     h = 1e-6
-    fd = (angular_velocity_map(th + h * thd, convention) - angular_velocity_map(th - h * thd, convention)) @ thd / (2 * h)
+    fd = (
+        (angular_velocity_map(th + h * thd, convention) - angular_velocity_map(th - h * thd, convention))
+        @ thd
+        / (2 * h)
+    )
     np.testing.assert_allclose(D.euler_rate_derivative(th, thd, convention), fd, atol=1e-8)
 
 
@@ -109,7 +121,12 @@ def test_coriolis_equals_christoffel_terms_of_M(plat, convention):
     q = plat.home_pose() + np.r_[rng.uniform(-0.05, 0.05, 3), rng.uniform(-0.6, 0.6, 3)]
     qd = rng.uniform(-1, 1, 6)
     h = 1e-6
-    dM = np.stack([(D.mass_matrix(p, q + h * e, convention) - D.mass_matrix(p, q - h * e, convention)) / (2 * h) for e in np.eye(6)])  # [k, i, j]
+    dM = np.stack(
+        [
+            (D.mass_matrix(p, q + h * e, convention) - D.mass_matrix(p, q - h * e, convention)) / (2 * h)
+            for e in np.eye(6)
+        ]
+    )  # [k, i, j]
     christoffel = np.einsum("kij,j,k->i", dM, qd, qd) - 0.5 * np.einsum("ijk,j,k->i", dM, qd, qd)
     cq = D.coriolis_vector(p, q, qd, convention)
     assert np.abs(cq).max() > 1e-4  # not trivially zero
@@ -132,7 +149,11 @@ def test_gravity_is_gradient_of_potential(plat):
 def test_generalized_force_is_M_qdd_plus_C_plus_G(plat):
     q, qd, qdd = rotating(np.linspace(0, 2, 7))
     lhs = D.generalized_force(plat, q, qd, qdd)
-    rhs = np.einsum("...ij,...j->...i", D.mass_matrix(plat, q), qdd) + D.coriolis_vector(plat, q, qd) + D.gravity_vector(plat, q)
+    rhs = (
+        np.einsum("...ij,...j->...i", D.mass_matrix(plat, q), qdd)
+        + D.coriolis_vector(plat, q, qd)
+        + D.gravity_vector(plat, q)
+    )
     np.testing.assert_allclose(lhs, rhs, atol=1e-13)
 
 
@@ -160,7 +181,9 @@ def test_seed_plot_range_and_symmetry(plat):
     np.testing.assert_array_equal(D.coriolis_vector(plat, q, qd), 0)
 
 
-@pytest.mark.parametrize("pose", [[0, 0, 0.7, 0, 0, 0], [-0.1, 0.1, 0.7, 0, 0, 0], [0.02, -0.03, 0.68, 0.2, -0.15, 0.4]])
+@pytest.mark.parametrize(
+    "pose", [[0, 0, 0.7, 0, 0, 0], [-0.1, 0.1, 0.7, 0, 0, 0], [0.02, -0.03, 0.68, 0.2, -0.15, 0.4]]
+)
 def test_at_rest_the_legs_hold_the_weight(plat, pose):
     F = D.leg_forces(plat, pose, np.zeros(6), np.zeros(6))
     u = leg_unit_vectors(plat, pose)
@@ -200,7 +223,9 @@ def test_platform_singularity_raises(plat):
 def test_bad_inputs_are_named(plat):
     with pytest.raises(ShapeError, match=re.escape(SHAPE.format(name="qd", shape="(..., 6)", got="(5,)"))):
         D.leg_forces(plat, plat.home_pose(), np.zeros(5), np.zeros(6))
-    with pytest.raises(NotFiniteError, match=re.escape(NOT_FINITE_SAMPLE.format(what="qdd sample", index=2, values=[np.nan] * 6))):
+    with pytest.raises(
+        NotFiniteError, match=re.escape(NOT_FINITE_SAMPLE.format(what="qdd sample", index=2, values=[np.nan] * 6))
+    ):
         D.leg_forces(plat, np.tile(plat.home_pose(), (2, 1)), np.zeros(6), [np.zeros(6), [np.nan] * 6])
     with pytest.raises(ValueError, match="unknown rotation convention 'xyz'"):
         D.leg_forces(plat, plat.home_pose(), np.zeros(6), np.zeros(6), convention="xyz")

@@ -123,7 +123,9 @@ def test_impossible_lengths_reported_not_returned():
     assert r.failures() == [(1,)]
     assert np.isnan(r.poses[1]).all() and np.isfinite(r.iterate[1]).all()
     assert r.residual[1] > 1e-3  # the triangle inequality is violated by 75 mm
-    with pytest.raises(ForwardKinematicsError, match=r"lengths sample 2 \(.*300\.000, 1300\.000.* mm\) (did not converge|diverged)"):
+    with pytest.raises(
+        ForwardKinematicsError, match=r"lengths sample 2 \(.*300\.000, 1300\.000.* mm\) (did not converge|diverged)"
+    ):
         r.raise_if_failed()
 
 

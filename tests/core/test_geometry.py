@@ -3,7 +3,6 @@ import re
 import numpy as np
 import pytest
 
-from stewart_drake.errors import GeometryError
 from stewart_drake.core.geometry import (
     PRESETS,
     Platform,
@@ -12,6 +11,7 @@ from stewart_drake.core.geometry import (
     triangular_plate,
     utn_anchors,
 )
+from stewart_drake.errors import GeometryError
 
 
 def _base_kwargs(**over):
@@ -80,10 +80,14 @@ def test_triangular_plate_against_point_quadrature():
 
 def test_yaml_round_trip_with_mm(tmp_path):
     f = tmp_path / "mine.yaml"
-    f.write_text("length_unit: mm\nutn: {b: 400, d: 100, a: 200}\nstroke: [550, 950]\nplate: {mass: 2.0, inertia: [0.01, 0.01, 0.02, 0, 0, 0]}\n")
+    f.write_text(
+        "length_unit: mm\nutn: {b: 400, d: 100, a: 200}\nstroke: [550, 950]\nplate: {mass: 2.0, inertia: [0.01, 0.01, 0.02, 0, 0, 0]}\n"
+    )
     p = load_platform(str(f))
     assert p.name == "mine"
-    ref = Platform.utn(0.4, 0.1, 0.2, **_base_kwargs(stroke=[0.55, 0.95], mass=2.0, inertia=np.diag([0.01, 0.01, 0.02])))
+    ref = Platform.utn(
+        0.4, 0.1, 0.2, **_base_kwargs(stroke=[0.55, 0.95], mass=2.0, inertia=np.diag([0.01, 0.01, 0.02]))
+    )
     np.testing.assert_allclose(p.base_anchors, ref.base_anchors)
     np.testing.assert_allclose(p.stroke, [0.55, 0.95])
 
@@ -104,8 +108,14 @@ def test_arrays_are_read_only():
 @pytest.mark.parametrize(
     "change, message",
     [
-        (dict(base_anchors=np.zeros((5, 3))), GeometryError.SHAPE.format(name="base_anchors", shape=(6, 3), got=(5, 3))),
-        (dict(base_anchors=np.full((6, 3), np.nan)), GeometryError.NOT_FINITE.format(name="base_anchors", value=[[np.nan] * 3] * 6)),
+        (
+            dict(base_anchors=np.zeros((5, 3))),
+            GeometryError.SHAPE.format(name="base_anchors", shape=(6, 3), got=(5, 3)),
+        ),
+        (
+            dict(base_anchors=np.full((6, 3), np.nan)),
+            GeometryError.NOT_FINITE.format(name="base_anchors", value=[[np.nan] * 3] * 6),
+        ),
         (dict(stroke=[0.9, 0.5]), GeometryError.STROKE.format(lmin=0.9, lmax=0.5)),
         (dict(stroke=[0.5, 0.5]), GeometryError.STROKE.format(lmin=0.5, lmax=0.5)),
         (dict(mass=-1.0), GeometryError.MASS.format(value=-1.0)),
@@ -113,8 +123,10 @@ def test_arrays_are_read_only():
         (dict(leg_top=[0, 0, 1, 1, 2, 7]), GeometryError.LEG_TOP_RANGE.format(leg=6, anchor=7, n=3, last=2)),
         (dict(leg_top=[0, 0, 1, 1, 1, 1]), GeometryError.LEG_TOP_UNUSED.format(anchor=2)),
         (dict(inertia=np.diag([1.0, 1.0, 3.0])), GeometryError.INERTIA_PHYSICAL.format(moments=[1.0, 1.0, 3.0])),
-        (dict(inertia=[[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]),
-         GeometryError.INERTIA_SYMMETRIC.format(value=[[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])),
+        (
+            dict(inertia=[[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]),
+            GeometryError.INERTIA_SYMMETRIC.format(value=[[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+        ),
         (dict(top_anchors=np.zeros((2, 3))), GeometryError.TOP_SHAPE.format(shape=(2, 3))),
     ],
 )
@@ -140,13 +152,19 @@ def test_bad_utn_dimension():
 
 
 def test_yaml_errors(tmp_path):
-    with pytest.raises(GeometryError, match=re.escape(GeometryError.UNKNOWN_PLATFORM.format(name="nope", presets=", ".join(PRESETS)))):
+    with pytest.raises(
+        GeometryError, match=re.escape(GeometryError.UNKNOWN_PLATFORM.format(name="nope", presets=", ".join(PRESETS)))
+    ):
         load_platform("nope")
     with pytest.raises(GeometryError, match="does not exist"):
         load_platform(str(tmp_path / "missing.yaml"))
     f = tmp_path / "two.yaml"
-    f.write_text("utn: {b: 0.4, d: 0.1, a: 0.2}\nradial: {base_radius: 1, base_angles_deg: [0,1,2,3,4,5], top_radius: 1, top_angles_deg: [0,1,2,3,4,5]}\nstroke: [0.5, 0.9]\n")
-    with pytest.raises(GeometryError, match=re.escape(GeometryError.ANCHOR_DESCRIPTIONS.format(name="two", given=["utn", "radial"]))):
+    f.write_text(
+        "utn: {b: 0.4, d: 0.1, a: 0.2}\nradial: {base_radius: 1, base_angles_deg: [0,1,2,3,4,5], top_radius: 1, top_angles_deg: [0,1,2,3,4,5]}\nstroke: [0.5, 0.9]\n"
+    )
+    with pytest.raises(
+        GeometryError, match=re.escape(GeometryError.ANCHOR_DESCRIPTIONS.format(name="two", given=["utn", "radial"]))
+    ):
         load_platform(str(f))
     f.write_text("utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nlength_unit: inch\n")
     with pytest.raises(GeometryError, match="length_unit: unknown length unit 'inch'"):

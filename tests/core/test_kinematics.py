@@ -3,14 +3,6 @@ import re
 import numpy as np
 import pytest
 
-from stewart_drake.errors import (
-    NOT_FINITE_SAMPLE,
-    SHAPE,
-    NotFiniteError,
-    ShapeError,
-    SingularPoseError,
-    UnreachablePoseError,
-)
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import (
     check_stroke,
@@ -25,6 +17,14 @@ from stewart_drake.core.kinematics import (
 )
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sampling import random_poses
+from stewart_drake.errors import (
+    NOT_FINITE_SAMPLE,
+    SHAPE,
+    NotFiniteError,
+    ShapeError,
+    SingularPoseError,
+    UnreachablePoseError,
+)
 
 
 def test_utn_home_pose_is_473_2_mm():
@@ -83,7 +83,13 @@ def test_length_jacobian_against_finite_differences(preset, convention):
     h = 1e-6
     for q in random_poses(preset, 20, seed=5):
         J = length_jacobian(preset, q, convention)
-        fd = np.stack([(leg_lengths(preset, q + h * e, convention) - leg_lengths(preset, q - h * e, convention)) / (2 * h) for e in np.eye(6)], -1)
+        fd = np.stack(
+            [
+                (leg_lengths(preset, q + h * e, convention) - leg_lengths(preset, q - h * e, convention)) / (2 * h)
+                for e in np.eye(6)
+            ],
+            -1,
+        )
         np.testing.assert_allclose(J, fd, atol=1e-8)
 
 
@@ -118,7 +124,10 @@ def test_stroke_violation_names_pose_leg_and_amount():
     v = check.violations()
     assert [x["leg"] for x in v] == [1, 2, 3, 4, 5, 6] and all(x["pose"] == [1] for x in v)
     assert v[0]["excess_m"] == pytest.approx(L[1, 0] - 0.7)
-    with pytest.raises(UnreachablePoseError, match=r"pose 2: leg 1 length \d+\.\d{3} mm is \d+\.\d{3} mm above the stroke maximum 700\.000 mm") as e:
+    with pytest.raises(
+        UnreachablePoseError,
+        match=r"pose 2: leg 1 length \d+\.\d{3} mm is \d+\.\d{3} mm above the stroke maximum 700\.000 mm",
+    ) as e:
         inverse_kinematics(p, poses)
     assert e.value.leg == 1 and e.value.excess == pytest.approx(L[1, 0] - 0.7)
 

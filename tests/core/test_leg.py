@@ -3,6 +3,7 @@
 
 import numpy as np
 import pytest
+
 from stewart_drake.core.leg3r import (
     SEED_FIXES,
     Leg3R,
@@ -73,7 +74,10 @@ def test_one_branch_recovers_the_original_configuration():
 def test_unreachable_target_raises_naming_it():
     r_min, r_max = LEG.reach
     targets = np.array([[0.05, -0.1], [0.0, -(r_max + 1e-3)]])
-    with pytest.raises(UnreachableTargetError, match=r"target 2: the foot is 184\.297 mm from the hip, outside the reachable range \[23\.297, 183\.297\] mm"):
+    with pytest.raises(
+        UnreachableTargetError,
+        match=r"target 2: the foot is 184\.297 mm from the hip, outside the reachable range \[23\.297, 183\.297\] mm",
+    ):
         inverse_kinematics(LEG, targets)
     with pytest.raises(UnreachableTargetError, match="the ankle"):
         inverse_kinematics_3r(LEG, [0.0, -0.3, 0.0])

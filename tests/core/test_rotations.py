@@ -1,5 +1,6 @@
 import numpy as np
 import pytest
+
 from stewart_drake.core.rotations import (
     angles_from_matrix,
     angular_velocity_map,

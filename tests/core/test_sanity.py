@@ -15,13 +15,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.cli._fuzz import fuzz
 from stewart_drake.cli import main
-from stewart_drake.errors import FAR_CENTRE, GRAVITY_RANGE, SERVO_NEUTRAL, PhysicalLimitError, UsageError
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.core.trajectory import SEED
+from stewart_drake.errors import FAR_CENTRE, GRAVITY_RANGE, SERVO_NEUTRAL, PhysicalLimitError, UsageError
+from tests.cli._fuzz import fuzz
 
 NOPLATE = """name: noplate
 length_unit: m
@@ -73,7 +73,10 @@ def test_ik_plate_below_base_exits_1(utn):
     assert rc == 1 and err == ""
     # the mirror pose has the same lengths (within stroke): only the base check can fail it
     assert np.allclose(leg_lengths(utn, pose_to_si([0, 0, -100, 0, 0, 0], "mm", "deg")), 0.473187, atol=1e-6)
-    assert "pose: the plate is below the base: plate anchor of leg 1 is at z = -100.000 mm (the base plane is z = 0)" in out
+    assert (
+        "pose: the plate is below the base: plate anchor of leg 1 is at z = -100.000 mm (the base plane is z = 0)"
+        in out
+    )
     rc, out, _ = cli("ik", "--pose", 0, 0, 100, 0, 0, 0, "--json")
     assert rc == 0 and json.loads(out)["above_base"] is True
 
@@ -81,14 +84,18 @@ def test_ik_plate_below_base_exits_1(utn):
 def test_ik_pose_in_metres_typed_as_mm_is_a_unit_mistake():
     rc, _, err = cli("ik", "--pose", 0, 0, 100, 0, 0, 0, "--length-unit", "m")
     assert rc == 2
-    assert err.strip() == ("stewart-drake ik: error: --pose: position [0.0, 0.0, 100.0] m is 143 × the platform's size (0.700 m); "
-                           "positions beyond 10 × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)")
+    assert err.strip() == (
+        "stewart-drake ik: error: --pose: position [0.0, 0.0, 100.0] m is 143 × the platform's size (0.700 m); "
+        "positions beyond 10 × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
+    )
 
 
 def test_ik_poses_flags_each_row_in_linear_time(tmp_path, utn):
     """Rows below the base, out of stroke and fine, flagged per row; the flags agree with an independent
     per-row computation (leg_lengths, plate anchors)."""
-    rows = np.array([[0, 0, 100, 0, 0, 0], [0, 0, -100, 0, 0, 0], [0, 0, 400, 0, 0, 0], [0, 0, 650, 0, 0, 0], [50, 0, 200, 5, 0, 0]])
+    rows = np.array(
+        [[0, 0, 100, 0, 0, 0], [0, 0, -100, 0, 0, 0], [0, 0, 400, 0, 0, 0], [0, 0, 650, 0, 0, 0], [50, 0, 200, 5, 0, 0]]
+    )
     f = tmp_path / "p.csv"
     f.write_text("px,py,pz,a,b,g\n" + "\n".join(",".join(map(str, r)) for r in rows) + "\n")
     rc, out, _ = cli("ik", "--poses", f, "--json")
@@ -143,7 +150,8 @@ def test_dynamics_out_of_stroke_names_first_time_leg_amount(utn):
     assert err.strip() == (
         f"stewart-drake dynamics: error: the seed trajectory leaves the stroke: first at t = 0.0000 s, leg {leg + 1} length "
         f"{L0[leg] * 1e3:.3f} mm is {(L0[leg] - 0.7) * 1e3:.3f} mm above the stroke maximum 700.000 mm; "
-        "--allow-out-of-stroke runs it anyway, with a warning")
+        "--allow-out-of-stroke runs it anyway, with a warning"
+    )
     rc, out, err = cli("dynamics", "--platform", "utn-kinematic", "--t-end", 0.2, "--allow-out-of-stroke", "--json")
     assert rc == 0 and "warning: the seed trajectory leaves the stroke" in err
     assert json.loads(out)["warnings"] == [err.split("warning: ")[1].strip()]
@@ -156,7 +164,10 @@ def test_dynamics_csv_first_violation_is_the_first_in_time(tmp_path):
     f.write_text("t,px,py,pz,a,b,g\n0,0,0,0.7,0,0,0\n0.1,0,0,0.75,0,0,0\n0.2,0,0,0.96,0,0,0\n0.3,0,0,0.8,0,0,0\n")
     rc, _, err = cli("dynamics", "--trajectory", f)
     L = leg_lengths(load_platform("utn-dynamic"), [0, 0, 0.96, 0, 0, 0])
-    assert rc == 1 and f"first at t = 0.2000 s, leg 1 length {L[0] * 1e3:.3f} mm is {(L[0] - 0.95) * 1e3:.3f} mm above" in err
+    assert (
+        rc == 1
+        and f"first at t = 0.2000 s, leg 1 length {L[0] * 1e3:.3f} mm is {(L[0] - 0.95) * 1e3:.3f} mm above" in err
+    )
     g = tmp_path / "u.csv"
     g.write_text("t,px,py,pz,a,b,g\n0,0,0,0.7,0,0,0\n0.1,0,0,0.7,0,0,0\n0.2,0,0,-0.7,0,0,0\n0.3,0,0,-0.7,0,0,0\n")
     rc, _, err = cli("dynamics", "--trajectory", g)
@@ -172,8 +183,11 @@ def test_singular_home_is_refused_when_loaded_naming_the_anchors(tmp_path):
     f.write_text(COLLINEAR)
     rc, _, err = cli("ik", "--platform", f, "--pose", 0, 0, 600, 0, 0, 0)
     assert rc == 2
-    assert re.fullmatch(r"stewart-drake ik: error: platform 'collinear' is singular at its home pose \(Jacobian condition number "
-                        r"\S+ > 1e\+08\): base anchors 1-6 are collinear \(every leg meets one line, so the plate can turn about it\)\n", err)
+    assert re.fullmatch(
+        r"stewart-drake ik: error: platform 'collinear' is singular at its home pose \(Jacobian condition number "
+        r"\S+ > 1e\+08\): base anchors 1-6 are collinear \(every leg meets one line, so the plate can turn about it\)\n",
+        err,
+    )
 
 
 @pytest.mark.parametrize("name", ["utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009"])
@@ -182,28 +196,45 @@ def test_presets_pass_their_own_sanity(name):
     from stewart_drake.core.sanity import HOME_MAX_CONDITION, above_base, has_plate
 
     p = load_platform(name)
-    assert has_plate(p) and bool(above_base(p, p.home_pose())) and condition_number(p, p.home_pose()) < HOME_MAX_CONDITION
+    assert (
+        has_plate(p) and bool(above_base(p, p.home_pose())) and condition_number(p, p.home_pose()) < HOME_MAX_CONDITION
+    )
 
 
 # ----------------------------------------------------------------------------------------------
 # Options: finite, in range, resolvable.
 
 
-@pytest.mark.parametrize("argv, message", [
-    (("dynamics", "--gravity", "nan"), "argument --gravity: " + UsageError.NOT_FINITE_NUMBER.format(value="nan")),
-    (("dynamics", "--gravity", "981"), GRAVITY_RANGE.format(option="--gravity", value="981")),
-    (("dynamics", "--t-end", "inf"), "argument --t-end: " + UsageError.NOT_FINITE_NUMBER.format(value="inf")),
-    (("servo", "--trim", "-1500", "1500", "1500", "1500", "1500", "1500"),
-     SERVO_NEUTRAL.format(what="--trim", servo=1, value="-1500", lo=900, hi=2100, swing=400, range_lo=500, range_hi=2500)),
-    (("servo", "--trim", "1500", "1500", "1500", "1500", "1500", "1e9"),
-     "--trim: servo 6's neutral pulse 1000000000 µs is outside [900, 2100] µs"),
-    (("servo", "--trim", "nan", "1500", "1500", "1500", "1500", "1500"),
-     "argument --trim: " + UsageError.NOT_FINITE_NUMBER.format(value="nan")),
-    (("workspace", "--centre", "100", "0", "0"),
-     FAR_CENTRE.format(option="--centre", centre="100 0 0", ratio=105, size_m=0.95, limit=10)),
-    (("fk", "--max-iter", "1000000000", "--lengths", "500", "500", "500", "500", "500", "500"),
-     "--max-iter 1000000000 would need 1e+09 Newton iterations; the limit is 1e+03 Newton iterations"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (("dynamics", "--gravity", "nan"), "argument --gravity: " + UsageError.NOT_FINITE_NUMBER.format(value="nan")),
+        (("dynamics", "--gravity", "981"), GRAVITY_RANGE.format(option="--gravity", value="981")),
+        (("dynamics", "--t-end", "inf"), "argument --t-end: " + UsageError.NOT_FINITE_NUMBER.format(value="inf")),
+        (
+            ("servo", "--trim", "-1500", "1500", "1500", "1500", "1500", "1500"),
+            SERVO_NEUTRAL.format(
+                what="--trim", servo=1, value="-1500", lo=900, hi=2100, swing=400, range_lo=500, range_hi=2500
+            ),
+        ),
+        (
+            ("servo", "--trim", "1500", "1500", "1500", "1500", "1500", "1e9"),
+            "--trim: servo 6's neutral pulse 1000000000 µs is outside [900, 2100] µs",
+        ),
+        (
+            ("servo", "--trim", "nan", "1500", "1500", "1500", "1500", "1500"),
+            "argument --trim: " + UsageError.NOT_FINITE_NUMBER.format(value="nan"),
+        ),
+        (
+            ("workspace", "--centre", "100", "0", "0"),
+            FAR_CENTRE.format(option="--centre", centre="100 0 0", ratio=105, size_m=0.95, limit=10),
+        ),
+        (
+            ("fk", "--max-iter", "1000000000", "--lengths", "500", "500", "500", "500", "500", "500"),
+            "--max-iter 1000000000 would need 1e+09 Newton iterations; the limit is 1e+03 Newton iterations",
+        ),
+    ],
+)
 def test_bad_options_exit_2_with_the_message(argv, message, tmp_path):
     if argv[0] == "simulate":
         argv = argv + ("--out", str(tmp_path / "o"))
@@ -262,19 +293,27 @@ def test_workspace_resolution_refused_before_allocating(h):
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert rc == 2 and peak < 50e6
-    assert re.search(rf"resolution {float(h):g} m would need \S+ grid nodes \(~\S+ GB\); the finest this machine can hold is ~[0-9.]+ mm; "
-                     r"use a coarser --resolution", err)
+    assert re.search(
+        rf"resolution {float(h):g} m would need \S+ grid nodes \(~\S+ GB\); the finest this machine can hold is ~[0-9.]+ mm; "
+        r"use a coarser --resolution",
+        err,
+    )
 
 
 # ----------------------------------------------------------------------------------------------
 # Bounded work: durations, steps.
 
 
-@pytest.mark.parametrize("argv, pattern", [
-    (("dynamics", "--t-end", "1e9", "--dt", "1e-6"),
-     r"--t-end/--dt 1000000000/1e-06 s would need 1e\+15 samples \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a larger --dt"),
-    (("dynamics", "--t-end", "1e4", "--dt", "1e-4"), r"would need 1e\+08 samples; the limit is 1e\+07 samples"),
-])
+@pytest.mark.parametrize(
+    "argv, pattern",
+    [
+        (
+            ("dynamics", "--t-end", "1e9", "--dt", "1e-6"),
+            r"--t-end/--dt 1000000000/1e-06 s would need 1e\+15 samples \(~10\^\d+ GB\); the limit is \S+ GB on this machine; use a larger --dt",
+        ),
+        (("dynamics", "--t-end", "1e4", "--dt", "1e-4"), r"would need 1e\+08 samples; the limit is 1e\+07 samples"),
+    ],
+)
 def test_work_is_bounded_before_allocation(argv, pattern, tmp_path, monkeypatch):
     import stewart_drake.core.sanity as sanity
 
@@ -312,7 +351,9 @@ def test_ik_any_pose_fuzz(pose, unit):
 def check_ik_pose(pose, unit):
     p = load_platform("utn-kinematic")
     # fixed notation: argparse takes "-1e-05" (and "-inf") for an option (its usage error is exit 2 too)
-    rc, out, err = cli("ik", "--pose", *[f"{v:.330f}" if math.isfinite(v) else repr(v) for v in pose], "--length-unit", unit, "--json")
+    rc, out, err = cli(
+        "ik", "--pose", *[f"{v:.330f}" if math.isfinite(v) else repr(v) for v in pose], "--length-unit", unit, "--json"
+    )
     assert rc in (0, 1, 2) and "Traceback" not in err
     assert not NUMBER.search(out)
     if rc == 2:
@@ -325,11 +366,24 @@ def check_ik_pose(pose, unit):
     assert json.loads(out)["lengths"] == pytest.approx((L * (1e3 if unit == "mm" else 1)).tolist(), rel=1e-12)
 
 
-SAMPLES = st.lists(st.tuples(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.sampled_from([0.7, 0.6, 0.9, -0.7, 0.0, 7.0, math.nan]),
-                             st.floats(-0.5, 0.5)), min_size=4, max_size=6)
+SAMPLES = st.lists(
+    st.tuples(
+        st.floats(-0.3, 0.3),
+        st.floats(-0.3, 0.3),
+        st.sampled_from([0.7, 0.6, 0.9, -0.7, 0.0, 7.0, math.nan]),
+        st.floats(-0.5, 0.5),
+    ),
+    min_size=4,
+    max_size=6,
+)
 
 
-@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=40,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
 @given(SAMPLES)
 def test_dynamics_any_trajectory(tmp_path, samples):
     check_dynamics_trajectory(tmp_path, samples)

@@ -42,7 +42,8 @@ def test_committed_sdf_is_what_the_generator_writes(tmp_path):
         path = write_sdf(model, tmp_path)
         names.add(path.name)
         assert path.read_bytes() == (committed / path.name).read_bytes(), (
-            f"sdf/{path.name} is stale: regenerate it (see sdf/README.md)")
+            f"sdf/{path.name} is stale: regenerate it (see sdf/README.md)"
+        )
     assert len(names) == 5 and names == {p.name for p in committed.glob("*.sdf")}
 
 
@@ -122,7 +123,9 @@ def test_models_and_their_commands_need_no_pydrake(tmp_path):
         "for argv in (['leg', 'sdf', '--write', 'a'], ['servo', '--write-sdf', 'b', '--json'], ['model', '--platform', 'utn-dynamic']):\n"
         "    assert main(argv) == 0, argv\n"
     )
-    r = subprocess.run([sys.executable, str(runner), "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [sys.executable, str(runner), "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
     assert r.returncode == 0, r.stderr[-2000:]
     assert (tmp_path / "a" / "leg-3r.sdf").read_text() == sdf_text(Leg3R())
     assert (tmp_path / "b" / "servo-hexapod.sdf").read_text() == sdf_text(hobby_servo_hexapod())

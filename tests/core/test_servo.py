@@ -4,6 +4,7 @@ and the closed loop: ``tests/drake/test_servo_drake.py``)."""
 import numpy as np
 import pytest
 from scipy.optimize import brentq
+
 from stewart_drake.core.servo import (
     RATE_US_PER_RAD,
     ServoPoseError,
@@ -49,6 +50,7 @@ def test_arm_angles_match_an_independent_root_solve(hexapod):
     worst = 0.0
     for k in range(len(poses)):
         for i in range(6):
+
             def f(a):
                 t = arm_tips(hexapod, np.full(6, a))[i]
                 return np.linalg.norm(t - q[k, i]) - hexapod.rod_length
@@ -78,8 +80,12 @@ def test_pulse_formula_and_inverse(hexapod):
 
 
 def test_limits_are_reported_per_servo_never_nan(hexapod):
-    poses = np.array([hexapod.home_pose() + [0, 0, 0.1, 0, 0, 0],  # far too high: rods cannot reach
-                      hexapod.home_pose() + [0, 0, 0.010, 0, 0, np.radians(60)]])  # big yaw: travel
+    poses = np.array(
+        [
+            hexapod.home_pose() + [0, 0, 0.1, 0, 0, 0],  # far too high: rods cannot reach
+            hexapod.home_pose() + [0, 0, 0.010, 0, 0, np.radians(60)],
+        ]
+    )  # big yaw: travel
     sol = solve(hexapod, poses)
     assert np.all(np.isfinite(sol.angles)) and np.all(np.isfinite(sol.pulse))
     v = sol.violations()
@@ -123,8 +129,18 @@ def test_yaml_preset_is_the_documented_layout(hexapod):
     y = load_servo_hexapod("hobby-servo")
     for name in ("base_pivots", "arm_directions", "platform_anchors", "shaft_directions", "neutral_us"):
         assert np.abs(getattr(y, name) - getattr(hexapod, name)).max() <= 1e-17, name
-    for name in ("arm_length", "rod_length", "rate_us_per_rad", "travel_rad", "servo_torque", "servo_speed", "servo_band",
-                 "arm_mass", "rod_mass", "platform_mass"):
+    for name in (
+        "arm_length",
+        "rod_length",
+        "rate_us_per_rad",
+        "travel_rad",
+        "servo_torque",
+        "servo_speed",
+        "servo_band",
+        "arm_mass",
+        "rod_mass",
+        "platform_mass",
+    ):
         assert getattr(y, name) == pytest.approx(getattr(hexapod, name), rel=1e-15), name
     assert y.servo_speed == pytest.approx(np.radians(60) / 0.17)
 
@@ -133,10 +149,12 @@ def _explicit_yaml(h, trims):
     """The hexapod written in the explicit YAML layout, millimetres and degrees (repr: exact round trip)."""
     pts = lambda a: "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]" for row in a) + "]"  # noqa: E731
     nums = lambda a: "[" + ", ".join(repr(float(v)) for v in a) + "]"  # noqa: E731
-    return (f"name: explicit\nlength_unit: mm\narm_length: {h.arm_length * 1e3!r}\nrod_length: {h.rod_length * 1e3!r}\n"
-            f"base_pivots: {pts(h.base_pivots * 1e3)}\narm_directions_deg: {nums(np.degrees(h.arm_directions))}\n"
-            f"platform_anchors: {pts(h.platform_anchors * 1e3)}\nshaft_directions: {pts(h.shaft_directions)}\n"
-            f"servo: {{neutral_us: {nums(trims)}}}\n")
+    return (
+        f"name: explicit\nlength_unit: mm\narm_length: {h.arm_length * 1e3!r}\nrod_length: {h.rod_length * 1e3!r}\n"
+        f"base_pivots: {pts(h.base_pivots * 1e3)}\narm_directions_deg: {nums(np.degrees(h.arm_directions))}\n"
+        f"platform_anchors: {pts(h.platform_anchors * 1e3)}\nshaft_directions: {pts(h.shaft_directions)}\n"
+        f"servo: {{neutral_us: {nums(trims)}}}\n"
+    )
 
 
 def test_yaml_explicit_layout_round_trip(hexapod, tmp_path):
@@ -153,15 +171,27 @@ def test_yaml_explicit_layout_round_trip(hexapod, tmp_path):
     assert np.abs(solve(y, y.home_pose()).pulse - trims).max() < 1e-9
 
 
-@pytest.mark.parametrize("edit, message", [
-    (("length_unit: mm", "length_unit: inch"), "length_unit must be m or mm, got 'inch'"),
-    (("arm_length: 25.0", "arm_length: -25.0"), r"arm_length must be a positive number of mm, got -25.0"),
-    (("speed_s_per_60deg: 0.17", "speed_s_per_60deg: 0"), r"servo.speed_s_per_60deg must be a positive number of seconds, got 0.0"),
-    (("neutral_us: [1500, 1500, 1500, 1500, 1500, 1500]", "neutral_us: [1500, 1500]"), r"servo.neutral_us must be 6 numbers \(one per servo\), got \[1500.0, 1500.0\]"),
-    (("travel_deg: 45.0", "travel_deg: 95.0"), "servo.travel_deg must be below 90 degrees, got 95.0"),
-    (("rod_length: 110.0", "rod_length: 110.0\nbase_pivots: [[0, 0, 0]]"), "give either paired or the explicit layout, not both"),
-    (("rod_length: 110.0", "rod_length: 110.0\nrod_colour: red"), "rod_colour"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (("length_unit: mm", "length_unit: inch"), "length_unit must be m or mm, got 'inch'"),
+        (("arm_length: 25.0", "arm_length: -25.0"), r"arm_length must be a positive number of mm, got -25.0"),
+        (
+            ("speed_s_per_60deg: 0.17", "speed_s_per_60deg: 0"),
+            r"servo.speed_s_per_60deg must be a positive number of seconds, got 0.0",
+        ),
+        (
+            ("neutral_us: [1500, 1500, 1500, 1500, 1500, 1500]", "neutral_us: [1500, 1500]"),
+            r"servo.neutral_us must be 6 numbers \(one per servo\), got \[1500.0, 1500.0\]",
+        ),
+        (("travel_deg: 45.0", "travel_deg: 95.0"), "servo.travel_deg must be below 90 degrees, got 95.0"),
+        (
+            ("rod_length: 110.0", "rod_length: 110.0\nbase_pivots: [[0, 0, 0]]"),
+            "give either paired or the explicit layout, not both",
+        ),
+        (("rod_length: 110.0", "rod_length: 110.0\nrod_colour: red"), "rod_colour"),
+    ],
+)
 def test_yaml_errors_name_the_field_and_value(tmp_path, edit, message):
     from stewart_drake.core.servo import load_servo_hexapod, servo_preset_path
 
@@ -177,7 +207,9 @@ def test_explicit_yaml_missing_fields_and_unknown_names(hexapod, tmp_path):
     from stewart_drake.core.servo import load_servo_hexapod
 
     path = tmp_path / "partial.yaml"
-    path.write_text("\n".join(line for line in _explicit_yaml(hexapod, [1500] * 6).splitlines() if not line.startswith("shaft")))
+    path.write_text(
+        "\n".join(line for line in _explicit_yaml(hexapod, [1500] * 6).splitlines() if not line.startswith("shaft"))
+    )
     with pytest.raises(GeometryError, match="missing shaft_directions"):
         load_servo_hexapod(path)
     with pytest.raises(GeometryError, match="unknown servo hexapod 'hobby'"):

@@ -42,7 +42,9 @@ def test_table_and_constant_trajectories_have_no_closed_form_rates():
     np.testing.assert_array_equal(tab.pose(0.5), (SEED.pose(0.0) + SEED.pose(1.0)) / 2)
     with pytest.raises(ValueError, match="trajectory 'tab' has no closed-form rates"):
         tab.derivatives(0.5)
-    np.testing.assert_array_equal(constant_trajectory("c", SEED.pose(0.0)).pose(np.zeros((2, 3))), np.broadcast_to(SEED.pose(0.0), (2, 3, 6)))
+    np.testing.assert_array_equal(
+        constant_trajectory("c", SEED.pose(0.0)).pose(np.zeros((2, 3))), np.broadcast_to(SEED.pose(0.0), (2, 3, 6))
+    )
 
 
 def test_every_kind_of_trajectory_pickles_to_the_same_poses():
@@ -50,8 +52,12 @@ def test_every_kind_of_trajectory_pickles_to_the_same_poses():
     trajectories must survive the round trip with the same poses bit for bit."""
     p = load_preset("utn-kinematic")
     prog = run_program("mover(0, 0, 60, 5, 0, 0) en 0.5\nwait 0.1\n", "p.stw", p).trajectory
-    trajs = [fit_trajectory(ROTATING, p), table_trajectory("tab", [0.0, 0.2, 0.4], SEED.pose(np.array([0.0, 0.2, 0.4]))),
-             constant_trajectory("c", p.home_pose(), 1.0), prog]
+    trajs = [
+        fit_trajectory(ROTATING, p),
+        table_trajectory("tab", [0.0, 0.2, 0.4], SEED.pose(np.array([0.0, 0.2, 0.4]))),
+        constant_trajectory("c", p.home_pose(), 1.0),
+        prog,
+    ]
     for tr in trajs:
         back = pickle.loads(pickle.dumps(tr))
         assert back.name == tr.name and back.duration == tr.duration

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.kinematics import condition_number
 from stewart_drake.design.maps import slice_maps
 from stewart_drake.design.modes import analytic_modes, spatial_inertia
 from stewart_drake.design.stiffness import principal_stiffness, stiffness_matrix
-from stewart_drake.core.geometry import load_platform
-from stewart_drake.core.kinematics import condition_number
 
 
 def test_slice_maps_match_single_pose_computations():
@@ -49,11 +49,33 @@ def test_cli_stiffness_map(tmp_path):
     from stewart_drake.cli import main
 
     out = tmp_path / "maps"
-    assert main(["stiffness", "--pose", "0", "0", "700", "5", "0", "30", "--map", str(out), "--map-n", "9", "--map-half-width", "300"]) == 0
+    assert (
+        main(
+            [
+                "stiffness",
+                "--pose",
+                "0",
+                "0",
+                "700",
+                "5",
+                "0",
+                "30",
+                "--map",
+                str(out),
+                "--map-n",
+                "9",
+                "--map-half-width",
+                "300",
+            ]
+        )
+        == 0
+    )
     assert (out / "maps.png").stat().st_size > 1000
     d = np.load(out / "maps.npz")
     p = load_platform("utn-dynamic")
     q = np.r_[d["x_m"][2], d["y_m"][6], 0.7, np.radians([5.0, 0.0, 30.0])]
-    assert np.isclose(d["k_min_n_per_m"][2, 6], principal_stiffness(stiffness_matrix(p, q, 1e5)).translational[0], rtol=1e-10)
+    assert np.isclose(
+        d["k_min_n_per_m"][2, 6], principal_stiffness(stiffness_matrix(p, q, 1e5)).translational[0], rtol=1e-10
+    )
     assert main(["stiffness", "--pose", "0", "0", "700", "0", "0", "0", "--map", str(out), "--map-n", "5000"]) == 2
     assert (out / "maps.png").exists()  # a refused run leaves the earlier output alone

@@ -9,14 +9,15 @@ import numpy as np
 import pytest
 
 from stewart_drake.cli import main
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.trajectory import ROTATING
 from stewart_drake.design.boxquad import box_quadratic_max
 from stewart_drake.design.envelope import Envelope, EnvelopeError, cartesian_leg_forces, envelope_sizing, load_envelope
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.sizing import leg_motion, rotating_trajectory, size_trajectory
 from stewart_drake.design.verify import newton_euler_fd, sample_box
 from stewart_drake.errors import OptionError, PayloadError
-from stewart_drake.core.geometry import load_platform
-from stewart_drake.core.trajectory import ROTATING
+
 
 @pytest.fixture(scope="module")
 def loaded_platform():
@@ -46,7 +47,12 @@ def test_sizing_with_translation_and_rotation(loaded_platform):
     """A trajectory moving every coordinate at once (the rotating one turns about x and z only)."""
     from stewart_drake.core.dynamics import harmonic_trajectory
 
-    args = ([0.01, -0.02, 0.7, 0.02, -0.03, 0.05], [0.03, 0.02, 0.01, 0.06, 0.05, 0.2], [1.3, 2.1, 2.9, 1.7, 2.3, 3.1], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    args = (
+        [0.01, -0.02, 0.7, 0.02, -0.03, 0.05],
+        [0.03, 0.02, 0.01, 0.06, 0.05, 0.2],
+        [1.3, 2.1, 2.9, 1.7, 2.3, 3.1],
+        [0.1, 0.2, 0.3, 0.4, 0.5, 0.6],
+    )
     t = np.linspace(0.0, 3.0, 301)
     q, qd, qdd = harmonic_trajectory(t, *args)
     s = size_trajectory(loaded_platform, t, q, qd, qdd)
@@ -86,7 +92,9 @@ def test_box_quadratic_max_is_the_maximum():
     assert np.all(best - vals <= 0.02)
 
 
-ENV_POSES = np.array([[0.0, 0.0, 0.7, 0.0, 0.0, 0.0], [0.05, -0.04, 0.72, 0.08, -0.05, 0.2], [-0.08, 0.06, 0.67, -0.05, 0.1, -0.15]])
+ENV_POSES = np.array(
+    [[0.0, 0.0, 0.7, 0.0, 0.0, 0.0], [0.05, -0.04, 0.72, 0.08, -0.05, 0.2], [-0.08, 0.06, 0.67, -0.05, 0.1, -0.15]]
+)
 
 
 @pytest.mark.parametrize("legs", [False, True])
@@ -137,7 +145,9 @@ def test_allowed_acceleration_is_the_limit(loaded_platform):
         probe = Envelope(ENV_POSES, env.v_max, a * es.allowed_accel[:, j].min())
         worst = envelope_sizing(p, probe).peak_force.max()
         assert worst <= 60.0 * (1 + 1e-9)
-        over = envelope_sizing(p, Envelope(ENV_POSES, env.v_max, a * es.allowed_accel[:, j].min() * 1.01)).peak_force.max()
+        over = envelope_sizing(
+            p, Envelope(ENV_POSES, env.v_max, a * es.allowed_accel[:, j].min() * 1.01)
+        ).peak_force.max()
         assert over > 60.0
 
 
@@ -164,7 +174,15 @@ def test_cli_size_trajectory_json(capsys):
     assert main(["size", "--trajectory", "rotating", "--json", "--dt", "0.01"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert len(out["legs"]) == 6
-    for key in ("peak_force_n", "rms_force_n", "peak_speed_m_s", "peak_accel_m_s2", "peak_power_w", "min_length_m", "max_length_m"):
+    for key in (
+        "peak_force_n",
+        "rms_force_n",
+        "peak_speed_m_s",
+        "peak_accel_m_s2",
+        "peak_power_w",
+        "min_length_m",
+        "max_length_m",
+    ):
         assert all(np.isfinite(r[key]) for r in out["legs"])
     t = np.arange(401) * 0.01
     s = size_trajectory(load_platform("utn-dynamic"), t, *rotating_trajectory(t))
@@ -212,13 +230,19 @@ def test_cli_size_speed_limit_on_envelope(tmp_path, capsys):
     assert "speed" in err and "legs.max_speed 0.1 m/s" in err and "envelope pose 1 " in err
 
 
-@pytest.mark.parametrize("text, needle", [
-    (ENV_YAML.replace("[2, 2, 2, 2, 2, 2]", "[2, 2, 2, 2, 2, 0]"), "box.steps must be >= 1"),
-    (ENV_YAML.replace("[-40, -40, 690", "[-400, -40, 690"), "leaves the workspace: leg"),
-    (ENV_YAML.replace("linear: [200, 200, 100]", "linear: [200, -200, 100]"), "velocity.linear bounds are magnitudes"),
-    (ENV_YAML.replace("[2, 2, 2, 2, 2, 2]", "[300, 300, 300, 300, 2, 2]"), "more than the limit"),
-    (ENV_YAML.replace("angular: [20, 20, 40]", "angular: [20, 20]"), "velocity.angular: expected 3 numbers"),
-])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        (ENV_YAML.replace("[2, 2, 2, 2, 2, 2]", "[2, 2, 2, 2, 2, 0]"), "box.steps must be >= 1"),
+        (ENV_YAML.replace("[-40, -40, 690", "[-400, -40, 690"), "leaves the workspace: leg"),
+        (
+            ENV_YAML.replace("linear: [200, 200, 100]", "linear: [200, -200, 100]"),
+            "velocity.linear bounds are magnitudes",
+        ),
+        (ENV_YAML.replace("[2, 2, 2, 2, 2, 2]", "[300, 300, 300, 300, 2, 2]"), "more than the limit"),
+        (ENV_YAML.replace("angular: [20, 20, 40]", "angular: [20, 20]"), "velocity.angular: expected 3 numbers"),
+    ],
+)
 def test_cli_envelope_errors(tmp_path, capsys, text, needle):
     env = _write(tmp_path, "env.yaml", text)
     assert main(["size", "--envelope", env]) == 2
@@ -228,11 +252,14 @@ def test_cli_envelope_errors(tmp_path, capsys, text, needle):
         envelope_sizing(load_platform("utn-dynamic"), load_envelope(env))
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["--payload", "-1"], PayloadError.MASS.format(option="--payload", value="-1")),
-    (["--payload", "2", "--payload-com", "0", "0", "-0.01"], PayloadError.BELOW_PLATE.format(z=-0.01, unit="m")),
-    (["--gravity", "-1"], OptionError.GRAVITY.format(option="--gravity", value="-1")),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--payload", "-1"], PayloadError.MASS.format(option="--payload", value="-1")),
+        (["--payload", "2", "--payload-com", "0", "0", "-0.01"], PayloadError.BELOW_PLATE.format(z=-0.01, unit="m")),
+        (["--gravity", "-1"], OptionError.GRAVITY.format(option="--gravity", value="-1")),
+    ],
+)
 def test_cli_size_bad_payload(capsys, args, needle):
     assert main(["size", "--trajectory", "seed", "--dt", "0.1"] + args) == 2
     err = capsys.readouterr().err
@@ -245,7 +272,9 @@ def test_envelope_without_velocity_is_affine(loaded_platform):
     for legs in (False, True):
         es = envelope_sizing(loaded_platform, env, legs=legs)
         signs = np.array(np.meshgrid(*[[-1.0, 1.0]] * 6, indexing="ij")).reshape(6, -1).T
-        F = cartesian_leg_forces(loaded_platform, np.broadcast_to(ENV_POSES[0], (64, 6)), np.zeros((64, 6)), signs * env.a_max, legs=legs)
+        F = cartesian_leg_forces(
+            loaded_platform, np.broadcast_to(ENV_POSES[0], (64, 6)), np.zeros((64, 6)), signs * env.a_max, legs=legs
+        )
         assert np.allclose(F.max(0), es.force_max[0], rtol=1e-12, atol=1e-12)
         assert np.allclose(F.min(0), es.force_min[0], rtol=1e-12, atol=1e-12)
 

@@ -11,11 +11,11 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from stewart_drake.cli import main
+from stewart_drake.core.geometry import load_platform
 from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.stiffness import deflection, principal_stiffness, stiffness_matrix
 from stewart_drake.errors import PayloadError, StiffnessError
-from stewart_drake.core.geometry import load_platform
 
 G = 9.81
 Q_OFF = np.array([0.05, -0.03, 0.72, 0.1, -0.05, 0.2])  # an asymmetric pose: no repeated frequencies
@@ -45,7 +45,10 @@ def test_zero_load_stiffness_is_At_k_A(loaded):
     r, u, _, _ = _geometry(loaded, Q_OFF)
     A = np.hstack([u, np.cross(r, u)])
     expected = A.T @ np.diag(K_LEGS) @ A
-    for K in (stiffness_matrix(loaded, Q_OFF, K_LEGS, gravity=0.0), stiffness_matrix(loaded, Q_OFF, K_LEGS, loaded=False)):
+    for K in (
+        stiffness_matrix(loaded, Q_OFF, K_LEGS, gravity=0.0),
+        stiffness_matrix(loaded, Q_OFF, K_LEGS, loaded=False),
+    ):
         assert np.abs(K - expected).max() <= 1e-9 * np.abs(expected).max()
 
 
@@ -66,7 +69,13 @@ def _total_wrench(p, q0, dx, k):
 def test_loaded_stiffness_matches_finite_differences(loaded):
     K = stiffness_matrix(loaded, Q_OFF, K_LEGS)
     h = 1e-6
-    K_fd = -np.stack([(_total_wrench(loaded, Q_OFF, h * e, K_LEGS) - _total_wrench(loaded, Q_OFF, -h * e, K_LEGS)) / (2 * h) for e in np.eye(6)], -1)
+    K_fd = -np.stack(
+        [
+            (_total_wrench(loaded, Q_OFF, h * e, K_LEGS) - _total_wrench(loaded, Q_OFF, -h * e, K_LEGS)) / (2 * h)
+            for e in np.eye(6)
+        ],
+        -1,
+    )
     # central differences: truncation ~ h² |w'''| and rounding ~ 1e-16 k L / h, both < 1e-8 of |K| here
     assert np.abs(K - K_fd).max() <= 1e-8 * np.abs(K).max()
     K0 = stiffness_matrix(loaded, Q_OFF, K_LEGS, loaded=False)
@@ -110,8 +119,8 @@ def test_deflection_solves_the_nonlinear_statics_to_first_order(loaded):
 
 def test_spatial_inertia_matches_inverse_dynamics(loaded):
     """M_C by formula equals the one read off the toolkit's inverse dynamics (unit accelerations)."""
-    from stewart_drake.design.envelope import cartesian_leg_forces
     from stewart_drake.core.kinematics import inverse_jacobian
+    from stewart_drake.design.envelope import cartesian_leg_forces
 
     A = inverse_jacobian(loaded, Q_OFF)
     F = cartesian_leg_forces(loaded, np.broadcast_to(Q_OFF, (6, 6)), np.zeros((6, 6)), np.eye(6), gravity=0.0)
@@ -124,7 +133,28 @@ def test_spatial_inertia_matches_inverse_dynamics(loaded):
 
 
 def test_cli_stiffness_json(capsys):
-    assert main(["stiffness", "--pose", "50", "-30", "720", "5", "-3", "10", "--payload", "8", "--payload-com", "30", "-20", "60", "--json"]) == 0
+    assert (
+        main(
+            [
+                "stiffness",
+                "--pose",
+                "50",
+                "-30",
+                "720",
+                "5",
+                "-3",
+                "10",
+                "--payload",
+                "8",
+                "--payload-com",
+                "30",
+                "-20",
+                "60",
+                "--json",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     p = with_payload(load_platform("utn-dynamic"), 8.0, [0.03, -0.02, 0.06])
     q = np.r_[0.05, -0.03, 0.72, np.radians([5, -3, 10])]
@@ -136,12 +166,15 @@ def test_cli_stiffness_json(capsys):
     assert np.allclose(K @ d, out["payload_wrench"], atol=1e-9)
 
 
-@pytest.mark.parametrize("args, needle, rc", [
-    (["--leg-stiffness", "-5"], StiffnessError.NOT_POSITIVE.format(option="--leg-stiffness", value=-5.0), 2),
-    (["--leg-stiffness", "nan"], "--leg-stiffness", 2),
-    (["--payload", "2", "--payload-com", "0", "0", "-5"], PayloadError.BELOW_PLATE.format(z=-5.0, unit="mm"), 2),
-    (["--platform", "utn-kinematic"], StiffnessError.MISSING.format(option="legs.stiffness"), 2),
-])
+@pytest.mark.parametrize(
+    "args, needle, rc",
+    [
+        (["--leg-stiffness", "-5"], StiffnessError.NOT_POSITIVE.format(option="--leg-stiffness", value=-5.0), 2),
+        (["--leg-stiffness", "nan"], "--leg-stiffness", 2),
+        (["--payload", "2", "--payload-com", "0", "0", "-5"], PayloadError.BELOW_PLATE.format(z=-5.0, unit="mm"), 2),
+        (["--platform", "utn-kinematic"], StiffnessError.MISSING.format(option="legs.stiffness"), 2),
+    ],
+)
 def test_cli_stiffness_errors(capsys, args, needle, rc):
     assert main(["stiffness", "--pose", "0", "0", "700", "0", "0", "0"] + args) == rc
     err = capsys.readouterr().err

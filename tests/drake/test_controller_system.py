@@ -32,7 +32,9 @@ def run_open_loop(kind, config, reference, measurement, duration, log_period):
     meas = b.AddSystem(PoseSource(measurement))
     b.Connect(ref.get_output_port(), ctrl.GetInputPort("reference"))
     b.Connect(meas.get_output_port(), ctrl.GetInputPort("leg_lengths"))
-    logs = {name: LogVectorOutput(ctrl.GetOutputPort(name), b, log_period) for name in ("command", "setpoint", "status")}
+    logs = {
+        name: LogVectorOutput(ctrl.GetOutputPort(name), b, log_period) for name in ("command", "setpoint", "status")
+    }
     logs["reference"] = LogVectorOutput(ref.get_output_port(), b, log_period)
     d = b.Build()
     sim = Simulator(d)

@@ -43,7 +43,9 @@ def test_drake_single_modes_mac(loaded):
 
 def test_drake_damped(loaded):
     c = 300.0
-    a = analytic_modes(stiffness_matrix(loaded, Q_OFF, K_LEGS), spatial_inertia(loaded, Q_OFF), damping_matrix(loaded, Q_OFF, c))
+    a = analytic_modes(
+        stiffness_matrix(loaded, Q_OFF, K_LEGS), spatial_inertia(loaded, Q_OFF), damping_matrix(loaded, Q_OFF, c)
+    )
     d = drake_modes(loaded, Q_OFF, K_LEGS, c)
     assert np.all(np.abs(d["modes"].frequencies_hz / a.frequencies_hz - 1) <= 1e-6)
     assert np.all(np.abs(d["modes"].damping_ratio - a.damping_ratio) <= 1e-6)

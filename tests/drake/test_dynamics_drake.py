@@ -25,7 +25,9 @@ def trajectory(kind, t):
     amp = np.array([0.02, 0.03, 0.015, 0, 0, 0])
     axes = {"about-x": [3], "about-y": [4], "about-z": [5], "all-axes": [3, 4, 5]}[kind]
     amp[axes] = 0.35
-    return D.harmonic_trajectory(t, [-0.02, 0.01, 0.7, 0.03, -0.02, 0.05], amp, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    return D.harmonic_trajectory(
+        t, [-0.02, 0.01, 0.7, 0.03, -0.02, 0.05], amp, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]
+    )
 
 
 KINDS = ["seed", "about-x", "about-y", "about-z", "all-axes"]
@@ -89,7 +91,9 @@ def test_open_loop_simulation_follows_and_drift_scales_with_time_step(plat):
     for dt in (2e-3, 1e-3):
         t = np.arange(0, 0.5 + dt / 2, dt)
         q, qd, qdd = D.seed_trajectory(t)
-        r = V.simulate_open_loop(plat, t, q, qd, D.leg_forces_with_legs(plat, q, qd, qdd), dt, record_every=int(0.05 / dt))
+        r = V.simulate_open_loop(
+            plat, t, q, qd, D.leg_forces_with_legs(plat, q, qd, qdd), dt, record_every=int(0.05 / dt)
+        )
         assert r["position_error"][0] == 0
         assert r["position_error"].max() < 2e-5  # m
         assert r["angle_error"].max() < 1e-4  # rad

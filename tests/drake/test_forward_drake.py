@@ -79,7 +79,9 @@ def test_dietmaier_40_real_solutions():
     am = assembly_modes(p, L)
     assert len(am) == 40 and am.complete
     P = np.array([m.position for m in am.modes])
-    gaps = np.linalg.norm(P[:, None] - P[None], axis=-1) + np.array([[np.abs(a.rotation - b.rotation).max() for b in am.modes] for a in am.modes])
+    gaps = np.linalg.norm(P[:, None] - P[None], axis=-1) + np.array(
+        [[np.abs(a.rotation - b.rotation).max() for b in am.modes] for a in am.modes]
+    )
     assert np.min(gaps + np.eye(40) * 9) > 1e-4  # well separated: not one solution counted twice
     assert all(m.certified and m.residual <= 1e-13 and m.sigma_min > 0 for m in am.modes)
     np.testing.assert_allclose(leg_lengths(p, am.poses()), np.broadcast_to(L, (40, 6)), atol=1e-12)
@@ -90,7 +92,9 @@ def test_assembly_impossible_lengths():
     p = load_preset("utn-kinematic")
     L = leg_lengths(p, p.home_pose())
     L[0], L[1] = 0.3, 1.3
-    with pytest.raises(ForwardKinematicsError, match=r"no assembly found for lengths \(300\.000, 1300\.000, .*\) mm from \d+ starts"):
+    with pytest.raises(
+        ForwardKinematicsError, match=r"no assembly found for lengths \(300\.000, 1300\.000, .*\) mm from \d+ starts"
+    ):
         assembly_modes(p, L, n_starts=200, polish=None)
 
 

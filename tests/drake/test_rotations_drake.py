@@ -32,9 +32,13 @@ def test_quaternion_to_matrix_matches_drake():
     q = RNG.normal(size=(40, 4))
     R = quaternion_to_matrix(q)
     for qk, Rk in zip(q / np.linalg.norm(q, axis=-1, keepdims=True), R):
-        np.testing.assert_allclose(Rk, RotationMatrix(Quaternion(qk)).matrix(), atol=2e-15)  # entries <= 1: a few roundings of 1.1e-16
+        np.testing.assert_allclose(
+            Rk, RotationMatrix(Quaternion(qk)).matrix(), atol=2e-15
+        )  # entries <= 1: a few roundings of 1.1e-16
     np.testing.assert_allclose(quaternion_to_matrix(-3.0 * q), R, atol=1e-15)
     np.testing.assert_allclose(quaternion_to_matrix(q.reshape(2, 20, 4)), R.reshape(2, 20, 3, 3), atol=0)
-    np.testing.assert_allclose(from_drake(Quaternion(q[0] / np.linalg.norm(q[0]))), angles_from_matrix(R[0]), atol=1e-13)
+    np.testing.assert_allclose(
+        from_drake(Quaternion(q[0] / np.linalg.norm(q[0]))), angles_from_matrix(R[0]), atol=1e-13
+    )
     with pytest.raises(ValueError, match=r"quaternions need 4 numbers \(w, x, y, z\), got shape \(3,\)"):
         quaternion_to_matrix([1.0, 0.0, 0.0])

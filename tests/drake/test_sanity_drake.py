@@ -10,7 +10,12 @@ def test_saturation_verdict_counts_the_longest_stretch():
     """``longest_saturation`` from the cumulative per-leg counters: leg 2 saturated on ticks 3..62 (60
     ticks = 0.060 s at 1 ms) fails; leg 5 saturated on 40 ticks in two stretches of 20 passes."""
     from stewart_drake.control import STATUS
-    from stewart_drake.control.simulation_log import MAX_SATURATION_S, SimulationLog, longest_saturation, tracking_verdict
+    from stewart_drake.control.simulation_log import (
+        MAX_SATURATION_S,
+        SimulationLog,
+        longest_saturation,
+        tracking_verdict,
+    )
 
     n, T = 100, 1e-3
     sat = np.zeros((n, 6), bool)
@@ -23,4 +28,6 @@ def test_saturation_verdict_counts_the_longest_stretch():
     log = SimulationLog("fixed", "p", "seed", T, np.arange(n) * T, z, z, z, z, z, status, np.arange(n) * T, z)
     assert longest_saturation(log) == pytest.approx([0, 0.060, 0, 0, 0.020, 0])
     v = tracking_verdict(load_platform("utn-dynamic"), z, z, log)
-    assert v["failures"] == [f"leg 2 saturated for 0.060 s in one stretch (longer than {MAX_SATURATION_S:g} s): its actuator cannot follow the reference"]
+    assert v["failures"] == [
+        f"leg 2 saturated for 0.060 s in one stretch (longer than {MAX_SATURATION_S:g} s): its actuator cannot follow the reference"
+    ]

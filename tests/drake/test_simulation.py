@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from stewart_drake.control import ControllerConfig, DspTiming, TimingError
-from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import SEED, fit_trajectory, get_trajectory, load_trajectory_csv
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SimulationLog, build_simulation
 from stewart_drake.drake.systems import Actuators
+from stewart_drake.fixedpoint import fixed_point_leg_lengths
 
 PLATFORM = load_preset("utn-dynamic")
 DURATION = 1.0
@@ -242,8 +242,12 @@ def test_stiffness_floor_is_what_keeps_the_heavy_platform_up():
     traj = fit_trajectory(ROTATING, platform)
     cfg = ControllerConfig.for_platform(platform)
     weak = replace(cfg, gains=replace(cfg.gains, kp=0.9 * strut_stiffness(platform)))
-    e_weak = np.abs(build_simulation(Scenario(platform, traj, "float", weak)).run(1.0).length_error(traj, platform)).max()
-    e_design = np.abs(build_simulation(Scenario(platform, traj, "float", cfg)).run(1.0).length_error(traj, platform)).max()
+    e_weak = np.abs(
+        build_simulation(Scenario(platform, traj, "float", weak)).run(1.0).length_error(traj, platform)
+    ).max()
+    e_design = np.abs(
+        build_simulation(Scenario(platform, traj, "float", cfg)).run(1.0).length_error(traj, platform)
+    ).max()
     assert e_weak > 5e-3 and e_design < 1e-3, (e_weak, e_design)
 
 
@@ -270,8 +274,8 @@ def test_feedforward_table_is_the_inverse_dynamics_ahead_of_time_and_helps():
     """The table holds ``leg_forces_with_legs`` of the reference at t + lead (lead = output delay + T/2 +
     actuator lag, checked against a direct evaluation), and on utn-dynamic it cuts the float twin's error
     several-fold compared with the PID alone."""
-    from stewart_drake.core.dynamics import leg_forces_with_legs
     from stewart_drake.control import feedforward_lead
+    from stewart_drake.core.dynamics import leg_forces_with_legs
 
     cfg = ControllerConfig.for_platform(PLATFORM)
     lead = feedforward_lead(cfg, 2e-3)
@@ -285,7 +289,9 @@ def test_feedforward_table_is_the_inverse_dynamics_ahead_of_time_and_helps():
     np.testing.assert_allclose(sim.feedforward.force(t), leg_forces_with_legs(PLATFORM, q, qd, qdd), atol=1e-5)
     log = sim.run(0.6)
     e_ff = np.abs(log.length_error(SEED, PLATFORM)).max()
-    e_pid = np.abs(build_simulation(Scenario(PLATFORM, SEED, "float", feedforward=False)).run(0.6).length_error(SEED, PLATFORM)).max()
+    e_pid = np.abs(
+        build_simulation(Scenario(PLATFORM, SEED, "float", feedforward=False)).run(0.6).length_error(SEED, PLATFORM)
+    ).max()
     assert e_ff < e_pid / 4, (e_ff, e_pid)
 
 

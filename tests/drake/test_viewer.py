@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.drake.animation import _frames, leg_warnings, log_saturating, stroke_margin
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.viewer import ReplayError, labels, load_replay, nearest_reachable, readout, reachable
+from stewart_drake.drake.animation import _frames, leg_warnings, log_saturating, stroke_margin
+from stewart_drake.drake.viewer import ReplayError, labels, load_replay, nearest_reachable, reachable, readout
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -25,7 +25,14 @@ def utn():
 
 def cli(*args, timeout=120):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.run([sys.executable, "-m", "stewart_drake.cli", *args], capture_output=True, text=True, env=env, cwd=ROOT, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "stewart_drake.cli", *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=ROOT,
+        timeout=timeout,
+    )
 
 
 def test_readout_at_home(utn):
@@ -116,14 +123,16 @@ def test_load_replay_errors(tmp_path):
 def test_cli_view_once(utn):
     r = cli("view", "--platform", "utn-dynamic", "--duration", "0", "--json", "--pose", "10", "0", "720", "0", "5", "0")
     assert r.returncode == 0, r.stderr
-    out = json.loads(r.stdout[r.stdout.index("{"):])
+    out = json.loads(r.stdout[r.stdout.index("{") :])
     pose = utn.home_pose() * 0 + [0.01, 0, 0.72, 0, np.radians(5), 0]
     np.testing.assert_allclose(out["lengths_m"], leg_lengths(utn, pose), rtol=1e-14)
     assert out["reachable"] and out["assembly_modes"] >= 1
 
 
 def test_cli_view_unreachable_and_bad_input(tmp_path, utn):
-    r = cli("view", "--platform", "utn-dynamic", "--duration", "0", "--no-modes", "--pose", "0", "0", "1100", "0", "0", "0")
+    r = cli(
+        "view", "--platform", "utn-dynamic", "--duration", "0", "--no-modes", "--pose", "0", "0", "1100", "0", "0", "0"
+    )
     assert r.returncode == 1 and "unreachable" in r.stderr and "beyond the stroke" in r.stderr
     r = cli("view", "--platform", "utn-dynamic", "--duration", "0", "--replay", str(tmp_path / "nope.npz"))
     assert r.returncode == 2 and r.stderr.strip().count("\n") == 0 and "nope.npz" in r.stderr
@@ -135,6 +144,6 @@ def test_cli_view_replays_a_log(tmp_path, utn):
     _fake_log(tmp_path / "log.npz", utn)
     r = cli("view", "--platform", "utn-dynamic", "--replay", str(tmp_path), "--speed", "4", "--duration", "2", "--json")
     assert r.returncode == 0, r.stderr
-    out = json.loads(r.stdout[r.stdout.index("{"):])
+    out = json.loads(r.stdout[r.stdout.index("{") :])
     # Played to the end at 4x: the last readout is the last logged pose.
     np.testing.assert_allclose(out["pose"], utn.home_pose() + [0, 0, 0.05 * np.sin(2 * np.pi), 0, 0, 0], atol=1e-12)

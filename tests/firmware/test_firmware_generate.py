@@ -12,12 +12,12 @@ import pytest
 from stewart_drake.cli import main
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
 from stewart_drake.core import c_build as build
+from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.firmware.check import emulation_trace, trace_names, workspace_poses
 from stewart_drake.firmware.generate import TRACE_WORDS, generate
 from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.fixedpoint import QFormat, SaturationCounter
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
-from stewart_drake.core.geometry import PRESETS, load_preset
 from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 
@@ -54,8 +54,10 @@ def test_generated_ik_is_bit_identical_with_two_compilers(name):
         assert int(nsat.sum()) == sat.total > 0
 
 
-@pytest.mark.parametrize("fmt,conv", [(QFormat(16, 1e-4, "exact"), "utn"), (QFormat(12, 1e-2, "exact"), "zyx"),
-                                      (QFormat(16, 1e-3, "tfr16"), "zyx")])
+@pytest.mark.parametrize(
+    "fmt,conv",
+    [(QFormat(16, 1e-4, "exact"), "utn"), (QFormat(12, 1e-2, "exact"), "zyx"), (QFormat(16, 1e-3, "tfr16"), "zyx")],
+)
 def test_other_formats_and_conventions(fmt, conv):
     p = load_preset("utn-kinematic")
     cfg = ControllerConfig.for_platform(p, ik_format=fmt, convention=conv)
@@ -72,8 +74,11 @@ def test_generated_code_has_no_floating_point_and_the_abi():
         code = re.sub(r"/\*.*?\*/", "", g.files[name], flags=re.S)
         assert not re.search(r"\b(float|double)\b|\d\.\d|\d[eE][+-]?\d", code), name
     h = g.files["sd_firmware.h"]
-    for decl in ("int sd_ik(const sd_word pose[6], sd_word lengths[6]);", "void sd_init(sd_state *s);",
-                 "int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], const int16_t feedforward[6], int16_t command[6]);"):
+    for decl in (
+        "int sd_ik(const sd_word pose[6], sd_word lengths[6]);",
+        "void sd_init(sd_state *s);",
+        "int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], const int16_t feedforward[6], int16_t command[6]);",
+    ):
         assert decl in h
 
 
@@ -101,12 +106,19 @@ def test_tick_equals_the_python_law_on_random_states():
     for k in range(400):
         ref = home + rng.normal(0, [0.02, 0.02, 0.02, 0.05, 0.05, 0.05])
         L = L0 + rng.normal(0, 0.01 if k % 2 else 0.2, 6)
-        state = np.r_[rng.integers(-(2**31), 2**31, 6), np.round(L0 / 1e-5) + rng.integers(-3000, 3000, 6),
-                      rng.integers(-32768, 32768, 6), ctrl.ik_words(home) + rng.integers(-5, 6, 6), rng.integers(-32768, 32768, 6)]
+        state = np.r_[
+            rng.integers(-(2**31), 2**31, 6),
+            np.round(L0 / 1e-5) + rng.integers(-3000, 3000, 6),
+            rng.integers(-32768, 32768, 6),
+            ctrl.ik_words(home) + rng.integers(-5, 6, 6),
+            rng.integers(-32768, 32768, 6),
+        ]
         ff = rng.normal(0, 300, 6) if k % 3 else None
         command, sp, new_state, saturated = ctrl.step(state.astype(float), ref, L, ff)
         r.set_state(state)
-        cmd = r.tick(pose_words(ref, cfg.ik_format), ctrl.quantise(L), None if ff is None else ctrl.feedforward_words(ff))
+        cmd = r.tick(
+            pose_words(ref, cfg.ik_format), ctrl.quantise(L), None if ff is None else ctrl.feedforward_words(ff)
+        )
         assert np.array_equal(cmd / 32768.0 * cfg.timing.command_range, command)
         assert np.array_equal(r.state(), new_state.astype(np.int64))
         assert np.array_equal(r.views["saturated"], saturated)
@@ -159,19 +171,52 @@ def generated(tmp_path_factory, firmware_cache):  # noqa: F811
 
 
 def test_cli_check_passes_the_generated_firmware(generated, capsys):
-    assert main(["firmware", "check", str(generated / "sd_firmware.c"), "--platform", "utn-dynamic", "--poses", "5000",
-                 "--duration", "0.1", "--json"]) == 0
+    assert (
+        main(
+            [
+                "firmware",
+                "check",
+                str(generated / "sd_firmware.c"),
+                "--platform",
+                "utn-dynamic",
+                "--poses",
+                "5000",
+                "--duration",
+                "0.1",
+                "--json",
+            ]
+        )
+        == 0
+    )
     r = json.loads(capsys.readouterr().out)
-    assert r["identical"] and r["ik"]["poses"] == 5000 and r["ik"]["worst_lsb"] == 0 and r["tick"]["ticks"] == 100  # ticks at 0, 1, ..., 99 ms
+    assert (
+        r["identical"] and r["ik"]["poses"] == 5000 and r["ik"]["worst_lsb"] == 0 and r["tick"]["ticks"] == 100
+    )  # ticks at 0, 1, ..., 99 ms
 
 
 def test_cli_check_catches_a_constant_off_by_one_lsb(generated, tmp_path, capsys):
     src = (generated / "sd_firmware.c").read_text()
     m = re.search(r"v = subw\(v, (-?\d+), &nsat\);", src)  # leg 1's first base-anchor coordinate
     bad = tmp_path / "altered.c"
-    bad.write_text(src[:m.start(1)] + str(int(m.group(1)) + 1) + src[m.end(1):])
-    assert main(["firmware", "check", str(bad), "--platform", "utn-dynamic", "--poses", "5000", "--duration", "0.1",
-                 "--trace", "--json"]) == 1
+    bad.write_text(src[: m.start(1)] + str(int(m.group(1)) + 1) + src[m.end(1) :])
+    assert (
+        main(
+            [
+                "firmware",
+                "check",
+                str(bad),
+                "--platform",
+                "utn-dynamic",
+                "--poses",
+                "5000",
+                "--duration",
+                "0.1",
+                "--trace",
+                "--json",
+            ]
+        )
+        == 1
+    )
     r = json.loads(capsys.readouterr().out)
     f = r["ik"]["first_difference"]
     assert not r["identical"] and r["ik"]["worst_lsb"] == 1 and r["ik"]["differing_poses"] > 0
@@ -182,7 +227,9 @@ def test_cli_check_catches_a_constant_off_by_one_lsb(generated, tmp_path, capsys
 
 def test_cli_check_compile_error_names_file_and_line(tmp_path, capsys):
     bad = tmp_path / "broken.c"
-    bad.write_text('#include "sd_firmware.h"\n\nint sd_ik(const sd_word pose[6], sd_word lengths[6])\n{\n    return pose[0]\n}\n')
+    bad.write_text(
+        '#include "sd_firmware.h"\n\nint sd_ik(const sd_word pose[6], sd_word lengths[6])\n{\n    return pose[0]\n}\n'
+    )
     assert main(["firmware", "check", str(bad), "--platform", "utn-dynamic"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"{bad}:5:" in err and "error" in err
@@ -191,9 +238,14 @@ def test_cli_check_compile_error_names_file_and_line(tmp_path, capsys):
 def test_cli_check_ik_only_firmware(tmp_path, capsys, generated):
     # a firmware with sd_ik only (written by hand: calls the generated IK through a renamed copy)
     src = (generated / "sd_firmware.c").read_text()
-    src = src[:src.index("/* ---- the controller tick")]
+    src = src[: src.index("/* ---- the controller tick")]
     (tmp_path / "ik_only.c").write_text(src)
-    assert main(["firmware", "check", str(tmp_path / "ik_only.c"), "--platform", "utn-dynamic", "--poses", "2000", "--json"]) == 0
+    assert (
+        main(
+            ["firmware", "check", str(tmp_path / "ik_only.c"), "--platform", "utn-dynamic", "--poses", "2000", "--json"]
+        )
+        == 0
+    )
     assert json.loads(capsys.readouterr().out)["tick"] is None
 
 
@@ -201,13 +253,24 @@ def test_no_compiler_falls_back_to_python_with_a_note(monkeypatch, capsys):
     monkeypatch.setenv(build.CC_ENV, "/nonexistent/cc")
     assert main(["dsp-ik", "--pose", "10", "10", "140", "0.2", "0", "0.1", "--engine", "c", "--json"]) == 0
     io = capsys.readouterr()
-    assert json.loads(io.out)["engine"] == "python" and json.loads(io.out)["dsp_lengths_mm"] == [638, 521, 547, 391, 608, 325]
+    assert json.loads(io.out)["engine"] == "python" and json.loads(io.out)["dsp_lengths_mm"] == [
+        638,
+        521,
+        547,
+        391,
+        608,
+        325,
+    ]
     assert "running the Python engine instead" in io.err
 
 
 def test_dsp_ik_engine_c_reproduces_the_seed_table(capsys):
-    seed = {(0, 0, 100, 0, 0, 0): [475, 471, 473, 473, 471, 475], (0, 0, 120, 0.1, 0, 0): [504, 515, 477, 477, 469, 458],
-            (0, 0, 130, 0.15, 0, 0): [523, 548, 480, 480, 478, 449], (10, 10, 140, 0.2, 0, 0.1): [638, 521, 547, 391, 608, 325]}
+    seed = {
+        (0, 0, 100, 0, 0, 0): [475, 471, 473, 473, 471, 475],
+        (0, 0, 120, 0.1, 0, 0): [504, 515, 477, 477, 469, 458],
+        (0, 0, 130, 0.15, 0, 0): [523, 548, 480, 480, 478, 449],
+        (10, 10, 140, 0.2, 0, 0.1): [638, 521, 547, 391, 608, 325],
+    }
     for pose, want in seed.items():
         rc = main(["dsp-ik", "--pose", *map(str, pose), "--engine", "c", "--json"])
         if pose == (0, 0, 130, 0.15, 0, 0):

@@ -14,16 +14,53 @@ from stewart_drake.fixedpoint import q15, scalar, tp17_leg_lengths
 from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 E16 = [-32768, -32767, -16385, -16384, -2, -1, 0, 1, 2, 16383, 16384, 16385, 32766, 32767]
-E32 = [-(2**31), -(2**31) + 1, -(2**30), -65536, -32769, -32768, -1, 0, 1, 0x7FFF, 0x8000, 65535, 2**30, 2**31 - 2, 2**31 - 1]
+E32 = [
+    -(2**31),
+    -(2**31) + 1,
+    -(2**30),
+    -65536,
+    -32769,
+    -32768,
+    -1,
+    0,
+    1,
+    0x7FFF,
+    0x8000,
+    65535,
+    2**30,
+    2**31 - 2,
+    2**31 - 1,
+]
 SHIFTS = [-40, -33, -32, -31, -17, -16, -15, -1, 0, 1, 3, 15, 16, 17, 31, 32, 33, 40]
 N = 1_000_000
 
 # operand kinds per intrinsic: w = Word16, L = Word32, n = shift count
 KINDS = {
-    "add": "ww", "sub": "ww", "negate": "w", "abs_s": "w", "mult": "ww", "mult_r": "ww", "shl": "wn", "shr": "wn",
-    "L_add": "LL", "L_sub": "LL", "L_negate": "L", "L_abs": "L", "L_mult": "ww", "L_mac": "Lww", "L_msu": "Lww",
-    "L_shl": "Ln", "L_shr": "Ln", "extract_h": "L", "extract_l": "L", "L_deposit_h": "w", "L_deposit_l": "w",
-    "round_": "L", "mac_r": "Lww", "msu_r": "Lww", "mfr32Sqrt": "L",
+    "add": "ww",
+    "sub": "ww",
+    "negate": "w",
+    "abs_s": "w",
+    "mult": "ww",
+    "mult_r": "ww",
+    "shl": "wn",
+    "shr": "wn",
+    "L_add": "LL",
+    "L_sub": "LL",
+    "L_negate": "L",
+    "L_abs": "L",
+    "L_mult": "ww",
+    "L_mac": "Lww",
+    "L_msu": "Lww",
+    "L_shl": "Ln",
+    "L_shr": "Ln",
+    "extract_h": "L",
+    "extract_l": "L",
+    "L_deposit_h": "w",
+    "L_deposit_l": "w",
+    "round_": "L",
+    "mac_r": "Lww",
+    "msu_r": "Lww",
+    "mfr32Sqrt": "L",
 }
 
 
@@ -39,7 +76,9 @@ def _random_operands(kinds, rng, n=N):
             out.append(rng.integers(-32768, 32768, n))
         elif k == "L":
             # half uniform over the 32-bit range, half small (where rounding and products matter)
-            out.append(np.where(rng.random(n) < 0.5, rng.integers(-(2**31), 2**31, n), rng.integers(-(2**17), 2**17, n)))
+            out.append(
+                np.where(rng.random(n) < 0.5, rng.integers(-(2**31), 2**31, n), rng.integers(-(2**17), 2**17, n))
+            )
         else:
             out.append(rng.integers(-40, 41, n))
     return out
@@ -82,7 +121,9 @@ def test_sin_cos_on_all_words(name):
 
 def test_frac16_frac32_truncate_and_saturate_like_the_emulation():
     rng = np.random.default_rng(3)
-    x = np.r_[rng.uniform(-1.2, 1.2, N), [-1.0, 1.0, -1.0 - 2**-16, 1.0 - 2**-16, 0.5, -0.5, 2.0, -2.0, 0.0, -0.0, 0.99999]]
+    x = np.r_[
+        rng.uniform(-1.2, 1.2, N), [-1.0, 1.0, -1.0 - 2**-16, 1.0 - 2**-16, 0.5, -0.5, 2.0, -2.0, 0.0, -0.0, 0.99999]
+    ]
     assert np.array_equal(frac(x, 16), q15.FRAC16(x))
     assert np.array_equal(frac(x, 32), q15.FRAC32(x))
 
@@ -90,9 +131,17 @@ def test_frac16_frac32_truncate_and_saturate_like_the_emulation():
 # ------------------------------------------------------------------------------------------------
 # tp17.C compiled
 
-SEED_POSES = np.array([[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]])
-SEED_DSP_MM = np.array([[475, 471, 473, 473, 471, 475], [504, 515, 477, 477, 469, 458],
-                        [523, 548, 480, 480, 478, 449], [638, 521, 547, 391, 608, 325]])
+SEED_POSES = np.array(
+    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]]
+)
+SEED_DSP_MM = np.array(
+    [
+        [475, 471, 473, 473, 471, 475],
+        [504, 515, 477, 477, 469, 458],
+        [523, 548, 480, 480, 478, 449],
+        [638, 521, 547, 391, 608, 325],
+    ]
+)
 
 
 def workspace_dsp_poses(n, seed):

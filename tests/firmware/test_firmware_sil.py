@@ -51,12 +51,42 @@ def test_latency_modes_and_no_feedforward_identical():
 def test_simulate_cli_runs_a_users_firmware(tmp_path, capsys):
     fw = tmp_path / "fw"
     # gains designed over the seed reference, as simulate designs them: the firmware then is the run's controller
-    assert main(["firmware", "generate", "--platform", "utn-dynamic", "--trajectory", "seed", "--out", str(fw), "--no-compile"]) == 0
+    assert (
+        main(
+            [
+                "firmware",
+                "generate",
+                "--platform",
+                "utn-dynamic",
+                "--trajectory",
+                "seed",
+                "--out",
+                str(fw),
+                "--no-compile",
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
     runs = {}
     for extra in ([], ["--engine", "c"], ["--firmware", str(fw / "sd_firmware.c")]):
         out = tmp_path / f"sim{len(runs)}"
-        assert main(["simulate", "--platform", "utn-dynamic", "--duration", "0.05", "--no-progress", "--out", str(out), *extra]) == 0
+        assert (
+            main(
+                [
+                    "simulate",
+                    "--platform",
+                    "utn-dynamic",
+                    "--duration",
+                    "0.05",
+                    "--no-progress",
+                    "--out",
+                    str(out),
+                    *extra,
+                ]
+            )
+            == 0
+        )
         s = json.loads(capsys.readouterr().out)
         runs[tuple(extra[:1])] = (s, np.load(out / "log.npz"))
     assert runs[("--engine",)][0]["engine"] == "c" and runs[("--firmware",)][0]["firmware"].endswith("sd_firmware.c")

@@ -9,13 +9,38 @@ import numpy as np
 import pytest
 
 from stewart_drake.errors import FixedPointError
-
 from stewart_drake.fixedpoint import q15
 from stewart_drake.fixedpoint import scalar as s
-from stewart_drake.fixedpoint.q15 import (FRAC16, MAX16, MAX32, MIN16, MIN32, L_add, L_mult,
-                                          L_negate, L_shl, L_shr, L_sub, SaturationCounter, abs_s, add, div_s,
-                                          extract_h, extract_l, mac_r, mfr32Sqrt, mult, mult_r, negate, round_,
-                                          shl, shr, sub, tfr16CosPIx, tfr16SinPIx)
+from stewart_drake.fixedpoint.q15 import (
+    FRAC16,
+    MAX16,
+    MAX32,
+    MIN16,
+    MIN32,
+    L_add,
+    L_mult,
+    L_negate,
+    L_shl,
+    L_shr,
+    L_sub,
+    SaturationCounter,
+    abs_s,
+    add,
+    div_s,
+    extract_h,
+    extract_l,
+    mac_r,
+    mfr32Sqrt,
+    mult,
+    mult_r,
+    negate,
+    round_,
+    shl,
+    shr,
+    sub,
+    tfr16CosPIx,
+    tfr16SinPIx,
+)
 
 N = 100_000
 
@@ -242,7 +267,12 @@ def test_saturation_counters_nest():
 
 def test_word16_validation_names_the_value():
     assert q15.word16([1, -2]).dtype == np.int64
-    with pytest.raises(FixedPointError, match=re.escape(FixedPointError.RANGE.format(name="gain", value=40000, bits=16, lo=MIN16, hi=MAX16))):
+    with pytest.raises(
+        FixedPointError,
+        match=re.escape(FixedPointError.RANGE.format(name="gain", value=40000, bits=16, lo=MIN16, hi=MAX16)),
+    ):
         q15.word16([1, 40000], "gain")
-    with pytest.raises(FixedPointError, match=re.escape(FixedPointError.NOT_INTEGER_16.format(name="gain", value=np.float64(1.5)))):
+    with pytest.raises(
+        FixedPointError, match=re.escape(FixedPointError.NOT_INTEGER_16.format(name="gain", value=np.float64(1.5)))
+    ):
         q15.word16([1.5], "gain")

@@ -6,22 +6,42 @@ import re
 import numpy as np
 import pytest
 
-from stewart_drake.errors import SHAPE, DspPoseError, FixedPointError
-
 from stewart_drake.cli import main
-from stewart_drake.fixedpoint import (CYCLE_TABLE, ERROR_STAGES, QFormat, SaturationCounter, dsp_poses_from_si,
-                                      dsp_poses_to_si, estimate_cycles, fixed_point_leg_lengths, fixed_point_rotation,
-                                      ik_latency_s, tp17_cycles, tp17_error_stages, tp17_leg_lengths, tp17_trace)
-from stewart_drake.fixedpoint import scalar
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sampling import random_poses
+from stewart_drake.errors import SHAPE, DspPoseError, FixedPointError
+from stewart_drake.fixedpoint import (
+    CYCLE_TABLE,
+    ERROR_STAGES,
+    QFormat,
+    SaturationCounter,
+    dsp_poses_from_si,
+    dsp_poses_to_si,
+    estimate_cycles,
+    fixed_point_leg_lengths,
+    fixed_point_rotation,
+    ik_latency_s,
+    scalar,
+    tp17_cycles,
+    tp17_error_stages,
+    tp17_leg_lengths,
+    tp17_trace,
+)
 
 # Seed 000 "Tabla comparativa": poses as the firmware takes them (mm; fractions of pi: 18° = 0.1)
-SEED_POSES = np.array([[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]])
-SEED_DSP_MM = np.array([[475, 471, 473, 473, 471, 475], [504, 515, 477, 477, 469, 458],
-                        [523, 548, 480, 480, 478, 449], [638, 521, 547, 391, 608, 325]])
+SEED_POSES = np.array(
+    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]]
+)
+SEED_DSP_MM = np.array(
+    [
+        [475, 471, 473, 473, 471, 475],
+        [504, 515, 477, 477, 469, 458],
+        [523, 548, 480, 480, 478, 449],
+        [638, 521, 547, 391, 608, 325],
+    ]
+)
 
 
 def random_dsp_poses(n, seed):
@@ -95,9 +115,13 @@ def test_saturation_counter_through_the_port():
 
 
 def test_pose_validation_messages():
-    with pytest.raises(DspPoseError, match=re.escape(DspPoseError.ANGLES.format(name="pose 1", values=[1.5, 0.0, 0.0]))):
+    with pytest.raises(
+        DspPoseError, match=re.escape(DspPoseError.ANGLES.format(name="pose 1", values=[1.5, 0.0, 0.0]))
+    ):
         tp17_leg_lengths([[0, 0, 100, 0, 0, 0], [0, 0, 100, 1.5, 0, 0]])
-    with pytest.raises(DspPoseError, match=re.escape(DspPoseError.POSITION.format(name="pose", values=[0.0, 0.0, 40000.0]))):
+    with pytest.raises(
+        DspPoseError, match=re.escape(DspPoseError.POSITION.format(name="pose", values=[0.0, 0.0, 40000.0]))
+    ):
         tp17_leg_lengths([0, 0, 40000, 0, 0, 0])
     with pytest.raises(DspPoseError, match=re.escape(SHAPE.format(name="DSP poses", shape="(..., 6)", got="(3,)"))):
         tp17_leg_lengths([0, 0, 100])

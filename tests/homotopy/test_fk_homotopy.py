@@ -7,11 +7,14 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.assembly_modes import assembly_modes
+from stewart_drake.core.geometry import load_platform_yaml, load_preset
+from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.reference_platforms import dietmaier_platform, planar_platform
+from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.drake.program_fk import ProgramFK
-from stewart_drake.core.geometry import load_preset, load_platform_yaml
-from stewart_drake.homotopy import architecture, solve, solve_batch
+from stewart_drake.homotopy import architecture, ctrack, solve, solve_batch
 from stewart_drake.homotopy.certify import certify, newton_real, real_forms
+from stewart_drake.homotopy.solve import _classify
 from stewart_drake.homotopy.start import load_start_system, monodromy_solve
 from stewart_drake.homotopy.study import (
     evaluate,
@@ -21,10 +24,6 @@ from stewart_drake.homotopy.study import (
     study_from_pose,
     study_parameters,
 )
-from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.core.rotations import rotation_matrix
-from stewart_drake.homotopy import ctrack
-from stewart_drake.homotopy.solve import _classify
 from stewart_drake.homotopy.track import DONE, STALLED, TrackOptions, track
 
 # Two solvers agree on a mode when positions and rotation matrices agree to this: both are
@@ -70,7 +69,17 @@ def test_study_system_is_the_leg_equations():
     F, J = evaluate(x, B[None], s[None], v)
     assert np.abs(F).max() < 1e-14
     h = 1e-6
-    Jn = np.stack([(evaluate(x + h * np.eye(8)[j], B[None], s[None], v)[0] - evaluate(x - h * np.eye(8)[j], B[None], s[None], v)[0])[0] / (2 * h) for j in range(8)], 1)
+    Jn = np.stack(
+        [
+            (
+                evaluate(x + h * np.eye(8)[j], B[None], s[None], v)[0]
+                - evaluate(x - h * np.eye(8)[j], B[None], s[None], v)[0]
+            )[0]
+            / (2 * h)
+            for j in range(8)
+        ],
+        1,
+    )
     np.testing.assert_allclose(Jn, J[0], atol=1e-9)
     xr = np.random.default_rng(1).normal(size=8)
     Fr, _ = evaluate(xr[None], B[None], s[None], v)
@@ -99,10 +108,12 @@ def test_monodromy_regenerates_a_start_system():
     assert len(fresh.x) == 16 and fresh.residual() < 1e-12
     S = load_start_system("3-6")
     paths = track(S.x, S.B, fresh.B, S.s, fresh.s, S.v, np.exp(0.7j))
+
     # Different charts: compare as projective points (normalise e·e = 1 up to sign).
     def norm(x):
         y = x / np.sqrt(np.einsum("kj,kj->k", x[:, :4], x[:, :4]))[:, None]
         return y * np.sign(y[np.arange(len(y)), np.argmax(np.abs(y[:, :4]), 1)].real)[:, None]
+
     A, B = norm(paths.x), norm(fresh.x)
     d = np.linalg.norm(A[:, None] - B[None], axis=-1)
     assert np.all(d.min(1) < 1e-8) and np.all(d.min(0) < 1e-8)
@@ -226,7 +237,13 @@ def test_branch_distance_matches_the_multistart_modes():
     for k in range(4):
         am = assembly_modes(p, leg_lengths(p, q[k]), polish=None)
         R_q = rotation_matrix(q[k, 3:], "utn")
-        d = [np.sqrt(np.sum((m.position - q[k, :3]) ** 2) + (r_a * np.arccos(np.clip((np.trace(m.rotation.T @ R_q) - 1) / 2, -1, 1))) ** 2) for m in am.modes]
+        d = [
+            np.sqrt(
+                np.sum((m.position - q[k, :3]) ** 2)
+                + (r_a * np.arccos(np.clip((np.trace(m.rotation.T @ R_q) - 1) / 2, -1, 1))) ** 2
+            )
+            for m in am.modes
+        ]
         d = np.sort(d)
         assert d[0] < 1e-9  # the pose itself
         assert rep.branch_distance[k] == pytest.approx(d[1], abs=1e-9)
@@ -252,7 +269,9 @@ def test_run_check_branches_cli(tmp_path, capsys):
     assert len(err) == 1 and "not branch-safe" in err[0] and "nearest other assembly mode" in err[0]
     assert main(args + ["--out", str(tmp_path / "c"), "--branch-margin", "-1"]) == 2
     assert "--branch-margin" in capsys.readouterr().err
-    assert main(["run", prog, "--platform", "utn-kinematic", "--out", str(tmp_path / "d"), "--branch-samples", "5"]) == 2
+    assert (
+        main(["run", prog, "--platform", "utn-kinematic", "--out", str(tmp_path / "d"), "--branch-samples", "5"]) == 2
+    )
     assert "--branch-samples needs --check-branches" in capsys.readouterr().err
     assert not (tmp_path / "d").exists()
 
@@ -270,8 +289,15 @@ def test_six_three_is_the_inverse_motion():
     q = p.home_pose() + [0.02, -0.01, 0.03, 0.1, 0.05, -0.1]
     L = leg_lengths(p, q)
     inv = Platform(
-        name="utn-dynamic-inverse", base_anchors=p.top_anchors_per_leg - p.rotation_centre, top_anchors=p.base_anchors,
-        leg_top=np.arange(6), stroke=p.stroke, mass=0.0, com=np.zeros(3), inertia=np.zeros((3, 3)), home_height=p.home_height,
+        name="utn-dynamic-inverse",
+        base_anchors=p.top_anchors_per_leg - p.rotation_centre,
+        top_anchors=p.base_anchors,
+        leg_top=np.arange(6),
+        stroke=p.stroke,
+        mass=0.0,
+        com=np.zeros(3),
+        inertia=np.zeros((3, 3)),
+        home_height=p.home_height,
     )
     assert architecture(inv).kind == "6-3"
     r63, r36 = solve(inv, L), solve(p, L)
@@ -291,7 +317,17 @@ def test_fk_all_cli_reports_paths_and_certificates(capsys):
 
     p = load_preset("gonzalez-dutra-2009")
     L = leg_lengths(p, p.home_pose() + [0.02, -0.01, 0.01, 0.1, -0.05, 0.2])
-    base = ["fk", "--platform", "gonzalez-dutra-2009", "--length-unit", "m", "--lengths", *(repr(float(v)) for v in L), "--all", "--json"]
+    base = [
+        "fk",
+        "--platform",
+        "gonzalez-dutra-2009",
+        "--length-unit",
+        "m",
+        "--lengths",
+        *(repr(float(v)) for v in L),
+        "--all",
+        "--json",
+    ]
     assert main(base) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["method"] == "homotopy" and d["architecture"] == "6-6" and d["complete"]
@@ -301,9 +337,21 @@ def test_fk_all_cli_reports_paths_and_certificates(capsys):
     assert main(base + ["--method", "multi-start"]) == 0
     m = json.loads(capsys.readouterr().out)
     assert m["method"] == "multi-start"
-    np.testing.assert_allclose(np.sort(np.array([s["pose"] for s in m["solutions"]]), 0),
-                               np.sort(np.array([s["pose"] for s in d["solutions"]]), 0), atol=1e-9)
-    short = ["fk", "--platform", "gonzalez-dutra-2009", "--length-unit", "mm", "--lengths", *(repr(float(v)) for v in L), "--all"]
+    np.testing.assert_allclose(
+        np.sort(np.array([s["pose"] for s in m["solutions"]]), 0),
+        np.sort(np.array([s["pose"] for s in d["solutions"]]), 0),
+        atol=1e-9,
+    )
+    short = [
+        "fk",
+        "--platform",
+        "gonzalez-dutra-2009",
+        "--length-unit",
+        "mm",
+        "--lengths",
+        *(repr(float(v)) for v in L),
+        "--all",
+    ]
     assert main(short) == 1
     err = capsys.readouterr().err
     assert "no real assembly mode" in err and "cannot be assembled" in err
@@ -376,8 +424,12 @@ def test_duplicate_end_points_are_found():
             y[b] = rng.choice([-1, 1]) * y[a] + rng.uniform(0, 2 * DISTINCT_TOL) * rng.normal(size=8)
         idx = np.arange(40)[::-1]
         z = y[idx]
-        d = np.minimum(np.abs(z[:, None] - z[None]).max(-1), np.abs(z[:, None] + z[None]).max(-1)) + np.diag(np.full(40, np.inf))
-        expected = sorted(int(i) for i in idx[np.any(d <= DISTINCT_TOL * np.maximum(1, np.abs(z).max(-1))[:, None], axis=1)])
+        d = np.minimum(np.abs(z[:, None] - z[None]).max(-1), np.abs(z[:, None] + z[None]).max(-1)) + np.diag(
+            np.full(40, np.inf)
+        )
+        expected = sorted(
+            int(i) for i in idx[np.any(d <= DISTINCT_TOL * np.maximum(1, np.abs(z).max(-1))[:, None], axis=1)]
+        )
         assert _duplicates(y, idx) == expected
     y[7] = -y[3]
     assert {3, 7} <= set(_duplicates(y, np.arange(40)))

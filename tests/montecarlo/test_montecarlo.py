@@ -25,7 +25,9 @@ def platform():
 
 
 def test_spec_values_units_and_laws():
-    s = parse_spec("anchor=±0.5mm sensor_resolution=10um latency=sample|none actuator_lag=1ms..3ms payload_mass=±20% force_limit=150|200")
+    s = parse_spec(
+        "anchor=±0.5mm sensor_resolution=10um latency=sample|none actuator_lag=1ms..3ms payload_mass=±20% force_limit=150|200"
+    )
     assert s.laws["anchor"].kind == "plusminus" and s.laws["anchor"].values == (0.0005,)
     assert s.laws["sensor_resolution"].values == (1e-05,)  # decimal scaling: exactly the float 1e-05
     assert s.laws["latency"].values == ("sample", "none")
@@ -43,13 +45,16 @@ def test_spec_yaml_names_the_line(tmp_path):
     assert parse_spec([str(f)]).laws["sensor_noise"].values == (2e-06,)
 
 
-@pytest.mark.parametrize("word, message", [
-    ("ancor=±1mm", "did you mean 'anchor'"),
-    ("anchor=±1furlong", "cannot read '1furlong'"),
-    ("anchor=±5%", "percentage of a zero nominal"),
-    ("actuator_lag=3ms..1ms", "low end is above its high end"),
-    ("latency=sometimes", "'sometimes' is not one of"),
-])
+@pytest.mark.parametrize(
+    "word, message",
+    [
+        ("ancor=±1mm", "did you mean 'anchor'"),
+        ("anchor=±1furlong", "cannot read '1furlong'"),
+        ("anchor=±5%", "percentage of a zero nominal"),
+        ("actuator_lag=3ms..1ms", "low end is above its high end"),
+        ("latency=sometimes", "'sometimes' is not one of"),
+    ],
+)
 def test_bad_spec_is_one_line_exit_2(capsys, tmp_path, word, message):
     assert main(["montecarlo", "--vary", word, "--runs", "1", "--out", str(tmp_path / "o"), *SHORT]) == 2
     err = capsys.readouterr().err
@@ -70,7 +75,10 @@ def test_each_run_redraws_alone(platform):
     draws = [draw(st, i) for i in range(5)]
     seed3, d3 = draw(Study(platform, parse_spec(VARY), seed=11, runs=1), 3)
     assert seed3 == draws[3][0] == run_seed(11, 3)
-    assert np.array_equal(d3.base_anchor_offset, draws[3][1].base_anchor_offset) and d3.payload_mass == draws[3][1].payload_mass
+    assert (
+        np.array_equal(d3.base_anchor_offset, draws[3][1].base_anchor_offset)
+        and d3.payload_mass == draws[3][1].payload_mass
+    )
     assert len({s for s, _ in draws}) == 5 and run_seed(12, 3) != seed3
     for _, d in draws:
         assert np.abs(d.base_anchor_offset).max() <= 0.5e-3 and np.abs(d.top_anchor_offset).max() <= 0.5e-3
@@ -95,8 +103,18 @@ def test_sensitivity_finds_the_parameter_that_drives_the_error():
     another: ρ = 1 for the first, ranked first."""
     rng = np.random.default_rng(0)
     x, z = rng.uniform(size=50), rng.uniform(size=50)
-    rows = [{"run": i, "seed": i, "a": float(x[i]), "b": float(z[i]), "max_leg_error_m": float(x[i] ** 3), "error": "", "lost_tracking": False}
-            for i in range(50)]
+    rows = [
+        {
+            "run": i,
+            "seed": i,
+            "a": float(x[i]),
+            "b": float(z[i]),
+            "max_leg_error_m": float(x[i] ** 3),
+            "error": "",
+            "lost_tracking": False,
+        }
+        for i in range(50)
+    ]
     ranking = sensitivity(rows)
     assert ranking[0]["parameter"] == "a" and ranking[0]["spearman"] == pytest.approx(1.0)
     assert abs(ranking[1]["spearman"]) < 0.4
@@ -133,12 +151,19 @@ def test_study_resumes_without_repeating_finished_runs(tmp_path, monkeypatch, ca
     assert main(_study_args(part, 3, "--workers", "0")) == 0
     assert calls == [0, 1, 2]
     a, b = read_table(full), read_table(part)
-    assert [{k: v for k, v in r.items() if k != "wall_s"} for r in a] == [{k: v for k, v in r.items() if k != "wall_s"} for r in b]
+    assert [{k: v for k, v in r.items() if k != "wall_s"} for r in a] == [
+        {k: v for k, v in r.items() if k != "wall_s"} for r in b
+    ]
     assert not (part / study_mod.PARTIAL).exists()
     summary = json.loads((part / "summary.json").read_text())
     assert summary["runs"] == 3 and set(summary["metrics"]["max_leg_error_m"]) >= {"p50", "p95", "max"}
     # another study's settings in the same folder: refused, folder untouched
-    assert main(["montecarlo", "--runs", "3", "--seed", "6", "--vary", *VARY, "--out", str(part), *SHORT, "--workers", "0"]) == 2
+    assert (
+        main(
+            ["montecarlo", "--runs", "3", "--seed", "6", "--vary", *VARY, "--out", str(part), *SHORT, "--workers", "0"]
+        )
+        == 2
+    )
     assert "holds another study" in capsys.readouterr().err
 
 
@@ -188,7 +213,23 @@ def test_unreachable_program_refused_before_any_run(tmp_path, capsys):
     from pathlib import Path
 
     program = Path(__file__).resolve().parents[2] / "examples" / "circle.stw"
-    assert main(["montecarlo", "--program", str(program), "--runs", "2", "--out", str(tmp_path / "o"), *SHORT, "--workers", "0"]) == 2
+    assert (
+        main(
+            [
+                "montecarlo",
+                "--program",
+                str(program),
+                "--runs",
+                "2",
+                "--out",
+                str(tmp_path / "o"),
+                *SHORT,
+                "--workers",
+                "0",
+            ]
+        )
+        == 2
+    )
     assert "out of reach on platform utn-dynamic" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
 
@@ -202,7 +243,13 @@ def test_a_pickled_run_scenario_builds_the_same_diagram(platform):
     from stewart_drake.drake.simulation import build_simulation
     from stewart_drake.montecarlo.scenario import scenario
 
-    study = Study(platform=platform, spec=parse_spec(VARY + ["sensor_noise=5um", "gain_scale=±10%"]), seed=11, runs=2, duration=0.05)
+    study = Study(
+        platform=platform,
+        spec=parse_spec(VARY + ["sensor_noise=5um", "gain_scale=±10%"]),
+        seed=11,
+        runs=2,
+        duration=0.05,
+    )
     _, d, sc = scenario(study, 1)
     back = pickle.loads(pickle.dumps(sc))
     assert back.plant_platform.mass == sc.plant_platform.mass != platform.mass  # the draw reaches the plant

@@ -12,11 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.report.browser import Browser, find_chromium
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.report.browser import Browser, find_chromium
 
-pytestmark = pytest.mark.skipif(find_chromium() is None, reason="Chromium or websocket-client not installed: run scripts/ensure-chromium")
+pytestmark = pytest.mark.skipif(
+    find_chromium() is None, reason="Chromium or websocket-client not installed: run scripts/ensure-chromium"
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 WIDTH = 1280
@@ -43,13 +45,18 @@ def _report(tmp_path):
 
     s = Section("Framework shapes", quick=True)
     s.table([f"column {k} [mm]" for k in range(24)], [[float(k) * 1.2345 for k in range(24)]], caption="a wide table")
-    s.table(["case", "first saturation s", "force (N)", "count"], [["a", float("nan"), 200.0, 1], ["b", 0.286, 3.5e-7, 12]],
-            nan_reason="never saturated")
+    s.table(
+        ["case", "first saturation s", "force (N)", "count"],
+        [["a", float("nan"), 200.0, 1], ["b", 0.286, 3.5e-7, 12]],
+        nan_reason="never saturated",
+    )
     s.check("a passing check", 0.5, 1.0, "mm")
     u = np.random.default_rng(0).normal(size=(3000, 3))
     s.points3d(0.3 * u / np.linalg.norm(u, axis=1, keepdims=True), "sphere", "points on a sphere")
     sections.append(s)
-    return write_report(sections, tmp_path / "report", meta=render.default_meta(sections, "pytest", 0.0, ("utn-dynamic",)))
+    return write_report(
+        sections, tmp_path / "report", meta=render.default_meta(sections, "pytest", 0.0, ("utn-dynamic",))
+    )
 
 
 def test_report_renders_cleanly(browser, tmp_path):
@@ -142,8 +149,14 @@ def _set_slider(browser, name, value):
 
 def test_viewer_slider_moves_the_leg_lengths(browser):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.Popen([sys.executable, "-m", "stewart_drake.cli", "view", "--platform", "utn-dynamic", "--duration", "60"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=ROOT)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "stewart_drake.cli", "view", "--platform", "utn-dynamic", "--duration", "60"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        cwd=ROOT,
+    )
     try:
         line = proc.stdout.readline()
         url = re.search(r"http://localhost:\d+", line)

@@ -10,11 +10,22 @@ import pytest
 from stewart_drake.report import Section, discover_analyses, render, run_analyses, unlabelled_axes
 
 
-@pytest.mark.parametrize("v, text", [
-    (0.286, "0.2860"), (1.0, "1.000"), (200.0, "200.0"), (1234.5678, "1235"), (9.99996, "10.00"),
-    (-0.0123456, "−0.01235"), (3.5e-7, "3.500e−07"), (946000.0, "9.460e+05"), (0.0, "0"), (7, "7"),
-    (float("inf"), "∞"),
-])
+@pytest.mark.parametrize(
+    "v, text",
+    [
+        (0.286, "0.2860"),
+        (1.0, "1.000"),
+        (200.0, "200.0"),
+        (1234.5678, "1235"),
+        (9.99996, "10.00"),
+        (-0.0123456, "−0.01235"),
+        (3.5e-7, "3.500e−07"),
+        (946000.0, "9.460e+05"),
+        (0.0, "0"),
+        (7, "7"),
+        (float("inf"), "∞"),
+    ],
+)
 def test_format_number_significant_digits(v, text):
     assert render.format_number(v) == text
 
@@ -26,18 +37,28 @@ def test_format_number_reads_back():
         assert abs(float(s) - v) <= 0.5 * 10 ** (math.floor(math.log10(abs(v))) - 3) * (1 + 1e-12)
 
 
-@pytest.mark.parametrize("header, split", [
-    ("max |leg err| mm", ("max |leg err|", "mm")), ("position error (mm)", ("position error", "mm")),
-    ("X [m]", ("X", "m")), ("ki N/(m·s)", ("ki", "N/(m·s)")), ("preset", ("preset", "")),
-    ("(fixed − float)/(Δ_IK + LSB + r)", ("(fixed − float)/(Δ_IK + LSB + r)", "")), ("saturated ticks", ("saturated ticks", "")),
-])
+@pytest.mark.parametrize(
+    "header, split",
+    [
+        ("max |leg err| mm", ("max |leg err|", "mm")),
+        ("position error (mm)", ("position error", "mm")),
+        ("X [m]", ("X", "m")),
+        ("ki N/(m·s)", ("ki", "N/(m·s)")),
+        ("preset", ("preset", "")),
+        ("(fixed − float)/(Δ_IK + LSB + r)", ("(fixed − float)/(Δ_IK + LSB + r)", "")),
+        ("saturated ticks", ("saturated ticks", "")),
+    ],
+)
 def test_units_written_alike(header, split):
     assert render.split_unit(header) == split
 
 
 def test_table_cells():
-    html = render.table_html(["case", "first saturation s", "force (N)"], [["a", float("nan"), 200.0], ["b", 0.286, "1.5"]],
-                             nan_reason="never saturated")
+    html = render.table_html(
+        ["case", "first saturation s", "force (N)"],
+        [["a", float("nan"), 200.0], ["b", 0.286, "1.5"]],
+        nan_reason="never saturated",
+    )
     assert 'class="scroll"' in html  # wide tables scroll in their box
     assert "nan" not in html.lower().replace("never saturated", "")
     assert "— <small>(never saturated)</small>" in html
@@ -78,7 +99,9 @@ def test_parallel_analyses_keep_their_order(tmp_path):
     assert all(s.elapsed is not None for s in sections) and sections[0].elapsed >= 1.0
     lines = log.getvalue().splitlines()
     assert len(lines) == 3 and lines[-1].startswith("[3/3] a_slow: 1/1 checks passed")
-    page = render.render_html(sections, "t", render.default_meta(sections, "stewart-drake report", 1.0, ("utn-dynamic",)))
+    page = render.render_html(
+        sections, "t", render.default_meta(sections, "stewart-drake report", 1.0, ("utn-dynamic",))
+    )
     assert page.index("Verdict") < page.index("All checks") < page.index('<section id="s0">')
     assert "a_slow headline" in page and "stewart-drake report" in page and "utn-dynamic" in page
 

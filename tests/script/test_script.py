@@ -53,7 +53,11 @@ def test_seed_example_second_mover_uses_its_own_arguments(utn):
     """The seed's compiler read mover arguments from a global counter (a second mover repeated the first
     one's values); here each mover gets its own."""
     _, m = run_env(SEED_PROGRAM + "z = 250\nmover(x, y, z, alpha, beta, gama)\nmover(0, 0, 200, 0, 0, 0)")
-    assert [s.values for s in m.segments] == [(100, 120, 300, 25, 10, 0), (100, 120, 250, 25, 10, 0), (0, 0, 200, 0, 0, 0)]
+    assert [s.values for s in m.segments] == [
+        (100, 120, 300, 25, 10, 0),
+        (100, 120, 250, 25, 10, 0),
+        (0, 0, 200, 0, 0, 0),
+    ]
 
 
 # ---- expressions ---------------------------------------------------------------------------------
@@ -138,9 +142,21 @@ def test_nested_loops_and_conditionals():
     assert run_env(src)[0]["s"] == expected
 
 
-@pytest.mark.parametrize("cond, taken", [("1 < 2", True), ("2 <= 2", True), ("1 > 2", False), ("2 >= 3", False),
-                                         ("1 = 1", True), ("1 == 1", True), ("1 <> 1", False), ("1 # 2", True),
-                                         ("1 != 2", True), ("NOT (1 < 2 OR 2 < 1)", False)])
+@pytest.mark.parametrize(
+    "cond, taken",
+    [
+        ("1 < 2", True),
+        ("2 <= 2", True),
+        ("1 > 2", False),
+        ("2 >= 3", False),
+        ("1 = 1", True),
+        ("1 == 1", True),
+        ("1 <> 1", False),
+        ("1 # 2", True),
+        ("1 != 2", True),
+        ("NOT (1 < 2 OR 2 < 1)", False),
+    ],
+)
 def test_comparisons(cond, taken):
     assert run_env(f"v = 0; IF {cond} THEN v = 1 ELSE v = 2 END")[0]["v"] == (1 if taken else 2)
 
@@ -183,7 +199,9 @@ def test_trajectory_velocity_and_acceleration_are_consistent(utn):
     """Sampled q̇, q̈ match central differences of the sampled q, q̇ at 1 kHz away from waypoints (error
     h²/6·max|q⁽⁴⁾| < 1e-3 of the peak). Across waypoints q̈ is continuous but the jerk jumps, so there
     consecutive samples of q̈ differ by at most h·max|jerk| (max|s⁽³⁾| = 60)."""
-    _, m = run_env("mover(20, 0, 150, 5, 0, 0) en 0.5\nmover(x = -20, gama = 10) in 0.7\nwait 0.2\nmover(0, 0, 100, 0, 0, 0)")
+    _, m = run_env(
+        "mover(20, 0, 150, 5, 0, 0) en 0.5\nmover(x = -20, gama = 10) in 0.7\nwait 0.2\nmover(0, 0, 100, 0, 0, 0)"
+    )
     tr = m.trajectory(rate=1000.0)
     dt = np.diff(tr.t)
     np.testing.assert_allclose(dt, 1e-3, atol=1e-12)

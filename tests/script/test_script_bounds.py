@@ -41,8 +41,10 @@ def test_huge_for_loop_refused_at_once(tmp_path):
     rc, _, err = cli("run", f, "--out", tmp_path / "o")
     spent = time.process_time() - t0
     assert rc == 2 and not (tmp_path / "o").exists()
-    assert err.startswith(f"{f}:2:1: error: this FOR loop would run 100000000 iterations, at least 200000000 steps with its body; "
-                          f"a program may run at most {MAX_STEPS} steps")
+    assert err.startswith(
+        f"{f}:2:1: error: this FOR loop would run 100000000 iterations, at least 200000000 steps with its body; "
+        f"a program may run at most {MAX_STEPS} steps"
+    )
     assert spent < 1.0  # refused before the first iteration, not after a million (CPU time, generous)
 
 
@@ -50,7 +52,9 @@ def test_nested_loops_refused_by_their_static_product(tmp_path):
     f = program(tmp_path, "FOR i := 1 TO 1000 DO\n  FOR j := 1 TO 1000 DO\n    x = j\n  END\nEND\n")
     rc, _, err = cli("run", f, "--out", tmp_path / "o")
     # steps: 1000 × (1 + [FOR statement 1 + 1000 × (1 + 1)]) = 2,002,000
-    assert rc == 2 and err.startswith(f"{f}:1:1: error: this FOR loop would run 1000 iterations, at least 2002000 steps")
+    assert rc == 2 and err.startswith(
+        f"{f}:1:1: error: this FOR loop would run 1000 iterations, at least 2002000 steps"
+    )
 
 
 def test_many_moves_refused_before_they_are_made(tmp_path):
@@ -58,19 +62,23 @@ def test_many_moves_refused_before_they_are_made(tmp_path):
     for cmd in (("run", f, "--out", tmp_path / "o"), ("compile", f, "--emit", "python")):
         rc, out, err = cli(*cmd)
         assert rc == 2 and out == ""
-        assert err.startswith(f"{f}:1:1: error: this FOR loop would make 400000 moves and waits; a program may make at most {MAX_SEGMENTS}")
+        assert err.startswith(
+            f"{f}:1:1: error: this FOR loop would make 400000 moves and waits; a program may make at most {MAX_SEGMENTS}"
+        )
 
 
 def test_static_cost_is_a_lower_bound(utn):
     """The static estimate never exceeds what the interpreter counts (so it never refuses a program that
     fits): a loop under an IF and a WHILE counts 0, a literal nested loop its product."""
-    text = ("n = 3\nFOR i := 1 TO 4 DO\n  FOR j := 1 TO 5 DO\n    mover(x = j) en 0.01\n  END\n"
-            "  IF i > 2 THEN\n    wait 0.01\n  END\n  k = 0\n  WHILE k < n DO\n    k = k + 1\n  END\nEND\n")
+    text = (
+        "n = 3\nFOR i := 1 TO 4 DO\n  FOR j := 1 TO 5 DO\n    mover(x = j) en 0.01\n  END\n"
+        "  IF i > 2 THEN\n    wait 0.01\n  END\n  k = 0\n  WHILE k < n DO\n    k = k + 1\n  END\nEND\n"
+    )
     prog, motion = compile_program(text, "c.stw", utn)
     steps, moves = static_cost(prog.body)
     assert moves == 20 and len(motion.segments) == 22 and moves <= len(motion.segments)
-    from stewart_drake.script.interpreter import _Interpreter
     from stewart_drake.script.check import assigned_names
+    from stewart_drake.script.interpreter import _Interpreter
     from stewart_drake.script.runtime import Motion
 
     it = _Interpreter(Motion.at_home(utn), assigned_names(prog.body))
@@ -87,18 +95,27 @@ def test_wait_too_long_names_the_statement(tmp_path):
     f = program(tmp_path, "mover(0, 0, 150, 0, 0, 0) en 1\nwait 1e307\n")
     rc, _, err = cli("run", f, "--out", tmp_path / "o")
     assert rc == 2 and "Traceback" not in err
-    assert err.startswith(f"{f}:2:1: error: wait lasts 1e+307 s, more than the {MAX_SAMPLES} samples a program may have at 100 Hz (20000 s)")
+    assert err.startswith(
+        f"{f}:2:1: error: wait lasts 1e+307 s, more than the {MAX_SAMPLES} samples a program may have at 100 Hz (20000 s)"
+    )
 
 
 def test_absurdly_short_move_is_an_error_at_its_place(tmp_path):
     f = program(tmp_path, "mover(0, 0, 150, 0, 0, 0) en 1\n  mover(0, 0, 160, 0, 0, 0) en 1e-200\n")
     rc, _, err = cli("run", f, "--out", tmp_path / "o")
     assert rc == 2
-    assert err.startswith(f"{f}:2:3: error: mover duration 1e-200 s is shorter than the shortest move, {MIN_MOVE_DURATION:g} s")
+    assert err.startswith(
+        f"{f}:2:3: error: mover duration 1e-200 s is shorter than the shortest move, {MIN_MOVE_DURATION:g} s"
+    )
 
 
 def _nested_ifs(n):
-    return "".join("  " * i + "IF 1 = 1 THEN\n" for i in range(n)) + "  " * n + "x = 1\n" + "".join("  " * i + "END\n" for i in reversed(range(n)))
+    return (
+        "".join("  " * i + "IF 1 = 1 THEN\n" for i in range(n))
+        + "  " * n
+        + "x = 1\n"
+        + "".join("  " * i + "END\n" for i in reversed(range(n)))
+    )
 
 
 def test_deep_ifs_refused_or_valid_python(tmp_path, utn):
@@ -113,7 +130,9 @@ def test_deep_ifs_refused_or_valid_python(tmp_path, utn):
 
 def test_deep_loops_refused_or_valid_python():
     def loops(n):
-        return "".join("  " * i + f"FOR i{i} := 1 TO 1 DO\n" for i in range(n)) + "".join("  " * i + "END\n" for i in reversed(range(n)))
+        return "".join("  " * i + f"FOR i{i} := 1 TO 1 DO\n" for i in range(n)) + "".join(
+            "  " * i + "END\n" for i in reversed(range(n))
+        )
 
     with pytest.raises(ScriptError, match=f"loops \\(FOR, WHILE\\) nested more than {MAX_LOOP_DEPTH} levels deep"):
         parse(loops(MAX_LOOP_DEPTH + 1), "l.stw")

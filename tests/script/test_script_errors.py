@@ -24,18 +24,45 @@ def error_of(src, platform):
 
 CASES = [
     # syntax: file:line:column, the offending token, the expected tokens
-    ("x = (1 + 2", "t.stw:1:11: syntax error: unexpected end of file; expected one of: ')', AND, OR, a comparison (= <> < <= > >=)"),
-    ("x = 3 $ 4", "t.stw:1:7: syntax error: unexpected character '$'; expected one of: '*', '+', '-', '/', ';', DIV, FOR, IF, MOD, WHILE, a name, end of file, mover, units, wait"),
-    ("x = 1\ny = end", "t.stw:2:5: syntax error: unexpected keyword 'end'; expected one of: '(', '+', '-', a name, a number"),
-    ("mover(1, 2 3)", "t.stw:1:12: syntax error: unexpected number 3; expected one of: ')', '*', '+', ',', '-', '/', DIV, MOD"),
-    ("FOR i := 1 TO 3 DO\n  wait 1\n", "t.stw:3:1: syntax error: unexpected end of file; expected one of: END, FOR, IF, WHILE, a name, mover, units, wait"),
-    ("x = 1 < 2", "t.stw:1:7: syntax error: unexpected '<'; expected one of: ';', FOR, IF, WHILE, a name, end of file, mover, units, wait"),
-    ("LOOP", "t.stw:1:1: error: 'LOOP' is a reserved word (Modula-2, kept from seed 004's Stewart.g) and cannot be used yet"),
+    (
+        "x = (1 + 2",
+        "t.stw:1:11: syntax error: unexpected end of file; expected one of: ')', AND, OR, a comparison (= <> < <= > >=)",
+    ),
+    (
+        "x = 3 $ 4",
+        "t.stw:1:7: syntax error: unexpected character '$'; expected one of: '*', '+', '-', '/', ';', DIV, FOR, IF, MOD, WHILE, a name, end of file, mover, units, wait",
+    ),
+    (
+        "x = 1\ny = end",
+        "t.stw:2:5: syntax error: unexpected keyword 'end'; expected one of: '(', '+', '-', a name, a number",
+    ),
+    (
+        "mover(1, 2 3)",
+        "t.stw:1:12: syntax error: unexpected number 3; expected one of: ')', '*', '+', ',', '-', '/', DIV, MOD",
+    ),
+    (
+        "FOR i := 1 TO 3 DO\n  wait 1\n",
+        "t.stw:3:1: syntax error: unexpected end of file; expected one of: END, FOR, IF, WHILE, a name, mover, units, wait",
+    ),
+    (
+        "x = 1 < 2",
+        "t.stw:1:7: syntax error: unexpected '<'; expected one of: ';', FOR, IF, WHILE, a name, end of file, mover, units, wait",
+    ),
+    (
+        "LOOP",
+        "t.stw:1:1: error: 'LOOP' is a reserved word (Modula-2, kept from seed 004's Stewart.g) and cannot be used yet",
+    ),
     ("x = 1e999", "t.stw:1:5: error: number 1e999 is too large"),
     # undefined variables
     ("x = yy + 1", "t.stw:1:5: error: undefined variable 'yy': it is never assigned in this program"),
-    ("alpha = 1\nz = alpah", "t.stw:2:5: error: undefined variable 'alpah': it is never assigned in this program (did you mean 'alpha'?)"),
-    ("y = x\nx = 1", "t.stw:1:5: error: undefined variable 'x': it is first assigned at line 2, column 1, after this use"),
+    (
+        "alpha = 1\nz = alpah",
+        "t.stw:2:5: error: undefined variable 'alpah': it is never assigned in this program (did you mean 'alpha'?)",
+    ),
+    (
+        "y = x\nx = 1",
+        "t.stw:1:5: error: undefined variable 'x': it is first assigned at line 2, column 1, after this use",
+    ),
     # argument lists
     ("mover(1, 2, 3)", "t.stw:1:1: error: mover takes 6 arguments (x, y, z, alpha, beta, gama), got 3"),
     ("move(1, 2, 3, 4, 5, 6, 7)", "t.stw:1:1: error: move takes 6 arguments (x, y, z, alpha, beta, gama), got 7"),
@@ -46,11 +73,17 @@ CASES = [
     ("mover(z=1, 2)", "t.stw:1:12: error: mover: positional argument after a keyword argument"),
     ("x = sin(1, 2)", "t.stw:1:5: error: sin() takes 1 argument, got 2"),
     ("x = atan2(1)", "t.stw:1:5: error: atan2() takes 2 arguments, got 1"),
-    ("x = foo(1)", "t.stw:1:5: error: unknown function 'foo'; available: abs, acos, asin, atan, atan2, cos, max, min, sin, sqrt, tan"),
+    (
+        "x = foo(1)",
+        "t.stw:1:5: error: unknown function 'foo'; available: abs, acos, asin, atan, atan2, cos, max, min, sin, sqrt, tan",
+    ),
     # types, units, values
     ("IF 1 THEN END", "t.stw:1:4: error: IF needs a condition such as x > 0, got a number"),
     ("x = (1 < 2) + 1", "t.stw:1:6: error: '+' needs a number, got a condition"),
-    ("units mm, kg", "t.stw:1:11: error: units: 'kg' is not a unit; expected m or mm (length), rad or deg or pi (angle)"),
+    (
+        "units mm, kg",
+        "t.stw:1:11: error: units: 'kg' is not a unit; expected m or mm (length), rad or deg or pi (angle)",
+    ),
     ("units mm, m", "t.stw:1:11: error: units: two length units given ('mm' and 'm')"),
     ("pi = 3", "t.stw:1:1: error: cannot assign to the constant 'pi'"),
     ("x = 1 / (2 - 2)", "t.stw:1:7: error: division by zero (1 / 0)"),
@@ -60,7 +93,10 @@ CASES = [
     ("FOR i := 1 TO 2 BY 0 DO END", "t.stw:1:1: error: FOR step is 0: the loop would never end"),
     ("mover(0, 0, 100, 0, 0, 0) en -1", "t.stw:1:1: error: mover duration must be positive, got -1 s"),
     ("wait -1", "t.stw:1:1: error: wait duration must be >= 0, got -1 s"),
-    ("WHILE 1 < 2 DO END", "t.stw:1:1: error: the program ran more than 1000000 steps (statements and loop iterations); does a loop never end?"),
+    (
+        "WHILE 1 < 2 DO END",
+        "t.stw:1:1: error: the program ran more than 1000000 steps (statements and loop iterations); does a loop never end?",
+    ),
 ]
 
 
@@ -136,7 +172,10 @@ def test_cli_reports_errors_without_traceback_and_writes_nothing(tmp_path, capsy
     prog.write_text("x = 100\nmover(x, 0, 100, 0, 0, 0)\nmover(0, 0, 900, 0, 0, 0)\n")
     assert main(["run", str(prog), "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert f"{prog}:3:1: error: mover #2 to (0, 0, 900 mm; 0, 0, 0 deg) is out of reach on platform utn-kinematic: leg 1" in err
+    assert (
+        f"{prog}:3:1: error: mover #2 to (0, 0, 900 mm; 0, 0, 0 deg) is out of reach on platform utn-kinematic: leg 1"
+        in err
+    )
     assert not out.exists()
     target = tmp_path / "bad.py"
     assert main(["compile", str(prog), "--emit", "python", "-o", str(target)]) == 2

@@ -71,7 +71,9 @@ def test_gruebler_paper_count():
 def test_grid_classification_equals_leg_lengths(gd, orientation):
     """The grid kernel (translation added to l_i(0)) agrees node by node with kinematics.leg_lengths."""
     rng = np.random.default_rng(1)
-    xs, ys, zs = (np.sort(rng.uniform(lo, hi, n)) for (lo, hi), n in zip(ws.default_bounds(gd, orientation), (17, 19, 23)))
+    xs, ys, zs = (
+        np.sort(rng.uniform(lo, hi, n)) for (lo, hi), n in zip(ws.default_bounds(gd, orientation), (17, 19, 23))
+    )
     spec = grid_spec(gd, orientation, "utn", ws.Limits(), (xs, ys, zs))
     inside, _ = inside_block(spec, xs, ys, zs)
     X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
@@ -273,8 +275,14 @@ def test_process_pool_gives_the_same_result(gd):
 
 def test_count_reachable_matches_brute_force(gd):
     h = gd.home_pose()
-    grids = [np.linspace(-0.2, 0.2, 5), np.linspace(-0.2, 0.2, 4), h[2] + np.linspace(-0.2, 0.2, 3),
-             np.linspace(-30, 30, 3) * DEG, np.linspace(-30, 30, 4) * DEG, np.linspace(-40, 40, 5) * DEG]
+    grids = [
+        np.linspace(-0.2, 0.2, 5),
+        np.linspace(-0.2, 0.2, 4),
+        h[2] + np.linspace(-0.2, 0.2, 3),
+        np.linspace(-30, 30, 3) * DEG,
+        np.linspace(-30, 30, 4) * DEG,
+        np.linspace(-40, 40, 5) * DEG,
+    ]
     res = ws.count_reachable(gd, grids, chunk=97)
     mesh = np.stack(np.meshgrid(*grids, indexing="ij"), -1)
     inside = ws.classify(gd, mesh)
@@ -284,16 +292,33 @@ def test_count_reachable_matches_brute_force(gd):
 
 
 def test_dask_local_cluster_same_result(gd, ws10):
-    pytest.importorskip("distributed", reason='the Dask back end needs dask.distributed (pip install "dask[distributed]")')
-    from stewart_drake.workspace.dask_sweep import close_client, count_reachable_on_dask, local_client, map_platforms, workspace_on_dask
+    pytest.importorskip(
+        "distributed", reason='the Dask back end needs dask.distributed (pip install "dask[distributed]")'
+    )
+    from stewart_drake.workspace.dask_sweep import (
+        close_client,
+        count_reachable_on_dask,
+        local_client,
+        map_platforms,
+        workspace_on_dask,
+    )
 
     client = local_client(n_workers=2)
     try:
         w = workspace_on_dask(gd, client=client, resolution=0.01, chunk_nodes=100_000)
         _same(w, ws10)
-        grids = [np.linspace(-0.1, 0.1, 3)] * 2 + [gd.home_height + np.linspace(-0.1, 0.1, 3)] + [np.linspace(-0.3, 0.3, 3)] * 3
-        assert count_reachable_on_dask(gd, grids, client=client, chunk=100)["count"] == ws.count_reachable(gd, grids)["count"]
-        vols = map_platforms(ws.stroke_volume_columns, [gd, gd.replace(stroke=np.array([0.5, 0.95]))], client, resolution=0.01)
+        grids = (
+            [np.linspace(-0.1, 0.1, 3)] * 2
+            + [gd.home_height + np.linspace(-0.1, 0.1, 3)]
+            + [np.linspace(-0.3, 0.3, 3)] * 3
+        )
+        assert (
+            count_reachable_on_dask(gd, grids, client=client, chunk=100)["count"]
+            == ws.count_reachable(gd, grids)["count"]
+        )
+        vols = map_platforms(
+            ws.stroke_volume_columns, [gd, gd.replace(stroke=np.array([0.5, 0.95]))], client, resolution=0.01
+        )
         assert vols[0] == pytest.approx(ws.stroke_volume_columns(gd, 0.01)) and vols[1] > vols[0]
     finally:
         close_client(client)
@@ -306,7 +331,10 @@ def test_dask_local_cluster_same_result(gd, ws10):
 def test_errors(gd):
     with pytest.raises(W, match=re.escape(W.RESOLUTION.format(value=-0.01))):
         ws.constant_orientation_workspace(gd, resolution=-0.01)
-    with pytest.raises(ws.WorkspaceError, match=r"resolution 1e-06 m would need .* grid nodes .*; the finest this machine can hold is ~.* mm; use a coarser --resolution"):
+    with pytest.raises(
+        ws.WorkspaceError,
+        match=r"resolution 1e-06 m would need .* grid nodes .*; the finest this machine can hold is ~.* mm; use a coarser --resolution",
+    ):
         ws.constant_orientation_workspace(gd, resolution=1e-6)
     with pytest.raises(W, match=re.escape(W.ORIENTATION.format(value=[0.0, 0.0]))):
         ws.constant_orientation_workspace(gd, orientation=(0.0, 0.0))
@@ -330,8 +358,25 @@ def test_errors(gd):
 
 
 def test_cli_limits_and_out(capsys, tmp_path):
-    rc = main(["workspace", "--resolution", "0.02", "--limits", "stroke,joints,collision", "--joint-cone", "40",
-               "--leg-diameter", "0.145", "--orientation", "0", "0", "10", "--out", str(tmp_path / "o")])
+    rc = main(
+        [
+            "workspace",
+            "--resolution",
+            "0.02",
+            "--limits",
+            "stroke,joints,collision",
+            "--joint-cone",
+            "40",
+            "--leg-diameter",
+            "0.145",
+            "--orientation",
+            "0",
+            "0",
+            "10",
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
     out = capsys.readouterr().out
     assert rc == 0 and "base_joint limit binds" in out and "collision limit binds" in out
     for f in ("workspace.json", "boundary.csv", "top.png", "front.png", "side.png", "3d.png"):

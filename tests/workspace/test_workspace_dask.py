@@ -31,12 +31,16 @@ def test_auto_sized_dask_sweeps_equal_serial():
     """Slabs and chunks sized by the cluster split the same sweep: identical volume, views, extents,
     count and marginals; the workers run without their statistical profiler."""
     p = load_preset("gonzalez-dutra-2009")
-    grids = [np.linspace(-0.1, 0.1, 4)] * 2 + [p.home_height + np.linspace(-0.1, 0.1, 4)] + [np.linspace(-0.3, 0.3, 4)] * 3
+    grids = (
+        [np.linspace(-0.1, 0.1, 4)] * 2 + [p.home_height + np.linspace(-0.1, 0.1, 4)] + [np.linspace(-0.3, 0.3, 4)] * 3
+    )
     serial_w = ws.constant_orientation_workspace(p, resolution=0.01)
     serial_c = ws.count_reachable(p, grids)
     client = wd.local_client(n_workers=1)
     try:
-        assert client.run(lambda: __import__("dask").config.get("distributed.worker.profile.enabled")) == {a: False for a in client.nthreads()}
+        assert client.run(lambda: __import__("dask").config.get("distributed.worker.profile.enabled")) == {
+            a: False for a in client.nthreads()
+        }
         w = wd.workspace_on_dask(p, client=client, resolution=0.01)
         c = wd.count_reachable_on_dask(p, grids, client=client)
     finally:
@@ -62,7 +66,9 @@ def test_local_client_workers_keep_the_adaptive_malloc(monkeypatch):
     assert os.environ.get("MALLOC_TRIM_THRESHOLD_") == "65536"  # Dask's, in this process now
     client = wd.local_client(n_workers=1)
     try:
-        env = client.run(lambda: {k: __import__("os").environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")})
+        env = client.run(
+            lambda: {k: __import__("os").environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")}
+        )
     finally:
         wd.close_client(client)
     assert list(env.values()) == [{"MALLOC_TRIM_THRESHOLD_": None, "OMP_NUM_THREADS": "1"}]

@@ -47,9 +47,16 @@ def six_three_config(seed: int) -> dict:
     ph = np.repeat(th, 2) + np.tile([-1, 1], 3) * np.radians(rng.uniform(40, 55, 6))
     rt = rng.uniform(0.25, 0.32, 6)
     top = np.stack([rt * np.cos(ph), rt * np.sin(ph), rng.uniform(-0.03, 0.03, 6)], -1)
-    return dict(name=f"random-6-3-seed{seed}", length_unit="m", base_anchors=np.round(base, 4).tolist(),
-                top_anchors=np.round(top, 4).tolist(), leg_top=list(range(6)), leg_base=[0, 0, 1, 1, 2, 2],
-                stroke=[0.5, 1.1], plate=MASS)
+    return dict(
+        name=f"random-6-3-seed{seed}",
+        length_unit="m",
+        base_anchors=np.round(base, 4).tolist(),
+        top_anchors=np.round(top, 4).tolist(),
+        leg_top=list(range(6)),
+        leg_base=[0, 0, 1, 1, 2, 2],
+        stroke=[0.5, 1.1],
+        plate=MASS,
+    )
 
 
 def non_planar_config(seed: int) -> dict:
@@ -61,8 +68,15 @@ def non_planar_config(seed: int) -> dict:
     rb, rt = rng.uniform(0.45, 0.55, 6), rng.uniform(0.25, 0.32, 6)
     base = np.stack([rb * np.cos(tb), rb * np.sin(tb), rng.uniform(-0.06, 0.06, 6)], -1)
     top = np.stack([rt * np.cos(tt), rt * np.sin(tt), rng.uniform(-0.06, 0.06, 6)], -1)
-    return dict(name=f"random-non-planar-seed{seed}", length_unit="m", base_anchors=np.round(base, 4).tolist(),
-                top_anchors=np.round(top, 4).tolist(), leg_top=list(range(6)), stroke=[0.5, 1.1], plate=MASS)
+    return dict(
+        name=f"random-non-planar-seed{seed}",
+        length_unit="m",
+        base_anchors=np.round(base, 4).tolist(),
+        top_anchors=np.round(top, 4).tolist(),
+        leg_top=list(range(6)),
+        stroke=[0.5, 1.1],
+        plate=MASS,
+    )
 
 
 def _write(tmp_path, cfg: dict):
@@ -123,9 +137,14 @@ def test_three_three_is_solved_in_the_general_family(tmp_path):
     offset pairs. No class of its own: the general 40-path start system, described with its joint counts;
     its 16 finite solutions found (Nanua, Waldron & Murthy 1990), the other 24 paths at infinity; complete,
     certified, and the real set equal to the multi-start's."""
-    cfg = dict(name="three-three", base_anchors=[[0.0, 0.5, 0.01], [-0.43, -0.25, 0.0], [0.43, -0.25, -0.01]],
-               leg_base=[0, 0, 1, 1, 2, 2], top_anchors=[[0.0, -0.3, 0.0], [0.26, 0.15, 0.01], [-0.26, 0.15, 0.0]],
-               leg_top=[2, 1, 1, 0, 0, 2], stroke=[0.5, 1.1])
+    cfg = dict(
+        name="three-three",
+        base_anchors=[[0.0, 0.5, 0.01], [-0.43, -0.25, 0.0], [0.43, -0.25, -0.01]],
+        leg_base=[0, 0, 1, 1, 2, 2],
+        top_anchors=[[0.0, -0.3, 0.0], [0.26, 0.15, 0.01], [-0.26, 0.15, 0.0]],
+        leg_top=[2, 1, 1, 0, 0, 2],
+        stroke=[0.5, 1.1],
+    )
     p = load_platform_yaml(_write(tmp_path, cfg))
     arch = architecture(p)
     assert arch.kind == "6-6" and arch.joints == (3, 3) and "3 base, 3 plate joints" in arch.describe()
@@ -200,9 +219,11 @@ def test_repeated_base_anchor_is_still_refused(tmp_path, capsys):
     written_out["base_anchors"] = [written_out["base_anchors"][j] for j in written_out.pop("leg_base")]
     with pytest.raises(GeometryError, match=r"base_anchors item 2: .* repeats item 1"):
         load_platform_yaml(_write(tmp_path, written_out))
-    for leg_base, message in (([0, 0, 1, 1, 2, 3], "leg_base: leg 6 refers to base anchor 3, but there are 3"),
-                              ([0, 0, 1, 1, 1, 1], "leg_base: base anchor 2 is used by no leg"),
-                              ([0, 0, 0, 1, 2, 2], "legs may share base joints only in three pairs")):
+    for leg_base, message in (
+        ([0, 0, 1, 1, 2, 3], "leg_base: leg 6 refers to base anchor 3, but there are 3"),
+        ([0, 0, 1, 1, 1, 1], "leg_base: base anchor 2 is used by no leg"),
+        ([0, 0, 0, 1, 2, 2], "legs may share base joints only in three pairs"),
+    ):
         bad = six_three_config(0) | {"leg_base": leg_base}
         with pytest.raises(GeometryError, match=message):
             load_platform_yaml(_write(tmp_path, bad))
@@ -235,6 +256,7 @@ def test_six_three_file_through_other_commands(tmp_path, capsys):
     # As tests/test_dynamics_drake.py: O(10) operations per term on forces of O(10 N), J well conditioned
     # (< 30 here): rounding gives ~1e-14 N; 1e-9 N is the bound asked of the dynamics everywhere.
     centre, amplitude = p.home_pose() + [0.01, -0.01, 0, 0.02, 0.01, 0.03], [0.02, 0.02, 0.01, 0.1, 0.1, 0.2]
-    q, qd, qdd = harmonic_trajectory(np.linspace(0, 2, 7), centre, amplitude, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5],
-                                     [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    q, qd, qdd = harmonic_trajectory(
+        np.linspace(0, 2, 7), centre, amplitude, [1.3, 2.1, 1.7, 3.0, 2.5, 3.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]
+    )
     assert np.abs(leg_forces(p, q, qd, qdd, "utn") - drake_leg_forces(p, q, qd, qdd, "utn")).max() <= 1e-9
