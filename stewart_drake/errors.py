@@ -60,6 +60,18 @@ class GeometryError(StewartError):
     UNKNOWN_PRESET = "unknown preset {name!r}; built-in presets: {presets}"
     UNKNOWN_PLATFORM = "unknown platform {name!r}: not a preset ({presets}) and not a YAML file"
     LEG_LIMIT = "platform {name!r}: legs.{field} must be a positive number, got {value}"
+    # shared base joints (6-3 platforms, ``leg_base``)
+    BASE_PAIRS = "{problem}; legs may share base joints only in three pairs (6-3), declared with leg_base"
+    BASE_COUNT = (
+        "base_anchors: {n} points given; give 6 (one per leg), or list each base joint once and give leg_base "
+        "(the base joint of each leg)"
+    )
+    LEG_BASE_RANGE = "leg_base: leg {leg} refers to base anchor {anchor}, but there are {n} base anchors (0..{last})"
+    LEG_BASE_UNUSED = "leg_base: base anchor {anchor} is used by no leg"
+    BASE_REPEATED = (
+        "repeats item {first} (closer than {limit} m); legs sharing a base joint list it once and give "
+        "leg_base (the base joint of each leg)"
+    )
 
     # a servo hexapod description (``core.servo``)
     SERVO_SHAPE = "servo hexapod {name} must have shape {shape}, got {got}"

@@ -122,6 +122,7 @@ def _homotopy_all(platform, L, args, k: float) -> dict:
         failed_paths=r.failed_paths,
         retracked_paths=r.retracked,
         stage=r.stage,
+        engine=r.engine,
         certificate="Krawczyk/Kantorovich existence and uniqueness in Study coordinates (e·e = 1): an exact solution "
         "lies within certified_radius of the returned point, no other within uniqueness_radius; position_bound / "
         "angle_bound are the implied pose bounds",
@@ -192,7 +193,8 @@ def run(args) -> int:
         )
         if "paths" in out:
             counts = ", ".join(f"{v} {c}" for c, v in out["paths"].items() if v)
-            print(f"architecture {out['architecture']}: {out['max_solutions']} paths ({counts})")
+            engine = {"c": "c (the compiled tracker, track.c)", "numpy": "numpy (no C compiler)"}[out["engine"]]
+            print(f"architecture {out['architecture_text']} ({counts}); tracking engine: {engine}")
             print(("complete: " if out["complete"] else "") + out["guarantee"])
         elif "modes_found" in out:
             print(

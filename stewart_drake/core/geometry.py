@@ -81,7 +81,7 @@ class LegConfig:
 @dataclass
 class PlatformConfig:
     """One platform as written in YAML. Exactly one anchor description: ``utn``, ``radial`` or
-    explicit ``base_anchors`` + ``top_anchors`` + ``leg_top``."""
+    explicit ``base_anchors`` + ``top_anchors`` + ``leg_top`` (+ ``leg_base`` when legs share base joints)."""
 
     name: str = ""
     description: str = ""
@@ -91,6 +91,7 @@ class PlatformConfig:
     base_anchors: list[list[float]] = field(default_factory=list)
     top_anchors: list[list[float]] = field(default_factory=list)
     leg_top: list[int] = field(default_factory=list)
+    leg_base: list[int] = field(default_factory=list)  # empty: leg i at base_anchors[i] (six distinct points)
     stroke: list[float] = field(default_factory=list)
     plate: PlateConfig = field(default_factory=PlateConfig)
     rotation_centre: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
@@ -107,7 +108,7 @@ class PlatformConfig:
 class Platform:
     """A Stewart platform. Arrays are read-only numpy arrays in SI units.
 
-    base_anchors  (6, 3)  p_BBi, metres
+    base_anchors  (6, 3)  p_BBi, metres; six distinct points, or three pairs (6-3: two legs per base joint)
     top_anchors   (k, 3)  p_TTj, metres, 3 <= k <= 6
     leg_top       (6,)    index into top_anchors for each leg
     stroke        (2,)    L_min, L_max, metres (joint centre to joint centre)
@@ -164,7 +165,7 @@ class Platform:
         leg_top = leg_top.astype(np.intp)
         leg_top.flags.writeable = False
         object.__setattr__(self, "leg_top", leg_top)
-        _check_distinct(self.base_anchors, "base anchors")
+        check_base_anchors(self.base_anchors)
         _check_distinct(top, "top anchors")
         lmin, lmax = self.stroke
         if not 0 < lmin < lmax:
@@ -359,7 +360,7 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
             r.base_radius * k, np.radians(r.base_angles_deg), r.top_radius * k, np.radians(r.top_angles_deg), **common
         )
     return Platform(
-        base_anchors=np.asarray(cfg.base_anchors, dtype=float) * k,
+        base_anchors=base_anchors_per_leg(cfg) * k,
         top_anchors=np.asarray(cfg.top_anchors, dtype=float) * k,
         leg_top=np.asarray(cfg.leg_top),
         **common,
@@ -376,6 +377,7 @@ PLATFORM_RULES = {
     "base_anchors[*][*]": Rule("any", "length"),
     "top_anchors[*][*]": Rule("any", "length"),
     "leg_top[*]": Rule("nonneg", "", 5),
+    "leg_base[*]": Rule("nonneg", "", 5),
     "stroke[*]": Rule("pos", "length"),
     "plate.mass": Rule("nonneg", "kg", 1e5),
     "plate.com[*]": Rule("any", "length"),
@@ -397,11 +399,12 @@ PLATFORM_RULES = {
 PLATFORM_SHAPES = {
     "radial.base_angles_deg": (6, 6),
     "radial.top_angles_deg": (6, 6),
-    "base_anchors": (6, 6),
+    "base_anchors": (3, 6),
     "base_anchors[*]": (3, 3),
     "top_anchors": (3, 6),
     "top_anchors[*]": (3, 3),
     "leg_top": (6, 6),
+    "leg_base": (6, 6),
     "stroke": (2, 2),
     "plate.com": (3, 3),
     "plate.inertia": (6, 6),
@@ -448,11 +451,66 @@ def check_length_unit(cfg, where: dict, shown: str) -> float:
     return length_scale(cfg.length_unit)
 
 
+def check_base_anchors(points: np.ndarray) -> None:
+    """``(6, 3)`` per-leg base anchors p_BBi: six distinct points, or exactly three disjoint coincident
+    pairs (a 6-3 platform: three base joints, each shared by two legs). Any other coincidence (one or
+    two pairs, three legs on one point) is refused as a modelling error, naming the first pair."""
+    close = np.linalg.norm(points[:, None] - points[None], axis=-1) < MIN_ANCHOR_SEPARATION
+    if np.all(close.sum(axis=1) == 2):  # each anchor coincides with itself and exactly one other
+        return
+    try:
+        _check_distinct(points, "base anchors")
+    except GeometryError as e:
+        raise GeometryError(GeometryError.BASE_PAIRS.format(problem=e)) from None
+
+
+def base_anchors_per_leg(cfg: PlatformConfig) -> np.ndarray:
+    """``(6, 3)`` the base anchor of each leg (file unit) of an explicit-anchor config: ``base_anchors``
+    itself, or ``base_anchors[leg_base]`` when ``leg_base`` lists each leg's base joint."""
+    pts = np.asarray(cfg.base_anchors, dtype=float).reshape(-1, 3)
+    if not cfg.leg_base:
+        if len(pts) != 6:
+            raise GeometryError(GeometryError.BASE_COUNT.format(n=len(pts)))
+        return pts
+    idx = np.asarray(cfg.leg_base)
+    bad = [i for i, j in enumerate(idx) if not 0 <= j < len(pts)]
+    if bad:
+        raise GeometryError(
+            GeometryError.LEG_BASE_RANGE.format(leg=bad[0] + 1, anchor=idx[bad[0]], n=len(pts), last=len(pts) - 1)
+        )
+    unused = sorted(set(range(len(pts))) - set(idx.tolist()))
+    if unused:
+        raise GeometryError(GeometryError.LEG_BASE_UNUSED.format(anchor=unused[0]))
+    return pts[idx]
+
+
+def check_shared_base(cfg: PlatformConfig, where: dict, shown: str, k: float) -> None:
+    """The points listed in ``base_anchors`` are distinct (a repeated point is a typing mistake: legs
+    sharing a base joint list it once and name it in ``leg_base``); ``k`` metres per file unit."""
+    pts = np.asarray(cfg.base_anchors, dtype=float).reshape(-1, 3) * k
+    d = np.linalg.norm(pts[:, None] - pts[None], axis=-1)
+    i, j = np.triu_indices(len(pts), 1)
+    close = d[i, j] < MIN_ANCHOR_SEPARATION
+    if np.any(close):
+        a, b = int(i[np.argmax(close)]), int(j[np.argmax(close)])
+        w = where.get(("base_anchors", b, 0))
+        raise YamlError(
+            YamlError.BAD_VALUE.format(
+                path=shown,
+                line=w.line if w else "?",
+                field=f"base_anchors item {b + 1}",
+                value=cfg.base_anchors[b],
+                problem=GeometryError.BASE_REPEATED.format(first=a + 1, limit=MIN_ANCHOR_SEPARATION),
+            )
+        )
+
+
 def _check_platform_fields(shown: str):
     def check(cfg, where):
         check_name(cfg, where, shown)
         k = check_length_unit(cfg, where, shown)
         check_rules(where, PLATFORM_RULES, PLATFORM_SHAPES, cfg, shown, k, cfg.length_unit)
+        check_shared_base(cfg, where, shown, k)
 
     return check
 

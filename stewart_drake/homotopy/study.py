@@ -84,16 +84,21 @@ class Architecture:
     kind   "6-6" (general, including planar and symmetric 6-6), "3-6" (plate anchors coincide in three
            pairs) or "6-3" (base anchors coincide in three pairs)
     order  ``(6,)`` leg permutation that puts coincident pairs at (0, 1), (2, 3), (4, 5)
+    joints (distinct base joints, distinct plate joints): a "6-6" with fewer than six on a side (e.g. the
+           3-3 octahedral platform) is solved with the general start system, its extra paths ending at infinity
     """
 
     kind: str
     order: np.ndarray
+    joints: tuple = (6, 6)
 
     @property
     def root_count(self) -> int:
         return ROOT_COUNT[self.kind]
 
     def describe(self) -> str:
+        if self.kind == GENERAL and self.joints != (6, 6):
+            return f"6-6 family with shared joints ({self.joints[0]} base, {self.joints[1]} plate joints): 40 paths"
         text = {
             GENERAL: "general 6-6 (six distinct plate and six distinct base joints): 40 paths",
             THREE_SIX: "3-6 (plate joints shared by leg pairs): 16 paths",
@@ -133,7 +138,17 @@ def architecture(platform: Platform) -> Architecture:
         return Architecture(THREE_SIX, top)
     if base is not None and top is None:
         return Architecture(SIX_THREE, base)
-    return Architecture(GENERAL, np.arange(6))
+    joints = tuple(len(_distinct(pts, tol)) for pts in (platform.base_anchors, platform.top_anchors_per_leg))
+    return Architecture(GENERAL, np.arange(6), joints)
+
+
+def _distinct(points: np.ndarray, tol: float) -> list[int]:
+    """Indices of the first of each group of ``(n, 3)`` points closer than ``tol``."""
+    keep = []
+    for i, q in enumerate(points):
+        if all(np.linalg.norm(q - points[j]) > tol for j in keep):
+            keep.append(i)
+    return keep
 
 
 def study_parameters(platform: Platform, lengths: np.ndarray, arch: Architecture):

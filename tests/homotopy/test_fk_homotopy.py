@@ -278,20 +278,26 @@ def test_run_check_branches_cli(tmp_path, capsys):
 
 def test_six_three_is_the_inverse_motion():
     """6-3 (base joints shared in pairs): the solver classifies it and solves it as the inverse 3-6
-    motion. ``Platform`` rejects coincident base anchors, so the 6-3 geometry is given to the solver
-    as a plain namespace: utn-dynamic's plate anchors become the base anchors and vice versa; its
-    modes must be the inverses (R → Rᵀ, p → −Rᵀ p) of the 3-6 platform's, all certified."""
+    motion: utn-dynamic's plate anchors become the base anchors (three joints, each shared by two legs)
+    and vice versa; its modes must be the inverses (R → Rᵀ, p → −Rᵀ p) of the 3-6 platform's, all
+    certified."""
     from types import SimpleNamespace
+
+    from stewart_drake.core.geometry import Platform
 
     p = load_preset("utn-dynamic")
     q = p.home_pose() + [0.02, -0.01, 0.03, 0.1, 0.05, -0.1]
     L = leg_lengths(p, q)
-    inv = SimpleNamespace(
+    inv = Platform(
         name="utn-dynamic-inverse",
         base_anchors=p.top_anchors_per_leg - p.rotation_centre,
-        top_anchors_per_leg=p.base_anchors.copy(),
-        rotation_centre=np.zeros(3),
+        top_anchors=p.base_anchors,
+        leg_top=np.arange(6),
         stroke=p.stroke,
+        mass=0.0,
+        com=np.zeros(3),
+        inertia=np.zeros((3, 3)),
+        home_height=p.home_height,
     )
     assert architecture(inv).kind == "6-3"
     r63, r36 = solve(inv, L), solve(p, L)
