@@ -11,10 +11,37 @@ if "STEWART_DRAKE_CACHE" not in os.environ:
 
 import pytest  # noqa: E402
 
+from stewart_drake import workspace as ws  # noqa: E402
 from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
+from stewart_drake.core.servo import hobby_servo_hexapod  # noqa: E402
 
 
 @pytest.fixture(params=PRESETS)
 def preset(request):
     """Each built-in preset, as a Platform."""
     return load_preset(request.param)
+
+
+# Fixtures shared by the numpy tests and the Drake / report tests of the same object.
+@pytest.fixture(scope="module")
+def hexapod():
+    """The hobby-servo hexapod preset."""
+    return hobby_servo_hexapod()
+
+
+@pytest.fixture(scope="module")
+def gd():
+    """The gonzalez-dutra-2009 preset (the workspace paper's platform)."""
+    return load_preset("gonzalez-dutra-2009")
+
+
+@pytest.fixture(scope="module")
+def ws10(gd):
+    """The stroke workspace at zero orientation, 10 mm grid."""
+    return ws.constant_orientation_workspace(gd, resolution=0.01)
+
+
+@pytest.fixture(scope="module")
+def rot(gd):
+    """The gonzalez-dutra-2009 rotation limits, by (axis, sign)."""
+    return {(r.axis, r.sign): r for r in ws.orientation_limits(gd)}

@@ -3,34 +3,12 @@ below the base refused before running, a platform without plate mass refused, ab
 refused before any work, and a reference the actuators cannot follow exits 1 saying why (the numpy commands' checks:
 ``tests/core/test_sanity.py``)."""
 
-import contextlib
-import io
 import json
 import re
 
 import pytest
 
-from stewart_drake.cli import main
-
-
-def cli(*argv):
-    """``(exit code, stdout, stderr)`` of the CLI run in-process; an exception other than SystemExit
-    (a traceback) fails the test."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            rc = main([str(a) for a in argv])
-        except SystemExit as e:  # argparse
-            rc = e.code
-    return rc, out.getvalue(), err.getvalue()
-
-
-NOPLATE = """name: noplate
-length_unit: m
-utn: {b: 0.4, d: 0.1, a: 0.2}
-stroke: [0.55, 0.95]
-home_height: 0.7
-"""
+from tests.core.test_sanity import NOPLATE, cli
 
 
 @pytest.fixture

@@ -18,11 +18,6 @@ from stewart_drake.core.servo import (
 from stewart_drake.errors import GeometryError
 
 
-@pytest.fixture(scope="module")
-def hexapod():
-    return hobby_servo_hexapod()
-
-
 def random_poses(h, n, seed, dx=0.008, da=np.radians(6)):
     rng = np.random.default_rng(seed)
     return h.home_pose() + np.c_[rng.uniform(-dx, dx, (n, 3)), rng.uniform(-da, da, (n, 3))]

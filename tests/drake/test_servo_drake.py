@@ -5,19 +5,10 @@ simulation."""
 import numpy as np
 import pytest
 
-from stewart_drake.core.servo import hobby_servo_hexapod, quantise_pulses, solve
+from stewart_drake.core.servo import quantise_pulses, solve
 from stewart_drake.core.servo_loop import tracking_bounds
 from stewart_drake.drake.servo_model import compare_with_drake, run_closed_loop, run_controller
-
-
-@pytest.fixture(scope="module")
-def hexapod():
-    return hobby_servo_hexapod()
-
-
-def random_poses(h, n, seed, dx=0.008, da=np.radians(6)):
-    rng = np.random.default_rng(seed)
-    return h.home_pose() + np.c_[rng.uniform(-dx, dx, (n, 3)), rng.uniform(-da, da, (n, 3))]
+from tests.core.test_servo import random_poses
 
 
 def test_drake_cross_checks(hexapod):

@@ -2,46 +2,15 @@
 tables, in the library and through ``workspace --json``. The paper's numbers live in the report's workspace analysis
 (one copy of the seed's data), so these tests sit with the report."""
 
-import importlib.util
 import json
 import math
 
 import numpy as np
 import pytest
 
-from stewart_drake import workspace as ws
+from stewart_drake.analyses import workspace as PAPER  # the paper's numbers: one copy, the analysis's
 from stewart_drake.cli import main
-from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.report import ANALYSES_DIR
-
-
-def _paper():
-    """The paper's numbers live in the analysis script (one copy of the seed's data)."""
-    spec = importlib.util.spec_from_file_location("analysis_workspace", ANALYSES_DIR / "workspace.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-PAPER = _paper()
-
-
-@pytest.fixture(scope="module")
-def gd():
-    return load_preset("gonzalez-dutra-2009")
-
-
-@pytest.fixture(scope="module")
-def ws10(gd):
-    """The stroke workspace at zero orientation, 10 mm grid."""
-    return ws.constant_orientation_workspace(gd, resolution=0.01)
-
-
-@pytest.fixture(scope="module")
-def rot(gd):
-    return {(r.axis, r.sign): r for r in ws.orientation_limits(gd)}
-
 
 # Tolerances from the issue: the paper prints 3 decimals / 1 decimal of a degree and the preset's anchors are a
 # least-squares fit with residuals up to 0.7 mm.

@@ -11,7 +11,6 @@ import pytest
 
 from stewart_drake import workspace as ws
 from stewart_drake.cli import main
-from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.workspace.slabs import grid_spec, inside_block
@@ -19,22 +18,6 @@ from stewart_drake.workspace.slabs import grid_spec, inside_block
 W = ws.WorkspaceError
 
 DEG = math.pi / 180
-
-
-@pytest.fixture(scope="module")
-def gd():
-    return load_preset("gonzalez-dutra-2009")
-
-
-@pytest.fixture(scope="module")
-def ws10(gd):
-    """The stroke workspace at zero orientation, 10 mm grid."""
-    return ws.constant_orientation_workspace(gd, resolution=0.01)
-
-
-@pytest.fixture(scope="module")
-def rot(gd):
-    return {(r.axis, r.sign): r for r in ws.orientation_limits(gd)}
 
 
 # ---------------------------------------------------------------------------------------------
