@@ -11,7 +11,7 @@ from stewart_drake.core.assembly_modes import modes_from_solutions
 from stewart_drake.core.newton_fk import forward_kinematics
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_from_si, pose_to_si
 from stewart_drake.core.sanity import check_finite, check_positive, check_work
-from stewart_drake.errors import UsageError
+from stewart_drake.errors import OPTION_MAX_ITER, OptionError, UsageError
 
 
 def register(sub) -> None:
@@ -138,7 +138,7 @@ def run(args) -> int:
     check_finite(args.lengths, "--lengths")
     check_positive(args.tol, "--tol", "metres")
     if args.max_iter < 1:
-        raise ValueError(f"--max-iter must be >= 1, got {args.max_iter}")
+        raise OptionError(OPTION_MAX_ITER.format(value=args.max_iter))
     check_work(
         "--max-iter",
         str(args.max_iter),

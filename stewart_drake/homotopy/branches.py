@@ -25,6 +25,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.errors import OPTION_BRANCH_SAMPLES, OptionError
 from stewart_drake.homotopy.solve import solve_batch
 
 MAX_SAMPLES = 5000  # bound on the samples checked (each is one homotopy solve)
@@ -73,7 +74,7 @@ class BranchReport:
 def sample_indices(n: int, samples: int) -> np.ndarray:
     """``(≤ samples,)`` evenly spaced indices of a trajectory of n samples, first and last included."""
     if not 2 <= samples <= MAX_SAMPLES:
-        raise ValueError(f"--branch-samples must be between 2 and {MAX_SAMPLES}, got {samples}")
+        raise OptionError(OPTION_BRANCH_SAMPLES.format(limit=MAX_SAMPLES, value=samples))
     return np.unique(np.round(np.linspace(0, n - 1, min(n, samples))).astype(int))
 
 

@@ -38,6 +38,7 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.newton_fk import leg_geometry, validate_lengths
+from stewart_drake.errors import SHAPE, FkInputError, ShapeError
 from stewart_drake.homotopy.certify import certify, newton_real, pose_bounds, real_forms
 from stewart_drake.homotopy.start import load_start_system
 from stewart_drake.homotopy.study import (
@@ -265,7 +266,7 @@ def solve_batch(
     t_start = time.perf_counter()
     L = np.atleast_2d(validate_lengths(lengths))
     if L.ndim != 2 or L.shape[1] != 6:
-        raise ValueError(f"lengths must have shape (6,) or (m, 6), got {np.shape(lengths)}")
+        raise ShapeError(SHAPE.format(name="lengths", shape="(6,) or (m, 6)", got=np.shape(lengths)))
     m = len(L)
     arch = architecture(platform)
     a, b, s, scale = study_parameters(platform, L, arch)
@@ -422,5 +423,5 @@ def solve(platform: Platform, lengths, **kwargs) -> HomotopyResult:
     """All assembly modes for one ``(6,)`` leg-length set (m); keywords as ``solve_batch``."""
     L = validate_lengths(lengths)
     if L.shape != (6,):
-        raise ValueError(f"solve takes one length set of shape (6,), got {L.shape}")
+        raise FkInputError(FkInputError.ONE_SET.format(what="solve", shape=L.shape))
     return solve_batch(platform, L, **kwargs)[0]

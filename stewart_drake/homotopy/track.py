@@ -174,7 +174,9 @@ def engine_used(options: TrackOptions) -> str:
     """ "c" or "numpy": the implementation ``track`` runs with these options ("c" raises
     CompilerUnavailable when there is no C compiler; "auto" then falls back to numpy)."""
     if options.engine not in ENGINES:
-        raise ValueError(f"TrackOptions.engine must be one of {ENGINES}, got {options.engine!r}")
+        raise ValueError(
+            f"TrackOptions.engine must be one of {ENGINES}, got {options.engine!r}"
+        )  # internal: set in code
     if options.engine == "auto":
         return "c" if ctrack.available() else "numpy"
     if options.engine == "c":
