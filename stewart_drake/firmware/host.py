@@ -9,49 +9,31 @@ firmware's IK (``fixedpoint/c/tp17.c``), called from numpy.
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 
 import numpy as np
 
-from stewart_drake.core.c_build import Compiler, build, library_sources, load
+from stewart_drake.core.c_build import C_DIR, Compiler, build, library_sources, load
 from stewart_drake.fixedpoint.tp17 import check_dsp_poses
 
-# The order of the B_* enum in dsp_batch.c.
-BATCH_OPS = (
-    "add",
-    "sub",
-    "negate",
-    "abs_s",
-    "mult",
-    "mult_r",
-    "shl",
-    "shr",
-    "L_add",
-    "L_sub",
-    "L_negate",
-    "L_abs",
-    "L_mult",
-    "L_mac",
-    "L_msu",
-    "L_shl",
-    "L_shr",
-    "extract_h",
-    "extract_l",
-    "L_deposit_h",
-    "L_deposit_l",
-    "round_",
-    "mac_r",
-    "msu_r",
-    "div_s",
-    "mfr32Sqrt",
-    "tfr16SinPIx",
-    "tfr16CosPIx",
-)
-# The order of the DSP_OP_* enum in dsp56800e.h.
-OP_NAMES = (
-    "add sub negate abs_s L_add L_sub L_negate L_abs L_mult extract_h extract_l L_deposit_h L_deposit_l "
-    "round mult mult_r shl shr L_shl L_shr div_s mfr32Sqrt tfr16SinPIx tfr16CosPIx FRAC16"
-).split()
+
+def c_enum(file: str, prefix: str) -> tuple[str, ...]:
+    """The members of the ``enum`` in ``fixedpoint/c/<file>`` whose names start with ``prefix``, in value
+    order (0, 1, ...) and with ``prefix`` removed; a closing count member ``<prefix>N`` is left out. Read
+    from the C source so that Python's operation indices cannot drift from the C build's."""
+    text = re.sub(r"/\*.*?\*/", "", (C_DIR / file).read_text(encoding="utf-8"), flags=re.S)
+    for body in re.findall(r"enum\s*\{(.*?)\}", text, re.S):
+        names = [n.strip() for n in body.split(",") if n.strip()]
+        if names and all(re.fullmatch(re.escape(prefix) + r"\w+", n) for n in names):
+            return tuple(n[len(prefix) :] for n in names if n != prefix + "N")
+    raise LookupError(f"no enum of {prefix}* members in {file}")  # internal: the shipped C sources have both
+
+
+# dsp_batch(op, ...)'s op codes, by q15 function name (the C ``round`` is q15's ``round_``).
+BATCH_OPS = tuple("round_" if n == "round" else n for n in c_enum("dsp_batch.c", "B_"))
+# The counters of the instrumented build, dsp_op_counts[DSP_OP_<name>] (names as in fixedpoint.cycles).
+OP_NAMES = c_enum("dsp56800e.h", "DSP_OP_")
 
 CDEF = """
 int dsp_batch(int op, const int64_t *a, const int64_t *b, const int64_t *c, int64_t *out, long n);
