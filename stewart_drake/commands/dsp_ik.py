@@ -12,7 +12,7 @@ from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.rotations import angle_scale
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.errors import DspPoseError
-from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.firmware.engine import ENGINES, resolve_engine
 from stewart_drake.firmware.host import tp17_leg_lengths_c
 from stewart_drake.fixedpoint.q15 import SaturationCounter
 from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
@@ -46,7 +46,7 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--engine",
-        choices=["python", "c"],
+        choices=ENGINES,
         default="python",
         help="python: the numpy emulation (default); c: tp17.C compiled for the host against the C intrinsics",
     )

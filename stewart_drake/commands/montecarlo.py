@@ -13,9 +13,10 @@ from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
+from stewart_drake.drake.integrators import INTEGRATORS
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, UsageError
-from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.firmware.engine import ENGINES, resolve_engine
 from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import STUDY_FILE, run_study, study_from_settings, study_key, study_settings
@@ -60,13 +61,13 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--engine",
-        choices=["python", "c"],
+        choices=ENGINES,
         default="python",
         help="fixed-point controller engine: python (the emulation) or c (the compiled firmware tick, bit-identical, faster)",
     )
     p.add_argument(
         "--integrator",
-        choices=["sap", "cenic"],
+        choices=INTEGRATORS,
         default=None,
         help="plant integrator (default cenic: see benchmarks/bench_integrators.py)",
     )

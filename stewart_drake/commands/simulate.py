@@ -25,6 +25,7 @@ from stewart_drake.core.sanity import (
     require_plate,
 )
 from stewart_drake.errors import OPTION_DURATION_POSITIVE, OPTION_ENGINE_FIXED, OptionError, UsageError
+from stewart_drake.firmware.engine import ENGINES
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -70,7 +71,7 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--engine",
-        choices=["python", "c"],
+        choices=ENGINES,
         default="python",
         help="fixed-point controller tick: python (the emulation, default) or c (the generated firmware, compiled; bit-identical)",
     )

@@ -24,9 +24,8 @@ from stewart_drake.control.laws import CONTROLLER_KINDS, STATUS, FixedPointLaw, 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.errors import SimulationError
+from stewart_drake.firmware.engine import ENGINES
 from stewart_drake.firmware.sil import CFixedPointLaw
-
-ENGINES = ("python", "c")
 
 
 class ControllerSystem(LeafSystem):
