@@ -20,28 +20,17 @@ from stewart_drake.firmware.host import op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.fixedpoint import QFormat, scalar
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
+from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
 from stewart_drake.report import run_standalone
 
 TITLE = "Firmware equivalence: the C compiled, generated and run in the loop"
 ORDER = 95
 
-SEED_POSES = np.array(
-    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]]
-)
-SEED_DSP_MM = np.array(
-    [
-        [475, 471, 473, 473, 471, 475],
-        [504, 515, 477, 477, 469, 458],
-        [523, 548, 480, 480, 478, 449],
-        [638, 521, 547, 391, 608, 325],
-    ]
-)
-
 
 def _seed_table(section) -> None:
-    c = tp17_leg_lengths_c(SEED_POSES)
+    c = tp17_leg_lengths_c(SEED_DSP_POSES)
     rows = []
-    for k, q in enumerate(SEED_POSES):
+    for k, q in enumerate(SEED_DSP_POSES):
         rows.append(
             [f"{q[0]:g}, {q[1]:g}, {q[2]:g} mm; {q[3]:g}π, {q[4]:g}π, {q[5]:g}π", "seed DSP"]
             + [int(v) for v in SEED_DSP_MM[k]]

@@ -11,21 +11,13 @@ import numpy as np
 
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_POSES_MM_DEG
 from stewart_drake.report import run_standalone
 
 TITLE = "Seed table: the Matlab block"
 ORDER = 10
 
-# Seed 000/004 table: pose (px, py, pz mm; alpha, beta, gamma in degrees as printed), Matlab L1..L6 (mm).
-SEED_POSES_MM_DEG = np.array(
-    [
-        [0, 0, 100, 0, 0, 0],
-        [0, 0, 120, 18, 0, 0],
-        [0, 0, 130, 27, 0, 0],
-        [10, 10, 140, 36, 0, 18],
-    ],
-    dtype=float,
-)
+# Seed 000/004 table: Matlab L1..L6 (mm) for the poses of fixedpoint.tp17.SEED_POSES_MM_DEG.
 SEED_MATLAB_MM = np.array(
     [
         [473, 473, 473, 473, 473, 473],
@@ -37,15 +29,6 @@ SEED_MATLAB_MM = np.array(
 )
 # Pose 3, L6 prints 460 mm where every reading gives ~468 mm (see build()).
 SUSPECTED_TYPO = (2, 5)
-SEED_DSP_MM = np.array(
-    [
-        [475, 471, 473, 473, 471, 475],
-        [504, 515, 477, 477, 469, 458],
-        [523, 548, 480, 480, 478, 449],
-        [638, 521, 547, 391, 608, 325],
-    ],
-    dtype=float,
-)
 
 
 def poses_si(reading: str) -> np.ndarray:

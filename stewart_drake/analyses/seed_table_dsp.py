@@ -7,35 +7,29 @@ import numpy as np
 
 from stewart_drake.analyses import seed_table
 from stewart_drake.fixedpoint import ERROR_STAGES, tp17_cycles, tp17_error_stages, tp17_leg_lengths, tp17_trace
+from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES, SEED_POSES_MM_DEG
 from stewart_drake.report import run_standalone
 
 TITLE = "Seed table: the DSP block (fixed-point emulation)"
 ORDER = 20
 
 
-def _seed_table():
-    """The seed table's constants and Matlab-block model, from the Matlab-block analysis."""
-    return seed_table
-
-
 def dsp_block() -> dict:
     """Emulated DSP lengths for the four seed poses (angles as the firmware takes them: the printed
     degrees / 180 as fractions of pi), the seed's values, and the error split into stages."""
-    st = _seed_table()
-    q = st.SEED_POSES_MM_DEG.copy()
-    q[:, 3:] /= 180.0  # 18° -> 0.1 (of pi), as in tp17.C
+    q = SEED_DSP_POSES  # 18° -> 0.1 (of pi), as in tp17.C
     emu = tp17_leg_lengths(q)
     stages = tp17_error_stages(q)
     return {
         "poses": q,
         "emulated": emu,
-        "seed_dsp": st.SEED_DSP_MM,
-        "seed_matlab": st.SEED_MATLAB_MM,
+        "seed_dsp": SEED_DSP_MM,
+        "seed_matlab": seed_table.SEED_MATLAB_MM,
         "float_deg": stages["float"],
-        "float_pi_as_rad": st.matlab_block_model()["pi-fraction-as-radians"]["lengths_mm"],
+        "float_pi_as_rad": seed_table.matlab_block_model()["pi-fraction-as-radians"]["lengths_mm"],
         "stages": stages["stages"],
         "trace": tp17_trace(q),
-        "labels": st.SEED_POSES_MM_DEG,
+        "labels": SEED_POSES_MM_DEG,
     }
 
 

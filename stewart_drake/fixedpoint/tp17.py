@@ -95,6 +95,25 @@ def tp17_base_offsets(b: int = 925, d: int = 150) -> np.ndarray:
     )
 
 
+# Seed 000's comparison table ("Tabla comparativa"): the poses as printed (px, py, pz mm; alpha, beta, gamma
+# in degrees), the same poses as the firmware takes them (the printed degrees / 180, fractions of pi: 18° -> 0.1)
+# and the lengths the DSP printed (mm). Read-only: the analyses and the tests share them.
+SEED_POSES_MM_DEG = np.array(
+    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 18, 0, 0], [0, 0, 130, 27, 0, 0], [10, 10, 140, 36, 0, 18]], dtype=float
+)
+SEED_DSP_POSES = np.c_[SEED_POSES_MM_DEG[:, :3], SEED_POSES_MM_DEG[:, 3:] / 180.0]
+SEED_DSP_MM = np.array(
+    [
+        [475, 471, 473, 473, 471, 475],
+        [504, 515, 477, 477, 469, 458],
+        [523, 548, 480, 480, 478, 449],
+        [638, 521, 547, 391, 608, 325],
+    ],
+    dtype=float,
+)
+for _table in (SEED_POSES_MM_DEG, SEED_DSP_POSES, SEED_DSP_MM):
+    _table.flags.writeable = False
+
 # leg i ends at plate joint LEG_JOINT[i]; its y offset is built from these terms, added in order
 LEG_JOINT = (0, 0, 1, 1, 2, 2)
 _Y_TERMS = (("-hd",), ("-hd", "-hb"), ("-hb",), ("+hb",), ("+hd", "+hb"), ("+hd",))

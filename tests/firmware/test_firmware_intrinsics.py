@@ -11,6 +11,7 @@ import pytest
 from stewart_drake.core import c_build as build
 from stewart_drake.firmware.host import BATCH_OPS, frac, intrinsic, op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.fixedpoint import q15, scalar, tp17_leg_lengths
+from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
 from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 E16 = [-32768, -32767, -16385, -16384, -2, -1, 0, 1, 2, 16383, 16384, 16385, 32766, 32767]
@@ -131,18 +132,6 @@ def test_frac16_frac32_truncate_and_saturate_like_the_emulation():
 # ------------------------------------------------------------------------------------------------
 # tp17.C compiled
 
-SEED_POSES = np.array(
-    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]]
-)
-SEED_DSP_MM = np.array(
-    [
-        [475, 471, 473, 473, 471, 475],
-        [504, 515, 477, 477, 469, 458],
-        [523, 548, 480, 480, 478, 449],
-        [638, 521, 547, 391, 608, 325],
-    ]
-)
-
 
 def workspace_dsp_poses(n, seed):
     """Firmware poses around the seed platform's workspace (mm, pi-fractions), some with large angles."""
@@ -152,7 +141,7 @@ def workspace_dsp_poses(n, seed):
 
 
 def test_compiled_tp17_reproduces_the_seed_table():
-    assert np.array_equal(tp17_leg_lengths_c(SEED_POSES), SEED_DSP_MM)
+    assert np.array_equal(tp17_leg_lengths_c(SEED_DSP_POSES), SEED_DSP_MM)
 
 
 def test_compiled_tp17_equals_the_python_port():

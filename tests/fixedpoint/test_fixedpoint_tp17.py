@@ -29,19 +29,7 @@ from stewart_drake.fixedpoint import (
     tp17_leg_lengths,
     tp17_trace,
 )
-
-# Seed 000 "Tabla comparativa": poses as the firmware takes them (mm; fractions of pi: 18° = 0.1)
-SEED_POSES = np.array(
-    [[0, 0, 100, 0, 0, 0], [0, 0, 120, 0.1, 0, 0], [0, 0, 130, 0.15, 0, 0], [10, 10, 140, 0.2, 0, 0.1]]
-)
-SEED_DSP_MM = np.array(
-    [
-        [475, 471, 473, 473, 471, 475],
-        [504, 515, 477, 477, 469, 458],
-        [523, 548, 480, 480, 478, 449],
-        [638, 521, 547, 391, 608, 325],
-    ]
-)
+from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
 
 
 def random_dsp_poses(n, seed):
@@ -51,7 +39,7 @@ def random_dsp_poses(n, seed):
 
 def test_seed_table_dsp_block_reproduced_exactly():
     # Done-when asks for ±1 mm; the emulation gives every one of the 24 values exactly.
-    assert np.array_equal(tp17_leg_lengths(SEED_POSES), SEED_DSP_MM)
+    assert np.array_equal(tp17_leg_lengths(SEED_DSP_POSES), SEED_DSP_MM)
 
 
 def test_scalar_port_equals_vectorised_port():
@@ -94,13 +82,13 @@ def test_dsp_within_6mm_of_float_ik_over_a_workspace_sample():
 
 
 def test_error_stages_sum_to_the_total_and_trig_is_small():
-    r = tp17_error_stages(SEED_POSES)
+    r = tp17_error_stages(SEED_DSP_POSES)
     total = sum(r["stages"].values())
     np.testing.assert_allclose(total, r["dsp"] - r["float"], atol=1e-9)
     assert list(r["stages"]) == [name for name, _ in ERROR_STAGES]
     assert np.array_equal(r["dsp"], SEED_DSP_MM)
     p = load_preset("utn-kinematic")
-    np.testing.assert_allclose(r["float"], leg_lengths(p, dsp_poses_to_si(SEED_POSES)) * 1e3, atol=1e-9)
+    np.testing.assert_allclose(r["float"], leg_lengths(p, dsp_poses_to_si(SEED_DSP_POSES)) * 1e3, atol=1e-9)
     # the seed blames sine/cosine precision; on its own table that stage is below 0.05 mm
     assert np.abs(r["stages"]["sin/cos library"]).max() < 0.05
     assert np.abs(r["stages"]["anchor words"]).max() > 1.0
