@@ -201,6 +201,29 @@ def test_presets_pass_their_own_sanity(name):
     )
 
 
+def assert_refused_in_one_line(argv, message, tmp_path):
+    """``argv`` exits 2 with ``message`` in one stderr line, no traceback, nothing on stdout; a ``simulate``
+    writes no --out folder."""
+    if argv[0] == "simulate":
+        argv = argv + ("--out", str(tmp_path / "o"))
+    rc, out, err = cli(*argv)
+    assert rc == 2 and out == "" and message in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def assert_refused_before_allocation(argv, pattern, tmp_path, monkeypatch):
+    """``argv`` exits 2 with an error matching ``pattern`` and nothing on stdout, before any allocation
+    (the time and count bounds are checked with the memory bound lifted)."""
+    import stewart_drake.core.sanity as sanity
+
+    if "7200" in argv or "1e4" in argv:  # the time and count bounds, whatever this machine's memory
+        monkeypatch.setattr(sanity, "memory_budget", lambda: 1 << 50)
+    if argv[0] == "simulate":
+        argv = argv + ("--out", str(tmp_path / "o"))
+    rc, out, err = cli(*argv)
+    assert rc == 2 and out == "" and re.search(pattern, err), err
+
+
 # ----------------------------------------------------------------------------------------------
 # Options: finite, in range, resolvable.
 
@@ -236,11 +259,7 @@ def test_presets_pass_their_own_sanity(name):
     ],
 )
 def test_bad_options_exit_2_with_the_message(argv, message, tmp_path):
-    if argv[0] == "simulate":
-        argv = argv + ("--out", str(tmp_path / "o"))
-    rc, out, err = cli(*argv)
-    assert rc == 2 and out == "" and message in err and err.count("\n") == 1 and "Traceback" not in err
-    assert not (tmp_path / "o").exists()
+    assert_refused_in_one_line(argv, message, tmp_path)
 
 
 def test_period_bound_is_the_crossover_margin():
@@ -315,14 +334,7 @@ def test_workspace_resolution_refused_before_allocating(h):
     ],
 )
 def test_work_is_bounded_before_allocation(argv, pattern, tmp_path, monkeypatch):
-    import stewart_drake.core.sanity as sanity
-
-    if "7200" in argv or "1e4" in argv:  # the time and count bounds, whatever this machine's memory
-        monkeypatch.setattr(sanity, "memory_budget", lambda: 1 << 50)
-    if argv[0] == "simulate":
-        argv = argv + ("--out", str(tmp_path / "o"))
-    rc, out, err = cli(*argv)
-    assert rc == 2 and out == "" and re.search(pattern, err), err
+    assert_refused_before_allocation(argv, pattern, tmp_path, monkeypatch)
 
 
 # ----------------------------------------------------------------------------------------------
