@@ -298,8 +298,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
     ctrl.initialize(ctrl.GetMyMutableContextFromRoot(root), L0, F0, None if ff is None else ff.force(0.0), rates0)
-    if act.state_index is not None:
-        act.GetMyMutableContextFromRoot(root).SetDiscreteState(act.state_index, np.clip(F0, -max_force, max_force))
+    act.set_force(root, F0)
     simulator.Initialize()
     return Simulation(
         platform,

@@ -5,7 +5,7 @@
   zero-order hold on its outputs;
 - ``PoseSource``: a ``core.trajectory.Trajectory`` as an output port;
 - ``FeedforwardSource``: the feed-forward table (``control.FeedforwardTable``) as an output port;
-- ``Actuators``: saturation and a first-order lag, discretised exactly at the plant's step;
+- ``Actuators``: saturation and a first-order lag, discretised exactly at the plant's step (Drake primitives);
 - ``LegLengthSensor``: the plant state's leg lengths plus an offset, white noise and the first-order
   effect of a late sample (a Monte Carlo draw's sensor).
 """
@@ -16,7 +16,8 @@ import math
 from pathlib import Path
 
 import numpy as np
-from pydrake.systems.framework import LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import LinearSystem, Saturation
 
 from stewart_drake.control.feedforward import FeedforwardTable
 from stewart_drake.control.gains import ControllerConfig
@@ -38,8 +39,10 @@ class ControllerSystem(LeafSystem):
     (``DspTiming.latency``): ``sample`` at (k+1)·T, ``computation`` at k·T + t_comp, ``none`` at k·T; the
     outputs read discrete state, so between releases the command is held (zero-order hold).
 
-    Discrete state groups: ``held`` (12: released command N, released set-point m), ``pending`` (12: the
-    same, computed but not yet released), ``pid`` (30: the law's state), ``status`` (``STATUS``).
+    Discrete state groups: ``command`` (6: the released command, N) and ``setpoint`` (6: the released
+    set-point, m), each its output port as it is (read in C++, no Python call per sample); ``pending`` (12:
+    command and set-point computed but not yet released), ``pid`` (30: the law's state), ``status``
+    (``STATUS``).
     """
 
     def __init__(self, law):
@@ -50,12 +53,13 @@ class ControllerSystem(LeafSystem):
         self.DeclareVectorInputPort("reference", 6)
         self.DeclareVectorInputPort("leg_lengths", 6)
         self._ff_port = self.DeclareVectorInputPort("feedforward", 6)
-        self._held = self.DeclareDiscreteState(12)
+        self._command = self.DeclareDiscreteState(6)
+        self._setpoint = self.DeclareDiscreteState(6)
         self._pending = self.DeclareDiscreteState(12)
         self._pid = self.DeclareDiscreteState(30)
         self._status = self.DeclareDiscreteState(len(STATUS))
-        self.DeclareVectorOutputPort("command", 6, self._CalcCommand)
-        self.DeclareVectorOutputPort("setpoint", 6, self._CalcSetpoint)
+        self.DeclareStateOutputPort("command", self._command)
+        self.DeclareStateOutputPort("setpoint", self._setpoint)
         self.DeclareStateOutputPort("status", self._status)
         self.DeclarePeriodicDiscreteUpdateEvent(T, 0.0, self._Tick)
         d = self.timing.output_delay
@@ -63,11 +67,10 @@ class ControllerSystem(LeafSystem):
         if self._release_separately:
             self.DeclarePeriodicDiscreteUpdateEvent(T, d, self._Release)
 
-    def _CalcCommand(self, context, output):
-        output.SetFromVector(context.get_discrete_state(self._held).value()[:6])
-
-    def _CalcSetpoint(self, context, output):
-        output.SetFromVector(context.get_discrete_state(self._held).value()[6:])
+    def _hold(self, discrete_state, released) -> None:
+        """Release ``released`` (12: command N, set-point m) to the output ports."""
+        discrete_state.set_value(self._command, released[:6])
+        discrete_state.set_value(self._setpoint, released[6:])
 
     def _Tick(self, context, discrete_state):
         ref = self.get_input_port(0).Eval(context)
@@ -83,12 +86,12 @@ class ControllerSystem(LeafSystem):
         st[4:10] += saturated
         out = np.concatenate([command, setpoint])
         if self.timing.latency == "none":
-            discrete_state.set_value(self._held, out)
+            self._hold(discrete_state, out)
             st[2] = t
         elif self.timing.latency == "sample" or not self._release_separately:
             # release the previous tick's result now, (k+1)·T, then compute the next one
             if st[0] > 1:
-                discrete_state.set_value(self._held, context.get_discrete_state(self._pending).value())
+                self._hold(discrete_state, context.get_discrete_state(self._pending).value())
                 st[2] = t
         discrete_state.set_value(self._pending, out)
         discrete_state.set_value(self._pid, pid_new)
@@ -98,7 +101,7 @@ class ControllerSystem(LeafSystem):
         st = context.get_discrete_state(self._status).value().copy()
         if st[0] < 1:
             return
-        discrete_state.set_value(self._held, context.get_discrete_state(self._pending).value())
+        self._hold(discrete_state, context.get_discrete_state(self._pending).value())
         st[2] = context.get_time()
         discrete_state.set_value(self._status, st)
 
@@ -114,7 +117,8 @@ class ControllerSystem(LeafSystem):
         pid = self.law.initial_pid_state(lengths, F - ff, rates)
         context.SetDiscreteState(self._pid, pid)
         held = np.concatenate([self.law.command_from_integrator(pid[:6], ff), lengths])
-        context.SetDiscreteState(self._held, held)
+        context.SetDiscreteState(self._command, held[:6])
+        context.SetDiscreteState(self._setpoint, held[6:])
         context.SetDiscreteState(self._pending, held)
         context.SetDiscreteState(self._status, np.zeros(len(STATUS)))
 
@@ -194,35 +198,35 @@ class FeedforwardSource(LeafSystem):
         output.SetFromVector(self.table.force(context.get_time()))
 
 
-class Actuators(LeafSystem):
+class Actuators(Diagram):
     """Input ``command`` (6, N) → output ``force`` (6, N): saturation at ±``max_force``, then a first-order
     lag with time constant ``time_constant`` (s) discretised exactly at ``period`` (the plant's step),
     F ← a·F + (1−a)·u, a = exp(−period/τ); with τ = 0 the saturated command passes straight through.
-    ``state_index``: the discrete state of the lag (None without one)."""
+    Drake's ``Saturation`` and a discrete ``LinearSystem``: no Python runs per step. ``lag``: the
+    ``LinearSystem`` (None without a lag)."""
 
     def __init__(self, max_force: float, time_constant: float, period: float):
         super().__init__()
         self.max_force = max_force
-        self._u = self.DeclareVectorInputPort("command", 6)
+        builder = DiagramBuilder()
+        saturation = builder.AddNamedSystem("saturation", Saturation(np.full(6, -max_force), np.full(6, max_force)))
+        builder.ExportInput(saturation.get_input_port(), "command")
+        self.lag = None
         if time_constant > 0:
-            self._a = math.exp(-period / time_constant)
-            self.state_index = self.DeclareDiscreteState(6)
-            self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._Update)
-            self.DeclareStateOutputPort("force", self.state_index)
+            a = math.exp(-period / time_constant)
+            I, O = np.eye(6), np.zeros((6, 6))
+            self.lag = builder.AddNamedSystem("lag", LinearSystem(a * I, (1 - a) * I, I, O, period))
+            builder.Connect(saturation.get_output_port(), self.lag.get_input_port())
+            builder.ExportOutput(self.lag.get_output_port(), "force")
         else:
-            self.state_index = None
-            self.DeclareVectorOutputPort("force", 6, self._CalcForce)
+            builder.ExportOutput(saturation.get_output_port(), "force")
+        builder.BuildInto(self)
 
-    def _saturated(self, context) -> np.ndarray:
-        # np.minimum(np.maximum()) is np.clip's result (NaN included), without its per-call overhead
-        return np.minimum(np.maximum(self._u.Eval(context), -self.max_force), self.max_force)
-
-    def _Update(self, context, discrete_state):
-        F = context.get_discrete_state(self.state_index).value()
-        discrete_state.set_value(self.state_index, self._a * F + (1 - self._a) * self._saturated(context))
-
-    def _CalcForce(self, context, output):
-        output.SetFromVector(self._saturated(context))
+    def set_force(self, root_context, force) -> None:
+        """Start the lag at ``force`` (6, N; saturated here) in the Diagram's ``root_context``."""
+        if self.lag is not None:
+            ctx = self.lag.GetMyMutableContextFromRoot(root_context)
+            ctx.SetDiscreteState(np.clip(force, -self.max_force, self.max_force))
 
 
 class LegLengthSensor(LeafSystem):

@@ -188,6 +188,30 @@ def test_actuator_saturates_and_lags():
         ActuatorModel(time_constant=-1)
 
 
+@pytest.mark.parametrize("tau", [2e-3, 0.0])
+def test_actuator_is_the_numpy_recurrence_bit_for_bit(tau):
+    """Drake's Saturation + LinearSystem compute exactly F ← a·F + (1−a)·clip(u): one rounding per
+    product and one per sum, as numpy does (random commands, half of them beyond the limit)."""
+    from pydrake.systems.analysis import Simulator
+
+    dt, F_max = 1e-3, 80.0
+    u = np.random.default_rng(3).normal(0.0, 100.0, (40, 6))
+    act = Actuators(F_max, tau, dt)
+    sim = Simulator(act)
+    ctx = sim.get_mutable_context()
+    F0 = np.linspace(-100.0, 100.0, 6)
+    act.set_force(ctx, F0)
+    a = np.exp(-dt / tau) if tau > 0 else 0.0
+    F = np.clip(F0, -F_max, F_max)
+    for k, uk in enumerate(u):
+        act.get_input_port().FixValue(ctx, uk)
+        sat = np.clip(uk, -F_max, F_max)
+        np.testing.assert_array_equal(act.get_output_port().Eval(ctx), F if tau > 0 else sat)
+        sim.AdvanceTo((k + 1) * dt)
+        if tau > 0:
+            F = a * F + (1 - a) * sat
+
+
 # ----------------------------------------------------------------------------------------------
 # Any platform: gains designed from the platform, model-based force feed-forward
 
