@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.core.geometry import load_preset
+from stewart_drake.firmware.engine import default_engine
 from stewart_drake.montecarlo.scenario import Study, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import run_study
@@ -34,7 +35,8 @@ def build(section) -> None:
     quick = section.quick
     runs, duration, workers = (8, 0.5, 0) if quick else (40, 4.0, 2)
     platform = load_preset(PLATFORM)
-    study = Study(platform, parse_spec(VARY), seed=2026, runs=runs, duration=duration)
+    engine = default_engine(None, "fixed", "analysis robustness")  # the montecarlo command's default
+    study = Study(platform, parse_spec(VARY), seed=2026, runs=runs, duration=duration, engine=engine)
     rows = run_study(study, None, workers=workers, progress=False)
     section.text(
         f"{runs} closed-loop runs of the fixed-point controller on {PLATFORM}, seed trajectory, {duration:g} s each "

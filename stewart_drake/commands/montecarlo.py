@@ -13,10 +13,10 @@ from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
-from stewart_drake.drake.integrators import INTEGRATORS
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, UsageError
-from stewart_drake.firmware.engine import ENGINES, resolve_engine
+from stewart_drake.firmware.engine import ENGINES, default_engine
 from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import STUDY_FILE, run_study, study_from_settings, study_key, study_settings
@@ -62,14 +62,16 @@ def register(sub) -> None:
     p.add_argument(
         "--engine",
         choices=ENGINES,
-        default="python",
-        help="fixed-point controller engine: python (the emulation) or c (the compiled firmware tick, bit-identical, faster)",
+        default=None,
+        help="fixed-point controller engine: c (the compiled firmware tick; the default where a C compiler is found) "
+        "or python (the emulation; bit-identical, slower)",
     )
     p.add_argument(
         "--integrator",
         choices=INTEGRATORS,
         default=None,
-        help="plant integrator (default cenic: see benchmarks/bench_integrators.py)",
+        help="plant integrator: cenic-fixed (default), cenic (error-controlled) or sap; see simulate --help and "
+        "benchmarks/bench_integrators.py",
     )
     p.add_argument(
         "--duration", type=float, default=None, metavar="S", help="simulated seconds per run (default the trajectory's)"
@@ -124,7 +126,7 @@ def build_study(args):
         raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=args.workers))
     if args.engine == "c" and args.controller != "fixed":
         raise UsageError(UsageError.ENGINE_C.format(controller=args.controller))
-    engine = resolve_engine(args.engine, "stewart-drake montecarlo")
+    engine = default_engine(args.engine, args.controller, "stewart-drake montecarlo")
     if not args.lost_tracking > 0:
         raise OptionError(OptionError.POSITIVE.format(option="--lost-tracking", unit="mm", value=args.lost_tracking))
     trajectory = None if program else args.trajectory
@@ -142,7 +144,7 @@ def build_study(args):
         table=table,
         fit=args.fit,
         controller=args.controller,
-        integrator=args.integrator,
+        integrator=args.integrator or DEFAULT_INTEGRATOR,
         engine=engine,
         duration=args.duration,
         plant_step=args.plant_step,

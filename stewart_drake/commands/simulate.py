@@ -24,6 +24,7 @@ from stewart_drake.core.sanity import (
     fmt_value,
     require_plate,
 )
+from stewart_drake.drake.integrators import INTEGRATORS
 from stewart_drake.errors import OPTION_DURATION_POSITIVE, OPTION_ENGINE_FIXED, OptionError, UsageError
 from stewart_drake.firmware.engine import ENGINES
 
@@ -72,8 +73,9 @@ def register(sub) -> None:
     p.add_argument(
         "--engine",
         choices=ENGINES,
-        default="python",
-        help="fixed-point controller tick: python (the emulation, default) or c (the generated firmware, compiled; bit-identical)",
+        default=None,
+        help="fixed-point controller tick: c (the generated firmware, compiled; the default where a C compiler is found) "
+        "or python (the emulation; bit-identical, slower)",
     )
     p.add_argument(
         "--firmware",
@@ -106,10 +108,10 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--integrator",
-        choices=["cenic", "sap"],
+        choices=INTEGRATORS,
         default=None,
-        help="plant integrator: cenic (default; error-controlled, continuous plant) or sap (discrete plant at --plant-step); "
-        "see benchmarks/bench_integrators.py",
+        help="plant integrator: cenic-fixed (default: CENIC at the fixed --plant-step on a continuous plant), cenic "
+        "(error-controlled) or sap (discrete plant at --plant-step); see benchmarks/bench_integrators.py",
     )
     p.add_argument(
         "--no-feedforward",
@@ -147,7 +149,7 @@ def run(args) -> int:
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
     from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
-    from stewart_drake.firmware.engine import resolve_engine
+    from stewart_drake.firmware.engine import default_engine
 
     reject_unused(
         args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
@@ -185,9 +187,9 @@ def run(args) -> int:
     config = ControllerConfig.for_platform(
         platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0))
     )
-    engine = resolve_engine(args.engine, "stewart-drake simulate") if args.firmware is None else "c"
-    if (engine == "c" or args.firmware) and args.controller != "fixed":
+    if (args.engine == "c" or args.firmware) and args.controller != "fixed":
         raise UsageError(OPTION_ENGINE_FIXED.format(controller=args.controller))
+    engine = "c" if args.firmware else default_engine(args.engine, args.controller, "stewart-drake simulate")
     scenario = Scenario(
         platform,
         traj,

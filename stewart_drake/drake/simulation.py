@@ -40,7 +40,7 @@ from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
-from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, apply_integrator, check_integrator
+from stewart_drake.drake.integrators import CONTINUOUS, DEFAULT_INTEGRATOR, apply_integrator, check_integrator
 from stewart_drake.drake.platform_model import build_plant, set_pose
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
 from stewart_drake.errors import SimulationError
@@ -87,8 +87,8 @@ class Scenario:
     compiled C; ``firmware``: a user's C file implementing the firmware ABI); ``config``: timing and gains
     (refused if infeasible; None: ``ControllerConfig.for_platform`` with the actuators' lag over the
     reference's poses from 0 to ``design_duration`` s, ``design_poses``); ``actuators``; ``plant_time_step``
-    (s): the discrete plant's step, or the continuous plant's logging period; ``integrator``: ``cenic`` or
-    ``sap`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect the model-based force
+    (s): the discrete plant's step, or the continuous plant's logging period; ``integrator``: one of
+    ``integrators.INTEGRATORS`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect the model-based force
     feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
     runs (None: the trajectory's own duration, else 1 s).
     """
@@ -234,7 +234,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         poses = design_poses(trajectory, s.design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     builder = DiagramBuilder()
-    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator == "cenic")
+    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
     ctrl = builder.AddSystem(make_controller(s.controller, platform, config, s.engine, s.firmware))
     ctrl.set_name(f"{s.controller}_controller")
     src = builder.AddSystem(PoseSource(trajectory))
@@ -286,7 +286,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         )
     diagram = builder.Build()
     simulator = Simulator(diagram)
-    apply_integrator(simulator, integrator)
+    apply_integrator(simulator, integrator, plant_time_step)
     root = simulator.get_mutable_context()
     pose0 = trajectory.pose(0.0)
     pc = plant.GetMyMutableContextFromRoot(root)

@@ -10,5 +10,6 @@ generation for any platform, the compiled controller tick as a control law, and 
 - :mod:`.sil`       ``CFixedPointLaw``: the fixed-point law with its tick by compiled C (``drake.systems`` runs it)
 - :mod:`.check`     ``check_ik``, ``check_tick``: a user's C vs the emulation (sd_ik over poses, sd_tick over a
                     recorded stream; ``drake.firmware_check.check_firmware`` records it from a closed loop)
-- :mod:`.engine`    ``resolve_engine``: ``c`` if a compiler exists, else ``python`` with a note
+- :mod:`.engine`    ``resolve_engine``: ``c`` if a compiler exists, else ``python`` with a note;
+                    ``default_engine``: a closed loop's (``c`` for the fixed-point controller)
 """

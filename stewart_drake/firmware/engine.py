@@ -1,5 +1,6 @@
-"""Choosing the engine that runs the firmware: ``python`` (the numpy emulation) or ``c`` (the compiled C),
-falling back to Python with a one-line notice on stderr when no C compiler is available."""
+"""Choosing the engine that runs the firmware: ``python`` (the numpy emulation) or ``c`` (the compiled C,
+the default for the fixed-point controller in the loop), falling back to Python with a one-line notice on
+stderr when no C compiler is available."""
 
 from __future__ import annotations
 
@@ -23,3 +24,12 @@ def resolve_engine(engine: str, what: str = "stewart-drake") -> str:
             print(f"{what}: note: {e}; running the Python engine instead (bit-identical, slower)", file=sys.stderr)
             return "python"
     return engine
+
+
+def default_engine(engine: str | None, controller: str, what: str = "stewart-drake") -> str:
+    """The engine a closed loop runs: ``engine`` if given (``resolve_engine``), else ``c`` for the
+    fixed-point controller (bit-identical to the emulation and faster; ``python`` without a compiler, with
+    the notice) and ``python`` for the float twin (it has no firmware)."""
+    if engine is None:
+        engine = "c" if controller == "fixed" else "python"
+    return resolve_engine(engine, what)

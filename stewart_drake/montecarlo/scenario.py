@@ -30,6 +30,7 @@ import numpy as np
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.montecarlo.spec import KEYS, VarySpec
 from stewart_drake.script import run_program
@@ -66,7 +67,7 @@ class Study:
     table: tuple | None = None
     fit: bool = False
     controller: str = "fixed"
-    integrator: str | None = None
+    integrator: str = DEFAULT_INTEGRATOR
     engine: str = "python"
     duration: float | None = None
     plant_step: float = 1e-3

@@ -96,7 +96,8 @@ def study_from_settings(settings: dict, runs: int) -> Study:
         table=tuple(settings["table"]) if settings.get("table") else None,
         fit=settings["fit"],
         controller=settings["controller"],
-        integrator=settings["integrator"],
+        # a study stored without an integrator ran under the default of its time, CENIC
+        integrator=settings["integrator"] or "cenic",
         engine=settings.get("engine", "python"),
         duration=settings["duration"],
         plant_step=settings["plant_step"],
@@ -122,8 +123,7 @@ def check_study(study: Study) -> float:
     """Raise ``StudyError`` if the study is too large or inconsistent; return the seconds per run."""
     from stewart_drake.drake.integrators import check_integrator
 
-    if study.integrator is not None:
-        check_integrator(study.integrator)
+    check_integrator(study.integrator)
     if not (isinstance(study.runs, int) and 1 <= study.runs <= MAX_RUNS):
         raise StudyError(StudyError.RUNS.format(limit=MAX_RUNS, value=study.runs))
     if not (isinstance(study.seed, int) and study.seed >= 0):

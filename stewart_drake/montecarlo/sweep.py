@@ -7,6 +7,7 @@ from __future__ import annotations
 import itertools
 
 from stewart_drake.core.geometry import Platform
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.montecarlo.scenario import Study
 from stewart_drake.montecarlo.spec import KEYS, SpecError, VarySpec, check_key
 from stewart_drake.montecarlo.study import run_study
@@ -19,7 +20,7 @@ def sweep_study(
     controller: str = "fixed",
     duration: float | None = None,
     plant_step: float = 1e-3,
-    integrator: str | None = None,
+    integrator: str = DEFAULT_INTEGRATOR,
     engine: str = "python",
 ) -> Study:
     """The ``Study`` of the cartesian product of ``axes`` (``{key: [SI values]}``, keys of ``spec.KEYS``;

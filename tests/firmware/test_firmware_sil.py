@@ -69,7 +69,7 @@ def test_simulate_cli_runs_a_users_firmware(tmp_path, capsys):
     )
     capsys.readouterr()
     runs = {}
-    for extra in ([], ["--engine", "c"], ["--firmware", str(fw / "sd_firmware.c")]):
+    for extra in ([], ["--engine", "python"], ["--engine", "c"], ["--firmware", str(fw / "sd_firmware.c")]):
         out = tmp_path / f"sim{len(runs)}"
         assert (
             main(
@@ -88,10 +88,12 @@ def test_simulate_cli_runs_a_users_firmware(tmp_path, capsys):
             == 0
         )
         s = json.loads(capsys.readouterr().out)
-        runs[tuple(extra[:1])] = (s, np.load(out / "log.npz"))
-    assert runs[("--engine",)][0]["engine"] == "c" and runs[("--firmware",)][0]["firmware"].endswith("sd_firmware.c")
-    base = runs[()][1]
-    for key in (("--engine",), ("--firmware",)):
+        runs[tuple(extra[-1:])] = (s, np.load(out / "log.npz"))
+    firmware = (str(fw / "sd_firmware.c"),)
+    assert runs[()][0]["engine"] == "c"  # the default: the compiled firmware (a compiler is found here)
+    assert runs[("python",)][0]["engine"] == "python" and runs[firmware][0]["firmware"].endswith("sd_firmware.c")
+    base = runs[("python",)][1]
+    for key in ((), ("c",), firmware):
         for k in base.files:
             assert np.array_equal(base[k], runs[key][1][k]), (key, k)
 

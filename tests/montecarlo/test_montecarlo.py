@@ -257,3 +257,14 @@ def test_a_pickled_run_scenario_builds_the_same_diagram(platform):
     a, b = (build_simulation(s).run(0.05) for s in (sc, back))
     for k in a.ARRAYS:
         np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+
+
+def test_a_study_stored_without_an_integrator_replays_under_cenic(platform):
+    """Studies written while error-controlled CENIC was the default stored ``integrator: null``; they are
+    read back as ``cenic`` (what they ran under), never as today's default. New studies store the
+    integrator by name, so a change of default cannot mix integrators within one study."""
+    st = Study(platform, parse_spec(["anchor=±0.5mm"]), seed=1, runs=2, duration=0.1)
+    settings = study_mod.study_settings(st)
+    assert settings["integrator"] == "cenic-fixed"
+    old = study_mod.study_from_settings({**settings, "integrator": None}, runs=2)
+    assert old.integrator == "cenic" and study_mod.study_from_settings(settings, 2).integrator == "cenic-fixed"
