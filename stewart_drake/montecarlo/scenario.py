@@ -9,8 +9,9 @@ spawn_key=(index,))``, so any run can be re-drawn alone from (S, index) or from 
 
 What a draw changes (the controller keeps the nominal model: it is what the firmware was built for):
 
-- the plant is built from the platform with every anchor moved (``anchor``) and the plate's mass and
-  centre of mass changed (``payload_mass``: the inertia scales with the mass; ``payload_com``);
+- the plant is built from the platform with every physical joint moved (``anchor``: one offset per
+  distinct base joint and per distinct plate anchor, so that legs sharing a joint keep sharing it) and the
+  plate's mass and centre of mass changed (``payload_mass``: the inertia scales with the mass; ``payload_com``);
 - the sensor reads L + offset (``leg_offset``) + white noise σ (``sensor_noise``) − j_k·dL/dt, the
   first-order effect of sampling tick k late by j_k ~ U[0, ``latency_jitter``], then quantises with the
   drawn ``sensor_resolution`` (in the controller);
@@ -28,7 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from stewart_drake.control import ControllerConfig, DspTiming
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import MIN_ANCHOR_SEPARATION, Platform
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
@@ -101,12 +102,25 @@ def run_seed(seed: int, index: int) -> int:
     return int(np.random.SeedSequence(seed, spawn_key=(index,)).generate_state(1, np.uint64)[0]) & (2**63 - 1)
 
 
+def base_joints(platform: Platform) -> tuple[np.ndarray, np.ndarray]:
+    """The platform's physical base joints: ``(first (m,), leg_joint (6,))``, the leg that first stands on
+    each joint and each leg's joint (0..m-1, numbered in leg order). Legs whose base anchors coincide
+    (closer than ``MIN_ANCHOR_SEPARATION``, the rule ``check_base_anchors`` accepts 6-3 pairs by) share one
+    joint: m = 3 on a 6-3 platform, 6 (``first`` = ``leg_joint`` = 0..5) when the six anchors are distinct."""
+    p = platform.base_anchors
+    close = np.linalg.norm(p[:, None] - p[None], axis=-1) < MIN_ANCHOR_SEPARATION
+    first, leg_joint = np.unique(np.argmax(close, axis=1), return_inverse=True)  # lowest leg at each point
+    return first, leg_joint
+
+
 @dataclass(frozen=True)
 class Draw:
-    """One run's parameters (SI). Anchor offsets ``(6, 3)`` base and ``(k, 3)`` plate, in B and T."""
+    """One run's parameters (SI). Anchor offsets per physical joint: ``(m, 3)`` base joints in B (leg i
+    on joint ``base_leg_joint[i]``) and ``(k, 3)`` plate anchors in T (leg i on ``platform.leg_top[i]``)."""
 
     base_anchor_offset: np.ndarray
     top_anchor_offset: np.ndarray
+    base_leg_joint: np.ndarray
     leg_offset: np.ndarray
     sensor_resolution: float
     sensor_noise: float
@@ -122,8 +136,8 @@ class Draw:
     def columns(self) -> dict:
         """The drawn parameters as flat ``{column: value}`` (SI, names with their unit)."""
         out = {}
-        for i, v in enumerate(self.base_anchor_offset):
-            out.update({f"anchor_base{i + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
+        for j, v in enumerate(self.base_anchor_offset):
+            out.update({f"anchor_base{j + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
         for j, v in enumerate(self.top_anchor_offset):
             out.update({f"anchor_top{j + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
         out.update({f"leg_offset{i + 1}_m": float(x) for i, x in enumerate(self.leg_offset)})
@@ -166,16 +180,20 @@ def _draw_one(rng, law, nominal, shape=()):
 
 def draw(study: Study, index: int) -> tuple[int, Draw]:
     """``(run seed, Draw)`` of run ``index``: every key drawn in ``KEYS`` order from the run's own
-    generator (a key left nominal draws nothing)."""
+    generator (a key left nominal draws nothing). ``anchor`` draws ``(6, 3)`` base offsets, one row per
+    leg, then ``(k, 3)`` plate offsets; a base joint takes the row of its first leg and the rows of the
+    other legs on it are skipped, so the stream (and so every key drawn after) is the same on every
+    architecture, and a platform with six distinct base anchors draws what it always drew."""
     seed = run_seed(study.seed, index)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
     p, laws = study.platform, study.spec.laws
     k = len(p.top_anchors)
+    first, leg_joint = base_joints(p)
     vals = {}
     for key in KEYS:
         law = laws.get(key)
         if key == "anchor":
-            vals[key] = (_draw_one(rng, law, 0.0, (6, 3)), _draw_one(rng, law, 0.0, (k, 3)))
+            vals[key] = (_draw_one(rng, law, 0.0, (6, 3))[first], _draw_one(rng, law, 0.0, (k, 3)))
         elif key == "leg_offset":
             vals[key] = _draw_one(rng, law, 0.0, (6,))
         elif key == "payload_com":
@@ -193,6 +211,7 @@ def draw(study: Study, index: int) -> tuple[int, Draw]:
     return seed, Draw(
         base_anchor_offset=np.asarray(vals["anchor"][0], float),
         top_anchor_offset=np.asarray(vals["anchor"][1], float),
+        base_leg_joint=leg_joint,
         leg_offset=np.asarray(vals["leg_offset"], float),
         sensor_resolution=vals["sensor_resolution"],
         sensor_noise=vals["sensor_noise"],
@@ -208,11 +227,11 @@ def draw(study: Study, index: int) -> tuple[int, Draw]:
 
 
 def plant_platform(platform: Platform, d: Draw) -> Platform:
-    """The platform the plant is built from: anchors moved, plate mass (inertia scaled alike) and centre
-    of mass changed."""
+    """The platform the plant is built from: each base joint and plate anchor moved by its offset (legs
+    on one joint move together), plate mass (inertia scaled alike) and centre of mass changed."""
     scale = d.payload_mass / platform.mass if platform.mass > 0 else 1.0
     return platform.replace(
-        base_anchors=platform.base_anchors + d.base_anchor_offset,
+        base_anchors=platform.base_anchors + d.base_anchor_offset[d.base_leg_joint],
         top_anchors=platform.top_anchors + d.top_anchor_offset,
         mass=d.payload_mass,
         inertia=platform.inertia * scale,

@@ -11,7 +11,7 @@ Every key takes one value written the same way in both forms (units allowed: ``m
 
 Keys (nominal in brackets):
 
-    anchor             base and plate anchor positions, per axis per anchor [0 offset]
+    anchor             base and plate joint positions, per axis per physical joint [0 offset]
     leg_offset         the length sensor's zero, per leg [0]
     sensor_resolution  metres per count [1e-5]
     sensor_noise       σ of white Gaussian noise on each reading, m [0]

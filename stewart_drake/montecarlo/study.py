@@ -24,7 +24,7 @@ import numpy as np
 
 from stewart_drake.core.output_folder import claim_in_manifest
 from stewart_drake.errors import StudyError
-from stewart_drake.montecarlo.scenario import Study, run_scenario
+from stewart_drake.montecarlo.scenario import Study, base_joints, run_scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -36,8 +36,12 @@ RETRIES = 3
 
 
 def study_settings(study: Study) -> dict:
-    """The study's settings as JSON-able data (the platform by value), without the number of runs."""
+    """The study's settings as JSON-able data (the platform by value), without the number of runs. A
+    platform whose legs share base joints adds ``base_joints`` (each leg's joint, ``scenario.base_joints``):
+    its anchors are drawn per joint, so its key differs from that of a study whose draws split them."""
     p = study.platform
+    joints, leg_joint = base_joints(p)
+    shared = {"base_joints": leg_joint.tolist()} if len(joints) < 6 else {}
     plat = {f.name: getattr(p, f.name) for f in dataclasses.fields(p)}
     plat["legs"] = dataclasses.asdict(p.legs)
     plat = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in plat.items()}
@@ -56,6 +60,7 @@ def study_settings(study: Study) -> dict:
         "plant_step": study.plant_step,
         "lost_tracking": study.lost_tracking,
         "grid": list(study.grid) if study.grid is not None else None,
+        **shared,
         **study.extra,
     }
 
@@ -84,6 +89,7 @@ def study_from_settings(settings: dict, runs: int) -> Study:
         "plant_step",
         "lost_tracking",
         "grid",
+        "base_joints",
     }
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(
