@@ -43,6 +43,14 @@ class CompilerUnavailable(StewartError):
     """No C compiler could be found (nor the ziglang wheel)."""
 
 
+class CacheUnavailable(StewartError):
+    """The folder compiled modules are cached in cannot be created or written."""
+
+
+# why compiled code cannot be built here (a fallback may run instead); a CompileError is a bug, never hidden
+UNAVAILABLE = (CompilerUnavailable, CacheUnavailable)
+
+
 class CompileError(StewartError):
     """The compiler rejected a source; the message is the compiler's own (file:line: error ...)."""
 
@@ -64,8 +72,15 @@ def cache_dir() -> Path:
         base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
         d = os.path.join(base, "stewart-drake")
     p = Path(d)
-    p.mkdir(parents=True, exist_ok=True)
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise CacheUnavailable(_cache_message(p, e)) from None
     return p
+
+
+def _cache_message(folder: Path, e: OSError) -> str:
+    return f"the compiled-module cache {folder} cannot be used ({e.strerror}); set ${CACHE_ENV} to a writable folder"
 
 
 def _probe(name: str, argv: tuple[str, ...]) -> Compiler | None:
@@ -171,7 +186,8 @@ def build(
     """Compile ``sources`` (with ``headers`` beside them and the package's ``fixedpoint/c`` on the include
     path) into a shared library in the cache and return its path; a cached build with the same compiler,
     flags and bytes is reused. ``strict``: add ``-Wall -Wextra -Werror -pedantic``. Raises CompileError
-    with the compiler's message, CompilerUnavailable without a compiler."""
+    with the compiler's message, CompilerUnavailable without a compiler, CacheUnavailable if the cache
+    cannot be written."""
     compiler = compiler or default_compiler()
     cflags = (
         tuple(f for f in BASE_FLAGS if f != "-O2")
@@ -188,7 +204,11 @@ def build(
     out = root / f"sd-{h.hexdigest()[:32]}.so"
     if out.exists():
         return out
-    with tempfile.TemporaryDirectory(prefix="build-", dir=root) as tmp:
+    try:
+        workdir = tempfile.TemporaryDirectory(prefix="build-", dir=root)
+    except OSError as e:
+        raise CacheUnavailable(_cache_message(root, e)) from None
+    with workdir as tmp:
         tmp = Path(tmp)
         files = []
         for s in [*sources, *headers]:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import CompilerUnavailable, Source, build, cache_dir, load
+from stewart_drake.core.c_build import UNAVAILABLE, Source, build, cache_dir, load
 
 SOURCE = Path(__file__).with_name("track.c")
 CDEF = """
@@ -26,7 +26,7 @@ void sd_track(int64_t n, const double *x0, const double *B0, const double *dB, i
               const double *ds, const double *v, const double *gamma, const int64_t *cap, const double *opts,
               int64_t end_newton, double *x_out, double *t_out, int64_t *state_out, int64_t *steps_out);
 """
-_LIB: list = []  # [(ffi, lib)] once built, or [CompilerUnavailable(...)] when there is no compiler
+_LIB: list = []  # [(ffi, lib)] once built, or [the UNAVAILABLE error] when it cannot be built here
 
 
 OPT = "-O2"
@@ -49,23 +49,23 @@ def _shared_library() -> Path:
 
 def library():
     """``(ffi, lib)`` of the compiled tracker, built on first use. Raises CompilerUnavailable without a
-    C compiler (remembered: not searched for again), CompileError if the source does not compile (a
+    C compiler, CacheUnavailable without a usable cache (remembered: not tried again), CompileError if the source does not compile (a
     bug, never hidden by a fallback)."""
     if not _LIB:
         try:
             _LIB.append(load(_shared_library(), CDEF))
-        except CompilerUnavailable as err:
+        except UNAVAILABLE as err:
             _LIB.append(err)
-    if isinstance(_LIB[0], CompilerUnavailable):
+    if isinstance(_LIB[0], UNAVAILABLE):
         raise _LIB[0]
     return _LIB[0]
 
 
 def available() -> bool:
-    """True when the compiled tracker can be used (a C compiler exists; built on first call)."""
+    """True when the compiled tracker can be used (a C compiler and a cache exist; built on first call)."""
     try:
         library()
-    except CompilerUnavailable:
+    except UNAVAILABLE:
         return False
     return True
 

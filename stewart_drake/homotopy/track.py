@@ -172,7 +172,7 @@ ENGINES = ("auto", "c", "numpy")
 
 def engine_used(options: TrackOptions) -> str:
     """ "c" or "numpy": the implementation ``track`` runs with these options ("c" raises
-    CompilerUnavailable when there is no C compiler; "auto" then falls back to numpy)."""
+    CompilerUnavailable or CacheUnavailable when it cannot be built here; "auto" then falls back to numpy)."""
     if options.engine not in ENGINES:
         raise ValueError(
             f"TrackOptions.engine must be one of {ENGINES}, got {options.engine!r}"

@@ -264,6 +264,21 @@ def test_no_compiler_falls_back_to_python_with_a_note(monkeypatch, capsys):
     assert "running the Python engine instead" in io.err
 
 
+def test_an_unusable_cache_falls_back_to_python_or_names_the_variable(monkeypatch, capsys, tmp_path):
+    """The C engine is the closed loop's default: a cache folder that cannot be created (under a file)
+    must not stop a run. The engine choice falls back to Python with a note naming the variable; a build
+    asked for directly fails in one line naming it too."""
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    monkeypatch.setenv(build.CACHE_ENV, str(blocker / "cache"))
+    assert main(["dsp-ik", "--pose", "10", "10", "140", "0.2", "0", "0.1", "--engine", "c", "--json"]) == 0
+    io = capsys.readouterr()
+    assert json.loads(io.out)["engine"] == "python"
+    assert f"set ${build.CACHE_ENV} to a writable folder" in io.err and "running the Python engine instead" in io.err
+    with pytest.raises(build.CacheUnavailable, match=f"cache {blocker / 'cache'} cannot be used"):
+        build.cache_dir()
+
+
 def test_dsp_ik_engine_c_reproduces_the_seed_table(capsys):
     seed = {
         (0, 0, 100, 0, 0, 0): [475, 471, 473, 473, 471, 475],
