@@ -17,6 +17,8 @@ import time
 from pathlib import Path
 
 from stewart_drake.core.geometry import load_platform
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
+from stewart_drake.firmware.engine import ENGINES, default_engine
 from stewart_drake.montecarlo.scenario import Study
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import run_study, study_key, study_settings
@@ -36,6 +38,8 @@ def main(argv=None) -> int:
         nargs="+",
         default=["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "payload_mass=±20%"],
     )
+    ap.add_argument("--engine", choices=ENGINES, default=None, help="default: the montecarlo command's")
+    ap.add_argument("--integrator", choices=INTEGRATORS, default=DEFAULT_INTEGRATOR)
     ap.add_argument("--workers", default="1,2", help="comma-separated worker counts")
     ap.add_argument("--out", required=True, help="a new folder; one study folder per worker count inside")
     args = ap.parse_args(argv)
@@ -47,7 +51,10 @@ def main(argv=None) -> int:
         trajectory=args.trajectory,
         controller=args.controller,
         duration=args.duration,
+        engine=default_engine(args.engine, args.controller, "bench_montecarlo"),
+        integrator=args.integrator,
     )
+    print(f"engine {study.engine}, integrator {study.integrator}, {args.runs} runs", flush=True)
     counts = [int(k) for k in args.workers.split(",")]
     base, first, report = Path(args.out), None, {}
     if base.exists():

@@ -13,6 +13,7 @@ whose visibility follows the warning.
 from __future__ import annotations
 
 import html as _html
+import logging
 
 import numpy as np
 from pydrake.geometry import Cylinder, Meshcat, MeshcatParams, MeshcatVisualizer, MeshcatVisualizerParams, Rgba
@@ -124,13 +125,25 @@ def _frames(t: np.ndarray, fps: float) -> np.ndarray:
     return np.unique(np.clip(np.searchsorted(t, grid), 0, len(t) - 1))
 
 
+def recording_meshcat() -> Meshcat:
+    """A Meshcat server on localhost used only to record an HTML file: nobody is meant to visit it, so
+    Drake's "Meshcat listening for connections at ..." INFO message is held back (warnings still show)."""
+    drake_logger = logging.getLogger("drake")
+    level = drake_logger.level
+    drake_logger.setLevel(max(drake_logger.getEffectiveLevel(), logging.WARNING))
+    try:
+        return Meshcat(MeshcatParams(host="localhost"))
+    finally:
+        drake_logger.setLevel(level)
+
+
 def record_animation(platform: Platform, t, poses, saturating=None, fps: float = 25.0, title: str = "") -> str:
     """A self-contained HTML Meshcat animation of ``poses`` ``(n, 6)`` (utn convention, SI) at times
     ``t`` ``(n,)`` s, thinned to ``fps`` frames per second; legs turn red where ``leg_warnings`` flags
     them (``saturating`` ``(n, 6)`` bool: saturated during that sample, optional; a frame shows a
     saturation of any sample since the previous frame)."""
     t, poses = np.asarray(t, dtype=float), np.asarray(poses, dtype=float)
-    meshcat = Meshcat(MeshcatParams(host="localhost"))
+    meshcat = recording_meshcat()
     scene = MeshcatScene(platform, meshcat, publish_period=1.0 / fps)
     idx = _frames(t, fps)
     warn = leg_warnings(platform, leg_lengths(platform, poses[idx]))
@@ -203,4 +216,12 @@ def log_saturating(status: np.ndarray) -> np.ndarray:
     return np.diff(counts, axis=0, prepend=counts[:1]) > 0
 
 
-__all__ = ["MeshcatScene", "camera_pose", "leg_warnings", "log_saturating", "record_animation", "stroke_margin"]
+__all__ = [
+    "MeshcatScene",
+    "camera_pose",
+    "leg_warnings",
+    "log_saturating",
+    "record_animation",
+    "recording_meshcat",
+    "stroke_margin",
+]

@@ -5,11 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
+from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.systems.framework import DiagramBuilder
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.output_folder import write_text_atomic
+from stewart_drake.drake.animation import recording_meshcat
 from stewart_drake.drake.platform_model import build_plant, set_pose
 
 FRAME_RATE = 32.0  # frames per second of the animation
@@ -20,7 +21,7 @@ def write_animation(platform: Platform, log, path) -> Path:
     closed-form joint positions) on ``platform`` to ``path``; return the path."""
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(platform, 1e-3, builder)
-    meshcat = Meshcat()
+    meshcat = recording_meshcat()
     vis = MeshcatVisualizer.AddToBuilder(
         builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / FRAME_RATE)
     )

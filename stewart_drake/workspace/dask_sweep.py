@@ -37,6 +37,7 @@ slab's result ~80 kB), so scattering it once would not change the time.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 
@@ -71,7 +72,12 @@ def local_client(n_workers: int | None = None, threads_per_worker: int = 1, proc
 def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool = True, **kwargs):
     """A ``LocalCluster`` whose workers run with ``WORKER_CONFIG``: no statistical profiler, glibc's
     adaptive malloc (no ``MALLOC_TRIM_THRESHOLD_``, also when an earlier cluster left it in this
-    process's environment)."""
+    process's environment). The scheduler's and nannies' INFO messages are not printed, warnings are:
+    ``LocalCluster(silence_logs=WARN)`` quiets only Dask's own handler, and in a process where another
+    library configured the root logger before Dask was imported (pydrake does, on its first message) they
+    reach the root's handler instead."""
+    distributed_logger = logging.getLogger("distributed")
+    distributed_logger.setLevel(max(distributed_logger.getEffectiveLevel(), logging.WARNING))
     held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
     try:
         with dask.config.set(WORKER_CONFIG):
