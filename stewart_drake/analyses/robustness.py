@@ -16,6 +16,7 @@ from stewart_drake.report import run_standalone
 
 TITLE = "Robustness: Monte Carlo over tolerances, sensor, timing and payload"
 ORDER = 95
+COST = 60  # relative run time: the report's workers start the costliest analyses first
 
 PLATFORM = "utn-dynamic"
 VARY = [
