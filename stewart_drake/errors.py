@@ -766,6 +766,7 @@ OPTION_SIMULATE_UTN = "--simulate drives the plant with utn-convention poses; us
 OPTION_SIMULATE_EMPTY = "--simulate: the program has no moves or waits (its trajectory lasts 0 s)"
 OPTION_DURATION_POSITIVE = "--duration must be a positive number of seconds, got {value}"
 OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
+OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine python; drop one of them"
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"
 OPTION_PORT = "--port must be in 1..65535, got {value}"

@@ -25,7 +25,13 @@ from stewart_drake.core.sanity import (
     require_plate,
 )
 from stewart_drake.drake.integrators import INTEGRATORS
-from stewart_drake.errors import OPTION_DURATION_POSITIVE, OPTION_ENGINE_FIXED, OptionError, UsageError
+from stewart_drake.errors import (
+    OPTION_DURATION_POSITIVE,
+    OPTION_ENGINE_FIXED,
+    OPTION_FIRMWARE_ENGINE,
+    OptionError,
+    UsageError,
+)
 from stewart_drake.firmware.engine import ENGINES
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
@@ -189,6 +195,8 @@ def run(args) -> int:
     )
     if (args.engine == "c" or args.firmware) and args.controller != "fixed":
         raise UsageError(OPTION_ENGINE_FIXED.format(controller=args.controller))
+    if args.firmware and args.engine == "python":
+        raise UsageError(OPTION_FIRMWARE_ENGINE)
     engine = "c" if args.firmware else default_engine(args.engine, args.controller, "stewart-drake simulate")
     scenario = Scenario(
         platform,

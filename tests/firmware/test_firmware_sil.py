@@ -101,3 +101,14 @@ def test_simulate_cli_runs_a_users_firmware(tmp_path, capsys):
 def test_simulate_engine_c_refuses_float_controller(capsys):
     assert main(["simulate", "--controller", "float", "--engine", "c", "--duration", "0.01", "--no-progress"]) == 2
     assert "--engine c" in capsys.readouterr().err
+
+
+def test_simulate_refuses_firmware_with_the_python_engine(capsys, tmp_path):
+    """``--firmware`` runs C: asked for together with ``--engine python`` it is a contradiction, refused
+    before anything runs (not one of them silently ignored)."""
+    fw = tmp_path / "fw.c"
+    fw.write_text("")
+    argv = ["simulate", "--firmware", str(fw), "--engine", "python", "--duration", "0.01", "--out", str(tmp_path / "o")]
+    assert main([*argv, "--no-progress"]) == 2
+    assert capsys.readouterr().err.strip().endswith("cannot run with --engine python; drop one of them")
+    assert not (tmp_path / "o").exists()
