@@ -181,7 +181,9 @@ def run_check(args) -> int:
     from stewart_drake.core.c_build import compiler_by_name
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.drake.firmware_check import check_firmware
+    from stewart_drake.firmware.module import check_source
 
+    check_source(args.file)
     platform = load_platform(args.platform)
     config = _config(args, platform)
     cc = compiler_by_name(args.compiler) if args.compiler else None

@@ -16,7 +16,7 @@ from stewart_drake.core.leg3r import (
 )
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sdf_models import sdf_text, write_sdf
-from stewart_drake.errors import OPTION_JOINT_ANGLES, OPTION_TARGET, LegError
+from stewart_drake.errors import OPTION_JOINT_ANGLES, OPTION_JOINT_OVERFLOW, OPTION_TARGET, LegError
 
 
 def register(sub) -> None:
@@ -69,6 +69,8 @@ def run(args) -> int:
         if not np.all(np.isfinite(q)):
             raise LegError(OPTION_JOINT_ANGLES.format(value=args.q))
         f = foot(leg, q)
+        if not np.isfinite(f[2] / ka):  # angles near the float range: their sum in the user's unit is no number
+            raise LegError(OPTION_JOINT_OVERFLOW.format(value=args.q, unit=args.angle_unit))
         out = {
             "q": list(args.q),
             "foot": [f[0] / k, f[1] / k],

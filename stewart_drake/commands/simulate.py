@@ -156,11 +156,14 @@ def run(args) -> int:
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
     from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
     from stewart_drake.firmware.engine import default_engine
+    from stewart_drake.firmware.module import check_source
 
     reject_unused(
         args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
     )
     out_folder = output_folder(args)
+    if args.firmware is not None:
+        check_source(args.firmware, "--firmware")
     platform = load_platform(args.platform)
     require_plate(platform, "simulate")
     period = check_positive(args.period, "--period", "seconds")

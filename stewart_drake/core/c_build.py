@@ -80,7 +80,8 @@ def cache_dir() -> Path:
 
 
 def _cache_message(folder: Path, e: OSError) -> str:
-    return f"the compiled-module cache {folder} cannot be used ({e.strerror}); set ${CACHE_ENV} to a writable folder"
+    reason = "it is a file, not a folder" if isinstance(e, FileExistsError) and not folder.is_dir() else e.strerror
+    return f"the compiled-module cache {folder} cannot be used ({reason}); set ${CACHE_ENV} to a writable folder"
 
 
 def _probe(name: str, argv: tuple[str, ...]) -> Compiler | None:
@@ -98,7 +99,10 @@ def _probe(name: str, argv: tuple[str, ...]) -> Compiler | None:
 def _compilers(cc_env: str | None) -> tuple[Compiler, ...]:
     found = []
     if cc_env:
-        argv = tuple(shlex.split(cc_env))
+        try:
+            argv = tuple(shlex.split(cc_env))
+        except ValueError:  # unbalanced quotes: not a command line
+            argv = ()
         c = _probe(argv[0], argv) if argv else None
         if c is None:
             raise CompilerUnavailable(f"{CC_ENV}={cc_env!r} does not run as a C compiler")
@@ -222,6 +226,10 @@ def build(
         if r.returncode != 0:
             msg = (r.stderr or r.stdout).replace(str(tmp) + os.sep, "")
             raise CompileError(_first_error(msg, compiler))
+        if not target.is_file():  # e.g. $STEWART_DRAKE_CC=true: it answers --version and exits 0
+            raise CompilerUnavailable(
+                f"{' '.join(compiler.argv)} exited 0 but wrote no library: not a working C compiler (set ${CC_ENV} to one)"
+            )
         os.replace(target, out)
     return out
 

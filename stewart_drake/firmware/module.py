@@ -3,6 +3,8 @@ with cffi: batch IK, traced IK, and the controller tick on an ``sd_state``."""
 
 from __future__ import annotations
 
+import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,14 +37,16 @@ int sd_host_tick(sd_state *s, const sd_word pose[6], const double L[6], double r
 
 @dataclass
 class FirmwareModule:
-    """A loaded firmware: ``ffi``, ``lib``, the library ``path``, ``word_dtype`` of ``sd_word`` and which
-    optional ABI functions it defines (``has_tick``, ``has_trace``)."""
+    """A loaded firmware: ``ffi``, ``lib``, the library ``path``, ``word_dtype`` of ``sd_word``, the C file it
+    was built from (``source``, a user's firmware; None for the generated module) and which optional ABI
+    functions it defines (``has_tick``, ``has_trace``)."""
 
     ffi: object
     lib: object
     path: Path
     word: str
     counting: bool = False
+    source: str | None = None
 
     @property
     def word_dtype(self):
@@ -131,20 +135,50 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
     """Compile a user's C file implementing the ABI (``#include "sd_firmware.h"``; the header generated for
     the same platform and format is on the include path, and so is ``dsp56800e.h``). The compiler's
     messages name the user's file and line; raises build.CompileError."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"firmware file {str(path)!r} does not exist")
+    path = check_source(path)
     sources = [Source(path.name, path=path.resolve()), *library_sources("sd_host.c", "dsp56800e.c")]
     headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
-    word = "int16_t"
-    lib_path = build(sources, headers=headers, compiler=compiler, flags=("-lm",))
-    m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
+    m = _load_user(build(sources, headers=headers, compiler=compiler, flags=("-lm",)), path)
     if m.has_tick:  # then link the tick's host glue too (it calls sd_tick)
         lib_path = build(
             sources + library_sources("sd_host_tick.c"), headers=headers, compiler=compiler, flags=("-lm",)
         )
-        m = FirmwareModule(*load(lib_path, _cdef(word, False)), lib_path, word)
+        m = _load_user(lib_path, path)
     return m
+
+
+def check_source(path, what: str = "firmware file") -> Path:
+    """``path`` (as the user wrote it) as a ``Path`` if it names a regular file, else a ``FirmwareError``
+    naming ``what`` and the value: no name at all (``""`` would be the current folder), missing, a folder,
+    or not a regular file (a device or FIFO the compiler would block on)."""
+    text = os.fspath(path)
+    if not text.strip():
+        raise FirmwareError(FirmwareError.FILE_NO_NAME.format(what=what, path=text))
+    p = Path(text)
+    if p.is_dir():
+        raise FirmwareError(FirmwareError.FILE_FOLDER.format(what=what, path=text))
+    if not p.exists():
+        raise FirmwareError(FirmwareError.FILE_MISSING.format(what=what, path=text))
+    if not p.is_file():
+        raise FirmwareError(FirmwareError.FILE_SPECIAL.format(what=what, path=text))
+    return p
+
+
+def _load_user(lib_path: Path, path: Path) -> FirmwareModule:
+    """Load the library built from the user's ``path``. A shared library links with undefined symbols, so a
+    function the file lacks (``sd_ik``, which the host glue calls) or misspells shows only here, as the
+    loader's "undefined symbol": that becomes a ``FirmwareError`` naming the file and the symbol."""
+    word = "int16_t"
+    try:
+        ffi, lib = load(lib_path, _cdef(word, False))
+    except OSError as e:
+        missing = re.search(r"undefined symbol: (\w+)", str(e))
+        if missing is None:
+            raise
+        if missing.group(1) == "sd_ik":
+            raise FirmwareError(FirmwareError.NO_IK.format(path=path)) from None
+        raise FirmwareError(FirmwareError.UNDEFINED.format(path=path, symbol=missing.group(1))) from None
+    return FirmwareModule(ffi, lib, lib_path, word, source=str(path))
 
 
 class TickRunner:
@@ -165,7 +199,7 @@ class TickRunner:
 
     def __init__(self, module: FirmwareModule):
         if not module.has_tick:
-            raise FirmwareError(FirmwareError.NO_TICK.format(name=module.path.name))
+            raise FirmwareError(FirmwareError.NO_TICK.format(name=module.source or module.path.name))
         self.module = m = module
         ffi = m.ffi
         self._buf = bytearray(ffi.sizeof("sd_state"))

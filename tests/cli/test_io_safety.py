@@ -21,8 +21,9 @@ from pathlib import Path
 import pytest
 
 from stewart_drake.cli import main
+from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
-from stewart_drake.errors import OutputError
+from stewart_drake.errors import OPTION_JOINT_OVERFLOW, OutputError
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "circle.stw"
@@ -508,10 +509,26 @@ def test_leg_help(capsys, op):
     assert rc == 0 and out.startswith(f"usage: stewart-drake leg {op}") and err == ""
 
 
-def test_strict_json_for_overflow(capsys):
-    rc, out, _ = cli(capsys, "leg", "fk", "1e308", "1e308", "--json")
-    data = json.loads(out, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
-    assert rc in (0, 1) and data["non_finite"]["reason"] == "not a finite number (written as null)"
+def test_strict_json_for_overflow():
+    """A non-finite number in a result is written as null and its path listed (strict JSON)."""
+    data = json.loads(dumps_strict({"a": [1.0, float("inf")], "b": {"c": float("nan")}, "d": 2.0}))
+    assert data == {
+        "a": [1.0, None],
+        "b": {"c": None},
+        "d": 2.0,
+        "non_finite": {"paths": ["a[1]", "b.c"], "reason": "not a finite number (written as null)"},
+    }
+
+
+@pytest.mark.parametrize("unit", ["deg", "rad"])
+def test_leg_fk_angles_whose_sum_overflows_are_refused(capsys, unit):
+    """Joint angles near the float range: gamma = q1 + q2 + alpha overflowed to inf, printed as "gamma = inf
+    deg" (found by ``pytest -m fuzz``); they are refused in one line naming the angles."""
+    rc, out, err = cli(capsys, "leg", "fk", "1e308", "1e308", "--angle-unit", unit)
+    message = OPTION_JOINT_OVERFLOW.format(value="[1e308, 1e308]", unit=unit)  # the values as written
+    assert (rc, out, err.strip()) == (2, "", f"stewart-drake leg fk: error: {message}")
+    rc, out, _ = cli(capsys, "leg", "fk", "1e300", "1e300", "--angle-unit", unit)  # large, but their sum is a float
+    assert rc == 1 and "inf" not in out
 
 
 def test_program_file_errors(here, capsys):

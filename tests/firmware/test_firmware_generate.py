@@ -4,6 +4,7 @@ the CLI (generate, check, the compile-error and altered-firmware cases) and the 
 
 import json
 import re
+import shutil
 from collections import Counter
 
 import numpy as np
@@ -299,3 +300,54 @@ def test_dsp_ik_engine_c_reproduces_the_seed_table(capsys):
         assert rc == 0
         out = json.loads(capsys.readouterr().out)
         assert out["engine"] == "c" and out["dsp_lengths_mm"] == want
+
+
+def test_cli_check_names_a_missing_function_and_a_non_file(tmp_path, capsys, monkeypatch):
+    """The loader's "undefined symbol" (a shared library links without its functions) becomes one line
+    naming the user's file and the function; a folder or an empty name is refused as such (they read
+    "does not exist", and "" named the current folder)."""
+    from stewart_drake.errors import FirmwareError
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "empty.c").write_text("")
+    (tmp_path / "undef.c").write_text(
+        '#include "sd_firmware.h"\nint helper(void);\n'
+        "int sd_ik(const sd_word pose[6], sd_word lengths[6]) { (void)pose; (void)lengths; return helper(); }\n"
+    )
+    (tmp_path / "fwdir").mkdir()
+    for value, message in (
+        ("empty.c", FirmwareError.NO_IK.format(path="empty.c")),
+        ("undef.c", FirmwareError.UNDEFINED.format(path="undef.c", symbol="helper")),
+        ("fwdir", FirmwareError.FILE_FOLDER.format(what="firmware file", path="fwdir")),
+        ("", FirmwareError.FILE_NO_NAME.format(what="firmware file", path="")),
+    ):
+        assert main(["firmware", "check", value, "--platform", "utn-dynamic"]) == 2, value
+        assert capsys.readouterr().err.strip() == f"stewart-drake firmware: error: {message}"
+
+
+def test_a_compiler_variable_that_is_no_command_or_no_compiler(monkeypatch, capsys, tmp_path):
+    """$STEWART_DRAKE_CC with unbalanced quotes is no compiler (the engine falls back to Python with the
+    note; it was a bare "No closing quotation"); one that runs but writes no library (``true``) fails a
+    build in one line saying so (it was the build folder's "lib.so: No such file or directory")."""
+    monkeypatch.setenv(build.CC_ENV, "'gcc")
+    assert main(["dsp-ik", "--pose", "10", "10", "140", "0.2", "0", "0.1", "--engine", "c", "--json"]) == 0
+    io = capsys.readouterr()
+    assert json.loads(io.out)["engine"] == "python"
+    assert f'{build.CC_ENV}="\'gcc" does not run as a C compiler' in io.err
+    true = shutil.which("true")
+    if true is None:
+        pytest.skip("no `true` program")
+    monkeypatch.setenv(build.CC_ENV, true)
+    with pytest.raises(build.CompilerUnavailable, match=re.escape(f"{true} exited 0 but wrote no library")):
+        build.build([build.Source("x.c", "int x;\n")])
+    assert not [p for p in build.cache_dir().iterdir() if p.name.startswith("build-")]  # its folder removed
+
+
+def test_a_cache_path_that_is_a_file_says_so(monkeypatch, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    monkeypatch.setenv(build.CACHE_ENV, str(blocker))
+    with pytest.raises(
+        build.CacheUnavailable, match=re.escape(f"cache {blocker} cannot be used (it is a file, not a folder)")
+    ):
+        build.cache_dir()

@@ -112,3 +112,50 @@ def test_simulate_refuses_firmware_with_the_python_engine(capsys, tmp_path):
     assert main([*argv, "--no-progress"]) == 2
     assert capsys.readouterr().err.strip().endswith("cannot run with --engine python; drop one of them")
     assert not (tmp_path / "o").exists()
+
+
+def _bad_firmware(tmp_path, kind):
+    """A --firmware value as a user writes it (relative to ``tmp_path``) and the error it must give."""
+    from stewart_drake.errors import FirmwareError
+
+    if kind == "folder":
+        (tmp_path / "fwdir").mkdir()
+        return "fwdir", FirmwareError.FILE_FOLDER.format(what="--firmware", path="fwdir")
+    if kind == "missing":
+        return "nope.c", FirmwareError.FILE_MISSING.format(what="--firmware", path="nope.c")
+    if kind == "no name":
+        return "", FirmwareError.FILE_NO_NAME.format(what="--firmware", path="")
+    return "/dev/null", FirmwareError.FILE_SPECIAL.format(what="--firmware", path="/dev/null")
+
+
+@pytest.mark.parametrize("kind", ["folder", "missing", "no name", "device"])
+def test_simulate_names_a_firmware_that_is_not_a_file(kind, capsys, tmp_path, monkeypatch):
+    """A --firmware value that is no C file is refused in one line naming the option and the value as
+    written (it said "does not exist" for a folder, and "" became the current folder), before the run."""
+    monkeypatch.chdir(tmp_path)
+    value, message = _bad_firmware(tmp_path, kind)
+    assert main(["simulate", "--firmware", value, "--duration", "0.01", "--out", "o", "--no-progress"]) == 2
+    assert capsys.readouterr().err.strip() == f"stewart-drake simulate: error: {message}"
+    assert not (tmp_path / "o").exists()
+
+
+def test_simulate_firmware_without_a_tick_or_ik_names_the_users_file(capsys, tmp_path):
+    """A firmware without sd_tick named the cached library (sd-<hash>.so), and one without sd_ik gave the
+    loader's "cannot load library ... undefined symbol" with the cache path: both now name the user's file."""
+    from stewart_drake.errors import FirmwareError
+
+    ik_only = tmp_path / "ik_only.c"
+    ik_only.write_text(
+        '#include "sd_firmware.h"\nint sd_ik(const sd_word pose[6], sd_word lengths[6])\n'
+        "{ for (int i = 0; i < 6; i++) lengths[i] = pose[i]; return 0; }\n"
+    )
+    empty = tmp_path / "empty.c"
+    empty.write_text("")
+    for fw, message in (
+        (ik_only, FirmwareError.NO_TICK.format(name=ik_only)),
+        (empty, FirmwareError.NO_IK.format(path=empty)),
+    ):
+        argv = ["simulate", "--firmware", str(fw), "--duration", "0.01", "--out", str(tmp_path / "o"), "--no-progress"]
+        assert main(argv) == 2
+        assert capsys.readouterr().err.strip() == f"stewart-drake simulate: error: {message}"
+        assert not (tmp_path / "o").exists()
