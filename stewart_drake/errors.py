@@ -420,6 +420,11 @@ class OptionError(UsageError):
     TOO_MANY_SAMPLES = "--t-end / --dt = {n} samples, more than {limit}"
     NO_STUDY = "--replay: {out!r} holds no finished study ({file} missing); run the study first"
     NO_RUN = "--replay {run}: the study in {out!r} has runs 0 … {last}"
+    BAD_STUDY = "--replay: {path} is not a study written by stewart-drake montecarlo ({reason})"
+    REPLAY_OTHER = (
+        "--replay {run}: the options describe another study than the one in {out!r} ({diff}); "
+        "--replay K --out DIR alone replays the stored study"
+    )
 
 
 # ----------------------------------------------------------------------------------------------

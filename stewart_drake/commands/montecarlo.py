@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
 
-from stewart_drake.commands._common import add_platform_arg, print_json
+from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
 from stewart_drake.commands.simulate import write_plots
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import load_platform
@@ -15,11 +16,18 @@ from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
 from stewart_drake.drake.montecarlo_animation import write_animation
-from stewart_drake.errors import OptionError, UsageError
-from stewart_drake.firmware.engine import ENGINES, default_engine
+from stewart_drake.errors import OptionError, StewartError, UsageError
+from stewart_drake.firmware.engine import ENGINES, default_engine, resolve_engine
 from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
-from stewart_drake.montecarlo.study import STUDY_FILE, run_study, study_from_settings, study_key, study_settings
+from stewart_drake.montecarlo.study import (
+    STUDY_FILE,
+    run_study,
+    settings_key,
+    study_from_settings,
+    study_key,
+    study_settings,
+)
 from stewart_drake.montecarlo.summary import read_table, summarise, write_outputs
 from stewart_drake.script import ScriptError
 from stewart_drake.script.source import read_program
@@ -161,6 +169,7 @@ def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
 
 
 def run(args) -> int:
+    reject_unused(args, "--replay", args.replay is not None, no_animation=False)
     if args.replay is not None:
         return replay(args)
     study = build_study(args)
@@ -211,13 +220,12 @@ def print_text(summary: dict) -> None:
 def replay(args) -> int:
     """Re-run one run of the study in ``--out`` and compare its row with the study's."""
     out = Path(args.out)
-    if not (out / STUDY_FILE).exists():
-        raise OptionError(OptionError.NO_STUDY.format(out=str(out), file=STUDY_FILE))
-    stored = json.loads((out / STUDY_FILE).read_text())
-    rows = read_table(out)
+    study, settings, rows = _finished_study(out)
     if not 0 <= args.replay < len(rows):
         raise OptionError(OptionError.NO_RUN.format(run=args.replay, out=str(out), last=len(rows) - 1))
-    study = study_from_settings(stored["settings"], stored["runs"])
+    _check_replay_options(args, study, settings)
+    # the C engine without a compiler here: Python, with the note (bit-identical, so the check still holds)
+    study = dataclasses.replace(study, engine=resolve_engine(study.engine, "stewart-drake montecarlo"))
     row = run_scenario(study, args.replay, keep_log=True)
     log = row.pop("log")
     want = rows[args.replay]
@@ -241,6 +249,74 @@ def replay(args) -> int:
             f"max leg error {row['max_leg_error_m'] * 1e3:.6g} mm; files in {folder}"
         )
     return 0 if not differ else 1
+
+
+def _finished_study(out: Path):
+    """``(study, settings, rows)`` of the finished study in ``out`` (``study.json``, ``results.parquet``); a
+    file missing, or one a study did not write (edited, truncated, foreign), is one line naming it."""
+    for name in (STUDY_FILE, "results.parquet"):
+        if not (out / name).is_file():
+            raise OptionError(OptionError.NO_STUDY.format(out=str(out), file=name))
+    try:
+        stored = json.loads((out / STUDY_FILE).read_text())
+        study = study_from_settings(stored["settings"], stored["runs"])
+    except StewartError:
+        raise
+    except KeyError as e:
+        raise OptionError(OptionError.BAD_STUDY.format(path=out / STUDY_FILE, reason=f"no {e.args[0]!r}")) from None
+    except (ValueError, TypeError, AttributeError) as e:  # not JSON, or values of the wrong kind
+        raise OptionError(OptionError.BAD_STUDY.format(path=out / STUDY_FILE, reason=e)) from None
+    try:
+        rows = read_table(out)
+    except (OSError, ValueError, KeyError) as e:  # pyarrow's ArrowInvalid is a ValueError
+        reason = f"no {e.args[0]!r} column" if isinstance(e, KeyError) else str(e).splitlines()[0]
+        raise OptionError(OptionError.BAD_STUDY.format(path=out / "results.parquet", reason=reason)) from None
+    return study, stored["settings"], rows
+
+
+# the options that define a study (its settings and its number of runs)
+STUDY_OPTIONS = (
+    "platform",
+    "trajectory",
+    "program",
+    "length_unit",
+    "angle_unit",
+    "fit",
+    "runs",
+    "seed",
+    "vary",
+    "controller",
+    "engine",
+    "integrator",
+    "duration",
+    "plant_step",
+    "lost_tracking",
+)
+
+
+def _check_replay_options(args, stored, settings: dict) -> None:
+    """A replay runs the stored study; study options given with ``--replay`` must describe that same study
+    (they were ignored: ``--integrator cenic`` replayed a SAP study as SAP, silently). The engine is
+    compared only when given (a study's engine is the one resolved on the machine that ran it)."""
+    from stewart_drake.cli import build_parser
+
+    defaults = vars(build_parser(only="montecarlo").parse_args(["montecarlo"]))
+    if all(getattr(args, n) == defaults[n] for n in STUDY_OPTIONS):
+        return
+    mine = study_settings(build_study(args)) | ({} if args.engine else {"engine": settings.get("engine")})
+    mine = json.loads(json.dumps(mine, default=repr))  # as stored: lists, not tuples
+    if settings_key(mine) == settings_key(settings) and args.runs in (defaults["runs"], stored.runs):
+        return
+    diff = [f"runs {stored.runs} there, {args.runs} here"] if args.runs not in (defaults["runs"], stored.runs) else []
+    for k in sorted(set(mine) | set(settings)):
+        a, b = settings.get(k), mine.get(k)
+        if a != b:
+            diff.append(
+                k if isinstance(a, (dict, list)) or isinstance(b, (dict, list)) else f"{k} {a!r} there, {b!r} here"
+            )
+    raise OptionError(
+        OptionError.REPLAY_OTHER.format(run=args.replay, out=str(args.out), diff="; ".join(diff[:3]) or "settings")
+    )
 
 
 def _plant_platform(study, index):

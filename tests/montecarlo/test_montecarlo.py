@@ -268,3 +268,45 @@ def test_a_study_stored_without_an_integrator_replays_under_cenic(platform):
     assert settings["integrator"] == "cenic-fixed"
     old = study_mod.study_from_settings({**settings, "integrator": None}, runs=2)
     assert old.integrator == "cenic" and study_mod.study_from_settings(settings, 2).integrator == "cenic-fixed"
+
+
+def test_replay_runs_the_stored_study_and_refuses_other_options(tmp_path, capsys, monkeypatch):
+    """--replay runs the study stored in --out. Study options that describe another study (a SAP study
+    replayed with --integrator cenic) were silently ignored: they are refused in one line naming the
+    difference. A study run with the C engine replays without a compiler (the Python engine, with the
+    note: bit-identical). A study.json or results.parquet a study did not write is one line naming it
+    (it was a KeyError traceback)."""
+    from stewart_drake.core.c_build import CC_ENV
+    from stewart_drake.errors import OptionError
+
+    out = tmp_path / "s"
+    options = ["--runs", "1", "--duration", "0.05", "--integrator", "sap", "--engine", "c"]
+    assert main(["montecarlo", *options, "--workers", "0", "--out", str(out), "--no-progress"]) == 0
+    replay = ["montecarlo", "--replay", "0", "--out", str(out), "--no-animation", "--json"]
+    capsys.readouterr()
+    assert main([*replay, *options]) == 0  # the study's own options: the same study
+    assert json.loads(capsys.readouterr().out)["bit_identical"]
+
+    assert main([*replay, "--duration", "0.05", "--integrator", "cenic"]) == 2
+    err = capsys.readouterr().err.strip()
+    diff = "integrator 'sap' there, 'cenic' here"
+    assert err == "stewart-drake montecarlo: error: " + OptionError.REPLAY_OTHER.format(run=0, out=str(out), diff=diff)
+
+    monkeypatch.setenv(CC_ENV, str(tmp_path / "no-cc"))  # no compiler
+    assert main(replay) == 0
+    io = capsys.readouterr()
+    assert json.loads(io.out)["bit_identical"] and "running the Python engine instead" in io.err
+    monkeypatch.delenv(CC_ENV)
+
+    assert main(["montecarlo", "--no-animation", *options, "--workers", "0", "--out", str(out)]) == 2
+    assert capsys.readouterr().err.strip().endswith("--no-animation only applies with --replay")
+
+    stored = json.loads((out / "study.json").read_text())
+    del stored["settings"]["integrator"]
+    (out / "study.json").write_text(json.dumps(stored))
+    assert main(replay) == 2
+    reason = OptionError.BAD_STUDY.format(path=out / "study.json", reason="no 'integrator'")
+    assert capsys.readouterr().err.strip() == f"stewart-drake montecarlo: error: {reason}"
+    (out / "study.json").write_text("{")
+    assert main(replay) == 2
+    assert capsys.readouterr().err.strip().startswith(f"stewart-drake montecarlo: error: --replay: {out}/study.json is")
