@@ -742,6 +742,14 @@ class StudyError(StewartError):
     PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
     DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
     TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
+    STEPS = (
+        "--plant-step {step:g} s: {duration:g} s per run is {steps:.3g} plant steps, more than the bound {limit:.3g}; "
+        "use a longer --plant-step or a shorter --duration"
+    )
+    TOTAL_STEPS = (
+        "--runs {runs} × {steps:.3g} plant steps = {total:.4g} is more than the bound {limit:.4g}; "
+        "use a longer --plant-step or fewer --runs"
+    )
     RESOLUTION_RANGE = (
         "--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
         "give a value or a|b|c list, not a range"
@@ -775,6 +783,9 @@ OPTION_NON_NEGATIVE = "{name} must be a non-negative number, got {value}"
 OPTION_SIMULATE_UTN = "--simulate drives the plant with utn-convention poses; use --convention utn"
 OPTION_SIMULATE_EMPTY = "--simulate: the program has no moves or waits (its trajectory lasts 0 s)"
 OPTION_DURATION_POSITIVE = "--duration must be a positive number of seconds, got {value}"
+OPTION_DURATION_PERIOD = (
+    "--duration {value} s is shorter than one controller period ({period} s); give at least one period"
+)
 OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
 OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine python; drop one of them"
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"

@@ -26,6 +26,7 @@ from stewart_drake.core.sanity import (
 )
 from stewart_drake.drake.integrators import INTEGRATORS
 from stewart_drake.errors import (
+    OPTION_DURATION_PERIOD,
     OPTION_DURATION_POSITIVE,
     OPTION_ENGINE_FIXED,
     OPTION_FIRMWARE_ENGINE,
@@ -178,6 +179,8 @@ def run(args) -> int:
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
     if not duration > 0:
         raise OptionError(OPTION_DURATION_POSITIVE.format(value=args.duration))
+    if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
+        raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
     timing = DspTiming(
         sample_period=period,
         latency=args.latency,

@@ -32,6 +32,10 @@ STUDY_FILE = "study.json"
 MAX_RUNS = 100_000
 MAX_RUN_SECONDS = 600.0
 MAX_TOTAL_SECONDS = 500_000.0
+# ... and plant steps (the work and each run's log scale with them, not with simulated seconds): the same
+# bounds at the default 1 ms step, so that a fine --plant-step cannot ask for days or a log beyond memory
+MAX_RUN_STEPS = MAX_RUN_SECONDS / 1e-3
+MAX_TOTAL_STEPS = MAX_TOTAL_SECONDS / 1e-3
 RETRIES = 3
 
 
@@ -146,6 +150,15 @@ def check_study(study: Study) -> float:
             StudyError.TOTAL.format(
                 runs=study.runs, duration=duration, total=study.runs * duration, limit=MAX_TOTAL_SECONDS
             )
+        )
+    steps = duration / study.plant_step
+    if steps > MAX_RUN_STEPS:
+        raise StudyError(
+            StudyError.STEPS.format(step=study.plant_step, duration=duration, steps=steps, limit=MAX_RUN_STEPS)
+        )
+    if study.runs * steps > MAX_TOTAL_STEPS:
+        raise StudyError(
+            StudyError.TOTAL_STEPS.format(runs=study.runs, steps=steps, total=study.runs * steps, limit=MAX_TOTAL_STEPS)
         )
     if study.controller == "fixed":
         law = study.spec.laws.get("sensor_resolution")

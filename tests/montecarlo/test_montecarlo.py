@@ -68,6 +68,23 @@ def test_runs_times_duration_bounded_before_running(capsys, tmp_path):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize(
+    ("argv", "what"),
+    [
+        (["--runs", "1", "--duration", "0.05", "--plant-step", "1e-9"], "per run is 5e+07 plant steps"),
+        (["--runs", "1001", "--duration", "5", "--plant-step", "1e-5"], "--runs 1001 × 5e+05 plant steps = 5.005e+08"),
+    ],
+)
+def test_plant_steps_bounded_before_running(capsys, tmp_path, argv, what):
+    """The work and each run's log grow with plant steps, not simulated seconds: --plant-step 1e-9 (5e7
+    steps of 0.05 s) ran on, its log headed for ~200 GB. Bounded like the default 1 ms step's seconds:
+    600 s per run (6e5 steps) and 500,000 s in all (5e8 steps)."""
+    assert main(["montecarlo", *argv, "--workers", "0", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert what in err and "more than the bound" in err and err.count("\n") == 1
+    assert not (tmp_path / "o").exists()
+
+
 def test_each_run_redraws_alone(platform):
     """Run i's draw depends on (S, i) only: drawn alone equals drawn in a sequence, and it is within the
     SPEC's bounds; other indices and seeds draw differently."""
