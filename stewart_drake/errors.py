@@ -790,7 +790,7 @@ OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; -
 OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine python; drop one of them"
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"
-OPTION_PORT = "--port must be in 1..65535, got {value}"
+OPTION_PORT = "--port must be in 1024..65535 (Meshcat does not listen on a privileged port), got {value}"
 OPTION_LEG_DAMPING = "--leg-damping must be a finite number >= 0 N·s/m, got {value}"
 OPTION_SAMPLE_RATE = "--sample-rate must be a positive number of Hz, got {value}"
 OPTION_JOINT_ANGLES = "joint angles must be finite, got {value}"

@@ -62,7 +62,7 @@ def run(args) -> int:
         raise OptionError(OPTION_VIEW_DURATION.format(value=args.duration))
     if not (np.isfinite(args.speed) and args.speed > 0):
         raise OptionError(OPTION_SPEED.format(value=args.speed))
-    if args.port is not None and not 1 <= args.port <= 65535:
+    if args.port is not None and not 1024 <= args.port <= 65535:  # Drake aborts (SystemExit) below 1024
         raise OptionError(OPTION_PORT.format(value=args.port))
     replay = load_replay(args.replay) if args.replay else None
     if replay is not None and replay[3] and replay[3] != platform.name:
@@ -80,6 +80,7 @@ def run(args) -> int:
     print(
         f"stewart-drake view: {platform.name} at {meshcat.web_url()}"
         + ("" if args.duration is not None else " (Ctrl-C to quit)"),
+        file=sys.stderr if args.json else sys.stdout,  # --json: stdout is the JSON alone
         flush=True,
     )
     try:

@@ -152,7 +152,10 @@ def labels(r: Readout, length_unit: str = "mm") -> list[str]:
 
 def open_meshcat(port: int | None = None) -> Meshcat:
     """A Meshcat server on localhost at ``port`` (None: the first free port from 7000). A port that
-    cannot be listened on raises ``ValueError`` naming it (the CLI prints it as one line)."""
+    cannot be listened on raises ``ValueError`` naming it (the CLI prints it as one line); so does a port
+    below 1024, which Drake does not return from but aborts on (a ``SystemExit`` from its DRAKE_DEMAND)."""
+    if port is not None and not 1024 <= port <= 65535:
+        raise SimulationError(SimulationError.PORT.format(port=port, reason="give 1024..65535"))
     try:
         return Meshcat(MeshcatParams(host="localhost", port=port))
     except RuntimeError as e:

@@ -147,3 +147,21 @@ def test_cli_view_replays_a_log(tmp_path, utn):
     out = json.loads(r.stdout[r.stdout.index("{") :])
     # Played to the end at 4x: the last readout is the last logged pose.
     np.testing.assert_allclose(out["pose"], utn.home_pose() + [0, 0, 0.05 * np.sin(2 * np.pi), 0, 0, 0], atol=1e-12)
+
+
+def test_cli_view_json_is_the_whole_stdout_and_a_privileged_port_is_refused(capsys):
+    """Found when the CLI fuzz test drew `view` vectors (bounded by --duration): with --json the
+    "listening at" line came first on stdout (not JSON), and --port 1 made Drake abort the process (a
+    SystemExit from its DRAKE_DEMAND: port 0 or >= 1024)."""
+    from stewart_drake.cli import main
+    from stewart_drake.drake.viewer import open_meshcat
+    from stewart_drake.errors import OPTION_PORT, SimulationError
+
+    assert main(["view", "--duration", "0", "--no-modes", "--json"]) == 0
+    io = capsys.readouterr()
+    assert json.loads(io.out)["reachable"] and "stewart-drake view: utn-dynamic at http://" in io.err
+    for port in ("1", "1023"):
+        assert main(["view", "--port", port, "--duration", "0"]) == 2
+        assert capsys.readouterr().err.strip() == "stewart-drake view: error: " + OPTION_PORT.format(value=port)
+    with pytest.raises(SimulationError, match="--port 80: "):
+        open_meshcat(80)
