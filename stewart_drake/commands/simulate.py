@@ -24,7 +24,7 @@ from stewart_drake.core.sanity import (
     fmt_value,
     require_plate,
 )
-from stewart_drake.drake.integrators import INTEGRATORS
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
 from stewart_drake.errors import (
     OPTION_DURATION_POSITIVE,
     OPTION_ENGINE_FIXED,
@@ -153,7 +153,6 @@ def run(args) -> int:
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
-    from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
     from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
     from stewart_drake.firmware.engine import default_engine
 

@@ -87,9 +87,9 @@ class Scenario:
     compiled C; ``firmware``: a user's C file implementing the firmware ABI); ``config``: timing and gains
     (refused if infeasible; None: ``ControllerConfig.for_platform`` with the actuators' lag over the
     reference's poses from 0 to ``design_duration`` s, ``design_poses``); ``actuators``; ``plant_time_step``
-    (s): the discrete plant's step, or the continuous plant's logging period; ``integrator``: one of
-    ``integrators.INTEGRATORS`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect the model-based force
-    feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
+    (s): the discrete plant's step, or the continuous plant's logging period and fixed step; ``integrator``:
+    one of ``integrators.INTEGRATORS`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect
+    the model-based force feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
     runs (None: the trajectory's own duration, else 1 s).
     """
 
