@@ -766,6 +766,10 @@ OPTION_SIMULATE_UTN = "--simulate drives the plant with utn-convention poses; us
 OPTION_SIMULATE_EMPTY = "--simulate: the program has no moves or waits (its trajectory lasts 0 s)"
 OPTION_DURATION_POSITIVE = "--duration must be a positive number of seconds, got {value}"
 OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
+SIMULATION_GAP_WARNING = (
+    "the loop closures opened by up to {gap:.3g} m, more than a tenth of the sensor's {count:g} m count: "
+    "try --integrator cenic or a smaller --plant-step"
+)
 OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine python; drop one of them"
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"
