@@ -787,6 +787,10 @@ OPTION_DURATION_PERIOD = (
     "--duration {value} s is shorter than one controller period ({period} s); give at least one period"
 )
 OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
+SIMULATION_GAP_WARNING = (
+    "the loop closures opened by up to {gap:.3g} m, more than a tenth of the sensor's {count:g} m count: "
+    "try --integrator cenic or a smaller --plant-step"
+)
 OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine python; drop one of them"
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"

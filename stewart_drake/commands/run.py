@@ -180,8 +180,10 @@ def simulate(platform, result, args) -> dict:
 
     from stewart_drake.control.simulation_log import tracking_verdict
     from stewart_drake.core.sanity import require_plate
+    from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
     from stewart_drake.drake.simulation import Scenario
     from stewart_drake.drake.simulation import simulate as sim_run
+    from stewart_drake.firmware.engine import default_engine
 
     if args.convention != "utn":
         raise UsageError(OPTION_SIMULATE_UTN)
@@ -190,7 +192,9 @@ def simulate(platform, result, args) -> dict:
         raise UsageError(OPTION_SIMULATE_EMPTY)
     reference = replace(traj, name=Path(args.program).stem)
     require_plate(platform, "run --simulate")
-    log = sim_run(Scenario(platform, reference, args.controller, duration=traj.duration + SETTLE), progress=True)
+    engine = default_engine(None, args.controller, "stewart-drake run")  # simulate's default: the compiled firmware
+    scenario = Scenario(platform, reference, args.controller, engine=engine, duration=traj.duration + SETTLE)
+    log = sim_run(scenario, progress=True)
     err = log.length_error(reference, platform)
     verdict = tracking_verdict(platform, err, log.pose_error(reference), log)
     return {
@@ -198,6 +202,8 @@ def simulate(platform, result, args) -> dict:
         "length_error": err,
         "summary": {
             "controller": args.controller,
+            "engine": engine,
+            "integrator": scenario.integrator or DEFAULT_INTEGRATOR,
             "plant_steps": len(log.t),
             "settle_s": SETTLE,
             "max_abs_length_error_mm": np.abs(err).max(axis=0) * 1e3,

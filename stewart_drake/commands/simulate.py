@@ -24,12 +24,13 @@ from stewart_drake.core.sanity import (
     fmt_value,
     require_plate,
 )
-from stewart_drake.drake.integrators import INTEGRATORS
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
 from stewart_drake.errors import (
     OPTION_DURATION_PERIOD,
     OPTION_DURATION_POSITIVE,
     OPTION_ENGINE_FIXED,
     OPTION_FIRMWARE_ENGINE,
+    SIMULATION_GAP_WARNING,
     OptionError,
     UsageError,
 )
@@ -154,8 +155,7 @@ def run(args) -> int:
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
-    from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.drake.simulation import ActuatorModel, Scenario, simulate
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation
     from stewart_drake.firmware.engine import default_engine
     from stewart_drake.firmware.module import check_source
 
@@ -216,7 +216,12 @@ def run(args) -> int:
         integrator=args.integrator or DEFAULT_INTEGRATOR,
         duration=duration,
     )
-    log = simulate(scenario, progress=not args.no_progress)
+    sim = build_simulation(scenario)
+    log = sim.run(duration, progress=not args.no_progress)
+    gap = sim.max_constraint_gap()
+    if gap > timing.sensor_resolution / 10:
+        warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
+        print(f"stewart-drake simulate: warning: {warnings[-1]}", file=sys.stderr)
     out = Path(args.out)
     e = log.length_error(traj, platform)
     pe = log.pose_error(traj)
@@ -235,6 +240,7 @@ def run(args) -> int:
         "computation_time_s": timing.computation_time,
         "plant_time_step_s": plant_step,
         "integrator": scenario.integrator,
+        "max_constraint_gap_m": gap,
         "duration_s": duration,
         "ticks": int(len(log.tick_times())),
         "max_leg_error_mm": float(np.abs(e).max() * 1e3),

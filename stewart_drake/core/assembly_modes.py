@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.joints import coincident_groups
 from stewart_drake.core.kinematics import check_stroke, plate_anchors
 from stewart_drake.core.newton_fk import (
     CONVERGED,
@@ -53,6 +54,10 @@ from stewart_drake.core.newton_fk import (
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, quaternion_to_matrix, rotation_matrix
 from stewart_drake.errors import FkInputError, ForwardKinematicsError
 
+# m: base anchors this close are one point to the polynomial system. The 16-solution family needs exact
+# coincidence, so this is rounding level, not the platform's MIN_ANCHOR_SEPARATION: a pair 1e-7 m apart
+# is one joint to the model, but a generic such system has the 6-6 count of 40 roots.
+EXACT_COINCIDENCE = 1e-12
 CERTIFY_RESIDUAL = 1e-9  # m: a polished solution with a larger leg residual is not a confirmation
 # polish(lengths (6,), p_BC (3,), R_BT (3, 3)) -> (p_BC, R_BT, success, residual m): an independent solve
 # started at a Newton solution.
@@ -66,7 +71,7 @@ Polish = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.nda
 def max_solutions(platform: Platform) -> int:
     """Upper bound on the number of isolated complex forward-kinematics solutions: 16 when the plate
     or the base has only three distinct joints each shared by two legs (3-6 / 6-3), else 40."""
-    n_base = len(np.unique(np.round(platform.base_anchors, 12), axis=0))
+    n_base = len(coincident_groups(platform.base_anchors, EXACT_COINCIDENCE)[0])
     if len(platform.top_anchors) == 3 or n_base == 3:
         return 16
     return 40

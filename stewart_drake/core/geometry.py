@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.joints import coincident_groups, first_close_pair
 from stewart_drake.core.rotations import length_scale
 from stewart_drake.core.sanity import check_home
 from stewart_drake.core.yamlio import Rule, check_rules, load_yaml_typed
@@ -283,14 +284,12 @@ def _finite_array(value, name, shape) -> np.ndarray:
 
 
 def _check_distinct(points: np.ndarray, what: str) -> None:
-    diff = np.linalg.norm(points[:, None] - points[None], axis=-1)
-    i, j = np.triu_indices(len(points), 1)
-    close = diff[i, j] < MIN_ANCHOR_SEPARATION
-    if np.any(close):
-        k = int(np.argmax(close))
+    pair = first_close_pair(points, MIN_ANCHOR_SEPARATION)
+    if pair is not None:
+        i, j = pair
         raise GeometryError(
             GeometryError.COINCIDE.format(
-                what=what, i=i[k] + 1, j=j[k] + 1, at=points[i[k]].tolist(), limit=MIN_ANCHOR_SEPARATION
+                what=what, i=i + 1, j=j + 1, at=points[i].tolist(), limit=MIN_ANCHOR_SEPARATION
             )
         )
 
@@ -455,13 +454,20 @@ def check_base_anchors(points: np.ndarray) -> None:
     """``(6, 3)`` per-leg base anchors p_BBi: six distinct points, or exactly three disjoint coincident
     pairs (a 6-3 platform: three base joints, each shared by two legs). Any other coincidence (one or
     two pairs, three legs on one point) is refused as a modelling error, naming the first pair."""
-    close = np.linalg.norm(points[:, None] - points[None], axis=-1) < MIN_ANCHOR_SEPARATION
-    if np.all(close.sum(axis=1) == 2):  # each anchor coincides with itself and exactly one other
+    if np.all(np.bincount(coincident_groups(points, MIN_ANCHOR_SEPARATION)[1]) == 2):  # three separate pairs
         return
     try:
         _check_distinct(points, "base anchors")
     except GeometryError as e:
         raise GeometryError(GeometryError.BASE_PAIRS.format(problem=e)) from None
+
+
+def base_joints(platform: Platform) -> tuple[np.ndarray, np.ndarray]:
+    """The platform's physical base joints: ``(first (m,), leg_joint (6,))``, the leg that first stands on
+    each joint and each leg's joint (0..m-1, numbered in leg order). Legs whose base anchors coincide
+    (closer than ``MIN_ANCHOR_SEPARATION``, the rule ``check_base_anchors`` accepts 6-3 pairs by) share one
+    joint: m = 3 on a 6-3 platform, 6 (``first`` = ``leg_joint`` = 0..5) when the six anchors are distinct."""
+    return coincident_groups(platform.base_anchors, MIN_ANCHOR_SEPARATION)
 
 
 def base_anchors_per_leg(cfg: PlatformConfig) -> np.ndarray:
@@ -488,11 +494,9 @@ def check_shared_base(cfg: PlatformConfig, where: dict, shown: str, k: float) ->
     """The points listed in ``base_anchors`` are distinct (a repeated point is a typing mistake: legs
     sharing a base joint list it once and name it in ``leg_base``); ``k`` metres per file unit."""
     pts = np.asarray(cfg.base_anchors, dtype=float).reshape(-1, 3) * k
-    d = np.linalg.norm(pts[:, None] - pts[None], axis=-1)
-    i, j = np.triu_indices(len(pts), 1)
-    close = d[i, j] < MIN_ANCHOR_SEPARATION
-    if np.any(close):
-        a, b = int(i[np.argmax(close)]), int(j[np.argmax(close)])
+    pair = first_close_pair(pts, MIN_ANCHOR_SEPARATION)
+    if pair is not None:
+        a, b = pair
         w = where.get(("base_anchors", b, 0))
         raise YamlError(
             YamlError.BAD_VALUE.format(

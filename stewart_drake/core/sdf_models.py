@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, base_joints
 from stewart_drake.core.leg3r import Leg3R, dh_rows
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions, leg_visual_dimensions
 from stewart_drake.core.output_folder import safe_file_stem, write_output_file
@@ -67,8 +67,9 @@ VISUAL_NOTE = (
 
 
 def convex_outline(points) -> np.ndarray:
-    """``(m, 2)`` the convex hull of ``(n, 2+)`` points' x, y, counter-clockwise (Andrew's monotone chain);
-    coincident points (legs sharing a joint) count once."""
+    """``(m, 2)`` the convex hull of ``(n, 2+)`` points' x, y, counter-clockwise (Andrew's monotone chain).
+    x, y are rounded to 1e-12 m (far below display precision) and equal points count once; which anchors
+    are one joint is decided by the caller (``geometry.base_joints``)."""
     pts = sorted({(round(float(x), 12), round(float(y), 12)) for x, y in np.asarray(points, dtype=float)[:, :2]})
     if len(pts) < 3:
         return np.array(pts, dtype=float).reshape(-1, 2)
@@ -147,7 +148,8 @@ def _body_visuals(platform: Platform) -> tuple[str, str]:
     vis = leg_visual_dimensions(platform)
     rj = vis["joint_radius"]
     base_z, top_z = float(platform.base_anchors[:, 2].min()), float(platform.top_anchors[:, 2].mean())
-    base = plate_visuals("base_plate", platform.base_anchors, base_z - rj, rj, rj, BASE_RGBA)
+    joints = platform.base_anchors[base_joints(platform)[0]]
+    base = plate_visuals("base_plate", joints, base_z - rj, rj, rj, BASE_RGBA)
     base += [
         visual_xml(f"base_joint_{i + 1}", (*b, 0, 0, 0), ("sphere", rj), JOINT_RGBA)
         for i, b in enumerate(platform.base_anchors)

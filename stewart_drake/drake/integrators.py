@@ -11,13 +11,13 @@ plant step, without the error estimate.
 Why ``cenic-fixed`` is the default (``benchmarks/bench_integrators.py``, utn-dynamic, seed trajectory): the
 1 kHz controller and actuator events stop the integrator at every plant step, so error-controlled CENIC
 never takes a step longer than the plant step and spends its error estimate (extra convex solves per
-step: its results match CENIC at a fixed half step) on steps it never lengthens. Accuracy first: with a 1 nm sensor
-(so that a flipped sensor count is not mistaken for integration error), the leg lengths against CENIC at
-accuracy 1e-9 are within 2.2 µm (``cenic``), 4.7 µm (``cenic-fixed``) and 0.10 mm (``sap``, its step
-error): only the two CENIC schemes stay within the 10 µm count of the sensor the controller reads, and
-``cenic-fixed`` runs the loop 1.2× (Python engine) to 1.5× (C engine) faster than either of the others.
-Largest ball-constraint gaps with the fixed-point controller: 2.5e-8 m (``cenic``), 8.6e-8 m
-(``cenic-fixed``), 1.5e-7 m (``sap``).
+step: its results match CENIC at a fixed half step) on steps it never lengthens. Accuracy first: with a
+1 nm sensor (so that a flipped sensor count is not mistaken for integration error), the leg lengths
+against CENIC at accuracy 1e-9 are within 2.2 µm (``cenic``), 4.7 µm (``cenic-fixed``) and 0.10 mm
+(``sap``, its step error): only the two CENIC schemes stay within the 10 µm count of the sensor the
+controller reads, and ``cenic-fixed`` runs the loop 1.2× (Python engine) to 1.5× (C engine) faster than
+either of the others. Largest ball-constraint gaps with the fixed-point controller: 2.5e-8 m (``cenic``),
+8.6e-8 m (``cenic-fixed``), 1.5e-7 m (``sap``).
 """
 
 from __future__ import annotations

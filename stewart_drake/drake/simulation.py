@@ -40,7 +40,13 @@ from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
-from stewart_drake.drake.integrators import CONTINUOUS, DEFAULT_INTEGRATOR, apply_integrator, check_integrator
+from stewart_drake.drake.integrators import (
+    CONTINUOUS,
+    DEFAULT_INTEGRATOR,
+    apply_integrator,
+    check_integrator,
+    constraint_gaps,
+)
 from stewart_drake.drake.platform_model import build_plant, set_pose
 from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
 from stewart_drake.errors import SimulationError
@@ -87,9 +93,9 @@ class Scenario:
     compiled C; ``firmware``: a user's C file implementing the firmware ABI); ``config``: timing and gains
     (refused if infeasible; None: ``ControllerConfig.for_platform`` with the actuators' lag over the
     reference's poses from 0 to ``design_duration`` s, ``design_poses``); ``actuators``; ``plant_time_step``
-    (s): the discrete plant's step, or the continuous plant's logging period; ``integrator``: one of
-    ``integrators.INTEGRATORS`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect the model-based force
-    feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
+    (s): the discrete plant's step, or the continuous plant's logging period and fixed step; ``integrator``:
+    one of ``integrators.INTEGRATORS`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect
+    the model-based force feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
     runs (None: the trajectory's own duration, else 1 s).
     """
 
@@ -180,6 +186,14 @@ class Simulation:
             self.visualizer.StopRecording()
             self.visualizer.PublishRecording()
         return self._collect()
+
+    def max_constraint_gap(self, samples: int = 1000) -> float:
+        """The largest ball-constraint gap (m) of this run: how far the loop closures opened, over up to
+        ``samples`` evenly spaced logged plant states (every state of a shorter run), first and last
+        included (``integrators.constraint_gaps``; a state costs ~50 µs)."""
+        X = self.loggers["state"].FindLog(self.simulator.get_context()).data().T
+        idx = np.unique(np.linspace(0, len(X) - 1, min(len(X), samples)).round().astype(int))
+        return float(constraint_gaps(self.plant, X[idx]).max())
 
     def _collect(self) -> SimulationLog:
         ctx = self.simulator.get_context()

@@ -30,12 +30,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.joints import coincident_groups
 
 GENERAL = "6-6"
 THREE_SIX = "3-6"  # plate anchors coincide in three pairs
 SIX_THREE = "6-3"  # base anchors coincide in three pairs (solved as the inverse 3-6 motion)
 ROOT_COUNT = {GENERAL: 40, THREE_SIX: 16, SIX_THREE: 16}
-COINCIDENT_TOL = 1e-9  # relative to the length scale: anchors closer than this are one joint
+# Anchors closer than COINCIDENT_TOL x length_scale are one joint to the solver: relative, in the scaled
+# units it tracks paths in (``study_parameters``), where the 16-path 3-6 / 6-3 families need the anchors to
+# coincide up to rounding; so much tighter than the platform's absolute MIN_ANCHOR_SEPARATION (1e-6 m).
+COINCIDENT_TOL = 1e-9
 
 
 def left_matrix(q: np.ndarray) -> np.ndarray:
@@ -108,18 +112,12 @@ class Architecture:
 
 
 def _pairs(points: np.ndarray, tol: float):
-    """Three disjoint coincident pairs of the ``(6, 3)`` points as a leg order, or None."""
-    d = np.linalg.norm(points[:, None] - points[None], axis=-1)
-    order, used = [], set()
-    for i in range(6):
-        if i in used:
-            continue
-        mates = [j for j in range(i + 1, 6) if j not in used and d[i, j] <= tol]
-        if len(mates) != 1:
-            return None
-        order += [i, mates[0]]
-        used |= {i, mates[0]}
-    return np.array(order) if len(order) == 6 else None
+    """Three disjoint coincident pairs of the ``(6, 3)`` points as a leg order (each pair's lower leg
+    first, pairs in the order of their lower legs), or None."""
+    first, index = coincident_groups(points, tol)
+    if len(first) != 3 or np.any(np.bincount(index) != 2):
+        return None
+    return np.argsort(index, kind="stable")
 
 
 def length_scale(platform: Platform) -> float:
@@ -138,17 +136,8 @@ def architecture(platform: Platform) -> Architecture:
         return Architecture(THREE_SIX, top)
     if base is not None and top is None:
         return Architecture(SIX_THREE, base)
-    joints = tuple(len(_distinct(pts, tol)) for pts in (platform.base_anchors, platform.top_anchors_per_leg))
+    joints = tuple(len(coincident_groups(pts, tol)[0]) for pts in (platform.base_anchors, platform.top_anchors_per_leg))
     return Architecture(GENERAL, np.arange(6), joints)
-
-
-def _distinct(points: np.ndarray, tol: float) -> list[int]:
-    """Indices of the first of each group of ``(n, 3)`` points closer than ``tol``."""
-    keep = []
-    for i, q in enumerate(points):
-        if all(np.linalg.norm(q - points[j]) > tol for j in keep):
-            keep.append(i)
-    return keep
 
 
 def study_parameters(platform: Platform, lengths: np.ndarray, arch: Architecture):

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from stewart_drake.control import ControllerConfig, DspTiming
-from stewart_drake.core.geometry import MIN_ANCHOR_SEPARATION, Platform
+from stewart_drake.core.geometry import Platform, base_joints
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
@@ -100,17 +100,6 @@ class Study:
 def run_seed(seed: int, index: int) -> int:
     """The seed (63 bits: a signed 64-bit column holds it) of run ``index`` of a study seeded ``seed``."""
     return int(np.random.SeedSequence(seed, spawn_key=(index,)).generate_state(1, np.uint64)[0]) & (2**63 - 1)
-
-
-def base_joints(platform: Platform) -> tuple[np.ndarray, np.ndarray]:
-    """The platform's physical base joints: ``(first (m,), leg_joint (6,))``, the leg that first stands on
-    each joint and each leg's joint (0..m-1, numbered in leg order). Legs whose base anchors coincide
-    (closer than ``MIN_ANCHOR_SEPARATION``, the rule ``check_base_anchors`` accepts 6-3 pairs by) share one
-    joint: m = 3 on a 6-3 platform, 6 (``first`` = ``leg_joint`` = 0..5) when the six anchors are distinct."""
-    p = platform.base_anchors
-    close = np.linalg.norm(p[:, None] - p[None], axis=-1) < MIN_ANCHOR_SEPARATION
-    first, leg_joint = np.unique(np.argmax(close, axis=1), return_inverse=True)  # lowest leg at each point
-    return first, leg_joint
 
 
 @dataclass(frozen=True)

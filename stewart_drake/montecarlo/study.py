@@ -22,9 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.geometry import base_joints
 from stewart_drake.core.output_folder import claim_in_manifest
 from stewart_drake.errors import StudyError
-from stewart_drake.montecarlo.scenario import Study, base_joints, run_scenario
+from stewart_drake.montecarlo.scenario import Study, run_scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -41,7 +42,7 @@ RETRIES = 3
 
 def study_settings(study: Study) -> dict:
     """The study's settings as JSON-able data (the platform by value), without the number of runs. A
-    platform whose legs share base joints adds ``base_joints`` (each leg's joint, ``scenario.base_joints``):
+    platform whose legs share base joints adds ``base_joints`` (each leg's joint, ``geometry.base_joints``):
     its anchors are drawn per joint, so its key differs from that of a study whose draws split them."""
     p = study.platform
     joints, leg_joint = base_joints(p)

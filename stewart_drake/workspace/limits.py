@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, base_joints
 from stewart_drake.core.kinematics import condition_number, leg_vectors
 from stewart_drake.core.rotations import check_convention, rotation_matrix
 from stewart_drake.errors import WorkspaceError
@@ -100,15 +100,12 @@ def segment_distances(P1, Q1, P2, Q2) -> np.ndarray:
 
 
 def leg_pairs(platform: Platform) -> np.ndarray:
-    """``(k, 2)`` leg index pairs (0-based) that can collide: every pair not sharing a joint."""
-    pairs = []
-    for i in range(6):
-        for j in range(i + 1, 6):
-            same_top = platform.leg_top[i] == platform.leg_top[j]
-            same_base = np.linalg.norm(platform.base_anchors[i] - platform.base_anchors[j]) < 1e-9
-            if not (same_top or same_base):
-                pairs.append((i, j))
-    return np.array(pairs, dtype=np.intp).reshape(-1, 2)
+    """``(k, 2)`` leg index pairs (0-based, in row order) that can collide: every pair sharing neither a
+    plate joint (``leg_top``) nor a base joint (``geometry.base_joints``)."""
+    leg_base = base_joints(platform)[1]
+    i, j = np.triu_indices(6, 1)
+    apart = (platform.leg_top[i] != platform.leg_top[j]) & (leg_base[i] != leg_base[j])
+    return np.stack([i[apart], j[apart]], axis=-1).astype(np.intp)
 
 
 def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention: str = "utn") -> dict:

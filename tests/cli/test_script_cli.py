@@ -114,4 +114,6 @@ def test_run_simulate_controller_in_the_loop(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert (out / "simulation" / "log.csv").is_file() and (out / "simulation.png").is_file()
     assert summary["simulation"]["controller"] == "fixed"
+    # simulate's defaults: the compiled firmware (a compiler is found here) on the default integrator
+    assert summary["simulation"]["engine"] == "c" and summary["simulation"]["integrator"] == "cenic-fixed"
     assert len(summary["simulation"]["max_abs_length_error_mm"]) == 6
