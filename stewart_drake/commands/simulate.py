@@ -179,8 +179,6 @@ def run(args) -> int:
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
     if not duration > 0:
         raise OptionError(OPTION_DURATION_POSITIVE.format(value=args.duration))
-    if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
-        raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
     timing = DspTiming(
         sample_period=period,
         latency=args.latency,
@@ -188,6 +186,8 @@ def run(args) -> int:
         command_range=float(platform.legs.max_force),
     ).check()
     check_timing(platform, period, plant_step, ActuatorModel().time_constant, timing.output_delay)
+    if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
+        raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
     check_simulation_size(duration, plant_step, "--duration", args.duration if args.duration is not None else duration)
     ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
     warnings = check_trajectory(
