@@ -28,7 +28,7 @@ class CFixedPointLaw(FixedPointLaw):
         self.firmware = None if firmware is None else Path(firmware).resolve()
         self.generated = generate(self.platform, self.config)
         m = (
-            compile_user(self.firmware, self.generated)
+            compile_user(Path(firmware), self.generated)  # as given: its messages name the file as the user wrote it
             if self.firmware is not None
             else compile_generated(self.generated)
         )

@@ -139,10 +139,13 @@ def test_simulate_names_a_firmware_that_is_not_a_file(kind, capsys, tmp_path, mo
     assert not (tmp_path / "o").exists()
 
 
-def test_simulate_firmware_without_a_tick_or_ik_names_the_users_file(capsys, tmp_path):
+def test_simulate_firmware_without_a_tick_or_ik_names_the_users_file(capsys, tmp_path, monkeypatch):
     """A firmware without sd_tick named the cached library (sd-<hash>.so), and one without sd_ik gave the
-    loader's "cannot load library ... undefined symbol" with the cache path: both now name the user's file."""
+    loader's "cannot load library ... undefined symbol" with the cache path: both now name the user's file
+    as written."""
     from stewart_drake.errors import FirmwareError
+
+    monkeypatch.chdir(tmp_path)
 
     ik_only = tmp_path / "ik_only.c"
     ik_only.write_text(
@@ -152,10 +155,10 @@ def test_simulate_firmware_without_a_tick_or_ik_names_the_users_file(capsys, tmp
     empty = tmp_path / "empty.c"
     empty.write_text("")
     for fw, message in (
-        (ik_only, FirmwareError.NO_TICK.format(name=ik_only)),
-        (empty, FirmwareError.NO_IK.format(path=empty)),
+        ("ik_only.c", FirmwareError.NO_TICK.format(name="ik_only.c")),
+        ("empty.c", FirmwareError.NO_IK.format(path="empty.c")),
     ):
-        argv = ["simulate", "--firmware", str(fw), "--duration", "0.01", "--out", str(tmp_path / "o"), "--no-progress"]
+        argv = ["simulate", "--firmware", fw, "--duration", "0.01", "--out", str(tmp_path / "o"), "--no-progress"]
         assert main(argv) == 2
         assert capsys.readouterr().err.strip() == f"stewart-drake simulate: error: {message}"
         assert not (tmp_path / "o").exists()
