@@ -8,16 +8,16 @@ import sys
 from pathlib import Path
 
 from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
-from stewart_drake.commands.simulate import write_plots
+from stewart_drake.commands.simulate import add_loop_args, write_plots
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
-from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, StewartError, UsageError
-from stewart_drake.firmware.engine import ENGINES, default_engine, resolve_engine
+from stewart_drake.firmware.engine import default_engine, resolve_engine
 from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import (
@@ -64,23 +64,7 @@ def register(sub) -> None:
         "latency, latency_jitter, actuator_lag, force_limit, payload_mass, payload_com, gain_scale; values X, ±T, ±P%%, A..B, a|b; "
         "units m mm um s ms us N kg g)",
     )
-    p.add_argument(
-        "--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin"
-    )
-    p.add_argument(
-        "--engine",
-        choices=ENGINES,
-        default=None,
-        help="fixed-point controller engine: c (the compiled firmware tick; the default where a C compiler is found) "
-        "or python (the emulation; bit-identical, slower)",
-    )
-    p.add_argument(
-        "--integrator",
-        choices=INTEGRATORS,
-        default=None,
-        help="plant integrator: cenic-fixed (default), cenic (error-controlled) or sap; see simulate --help and "
-        "benchmarks/bench_integrators.py",
-    )
+    add_loop_args(p)
     p.add_argument(
         "--duration", type=float, default=None, metavar="S", help="simulated seconds per run (default the trajectory's)"
     )

@@ -75,16 +75,7 @@ def register(sub) -> None:
     )
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
-    p.add_argument(
-        "--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin"
-    )
-    p.add_argument(
-        "--engine",
-        choices=ENGINES,
-        default=None,
-        help="fixed-point controller tick: c (the generated firmware, compiled; the default where a C compiler is found) "
-        "or python (the emulation; bit-identical, slower)",
-    )
+    add_loop_args(p)
     p.add_argument(
         "--firmware",
         default=None,
@@ -115,13 +106,6 @@ def register(sub) -> None:
         help="plant time step, s (default: the period, at most 1 ms)",
     )
     p.add_argument(
-        "--integrator",
-        choices=INTEGRATORS,
-        default=None,
-        help="plant integrator: cenic-fixed (default: CENIC at the fixed --plant-step on a continuous plant), cenic "
-        "(error-controlled) or sap (discrete plant at --plant-step); see benchmarks/bench_integrators.py",
-    )
-    p.add_argument(
         "--no-feedforward",
         action="store_true",
         help="no model-based force feed-forward (the PID alone carries the plate)",
@@ -147,6 +131,28 @@ def register(sub) -> None:
     )
     add_force_arg(p)
     p.set_defaults(func=run)
+
+
+def add_loop_args(p) -> None:
+    """The closed loop's options, shared by ``simulate`` and ``montecarlo``: ``--controller``, ``--engine``,
+    ``--integrator``."""
+    p.add_argument(
+        "--controller", choices=["fixed", "float"], default="fixed", help="fixed-point DSP controller or its float twin"
+    )
+    p.add_argument(
+        "--engine",
+        choices=ENGINES,
+        default=None,
+        help="fixed-point controller tick: c (the generated firmware, compiled; the default where a C compiler is found) "
+        "or python (the emulation; bit-identical, slower)",
+    )
+    p.add_argument(
+        "--integrator",
+        choices=INTEGRATORS,
+        default=None,
+        help="plant integrator: cenic-fixed (default: CENIC at the fixed --plant-step on a continuous plant), cenic "
+        "(error-controlled) or sap (discrete plant at --plant-step); see benchmarks/bench_integrators.py",
+    )
 
 
 def run(args) -> int:
