@@ -167,7 +167,7 @@ def plan_run(
         raise UsageError(OPTION_ENGINE_FIXED.format(controller=controller))
     if firmware and engine == "python":
         raise UsageError(OPTION_FIRMWARE_ENGINE)
-    engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command}")
+    engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command.split()[0]}")
     scenario = Scenario(
         platform,
         traj,
