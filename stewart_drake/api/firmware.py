@@ -63,10 +63,12 @@ class GenerateResult(Result):
         summary: platform, output folder, number format, rate, gains, files (name, bytes), cycle estimates
             of ``sd_ik`` and ``sd_tick``, and the compilers that compile-checked it.
         files: the paths written.
+        config: the controller's number format, timing and gains.
     """
 
     summary: dict
     files: list
+    config: ControllerConfig
 
     def _fields(self) -> dict:
         return self.summary
@@ -144,7 +146,7 @@ def generate(
         "tick_us": round(g.tick_cycles / config.timing.clock_hz * 1e6, 2),
         "compiled_with": compiled,
     }
-    return GenerateResult(summary, [out / p.name for p in written])
+    return GenerateResult(summary, [out / p.name for p in written], config)
 
 
 @dataclass(repr=False)

@@ -252,3 +252,14 @@ def test_firmware_generate(capsys, platform_arg, tmp_path):
     assert_same(api, cli)
     assert (tmp_path / "a" / "sd_firmware.c").read_text() == (tmp_path / "b" / "sd_firmware.c").read_text()
     assert rc == 0
+
+
+def test_firmware_check(capsys, platform_arg, tmp_path):
+    """The generated firmware checked against the emulation: the same comparison from both (and identical)."""
+    p = sd.load_platform(platform_arg)
+    fw = sd.firmware.generate(p, tmp_path / "fw", compile=False).files
+    source = next(str(f) for f in fw if f.name == "sd_firmware.c")
+    rc, cli = cli_json(capsys, "firmware", "check", source, "--platform", platform_arg, "--poses", "500", "--duration", "0.05", "--json")  # fmt: skip
+    r = sd.firmware.check(source, p, poses=500, duration=0.05)
+    assert_same(r.to_dict(), cli)
+    assert r.identical and rc == 0
