@@ -108,6 +108,7 @@ def plan_run(
     plant_platform: Platform | None = None,
     gain_scale: float = 1.0,
     nominal_gains: bool = False,
+    command_range: float | None = None,
     checks: bool = True,
     command: str = "simulate",
     duration_shown=None,
@@ -116,7 +117,8 @@ def plan_run(
 
     ``actuators``, ``sensor``, ``plant_platform``: a perturbed run (Monte Carlo); ``gain_scale`` multiplies
     the designed gains; ``nominal_gains``: design them for the nominal timing (``DspTiming()``: what the
-    firmware was built for) rather than this run's; ``checks=False`` skips the per-run sanity checks (the
+    firmware was built for) rather than this run's; ``command_range``: the Q15 command's full scale, N (default the
+    platform's ``legs.max_force``); ``checks=False`` skips the per-run sanity checks (the
     caller has checked the study); ``command``: how messages name the caller; ``duration_shown``: the
     duration as the user wrote it.
     """
@@ -141,7 +143,7 @@ def plan_run(
         sample_period=period,
         latency=latency,
         sensor_resolution=sensor_resolution,
-        command_range=float(platform.legs.max_force),
+        command_range=float(platform.legs.max_force) if command_range is None else command_range,
     )
     warnings: list[str] = []
     if checks:
