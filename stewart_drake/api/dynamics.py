@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -89,7 +90,7 @@ def inverse_dynamics(
     length_unit: str = "m",
     angle_unit: str = "rad",
     allow_out_of_stroke: bool = False,
-    on_warning=None,
+    on_warning: Callable[[str], None] | None = None,
 ) -> DynamicsResult:
     """The leg forces that move the plate along a trajectory (rigid-body inverse dynamics).
 

@@ -3,6 +3,7 @@ C firmware with the bit-exact emulation. ``sd.firmware.generate(...)``, ``sd.fir
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -76,7 +77,7 @@ class GenerateResult(Result):
 
 def generate(
     platform: Platform,
-    out,
+    out: str | Path,
     *,
     word_bits: int = 16,
     length_lsb: float = 1e-3,
@@ -86,7 +87,7 @@ def generate(
     sensor_resolution: float = 1e-5,
     trajectory: str | Trajectory | None = None,
     compile: bool = True,
-    on_note=None,
+    on_note: Callable[[str], None] | None = None,
 ) -> GenerateResult:
     """Generate the C firmware (``sd_firmware.h``, ``sd_firmware.c``, README) for a platform into a folder.
 
@@ -170,7 +171,7 @@ class CheckResult(Result):
 
 
 def check(
-    path,
+    path: str | Path,
     platform: Platform,
     *,
     poses: int = 100_000,

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.assembly_modes import modes_from_solutions
@@ -77,7 +78,7 @@ class IKResult(Result):
         return {"platform": self.platform, "results": results}
 
 
-def ik(platform: Platform, poses, convention: str = "utn") -> IKResult:
+def ik(platform: Platform, poses: ArrayLike, convention: str = "utn") -> IKResult:
     """Leg lengths for poses (closed-form inverse kinematics), with the stroke and base checks.
 
     Args:
@@ -231,10 +232,10 @@ class FKResult(Result):
 
 def fk(
     platform: Platform,
-    lengths,
+    lengths: ArrayLike,
     all_modes: bool = False,
     *,
-    initial=None,
+    initial: ArrayLike | None = None,
     convention: str = "utn",
     method: str = "homotopy",
     tol: float = 1e-13,

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -41,6 +42,10 @@ from stewart_drake.errors import (
 )
 from stewart_drake.firmware.engine import default_engine
 from stewart_drake.firmware.module import check_source
+
+if TYPE_CHECKING:  # annotations only: matplotlib and pandas are loaded when a figure or a table is asked for
+    import pandas
+    from matplotlib.figure import Figure
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -215,7 +220,7 @@ class Log:
         """The names of the arrays."""
         return [*SimulationLog.ARRAYS, "length_error", "pose_error"]
 
-    def to_pandas(self):
+    def to_pandas(self) -> pandas.DataFrame:
         """One row per plant step: ``t``, the pose, leg lengths, set-points, commands, forces, errors.
 
         Returns:
@@ -248,7 +253,7 @@ class Animation:
         escaped = self.html.replace("&", "&amp;").replace('"', "&quot;")
         return f'<iframe srcdoc="{escaped}" style="width: 100%; height: 480px; border: none"></iframe>'
 
-    def save(self, path) -> Path:
+    def save(self, path: str | Path) -> Path:
         """Write the page to ``path`` (a new file).
 
         Args:
@@ -290,7 +295,7 @@ class SimulationResult(Result):
     def _fields(self) -> dict:
         return self.summary
 
-    def plot(self):
+    def plot(self) -> Figure:
         """Leg-length errors and leg forces over time.
 
         Returns:

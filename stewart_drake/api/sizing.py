@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.api.design import carrying
 from stewart_drake.api.dynamics import read_trajectory_csv
@@ -71,7 +72,7 @@ def size(
     envelope: str | None = None,
     legs: bool = False,
     payload: float = 0.0,
-    payload_com=(0.0, 0.0, 0.0),
+    payload_com: ArrayLike = (0.0, 0.0, 0.0),
     gravity: float = 9.81,
     rate: float = 100.0,
     t_end: float = 4.0,

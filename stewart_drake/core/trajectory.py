@@ -94,7 +94,7 @@ class Trajectory:
         return _fitted(ROTATING, platform, fit)
 
     @classmethod
-    def from_csv(cls, path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+    def from_csv(cls, path: str | Path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
         """A table of ``t, px, py, pz, a, b, g`` rows (header optional; times increasing), interpolated linearly.
 
         Args:
@@ -111,7 +111,9 @@ class Trajectory:
         return load_trajectory_csv(path, length_unit, angle_unit)
 
     @classmethod
-    def from_program(cls, path, platform: Platform, rate: float = 100.0, convention: str = "utn") -> Trajectory:
+    def from_program(
+        cls, path: str | Path, platform: Platform, rate: float = 100.0, convention: str = "utn"
+    ) -> Trajectory:
         """The trajectory of a motion program (``.stw``), sampled at ``rate``, with its samples and moves.
 
         Args:
