@@ -21,7 +21,7 @@ from stewart_drake.core.sanity import (
     check_work,
     plate_anchor_heights,
 )
-from stewart_drake.errors import OPTION_MAX_ITER, OptionError, UsageError
+from stewart_drake.errors import API_POSE_SHAPE, OPTION_MAX_ITER, OptionError, UsageError
 
 # Newton converges quadratically from a good start (< 20 iterations); beyond this many it is not
 # converging, and each iteration costs a Jacobian solve.
@@ -99,7 +99,7 @@ def solve_ik(platform: Platform, poses, convention: str = "utn", what: str = "po
     """``ik`` with the name its errors give the poses (``what``, and the file ``lines`` they came from)."""
     q = np.asarray(poses, dtype=float)
     if q.shape[-1:] != (6,):
-        raise UsageError(f"{what}: expected poses of shape (..., 6), got {q.shape}")
+        raise UsageError(API_POSE_SHAPE.format(what=what, shape=q.shape))
     flat = q.reshape(-1, 6)
     check_poses(platform, flat, convention, what=what, lines=lines, base=False)
     L = leg_lengths(platform, flat, convention)

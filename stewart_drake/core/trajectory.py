@@ -22,7 +22,7 @@ from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.errors import TrajectoryError
+from stewart_drake.errors import API_FIT_PLATFORM, TrajectoryError
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,7 +166,7 @@ def _fitted(trajectory: Trajectory, platform: Platform | None, fit: bool) -> Tra
     if not fit:
         return trajectory
     if platform is None:
-        raise TrajectoryError("fit=True needs the platform to fit the trajectory to")
+        raise TrajectoryError(API_FIT_PLATFORM)
     return fit_trajectory(trajectory, platform)
 
 

@@ -111,3 +111,18 @@ def test_trajectory_constructors(tmp_path):
     prog.write_text("units mm, deg\nmover(0, 0, 700, 0, 0, 0) en 0.5\nmove(x = 10) in 0.5\n")
     tp = sd.Trajectory.from_program(prog, p)
     assert tp.name == "p" and len(tp.moves) == 2 and np.allclose(tp.q[-1, :3], [0.01, 0, 0.7])
+
+
+def test_simulation_result_animates(tmp_path):
+    """``animate()`` records a self-contained Meshcat page that Jupyter shows inline; ``save`` never overwrites."""
+    r = sd.simulate(sd.load_platform("utn-dynamic"), "seed", duration=0.02, engine="python")
+    a = r.animate(fps=50)
+    assert "<html" in a.html.lower() and "meshcat" in a.html.lower()
+    assert a._repr_html_().startswith("<iframe srcdoc=")
+    page = a.save(tmp_path / "run.html")
+    assert page.read_text(encoding="utf-8") == a.html
+    with pytest.raises(FileExistsError):
+        a.save(page)
+    assert set(r.to_dict()) >= {"max_leg_error_mm", "failures", "gains", "ticks"} and r.ok == (
+        not r.verdict["failures"]
+    )
