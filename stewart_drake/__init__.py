@@ -103,9 +103,47 @@ __all__ = [
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,
-# .firmware). Importing a subpackage binds it as an attribute of this package; for these names the public
-# function wins (see _Package), and internal code imports those subpackages with ``from ... import``.
+# .firmware): ``sd.workspace`` is a ``_Shadow``, the public function (or namespace) that also passes attribute
+# access on to the subpackage, so that ``from stewart_drake import workspace as ws; ws.Limits`` keeps working.
 _SHADOWED = frozenset({"workspace", "montecarlo", "report", "firmware"})
+
+
+class _Shadow:
+    """The public object of a name that is also an internal subpackage. Calling it calls the public function;
+    an attribute is the public object's (``firmware.generate``, ``firmware.check``) if it has one, else the
+    subpackage's (imported on first use). ``inspect.signature`` and ``help`` see the public object."""
+
+    def __init__(self, public, package: str):
+        object.__setattr__(self, "__public__", public)
+        object.__setattr__(self, "__package_name__", package)
+        for attr in ("__doc__", "__name__", "__qualname__", "__module__"):
+            object.__setattr__(self, attr, getattr(public, attr, None))
+        if callable(public):
+            object.__setattr__(self, "__wrapped__", public)
+
+    def __call__(self, *args, **kwargs):
+        return self.__public__(*args, **kwargs)
+
+    def _package(self):
+        return importlib.import_module(self.__package_name__)
+
+    def __getattr__(self, name: str):
+        try:
+            return getattr(self.__public__, name)
+        except AttributeError:
+            return getattr(self._package(), name)
+
+    def __setattr__(self, name: str, value) -> None:  # a test's monkeypatch reaches the subpackage
+        setattr(self._package(), name, value)
+
+    def __delattr__(self, name: str) -> None:
+        delattr(self._package(), name)
+
+    def __dir__(self) -> list[str]:
+        return sorted(set(dir(self.__public__)) | set(dir(self._package())))
+
+    def __repr__(self) -> str:
+        return f"<stewart_drake.{self.__public__.__name__.rsplit('.', 1)[-1]}: {self.__public__!r}>"
 
 
 def __getattr__(name: str):
@@ -115,6 +153,8 @@ def __getattr__(name: str):
     module_name, attr = _PUBLIC[name]
     module = importlib.import_module(module_name)
     value = module if attr is None else getattr(module, attr)
+    if name in _SHADOWED:
+        value = _Shadow(value, f"{__name__}.{name}")
     globals()[name] = value
     return value
 
@@ -124,9 +164,9 @@ def __dir__() -> list[str]:
 
 
 class _Package(types.ModuleType):
-    """This package's module type: the import system's binding of a subpackage named like a public function
-    (``_SHADOWED``) is not kept, so that ``sd.workspace`` stays the function after ``stewart_drake.workspace``
-    (the package) has been imported."""
+    """This package's module type: the import system's binding of a subpackage named like a public name
+    (``_SHADOWED``) is not kept, so that ``sd.workspace`` stays the public ``_Shadow`` after
+    ``stewart_drake.workspace`` (the package) has been imported."""
 
     def __setattr__(self, name: str, value) -> None:
         if name in _SHADOWED and isinstance(value, types.ModuleType) and value.__name__ == f"{__name__}.{name}":

@@ -55,6 +55,7 @@ def _members(cls) -> list[str]:
 
 
 def _describe(name: str, obj) -> list[str]:
+    obj = getattr(obj, "__public__", obj)  # a public name that is also an internal subpackage: its public object
     if isinstance(obj, types.ModuleType):
         out = [f"namespace {name}"]
         for sub in obj.__all__:

@@ -126,3 +126,20 @@ def test_simulation_result_animates(tmp_path):
     assert set(r.to_dict()) >= {"max_leg_error_mm", "failures", "gains", "ticks"} and r.ok == (
         not r.verdict["failures"]
     )
+
+
+def test_public_names_shared_with_internal_packages():
+    """``sd.workspace``, ``sd.montecarlo``, ``sd.report``, ``sd.firmware`` are the public function (namespace),
+    and attribute access still reaches the internal package of the same name, however it was imported."""
+    import inspect
+
+    import stewart_drake.workspace.grid  # noqa: F401  (the import system's binding must not replace sd.workspace)
+    from stewart_drake import workspace as ws
+    from stewart_drake.firmware import generate as generate_module
+    from stewart_drake.workspace.limits import Limits
+
+    assert ws is sd.workspace and ws.Limits is Limits  # the package's name, through the public object
+    assert list(inspect.signature(sd.workspace).parameters)[:4] == ["platform", "orientation", "resolution", "limits"]
+    assert sd.workspace(sd.load_platform("gonzalez-dutra-2009"), resolution=0.05).volume > 0
+    assert callable(sd.firmware.generate) and sd.firmware.generate is not generate_module
+    assert inspect.ismodule(generate_module) and callable(sd.report) and callable(sd.montecarlo)
