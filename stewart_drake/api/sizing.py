@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.design import carrying
-from stewart_drake.api.dynamics import read_trajectory_csv
+from stewart_drake.api.dynamics import read_trajectory_csv, trajectory_rates
 from stewart_drake.api.result import Result
 from stewart_drake.core.dynamics import seed_trajectory
 from stewart_drake.core.geometry import Platform
@@ -185,7 +185,7 @@ def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_
         if trajectory.t is not None:
             return trajectory.name, trajectory.t, trajectory.q, trajectory.qd, trajectory.qdd, "utn"
         t = _times(t_end if trajectory.duration is None else trajectory.duration, dt)
-        return (trajectory.name, t, *trajectory.derivatives(t), "utn")
+        return (trajectory.name, t, *trajectory_rates(trajectory, t), "utn")
     if trajectory in ("seed", "rotating"):
         t = _times(t_end, dt)
         q, qd, qdd = (seed_trajectory if trajectory == "seed" else rotating_trajectory)(t)

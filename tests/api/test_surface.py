@@ -143,3 +143,15 @@ def test_public_names_shared_with_internal_packages():
     assert sd.workspace(sd.load_platform("gonzalez-dutra-2009"), resolution=0.05).volume > 0
     assert callable(sd.firmware.generate) and sd.firmware.generate is not generate_module
     assert inspect.ismodule(generate_module) and callable(sd.report) and callable(sd.montecarlo)
+
+
+def test_size_and_dynamics_take_a_trajectory_object():
+    """A ``Trajectory`` gives the same sizing as its name (exact rates); one without exact rates (fitted) is
+    differentiated by a cubic spline, whose error at dt = 1 ms on this smooth reference is far below 1e-6."""
+    p = sd.load_platform("utn-dynamic")
+    named = sd.size(p, "seed", dt=0.001).summary["set"]
+    assert sd.size(p, sd.Trajectory.seed(), dt=0.001).summary["set"] == named
+    splined = sd.size(p, sd.Trajectory.seed(p, fit=True), dt=0.001).summary["set"]
+    assert abs(splined["peak_force_n"]["value"] / named["peak_force_n"]["value"] - 1) < 1e-6
+    forces = sd.inverse_dynamics(p, sd.Trajectory.seed(), dt=0.1).forces
+    assert np.array_equal(forces, sd.inverse_dynamics(p, "seed").forces)
