@@ -30,7 +30,8 @@ MAX_ITER = 1000
 
 @dataclass(repr=False)
 class IKResult(Result):
-    """Leg lengths for poses (``ik``).
+    """Leg lengths for poses (``ik``). ``to_dict()`` is one pose's dict for a single pose ``(6,)``, else
+    ``{"platform", "results": [one dict per pose]}`` (as ``stewart-drake ik --pose`` / ``--poses`` print).
 
     Attributes:
         poses: ``(..., 6)`` the poses asked for (m, rad).
