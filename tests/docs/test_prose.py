@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import re
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -136,3 +137,29 @@ def test_firmware_abi_page_matches_a_generated_header(word_bits):
         assert f"{ctype} {name}[6];" in header, name
     for macro in ("SD_WORD_BITS", "SD_FRAC_BITS", "SD_TRACE_WORDS", "SD_OP_NAMES"):
         assert f"#define {macro}" in header
+
+
+def shell_commands(page: str) -> list[list[str]]:
+    """The ``stewart-drake`` lines of the page's bash blocks, as argument lists (comments dropped)."""
+    lines = [ln for block in fenced(page, "bash") for ln in block.splitlines()]
+    return [shlex.split(ln.split(" #")[0]) for ln in lines if ln.startswith("stewart-drake ")]
+
+
+def test_getting_started_commands_run(tmp_path, monkeypatch, capsys):
+    """Every command of the getting-started page, in order, in an empty folder (``> FILE`` redirects): each exits
+    0, i.e. the templates load, the poses are in stroke and the lengths assemble."""
+    from stewart_drake.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    commands = shell_commands("getting-started.md")
+    assert len(commands) >= 8
+    for argv in commands:
+        target = argv[argv.index(">") + 1] if ">" in argv else None
+        argv = argv[1 : argv.index(">")] if target else argv[1:]
+        if argv[0] in ("--help",):
+            continue
+        rc = main(argv)
+        out = capsys.readouterr().out
+        assert rc == 0, argv
+        if target:
+            Path(target).write_text(out)
