@@ -117,20 +117,41 @@ def public_names() -> list[str]:
     return [n for n in getattr(stewart_drake, "__all__", []) if not n.startswith("_")]
 
 
+def api_target(name: str) -> str:
+    """Where public name ``name`` is defined (``module.qualname``, or the module's name for a namespace such as
+    ``sd.firmware``): the names are loaded lazily by the package's ``__getattr__``, so mkdocstrings, which reads
+    the sources statically, is pointed at their definitions."""
+    obj = getattr(stewart_drake, name)
+    return obj.__name__ if inspect.ismodule(obj) else f"{obj.__module__}.{obj.__qualname__}"
+
+
+def _members(obj) -> dict:
+    """The public members a page shows of a class (its own attributes) or of a module (what it defines)."""
+    if inspect.isclass(obj):
+        return {k: v for k, v in vars(obj).items() if not k.startswith("_")}
+    if inspect.ismodule(obj):
+        names = getattr(obj, "__all__", None) or [k for k in vars(obj) if not k.startswith("_")]
+        return {k: getattr(obj, k) for k in names if getattr(getattr(obj, k), "__module__", None) == obj.__name__}
+    return {}
+
+
 def undocumented(names) -> list[str]:
-    """Public names, and public methods/properties of public classes, that have no docstring of their own."""
+    """Public names, and the public methods/properties of public classes and namespaces (one level down, and
+    the methods of a namespace's classes), that have no docstring of their own."""
     missing = []
+
+    def visit(obj, shown: str, depth: int) -> None:
+        target = obj.fget if isinstance(obj, property) else getattr(obj, "__func__", obj)
+        if not (callable(target) or inspect.ismodule(target) or isinstance(obj, property)):
+            return  # a field or constant: documented by its class's docstring
+        if not (getattr(target, "__doc__", None) or "").strip():
+            missing.append(shown)
+        if depth < 2:
+            for attr, member in _members(target).items():
+                visit(member, f"{shown}.{attr}", depth + 1)
+
     for n in names:
-        obj = getattr(stewart_drake, n)
-        if not (inspect.getdoc(obj) or "").strip():
-            missing.append(n)
-        if inspect.isclass(obj):
-            for attr, member in vars(obj).items():
-                if attr.startswith("_"):
-                    continue
-                target = member.fget if isinstance(member, property) else getattr(member, "__func__", member)
-                if callable(target) and not (target.__doc__ or "").strip():
-                    missing.append(f"{n}.{attr}")
+        visit(getattr(stewart_drake, n), n, 0)
     return missing
 
 
@@ -142,8 +163,10 @@ def api_page(names) -> str:
         "says otherwise. See [units and conventions](units.md).",
         "",
     ]
+    if "__version__" in getattr(stewart_drake, "__all__", []):
+        out += ["`sd.__version__`: the package's version (a string).", ""]
     for n in names:
-        out += [f"::: stewart_drake.{n}", ""]
+        out += [f"::: {api_target(n)}", "    options:", f'      heading: "sd.{n}"', ""]
     return "\n".join(out)
 
 

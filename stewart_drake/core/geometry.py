@@ -193,10 +193,12 @@ class Platform:
 
     @property
     def L_min(self) -> float:
+        """The shortest leg length, m (``stroke[0]``)."""
         return float(self.stroke[0])
 
     @property
     def L_max(self) -> float:
+        """The longest leg length, m (``stroke[1]``)."""
         return float(self.stroke[1])
 
     def home_pose(self) -> np.ndarray:
