@@ -1,7 +1,89 @@
 """stewart-drake: model and verify Stewart platforms and their fixed-point controllers with Drake.
 
-The maths core (geometry, rotations, kinematics, ...) is plain numpy and imports no Drake; the
-modules that build Drake models and systems import pydrake when they are imported.
+The public API is this package's top: ``import stewart_drake as sd``, then ``sd.load_platform``, ``sd.ik``,
+``sd.fk``, ``sd.simulate``, ... (``__all__`` lists every public name; ``tests/api_snapshot.txt`` records their
+signatures and ``CHANGELOG.md`` every change to them). Units are SI (metres, radians, seconds, newtons) and
+poses are ``(..., 6)`` ``[px, py, pz, a, b, g]`` in the platform's Euler convention (``utn`` unless an argument
+says otherwise). Everything below the top (``stewart_drake.core``, ``stewart_drake.drake``, ...) is internal
+and may move between releases.
+
+``import stewart_drake`` is light: the names are loaded when first used (module ``__getattr__``), so that the
+numpy functions (``ik``, ``fk``, ``inverse_dynamics``, ``stiffness``, ...) work where pydrake is not installed and
+only ``simulate``, ``montecarlo``, ``firmware.check`` and ``report`` import Drake.
 """
 
-__version__ = "0.1.0"
+import importlib
+import sys
+import types
+
+__version__ = "0.2.0"
+
+# public name -> (module that defines it, its name there). The module is imported on first use of the name:
+# the Drake-backed names import pydrake at their module top, and the numpy names must work without it.
+_PUBLIC = {
+    "StewartError": ("stewart_drake.errors", "StewartError"),
+    "UsageError": ("stewart_drake.errors", "UsageError"),
+    "PhysicalLimitError": ("stewart_drake.errors", "PhysicalLimitError"),
+    "Platform": ("stewart_drake.core.geometry", "Platform"),
+    "load_platform": ("stewart_drake.api.platform", "load_platform"),
+    "presets": ("stewart_drake.api.platform", "presets"),
+    "Trajectory": ("stewart_drake.core.trajectory", "Trajectory"),
+    "ik": ("stewart_drake.api.kinematics", "ik"),
+    "IKResult": ("stewart_drake.api.kinematics", "IKResult"),
+    "fk": ("stewart_drake.api.kinematics", "fk"),
+    "FKResult": ("stewart_drake.api.kinematics", "FKResult"),
+    "FKSolution": ("stewart_drake.api.kinematics", "FKSolution"),
+    "inverse_dynamics": ("stewart_drake.api.dynamics", "inverse_dynamics"),
+    "DynamicsResult": ("stewart_drake.api.dynamics", "DynamicsResult"),
+    "stiffness": ("stewart_drake.api.design", "stiffness"),
+    "StiffnessResult": ("stewart_drake.api.design", "StiffnessResult"),
+    "modes": ("stewart_drake.api.design", "modes"),
+    "ModesResult": ("stewart_drake.api.design", "ModesResult"),
+    "size": ("stewart_drake.api.sizing", "size"),
+    "SizingResult": ("stewart_drake.api.sizing", "SizingResult"),
+    "workspace": ("stewart_drake.api.reach", "workspace"),
+    "WorkspaceResult": ("stewart_drake.api.reach", "WorkspaceResult"),
+    "simulate": ("stewart_drake.api.simulation", "simulate"),
+    "SimulationResult": ("stewart_drake.api.simulation", "SimulationResult"),
+    "montecarlo": ("stewart_drake.montecarlo.api", "montecarlo"),
+    "MonteCarloResult": ("stewart_drake.montecarlo.api", "MonteCarloResult"),
+    "firmware": ("stewart_drake.api.firmware", None),
+    "report": ("stewart_drake.report.api", "report"),
+    "ReportResult": ("stewart_drake.report.api", "ReportResult"),
+}
+
+__all__ = ["__version__", *_PUBLIC]
+
+# Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,
+# .firmware). Importing a subpackage binds it as an attribute of this package; for these names the public
+# function wins (see _Package), and internal code imports those subpackages with ``from ... import``.
+_SHADOWED = frozenset({"workspace", "montecarlo", "report", "firmware"})
+
+
+def __getattr__(name: str):
+    """Load a public name on first use (see ``_PUBLIC``) and keep it."""
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'stewart_drake' has no attribute {name!r}")
+    module_name, attr = _PUBLIC[name]
+    module = importlib.import_module(module_name)
+    value = module if attr is None else getattr(module, attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(types.ModuleType):
+    """This package's module type: the import system's binding of a subpackage named like a public function
+    (``_SHADOWED``) is not kept, so that ``sd.workspace`` stays the function after ``stewart_drake.workspace``
+    (the package) has been imported."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name in _SHADOWED and isinstance(value, types.ModuleType) and value.__name__ == f"{__name__}.{name}":
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

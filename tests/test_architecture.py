@@ -18,6 +18,7 @@ ALLOWED = {
     **{layer: CORE for layer in CORE},
     **{layer: CORE | CONTROL for layer in CONTROL},
     "drake": CORE | CONTROL | {"drake"},
+    "api": CORE | CONTROL | {"drake", "api"},  # the public API (stewart_drake.__all__); the app sits above it
 }
 APP = {"commands", "report", "analyses", "montecarlo", "cli", "__init__", "__main__"}
 

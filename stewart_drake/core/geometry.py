@@ -209,7 +209,42 @@ class Platform:
         """A copy with some fields changed (validated again)."""
         return dataclasses.replace(self, **changes)
 
+    def to_yaml(self, path, overwrite: bool = False) -> Path:
+        """Write this platform as a platform file (explicit anchors, metres) that ``load_platform`` reads back
+        to the same platform.
+
+        Args:
+            path: the file to write.
+            overwrite: replace an existing file (default: refuse).
+
+        Returns:
+            The path written.
+        """
+        # deferred: the writer imports this module (the Platform type)
+        from stewart_drake.core.platform_file import write_platform_yaml
+
+        return write_platform_yaml(self, path, overwrite)
+
     # -- constructors --------------------------------------------------------------------------
+    @classmethod
+    def from_anchors(cls, base_anchors, top_anchors_per_leg, stroke, name: str = "custom", **kwargs) -> "Platform":
+        """A platform from explicit anchors: each leg's base anchor in B and plate anchor in T.
+
+        Args:
+            base_anchors: ``(6, 3)`` metres.
+            top_anchors_per_leg: ``(6, 3)`` metres (legs sharing a plate point share its anchor).
+            stroke: ``(2,)`` L_min, L_max, metres.
+            name: the platform's name.
+            **kwargs: the other fields (``mass``, ``com``, ``inertia``, ``home_height``, ``legs``, ...).
+
+        Returns:
+            The validated platform (a massless plate unless ``mass``, ``com``, ``inertia`` are given).
+        """
+        # deferred: the constructor's module imports this one (the Platform type)
+        from stewart_drake.core.platform_file import platform_from_anchors
+
+        return platform_from_anchors(base_anchors, top_anchors_per_leg, stroke, name, **kwargs)
+
     @classmethod
     def utn(cls, b: float, d: float, a: float, **kwargs) -> "Platform":
         """The UTN 3-6 platform: hexagon sides ``b`` (long), ``d`` (short); triangle side ``a``.

@@ -9,6 +9,7 @@ its samples (``t``, ``q``, ``qd``, ``qdd``) and segments. Pose functions are mod
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -65,6 +66,73 @@ class Trajectory:
         """The program's ``move`` segments, in order."""
         return [s for s in self.segments if s.kind == "move"]
 
+    # -- constructors (the public API's: ``sd.Trajectory.seed(...)``, ...) ---------------------------
+    @classmethod
+    def seed(cls, platform: Platform | None = None, fit: bool = False) -> Trajectory:
+        """The seed's reference: px = −0.1 m, py = 0.1 sin(2t) m, pz = 0.7 m, no rotation, 4 s.
+
+        Args:
+            platform: with ``fit``, the platform whose home and stroke the reference is moved to.
+            fit: move and scale the reference (made for utn-dynamic) to ``platform`` (the CLI's ``--fit``).
+
+        Returns:
+            The reference (exact rates unless fitted).
+        """
+        return _fitted(SEED, platform, fit)
+
+    @classmethod
+    def rotating(cls, platform: Platform | None = None, fit: bool = False) -> Trajectory:
+        """A rotating reference: pz = 0.7 m, turning 15°·sin(2t) about Z while tilting 5°·sin(3t) about X, 4 s.
+
+        Args:
+            platform: with ``fit``, the platform whose home and stroke the reference is moved to.
+            fit: move and scale the reference (made for utn-dynamic) to ``platform`` (the CLI's ``--fit``).
+
+        Returns:
+            The reference (exact rates unless fitted).
+        """
+        return _fitted(ROTATING, platform, fit)
+
+    @classmethod
+    def from_csv(cls, path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+        """A table of ``t, px, py, pz, a, b, g`` rows (header optional; times increasing), interpolated linearly.
+
+        Args:
+            path: the CSV file.
+            length_unit: unit of its positions (``"m"`` or ``"mm"``).
+            angle_unit: unit of its angles (``"rad"``, ``"deg"`` or ``"pi"``).
+
+        Returns:
+            The reference, named after the file.
+
+        Raises:
+            StewartError: the file's first bad line, named.
+        """
+        return load_trajectory_csv(path, length_unit, angle_unit)
+
+    @classmethod
+    def from_program(cls, path, platform: Platform, rate: float = 100.0, convention: str = "utn") -> Trajectory:
+        """The trajectory of a motion program (``.stw``), sampled at ``rate``, with its samples and moves.
+
+        Args:
+            path: the program file.
+            platform: the platform it runs on (its home pose and stroke).
+            rate: samples per second.
+            convention: Euler convention of the program's angles.
+
+        Returns:
+            The reference, named after the file.
+
+        Raises:
+            StewartError: the program's first error (``ScriptError``: file, line and column).
+        """
+        # deferred: the motion language's interpreter imports this module (its trajectories are Trajectory)
+        from stewart_drake.script import run_program
+        from stewart_drake.script.source import read_program
+
+        result = run_program(read_program(str(path)), str(path), platform, rate=rate, convention=convention)
+        return dataclasses.replace(result.trajectory, name=Path(path).stem)
+
 
 def _seed_pose(t):
     return seed_trajectory(t)[0]
@@ -90,6 +158,14 @@ def _rotating_pose(t):
 SEED = Trajectory("seed", _seed_pose, 4.0, seed_trajectory)
 ROTATING = Trajectory("rotating", _rotating_pose, 4.0, _rotating_exact)
 TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
+
+
+def _fitted(trajectory: Trajectory, platform: Platform | None, fit: bool) -> Trajectory:
+    if not fit:
+        return trajectory
+    if platform is None:
+        raise TrajectoryError("fit=True needs the platform to fit the trajectory to")
+    return fit_trajectory(trajectory, platform)
 
 
 def fit_trajectory(

@@ -22,15 +22,14 @@ What a draw changes (the controller keeps the nominal model: it is what the firm
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from stewart_drake.control import ControllerConfig, DspTiming
+from stewart_drake.api.simulation import plan_run, tick_count
 from stewart_drake.core.geometry import Platform, base_joints
-from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
+from stewart_drake.core.trajectory import Trajectory, fit_trajectory, get_trajectory, table_trajectory
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.montecarlo.spec import KEYS, VarySpec
@@ -238,42 +237,35 @@ def sensor_model(d: Draw, seed: int, period: float, n_ticks: int) -> SensorModel
 
 
 def scenario(study: Study, index: int, reference: Trajectory | None = None) -> tuple[int, Draw, Scenario]:
-    """``(run seed, Draw, Scenario)`` of run ``index``: the controller keeps the nominal model with the
-    gains designed for the nominal timing and actuator lag over the run's poses (as ``simulate`` does),
-    scaled by the draw's ``gain_scale``; the plant and sensor are the draw's."""
+    """``(run seed, Draw, Scenario)`` of run ``index``, built by ``api.simulation.plan_run`` (the one home of a
+    closed-loop run): the controller keeps the nominal model with the gains designed for the nominal timing
+    and actuator lag over the run's poses (as ``simulate`` does), scaled by the draw's ``gain_scale``; the plant,
+    actuators and sensor are the draw's. The study was checked as a whole (``study.check_study``), so the
+    per-run checks are skipped."""
     seed, d = draw(study, index)
     ref = reference or study.reference()
     duration = study.run_duration(ref)
-    p = study.platform
-    g = ControllerConfig.for_platform(p, poses=design_poses(ref, max(duration, ref.duration or 0.0))).gains
-    s = d.gain_scale
-    timing = DspTiming(
-        sample_period=d.sample_period,
+    n_ticks = tick_count(duration, d.sample_period) + 1
+    plan = plan_run(
+        study.platform,
+        ref,
+        study.controller,
+        duration,
+        period=d.sample_period,
         latency=d.latency,
         sensor_resolution=d.sensor_resolution,
-        command_range=float(p.legs.max_force),
+        plant_step=study.plant_step,
+        engine=study.engine,
+        integrator=study.integrator,
+        actuators=ActuatorModel(d.force_limit, d.actuator_lag),
+        sensor=sensor_model(d, seed, d.sample_period, n_ticks),
+        plant_platform=plant_platform(study.platform, d),
+        gain_scale=d.gain_scale,
+        nominal_gains=True,
+        checks=False,
+        command="montecarlo",
     )
-    config = ControllerConfig.for_platform(
-        p, timing, gains=replace(g, kp=g.kp * s, ki=g.ki * s, kd=g.kd * s, kv=g.kv * s)
-    )
-    n_ticks = int(math.floor(duration / timing.sample_period + 1e-9)) + 2
-    return (
-        seed,
-        d,
-        Scenario(
-            p,
-            ref,
-            study.controller,
-            config,
-            ActuatorModel(d.force_limit, d.actuator_lag),
-            plant_time_step=study.plant_step,
-            integrator=study.integrator,
-            engine=study.engine,
-            plant_platform=plant_platform(p, d),
-            sensor=sensor_model(d, seed, timing.sample_period, n_ticks),
-            duration=duration,
-        ),
-    )
+    return seed, d, plan.scenario
 
 
 def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None) -> dict:

@@ -1,0 +1,339 @@
+"""Design checks at a pose: the Cartesian stiffness (``stiffness``) and the natural frequencies (``modes``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stewart_drake.api.result import Result
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.sanity import check_poses
+from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
+from stewart_drake.design.payload import payload_wrench, with_payload
+from stewart_drake.design.stiffness import compliance, deflection, leg_stiffness_vector, principal_stiffness
+from stewart_drake.design.stiffness import stiffness_matrix as cartesian_stiffness
+from stewart_drake.errors import (
+    OPTION_LEG_DAMPING,
+    OPTION_SAMPLE_RATE,
+    OptionError,
+    PayloadError,
+    PhysicalLimitError,
+    StewartError,
+)
+
+
+@dataclass
+class Load:
+    """A platform at a pose with its payload, checked once for ``stiffness`` and ``modes``: the platform
+    carrying the payload, the pose ``q`` (6,) SI, leg stiffnesses ``k`` (6,) N/m and the payload position
+    ``p_TP`` (3,) m."""
+
+    platform: Platform
+    q: np.ndarray
+    k: np.ndarray
+    p_TP: np.ndarray
+    gravity: float
+    legs: bool
+    payload: float
+    convention: str
+
+
+def load_at_pose(
+    platform: Platform,
+    pose,
+    leg_stiffness=None,
+    convention: str = "utn",
+    legs: bool = False,
+    payload: float = 0.0,
+    payload_com=(0.0, 0.0, 0.0),
+    gravity: float = 9.81,
+    *,
+    shown_com=None,
+    unit: str = "m",
+    check_pose: bool = True,
+) -> Load:
+    """The checks ``stiffness`` and ``modes`` share: gravity finite and >= 0, the payload above the plate
+    (``shown_com``: its position as the user wrote it, in ``unit``), the leg stiffness (argument, else the
+    platform's ``legs.stiffness``), and the pose analysable (finite, near, above the base; then within the
+    stroke and away from a singularity: ``PhysicalLimitError``)."""
+    loaded, p_TP = carrying(platform, payload, payload_com, gravity, shown_com=shown_com, unit=unit)
+    if leg_stiffness is not None:
+        k = leg_stiffness_vector(leg_stiffness, "--leg-stiffness")
+    else:
+        k = leg_stiffness_vector(platform.legs.stiffness, "legs.stiffness")
+    load = Load(loaded, np.asarray(pose, dtype=float).reshape(6), k, p_TP, gravity, bool(legs), payload, convention)
+    if check_pose:
+        require_analysable(load)
+    return load
+
+
+def require_analysable(load: Load) -> None:
+    """Refuse a pose that cannot be analysed: the sanity checks every command applies (finite, near the
+    platform, plate above the base), then within the stroke and away from a singularity
+    (``PhysicalLimitError``)."""
+    check_poses(load.platform, load.q, load.convention, what="--pose")
+    try:
+        inverse_kinematics(load.platform, load.q, load.convention)
+        require_nonsingular(load.platform, load.q, load.convention)
+    except StewartError as e:
+        raise PhysicalLimitError(str(e)) from None
+
+
+def carrying(platform: Platform, payload: float, payload_com, gravity: float, *, shown_com=None, unit: str = "m"):
+    """``(platform carrying the payload, p_TP (3,) m)`` after checking ``gravity`` (finite, >= 0) and that the
+    payload sits on the plate (``shown_com``: its position as the user wrote it, in ``unit``)."""
+    if not (np.isfinite(gravity) and gravity >= 0):
+        raise OptionError(OptionError.GRAVITY.format(option="--gravity", value=gravity))
+    shown = payload_com if shown_com is None else shown_com
+    if shown[2] < 0:
+        raise PayloadError(PayloadError.BELOW_PLATE.format(z=shown[2], unit=unit))
+    p_TP = np.asarray(payload_com, dtype=float).reshape(3)
+    return with_payload(platform, payload, p_TP), p_TP
+
+
+@dataclass(repr=False)
+class StiffnessResult(Result):
+    """The Cartesian stiffness about the rotation centre at a pose (``stiffness``).
+
+    Attributes:
+        matrix: ``(6, 6)`` stiffness K (rows: force N, moment N·m; columns: δp m, δθ rad), with the load's
+            geometric term.
+        zero_load: ``(6, 6)`` K without the load's geometric term.
+        compliance: ``(6, 6)`` K⁻¹.
+        principal: principal translational (N/m) and rotational (N·m/rad) stiffnesses, softest first, and
+            their directions (one per row).
+        payload_wrench: ``(6,)`` the payload's weight as a wrench about the rotation centre (N, N·m).
+        deflection: ``(6,)`` the static deflection under it (m, rad).
+        pose: ``(6,)`` the pose (m, rad).
+        leg_stiffness: ``(6,)`` N/m.
+        platform: the platform's name.
+        convention: Euler convention of the pose.
+        legs: the legs' masses are included.
+        payload: kg.
+        payload_com: ``(3,)`` m, in the plate frame.
+        gravity: m/s².
+    """
+
+    matrix: np.ndarray
+    zero_load: np.ndarray
+    compliance: np.ndarray
+    principal: dict
+    payload_wrench: np.ndarray
+    deflection: np.ndarray
+    pose: np.ndarray
+    leg_stiffness: np.ndarray
+    platform: str
+    convention: str
+    legs: bool
+    payload: float
+    payload_com: np.ndarray
+    gravity: float
+
+    def _fields(self) -> dict:
+        return {
+            "platform": self.platform,
+            "pose": self.pose,
+            "length_unit": "m",
+            "angle_unit": "rad",
+            "convention": self.convention,
+            "leg_stiffness_n_per_m": self.leg_stiffness,
+            "legs_model": self.legs,
+            "payload_kg": self.payload,
+            "payload_com_m": self.payload_com,
+            "gravity": self.gravity,
+            "stiffness": self.matrix,
+            "stiffness_zero_load": self.zero_load,
+            "compliance": self.compliance,
+            "principal_stiffness": self.principal,
+            "payload_wrench": self.payload_wrench,
+            "deflection": self.deflection,
+            "deflection_edge_units": self.deflection,
+        }
+
+
+def stiffness(
+    platform: Platform,
+    pose,
+    leg_stiffness=None,
+    *,
+    convention: str = "utn",
+    legs: bool = False,
+    payload: float = 0.0,
+    payload_com=(0.0, 0.0, 0.0),
+    gravity: float = 9.81,
+) -> StiffnessResult:
+    """The 6×6 Cartesian stiffness about the rotation centre at a pose, its principal values, the compliance
+    and the static deflection under a payload.
+
+    Args:
+        platform: the platform.
+        pose: ``(6,)`` the pose (m, rad).
+        leg_stiffness: axial stiffness of every leg, N/m (a number or six); default the platform's
+            ``legs.stiffness``.
+        convention: Euler convention of the pose.
+        legs: include the legs' masses in the load.
+        payload: a point mass carried by the plate, kg.
+        payload_com: ``(3,)`` its position in the plate frame, m (z >= 0).
+        gravity: m/s².
+
+    Returns:
+        The stiffness, compliance, principal stiffnesses and deflection.
+
+    Raises:
+        StewartError: bad options or a pose that is not analysable; ``PhysicalLimitError`` outside the stroke or
+            at a singularity.
+    """
+    load = load_at_pose(platform, pose, leg_stiffness, convention, legs, payload, payload_com, gravity)
+    return stiffness_at(load)
+
+
+def stiffness_at(load: Load) -> StiffnessResult:
+    """``stiffness`` of a checked ``Load``."""
+    p, q, k, c, g = load.platform, load.q, load.k, load.convention, load.gravity
+    K = cartesian_stiffness(p, q, k, c, g, load.legs)
+    K0 = cartesian_stiffness(p, q, k, c, g, load.legs, loaded=False)
+    pr = principal_stiffness(K)
+    w = payload_wrench(p, rotation_matrix(q[3:], c), load.payload, load.p_TP, g)
+    principal = {
+        "translational_n_per_m": pr.translational,
+        "translational_directions": pr.translational_dirs.T,
+        "rotational_nm_per_rad": pr.rotational,
+        "rotational_directions": pr.rotational_dirs.T,
+    }
+    return StiffnessResult(
+        K, K0, compliance(K), principal, w, deflection(K, w), q, k, p.name, c, load.legs, load.payload, load.p_TP, g
+    )
+
+
+@dataclass(repr=False)
+class ModesResult(Result):
+    """Natural frequencies and mode shapes about the static equilibrium at a pose (``modes``).
+
+    Attributes:
+        frequencies_hz: ``(6,)`` natural frequencies, Hz, lowest first.
+        damping_ratio: ``(6,)`` damping ratios.
+        shapes: ``(6, 6)`` mode shapes, one per column (None with damping: complex).
+        controller: how a controller at ``sample_rate`` sees the lowest mode.
+        drake: Drake's linearisation of the same plant and its agreement (with ``drake=True``), else None.
+        pose: ``(6,)`` m, rad.
+        leg_stiffness: ``(6,)`` N/m.
+        leg_damping: N·s/m.
+        legs: the legs' masses are included.
+        platform: the platform's name.
+    """
+
+    frequencies_hz: np.ndarray
+    damping_ratio: np.ndarray
+    shapes: np.ndarray | None
+    controller: dict
+    drake: dict | None
+    pose: np.ndarray
+    leg_stiffness: np.ndarray
+    leg_damping: float
+    legs: bool
+    platform: str
+
+    def _fields(self) -> dict:
+        out = {
+            "platform": self.platform,
+            "pose": self.pose,
+            "legs_model": self.legs,
+            "leg_stiffness_n_per_m": self.leg_stiffness,
+            "leg_damping_ns_per_m": self.leg_damping,
+            "frequencies_hz": self.frequencies_hz,
+            "damping_ratio": self.damping_ratio,
+            "mode_shapes": None if self.shapes is None else self.shapes.T,
+            "controller": self.controller,
+        }
+        if self.drake is not None:
+            out["drake"] = self.drake
+        return out
+
+
+def modes(
+    platform: Platform,
+    pose,
+    leg_stiffness=None,
+    *,
+    leg_damping: float = 0.0,
+    convention: str = "utn",
+    legs: bool = False,
+    payload: float = 0.0,
+    payload_com=(0.0, 0.0, 0.0),
+    gravity: float = 9.81,
+    sample_rate: float = 1000.0,
+    drake: bool = False,
+) -> ModesResult:
+    """Natural frequencies and mode shapes about the static equilibrium at a pose (legs as springs and
+    dampers), analytic; with ``drake``, checked against Drake's linearisation of the plant.
+
+    Args:
+        platform: the platform.
+        pose: ``(6,)`` the pose (m, rad).
+        leg_stiffness: axial stiffness of every leg, N/m; default the platform's ``legs.stiffness``.
+        leg_damping: axial damping of every leg, N·s/m.
+        convention: Euler convention of the pose.
+        legs: include the legs' masses.
+        payload: a point mass carried by the plate, kg.
+        payload_com: ``(3,)`` its position in the plate frame, m.
+        gravity: m/s².
+        sample_rate: the controller's sample rate, Hz (how many samples per lowest period).
+        drake: also linearise the Drake plant and compare (needs pydrake).
+
+    Returns:
+        The frequencies, damping ratios, shapes and the controller's view of the lowest mode.
+
+    Raises:
+        StewartError: bad options or a pose that is not analysable.
+    """
+    load = load_at_pose(
+        platform, pose, leg_stiffness, convention, legs, payload, payload_com, gravity, check_pose=False
+    )
+    check_modes_options(leg_damping, sample_rate)
+    require_analysable(load)
+    return modes_at(load, leg_damping, sample_rate, drake)
+
+
+def check_modes_options(leg_damping: float, sample_rate: float) -> None:
+    """``OptionError`` for a damping that is not finite and >= 0 or a sample rate that is not positive."""
+    if not (np.isfinite(leg_damping) and leg_damping >= 0):
+        raise OptionError(OPTION_LEG_DAMPING.format(value=leg_damping))
+    if not (np.isfinite(sample_rate) and sample_rate > 0):
+        raise OptionError(OPTION_SAMPLE_RATE.format(value=sample_rate))
+
+
+def modes_at(load: Load, leg_damping: float, sample_rate: float, drake: bool) -> ModesResult:
+    """``modes`` of a checked ``Load``."""
+    p, q, k, c, legs = load.platform, load.q, load.k, load.convention, load.legs
+    K = cartesian_stiffness(p, q, k, c, load.gravity, legs)
+    M = spatial_inertia(p, q, c, legs)
+    C = damping_matrix(p, q, leg_damping, c) if leg_damping > 0 else None
+    m = analytic_modes(K, M, C)
+    f1 = float(m.frequencies_hz[0])
+    delay = 1.5 / sample_rate  # one sample of output delay + half a sample of zero-order hold
+    controller = {
+        "sample_rate_hz": sample_rate,
+        "samples_per_lowest_period": sample_rate / f1 if f1 > 0 else None,
+        "loop_delay_s": delay,
+        "phase_lag_at_lowest_deg": 360.0 * f1 * delay,
+    }
+    checked = None
+    if drake:
+        # Deferred: only this check needs Drake; stiffness and modes run without pydrake.
+        from stewart_drake.drake.design_checks import drake_modes
+
+        d = drake_modes(p, q, k, leg_damping, c, load.gravity, legs)
+        md = d["modes"]
+        checked = {
+            "frequencies_hz": md.frequencies_hz,
+            "damping_ratio": md.damping_ratio,
+            "relative_difference": np.abs(md.frequencies_hz / m.frequencies_hz - 1),
+            "mac": subspace_mac(m.shapes, md.shapes, m.frequencies_hz),
+            "equilibrium_residual": d["residual"],
+            "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize",
+        }
+    shapes = m.shapes.real if C is None else None
+    return ModesResult(m.frequencies_hz, m.damping_ratio, shapes, controller, checked, q, k, leg_damping, legs, p.name)

@@ -1,0 +1,458 @@
+"""The one home of a closed-loop run: ``plan_run`` checks a run's settings and builds its ``Scenario``;
+``simulate`` runs it and summarises it. ``stewart-drake simulate``, ``run --simulate``, every Monte Carlo run
+and the report's loops build their runs here, so that the timing checks, the gain-design horizon, the tick
+count and the engine/firmware rules are written once.
+
+Imports pydrake (through ``drake.simulation``): ``import stewart_drake`` loads this module on first use of
+``simulate``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from stewart_drake.api.result import Result, plain
+from stewart_drake.control import ControllerConfig, DspTiming, check_timing
+from stewart_drake.control.simulation_log import SimulationLog, tracking_verdict
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.sanity import (
+    check_file_rows,
+    check_positive,
+    check_trajectory,
+    check_work,
+    fmt_value,
+    require_plate,
+)
+from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory
+from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
+from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
+from stewart_drake.errors import (
+    OPTION_DURATION_PERIOD,
+    OPTION_DURATION_POSITIVE,
+    OPTION_ENGINE_FIXED,
+    OPTION_FIRMWARE_ENGINE,
+    SIMULATION_GAP_WARNING,
+    OptionError,
+    UsageError,
+)
+from stewart_drake.firmware.engine import default_engine
+from stewart_drake.firmware.module import check_source
+
+# Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
+# log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
+# the SAP plant: ~1 ms on one core); a run is refused beyond the memory budget or MAX_RUN_SECONDS.
+BYTES_PER_STEP = 4000
+SECONDS_PER_STEP = 1e-3
+MAX_RUN_SECONDS = 3600.0
+
+
+def check_simulation_size(duration: float, plant_step: float, option: str, value) -> None:
+    """Refuse a simulation whose logs would not fit in memory or that would run for more than an hour."""
+    check_work(
+        option,
+        f"{fmt_value(value)} s",
+        duration / plant_step,
+        f"plant steps of {fmt_value(plant_step)} s",
+        BYTES_PER_STEP,
+        seconds_per=SECONDS_PER_STEP,
+        max_seconds=MAX_RUN_SECONDS,
+        hint=f"; use a shorter {option}",
+    )
+
+
+def tick_count(duration: float, period: float) -> int:
+    """The controller ticks of a run of ``duration`` s at ``period`` s: t = 0, T, ... <= duration."""
+    return int(math.floor(duration / period + 1e-9)) + 1
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """A checked closed-loop run: its ``scenario`` (what ``drake.simulation.build_simulation`` builds), the
+    controller's ``timing``, the ``duration`` (s) and the ``warnings`` found while checking."""
+
+    scenario: Scenario
+    timing: DspTiming
+    duration: float
+    warnings: tuple = ()
+
+    @property
+    def config(self) -> ControllerConfig:
+        """The controller's timing and gains."""
+        return self.scenario.config
+
+
+def plan_run(
+    platform: Platform,
+    trajectory: str | Path | Trajectory = "seed",
+    controller: str = "fixed",
+    duration: float | None = None,
+    *,
+    period: float = 1e-3,
+    latency: str = "sample",
+    sensor_resolution: float = 1e-5,
+    plant_step: float | None = None,
+    feedforward: bool = True,
+    engine: str | None = None,
+    firmware: str | None = None,
+    integrator: str | None = None,
+    fit: bool = False,
+    allow_out_of_stroke: bool = False,
+    length_unit: str = "m",
+    angle_unit: str = "rad",
+    actuators: ActuatorModel | None = None,
+    sensor: SensorModel | None = None,
+    plant_platform: Platform | None = None,
+    gain_scale: float = 1.0,
+    nominal_gains: bool = False,
+    checks: bool = True,
+    command: str = "simulate",
+    duration_shown=None,
+) -> RunPlan:
+    """Check a closed-loop run's settings and build its ``Scenario`` (see ``simulate`` for the arguments).
+
+    ``actuators``, ``sensor``, ``plant_platform``: a perturbed run (Monte Carlo); ``gain_scale`` multiplies
+    the designed gains; ``nominal_gains``: design them for the nominal timing (``DspTiming()``: what the
+    firmware was built for) rather than this run's; ``checks=False`` skips the per-run sanity checks (the
+    caller has checked the study); ``command``: how messages name the caller; ``duration_shown``: the
+    duration as the user wrote it.
+    """
+    if firmware is not None:
+        check_source(firmware, "--firmware")
+    if checks:
+        require_plate(platform, command)
+    period = check_positive(period, "--period", "seconds")
+    plant_step = plant_step if plant_step is not None else min(period, 1e-3)
+    if duration is not None:
+        check_positive(duration, "--duration", "seconds")
+    if isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating"):
+        check_file_rows(str(trajectory), "--trajectory", 700, 14)
+    traj = get_trajectory(trajectory, length_unit=length_unit, angle_unit=angle_unit)
+    if fit:
+        traj = fit_trajectory(traj, platform)
+    duration = duration if duration is not None else (traj.duration or 1.0)
+    if not duration > 0:
+        raise OptionError(OPTION_DURATION_POSITIVE.format(value=duration_shown))
+    actuators = actuators or ActuatorModel()
+    timing = DspTiming(
+        sample_period=period,
+        latency=latency,
+        sensor_resolution=sensor_resolution,
+        command_range=float(platform.legs.max_force),
+    )
+    warnings: list[str] = []
+    if checks:
+        timing.check()
+        check_timing(platform, period, plant_step, actuators.time_constant, timing.output_delay)
+        if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
+            raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
+        shown = duration_shown if duration_shown is not None else duration
+        check_simulation_size(duration, plant_step, "--duration", shown)
+        ticks = np.arange(tick_count(duration, period)) * period
+        warnings = check_trajectory(
+            platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", allow_out_of_stroke
+        )
+    # the gains designed for the platform over the poses of the whole run (and the reference's own length)
+    poses = design_poses(traj, max(duration, traj.duration or 0.0))
+    if nominal_gains:
+        g = ControllerConfig.for_platform(platform, poses=poses).gains
+        gains = replace(g, kp=g.kp * gain_scale, ki=g.ki * gain_scale, kd=g.kd * gain_scale, kv=g.kv * gain_scale)
+        config = ControllerConfig.for_platform(platform, timing, gains=gains)
+    else:
+        config = ControllerConfig.for_platform(platform, timing, poses=poses)
+    if (engine == "c" or firmware) and controller != "fixed":
+        raise UsageError(OPTION_ENGINE_FIXED.format(controller=controller))
+    if firmware and engine == "python":
+        raise UsageError(OPTION_FIRMWARE_ENGINE)
+    engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command}")
+    scenario = Scenario(
+        platform,
+        traj,
+        controller,
+        config,
+        actuators,
+        plant_time_step=plant_step,
+        feedforward=feedforward,
+        engine=engine,
+        firmware=firmware,
+        integrator=integrator or DEFAULT_INTEGRATOR,
+        plant_platform=plant_platform,
+        sensor=sensor,
+        duration=duration,
+    )
+    return RunPlan(scenario, timing, duration, tuple(warnings))
+
+
+@dataclass(frozen=True)
+class Log:
+    """The logs of a closed-loop run, arrays by name (SI): ``t`` (n,) s; ``pose`` (n, 6) measured pose;
+    ``lengths`` (n, 6) true leg lengths, m; ``command`` and ``force`` (n, 6) N; ``setpoint`` (n, 6) m;
+    ``status`` (n, k); ``length_error`` and ``pose_error`` (n, 6) against the reference; ``t_ref`` (m,),
+    ``reference`` (m, 6) the reference at the ticks. ``log["pose"]`` or ``log.pose``."""
+
+    raw: SimulationLog
+    length_error: np.ndarray
+    pose_error: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name in ("length_error", "pose_error"):
+            return getattr(self, name)
+        if name not in SimulationLog.ARRAYS:
+            raise KeyError(name)
+        return getattr(self.raw, name)
+
+    def __getattr__(self, name: str):
+        if name in SimulationLog.ARRAYS:
+            return getattr(self.raw, name)
+        raise AttributeError(name)
+
+    def keys(self) -> list[str]:
+        """The names of the arrays."""
+        return [*SimulationLog.ARRAYS, "length_error", "pose_error"]
+
+    def to_pandas(self):
+        """One row per plant step: ``t``, the pose, leg lengths, set-points, commands, forces, errors.
+
+        Returns:
+            A ``pandas.DataFrame`` (pandas must be installed).
+        """
+        # deferred: pandas is optional (a notebook's), the library does not need it
+        import pandas as pd
+
+        cols = {"t": self.raw.t}
+        for name, arr in (
+            ("pose", self.raw.pose),
+            ("L", self.raw.lengths),
+            ("setpoint", self.raw.setpoint),
+            ("command", self.raw.command),
+            ("force", self.raw.force),
+            ("length_error", self.length_error),
+        ):
+            labels = ("px", "py", "pz", "a", "b", "g") if name == "pose" else range(1, 7)
+            cols.update({f"{name}_{c}": arr[:, i] for i, c in enumerate(labels)})
+        return pd.DataFrame(cols)
+
+
+@dataclass(frozen=True)
+class Animation:
+    """A self-contained HTML Meshcat animation of a run (shown inline by Jupyter; ``save`` writes it)."""
+
+    html: str
+
+    def _repr_html_(self) -> str:
+        escaped = self.html.replace("&", "&amp;").replace('"', "&quot;")
+        return f'<iframe srcdoc="{escaped}" style="width: 100%; height: 480px; border: none"></iframe>'
+
+    def save(self, path) -> Path:
+        """Write the page to ``path`` (a new file).
+
+        Args:
+            path: where to write, e.g. ``"run.html"``.
+
+        Returns:
+            The path written.
+        """
+        p = Path(path)
+        with p.open("x", encoding="utf-8") as fh:  # never overwrite a file the user did not name to replace
+            fh.write(self.html)
+        return p
+
+
+@dataclass(repr=False)
+class SimulationResult(Result):
+    """A closed-loop run (``simulate``).
+
+    Attributes:
+        summary: the run's settings, gains and errors (the dict ``stewart-drake simulate`` writes to
+            summary.json, less its ``files``).
+        log: the logs, arrays by name (``log.to_pandas()``).
+        verdict: ``{"tracking_bound_mm", "saturation_bound_s", "longest_saturation_s", "failures"}``.
+        warnings: what was allowed but is worth knowing (a reference outside the stroke, an opened loop).
+        plan: the checked run (its ``Scenario``, timing and duration).
+    """
+
+    summary: dict
+    log: Log
+    verdict: dict
+    warnings: list
+    plan: RunPlan = field(repr=False)
+
+    @property
+    def ok(self) -> bool:
+        """The run tracked its reference (no failure in ``verdict``)."""
+        return not self.verdict["failures"]
+
+    def _fields(self) -> dict:
+        return self.summary
+
+    def plot(self):
+        """Leg-length errors and leg forces over time.
+
+        Returns:
+            A matplotlib ``Figure``.
+        """
+        # deferred: pyplot is loaded only when a figure is drawn
+        import matplotlib.pyplot as plt
+
+        log = self.log.raw
+        fig, ax = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+        ax[0].plot(log.t, self.log.length_error * 1e3)
+        ax[0].set_ylabel("leg length − IK(reference) [mm]")
+        ax[0].legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
+        ax[1].plot(log.t, log.force)
+        ax[1].set_ylabel("actuator force [N]")
+        ax[1].set_xlabel("t [s]")
+        fig.suptitle(
+            f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace('$', r'\$')}, "
+            f"T = {log.sample_period * 1e3:g} ms"
+        )
+        return fig
+
+    def animate(self, fps: float = 25.0) -> Animation:
+        """The run as a Meshcat animation (legs turn red near a stroke end or while saturated).
+
+        Args:
+            fps: frames per second of the animation.
+
+        Returns:
+            An `Animation`: displayed inline in Jupyter, ``save(path)`` writes the HTML.
+        """
+        # deferred: the Meshcat scene is built only when an animation is asked for
+        from stewart_drake.drake.animation import log_saturating, record_animation
+
+        log = self.log.raw
+        sc = self.plan.scenario
+        html = record_animation(
+            sc.plant_platform or sc.platform,
+            log.t,
+            log.pose,
+            saturating=log_saturating(log.status),
+            fps=fps,
+            title=f"{log.kind} controller, {log.trajectory} on {log.platform}",
+        )
+        return Animation(html)
+
+
+def simulate(
+    platform: Platform,
+    trajectory: str | Path | Trajectory = "seed",
+    controller: str = "fixed",
+    duration: float | None = None,
+    *,
+    period: float = 1e-3,
+    latency: str = "sample",
+    sensor_resolution: float = 1e-5,
+    plant_step: float | None = None,
+    feedforward: bool = True,
+    engine: str | None = None,
+    firmware: str | None = None,
+    integrator: str | None = None,
+    fit: bool = False,
+    allow_out_of_stroke: bool = False,
+    length_unit: str = "m",
+    angle_unit: str = "rad",
+    progress: bool = False,
+) -> SimulationResult:
+    """Run the fixed-point (or float) controller in the loop with the Drake plant.
+
+    Args:
+        platform: the platform (it must have plate mass properties).
+        trajectory: the pose reference: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, or a
+            `Trajectory`.
+        controller: ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin).
+        duration: simulated seconds (default the trajectory's, else 1 s).
+        period: controller sample period, s.
+        latency: when a tick's output is released: ``"sample"`` (one sample later), ``"computation"`` (after
+            the cycle model's computation time) or ``"none"``.
+        sensor_resolution: leg-length sensor resolution, m per count.
+        plant_step: plant time step, s (default the period, at most 1 ms).
+        feedforward: connect the model-based force feed-forward.
+        engine: the fixed-point tick: ``"c"`` (the generated firmware, compiled) or ``"python"`` (the
+            emulation); default ``"c"`` where a C compiler is found.
+        firmware: a C file implementing the firmware ABI, run as the controller tick.
+        integrator: ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"``.
+        fit: move and scale the reference to the platform's home height and stroke.
+        allow_out_of_stroke: simulate a reference that leaves the stroke (a warning) instead of raising.
+        length_unit: unit of a CSV reference's positions.
+        angle_unit: unit of a CSV reference's angles.
+        progress: show a progress bar.
+
+    Returns:
+        The summary, logs and verdict of the run.
+
+    Raises:
+        StewartError: bad settings (a period too slow for the dynamics, a run too large, an engine that does
+            not fit the controller, ...); ``PhysicalLimitError`` when the reference leaves the stroke.
+    """
+    plan = plan_run(
+        platform,
+        trajectory,
+        controller,
+        duration,
+        period=period,
+        latency=latency,
+        sensor_resolution=sensor_resolution,
+        plant_step=plant_step,
+        feedforward=feedforward,
+        engine=engine,
+        firmware=firmware,
+        integrator=integrator,
+        fit=fit,
+        allow_out_of_stroke=allow_out_of_stroke,
+        length_unit=length_unit,
+        angle_unit=angle_unit,
+    )
+    return run_plan(plan, progress=progress)
+
+
+def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=None) -> SimulationResult:
+    """Run a checked ``RunPlan`` and summarise it (``on_warning(message)`` is called for each warning as it
+    is found, e.g. to print it before the run's progress bar)."""
+    warnings = list(plan.warnings)
+    for w in warnings:
+        if on_warning:
+            on_warning(w)
+    sc, timing = plan.scenario, plan.timing
+    sim = build_simulation(sc, meshcat=meshcat)
+    log = sim.run(plan.duration, progress=progress)
+    gap = sim.max_constraint_gap()
+    if gap > timing.sensor_resolution / 10:
+        warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
+        if on_warning:
+            on_warning(warnings[-1])
+    traj = sc.trajectory
+    truth = sc.plant_platform or sc.platform
+    e = log.length_error(traj, truth)
+    pe = log.pose_error(traj)
+    config = sc.config
+    summary = {
+        "platform": sc.platform.name,
+        "trajectory": traj.name,
+        "controller": sc.controller,
+        "engine": sc.engine,
+        "firmware": sc.firmware,
+        "sample_period_s": timing.sample_period,
+        "latency": timing.latency,
+        "feedforward": sc.feedforward,
+        "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
+        "command_range_N": config.timing.command_range,
+        "output_delay_s": timing.output_delay,
+        "computation_time_s": timing.computation_time,
+        "plant_time_step_s": sc.plant_time_step,
+        "integrator": sc.integrator,
+        "max_constraint_gap_m": gap,
+        "duration_s": plan.duration,
+        "ticks": int(len(log.tick_times())),
+        "max_leg_error_mm": float(np.abs(e).max() * 1e3),
+        "rms_leg_error_mm": float(np.sqrt(np.mean(e**2)) * 1e3),
+        "max_position_error_mm": float(np.abs(pe[:, :3]).max() * 1e3),
+        "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
+        "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
+    }
+    verdict = tracking_verdict(truth, e, pe, log)
+    summary.update(verdict)
+    summary["warnings"] = warnings
+    return SimulationResult(plain(summary), Log(log, e, pe), verdict, warnings, plan)

@@ -1,0 +1,283 @@
+"""``size``: actuator sizing (peak and RMS force, speed, acceleration, power, stroke per leg) for a motion
+program, a trajectory or a duty envelope, against the platform's actuator limits."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from stewart_drake.api.design import carrying
+from stewart_drake.api.dynamics import read_trajectory_csv
+from stewart_drake.api.result import Result
+from stewart_drake.core.dynamics import seed_trajectory
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.sanity import check_poses
+from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.design.envelope import envelope_sizing, load_envelope
+from stewart_drake.design.sizing import UNITS, first_violation, limits_of, rotating_trajectory, size_trajectory
+from stewart_drake.errors import OptionError
+from stewart_drake.script import run_program
+from stewart_drake.script.source import read_program
+
+MAX_LISTED = 10_000  # envelope poses whose allowed accelerations are listed in the JSON
+MAX_SAMPLES = 10_000_000  # samples of a seed/rotating trajectory (t_end / dt)
+AXES = ("x", "y", "z", "roll", "pitch", "yaw")
+
+
+@dataclass(repr=False)
+class SizingResult(Result):
+    """Actuator sizing (``size``).
+
+    Attributes:
+        summary: per leg (peak and RMS force N, speed m/s, acceleration m/s², power W, length range m, with
+            when or where each peak occurs), the set's worst, the limits and the first violation (the dict
+            ``stewart-drake size --json`` prints).
+        violation: the first limit exceeded (``quantity``, ``leg``, ``value``, ``limit``), or None.
+        where: where the violation occurs, as text ("at t = 1.2 s", an envelope pose).
+    """
+
+    summary: dict
+    violation: dict | None
+    where: str
+
+    @property
+    def ok(self) -> bool:
+        """Every leg within its limits."""
+        return self.violation is None
+
+    def violation_message(self) -> str | None:
+        """The violation as one line, or None."""
+        v = self.violation
+        if v is None:
+            return None
+        name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[v["quantity"]]
+        unit = UNITS[v["quantity"]]
+        return (
+            f"leg {v['leg']} {v['quantity']} {v['value']:.6g} {unit} exceeds legs.{name} {v['limit']:.6g} {unit} "
+            f"{self.where}"
+        )
+
+    def _fields(self) -> dict:
+        return self.summary
+
+
+def size(
+    platform: Platform,
+    trajectory: str | Path | Trajectory | None = None,
+    *,
+    program: str | None = None,
+    envelope: str | None = None,
+    legs: bool = False,
+    payload: float = 0.0,
+    payload_com=(0.0, 0.0, 0.0),
+    gravity: float = 9.81,
+    rate: float = 100.0,
+    t_end: float = 4.0,
+    dt: float = 0.001,
+    convention: str = "utn",
+    length_unit: str = "m",
+    angle_unit: str = "rad",
+) -> SizingResult:
+    """Actuator sizing for one source of motion: a trajectory, a motion program or a duty envelope.
+
+    Args:
+        platform: the platform (its ``legs`` limits are checked).
+        trajectory: ``"seed"``, ``"rotating"``, a CSV file (as for `inverse_dynamics`) or a `Trajectory` with
+            samples or exact rates.
+        program: a motion program (``.stw``), sampled at ``rate``.
+        envelope: a duty envelope YAML file (poses with Cartesian velocity and acceleration bounds).
+        legs: include the legs' masses.
+        payload: a point mass carried by the plate, kg.
+        payload_com: ``(3,)`` its position in the plate frame, m.
+        gravity: m/s².
+        rate: a program's samples per second.
+        t_end: the seed's or rotating reference's duration, s.
+        dt: their time step, s.
+        convention: Euler convention of a program's or CSV's angles.
+        length_unit: a CSV's length unit.
+        angle_unit: a CSV's angle unit.
+
+    Returns:
+        The sizing and the first violation of a limit.
+
+    Raises:
+        StewartError: not exactly one source, bad options or samples.
+    """
+    sources = [s for s in (trajectory, program, envelope) if s is not None]
+    if len(sources) != 1:
+        raise OptionError("size: give exactly one of trajectory, program, envelope")
+    loaded, p_TP = carrying(platform, payload, payload_com, gravity)
+    return size_loaded(
+        platform, loaded, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
+        length_unit, angle_unit,
+    )  # fmt: skip
+
+
+def size_loaded(
+    base, platform, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
+    length_unit, angle_unit, envelope_shown=None,
+) -> SizingResult:  # fmt: skip
+    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name)."""
+    header = {
+        "platform": base.name,
+        "legs_model": bool(legs),
+        "payload_kg": payload,
+        "payload_com_m": p_TP,
+        "gravity": gravity,
+    }
+    if envelope is not None:
+        return _envelope(platform, header, bool(legs), str(envelope), gravity)
+    source, t, q, qd, qdd, convention = _samples(
+        platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit
+    )
+    check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
+    s = size_trajectory(platform, t, q, qd, qdd, convention, legs, gravity)
+    limits = limits_of(platform)
+    viol = first_violation(limits, {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length})
+    legs_json = [
+        {
+            "leg": r["leg"],
+            "peak_force_n": r["force"]["peak"],
+            "peak_force_t_s": r["force"]["t"],
+            "peak_force_pose": r["force"]["pose"],
+            "rms_force_n": r["rms_force"],
+            "peak_speed_m_s": r["speed"]["peak"],
+            "peak_speed_t_s": r["speed"]["t"],
+            "peak_speed_pose": r["speed"]["pose"],
+            "peak_accel_m_s2": r["accel"]["peak"],
+            "peak_accel_t_s": r["accel"]["t"],
+            "peak_accel_pose": r["accel"]["pose"],
+            "peak_power_w": r["power"]["peak"],
+            "peak_power_t_s": r["power"]["t"],
+            "peak_power_pose": r["power"]["pose"],
+            "min_length_m": r["min_length"],
+            "max_length_m": r["max_length"],
+        }
+        for r in s.legs()
+    ]
+    if viol is not None:
+        viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]])
+    out = dict(
+        header,
+        source=source,
+        samples=len(t),
+        duration_s=float(t[-1] - t[0]) if len(t) else 0.0,
+        convention=convention,
+        legs=legs_json,
+        set=set_summary(legs_json),
+        limits=limits,
+        violation=viol,
+    )
+    return SizingResult(out, viol, "at t = {t:.4f} s".format(t=viol["t_s"]) if viol else "")
+
+
+def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit):
+    """``(source name, t, q, q̇, q̈, convention)`` of the motion to size."""
+    if program is not None:
+        if not (np.isfinite(rate) and rate > 0):
+            raise OptionError(OptionError.POSITIVE.format(option="--rate", unit="samples per second", value=rate))
+        tr = run_program(read_program(program), program, platform, rate=rate, convention=convention).trajectory
+        return program, tr.t, tr.q, tr.qd, tr.qdd, convention
+    if isinstance(trajectory, Trajectory):
+        if trajectory.t is not None:
+            return trajectory.name, trajectory.t, trajectory.q, trajectory.qd, trajectory.qdd, "utn"
+        t = _times(t_end if trajectory.duration is None else trajectory.duration, dt)
+        return (trajectory.name, t, *trajectory.derivatives(t), "utn")
+    if trajectory in ("seed", "rotating"):
+        t = _times(t_end, dt)
+        q, qd, qdd = (seed_trajectory if trajectory == "seed" else rotating_trajectory)(t)
+        return trajectory, t, q, qd, qdd, "utn"
+    t, q, qd, qdd = read_trajectory_csv(str(trajectory), length_unit, angle_unit)
+    return str(trajectory), t, q, qd, qdd, convention
+
+
+def _times(t_end: float, dt: float) -> np.ndarray:
+    if not (np.isfinite(dt) and dt > 0 and np.isfinite(t_end) and t_end >= 0):
+        raise OptionError(OptionError.DT.format(dt=dt, t_end=t_end))
+    n = int(np.floor(t_end / dt + 0.5)) + 1
+    if n > MAX_SAMPLES:
+        raise OptionError(OptionError.TOO_MANY_SAMPLES.format(n=n, limit=MAX_SAMPLES))
+    return np.arange(n) * dt
+
+
+def set_summary(legs_json) -> dict:
+    """The set's worst leg for each quantity, and its length range."""
+    out = {}
+    for key in ("peak_force_n", "rms_force_n", "peak_speed_m_s", "peak_accel_m_s2", "peak_power_w"):
+        vals = [r[key] for r in legs_json]
+        if any(v is None for v in vals):
+            continue
+        i = int(np.argmax(vals))
+        out[key] = {"value": vals[i], "leg": i + 1}
+    out["min_length_m"] = min(r["min_length_m"] for r in legs_json)
+    out["max_length_m"] = max(r["max_length_m"] for r in legs_json)
+    return out
+
+
+def _envelope(platform, header, legs: bool, path: str, gravity: float) -> SizingResult:
+    env = load_envelope(path)
+    es = envelope_sizing(platform, env, legs=legs, gravity=gravity)
+    legs_json = []
+    for i in range(6):
+        w = es.worst[i]
+        ks = int(np.argmax(es.peak_speed[:, i]))
+        ka = int(np.argmax(es.peak_accel[:, i]))
+        kp = int(np.argmax(es.peak_power[:, i]))
+        legs_json.append(
+            {
+                "leg": i + 1,
+                "peak_force_n": w["peak"],
+                "peak_force_pose": w["pose"],
+                "peak_force_pose_index": w["index"],
+                "peak_force_accel": w["accel"],
+                "peak_force_velocity": w["velocity"],
+                "rms_force_n": None,
+                "peak_speed_m_s": float(es.peak_speed[ks, i]),
+                "peak_speed_pose": env.poses[ks],
+                "peak_accel_m_s2": float(es.peak_accel[ka, i]),
+                "peak_accel_pose": env.poses[ka],
+                "peak_power_w": float(es.peak_power[kp, i]),
+                "peak_power_pose": env.poses[kp],
+                "min_length_m": float(es.length[:, i].min()),
+                "max_length_m": float(es.length[:, i].max()),
+            }
+        )
+    limits = limits_of(platform)
+    viol = first_violation(limits, {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power})
+    if viol is not None:
+        viol = dict(viol, pose_index=viol["index"], pose=env.poses[viol["index"]])
+    allowed = {
+        "axes": list(AXES),
+        "units": ["m/s²"] * 3 + ["rad/s²"] * 3,
+        "min_over_poses": es.allowed_accel.min(axis=0),
+    }
+    if len(env.poses) <= MAX_LISTED:
+        allowed["per_pose"] = es.allowed_accel
+    out = dict(
+        header,
+        source=path,
+        poses=len(env.poses),
+        convention=env.convention,
+        v_max=env.v_max,
+        a_max=env.a_max,
+        legs=legs_json,
+        set=set_summary(legs_json),
+        limits=limits,
+        violation=viol,
+        allowed_acceleration=allowed,
+        bounds={
+            "peak_force_n": "exact worst case",
+            "peak_speed_m_s": "exact worst case",
+            "peak_accel_m_s2": "upper bound",
+            "peak_power_w": "upper bound (peak |F| x peak |L̇|)",
+            "rms_force_n": "undefined for an envelope",
+        },
+    )
+    where = ""
+    if viol:
+        where = f"at envelope {env.shown(viol['index'])}"
+        if viol["quantity"] == "power":
+            where += " (power over an envelope is an upper bound: peak |F| x peak |L̇|)"
+    return SizingResult(out, viol, where)
