@@ -4,7 +4,7 @@
 # `sd.simulate` runs the DSP's controller (16-bit IK in integer millimetres, Q15/Q31 PID) at its sample
 # period against the closed-loop Drake model of the platform, or the same law in floating point. Here: both
 # on the UTN dynamic preset along the seed's reference, then a small sweep of the sample period, and the
-# run recorded as a Meshcat animation. Runs are kept short (0.4 s) so that the notebook runs in seconds.
+# run recorded as a Meshcat animation. Runs are kept short (0.3 s) so that the notebook runs in seconds.
 
 # %%
 import tempfile
@@ -18,7 +18,7 @@ import stewart_drake as sd
 OUT = Path(tempfile.mkdtemp(prefix="stewart-drake-loop-"))  # everything this notebook writes goes here
 platform = sd.load_platform("utn-dynamic")
 reference = sd.Trajectory.seed()
-DURATION = 0.4  # s
+DURATION = 0.3  # s
 
 # %% [markdown]
 # ## Fixed point vs float

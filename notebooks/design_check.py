@@ -127,7 +127,7 @@ plt.show()
 home = platform.home_pose()
 k = sd.stiffness(platform, home, leg_stiffness=2e7)
 m = sd.modes(platform, home, leg_stiffness=2e7)
-np.set_printoptions(precision=3, suppress=False)
+np.set_printoptions(precision=3, suppress=True)
 print("K (N/m, N/rad, N·m/rad):\n", k.matrix)
 print("natural frequencies [Hz]:", np.round(m.frequencies_hz, 1))
 
