@@ -163,3 +163,43 @@ def test_getting_started_commands_run(tmp_path, monkeypatch, capsys):
         assert rc == 0, argv
         if target:
             Path(target).write_text(out)
+    # then the Python of this page and of the envelope page, on the files the commands wrote
+    for block in fenced("getting-started.md", "python") + fenced("envelope-file.md", "python"):
+        exec(compile(block, "docs", "exec"), {})
+    printed = capsys.readouterr().out
+    assert "True" in printed and "N peak on leg 1" in printed
+
+
+def python_blocks() -> list[tuple[str, str]]:
+    return [(p.name, b) for p in sorted(DOCS.glob("*.md")) for b in fenced(p.name, "python")]
+
+
+@pytest.mark.parametrize("page, block", python_blocks())
+def test_python_snippets_call_public_names_with_real_keywords(page, block):
+    """Every ``sd.NAME(...)`` (and ``sd.NAME.method(...)``) in the pages' Python is a public name, called with
+    keywords its signature has: a snippet cannot drift from the API unnoticed, even where it is not run."""
+    import ast
+    import inspect
+
+    import stewart_drake as sd
+
+    calls = 0
+    for node in ast.walk(ast.parse(block)):
+        if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Attribute):
+            continue
+        chain, value = [node.func.attr], node.func.value
+        while isinstance(value, ast.Attribute):
+            chain.insert(0, value.attr)
+            value = value.value
+        if not (isinstance(value, ast.Name) and value.id == "sd"):
+            continue
+        assert chain[0] in sd.__all__, (page, chain)
+        obj = sd
+        for name in chain:
+            obj = getattr(obj, name)
+        params = inspect.signature(obj).parameters
+        if not any(p.kind is p.VAR_KEYWORD for p in params.values()):
+            for kw in node.keywords:
+                assert kw.arg in params, (page, ".".join(chain), kw.arg)
+        calls += 1
+    assert calls >= 1, page
