@@ -20,9 +20,9 @@ import time
 
 import numpy as np
 
-import stewart_drake.workspace.dask_sweep as wd
 from stewart_drake import workspace as ws
 from stewart_drake.core.geometry import load_preset
+from stewart_drake.workspace import dask_sweep as wd
 
 
 def _cpu() -> float:

@@ -20,6 +20,9 @@ ALLOWED = {
     "drake": CORE | CONTROL | {"drake"},
     "api": CORE | CONTROL | {"drake", "api"},  # the public API (stewart_drake.__all__); the app sits above it
 }
+# internal packages named like a public function of stewart_drake.__all__ (sd.workspace, sd.montecarlo, sd.report,
+# sd.firmware): the package top keeps the public name, so `import stewart_drake.workspace as ws` binds the function
+SHADOWED = [["stewart_drake", n] for n in ("workspace", "montecarlo", "report", "firmware")]
 APP = {"commands", "report", "analyses", "montecarlo", "cli", "__init__", "__main__"}
 
 
@@ -79,6 +82,11 @@ def test_module_respects_its_layer(path):
         if name.startswith("."):
             problems.append(f"line {node.lineno}: relative import {name}")
             continue
+        if isinstance(node, ast.Import) and name.split(".")[:2] in SHADOWED and any(a.asname for a in node.names):
+            problems.append(
+                f"line {node.lineno}: `import {name} as ...` gives the public function stewart_drake.{name.split('.')[1]}, "
+                f"not the package: write `from {name.rsplit('.', 1)[0]} import {name.rsplit('.', 1)[1]}` or import names from it"
+            )
         if name == "pydrake" or name.startswith("pydrake."):
             if layer != "drake":
                 problems.append(f"line {node.lineno}: imports {name} outside the drake package")

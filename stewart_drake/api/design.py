@@ -215,7 +215,7 @@ class ModesResult(Result):
     Attributes:
         frequencies_hz: ``(6,)`` natural frequencies, Hz, lowest first.
         damping_ratio: ``(6,)`` damping ratios.
-        shapes: ``(6, 6)`` mode shapes, one per column (None with damping: complex).
+        shapes: ``(6, 6)`` mode shapes, one per column (complex with damping).
         controller: how a controller at ``sample_rate`` sees the lowest mode.
         drake: Drake's linearisation of the same plant and its agreement (with ``drake=True``), else None.
         pose: ``(6,)`` m, rad.
@@ -227,7 +227,7 @@ class ModesResult(Result):
 
     frequencies_hz: np.ndarray
     damping_ratio: np.ndarray
-    shapes: np.ndarray | None
+    shapes: np.ndarray
     controller: dict
     drake: dict | None
     pose: np.ndarray
@@ -245,7 +245,7 @@ class ModesResult(Result):
             "leg_damping_ns_per_m": self.leg_damping,
             "frequencies_hz": self.frequencies_hz,
             "damping_ratio": self.damping_ratio,
-            "mode_shapes": None if self.shapes is None else self.shapes.T,
+            "mode_shapes": self.shapes.T.real if self.leg_damping == 0 else None,
             "controller": self.controller,
         }
         if self.drake is not None:
@@ -335,5 +335,6 @@ def modes_at(load: Load, leg_damping: float, sample_rate: float, drake: bool) ->
             "equilibrium_residual": d["residual"],
             "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize",
         }
-    shapes = m.shapes.real if C is None else None
-    return ModesResult(m.frequencies_hz, m.damping_ratio, shapes, controller, checked, q, k, leg_damping, legs, p.name)
+    return ModesResult(
+        m.frequencies_hz, m.damping_ratio, m.shapes, controller, checked, q, k, leg_damping, legs, p.name
+    )

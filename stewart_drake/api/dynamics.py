@@ -89,6 +89,7 @@ def inverse_dynamics(
     length_unit: str = "m",
     angle_unit: str = "rad",
     allow_out_of_stroke: bool = False,
+    on_warning=None,
 ) -> DynamicsResult:
     """The leg forces that move the plate along a trajectory (rigid-body inverse dynamics).
 
@@ -105,6 +106,7 @@ def inverse_dynamics(
         length_unit: unit of a CSV's positions (``"m"`` or ``"mm"``).
         angle_unit: unit of a CSV's angles (``"rad"``, ``"deg"`` or ``"pi"``).
         allow_out_of_stroke: compute forces where a leg leaves the stroke (a warning) instead of raising.
+        on_warning: called with each warning as it is found.
 
     Returns:
         The sample times and the forces.
@@ -124,9 +126,11 @@ def inverse_dynamics(
         (q, qd, qdd), convention, name, what = seed_trajectory(t), "utn", "seed", "the seed trajectory"
     else:
         t, q, qd, qdd = read_trajectory_csv(str(trajectory), length_unit, angle_unit)
-        name = what = str(trajectory)
-        what = f"trajectory {name}"
+        name, what = str(trajectory), f"trajectory {trajectory}"
     warnings = check_trajectory(platform, t, q, convention, what, allow_out_of_stroke)
+    for w in warnings:
+        if on_warning:
+            on_warning(w)
     if legs:
         if not coriolis:
             raise UsageError(UsageError.LEGS_CORIOLIS)

@@ -222,9 +222,10 @@ class FKResult(Result):
             "solutions": [s.to_dict() for s in self.solutions],
             "method": self.method,
         }
-        if self.complete is not None:
-            out["complete"] = self.complete
-        out.update(self.info)
+        for k, v in self.info.items():  # the CLI's key order: complete after the counts
+            out[k] = v
+            if k == "max_solutions" and self.complete is not None:
+                out["complete"] = self.complete
         return out
 
 

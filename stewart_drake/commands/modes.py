@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.api.design import check_modes_options, modes_at, require_analysable
 from stewart_drake.commands._common import print_json
-from stewart_drake.commands.stiffness import NAMES, add_pose_args, prepare, require_analysable_pose
-from stewart_drake.errors import OPTION_LEG_DAMPING, OPTION_SAMPLE_RATE, OptionError
+from stewart_drake.commands.stiffness import NAMES, add_pose_args, load
 
 
 def register(sub) -> None:
@@ -35,59 +35,20 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    # Deferred: these pull in scipy (~0.2 s) and cli.py imports every command module at start-up.
-    from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
-    from stewart_drake.design.stiffness import stiffness_matrix
-
-    platform, q, k, _ = prepare(args)
-    if not (np.isfinite(args.leg_damping) and args.leg_damping >= 0):
-        raise OptionError(OPTION_LEG_DAMPING.format(value=args.leg_damping))
-    if not (np.isfinite(args.sample_rate) and args.sample_rate > 0):
-        raise OptionError(OPTION_SAMPLE_RATE.format(value=args.sample_rate))
-    require_analysable_pose(platform, q, args.convention)
-    legs = args.legs == "on"
-    K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)
-    M = spatial_inertia(platform, q, args.convention, legs)
-    C = damping_matrix(platform, q, args.leg_damping, args.convention) if args.leg_damping > 0 else None
-    m = analytic_modes(K, M, C)
-    f1 = float(m.frequencies_hz[0])
-    T = 1.0 / args.sample_rate
-    delay = 1.5 * T  # one sample of output delay + half a sample of zero-order hold
-    out = {
-        "platform": platform.name,
-        "pose": args.pose,
-        "legs_model": legs,
-        "leg_stiffness_n_per_m": k,
-        "leg_damping_ns_per_m": args.leg_damping,
-        "frequencies_hz": m.frequencies_hz,
-        "damping_ratio": m.damping_ratio,
-        "mode_shapes": m.shapes.T.real if C is None else None,
-        "controller": {
-            "sample_rate_hz": args.sample_rate,
-            "samples_per_lowest_period": args.sample_rate / f1 if f1 > 0 else None,
-            "loop_delay_s": delay,
-            "phase_lag_at_lowest_deg": 360.0 * f1 * delay,
-        },
-    }
-    if args.drake:
-        # Deferred: only this check needs Drake; cli.py imports every command module at start-up.
-        from stewart_drake.drake.design_checks import drake_modes
-
-        d = drake_modes(platform, q, k, args.leg_damping, args.convention, args.gravity, legs)
-        md = d["modes"]
-        out["drake"] = {
-            "frequencies_hz": md.frequencies_hz,
-            "damping_ratio": md.damping_ratio,
-            "relative_difference": np.abs(md.frequencies_hz / m.frequencies_hz - 1),
-            "mac": subspace_mac(m.shapes, md.shapes, m.frequencies_hz),
-            "equilibrium_residual": d["residual"],
-            "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize",
-        }
+    ld = load(args, check_pose=False)
+    check_modes_options(args.leg_damping, args.sample_rate)
+    require_analysable(ld)
+    r = modes_at(ld, args.leg_damping, args.sample_rate, args.drake)
+    out = r.to_dict() | {"pose": args.pose}
+    if r.drake is not None:  # after the controller's numbers, as before
+        out["drake"] = out.pop("drake")
+    m, k, legs, f1 = r, r.leg_stiffness, r.legs, float(r.frequencies_hz[0])
+    delay = r.controller["loop_delay_s"]
     if args.json:
         print_json(out)
         return 0
     print(
-        f"platform {platform.name}, pose {args.pose}; legs {'with' if legs else 'without'} mass, k = {k[0]:.6g} N/m, c = {args.leg_damping} N·s/m"
+        f"platform {r.platform}, pose {args.pose}; legs {'with' if legs else 'without'} mass, k = {k[0]:.6g} N/m, c = {args.leg_damping} N·s/m"
     )
     print(
         f"{'mode':>4} {'f (Hz)':>11} {'ζ':>8}  shape ["

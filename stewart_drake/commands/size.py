@@ -6,21 +6,12 @@ import sys
 
 import numpy as np
 
+from stewart_drake.api.design import carrying
+from stewart_drake.api.sizing import AXES, size_loaded
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
-from stewart_drake.commands._design import add_payload_args, platform_with_payload
-from stewart_drake.commands.dynamics import read_trajectory_csv
-from stewart_drake.core.dynamics import seed_trajectory
-from stewart_drake.core.rotations import CONVENTIONS
-from stewart_drake.core.sanity import check_poses
-from stewart_drake.design.envelope import envelope_sizing, load_envelope
-from stewart_drake.design.sizing import UNITS, first_violation, limits_of, rotating_trajectory, size_trajectory
-from stewart_drake.errors import OptionError
-from stewart_drake.script import ScriptError, run_program
-from stewart_drake.script.source import read_program
-
-MAX_LISTED = 10_000  # envelope poses whose allowed accelerations are listed in the JSON
-MAX_SAMPLES = 10_000_000  # samples of a seed/rotating trajectory (--t-end / --dt)
-AXES = ("x", "y", "z", "roll", "pitch", "yaw")
+from stewart_drake.commands._design import add_payload_args
+from stewart_drake.core.rotations import CONVENTIONS, length_scale
+from stewart_drake.script import ScriptError
 
 
 def register(sub) -> None:
@@ -55,105 +46,47 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _trajectory(args, platform):
-    if args.program is not None:
-        if not (np.isfinite(args.rate) and args.rate > 0):
-            raise OptionError(OptionError.POSITIVE.format(option="--rate", unit="samples per second", value=args.rate))
-        tr = run_program(
-            read_program(args.program), args.program, platform, rate=args.rate, convention=args.convention
-        ).trajectory
-        return args.program, tr.t, tr.q, tr.qd, tr.qdd, args.convention
-    if args.trajectory in ("seed", "rotating"):
-        if not (np.isfinite(args.dt) and args.dt > 0 and np.isfinite(args.t_end) and args.t_end >= 0):
-            raise OptionError(OptionError.DT.format(dt=args.dt, t_end=args.t_end))
-        n = int(np.floor(args.t_end / args.dt + 0.5)) + 1
-        if n > MAX_SAMPLES:
-            raise OptionError(OptionError.TOO_MANY_SAMPLES.format(n=n, limit=MAX_SAMPLES))
-        t = np.arange(n) * args.dt
-        q, qd, qdd = (seed_trajectory if args.trajectory == "seed" else rotating_trajectory)(t)
-        return args.trajectory, t, q, qd, qdd, "utn"
-    t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
-    return args.trajectory, t, q, qd, qdd, args.convention
-
-
 def run(args) -> int:
     base = platform_from_args(args)
-    platform, p_TP = platform_with_payload(base, args, args.length_unit)
-    legs = args.legs == "on"
-    header = {
-        "platform": base.name,
-        "legs_model": legs,
-        "payload_kg": args.payload,
-        "payload_com_m": p_TP,
-        "gravity": args.gravity,
-    }
-    if args.envelope is not None:
-        return _run_envelope(args, platform, header, legs)
+    k = length_scale(args.length_unit)
+    platform, p_TP = carrying(
+        base,
+        args.payload,
+        np.asarray(args.payload_com, dtype=float) * k,
+        args.gravity,
+        shown_com=args.payload_com,
+        unit=args.length_unit,
+    )
     try:
-        source, t, q, qd, qdd, convention = _trajectory(args, platform)
+        r = size_loaded(
+            base, platform, p_TP, args.trajectory, args.program, args.envelope, args.legs == "on", args.payload,
+            args.gravity, args.rate, args.t_end, args.dt, args.convention, args.length_unit, args.angle_unit,
+        )  # fmt: skip
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
-    check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
-    s = size_trajectory(platform, t, q, qd, qdd, convention, legs, args.gravity)
-    limits = limits_of(platform)
-    viol = first_violation(limits, {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length})
-    rows = s.legs()
-    legs_json = [
-        {
-            "leg": r["leg"],
-            "peak_force_n": r["force"]["peak"],
-            "peak_force_t_s": r["force"]["t"],
-            "peak_force_pose": r["force"]["pose"],
-            "rms_force_n": r["rms_force"],
-            "peak_speed_m_s": r["speed"]["peak"],
-            "peak_speed_t_s": r["speed"]["t"],
-            "peak_speed_pose": r["speed"]["pose"],
-            "peak_accel_m_s2": r["accel"]["peak"],
-            "peak_accel_t_s": r["accel"]["t"],
-            "peak_accel_pose": r["accel"]["pose"],
-            "peak_power_w": r["power"]["peak"],
-            "peak_power_t_s": r["power"]["t"],
-            "peak_power_pose": r["power"]["pose"],
-            "min_length_m": r["min_length"],
-            "max_length_m": r["max_length"],
-        }
-        for r in rows
-    ]
-    if viol is not None:
-        viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]])
-    out = dict(
-        header,
-        source=source,
-        samples=len(t),
-        duration_s=float(t[-1] - t[0]) if len(t) else 0.0,
-        convention=convention,
-        legs=legs_json,
-        set=_set_summary(legs_json),
-        limits=limits,
-        violation=viol,
-    )
+    out = r.to_dict()
     if args.json:
         print_json(out)
+    elif args.envelope is not None:
+        print(
+            f"platform {platform.name}, envelope {args.envelope}: {out['poses']} poses, legs model {args.legs}, payload {args.payload} kg"
+        )
+        _print_table(out["legs"], with_times=False)
+        a, units = out["allowed_acceleration"]["min_over_poses"], out["allowed_acceleration"]["units"]
+        print(
+            "largest acceleration per axis the actuators allow at every pose (others zero, worst velocity): "
+            + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, units))
+        )
     else:
         print(
-            f"platform {base.name}, {source}: {len(t)} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
+            f"platform {base.name}, {out['source']}: {out['samples']} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
         )
-        _print_table(legs_json, with_times=True)
-    return _report_violation(viol, "at t = {t:.4f} s".format(t=viol["t_s"]) if viol else "")
-
-
-def _set_summary(legs_json) -> dict:
-    out = {}
-    for key in ("peak_force_n", "rms_force_n", "peak_speed_m_s", "peak_accel_m_s2", "peak_power_w"):
-        vals = [r[key] for r in legs_json]
-        if any(v is None for v in vals):
-            continue
-        i = int(np.argmax(vals))
-        out[key] = {"value": vals[i], "leg": i + 1}
-    out["min_length_m"] = min(r["min_length_m"] for r in legs_json)
-    out["max_length_m"] = max(r["max_length_m"] for r in legs_json)
-    return out
+        _print_table(out["legs"], with_times=True)
+    if r.violation is not None:
+        print(f"stewart-drake size: {r.violation_message()}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def _print_table(legs_json, with_times: bool) -> None:
@@ -168,94 +101,3 @@ def _print_table(legs_json, with_times: bool) -> None:
             f"{r['min_length_m'] * 1e3:9.2f} {r['max_length_m'] * 1e3:9.2f}"
             + (f"   {r['peak_force_t_s']:.4f}" if with_times else "")
         )
-
-
-def _report_violation(viol, where: str) -> int:
-    if viol is None:
-        return 0
-    name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[viol["quantity"]]
-    print(
-        f"stewart-drake size: leg {viol['leg']} {viol['quantity']} {viol['value']:.6g} {UNITS[viol['quantity']]} exceeds "
-        f"legs.{name} {viol['limit']:.6g} {UNITS[viol['quantity']]} {where}",
-        file=sys.stderr,
-    )
-    return 1
-
-
-def _run_envelope(args, platform, header, legs) -> int:
-    env = load_envelope(args.envelope)
-    es = envelope_sizing(platform, env, legs=legs, gravity=args.gravity)
-    legs_json = []
-    for i in range(6):
-        w = es.worst[i]
-        ks = int(np.argmax(es.peak_speed[:, i]))
-        ka = int(np.argmax(es.peak_accel[:, i]))
-        kp = int(np.argmax(es.peak_power[:, i]))
-        legs_json.append(
-            {
-                "leg": i + 1,
-                "peak_force_n": w["peak"],
-                "peak_force_pose": w["pose"],
-                "peak_force_pose_index": w["index"],
-                "peak_force_accel": w["accel"],
-                "peak_force_velocity": w["velocity"],
-                "rms_force_n": None,
-                "peak_speed_m_s": float(es.peak_speed[ks, i]),
-                "peak_speed_pose": env.poses[ks],
-                "peak_accel_m_s2": float(es.peak_accel[ka, i]),
-                "peak_accel_pose": env.poses[ka],
-                "peak_power_w": float(es.peak_power[kp, i]),
-                "peak_power_pose": env.poses[kp],
-                "min_length_m": float(es.length[:, i].min()),
-                "max_length_m": float(es.length[:, i].max()),
-            }
-        )
-    limits = limits_of(platform)
-    viol = first_violation(limits, {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power})
-    if viol is not None:
-        viol = dict(viol, pose_index=viol["index"], pose=env.poses[viol["index"]])
-    allowed = {
-        "axes": list(AXES),
-        "units": ["m/s²"] * 3 + ["rad/s²"] * 3,
-        "min_over_poses": es.allowed_accel.min(axis=0),
-    }
-    if len(env.poses) <= MAX_LISTED:
-        allowed["per_pose"] = es.allowed_accel
-    out = dict(
-        header,
-        source=args.envelope,
-        poses=len(env.poses),
-        convention=env.convention,
-        v_max=env.v_max,
-        a_max=env.a_max,
-        legs=legs_json,
-        set=_set_summary(legs_json),
-        limits=limits,
-        violation=viol,
-        allowed_acceleration=allowed,
-        bounds={
-            "peak_force_n": "exact worst case",
-            "peak_speed_m_s": "exact worst case",
-            "peak_accel_m_s2": "upper bound",
-            "peak_power_w": "upper bound (peak |F| x peak |L̇|)",
-            "rms_force_n": "undefined for an envelope",
-        },
-    )
-    if args.json:
-        print_json(out)
-    else:
-        print(
-            f"platform {platform.name}, envelope {args.envelope}: {len(env.poses)} poses, legs model {args.legs}, payload {args.payload} kg"
-        )
-        _print_table(legs_json, with_times=False)
-        a = allowed["min_over_poses"]
-        print(
-            "largest acceleration per axis the actuators allow at every pose (others zero, worst velocity): "
-            + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, allowed["units"]))
-        )
-    where = ""
-    if viol:
-        where = f"at envelope {env.shown(viol['index'])}"
-        if viol["quantity"] == "power":
-            where += " (power over an envelope is an upper bound: peak |F| x peak |L̇|)"
-    return _report_violation(viol, where)

@@ -5,23 +5,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.api.design import Load, load_at_pose, stiffness_at
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
-from stewart_drake.commands._design import add_payload_args, platform_with_payload
-from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
+from stewart_drake.commands._design import add_payload_args
 from stewart_drake.core.output_folder import atomic_folder
-from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si, rotation_matrix
-from stewart_drake.core.sanity import check_poses
+from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si
 from stewart_drake.design.maps import MAX_POINTS, slice_maps
-from stewart_drake.design.payload import payload_wrench
 from stewart_drake.design.plots import plot_slice_maps
-from stewart_drake.design.stiffness import (
-    compliance,
-    deflection,
-    leg_stiffness_vector,
-    principal_stiffness,
-    stiffness_matrix,
-)
-from stewart_drake.errors import OptionError, PhysicalLimitError, StewartError
+from stewart_drake.errors import OptionError
 
 NAMES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -69,71 +60,43 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def prepare(args):
-    """``(platform with payload, pose q (6,) SI, k (6,) N/m, p_TP payload position m)``."""
-    base = platform_from_args(args)
-    platform, p_TP = platform_with_payload(base, args, args.length_unit)
-    if args.leg_stiffness is not None:
-        k = leg_stiffness_vector(args.leg_stiffness, "--leg-stiffness")
-    else:
-        k = leg_stiffness_vector(base.legs.stiffness, "legs.stiffness")
-    q = pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit)
-    return platform, q, k, p_TP
-
-
-def require_analysable_pose(platform, q, convention) -> None:
-    """Refuse a pose that cannot be analysed: the sanity checks every command applies (finite, near the
-    platform, plate above the base), then within the stroke and away from a singularity
-    (``PhysicalLimitError``, exit 1)."""
-    check_poses(platform, q, convention, what="--pose")
-    try:
-        inverse_kinematics(platform, q, convention)
-        require_nonsingular(platform, q, convention)
-    except StewartError as e:
-        raise PhysicalLimitError(str(e)) from None
+def load(args, check_pose: bool = True) -> Load:
+    """The platform with its payload at ``--pose`` (SI), checked once (``api.design.load_at_pose``)."""
+    k = length_scale(args.length_unit)
+    return load_at_pose(
+        platform_from_args(args),
+        pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit),
+        args.leg_stiffness,
+        args.convention,
+        args.legs == "on",
+        args.payload,
+        np.asarray(args.payload_com, dtype=float) * k,
+        args.gravity,
+        shown_com=args.payload_com,
+        unit=args.length_unit,
+        check_pose=check_pose,
+    )
 
 
 def run(args) -> int:
-    platform, q, k, p_TP = prepare(args)
-    require_analysable_pose(platform, q, args.convention)
-    legs = args.legs == "on"
-    K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)
-    K0 = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs, loaded=False)
-    pr = principal_stiffness(K)
-    w = payload_wrench(platform, rotation_matrix(q[3:], args.convention), args.payload, p_TP, args.gravity)
-    d = deflection(K, w)
+    ld = load(args)
+    r = stiffness_at(ld)
     kl, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
-    out = {
-        "platform": platform.name,
+    d = r.deflection
+    out = r.to_dict() | {
         "pose": args.pose,
         "length_unit": args.length_unit,
         "angle_unit": args.angle_unit,
-        "convention": args.convention,
-        "leg_stiffness_n_per_m": k,
-        "legs_model": legs,
-        "payload_kg": args.payload,
-        "payload_com_m": p_TP,
-        "gravity": args.gravity,
-        "stiffness": K,
-        "stiffness_zero_load": K0,
-        "compliance": compliance(K),
-        "principal_stiffness": {
-            "translational_n_per_m": pr.translational,
-            "translational_directions": pr.translational_dirs.T,
-            "rotational_nm_per_rad": pr.rotational,
-            "rotational_directions": pr.rotational_dirs.T,
-        },
-        "payload_wrench": w,
-        "deflection": d,
         "deflection_edge_units": np.r_[d[:3] / kl, d[3:] / ka],
     }
     if args.map:
-        write_maps(args, platform, q, k)
+        write_maps(args, ld.platform, ld.q, ld.k)
     if args.json:
         print_json(out)
         return 0
+    k, K, pr = r.leg_stiffness, r.matrix, r.principal
     print(
-        f"platform {platform.name}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
+        f"platform {r.platform}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
         + ("" if np.all(k == k[0]) else " ...")
     )
     print("stiffness K about the rotation centre (rows: force N, moment N·m; columns: δp m, δθ rad):")
@@ -141,11 +104,11 @@ def run(args) -> int:
     for n, row in zip(("fx", "fy", "fz", "mx", "my", "mz"), K):
         print(f"{n:>4}" + "".join(f"{v:13.5g}" for v in row))
     for label, vals, dirs, unit in (
-        ("translational", pr.translational, pr.translational_dirs, "N/m"),
-        ("rotational", pr.rotational, pr.rotational_dirs, "N·m/rad"),
+        ("translational", pr["translational_n_per_m"], pr["translational_directions"], "N/m"),
+        ("rotational", pr["rotational_nm_per_rad"], pr["rotational_directions"], "N·m/rad"),
     ):
         print(f"principal {label} stiffness ({unit}), softest first:")
-        for v, e in zip(vals, dirs.T):
+        for v, e in zip(vals, dirs):
             print(f"  {v:12.5g}  along [{e[0]:+.4f} {e[1]:+.4f} {e[2]:+.4f}]")
     print(
         f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "

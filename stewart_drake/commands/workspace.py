@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import math
-import os
 import sys
 
 import numpy as np
 
-import stewart_drake.workspace as ws
+from stewart_drake.api.reach import LIMIT_CHOICES, solve_workspace
 from stewart_drake.commands._common import (
     add_force_arg,
     add_platform_arg,
@@ -18,14 +17,9 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
-from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from stewart_drake.core.sanity import check_centre, check_finite, check_work
-from stewart_drake.errors import OptionError
-from stewart_drake.workspace import Limits, view_figures
-
-LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
+from stewart_drake.workspace import AXES, view_figures
 
 
 def register(sub) -> None:
@@ -98,26 +92,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | None, max_condition: float):
-    """A ``workspace.Limits`` from the ``--limits`` list (angles already in radians)."""
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    unknown = [n for n in names if n not in LIMIT_CHOICES]
-    if unknown:
-        raise OptionError(
-            OptionError.UNKNOWN_LIMIT.format(option="--limits", value=unknown[0], valid=", ".join(LIMIT_CHOICES))
-        )
-    kw = {}
-    if "joints" in names:
-        kw["base_cone"] = kw["top_cone"] = joint_cone
-    if "collision" in names:
-        if leg_diameter is None:
-            leg_diameter = 2 * leg_dimensions(platform)["cylinder_radius"]
-        kw["leg_diameter"] = leg_diameter
-    if "dexterity" in names:
-        kw["max_condition"] = max_condition
-    return Limits(**kw)
-
-
 def run(args) -> int:
     names = [n.strip() for n in args.limits.split(",")]
     reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
@@ -126,42 +100,21 @@ def run(args) -> int:
     reject_unused(args, "--out", args.out is not None, force=False)
     out = output_folder(args)
     platform = platform_from_args(args)
-    if not (args.resolution > 0 and math.isfinite(args.resolution)):
-        raise OptionError(OptionError.POSITIVE.format(option="--resolution", unit="metres", value=args.resolution))
-    if args.centre is not None:
-        check_centre(platform, args.centre)
-    check_finite(args.orientation, "--orientation")
-    # each worker is a Python process with numpy (~150 MB); more than 4 per CPU only adds overhead
-    check_work(
-        "--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1)
-    )
-    if args.workers < 1:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=1, value=args.workers))
-    orientation = to_radians(args.orientation, args.angle_unit)
-    cone = float(to_radians(args.joint_cone, args.angle_unit))
-    limits = parse_limits(args.limits, platform, cone, args.leg_diameter, args.max_condition)
-    w = ws.constant_orientation_workspace(
+    r = solve_workspace(
         platform,
-        orientation,
+        to_radians(args.orientation, args.angle_unit),
         args.resolution,
-        limits,
+        args.limits,
         args.convention,
-        workers=args.workers,
-        progress=sys.stderr.isatty(),
+        float(to_radians(args.joint_cone, args.angle_unit)),
+        args.leg_diameter,
+        args.max_condition,
+        args.centre,
+        args.workers,
+        sys.stderr.isatty(),
+        orientation_shown=args.orientation,
     )
-    rot = ws.orientation_limits(platform, centre=args.centre, limits=limits)
-    result = {
-        "platform": platform.name,
-        "orientation_deg": np.degrees(orientation).tolist(),
-        "convention": args.convention,
-    }
-    result.update(w.summary())
-    result["rotation_limits_deg"] = {
-        a: {("+" if r.sign > 0 else "-"): math.degrees(r.angle) for r in rot if r.axis == a} for a in ws.AXES
-    }
-    result["rotation_limits"] = [r.as_dict() for r in rot]
-    result["rotation_centre_m"] = list(platform.rotation_centre if args.centre is None else args.centre)
-    result["mobility"] = ws.stewart_mobility("SPS")["m"]
+    w, result, rot = r.grid, r.to_dict(), r.rotation_limits
     if out is not None:
         write_outputs(w, result, out)
     if args.json:
@@ -169,9 +122,9 @@ def run(args) -> int:
     else:
         print(
             f"platform {platform.name}: workspace at orientation {np.round(args.orientation, 6).tolist()} {args.angle_unit}, "
-            f"limits {', '.join(limits.active)}, grid {args.resolution} m"
+            f"limits {', '.join(w.limits.active)}, grid {args.resolution} m"
         )
-        for a in ws.AXES:
+        for a in AXES:
             lo, hi = result[f"{a}_range"]
             print(f"  {a}: [{lo:+.4f}, {hi:+.4f}] m")
         print(

@@ -45,8 +45,9 @@ import dask
 import distributed
 import numpy as np
 
-import stewart_drake.workspace as _ws
-from stewart_drake.workspace.grid import grid_axes
+from stewart_drake.workspace.executors import default_workers
+from stewart_drake.workspace.grid import constant_orientation_workspace, default_bounds, grid_axes
+from stewart_drake.workspace.maps import count_reachable
 
 # Dask settings for the workers of ``local_client`` (see the module docstring): no statistical profiler,
 # and Dask's default worker environment without MALLOC_TRIM_THRESHOLD_ (numpy temporaries reuse the heap).
@@ -62,7 +63,7 @@ def local_client(n_workers: int | None = None, threads_per_worker: int = 1, proc
     """A ``distributed.Client`` on a ``LocalCluster`` of ``n_workers`` (default: the usable CPUs) worker
     processes, one thread each (the numpy kernels are single-threaded per slab). Use as a context
     manager; closing the client closes the cluster."""
-    cluster = local_cluster(n_workers or _ws.default_workers(), threads_per_worker, processes, **kwargs)
+    cluster = local_cluster(n_workers or default_workers(), threads_per_worker, processes, **kwargs)
     client = distributed.Client(cluster)
     client._stewart_owned_cluster = cluster  # closed with the client (see close_client)
     warm_up(client)
@@ -134,7 +135,7 @@ def slab_nodes(
 ) -> int:
     """The ``chunk_nodes`` that gives at least ``TASKS_PER_WORKER`` slabs per thread (never more than
     ``chunk_nodes``; a slab keeps at least two x-planes)."""
-    b = _ws.default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
+    b = default_bounds(platform, orientation, convention) if bounds is None else np.asarray(bounds, dtype=float)
     nx, ny, nz = (len(a) for a in grid_axes(b, float(resolution)))
     planes = max(2, math.ceil(nx / (TASKS_PER_WORKER * threads)))
     return int(min(chunk_nodes, planes * ny * nz))
@@ -150,7 +151,7 @@ def workspace_on_dask(platform, client=None, **kwargs):
     try:
         if "chunk_nodes" not in kwargs:
             kwargs["chunk_nodes"] = slab_nodes(platform, worker_threads(client), **kwargs)
-        return _ws.constant_orientation_workspace(platform, executor=dask_executor(client), **kwargs)
+        return constant_orientation_workspace(platform, executor=dask_executor(client), **kwargs)
     finally:
         if own:
             close_client(client)
@@ -165,7 +166,7 @@ def count_reachable_on_dask(platform, grids, client=None, **kwargs):
         if "chunk" not in kwargs:
             total = math.prod(len(np.ravel(g)) for g in grids)
             kwargs["chunk"] = int(max(1, min(1 << 18, math.ceil(total / (TASKS_PER_WORKER * worker_threads(client))))))
-        return _ws.count_reachable(platform, grids, executor=dask_executor(client), **kwargs)
+        return count_reachable(platform, grids, executor=dask_executor(client), **kwargs)
     finally:
         if own:
             close_client(client)

@@ -12,7 +12,7 @@ from stewart_drake.core.geometry import load_preset
 
 pytest.importorskip("distributed", reason='the Dask back end needs dask.distributed (pip install "dask[distributed]")')
 
-import stewart_drake.workspace.dask_sweep as wd  # noqa: E402
+from stewart_drake.workspace import dask_sweep as wd  # noqa: E402
 
 
 def test_slab_size_gives_enough_tasks_per_worker():
