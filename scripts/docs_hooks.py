@@ -11,6 +11,7 @@ drift from them.
 from __future__ import annotations
 
 import argparse
+import importlib
 import inspect
 import logging
 from pathlib import Path
@@ -34,6 +35,22 @@ SEE_ALSO = {
     "montecarlo": ["../montecarlo-vary.md"],
     "firmware": ["../firmware-abi.md"],
     "simulate": ["../firmware-abi.md"],
+}
+
+
+# The public function each command calls (``import stewart_drake as sd``), linked from its page.
+PYTHON = {
+    "ik": "ik",
+    "fk": "fk",
+    "dynamics": "inverse_dynamics",
+    "stiffness": "stiffness",
+    "modes": "modes",
+    "size": "size",
+    "workspace": "workspace",
+    "simulate": "simulate",
+    "montecarlo": "montecarlo",
+    "firmware": "firmware",
+    "report": "report",
 }
 
 
@@ -82,6 +99,13 @@ def command_page(name: str, parser: argparse.ArgumentParser) -> str:
     out += ["```text", parser.format_usage().strip(), "```", ""]
     if parser.description:
         out += [parser.description.strip(), ""]
+    module = inspect.getdoc(importlib.import_module(f"stewart_drake.commands.{COMMANDS[name][0]}")) or ""
+    more = module.split("\n\n", 1)[1:]  # the module docstring past its first paragraph (the help line again)
+    if more:
+        out += [more[0].strip(), ""]
+    function = PYTHON.get(name)
+    if function and function in public_names():
+        out += [f"From Python: [`sd.{function}`](../api.md#{api_target(function)}).", ""]
     subs = _subparsers(parser)
     if len(_option_rows(parser)) > 2:
         out += ["## Options", "", *_option_rows(parser), ""]

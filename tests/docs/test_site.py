@@ -128,3 +128,13 @@ def test_a_public_name_without_docstring_is_reported(monkeypatch):
     monkeypatch.setattr(stewart_drake, "Documented", Documented, raising=False)
     assert hooks.undocumented(["bare", "Documented"]) == ["bare", "Documented.method"]
     assert hooks.undocumented(public_names()) == []
+
+
+def test_command_pages_link_their_python_function(site):
+    """Each command that calls a public function links to it (the link is dropped for a name that is not
+    public, so a renamed function would silently lose it: the map must name public functions only)."""
+    hooks = load_hooks()
+    assert set(hooks.PYTHON) <= set(COMMANDS) and set(hooks.PYTHON.values()) <= set(public_names())
+    for command, function in hooks.PYTHON.items():
+        page = (site[0] / "commands" / command / "index.html").read_text(encoding="utf-8")
+        assert f'href="../../api/#{hooks.api_target(function)}"' in page, command
