@@ -802,3 +802,8 @@ OPTION_JOINT_OVERFLOW = "joint angles {value} {unit}: the foot angle gamma = q1 
 OPTION_TARGET = "target must be finite, got {value}"
 OPTION_SERVO_POSE = "--pose has a non-finite number: {value}"
 REPORT_UNKNOWN_ANALYSIS = "unknown analysis {name!r}; available: {available}"
+# The Python API's own argument errors (stewart_drake.api: what a caller passes that no CLI option can)
+API_POSE_SHAPE = "{what}: expected poses of shape (..., 6), got {shape}"
+API_FIT_PLATFORM = "fit=True needs the platform to fit the trajectory to"
+API_SIZE_SOURCE = "size: give exactly one of trajectory, program, envelope (got {given})"
+API_FILE_EXISTS = "{path}: exists; pass overwrite=True to replace it"

@@ -6,12 +6,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.api.simulation import plan_run
 from stewart_drake.control import ControllerConfig, DspTiming, leg_space_inertia, strut_stiffness
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import ROTATING, SEED, design_poses, fit_trajectory
 from stewart_drake.drake.animation import log_saturating, record_animation
-from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation, setpoint_step_gain
+from stewart_drake.drake.simulation import ActuatorModel, build_simulation, setpoint_step_gain
 from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.montecarlo.sweep import run_sweep, sweep_study
@@ -25,6 +26,19 @@ PLATFORM = "utn-dynamic"
 # the fixed-point controller's tick as compiled C (bit-identical to the Python engine, several times faster)
 ENGINE = resolve_engine("c", "analysis controller_in_the_loop")
 PRESETS = ("utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009")
+
+
+def loop_plan(platform, traj, kind: str, duration: float, **options):
+    """A closed loop of this analysis, built by ``api.simulation.plan_run`` (the one home of a closed-loop run:
+    gains designed over the reference's poses, the C engine for the fixed-point law); the report's loops are
+    its own settings, so the per-run sanity checks are skipped."""
+    engine = ENGINE if kind == "fixed" else None
+    return plan_run(platform, traj, kind, duration, engine=engine, checks=False, command="report", **options)
+
+
+def simulate_log(platform, traj, kind: str, duration: float, **options):
+    """The log of ``loop_plan``'s run."""
+    return build_simulation(loop_plan(platform, traj, kind, duration, **options).scenario).run(duration)
 
 
 def _bound_terms(platform, traj, log_float, duration, cfg: ControllerConfig):
@@ -63,9 +77,9 @@ def _tracking(section, platform, duration):
     rows, logs = [], {}
     fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True)
     for j, traj in enumerate((SEED, ROTATING)):
-        cfg = ControllerConfig.for_platform(platform, poses=design_poses(traj, duration))
+        cfg = loop_plan(platform, traj, "float", duration).config  # the gains every loop of this trajectory runs
         for i, kind in enumerate(("float", "fixed")):
-            log = build_simulation(Scenario(platform, traj, kind, cfg, engine=ENGINE)).run(duration)
+            log = simulate_log(platform, traj, kind, duration)
             logs[traj.name, kind] = log
             e = log.length_error(traj, platform)
             pe = log.pose_error(traj)
@@ -133,14 +147,12 @@ def _preset_case(case):
     m = np.linalg.eigvalsh(leg_space_inertia(platform))
     base = {"seed": SEED, "rotating": ROTATING}[base_name]
     traj = fit_trajectory(base, platform)
-    poses = design_poses(traj, duration)
-    cfg = ControllerConfig.for_platform(platform, poses=poses)
+    plans = {kind: loop_plan(platform, traj, kind, duration) for kind in ("float", "fixed")}
+    cfg = plans["float"].config
+    poses = design_poses(traj, max(duration, traj.duration or 0.0))  # the poses the gains were designed over
     g = cfg.gains
-    logs = {
-        kind: build_simulation(Scenario(platform, traj, kind, cfg, engine=ENGINE)).run(duration)
-        for kind in ("float", "fixed")
-    }
-    pid_only = build_simulation(Scenario(platform, traj, "float", cfg, feedforward=False)).run(duration)
+    logs = {kind: build_simulation(plan.scenario).run(duration) for kind, plan in plans.items()}
+    pid_only = build_simulation(loop_plan(platform, traj, "float", duration, feedforward=False).scenario).run(duration)
     e = {k: float(np.abs(v.length_error(traj, platform)).max()) for k, v in logs.items()}
     e_pid = float(np.abs(pid_only.length_error(traj, platform)).max())
     d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs["float"], duration, cfg)
@@ -259,8 +271,7 @@ def _sweep(section, platform, periods, duration):
 def _saturation(section, platform, ranges, duration):
     rows = []
     for rng in ranges:
-        cfg = ControllerConfig.for_platform(platform, DspTiming(command_range=rng), poses=design_poses(SEED))
-        log = build_simulation(Scenario(platform, SEED, "fixed", cfg, engine=ENGINE)).run(duration)
+        log = simulate_log(platform, SEED, "fixed", duration, command_range=rng)
         sat = log.saturations().astype(int)
         st = log.status[:, 3]
         first = log.t[np.argmax(st > 0)] if st[-1] > 0 else float("nan")

@@ -9,11 +9,12 @@ from collections import Counter
 
 import numpy as np
 
+from stewart_drake.api.simulation import plan_run
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
 from stewart_drake.core.c_build import compilers
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.simulation import Scenario, build_simulation
+from stewart_drake.drake.simulation import build_simulation
 from stewart_drake.firmware.check import workspace_poses
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.host import op_counts_tp17, tp17_leg_lengths_c
@@ -192,7 +193,9 @@ def _sil(section, quick: bool) -> None:
     duration = 0.3 if quick else 4.0
     logs, wall = {}, {}
     for eng in ("python", "c"):
-        sim = build_simulation(Scenario(p, "seed", "fixed", engine=eng))
+        sim = build_simulation(
+            plan_run(p, "seed", "fixed", duration, engine=eng, checks=False, command="report").scenario
+        )
         t0 = time.perf_counter()
         logs[eng] = sim.run(duration)
         wall[eng] = time.perf_counter() - t0

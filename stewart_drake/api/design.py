@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
@@ -156,13 +157,13 @@ class StiffnessResult(Result):
 
 def stiffness(
     platform: Platform,
-    pose,
-    leg_stiffness=None,
+    pose: ArrayLike,
+    leg_stiffness: float | ArrayLike | None = None,
     *,
     convention: str = "utn",
     legs: bool = False,
     payload: float = 0.0,
-    payload_com=(0.0, 0.0, 0.0),
+    payload_com: ArrayLike = (0.0, 0.0, 0.0),
     gravity: float = 9.81,
 ) -> StiffnessResult:
     """The 6×6 Cartesian stiffness about the rotation centre at a pose, its principal values, the compliance
@@ -255,14 +256,14 @@ class ModesResult(Result):
 
 def modes(
     platform: Platform,
-    pose,
-    leg_stiffness=None,
+    pose: ArrayLike,
+    leg_stiffness: float | ArrayLike | None = None,
     *,
     leg_damping: float = 0.0,
     convention: str = "utn",
     legs: bool = False,
     payload: float = 0.0,
-    payload_com=(0.0, 0.0, 0.0),
+    payload_com: ArrayLike = (0.0, 0.0, 0.0),
     gravity: float = 9.81,
     sample_rate: float = 1000.0,
     drake: bool = False,

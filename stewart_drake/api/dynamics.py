@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -89,14 +90,15 @@ def inverse_dynamics(
     length_unit: str = "m",
     angle_unit: str = "rad",
     allow_out_of_stroke: bool = False,
-    on_warning=None,
+    on_warning: Callable[[str], None] | None = None,
 ) -> DynamicsResult:
     """The leg forces that move the plate along a trajectory (rigid-body inverse dynamics).
 
     Args:
         platform: the platform (it must have plate mass properties).
         trajectory: ``"seed"``, a CSV file (7 columns t, pose: rates by a cubic spline; or 19 columns
-            t, q, q̇, q̈), or a `Trajectory` (sampled every ``dt`` seconds up to ``t_end``).
+            t, q, q̇, q̈), or a `Trajectory` (a motion program's own samples; otherwise, or with ``t_end``,
+            sampled every ``dt`` seconds up to ``t_end``).
         legs: include the legs' masses (needs ``coriolis``).
         coriolis: include C(q, q̇) q̇ (False: the seed's model).
         gravity: m/s².
@@ -117,7 +119,10 @@ def inverse_dynamics(
     """
     require_plate(platform, "dynamics")
     gravity = check_gravity(gravity)
-    if isinstance(trajectory, Trajectory):
+    if isinstance(trajectory, Trajectory) and trajectory.t is not None and t_end is None:  # a program's samples
+        t, q, qd, qdd = trajectory.t, trajectory.q, trajectory.qd, trajectory.qdd
+        convention, name, what = "utn", trajectory.name, f"trajectory {trajectory.name}"
+    elif isinstance(trajectory, Trajectory):
         times = sample_times(trajectory.duration if t_end is None else t_end, dt)
         t, (q, qd, qdd), convention, name = times, trajectory_rates(trajectory, times), "utn", trajectory.name
         what = f"trajectory {name}"

@@ -3,6 +3,7 @@ C firmware with the bit-exact emulation. ``sd.firmware.generate(...)``, ``sd.fir
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -63,10 +64,12 @@ class GenerateResult(Result):
         summary: platform, output folder, number format, rate, gains, files (name, bytes), cycle estimates
             of ``sd_ik`` and ``sd_tick``, and the compilers that compile-checked it.
         files: the paths written.
+        config: the controller's number format, timing and gains.
     """
 
     summary: dict
     files: list
+    config: ControllerConfig
 
     def _fields(self) -> dict:
         return self.summary
@@ -74,7 +77,7 @@ class GenerateResult(Result):
 
 def generate(
     platform: Platform,
-    out,
+    out: str | Path,
     *,
     word_bits: int = 16,
     length_lsb: float = 1e-3,
@@ -84,7 +87,7 @@ def generate(
     sensor_resolution: float = 1e-5,
     trajectory: str | Trajectory | None = None,
     compile: bool = True,
-    on_note=None,
+    on_note: Callable[[str], None] | None = None,
 ) -> GenerateResult:
     """Generate the C firmware (``sd_firmware.h``, ``sd_firmware.c``, README) for a platform into a folder.
 
@@ -144,7 +147,7 @@ def generate(
         "tick_us": round(g.tick_cycles / config.timing.clock_hz * 1e6, 2),
         "compiled_with": compiled,
     }
-    return GenerateResult(summary, [out / p.name for p in written])
+    return GenerateResult(summary, [out / p.name for p in written], config)
 
 
 @dataclass(repr=False)
@@ -168,7 +171,7 @@ class CheckResult(Result):
 
 
 def check(
-    path,
+    path: str | Path,
     platform: Platform,
     *,
     poses: int = 100_000,

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.assembly_modes import modes_from_solutions
@@ -20,7 +21,7 @@ from stewart_drake.core.sanity import (
     check_work,
     plate_anchor_heights,
 )
-from stewart_drake.errors import OPTION_MAX_ITER, OptionError, UsageError
+from stewart_drake.errors import API_POSE_SHAPE, OPTION_MAX_ITER, OptionError, UsageError
 
 # Newton converges quadratically from a good start (< 20 iterations); beyond this many it is not
 # converging, and each iteration costs a Jacobian solve.
@@ -77,7 +78,7 @@ class IKResult(Result):
         return {"platform": self.platform, "results": results}
 
 
-def ik(platform: Platform, poses, convention: str = "utn") -> IKResult:
+def ik(platform: Platform, poses: ArrayLike, convention: str = "utn") -> IKResult:
     """Leg lengths for poses (closed-form inverse kinematics), with the stroke and base checks.
 
     Args:
@@ -98,7 +99,7 @@ def solve_ik(platform: Platform, poses, convention: str = "utn", what: str = "po
     """``ik`` with the name its errors give the poses (``what``, and the file ``lines`` they came from)."""
     q = np.asarray(poses, dtype=float)
     if q.shape[-1:] != (6,):
-        raise UsageError(f"{what}: expected poses of shape (..., 6), got {q.shape}")
+        raise UsageError(API_POSE_SHAPE.format(what=what, shape=q.shape))
     flat = q.reshape(-1, 6)
     check_poses(platform, flat, convention, what=what, lines=lines, base=False)
     L = leg_lengths(platform, flat, convention)
@@ -231,10 +232,10 @@ class FKResult(Result):
 
 def fk(
     platform: Platform,
-    lengths,
+    lengths: ArrayLike,
     all_modes: bool = False,
     *,
-    initial=None,
+    initial: ArrayLike | None = None,
     convention: str = "utn",
     method: str = "homotopy",
     tol: float = 1e-13,

@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
@@ -73,15 +75,15 @@ def parse_limits(limits, platform: Platform, joint_cone: float, leg_diameter: fl
 
 def workspace(
     platform: Platform,
-    orientation=(0.0, 0.0, 0.0),
+    orientation: ArrayLike = (0.0, 0.0, 0.0),
     resolution: float = 0.01,
-    limits="stroke",
+    limits: str | Sequence[str] = "stroke",
     *,
     convention: str = "utn",
     joint_cone: float = math.radians(45.0),
     leg_diameter: float | None = None,
     max_condition: float = 100.0,
-    centre=None,
+    centre: ArrayLike | None = None,
     workers: int = 1,
     progress: bool = False,
 ) -> WorkspaceResult:

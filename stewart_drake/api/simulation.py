@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -41,6 +42,10 @@ from stewart_drake.errors import (
 )
 from stewart_drake.firmware.engine import default_engine
 from stewart_drake.firmware.module import check_source
+
+if TYPE_CHECKING:  # annotations only: matplotlib and pandas are loaded when a figure or a table is asked for
+    import pandas
+    from matplotlib.figure import Figure
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -108,6 +113,7 @@ def plan_run(
     plant_platform: Platform | None = None,
     gain_scale: float = 1.0,
     nominal_gains: bool = False,
+    command_range: float | None = None,
     checks: bool = True,
     command: str = "simulate",
     duration_shown=None,
@@ -116,7 +122,8 @@ def plan_run(
 
     ``actuators``, ``sensor``, ``plant_platform``: a perturbed run (Monte Carlo); ``gain_scale`` multiplies
     the designed gains; ``nominal_gains``: design them for the nominal timing (``DspTiming()``: what the
-    firmware was built for) rather than this run's; ``checks=False`` skips the per-run sanity checks (the
+    firmware was built for) rather than this run's; ``command_range``: the Q15 command's full scale, N (default the
+    platform's ``legs.max_force``); ``checks=False`` skips the per-run sanity checks (the
     caller has checked the study); ``command``: how messages name the caller; ``duration_shown``: the
     duration as the user wrote it.
     """
@@ -141,7 +148,7 @@ def plan_run(
         sample_period=period,
         latency=latency,
         sensor_resolution=sensor_resolution,
-        command_range=float(platform.legs.max_force),
+        command_range=float(platform.legs.max_force) if command_range is None else command_range,
     )
     warnings: list[str] = []
     if checks:
@@ -167,7 +174,7 @@ def plan_run(
         raise UsageError(OPTION_ENGINE_FIXED.format(controller=controller))
     if firmware and engine == "python":
         raise UsageError(OPTION_FIRMWARE_ENGINE)
-    engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command}")
+    engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command.split()[0]}")
     scenario = Scenario(
         platform,
         traj,
@@ -213,7 +220,7 @@ class Log:
         """The names of the arrays."""
         return [*SimulationLog.ARRAYS, "length_error", "pose_error"]
 
-    def to_pandas(self):
+    def to_pandas(self) -> pandas.DataFrame:
         """One row per plant step: ``t``, the pose, leg lengths, set-points, commands, forces, errors.
 
         Returns:
@@ -246,7 +253,7 @@ class Animation:
         escaped = self.html.replace("&", "&amp;").replace('"', "&quot;")
         return f'<iframe srcdoc="{escaped}" style="width: 100%; height: 480px; border: none"></iframe>'
 
-    def save(self, path) -> Path:
+    def save(self, path: str | Path) -> Path:
         """Write the page to ``path`` (a new file).
 
         Args:
@@ -288,7 +295,7 @@ class SimulationResult(Result):
     def _fields(self) -> dict:
         return self.summary
 
-    def plot(self):
+    def plot(self) -> Figure:
         """Leg-length errors and leg forces over time.
 
         Returns:

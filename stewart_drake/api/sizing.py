@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.api.design import carrying
 from stewart_drake.api.dynamics import read_trajectory_csv
@@ -17,7 +18,7 @@ from stewart_drake.core.sanity import check_poses
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
 from stewart_drake.design.sizing import UNITS, first_violation, limits_of, rotating_trajectory, size_trajectory
-from stewart_drake.errors import OptionError
+from stewart_drake.errors import API_SIZE_SOURCE, OptionError
 from stewart_drake.script import run_program
 from stewart_drake.script.source import read_program
 
@@ -71,7 +72,7 @@ def size(
     envelope: str | None = None,
     legs: bool = False,
     payload: float = 0.0,
-    payload_com=(0.0, 0.0, 0.0),
+    payload_com: ArrayLike = (0.0, 0.0, 0.0),
     gravity: float = 9.81,
     rate: float = 100.0,
     t_end: float = 4.0,
@@ -107,7 +108,7 @@ def size(
     """
     sources = [s for s in (trajectory, program, envelope) if s is not None]
     if len(sources) != 1:
-        raise OptionError("size: give exactly one of trajectory, program, envelope")
+        raise OptionError(API_SIZE_SOURCE.format(given=len(sources)))
     loaded, p_TP = carrying(platform, payload, payload_com, gravity)
     return size_loaded(
         platform, loaded, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,

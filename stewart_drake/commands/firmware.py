@@ -6,17 +6,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from stewart_drake.api import firmware
 from stewart_drake.commands._common import add_platform_arg, print_json
-from stewart_drake.errors import (
-    OPTION_FIRMWARE_RATE,
-    OPTION_FIRMWARE_TFR16,
-    OPTION_FIRMWARE_WORD_BITS,
-    OPTION_OUT_FOREIGN,
-    OPTION_OUT_NOT_FOLDER,
-    OptionError,
-    OutputError,
-    UsageError,
-)
+from stewart_drake.core.geometry import load_platform
 
 
 def _format_args(p) -> None:
@@ -89,78 +81,25 @@ def register(sub) -> None:
     c.set_defaults(func=run_check)
 
 
-def _config(args, platform):
-    from stewart_drake.control import ControllerConfig, DspTiming
-    from stewart_drake.fixedpoint.generic import QFormat
-
-    if not 8 <= args.word_bits <= 16:
-        raise OptionError(OPTION_FIRMWARE_WORD_BITS.format(value=args.word_bits))
-    if not (args.rate > 0 and args.rate <= 1e6):
-        raise OptionError(OPTION_FIRMWARE_RATE.format(value=args.rate))
-    if args.trig == "tfr16" and args.word_bits != 16:
-        raise UsageError(OPTION_FIRMWARE_TFR16.format(value=args.word_bits))
-    fmt = QFormat(args.word_bits, args.length_lsb, args.trig)
-    timing = DspTiming(
-        sample_period=1.0 / args.rate,
+def _format(args) -> dict:
+    """The number format, rate, sensor and design reference the options give (``api.firmware``'s keywords)."""
+    return dict(
+        word_bits=args.word_bits,
+        length_lsb=args.length_lsb,
+        trig=args.trig,
+        convention=args.convention,
+        rate=args.rate,
         sensor_resolution=args.sensor_resolution,
-        command_range=float(platform.legs.max_force),
-    ).check()
-    poses = None
-    if args.trajectory is not None:
-        from stewart_drake.core.trajectory import design_poses, get_trajectory
-
-        poses = design_poses(get_trajectory(args.trajectory))
-    return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=args.convention)
+        trajectory=args.trajectory,
+    )
 
 
 def run_generate(args) -> int:
-    from stewart_drake.core.c_build import compilers
-    from stewart_drake.core.geometry import load_platform
-    from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.firmware.generate import FILES, generate
-    from stewart_drake.firmware.module import compile_generated
-
+    note = lambda n: print(f"stewart-drake firmware generate: note: {n}", file=sys.stderr)  # noqa: E731
     platform = load_platform(args.platform)
-    config = _config(args, platform)
-    out = Path(args.out)
-    if out.exists():
-        if not out.is_dir():
-            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=args.out))
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
-        if foreign:
-            raise OutputError(OPTION_OUT_FOREIGN.format(out=args.out, names=", ".join(foreign[:3])))
-    g = generate(platform, config)
-    compiled = []
-    if not args.no_compile:
-        for cc in compilers():
-            compile_generated(g, compiler=cc)  # -std=c99 -Wall -Wextra -Werror -pedantic
-            compiled.append(cc.name)
-        if not compiled:
-            print(
-                "stewart-drake firmware generate: note: no C compiler found; the module was not compile-checked",
-                file=sys.stderr,
-            )
-    with atomic_folder(out) as tmp:
-        written = g.write(tmp)
-    ik = g.ik_cycles
-    summary = {
-        "platform": platform.name,
-        "out": str(out),
-        "format": {
-            "word_bits": config.ik_format.word_bits,
-            "length_lsb_m": config.ik_format.length_lsb,
-            "trig": config.ik_format.trig,
-            "convention": config.convention,
-        },
-        "rate_hz": args.rate,
-        "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
-        "files": [{"name": p.name, "bytes": (out / p.name).stat().st_size} for p in written],
-        "ik_cycles": round(ik.cycles),
-        "ik_us": round(ik.microseconds, 2),
-        "tick_cycles": round(g.tick_cycles),
-        "tick_us": round(g.tick_cycles / config.timing.clock_hz * 1e6, 2),
-        "compiled_with": compiled,
-    }
+    r = firmware.generate(platform, args.out, compile=not args.no_compile, on_note=note, **_format(args))
+    summary, out, compiled, written = r.to_dict(), Path(args.out), r.summary["compiled_with"], r.files
+    clock_hz = r.config.timing.clock_hz
     if args.json:
         print_json(summary)
     else:
@@ -169,7 +108,7 @@ def run_generate(args) -> int:
             + ", ".join(f"{f['name']} ({f['bytes']} B)" for f in summary["files"])
         )
         print(
-            f"cycle estimate at {config.timing.clock_hz / 1e6:g} MHz: sd_ik {summary['ik_cycles']} cycles ({summary['ik_us']} µs), "
+            f"cycle estimate at {clock_hz / 1e6:g} MHz: sd_ik {summary['ik_cycles']} cycles ({summary['ik_us']} µs), "
             f"sd_tick {summary['tick_cycles']} cycles ({summary['tick_us']} µs)"
         )
         if not args.no_compile:
@@ -178,16 +117,17 @@ def run_generate(args) -> int:
 
 
 def run_check(args) -> int:
-    from stewart_drake.core.c_build import compiler_by_name
-    from stewart_drake.core.geometry import load_platform
-    from stewart_drake.drake.firmware_check import check_firmware
-    from stewart_drake.firmware.module import check_source
-
-    check_source(args.file)
-    platform = load_platform(args.platform)
-    config = _config(args, platform)
-    cc = compiler_by_name(args.compiler) if args.compiler else None
-    r = check_firmware(Path(args.file), platform, config, args.poses, args.seed, args.trace, args.duration, cc)
+    result = firmware.check(
+        args.file,
+        load_platform(args.platform),
+        poses=args.poses,
+        seed=args.seed,
+        trace=args.trace,
+        duration=args.duration,
+        compiler=args.compiler,
+        **_format(args),
+    )
+    r = result.to_dict()
     if args.json:
         print_json(r)
     else:

@@ -9,28 +9,21 @@ from pathlib import Path
 
 from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
-from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
-from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
-from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.montecarlo_animation import write_animation
-from stewart_drake.errors import OptionError, StewartError, UsageError
-from stewart_drake.firmware.engine import default_engine, resolve_engine
-from stewart_drake.montecarlo.scenario import Study, draw, plant_platform, run_scenario
-from stewart_drake.montecarlo.spec import parse_spec
+from stewart_drake.errors import OptionError, StewartError
+from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.montecarlo.api import make_study, run_montecarlo
+from stewart_drake.montecarlo.scenario import draw, plant_platform, run_scenario
 from stewart_drake.montecarlo.study import (
     STUDY_FILE,
-    run_study,
     settings_key,
     study_from_settings,
-    study_key,
     study_settings,
 )
-from stewart_drake.montecarlo.summary import read_table, summarise, write_outputs
+from stewart_drake.montecarlo.summary import read_table
 from stewart_drake.script import ScriptError
-from stewart_drake.script.source import read_program
 
 
 def register(sub) -> None:
@@ -109,47 +102,26 @@ def register(sub) -> None:
 
 
 def build_study(args):
-    """The ``Study`` the options describe (platform, tolerance spec, reference, controller, integrator);
-    the options are checked here."""
-    platform = load_platform(args.platform)
-    spec = parse_spec(args.vary)
-    program = (args.program, read_program(args.program)) if args.program else None
-    if args.workers is not None and args.workers < 0:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=args.workers))
-    if args.engine == "c" and args.controller != "fixed":
-        raise UsageError(UsageError.ENGINE_C.format(controller=args.controller))
-    engine = default_engine(args.engine, args.controller, "stewart-drake montecarlo")
-    if not args.lost_tracking > 0:
-        raise OptionError(OptionError.POSITIVE.format(option="--lost-tracking", unit="mm", value=args.lost_tracking))
-    trajectory = None if program else args.trajectory
-    table = None
-    if trajectory is not None and trajectory not in TRAJECTORIES:
-        table = csv_table(trajectory, args.length_unit, args.angle_unit)
-        trajectory = None
-    return Study(
-        platform=platform,
-        spec=spec,
-        seed=args.seed,
+    """The ``Study`` the options describe, checked by the API (``montecarlo.api.make_study``)."""
+    return make_study(
+        load_platform(args.platform),
+        args.trajectory,
         runs=args.runs,
-        trajectory=trajectory,
-        program=program,
-        table=table,
-        fit=args.fit,
+        seed=args.seed,
+        vary=args.vary,
+        program=args.program,
         controller=args.controller,
-        integrator=args.integrator or DEFAULT_INTEGRATOR,
-        engine=engine,
+        engine=args.engine,
+        integrator=args.integrator,
         duration=args.duration,
         plant_step=args.plant_step,
         lost_tracking=args.lost_tracking * 1e-3,
+        fit=args.fit,
+        length_unit=args.length_unit,
+        angle_unit=args.angle_unit,
+        workers=args.workers,
+        lost_tracking_shown=args.lost_tracking,
     )
-
-
-def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
-    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
-    (``load_trajectory_csv`` checks it and names a bad line)."""
-    traj = load_trajectory_csv(path, length_unit, angle_unit)
-    data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
-    return (traj.name, data[:, 0].tolist(), pose_to_si(data[:, 1:], length_unit, angle_unit).tolist())
 
 
 def run(args) -> int:
@@ -157,14 +129,12 @@ def run(args) -> int:
     if args.replay is not None:
         return replay(args)
     study = build_study(args)
-    try:  # the reference (program compiled, CSV read) checked here, before any run starts
-        study.reference()
-    except ScriptError as e:
+    try:
+        result = run_montecarlo(study, args.out, args.workers, args.scheduler, progress=not args.no_progress)
+    except ScriptError as e:  # the reference (program compiled, CSV read) is checked before any run starts
         print(e.render(), file=sys.stderr)
         return 2
-    rows = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
-    summary = summarise(rows, study_settings(study), study_key(study))
-    summary["files"] = [str(p) for p in write_outputs(args.out, rows, summary)]
+    rows, summary = result.rows, result.to_dict()
     if args.json:
         print_json(summary)
     else:

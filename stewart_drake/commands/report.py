@@ -2,14 +2,10 @@
 
 from __future__ import annotations
 
-import os
 import sys
-import time
 
 from stewart_drake.commands._common import add_force_arg, output_folder
-from stewart_drake.core.geometry import PRESETS
-from stewart_drake.errors import OptionError
-from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
+from stewart_drake.report.api import report
 
 
 def register(sub) -> None:
@@ -30,19 +26,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = output_folder(args)
-    jobs = args.jobs if args.jobs is not None else min(4, os.cpu_count() or 1)
-    if not 1 <= jobs <= 64:
-        raise OptionError(OptionError.BETWEEN.format(option="--jobs", lo=1, hi=64, value=jobs))
-    t0 = time.perf_counter()
-    analyses = discover_analyses(only=args.only)
-    print(f"running {len(analyses)} analyses in {jobs} process{'es' if jobs > 1 else ''}", file=sys.stderr, flush=True)
-    sections = run_analyses(analyses, quick=args.quick, jobs=jobs)
-    elapsed = time.perf_counter() - t0
-    meta = render.default_meta(sections, command_line(), elapsed, PRESETS)
-    index = write_report(sections, out, meta=meta)
-    checks = [c for s in sections for c in s.checks]
-    failed = [c for c in checks if not c.passed]
-    print(f"wrote {index}: {len(checks)} checks, {len(failed)} failed, {elapsed:.0f} s")
-    for c in failed:
+    say = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
+    r = report(out, only=args.only, quick=args.quick, jobs=args.jobs, on_start=say)
+    print(f"wrote {r.index}: {len(r.checks)} checks, {len(r.failed)} failed, {r.elapsed_s:.0f} s")
+    for c in r.failed:
         print(f"  FAIL {c.section}: {c.what}: worst {c.worst:.4g} {c.unit} > tolerance {c.tolerance:.4g} {c.unit}")
-    return 1 if failed else 0
+    return 0 if r.ok else 1

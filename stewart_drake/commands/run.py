@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -175,15 +176,10 @@ def branch_exit(b: dict | None, args) -> int:
 
 
 def simulate(platform, result, args) -> dict:
-    """Controller in the loop (``drake.simulation``) along the program's trajectory."""
-    from dataclasses import replace
-
-    from stewart_drake.control.simulation_log import tracking_verdict
-    from stewart_drake.core.sanity import require_plate
-    from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.drake.simulation import Scenario
-    from stewart_drake.drake.simulation import simulate as sim_run
-    from stewart_drake.firmware.engine import default_engine
+    """Controller in the loop along the program's trajectory, built and checked by ``api.simulation.plan_run``
+    (the one home of a closed-loop run: the timing, size and reference checks of ``simulate``)."""
+    # Deferred: only --simulate needs Drake; the rest of run is numpy.
+    from stewart_drake.api.simulation import plan_run, run_plan
 
     if args.convention != "utn":
         raise UsageError(OPTION_SIMULATE_UTN)
@@ -191,24 +187,22 @@ def simulate(platform, result, args) -> dict:
     if traj.duration <= 0:
         raise UsageError(OPTION_SIMULATE_EMPTY)
     reference = replace(traj, name=Path(args.program).stem)
-    require_plate(platform, "run --simulate")
-    engine = default_engine(None, args.controller, "stewart-drake run")  # simulate's default: the compiled firmware
-    scenario = Scenario(platform, reference, args.controller, engine=engine, duration=traj.duration + SETTLE)
-    log = sim_run(scenario, progress=True)
-    err = log.length_error(reference, platform)
-    verdict = tracking_verdict(platform, err, log.pose_error(reference), log)
+    plan = plan_run(platform, reference, args.controller, traj.duration + SETTLE, command="run --simulate")
+    warn = lambda w: print(f"stewart-drake run: warning: {w}", file=sys.stderr)  # noqa: E731
+    sim = run_plan(plan, progress=True, on_warning=warn)
+    log, err = sim.log.raw, sim.log.length_error
     return {
         "log": log,
         "length_error": err,
         "summary": {
             "controller": args.controller,
-            "engine": engine,
-            "integrator": scenario.integrator or DEFAULT_INTEGRATOR,
+            "engine": plan.scenario.engine,
+            "integrator": plan.scenario.integrator,
             "plant_steps": len(log.t),
             "settle_s": SETTLE,
             "max_abs_length_error_mm": np.abs(err).max(axis=0) * 1e3,
             "max_abs_actuator_force_N": np.abs(log.force).max(axis=0),
-            **verdict,
+            **sim.verdict,
         },
     }
 

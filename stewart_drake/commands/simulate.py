@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import math
 import sys
 from pathlib import Path
 
-import numpy as np
-
+from stewart_drake.api.simulation import plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
     add_platform_arg,
@@ -16,46 +14,10 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
-from stewart_drake.core.sanity import (
-    check_file_rows,
-    check_positive,
-    check_trajectory,
-    check_work,
-    fmt_value,
-    require_plate,
-)
-from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
-from stewart_drake.errors import (
-    OPTION_DURATION_PERIOD,
-    OPTION_DURATION_POSITIVE,
-    OPTION_ENGINE_FIXED,
-    OPTION_FIRMWARE_ENGINE,
-    SIMULATION_GAP_WARNING,
-    OptionError,
-    UsageError,
-)
+from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.drake.integrators import INTEGRATORS
 from stewart_drake.firmware.engine import ENGINES
-
-# Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
-# log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
-# the SAP plant: ~1 ms on one core); a run is refused beyond the memory budget or MAX_RUN_SECONDS.
-BYTES_PER_STEP = 4000
-SECONDS_PER_STEP = 1e-3
-MAX_RUN_SECONDS = 3600.0
-
-
-def check_simulation_size(duration: float, plant_step: float, option: str, value) -> None:
-    """Refuse a simulation whose logs would not fit in memory or that would run for more than an hour."""
-    check_work(
-        option,
-        f"{fmt_value(value)} s",
-        duration / plant_step,
-        f"plant steps of {fmt_value(plant_step)} s",
-        BYTES_PER_STEP,
-        seconds_per=SECONDS_PER_STEP,
-        max_seconds=MAX_RUN_SECONDS,
-        hint=f"; use a shorter {option}",
-    )
 
 
 def register(sub) -> None:
@@ -156,118 +118,42 @@ def add_loop_args(p) -> None:
 
 
 def run(args) -> int:
-    from stewart_drake.control import ControllerConfig, DspTiming, check_timing
-    from stewart_drake.control.simulation_log import tracking_verdict
-    from stewart_drake.core.geometry import load_platform
-    from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
-    from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation
-    from stewart_drake.firmware.engine import default_engine
-    from stewart_drake.firmware.module import check_source
-
     reject_unused(
         args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
     )
     out_folder = output_folder(args)
-    if args.firmware is not None:
-        check_source(args.firmware, "--firmware")
-    platform = load_platform(args.platform)
-    require_plate(platform, "simulate")
-    period = check_positive(args.period, "--period", "seconds")
-    plant_step = args.plant_step if args.plant_step is not None else min(period, 1e-3)
-    if args.duration is not None:
-        check_positive(args.duration, "--duration", "seconds")
-    if args.trajectory not in ("seed", "rotating"):
-        check_file_rows(args.trajectory, "--trajectory", 700, 14)
-    traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)
-    if args.fit:
-        traj = fit_trajectory(traj, platform)
-    duration = args.duration if args.duration is not None else (traj.duration or 1.0)
-    if not duration > 0:
-        raise OptionError(OPTION_DURATION_POSITIVE.format(value=args.duration))
-    timing = DspTiming(
-        sample_period=period,
+    plan = plan_run(
+        load_platform(args.platform),
+        args.trajectory,
+        args.controller,
+        args.duration,
+        period=args.period,
         latency=args.latency,
         sensor_resolution=args.sensor_resolution,
-        command_range=float(platform.legs.max_force),
-    ).check()
-    check_timing(platform, period, plant_step, ActuatorModel().time_constant, timing.output_delay)
-    if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
-        raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
-    check_simulation_size(duration, plant_step, "--duration", args.duration if args.duration is not None else duration)
-    ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
-    warnings = check_trajectory(
-        platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", args.allow_out_of_stroke
-    )
-    for w in warnings:
-        print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
-    # command range and gains designed for the platform over the poses of the run
-    config = ControllerConfig.for_platform(
-        platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0))
-    )
-    if (args.engine == "c" or args.firmware) and args.controller != "fixed":
-        raise UsageError(OPTION_ENGINE_FIXED.format(controller=args.controller))
-    if args.firmware and args.engine == "python":
-        raise UsageError(OPTION_FIRMWARE_ENGINE)
-    engine = "c" if args.firmware else default_engine(args.engine, args.controller, "stewart-drake simulate")
-    scenario = Scenario(
-        platform,
-        traj,
-        args.controller,
-        config,
-        plant_time_step=plant_step,
+        plant_step=args.plant_step,
         feedforward=not args.no_feedforward,
-        engine=engine,
+        engine=args.engine,
         firmware=args.firmware,
-        integrator=args.integrator or DEFAULT_INTEGRATOR,
-        duration=duration,
+        integrator=args.integrator,
+        fit=args.fit,
+        allow_out_of_stroke=args.allow_out_of_stroke,
+        length_unit=args.length_unit,
+        angle_unit=args.angle_unit,
+        duration_shown=args.duration,
     )
-    sim = build_simulation(scenario)
-    log = sim.run(duration, progress=not args.no_progress)
-    gap = sim.max_constraint_gap()
-    if gap > timing.sensor_resolution / 10:
-        warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
-        print(f"stewart-drake simulate: warning: {warnings[-1]}", file=sys.stderr)
+    warn = lambda w: print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)  # noqa: E731
+    result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
+    summary = result.to_dict()
     out = Path(args.out)
-    e = log.length_error(traj, platform)
-    pe = log.pose_error(traj)
-    summary = {
-        "platform": platform.name,
-        "trajectory": traj.name,
-        "controller": args.controller,
-        "engine": engine,
-        "firmware": args.firmware,
-        "sample_period_s": args.period,
-        "latency": args.latency,
-        "feedforward": not args.no_feedforward,
-        "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
-        "command_range_N": config.timing.command_range,
-        "output_delay_s": timing.output_delay,
-        "computation_time_s": timing.computation_time,
-        "plant_time_step_s": plant_step,
-        "integrator": scenario.integrator,
-        "max_constraint_gap_m": gap,
-        "duration_s": duration,
-        "ticks": int(len(log.tick_times())),
-        "max_leg_error_mm": float(np.abs(e).max() * 1e3),
-        "rms_leg_error_mm": float(np.sqrt(np.mean(e**2)) * 1e3),
-        "max_position_error_mm": float(np.abs(pe[:, :3]).max() * 1e3),
-        "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
-        "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
-    }
-    verdict = tracking_verdict(platform, e, pe, log)
-    summary.update(verdict)
-    summary["warnings"] = warnings
     with atomic_folder(out_folder) as tmp:
-        written = log.save(tmp) + write_plots(log, e, tmp) + [tmp / "summary.json"]
+        log = result.log
+        written = log.raw.save(tmp) + write_plots(log.raw, log.length_error, tmp) + [tmp / "summary.json"]
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
         (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
-    if verdict["failures"]:
-        for f in verdict["failures"]:
-            print(f"stewart-drake simulate: {f}", file=sys.stderr)
-        return 1
-    return 0
+    for f in result.verdict["failures"]:
+        print(f"stewart-drake simulate: {f}", file=sys.stderr)
+    return 0 if result.ok else 1
 
 
 def write_plots(log, length_error, out: Path) -> list[Path]:

@@ -14,6 +14,7 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stewart_drake.core.joints import coincident_groups, first_close_pair
 from stewart_drake.core.rotations import length_scale
@@ -214,7 +215,7 @@ class Platform:
         """A copy with some fields changed (validated again)."""
         return dataclasses.replace(self, **changes)
 
-    def to_yaml(self, path, overwrite: bool = False) -> Path:
+    def to_yaml(self, path: "str | Path", overwrite: bool = False) -> Path:
         """Write this platform as a platform file (explicit anchors, metres) that ``load_platform`` reads back
         to the same platform.
 
@@ -232,7 +233,14 @@ class Platform:
 
     # -- constructors --------------------------------------------------------------------------
     @classmethod
-    def from_anchors(cls, base_anchors, top_anchors_per_leg, stroke, name: str = "custom", **kwargs) -> "Platform":
+    def from_anchors(
+        cls,
+        base_anchors: "ArrayLike",
+        top_anchors_per_leg: "ArrayLike",
+        stroke: "ArrayLike",
+        name: str = "custom",
+        **kwargs: object,
+    ) -> "Platform":
         """A platform from explicit anchors: each leg's base anchor in B and plate anchor in T.
 
         Args:

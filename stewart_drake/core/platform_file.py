@@ -9,7 +9,7 @@ import numpy as np
 import yaml
 
 from stewart_drake.core.geometry import LegConfig, Platform
-from stewart_drake.errors import OutputError
+from stewart_drake.errors import API_FILE_EXISTS, OutputError
 
 HEADER = "# stewart-drake platform file (explicit anchors, SI: metres, kilograms), written by Platform.to_yaml\n"
 
@@ -58,7 +58,7 @@ def write_platform_yaml(platform: Platform, path, overwrite: bool = False) -> Pa
     loading the file gives the same arrays bit for bit."""
     p = Path(path)
     if p.exists() and not overwrite:
-        raise OutputError(f"{path}: exists; pass overwrite=True to replace it")
+        raise OutputError(API_FILE_EXISTS.format(path=path))
     text = HEADER + yaml.safe_dump(platform_document(platform), sort_keys=False, default_flow_style=None, width=120)
     p.write_text(text, encoding="utf-8")
     return p

@@ -22,7 +22,7 @@ from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.errors import TrajectoryError
+from stewart_drake.errors import API_FIT_PLATFORM, TrajectoryError
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +94,7 @@ class Trajectory:
         return _fitted(ROTATING, platform, fit)
 
     @classmethod
-    def from_csv(cls, path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+    def from_csv(cls, path: str | Path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
         """A table of ``t, px, py, pz, a, b, g`` rows (header optional; times increasing), interpolated linearly.
 
         Args:
@@ -111,7 +111,9 @@ class Trajectory:
         return load_trajectory_csv(path, length_unit, angle_unit)
 
     @classmethod
-    def from_program(cls, path, platform: Platform, rate: float = 100.0, convention: str = "utn") -> Trajectory:
+    def from_program(
+        cls, path: str | Path, platform: Platform, rate: float = 100.0, convention: str = "utn"
+    ) -> Trajectory:
         """The trajectory of a motion program (``.stw``), sampled at ``rate``, with its samples and moves.
 
         Args:
@@ -164,7 +166,7 @@ def _fitted(trajectory: Trajectory, platform: Platform | None, fit: bool) -> Tra
     if not fit:
         return trajectory
     if platform is None:
-        raise TrajectoryError("fit=True needs the platform to fit the trajectory to")
+        raise TrajectoryError(API_FIT_PLATFORM)
     return fit_trajectory(trajectory, platform)
 
 

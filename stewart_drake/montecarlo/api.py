@@ -3,8 +3,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.csvio import read_numeric_csv
@@ -19,6 +21,9 @@ from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import run_study, study_key, study_settings
 from stewart_drake.montecarlo.summary import summarise, write_outputs
 from stewart_drake.script.source import read_program
+
+if TYPE_CHECKING:  # annotations only: pandas is optional
+    import pandas
 
 
 def make_study(
@@ -107,7 +112,7 @@ class MonteCarloResult(Result):
     def _fields(self) -> dict:
         return self.summary
 
-    def to_pandas(self):
+    def to_pandas(self) -> pandas.DataFrame:
         """One row per run (pandas must be installed).
 
         Returns:
@@ -123,10 +128,10 @@ def montecarlo(
     platform: Platform,
     trajectory: str = "seed",
     *,
-    out,
+    out: str | Path,
     runs: int = 100,
     seed: int = 0,
-    vary=(),
+    vary: Sequence[str] | str = (),
     program: str | None = None,
     controller: str = "fixed",
     engine: str | None = None,

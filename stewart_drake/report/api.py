@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -52,7 +53,13 @@ class ReportResult(Result):
 
 
 def report(
-    out="report", *, only=None, quick: bool = False, jobs: int | None = None, force: bool = False, on_start=None
+    out: str | Path = "report",
+    *,
+    only: Sequence[str] | None = None,
+    quick: bool = False,
+    jobs: int | None = None,
+    force: bool = False,
+    on_start: Callable[[str], None] | None = None,
 ) -> ReportResult:
     """Run the analyses on the built-in presets and write the HTML report (``index.html``, ``checks.json``).
 
