@@ -73,18 +73,16 @@ plt.show()
 # %%
 w = sd.workspace(platform, resolution=0.01)
 print(f"volume {w.volume * 1e3:.2f} litres")
-for lim in w.rotation_limits:
-    print(
-        f"about {lim.axis} {'+' if lim.sign > 0 else '-'}: {np.degrees(lim.angle):+7.2f} deg, {lim.limit} of leg {lim.leg}"
-    )
+for lim in w.summary["rotation_limits"]:  # the dict `stewart-drake workspace --json` prints
+    print(f"about {lim['axis']} {lim['direction']}: {lim['angle_deg']:+7.2f} deg, {lim['limit']} of leg {lim['leg']}")
 
 # %%
-x, y, z = (np.asarray(a) for a in w.grid.axes)  # grid node coordinates, m
+edge = w.grid.boundary  # (n, 3) m: grid nodes inside the workspace with a neighbour outside
 fig, ax = plt.subplots(1, 2, figsize=(9, 3.8))
-ax[0].imshow(w.grid.top.T, origin="lower", extent=[x[0], x[-1], y[0], y[-1]], cmap="Blues")
-ax[0].set(xlabel="x [m]", ylabel="y [m]", title="top view (reachable at some z)")
-ax[1].imshow(w.grid.front.T, origin="lower", extent=[x[0], x[-1], z[0], z[-1]], cmap="Blues", aspect="auto")
-ax[1].set(xlabel="x [m]", ylabel="z [m]", title="front view (reachable at some y)")
+ax[0].scatter(edge[:, 0], edge[:, 1], s=1, c=edge[:, 2], cmap="viridis")
+ax[0].set(xlabel="x [m]", ylabel="y [m]", title="boundary, top view (colour: z)", aspect="equal")
+ax[1].scatter(edge[:, 0], edge[:, 2], s=1, c=edge[:, 1], cmap="viridis")
+ax[1].set(xlabel="x [m]", ylabel="z [m]", title="boundary, front view (colour: y)", aspect="equal")
 plt.show()
 
 # %% [markdown]
@@ -127,8 +125,9 @@ plt.show()
 home = platform.home_pose()
 k = sd.stiffness(platform, home, leg_stiffness=2e7)
 m = sd.modes(platform, home, leg_stiffness=2e7)
-np.set_printoptions(precision=3, suppress=True)
-print("K (N/m, N/rad, N·m/rad):\n", k.matrix)
+axes = ["x", "y", "z", "θx", "θy", "θz"]
+print("K, rounded to 1 (N/m, N/rad, N·m/m, N·m/rad):")
+print(pd.DataFrame(k.matrix.round(0), index=axes, columns=axes).to_string())
 print("natural frequencies [Hz]:", np.round(m.frequencies_hz, 1))
 
 fig, ax = plt.subplots(1, 2, figsize=(9, 3.5))
