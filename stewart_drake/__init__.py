@@ -15,6 +15,23 @@ only ``simulate``, ``montecarlo``, ``firmware.check`` and ``report`` import Drak
 import importlib
 import sys
 import types
+import typing
+
+# The same names as _PUBLIC, for type checkers and the docs (at run time each is loaded on first use).
+if typing.TYPE_CHECKING:
+    from stewart_drake.api import firmware
+    from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
+    from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
+    from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
+    from stewart_drake.api.platform import load_platform, presets
+    from stewart_drake.api.reach import WorkspaceResult, workspace
+    from stewart_drake.api.simulation import SimulationResult, simulate
+    from stewart_drake.api.sizing import SizingResult, size
+    from stewart_drake.core.geometry import Platform
+    from stewart_drake.core.trajectory import Trajectory
+    from stewart_drake.errors import PhysicalLimitError, StewartError, UsageError
+    from stewart_drake.montecarlo.api import MonteCarloResult, montecarlo
+    from stewart_drake.report.api import ReportResult, report
 
 __version__ = "0.2.0"
 
@@ -52,7 +69,38 @@ _PUBLIC = {
     "ReportResult": ("stewart_drake.report.api", "ReportResult"),
 }
 
-__all__ = ["__version__", *_PUBLIC]
+__all__ = [
+    "__version__",
+    "StewartError",
+    "UsageError",
+    "PhysicalLimitError",
+    "Platform",
+    "load_platform",
+    "presets",
+    "Trajectory",
+    "ik",
+    "IKResult",
+    "fk",
+    "FKResult",
+    "FKSolution",
+    "inverse_dynamics",
+    "DynamicsResult",
+    "stiffness",
+    "StiffnessResult",
+    "modes",
+    "ModesResult",
+    "size",
+    "SizingResult",
+    "workspace",
+    "WorkspaceResult",
+    "simulate",
+    "SimulationResult",
+    "montecarlo",
+    "MonteCarloResult",
+    "firmware",
+    "report",
+    "ReportResult",
+]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,
 # .firmware). Importing a subpackage binds it as an attribute of this package; for these names the public

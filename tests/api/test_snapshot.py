@@ -125,6 +125,7 @@ def test_all_names_resolve_and_nothing_public_is_unlisted():
     (its internal subpackages, bound by the import system, excepted)."""
     import stewart_drake as sd
 
+    assert set(sd.__all__) == {"__version__", *sd._PUBLIC}  # the literal list and the loader's table agree
     for name in sd.__all__:
         assert getattr(sd, name) is not None
     extra = [
