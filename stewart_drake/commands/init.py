@@ -1,4 +1,5 @@
-"""``stewart-drake init``: print a commented, valid starting file (``--platform-template``)."""
+"""``stewart-drake init``: print a commented, valid starting file (``--platform-template`` or
+``--envelope-template``)."""
 
 from __future__ import annotations
 
@@ -13,20 +14,28 @@ def register(sub) -> None:
         "init",
         help="print a commented platform file template to start from (stewart-drake init --platform-template radial > my.yaml)",
     )
-    p.add_argument(
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument(
         "--platform-template",
         choices=TEMPLATES,
-        required=True,
         help="utn: the UTN 3-6 family; radial: anchors on two circles; explicit: anchor by anchor",
+    )
+    which.add_argument(
+        "--envelope-template",
+        action="store_true",
+        help="a duty envelope for `size --envelope` (poses + velocity and acceleration bounds), "
+        "made for the radial platform template",
     )
     p.set_defaults(func=run)
 
 
 def template_text(kind: str) -> str:
-    """The text of the platform template ``kind`` (one of ``TEMPLATES``)."""
-    return (resources.files("stewart_drake") / "templates" / f"platform-{kind}.yaml").read_text(encoding="utf-8")
+    """The text of the platform template ``kind`` (one of ``TEMPLATES``), or of the envelope template when
+    ``kind`` is ``"envelope"``."""
+    name = "envelope.yaml" if kind == "envelope" else f"platform-{kind}.yaml"
+    return (resources.files("stewart_drake") / "templates" / name).read_text(encoding="utf-8")
 
 
 def run(args) -> int:
-    sys.stdout.write(template_text(args.platform_template))
+    sys.stdout.write(template_text("envelope" if args.envelope_template else args.platform_template))
     return 0

@@ -110,16 +110,21 @@ class PlatformConfig:
 class Platform:
     """A Stewart platform. Arrays are read-only numpy arrays in SI units.
 
-    base_anchors  (6, 3)  p_BBi, metres; six distinct points, or three pairs (6-3: two legs per base joint)
-    top_anchors   (k, 3)  p_TTj, metres, 3 <= k <= 6
-    leg_top       (6,)    index into top_anchors for each leg
-    stroke        (2,)    L_min, L_max, metres (joint centre to joint centre)
-    mass          float   plate mass, kg
-    com           (3,)    p_TTcm, plate centre of mass in T, metres
-    inertia       (3, 3)  I_Tcm, plate rotational inertia about its centre of mass, in T, kg·m²
-    rotation_centre (3,)  p_TC: the plate point whose position a pose gives (default the T origin)
-    home_height   float   pz of the home pose [0, 0, h, 0, 0, 0], metres
-    legs          LegConfig in metres
+    Attributes:
+        name: the platform's name, shown in outputs.
+        base_anchors: ``(6, 3)`` p_BBi, metres; six distinct points, or three pairs (6-3: two legs per base
+            joint).
+        top_anchors: ``(k, 3)`` p_TTj, metres, 3 <= k <= 6.
+        leg_top: ``(6,)`` index into ``top_anchors`` for each leg.
+        stroke: ``(2,)`` L_min, L_max, metres (joint centre to joint centre).
+        mass: plate mass, kg.
+        com: ``(3,)`` p_TTcm, plate centre of mass in T, metres.
+        inertia: ``(3, 3)`` I_Tcm, plate rotational inertia about its centre of mass, in T, kg·m².
+        rotation_centre: ``(3,)`` p_TC: the plate point whose position a pose gives (default the T origin).
+        home_height: pz of the home pose [0, 0, h, 0, 0, 0], metres.
+        legs: the legs' masses, sizes and limits (``LegConfig``, metres).
+        description: free text.
+        plate_below_base_allowed: poses may put plate anchors at or below the base plane z = 0.
     """
 
     name: str
@@ -194,10 +199,12 @@ class Platform:
 
     @property
     def L_min(self) -> float:
+        """The shortest leg length, m (``stroke[0]``)."""
         return float(self.stroke[0])
 
     @property
     def L_max(self) -> float:
+        """The longest leg length, m (``stroke[1]``)."""
         return float(self.stroke[1])
 
     def home_pose(self) -> np.ndarray:

@@ -117,14 +117,14 @@ def read_table(folder) -> list[dict]:
 
 def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
     """``distributions.png`` (histograms of the leg and pose errors) and ``sensitivity.png`` (the leg
-    error against the most influential parameter, and the ranking)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    error against the most influential parameter, and the ranking). Drawn on ``Figure`` objects, not pyplot,
+    so that the caller's backend (a notebook's inline figures) is left as it was."""
+    # deferred: matplotlib is loaded only when a study writes its plots
+    from matplotlib.figure import Figure
 
     paths = []
-    fig, ax = plt.subplots(1, 3, figsize=(13, 3.6))
+    fig = Figure(figsize=(13, 3.6))
+    ax = fig.subplots(1, 3)
     for a, (m, scale, label) in zip(
         ax,
         [
@@ -140,9 +140,9 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
     fig.suptitle(f"{len(rows)} runs")
     paths.append(folder / "distributions.png")
     fig.savefig(paths[-1], dpi=100, bbox_inches="tight")
-    plt.close(fig)
     ranking = summary["sensitivity"]["max_leg_error_m"]
-    fig, ax = plt.subplots(1, 2, figsize=(13, 4), constrained_layout=True)
+    fig = Figure(figsize=(13, 4), layout="constrained")
+    ax = fig.subplots(1, 2)
     if ranking:
         top = ranking[0]["parameter"]
         ax[0].scatter(_numeric(rows, top), _numeric(rows, "max_leg_error_m") * 1e3, s=8)
@@ -154,7 +154,6 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
         ax[1].set_xlabel("Spearman ρ with max leg error")
     paths.append(folder / "sensitivity.png")
     fig.savefig(paths[-1], dpi=100, bbox_inches="tight")
-    plt.close(fig)
     return paths
 
 

@@ -1,0 +1,263 @@
+"""MkDocs hooks (``mkdocs.yml``: ``hooks``): the pages that are generated from the sources, so that they cannot
+drift from them.
+
+- ``commands/*.md``: one reference page per ``stewart-drake`` command, its usage and every option read from the
+  command's own argparse parser (``stewart_drake.cli.build_parser``);
+- ``api.md``: one mkdocstrings block per name of ``stewart_drake.__all__``; a public name (or a public method or
+  property of a public class) without a docstring is a warning, so ``mkdocs build --strict`` fails on it;
+- ``examples/*.md``: the example notebooks (``notebooks/*.py``, jupytext percent scripts) as pages.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import inspect
+import logging
+from pathlib import Path
+
+import jupytext
+from mkdocs.structure.files import File
+
+import stewart_drake
+from stewart_drake.cli import COMMANDS, build_parser
+
+log = logging.getLogger("mkdocs.hooks.stewart_drake")
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+
+# Prose pages a command's reference links to (relative to the commands/ folder).
+SEE_ALSO = {
+    "compile": ["../motion-language.md"],
+    "run": ["../motion-language.md"],
+    "size": ["../envelope-file.md", "../motion-language.md"],
+    "init": ["../platform-file.md", "../envelope-file.md"],
+    "montecarlo": ["../montecarlo-vary.md"],
+    "firmware": ["../firmware-abi.md"],
+    "simulate": ["../firmware-abi.md"],
+}
+
+
+# The public function each command calls (``import stewart_drake as sd``), linked from its page.
+PYTHON = {
+    "ik": "ik",
+    "fk": "fk",
+    "dynamics": "inverse_dynamics",
+    "stiffness": "stiffness",
+    "modes": "modes",
+    "size": "size",
+    "workspace": "workspace",
+    "simulate": "simulate",
+    "montecarlo": "montecarlo",
+    "firmware": "firmware",
+    "report": "report",
+}
+
+
+def _cell(text: str) -> str:
+    """Text safe inside a Markdown table cell."""
+    return " ".join(str(text).split()).replace("|", "\\|")
+
+
+def _option_rows(parser: argparse.ArgumentParser) -> list[str]:
+    rows = ["| option | value | default | what |", "|---|---|---|---|"]
+    for a in parser._actions:  # argparse keeps its actions here; there is no public accessor
+        if isinstance(a, (argparse._HelpAction, argparse._SubParsersAction)):
+            continue
+        names = ", ".join(f"`{s}`" for s in a.option_strings) or f"`{a.metavar or a.dest}` (positional)"
+        if a.choices is not None:
+            value = " \\| ".join(f"`{c}`" for c in a.choices)
+        elif a.nargs == 0:
+            value = "flag"
+        else:
+            metavar = a.metavar if a.metavar is not None else a.dest.upper()
+            if isinstance(metavar, tuple):
+                metavar = " ".join(metavar)
+            count = {None: "", "?": " (optional)", "*": " ...", "+": " ..."}.get(a.nargs, "")
+            if isinstance(a.nargs, int) and a.nargs > 1 and not isinstance(a.metavar, tuple):
+                metavar = " ".join([metavar] * a.nargs)
+            value = f"`{metavar}`{count}"
+        default = "" if a.default in (None, argparse.SUPPRESS, False) or a.required else f"`{a.default}`"
+        if a.required:
+            default = "required"
+        help_text = (a.help or "") % {"default": a.default, "prog": parser.prog} if a.help else ""
+        rows.append(f"| {names} | {value} | {_cell(default)} | {_cell(help_text)} |")
+    return rows
+
+
+def _subparsers(parser: argparse.ArgumentParser) -> dict:
+    for a in parser._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            return dict(a.choices)
+    return {}
+
+
+def command_page(name: str, parser: argparse.ArgumentParser) -> str:
+    """The reference page of command ``name`` from its parser: usage, description, options, subcommands."""
+    help_line = COMMANDS[name][1]
+    out = [f"# stewart-drake {name}", "", help_line[0].upper() + help_line[1:] + ".", ""]
+    out += ["```text", parser.format_usage().strip(), "```", ""]
+    if parser.description:
+        out += [parser.description.strip(), ""]
+    module = inspect.getdoc(importlib.import_module(f"stewart_drake.commands.{COMMANDS[name][0]}")) or ""
+    more = module.split("\n\n", 1)[1:]  # the module docstring past its first paragraph (the help line again)
+    if more:
+        out += [more[0].strip(), ""]
+    function = PYTHON.get(name)
+    if function and function in public_names():
+        out += [f"From Python: [`sd.{function}`](../api.md#{api_target(function)}).", ""]
+    subs = _subparsers(parser)
+    if len(_option_rows(parser)) > 2:
+        out += ["## Options", "", *_option_rows(parser), ""]
+    for sub_name, sub in subs.items():
+        out += [f"## {name} {sub_name}", "", "```text", sub.format_usage().strip(), "```", ""]
+        if sub.description:
+            out += [sub.description.strip(), ""]
+        out += [*_option_rows(sub), ""]
+    out += [
+        "## Exit status",
+        "",
+        "0: the run is good; 1: a result outside physical limits (shown, with the first violation named); "
+        "2: bad input, one line on stderr naming the option, file, line or field.",
+        "",
+    ]
+    links = SEE_ALSO.get(name, [])
+    if links:
+        out += ["See also: " + ", ".join(f"[{Path(p).stem.replace('-', ' ')}]({p})" for p in links) + ".", ""]
+    out += ["*Generated from the command's argparse parser by `scripts/docs_hooks.py`.*", ""]
+    return "\n".join(out)
+
+
+def commands_index() -> str:
+    rows = ["| command | what |", "|---|---|"]
+    rows += [f"| [`{n}`]({n}.md) | {_cell(h)} |" for n, (_, h) in COMMANDS.items()]
+    return "\n".join(
+        ["# Commands", "", "`stewart-drake COMMAND --help` prints the same options as these pages.", "", *rows, ""]
+    )
+
+
+def public_names() -> list[str]:
+    """``stewart_drake.__all__`` (the public API), without ``__version__``."""
+    return [n for n in getattr(stewart_drake, "__all__", []) if not n.startswith("_")]
+
+
+def api_target(name: str) -> str:
+    """Where public name ``name`` is defined (``module.qualname``, or the module's name for a namespace such as
+    ``sd.firmware``): the names are loaded lazily by the package's ``__getattr__``, so mkdocstrings, which reads
+    the sources statically, is pointed at their definitions."""
+    obj = getattr(stewart_drake, name)
+    return obj.__name__ if inspect.ismodule(obj) else f"{obj.__module__}.{obj.__qualname__}"
+
+
+def _members(obj) -> dict:
+    """The public members a page shows of a class (its own attributes) or of a module (what it defines)."""
+    if inspect.isclass(obj):
+        return {k: v for k, v in vars(obj).items() if not k.startswith("_")}
+    if inspect.ismodule(obj):
+        names = getattr(obj, "__all__", None) or [k for k in vars(obj) if not k.startswith("_")]
+        return {k: getattr(obj, k) for k in names if getattr(getattr(obj, k), "__module__", None) == obj.__name__}
+    return {}
+
+
+def undocumented(names) -> list[str]:
+    """Public names, and the public methods/properties of public classes and namespaces (one level down, and
+    the methods of a namespace's classes), that have no docstring of their own."""
+    missing = []
+
+    def visit(obj, shown: str, depth: int) -> None:
+        target = obj.fget if isinstance(obj, property) else getattr(obj, "__func__", obj)
+        if not (callable(target) or inspect.ismodule(target) or isinstance(obj, property)):
+            return  # a field or constant: documented by its class's docstring
+        if not (getattr(target, "__doc__", None) or "").strip():
+            missing.append(shown)
+        if depth < 2:
+            for attr, member in _members(target).items():
+                visit(member, f"{shown}.{attr}", depth + 1)
+
+    for n in names:
+        visit(getattr(stewart_drake, n), n, 0)
+    return missing
+
+
+def api_page(names) -> str:
+    out = [
+        "# API reference",
+        "",
+        "`import stewart_drake as sd`: every name of `sd.__all__`, SI units (m, rad, s, N, kg) unless an argument "
+        "says otherwise. See [units and conventions](units.md).",
+        "",
+    ]
+    if "__version__" in getattr(stewart_drake, "__all__", []):
+        out += ["`sd.__version__`: the package's version (a string).", ""]
+    for n in names:
+        out += [f"::: {api_target(n)}", "    options:", f'      heading: "sd.{n}"', ""]
+    return "\n".join(out)
+
+
+def notebook_page(path: Path) -> str:
+    """A percent-script notebook as Markdown: its markdown cells as text, its code cells as Python blocks."""
+    nb = jupytext.read(path)
+    out = [
+        f'!!! note "Run it"\n    `notebooks/{path.name}` (a jupytext percent script). Open it as a notebook with '
+        f"`jupytext --to notebook notebooks/{path.name}`, or run it as a script: `python notebooks/{path.name}`.",
+        "",
+    ]
+    for cell in nb.cells:
+        if cell.cell_type == "markdown":
+            out += [cell.source, ""]
+        elif cell.cell_type == "code" and cell.source.strip():
+            out += ["```python", cell.source, "```", ""]
+    return "\n".join(out)
+
+
+def examples_index(paths) -> str:
+    rows = ["| notebook | what |", "|---|---|"]
+    for path in paths:
+        nb = jupytext.read(path)
+        title = next((c.source.splitlines()[0].lstrip("# ") for c in nb.cells if c.cell_type == "markdown"), path.stem)
+        rows.append(f"| [`{path.name}`]({path.stem}.md) | {_cell(title)} |")
+    return "\n".join(
+        [
+            "# Examples",
+            "",
+            "Notebooks written as jupytext percent scripts in `notebooks/`; the test suite executes each one as a "
+            "notebook (`tests/docs/test_notebooks.py`). They write only into a temporary folder.",
+            "",
+            *rows,
+            "",
+        ]
+    )
+
+
+def on_config(config):
+    """Expand the nav's ``Commands`` and ``Examples`` entries into one page per command and notebook."""
+    generated = {
+        "commands/index.md": ["commands/index.md", *(f"commands/{n}.md" for n in COMMANDS)],
+        "examples/index.md": ["examples/index.md", *(f"examples/{p.stem}.md" for p in sorted(NOTEBOOKS.glob("*.py")))],
+    }
+    for entry in config["nav"]:
+        if isinstance(entry, dict):
+            for title, target in entry.items():
+                if isinstance(target, str) and target in generated:
+                    entry[title] = generated[target]
+    return config
+
+
+def on_files(files, config):
+    """Add the generated pages to the site."""
+    parser = build_parser()
+    commands = _subparsers(parser)
+    files.append(File.generated(config, "commands/index.md", content=commands_index()))
+    for name in COMMANDS:
+        files.append(File.generated(config, f"commands/{name}.md", content=command_page(name, commands[name])))
+    names = public_names()
+    if not names:
+        log.warning("stewart_drake.__all__ is missing or empty: the API reference would be empty")
+    for n in undocumented(names):
+        log.warning(f"public name without a docstring: stewart_drake.{n}")
+    files.append(File.generated(config, "api.md", content=api_page(names)))
+    notebooks = sorted(NOTEBOOKS.glob("*.py"))
+    files.append(File.generated(config, "examples/index.md", content=examples_index(notebooks)))
+    for path in notebooks:
+        files.append(File.generated(config, f"examples/{path.stem}.md", content=notebook_page(path)))
+    return files
