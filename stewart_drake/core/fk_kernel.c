@@ -92,20 +92,26 @@ static void jac(double r[6][3], double l[6][3], const double L[6], double a, dou
     }
 }
 
-/* LU with partial pivoting in place; 0 when a pivot is exactly zero (numpy's LinAlgError). */
+/* LU with partial pivoting in place (multipliers below the diagonal, rows swapped whole); 0 when a pivot
+ * is exactly zero (numpy's LinAlgError). The updates run over all six columns (fixed trip counts the
+ * compiler unrolls): row k is zero left of its pivot, so columns < k are unchanged but for column k,
+ * whose multiplier is written after the update. */
 static int lu(double A[6][6], int piv[6]) {
     for (int k = 0; k < 6; k++) {
         int m = k;
+        double big = fabs(A[k][k]);
         for (int i = k + 1; i < 6; i++)
-            if (fabs(A[i][k]) > fabs(A[m][k])) m = i;
+            if (fabs(A[i][k]) > big) { m = i; big = fabs(A[i][k]); }
         piv[k] = m;
-        if (A[m][k] == 0.0) return 0;
+        if (big == 0.0) return 0;
         if (m != k)
             for (int j = 0; j < 6; j++) { double t = A[k][j]; A[k][j] = A[m][j]; A[m][j] = t; }
+        double inv = 1.0 / A[k][k], row[6];
+        for (int j = 0; j < 6; j++) row[j] = j > k ? A[k][j] : 0.0;
         for (int i = k + 1; i < 6; i++) {
-            double f = A[i][k] / A[k][k];
+            double f = A[i][k] * inv;
+            for (int j = 0; j < 6; j++) A[i][j] -= f * row[j];
             A[i][k] = f;
-            for (int j = k + 1; j < 6; j++) A[i][j] -= f * A[k][j];
         }
     }
     return 1;
@@ -120,6 +126,24 @@ static void lu_solve(double A[6][6], const int piv[6], double x[6]) {
     for (int k = 5; k >= 0; k--) {
         for (int j = k + 1; j < 6; j++) x[k] -= A[k][j] * x[j];
         x[k] /= A[k][k];
+    }
+}
+
+/* The inverse from the LU: all six right-hand sides at once (rows of X, the inner loops over columns). */
+static void lu_inverse(double A[6][6], const int piv[6], double X[6][6]) {
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) X[i][j] = (i == j);
+    for (int k = 0; k < 6; k++)
+        if (piv[k] != k)
+            for (int j = 0; j < 6; j++) { double t = X[k][j]; X[k][j] = X[piv[k]][j]; X[piv[k]][j] = t; }
+    for (int k = 0; k < 6; k++)
+        for (int i = k + 1; i < 6; i++)
+            for (int j = 0; j < 6; j++) X[i][j] -= A[i][k] * X[k][j];
+    for (int k = 5; k >= 0; k--) {
+        for (int i = k + 1; i < 6; i++)
+            for (int j = 0; j < 6; j++) X[k][j] -= A[k][i] * X[i][j];
+        double inv = 1.0 / A[k][k];
+        for (int j = 0; j < 6; j++) X[k][j] *= inv;
     }
 }
 
@@ -158,24 +182,23 @@ static double lipschitz(double a, const double rt[6], const double L0[6], double
  * badly conditioned to bound) and eta. The scaled J_s = J D^-1, D = diag(1, 1, 1, a, a, a): J_s^-1 = D J^-1. */
 static void certificate(const double *g, double J0[6][6], double F[6][6], const int piv[6], const double L0[6],
                         const double d0[6], double nf, double *rho_out, double *eta_out) {
-    double a = g[G_A], X[6][6], D[6] = {1, 1, 1, a, a, a}, rt[6];
+    double a = g[G_A], X[6][6], Y[6][6], D[6] = {1, 1, 1, a, a, a}, Dinv[6] = {1, 1, 1, 1 / a, 1 / a, 1 / a}, rt[6];
     *rho_out = 0.0;
     *eta_out = INFINITY;
-    for (int j = 0; j < 6; j++) {
-        double c[6] = {0, 0, 0, 0, 0, 0};
-        c[j] = 1.0;
-        lu_solve(F, piv, c);
-        for (int i = 0; i < 6; i++) X[i][j] = D[i] * c[i]; /* X = J_s^-1 = D J^-1 */
-    }
-    double xf = 0.0, df = 0.0;
+    lu_inverse(F, piv, Y); /* Y = J^-1 */
     for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) X[i][j] = D[i] * Y[i][j]; /* X = J_s^-1 = D J^-1 */
+    double xf = 0.0, df = 0.0;
+    for (int i = 0; i < 6; i++) {
+        double row[6] = {0, 0, 0, 0, 0, 0};
+        for (int k = 0; k < 6; k++)
+            for (int j = 0; j < 6; j++) row[j] += X[i][k] * J0[k][j];
         for (int j = 0; j < 6; j++) {
-            double d = 0.0;
-            for (int k = 0; k < 6; k++) d += X[i][k] * J0[k][j];
-            d = (i == j) - d / D[j]; /* I - X J_s */
+            double d = (i == j) - row[j] * Dinv[j]; /* I - X J_s */
             df += d * d;
             xf += X[i][j] * X[i][j];
         }
+    }
     double delta = sqrt(df) * (1.0 + MARGIN) + 1e-15;
     if (!(delta < 0.5)) return;
     double beta = sqrt(xf) * (1.0 + MARGIN) / (1.0 - delta), xd = 0.0;

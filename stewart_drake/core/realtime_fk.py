@@ -56,6 +56,7 @@ void sd_rtfk(int64_t n, const double *g, int conv, const double *L, const double
              double tol, int max_iter, int max_sub, double *q_out, double *info);
 """
 OPT = "-O2"
+FLAGS = ("-funroll-loops",)  # the 6x6 loops fully unrolled: a third fewer instructions per solve (callgrind)
 INFO = ("residual", "iterations", "status", "certified", "radius", "eta", "step", "substeps")
 MARGIN = 1e-9  # relative margin on the bounds (the C kernel's MARGIN)
 NO_COMPILER_NOTE = "note: no C compiler: real-time FK runs the numpy Newton (~100x slower per call)"
@@ -64,10 +65,10 @@ _LIB: list = []
 
 def _shared_library() -> Path:
     """The compiled kernel, keyed on its source alone (as ``homotopy.ctrack``: no compiler probe per process)."""
-    key = hashlib.sha256(SOURCE.read_bytes() + CDEF.encode() + OPT.encode()).hexdigest()[:32]
+    key = hashlib.sha256(SOURCE.read_bytes() + CDEF.encode() + " ".join((OPT, *FLAGS)).encode()).hexdigest()[:32]
     fast = cache_dir() / f"sd-realtime-fk-{key}.so"
     if not fast.exists():
-        built = build([Source(SOURCE.name, path=SOURCE)], opt=OPT)
+        built = build([Source(SOURCE.name, path=SOURCE)], opt=OPT, flags=FLAGS)
         fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
         os.close(fd)
         shutil.copyfile(built, tmp)
