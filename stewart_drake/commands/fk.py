@@ -9,6 +9,7 @@ import numpy as np
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.core.assembly_modes import modes_from_solutions
 from stewart_drake.core.newton_fk import forward_kinematics
+from stewart_drake.core.realtime_fk import branch_check
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_from_si, pose_to_si
 from stewart_drake.core.sanity import check_finite, check_positive, check_work
 from stewart_drake.errors import OPTION_MAX_ITER, OptionError, UsageError
@@ -165,7 +166,18 @@ def run(args) -> int:
             mode = modes_from_solutions(
                 platform, r.iterate[None, :3], r.rotation[None], L, np.array([False]), args.convention
             )[0]
-            single = _entry(mode, args, k, converged=True, iterations=int(r.iterations), method="newton")
+            start = platform.home_pose() if initial is None else initial
+            on_branch, radius = branch_check(platform, start, L, r.iterate[:3], r.rotation, args.convention)
+            single = _entry(
+                mode,
+                args,
+                k,
+                converged=True,
+                iterations=int(r.iterations),
+                method="newton",
+                branch_certified=on_branch,
+                uniqueness_radius_initial=radius / k,
+            )
             out.update(solutions=[single], method="newton")
     if single is None and args.all and args.method == "homotopy":
         out.update(_homotopy_all(platform, L, args, k))
@@ -211,6 +223,12 @@ def run(args) -> int:
                 if s["certified"]
                 else []
             )
+            if "branch_certified" in s:
+                flags.append(
+                    "on the initial pose's branch (certified)"
+                    if s["branch_certified"]
+                    else "branch from the initial pose NOT certified (another assembly mode may have been reached)"
+                )
             print(
                 f"{i:3d}",
                 " ".join(f"{x:11.5f}" for x in s["pose"]),

@@ -336,3 +336,22 @@ def certificate(platform: Platform, p0, R0, L_target) -> tuple[np.ndarray, np.nd
         wider = ok & (c > rho_s) & (beta * lipschitz(platform, L, c) * c < 1.0)
         best = np.where(wider, c, best)
     return best, eta
+
+
+def branch_check(
+    platform: Platform, initial, lengths, position, rotation, convention: str = "utn", max_substeps: int = 64
+) -> tuple[bool, float]:
+    """``(certified, radius m)`` for a Newton solution (``position (3,)``, ``rotation (3, 3)``) of one
+    length set ``(6,)`` reached from the pose ``initial (6,)``: certified when the solution is the
+    continuation of the initial pose's branch along the straight length path (followed in at most
+    ``max_substeps`` certified sub-steps; the solution must be the followed pose to 1e-9 m and rad);
+    radius: the certified uniqueness radius around the initial pose."""
+    r = RealtimeFK(platform, convention, max_substeps=max_substeps).solve_batch(
+        np.asarray(lengths, dtype=float)[None], np.asarray(initial, dtype=float)
+    )
+    p, R = np.asarray(position, dtype=float), np.asarray(rotation, dtype=float)
+    q = np.r_[p, angles_from_matrix(R, convention)]
+    same = bool(np.all(np.abs(r.poses[0] - q) <= 1e-9))
+    q0 = np.asarray(initial, dtype=float)
+    rho, _ = certificate(platform, q0[None, :3], rotation_matrix(q0[None, 3:], convention), np.asarray(lengths)[None])
+    return bool(r.certified[0]) and same, float(rho[0])
