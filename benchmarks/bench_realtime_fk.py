@@ -96,7 +96,7 @@ def main(argv=None) -> int:
         cpu_c, cpu_tr = args.n / c["c_batch"], args.n / c["c_track"]
         print(f"\n## {name}: {args.n} length sets, previous pose 1 mm / 1 mrad off; track: a 1 kHz trajectory")
         print(
-            f"per call from Python: {us_c:7.2f} µs (target <= {PER_CALL_TARGET_US:.0f} µs)   "
+            f"per call from Python: {us_c:7.2f} µs, {1e6 * c['c_call'] / m:5.2f} CPU µs (target <= {PER_CALL_TARGET_US:.0f} µs)   "
             f"numpy Newton per call {us_np:7.1f} µs -> {us_np / us_c:.0f}x"
         )
         print(
