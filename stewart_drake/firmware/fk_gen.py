@@ -28,13 +28,14 @@ from stewart_drake.core.sampling import random_poses
 FK_ITERATIONS = 6
 MANTISSA_MAX = 32767
 CONTRACTION_POSES = 256  # workspace poses the chord's contraction is evaluated on at generation time
+_CONTRACTION: dict[bytes, float] = {}  # by geometry and convention: the C engine generates once per simulation
 
 
 def pose_jacobian(platform: Platform, pose, convention: str) -> np.ndarray:
-    """``(6, 6)`` ∂L/∂q at ``pose``: J⁻¹ · diag(I, E(angles)), q = [p (m), angles (rad)]."""
+    """``(..., 6, 6)`` ∂L/∂q at ``(..., 6)`` poses: J⁻¹ · diag(I, E(angles)), q = [p (m), angles (rad)]."""
     A = inverse_jacobian(platform, pose, convention)
-    E = angular_velocity_map(np.asarray(pose)[3:], convention)
-    return np.concatenate([A[:, :3], A[:, 3:] @ E], axis=1)
+    E = angular_velocity_map(np.asarray(pose)[..., 3:], convention)
+    return np.concatenate([A[..., :3], A[..., 3:] @ E], axis=-1)
 
 
 def word_scales(config: ControllerConfig) -> np.ndarray:
@@ -64,10 +65,19 @@ def contraction(platform: Platform, config: ControllerConfig) -> float:
     """The chord's worst spectral radius of I − K ∂L/∂q over ``CONTRACTION_POSES`` sampled workspace poses
     (``core.sampling``, seed 0; a sample, not a bound): below 1 the iteration converges there, at that rate."""
     conv = config.convention
-    K = np.linalg.inv(pose_jacobian(platform, platform.home_pose(), conv))
-    q = random_poses(platform, CONTRACTION_POSES, seed=0, region="workspace", convention=conv)
-    ev = np.array([np.linalg.eigvals(np.eye(6) - K @ pose_jacobian(platform, x, conv)) for x in q])
-    return float(np.abs(ev).max())
+    parts = (
+        platform.base_anchors,
+        platform.top_anchors,
+        platform.top_anchors_per_leg,
+        platform.rotation_centre,
+        platform.stroke,
+    )
+    key = b"".join(np.asarray(a, dtype=float).tobytes() for a in (*parts, platform.home_pose())) + conv.encode()
+    if key not in _CONTRACTION:
+        K = np.linalg.inv(pose_jacobian(platform, platform.home_pose(), conv))
+        q = random_poses(platform, CONTRACTION_POSES, seed=0, region="workspace", convention=conv)
+        _CONTRACTION[key] = float(np.abs(np.linalg.eigvals(np.eye(6) - K @ pose_jacobian(platform, q, conv))).max())
+    return _CONTRACTION[key]
 
 
 def fk_ops(ik_ops: Counter) -> Counter:
