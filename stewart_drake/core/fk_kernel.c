@@ -28,8 +28,8 @@ enum { I_RES = 0, I_ITER, I_STATUS, I_CERT, I_RADIUS, I_ETA, I_STEP, I_SUB, N_IN
 #define MARGIN 1e-9
 
 /* g: base anchors (6x3), plate anchors relative to the rotation centre in T (6x3), anchor radius a,
- * size0 = max(|base anchors|max, |top anchors|max) (the numpy divergence test's scale). */
-enum { G_BASE = 0, G_TOP = 18, G_A = 36, G_SIZE = 37, N_GEOM = 38 };
+ * size0 = max(|base anchors|max, |top anchors|max) (the numpy divergence test's scale), |t_i| (6). */
+enum { G_BASE = 0, G_TOP = 18, G_A = 36, G_SIZE = 37, G_RT = 38, N_GEOM = 44 }; /* G_RT: |t_i| */
 
 static void rotation(int conv, const double *ang, double R[9]) {
     double ca = cos(ang[0]), cb = cos(ang[1]), cg = cos(ang[2]);
@@ -50,7 +50,7 @@ static double clip1(double x) { return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x); }
 static void angles(int conv, const double R[9], double *ang) {
     if (conv == 0) {
         ang[0] = asin(clip1(-R[5]));
-        if (hypot(R[2], R[8]) < 1e-12) {
+        if (R[2] * R[2] + R[8] * R[8] < 1e-24) { /* hypot < 1e-12 (no underflow at these magnitudes) */
             ang[1] = atan2(-R[6], R[0]);
             ang[2] = 0.0;
         } else {
@@ -59,7 +59,7 @@ static void angles(int conv, const double R[9], double *ang) {
         }
     } else {
         ang[1] = asin(clip1(-R[6]));
-        if (hypot(R[7], R[8]) < 1e-12) {
+        if (R[7] * R[7] + R[8] * R[8] < 1e-24) {
             ang[0] = 0.0;
             ang[2] = atan2(-R[1], R[4]);
         } else {
@@ -182,7 +182,8 @@ static double lipschitz(double a, const double rt[6], const double L0[6], double
  * badly conditioned to bound) and eta. The scaled J_s = J D^-1, D = diag(1, 1, 1, a, a, a): J_s^-1 = D J^-1. */
 static void certificate(const double *g, double J0[6][6], double F[6][6], const int piv[6], const double L0[6],
                         const double d0[6], double nf, double *rho_out, double *eta_out) {
-    double a = g[G_A], X[6][6], Y[6][6], D[6] = {1, 1, 1, a, a, a}, Dinv[6] = {1, 1, 1, 1 / a, 1 / a, 1 / a}, rt[6];
+    double a = g[G_A], X[6][6], Y[6][6], D[6] = {1, 1, 1, a, a, a}, Dinv[6] = {1, 1, 1, 1 / a, 1 / a, 1 / a};
+    const double *rt = g + G_RT;
     *rho_out = 0.0;
     *eta_out = INFINITY;
     lu_inverse(F, piv, Y); /* Y = J^-1 */
@@ -205,11 +206,7 @@ static void certificate(const double *g, double J0[6][6], double F[6][6], const 
     for (int i = 0; i < 6; i++) xd += (D[i] * d0[i]) * (D[i] * d0[i]);
     *eta_out = (sqrt(xd) + beta * delta * nf) * (1.0 + MARGIN);
     double lmin = L0[0];
-    for (int i = 0; i < 6; i++) {
-        const double *t = g + G_TOP + 3 * i;
-        rt[i] = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-        lmin = L0[i] < lmin ? L0[i] : lmin;
-    }
+    for (int i = 0; i < 6; i++) lmin = L0[i] < lmin ? L0[i] : lmin;
     /* gamma grows with rho: rho = min(c, rho_s), c = 0.999 / (beta gamma(rho_s)), satisfies beta gamma(rho) rho < 1
      * with one bound; when c > rho_s, c itself (capped at rho_max = |l|min / 4) is tried with a second. */
     double rho_max = 0.25 * lmin, rho_s = 0.2 * a < rho_max ? 0.2 * a : rho_max;

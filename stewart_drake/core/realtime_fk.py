@@ -88,11 +88,12 @@ def library():
 
 
 def geometry_vector(platform: Platform) -> np.ndarray:
-    """``(38,)`` the kernel's geometry: base anchors, plate anchors relative to the rotation centre (per
-    leg, in T), the anchor radius a and the numpy divergence test's size (metres)."""
+    """``(44,)`` the kernel's geometry: base anchors, plate anchors relative to the rotation centre (per
+    leg, in T), the anchor radius a, the numpy divergence test's size and |t_i| (metres)."""
     t = platform.top_anchors_per_leg - platform.rotation_centre
     size = max(np.abs(platform.base_anchors).max(), np.abs(platform.top_anchors).max())
-    return np.concatenate([platform.base_anchors.ravel(), t.ravel(), [anchor_radius(platform), size]]).astype(float)
+    rt = np.linalg.norm(t, axis=-1)
+    return np.concatenate([platform.base_anchors.ravel(), t.ravel(), [anchor_radius(platform), size], rt]).astype(float)
 
 
 @dataclass(frozen=True)
