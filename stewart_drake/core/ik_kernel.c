@@ -69,6 +69,34 @@ static void sd_sincos(double x, double *s, double *c) {
     }
 }
 
+#if defined(__SSE2__)
+/* ksin(x, 0) and kcos(x, 0) of two angles at once: the scalar kernels' operations in the same order */
+static inline void ksincos2(double x0, double x1, double *s0, double *c0, double *s1, double *c1) {
+    const __m128d zero = _mm_setzero_pd(), half = _mm_set1_pd(0.5), one = _mm_set1_pd(1.0);
+    __m128d x = _mm_set_pd(x1, x0), y = zero;
+    __m128d z = _mm_mul_pd(x, x), w = _mm_mul_pd(z, z);
+    /* sin: r = S2 + z (S3 + z S4) + z w (S5 + z S6); x - ((z (0.5 y - v r) - y) - v S1), v = z x */
+    __m128d r = _mm_add_pd(
+        _mm_add_pd(_mm_set1_pd(S2), _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(S3), _mm_mul_pd(z, _mm_set1_pd(S4))))),
+        _mm_mul_pd(_mm_mul_pd(z, w), _mm_add_pd(_mm_set1_pd(S5), _mm_mul_pd(z, _mm_set1_pd(S6)))));
+    __m128d v = _mm_mul_pd(z, x);
+    __m128d t = _mm_sub_pd(_mm_mul_pd(z, _mm_sub_pd(_mm_mul_pd(half, y), _mm_mul_pd(v, r))), y);
+    __m128d sn = _mm_sub_pd(x, _mm_sub_pd(t, _mm_mul_pd(v, _mm_set1_pd(S1))));
+    /* cos: r = z (C1 + z (C2 + z C3)) + w w (C4 + z (C5 + z C6)); u + (((1 - u) - hz) + (z r - x y)) */
+    __m128d rc = _mm_add_pd(
+        _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(C1), _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(C2), _mm_mul_pd(z, _mm_set1_pd(C3)))))),
+        _mm_mul_pd(_mm_mul_pd(w, w),
+                   _mm_add_pd(_mm_set1_pd(C4), _mm_mul_pd(z, _mm_add_pd(_mm_set1_pd(C5), _mm_mul_pd(z, _mm_set1_pd(C6)))))));
+    __m128d hz = _mm_mul_pd(half, z), u = _mm_sub_pd(one, hz);
+    __m128d cs = _mm_add_pd(u, _mm_add_pd(_mm_sub_pd(_mm_sub_pd(one, u), hz), _mm_sub_pd(_mm_mul_pd(z, rc), _mm_mul_pd(x, y))));
+    double out[2];
+    _mm_storeu_pd(out, sn);
+    *s0 = out[0]; *s1 = out[1];
+    _mm_storeu_pd(out, cs);
+    *c0 = out[0]; *c1 = out[1];
+}
+#endif
+
 /* g: base anchors b_i (6x3) then plate anchors relative to the rotation centre t_i (6x3), metres. */
 void sd_ik(int64_t n, const double *restrict g, int conv, const double *restrict q, double *restrict L) {
     double bx[6], by[6], bz[6], tx[6], ty[6], tz[6];
@@ -79,8 +107,17 @@ void sd_ik(int64_t n, const double *restrict g, int conv, const double *restrict
     for (int64_t k = 0; k < n; k++) {
         const double *p = q + 6 * k;
         double sa, ca, sb, cb, sg, cg, R[9];
+#if defined(__SSE2__)
+        if (fabs(p[3]) <= 0.785398163397448279 && fabs(p[4]) <= 0.785398163397448279) {
+            ksincos2(p[3], p[4], &sa, &ca, &sb, &cb);
+        } else {
+            sd_sincos(p[3], &sa, &ca);
+            sd_sincos(p[4], &sb, &cb);
+        }
+#else
         sd_sincos(p[3], &sa, &ca);
         sd_sincos(p[4], &sb, &cb);
+#endif
         sd_sincos(p[5], &sg, &cg);
         if (conv == 0) { /* utn: Ry(b) Rx(a) Rz(g) */
             R[0] = cb * cg + sa * sb * sg; R[1] = sa * sb * cg - cb * sg; R[2] = ca * sb;

@@ -3,8 +3,8 @@ through ``core.c_build`` (cffi), with ``kinematics.leg_lengths`` as the referenc
 
 Why: a design search or a dense map evaluates IK billions of times; the numpy path streams a dozen
 ``(n, 6)`` temporaries per block, the C loop keeps a pose in registers and uses its own sine and cosine
-(fdlibm's kernels, < 1 ulp): ≈ 6x the numpy path's poses per CPU second on one core
-(``benchmarks/bench_ik_kernel.py``; ≈ 400 instructions per pose by callgrind). Same formula and summation order
+(fdlibm's kernels, < 1 ulp): ≈ 7x the numpy path's poses per CPU second on one core
+(``benchmarks/bench_ik_kernel.py``; ≈ 350 instructions per pose by callgrind). Same formula and summation order
 as the numpy path; the only difference is the last bit of a sine or cosine, so the lengths agree to a few
 ulp (the tests pin 1e-15 m, absolute, on legs of 0.2–1.2 m). Without a C compiler the numpy path runs,
 with a one-line note on stderr.
