@@ -602,6 +602,8 @@ class FkInputError(StewartError):
     INITIAL_BROADCAST = "initial poses of shape {shape} do not match lengths of shape {lengths_shape}"
     INITIAL_SIX = "initial pose must be 6 finite numbers, got {value}"
     ONE_SET = "{what} takes one length set of shape (6,), got {shape}"
+    ENGINE = "engine must be 'auto', 'c' or 'numpy', got {value!r}"
+    NO_COMPILER = "engine 'c' asked for, but no C compiler is available (engine 'auto' runs the numpy path)"
     ROTATION = "unknown rotation parametrisation {value!r}; expected one of {valid}"
     SOLVER = "unknown solver {value!r}; expected one of {valid}"
     POLISH = "polish must be one of {valid} or None, got {value!r}"

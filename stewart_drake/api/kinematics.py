@@ -13,6 +13,7 @@ from stewart_drake.core.assembly_modes import modes_from_solutions
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.newton_fk import forward_kinematics
+from stewart_drake.core.realtime_fk import branch_check
 from stewart_drake.core.sanity import (
     below_base_message,
     check_finite,
@@ -312,7 +313,15 @@ def solve_fk(
             mode = modes_from_solutions(
                 platform, r.iterate[None, :3], r.rotation[None], L, np.array([False]), convention
             )
-            sol = _solution(mode[0], "newton", iterations=int(r.iterations))
+            start = platform.home_pose() if initial is None else initial
+            on_branch, radius = branch_check(platform, start, L, r.iterate[:3], r.rotation, convention)
+            sol = _solution(
+                mode[0],
+                "newton",
+                iterations=int(r.iterations),
+                branch_certified=on_branch,
+                uniqueness_radius_initial=radius,
+            )
             return FKResult([sol], "newton", None, *common, **allowed)
     if all_modes and method == "homotopy":
         return _homotopy_all(platform, L, convention, seed, common, allowed)

@@ -66,6 +66,8 @@ def cli_units(result, args, k: float) -> dict:
         s["residual"] /= k
         if "position_bound" in s:
             s.update(position_bound=s["position_bound"] / k, angle_bound=s["angle_bound"] / ka)
+        if "uniqueness_radius_initial" in s:
+            s["uniqueness_radius_initial"] /= k
     return out
 
 
@@ -115,6 +117,12 @@ def run(args) -> int:
                 if s["certified"]
                 else []
             )
+            if "branch_certified" in s:
+                flags.append(
+                    "on the initial pose's branch (certified)"
+                    if s["branch_certified"]
+                    else "branch from the initial pose NOT certified (another assembly mode may have been reached)"
+                )
             print(
                 f"{i:3d}",
                 " ".join(f"{x:11.5f}" for x in s["pose"]),

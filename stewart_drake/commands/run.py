@@ -169,7 +169,10 @@ def branch_exit(b: dict | None, args) -> int:
         f"run --check-branches: not branch-safe: nearest other assembly mode {b['min_branch_distance_m'] * 1e3:.3f} mm "
         f"(margin {args.branch_margin:g} mm) at t = {b['min_branch_distance_t_s']:.3f} s; smallest sigma_min "
         f"{b['min_sigma_min']:.4g} (margin {args.singularity_margin:g}) at t = {b['min_sigma_min_t_s']:.3f} s"
-        + ("" if b["all_complete"] else f"; FK not complete at samples {b['incomplete_samples']}"),
+        + ("" if b["all_complete"] else f"; FK not complete at samples {b['incomplete_samples']}")
+        + (
+            "" if b["fk_certified_every_sample"] else f"; real-time FK not certified at t = {b['fk_uncertified_t_s']} s"
+        ),
         file=sys.stderr,
     )
     return 1
@@ -317,6 +320,8 @@ def print_summary(summary: dict, out: Path) -> None:
         print(
             f"  branches ({b['samples_checked']} samples, {b['modes_min']}-{b['modes_max']} real modes, complete: {b['all_complete']}): "
             f"nearest other mode {b['min_branch_distance_m'] * 1e3:.3f} mm at t = {b['min_branch_distance_t_s']:.3f} s, "
-            f"smallest sigma_min {b['min_sigma_min']:.4g} at t = {b['min_sigma_min_t_s']:.3f} s -> {'safe' if b['safe'] else 'NOT SAFE'}"
+            f"smallest sigma_min {b['min_sigma_min']:.4g} at t = {b['min_sigma_min_t_s']:.3f} s; real-time FK certified on the "
+            f"branch at {'every' if b['fk_certified_every_sample'] else 'NOT every'} one of {b['fk_samples_followed']} samples "
+            f"-> {'safe' if b['safe'] else 'NOT SAFE'}"
         )
     print(f"wrote {out}/")

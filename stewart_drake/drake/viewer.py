@@ -23,6 +23,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.leg_bodies import leg_visual_dimensions
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
+from stewart_drake.core.realtime_fk import certificate
 from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length_scale, rotation_matrix
 from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
 from stewart_drake.errors import ReplayError, SimulationError, StewartError
@@ -53,6 +54,7 @@ class Readout:
     modes: int | None = None
     modes_near: int | None = None
     warnings: np.ndarray = field(default_factory=lambda: np.zeros(6, bool))
+    uniqueness_radius: float = 0.0  # m: no other assembly mode this close to the pose (realtime_fk certificate)
 
     def to_dict(self) -> dict:
         return {
@@ -66,6 +68,7 @@ class Readout:
             "fraction_from_home": self.fraction,
             "assembly_modes": self.modes,
             "assembly_modes_near": self.modes_near,
+            "uniqueness_radius_m": self.uniqueness_radius,
         }
 
 
@@ -113,10 +116,18 @@ def readout(platform: Platform, pose, convention: str = "utn", modes: bool = Tru
         nearest,
         s,
         warnings=leg_warnings(platform, L),
+        uniqueness_radius=uniqueness_radius(platform, pose, L, convention),
     )
     if modes:
         r.modes, r.modes_near = count_modes(platform, pose, L, convention)
     return r
+
+
+def uniqueness_radius(platform: Platform, pose, lengths, convention: str = "utn") -> float:
+    """Metres within which no other assembly mode of ``lengths`` lies around ``pose`` (6,): the real-time
+    FK's certified uniqueness radius (``core.realtime_fk.certificate``), a bound that costs no search."""
+    p, R = np.asarray(pose, dtype=float)[None, :3], rotation_matrix(np.asarray(pose, dtype=float)[None, 3:], convention)
+    return float(certificate(platform, p, R, np.asarray(lengths, dtype=float)[None])[0][0])
 
 
 def count_modes(platform: Platform, pose, lengths, convention: str = "utn") -> tuple[int, int]:
@@ -139,6 +150,7 @@ def labels(r: Readout, length_unit: str = "mm") -> list[str]:
     k = 1.0 / length_scale(length_unit)
     out = [f"L{i + 1} {r.lengths[i] * k:.1f} {length_unit}, margin {r.margin[i] * k:+.1f}" for i in range(6)]
     out.append(f"condition {r.condition:.3g}, σmin {r.sigma_min:.3g}")
+    out.append(f"no other assembly mode within {r.uniqueness_radius * k:.1f} {length_unit} (certified)")
     if r.modes is not None:
         out.append(f"assembly modes {r.modes}, {r.modes_near} near")
     if r.reachable:

@@ -33,6 +33,7 @@ from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains
 from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG
 from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import FirmwareError
+from stewart_drake.firmware.fk_gen import contraction, fk_ops, fk_prototype, fk_readme, fk_source
 from stewart_drake.fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
 from stewart_drake.fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 
@@ -76,10 +77,16 @@ class GeneratedFirmware:
     files: dict = field(default_factory=dict)
     ik_ops: Counter = field(default_factory=Counter)
     tick_ops: Counter = field(default_factory=Counter)
+    fk_ops: Counter = field(default_factory=Counter)  # one sd_fk (firmware.fk_gen)
 
     @property
     def ik_cycles(self) -> CycleEstimate:
         return estimate_cycles(self.ik_ops, _cycle_table())
+
+    @property
+    def fk_cycles(self) -> CycleEstimate:
+        """Cycles of one ``sd_fk`` (its iterations unrolled in the count: one loop overhead)."""
+        return estimate_cycles(self.fk_ops, _cycle_table())
 
     @property
     def tick_cycles(self) -> float:
@@ -276,6 +283,12 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     g.files["sd_firmware.h"] = _header(ctx, config)
     g.files["sd_firmware.c"] = _source(ctx, e.lines, table)
     g.files["README.md"] = _readme(ctx, g, config, r_T, B)
+    # sd_fk (firmware.fk_gen): appended, so the IK and tick above are unchanged
+    g.fk_ops = fk_ops(ik_ops)
+    end = "\n#endif /* SD_FIRMWARE_H */"
+    g.files["sd_firmware.h"] = g.files["sd_firmware.h"].replace(end, "\n" + fk_prototype() + end, 1)
+    g.files["sd_firmware.c"] += fk_source(platform, config)
+    g.files["README.md"] += fk_readme(g.fk_cycles, config.timing.clock_hz, contraction(platform, config))
     return g
 
 

@@ -24,6 +24,7 @@ typedef int32_t sd_count;
 typedef struct {{ int32_t integ[6]; sd_count prev[6]; int16_t dfilt[6]; sd_word setpoint[6]; int16_t vfilt[6]; int16_t saturated[6]; }} sd_state;
 int sd_ik(const sd_word pose[6], sd_word lengths[6]);
 int sd_ik_trace(const sd_word pose[6], int32_t trace[{TRACE_WORDS}]);
+int sd_fk(const sd_count measured[6], sd_word pose[6]);
 void sd_init(sd_state *s);
 int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], const int16_t feedforward[6], int16_t command[6]);
 void sd_ik_batch(const sd_word *poses, long n, sd_word *lengths, int32_t *nsat);

@@ -13,6 +13,13 @@ with a certificate; we report
   singularity distance: 0 on a singularity).
 
 The check is only as complete as the solver: a sample whose result is not ``complete`` is reported.
+
+Between the checked samples, every sample of the trajectory is followed by the real-time FK
+(``core.realtime_fk``: compiled Newton from the previous sample, split into certified sub-steps where
+needed): ``fk_certified`` says, per sample, that the FK a controller would run from the leg lengths
+stays on the trajectory's branch (a Kantorovich certificate), and ``fk_radius`` is the certified
+uniqueness radius around each pose — a lower bound on the distance to any other mode at every sample,
+where ``branch_distance`` is exact at the checked ones.
 """
 
 from __future__ import annotations
@@ -24,19 +31,23 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
+from stewart_drake.core.realtime_fk import RealtimeFK
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import OPTION_BRANCH_SAMPLES, OptionError
 from stewart_drake.homotopy.solve import solve_batch
 
 MAX_SAMPLES = 5000  # bound on the samples checked (each is one homotopy solve)
 SAME_MODE = 1e-6  # m: the mode the platform is on is found within this of the sampled pose
+FK_SUBSTEPS = 64  # certified sub-steps the real-time FK may split one sample-to-sample step into
 
 
 @dataclass(frozen=True)
 class BranchReport:
     """Per checked sample ``(k,)``: ``index`` into the trajectory, ``t`` (s), ``branch_distance`` (m,
     inf when the pose is the only real mode), ``sigma_min``, ``modes`` (real modes), ``complete``,
-    ``on_mode`` (the sampled pose is among the certified modes). Worst values and where."""
+    ``on_mode`` (the sampled pose is among the certified modes). Per trajectory sample ``(n,)``:
+    ``fk_certified`` (the real-time FK followed the branch to this pose, certified) and ``fk_radius``
+    (m, the certified uniqueness radius around the previous pose). Worst values and where."""
 
     index: np.ndarray
     t: np.ndarray
@@ -45,10 +56,15 @@ class BranchReport:
     modes: np.ndarray
     complete: np.ndarray
     on_mode: np.ndarray
+    t_all: np.ndarray = None
+    fk_certified: np.ndarray = None
+    fk_radius: np.ndarray = None
 
     def summary(self, branch_margin: float, singularity_margin: float) -> dict:
         kb = int(np.argmin(self.branch_distance))
         ks = int(np.argmin(self.sigma_min))
+        kr = int(np.argmin(self.fk_radius))
+        uncertified = np.flatnonzero(~self.fk_certified)
         return {
             "samples_checked": len(self.index),
             "min_branch_distance_m": float(self.branch_distance[kb]),
@@ -62,11 +78,17 @@ class BranchReport:
             "all_complete": bool(self.complete.all()),
             "incomplete_samples": [int(i) for i in self.index[~self.complete]],
             "pose_found_at_every_sample": bool(self.on_mode.all()),
+            "fk_samples_followed": len(self.fk_certified),
+            "fk_certified_every_sample": bool(self.fk_certified.all()),
+            "fk_uncertified_t_s": [float(self.t_all[k]) for k in uncertified[:10]],
+            "fk_min_uniqueness_radius_m": float(self.fk_radius[kr]),
+            "fk_min_uniqueness_radius_t_s": float(self.t_all[kr]),
             "safe": bool(
                 self.branch_distance[kb] >= branch_margin
                 and self.sigma_min[ks] >= singularity_margin
                 and self.complete.all()
                 and self.on_mode.all()
+                and self.fk_certified.all()
             ),
         }
 
@@ -103,6 +125,7 @@ def branch_safety(
         others = np.delete(d, me)
         dist[k] = others.min() if len(others) else np.inf
     sig = jacobian_analysis(platform, q, convention).sigma_min
+    fk_cert, fk_radius = follow(platform, poses, convention)
     return BranchReport(
         idx,
         np.asarray(t)[idx],
@@ -111,4 +134,17 @@ def branch_safety(
         np.array([len(r.modes) for r in results]),
         np.array([r.complete for r in results]),
         on,
+        np.asarray(t, dtype=float),
+        fk_cert,
+        fk_radius,
     )
+
+
+def follow(platform: Platform, poses: np.ndarray, convention: str) -> tuple[np.ndarray, np.ndarray]:
+    """The real-time FK along every ``(n, 6)`` pose of a trajectory, each from the previous: ``(certified,
+    radius)``, each ``(n,)``; certified also requires the followed pose to be the trajectory's own (1e-9 m and
+    rad: the FK tolerance 1e-13 m over the smallest singular value of a pose the certificate accepts)."""
+    q = np.asarray(poses, dtype=float)
+    r = RealtimeFK(platform, convention, max_substeps=FK_SUBSTEPS).track(leg_lengths(platform, q, convention), q[0])
+    on = np.all(np.abs(r.poses - q) <= 1e-9, axis=-1)
+    return r.certified & on, r.radius

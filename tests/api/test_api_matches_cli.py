@@ -132,6 +132,8 @@ def test_fk(capsys, platform_arg, all_modes):
         s.update(pose=pose_mm_deg(s["pose"]), residual=s["residual"] * MM)
         if "position_bound" in s:
             s.update(position_bound=s["position_bound"] * MM, angle_bound=s["angle_bound"] * DEG)
+        if "uniqueness_radius_initial" in s:
+            s["uniqueness_radius_initial"] *= MM
     assert_same(api, cli)
     assert rc == (0 if r.ok else 1)
 

@@ -1,0 +1,381 @@
+/* Real-time forward kinematics of stewart_drake.core.realtime_fk: Newton from the previous pose with a
+ * certificate that the new pose is on the previous pose's branch (assembly mode).
+ *
+ * Newton is the numpy reference's (newton_fk.newton_core) step for step: iterate on the rotation centre's
+ * position p and the orientation R, solve J d = L* - L(p, R) with rows [u_i, r_i x u_i], scale the step so
+ * that |dp| <= max_step_m and |w| <= max_step_rad, update p += dp, R = exp([w]x) R.
+ *
+ * Certificate (see realtime_fk.py for the argument): in the coordinates y = (p, a w) around the previous
+ * pose y0 (a the anchor radius, R = exp([w]x) R0), F(y) = L(y) - L*. With beta >= |J(y0)^-1| (2-norm, from
+ * the computed inverse X and its residual |I - X J|_F), gamma(rho) a Lipschitz constant of F' on the ball
+ * B(y0, rho) (from |d exp([w]x) r| <= |r| e^|w| |dw| and its second derivative bound, term by term of the
+ * series) and eta >= |J^-1 F(y0)|:
+ *   uniqueness: beta gamma(rho) rho < 1  => F has at most one zero in B(y0, rho), for every L*;
+ *   branch:     2 eta <= rho              => along L(s) = L(y0) + s (L* - L(y0)), s in [0, 1], the zero
+ *               in B(y0, rho) exists (Kantorovich), is unique and moves continuously: it is y0's branch.
+ * The Newton result is accepted as that zero when it lies in B(y0, rho). Evaluated in double precision
+ * with the rounding of the 6x6 products covered by a relative margin (MARGIN), not interval arithmetic.
+ */
+#include <math.h>
+#include <stdint.h>
+
+enum { CONVERGED = 0, MAX_ITER = 1, DIVERGED = 2, SINGULAR = 3 };
+enum { I_RES = 0, I_ITER, I_STATUS, I_CERT, I_RADIUS, I_ETA, I_STEP, I_SUB, N_INFO };
+
+#define DIVERGENCE_FACTOR 1e3
+#define MAX_STEP_M 0.1
+#define MAX_STEP_RAD 0.5
+#define MARGIN 1e-9
+
+/* g: base anchors (6x3), plate anchors relative to the rotation centre in T (6x3), anchor radius a,
+ * size0 = max(|base anchors|max, |top anchors|max) (the numpy divergence test's scale), |t_i| (6). */
+enum { G_BASE = 0, G_TOP = 18, G_A = 36, G_SIZE = 37, G_RT = 38, N_GEOM = 44 }; /* G_RT: |t_i| */
+
+static void rotation(int conv, const double *ang, double R[9]) {
+    double ca = cos(ang[0]), cb = cos(ang[1]), cg = cos(ang[2]);
+    double sa = sin(ang[0]), sb = sin(ang[1]), sg = sin(ang[2]);
+    if (conv == 0) { /* utn: Ry(b) Rx(a) Rz(g) */
+        R[0] = cb * cg + sa * sb * sg; R[1] = sa * sb * cg - cb * sg; R[2] = ca * sb;
+        R[3] = ca * sg; R[4] = ca * cg; R[5] = -sa;
+        R[6] = sa * cb * sg - sb * cg; R[7] = sb * sg + sa * cb * cg; R[8] = ca * cb;
+    } else { /* zyx: Rz(psi) Ry(theta) Rx(phi) */
+        R[0] = cb * cg; R[1] = sa * sb * cg - ca * sg; R[2] = ca * sb * cg + sa * sg;
+        R[3] = cb * sg; R[4] = sa * sb * sg + ca * cg; R[5] = ca * sb * sg - sa * cg;
+        R[6] = -sb; R[7] = sa * cb; R[8] = ca * cb;
+    }
+}
+
+static double clip1(double x) { return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x); }
+
+static void angles(int conv, const double R[9], double *ang) {
+    if (conv == 0) {
+        ang[0] = asin(clip1(-R[5]));
+        if (R[2] * R[2] + R[8] * R[8] < 1e-24) { /* hypot < 1e-12 (no underflow at these magnitudes) */
+            ang[1] = atan2(-R[6], R[0]);
+            ang[2] = 0.0;
+        } else {
+            ang[1] = atan2(R[2], R[8]);
+            ang[2] = atan2(R[3], R[4]);
+        }
+    } else {
+        ang[1] = asin(clip1(-R[6]));
+        if (R[7] * R[7] + R[8] * R[8] < 1e-24) {
+            ang[0] = 0.0;
+            ang[2] = atan2(-R[1], R[4]);
+        } else {
+            ang[0] = atan2(R[7], R[8]);
+            ang[2] = atan2(R[3], R[0]);
+        }
+    }
+}
+
+/* Leg vectors l_i = p + R t_i - b_i, lengths, plate vectors r_i = R t_i. */
+static void legs(const double *g, const double p[3], const double R[9], double r[6][3], double l[6][3], double L[6]) {
+    for (int i = 0; i < 6; i++) {
+        const double *t = g + G_TOP + 3 * i, *b = g + G_BASE + 3 * i;
+        for (int k = 0; k < 3; k++) {
+            r[i][k] = R[3 * k] * t[0] + R[3 * k + 1] * t[1] + R[3 * k + 2] * t[2];
+            l[i][k] = p[k] + r[i][k] - b[k];
+        }
+        L[i] = sqrt(l[i][0] * l[i][0] + l[i][1] * l[i][1] + l[i][2] * l[i][2]);
+    }
+}
+
+/* Rows [u_i, (r_i x u_i) / a] (a = 1: the unscaled J^-1 of newton_fk). */
+static void jac(double r[6][3], double l[6][3], const double L[6], double a, double J[6][6]) {
+    for (int i = 0; i < 6; i++) {
+        double ux = l[i][0] / L[i], uy = l[i][1] / L[i], uz = l[i][2] / L[i];
+        J[i][0] = ux; J[i][1] = uy; J[i][2] = uz;
+        J[i][3] = (r[i][1] * uz - r[i][2] * uy) / a;
+        J[i][4] = (r[i][2] * ux - r[i][0] * uz) / a;
+        J[i][5] = (r[i][0] * uy - r[i][1] * ux) / a;
+    }
+}
+
+/* LU with partial pivoting in place (multipliers below the diagonal, rows swapped whole); 0 when a pivot
+ * is exactly zero (numpy's LinAlgError). The updates run over all six columns (fixed trip counts the
+ * compiler unrolls): row k is zero left of its pivot, so columns < k are unchanged but for column k,
+ * whose multiplier is written after the update. */
+static int lu(double A[6][6], int piv[6]) {
+    for (int k = 0; k < 6; k++) {
+        int m = k;
+        double big = fabs(A[k][k]);
+        for (int i = k + 1; i < 6; i++)
+            if (fabs(A[i][k]) > big) { m = i; big = fabs(A[i][k]); }
+        piv[k] = m;
+        if (big == 0.0) return 0;
+        if (m != k)
+            for (int j = 0; j < 6; j++) { double t = A[k][j]; A[k][j] = A[m][j]; A[m][j] = t; }
+        double inv = 1.0 / A[k][k], row[6];
+        for (int j = 0; j < 6; j++) row[j] = j > k ? A[k][j] : 0.0;
+        for (int i = k + 1; i < 6; i++) {
+            double f = A[i][k] * inv;
+            for (int j = 0; j < 6; j++) A[i][j] -= f * row[j];
+            A[i][k] = f;
+        }
+    }
+    return 1;
+}
+
+static void lu_solve(double A[6][6], const int piv[6], double x[6]) {
+    for (int k = 0; k < 6; k++) { /* rows were swapped whole (multipliers too): permute first */
+        double t = x[k]; x[k] = x[piv[k]]; x[piv[k]] = t;
+    }
+    for (int k = 0; k < 6; k++)
+        for (int i = k + 1; i < 6; i++) x[i] -= A[i][k] * x[k];
+    for (int k = 5; k >= 0; k--) {
+        for (int j = k + 1; j < 6; j++) x[k] -= A[k][j] * x[j];
+        x[k] /= A[k][k];
+    }
+}
+
+/* The inverse from the LU: all six right-hand sides at once (rows of X, the inner loops over columns). */
+static void lu_inverse(double A[6][6], const int piv[6], double X[6][6]) {
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) X[i][j] = (i == j);
+    for (int k = 0; k < 6; k++)
+        if (piv[k] != k)
+            for (int j = 0; j < 6; j++) { double t = X[k][j]; X[k][j] = X[piv[k]][j]; X[piv[k]][j] = t; }
+    for (int k = 0; k < 6; k++)
+        for (int i = k + 1; i < 6; i++)
+            for (int j = 0; j < 6; j++) X[i][j] -= A[i][k] * X[k][j];
+    for (int k = 5; k >= 0; k--) {
+        for (int i = k + 1; i < 6; i++)
+            for (int j = 0; j < 6; j++) X[k][j] -= A[k][i] * X[i][j];
+        double inv = 1.0 / A[k][k];
+        for (int j = 0; j < 6; j++) X[k][j] *= inv;
+    }
+}
+
+/* R <- exp([w]x) R (Rodrigues, the numpy _exp_so3's series below 1e-6 rad). */
+static void rotate(const double w[3], double R[9]) {
+    double th2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], th = sqrt(th2), A, B;
+    if (th < 1e-6) { A = 1.0 - th2 / 6.0; B = 0.5 - th2 / 24.0; }
+    else { A = sin(th) / th; B = (1.0 - cos(th)) / (th * th); }
+    double K[9] = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0}, E[9], out[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double kk = K[3 * i] * K[j] + K[3 * i + 1] * K[3 + j] + K[3 * i + 2] * K[6 + j];
+            E[3 * i + j] = (i == j) + A * K[3 * i + j] + B * kk;
+        }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) out[3 * i + j] = E[3 * i] * R[j] + E[3 * i + 1] * R[3 + j] + E[3 * i + 2] * R[6 + j];
+    for (int k = 0; k < 9; k++) R[k] = out[k];
+}
+
+/* Lipschitz constant of F' on B(y0, rho) in y = (p, a w): per leg, |D l| <= c1 |dy|, |D^2 l| <= |t| E / a^2 |dy|^2
+ * with E = e^(rho / a), |l| >= |l0| - c1 rho; |D^2 |l|| <= c1^2 / |l| + |t| E / a^2; gamma = sqrt(sum M_i^2).
+ * rt: |t_i|, the plate anchors' distances from the rotation centre. */
+static double lipschitz(double a, const double rt[6], const double L0[6], double rho) {
+    double E = exp(rho / a), s = 0.0;
+    for (int i = 0; i < 6; i++) {
+        double c1sq = 1.0 + (rt[i] * E / a) * (rt[i] * E / a), lmin = L0[i] - sqrt(c1sq) * rho;
+        if (!(lmin > 0)) return INFINITY;
+        double M = c1sq / lmin + rt[i] * E / (a * a);
+        s += M * M;
+    }
+    return sqrt(s) * (1.0 + MARGIN);
+}
+
+/* The certificate at y0 from the unscaled J(y0) (LU-factorised in F, original in J0), the leg lengths L0 at
+ * y0, the first Newton step d0 = J^-1 (Lt - L0) and |Lt - L0|: uniqueness radius rho (0 when J(y0) is too
+ * badly conditioned to bound) and eta. The scaled J_s = J D^-1, D = diag(1, 1, 1, a, a, a): J_s^-1 = D J^-1. */
+static void certificate(const double *g, double J0[6][6], double F[6][6], const int piv[6], const double L0[6],
+                        const double d0[6], double nf, double *rho_out, double *eta_out) {
+    double a = g[G_A], X[6][6], Y[6][6], D[6] = {1, 1, 1, a, a, a}, Dinv[6] = {1, 1, 1, 1 / a, 1 / a, 1 / a};
+    const double *rt = g + G_RT;
+    *rho_out = 0.0;
+    *eta_out = INFINITY;
+    lu_inverse(F, piv, Y); /* Y = J^-1 */
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) X[i][j] = D[i] * Y[i][j]; /* X = J_s^-1 = D J^-1 */
+    double xf = 0.0, df = 0.0;
+    for (int i = 0; i < 6; i++) {
+        double row[6] = {0, 0, 0, 0, 0, 0};
+        for (int k = 0; k < 6; k++)
+            for (int j = 0; j < 6; j++) row[j] += X[i][k] * J0[k][j];
+        for (int j = 0; j < 6; j++) {
+            double d = (i == j) - row[j] * Dinv[j]; /* I - X J_s */
+            df += d * d;
+            xf += X[i][j] * X[i][j];
+        }
+    }
+    double delta = sqrt(df) * (1.0 + MARGIN) + 1e-15;
+    if (!(delta < 0.5)) return;
+    double beta = sqrt(xf) * (1.0 + MARGIN) / (1.0 - delta), xd = 0.0;
+    for (int i = 0; i < 6; i++) xd += (D[i] * d0[i]) * (D[i] * d0[i]);
+    *eta_out = (sqrt(xd) + beta * delta * nf) * (1.0 + MARGIN);
+    double lmin = L0[0];
+    for (int i = 0; i < 6; i++) lmin = L0[i] < lmin ? L0[i] : lmin;
+    /* gamma grows with rho: rho = min(c, rho_s), c = 0.999 / (beta gamma(rho_s)), satisfies beta gamma(rho) rho < 1
+     * with one bound; when c > rho_s, c itself (capped at rho_max = |l|min / 4) is tried with a second. */
+    double rho_max = 0.25 * lmin, rho_s = 0.2 * a < rho_max ? 0.2 * a : rho_max;
+    double c = 0.999 / (beta * lipschitz(a, rt, L0, rho_s)), best = c < rho_s ? c : rho_s;
+    if (c > rho_s) {
+        c = c < rho_max ? c : rho_max;
+        if (beta * lipschitz(a, rt, L0, c) * c < 1.0) best = c;
+    }
+    *rho_out = best;
+}
+
+/* Newton from (p, R) to lengths Lt; (p, R) updated in place; returns the status, writes residual, iterations
+ * and (cert != NULL) the certificate at the start (rho, eta), sharing the first iteration's LU. */
+static int newton(const double *g, const double *Lt, double tol, int max_iter, double p[3], double R[9], double *res_out,
+                  int *its_out, double *cert) {
+    double size = g[G_SIZE];
+    for (int i = 0; i < 6; i++) size = Lt[i] > size ? Lt[i] : size;
+    double r[6][3], l[6][3], L[6], J[6][6], J0[6][6], e[6];
+    int piv[6], its = 0, st = MAX_ITER;
+    double res = INFINITY;
+    if (cert) { cert[0] = 0.0; cert[1] = INFINITY; }
+    for (int k = 0; k <= max_iter; k++) {
+        legs(g, p, R, r, l, L);
+        res = 0.0;
+        double nf = 0.0;
+        for (int i = 0; i < 6; i++) {
+            e[i] = Lt[i] - L[i];
+            double a = fabs(e[i]);
+            res = (a > res || a != a) ? a : res;
+            nf += e[i] * e[i];
+        }
+        int done = res <= tol;
+        if (!done && (!isfinite(res) || sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) > DIVERGENCE_FACTOR * size)) {
+            st = DIVERGED;
+            break;
+        }
+        if (k == 0 && cert) { /* the certificate needs J(y0) and the first step even when y0 already fits */
+            jac(r, l, L, 1.0, J);
+            for (int i = 0; i < 6; i++)
+                for (int j = 0; j < 6; j++) J0[i][j] = J[i][j];
+            if (lu(J, piv)) {
+                double d0[6] = {e[0], e[1], e[2], e[3], e[4], e[5]};
+                lu_solve(J, piv, d0);
+                certificate(g, J0, J, piv, L, d0, sqrt(nf), cert, cert + 1);
+                if (!done) for (int i = 0; i < 6; i++) e[i] = d0[i];
+            } else if (!done) {
+                st = SINGULAR;
+                break;
+            }
+        }
+        if (done) { st = CONVERGED; break; }
+        if (k == max_iter) break;
+        if (!(k == 0 && cert)) {
+            jac(r, l, L, 1.0, J);
+            if (!lu(J, piv)) { st = SINGULAR; break; }
+            lu_solve(J, piv, e);
+        }
+        double ndp = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]), nw = sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]);
+        double s = 1.0;
+        if (ndp > 0 && MAX_STEP_M / ndp < s) s = MAX_STEP_M / ndp;
+        if (nw > 0 && MAX_STEP_RAD / nw < s) s = MAX_STEP_RAD / nw;
+        for (int j = 0; j < 3; j++) p[j] += s * e[j];
+        double w[3] = {s * e[3], s * e[4], s * e[5]};
+        rotate(w, R);
+        its++;
+    }
+    *res_out = res;
+    *its_out = its;
+    return st;
+}
+
+/* Distance sqrt(|dp|^2 + (a theta)^2) between two poses, theta the angle of R1 R0^T. */
+static double distance(double a, const double p0[3], const double R0[9], const double p1[3], const double R1[9]) {
+    double M[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) M[3 * i + j] = R1[3 * i] * R0[3 * j] + R1[3 * i + 1] * R0[3 * j + 1] + R1[3 * i + 2] * R0[3 * j + 2];
+    double vx = M[7] - M[5], vy = M[2] - M[6], vz = M[3] - M[1];
+    double th = atan2(0.5 * sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (M[0] + M[4] + M[8] - 1.0));
+    double dx = p1[0] - p0[0], dy = p1[1] - p0[1], dz = p1[2] - p0[2];
+    return sqrt(dx * dx + dy * dy + dz * dz + a * a * th * th);
+}
+
+/* One certified step from (p, R) to Lt (both updated in place on success of Newton). */
+static int step(const double *g, const double *Lt, double tol, int max_iter, double p[3], double R[9], double *info) {
+    double p0[3] = {p[0], p[1], p[2]}, R0[9], c[2], res;
+    int its;
+    for (int k = 0; k < 9; k++) R0[k] = R[k];
+    int st = newton(g, Lt, tol, max_iter, p, R, &res, &its, c);
+    double rho = c[0], eta = c[1];
+    double d = distance(g[G_A], p0, R0, p, R);
+    info[I_RES] = res;
+    info[I_ITER] += its;
+    info[I_STATUS] = st;
+    info[I_RADIUS] = rho;
+    info[I_ETA] = eta;
+    info[I_STEP] = d;
+    info[I_CERT] = (st == CONVERGED && 2.0 * eta <= rho && d < rho) ? 1.0 : 0.0;
+    return st;
+}
+
+/* Solve from (p, R) to Lt; with max_sub > 0, an uncertified step is split along the straight length path
+ * L(s) = L(y0) + s (Lt - L(y0)) (halving, at most max_sub accepted sub-steps): certified when every sub-step is. */
+static void solve_one(const double *g, const double *Lt, double tol, int max_iter, int max_sub, double p[3], double R[9],
+                      double *info) {
+    for (int k = 0; k < N_INFO; k++) info[k] = 0.0;
+    double pk[3] = {p[0], p[1], p[2]}, Rk[9];
+    for (int k = 0; k < 9; k++) Rk[k] = R[k];
+    step(g, Lt, tol, max_iter, p, R, info);
+    info[I_SUB] = 1;
+    if (info[I_CERT] == 1.0 || max_sub <= 0) return;
+    double r[6][3], l[6][3], L0[6];
+    legs(g, pk, Rk, r, l, L0);
+    double s = 0.0, ds = 0.5, sub[N_INFO], rho0 = -1.0, eta_total = 0.0;
+    int n = 0, iters = (int)info[I_ITER];
+    while (s < 1.0 && n < max_sub && ds > 1e-6) {
+        double sn = s + ds > 1.0 ? 1.0 : s + ds, Ls[6], pt[3] = {pk[0], pk[1], pk[2]}, Rt[9];
+        for (int i = 0; i < 6; i++) Ls[i] = sn >= 1.0 ? Lt[i] : L0[i] + sn * (Lt[i] - L0[i]);
+        for (int k = 0; k < 9; k++) Rt[k] = Rk[k];
+        for (int k = 0; k < N_INFO; k++) sub[k] = 0.0;
+        step(g, Ls, tol, max_iter, pt, Rt, sub);
+        iters += (int)sub[I_ITER];
+        if (sub[I_CERT] == 1.0) {
+            if (rho0 < 0) rho0 = sub[I_RADIUS];
+            eta_total += sub[I_STEP];
+            s = sn;
+            n++;
+            for (int k = 0; k < 3; k++) pk[k] = pt[k];
+            for (int k = 0; k < 9; k++) Rk[k] = Rt[k];
+            ds *= 2.0;
+        } else {
+            ds *= 0.5;
+        }
+    }
+    if (s >= 1.0) { /* every sub-step certified: the branch of the previous pose */
+        for (int k = 0; k < 3; k++) p[k] = pk[k];
+        for (int k = 0; k < 9; k++) R[k] = Rk[k];
+        info[I_RES] = sub[I_RES];
+        info[I_STATUS] = CONVERGED;
+        info[I_CERT] = 1.0;
+        info[I_RADIUS] = rho0;
+        info[I_STEP] = eta_total;
+        info[I_SUB] = n;
+    }
+    info[I_ITER] = iters;
+}
+
+/* n length sets; initial pose q0 (Euler, conv) per row (q0_stride 6) or one for all (0); track = 1: row k
+ * starts from row k-1's result (kept as a matrix, no angle round trip) when that converged. */
+void sd_rtfk(int64_t n, const double *g, int conv, const double *L, const double *q0, int64_t q0_stride, int track,
+             double tol, int max_iter, int max_sub, double *q_out, double *info) {
+    double p[3] = {0, 0, 0}, R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int have = 0;
+    for (int64_t k = 0; k < n; k++) {
+        if (!(track && have)) {
+            const double *q = q0 + k * q0_stride;
+            p[0] = q[0]; p[1] = q[1]; p[2] = q[2];
+            rotation(conv, q + 3, R);
+        }
+        double pp[3] = {p[0], p[1], p[2]}, RR[9];
+        for (int j = 0; j < 9; j++) RR[j] = R[j];
+        double *inf = info + N_INFO * k;
+        solve_one(g, L + 6 * k, tol, max_iter, max_sub, pp, RR, inf);
+        double *q = q_out + 6 * k;
+        q[0] = pp[0]; q[1] = pp[1]; q[2] = pp[2];
+        angles(conv, RR, q + 3);
+        if (track && inf[I_STATUS] == CONVERGED) {
+            for (int j = 0; j < 3; j++) p[j] = pp[j];
+            for (int j = 0; j < 9; j++) R[j] = RR[j];
+            have = 1;
+        }
+    }
+}
