@@ -19,7 +19,7 @@ ALLOWED = {
     **{layer: CORE | CONTROL for layer in CONTROL},
     "drake": CORE | CONTROL | {"drake"},
 }
-APP = {"commands", "report", "analyses", "montecarlo", "cli", "__init__", "__main__"}
+APP = {"commands", "report", "analyses", "montecarlo", "synthesis", "cli", "__init__", "__main__"}
 
 
 def layer_of(path: Path) -> str:

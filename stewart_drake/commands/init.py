@@ -13,11 +13,16 @@ def register(sub) -> None:
         "init",
         help="print a commented platform file template to start from (stewart-drake init --platform-template radial > my.yaml)",
     )
-    p.add_argument(
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument(
         "--platform-template",
         choices=TEMPLATES,
-        required=True,
         help="utn: the UTN 3-6 family; radial: anchors on two circles; explicit: anchor by anchor",
+    )
+    which.add_argument(
+        "--requirements-template",
+        action="store_true",
+        help="a requirements file for stewart-drake optimize (design synthesis)",
     )
     p.set_defaults(func=run)
 
@@ -27,6 +32,14 @@ def template_text(kind: str) -> str:
     return (resources.files("stewart_drake") / "templates" / f"platform-{kind}.yaml").read_text(encoding="utf-8")
 
 
+def requirements_template_text() -> str:
+    """The text of the requirements template (``stewart-drake optimize``)."""
+    return (resources.files("stewart_drake") / "templates" / "requirements.yaml").read_text(encoding="utf-8")
+
+
 def run(args) -> int:
+    if args.requirements_template:
+        sys.stdout.write(requirements_template_text())
+        return 0
     sys.stdout.write(template_text(args.platform_template))
     return 0
