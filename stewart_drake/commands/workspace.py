@@ -22,10 +22,12 @@ from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from stewart_drake.core.sanity import check_centre, check_finite, check_work
-from stewart_drake.errors import OptionError
+from stewart_drake.errors import OptionError, SynthesisError
+from stewart_drake.synthesis.proof import prove_requirements_box
 from stewart_drake.workspace import Limits, view_figures
 
 LIMIT_CHOICES = ("stroke", "joints", "collision", "dexterity")
+BOX_AXES = ("px", "py", "pz", "a", "b", "g")
 
 
 def register(sub) -> None:
@@ -95,6 +97,27 @@ def register(sub) -> None:
         help="write workspace.json, boundary.csv and the views (top, front, side, 3d PNG) into DIR",
     )
     add_force_arg(p)
+    p.add_argument(
+        "--require-box",
+        nargs=12,
+        type=float,
+        default=None,
+        metavar="V",
+        help="with --prove: a box of poses relative to home, px py pz (m) a b g (--angle-unit), each as low high",
+    )
+    p.add_argument(
+        "--prove",
+        action="store_true",
+        help="prove every pose of --require-box within the stroke and above the base (interval cover); "
+        "exit 1 if violated (a witness pose) or unresolved",
+    )
+    p.add_argument(
+        "--max-cells",
+        type=int,
+        default=200_000,
+        metavar="N",
+        help="with --prove: cells the proof may examine (default 200000)",
+    )
     p.set_defaults(func=run)
 
 
@@ -119,6 +142,9 @@ def parse_limits(text: str, platform, joint_cone: float, leg_diameter: float | N
 
 
 def run(args) -> int:
+    reject_unused(args, "--prove", args.prove, require_box=None, max_cells=200_000)
+    if args.prove:
+        return run_proof(args)
     names = [n.strip() for n in args.limits.split(",")]
     reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
     reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
@@ -210,3 +236,49 @@ def write_outputs(w, result: dict, out) -> None:
         for name, fig in view_figures(w, title=result["platform"].replace("$", r"\$")).items():
             fig.savefig(tmp / f"{name}.png", dpi=110, bbox_inches="tight")
             plt.close(fig)
+
+
+def run_proof(args) -> int:
+    """``--prove``: the proof of ``--require-box`` alone (``synthesis.proof``); exit 1 unless proven."""
+    reject_unused(
+        args, "the workspace sweep (without --prove)", False, out=None, limits="stroke", centre=None, workers=1
+    )
+    if args.require_box is None:
+        raise OptionError(SynthesisError.BOX_OPTION_COUNT.format(n=0))
+    platform = platform_from_args(args)
+    box = np.asarray(args.require_box, dtype=float).reshape(6, 2)
+    check_finite(box, "--require-box")
+    for j, (lo, hi) in enumerate(box):
+        if lo > hi:
+            raise OptionError(
+                SynthesisError.BOX_OPTION.format(axis=BOX_AXES[j], lo=lo, hi=hi, problem="low is above high")
+            )
+    if not 1 <= args.max_cells <= 10_000_000:
+        raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=10_000_000, value=args.max_cells))
+    box[3:] = to_radians(box[3:], args.angle_unit)
+    if np.any(np.abs(box[3:]) > np.radians(80.0)):
+        raise OptionError(SynthesisError.BOX_OPTION.format(axis="a/b/g", lo="", hi="", problem="angles beyond 80 deg"))
+    result = prove_requirements_box(platform, box[:, 0], box[:, 1], args.convention, max_cells=args.max_cells)
+    if args.json:
+        print_json({"platform": platform.name, "convention": args.convention, **result.to_dict()})
+    else:
+        print(
+            f"platform {platform.name}: proof that every pose of the box (relative to home "
+            f"{np.round(platform.home_pose()[:3], 6).tolist()} m) is within the stroke and above the base: {result.status}"
+        )
+        print(f"  {result.cells_examined} cells examined, {result.cells_proven} proven, {result.seconds:.2f} s")
+        if result.status == "proven":
+            lo, hi = result.length_bounds
+            print(
+                f"  leg lengths within [{lo:.6f}, {hi:.6f}] m (stroke [{platform.L_min}, {platform.L_max}] m); "
+                f"least margin {result.stroke_margin_m * 1e3:.3f} mm"
+            )
+        elif result.witness:
+            w = result.witness
+            print(
+                f"  witness pose {np.round(w['pose'], 9).tolist()} (m, rad): leg {w['leg']} {w['what']} "
+                f"(length {w['length_m']:.6f} m, checked by the IK)"
+            )
+        else:
+            print(f"  {result.unresolved_count} cells left unresolved after --max-cells {args.max_cells}")
+    return 0 if result.status == "proven" else 1

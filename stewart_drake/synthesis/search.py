@@ -109,7 +109,10 @@ class CacheWriter:
         out.mkdir(parents=True, exist_ok=True)
         path = out / CACHE
         new = not path.exists() or path.stat().st_size == 0
+        cut = not new and path.read_bytes()[-1:] != b"\n"  # a line cut short by an interruption: end it
         self.fh = path.open("a", encoding="utf-8")
+        if cut:
+            self.fh.write("\n")
         if new:
             self.write({"key": key})
             claim_in_manifest(out, [CACHE])

@@ -1,0 +1,96 @@
+"""The search: the family reproduces the paper's geometry, the evaluation agrees with independent computations,
+the same seed gives the same Pareto set on 1 and 2 Dask workers, and a search resumes from its folder."""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.design.modes import spatial_inertia
+from stewart_drake.design.stiffness import stiffness_matrix
+from stewart_drake.synthesis.evaluate import evaluate_design, leg_range
+from stewart_drake.synthesis.families import design_platform
+from stewart_drake.synthesis.requirements import load_requirements
+from stewart_drake.synthesis.search import CACHE, run_search
+
+SEED_001 = resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml"
+
+
+@pytest.fixture(scope="module")
+def req():
+    return load_requirements(SEED_001)
+
+
+def paper_x(gd):
+    return np.array([0.624850, 0.392956, np.radians(6.9590), np.radians(17.2124), gd.home_height])
+
+
+def test_radial_family_is_the_papers_pairing(gd, req):
+    p = design_platform(req, paper_x(gd), gd.stroke)
+    np.testing.assert_allclose(p.base_anchors, gd.base_anchors, atol=1e-12)
+    np.testing.assert_allclose(p.top_anchors, gd.top_anchors, atol=1e-12)
+
+
+def test_leg_range_bounds_a_dense_sample(gd, req):
+    """The position is exact and the angles are sampled: a dense random sample of the box stays within the
+    range up to the angle grid's curvature gap (well under the 2 mm stroke margin)."""
+    lo, hi, _ = leg_range(req, paper_x(gd))
+    rng = np.random.default_rng(0)
+    u = rng.random((50_000, 6))
+    u[:64] = np.stack(np.meshgrid(*[[0.0, 1.0]] * 6, indexing="ij"), -1).reshape(-1, 6)  # the vertices too
+    poses = gd.home_pose() + req.box_lo + u * (req.box_hi - req.box_lo)
+    L = leg_lengths(gd, poses)
+    assert L.min() >= lo - 1e-3 and L.max() <= hi + 1e-3
+    assert L.min() - lo < 1e-3 and hi - L.max() < 1e-3  # and the range is attained (not loose)
+
+
+def test_frequency_matches_scipy_eigh(gd, req):
+    """The evaluation's lowest frequency is the minimum over the box's poses of the generalised eigenproblem
+    K φ = ω² M φ solved by scipy (an independent solver) with the toolkit's K and M."""
+    row = evaluate_design(req, paper_x(gd))
+    p = design_platform(req, paper_x(gd), [row["L_min"], row["L_max"]])
+    corners = np.stack(np.meshgrid(*[[a, b] for a, b in zip(req.box_lo, req.box_hi, strict=True)], indexing="ij"), -1)
+    poses = np.concatenate([corners.reshape(-1, 6), [(req.box_lo + req.box_hi) / 2]]) + p.home_pose()
+    f = []
+    for q in poses:
+        K = stiffness_matrix(p, q, req.stiffness)
+        w2 = scipy.linalg.eigh(0.5 * (K + K.T), spatial_inertia(p, q), eigvals_only=True)[0]
+        f.append(np.sqrt(w2) / (2 * np.pi))
+    assert row["frequency"] == pytest.approx(min(f), rel=1e-9)
+
+
+def small(req):
+    return {"budget": 36, "seed": 7, "pop_size": 12}
+
+
+def test_same_pareto_set_on_one_and_two_workers(req):
+    one = run_search(req, workers=1, **small(req))
+    two = run_search(req, workers=2, **small(req))
+    assert [r["x"] for r in one.rows] == [r["x"] for r in two.rows]
+    assert [one.rows[i]["x"] for i in one.front] == [two.rows[i]["x"] for i in two.front]
+    assert [one.rows[i]["f"] for i in one.front] == [two.rows[i]["f"] for i in two.front]
+    assert len(one.front) > 0
+
+
+def test_resume_after_interruption_and_with_a_larger_budget(req, tmp_path):
+    full = run_search(req, **small(req))
+    out = tmp_path / "search"
+    first = run_search(req, out=out, **small(req))
+    assert first.evaluated == 36 and [r["x"] for r in first.rows] == [r["x"] for r in full.rows]
+    # an interruption: the cache loses its last 10 lines and half a line
+    lines = (out / CACHE).read_text().splitlines()
+    (out / CACHE).write_text("\n".join(lines[:-10]) + "\n" + lines[-10][:40])
+    again = run_search(req, out=out, **small(req))
+    assert again.evaluated == 10 and again.cached == 26
+    assert [r["f"] for r in again.rows] == [r["f"] for r in full.rows]
+    longer = run_search(req, out=out, budget=48, seed=7, pop_size=12)
+    assert longer.evaluated == 12 and [r["x"] for r in longer.rows[:36]] == [r["x"] for r in full.rows]
+    head = json.loads((out / CACHE).read_text().splitlines()[0])
+    with pytest.raises(Exception, match="holds a search with other requirements or seed"):
+        run_search(req, out=out, budget=12, seed=8, pop_size=12)
+    assert head["key"] == first.key
