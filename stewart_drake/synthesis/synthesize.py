@@ -49,7 +49,7 @@ class SynthesisResult:
         }
 
 
-SAMPLE_NOTE = "the box's {n} vertices and centre (a sample of the box; exact over the motion envelope at each pose)"
+SAMPLE_NOTE = "the box's {n} vertices and centre (a sample of the box)"
 
 
 def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[dict]:
@@ -73,7 +73,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
             row["peak_force"],
             "N",
             "<=",
-            "peak leg force: exact worst case at " + sample,
+            "peak leg force: exact worst case over the motion envelope at " + sample,
         ),
     ]
     if req.max_speed is not None:
@@ -84,7 +84,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
                 row["peak_speed"],
                 "m/s",
                 "<=",
-                "peak leg speed: exact at " + sample,
+                "peak leg speed: exact worst case over the motion envelope at " + sample,
             )
         )
     if req.stroke_ratio is not None:
