@@ -122,24 +122,30 @@ def evaluate_design(req, x) -> dict:
         "L_needed": [L_low, L_high],
     }
     out.update(m)
+    out["g"] = constraint_values(req, m, home_height(req.family, x))
+    out["f"] = objective_values(req, m)
+    return out
+
+
+def constraint_values(req, m: dict, home: float) -> list[float]:
+    """The constraints (``CONSTRAINTS``, normalised, <= 0 met) of a design's metrics ``m``; ``home`` its home height (m)."""
     g = {
         "force": m["peak_force"] / req.max_force - 1.0,
         "speed": m["peak_speed"] / req.max_speed - 1.0 if req.max_speed else -1.0,
         "base_radius": m["base_radius"] / req.base_radius_max - 1.0 if req.base_radius_max else -1.0,
-        "frequency": 1.0 - freq / req.min_frequency_hz if req.min_frequency_hz else -1.0,
-        "condition": cond / req.max_condition - 1.0 if req.max_condition else -1.0,
-        "above_base": -z_low / max(home_height(req.family, x), 1e-9),
+        "frequency": 1.0 - m["frequency"] / req.min_frequency_hz if req.min_frequency_hz else -1.0,
+        "condition": m["condition"] / req.max_condition - 1.0 if req.max_condition else -1.0,
+        "above_base": -m["min_anchor_height"] / max(home, 1e-9),
     }
+    L_low, L_high = m["L_needed"]
     if req.stroke is None:
         g["stroke"] = m["stroke_ratio"] / req.stroke_ratio - 1.0
     else:
         s0, s1 = req.stroke
         g["stroke"] = max((s0 - (L_low - req.stroke_margin)) / s0, ((L_high + req.stroke_margin) - s1) / s1)
-    out["g"] = [float(g[k]) for k in CONSTRAINTS]
-    out["f"] = [OBJECTIVES[o][1] * m[OBJECTIVES[o][0]] for o in req.objectives]
-    return out
+    return [float(g[k]) for k in CONSTRAINTS]
 
 
-def evaluate_batch(req, X) -> list[dict]:
-    """``[evaluate_design(req, x) for x in X]``: the Dask task (one batch of designs per task)."""
-    return [evaluate_design(req, x) for x in np.asarray(X, dtype=float)]
+def objective_values(req, m: dict) -> list[float]:
+    """The objectives (minimised; a maximised metric negated) of a design's metrics ``m``."""
+    return [OBJECTIVES[o][1] * m[OBJECTIVES[o][0]] for o in req.objectives]

@@ -36,7 +36,8 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from stewart_drake.core.output_folder import claim_in_manifest
 from stewart_drake.errors import InfeasibleRequirementsError, SynthesisError
-from stewart_drake.synthesis.evaluate import CONSTRAINTS, evaluate_batch
+from stewart_drake.synthesis.batch import evaluate_designs
+from stewart_drake.synthesis.evaluate import CONSTRAINTS
 from stewart_drake.synthesis.requirements import OBJECTIVES, Requirements
 
 CACHE = "evaluations.jsonl"
@@ -148,9 +149,9 @@ class Evaluations:
 
     def __call__(self, X: np.ndarray) -> list[dict]:
         if self.client is None or len(X) == 0:
-            return evaluate_batch(self.req, X)
+            return evaluate_designs(self.req, X)
         chunks = [c for c in np.array_split(X, min(len(X), 2 * self.threads)) if len(c)]
-        futures = self.client.map(evaluate_batch, [self.req_future] * len(chunks), chunks, pure=False)
+        futures = self.client.map(evaluate_designs, [self.req_future] * len(chunks), chunks, pure=False)
         return [row for part in self.client.gather(futures) for row in part]
 
     def close(self) -> None:
