@@ -240,9 +240,13 @@ def write_outputs(w, result: dict, out) -> None:
 
 def run_proof(args) -> int:
     """``--prove``: the proof of ``--require-box`` alone (``synthesis.proof``); exit 1 unless proven."""
-    reject_unused(
-        args, "the workspace sweep (without --prove)", False, out=None, limits="stroke", centre=None, workers=1
-    )
+    reject_unused(args, "the workspace sweep (without --prove)", False, out=None, centre=None, workers=1)
+    names = [n.strip() for n in args.limits.split(",") if n.strip()]
+    other = [n for n in names if n not in ("stroke", "joints")]
+    if other:
+        raise OptionError(
+            OptionError.UNKNOWN_LIMIT.format(option="--limits (with --prove)", value=other[0], valid="stroke, joints")
+        )
     if args.require_box is None:
         raise OptionError(SynthesisError.BOX_OPTION_COUNT.format(n=0))
     platform = platform_from_args(args)
@@ -258,13 +262,17 @@ def run_proof(args) -> int:
     box[3:] = to_radians(box[3:], args.angle_unit)
     if np.any(np.abs(box[3:]) > np.radians(80.0)):
         raise OptionError(SynthesisError.BOX_OPTION.format(axis="a/b/g", lo="", hi="", problem="angles beyond 80 deg"))
-    result = prove_requirements_box(platform, box[:, 0], box[:, 1], args.convention, max_cells=args.max_cells)
+    cone = float(to_radians(args.joint_cone, args.angle_unit)) if "joints" in names else None
+    result = prove_requirements_box(
+        platform, box[:, 0], box[:, 1], args.convention, max_cells=args.max_cells, joint_cone=cone
+    )
     if args.json:
         print_json({"platform": platform.name, "convention": args.convention, **result.to_dict()})
     else:
         print(
             f"platform {platform.name}: proof that every pose of the box (relative to home "
-            f"{np.round(platform.home_pose()[:3], 6).tolist()} m) is within the stroke and above the base: {result.status}"
+            f"{np.round(platform.home_pose()[:3], 6).tolist()} m) is within the stroke and above the base"
+            f"{f' with joint cones of {args.joint_cone} {args.angle_unit}' if cone is not None else ''}: {result.status}"
         )
         print(f"  {result.cells_examined} cells examined, {result.cells_proven} proven, {result.seconds:.2f} s")
         if result.status == "proven":

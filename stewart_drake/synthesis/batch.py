@@ -35,6 +35,7 @@ from stewart_drake.synthesis.evaluate import (
     box_vertices,
     constraint_values,
     design_stroke,
+    joint_angles,
     objective_values,
 )
 from stewart_drake.synthesis.families import anchors, design_platform
@@ -125,6 +126,7 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     M = spatial_inertia_about_C(payload, R)
     freq = lowest_frequency(K, np.broadcast_to(M, K.shape)).min(-1)
     radius = np.hypot(base[..., 0], base[..., 1]).max(-1)
+    joint = joint_angles(l[ok], np.broadcast_to(R, l[ok].shape[:2] + (3, 3))).max(axis=(1, 2))
     for n, k in enumerate(idx):
         lo, hi = float(L_low[good.index(k)]), float(L_high[good.index(k)])
         stroke = design_stroke(req, lo, hi)
@@ -139,6 +141,7 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
             "frequency": float(freq[n]),
             "condition": float(cond[ok][n]),
             "min_anchor_height": float(z_low[good.index(k)]),
+            "max_joint_angle": float(joint[n]),
             "L_needed": [lo, hi],
         }
         out[k].update(m)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.kinematics import condition_number
+from stewart_drake.core.kinematics import condition_number, leg_vectors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.design.envelope import Envelope, envelope_sizing, spatial_inertia_about_C
 from stewart_drake.design.maps import lowest_frequency
@@ -31,7 +31,7 @@ from stewart_drake.synthesis.requirements import OBJECTIVES
 ANGLE_SAMPLES = 5  # per angle axis, for the leg-length range
 INFEASIBLE_F = 1e9  # objective of a design that cannot be evaluated (invalid geometry, singular pose)
 INFEASIBLE_G = 1e3
-CONSTRAINTS = ("force", "speed", "stroke", "base_radius", "frequency", "condition", "above_base")
+CONSTRAINTS = ("force", "speed", "stroke", "base_radius", "frequency", "condition", "above_base", "joint_cone")
 METRICS = (
     "peak_force",
     "peak_speed",
@@ -43,6 +43,7 @@ METRICS = (
     "frequency",
     "condition",
     "min_anchor_height",
+    "max_joint_angle",
 )
 
 
@@ -52,6 +53,15 @@ def box_vertices(lo, hi) -> np.ndarray:
     axes = [np.unique([lo[j], hi[j]]) for j in range(6)]
     v = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
     return np.concatenate([v, (0.5 * (lo + hi))[None]], 0)
+
+
+def joint_angles(l, R) -> np.ndarray:
+    """``(..., 6)`` the larger of each leg's angles (rad) to the base normal e_z and to the plate normal R e_z
+    (the joint cones of ``workspace.limits``) for leg vectors l (..., 6, 3) and rotations R (..., 3, 3)."""
+    u = l / np.linalg.norm(l, axis=-1)[..., None]
+    base = np.arccos(np.clip(u[..., 2], -1.0, 1.0))
+    top = np.arccos(np.clip(np.einsum("...li,...i->...l", u, R[..., :, 2]), -1.0, 1.0))
+    return np.maximum(base, top)
 
 
 def leg_range(req, x) -> tuple[float, float, float]:
@@ -103,6 +113,11 @@ def evaluate_design(req, x) -> dict:
         M = spatial_inertia_about_C(platform, rotation_matrix(poses[:, 3:], req.convention))
         freq = float(lowest_frequency(K, M).min())
         cond = float(condition_number(platform, poses, req.convention).max())
+        joint = float(
+            joint_angles(
+                leg_vectors(platform, poses, req.convention), rotation_matrix(poses[:, 3:], req.convention)
+            ).max()
+        )
     except (StewartError, np.linalg.LinAlgError) as e:
         out.update({k: None for k in METRICS})
         out.update(error=str(e).splitlines()[0][:200], f=[INFEASIBLE_F] * len(req.objectives))
@@ -119,6 +134,7 @@ def evaluate_design(req, x) -> dict:
         "frequency": freq,
         "condition": cond,
         "min_anchor_height": z_low,
+        "max_joint_angle": joint,
         "L_needed": [L_low, L_high],
     }
     out.update(m)
@@ -136,6 +152,7 @@ def constraint_values(req, m: dict, home: float) -> list[float]:
         "frequency": 1.0 - m["frequency"] / req.min_frequency_hz if req.min_frequency_hz else -1.0,
         "condition": m["condition"] / req.max_condition - 1.0 if req.max_condition else -1.0,
         "above_base": -m["min_anchor_height"] / max(home, 1e-9),
+        "joint_cone": m["max_joint_angle"] / req.joint_cone - 1.0 if req.joint_cone else -1.0,
     }
     L_low, L_high = m["L_needed"]
     if req.stroke is None:

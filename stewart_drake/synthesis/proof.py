@@ -21,7 +21,14 @@ Taylor expansion is at most ½ |t| ‖δθ‖₁².
   valid bound; a good n makes it tight. Minus r_i.
 - Plate anchor height z_i = p_z + (R t_i)_z >= c_z + (R(c) t_i)_z − h_p,z − Σ_j |∂(R t_i)_z/∂θ_j| h_θ,j − r_i.
 
-A cell is proven when every leg's bounds lie inside [L_min, L_max] and every anchor height is > 0. A cell
+- Joint cones (optional, the toolkit's definition in ``workspace.limits``: the angle between a leg and the base
+  normal e_z at its base joint, and the plate normal n = R e_z at its plate joint): l_i·e_z is bounded below on
+  the zonotope like the height; l_i·n = (p − b_i)·n + t_i,z with n ∈ n(c) + Σ_j δ_j ∂n/∂θ_j ⊕ B(½ ‖δθ‖₁²) (the
+  same derived constant, |e_z| = 1), bounded below term by term. A leg is within the cone when
+  l_i·a >= |l_i| cos(cone) for both axes a, checked with the bounds of |l_i|.
+
+A cell is proven when every leg's bounds lie inside [L_min, L_max] and every anchor height is > 0 (and the
+cones hold when asked). A cell
 that is not proven is tested at its centre and at the poses where the bounds are attained, with the
 toolkit's IK (``core.kinematics.leg_lengths``): a pose outside the stroke (by more than the slack below) is
 a witness and the result is ``violated``; otherwise the cell is halved across its widest side (positions
@@ -47,6 +54,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import plate_anchor_heights
+from stewart_drake.workspace.limits import Limits, limit_margins
 
 FP_SLACK = 1e-9  # m: each bound widened by this (rounding; see the module docstring)
 MAX_CELLS = 200_000  # default limit on cells examined
@@ -110,10 +118,13 @@ class CellBounds:
     z_lower: np.ndarray
     lower_pose: np.ndarray
     upper_pose: np.ndarray
+    axial_lower: np.ndarray | None = None
+    normal_lower: np.ndarray | None = None
 
 
-def cell_bounds(platform: Platform, cells: Cells, convention: str = "utn") -> CellBounds:
-    """Rigorous leg-length and anchor-height bounds on each cell (see the module docstring)."""
+def cell_bounds(platform: Platform, cells: Cells, convention: str = "utn", cones: bool = False) -> CellBounds:
+    """Rigorous leg-length and anchor-height bounds on each cell (see the module docstring); with ``cones``
+    also lower bounds of l_i·e_z (``axial_lower``) and of l_i·n (``normal_lower``, n = R e_z the plate normal)."""
     c, h = cells.c, cells.h
     t = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
     R, dR = rotation_derivatives(c[:, 3:], convention)  # (n, 3, 3), (n, 3, 3, 3)
@@ -144,7 +155,28 @@ def cell_bounds(platform: Platform, cells: Cells, convention: str = "utn") -> Ce
     lower = np.where(nx > 0, np.maximum(support, 0.0), 0.0) - r2 - FP_SLACK
     lower_pose = c[:, None, :] + u * h[:, None, :]
     z_lower = c[:, None, 2] + q[..., 2] - h[:, None, 2] - np.sum(np.abs(Jq[:, :, 2, :]) * h[:, None, 3:], -1) - r2
-    return CellBounds(lower, upper, z_lower - FP_SLACK, lower_pose, upper_pose)
+    out = CellBounds(lower, upper, z_lower - FP_SLACK, lower_pose, upper_pose)
+    if cones:
+        # l·e_z over the zonotope and the ball
+        out.axial_lower = lc[..., 2] - np.sum(np.abs(G[:, :, 2, :]), -1) - r2 - FP_SLACK
+        # l·n = (p − b)·n + t_z with n = R e_z ∈ n(c) + Σ_j δ_j ∂n/∂θ_j + B(½ ‖δθ‖₁²) (|e_z| = 1)
+        n_c, Jn = R[:, :, 2], dR[:, :, :, 2]  # (n, 3), (n, 3 [j], 3)
+        rn = 0.5 * np.sum(h[:, 3:], 1) ** 2  # (n,)
+        a_c = c[:, None, :3] - platform.base_anchors  # (n, 6, 3)
+        first = np.einsum("nli,ni->nl", a_c, n_c)
+        first -= np.sum(np.abs(np.einsum("nli,nji->nlj", a_c, Jn)) * h[:, None, 3:], -1)
+        first -= np.linalg.norm(a_c, axis=-1) * rn[:, None]
+        n_abs = np.abs(n_c) + np.einsum("nji,nj->ni", np.abs(Jn), h[:, 3:]) + rn[:, None]  # (n, 3) max |n_k|
+        out.normal_lower = first - np.sum(h[:, :3] * n_abs, -1)[:, None] + t[None, :, 2] - FP_SLACK
+    return out
+
+
+def cones_ok(b: CellBounds, cone: float) -> np.ndarray:
+    """``(n,)`` cells on which every leg is within ``cone`` (rad) of the base normal and of the plate normal:
+    l·a >= |l| cos(cone) for both axes a, from the lower bounds of l·a and the bounds of |l|."""
+    cos = np.cos(cone)
+    need = np.maximum(cos * b.upper, cos * b.lower)
+    return np.all(b.axial_lower >= need, -1) & np.all(b.normal_lower >= need, -1)
 
 
 @dataclass
@@ -189,9 +221,23 @@ class ProofResult:
         }
 
 
-def _witness(platform: Platform, poses, convention: str) -> dict | None:
+def _witness(platform: Platform, poses, convention: str, cone: float | None = None) -> dict | None:
     """The first pose among ``poses`` (m, 6) that the toolkit's IK finds outside the stroke (by more than
-    FP_SLACK) or with a plate anchor at or below the base; None if all are fine."""
+    FP_SLACK), with a plate anchor at or below the base, or (``cone``) with a joint beyond its cone by more
+    than 1e-9 rad (``workspace.limits``' joint angles); None if all are fine."""
+    if cone is not None:
+        m = limit_margins(platform, poses, Limits(stroke=False, base_cone=cone, top_cone=cone), convention)
+        for name in ("base_joint", "top_joint"):
+            margin, leg = m[name]
+            if np.any(margin < -1e-9):
+                k = int(np.argmax(margin < -1e-9))
+                return {
+                    "pose": poses[k].tolist(),
+                    "leg": int(leg[k]) + 1,
+                    "length_m": float(leg_lengths(platform, poses[k], convention)[leg[k]]),
+                    "anchor_height_m": float(plate_anchor_heights(platform, poses[k], convention)[leg[k]]),
+                    "what": f"{name.replace('_', ' ')} beyond its cone by {np.degrees(-margin[k]):.6f} deg",
+                }
     L = leg_lengths(platform, poses, convention)
     z = plate_anchor_heights(platform, poses, convention)
     below = L < platform.L_min - FP_SLACK
@@ -218,11 +264,18 @@ def _witness(platform: Platform, poses, convention: str) -> dict | None:
 
 
 def prove_box(
-    platform: Platform, lo, hi, convention: str = "utn", max_cells: int = MAX_CELLS, initial: int | None = None
+    platform: Platform,
+    lo,
+    hi,
+    convention: str = "utn",
+    max_cells: int = MAX_CELLS,
+    initial: int | None = None,
+    joint_cone: float | None = None,
 ) -> ProofResult:
     """Prove that every pose in the box [lo, hi] (absolute, (6,) m and rad) is within the stroke with the
-    plate above the base, or find a witness pose that is not, or give up after ``max_cells`` cells
-    (unresolved). ``initial``: splits per angle axis to start with (default: cells of about 5°)."""
+    plate above the base (and, with ``joint_cone`` (rad), every leg within that angle of the base normal and
+    of the plate normal at its joints), or find a witness pose that is not, or give up after ``max_cells``
+    cells (unresolved). ``initial``: splits per angle axis to start with (default: cells of about 5°)."""
     check_convention(convention)
     t0 = time.perf_counter()
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
@@ -248,9 +301,11 @@ def prove_box(
         nxt_c, nxt_h = [], []
         for s in range(0, len(pending), BATCH):
             cells = Cells(pending.c[s : s + BATCH], pending.h[s : s + BATCH])
-            b = cell_bounds(platform, cells, convention)
+            b = cell_bounds(platform, cells, convention, cones=joint_cone is not None)
             z_ok = np.all(b.z_lower > 0, -1) | platform.plate_below_base_allowed
             ok = np.all(b.lower >= platform.L_min, -1) & np.all(b.upper <= platform.L_max, -1) & z_ok
+            if joint_cone is not None:
+                ok &= cones_ok(b, joint_cone)
             examined += len(cells)
             proven += int(ok.sum())
             if ok.any():
@@ -266,7 +321,7 @@ def prove_box(
             cand = np.concatenate([cells.c[bad][:, None, :], b.lower_pose[bad], b.upper_pose[bad]], axis=1).reshape(
                 -1, 6
             )
-            w = _witness(platform, cand, convention)
+            w = _witness(platform, cand, convention, joint_cone)
             if w is not None:
                 return ProofResult(
                     "violated", lo, hi, examined, proven, max_cells, witness=w, seconds=time.perf_counter() - t0
@@ -299,6 +354,7 @@ def prove_box(
 
 
 def prove_requirements_box(platform: Platform, box_lo, box_hi, convention: str = "utn", **kw) -> ProofResult:
+    # joint_cone, max_cells, initial: as prove_box
     """``prove_box`` for a box given relative to the platform's home pose."""
     home = platform.home_pose()
     return prove_box(platform, home + np.asarray(box_lo), home + np.asarray(box_hi), convention, **kw)

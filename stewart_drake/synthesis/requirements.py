@@ -110,6 +110,7 @@ class LimitsConfig:
     base_radius_max: float | None = None  # length unit
     min_frequency_hz: float | None = None  # Hz, lowest natural frequency over the box
     max_condition: float | None = None  # worst scaled condition number of J⁻¹ over the box
+    joint_cone: float | None = None  # angle unit: largest angle between a leg and the base / plate normal
 
 
 @dataclass
@@ -161,6 +162,7 @@ class Requirements:
     min_frequency_hz: float | None
     max_condition: float | None
     objectives: tuple
+    joint_cone: float | None = None
     convention: str = "utn"
     source: str = "requirements"
     units: tuple = ("m", "rad")
@@ -352,6 +354,9 @@ def requirements_from_config(cfg: RequirementsConfig, where: dict, shown: str) -
     cmax = _positive(lim.max_condition, ("limits", "max_condition"), where, shown)
     if cmax is not None and cmax < 1:
         raise _err(where, ("limits", "max_condition"), shown, "must be >= 1 (a condition number)")
+    cone = _positive(lim.joint_cone, ("limits", "joint_cone"), where, shown)
+    if cone is not None and cone * ka >= np.pi / 2:
+        raise _err(where, ("limits", "joint_cone"), shown, "must be below 90 degrees")
     if not cfg.objectives:
         raise _err(where, ("objectives",), shown, "must list at least one objective", value="[]")
     for k, name in enumerate(cfg.objectives):
@@ -387,6 +392,7 @@ def requirements_from_config(cfg: RequirementsConfig, where: dict, shown: str) -
         min_frequency_hz=fmin,
         max_condition=cmax,
         objectives=tuple(cfg.objectives),
+        joint_cone=None if cone is None else cone * ka,
         convention=cfg.convention,
         source=shown,
         units=(cfg.length_unit, cfg.angle_unit),

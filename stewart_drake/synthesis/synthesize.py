@@ -135,6 +135,20 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
                 "lowest natural frequency at " + sample,
             )
         )
+    if req.joint_cone is not None:
+        out.append(
+            {
+                "requirement": "limits.joint_cone: every pose of the box, every joint within the cone",
+                "required": float(req.joint_cone),
+                "achieved": proof.status,
+                "margin": None,
+                "unit": "rad",
+                "met": proof.status == "proven",
+                "established": "the proof (l·e_z and l·n bounded on every cell); the search sampled "
+                + f"{float(row['max_joint_angle']):.6f} rad at "
+                + sample,
+            }
+        )
     if req.max_condition is not None:
         out.append(
             _row(
@@ -186,5 +200,7 @@ def synthesize(
     k = pick_design(result, pick)
     row = result.rows[k]
     platform = chosen_platform(req, row, req.name or "synthesised")
-    proof = prove_requirements_box(platform, req.box_lo, req.box_hi, req.convention, max_cells=max_cells)
+    proof = prove_requirements_box(
+        platform, req.box_lo, req.box_hi, req.convention, max_cells=max_cells, joint_cone=req.joint_cone
+    )
     return SynthesisResult(result, k, pick, platform, proof, requirement_table(req, row, proof))

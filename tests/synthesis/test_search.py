@@ -111,7 +111,17 @@ def test_batch_evaluation_equals_the_per_platform_functions(req):
             assert b["error"] is not None or max(b["g"]) > 0
             continue
         compared += 1
-        for key in ("peak_force", "peak_speed", "L_min", "L_max", "base_radius", "frequency", "condition"):
+        keys = (
+            "peak_force",
+            "peak_speed",
+            "L_min",
+            "L_max",
+            "base_radius",
+            "frequency",
+            "condition",
+            "max_joint_angle",
+        )
+        for key in keys:
             assert b[key] == pytest.approx(ref[key], rel=1e-9, abs=1e-9), key
         np.testing.assert_allclose(b["g"], ref["g"], rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(b["f"], ref["f"], rtol=1e-9)
