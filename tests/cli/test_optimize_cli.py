@@ -60,3 +60,23 @@ def test_optimize_writes_a_proven_platform_file(tmp_path, capsys):
     w = proof["witness"]
     L = leg_lengths(p, np.array(w["pose"]))[w["leg"] - 1]
     assert L < p.L_min or L > p.L_max or w["what"].startswith("plate")
+
+
+def test_unmeetable_requirements_exit_1_with_the_reason(tmp_path, capsys):
+    """A 1 N actuator meets nothing: exit 1 (a result, not bad input), one line naming the least violated."""
+    text = (resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml").read_text()
+    path = tmp_path / "r.yaml"
+    path.write_text(text.replace("max_force: 5000", "max_force: 1"))
+    rc = main(["optimize", "--requirements", str(path), "--out", str(tmp_path / "o"), "--budget", "12",
+               "--pop-size", "12", "--workers", "0"])  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert rc == 1 and len(err.splitlines()) == 1
+    assert "no design among 12 evaluated meets every requirement (least violated: force by" in err
+
+
+def test_prove_unresolved_exits_1(capsys):
+    box = ["-0.07", "0.07", "-0.09", "0.09", "-0.05", "0.045", "-8", "7", "-6", "6", "-9", "9"]
+    rc = main(["workspace", "--platform", "gonzalez-dutra-2009", "--prove", "--max-cells", "5", "--json",
+               "--require-box", *box])  # fmt: skip
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 1 and out["status"] == "unresolved" and out["unresolved_count"] > 0

@@ -10,14 +10,18 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from stewart_drake.core.geometry import load_platform_yaml
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.stiffness import stiffness_matrix
 from stewart_drake.synthesis.batch import evaluate_designs
 from stewart_drake.synthesis.evaluate import evaluate_design, leg_range
 from stewart_drake.synthesis.families import design_platform
+from stewart_drake.synthesis.outputs import design_yaml
+from stewart_drake.synthesis.proof import prove_requirements_box
 from stewart_drake.synthesis.requirements import load_requirements
 from stewart_drake.synthesis.search import CACHE, run_search
+from stewart_drake.synthesis.synthesize import synthesize
 
 SEED_001 = resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml"
 
@@ -126,3 +130,36 @@ def test_batch_evaluation_equals_the_per_platform_functions(req):
         np.testing.assert_allclose(b["g"], ref["g"], rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(b["f"], ref["f"], rtol=1e-9)
     assert compared >= 20
+
+
+UTN = """
+length_unit: mm
+angle_unit: deg
+family: utn-3-6
+variables: {b: [300, 500], d: [60, 150], a: [150, 300], home_height: [250, 450]}
+workspace: {px: [-20, 20], py: [-20, 20], pz: [-10, 10], a: [-5, 5], b: [-5, 5], g: [-8, 8]}
+payload: {mass: 5, com: [0, 0, 20], inertia: [30000, 30000, 50000, 0, 0, 0]}
+motion: {velocity: {linear: 100, angular: 20}, acceleration: {linear: 1000, angular: 100}}
+actuator: {max_force: 300, stroke: [250, 600], stiffness: 1.0e5}
+objectives: [peak_force, base_radius]
+"""
+
+
+def test_utn_family_batch_and_design_file(tmp_path):
+    """The utn-3-6 family (three plate joints, two legs each) with a fixed stroke, in millimetres: the batch
+    equals the per-platform path, and the chosen design's file is a UTN platform file that loads and proves."""
+    (tmp_path / "u.yaml").write_text(UTN)
+    req = load_requirements(tmp_path / "u.yaml")
+    assert req.variables == ("b", "d", "a", "home_height") and req.stroke.tolist() == [0.25, 0.6]
+    X = req.lower + np.random.default_rng(8).random((12, 4)) * (req.upper - req.lower)
+    for x, b in zip(X, evaluate_designs(req, X), strict=True):
+        ref = evaluate_design(req, x)
+        if ref["error"] is None:
+            np.testing.assert_allclose(b["g"], ref["g"], rtol=1e-9, atol=1e-9)
+    res = synthesize(req, budget=24, seed=1, pop_size=12)
+    assert res.platform.top_anchors.shape == (3, 3) and res.platform.stroke.tolist() == [0.25, 0.6]
+    text = design_yaml(res, "u.yaml")
+    (tmp_path / "d.yaml").write_text(text)
+    p = load_platform_yaml(tmp_path / "d.yaml")
+    np.testing.assert_allclose(p.base_anchors, res.platform.base_anchors, atol=1e-12)
+    assert prove_requirements_box(p, req.box_lo, req.box_hi).status == res.proof.status == "proven"
