@@ -40,6 +40,9 @@ rounded operations on numbers at most 100 m (the project's size limit) and on si
 are within 4 ulp); by the standard error bound (n·u / (1 − n·u) relative, u = 2⁻⁵³) every bound is within
 2.3e-12 m of its exact value. Every bound is widened by ``FP_SLACK`` = 1e-9 m, more than 400 times that;
 a test recomputes cells' bounds in python-flint's ball arithmetic (rigorous) and finds them inside.
+The cells' centres and half-widths are rounded too (c ± h of neighbours may leave a gap of a few ulp): each
+cell's half-widths are grown by ``COVER_PAD`` × (1 + |c|) before its bounds are taken, so neighbours overlap
+and every pose of the box lies in a cell whose bounds hold.
 """
 
 from __future__ import annotations
@@ -57,6 +60,7 @@ from stewart_drake.core.sanity import plate_anchor_heights
 from stewart_drake.workspace.limits import Limits, limit_margins
 
 FP_SLACK = 1e-9  # m: each bound widened by this (rounding; see the module docstring)
+COVER_PAD = 1e-12  # each cell's half-widths grown by this × (1 + |centre|): adjacent cells overlap
 MAX_CELLS = 200_000  # default limit on cells examined
 BATCH = 4096  # cells per vectorised step
 PG_STEPS = 40  # projected-gradient steps for the direction of the lower bound
@@ -125,7 +129,8 @@ class CellBounds:
 def cell_bounds(platform: Platform, cells: Cells, convention: str = "utn", cones: bool = False) -> CellBounds:
     """Rigorous leg-length and anchor-height bounds on each cell (see the module docstring); with ``cones``
     also lower bounds of l_i·e_z (``axial_lower``) and of l_i·n (``normal_lower``, n = R e_z the plate normal)."""
-    c, h = cells.c, cells.h
+    c = cells.c
+    h = cells.h + COVER_PAD * (1.0 + np.abs(c))  # cells overlap: no gap from rounded centres (docstring)
     t = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
     R, dR = rotation_derivatives(c[:, 3:], convention)  # (n, 3, 3), (n, 3, 3, 3)
     q = np.einsum("nij,lj->nli", R, t)  # (n, 6, 3)
@@ -321,7 +326,7 @@ def prove_box(
             cand = np.concatenate([cells.c[bad][:, None, :], b.lower_pose[bad], b.upper_pose[bad]], axis=1).reshape(
                 -1, 6
             )
-            w = _witness(platform, cand, convention, joint_cone)
+            w = _witness(platform, np.clip(cand, lo, hi), convention, joint_cone)  # cells overlap the box
             if w is not None:
                 return ProofResult(
                     "violated", lo, hi, examined, proven, max_cells, witness=w, seconds=time.perf_counter() - t0
@@ -354,7 +359,7 @@ def prove_box(
 
 
 def prove_requirements_box(platform: Platform, box_lo, box_hi, convention: str = "utn", **kw) -> ProofResult:
-    # joint_cone, max_cells, initial: as prove_box
-    """``prove_box`` for a box given relative to the platform's home pose."""
+    """``prove_box`` for a box given relative to the platform's home pose (keywords ``joint_cone``, ``max_cells``,
+    ``initial`` as there)."""
     home = platform.home_pose()
     return prove_box(platform, home + np.asarray(box_lo), home + np.asarray(box_hi), convention, **kw)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -60,7 +60,6 @@ class SearchResult:
     evaluated: int
     cached: int
     key: str
-    extra: dict = field(default_factory=dict)
 
     def front_rows(self) -> list[dict]:
         return [self.rows[i] for i in self.front]

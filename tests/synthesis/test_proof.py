@@ -11,6 +11,7 @@ from stewart_drake.core.kinematics import leg_lengths, leg_vectors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import plate_anchor_heights
 from stewart_drake.synthesis.proof import (
+    COVER_PAD,
     FP_SLACK,
     VERTICES,
     Cells,
@@ -88,7 +89,7 @@ def test_rounding_is_covered_in_ball_arithmetic(gd):
     t = gd.top_anchors_per_leg - gd.rotation_centre
     for n in range(3):
         c = [flint.arb(float(v)) for v in cells.c[n]]
-        h = [flint.arb(float(v)) for v in cells.h[n]]
+        h = [flint.arb(float(v)) for v in cells.h[n] + COVER_PAD * (1 + np.abs(cells.c[n]))]  # as cell_bounds
         sa, ca, sb, cb, sg, cg = c[3].sin(), c[3].cos(), c[4].sin(), c[4].cos(), c[5].sin(), c[5].cos()
         R = flint.arb_mat([[cb * cg + sa * sb * sg, sa * sb * cg - cb * sg, ca * sb], [ca * sg, ca * cg, -sa],
                            [sa * cb * sg - sb * cg, sb * sg + sa * cb * cg, ca * cb]])  # fmt: skip
