@@ -38,7 +38,9 @@ def build(section) -> None:
     result = synthesize(req, budget=budget, seed=SEED, workers=0, pop_size=24)
     paper = load_preset(PRESET)
     paper_row = evaluate_design(req, paper_vector(paper))
-    paper_proof = prove_requirements_box(paper, req.box_lo, req.box_hi, req.convention, joint_cone=req.joint_cone)
+    paper_proof = prove_requirements_box(
+        paper, req.box_lo, req.box_hi, req.convention, joint_cone=req.joint_cone, leg_diameter=req.leg_diameter
+    )
     d, pr = result.design, result.proof
     section.text(
         "The requirements (stewart_drake/examples/seed_001_requirements.yaml): the paper's one-axis extents "
@@ -74,7 +76,10 @@ def build(section) -> None:
         ["lowest natural frequency (Hz)", paper_row["frequency"], d["frequency"]],
         ["worst condition number", paper_row["condition"], d["condition"]],
         ["proof of the box (own stroke)", paper_proof.status, pr.status],
-        ["least stroke margin proven (mm)", 1e3 * (paper_proof.stroke_margin_m or np.nan), 1e3 * pr.stroke_margin_m],
+        [
+            "least stroke margin proven (mm)",
+            *(1e3 * (m if m is not None else np.nan) for m in (paper_proof.stroke_margin_m, pr.stroke_margin_m)),
+        ],
     ]
     section.table(names, rows, caption="The paper's geometry and the synthesised one on the same requirements")
     unmet_paper = [n for n, g in zip(CONSTRAINTS, paper_row["g"], strict=True) if g > 0]

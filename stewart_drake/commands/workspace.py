@@ -242,10 +242,12 @@ def run_proof(args) -> int:
     """``--prove``: the proof of ``--require-box`` alone (``synthesis.proof``); exit 1 unless proven."""
     reject_unused(args, "the workspace sweep (without --prove)", False, out=None, centre=None, workers=1)
     names = [n.strip() for n in args.limits.split(",") if n.strip()]
-    other = [n for n in names if n not in ("stroke", "joints")]
+    other = [n for n in names if n not in ("stroke", "joints", "collision")]
     if other:
         raise OptionError(
-            OptionError.UNKNOWN_LIMIT.format(option="--limits (with --prove)", value=other[0], valid="stroke, joints")
+            OptionError.UNKNOWN_LIMIT.format(
+                option="--limits (with --prove)", value=other[0], valid="stroke, joints, collision"
+            )
         )
     if args.require_box is None:
         raise OptionError(SynthesisError.BOX_OPTION_COUNT.format(n=0))
@@ -262,9 +264,24 @@ def run_proof(args) -> int:
     box[3:] = to_radians(box[3:], args.angle_unit)
     if np.any(np.abs(box[3:]) > np.radians(80.0)):
         raise OptionError(SynthesisError.BOX_OPTION.format(axis="a/b/g", lo="", hi="", problem="angles beyond 80 deg"))
+    reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
+    reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
     cone = float(to_radians(args.joint_cone, args.angle_unit)) if "joints" in names else None
+    diameter = None
+    if "collision" in names:
+        diameter = (
+            args.leg_diameter if args.leg_diameter is not None else 2 * leg_dimensions(platform)["cylinder_radius"]
+        )
+        if not (math.isfinite(diameter) and diameter > 0):
+            raise OptionError(OptionError.POSITIVE.format(option="--leg-diameter", unit="metres", value=diameter))
     result = prove_requirements_box(
-        platform, box[:, 0], box[:, 1], args.convention, max_cells=args.max_cells, joint_cone=cone
+        platform,
+        box[:, 0],
+        box[:, 1],
+        args.convention,
+        max_cells=args.max_cells,
+        joint_cone=cone,
+        leg_diameter=diameter,
     )
     if args.json:
         print_json({"platform": platform.name, "convention": args.convention, **result.to_dict()})
@@ -272,7 +289,8 @@ def run_proof(args) -> int:
         print(
             f"platform {platform.name}: proof that every pose of the box (relative to home "
             f"{np.round(platform.home_pose()[:3], 6).tolist()} m) is within the stroke and above the base"
-            f"{f' with joint cones of {args.joint_cone} {args.angle_unit}' if cone is not None else ''}: {result.status}"
+            f"{f' with joint cones of {args.joint_cone} {args.angle_unit}' if cone is not None else ''}"
+            f"{f', legs {diameter} m thick apart' if diameter is not None else ''}: {result.status}"
         )
         print(f"  {result.cells_examined} cells examined, {result.cells_proven} proven, {result.seconds:.2f} s")
         if result.status == "proven":

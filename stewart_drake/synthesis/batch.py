@@ -39,6 +39,7 @@ from stewart_drake.synthesis.evaluate import (
     objective_values,
 )
 from stewart_drake.synthesis.families import anchors, design_platform
+from stewart_drake.workspace.limits import leg_pairs, segment_distances
 
 SINGULAR = "a pose of the box is singular or nearly so (scaled condition number above {limit:g})"
 
@@ -127,6 +128,7 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     freq = lowest_frequency(K, np.broadcast_to(M, K.shape)).min(-1)
     radius = np.hypot(base[..., 0], base[..., 1]).max(-1)
     joint = joint_angles(l[ok], np.broadcast_to(R, l[ok].shape[:2] + (3, 3))).max(axis=(1, 2))
+    gap = _clearances(l[ok], base, [plats[good.index(k)] for k in idx])
     for n, k in enumerate(idx):
         lo, hi = float(L_low[good.index(k)]), float(L_high[good.index(k)])
         stroke = design_stroke(req, lo, hi)
@@ -142,12 +144,27 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
             "condition": float(cond[ok][n]),
             "min_anchor_height": float(z_low[good.index(k)]),
             "max_joint_angle": float(joint[n]),
+            "min_leg_distance": float(gap[n]),
             "L_needed": [lo, hi],
         }
         out[k].update(m)
         out[k]["g"] = constraint_values(req, m, float(h[n]))
         out[k]["f"] = objective_values(req, m)
     return out
+
+
+def _clearances(l, base, platforms) -> np.ndarray:
+    """``(D,)`` the smallest distance (m) between two legs that can touch, over the poses: every pair of legs
+    at once (``segment_distances``), masked by each design's ``leg_pairs``."""
+    i, j = np.triu_indices(6, 1)
+    P = base[:, None] + l  # (D, P, 6, 3) plate anchors
+    b = np.broadcast_to(base[:, None], P.shape)
+    d = segment_distances(b[:, :, i], P[:, :, i], b[:, :, j], P[:, :, j]).min(1)  # (D, 15)
+    mask = np.zeros((len(platforms), 15), bool)
+    for k, plat in enumerate(platforms):
+        rows = {tuple(r) for r in leg_pairs(plat).tolist()}
+        mask[k] = [(a, c) in rows for a, c in zip(i.tolist(), j.tolist(), strict=True)]
+    return np.where(mask, d, np.inf).min(-1)
 
 
 def _infeasible(req, row: dict, why: str) -> None:

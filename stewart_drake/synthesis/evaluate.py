@@ -27,11 +27,22 @@ from stewart_drake.design.stiffness import stiffness_matrix
 from stewart_drake.errors import StewartError
 from stewart_drake.synthesis.families import anchors, base_radius, design_platform, home_height
 from stewart_drake.synthesis.requirements import OBJECTIVES
+from stewart_drake.workspace.limits import leg_pairs, segment_distances
 
 ANGLE_SAMPLES = 5  # per angle axis, for the leg-length range
 INFEASIBLE_F = 1e9  # objective of a design that cannot be evaluated (invalid geometry, singular pose)
 INFEASIBLE_G = 1e3
-CONSTRAINTS = ("force", "speed", "stroke", "base_radius", "frequency", "condition", "above_base", "joint_cone")
+CONSTRAINTS = (
+    "force",
+    "speed",
+    "stroke",
+    "base_radius",
+    "frequency",
+    "condition",
+    "above_base",
+    "joint_cone",
+    "clearance",
+)
 METRICS = (
     "peak_force",
     "peak_speed",
@@ -44,6 +55,7 @@ METRICS = (
     "condition",
     "min_anchor_height",
     "max_joint_angle",
+    "min_leg_distance",
 )
 
 
@@ -62,6 +74,18 @@ def joint_angles(l, R) -> np.ndarray:
     base = np.arccos(np.clip(u[..., 2], -1.0, 1.0))
     top = np.arccos(np.clip(np.einsum("...li,...i->...l", u, R[..., :, 2]), -1.0, 1.0))
     return np.maximum(base, top)
+
+
+def leg_clearance(platform, poses, convention: str = "utn") -> np.ndarray:
+    """``(n,)`` the smallest distance (m) between the axes of two legs that can touch (``workspace.limits``'
+    ``leg_pairs`` and ``segment_distances``) at each pose; inf when no pair can."""
+    pairs = leg_pairs(platform)
+    if not len(pairs):
+        return np.full(len(poses), np.inf)
+    B = platform.base_anchors
+    P = B + leg_vectors(platform, poses, convention)
+    i, j = pairs[:, 0], pairs[:, 1]
+    return segment_distances(B[i], P[:, i], B[j], P[:, j]).min(-1)
 
 
 def leg_range(req, x) -> tuple[float, float, float]:
@@ -113,6 +137,7 @@ def evaluate_design(req, x) -> dict:
         M = spatial_inertia_about_C(platform, rotation_matrix(poses[:, 3:], req.convention))
         freq = float(lowest_frequency(K, M).min())
         cond = float(condition_number(platform, poses, req.convention).max())
+        gap = float(leg_clearance(platform, poses, req.convention).min())
         joint = float(
             joint_angles(
                 leg_vectors(platform, poses, req.convention), rotation_matrix(poses[:, 3:], req.convention)
@@ -135,6 +160,7 @@ def evaluate_design(req, x) -> dict:
         "condition": cond,
         "min_anchor_height": z_low,
         "max_joint_angle": joint,
+        "min_leg_distance": gap,
         "L_needed": [L_low, L_high],
     }
     out.update(m)
@@ -153,6 +179,7 @@ def constraint_values(req, m: dict, home: float) -> list[float]:
         "condition": m["condition"] / req.max_condition - 1.0 if req.max_condition else -1.0,
         "above_base": -m["min_anchor_height"] / max(home, 1e-9),
         "joint_cone": m["max_joint_angle"] / req.joint_cone - 1.0 if req.joint_cone else -1.0,
+        "clearance": 1.0 - m["min_leg_distance"] / req.leg_diameter if req.leg_diameter else -1.0,
     }
     L_low, L_high = m["L_needed"]
     if req.stroke is None:

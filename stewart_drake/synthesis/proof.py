@@ -57,7 +57,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import plate_anchor_heights
-from stewart_drake.workspace.limits import Limits, limit_margins
+from stewart_drake.workspace.limits import Limits, leg_pairs, limit_margins
 
 FP_SLACK = 1e-9  # m: each bound widened by this (rounding; see the module docstring)
 COVER_PAD = 1e-12  # each cell's half-widths grown by this × (1 + |centre|): adjacent cells overlap
@@ -124,9 +124,12 @@ class CellBounds:
     upper_pose: np.ndarray
     axial_lower: np.ndarray | None = None
     normal_lower: np.ndarray | None = None
+    clearance_lower: np.ndarray | None = None  # (n, k): lower bound of the distance between leg_pairs' segments
 
 
-def cell_bounds(platform: Platform, cells: Cells, convention: str = "utn", cones: bool = False) -> CellBounds:
+def cell_bounds(
+    platform: Platform, cells: Cells, convention: str = "utn", cones: bool = False, clearance: bool = False
+) -> CellBounds:
     """Rigorous leg-length and anchor-height bounds on each cell (see the module docstring); with ``cones``
     also lower bounds of l_i·e_z (``axial_lower``) and of l_i·n (``normal_lower``, n = R e_z the plate normal)."""
     c = cells.c
@@ -173,7 +176,39 @@ def cell_bounds(platform: Platform, cells: Cells, convention: str = "utn", cones
         first -= np.linalg.norm(a_c, axis=-1) * rn[:, None]
         n_abs = np.abs(n_c) + np.einsum("nji,nj->ni", np.abs(Jn), h[:, 3:]) + rn[:, None]  # (n, 3) max |n_k|
         out.normal_lower = first - np.sum(h[:, :3] * n_abs, -1)[:, None] + t[None, :, 2] - FP_SLACK
+    if clearance:
+        out.clearance_lower = _clearance_lower(platform, lc + platform.base_anchors, G, r2)
     return out
+
+
+def _clearance_lower(platform: Platform, P_c, G, r2) -> np.ndarray:
+    """``(n, k)`` lower bounds of the distance between the legs of each ``leg_pairs`` row over each cell.
+
+    Every segment of leg i over the cell lies in C_i = conv({b_i} ∪ (Z_i ⊕ B(r_i))), Z_i the plate anchor's
+    zonotope (centre P_c, generators G). For any unit n, dist(C_i, C_j) >= min_{C_j} n·x − max_{C_i} n·x, and
+    the support function of C_i is max(n·b_i, n·P_c + Σ_k |n·g_k| + r_i). n: from the closest of 11 × 11
+    points of the two centre segments (any n gives a valid bound)."""
+    pairs = leg_pairs(platform)
+    if not len(pairs):
+        return np.full((len(P_c), 1), np.inf)
+    i, j = pairs[:, 0], pairs[:, 1]
+    B = platform.base_anchors
+    s = np.linspace(0.0, 1.0, 11)[:, None]
+    pi = B[i][None, :, None] + s * (P_c[:, i] - B[i])[:, :, None]  # (n, k, 11, 3)
+    pj = B[j][None, :, None] + s * (P_c[:, j] - B[j])[:, :, None]
+    d = pj[:, :, None, :, :] - pi[:, :, :, None, :]  # (n, k, 11, 11, 3)
+    dn = np.linalg.norm(d, axis=-1).reshape(d.shape[:2] + (-1,))
+    best = np.argmin(dn, -1)
+    v = np.take_along_axis(d.reshape(d.shape[:2] + (-1, 3)), best[..., None, None], -2)[..., 0, :]
+    norm = np.linalg.norm(v, axis=-1)
+    n = v / np.where(norm > 0, norm, 1.0)[..., None]
+
+    def spread(k):  # Σ_g |n·g| + r over leg k's zonotope and ball
+        return np.sum(np.abs(np.einsum("nci,ncig->ncg", n, G[:, k])), -1) + r2[:, k]
+
+    h_i = np.maximum(np.einsum("nci,ci->nc", n, B[i]), np.einsum("nci,nci->nc", n, P_c[:, i]) + spread(i))
+    g_j = np.minimum(np.einsum("nci,ci->nc", n, B[j]), np.einsum("nci,nci->nc", n, P_c[:, j]) - spread(j))
+    return np.where(norm > 0, g_j - h_i, -np.inf) - FP_SLACK
 
 
 def cones_ok(b: CellBounds, cone: float) -> np.ndarray:
@@ -226,7 +261,9 @@ class ProofResult:
         }
 
 
-def _witness(platform: Platform, poses, convention: str, cone: float | None = None) -> dict | None:
+def _witness(
+    platform: Platform, poses, convention: str, cone: float | None = None, diameter: float | None = None
+) -> dict | None:
     """The first pose among ``poses`` (m, 6) that the toolkit's IK finds outside the stroke (by more than
     FP_SLACK), with a plate anchor at or below the base, or (``cone``) with a joint beyond its cone by more
     than 1e-9 rad (``workspace.limits``' joint angles); None if all are fine."""
@@ -243,6 +280,20 @@ def _witness(platform: Platform, poses, convention: str, cone: float | None = No
                     "anchor_height_m": float(plate_anchor_heights(platform, poses[k], convention)[leg[k]]),
                     "what": f"{name.replace('_', ' ')} beyond its cone by {np.degrees(-margin[k]):.6f} deg",
                 }
+    if diameter is not None:
+        margin, row = limit_margins(platform, poses, Limits(stroke=False, leg_diameter=diameter), convention)[
+            "collision"
+        ]
+        if np.any(margin < -1e-9):
+            k = int(np.argmax(margin < -1e-9))
+            a, b = leg_pairs(platform)[row[k]]
+            return {
+                "pose": poses[k].tolist(),
+                "leg": int(a) + 1,
+                "length_m": float(leg_lengths(platform, poses[k], convention)[a]),
+                "anchor_height_m": float(plate_anchor_heights(platform, poses[k], convention)[a]),
+                "what": f"legs {a + 1} and {b + 1} closer than the leg diameter by {-margin[k] * 1e3:.6f} mm",
+            }
     L = leg_lengths(platform, poses, convention)
     z = plate_anchor_heights(platform, poses, convention)
     below = L < platform.L_min - FP_SLACK
@@ -276,6 +327,7 @@ def prove_box(
     max_cells: int = MAX_CELLS,
     initial: int | None = None,
     joint_cone: float | None = None,
+    leg_diameter: float | None = None,
 ) -> ProofResult:
     """Prove that every pose in the box [lo, hi] (absolute, (6,) m and rad) is within the stroke with the
     plate above the base (and, with ``joint_cone`` (rad), every leg within that angle of the base normal and
@@ -306,11 +358,13 @@ def prove_box(
         nxt_c, nxt_h = [], []
         for s in range(0, len(pending), BATCH):
             cells = Cells(pending.c[s : s + BATCH], pending.h[s : s + BATCH])
-            b = cell_bounds(platform, cells, convention, cones=joint_cone is not None)
+            b = cell_bounds(platform, cells, convention, joint_cone is not None, leg_diameter is not None)
             z_ok = np.all(b.z_lower > 0, -1) | platform.plate_below_base_allowed
             ok = np.all(b.lower >= platform.L_min, -1) & np.all(b.upper <= platform.L_max, -1) & z_ok
             if joint_cone is not None:
                 ok &= cones_ok(b, joint_cone)
+            if leg_diameter is not None:
+                ok &= np.all(b.clearance_lower >= leg_diameter, -1)
             examined += len(cells)
             proven += int(ok.sum())
             if ok.any():
@@ -326,7 +380,7 @@ def prove_box(
             cand = np.concatenate([cells.c[bad][:, None, :], b.lower_pose[bad], b.upper_pose[bad]], axis=1).reshape(
                 -1, 6
             )
-            w = _witness(platform, np.clip(cand, lo, hi), convention, joint_cone)  # cells overlap the box
+            w = _witness(platform, np.clip(cand, lo, hi), convention, joint_cone, leg_diameter)  # cells overlap the box
             if w is not None:
                 return ProofResult(
                     "violated", lo, hi, examined, proven, max_cells, witness=w, seconds=time.perf_counter() - t0

@@ -111,6 +111,7 @@ class LimitsConfig:
     min_frequency_hz: float | None = None  # Hz, lowest natural frequency over the box
     max_condition: float | None = None  # worst scaled condition number of J⁻¹ over the box
     joint_cone: float | None = None  # angle unit: largest angle between a leg and the base / plate normal
+    leg_diameter: float | None = None  # length unit: legs (as cylinders of this diameter) never touch
 
 
 @dataclass
@@ -163,6 +164,7 @@ class Requirements:
     max_condition: float | None
     objectives: tuple
     joint_cone: float | None = None
+    leg_diameter: float | None = None
     convention: str = "utn"
     source: str = "requirements"
     units: tuple = ("m", "rad")
@@ -357,6 +359,7 @@ def requirements_from_config(cfg: RequirementsConfig, where: dict, shown: str) -
     cone = _positive(lim.joint_cone, ("limits", "joint_cone"), where, shown)
     if cone is not None and cone * ka >= np.pi / 2:
         raise _err(where, ("limits", "joint_cone"), shown, "must be below 90 degrees")
+    diameter = _positive(lim.leg_diameter, ("limits", "leg_diameter"), where, shown)
     if not cfg.objectives:
         raise _err(where, ("objectives",), shown, "must list at least one objective", value="[]")
     for k, name in enumerate(cfg.objectives):
@@ -393,6 +396,7 @@ def requirements_from_config(cfg: RequirementsConfig, where: dict, shown: str) -
         max_condition=cmax,
         objectives=tuple(cfg.objectives),
         joint_cone=None if cone is None else cone * ka,
+        leg_diameter=None if diameter is None else diameter * kl,
         convention=cfg.convention,
         source=shown,
         units=(cfg.length_unit, cfg.angle_unit),

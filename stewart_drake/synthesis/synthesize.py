@@ -149,6 +149,20 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
                 + sample,
             }
         )
+    if req.leg_diameter is not None:
+        out.append(
+            {
+                "requirement": "limits.leg_diameter: every pose of the box, no two legs closer than it",
+                "required": float(req.leg_diameter),
+                "achieved": proof.status,
+                "margin": None,
+                "unit": "m",
+                "met": proof.status == "proven",
+                "established": "the proof (a separating direction between each pair's hulls on every cell); the search "
+                + f"sampled {float(row['min_leg_distance']):.6f} m at "
+                + sample,
+            }
+        )
     if req.max_condition is not None:
         out.append(
             _row(
@@ -201,6 +215,12 @@ def synthesize(
     row = result.rows[k]
     platform = chosen_platform(req, row, req.name or "synthesised")
     proof = prove_requirements_box(
-        platform, req.box_lo, req.box_hi, req.convention, max_cells=max_cells, joint_cone=req.joint_cone
+        platform,
+        req.box_lo,
+        req.box_hi,
+        req.convention,
+        max_cells=max_cells,
+        joint_cone=req.joint_cone,
+        leg_diameter=req.leg_diameter,
     )
     return SynthesisResult(result, k, pick, platform, proof, requirement_table(req, row, proof))

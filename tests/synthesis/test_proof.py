@@ -20,7 +20,7 @@ from stewart_drake.synthesis.proof import (
     prove_requirements_box,
     rotation_derivatives,
 )
-from stewart_drake.workspace.limits import Limits, limit_margins
+from stewart_drake.workspace.limits import Limits, limit_margins, raw_margins
 
 # A fifth of the paper's one-axis extents (seed 001): inside the gonzalez-dutra-2009 geometry's reach.
 FIFTH_LO = np.array([-0.0782, -0.0902, -0.0501, *np.radians([-8.36, -6.58, -9.46])])
@@ -173,3 +173,25 @@ def test_joint_cone_proven_and_violated(gd):
     cone = worst + np.radians(2)
     w = limit_margins(gd, np.array(bad.witness["pose"]), Limits(stroke=False, base_cone=cone, top_cone=cone))
     assert min(w["base_joint"][0], w["top_joint"][0]) < 0
+
+
+def test_clearance_bounds_and_outcomes(gd):
+    """The lower bound of the distance between two legs (a separating direction between their hulls over a
+    cell) holds at sampled poses (workspace.limits' segment distances); a diameter half the sampled minimum is
+    proven, one above the sampled minimum is violated with a witness pair that workspace.limits confirms."""
+    rng = np.random.default_rng(9)
+    cells = random_cells(rng, gd.home_pose(), 20, np.r_[0.03, 0.03, 0.03, 0.06, 0.06, 0.06])
+    b = cell_bounds(gd, cells, clearance=True)
+    poses = cells.c[:, None] + rng.uniform(-1, 1, (20, 2000, 6)) * cells.h[:, None]
+    d = raw_margins(
+        gd, leg_vectors(gd, poses), rotation_matrix(poses[..., 3:]), Limits(stroke=False, leg_diameter=1e-300)
+    )
+    assert np.all(d["collision"] >= b.clearance_lower[:, None])
+    home = gd.home_pose()
+    sample = home + FIFTH_LO + rng.random((20_000, 6)) * (FIFTH_HI - FIFTH_LO)
+    dmin = limit_margins(gd, sample, Limits(stroke=False, leg_diameter=1e-300))["collision"][0].min()
+    assert prove_requirements_box(gd, FIFTH_LO, FIFTH_HI, leg_diameter=0.5 * dmin).status == "proven"
+    bad = prove_requirements_box(gd, FIFTH_LO, FIFTH_HI, leg_diameter=1.05 * dmin)
+    assert bad.status == "violated" and "closer than the leg diameter" in bad.witness["what"]
+    m = limit_margins(gd, np.array(bad.witness["pose"]), Limits(stroke=False, leg_diameter=1.05 * dmin))
+    assert m["collision"][0] < 0

@@ -30,8 +30,11 @@ def test_template_loads_in_si(tmp_path):
     np.testing.assert_allclose(req.v_max, [0.3, 0.3, 0.3, *np.radians([20, 20, 20])])
     assert req.stroke_ratio == 1.6 and req.stroke is None and req.stiffness == 5.0e7
     assert req.joint_cone is None  # commented out in the template
-    cone = load_requirements(write(tmp_path, TEMPLATE.replace("# joint_cone: 40 ", "joint_cone: 40 "), "c.yaml"))
-    assert cone.joint_cone == pytest.approx(np.radians(40))
+    text = TEMPLATE.replace("# joint_cone: 40 ", "joint_cone: 40 ").replace(
+        "# leg_diameter: 0.08 ", "leg_diameter: 0.08 "
+    )
+    cone = load_requirements(write(tmp_path, text, "c.yaml"))
+    assert cone.joint_cone == pytest.approx(np.radians(40)) and cone.leg_diameter == pytest.approx(0.08)
 
 
 def test_millimetres_scale_lengths_not_angles(tmp_path):

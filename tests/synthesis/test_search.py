@@ -124,6 +124,7 @@ def test_batch_evaluation_equals_the_per_platform_functions(req):
             "frequency",
             "condition",
             "max_joint_angle",
+            "min_leg_distance",
         )
         for key in keys:
             assert b[key] == pytest.approx(ref[key], rel=1e-9, abs=1e-9), key
