@@ -25,6 +25,8 @@ METRIC_COLUMNS = {
     "base_radius": "base_radius_m",
     "frequency": "frequency_hz",
     "condition": "condition",
+    "max_joint_angle": "max_joint_angle_rad",
+    "min_leg_distance": "min_leg_distance_m",
 }
 
 
