@@ -181,34 +181,58 @@ def cell_bounds(
     return out
 
 
+PIECES = 4  # each leg cut into this many pieces for the clearance bound
+
+
 def _clearance_lower(platform: Platform, P_c, G, r2) -> np.ndarray:
     """``(n, k)`` lower bounds of the distance between the legs of each ``leg_pairs`` row over each cell.
 
-    Every segment of leg i over the cell lies in C_i = conv({b_i} ∪ (Z_i ⊕ B(r_i))), Z_i the plate anchor's
-    zonotope (centre P_c, generators G). For any unit n, dist(C_i, C_j) >= min_{C_j} n·x − max_{C_i} n·x, and
-    the support function of C_i is max(n·b_i, n·P_c + Σ_k |n·g_k| + r_i). n: from the closest of 11 × 11
-    points of the two centre segments (any n gives a valid bound)."""
+    Leg i's points are b_i + s l_i, s in [0, 1], with l_i = l_i(c) + G_i u + e_i, |u_g| <= 1 (the cell's
+    coefficients, the same u for every leg: the pose is shared) and |e_i| <= r_i. For a point s on leg i and t on
+    leg j and a unit n, n·(y_j − y_i) = n·(b_j − b_i) + t n·l_j(c) − s n·l_i(c) + Σ_g (t n·g_j − s n·g_i) u_g
+    + n·(t e_j − s e_i) >= n·(b_j − b_i) + t n·l_j(c) − s n·l_i(c) − Σ_g |t n·g_j − s n·g_i| − t r_j − s r_i,
+    and the distance is at least that. Cut s and t into ``PIECES`` intervals; on a pair of pieces the right side
+    is concave in (s, t), so its minimum is at one of the four corners. n: from the closest of 3 × 3 points of
+    the two centre-pose pieces (any n gives a valid bound). The bound is the least over the piece pairs."""
     pairs = leg_pairs(platform)
     if not len(pairs):
         return np.full((len(P_c), 1), np.inf)
+    out = np.empty((len(P_c), len(pairs)))
+    for s in range(0, len(P_c), 256):
+        out[s : s + 256] = _clearance_chunk(platform, pairs, P_c[s : s + 256], G[s : s + 256], r2[s : s + 256])
+    return out
+
+
+def _clearance_chunk(platform: Platform, pairs, P_c, G, r2) -> np.ndarray:
     i, j = pairs[:, 0], pairs[:, 1]
     B = platform.base_anchors
-    s = np.linspace(0.0, 1.0, 11)[:, None]
-    pi = B[i][None, :, None] + s * (P_c[:, i] - B[i])[:, :, None]  # (n, k, 11, 3)
-    pj = B[j][None, :, None] + s * (P_c[:, j] - B[j])[:, :, None]
-    d = pj[:, :, None, :, :] - pi[:, :, :, None, :]  # (n, k, 11, 11, 3)
-    dn = np.linalg.norm(d, axis=-1).reshape(d.shape[:2] + (-1,))
-    best = np.argmin(dn, -1)
-    v = np.take_along_axis(d.reshape(d.shape[:2] + (-1, 3)), best[..., None, None], -2)[..., 0, :]
+    edges = np.linspace(0.0, 1.0, PIECES + 1)
+    s0, s1 = edges[:-1], edges[1:]
+    pts = np.stack([s0, 0.5 * (s0 + s1), s1], -1)  # (m, 3) sample parameters per piece
+    lc = P_c - B  # (n, 6, 3) centre leg vectors
+    pi = B[i][None, :, None, None] + pts[None, None, :, :, None] * lc[:, i][:, :, None, None]  # (n, k, m, 3, 3)
+    pj = B[j][None, :, None, None] + pts[None, None, :, :, None] * lc[:, j][:, :, None, None]
+    d = pj[:, :, None, :, None] - pi[:, :, :, None, :, None]  # (n, k, m, m, 3 pts, 3 pts, 3)
+    d = d.reshape(d.shape[:4] + (9, 3))
+    best = np.argmin(np.linalg.norm(d, axis=-1), -1)
+    v = np.take_along_axis(d, best[..., None, None], -2)[..., 0, :]  # (n, k, m, m, 3)
     norm = np.linalg.norm(v, axis=-1)
     n = v / np.where(norm > 0, norm, 1.0)[..., None]
-
-    def spread(k):  # Σ_g |n·g| + r over leg k's zonotope and ball
-        return np.sum(np.abs(np.einsum("nci,ncig->ncg", n, G[:, k])), -1) + r2[:, k]
-
-    h_i = np.maximum(np.einsum("nci,ci->nc", n, B[i]), np.einsum("nci,nci->nc", n, P_c[:, i]) + spread(i))
-    g_j = np.minimum(np.einsum("nci,ci->nc", n, B[j]), np.einsum("nci,nci->nc", n, P_c[:, j]) - spread(j))
-    return np.where(norm > 0, g_j - h_i, -np.inf) - FP_SLACK
+    Ai = np.einsum("nkabx,nkxg->nkabg", n, G[:, i])  # n·g for leg i's generators (shared coefficients u)
+    Aj = np.einsum("nkabx,nkxg->nkabg", n, G[:, j])
+    ci = np.einsum("nkabx,nkx->nkab", n, lc[:, i])
+    cj = np.einsum("nkabx,nkx->nkab", n, lc[:, j])
+    base = np.einsum("nkabx,kx->nkab", n, B[j] - B[i])
+    a0, a1 = s0[None, None, :, None], s1[None, None, :, None]
+    b0, b1 = s0[None, None, None, :], s1[None, None, None, :]
+    ball = a1 * r2[:, i][:, :, None, None] + b1 * r2[:, j][:, :, None, None]
+    g = np.full(ci.shape, np.inf)
+    for sa in (a0, a1):  # the bound is concave in (s, t): its minimum over the piece pair is at a corner
+        for tb in (b0, b1):
+            spread = np.sum(np.abs(tb[..., None] * Aj - sa[..., None] * Ai), -1)
+            g = np.minimum(g, base + tb * cj - sa * ci - spread)
+    gap = np.where(norm > 0, g - ball, -np.inf)
+    return gap.min(axis=(2, 3)) - FP_SLACK
 
 
 def cones_ok(b: CellBounds, cone: float) -> np.ndarray:
