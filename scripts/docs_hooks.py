@@ -146,6 +146,7 @@ def api_target(name: str) -> str:
     ``sd.firmware``): the names are loaded lazily by the package's ``__getattr__``, so mkdocstrings, which reads
     the sources statically, is pointed at their definitions."""
     obj = getattr(stewart_drake, name)
+    obj = getattr(obj, "__public__", obj)  # a name shared with an internal subpackage: its public object
     return obj.__name__ if inspect.ismodule(obj) else f"{obj.__module__}.{obj.__qualname__}"
 
 

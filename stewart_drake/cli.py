@@ -43,6 +43,10 @@ COMMANDS = {
         "montecarlo",
         "robustness study: many closed-loop runs with drawn tolerances (Dask), or --replay one of them",
     ),
+    "optimize": (
+        "optimize",
+        "design synthesis: the geometry with the smallest actuators that meets a requirements file, proven",
+    ),
     "report": ("report", "run the analyses on the built-in presets and write an HTML report"),
     "run": ("run", "run a motion program (.stw): leg lengths and forces along its trajectory"),
     "servo": ("servo", "servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)"),

@@ -809,3 +809,34 @@ API_POSE_SHAPE = "{what}: expected poses of shape (..., 6), got {shape}"
 API_FIT_PLATFORM = "fit=True needs the platform to fit the trajectory to"
 API_SIZE_SOURCE = "size: give exactly one of trajectory, program, envelope (got {given})"
 API_FILE_EXISTS = "{path}: exists; pass overwrite=True to replace it"
+
+
+class SynthesisError(StewartError):
+    """A requirements file (``stewart-drake optimize``) or a workspace proof request is malformed: messages
+    name the file, line and field, and the value as written."""
+
+    FIELD = "{path}:{line}: {field}: {value} {problem}"
+    MISSING = "{path}: {field} is required ({what})"
+    FAMILY = "{path}:{line}: family: unknown family {value!r}; choose from {valid}"
+    VARIABLE = "{path}:{line}: variables.{name}: not a variable of family {family!r} (its variables: {valid})"
+    VARIABLE_MISSING = "{path}: variables.{name} is required for family {family!r} (bounds [low, high])"
+    OBJECTIVE = "{path}:{line}: objectives item {k}: unknown objective {value!r}; choose from {valid}"
+    STROKE_BOTH = "{path}: actuator: give stroke_ratio or stroke, not both"
+    STROKE_NONE = "{path}: actuator: give stroke_ratio (L_max / L_min) or stroke [min, max]"
+    BOX_OPTION = "--require-box {axis} {lo} {hi}: {problem}"
+    BOX_OPTION_COUNT = "--require-box needs 12 numbers (px py pz a b g, each low high), got {n}"
+    PICK = "--pick {value!r}: give knee, an objective ({valid}) or a row of the front (1..{n})"
+    OUT_OTHER = (
+        "--out {out}: holds a search with other requirements or seed (key {old} here, {new} now); give another folder"
+    )
+    OUT_NOT_OURS = "--out {out}: holds files that are not a search's ({name}); give another folder"
+    BUDGET = "--budget must be between {lo} and {hi} design evaluations, got {value}"
+
+
+class InfeasibleRequirementsError(PhysicalLimitError):
+    """No design the search evaluated meets every requirement (exit 1: a result, not bad input)."""
+
+    NO_FEASIBLE = (
+        "no design among {n} evaluated meets every requirement (least violated: {worst}); "
+        "widen the bounds or raise --budget"
+    )

@@ -20,7 +20,7 @@ ALLOWED = {
     "drake": CORE | CONTROL | {"drake"},
     "api": CORE | CONTROL | {"drake", "api"},  # the public API (stewart_drake.__all__); the app sits above it
 }
-APP = {"commands", "report", "analyses", "montecarlo", "cli", "__init__", "__main__"}
+APP = {"commands", "report", "analyses", "montecarlo", "synthesis", "cli", "__init__", "__main__"}
 
 
 def layer_of(path: Path) -> str:

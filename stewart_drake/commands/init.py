@@ -26,6 +26,11 @@ def register(sub) -> None:
         help="a duty envelope for `size --envelope` (poses + velocity and acceleration bounds), "
         "made for the radial platform template",
     )
+    which.add_argument(
+        "--requirements-template",
+        action="store_true",
+        help="a requirements file for stewart-drake optimize (design synthesis)",
+    )
     p.set_defaults(func=run)
 
 
@@ -36,6 +41,14 @@ def template_text(kind: str) -> str:
     return (resources.files("stewart_drake") / "templates" / name).read_text(encoding="utf-8")
 
 
+def requirements_template_text() -> str:
+    """The text of the requirements template (``stewart-drake optimize``)."""
+    return (resources.files("stewart_drake") / "templates" / "requirements.yaml").read_text(encoding="utf-8")
+
+
 def run(args) -> int:
+    if args.requirements_template:
+        sys.stdout.write(requirements_template_text())
+        return 0
     sys.stdout.write(template_text("envelope" if args.envelope_template else args.platform_template))
     return 0

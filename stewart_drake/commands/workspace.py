@@ -17,9 +17,15 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
+from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
+from stewart_drake.core.sanity import check_finite
+from stewart_drake.errors import OptionError, SynthesisError
+from stewart_drake.synthesis.proof import prove_requirements_box
 from stewart_drake.workspace import AXES, view_figures
+
+BOX_AXES = ("px", "py", "pz", "a", "b", "g")
 
 
 def register(sub) -> None:
@@ -89,10 +95,34 @@ def register(sub) -> None:
         help="write workspace.json, boundary.csv and the views (top, front, side, 3d PNG) into DIR",
     )
     add_force_arg(p)
+    p.add_argument(
+        "--require-box",
+        nargs=12,
+        type=float,
+        default=None,
+        metavar="V",
+        help="with --prove: a box of poses relative to home, px py pz (m) a b g (--angle-unit), each as low high",
+    )
+    p.add_argument(
+        "--prove",
+        action="store_true",
+        help="prove every pose of --require-box within the stroke and above the base (interval cover); "
+        "exit 1 if violated (a witness pose) or unresolved",
+    )
+    p.add_argument(
+        "--max-cells",
+        type=int,
+        default=200_000,
+        metavar="N",
+        help="with --prove: cells the proof may examine (default 200000)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    reject_unused(args, "--prove", args.prove, require_box=None, max_cells=200_000)
+    if args.prove:
+        return run_proof(args)
     names = [n.strip() for n in args.limits.split(",")]
     reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
     reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
@@ -163,3 +193,75 @@ def write_outputs(w, result: dict, out) -> None:
         for name, fig in view_figures(w, title=result["platform"].replace("$", r"\$")).items():
             fig.savefig(tmp / f"{name}.png", dpi=110, bbox_inches="tight")
             plt.close(fig)
+
+
+def run_proof(args) -> int:
+    """``--prove``: the proof of ``--require-box`` alone (``synthesis.proof``); exit 1 unless proven."""
+    reject_unused(args, "the workspace sweep (without --prove)", False, out=None, centre=None, workers=1)
+    names = [n.strip() for n in args.limits.split(",") if n.strip()]
+    other = [n for n in names if n not in ("stroke", "joints", "collision")]
+    if other:
+        raise OptionError(
+            OptionError.UNKNOWN_LIMIT.format(
+                option="--limits (with --prove)", value=other[0], valid="stroke, joints, collision"
+            )
+        )
+    if args.require_box is None:
+        raise OptionError(SynthesisError.BOX_OPTION_COUNT.format(n=0))
+    platform = platform_from_args(args)
+    box = np.asarray(args.require_box, dtype=float).reshape(6, 2)
+    check_finite(box, "--require-box")
+    for j, (lo, hi) in enumerate(box):
+        if lo > hi:
+            raise OptionError(
+                SynthesisError.BOX_OPTION.format(axis=BOX_AXES[j], lo=lo, hi=hi, problem="low is above high")
+            )
+    if not 1 <= args.max_cells <= 10_000_000:
+        raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=10_000_000, value=args.max_cells))
+    box[3:] = to_radians(box[3:], args.angle_unit)
+    if np.any(np.abs(box[3:]) > np.radians(80.0)):
+        raise OptionError(SynthesisError.BOX_OPTION.format(axis="a/b/g", lo="", hi="", problem="angles beyond 80 deg"))
+    reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
+    reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
+    cone = float(to_radians(args.joint_cone, args.angle_unit)) if "joints" in names else None
+    diameter = None
+    if "collision" in names:
+        diameter = (
+            args.leg_diameter if args.leg_diameter is not None else 2 * leg_dimensions(platform)["cylinder_radius"]
+        )
+        if not (math.isfinite(diameter) and diameter > 0):
+            raise OptionError(OptionError.POSITIVE.format(option="--leg-diameter", unit="metres", value=diameter))
+    result = prove_requirements_box(
+        platform,
+        box[:, 0],
+        box[:, 1],
+        args.convention,
+        max_cells=args.max_cells,
+        joint_cone=cone,
+        leg_diameter=diameter,
+    )
+    if args.json:
+        print_json({"platform": platform.name, "convention": args.convention, **result.to_dict()})
+    else:
+        print(
+            f"platform {platform.name}: proof that every pose of the box (relative to home "
+            f"{np.round(platform.home_pose()[:3], 6).tolist()} m) is within the stroke and above the base"
+            f"{f' with joint cones of {args.joint_cone} {args.angle_unit}' if cone is not None else ''}"
+            f"{f', legs {diameter} m thick apart' if diameter is not None else ''}: {result.status}"
+        )
+        print(f"  {result.cells_examined} cells examined, {result.cells_proven} proven, {result.seconds:.2f} s")
+        if result.status == "proven":
+            lo, hi = result.length_bounds
+            print(
+                f"  leg lengths within [{lo:.6f}, {hi:.6f}] m (stroke [{platform.L_min}, {platform.L_max}] m); "
+                f"least margin {result.stroke_margin_m * 1e3:.3f} mm"
+            )
+        elif result.witness:
+            w = result.witness
+            print(
+                f"  witness pose {np.round(w['pose'], 9).tolist()} (m, rad): leg {w['leg']} {w['what']} "
+                f"(length {w['length_m']:.6f} m, checked by the IK)"
+            )
+        else:
+            print(f"  {result.unresolved_count} cells left unresolved after --max-cells {args.max_cells}")
+    return 0 if result.status == "proven" else 1

@@ -240,6 +240,17 @@ def spatial_inertia_about_C(platform: Platform, R) -> np.ndarray:
 def _plate_terms(platform: Platform, q, convention, gravity):
     """c (..., 6), G (..., 6, 6) [leg, axis], Q (..., 6, 3, 3) over ω, and the geometry."""
     R, r_legs, u, L, Jinv = _plate_geometry(platform, q, convention)
+    rhs = plate_wrench_terms(platform, R, gravity)
+    X = np.linalg.solve(np.swapaxes(Jinv, -1, -2), rhs)  # J⁻ᵀ [w_g, M_C, H]
+    c, G, Q = X[..., 0], X[..., 1:7], X[..., 7:].reshape(X.shape[:-1] + (3, 3))
+    return c, G, Q, (R, r_legs, u, L, Jinv)
+
+
+def plate_wrench_terms(platform: Platform, R, gravity: float = G_EARTH) -> np.ndarray:
+    """``(..., 6, 16)`` the plate's wrench terms about C at orientations R (..., 3, 3), base frame: column 0 the
+    weight's [f; m] to hold, columns 1..6 the spatial inertia M_C, columns 7..15 the velocity wrench's
+    quadratic form in ω (3 × 3, flattened). Leg forces are F = J⁻ᵀ times them (``_plate_terms``); they depend
+    on the plate's mass properties and orientation only, not on the anchors."""
     m = platform.mass
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     I_W = R @ platform.inertia @ np.swapaxes(R, -1, -2)
@@ -258,10 +269,7 @@ def _plate_terms(platform: Platform, q, convention, gravity):
         Hw[..., j, j] = diag[j]
         for k in range(j + 1, 3):
             Hw[..., j, k] = Hw[..., k, j] = 0.5 * (h(E[j] + E[k]) - diag[j] - diag[k])
-    rhs = np.concatenate([w_g[..., None], spatial_inertia_about_C(platform, R), Hw.reshape(r.shape[:-1] + (6, 9))], -1)
-    X = np.linalg.solve(np.swapaxes(Jinv, -1, -2), rhs)  # J⁻ᵀ [w_g, M_C, H]
-    c, G, Q = X[..., 0], X[..., 1:7], X[..., 7:].reshape(X.shape[:-1] + (3, 3))
-    return c, G, Q, (R, r_legs, u, L, Jinv)
+    return np.concatenate([w_g[..., None], spatial_inertia_about_C(platform, R), Hw.reshape(r.shape[:-1] + (6, 9))], -1)
 
 
 def cartesian_to_euler(q, V, Vd, convention):

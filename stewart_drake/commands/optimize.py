@@ -1,0 +1,130 @@
+"""``stewart-drake optimize``: design synthesis from a requirements file (NSGA-II on Dask), with a proof."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from stewart_drake.commands._common import add_force_arg, output_folder, print_json
+from stewart_drake.core.sanity import check_work
+from stewart_drake.errors import OptionError
+from stewart_drake.synthesis.outputs import write_outputs
+from stewart_drake.synthesis.proof import MAX_CELLS
+from stewart_drake.synthesis.requirements import OBJECTIVES, load_requirements
+from stewart_drake.synthesis.search import CACHE, DEFAULT_POP
+from stewart_drake.synthesis.synthesize import synthesize
+
+HELP = "design synthesis: the geometry with the smallest actuators that meets a requirements file, proven"
+
+
+def register(sub) -> None:
+    p = sub.add_parser("optimize", help=HELP)
+    p.add_argument(
+        "--requirements",
+        required=True,
+        metavar="R.yaml",
+        help="the requirements (stewart-drake init --requirements-template)",
+    )
+    p.add_argument(
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="output folder; a search there with the same requirements and seed resumes",
+    )
+    p.add_argument(
+        "--budget", type=int, default=480, metavar="N", help="design evaluations (whole generations; default 480)"
+    )
+    p.add_argument(
+        "--pop-size", type=int, default=DEFAULT_POP, metavar="P", help=f"NSGA-II population (default {DEFAULT_POP})"
+    )
+    p.add_argument("--seed", type=int, default=0, metavar="S", help="search seed (default 0)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        metavar="K",
+        help="LocalCluster worker processes (default 1; 0: in this process, no Dask)",
+    )
+    where.add_argument(
+        "--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask scheduler instead of a LocalCluster"
+    )
+    p.add_argument(
+        "--pick",
+        default="knee",
+        metavar="knee|OBJECTIVE|ROW",
+        help=f"the design written to design.yaml: knee (default), the best of an objective ({', '.join(OBJECTIVES)}) or a row of the front",
+    )
+    p.add_argument(
+        "--max-cells",
+        type=int,
+        default=MAX_CELLS,
+        metavar="N",
+        help=f"cells the proof may examine (default {MAX_CELLS})",
+    )
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_force_arg(p)
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    out = output_folder(args)
+    req = load_requirements(args.requirements)
+    if args.workers is not None and args.workers < 0:
+        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=args.workers))
+    if args.workers:
+        check_work(
+            "--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1)
+        )
+    if args.pop_size < 2:
+        raise OptionError(OptionError.AT_LEAST.format(option="--pop-size", min=2, value=args.pop_size))
+    if not 1 <= args.max_cells <= 10_000_000:
+        raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=10_000_000, value=args.max_cells))
+    if args.seed < 0:
+        raise OptionError(OptionError.AT_LEAST.format(option="--seed", min=0, value=args.seed))
+    result = synthesize(
+        req,
+        out.path,
+        args.budget,
+        args.seed,
+        args.workers or 0,
+        args.scheduler,
+        args.pick,
+        progress=not args.no_progress and sys.stderr.isatty(),
+        max_cells=args.max_cells,
+        pop_size=args.pop_size,
+    )
+    with out.writing() as tmp:
+        write_outputs(result, tmp, args.requirements, cache_from=out.path / CACHE)
+    if args.json:
+        print_json(result.to_dict())
+    else:
+        s, d = result.search, result.design
+        print(
+            f"optimize {args.requirements}: {len(s.rows)} designs ({s.evaluated} evaluated now, {s.cached} from {args.out}), "
+            f"{len(s.front)} on the Pareto front; chosen ({args.pick}):"
+        )
+        for name, value in zip(s.requirements.variables, d["x"], strict=True):
+            shown = f"{value * 57.29577951308232:.3f} deg" if name.endswith("half_angle") else f"{value:.4f} m"
+            print(f"  {name} = {shown}")
+        print(
+            f"  stroke [{d['L_min']:.4f}, {d['L_max']:.4f}] m, peak force {d['peak_force']:.1f} N, lowest frequency {d['frequency']:.1f} Hz"
+        )
+        pr = result.proof
+        print(f"  proof of the box: {pr.status} ({pr.cells_examined} cells, {pr.seconds:.2f} s)")
+        if pr.witness:
+            print(
+                f"  witness: pose {pr.witness['pose']} leg {pr.witness['leg']} {pr.witness['what']} (L = {pr.witness['length_m']:.6f} m)"
+            )
+        for r in result.table:
+            mark = "met" if r["met"] else "NOT MET"
+            if isinstance(r["achieved"], str):
+                room = f" (least stroke margin {r['margin'] * 1e3:.2f} mm)" if r["margin"] is not None else ""
+                print(f"  {mark:7s} {r['requirement']}: {r['achieved']}{room}")
+            else:
+                print(
+                    f"  {mark:7s} {r['requirement']}: required {r['required']:g}, achieved {r['achieved']:.6g} {r['unit']}"
+                )
+        print(f"  wrote {args.out}/ (design.yaml, pareto.parquet/.csv/.png, requirements.json)")
+    return 0 if result.ok else 1

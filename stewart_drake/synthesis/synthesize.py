@@ -1,0 +1,226 @@
+"""From requirements to a chosen, proven design: search, pick, prove, and the table of requirements met.
+
+``synthesize`` is the Python entry point behind ``stewart-drake optimize``: it returns a
+``SynthesisResult`` (``to_dict()`` is the command's ``--json``) holding the search, the chosen design as a
+``Platform`` and its proof.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from stewart_drake.core.geometry import Platform
+from stewart_drake.synthesis.evaluate import box_vertices
+from stewart_drake.synthesis.families import design_platform
+from stewart_drake.synthesis.proof import MAX_CELLS, ProofResult, prove_requirements_box
+from stewart_drake.synthesis.requirements import Requirements
+from stewart_drake.synthesis.search import SearchResult, pick_design, run_search
+
+
+@dataclass
+class SynthesisResult:
+    """The search, the chosen row (index into ``search.rows``), the chosen design's ``platform``, its
+    ``proof`` and the ``requirements`` table (see ``requirement_table``); ``ok``: every requirement met."""
+
+    search: SearchResult
+    chosen: int
+    pick: str
+    platform: Platform
+    proof: ProofResult
+    table: list
+
+    @property
+    def design(self) -> dict:
+        return self.search.rows[self.chosen]
+
+    @property
+    def ok(self) -> bool:
+        return self.proof.status == "proven" and all(r["met"] for r in self.table)
+
+    def to_dict(self) -> dict:
+        return {
+            "ok": self.ok,
+            "pick": self.pick,
+            "design": {k: v for k, v in self.design.items() if k not in ("g", "f")},
+            "variables": dict(zip(self.search.requirements.variables, self.design["x"], strict=True)),
+            "proof": self.proof.to_dict(),
+            "requirements": self.table,
+            "search": self.search.to_dict(),
+        }
+
+
+SAMPLE_NOTE = "the box's {n} vertices and centre (a sample of the box)"
+
+
+def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[dict]:
+    """Each requirement: ``required``, ``achieved``, ``margin`` (positive: met with room), ``unit``, ``met`` and
+    ``established`` (how: proof, exact, or a sample, said so)."""
+    n = len(box_vertices(req.box_lo, req.box_hi))
+    sample = SAMPLE_NOTE.format(n=n - 1)
+    out = [
+        {
+            "requirement": "workspace: every pose of the box within the stroke, plate above the base",
+            "required": "every pose",
+            "achieved": proof.status,
+            "margin": proof.stroke_margin_m,
+            "unit": "m",
+            "met": proof.status == "proven",
+            "established": f"proof over {proof.cells_examined} cells ({proof.method})",
+        },
+        _row(
+            "actuator.max_force",
+            req.max_force,
+            row["peak_force"],
+            "N",
+            "<=",
+            "peak leg force: exact worst case over the motion envelope at " + sample,
+        ),
+    ]
+    if req.max_speed is not None:
+        out.append(
+            _row(
+                "actuator.max_speed",
+                req.max_speed,
+                row["peak_speed"],
+                "m/s",
+                "<=",
+                "peak leg speed: exact worst case over the motion envelope at " + sample,
+            )
+        )
+    if req.stroke_ratio is not None:
+        out.append(
+            _row(
+                "actuator.stroke_ratio",
+                req.stroke_ratio,
+                row["stroke_ratio"],
+                "",
+                "<=",
+                "L_max / L_min of the design's stroke (exact)",
+            )
+        )
+    else:
+        lo, hi = row["L_needed"]
+        out.append(
+            _row(
+                "actuator.stroke (L_min)",
+                req.stroke[0],
+                lo - req.stroke_margin,
+                "m",
+                ">=",
+                "leg range: angles sampled, position exact; the proof covers every pose",
+            )
+        )
+        out.append(
+            _row(
+                "actuator.stroke (L_max)",
+                req.stroke[1],
+                hi + req.stroke_margin,
+                "m",
+                "<=",
+                "leg range: angles sampled, position exact; the proof covers every pose",
+            )
+        )
+    if req.base_radius_max is not None:
+        out.append(
+            _row("limits.base_radius_max", req.base_radius_max, row["base_radius"], "m", "<=", "exact (anchor radius)")
+        )
+    if req.min_frequency_hz is not None:
+        out.append(
+            _row(
+                "limits.min_frequency_hz",
+                req.min_frequency_hz,
+                row["frequency"],
+                "Hz",
+                ">=",
+                "lowest natural frequency at " + sample,
+            )
+        )
+    if req.joint_cone is not None:
+        out.append(
+            {
+                "requirement": "limits.joint_cone: every pose of the box, every joint within the cone",
+                "required": float(req.joint_cone),
+                "achieved": proof.status,
+                "margin": None,
+                "unit": "rad",
+                "met": proof.status == "proven",
+                "established": "the proof (l·e_z and l·n bounded on every cell); the search sampled "
+                + f"{float(row['max_joint_angle']):.6f} rad at "
+                + sample,
+            }
+        )
+    if req.leg_diameter is not None:
+        out.append(
+            {
+                "requirement": "limits.leg_diameter: every pose of the box, no two legs closer than it",
+                "required": float(req.leg_diameter),
+                "achieved": proof.status,
+                "margin": None,
+                "unit": "m",
+                "met": proof.status == "proven",
+                "established": "the proof (a separating direction between each pair's hulls on every cell); the search "
+                + f"sampled {float(row['min_leg_distance']):.6f} m at "
+                + sample,
+            }
+        )
+    if req.max_condition is not None:
+        out.append(
+            _row(
+                "limits.max_condition",
+                req.max_condition,
+                row["condition"],
+                "",
+                "<=",
+                "worst condition number at " + sample,
+            )
+        )
+    return out
+
+
+def _row(name, required, achieved, unit, sense, how) -> dict:
+    margin = required - achieved if sense == "<=" else achieved - required
+    return {
+        "requirement": name,
+        "required": float(required),
+        "achieved": float(achieved),
+        "margin": float(margin),
+        "unit": unit,
+        "met": bool(margin >= 0),
+        "established": how,
+    }
+
+
+def chosen_platform(req: Requirements, row: dict, name: str = "synthesised") -> Platform:
+    """The ``Platform`` of an evaluated row: its variables and its stroke."""
+    return design_platform(req, row["x"], [row["L_min"], row["L_max"]], name)
+
+
+def synthesize(
+    req: Requirements,
+    out=None,
+    budget: int = 480,
+    seed: int = 0,
+    workers: int = 0,
+    scheduler: str | None = None,
+    pick: str = "knee",
+    progress: bool = False,
+    max_cells: int = MAX_CELLS,
+    pop_size: int | None = None,
+) -> SynthesisResult:
+    """Search (``search.run_search``), pick a design of the front (``search.pick_design``), prove the box on it
+    (``proof.prove_requirements_box``) and tabulate the requirements."""
+    kw = {} if pop_size is None else {"pop_size": pop_size}
+    result = run_search(req, out, budget, seed, workers, scheduler, progress=progress, **kw)
+    k = pick_design(result, pick)
+    row = result.rows[k]
+    platform = chosen_platform(req, row, req.name or "synthesised")
+    proof = prove_requirements_box(
+        platform,
+        req.box_lo,
+        req.box_hi,
+        req.convention,
+        max_cells=max_cells,
+        joint_cone=req.joint_cone,
+        leg_diameter=req.leg_diameter,
+    )
+    return SynthesisResult(result, k, pick, platform, proof, requirement_table(req, row, proof))

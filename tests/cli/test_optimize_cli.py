@@ -1,0 +1,82 @@
+"""``stewart-drake optimize`` end to end on seed 001's requirements: a proven design whose design.yaml every
+command takes, requirements.json complete; ``workspace --prove`` on a larger box: violated, a witness, exit 1."""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+
+import numpy as np
+import pyarrow.parquet as pq
+
+from stewart_drake.cli import main
+from stewart_drake.core.geometry import load_platform_yaml
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.sanity import plate_anchor_heights
+from stewart_drake.synthesis.requirements import load_requirements
+
+SEED_001 = str(resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml")
+
+
+def test_optimize_writes_a_proven_platform_file(tmp_path, capsys):
+    out = tmp_path / "o"
+    rc = main(["optimize", "--requirements", SEED_001, "--out", str(out), "--budget", "48", "--pop-size", "16",
+               "--workers", "0", "--json"])  # fmt: skip
+    result = json.loads(capsys.readouterr().out)
+    assert rc == 0 and result["ok"] and result["proof"]["status"] == "proven"
+    for name in ("pareto.parquet", "pareto.csv", "pareto.png", "design.yaml", "requirements.json", "evaluations.jsonl"):
+        assert (out / name).is_file(), name
+    table = pq.read_table(out / "pareto.parquet").to_pydict()
+    assert sum(table["chosen"]) == 1 and len(table["row"]) == len(result["search"]["front"])
+    reqs = json.loads((out / "requirements.json").read_text())["requirements"]
+    assert {"required", "achieved", "margin", "established"} <= set(reqs[0]) and all(r["met"] for r in reqs)
+    # design.yaml is an ordinary platform file: stroke, home height, payload as plate, actuator as legs
+    p = load_platform_yaml(out / "design.yaml")
+    req = load_requirements(SEED_001)
+    d = result["design"]
+    assert p.L_min == d["L_min"] and p.L_max == d["L_max"] and p.mass == req.mass
+    assert p.legs.max_force == req.max_force and p.legs.stiffness == req.stiffness
+    # a sample of the required box on the file's platform (the proof covers every pose)
+    rng = np.random.default_rng(0)
+    poses = p.home_pose() + req.box_lo + rng.random((20_000, 6)) * (req.box_hi - req.box_lo)
+    L = leg_lengths(p, poses)
+    assert np.all((L >= p.L_min) & (L <= p.L_max)) and np.all(plate_anchor_heights(p, poses) > 0)
+    assert (
+        main(
+            ["ik", "--platform", str(out / "design.yaml"), "--pose", "0", "0", f"{p.home_height * 1e3}", "0", "0", "0"]
+        )
+        == 0
+    )
+    box = np.c_[req.box_lo, req.box_hi]
+    box[3:] = np.degrees(box[3:])
+    args = ["workspace", "--platform", str(out / "design.yaml"), "--prove", "--json", "--require-box"]
+    capsys.readouterr()
+    assert main(args + [f"{v}" for v in box.ravel()]) == 0
+    assert json.loads(capsys.readouterr().out)["status"] == "proven"
+    # an infeasible requirement on the same design: twice the box -> violated, a witness, exit 1
+    assert main(args + [f"{v}" for v in (2 * box).ravel()]) == 1
+    proof = json.loads(capsys.readouterr().out)
+    assert proof["status"] == "violated"
+    w = proof["witness"]
+    L = leg_lengths(p, np.array(w["pose"]))[w["leg"] - 1]
+    assert L < p.L_min or L > p.L_max or w["what"].startswith("plate")
+
+
+def test_unmeetable_requirements_exit_1_with_the_reason(tmp_path, capsys):
+    """A 1 N actuator meets nothing: exit 1 (a result, not bad input), one line naming the least violated."""
+    text = (resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml").read_text()
+    path = tmp_path / "r.yaml"
+    path.write_text(text.replace("max_force: 5000", "max_force: 1"))
+    rc = main(["optimize", "--requirements", str(path), "--out", str(tmp_path / "o"), "--budget", "12",
+               "--pop-size", "12", "--workers", "0"])  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert rc == 1 and len(err.splitlines()) == 1
+    assert "no design among 12 evaluated meets every requirement (least violated: force by" in err
+
+
+def test_prove_unresolved_exits_1(capsys):
+    box = ["-0.07", "0.07", "-0.09", "0.09", "-0.05", "0.045", "-8", "7", "-6", "6", "-9", "9"]
+    rc = main(["workspace", "--platform", "gonzalez-dutra-2009", "--prove", "--max-cells", "5", "--json",
+               "--require-box", *box])  # fmt: skip
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 1 and out["status"] == "unresolved" and out["unresolved_count"] > 0
