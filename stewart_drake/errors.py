@@ -802,3 +802,56 @@ OPTION_JOINT_OVERFLOW = "joint angles {value} {unit}: the foot angle gamma = q1 
 OPTION_TARGET = "target must be finite, got {value}"
 OPTION_SERVO_POSE = "--pose has a non-finite number: {value}"
 REPORT_UNKNOWN_ANALYSIS = "unknown analysis {name!r}; available: {available}"
+
+
+class CalibrationError(InputError):
+    """A calibration input is unusable (measurement file, noise or error SPEC, options): one line naming it."""
+
+    COLUMNS = (
+        "{path}:{line}: a {kind} measurement file needs the columns {need}; missing {missing} "
+        "(header: {header}; --type {kind})"
+    )
+    UNKNOWN_COLUMN = "{path}:{line}: unknown column {name!r} for --type {kind} (columns: {need}, optional w)"
+    NO_HEADER = "{path}:1: a measurement file starts with a header row naming its columns ({need}), got {row}"
+    NOT_NUMBER = "{path}:{line}: column {column}: not a number: {value!r}"
+    NOT_FINITE = "{path}:{line}: column {column}: values must be finite, got {value!r}"
+    WIDTH = "{path}:{line}: expected {expected} values (one per header column), got {got}"
+    WEIGHT = "{path}:{line}: column w: a weight must be > 0, got {value!r}"
+    EMPTY = "{path}: no measurement rows"
+    TOO_MANY = "{path}: more than {limit} measurement rows; a calibration needs tens"
+    TOO_FEW = (
+        "{path}: {n} poses give {equations} equations for {unknowns} unknowns ({parameters} parameters"
+        "{nuisance}); give at least {need} poses"
+    )
+    STROKE = (
+        "{path}:{line}: leg {leg} reads {value} {unit}, so its length {length:.6g} m lies outside the stroke "
+        "[{lmin:g}, {lmax:g}] m of platform {name!r}{hint}"
+    )
+    UNIT_HINT = " (are the readings in {guess}? give --length-unit {guess})"
+    ANGLE = "{path}:{line}: column {column}: {value} {unit} is beyond ±{limit} {unit}{hint}"
+    ANGLE_HINT = " (are the angles in degrees? give --angle-unit deg)"
+    TYPE = "{path}: --type {kind} given, but the header names the columns of a {found} file ({header})"
+    TARGETS = "{path}:1: target columns must be tK_x,tK_y,tK_z for K = 1, 2, ... in order, got {names}"
+    NOISE_WORD = "--noise: {word!r} is not key=value (keys: {keys})"
+    NOISE_KEY = "--noise: unknown key {key!r} (keys: {keys})"
+    NOISE_VALUE = "--noise: {key}={text}: expected a number >= 0 with a unit ({units})"
+    ERRORS_KEY = "--errors: key {key!r} is not a geometric error (keys: anchor, leg_offset)"
+    HOLDOUT = "--holdout {value}: give a fraction in (0, 0.5] of the poses to hold out for validation"
+    HOLDOUT_TOO_FEW = "--holdout {value}: holding out {held} of {n} poses leaves {left}, fewer than the {need} needed"
+    POSES = "--poses {value}: give between {lo} and {hi} poses"
+    CANDIDATES = "platform {name!r}: only {got} candidate poses of {want} drawn lie within stroke, above the base and away from singularities in {box}"
+    WORKSPACE = "--workspace {value}: give six numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
+    PLAN_TYPE = "{path}: a measurement plan needs the columns px,py,pz,a,b,g (a plan-measurements poses.csv); {problem}"
+
+
+class CalibrationLimitError(PhysicalLimitError):
+    """An identification that does not converge, or data that fix too little: the CLI exits 1, result shown."""
+
+    NOT_CONVERGED = (
+        "the identification did not converge ({reason}); residual RMS {rms:.3g} (in σ) after {nfev} evaluations: "
+        "the nominal platform may be too far from the machine, or the data inconsistent"
+    )
+    BAD_FIT = (
+        "the identification converged to residuals {rms:.3g} times the stated noise: the model does not explain the "
+        "data (wrong --type, units, convention or noise levels?)"
+    )
