@@ -61,6 +61,7 @@ class CalibrationResult:
     nfev: int
     rms_sigma_before: float
     rms_sigma_after: float
+    pose_rms_before: np.ndarray
     pose_rms_after: np.ndarray
     lines: np.ndarray
     outliers: list = field(default_factory=list)
@@ -143,7 +144,9 @@ def _jacobian(problem: Problem, theta, xi, free) -> np.ndarray:
     return np.concatenate(parts, axis=1)
 
 
-def identify(nominal: Platform, data: Measurements, noise: Noise = Noise(), convention: str = "utn") -> CalibrationResult:
+def identify(
+    nominal: Platform, data: Measurements, noise: Noise = Noise(), convention: str = "utn"
+) -> CalibrationResult:
     """Identify the geometry of the machine that produced ``data`` (see the module docstring). Returns a
     ``CalibrationResult`` whose ``converged`` is False (with the reason in ``message``) when the solver
     stopped short or the fit leaves residuals far above the stated noise."""
@@ -198,7 +201,12 @@ def identify(nominal: Platform, data: Measurements, noise: Noise = Noise(), conv
     per_pose = np.sum(r**2, axis=1)
     bad = np.flatnonzero(per_pose > limit)
     outliers = [
-        {"line": int(data.lines[i]), "chi2": float(per_pose[i]), "limit": float(limit), "rms_sigma": float(np.sqrt(per_pose[i] / k))}
+        {
+            "line": int(data.lines[i]),
+            "chi2": float(per_pose[i]),
+            "limit": float(limit),
+            "rms_sigma": float(np.sqrt(per_pose[i] / k)),
+        }
         for i in bad
     ]
     inlier = np.ones(problem.n, bool)
@@ -226,6 +234,7 @@ def identify(nominal: Platform, data: Measurements, noise: Noise = Noise(), conv
         nfev=int(first.nfev + second.nfev),
         rms_sigma_before=float(np.sqrt(np.mean(r0**2))),
         rms_sigma_after=rms_after,
+        pose_rms_before=np.sqrt(np.mean(r0.reshape(problem.n, -1) ** 2, axis=1)),
         pose_rms_after=np.sqrt(per_pose / k),
         lines=data.lines,
         outliers=outliers,

@@ -140,7 +140,9 @@ def read_measurements(
     if all(_is_number(h) for h in header):
         raise CalibrationError(CalibrationError.NO_HEADER.format(path=shown, need=need, row=",".join(head)[:80]))
     if found is not None and found != kind:
-        raise CalibrationError(CalibrationError.TYPE.format(path=shown, kind=kind, found=found, header=",".join(header)))
+        raise CalibrationError(
+            CalibrationError.TYPE.format(path=shown, kind=kind, found=found, header=",".join(header))
+        )
     n_targets = 0
     if kind == "points":
         tk = [h for h in header if _TARGET.match(h)]
@@ -174,7 +176,9 @@ def read_measurements(
     values = np.empty((len(body), len(header)))
     for r, (line, row) in enumerate(body):
         if len(row) != len(header):
-            raise CalibrationError(CalibrationError.WIDTH.format(path=shown, line=line, expected=len(header), got=len(row)))
+            raise CalibrationError(
+                CalibrationError.WIDTH.format(path=shown, line=line, expected=len(header), got=len(row))
+            )
         for c, cell in enumerate(row):
             try:
                 v = float(cell)
@@ -230,7 +234,10 @@ def _check_readings(readings, platform: Platform, lines, shown: str, unit: str) 
     r, leg = bad[0]
     hint = ""
     for guess, factor in (("mm", 1e-3), ("m", 1e3)):
-        if guess != unit and np.all((platform.lengths_from_readings(readings * factor) >= lo) & (platform.lengths_from_readings(readings * factor) <= hi)):
+        if guess != unit and np.all(
+            (platform.lengths_from_readings(readings * factor) >= lo)
+            & (platform.lengths_from_readings(readings * factor) <= hi)
+        ):
             hint = CalibrationError.UNIT_HINT.format(guess=guess)
     shown_value = readings[r, leg] / length_scale(unit)
     raise CalibrationError(
@@ -257,7 +264,13 @@ def _check_angles(angles, names, lines, shown: str, unit: str) -> None:
         hint = CalibrationError.ANGLE_HINT if unit == "rad" and np.all(np.abs(angles) <= 180) else ""
         raise CalibrationError(
             CalibrationError.ANGLE.format(
-                path=shown, line=lines[r], column=names[c], value=f"{angles[r, c]:g}", unit=unit, limit=f"{limit:g}", hint=hint
+                path=shown,
+                line=lines[r],
+                column=names[c],
+                value=f"{angles[r, c]:g}",
+                unit=unit,
+                limit=f"{limit:g}",
+                hint=hint,
             )
         )
 

@@ -144,9 +144,7 @@ class Layout:
         B, T, o, _ = self.split(theta)
         _, leg_joint = self.base
         legs = type(self.nominal.legs)(**{**vars(self.nominal.legs), "length_offset": [float(v) for v in o]})
-        return self.nominal.replace(
-            base_anchors=B[leg_joint], top_anchors=T, legs=legs, name=name or self.nominal.name
-        )
+        return self.nominal.replace(base_anchors=B[leg_joint], top_anchors=T, legs=legs, name=name or self.nominal.name)
 
     def rows(self, n_targets: int | None = None) -> int:
         """Residual rows per pose."""

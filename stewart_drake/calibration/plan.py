@@ -47,7 +47,7 @@ class Box:
     @classmethod
     def default(cls, platform: Platform) -> Box:
         span = platform.L_max - platform.L_min
-        return cls(0.25 * span, 0.25 * span, 0.2 * span, np.radians(10.0))
+        return cls(0.3 * span, 0.3 * span, 0.2 * span, np.radians(20.0))
 
     def to_dict(self) -> dict:
         return {"x_m": self.x, "y_m": self.y, "z_m": self.z, "rotation_rad": self.rotation}
@@ -71,7 +71,10 @@ class PlanResult:
     def to_dict(self) -> dict:
         def idx(i: Identifiability) -> dict:
             d = i.to_dict()
-            return {k: d[k] for k in ("d_index", "noise_amplification_index", "condition_number", "identifiable", "unidentifiable")}
+            return {
+                k: d[k]
+                for k in ("d_index", "noise_amplification_index", "condition_number", "identifiable", "unidentifiable")
+            }
 
         return {
             "platform": self.platform,

@@ -25,13 +25,20 @@ def register(sub) -> None:
         "confirmed by a Drake MathematicalProgram).",
     )
     add_platform_arg(p)
-    p.add_argument(
+    given = p.add_mutually_exclusive_group(required=True)
+    given.add_argument(
         "--lengths",
         nargs=6,
         type=float,
-        required=True,
         metavar=("L1", "L2", "L3", "L4", "L5", "L6"),
-        help="leg lengths in --length-unit",
+        help="leg lengths (joint to joint) in --length-unit",
+    )
+    given.add_argument(
+        "--readings",
+        nargs=6,
+        type=float,
+        metavar=("R1", "R2", "R3", "R4", "R5", "R6"),
+        help="leg sensor readings in --length-unit: lengths = readings + the platform's legs.length_offset",
     )
     add_unit_args(p)
     p.add_argument("--all", action="store_true", help="every assembly mode, not just one")
@@ -130,11 +137,16 @@ def _homotopy_all(platform, L, args, k: float) -> dict:
 
 
 def run(args) -> int:
-    for i, v in enumerate(args.lengths, 1):
-        if not v > 0:
-            raise UsageError(f"--lengths: leg {i} length {v} {args.length_unit} must be a positive number")
     platform = platform_from_args(args)
     k = length_scale(args.length_unit)
+    if args.readings is not None:
+        check_finite(args.readings, "--readings")
+        lengths = platform.lengths_from_readings(np.asarray(args.readings, dtype=float) * k) / k
+        args.lengths = [float(v) for v in lengths]
+    for i, v in enumerate(args.lengths, 1):
+        if not v > 0:
+            given = "" if args.readings is None else f" (reading {args.readings[i - 1]} + offset)"
+            raise UsageError(f"--lengths: leg {i} length {v}{given} {args.length_unit} must be a positive number")
     check_finite(args.lengths, "--lengths")
     check_positive(args.tol, "--tol", "metres")
     if args.max_iter < 1:
@@ -150,7 +162,8 @@ def run(args) -> int:
     L = np.asarray(args.lengths, dtype=float) * k
     out = {
         "platform": platform.name,
-        "lengths": list(args.lengths),
+        "lengths": [float(v) for v in args.lengths],
+        **({"readings": list(args.readings)} if args.readings is not None else {}),
         "length_unit": args.length_unit,
         "angle_unit": args.angle_unit,
         "convention": args.convention,

@@ -79,10 +79,12 @@ def run(args) -> int:
     if args.json:
         rows = raw.tolist()
         lengths = Lu.tolist()
+        readings = (platform.readings(L) / k).tolist() if np.any(platform.length_offset) else None
         results = [
             {
                 "pose": rows[i],
                 "lengths": lengths[i],
+                **({"readings": readings[i]} if readings is not None else {}),
                 "length_unit": args.length_unit,
                 "within_stroke": bool(within[i]),
                 "above_base": bool(above[i]),
