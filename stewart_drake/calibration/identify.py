@@ -30,6 +30,7 @@ from stewart_drake.calibration.model import (
 )
 from stewart_drake.calibration.validate import validation_errors
 from stewart_drake.core.geometry import Platform
+from stewart_drake.errors import ForwardKinematicsError, GeometryError
 
 HUBER_SIGMAS = 3.0
 MAX_NFEV = 200  # evaluations per pass; Gauss–Newton converges in a handful from ~1 mm errors
@@ -218,7 +219,14 @@ def identify(
             f"residuals {inlier_ratio:.3g} times the stated noise after the fit ({len(bad)} of {problem.n} poses "
             "outlying): the model does not explain the data (wrong --type, units, convention or noise?)"
         )
-    calibrated = layout.platform(theta, name=f"{nominal.name}-calibrated")
+    try:
+        calibrated = layout.platform(theta, name=f"{nominal.name}-calibrated")
+        fit_after = validation_errors(calibrated, layout.split(theta)[3], data, convention)
+    except (GeometryError, ForwardKinematicsError) as e:  # the fit wandered off to no platform at all
+        calibrated, fit_after = nominal, {}
+        if converged:
+            message = f"the fitted geometry is not a usable platform ({e})"
+        converged = False
     result = CalibrationResult(
         nominal=nominal,
         calibrated=calibrated,
@@ -242,5 +250,5 @@ def identify(
         sha256=data.sha256,
     )
     result.fit_before = validation_errors(nominal, targets0, data, convention)
-    result.fit_after = validation_errors(calibrated, result.targets, data, convention)
+    result.fit_after = fit_after
     return result

@@ -199,7 +199,8 @@ def read_measurements(
     weights = col.get("w", np.ones(len(body)))
     bad = np.flatnonzero(~(weights > 0))
     if bad.size:
-        raise CalibrationError(CalibrationError.WEIGHT.format(path=shown, line=lines[bad[0]], value=weights[bad[0]]))
+        cell = body[bad[0]][1][header.index("w")].strip()
+        raise CalibrationError(CalibrationError.WEIGHT.format(path=shown, line=lines[bad[0]], value=cell))
     poses = targets = tilts = None
     if kind == "pose":
         poses = np.stack([col[c] for c in POSE], axis=1)
