@@ -839,7 +839,15 @@ class CalibrationError(InputError):
     HOLDOUT = "--holdout {value}: give a fraction in (0, 0.5] of the poses to hold out for validation"
     HOLDOUT_TOO_FEW = "--holdout {value}: holding out {held} of {n} poses leaves {left}, fewer than the {need} needed"
     POSES = "--poses {value}: give between {lo} and {hi} poses"
-    CANDIDATES = "platform {name!r}: only {got} candidate poses of {want} drawn lie within stroke, above the base and away from singularities in {box}"
+    CANDIDATES = (
+        "platform {name!r}: only {got} of {want} candidate poses drawn in {box} lie within the stroke, above the "
+        "base and away from singularities; give a smaller --workspace or more --candidates"
+    )
+    PLAN_TOO_FEW = (
+        "--poses {value}: a {kind} measurement needs at least {need} poses on platform {name!r} ({unknowns} unknowns, "
+        "{per} equations per pose)"
+    )
+    POSE_STROKE = "{path}:{line}: leg {leg} length {length:.6g} m lies outside the stroke [{lmin:g}, {lmax:g}] m"
     WORKSPACE = "--workspace {value}: give six numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
     PLAN_TYPE = "{path}: a measurement plan needs the columns px,py,pz,a,b,g (a plan-measurements poses.csv); {problem}"
 

@@ -31,6 +31,7 @@ from stewart_drake.calibration.model import Layout
 
 RANK_TOL = 1e-7
 FRAME_TOL = 1e-6  # a frame motion this invisible (relative to s_1) is a freedom of the data
+PIVOT_TOL = 1e-3  # a parameter that moves a null direction less than this (relative) is not fixed for it
 NAME_TOL = 0.05  # a coefficient below this (of the combination's largest) is not named
 
 
@@ -107,15 +108,28 @@ def analyse(layout: Layout, J: np.ndarray, theta) -> Identifiability:
 
 
 def _pivots(N: np.ndarray) -> list[int]:
-    """Greedy: parameters (in θ order) whose rows of the null basis ``N`` raise its rank, until full."""
+    """Rows of the null basis ``N`` ``(P, d)`` to fix: greedily in θ order, a row whose part outside the span
+    of the rows already chosen is at least ``PIVOT_TOL`` of the largest such part (Gram–Schmidt on the rows);
+    if the order leaves directions uncovered, the rows with the largest remaining parts complete the set."""
     d = N.shape[1]
+    R = N.astype(float).copy()
     chosen: list[int] = []
+
+    def take(i):
+        q = R[i] / np.linalg.norm(R[i])
+        R[:] -= np.outer(R @ q, q)
+        chosen.append(i)
+
     for i in range(N.shape[0]):
         if len(chosen) == d:
             break
-        trial = N[chosen + [i]]
-        if np.linalg.matrix_rank(trial, tol=1e-6) > len(chosen):
-            chosen.append(i)
+        norms = np.linalg.norm(R, axis=1)
+        if norms[i] > PIVOT_TOL * norms.max():
+            take(i)
+    while len(chosen) < d:
+        norms = np.linalg.norm(R, axis=1)
+        norms[chosen] = -1.0
+        take(int(np.argmax(norms)))
     return chosen
 
 

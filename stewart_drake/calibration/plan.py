@@ -52,6 +52,13 @@ class Box:
     def to_dict(self) -> dict:
         return {"x_m": self.x, "y_m": self.y, "z_m": self.z, "rotation_rad": self.rotation}
 
+    def describe(self) -> str:
+        """The box in words: ``±0.12 m x, ±0.12 m y, ±0.08 m z, ±20° per angle about home``."""
+        return (
+            f"±{self.x:.4g} m x, ±{self.y:.4g} m y, ±{self.z:.4g} m z, ±{np.degrees(self.rotation):.4g}° per angle "
+            "about home"
+        )
+
 
 @dataclass
 class PlanResult:
@@ -186,7 +193,7 @@ def plan_measurements(
     cand = candidate_poses(platform, box, candidates, seed, convention)
     if len(cand) < max(2 * n, 50):
         raise CalibrationError(
-            CalibrationError.CANDIDATES.format(name=platform.name, got=len(cand), want=candidates, box=box.to_dict())
+            CalibrationError.CANDIDATES.format(name=platform.name, got=len(cand), want=candidates, box=box.describe())
         )
     layout, problem, theta = design_problem(platform, cand, kind, noise, convention, n_targets)
     A = reduced_blocks(*pose_blocks(problem, theta)) * noise.length

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.calibration.identify import min_poses
 from stewart_drake.calibration.measurements import TYPES
+from stewart_drake.calibration.model import Layout
 from stewart_drake.calibration.noise import parse_noise
 from stewart_drake.calibration.plan import MAX_POSES, Box, plan_measurements, stw_program
 from stewart_drake.commands._common import (
@@ -65,6 +67,18 @@ def run(args) -> int:
         )
     if not 1 <= args.targets <= 8:
         raise CalibrationError(f"--targets {args.targets}: give 1 to 8 targets")
+    layout = Layout(platform, args.type, args.targets if args.type == "points" else 0)
+    if args.poses < min_poses(layout):
+        raise CalibrationError(
+            CalibrationError.PLAN_TOO_FEW.format(
+                value=args.poses,
+                kind=args.type,
+                need=min_poses(layout),
+                name=platform.name,
+                unknowns=f"{layout.size} + {layout.nuisance} per pose" if layout.nuisance else layout.size,
+                per=layout.rows(),
+            )
+        )
     box = None
     if args.workspace is not None:
         x, y, z, rot = args.workspace

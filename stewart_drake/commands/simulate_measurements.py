@@ -4,6 +4,8 @@ apart, for checking a calibration."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from stewart_drake.calibration.export import platform_yaml
 from stewart_drake.calibration.measurements import TYPES, measurements_csv
 from stewart_drake.calibration.noise import parse_noise
@@ -17,6 +19,7 @@ from stewart_drake.commands._common import (
 )
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.jsonout import dumps_strict
+from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS, pose_to_si
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.errors import CalibrationError
@@ -71,6 +74,15 @@ def run(args) -> int:
         raise CalibrationError(f"{args.poses}: more than {MAX_POSES} poses")
     q = pose_to_si(raw, args.length_unit, args.angle_unit)
     check_poses(platform, q, args.convention, what=f"{args.poses}: pose", lines=lines)
+    L = leg_lengths(platform, q, args.convention)
+    bad = np.argwhere((L < platform.L_min) | (L > platform.L_max))
+    if bad.size:
+        r, leg = bad[0]
+        raise CalibrationError(
+            CalibrationError.POSE_STROKE.format(
+                path=args.poses, line=lines[r], leg=leg + 1, length=L[r, leg], lmin=platform.L_min, lmax=platform.L_max
+            )
+        )
     data, truth = simulate_measurements(
         platform, spec.laws, q, args.type, noise, args.seed, args.convention, args.targets
     )
