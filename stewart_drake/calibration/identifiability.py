@@ -86,8 +86,10 @@ def stacked(A: np.ndarray, noise_length: float) -> np.ndarray:
     return A.reshape(-1, A.shape[-1]) * noise_length
 
 
-def analyse(layout: Layout, J: np.ndarray, theta) -> Identifiability:
-    """Identifiability of θ from the scaled Jacobian ``J`` ``(m, P)`` at ``theta`` (see the module docstring)."""
+def analyse(layout: Layout, J: np.ndarray, theta, fixed: list[int] | None = None) -> Identifiability:
+    """Identifiability of θ from the scaled Jacobian ``J`` ``(m, P)`` at ``theta`` (see the module docstring).
+    ``fixed``: keep these parameters fixed (the convention chosen at the start of a fit) instead of choosing
+    again, when they still fix every null direction."""
     names = layout.names
     P = J.shape[1]
     _, s, Vt = np.linalg.svd(J, full_matrices=J.shape[0] < P)
@@ -95,7 +97,8 @@ def analyse(layout: Layout, J: np.ndarray, theta) -> Identifiability:
     s_full[: s.size] = s
     null_mask = s_full <= RANK_TOL * s_full[0]
     N = Vt[null_mask].T  # (P, d)
-    fixed = _pivots(N)
+    if fixed is None or len(fixed) != N.shape[1] or np.linalg.matrix_rank(N[fixed]) < N.shape[1]:
+        fixed = _pivots(N)
     free = np.ones(P, bool)
     free[fixed] = False
     if fixed:

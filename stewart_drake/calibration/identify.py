@@ -188,7 +188,8 @@ def identify(
     # covariance of θ at the solution, poses' unknowns eliminated
     Jg, Jn = pose_blocks(problem, theta, xi)
     A = reduced_blocks(Jg, Jn)
-    ident = analyse(layout, stacked(A, noise.length), theta)
+    ident = analyse(layout, stacked(A, noise.length), theta, fixed=ident0.fixed)
+    free = ident.free
     Af = A[:, :, free].reshape(-1, free.sum())
     cov = np.linalg.pinv(Af.T @ Af)
     sigma = np.zeros(layout.size)

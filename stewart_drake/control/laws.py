@@ -42,6 +42,7 @@ class FloatLaw:
         self.config = config or ControllerConfig.for_platform(platform)
         self.timing = self.config.timing.check()
         self._limit = self.timing.command_range
+        self._offset = platform.length_offset  # (6,) m: joint-to-joint length = reading + offset
         self._cache: dict[bytes, np.ndarray] = {}
         # (6,) metres added to every set-point (None: nothing). A probe, not a feature: a constant offset
         # from t = 0 is a set-point step on the legs, whose length response measures the loop's gain from
@@ -72,8 +73,8 @@ class FloatLaw:
         """PID state holding ``lengths`` (m) with integrator ``forces`` (N), legs moving at ``rates`` (m/s)."""
         lengths = np.asarray(lengths, float)
         d = np.zeros(6) if rates is None else np.asarray(rates, float) * self.timing.sample_period
-        m = self.quantise(lengths - d) + self.platform.length_offset
-        L = lengths + self.platform.length_offset
+        m = self.quantise(lengths - d) + self._offset
+        L = lengths + self._offset
         return np.concatenate([np.clip(forces, -self._limit, self._limit), m, d, L - d, d])
 
     def command_from_integrator(self, integ, ff=None):
@@ -87,7 +88,7 @@ class FloatLaw:
         feed-forward ``feedforward`` (6,) N (None: none)."""
         g, T, lim = self.config.gains, self.timing.sample_period, self._limit
         sp = self.setpoints(reference)
-        m = self.quantise(measured) + self.platform.length_offset  # readings -> joint-to-joint lengths
+        m = self.quantise(measured) + self._offset  # readings -> joint-to-joint lengths
         integ, prev, dfilt, sp_prev, vfilt = np.split(np.asarray(state, dtype=float), 5)
         e = sp - m
         dfilt = dfilt + g.derivative_filter * ((m - prev) - dfilt)
