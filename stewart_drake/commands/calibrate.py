@@ -183,7 +183,7 @@ def run(args) -> int:
         raise CalibrationError("--platform: give the nominal platform (a preset or a YAML file)")
     result, d = calibrate(args)
     if not result.converged:
-        print(_summary(d, result))
+        print_json(d) if args.json else print(_summary(d, result))
         raise CalibrationLimitError(f"the identification did not converge: {result.message}; nothing written")
     rec = record(result)
     header = (

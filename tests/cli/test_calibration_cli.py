@@ -144,3 +144,19 @@ def test_an_identification_that_does_not_converge_exits_1(flow, capsys, tmp_path
 def test_simulate_measurements_refuses_keys_that_are_not_geometric(capsys, tmp_path, flow):
     rc, _, err = cli(capsys, "simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--errors", "payload_mass=±10%", "--out", tmp_path / "o")  # fmt: skip
     assert rc == 2 and "--errors: key 'payload_mass' is not a geometric error (keys: anchor, leg_offset)" in err
+
+
+def test_the_calibration_commands_run_without_pydrake(flow, tmp_path):
+    """plan-measurements, simulate-measurements and calibrate are numpy commands: with pydrake unimportable
+    they run, and only their own command module is loaded."""
+    from tests.cli.test_cli_lazy import run_blocked
+
+    for argv, module in (
+        (["plan-measurements", "--platform", "utn-dynamic", "--poses", "8", "--candidates", "200", "--out", tmp_path / "p", "--json"], "plan_measurements"),
+        (["simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--out", tmp_path / "m", "--json"], "simulate_measurements"),
+        (["calibrate", "--platform", "utn-dynamic", "--measurements", tmp_path / "m" / "measurements.csv", "--no-plots", "--out", tmp_path / "c", "--json"], "calibrate"),
+    ):  # fmt: skip
+        status, out, err = run_blocked(*map(str, argv))
+        assert status["rc"] == 0 and not status["pydrake"], err
+        assert status["commands"] == [f"stewart_drake.commands.{module}"]
+        json.loads(out)
