@@ -17,13 +17,13 @@ def plot_calibration(result: CalibrationResult, folder: Path) -> list[str]:
     before = result.pose_rms_before
     after = result.pose_rms_after
     fig, ax = plt.subplots(figsize=(8, 3.5))
-    x = np.arange(1, len(after) + 1)
+    x = np.asarray(result.lines)
     ax.semilogy(x, before, "o-", label="nominal model", color="tab:red")
     ax.semilogy(x, after, "o-", label="calibrated model", color="tab:blue")
     for o in result.outliers:
-        k = int(np.flatnonzero(result.lines == o["line"])[0])
+        k = int(np.flatnonzero(x == o["line"])[0])
         ax.annotate(f"line {o['line']}", (x[k], after[k]), fontsize=7)
-    ax.set_xlabel("pose (fitted)")
+    ax.set_xlabel("pose (its line in the measurement file)")
     ax.set_ylabel("residual RMS, in σ of the stated noise")
     ax.set_title(f"{result.nominal.name}: residuals per pose ({result.layout.kind} data)", fontsize=9)
     ax.legend(fontsize=8)
@@ -38,7 +38,8 @@ def plot_calibration(result: CalibrationResult, folder: Path) -> list[str]:
     idx = np.arange(len(names))
     fixed = ~result.identifiability.free
     ax.bar(idx[~fixed], corr[~fixed], yerr=2 * sig[~fixed], color="tab:blue", capsize=2, label="correction ± 2σ")
-    ax.bar(idx[fixed], corr[fixed], color="lightgray", label="fixed by convention")
+    if fixed.any():
+        ax.bar(idx[fixed], corr[fixed] + 0.0, color="lightgray", edgecolor="gray", label="fixed by convention (0)")
     ax.set_xticks(idx, names, rotation=90, fontsize=6)
     ax.set_ylabel("µm")
     ax.set_title("identified corrections to the nominal geometry", fontsize=9)

@@ -15,7 +15,6 @@ from stewart_drake.calibration.noise import parse_noise
 from stewart_drake.calibration.validate import validation_errors
 from stewart_drake.commands._common import (
     add_force_arg,
-    add_platform_arg,
     output_folder,
     platform_from_args,
     print_json,
@@ -36,7 +35,9 @@ def register(sub) -> None:
         "on measured poses; the data's unidentifiable combinations are named and held at nominal; σ per parameter "
         "from the stated noise; validation on held-out poses. See docs/calibration.md.",
     )
-    add_platform_arg(p, default=None)
+    p.add_argument(
+        "--platform", required=True, metavar="NAME|FILE", help="the nominal platform: a preset or a platform YAML file"
+    )
     p.add_argument("--measurements", required=True, metavar="M.csv", help="measurement CSV (header: l1..l6 and ...)")
     p.add_argument("--type", choices=TYPES, default=None, help="measurement kind (default: from the header)")
     g = p.add_mutually_exclusive_group()
@@ -179,8 +180,6 @@ def _fmt(s: dict, key: str = "rms") -> str:
 
 def run(args) -> int:
     out = output_folder(args)
-    if args.platform is None:
-        raise CalibrationError("--platform: give the nominal platform (a preset or a YAML file)")
     result, d = calibrate(args)
     if not result.converged:
         print_json(d) if args.json else print(_summary(d, result))
