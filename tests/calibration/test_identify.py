@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.calibration.identify import identify
-from stewart_drake.calibration.model import make_problem, pose_blocks, reduced_blocks
+from stewart_drake.calibration.montecarlo import sigma_monte_carlo
 from stewart_drake.calibration.plan import Box, candidate_poses, plan_measurements
 from stewart_drake.calibration.simulate import simulate_measurements
 from stewart_drake.calibration.validate import truth_errors
@@ -47,29 +47,12 @@ def test_sigma_matches_the_monte_carlo_spread():
     nominal = load_preset("utn-dynamic")
     plan = plan_measurements(nominal, 30, "pose", noise=NOISE, seed=0, candidates=400)
     _, truth = simulate_measurements(nominal, ERRORS, plan.poses, "pose", NOISE, seed=1)
-    N = 40
-    thetas, sigma = [], None
-    for k in range(N):
-        data, _ = simulate_measurements(nominal, {}, plan.poses, "pose", NOISE, seed=100 + k, truth=truth.platform)
-        res = identify(nominal, data, NOISE)
-        assert res.converged
-        thetas.append(res.theta)
-        if sigma is None:
-            sigma = res.sigma
-    T = np.array(thetas)
-    mc = T.std(axis=0, ddof=1)
-    ratio = mc / sigma
-    se = 1 / np.sqrt(2 * (N - 1))
-    assert abs(ratio.mean() - 1) < 0.2, ratio
-    assert np.abs(ratio - 1).max() < 4.5 * se, ratio
-    # Mahalanobis with the information (the inverse covariance) at the fits' mean
-    problem = make_problem(res.layout, data, NOISE)
-    A = reduced_blocks(*pose_blocks(problem, T.mean(0))).reshape(-1, T.shape[1])
-    info = A.T @ A
-    D = T - T.mean(0)
-    m = np.einsum("ki,ij,kj->k", D, info, D).mean()
-    p = T.shape[1]
-    assert abs(m / (p * (N - 1) / N) - 1) < 4 * np.sqrt(2 / (p * N)), m
+    mc = sigma_monte_carlo(nominal, truth.platform, plan.poses, "pose", NOISE, draws=40, seed=100)
+    d = mc.to_dict()
+    assert mc.converged == 40 and len(mc.ratio) == 33
+    assert abs(d["mean_ratio"] - 1) < 0.2, d
+    assert d["max_abs_deviation"] < 4.5 * mc.standard_error, d
+    assert abs(d["mahalanobis_ratio"] - 1) < 4 * d["mahalanobis_standard_error"], d
 
 
 def test_an_outlier_is_named_by_its_line_and_discounted():
