@@ -677,6 +677,12 @@ class SimulationError(StewartError):
 class FirmwareError(StewartError):
     """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
 
+    SENSOR_GAINS = (
+        "platform {name!r}: legs.length_gain {gains} is not 1: the controller's sensor path (the firmware, its "
+        "emulation, the simulated sensor) adds legs.length_offset but has no gain; calibrate without --gains, or "
+        "scale the sensors' resolution"
+    )
+
     POSES = "--poses must be an integer in 1..{limit}, got {value!r}"
     DURATION = "--duration must be in (0, 60] s, got {value!r}"
     NO_IK = "{path}: defines no sd_ik (the firmware ABI: int sd_ik(const sd_word pose[6], sd_word lengths[6]))"

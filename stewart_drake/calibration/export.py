@@ -33,6 +33,10 @@ def platform_document(platform: Platform, calibration: CalibrationRecord | None 
     I = platform.inertia
     legs = {k: v for k, v in dataclasses.asdict(platform.legs).items() if v is not None}
     legs["length_offset"] = _floats(platform.length_offset)
+    if platform.has_sensor_gains:
+        legs["length_gain"] = _floats(platform.length_gain)
+    else:
+        legs.pop("length_gain", None)
     doc = {
         "name": platform.name,
         "description": platform.description,

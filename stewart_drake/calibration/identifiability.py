@@ -77,7 +77,7 @@ class Identifiability:
             "unidentifiable_combinations": self.combinations,
             "fixed_by_convention": [self.names[i] for i in self.fixed],
             "convention": "each unidentifiable combination is fixed by holding one parameter at its nominal value, "
-            "chosen in the order base joints, plate joints, offsets, targets",
+            "chosen in the order base joints, plate joints, offsets, gains, targets",
         }
 
 
@@ -164,7 +164,7 @@ def frame_generators(layout: Layout, theta) -> dict[str, np.ndarray]:
                     dS[:] = e if motion == "translation" else np.cross(e, S - c)
                 word = "along" if motion == "translation" else "about"
                 out[f"{frame} frame {motion} {word} {axis}"] = np.concatenate(
-                    [dB.ravel(), dT.ravel(), np.zeros(6), dS.ravel()]
+                    [dB.ravel(), dT.ravel(), np.zeros(6 + 6 * layout.gains), dS.ravel()]
                 )
     return out
 

@@ -102,13 +102,16 @@ class CalibrationResult:
             "parameters": [
                 {
                     "name": n,
-                    "nominal_m": float(a),
-                    "identified_m": float(b),
-                    "correction_m": float(b - a),
-                    "sigma_m": float(s),
+                    "unit": "m" if k == 1.0 else "1",
+                    "nominal": float(a * k + (k != 1.0)),
+                    "identified": float(b * k + (k != 1.0)),
+                    "correction": float((b - a) * k),
+                    "sigma": float(s * k),
                     "fixed": i in fixed,
                 }
-                for i, (n, a, b, s) in enumerate(zip(names, self.theta0, self.theta, self.sigma))
+                for i, (n, a, b, s, k) in enumerate(
+                    zip(names, self.theta0, self.theta, self.sigma, self.layout.scales())
+                )
             ],
             "outliers": self.outliers,
             "pose_rms_sigma": [{"line": int(ln), "rms": float(r)} for ln, r in zip(self.lines, self.pose_rms_after)],
@@ -146,12 +149,13 @@ def _jacobian(problem: Problem, theta, xi, free) -> np.ndarray:
 
 
 def identify(
-    nominal: Platform, data: Measurements, noise: Noise = Noise(), convention: str = "utn"
+    nominal: Platform, data: Measurements, noise: Noise = Noise(), convention: str = "utn", gains: bool = False
 ) -> CalibrationResult:
     """Identify the geometry of the machine that produced ``data`` (see the module docstring). Returns a
     ``CalibrationResult`` whose ``converged`` is False (with the reason in ``message``) when the solver
-    stopped short or the fit leaves residuals far above the stated noise."""
-    layout = Layout(nominal, data.kind, data.n_targets)
+    stopped short or the fit leaves residuals far above the stated noise. ``gains``: identify each sensor's
+    gain too (48 parameters on a 6-6)."""
+    layout = Layout(nominal, data.kind, data.n_targets, gains)
     problem = make_problem(layout, data, noise, convention)
     targets0 = initial_targets(problem) if data.kind == "points" else None
     theta0 = layout.theta(nominal, targets0)

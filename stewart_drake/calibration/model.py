@@ -4,7 +4,9 @@ Geometric parameters θ (metres), in this order (``Layout.names``):
 
 - each physical base joint p_BBj (3 each: legs that share a joint on a 6-3 platform keep sharing it);
 - each plate joint p_TTj (3 each: the three shared joints of a 3-6 platform stay three);
-- each leg sensor's zero offset o_i (6): joint-to-joint length L_i = reading_i + o_i;
+- each leg sensor's zero offset o_i (6): joint-to-joint length L_i = g_i × reading_i + o_i;
+- optionally (``gains``) each sensor's gain g_i, as (g_i − 1) × L_ref (6, metres: the length error the gain
+  makes at the mid-stroke reading L_ref, so that θ holds lengths only);
 - for ``points`` data, each target's plate-frame position p_TSk (3 each).
 
 Per-pose nuisance ξ_k (``points`` and ``inclinometer`` only, where the pose is not measured): the pose as
@@ -85,6 +87,7 @@ class Layout:
     nominal: Platform
     kind: str
     n_targets: int = 0
+    gains: bool = False
 
     @property
     def base(self) -> tuple[np.ndarray, np.ndarray]:
@@ -101,14 +104,20 @@ class Layout:
 
     @property
     def size(self) -> int:
-        """The number of geometric parameters (42 on a 6-6 without targets; 33 on a 3-6)."""
-        return 3 * self.n_base + 3 * self.n_top + 6 + 3 * self.n_targets
+        """The number of geometric parameters (42 on a 6-6 without targets and gains; 33 on a 3-6)."""
+        return 3 * self.n_base + 3 * self.n_top + 6 + 6 * self.gains + 3 * self.n_targets
+
+    @property
+    def reference_length(self) -> float:
+        """L_ref (m): the mid-stroke length that scales the gain parameters."""
+        return float(self.nominal.stroke.mean())
 
     @property
     def names(self) -> tuple[str, ...]:
         out = [f"base joint {j + 1} {a}" for j in range(self.n_base) for a in AXES]
         out += [f"plate joint {j + 1} {a}" for j in range(self.n_top) for a in AXES]
         out += [f"leg {i + 1} offset" for i in range(6)]
+        out += [f"leg {i + 1} gain" for i in range(6) if self.gains]
         out += [f"target {k + 1} {a}" for k in range(self.n_targets) for a in AXES]
         return tuple(out)
 
@@ -122,6 +131,8 @@ class Layout:
         target positions (m) for ``points``."""
         first, _ = self.base
         parts = [platform.base_anchors[first].ravel(), platform.top_anchors.ravel(), platform.length_offset]
+        if self.gains:
+            parts.append((platform.length_gain - 1.0) * self.reference_length)
         if self.n_targets:
             parts.append(np.asarray(targets, dtype=float).reshape(self.n_targets * 3))
         return np.concatenate(parts)
@@ -132,21 +143,41 @@ class Layout:
         theta = np.asarray(theta, dtype=float)
         lead = theta.shape[:-1]
         a, b = 3 * self.n_base, 3 * self.n_base + 3 * self.n_top
+        c = b + 6 + 6 * self.gains
         return (
             theta[..., :a].reshape(lead + (self.n_base, 3)),
             theta[..., a:b].reshape(lead + (self.n_top, 3)),
             theta[..., b : b + 6],
-            theta[..., b + 6 :].reshape(lead + (self.n_targets, 3)),
+            theta[..., c:].reshape(lead + (self.n_targets, 3)),
         )
+
+    def gain(self, theta) -> np.ndarray:
+        """``(..., 6)`` the sensor gains g_i of ``(..., P)`` θ (ones without ``gains``: the nominal's)."""
+        theta = np.asarray(theta, dtype=float)
+        if not self.gains:
+            return np.broadcast_to(self.nominal.length_gain, theta.shape[:-1] + (6,))
+        b = 3 * self.n_base + 3 * self.n_top + 6
+        return 1.0 + theta[..., b : b + 6] / self.reference_length
+
+    def scales(self) -> np.ndarray:
+        """``(P,)`` what one unit of each parameter is: 1 (metres) or, for a gain, 1 / L_ref per metre."""
+        out = np.ones(self.size)
+        if self.gains:
+            b = 3 * self.n_base + 3 * self.n_top + 6
+            out[b : b + 6] = 1.0 / self.reference_length
+        return out
 
     def platform(self, theta, name: str | None = None) -> Platform:
         """The nominal platform with the geometry θ: joints moved (shared joints together), offsets set."""
         B, T, o, _ = self.split(theta)
         _, leg_joint = self.base
-        legs = type(self.nominal.legs)(**{**vars(self.nominal.legs), "length_offset": [float(v) for v in o]})
+        changes = {"length_offset": [float(v) for v in o]}
+        if self.gains:
+            changes["length_gain"] = [float(v) for v in self.gain(theta)]
+        legs = type(self.nominal.legs)(**{**vars(self.nominal.legs), **changes})
         return self.nominal.replace(base_anchors=B[leg_joint], top_anchors=T, legs=legs, name=name or self.nominal.name)
 
-    def rows(self, n_targets: int | None = None) -> int:
+    def rows(self) -> int:
         """Residual rows per pose."""
         return {"pose": 6, "points": 6 + 3 * self.n_targets, "inclinometer": 8}[self.kind]
 
@@ -228,7 +259,7 @@ def pose_residuals(problem: Problem, theta, xi=None) -> np.ndarray:
     t_leg = T[..., lay.nominal.leg_top, :] - c  # (..., 6, 3)
     l = p[..., None, :] + np.einsum("...nij,...kj->...nki", R, t_leg) - B[..., None, leg_joint, :]
     L = np.linalg.norm(l, axis=-1)
-    e_leg = L - (d.readings + o[..., None, :])
+    e_leg = L - (d.readings * lay.gain(theta)[..., None, :] + o[..., None, :])
     sw = np.sqrt(d.weights)[:, None]
     if lay.kind == "pose":
         return np.einsum("nij,...nj->...ni", problem.whiten, e_leg) * sw

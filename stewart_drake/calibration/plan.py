@@ -114,7 +114,9 @@ def candidate_poses(platform: Platform, box: Box, count: int, seed: int, convent
     return q[ok]
 
 
-def design_problem(platform: Platform, poses, kind: str, noise: Noise, convention: str = "utn", n_targets: int = 3):
+def design_problem(
+    platform: Platform, poses, kind: str, noise: Noise, convention: str = "utn", n_targets: int = 3, gains: bool = False
+):
     """``(layout, problem)`` of noise-free measurements of the nominal at ``poses`` (for the design)."""
     q = np.asarray(poses, dtype=float)
     K = n_targets if kind == "points" else 0
@@ -130,7 +132,7 @@ def design_problem(platform: Platform, poses, kind: str, noise: Noise, conventio
         np.ones(n),
         np.arange(2, n + 2),
     )
-    layout = Layout(platform, kind, K)
+    layout = Layout(platform, kind, K, gains)
     if kind == "pose":
         problem = make_problem(layout, data, noise, convention)
     else:
@@ -186,6 +188,7 @@ def plan_measurements(
     convention: str = "utn",
     candidates: int = CANDIDATES,
     n_targets: int = 3,
+    gains: bool = False,
 ) -> PlanResult:
     """Plan ``n`` measurement poses (D-optimal, see the module docstring) and draw ``n`` random ones from
     the same candidates for comparison; both sets' identifiability is analysed."""
@@ -195,7 +198,7 @@ def plan_measurements(
         raise CalibrationError(
             CalibrationError.CANDIDATES.format(name=platform.name, got=len(cand), want=candidates, box=box.describe())
         )
-    layout, problem, theta = design_problem(platform, cand, kind, noise, convention, n_targets)
+    layout, problem, theta = design_problem(platform, cand, kind, noise, convention, n_targets, gains)
     A = reduced_blocks(*pose_blocks(problem, theta)) * noise.length
     whole = analyse(layout, A.reshape(-1, A.shape[-1]), theta)
     chosen = d_optimal(A[:, :, whole.free], n)

@@ -41,7 +41,7 @@ def plot_calibration(result: CalibrationResult, folder: Path) -> list[str]:
     if fixed.any():
         ax.bar(idx[fixed], corr[fixed] + 0.0, color="lightgray", edgecolor="gray", label="fixed by convention (0)")
     ax.set_xticks(idx, names, rotation=90, fontsize=6)
-    ax.set_ylabel("µm")
+    ax.set_ylabel("µm (a gain: its error × L_ref)")
     ax.set_title("identified corrections to the nominal geometry", fontsize=9)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -55,6 +55,7 @@ def register(sub) -> None:
     p.add_argument("--length-unit", choices=list(LENGTH_UNITS), default="m", help="lengths in the CSV (default m)")
     p.add_argument("--angle-unit", choices=list(ANGLE_UNITS), default="rad", help="angles in the CSV (default rad)")
     p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention of the poses")
+    p.add_argument("--gains", action="store_true", help="identify each leg sensor's gain too (legs.length_gain)")
     p.add_argument("--seed", type=int, default=0, help="seed of the --holdout split (default 0)")
     p.add_argument("--no-plots", action="store_true", help="skip residuals.png and corrections.png")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created; only its own files replaced)")
@@ -93,7 +94,7 @@ def calibrate(args) -> tuple[CalibrationResult, dict]:
     platform = platform_from_args(args)
     noise = parse_noise(args.noise)
     data = read_measurements(args.measurements, platform, args.type, args.length_unit, args.angle_unit)
-    layout = Layout(platform, data.kind, data.n_targets)
+    layout = Layout(platform, data.kind, data.n_targets, args.gains)
     fit, val = _split(args, data, layout)
     need = min_poses(layout)
     if len(fit) < need:
@@ -109,7 +110,7 @@ def calibrate(args) -> tuple[CalibrationResult, dict]:
                 need=need,
             )
         )
-    result = identify(platform, fit, noise, args.convention)
+    result = identify(platform, fit, noise, args.convention, args.gains)
     if val is not None:
         targets0 = layout.split(result.theta0)[3]
         result.validation = {
@@ -138,7 +139,7 @@ def record(result: CalibrationResult) -> CalibrationRecord:
         residual_unit=unit[1],
         validation_rms_m=v["calibrated"][vkey]["rms"] if v and unit[1] == "m" else None,
         parameters=list(result.layout.names),
-        sigma_m=[float(s) for s in result.sigma],
+        sigma=[float(s * k) for s, k in zip(result.sigma, result.layout.scales())],
     )
 
 

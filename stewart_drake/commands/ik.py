@@ -79,7 +79,9 @@ def run(args) -> int:
     if args.json:
         rows = raw.tolist()
         lengths = Lu.tolist()
-        readings = (platform.readings(L) / k).tolist() if np.any(platform.length_offset) else None
+        readings = (
+            (platform.readings(L) / k).tolist() if np.any(platform.length_offset) or platform.has_sensor_gains else None
+        )
         results = [
             {
                 "pose": rows[i],

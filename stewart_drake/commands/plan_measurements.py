@@ -43,6 +43,7 @@ def register(sub) -> None:
     p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention of the poses")
     p.add_argument("--noise", nargs="+", default=[], metavar="KEY=VALUE", help="σ as for calibrate (weights the rows)")
     p.add_argument("--targets", type=int, default=3, help="--type points: targets on the plate (default 3)")
+    p.add_argument("--gains", action="store_true", help="plan for identifying the sensor gains too")
     p.add_argument("--candidates", type=int, default=1000, help="candidate poses drawn (default 1000)")
     p.add_argument("--seed", type=int, default=0, help="seed of the candidates and of the random baseline")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created; only its own files replaced)")
@@ -67,7 +68,7 @@ def run(args) -> int:
         )
     if not 1 <= args.targets <= 8:
         raise CalibrationError(f"--targets {args.targets}: give 1 to 8 targets")
-    layout = Layout(platform, args.type, args.targets if args.type == "points" else 0)
+    layout = Layout(platform, args.type, args.targets if args.type == "points" else 0, args.gains)
     if args.poses < min_poses(layout):
         raise CalibrationError(
             CalibrationError.PLAN_TOO_FEW.format(
@@ -100,6 +101,7 @@ def run(args) -> int:
         args.convention,
         args.candidates,
         args.targets,
+        args.gains,
     )
     d = plan.to_dict()
     with out.writing() as tmp:

@@ -23,6 +23,7 @@ import numpy as np
 from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.errors import FirmwareError
 from stewart_drake.fixedpoint import fixed_point_leg_lengths, q15
 
 # Layout of a controller's ``status``: tick count, time of the last tick, time of the last release of a
@@ -31,6 +32,15 @@ STATUS = ("ticks", "last_tick_time", "last_release_time", "saturations") + tuple
     f"saturations_{i}" for i in range(1, 7)
 )
 CONTROLLER_KINDS = ("fixed", "float")
+
+
+def check_no_sensor_gains(platform: Platform) -> None:
+    """Refuse a platform whose sensors have gains (``legs.length_gain`` ≠ 1): the laws, the firmware and the
+    simulated sensor model an offset per leg, not a scale."""
+    if platform.has_sensor_gains:
+        raise FirmwareError(
+            FirmwareError.SENSOR_GAINS.format(name=platform.name, gains=[float(g) for g in platform.length_gain])
+        )
 
 
 class FloatLaw:
@@ -42,6 +52,7 @@ class FloatLaw:
         self.config = config or ControllerConfig.for_platform(platform)
         self.timing = self.config.timing.check()
         self._limit = self.timing.command_range
+        check_no_sensor_gains(platform)
         self._offset = platform.length_offset  # (6,) m: joint-to-joint length = reading + offset
         self._cache: dict[bytes, np.ndarray] = {}
         # (6,) metres added to every set-point (None: nothing). A probe, not a feature: a constant offset
@@ -114,6 +125,7 @@ class FixedPointLaw:
         self.timing = self.config.timing.check()
         self.gains = FixedGains.from_si(self.config.gains, self.timing)
         self._counts_per_lsb = counts_per_lsb(self.config)
+        check_no_sensor_gains(platform)
         # legs.length_offset in sensor counts: the firmware adds them to the readings (``generate.offset_counts``)
         self._offset_counts = np.round(platform.length_offset / self.timing.sensor_resolution).astype(np.int64)
         g = self.gains

@@ -77,15 +77,18 @@ class LegConfig:
     max_speed: float | None = None  # length unit per s, actuator speed limit (None: not checked)
     max_power: float | None = None  # W, actuator mechanical power limit (None: not checked)
     stiffness: float | None = None  # N per length unit, axial stiffness of a leg (None: unknown)
-    # length unit, per leg: joint-to-joint length = sensor reading + length_offset[i] (empty: all zero)
+    # per leg: joint-to-joint length = length_gain[i] × sensor reading + length_offset[i] (length unit; empty:
+    # gains 1, offsets 0)
     length_offset: list[float] = field(default_factory=list)
+    length_gain: list[float] = field(default_factory=list)
 
 
 @dataclass
 class CalibrationRecord:
     """Where a calibrated platform file came from (``stewart-drake calibrate``): the measurement file and
     its SHA-256, the date, the measurement type, the pose count, the measurement residuals' RMS before and
-    after (in ``residual_unit``), the validation RMS (m) and each parameter's σ (m; 0: fixed), named in order."""
+    after (in ``residual_unit``), the validation RMS (m) and each parameter's σ (m, a gain's in 1; 0: fixed),
+    named in order."""
 
     source: str = ""
     sha256: str = ""
@@ -97,7 +100,7 @@ class CalibrationRecord:
     residual_unit: str = "m"
     validation_rms_m: float | None = None
     parameters: list[str] = field(default_factory=list)
-    sigma_m: list[float] = field(default_factory=list)
+    sigma: list[float] = field(default_factory=list)
 
 
 @dataclass
@@ -194,6 +197,7 @@ class Platform:
         if not 0 < lmin < lmax:
             raise GeometryError(GeometryError.STROKE.format(lmin=lmin, lmax=lmax))
         self.length_offset  # noqa: B018 -- validates legs.length_offset: six finite numbers (or none)
+        self.length_gain  # noqa: B018 -- validates legs.length_gain: six positive numbers (or none)
         if not np.isfinite(self.mass) or self.mass < 0:
             raise GeometryError(GeometryError.MASS.format(value=self.mass))
         if not np.allclose(self.inertia, self.inertia.T, atol=1e-12):
@@ -223,13 +227,27 @@ class Platform:
             raise GeometryError(GeometryError.SHAPE.format(name="legs.length_offset", shape=(6,), got=o.shape))
         return o
 
+    @property
+    def length_gain(self) -> np.ndarray:
+        """``(6,)`` g_i: each leg's joint-to-joint length is g_i × its sensor reading + o_i (``legs.length_gain``;
+        ones when the file gives none)."""
+        g = np.ones(6) if not self.legs.length_gain else np.asarray(self.legs.length_gain, dtype=float)
+        if g.shape != (6,) or not np.all(np.isfinite(g) & (g > 0)):
+            raise GeometryError(GeometryError.SHAPE.format(name="legs.length_gain (positive)", shape=(6,), got=g))
+        return g
+
+    @property
+    def has_sensor_gains(self) -> bool:
+        """True when some ``legs.length_gain`` differs from 1."""
+        return bool(np.any(self.length_gain != 1.0))
+
     def readings(self, lengths) -> np.ndarray:
-        """``(..., 6)`` sensor readings (m) of joint-to-joint ``lengths`` (m): L − o."""
-        return np.asarray(lengths, dtype=float) - self.length_offset
+        """``(..., 6)`` sensor readings (m) of joint-to-joint ``lengths`` (m): (L − o) / g."""
+        return (np.asarray(lengths, dtype=float) - self.length_offset) / self.length_gain
 
     def lengths_from_readings(self, readings) -> np.ndarray:
-        """``(..., 6)`` joint-to-joint lengths (m) of sensor ``readings`` (m): r + o."""
-        return np.asarray(readings, dtype=float) + self.length_offset
+        """``(..., 6)`` joint-to-joint lengths (m) of sensor ``readings`` (m): g r + o."""
+        return np.asarray(readings, dtype=float) * self.length_gain + self.length_offset
 
     @property
     def L_min(self) -> float:
@@ -436,6 +454,7 @@ PLATFORM_RULES = {
     "legs.max_power": Rule("pos", "W", 1e9),
     "legs.stiffness": Rule("pos", "N per length unit", 1e15),
     "legs.length_offset[*]": Rule("any", "length"),
+    "legs.length_gain[*]": Rule("pos", "", 10.0),
 }
 PLATFORM_SHAPES = {
     "radial.base_angles_deg": (6, 6),
@@ -451,6 +470,7 @@ PLATFORM_SHAPES = {
     "plate.inertia": (6, 6),
     "rotation_centre": (3, 3),
     "legs.length_offset": (6, 6),
+    "legs.length_gain": (6, 6),
 }
 MAX_NAME_CHARS = 200
 

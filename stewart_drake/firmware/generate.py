@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
+from stewart_drake.control.laws import check_no_sensor_gains
 from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG
 from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import FirmwareError
@@ -138,6 +139,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     gains). Raises ValueError if the format cannot be generated (exact trig beyond 16-bit words, a
     sensor resolution that does not divide the length LSB, a platform that does not fit the words)."""
     fmt, conv = config.ik_format, config.convention
+    check_no_sensor_gains(platform)
     if fmt.word_bits > 16:
         raise FirmwareError(FirmwareError.WORD_BITS.format(value=fmt.word_bits))
     cpl = counts_per_lsb(config)

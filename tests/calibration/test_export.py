@@ -19,7 +19,11 @@ from tests.calibration.test_model import _six_three
 def test_written_platform_reads_back_equal(tmp_path, make):
     nominal = make()
     truth, _ = draw_machine(nominal, ERRORS, np.random.default_rng(3))
-    rec = CalibrationRecord(source="m.csv", sha256="ab" * 32, poses=30, parameters=["leg 1 offset"], sigma_m=[1.5e-6])
+    if nominal.name == "gonzalez-dutra-2009":  # sensor gains too (calibrate --gains)
+        truth = truth.replace(
+            legs=type(truth.legs)(**{**vars(truth.legs), "length_gain": [1.0002, 1, 1, 0.9995, 1, 1]})
+        )
+    rec = CalibrationRecord(source="m.csv", sha256="ab" * 32, poses=30, parameters=["leg 1 offset"], sigma=[1.5e-6])
     f = tmp_path / "c.yaml"
     f.write_text(platform_yaml(truth, rec, "a header\nof two lines"))
     back = load_platform(f)
@@ -37,4 +41,5 @@ def test_written_platform_reads_back_equal(tmp_path, make):
     assert back.mass == truth.mass and back.home_height == truth.home_height and back.name == truth.name
     assert np.any(back.length_offset)
     assert ("leg_base:" in f.read_text()) == (nominal.name == "six-three")
-    assert "sigma_m: [1.5e-06]" in f.read_text() and f.read_text().startswith("# a header\n# of two lines\n")
+    assert ("length_gain:" in f.read_text()) == (nominal.name == "gonzalez-dutra-2009")
+    assert "sigma: [1.5e-06]" in f.read_text() and f.read_text().startswith("# a header\n# of two lines\n")

@@ -77,7 +77,7 @@ def test_outputs_and_the_calibrated_file(flow):
     d = json.loads((flow / "cal" / "calibration.json").read_text())
     # every identified parameter within 4.5 σ of the truth (33 Gaussian errors: P(any beyond) ~ 2e-4)
     z = (Layout(nominal, "pose").theta(cal) - Layout(nominal, "pose").theta(truth)) / [
-        q["sigma_m"] for q in d["parameters"]
+        q["sigma"] for q in d["parameters"]
     ]
     assert np.any(cal.length_offset) and np.abs(z).max() < 4.5, z
     val = candidate_poses(nominal, Box.default(nominal), 100, seed=99)[:30]

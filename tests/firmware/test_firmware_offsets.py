@@ -67,3 +67,18 @@ def test_tick_with_offsets_equals_the_python_law():
         assert np.array_equal(r.state(), new_state.astype(np.int64))
         differs += not np.array_equal(plain.step(state.astype(float), ref, reading, None)[0], command)
     assert differs > 100
+
+
+def test_sensor_gains_are_refused_by_the_controller_path():
+    """legs.length_gain ≠ 1 (calibrate --gains): the generator and both laws refuse it in one line."""
+    import pytest
+
+    from stewart_drake.control import FloatLaw
+    from stewart_drake.errors import FirmwareError
+
+    p = _with_offsets()
+    p = p.replace(legs=type(p.legs)(**{**vars(p.legs), "length_gain": [1.0, 1.0, 1.0005, 1.0, 1.0, 1.0]}))
+    cfg = ControllerConfig.for_platform(p)
+    for make in (lambda: generate(p, cfg), lambda: FixedPointLaw(p, cfg), lambda: FloatLaw(p, cfg)):
+        with pytest.raises(FirmwareError, match=r"legs.length_gain \[1.0, 1.0, 1.0005, 1.0, 1.0, 1.0\] is not 1"):
+            make()
