@@ -855,17 +855,16 @@ class CalibrationError(InputError):
     )
     POSE_STROKE = "{path}:{line}: leg {leg} length {length:.6g} m lies outside the stroke [{lmin:g}, {lmax:g}] m"
     WORKSPACE = "--workspace {value}: give six numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
-    PLAN_TYPE = "{path}: a measurement plan needs the columns px,py,pz,a,b,g (a plan-measurements poses.csv); {problem}"
+    MISSING = "measurement file {path!r} does not exist"
+    NOT_A_FILE = "measurement file {path!r} is not a file"
+    NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
+    TARGET_COUNT = "--targets {value}: give 1 to 8 targets"
+    POSE_COUNT = "{path}: more than {limit} poses"
+    CANDIDATE_COUNT = "--candidates {value}: give between {lo} and {hi} (twice --poses at least)"
+    VALIDATE_TARGETS = "{path}: {got} targets, but {fit} has {want}"
 
 
 class CalibrationLimitError(PhysicalLimitError):
     """An identification that does not converge, or data that fix too little: the CLI exits 1, result shown."""
 
-    NOT_CONVERGED = (
-        "the identification did not converge ({reason}); residual RMS {rms:.3g} (in σ) after {nfev} evaluations: "
-        "the nominal platform may be too far from the machine, or the data inconsistent"
-    )
-    BAD_FIT = (
-        "the identification converged to residuals {rms:.3g} times the stated noise: the model does not explain the "
-        "data (wrong --type, units, convention or noise levels?)"
-    )
+    NOT_CONVERGED = "the identification did not converge: {reason}; nothing written"

@@ -118,15 +118,15 @@ def read_measurements(
     f = Path(path)
     shown = str(path)
     if not f.exists():
-        raise CalibrationError(f"measurement file {shown!r} does not exist")
+        raise CalibrationError(CalibrationError.MISSING.format(path=shown))
     if not f.is_file():
-        raise CalibrationError(f"measurement file {shown!r} is not a file")
+        raise CalibrationError(CalibrationError.NOT_A_FILE.format(path=shown))
     data = f.read_bytes()
     digest = hashlib.sha256(data).hexdigest()
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
-        raise CalibrationError(f"{shown}: not UTF-8 text (byte {e.start})") from None
+        raise CalibrationError(CalibrationError.NOT_TEXT.format(path=shown, offset=e.start)) from None
     rows = list(csv.reader(text.splitlines()))
     numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r)]
     if not numbered:
@@ -136,7 +136,7 @@ def read_measurements(
     found = _kind_of(header)
     if kind is None:
         kind = found or "pose"
-    need = ",".join(columns_of(kind, 1 if kind != "points" else 1)).replace("t1_x,t1_y,t1_z", "tK_x,tK_y,tK_z")
+    need = ",".join(columns_of(kind, 1)).replace("t1_x,t1_y,t1_z", "tK_x,tK_y,tK_z")
     if all(_is_number(h) for h in header):
         raise CalibrationError(CalibrationError.NO_HEADER.format(path=shown, need=need, row=",".join(head)[:80]))
     if found is not None and found != kind:

@@ -72,7 +72,9 @@ def _split(args, data, layout: Layout):
         val = read_measurements(args.validate, platform, data.kind, args.length_unit, args.angle_unit)
         if val.n_targets != data.n_targets:
             raise CalibrationError(
-                f"{args.validate}: {val.n_targets} targets, but {args.measurements} has {data.n_targets}"
+                CalibrationError.VALIDATE_TARGETS.format(
+                    path=args.validate, got=val.n_targets, fit=args.measurements, want=data.n_targets
+                )
             )
         return data, val
     if args.holdout is None:
@@ -184,7 +186,7 @@ def run(args) -> int:
     result, d = calibrate(args)
     if not result.converged:
         print_json(d) if args.json else print(_summary(d, result))
-        raise CalibrationLimitError(f"the identification did not converge: {result.message}; nothing written")
+        raise CalibrationLimitError(CalibrationLimitError.NOT_CONVERGED.format(reason=result.message))
     rec = record(result)
     header = (
         f"{result.calibrated.name}: calibrated by stewart-drake calibrate from {result.source} "

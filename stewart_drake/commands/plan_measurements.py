@@ -64,10 +64,10 @@ def run(args) -> int:
         raise CalibrationError(CalibrationError.POSES.format(value=args.poses, lo=1, hi=MAX_POSES))
     if not 1 <= args.candidates <= MAX_CANDIDATES or args.candidates < 2 * args.poses:
         raise CalibrationError(
-            f"--candidates {args.candidates}: give between {max(2 * args.poses, 1)} and {MAX_CANDIDATES} (twice --poses at least)"
+            CalibrationError.CANDIDATE_COUNT.format(value=args.candidates, lo=max(2 * args.poses, 1), hi=MAX_CANDIDATES)
         )
     if not 1 <= args.targets <= 8:
-        raise CalibrationError(f"--targets {args.targets}: give 1 to 8 targets")
+        raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=args.targets))
     layout = Layout(platform, args.type, args.targets if args.type == "points" else 0, args.gains)
     if args.poses < min_poses(layout):
         raise CalibrationError(

@@ -68,10 +68,10 @@ def run(args) -> int:
         raise CalibrationError(CalibrationError.ERRORS_KEY.format(key=bad[0]))
     noise = parse_noise(args.noise)
     if not 1 <= args.targets <= 8:
-        raise CalibrationError(f"--targets {args.targets}: give 1 to 8 targets")
+        raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=args.targets))
     raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g")
     if len(raw) > MAX_POSES:
-        raise CalibrationError(f"{args.poses}: more than {MAX_POSES} poses")
+        raise CalibrationError(CalibrationError.POSE_COUNT.format(path=args.poses, limit=MAX_POSES))
     q = pose_to_si(raw, args.length_unit, args.angle_unit)
     check_poses(platform, q, args.convention, what=f"{args.poses}: pose", lines=lines)
     L = leg_lengths(platform, q, args.convention)
