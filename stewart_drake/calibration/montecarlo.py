@@ -35,7 +35,7 @@ class SigmaCheck:
             "converged": self.converged,
             "mean_ratio": float(self.ratio.mean()),
             "max_abs_deviation": float(np.abs(self.ratio - 1).max()),
-            "standard_error": self.standard_error,
+            "standard_error": float(self.standard_error),
             "mahalanobis_ratio": self.mahalanobis_ratio,
             "mahalanobis_standard_error": float(np.sqrt(2 / (len(self.ratio) * self.draws))),
             "ratio": {n: float(r) for n, r in zip(self.names, self.ratio)},
