@@ -19,6 +19,10 @@ from stewart_drake.errors import StewartError, UsageError
 # A command's module is imported only when that command runs: the Drake commands import pydrake at
 # their module top, and the numpy commands must work where pydrake is not installed.
 COMMANDS = {
+    "calibrate": (
+        "calibrate",
+        "identify a built platform's geometry from measured poses; write a calibrated platform file",
+    ),
     "compile": (
         "compile",
         "translate a motion program (.stw) to Python (calling this library) or Matlab (the seed's output)",
@@ -47,10 +51,18 @@ COMMANDS = {
         "optimize",
         "design synthesis: the geometry with the smallest actuators that meets a requirements file, proven",
     ),
+    "plan-measurements": (
+        "plan_measurements",
+        "plan calibration poses (D-optimal) inside a workspace box; CSV and a .stw program that visits them",
+    ),
     "report": ("report", "run the analyses on the built-in presets and write an HTML report"),
     "run": ("run", "run a motion program (.stw): leg lengths and forces along its trajectory"),
     "servo": ("servo", "servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)"),
     "simulate": ("simulate", "run the fixed-point (or float) controller in the loop with the Drake plant"),
+    "simulate-measurements": (
+        "simulate_measurements",
+        "synthetic calibration measurements of a machine drawn around the nominal (truth written apart)",
+    ),
     "size": ("size", "actuator sizing: peak/RMS force, speed, acceleration, power and stroke per leg"),
     "stiffness": ("stiffness", "6×6 Cartesian stiffness, compliance and payload deflection at a pose"),
     "view": (

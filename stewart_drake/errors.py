@@ -679,6 +679,12 @@ class SimulationError(StewartError):
 class FirmwareError(StewartError):
     """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
 
+    SENSOR_GAINS = (
+        "platform {name!r}: legs.length_gain {gains} is not 1: the controller's sensor path (the firmware, its "
+        "emulation, the simulated sensor) adds legs.length_offset but has no gain; calibrate without --gains, or "
+        "scale the sensors' resolution"
+    )
+
     POSES = "--poses must be an integer in 1..{limit}, got {value!r}"
     DURATION = "--duration must be in (0, 60] s, got {value!r}"
     NO_IK = "{path}: defines no sd_ik (the firmware ABI: int sd_ik(const sd_word pose[6], sd_word lengths[6]))"
@@ -840,3 +846,63 @@ class InfeasibleRequirementsError(PhysicalLimitError):
         "no design among {n} evaluated meets every requirement (least violated: {worst}); "
         "widen the bounds or raise --budget"
     )
+
+
+class CalibrationError(InputError):
+    """A calibration input is unusable (measurement file, noise or error SPEC, options): one line naming it."""
+
+    COLUMNS = (
+        "{path}:{line}: a {kind} measurement file needs the columns {need}; missing {missing} "
+        "(header: {header}; --type {kind})"
+    )
+    UNKNOWN_COLUMN = "{path}:{line}: unknown column {name!r} for --type {kind} (columns: {need}, optional w)"
+    NO_HEADER = "{path}:1: a measurement file starts with a header row naming its columns ({need}), got {row}"
+    NOT_NUMBER = "{path}:{line}: column {column}: not a number: {value!r}"
+    NOT_FINITE = "{path}:{line}: column {column}: values must be finite, got {value!r}"
+    WIDTH = "{path}:{line}: expected {expected} values (one per header column), got {got}"
+    WEIGHT = "{path}:{line}: column w: a weight must be > 0, got {value!r}"
+    EMPTY = "{path}: no measurement rows"
+    TOO_MANY = "{path}: more than {limit} measurement rows; a calibration needs tens"
+    TOO_FEW = (
+        "{path}: {n} poses give {equations} equations for {unknowns} unknowns ({parameters} parameters"
+        "{nuisance}); give at least {need} poses"
+    )
+    STROKE = (
+        "{path}:{line}: leg {leg} reads {value} {unit}, so its length {length:.6g} m lies outside the stroke "
+        "[{lmin:g}, {lmax:g}] m of platform {name!r}{hint}"
+    )
+    UNIT_HINT = " (are the readings in {guess}? give --length-unit {guess})"
+    ANGLE = "{path}:{line}: column {column}: {value} {unit} is beyond ±{limit} {unit}{hint}"
+    ANGLE_HINT = " (are the angles in degrees? give --angle-unit deg)"
+    TYPE = "{path}: --type {kind} given, but the header names the columns of a {found} file ({header})"
+    TARGETS = "{path}:1: target columns must be tK_x,tK_y,tK_z for K = 1, 2, ... in order, got {names}"
+    NOISE_WORD = "--noise: {word!r} is not key=value (keys: {keys})"
+    NOISE_KEY = "--noise: unknown key {key!r} (keys: {keys})"
+    NOISE_VALUE = "--noise: {key}={text}: expected a number >= 0 with a unit ({units})"
+    ERRORS_KEY = "--errors: key {key!r} is not a geometric error (keys: anchor, leg_offset)"
+    HOLDOUT = "--holdout {value}: give a fraction in (0, 0.5] of the poses to hold out for validation"
+    HOLDOUT_TOO_FEW = "--holdout {value}: holding out {held} of {n} poses leaves {left}, fewer than the {need} needed"
+    POSES = "--poses {value}: give between {lo} and {hi} poses"
+    CANDIDATES = (
+        "platform {name!r}: only {got} of {want} candidate poses drawn in {box} lie within the stroke, above the "
+        "base and away from singularities; give a smaller --workspace or more --candidates"
+    )
+    PLAN_TOO_FEW = (
+        "--poses {value}: a {kind} measurement needs at least {need} poses on platform {name!r} ({unknowns} unknowns, "
+        "{per} equations per pose)"
+    )
+    POSE_STROKE = "{path}:{line}: leg {leg} length {length:.6g} m lies outside the stroke [{lmin:g}, {lmax:g}] m"
+    WORKSPACE = "--workspace {value}: give six numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
+    MISSING = "measurement file {path!r} does not exist"
+    NOT_A_FILE = "measurement file {path!r} is not a file"
+    NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
+    TARGET_COUNT = "--targets {value}: give 1 to 8 targets"
+    POSE_COUNT = "{path}: more than {limit} poses"
+    CANDIDATE_COUNT = "--candidates {value}: give between {lo} and {hi} (twice --poses at least)"
+    VALIDATE_TARGETS = "{path}: {got} targets, but {fit} has {want}"
+
+
+class CalibrationLimitError(PhysicalLimitError):
+    """An identification that does not converge, or data that fix too little: the CLI exits 1, result shown."""
+
+    NOT_CONVERGED = "the identification did not converge: {reason}; nothing written"

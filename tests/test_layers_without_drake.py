@@ -10,7 +10,15 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = "tests.cli._no_drake"
-DRAKE_FREE = ("tests/core", "tests/control", "tests/fixedpoint", "tests/workspace", "tests/script", "tests/design")
+DRAKE_FREE = (
+    "tests/core",
+    "tests/control",
+    "tests/fixedpoint",
+    "tests/workspace",
+    "tests/script",
+    "tests/design",
+    "tests/calibration",
+)
 
 
 def pytest_without_drake(*args):

@@ -44,6 +44,8 @@ class IKResult(Result):
         notes: flat pose index -> why the plate is below the base.
         platform: the platform's name.
         convention: the Euler convention of the poses.
+        readings: ``(..., 6)`` what the leg sensors read at those lengths, m (``legs.length_offset`` and
+            ``legs.length_gain`` of a calibrated platform), or None when every sensor reads the length itself.
     """
 
     poses: np.ndarray
@@ -54,6 +56,7 @@ class IKResult(Result):
     notes: dict
     platform: str
     convention: str
+    readings: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
@@ -63,11 +66,13 @@ class IKResult(Result):
     def _fields(self) -> dict:
         flat = self.poses.reshape(-1, 6).tolist()
         lengths = self.lengths.reshape(-1, 6).tolist()
+        readings = None if self.readings is None else self.readings.reshape(-1, 6).tolist()
         within, above = self.within_stroke.reshape(-1), self.above_base.reshape(-1)
         results = [
             {
                 "pose": flat[i],
                 "lengths": lengths[i],
+                **({"readings": readings[i]} if readings is not None else {}),
                 "length_unit": "m",
                 "within_stroke": bool(within[i]),
                 "above_base": bool(above[i]),
@@ -127,8 +132,17 @@ def solve_ik(platform: Platform, poses, convention: str = "utn", what: str = "po
         v.sort(key=lambda d: d["leg"])
     notes = {int(i): below_base_message("pose", z[i]) for i in np.flatnonzero(~above)}
     lead = q.shape[:-1]
+    offsets = np.any(platform.length_offset) or platform.has_sensor_gains
     return IKResult(
-        q, L.reshape(q.shape), within.reshape(lead), above.reshape(lead), viol, notes, platform.name, convention
+        q,
+        L.reshape(q.shape),
+        within.reshape(lead),
+        above.reshape(lead),
+        viol,
+        notes,
+        platform.name,
+        convention,
+        platform.readings(L).reshape(q.shape) if offsets else None,
     )
 
 

@@ -9,6 +9,7 @@ import numpy as np
 from stewart_drake.api.kinematics import solve_fk
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_from_si, pose_to_si
+from stewart_drake.core.sanity import check_finite
 
 
 def register(sub) -> None:
@@ -22,13 +23,20 @@ def register(sub) -> None:
         "confirmed by a Drake MathematicalProgram).",
     )
     add_platform_arg(p)
-    p.add_argument(
+    given = p.add_mutually_exclusive_group(required=True)
+    given.add_argument(
         "--lengths",
         nargs=6,
         type=float,
-        required=True,
         metavar=("L1", "L2", "L3", "L4", "L5", "L6"),
-        help="leg lengths in --length-unit",
+        help="leg lengths (joint to joint) in --length-unit",
+    )
+    given.add_argument(
+        "--readings",
+        nargs=6,
+        type=float,
+        metavar=("R1", "R2", "R3", "R4", "R5", "R6"),
+        help="leg sensor readings in --length-unit: lengths = readings + the platform's legs.length_offset",
     )
     add_unit_args(p)
     p.add_argument("--all", action="store_true", help="every assembly mode, not just one")
@@ -60,7 +68,9 @@ def cli_units(result, args, k: float) -> dict:
     """The result's dict in the command's units (``--length-unit``, ``--angle-unit``), lengths as typed."""
     out = result.to_dict()
     ka = angle_scale(args.angle_unit)
-    out.update(lengths=list(args.lengths), length_unit=args.length_unit, angle_unit=args.angle_unit)
+    out.update(lengths=[float(v) for v in args.lengths], length_unit=args.length_unit, angle_unit=args.angle_unit)
+    if args.readings is not None:
+        out["readings"] = list(args.readings)
     for s in out["solutions"]:
         s["pose"] = pose_from_si(np.array(s["pose"]), args.length_unit, args.angle_unit).tolist()
         s["residual"] /= k
@@ -74,6 +84,10 @@ def cli_units(result, args, k: float) -> dict:
 def run(args) -> int:
     platform = platform_from_args(args)
     k = length_scale(args.length_unit)
+    if args.readings is not None:  # the sensors' readings of a calibrated platform: joint-to-joint lengths first
+        check_finite(args.readings, "--readings")
+        lengths = platform.lengths_from_readings(np.asarray(args.readings, dtype=float) * k) / k
+        args.lengths = [float(v) for v in lengths]
     initial = None if args.initial is None else pose_to_si(args.initial, args.length_unit, args.angle_unit)
     result = solve_fk(
         platform,
@@ -85,7 +99,7 @@ def run(args) -> int:
         args.tol,
         args.max_iter,
         args.seed,
-        what="--lengths",
+        what="--lengths" if args.readings is None else "--readings + legs.length_offset",
         unit=args.length_unit,
         given=args.lengths,
     )

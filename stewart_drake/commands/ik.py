@@ -52,6 +52,8 @@ def run(args) -> int:
     results = [r.to_dict()] if args.pose is not None else r.to_dict()["results"]
     for res, row in zip(results, raw.reshape(-1, 6).tolist()):  # the CLI's units: lengths as asked, pose as typed
         res.update(pose=row, lengths=[v / k for v in res["lengths"]], length_unit=args.length_unit)
+        if "readings" in res:
+            res["readings"] = [v / k for v in res["readings"]]
         for v in res["violations"]:
             v.update(length=v["length"] / k, limit=v["limit"] / k, excess=v["excess"] / k)
     if args.json:

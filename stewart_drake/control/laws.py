@@ -23,6 +23,7 @@ import numpy as np
 from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.errors import FirmwareError
 from stewart_drake.fixedpoint import fixed_point_leg_lengths, q15
 
 # Layout of a controller's ``status``: tick count, time of the last tick, time of the last release of a
@@ -31,6 +32,15 @@ STATUS = ("ticks", "last_tick_time", "last_release_time", "saturations") + tuple
     f"saturations_{i}" for i in range(1, 7)
 )
 CONTROLLER_KINDS = ("fixed", "float")
+
+
+def check_no_sensor_gains(platform: Platform) -> None:
+    """Refuse a platform whose sensors have gains (``legs.length_gain`` ≠ 1): the laws, the firmware and the
+    simulated sensor model an offset per leg, not a scale."""
+    if platform.has_sensor_gains:
+        raise FirmwareError(
+            FirmwareError.SENSOR_GAINS.format(name=platform.name, gains=[float(g) for g in platform.length_gain])
+        )
 
 
 class FloatLaw:
@@ -42,6 +52,8 @@ class FloatLaw:
         self.config = config or ControllerConfig.for_platform(platform)
         self.timing = self.config.timing.check()
         self._limit = self.timing.command_range
+        check_no_sensor_gains(platform)
+        self._offset = platform.length_offset  # (6,) m: joint-to-joint length = reading + offset
         self._cache: dict[bytes, np.ndarray] = {}
         # (6,) metres added to every set-point (None: nothing). A probe, not a feature: a constant offset
         # from t = 0 is a set-point step on the legs, whose length response measures the loop's gain from
@@ -72,8 +84,9 @@ class FloatLaw:
         """PID state holding ``lengths`` (m) with integrator ``forces`` (N), legs moving at ``rates`` (m/s)."""
         lengths = np.asarray(lengths, float)
         d = np.zeros(6) if rates is None else np.asarray(rates, float) * self.timing.sample_period
-        m = self.quantise(lengths - d)
-        return np.concatenate([np.clip(forces, -self._limit, self._limit), m, d, lengths - d, d])
+        m = self.quantise(lengths - d) + self._offset
+        L = lengths + self._offset
+        return np.concatenate([np.clip(forces, -self._limit, self._limit), m, d, L - d, d])
 
     def command_from_integrator(self, integ, ff=None):
         """The command (N) of the integrator alone plus the feed-forward ``ff`` (N), saturated."""
@@ -86,7 +99,7 @@ class FloatLaw:
         feed-forward ``feedforward`` (6,) N (None: none)."""
         g, T, lim = self.config.gains, self.timing.sample_period, self._limit
         sp = self.setpoints(reference)
-        m = self.quantise(measured)
+        m = self.quantise(measured) + self._offset  # readings -> joint-to-joint lengths
         integ, prev, dfilt, sp_prev, vfilt = np.split(np.asarray(state, dtype=float), 5)
         e = sp - m
         dfilt = dfilt + g.derivative_filter * ((m - prev) - dfilt)
@@ -112,6 +125,9 @@ class FixedPointLaw:
         self.timing = self.config.timing.check()
         self.gains = FixedGains.from_si(self.config.gains, self.timing)
         self._counts_per_lsb = counts_per_lsb(self.config)
+        check_no_sensor_gains(platform)
+        # legs.length_offset in sensor counts: the firmware adds them to the readings (``generate.offset_counts``)
+        self._offset_counts = np.round(platform.length_offset / self.timing.sensor_resolution).astype(np.int64)
         g = self.gains
         self._alphas = np.array([[g.alpha], [g.alpha_ff]], dtype=np.int64)
         self._mantissas = np.array([[k.mantissa] for k in (g.kp, g.kd, g.kv, g.ki)], dtype=np.int64)
@@ -155,9 +171,9 @@ class FixedPointLaw:
         integ = q15.sat32(np.round(frac * 2.0**31).astype(np.int64))
         lengths = np.asarray(lengths, dtype=float)
         d = np.zeros(6) if rates is None else np.asarray(rates, float) * self.timing.sample_period
-        sp = np.round((lengths - d) / self.config.ik_format.length_lsb).astype(np.int64)
+        sp = np.round((lengths + self.platform.length_offset - d) / self.config.ik_format.length_lsb).astype(np.int64)
         filt = q15.sat16(np.round(d / self.timing.sensor_resolution).astype(np.int64) * 2**DIFF_SHIFT)
-        return np.concatenate([integ, self.quantise(lengths - d), filt, sp, filt]).astype(float)
+        return np.concatenate([integ, self.quantise(lengths - d) + self._offset_counts, filt, sp, filt]).astype(float)
 
     def command_from_integrator(self, integ, ff=None):
         """The command (N) of the integrator word alone plus the feed-forward's table word, saturated."""
@@ -176,7 +192,7 @@ class FixedPointLaw:
         table word (``feedforward_words``) added to the Q31 sum. The state holds integer words."""
         q = q15
         sp = self.setpoint_words(reference)
-        m = self.quantise(measured)
+        m = self.quantise(measured) + self._offset_counts
         st = np.asarray(state).astype(np.int64)
         integ, prev, dfilt, sp_prev, vfilt = st[:6], st[6:12], st[12:18], st[18:24], st[24:]
         # The same elementwise intrinsics as the firmware's per-leg code, on stacked rows (one numpy call per

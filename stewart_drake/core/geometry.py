@@ -78,6 +78,30 @@ class LegConfig:
     max_speed: float | None = None  # length unit per s, actuator speed limit (None: not checked)
     max_power: float | None = None  # W, actuator mechanical power limit (None: not checked)
     stiffness: float | None = None  # N per length unit, axial stiffness of a leg (None: unknown)
+    # per leg: joint-to-joint length = length_gain[i] × sensor reading + length_offset[i] (length unit; empty:
+    # gains 1, offsets 0)
+    length_offset: list[float] = field(default_factory=list)
+    length_gain: list[float] = field(default_factory=list)
+
+
+@dataclass
+class CalibrationRecord:
+    """Where a calibrated platform file came from (``stewart-drake calibrate``): the measurement file and
+    its SHA-256, the date, the measurement type, the pose count, the measurement residuals' RMS before and
+    after (in ``residual_unit``), the validation RMS (m) and each parameter's σ (m, a gain's in 1; 0: fixed),
+    named in order."""
+
+    source: str = ""
+    sha256: str = ""
+    date: str = ""
+    measurement_type: str = ""
+    poses: int = 0
+    residual_rms_before: float = 0.0
+    residual_rms_after: float = 0.0
+    residual_unit: str = "m"
+    validation_rms_m: float | None = None
+    parameters: list[str] = field(default_factory=list)
+    sigma: list[float] = field(default_factory=list)
 
 
 @dataclass
@@ -100,6 +124,7 @@ class PlatformConfig:
     home_height: float | None = None
     legs: LegConfig = field(default_factory=LegConfig)
     plate_below_base_allowed: bool = False
+    calibration: CalibrationRecord | None = None
 
 
 # ----------------------------------------------------------------------------------------------
@@ -177,6 +202,8 @@ class Platform:
         lmin, lmax = self.stroke
         if not 0 < lmin < lmax:
             raise GeometryError(GeometryError.STROKE.format(lmin=lmin, lmax=lmax))
+        self.length_offset  # noqa: B018 -- validates legs.length_offset: six finite numbers (or none)
+        self.length_gain  # noqa: B018 -- validates legs.length_gain: six positive numbers (or none)
         if not np.isfinite(self.mass) or self.mass < 0:
             raise GeometryError(GeometryError.MASS.format(value=self.mass))
         if not np.allclose(self.inertia, self.inertia.T, atol=1e-12):
@@ -196,6 +223,37 @@ class Platform:
     def top_anchors_per_leg(self) -> np.ndarray:
         """``(6, 3)`` p_TTi: the plate anchor of each leg, in T (metres)."""
         return self.top_anchors[self.leg_top]
+
+    @property
+    def length_offset(self) -> np.ndarray:
+        """``(6,)`` o_i, metres: each leg's joint-to-joint length is its sensor reading + o_i
+        (``legs.length_offset``; zeros when the file gives none)."""
+        o = np.zeros(6) if not self.legs.length_offset else np.asarray(self.legs.length_offset, dtype=float)
+        if o.shape != (6,) or not np.all(np.isfinite(o)):
+            raise GeometryError(GeometryError.SHAPE.format(name="legs.length_offset", shape=(6,), got=o.shape))
+        return o
+
+    @property
+    def length_gain(self) -> np.ndarray:
+        """``(6,)`` g_i: each leg's joint-to-joint length is g_i × its sensor reading + o_i (``legs.length_gain``;
+        ones when the file gives none)."""
+        g = np.ones(6) if not self.legs.length_gain else np.asarray(self.legs.length_gain, dtype=float)
+        if g.shape != (6,) or not np.all(np.isfinite(g) & (g > 0)):
+            raise GeometryError(GeometryError.SHAPE.format(name="legs.length_gain (positive)", shape=(6,), got=g))
+        return g
+
+    @property
+    def has_sensor_gains(self) -> bool:
+        """True when some ``legs.length_gain`` differs from 1."""
+        return bool(np.any(self.length_gain != 1.0))
+
+    def readings(self, lengths) -> np.ndarray:
+        """``(..., 6)`` sensor readings (m) of joint-to-joint ``lengths`` (m): (L − o) / g."""
+        return (np.asarray(lengths, dtype=float) - self.length_offset) / self.length_gain
+
+    def lengths_from_readings(self, readings) -> np.ndarray:
+        """``(..., 6)`` joint-to-joint lengths (m) of sensor ``readings`` (m): g r + o."""
+        return np.asarray(readings, dtype=float) * self.length_gain + self.length_offset
 
     @property
     def L_min(self) -> float:
@@ -388,6 +446,7 @@ def platform_from_config(cfg: PlatformConfig) -> Platform:
         piston_radius=cfg.legs.piston_radius * k,
         max_speed=None if cfg.legs.max_speed is None else cfg.legs.max_speed * k,
         stiffness=None if cfg.legs.stiffness is None else cfg.legs.stiffness / k,
+        length_offset=[v * k for v in cfg.legs.length_offset],
     )
     common = dict(
         name=cfg.name,
@@ -444,6 +503,8 @@ PLATFORM_RULES = {
     "legs.max_speed": Rule("pos", "length"),
     "legs.max_power": Rule("pos", "W", 1e9),
     "legs.stiffness": Rule("pos", "N per length unit", 1e15),
+    "legs.length_offset[*]": Rule("any", "length"),
+    "legs.length_gain[*]": Rule("pos", "", 10.0),
 }
 PLATFORM_SHAPES = {
     "radial.base_angles_deg": (6, 6),
@@ -458,6 +519,8 @@ PLATFORM_SHAPES = {
     "plate.com": (3, 3),
     "plate.inertia": (6, 6),
     "rotation_centre": (3, 3),
+    "legs.length_offset": (6, 6),
+    "legs.length_gain": (6, 6),
 }
 MAX_NAME_CHARS = 200
 

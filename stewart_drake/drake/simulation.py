@@ -258,7 +258,15 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     act.set_name("actuators")
     nx = plant.num_multibody_states()
     joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
-    if s.sensor is None:
+    sensor_model = s.sensor
+    if np.any(plant_platform.length_offset):  # a sensor reads the joint-to-joint length − legs.length_offset
+        o = -plant_platform.length_offset
+        sensor_model = (
+            SensorModel(o, np.zeros((1, 6)), np.zeros(1), 1.0)
+            if s.sensor is None
+            else replace(s.sensor, offset=np.asarray(s.sensor.offset) + o)
+        )
+    if sensor_model is None:
         D = np.zeros((6, nx))
         for i in range(6):
             D[i, joints[i].position_start()] = 1.0
@@ -267,7 +275,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         pos = np.array([j.position_start() for j in joints])
         vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
         sensor = builder.AddSystem(
-            LegLengthSensor(nx, pos, vel, s.sensor.offset, s.sensor.noise, s.sensor.jitter, s.sensor.period)
+            LegLengthSensor(
+                nx, pos, vel, sensor_model.offset, sensor_model.noise, sensor_model.jitter, sensor_model.period
+            )
         )
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
+from stewart_drake.control.laws import check_no_sensor_gains
 from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG
 from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import FirmwareError
@@ -145,6 +146,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     gains). Raises ValueError if the format cannot be generated (exact trig beyond 16-bit words, a
     sensor resolution that does not divide the length LSB, a platform that does not fit the words)."""
     fmt, conv = config.ik_format, config.convention
+    check_no_sensor_gains(platform)
     if fmt.word_bits > 16:
         raise FirmwareError(FirmwareError.WORD_BITS.format(value=fmt.word_bits))
     cpl = counts_per_lsb(config)
@@ -279,6 +281,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
         at_sin=TRACE_AT["sin"],
         at_cos=TRACE_AT["cos"],
         at_len=TRACE_AT["lengths"],
+        **offset_context(platform, config),
     )
     g.files["sd_firmware.h"] = _header(ctx, config)
     g.files["sd_firmware.c"] = _source(ctx, e.lines, table)
@@ -290,6 +293,25 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     g.files["sd_firmware.c"] += fk_source(platform, config)
     g.files["README.md"] += fk_readme(g.fk_cycles, config.timing.clock_hz, contraction(platform, config))
     return g
+
+
+def offset_counts(platform: Platform, config: ControllerConfig) -> np.ndarray:
+    """``(6,)`` int64 ``legs.length_offset`` in sensor counts, rounded to nearest (the firmware adds them to
+    the readings: joint-to-joint length = reading + offset; within half a count of the file's values)."""
+    return np.round(platform.length_offset / config.timing.sensor_resolution).astype(np.int64)
+
+
+def offset_context(platform: Platform, config: ControllerConfig) -> dict:
+    """The C of the sensor offsets: a constant table and ``measured[i] + SD_LENGTH_OFFSET[i]`` when any is
+    non-zero; a platform without offsets generates the code it always did."""
+    off = offset_counts(platform, config)
+    if not np.any(off):
+        return {"offset_table": "", "measured": "measured[i]"}
+    table = (
+        "/* legs.length_offset in sensor counts (calibration): joint-to-joint length = reading + offset */\n"
+        f"static const int32_t SD_LENGTH_OFFSET[6] = {{{', '.join(str(int(v)) for v in off)}}};\n"
+    )
+    return {"offset_table": table, "measured": "(int64_t)measured[i] + SD_LENGTH_OFFSET[i]"}
 
 
 def _verify_table(U: np.ndarray, fmt: QFormat) -> None:
@@ -544,7 +566,7 @@ static int32_t i_L_deposit_h(int32_t a) {{ SD_OP(SD_L_deposit_h); return a * 655
 #define ALPHA_FF {c["alpha_ff"]}
 #define COUNTS_PER_LSB {c["cpl"]}
 #define DIFF_SHIFT {c["diff_shift"]}
-
+{c["offset_table"]}
 void sd_init(sd_state *s)
 {{
     int i;
@@ -559,7 +581,7 @@ int sd_tick(sd_state *s, const sd_word pose[6], const sd_count measured[6], cons
     int i, nsat = 0;
     sd_ik(pose, sp);
     for (i = 0; i < 6; i++) {{
-        int64_t m = measured[i];
+        int64_t m = {c["measured"]};
         int32_t e = i_sub_l(i_scale(sp[i], COUNTS_PER_LSB), m);                 /* error, counts */
         int32_t dm = i_shl(i_sub_l(m, s->prev[i]), DIFF_SHIFT);                  /* measurement difference */
         int32_t dfilt = i_add(s->dfilt[i], i_mult_r(ALPHA, i_sub(dm, s->dfilt[i])));

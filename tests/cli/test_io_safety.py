@@ -317,7 +317,8 @@ YAML_CASES = [
     (
         "utn: {b: 0.4, d: 0.1, a: 0.2}\nstrok: [0.5, 0.9]",
         "p.yaml:2: strok: unknown key (did you mean 'stroke'?); valid keys: name, description, length_unit, utn, radial, "
-        "base_anchors, top_anchors, leg_top, leg_base, stroke, plate, rotation_centre, home_height, legs, plate_below_base_allowed",
+        "base_anchors, top_anchors, leg_top, leg_base, stroke, plate, rotation_centre, home_height, legs, "
+        "plate_below_base_allowed, calibration",
     ),
     (
         "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.5, 0.9]\nplate: {mas: 1}",

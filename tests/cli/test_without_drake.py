@@ -16,7 +16,17 @@ import stewart_drake
 
 ROOT = Path(__file__).resolve().parents[2]
 RUNNER = str(Path(__file__).with_name("_no_drake.py"))
-NUMPY_PACKAGES = ("core", "control", "fixedpoint", "workspace", "script", "homotopy", "design", "firmware")
+NUMPY_PACKAGES = (
+    "core",
+    "control",
+    "fixedpoint",
+    "workspace",
+    "script",
+    "homotopy",
+    "design",
+    "firmware",
+    "calibration",
+)
 
 
 def run(*args, cwd):

@@ -1,0 +1,289 @@
+"""Calibration measurements: the three CSV kinds, read with every bad row named by its line, and written.
+
+Every file has a header row naming its columns (any order; an optional ``w`` column weighs a pose):
+
+- ``pose``: ``l1..l6`` (the legs' sensor readings) and ``px,py,pz,a,b,g`` (the plate's measured pose in the
+  base frame, as ``ik --pose`` takes it: rotation centre and angles in the platform file's convention);
+- ``points``: ``l1..l6`` and targets ``tK_x,tK_y,tK_z`` (K = 1, 2, ...: points fixed on the plate, measured
+  in the base frame; their plate-frame positions are identified too);
+- ``inclinometer``: ``l1..l6`` and ``tilt_x,tilt_y`` (the plate's tilt: for R_BT = Rz(γ)·Ry(β)·Rx(α),
+  tilt_x = α and tilt_y = β, whatever the yaw γ; see ``model.tilts``).
+
+Lengths are in ``length_unit`` (m or mm), angles in ``angle_unit`` (rad, deg or pi); inside, SI.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.errors import CalibrationError
+
+TYPES = ("pose", "points", "inclinometer")
+READINGS = tuple(f"l{i}" for i in range(1, 7))
+POSE = ("px", "py", "pz", "a", "b", "g")
+TILTS = ("tilt_x", "tilt_y")
+MAX_ROWS = 100_000
+MAX_TARGETS = 8
+_TARGET = re.compile(r"^t(\d+)_([xyz])$")
+
+
+@dataclass(frozen=True, eq=False)
+class Measurements:
+    """One measurement set in SI units.
+
+    kind      ``pose`` | ``points`` | ``inclinometer``
+    readings  ``(n, 6)`` sensor readings, m
+    poses     ``(n, 6)`` measured poses (m, rad, ``convention``), ``pose`` kind; else None
+    targets   ``(n, K, 3)`` measured target positions in B, m, ``points`` kind; else None
+    tilts     ``(n, 2)`` tilt_x, tilt_y, rad, ``inclinometer`` kind; else None
+    weights   ``(n,)`` > 0 (1 when the file has no ``w``)
+    lines     ``(n,)`` the file line of each row (counted from 1)
+    """
+
+    kind: str
+    readings: np.ndarray
+    poses: np.ndarray | None = None
+    targets: np.ndarray | None = None
+    tilts: np.ndarray | None = None
+    weights: np.ndarray = field(default_factory=lambda: np.ones(0))
+    lines: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+    source: str = ""
+    sha256: str = ""
+
+    def __len__(self) -> int:
+        return len(self.readings)
+
+    @property
+    def n_targets(self) -> int:
+        return 0 if self.targets is None else self.targets.shape[1]
+
+    def subset(self, rows) -> Measurements:
+        """The measurements of ``rows`` (indices or a mask), same file and hash."""
+        rows = np.asarray(rows)
+
+        def pick(a):
+            return None if a is None else a[rows]
+
+        return Measurements(
+            self.kind,
+            self.readings[rows],
+            pick(self.poses),
+            pick(self.targets),
+            pick(self.tilts),
+            self.weights[rows],
+            self.lines[rows],
+            self.source,
+            self.sha256,
+        )
+
+
+def columns_of(kind: str, n_targets: int = 1) -> tuple[str, ...]:
+    """The columns of a ``kind`` file, in the order ``write_measurements`` writes them."""
+    if kind == "pose":
+        return READINGS + POSE
+    if kind == "points":
+        return READINGS + tuple(f"t{k}_{a}" for k in range(1, n_targets + 1) for a in "xyz")
+    return READINGS + TILTS
+
+
+def _kind_of(header: list[str]) -> str | None:
+    if "px" in header:
+        return "pose"
+    if any(_TARGET.match(h) for h in header):
+        return "points"
+    if "tilt_x" in header:
+        return "inclinometer"
+    return None
+
+
+def read_measurements(
+    path,
+    platform: Platform,
+    kind: str | None = None,
+    length_unit: str = "m",
+    angle_unit: str = "rad",
+) -> Measurements:
+    """Read and check one measurement CSV (see the module docstring): every value finite, weights > 0,
+    every reading giving a length within the platform's stroke (a mistaken unit is named), angles within
+    ±π rad. ``kind`` None: taken from the header. Raises ``CalibrationError`` naming file, line and column."""
+    f = Path(path)
+    shown = str(path)
+    if not f.exists():
+        raise CalibrationError(CalibrationError.MISSING.format(path=shown))
+    if not f.is_file():
+        raise CalibrationError(CalibrationError.NOT_A_FILE.format(path=shown))
+    data = f.read_bytes()
+    digest = hashlib.sha256(data).hexdigest()
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise CalibrationError(CalibrationError.NOT_TEXT.format(path=shown, offset=e.start)) from None
+    rows = list(csv.reader(text.splitlines()))
+    numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r)]
+    if not numbered:
+        raise CalibrationError(CalibrationError.EMPTY.format(path=shown))
+    head_line, head = numbered[0]
+    header = [h.strip() for h in head]
+    found = _kind_of(header)
+    if kind is None:
+        kind = found or "pose"
+    need = ",".join(columns_of(kind, 1)).replace("t1_x,t1_y,t1_z", "tK_x,tK_y,tK_z")
+    if all(_is_number(h) for h in header):
+        raise CalibrationError(CalibrationError.NO_HEADER.format(path=shown, need=need, row=",".join(head)[:80]))
+    if found is not None and found != kind:
+        raise CalibrationError(
+            CalibrationError.TYPE.format(path=shown, kind=kind, found=found, header=",".join(header))
+        )
+    n_targets = 0
+    if kind == "points":
+        tk = [h for h in header if _TARGET.match(h)]
+        n_targets = len(tk) // 3
+        expect = [f"t{k}_{a}" for k in range(1, n_targets + 1) for a in "xyz"]
+        if not tk or sorted(tk) != sorted(expect) or n_targets > MAX_TARGETS:
+            raise CalibrationError(CalibrationError.TARGETS.format(path=shown, names=",".join(tk) or "none"))
+    wanted = columns_of(kind, n_targets)
+    for h in header:
+        if h not in wanted and h != "w":
+            raise CalibrationError(
+                CalibrationError.UNKNOWN_COLUMN.format(path=shown, line=head_line, name=h, kind=kind, need=need)
+            )
+    missing = [c for c in wanted if c not in header]
+    if missing or len(set(header)) != len(header):
+        raise CalibrationError(
+            CalibrationError.COLUMNS.format(
+                path=shown,
+                line=head_line,
+                kind=kind,
+                need=need,
+                missing=",".join(missing) or "(a column is repeated)",
+                header=",".join(header),
+            )
+        )
+    body = numbered[1:]
+    if len(body) > MAX_ROWS:
+        raise CalibrationError(CalibrationError.TOO_MANY.format(path=shown, limit=MAX_ROWS))
+    if not body:
+        raise CalibrationError(CalibrationError.EMPTY.format(path=shown))
+    values = np.empty((len(body), len(header)))
+    for r, (line, row) in enumerate(body):
+        if len(row) != len(header):
+            raise CalibrationError(
+                CalibrationError.WIDTH.format(path=shown, line=line, expected=len(header), got=len(row))
+            )
+        for c, cell in enumerate(row):
+            try:
+                v = float(cell)
+            except ValueError:
+                raise CalibrationError(
+                    CalibrationError.NOT_NUMBER.format(path=shown, line=line, column=header[c], value=cell[:40])
+                ) from None
+            if not math.isfinite(v):
+                raise CalibrationError(
+                    CalibrationError.NOT_FINITE.format(path=shown, line=line, column=header[c], value=cell[:40])
+                )
+            values[r, c] = v
+    lines = np.array([line for line, _ in body])
+    col = {h: values[:, i] for i, h in enumerate(header)}
+    k, a = length_scale(length_unit), angle_scale(angle_unit)
+    readings = np.stack([col[c] for c in READINGS], axis=1) * k
+    _check_readings(readings, platform, lines, shown, length_unit)
+    weights = col.get("w", np.ones(len(body)))
+    bad = np.flatnonzero(~(weights > 0))
+    if bad.size:
+        cell = body[bad[0]][1][header.index("w")].strip()
+        raise CalibrationError(CalibrationError.WEIGHT.format(path=shown, line=lines[bad[0]], value=cell))
+    poses = targets = tilts = None
+    if kind == "pose":
+        poses = np.stack([col[c] for c in POSE], axis=1)
+        _check_angles(poses[:, 3:], POSE[3:], lines, shown, angle_unit)
+        poses = np.concatenate([poses[:, :3] * k, poses[:, 3:] * a], axis=1)
+    elif kind == "points":
+        targets = np.stack([col[c] for c in columns_of(kind, n_targets)[6:]], axis=1).reshape(-1, n_targets, 3) * k
+    else:
+        tilts = np.stack([col[c] for c in TILTS], axis=1)
+        _check_angles(tilts, TILTS, lines, shown, angle_unit)
+        tilts = tilts * a
+    return Measurements(kind, readings, poses, targets, tilts, np.asarray(weights, float), lines, shown, digest)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_readings(readings, platform: Platform, lines, shown: str, unit: str) -> None:
+    """Each reading + the platform's offset within the stroke (a 1 % margin: a built machine's joints
+    sit off the drawing), else the first bad one named, with a unit hint when another unit fits."""
+    L = platform.lengths_from_readings(readings)
+    span = platform.L_max - platform.L_min
+    lo, hi = platform.L_min - 0.05 * span, platform.L_max + 0.05 * span
+    bad = np.argwhere((L < lo) | (L > hi))
+    if not bad.size:
+        return
+    r, leg = bad[0]
+    hint = ""
+    for guess, factor in (("mm", 1e-3), ("m", 1e3)):
+        if guess != unit and np.all(
+            (platform.lengths_from_readings(readings * factor) >= lo)
+            & (platform.lengths_from_readings(readings * factor) <= hi)
+        ):
+            hint = CalibrationError.UNIT_HINT.format(guess=guess)
+    shown_value = readings[r, leg] / length_scale(unit)
+    raise CalibrationError(
+        CalibrationError.STROKE.format(
+            path=shown,
+            line=lines[r],
+            leg=leg + 1,
+            value=f"{shown_value:g}",
+            unit=unit,
+            length=L[r, leg],
+            lmin=platform.L_min,
+            lmax=platform.L_max,
+            name=platform.name,
+            hint=hint,
+        )
+    )
+
+
+def _check_angles(angles, names, lines, shown: str, unit: str) -> None:
+    limit = math.pi / angle_scale(unit)
+    bad = np.argwhere(np.abs(angles) > limit)
+    if bad.size:
+        r, c = bad[0]
+        hint = CalibrationError.ANGLE_HINT if unit == "rad" and np.all(np.abs(angles) <= 180) else ""
+        raise CalibrationError(
+            CalibrationError.ANGLE.format(
+                path=shown,
+                line=lines[r],
+                column=names[c],
+                value=f"{angles[r, c]:g}",
+                unit=unit,
+                limit=f"{limit:g}",
+                hint=hint,
+            )
+        )
+
+
+def measurements_csv(m: Measurements) -> str:
+    """The CSV text of ``m`` (SI units: m, rad), header first, full precision, with its ``w`` column."""
+    cols = columns_of(m.kind, m.n_targets) + ("w",)
+    if m.kind == "pose":
+        data = np.concatenate([m.readings, m.poses], axis=1)
+    elif m.kind == "points":
+        data = np.concatenate([m.readings, m.targets.reshape(len(m), -1)], axis=1)
+    else:
+        data = np.concatenate([m.readings, m.tilts], axis=1)
+    data = np.concatenate([data, m.weights[:, None]], axis=1)
+    return ",".join(cols) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in data)

@@ -1,0 +1,162 @@
+"""The calibration commands end to end: plan-measurements → simulate-measurements → calibrate → the
+calibrated file loads, ik/fk speak readings, firmware generate bakes the offsets in and firmware check
+passes; bad input is one line with exit 2, an identification that does not converge exit 1."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from stewart_drake.calibration.model import Layout
+from stewart_drake.calibration.plan import Box, candidate_poses
+from stewart_drake.calibration.validate import truth_errors
+from stewart_drake.cli import main
+from stewart_drake.core.geometry import load_platform, load_preset
+
+
+def cli(capsys, *argv):
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    assert "Traceback" not in err
+    return rc, out, err
+
+
+@pytest.fixture(scope="module")
+def flow(tmp_path_factory):
+    """plan (30 poses) → simulate (seed 1) → calibrate with a 20 % holdout, in one folder."""
+    d = tmp_path_factory.mktemp("calibration")
+    assert (
+        main(
+            [
+                "plan-measurements",
+                "--platform",
+                "utn-dynamic",
+                "--poses",
+                "30",
+                "--candidates",
+                "400",
+                "--out",
+                str(d / "plan"),
+            ]
+        )
+        == 0
+    )
+    assert (
+        main(
+            [
+                "simulate-measurements",
+                "--platform",
+                "utn-dynamic",
+                "--poses",
+                str(d / "plan" / "poses.csv"),
+                "--seed",
+                "1",
+                "--out",
+                str(d / "meas"),
+            ]
+        )
+        == 0
+    )
+    assert main(["calibrate", "--platform", "utn-dynamic", "--measurements", str(d / "meas" / "measurements.csv"), "--holdout", "0.2", "--out", str(d / "cal")]) == 0  # fmt: skip
+    return d
+
+
+def test_outputs_and_the_calibrated_file(flow):
+    plan = json.loads((flow / "plan" / "plan.json").read_text())
+    assert plan["planned"]["d_index"] > plan["random"]["d_index"]
+    assert (flow / "plan" / "plan.stw").read_text().count("move(") == 30
+    assert sorted(p.name for p in (flow / "cal").iterdir()) == [
+        ".stewart-drake-manifest.json", "calibrated.yaml", "calibration.json", "corrections.png", "residuals.png",
+    ]  # fmt: skip
+    assert not (flow / "meas" / "truth" / "platform.yaml").samefile(flow / "meas" / "measurements.csv")
+    cal = load_platform(flow / "cal" / "calibrated.yaml")
+    truth = load_platform(flow / "meas" / "truth" / "platform.yaml")
+    nominal = load_preset("utn-dynamic")
+    d = json.loads((flow / "cal" / "calibration.json").read_text())
+    # every identified parameter within 4.5 σ of the truth (33 Gaussian errors: P(any beyond) ~ 2e-4)
+    z = (Layout(nominal, "pose").theta(cal) - Layout(nominal, "pose").theta(truth)) / [
+        q["sigma"] for q in d["parameters"]
+    ]
+    assert np.any(cal.length_offset) and np.abs(z).max() < 4.5, z
+    val = candidate_poses(nominal, Box.default(nominal), 100, seed=99)[:30]
+    assert truth_errors(truth, cal, val)["position"]["rms"] < 15e-6
+    assert d["converged"] and d["validation"]["poses"] == 6 and len(d["validation"]["lines"]) == 6
+    assert d["identifiability"]["identifiable"] == 33 and d["identifiability"]["frame_freedoms"] == []
+    text = (flow / "cal" / "calibrated.yaml").read_text()
+    assert "calibration:" in text and d["sha256"] in text
+
+
+def test_ik_readings_and_fk_readings_round_trip(flow, capsys):
+    f = flow / "cal" / "calibrated.yaml"
+    cal = load_platform(f)
+    rc, out, _ = cli(capsys, "ik", "--platform", f, "--pose", 5, -3, 720, 2, -1, 3, "--json")
+    r = json.loads(out)
+    assert rc == 0 and np.allclose(np.subtract(r["lengths"], r["readings"]), cal.length_offset * 1e3, atol=1e-9)
+    rc, out, _ = cli(capsys, "fk", "--platform", f, "--readings", *r["readings"], "--json")
+    pose = json.loads(out)["solutions"][0]["pose"]
+    assert rc == 0 and np.allclose(pose, [5, -3, 720, 2, -1, 3], atol=1e-6)
+    rc, out, _ = cli(capsys, "ik", "--platform", "utn-dynamic", "--pose", 5, -3, 720, 2, -1, 3, "--json")
+    assert "readings" not in json.loads(out)  # no offsets: the output it always had
+
+
+def test_firmware_bakes_the_offsets_in_and_checks(flow, capsys, tmp_path, monkeypatch):
+    from stewart_drake.core.c_build import CACHE_ENV
+
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
+    f = flow / "cal" / "calibrated.yaml"
+    rc, _, _ = cli(capsys, "firmware", "generate", "--platform", f, "--length-lsb", "3e-5", "--out", tmp_path / "fw")
+    assert rc == 0
+    counts = np.round(load_platform(f).length_offset / 1e-5).astype(int)
+    c = (tmp_path / "fw" / "sd_firmware.c").read_text()
+    assert f"SD_LENGTH_OFFSET[6] = {{{', '.join(map(str, counts))}}};" in c
+    rc, out, _ = cli(capsys, "firmware", "check", tmp_path / "fw" / "sd_firmware.c", "--platform", f, "--length-lsb", "3e-5", "--poses", "2000", "--duration", "0.1")  # fmt: skip
+    assert rc == 0 and "identical to the emulation" in out
+
+
+def test_too_few_poses_and_bad_rows_are_one_line(flow, capsys, tmp_path):
+    lines = (flow / "meas" / "measurements.csv").read_text().splitlines()
+    few = tmp_path / "few.csv"
+    few.write_text("\n".join(lines[:5]) + "\n")
+    rc, out, err = cli(capsys, "calibrate", "--platform", "utn-dynamic", "--measurements", few, "--out", tmp_path / "o")
+    assert rc == 2 and err.count("\n") == 1
+    assert "4 poses give 24 equations for 33 unknowns (33 parameters); give at least 6 poses" in err
+    bad = tmp_path / "bad.csv"
+    bad.write_text("\n".join(lines[:3] + [lines[3].replace(lines[3].split(",")[8], "nan", 1)] + lines[4:]) + "\n")
+    rc, out, err = cli(capsys, "calibrate", "--platform", "utn-dynamic", "--measurements", bad, "--out", tmp_path / "o")
+    assert rc == 2 and f"{bad}:4: column pz: values must be finite, got 'nan'" in err and err.count("\n") == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_identification_that_does_not_converge_exits_1(flow, capsys, tmp_path):
+    lines = (flow / "meas" / "measurements.csv").read_text().splitlines()
+    rows = [ln.split(",") for ln in lines[1:]]
+    shuffled = [",".join(rows[(k + 1) % len(rows)][:6] + rows[k][6:]) for k in range(len(rows))]  # readings vs poses
+    f = tmp_path / "shuffled.csv"
+    f.write_text(lines[0] + "\n" + "\n".join(shuffled) + "\n")
+    rc, out, err = cli(capsys, "calibrate", "--platform", "utn-dynamic", "--measurements", f, "--out", tmp_path / "o")
+    assert rc == 1 and "the identification did not converge" in err and err.count("\n") == 1
+    assert "residual RMS" in out  # the result is still shown
+    assert not (tmp_path / "o").exists()
+
+
+def test_simulate_measurements_refuses_keys_that_are_not_geometric(capsys, tmp_path, flow):
+    rc, _, err = cli(capsys, "simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--errors", "payload_mass=±10%", "--out", tmp_path / "o")  # fmt: skip
+    assert rc == 2 and "--errors: key 'payload_mass' is not a geometric error (keys: anchor, leg_offset)" in err
+
+
+def test_the_calibration_commands_run_without_pydrake(flow, tmp_path):
+    """plan-measurements, simulate-measurements and calibrate are numpy commands: with pydrake unimportable
+    they run, and only their own command module is loaded."""
+    from tests.cli.test_cli_lazy import run_blocked
+
+    for argv, module in (
+        (["plan-measurements", "--platform", "utn-dynamic", "--poses", "8", "--candidates", "200", "--out", tmp_path / "p", "--json"], "plan_measurements"),
+        (["simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--out", tmp_path / "m", "--json"], "simulate_measurements"),
+        (["calibrate", "--platform", "utn-dynamic", "--measurements", tmp_path / "m" / "measurements.csv", "--no-plots", "--out", tmp_path / "c", "--json"], "calibrate"),
+    ):  # fmt: skip
+        status, out, err = run_blocked(*map(str, argv))
+        assert status["rc"] == 0 and not status["pydrake"], err
+        assert status["commands"] == [f"stewart_drake.commands.{module}"]
+        json.loads(out)
