@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from stewart_drake.commands._certify import register as register_certify
 from stewart_drake.commands._common import add_platform_arg, print_json
 from stewart_drake.errors import (
     OPTION_FIRMWARE_RATE,
@@ -52,7 +53,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "firmware", help="generate the C firmware (IK + controller tick) or check a C firmware against the emulation"
     )
-    fs = p.add_subparsers(dest="firmware_command", required=True, metavar="generate|check")
+    fs = p.add_subparsers(dest="firmware_command", required=True, metavar="generate|check|certify|optimize")
     g = fs.add_parser("generate", help="emit a self-contained C99 module: sd_ik, sd_init, sd_tick (+ README)")
     _format_args(g)
     g.add_argument(
@@ -87,6 +88,7 @@ def register(sub) -> None:
     )
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_check)
+    register_certify(fs, _format_args, _config, check_firmware_out)
 
 
 def _config(args, platform):
@@ -113,22 +115,30 @@ def _config(args, platform):
     return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=args.convention)
 
 
+def check_firmware_out(out_arg: str) -> Path:
+    """``--out`` for generated firmware: new, or a folder holding only the generator's files (exit 2 otherwise)."""
+    from stewart_drake.firmware.generate import FILES
+
+    out = Path(out_arg)
+    if out.exists():
+        if not out.is_dir():
+            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=out_arg))
+        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
+        if foreign:
+            raise OutputError(OPTION_OUT_FOREIGN.format(out=out_arg, names=", ".join(foreign[:3])))
+    return out
+
+
 def run_generate(args) -> int:
     from stewart_drake.core.c_build import compilers
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.firmware.generate import FILES, generate
+    from stewart_drake.firmware.generate import generate
     from stewart_drake.firmware.module import compile_generated
 
     platform = load_platform(args.platform)
     config = _config(args, platform)
-    out = Path(args.out)
-    if out.exists():
-        if not out.is_dir():
-            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=args.out))
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
-        if foreign:
-            raise OutputError(OPTION_OUT_FOREIGN.format(out=args.out, names=", ".join(foreign[:3])))
+    out = check_firmware_out(args.out)
     g = generate(platform, config)
     compiled = []
     if not args.no_compile:

@@ -32,7 +32,7 @@ class PoseBox:
     def to_units(self, length_unit: str = "mm", angle_unit: str = "pi") -> dict:
         """``{key: [lo, hi]}`` in the given units."""
         s = np.r_[[1 / length_scale(length_unit)] * 3, [1 / angle_scale(angle_unit)] * 3]
-        return {k: [float(self.lo[i] * s[i]), float(self.hi[i] * s[i])] for i, k in enumerate(KEYS)}
+        return {k: [float(f"{self.lo[i] * s[i]:.12g}"), float(f"{self.hi[i] * s[i]:.12g}")] for i, k in enumerate(KEYS)}
 
     def words(self, fmt: QFormat) -> tuple[np.ndarray, np.ndarray]:
         """``(lo, hi)`` int64 (6,) pose words covering every pose of the box (the conversion is monotone)."""

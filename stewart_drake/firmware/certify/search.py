@@ -31,7 +31,7 @@ class Search:
     err_bound_lsb: np.ndarray  # (6,) max over leaves of |L_words - L_true| (inf where saturation is possible)
     witness: np.ndarray | None  # (6,) pose words that saturate the emulation, or None
     witness_ops: dict  # the emulation's saturation counts at the witness
-    witness_words: list  # the words the recipe says clamp at the witness
+    witness_words: list  # the words the recipe says clamp at the witness (the emulation agrees: a test pins it)
     unresolved: np.ndarray  # (k, 2, 6) cells with an undecided saturation and no witness (at most 20)
     unresolved_count: int
     cells: int  # cells evaluated
@@ -120,7 +120,12 @@ class _Hull:
 def run_search(
     model: Model, box_lo: np.ndarray, box_hi: np.ndarray, max_cells: int = MAX_CELLS, seed: int = 0
 ) -> Search:
-    """Certify the box of pose words ``[box_lo, box_hi]`` within ``max_cells`` cell evaluations."""
+    """Certify the box of pose words ``[box_lo, box_hi]`` within ``max_cells`` cell evaluations.
+
+    A cell's priority: infinite while a word may clamp there and no witness has shown that word clamping
+    (split it to decide), -1 once its clamps are all shown (its error is unbounded anyway), else its
+    largest error bound (split the worst first). A word is shown by a witness pose confirmed by the
+    emulation's own saturation counter, or by a cell where it clamps at every pose."""
     names = word_names()
     arith = np.array([n not in BENIGN for n in names])
     rot_words = np.array([n.startswith("R[") for n in names])
@@ -130,33 +135,38 @@ def run_search(
     lo = np.asarray(box_lo, dtype=np.int64)[None, :]
     hi = np.asarray(box_hi, dtype=np.int64)[None, :]
     cells = 0
-    witness, witness_ops, witness_words = None, {}, []
+    shown = np.zeros(len(names), dtype=bool)
+    witnesses: list[tuple[np.ndarray, dict, list]] = []
+
+    def undecided_of(ev: CellEval):
+        return ev.possible & arith & ~ev.certain & ~shown
 
     def score_of(ev: CellEval, lo, hi):
-        undecided = (ev.possible & arith & ~ev.certain).any(axis=1)
         s = ev.err_abs.max(axis=1)
-        s = np.where(undecided, np.inf, s)
-        decided_sat = (ev.certain & arith).any(axis=1)
-        s = np.where(decided_sat, -1.0, s)  # every pose saturates: nothing left to learn by splitting
+        s = np.where((ev.possible & arith).any(axis=1), -1.0, s)
+        if shown.any():  # saturation shown: the error is unbounded, only undecided words are worth splitting for
+            s = np.full_like(s, -1.0)
+        s = np.where(undecided_of(ev).any(axis=1), np.inf, s)
         return np.where(np.all(hi <= lo, axis=1), -2.0, s)  # a single pose: final
 
     def look_for_witness(ev: CellEval, lo, hi):
-        nonlocal witness, witness_ops, witness_words
-        flagged = np.flatnonzero((ev.possible & arith).any(axis=1))
-        if witness is not None or flagged.size == 0:
+        nonlocal shown
+        shown |= (ev.certain & arith).any(axis=0)
+        flagged = np.flatnonzero(undecided_of(ev).any(axis=1))[:256]
+        if flagged.size == 0:
             return
-        flagged = flagged[:256]
         pts = [lo[flagged], hi[flagged], (lo[flagged] + hi[flagged]) // 2]
         pts.append(lo[flagged] + (rng.random(lo[flagged].shape) * (hi[flagged] - lo[flagged] + 1)).astype(np.int64))
         cand = np.concatenate(pts)
         pe = evaluate(model, cand, cand)
-        hit = np.flatnonzero((pe.possible & arith).any(axis=1))
-        for k in hit[:8]:
+        for k in np.flatnonzero((pe.possible & arith & ~shown).any(axis=1))[:8]:
+            new = pe.possible[k] & arith & ~shown
+            if not new.any():
+                continue
             ops = emulation_saturates(model, cand[k])
             if ops:  # confirmed by the emulation itself
-                witness, witness_ops = cand[k].copy(), ops
-                witness_words = [names[j] for j in np.flatnonzero(pe.possible[k] & arith)]
-                return
+                witnesses.append((cand[k].copy(), ops, [names[j] for j in np.flatnonzero(pe.possible[k] & arith)]))
+                shown |= new
 
     ev = evaluate(model, lo, hi)
     cells += 1
@@ -164,58 +174,49 @@ def run_search(
     pool.add(lo, hi, ev, score_of(ev, lo, hi))
     exhausted = False
     while True:
-        s = pool.score
-        if witness is not None:  # saturation shown: stop refining the saturating cells
-            s = np.where(np.isinf(s), -1.0, s)
-            pool.score = s
+        pool.score = s = score_of(pool.ev, pool.lo, pool.hi)
         live = np.flatnonzero(s >= 0)
         if live.size == 0:
             break
-        if cells >= max_cells:
-            exhausted = True
-            break
-        k = min(BATCH, live.size, (max_cells - cells + 1) // 2)
+        k = min(BATCH, live.size, (max_cells - cells) // 2)
         if k <= 0:
             exhausted = True
             break
         top = live[np.argsort(-s[live], kind="stable")[:k]]
-        best = s[top[0]]
         lo, hi, ev_t, _ = pool.take(top)
-        und = ev_t.possible & arith & ~ev_t.certain
+        und = undecided_of(ev_t)
         angles_only = und.any(axis=1) & ~(und & ~rot_words).any(axis=1)
         lo, hi = _split(model, lo, hi, angles_only)
         ev = evaluate(model, lo, hi)
         cells += lo.shape[0]
         look_for_witness(ev, lo, hi)
         pool.add(lo, hi, ev, score_of(ev, lo, hi))
-        if np.isfinite(best) and best <= 0:
-            break
         if pool.lo.shape[0] > MAX_POOL:  # retire the least interesting cells into the running hull
             order = np.argsort(pool.score, kind="stable")
-            lo_r, hi_r, ev_r, _ = pool.take(order[: pool.lo.shape[0] - MAX_POOL // 2])
+            _, _, ev_r, _ = pool.take(order[: pool.lo.shape[0] - MAX_POOL // 2])
             hull.absorb(ev_r)
     hull.absorb(pool.ev)
-    undecided = np.flatnonzero((pool.ev.possible & arith & ~pool.ev.certain).any(axis=1))
-    unresolved = np.stack([pool.lo[undecided[:20]], pool.hi[undecided[:20]]], axis=1) if witness is None else None
-    if hull.certain[arith].any() and witness is None:  # a cell that saturates everywhere: its corner is a witness
-        k = np.flatnonzero((pool.ev.certain & arith).any(axis=1))
-        if k.size:
-            cand = pool.lo[k[0]]
-            ops = emulation_saturates(model, cand)
-            if ops:
-                witness, witness_ops = cand.copy(), ops
-                witness_words = [names[j] for j in np.flatnonzero(pool.ev.certain[k[0]] & arith)]
+    undecided = np.flatnonzero(undecided_of(pool.ev).any(axis=1))
+    certain_cells = np.flatnonzero((pool.ev.certain & arith).any(axis=1))
+    if certain_cells.size and not witnesses:  # a cell that clamps everywhere: its corner is a witness
+        cand = pool.lo[certain_cells[0]]
+        ops = emulation_saturates(model, cand)
+        if ops:
+            witnesses.append(
+                (cand.copy(), ops, [names[j] for j in np.flatnonzero(pool.ev.certain[certain_cells[0]] & arith)])
+            )
+    w = witnesses[0] if witnesses else (None, {}, [])
     return Search(
         hull.pre_lo,
         hull.pre_hi,
         hull.possible,
-        hull.certain,
+        hull.certain | shown,
         hull.err,
-        witness,
-        witness_ops,
-        witness_words,
-        np.zeros((0, 2, 6), dtype=np.int64) if unresolved is None else unresolved,
-        0 if witness is not None else int(undecided.size),
+        w[0],
+        w[1],
+        w[2],
+        np.stack([pool.lo[undecided[:20]], pool.hi[undecided[:20]]], axis=1),
+        int(undecided.size),
         cells,
         exhausted,
     )
