@@ -31,7 +31,7 @@ def add_box_args(p) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="branch-and-bound budget: cells evaluated (default 400000; memory stays bounded whatever N)",
+        help="branch-and-bound budget: cells evaluated (default 200000; memory stays bounded whatever N)",
     )
 
 

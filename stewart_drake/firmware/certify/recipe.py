@@ -233,13 +233,23 @@ def _mulq(a: _V, b: _V, f: int, rec: _Recorder, name: str, m: Model) -> _V:
     return _V(w, e, t)
 
 
-def _addw(acc: _V, term: _V, sign: int, rec: _Recorder, name: str, m: Model, final: bool) -> _V:
+def _addw(
+    acc: _V, term: _V, sign: int, rec: _Recorder, name: str, m: Model, final: bool, bound: float | None = None
+) -> _V:
     if sign > 0:
         lo, hi = acc.w[0] + term.w[0], acc.w[1] + term.w[1]
         e, t = fadd(acc.e, term.e), fadd(acc.t, term.t)
     else:
         lo, hi = acc.w[0] - term.w[1], acc.w[1] - term.w[0]
         e, t = fsub(acc.e, term.e), fsub(acc.t, term.t)
+    if bound is not None:
+        # the true value is bounded by geometry (|R_ij| <= 1): true in [-bound, bound]; where nothing before
+        # clamped, word = true + error exactly, so the integer word lies in [ceil(t + e), floor(t + e)]
+        t = (np.maximum(t[0], -bound), np.minimum(t[1], bound))
+        clean = ~rec.flag(name)
+        te = fadd(t, e)
+        lo = np.where(clean, np.maximum(lo, np.ceil(te[0]).astype(np.int64)), lo)
+        hi = np.where(clean, np.minimum(hi, np.floor(te[1]).astype(np.int64)), hi)
     return _V(rec.sat(name, lo, hi, m.lo, m.hi, final), e, t)
 
 
@@ -284,11 +294,13 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
                     term = _mulq(term, trig[fac], f, rec, name, m)
                 for _ in range(abs(coef)):
                     done += 1
-                    acc = _addw(acc, term, coef, rec, name, m, final=done == adds)
+                    last = done == adds
+                    acc = _addw(acc, term, coef, rec, name, m, last, float(1 << f) if last else None)
             if adds == 0:
                 rec.pre_lo[:, rec.index[name]] = 0
                 rec.pre_hi[:, rec.index[name]] = 0
             R[(i, j)] = acc
+    _exact_rotation(model, cell_lo, cell_hi, rec)
     r_sat = np.zeros(n, dtype=bool)
     for i in range(3):
         for j in range(3):
@@ -355,3 +367,85 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
         err_lo[:, i] = np.where(good, e[0], -np.inf)
         err_hi[:, i] = np.where(good, e[1], np.inf)
     return CellEval(rec.pre_lo, rec.pre_hi, rec.possible, rec.certain, err_lo, err_hi)
+
+
+ENUMERATION_LIMIT = 4096  # angle-word pairs enumerated per cell for an exact rotation hull
+
+
+def _entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+    """R[i][j] before its final clamp, from sine/cosine words (arrays), as rotation_from_words forms it,
+    and where a product or a partial sum on the way clamped."""
+    f = model.fmt.frac_bits
+    shape = np.broadcast(*words.values()).shape
+    acc = np.zeros(shape, dtype=np.int64)
+    clamped = np.zeros(shape, dtype=bool)
+    items = list(model.monomials[i][j].items())
+    adds = sum(abs(c) for _, c in items)
+    done = 0
+    for factors, coef in items:
+        term = words[factors[0]]
+        for fac in factors[1:]:
+            raw = (term * words[fac]) >> f
+            clamped |= (raw < model.lo) | (raw > model.hi)
+            term = np.clip(raw, model.lo, model.hi)
+        for _ in range(abs(coef)):
+            done += 1
+            acc = acc + (term if coef > 0 else -term)
+            if done < adds:
+                clamped |= (acc < model.lo) | (acc > model.hi)
+                acc = np.clip(acc, model.lo, model.hi)
+    return acc, clamped
+
+
+def _exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec: _Recorder) -> None:
+    """Exact hulls of the rotation words in cells where the intervals leave a clamp undecided.
+
+    Each entry holds at most one factor (sine or cosine) of each angle, and every step (product, floor
+    shift, clamp, sum of terms without that angle) is monotone in that factor's word: fixing two angles,
+    the entry's extremes over the third lie at the extremes of its factor words. So enumerating the word
+    pairs of the two narrower angles (up to ``ENUMERATION_LIMIT``) and taking the third's factor extremes
+    gives the exact hull (and where no partial sum clamps, its clamp is decided exactly)."""
+    names = [f"R[{i}][{j}]" for i in range(3) for j in range(3)]
+    cols = [rec.index[nm] for nm in names]
+    flagged = np.flatnonzero(rec.possible[:, cols].any(axis=1))
+    if flagged.size == 0:
+        return
+    tb = model.tables
+    width = cell_hi[:, 3:] - cell_lo[:, 3:] + 1
+    for c in flagged:
+        free = int(np.argmax(width[c]))
+        pair = [k for k in range(3) if k != free]
+        if int(width[c, pair[0]]) * int(width[c, pair[1]]) > ENUMERATION_LIMIT:
+            continue
+        ga, gb = np.meshgrid(
+            np.arange(cell_lo[c, 3 + pair[0]], cell_hi[c, 3 + pair[0]] + 1),
+            np.arange(cell_lo[c, 3 + pair[1]], cell_hi[c, 3 + pair[1]] + 1),
+            indexing="ij",
+        )
+        grid = {pair[0]: ga.ravel(), pair[1]: gb.ravel()}
+        words = {}
+        for k in pair:
+            s_, c_ = trig_words(grid[k], model.fmt)
+            words[f"s{AXES[k]}"], words[f"c{AXES[k]}"] = s_, c_
+        ext = {}
+        for nm, tab in (("s", tb.sin_pre), ("c", tb.cos_pre)):
+            lo_, hi_ = tab.query(cell_lo[c : c + 1, 3 + free], cell_hi[c : c + 1, 3 + free])
+            ext[nm] = np.clip(np.array([lo_[0], hi_[0]]), model.lo, model.hi)
+        lo_all = []
+        for i in range(3):
+            for j in range(3):
+                vals = []
+                for which in (0, 1):
+                    w = dict(words)
+                    w[f"s{AXES[free]}"] = ext["s"][which]
+                    w[f"c{AXES[free]}"] = ext["c"][which]
+                    vals.append(_entry(model, w, i, j))
+                v = np.concatenate([vals[0][0].ravel(), vals[1][0].ravel()])
+                inner = bool(vals[0][1].any() or vals[1][1].any())
+                lo_all.append((int(v.min()), int(v.max()), inner))
+        for col, (lo_, hi_, inner) in zip(cols, lo_all):
+            rec.pre_lo[c, col], rec.pre_hi[c, col] = lo_, hi_
+            # an inner clamp makes the path non-monotone in general: keep the interval flags then
+            if not inner:
+                rec.possible[c, col] = (hi_ > model.hi) | (lo_ < model.lo)
+                rec.certain[c, col] = (lo_ > model.hi) | (hi_ < model.lo)

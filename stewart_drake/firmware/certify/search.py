@@ -14,9 +14,9 @@ from stewart_drake.firmware.certify.recipe import BENIGN, CellEval, Model, evalu
 from stewart_drake.fixedpoint.generic import leg_length_words
 from stewart_drake.fixedpoint.q15 import SaturationCounter
 
-MAX_CELLS = 400_000  # default evaluation budget
+MAX_CELLS = 200_000  # default evaluation budget
 BATCH = 4096  # cells split per round
-MAX_POOL = 65_536  # live cells kept; beyond, the least interesting retire into the running hulls
+MAX_POOL = 32_768  # live cells kept; beyond, the least interesting retire into the running hulls
 ARITHMETIC_OPS = ("generic.mult", "generic.add", "generic.sub", "generic.L_add", "generic.sqrt")
 
 
@@ -44,9 +44,15 @@ def _split_dim(model: Model, lo: np.ndarray, hi: np.ndarray, angles_only: np.nda
     f = model.fmt.frac_bits
     sens = np.r_[[1.0] * 3, [np.pi / (1 << f) * (np.abs(model.r_T).max() + 1.0)] * 3]
     eff = (hi - lo).astype(float) * sens
-    eff[angles_only, :3] = -0.5
     eff[hi <= lo] = -1.0
-    return np.argmax(eff, axis=1)
+    d = np.argmax(eff, axis=1)
+    # rotation words alone undecided: the exact rotation hull enumerates the two narrower angles and takes
+    # the widest at its extremes, so halve the wider of the two narrower angles
+    ang = (hi[:, 3:] - lo[:, 3:]).astype(float)
+    ang[np.arange(ang.shape[0]), np.argmax(ang, axis=1)] = -1.0
+    d_rot = 3 + np.argmax(ang, axis=1)
+    ok = ang[np.arange(ang.shape[0]), d_rot - 3] > 0
+    return np.where(angles_only & ok, d_rot, d)
 
 
 def _split(model: Model, lo: np.ndarray, hi: np.ndarray, angles_only: np.ndarray):
