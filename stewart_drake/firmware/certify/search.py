@@ -162,6 +162,8 @@ def run_search(
         if flagged.size == 0:
             return
         pts = [lo[flagged], hi[flagged], (lo[flagged] + hi[flagged]) // 2]
+        if cells <= 1:  # the whole box: its 64 corners, where the longest legs are
+            pts.append(np.array([[hi[0, k] if (c >> k) & 1 else lo[0, k] for k in range(6)] for c in range(64)]))
         pts.append(lo[flagged] + (rng.random(lo[flagged].shape) * (hi[flagged] - lo[flagged] + 1)).astype(np.int64))
         cand = np.concatenate(pts)
         pe = evaluate(model, cand, cand)
@@ -179,12 +181,17 @@ def run_search(
     look_for_witness(ev, lo, hi)
     pool.add(lo, hi, ev, score_of(ev, lo, hi))
     exhausted = False
+    first_witness_at = None
     while True:
+        if witnesses and first_witness_at is None:
+            first_witness_at = cells
         pool.score = s = score_of(pool.ev, pool.lo, pool.hi)
         live = np.flatnonzero(s >= 0)
         if live.size == 0:
             break
-        k = min(BATCH, live.size, (max_cells - cells) // 2)
+        # once a witness shows saturation, deciding the other words gets a quarter of the budget
+        limit = max_cells if not witnesses else min(max_cells, first_witness_at + max_cells // 4)
+        k = min(BATCH, live.size, (limit - cells) // 2)
         if k <= 0:
             exhausted = True
             break

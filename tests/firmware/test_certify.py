@@ -1,0 +1,203 @@
+"""The firmware certificate (``firmware.certify``): the interval recipe against the bit-exact emulation,
+the soundness of its hulls and error enclosures, and the verdicts the issue names.
+
+The checks against samples here use a few thousand poses, not the 10^7 of the done-when: CI must stay
+short; ``benchmarks/bench_certify.py --poses 10000000`` runs the full comparison by hand."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from flint import arb, ctx
+
+from stewart_drake.cli import main
+from stewart_drake.core.geometry import load_platform, load_preset
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.errors import CertifyError
+from stewart_drake.firmware.certify.box import workspace_box
+from stewart_drake.firmware.certify.certificate import certify
+from stewart_drake.firmware.certify.intervals import RangeTable
+from stewart_drake.firmware.certify.recipe import Model, evaluate, isqrt_nearest, word_names
+from stewart_drake.firmware.certify.sampling import sample_box, word_pose_si
+from stewart_drake.firmware.check import emulation_trace
+from stewart_drake.fixedpoint.generic import QFormat, leg_length_words
+from stewart_drake.fixedpoint.q15 import SaturationCounter
+
+FORMATS = [
+    ("utn-kinematic", QFormat(16, 1e-3, "tfr16")),
+    ("utn-dynamic", QFormat(16, 2e-5, "exact")),  # saturates: the hulls must still match
+    ("gonzalez-dutra-2009", QFormat(12, 1e-3, "exact")),
+]
+
+
+class _Config:
+    def __init__(self, fmt):
+        self.ik_format, self.convention = fmt, "utn"
+
+
+def _words_in_box(model, box, n, seed):
+    lo, hi = box.words(model.fmt)
+    rng = np.random.default_rng(seed)
+    return lo + np.floor(rng.random((n, 6)) * (hi - lo + 1)).astype(np.int64)
+
+
+@pytest.mark.parametrize("name,fmt", FORMATS, ids=[f[0] for f in FORMATS])
+def test_a_one_pose_cell_gives_the_emulations_words(name, fmt):
+    """At a cell of one pose the interval recipe is the emulation, word for word (``emulation_trace`` is
+    independent scalar code): the certifier cannot drift from the firmware it certifies."""
+    platform = load_platform(name)
+    model = Model.build(platform, fmt)
+    w = _words_in_box(model, workspace_box(platform), 60, 1)
+    lo, hi = evaluate(model, w, w).post(model)
+    assert np.array_equal(lo, hi)
+    want = np.array([emulation_trace(platform, w[k], _Config(fmt)) for k in range(len(w))])
+    assert np.array_equal(lo, want)
+
+
+@pytest.mark.parametrize("name,fmt", FORMATS, ids=[f[0] for f in FORMATS])
+def test_cell_hulls_and_error_enclosures_hold_every_pose_inside(name, fmt):
+    """Random small cells: every word of every pose inside lies in the cell's hull, and every pose's
+    L_emulation - L_double lies in the cell's error enclosure (where it is finite)."""
+    platform = load_platform(name)
+    model = Model.build(platform, fmt)
+    rng = np.random.default_rng(2)
+    c_lo = _words_in_box(model, workspace_box(platform), 40, 3)
+    c_hi = c_lo + rng.integers(0, 40, (40, 6))
+    ev = evaluate(model, c_lo, c_hi)
+    post_lo, post_hi = ev.post(model)
+    for k in range(40):
+        pts = c_lo[k] + np.floor(rng.random((50, 6)) * (c_hi[k] - c_lo[k] + 1)).astype(np.int64)
+        pe = evaluate(model, pts, pts)
+        pl, _ = pe.post(model)
+        assert np.all(pl >= post_lo[k]) and np.all(pl <= post_hi[k])
+        assert np.all(pe.pre_lo >= ev.pre_lo[k]) and np.all(pe.pre_lo <= ev.pre_hi[k])
+        assert not np.any(pe.possible & ~ev.possible[k])  # a clamp at a pose is flagged in its cell
+        err = leg_length_words(platform, pts, fmt) - leg_lengths(platform, word_pose_si(model, pts)) / fmt.length_lsb
+        fin = np.isfinite(ev.err_lo[k])
+        assert np.all(err[:, fin] >= ev.err_lo[k, fin]) and np.all(err[:, fin] <= ev.err_hi[k, fin])
+
+
+def test_error_enclosure_contains_the_exact_ik_in_arb_balls():
+    """The float side made rigorous: the leg length at the word pose computed in arb balls (python-flint,
+    200 bits) lies inside L_words - [err_lo, err_hi] at single poses."""
+    platform = load_platform("utn-kinematic")
+    fmt = QFormat(16, 1e-4, "tfr16")
+    model = Model.build(platform, fmt)
+    w = _words_in_box(model, workspace_box(platform), 5, 4)
+    ev = evaluate(model, w, w)
+    Lw = leg_length_words(platform, w, fmt)
+    r_T = platform.top_anchors_per_leg - platform.rotation_centre
+    ctx.prec = 200
+    for k in range(len(w)):
+        ang = [arb(int(v)) * arb.pi() / (1 << fmt.frac_bits) for v in w[k, 3:]]
+        s = [a.sin() for a in ang]
+        c = [a.cos() for a in ang]
+        # utn: R = Ry(b) Rx(a) Rz(g) (the convention's definition; checked against rotation_matrix below)
+        R = [
+            [c[1] * c[2] + s[1] * s[0] * s[2], -c[1] * s[2] + s[1] * s[0] * c[2], s[1] * c[0]],
+            [c[0] * s[2], c[0] * c[2], -s[0]],
+            [-s[1] * c[2] + c[1] * s[0] * s[2], s[1] * s[2] + c[1] * s[0] * c[2], c[1] * c[0]],
+        ]
+        Rf = rotation_matrix(word_pose_si(model, w[k])[3:], "utn")
+        assert np.allclose([[float(x.mid()) for x in row] for row in R], Rf, atol=1e-15)
+        p = [arb(int(v)) * arb(fmt.length_lsb) for v in w[k, :3]]
+        for i in range(6):
+            v = [
+                p[r] + sum(R[r][j] * arb(float(r_T[i, j])) for j in range(3)) - arb(float(platform.base_anchors[i, r]))
+                for r in range(3)
+            ]
+            L = (v[0] ** 2 + v[1] ** 2 + v[2] ** 2).sqrt() / arb(fmt.length_lsb)
+            assert float(Lw[k, i]) - ev.err_hi[k, i] <= float(L.lower())
+            assert float(L.upper()) <= float(Lw[k, i]) - ev.err_lo[k, i]
+
+
+def test_range_table_gives_the_exact_min_and_max():
+    v = np.random.default_rng(5).integers(-1000, 1000, 777)
+    t = RangeTable(v, offset=-10)
+    rng = np.random.default_rng(6)
+    a = rng.integers(-10, 767, 300)
+    b = np.minimum(a + rng.integers(0, 300, 300), 766)
+    mn, mx = t.query(a, b)
+    assert all(mn[k] == v[a[k] + 10 : b[k] + 11].min() and mx[k] == v[a[k] + 10 : b[k] + 11].max() for k in range(300))
+
+
+def test_isqrt_nearest_is_the_nearest_of_two_rule():
+    S = np.r_[np.arange(0, 5000), np.random.default_rng(0).integers(0, 2**31 - 1, 5000)]
+    y = isqrt_nearest(S)
+    assert np.all(np.abs(y * y - S) <= np.minimum(np.abs((y + 1) ** 2 - S), np.abs((y - 1) ** 2 - S)))
+
+
+def test_default_format_bound_holds_and_is_within_twice_the_sampled_worst():
+    """utn-kinematic's workspace box at the default format: no saturation; the proven bound is above the
+    worst of 3,000 random + 37,000 adversarial poses and within twice it (the benchmark repeats this on 10^7)."""
+    platform = load_preset("utn-kinematic")
+    fmt = QFormat(16, 1e-3, "tfr16")
+    box = workspace_box(platform)
+    cert = certify(platform, fmt, box, max_cells=30_000)
+    assert not cert.saturation_possible
+    model = Model.build(platform, fmt)
+    s = sample_box(model, *box.words(fmt), 3000, seed=0, adversarial=6)
+    worst_mm = s.worst_err * fmt.length_lsb * 1e3
+    bound = np.array(cert.error_bound_mm)
+    assert np.all(bound >= worst_mm)
+    assert bound.max() <= 2 * worst_mm.max()
+    names = word_names()
+    proven = {w.name: w for w in cert.words}
+    for k, n in enumerate(names):
+        assert proven[n].min <= s.word_min[k] and s.word_max[k] <= proven[n].max, n
+
+
+def test_lsb_2e5_saturates_with_a_witness_and_1e4_proves_none(capsys):
+    """The issue's pair, through the command: utn-kinematic over its workspace box (±60 mm, 120–250 mm,
+    ±0.08π) saturates at a 20 µm LSB, with a witness the emulation itself saturates at (exit 1); at 100 µm
+    the certificate proves no saturation anywhere (exit 0)."""
+    platform = load_preset("utn-kinematic")
+    args = ["firmware", "certify", "--platform", "utn-kinematic", "--workspace", "--max-cells", "20000", "--json"]
+    assert main(args + ["--length-lsb", "2e-5"]) == 1
+    d = json.loads(capsys.readouterr().out)
+    assert d["box"] == {"px": [-60, 60], "py": [-60, 60], "pz": [120, 250], **{k: [-0.08, 0.08] for k in "abg"}}
+    assert d["saturation_possible"] is True and d["witness"]["saturates"]
+    assert {"name", "min", "max", "headroom_bits", "saturation"} <= set(d["words"][0])
+    assert d["error_bound_mm"] == [None] * 6
+    w = np.array(d["witness"]["pose_words"])
+    fmt = QFormat(16, 2e-5, "tfr16")
+    lo, hi = workspace_box(platform).words(fmt)
+    assert np.all(w >= lo) and np.all(w <= hi)
+    with SaturationCounter() as sat:  # the emulation itself saturates at the witness
+        leg_length_words(platform, w, fmt)
+    assert sat.counts["generic.sqrt"] >= 1
+    assert main(args + ["--length-lsb", "1e-4"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["saturation_possible"] is False and d["unresolved_count"] == 0 and d["witness"] is None
+    assert all(w["saturation"] == "impossible" for w in d["words"] if not w["benign"])
+    assert all(0 < e < 1.0 for e in d["error_bound_mm"])
+
+
+@pytest.mark.parametrize(
+    "box,message",
+    [
+        (["pz=250..120"], CertifyError.BOX_ORDER.format(value="pz=250..120")),
+        (["q=1..2"], CertifyError.BOX_WORD.format(value="q=1..2")),
+        (["a=-2..2"], CertifyError.BOX_ANGLE.format(value="a=-2..2")),
+        (["px=1..2", "px=3..4"], CertifyError.BOX_TWICE.format(key="px", value="px=3..4")),
+    ],
+)
+def test_bad_box_is_one_line_exit_2(box, message, capsys):
+    assert main(["firmware", "certify", "--platform", "utn-kinematic", "--box", *box]) == 2
+    assert capsys.readouterr().err.strip().endswith(message)
+
+
+def test_a_user_platform_file(tmp_path, capsys):
+    """A platform of our own (the radial template), its default workspace box."""
+    yaml = tmp_path / "mine.yaml"
+    assert main(["init", "--platform-template", "radial"]) == 0
+    yaml.write_text(capsys.readouterr().out)
+    platform = load_platform(str(yaml))
+    cert = certify(platform, QFormat(16, 1e-3, "tfr16"), workspace_box(platform), max_cells=20_000)
+    assert not cert.saturation_possible
+    model = Model.build(platform, cert.fmt)
+    s = sample_box(model, *workspace_box(platform).words(cert.fmt), 2000, seed=1)
+    assert np.all(np.array(cert.error_bound_mm) >= s.worst_err * 1e-3 * 1e3)
