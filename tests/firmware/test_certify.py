@@ -17,7 +17,7 @@ from stewart_drake.core.geometry import load_platform, load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import CertifyError
-from stewart_drake.firmware.certify.box import workspace_box
+from stewart_drake.firmware.certify.box import parse_box, workspace_box
 from stewart_drake.firmware.certify.certificate import certify
 from stewart_drake.firmware.certify.intervals import RangeTable
 from stewart_drake.firmware.certify.recipe import Model, evaluate, isqrt_nearest, word_names
@@ -201,3 +201,33 @@ def test_a_user_platform_file(tmp_path, capsys):
     model = Model.build(platform, cert.fmt)
     s = sample_box(model, *workspace_box(platform).words(cert.fmt), 2000, seed=1)
     assert np.all(np.array(cert.error_bound_mm) >= s.worst_err * 1e-3 * 1e3)
+
+
+def test_optimize_meets_the_budget_with_a_proof_and_its_firmware_matches_the_emulation():
+    """A small box and a 0.5 mm budget: the chosen formats have a proven bound within the budget and no
+    possible saturation; their generated sd_ik (compiled) equals the emulation on the check's poses and
+    its sampled error is within the budget; the simulation-only choice never has fewer proven guarantees
+    than it claims silently (if it is not provable, it is reported as such)."""
+    from stewart_drake.control.gains import ControllerConfig
+    from stewart_drake.firmware.certify.optimize import optimize
+    from stewart_drake.firmware.certify.sampling import length_errors
+    from stewart_drake.firmware.check import check_ik
+    from stewart_drake.firmware.module import compile_generated
+
+    platform = load_preset("utn-kinematic")
+    box = parse_box(
+        ["px=-10..10", "py=-10..10", "pz=150..170", "a=-0.02..0.02", "b=-0.02..0.02", "g=-0.02..0.02"], platform
+    )
+    config = ControllerConfig.for_platform(platform)
+    res = optimize(platform, config, box, 0.5e-3, "bits", max_cells=4000, search_cells=4000, samples=2000)
+    c = res.chosen
+    assert c is not None and not c.saturation_possible and c.error_mm <= 0.5
+    assert c.fmt.word_bits <= res.default.fmt.word_bits
+    assert res.default.error_mm is None or res.default.error_mm > 0.5  # the default 1 mm LSB cannot meet it
+    model = Model.build(platform, c.fmt)
+    w = _words_in_box(model, box, 5000, 9)
+    assert np.abs(length_errors(model, w)).max() * c.fmt.length_lsb <= 0.5e-3
+    r = check_ik(compile_generated(res.firmware), platform, res.firmware.config, 20_000)
+    assert r["differing_poses"] == 0
+    assert res.simulation_only is not None and res.simulation_only_proven is not None
+    assert res.simulation_only_proven.fmt == res.simulation_only.fmt
