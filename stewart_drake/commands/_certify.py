@@ -4,8 +4,11 @@ by that proof."""
 
 from __future__ import annotations
 
+import math
+
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
+from stewart_drake.errors import OptionError
 
 
 def add_box_args(p) -> None:
@@ -51,6 +54,14 @@ def register(fs, format_args, make_config, check_out) -> None:
         default="generated",
         help="generated: the sd_ik of `firmware generate` with these format options (default)",
     )
+    c.add_argument(
+        "--tick",
+        action="store_true",
+        help="also certify sd_tick's PID words for the stated bounds (--tick-error, --tick-speed, --tick-feedforward)",
+    )
+    c.add_argument("--tick-error", type=float, default=5.0, metavar="MM", help="|set-point - measured| bound, mm (5)")
+    c.add_argument("--tick-speed", type=float, default=0.1, metavar="M/S", help="leg speed bound, m/s (0.1)")
+    c.add_argument("--tick-feedforward", type=float, default=0.0, metavar="N", help="|feed-forward| bound, N (0: none)")
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_certify, make_config=make_config)
     o = fs.add_parser(
@@ -81,6 +92,7 @@ def _max_cells(args) -> int:
 def run_certify(args) -> int:
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.firmware.certify.certificate import certify
+    from stewart_drake.firmware.certify.tick import certify_tick
 
     platform = load_platform(args.platform)
     config = args.make_config(args, platform)
@@ -88,11 +100,43 @@ def run_certify(args) -> int:
     cert = certify(
         platform, config.ik_format, box, config.convention, _max_cells(args), args.length_unit, args.angle_unit
     )
+    tick = None
+    if args.tick:
+        for opt, v in (
+            ("--tick-error", args.tick_error),
+            ("--tick-speed", args.tick_speed),
+            ("--tick-feedforward", args.tick_feedforward),
+        ):
+            if not (math.isfinite(v) and v >= 0):
+                raise OptionError(OptionError.AT_LEAST.format(option=opt, min=0, value=v))
+        tick = certify_tick(config, args.tick_error * 1e-3, args.tick_speed, args.tick_feedforward)
     if args.json:
-        print_json(cert.to_dict())
+        d = cert.to_dict()
+        if tick is not None:
+            d["tick"] = tick.to_dict()
+        print_json(d)
     else:
         print(format_certificate(cert))
+        if tick is not None:
+            print(format_tick(tick))
     return 1 if cert.saturation_possible else 0
+
+
+def format_tick(tick) -> str:
+    """The tick's certificate as text."""
+    lines = [
+        f"sd_tick for |error| <= {tick.max_error_m * 1e3:g} mm, leg speed <= {tick.max_speed_mps:g} m/s, "
+        f"|feed-forward| <= {tick.max_feedforward_n:g} N:",
+        f"{'word':>28} {'proven min':>12} {'proven max':>12} {'headroom':>9}  saturation",
+    ]
+    for w in tick.words:
+        lines.append(f"{w.name:>28} {w.min:>12} {w.max:>12} {w.headroom_bits:>8.2f}b  {w.saturation}")
+    lines.append(
+        "anti-windup: the integrator is proven to stay inside its Q31 rails"
+        if tick.anti_windup
+        else "anti-windup: not proven to keep the integrator off its rails (it may reach them; saturating adds: no wrap)"
+    )
+    return "\n".join(lines)
 
 
 def format_certificate(cert) -> str:
