@@ -38,9 +38,10 @@ def main() -> None:
     ap.add_argument("--poses", type=int, default=0, help="random poses per preset for the comparison (0: skip)")
     ap.add_argument("--adversarial", type=int, default=200, help="local-search rounds after the random poses")
     ap.add_argument("--lsb", type=float, default=1e-3, help="length LSB (m), default 1e-3")
+    ap.add_argument("--preset", action="append", choices=PRESETS, help="only these presets (default: all)")
     a = ap.parse_args()
     fmt = QFormat(16, a.lsb, "tfr16")
-    for name in PRESETS:
+    for name in a.preset or PRESETS:
         p = load_preset(name)
         box = workspace_box(p)
         t0, c0 = time.perf_counter(), time.process_time()

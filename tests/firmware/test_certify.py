@@ -279,3 +279,30 @@ def test_tick_ranges_hold_along_runs_of_the_fixed_point_law():
         dfilt_seen = [min(dfilt_seen[0], df.min()), max(dfilt_seen[1], df.max())]
     w = words["derivative filter"]
     assert w.min <= dfilt_seen[0] and dfilt_seen[1] <= w.max
+
+
+@pytest.mark.parametrize("convention", ["utn", "zyx"])
+def test_rotation_hulls_near_zero_angles_are_exact(convention):
+    """Cells around zero angles, where the intervals leave R's clamp undecided and the enumeration takes
+    over: the hull of every rotation word equals the brute-force hull over every angle word of the cell."""
+    from stewart_drake.fixedpoint.generic import rotation_from_words
+
+    platform = load_preset("utn-kinematic")
+    fmt = QFormat(12, 1e-3, "exact")
+    model = Model.build(platform, fmt, convention)
+    rng = np.random.default_rng(8)
+    for _ in range(4):
+        a_lo = rng.integers(-30, 5, 3)
+        c_lo = np.r_[0, 0, 200, a_lo][None, :]
+        c_hi = np.r_[0, 0, 200, a_lo + rng.integers(3, 25, 3)][None, :]
+        ev = evaluate(model, c_lo, c_hi)
+        grids = np.meshgrid(*[np.arange(c_lo[0, 3 + k], c_hi[0, 3 + k] + 1) for k in range(3)], indexing="ij")
+        w = np.stack([g.ravel() for g in grids], axis=-1)
+        R = rotation_from_words(w, fmt, convention).reshape(-1, 9)  # clamped words, as the firmware holds them
+        lo, hi = ev.post(model)
+        names = word_names()
+        for j in range(9):
+            k = names.index(f"R[{j // 3}][{j % 3}]")
+            assert lo[0, k] <= R[:, j].min() and R[:, j].max() <= hi[0, k]
+            if j in (0, 4, 8) and not ev.possible[0, k]:  # near 1: enumerated, decided, so exact
+                assert (lo[0, k], hi[0, k]) == (R[:, j].min(), R[:, j].max())

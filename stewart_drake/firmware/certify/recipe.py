@@ -134,6 +134,18 @@ class Model:
         )
 
     @property
+    def free_axis(self) -> int:
+        """The angle every rotation entry holds at most one factor of (the middle rotation)."""
+        for k, ax in enumerate(AXES):
+            if all(
+                len({fac for factors in e for fac in factors if fac[1] == ax}) <= 1
+                for row in self.monomials
+                for e in row
+            ):
+                return k
+        raise RuntimeError("no rotation angle enters every entry once")  # internal: not an Euler product
+
+    @property
     def lo(self) -> int:
         return -(1 << self.fmt.frac_bits)
 
@@ -400,11 +412,12 @@ def _entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.nd
 def _exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec: _Recorder) -> None:
     """Exact hulls of the rotation words in cells where the intervals leave a clamp undecided.
 
-    Each entry holds at most one factor (sine or cosine) of each angle, and every step (product, floor
-    shift, clamp, sum of terms without that angle) is monotone in that factor's word: fixing two angles,
-    the entry's extremes over the third lie at the extremes of its factor words. So enumerating the word
-    pairs of the two narrower angles (up to ``ENUMERATION_LIMIT``) and taking the third's factor extremes
-    gives the exact hull (and where no partial sum clamps, its clamp is decided exactly)."""
+    Every entry holds at most one factor (sine or cosine) of the middle rotation's angle (``free_axis``),
+    and every step (product, floor shift, clamp, sum of terms without that angle) is monotone in that
+    factor's word: fixing the other two angles, the entry's extremes lie at the extremes of its factor
+    words. So enumerating the word pairs of the other two angles (up to ``ENUMERATION_LIMIT``) and taking
+    the free angle's factor extremes gives the exact hull (and where no product or partial sum clamps, its
+    clamp is decided exactly)."""
     names = [f"R[{i}][{j}]" for i in range(3) for j in range(3)]
     cols = [rec.index[nm] for nm in names]
     flagged = np.flatnonzero(rec.possible[:, cols].any(axis=1))
@@ -412,9 +425,9 @@ def _exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec:
         return
     tb = model.tables
     width = cell_hi[:, 3:] - cell_lo[:, 3:] + 1
+    free = model.free_axis
+    pair = [k for k in range(3) if k != free]
     for c in flagged:
-        free = int(np.argmax(width[c]))
-        pair = [k for k in range(3) if k != free]
         if int(width[c, pair[0]]) * int(width[c, pair[1]]) > ENUMERATION_LIMIT:
             continue
         ga, gb = np.meshgrid(

@@ -46,10 +46,10 @@ def _split_dim(model: Model, lo: np.ndarray, hi: np.ndarray, angles_only: np.nda
     eff = (hi - lo).astype(float) * sens
     eff[hi <= lo] = -1.0
     d = np.argmax(eff, axis=1)
-    # rotation words alone undecided: the exact rotation hull enumerates the two narrower angles and takes
-    # the widest at its extremes, so halve the wider of the two narrower angles
+    # rotation words alone undecided: the exact rotation hull enumerates the two angles other than the
+    # middle rotation's and takes that one at its extremes, so halve the wider of the two others
     ang = (hi[:, 3:] - lo[:, 3:]).astype(float)
-    ang[np.arange(ang.shape[0]), np.argmax(ang, axis=1)] = -1.0
+    ang[:, model.free_axis] = -1.0
     d_rot = 3 + np.argmax(ang, axis=1)
     ok = ang[np.arange(ang.shape[0]), d_rot - 3] > 0
     return np.where(angles_only & ok, d_rot, d)
