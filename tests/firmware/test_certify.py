@@ -306,3 +306,13 @@ def test_rotation_hulls_near_zero_angles_are_exact(convention):
             assert lo[0, k] <= R[:, j].min() and R[:, j].max() <= hi[0, k]
             if j in (0, 4, 8) and not ev.possible[0, k]:  # near 1: enumerated, decided, so exact
                 assert (lo[0, k], hi[0, k]) == (R[:, j].min(), R[:, j].max())
+
+
+def test_certify_tick_option(capsys):
+    args = ["firmware", "certify", "--platform", "utn-dynamic", "--max-cells", "2000", "--tick", "--json"]
+    main(args + ["--tick-speed", "0"])  # the IK verdict at this tiny budget does not matter here
+    tick = json.loads(capsys.readouterr().out)["tick"]
+    assert tick["anti_windup_proven"] is True and tick["no_wrap"] is True
+    assert {w["name"] for w in tick["words"]} >= {"integrator (Q31)", "derivative filter", "command (Q15)"}
+    assert main(args + ["--tick-error", "-1"]) == 2
+    assert capsys.readouterr().err.endswith("--tick-error must be >= 0, got -1\n")
