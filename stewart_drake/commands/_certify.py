@@ -8,7 +8,8 @@ import math
 
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
-from stewart_drake.errors import OptionError
+from stewart_drake.errors import CertifyError, OptionError
+from stewart_drake.fixedpoint.generic import QFormat
 
 
 def add_box_args(p) -> None:
@@ -50,9 +51,10 @@ def register(fs, format_args, make_config, check_out) -> None:
     add_box_args(c)
     c.add_argument(
         "--implementation",
-        choices=["generated"],
+        choices=["generated", "tp17"],
         default="generated",
-        help="generated: the sd_ik of `firmware generate` with these format options (default)",
+        help="generated: the sd_ik of `firmware generate` with these format options (default); "
+        "tp17: the seed's DSP firmware (utn-kinematic; its own 16-bit, 1 mm, tfr16 words)",
     )
     c.add_argument(
         "--tick",
@@ -97,8 +99,13 @@ def run_certify(args) -> int:
     platform = load_platform(args.platform)
     config = args.make_config(args, platform)
     box = _box(args, platform)
+    fmt = config.ik_format
+    if args.implementation == "tp17":
+        if platform.name != "utn-kinematic":
+            raise CertifyError(CertifyError.IMPLEMENTATION.format(value=args.platform))
+        fmt = QFormat(16, 1e-3, "tfr16")
     cert = certify(
-        platform, config.ik_format, box, config.convention, _max_cells(args), args.length_unit, args.angle_unit
+        platform, fmt, box, config.convention, _max_cells(args), args.length_unit, args.angle_unit, args.implementation
     )
     tick = None
     if args.tick:

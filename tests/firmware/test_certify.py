@@ -316,3 +316,28 @@ def test_certify_tick_option(capsys):
     assert {w["name"] for w in tick["words"]} >= {"integrator (Q31)", "derivative filter", "command (Q15)"}
     assert main(args + ["--tick-error", "-1"]) == 2
     assert capsys.readouterr().err.endswith("--tick-error must be >= 0, got -1\n")
+
+
+def test_tp17_one_pose_cells_give_tp17_trace_and_the_bound_holds():
+    """The seed's firmware: at cells of one pose the interval recipe gives every word of ``tp17_trace``;
+    the certificate over the workspace box proves no saturation and its bound is above the sampled worst
+    error of tp17 against utn-kinematic's float IK (a = 612.5 mm)."""
+    from stewart_drake.firmware.certify.tp17_recipe import evaluate_tp17, tp17_model
+    from stewart_drake.fixedpoint.tp17 import dsp_poses_to_si, tp17_leg_lengths, tp17_trace
+
+    platform = load_preset("utn-kinematic")
+    model = tp17_model(platform)
+    rng = np.random.default_rng(4)
+    lo, hi = np.array([-60, -60, 120, -2621, -2621, -2621]), np.array([60, 60, 250, 2621, 2621, 2621])
+    w = lo + np.floor(rng.random((200, 6)) * (hi - lo + 1)).astype(np.int64)
+    ev = evaluate_tp17(model, w, w)
+    q = np.c_[w[:, :3].astype(float), w[:, 3:] / 32768.0]
+    tr = tp17_trace(q)
+    want = np.concatenate([w, tr.sin, tr.cos, tr.R.reshape(-1, 9), tr.leg.reshape(-1, 18), tr.L32, tr.lengths], axis=1)
+    assert np.array_equal(ev.pre_lo, want) and np.array_equal(ev.pre_hi, want)
+    cert = certify(platform, model.fmt, workspace_box(platform), max_cells=20_000, implementation="tp17")
+    assert not cert.saturation_possible
+    w = lo + np.floor(rng.random((20_000, 6)) * (hi - lo + 1)).astype(np.int64)
+    q = np.c_[w[:, :3].astype(float), w[:, 3:] / 32768.0]
+    err = np.abs(tp17_leg_lengths(q) - leg_lengths(platform, dsp_poses_to_si(q)) * 1e3).max(axis=0)
+    assert np.all(np.array(cert.error_bound_mm) >= err)

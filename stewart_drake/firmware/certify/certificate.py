@@ -14,6 +14,7 @@ from stewart_drake.errors import CertifyError
 from stewart_drake.firmware.certify.box import KEYS, PoseBox
 from stewart_drake.firmware.certify.recipe import BENIGN, Model, word_names
 from stewart_drake.firmware.certify.search import MAX_CELLS, run_search
+from stewart_drake.firmware.certify.tp17_recipe import tp17_word_names
 from stewart_drake.fixedpoint.generic import QFormat
 
 # |L_double - L_exact|: the double IK is ~30 correctly rounded operations on values below 10 m, so its
@@ -72,6 +73,7 @@ class Certificate:
     unresolved_count: int = 0
     cells: int = 0
     exhausted: bool = False
+    implementation: str = "generated"
 
     @property
     def error_bound_mm(self) -> list:
@@ -101,7 +103,7 @@ class Certificate:
     def to_dict(self) -> dict:
         return {
             "platform": self.platform,
-            "implementation": "generated",
+            "implementation": self.implementation,
             "format": {
                 "word_bits": self.fmt.word_bits,
                 "length_lsb_m": self.fmt.length_lsb,
@@ -139,10 +141,12 @@ def certify(
     max_cells: int = MAX_CELLS,
     length_unit: str = "mm",
     angle_unit: str = "pi",
+    implementation: str = "generated",
 ) -> Certificate:
     """Certify the generated ``sd_ik`` of ``platform`` in format ``fmt`` over every pose of ``box``
-    (within ``max_cells`` cell evaluations; memory bounded). Raises ``CertifyError`` if a box end does
-    not fit the pose words."""
+    (within ``max_cells`` cell evaluations; memory bounded). ``implementation="tp17"``: the seed's DSP
+    firmware instead (its own format: whole-mm positions, FRAC16 angles; ``fmt`` must be 16-bit, 1 mm,
+    tfr16). Raises ``CertifyError`` if a box end does not fit the pose words."""
     if not (isinstance(max_cells, (int, np.integer)) and 1 <= max_cells <= MAX_CELLS_LIMIT):
         raise CertifyError(CertifyError.CELLS.format(lo=1, hi=MAX_CELLS_LIMIT, value=max_cells))
     f = fmt.frac_bits
@@ -159,12 +163,17 @@ def certify(
                 )
     model = Model.build(platform, fmt, convention)
     lo, hi = box.words(fmt)
-    s = run_search(model, lo, hi, max_cells=max_cells)
-    names = word_names()
-    limit_of = {n: float(1 << (2 * fmt.word_bits - 1)) if n.startswith("sq") else float(1 << f) for n in names}
+    if implementation == "tp17":  # tp17.C truncates positions to whole mm and angles to FRAC16 words
+        lo = np.r_[np.trunc(box.lo[:3] * 1e3), np.trunc(box.lo[3:] / np.pi * 32768.0)].astype(np.int64)
+        hi = np.r_[np.trunc(box.hi[:3] * 1e3), np.trunc(box.hi[3:] / np.pi * 32768.0)].astype(np.int64)
+        hi[3:] = np.minimum(hi[3:], 32767)
+    s = run_search(model, lo, hi, max_cells=max_cells, implementation=implementation)
+    names = tp17_word_names() if implementation == "tp17" else word_names()
+    limit_of = {n: float(1 << (2 * fmt.word_bits - 1)) if n.startswith(("sq", "L32")) else float(1 << f) for n in names}
     words = []
     for k, n in enumerate(names):
-        wlo = -(1 << (2 * fmt.word_bits - 1)) if n.startswith("sq") else -(1 << f)
+        wide = n.startswith("sq") or n.startswith("L32")
+        wlo = -(1 << (2 * fmt.word_bits - 1)) if wide else -(1 << f)
         whi = -wlo - 1
         status = "impossible"
         if s.possible[k]:
@@ -202,4 +211,5 @@ def certify(
         s.unresolved_count,
         s.cells,
         s.exhausted,
+        implementation,
     )

@@ -172,7 +172,7 @@ def word_names() -> list[str]:
 BENIGN = {f"{t}.{a}" for t in ("sin", "cos") for a in AXES}
 
 
-class _V:
+class IV:
     """An interval quantity of the recipe: integer word hull, error and true-value enclosures (LSB)."""
 
     __slots__ = ("w", "e", "t")
@@ -212,7 +212,7 @@ def _bounds(model: Model):
     return lo_b, hi_b
 
 
-class _Recorder:
+class Recorder:
     def __init__(self, n: int, model: Model):
         self.names = word_names()
         self.index = {k: i for i, k in enumerate(self.names)}
@@ -235,19 +235,19 @@ class _Recorder:
         return self.possible[:, self.index[name]]
 
 
-def _mulq(a: _V, b: _V, f: int, rec: _Recorder, name: str, m: Model) -> _V:
+def mulq(a: IV, b: IV, f: int, rec: Recorder, name: str, m: Model) -> IV:
     lo, hi = imul(a.w, b.w)
     w = rec.sat(name, lo >> f, hi >> f, m.lo, m.hi)
     af = (a.w[0].astype(float), a.w[1].astype(float))
     e = fscale(fadd(fmul(af, b.e), fmul(b.t, a.e)), 2.0**-f)
     e = fsub(e, (0.0, 1.0))
     t = fscale(fmul(a.t, b.t), 2.0**-f)
-    return _V(w, e, t)
+    return IV(w, e, t)
 
 
-def _addw(
-    acc: _V, term: _V, sign: int, rec: _Recorder, name: str, m: Model, final: bool, bound: float | None = None
-) -> _V:
+def addw(
+    acc: IV, term: IV, sign: int, rec: Recorder, name: str, m: Model, final: bool, bound: float | None = None
+) -> IV:
     if sign > 0:
         lo, hi = acc.w[0] + term.w[0], acc.w[1] + term.w[1]
         e, t = fadd(acc.e, term.e), fadd(acc.t, term.t)
@@ -262,7 +262,7 @@ def _addw(
         te = fadd(t, e)
         lo = np.where(clean, np.maximum(lo, np.ceil(te[0]).astype(np.int64)), lo)
         hi = np.where(clean, np.minimum(hi, np.floor(te[1]).astype(np.int64)), hi)
-    return _V(rec.sat(name, lo, hi, m.lo, m.hi, final), e, t)
+    return IV(rec.sat(name, lo, hi, m.lo, m.hi, final), e, t)
 
 
 def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval:
@@ -271,7 +271,7 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
     cell_hi = np.asarray(cell_hi, dtype=np.int64)
     n = cell_lo.shape[0]
     m, f = model, model.fmt.frac_bits
-    rec = _Recorder(n, m)
+    rec = Recorder(n, m)
     zero_f = (np.zeros(n), np.zeros(n))
     for k in range(6):
         rec.pre_lo[:, k], rec.pre_hi[:, k] = cell_lo[:, k], cell_hi[:, k]
@@ -289,30 +289,30 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
             w = rec.sat(label, plo, phi, m.lo, m.hi, final=True)
             e = (elo_t.query(a_lo, a_hi)[0] * ERR_UNIT, ehi_t.query(a_lo, a_hi)[1] * ERR_UNIT)
             t = fsub((w[0].astype(float), w[1].astype(float)), e)
-            trig[f"{name}{ax}"] = _V(w, e, t)
+            trig[f"{name}{ax}"] = IV(w, e, t)
     # -- rotation entries: sums of truncated products, as rotation_from_words forms them
     R = {}
     zero_i = (np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64))
     for i in range(3):
         for j in range(3):
             name = f"R[{i}][{j}]"
-            acc = _V(zero_i, zero_f, zero_f)
+            acc = IV(zero_i, zero_f, zero_f)
             items = list(model.monomials[i][j].items())
             adds = sum(abs(c) for _, c in items)
             done = 0
             for factors, coef in items:
                 term = trig[factors[0]]
                 for fac in factors[1:]:
-                    term = _mulq(term, trig[fac], f, rec, name, m)
+                    term = mulq(term, trig[fac], f, rec, name, m)
                 for _ in range(abs(coef)):
                     done += 1
                     last = done == adds
-                    acc = _addw(acc, term, coef, rec, name, m, last, float(1 << f) if last else None)
+                    acc = addw(acc, term, coef, rec, name, m, last, float(1 << f) if last else None)
             if adds == 0:
                 rec.pre_lo[:, rec.index[name]] = 0
                 rec.pre_hi[:, rec.index[name]] = 0
             R[(i, j)] = acc
-    _exact_rotation(model, cell_lo, cell_hi, rec)
+    exact_rotation(model, cell_lo, cell_hi, rec)
     r_sat = np.zeros(n, dtype=bool)
     for i in range(3):
         for j in range(3):
@@ -327,7 +327,7 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
         for r in range(3):
             name = f"leg{i + 1}.{AXES[r]}"
             pf = (cell_lo[:, r].astype(float), cell_hi[:, r].astype(float))
-            v = _V((cell_lo[:, r], cell_hi[:, r]), zero_f, pf)
+            v = IV((cell_lo[:, r], cell_hi[:, r]), zero_f, pf)
             for k in range(3):
                 c = int(m.r_T[i, k])
                 ct = (m.r_T_true[0][i, k], m.r_T_true[1][i, k])
@@ -340,10 +340,10 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
                     dc = fsub((float(c), float(c)), ct)
                     e = fscale(fadd(fmul(Rk.t, dc), fscale(Rk.e, float(c))), 2.0**-f)
                     e = fsub(e, (0.0, 1.0))
-                    term = _V((lo >> f, hi >> f), e, contrib_t)
-                    v = _addw(v, term, 1, rec, name, m, final=False)
+                    term = IV((lo >> f, hi >> f), e, contrib_t)
+                    v = addw(v, term, 1, rec, name, m, final=False)
                 else:  # the firmware omits a term that rounds to zero: its true value is all error
-                    v = _V(v.w, fsub(v.e, contrib_t), fadd(v.t, contrib_t))
+                    v = IV(v.w, fsub(v.e, contrib_t), fadd(v.t, contrib_t))
             b = int(m.B[i, r])
             bt = (m.B_true[0][i, r], m.B_true[1][i, r])
             if b:
@@ -353,7 +353,7 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
                 w = v.w
                 rec.pre_lo[:, rec.index[name]], rec.pre_hi[:, rec.index[name]] = v.w
             # word - true: the word subtracts b, the truth bt
-            v = _V(w, fadd(v.e, fsub(bt, (float(b), float(b)))), fsub(v.t, bt))
+            v = IV(w, fadd(v.e, fsub(bt, (float(b), float(b)))), fsub(v.t, bt))
             # sq += v^2, saturating at the accumulator
             v2 = isquare(v.w)
             sq_lo, sq_hi = sq_w[0] + v2[0], sq_w[1] + v2[1]
@@ -409,7 +409,7 @@ def _entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.nd
     return acc, clamped
 
 
-def _exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec: _Recorder) -> None:
+def exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec: Recorder, entry=None) -> None:
     """Exact hulls of the rotation words in cells where the intervals leave a clamp undecided.
 
     Every entry holds at most one factor (sine or cosine) of the middle rotation's angle (``free_axis``),
@@ -417,7 +417,9 @@ def _exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec:
     factor's word: fixing the other two angles, the entry's extremes lie at the extremes of its factor
     words. So enumerating the word pairs of the other two angles (up to ``ENUMERATION_LIMIT``) and taking
     the free angle's factor extremes gives the exact hull (and where no product or partial sum clamps, its
-    clamp is decided exactly)."""
+    clamp is decided exactly). ``entry(model, words, i, j) -> (word before its final clamp, inner clamp)``:
+    the entry as the firmware forms it from sine/cosine words (default: ``rotation_from_words``' way)."""
+    entry = entry or _entry
     names = [f"R[{i}][{j}]" for i in range(3) for j in range(3)]
     cols = [rec.index[nm] for nm in names]
     flagged = np.flatnonzero(rec.possible[:, cols].any(axis=1))
@@ -452,7 +454,7 @@ def _exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec:
                     w = dict(words)
                     w[f"s{AXES[free]}"] = ext["s"][which]
                     w[f"c{AXES[free]}"] = ext["c"][which]
-                    vals.append(_entry(model, w, i, j))
+                    vals.append(entry(model, w, i, j))
                 v = np.concatenate([vals[0][0].ravel(), vals[1][0].ravel()])
                 inner = bool(vals[0][1].any() or vals[1][1].any())
                 lo_all.append((int(v.min()), int(v.max()), inner))

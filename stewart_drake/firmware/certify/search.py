@@ -10,9 +10,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.firmware.certify.recipe import BENIGN, CellEval, Model, evaluate, word_names
+from stewart_drake.firmware.certify.recipe import BENIGN, CellEval, Model, word_names
+from stewart_drake.firmware.certify.recipe import evaluate as evaluate_generic
+from stewart_drake.firmware.certify.tp17_recipe import evaluate_tp17, tp17_word_names
 from stewart_drake.fixedpoint.generic import leg_length_words
 from stewart_drake.fixedpoint.q15 import SaturationCounter
+from stewart_drake.fixedpoint.tp17 import tp17_leg_lengths
 
 MAX_CELLS = 200_000  # default evaluation budget
 BATCH = 4096  # cells split per round
@@ -65,12 +68,18 @@ def _split(model: Model, lo: np.ndarray, hi: np.ndarray, angles_only: np.ndarray
     return np.concatenate([lo, lo2]), np.concatenate([hi1, hi])
 
 
-def emulation_saturates(model: Model, words: np.ndarray) -> dict:
+def emulation_saturates(model: Model, words: np.ndarray, implementation: str = "generated") -> dict:
     """The emulation's own saturation counts (arithmetic only: the trig clamp is within its certified
-    error) for one pose-words vector: the independent confirmation of a witness."""
+    error; the pose conversion is not the firmware's arithmetic) for one pose-words vector: the
+    independent confirmation of a witness."""
+    w = np.asarray(words, dtype=np.int64)
     with SaturationCounter() as sat:
-        leg_length_words(model.platform, np.asarray(words, dtype=np.int64), model.fmt, model.convention)
-    return {k: int(v) for k, v in sat.counts.items() if k in ARITHMETIC_OPS}
+        if implementation == "tp17":
+            tp17_leg_lengths(np.r_[w[:3].astype(float), w[3:] / 32768.0])
+        else:
+            leg_length_words(model.platform, w, model.fmt, model.convention)
+    keep = (lambda k: k != "FRAC16") if implementation == "tp17" else (lambda k: k in ARITHMETIC_OPS)
+    return {k: int(v) for k, v in sat.counts.items() if keep(k)}
 
 
 class _Pool:
@@ -124,7 +133,12 @@ class _Hull:
 
 
 def run_search(
-    model: Model, box_lo: np.ndarray, box_hi: np.ndarray, max_cells: int = MAX_CELLS, seed: int = 0
+    model: Model,
+    box_lo: np.ndarray,
+    box_hi: np.ndarray,
+    max_cells: int = MAX_CELLS,
+    seed: int = 0,
+    implementation: str = "generated",
 ) -> Search:
     """Certify the box of pose words ``[box_lo, box_hi]`` within ``max_cells`` cell evaluations.
 
@@ -132,7 +146,8 @@ def run_search(
     (split it to decide), -1 once its clamps are all shown (its error is unbounded anyway), else its
     largest error bound (split the worst first). A word is shown by a witness pose confirmed by the
     emulation's own saturation counter, or by a cell where it clamps at every pose."""
-    names = word_names()
+    names = tp17_word_names() if implementation == "tp17" else word_names()
+    evaluate = evaluate_tp17 if implementation == "tp17" else evaluate_generic
     arith = np.array([n not in BENIGN for n in names])
     rot_words = np.array([n.startswith("R[") for n in names])
     rng = np.random.default_rng(seed)
@@ -171,7 +186,7 @@ def run_search(
             new = pe.possible[k] & arith & ~shown
             if not new.any():
                 continue
-            ops = emulation_saturates(model, cand[k])
+            ops = emulation_saturates(model, cand[k], implementation)
             if ops:  # confirmed by the emulation itself
                 witnesses.append((cand[k].copy(), ops, [names[j] for j in np.flatnonzero(pe.possible[k] & arith)]))
                 shown |= new
@@ -213,7 +228,7 @@ def run_search(
     certain_cells = np.flatnonzero((pool.ev.certain & arith).any(axis=1))
     if certain_cells.size and not witnesses:  # a cell that clamps everywhere: its corner is a witness
         cand = pool.lo[certain_cells[0]]
-        ops = emulation_saturates(model, cand)
+        ops = emulation_saturates(model, cand, implementation)
         if ops:
             witnesses.append(
                 (cand.copy(), ops, [names[j] for j in np.flatnonzero(pool.ev.certain[certain_cells[0]] & arith)])
