@@ -14,11 +14,11 @@ from stewart_drake.errors import CertifyError
 from stewart_drake.fixedpoint.generic import QFormat, pose_words
 
 KEYS = ("px", "py", "pz", "a", "b", "g")
-# Workspace boxes stated for a preset (mm, fractions of pi); others get DEFAULT_BOX_RULE around home.
+# Workspace boxes stated for a preset (mm, fractions of pi); other platforms get home ± 10 % of the stroke
+# range on x, y, z and ±15° on each angle (the region `firmware check` samples).
 WORKSPACE_BOXES = {
     "utn-kinematic": ((-60.0, 60.0), (-60.0, 60.0), (120.0, 250.0), (-0.08, 0.08), (-0.08, 0.08), (-0.08, 0.08)),
 }
-DEFAULT_BOX_RULE = "home ± 10 % of the stroke range on x, y, z and ±15° on each angle (firmware check's region)"
 _SPEC = re.compile(r"^(px|py|pz|a|b|g)=([^.][^ ]*?)\.\.(.+)$")
 
 
@@ -40,7 +40,7 @@ class PoseBox:
 
 
 def workspace_box(platform: Platform) -> PoseBox:
-    """The preset's stated workspace box, or ``DEFAULT_BOX_RULE`` around the home pose."""
+    """The preset's stated workspace box, or home ± 10 % of the stroke range and ±15° (see ``WORKSPACE_BOXES``)."""
     if platform.name in WORKSPACE_BOXES:
         b = np.array(WORKSPACE_BOXES[platform.name], dtype=float)
         s = np.r_[[1e-3] * 3, [np.pi] * 3]

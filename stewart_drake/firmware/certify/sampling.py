@@ -16,7 +16,6 @@ from stewart_drake.fixedpoint.generic import leg_length_words
 
 CHUNK = 1 << 16
 BENIGN_MASK = np.array([n in BENIGN for n in word_names()])
-MAX_SAMPLES = 100_000_000
 
 
 def word_pose_si(model: Model, words: np.ndarray) -> np.ndarray:

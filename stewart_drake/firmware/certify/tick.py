@@ -20,7 +20,7 @@ import numpy as np
 from stewart_drake.control.gains import DIFF_SHIFT, ControllerConfig, FixedGains, counts_per_lsb
 from stewart_drake.fixedpoint import q15
 
-FILTER_ITERATIONS = 1_000_000
+FILTER_ITERATIONS = 100_000
 
 
 @dataclass
