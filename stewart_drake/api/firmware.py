@@ -75,6 +75,18 @@ class GenerateResult(Result):
         return self.summary
 
 
+def check_out_folder(out: str | Path) -> Path:
+    """``out`` for generated firmware: new, or a folder holding only the generator's files (exit 2 otherwise)."""
+    shown, out = out, Path(out)
+    if out.exists():
+        if not out.is_dir():
+            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=shown))
+        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
+        if foreign:
+            raise OutputError(OPTION_OUT_FOREIGN.format(out=shown, names=", ".join(foreign[:3])))
+    return out
+
+
 def generate(
     platform: Platform,
     out: str | Path,
@@ -111,13 +123,7 @@ def generate(
         StewartError: bad options, or an output folder that holds other files.
     """
     config = controller_config(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
-    shown, out = out, Path(out)
-    if out.exists():
-        if not out.is_dir():
-            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=shown))
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
-        if foreign:
-            raise OutputError(OPTION_OUT_FOREIGN.format(out=shown, names=", ".join(foreign[:3])))
+    out = check_out_folder(out)
     g = generate_sources(platform, config)
     compiled = []
     if compile:

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from stewart_drake.api import firmware
+from stewart_drake.commands._certify import register as register_certify
 from stewart_drake.commands._common import add_platform_arg, print_json
 from stewart_drake.core.geometry import load_platform
 
@@ -44,7 +45,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "firmware", help="generate the C firmware (IK + controller tick) or check a C firmware against the emulation"
     )
-    fs = p.add_subparsers(dest="firmware_command", required=True, metavar="generate|check")
+    fs = p.add_subparsers(dest="firmware_command", required=True, metavar="generate|check|certify|optimize")
     g = fs.add_parser("generate", help="emit a self-contained C99 module: sd_ik, sd_init, sd_tick (+ README)")
     _format_args(g)
     g.add_argument(
@@ -79,6 +80,7 @@ def register(sub) -> None:
     )
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_check)
+    register_certify(fs, _format_args, _config, firmware.check_out_folder)
 
 
 def _format(args) -> dict:
@@ -92,6 +94,11 @@ def _format(args) -> dict:
         sensor_resolution=args.sensor_resolution,
         trajectory=args.trajectory,
     )
+
+
+def _config(args, platform):
+    """The controller configuration (number format, timing, gains) the format options give."""
+    return firmware.controller_config(platform, **_format(args))
 
 
 def run_generate(args) -> int:

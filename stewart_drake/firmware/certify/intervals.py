@@ -1,0 +1,125 @@
+"""Interval arithmetic for the certificate: exact on integer words (int64 numpy arrays, vectorised over
+cells), outward-rounded on the float error terms.
+
+Integer words: a pair ``(lo, hi)`` of int64 arrays; every operation of the firmware (product, floor
+shift, sum, saturation, nearest integer square root) is monotone in each argument or evaluated at the
+corners, so the integer intervals are exact hulls of the operation over the input intervals.
+
+Floats: a pair ``(lo, hi)`` of float64 arrays. Every IEEE operation is correctly rounded (its exact
+result lies within half an ulp), so moving each computed end one ulp outward (``np.nextafter``) keeps
+the exact real result inside: the float intervals are rigorous enclosures, not estimates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_INF = np.inf
+
+
+def down(x):
+    """One ulp toward -inf: the lower end of an enclosure of a correctly rounded result."""
+    return np.nextafter(x, -_INF)
+
+
+def up(x):
+    """One ulp toward +inf."""
+    return np.nextafter(x, _INF)
+
+
+def fadd(a, b):
+    """Enclosure of a + b for float intervals a, b."""
+    return down(a[0] + b[0]), up(a[1] + b[1])
+
+
+def fsub(a, b):
+    """Enclosure of a - b."""
+    return down(a[0] - b[1]), up(a[1] - b[0])
+
+
+def fmul(a, b):
+    """Enclosure of a * b (the four corner products, each rounded outward)."""
+    p = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
+    return down(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))), up(
+        np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
+    )
+
+
+def fscale(a, c: float):
+    """Enclosure of c * a for a float constant c (exact when c is a power of two)."""
+    lo, hi = a[0] * c, a[1] * c
+    if c < 0:
+        lo, hi = hi, lo
+    return down(lo), up(hi)
+
+
+def fsquare(a):
+    """Enclosure of a**2 (0 when a straddles 0)."""
+    lo2, hi2 = a[0] * a[0], a[1] * a[1]
+    straddle = (a[0] <= 0) & (a[1] >= 0)
+    lo = np.where(straddle, 0.0, np.minimum(lo2, hi2))
+    return np.maximum(down(lo), 0.0), up(np.maximum(lo2, hi2))
+
+
+def fdiv_pos(a, d):
+    """Enclosure of a / d for a divisor interval d with d[0] > 0."""
+    q = (a[0] / d[0], a[0] / d[1], a[1] / d[0], a[1] / d[1])
+    return down(np.minimum(np.minimum(q[0], q[1]), np.minimum(q[2], q[3]))), up(
+        np.maximum(np.maximum(q[0], q[1]), np.maximum(q[2], q[3]))
+    )
+
+
+def fsqrt(a):
+    """Enclosure of sqrt(a) for a >= 0 (negative lower ends clipped to 0)."""
+    return np.maximum(down(np.sqrt(np.maximum(a[0], 0.0))), 0.0), up(np.sqrt(np.maximum(a[1], 0.0)))
+
+
+def imul(a, b):
+    """Exact hull of the integer products a * b (int64; the callers keep |a|, |b| < 2^31)."""
+    p = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
+    return np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3])), np.maximum(
+        np.maximum(p[0], p[1]), np.maximum(p[2], p[3])
+    )
+
+
+def isquare(a):
+    """Exact hull of a**2 over an integer interval."""
+    lo2, hi2 = a[0] * a[0], a[1] * a[1]
+    straddle = (a[0] <= 0) & (a[1] >= 0)
+    return np.where(straddle, 0, np.minimum(lo2, hi2)), np.maximum(lo2, hi2)
+
+
+class RangeTable:
+    """Range minimum and maximum queries on a fixed integer array (a sparse table: O(1) per query,
+    ``len(values) * log2(len(values))`` int32 of memory). Used for the sine/cosine words and their
+    errors over every angle-word interval: the exact hull, not a bound by monotone pieces."""
+
+    def __init__(self, values: np.ndarray, offset: int):
+        v = np.asarray(values, dtype=np.int64)
+        self.offset = offset
+        self.mins = [v.astype(np.int32)]
+        self.maxs = [v.astype(np.int32)]
+        k = 1
+        while (1 << k) <= v.size:
+            a, b = self.mins[-1], self.maxs[-1]
+            h = 1 << (k - 1)
+            self.mins.append(np.minimum(a[:-h], a[h:]))
+            self.maxs.append(np.maximum(b[:-h], b[h:]))
+            k += 1
+
+    def query(self, lo, hi):
+        """``(min, max)`` of ``values[lo - offset .. hi - offset]`` (inclusive), vectorised; lo <= hi."""
+        i = np.asarray(lo, dtype=np.int64) - self.offset
+        j = np.asarray(hi, dtype=np.int64) - self.offset
+        n = j - i + 1
+        k = np.floor(np.log2(n)).astype(np.int64)
+        k -= ((1 << k) > n).astype(np.int64)  # guard the float log at powers of two
+        k += ((1 << (k + 1)) <= n).astype(np.int64)
+        mn = np.empty(i.shape, dtype=np.int64)
+        mx = np.empty(i.shape, dtype=np.int64)
+        for lev in np.unique(k):
+            sel = k == lev
+            a, b = i[sel], j[sel] - (1 << int(lev)) + 1
+            mn[sel] = np.minimum(self.mins[lev][a], self.mins[lev][b])
+            mx[sel] = np.maximum(self.maxs[lev][a], self.maxs[lev][b])
+        return mn, mx
