@@ -617,13 +617,18 @@ class SamplingError(StewartError):
 class GainError(StewartError):
     """Controller gains or their design inputs are not usable (``control.gains``)."""
 
-    PID_NEGATIVE = "PidGains.{name} must be a finite number >= 0, got {value!r}"
-    PID_FILTER = "PidGains.{name} must be in (0, 1], got {value!r}"
+    PID_NEGATIVE = "the controller's {name} gain must be a finite number >= 0, got {value!r}{hint}"
+    PID_FILTER = "the controller's {name} must be in (0, 1], got {value!r}"
     ACTUATOR_LAG = "actuator_lag must be >= 0 s, got {value!r}"
     INERTIA = "platform {name!r}: the leg-space inertia is not positive definite (smallest eigenvalue {m_min:.3g} kg)"
     DESIGN_POSE = "design pose {index} is not finite: {value!r}"
     GAIN = "a gain must be a finite number >= 0, got {value!r}"
     Q15_RANGE = "gain {value!r} is too large for a Q15 mantissa with a 32-bit shift"
+    Q15_SCALE = (
+        "the {name} gain {value:.4g} (SI) does not fit the firmware's Q15 words with a command range of "
+        "{range:.4g} N (legs.max_force), a sensor count of {r:.4g} m and a period of {T:.4g} s; "
+        "a command range this small (or a count this large) is not a usable actuator"
+    )
     SENSOR_COUNTS = (
         "sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts "
         "for the fixed-point controller"
@@ -631,7 +636,7 @@ class GainError(StewartError):
 
 
 # DspTiming fields (``control.timing``), raised as ``TimingError``.
-TIMING_POSITIVE = "DspTiming.{name} must be a positive number, got {value!r}"
+TIMING_POSITIVE = "the controller's {name} must be a positive number, got {value!r}"
 TIMING_LATENCY = "DspTiming.latency must be one of {valid}, got {value!r}"
 TIMING_CYCLES = "DspTiming.computation_cycles must be a positive integer, got {value!r}"
 
@@ -728,6 +733,9 @@ class SpecError(StewartError):
     NOT_YAML = "{path}:{line}: not YAML ({problem})"
     NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
     NOT_SCALAR = "{where}: {key}: the value must be one scalar (e.g. ±0.5mm)"
+    KEY_NOT_TEXT = "{where}: a key must be a name (one of the keys), got {key}"
+    RENAMED = "{where}: the key {key!r} is no longer read: {why}"
+    VECTOR_3 = "{where}: {key}: {text!r}: a fixed vector is three numbers X,Y,Z"
     SWEEP_VECTOR = "sweep: {key} is a per-component key; sweep scalar keys"
     SWEEP_EMPTY = "sweep: {key} has no values"
 
@@ -756,6 +764,10 @@ class StudyError(StewartError):
     )
     RESOLUTION_DIVIDE = (
         "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
+    )
+    DRAW = (
+        "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; "
+        "no run was started — narrow the --vary ranges"
     )
     OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
     OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
@@ -802,3 +814,22 @@ OPTION_JOINT_OVERFLOW = "joint angles {value} {unit}: the foot angle gamma = q1 
 OPTION_TARGET = "target must be finite, got {value}"
 OPTION_SERVO_POSE = "--pose has a non-finite number: {value}"
 REPORT_UNKNOWN_ANALYSIS = "unknown analysis {name!r}; available: {available}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Values echoed in messages: shortened the same way everywhere (a 1e300 length is not 300 digits).
+
+MAX_ECHO = 60
+
+
+def short_number(v, decimals: int = 3) -> str:
+    """A number for a message: ``decimals`` places while it is below 1e9 in size, else 6 significant
+    digits (``1e+300``, not 301 digits); ``nan``/``inf`` as such."""
+    v = float(v)
+    return f"{v:.{decimals}f}" if abs(v) < 1e9 else f"{v:.6g}"
+
+
+def short_text(value, limit: int = MAX_ECHO) -> str:
+    """``value`` as text for a message, cut to ``limit`` characters with an ellipsis."""
+    s = value if isinstance(value, str) else repr(value)
+    return s if len(s) <= limit else s[: limit - 1] + "…"

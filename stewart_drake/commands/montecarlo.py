@@ -61,7 +61,7 @@ def register(sub) -> None:
         default=[],
         metavar="SPEC",
         help="what varies: key=value words or one YAML file (keys: anchor, leg_offset, sensor_resolution, sensor_noise, "
-        "latency, latency_jitter, actuator_lag, force_limit, payload_mass, payload_com, gain_scale; values X, ±T, ±P%%, A..B, a|b; "
+        "latency, latency_jitter, actuator_lag, force_limit, plate_mass, plate_com, gain_scale, sample_period, payload, payload_position; values X, ±T, ±P%%, A..B, a|b; "
         "units m mm um s ms us N kg g)",
     )
     add_loop_args(p)

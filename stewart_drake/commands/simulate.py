@@ -157,6 +157,7 @@ def add_loop_args(p) -> None:
 
 def run(args) -> int:
     from stewart_drake.control import ControllerConfig, DspTiming, check_timing
+    from stewart_drake.control.chatter import loop_verdict
     from stewart_drake.control.simulation_log import tracking_verdict
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
@@ -256,6 +257,12 @@ def run(args) -> int:
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
     verdict = tracking_verdict(platform, e, pe, log)
+    loop = loop_verdict(platform, traj, log, config)
+    verdict["failures"] += loop.pop("failures")
+    for w in loop.pop("warnings"):
+        warnings.append(w)
+        print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
+    summary.update(loop)
     summary.update(verdict)
     summary["warnings"] = warnings
     with atomic_folder(out_folder) as tmp:
