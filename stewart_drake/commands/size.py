@@ -13,7 +13,14 @@ from stewart_drake.core.dynamics import seed_trajectory
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
-from stewart_drake.design.sizing import UNITS, first_violation, limits_of, rotating_trajectory, size_trajectory
+from stewart_drake.design.sizing import (
+    UNITS,
+    first_violation,
+    limits_of,
+    rotating_trajectory,
+    size_trajectory,
+    with_peak,
+)
 from stewart_drake.errors import OptionError
 from stewart_drake.script import ScriptError, run_program
 from stewart_drake.script.source import read_program
@@ -97,7 +104,8 @@ def run(args) -> int:
     check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
     s = size_trajectory(platform, t, q, qd, qdd, convention, legs, args.gravity)
     limits = limits_of(platform)
-    viol = first_violation(limits, {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length})
+    peaks = {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length}
+    viol = with_peak(first_violation(limits, peaks), limits, peaks)
     rows = s.legs()
     legs_json = [
         {
@@ -121,7 +129,7 @@ def run(args) -> int:
         for r in rows
     ]
     if viol is not None:
-        viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]])
+        viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]], peak_t_s=float(t[viol["peak_index"]]))
     out = dict(
         header,
         source=source,
@@ -140,7 +148,9 @@ def run(args) -> int:
             f"platform {base.name}, {source}: {len(t)} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
         )
         _print_table(legs_json, with_times=True)
-    return _report_violation(viol, "at t = {t:.4f} s".format(t=viol["t_s"]) if viol else "")
+    if viol is None:
+        return 0
+    return _report_violation(viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s")
 
 
 def _set_summary(legs_json) -> dict:
@@ -170,13 +180,15 @@ def _print_table(legs_json, with_times: bool) -> None:
         )
 
 
-def _report_violation(viol, where: str) -> int:
-    if viol is None:
-        return 0
-    name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[viol["quantity"]]
+def _report_violation(viol, first_where: str, peak_where: str) -> int:
+    """The worst excess (the peak the table shows) and where the limit is first exceeded; exit 1."""
+    qty = viol["quantity"]
+    name = "stroke" if qty == "length" else f"legs.max_{qty}"
+    u = UNITS[qty]
     print(
-        f"stewart-drake size: leg {viol['leg']} {viol['quantity']} {viol['value']:.6g} {UNITS[viol['quantity']]} exceeds "
-        f"legs.{name} {viol['limit']:.6g} {UNITS[viol['quantity']]} {where}",
+        f"stewart-drake size: leg {viol['peak_leg']} {qty} peaks at {viol['peak']:.6g} {u}, beyond {name} "
+        f"{viol['peak_limit']:.6g} {u} {peak_where}; first exceeded by leg {viol['leg']} ({viol['value']:.6g} {u}) "
+        f"{first_where}",
         file=sys.stderr,
     )
     return 1
@@ -184,7 +196,8 @@ def _report_violation(viol, where: str) -> int:
 
 def _run_envelope(args, platform, header, legs) -> int:
     env = load_envelope(args.envelope)
-    es = envelope_sizing(platform, env, legs=legs, gravity=args.gravity)
+    # a pose outside the stroke is a result outside limits (exit 1, the table shown), not bad input
+    es = envelope_sizing(platform, env, legs=legs, gravity=args.gravity, stroke=False)
     legs_json = []
     for i in range(6):
         w = es.worst[i]
@@ -211,9 +224,12 @@ def _run_envelope(args, platform, header, legs) -> int:
             }
         )
     limits = limits_of(platform)
-    viol = first_violation(limits, {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power})
+    peaks = {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power, "length": es.length}
+    viol = with_peak(first_violation(limits, peaks), limits, peaks)
     if viol is not None:
-        viol = dict(viol, pose_index=viol["index"], pose=env.poses[viol["index"]])
+        viol = dict(
+            viol, pose_index=viol["index"], pose=env.poses[viol["index"]], peak_pose=env.poses[viol["peak_index"]]
+        )
     allowed = {
         "axes": list(AXES),
         "units": ["m/s²"] * 3 + ["rad/s²"] * 3,
@@ -253,9 +269,9 @@ def _run_envelope(args, platform, header, legs) -> int:
             "largest acceleration per axis the actuators allow at every pose (others zero, worst velocity): "
             + ", ".join(f"{n} {v:.4g} {u}" for n, v, u in zip(AXES, a, allowed["units"]))
         )
-    where = ""
-    if viol:
-        where = f"at envelope {env.shown(viol['index'])}"
-        if viol["quantity"] == "power":
-            where += " (power over an envelope is an upper bound: peak |F| x peak |L̇|)"
-    return _report_violation(viol, where)
+    if viol is None:
+        return 0
+    note = " (power over an envelope is an upper bound: peak |F| x peak |L̇|)" if viol["quantity"] == "power" else ""
+    return _report_violation(
+        viol, f"at envelope {env.shown(viol['index'])}", f"at envelope {env.shown(viol['peak_index'])}{note}"
+    )
