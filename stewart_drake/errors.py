@@ -26,6 +26,10 @@ class StewartError(ValueError):
 class GeometryError(StewartError):
     """A platform description is inconsistent (shapes, values, anchors, limits)."""
 
+    INERTIA_SINGULAR = (
+        "platform {name!r}: the plate's mass matrix is not positive definite (plate.mass {mass:g} kg, plate.inertia): "
+        "a plate without mass or inertia has no natural frequencies"
+    )
     TOP_SHAPE = "top_anchors must have shape (k, 3) with 3 <= k <= 6, got {shape}"
     LEG_TOP = "leg_top must list 6 integer top-anchor indices (one per leg), got {value!r}"
     LEG_TOP_RANGE = "leg_top: leg {leg} refers to top anchor {anchor}, but there are {n} top anchors (0..{last})"
@@ -649,6 +653,13 @@ class TrajectoryError(InputError):
     TIME_ORDER = "{path}:{line}: time {t} s is not after the previous sample's {t_prev} s"
     DESIGN_DURATION = "design duration must be a number of seconds >= 0, got {value!r}"
     UNKNOWN = "unknown trajectory {value!r}: not one of {valid} and not a CSV file"
+    QUANTISED = (
+        "{path}: column {column} is rounded too coarsely for its accelerations: its second differences are rounding "
+        "noise (RMS(Δ⁴)/RMS(Δ²) = {ratio:.3g}; a smooth motion gives << 1), {noise:.3g} {unit} of acceleration noise; "
+        "give {option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
+        "rounding step) or write more decimals"
+    )
+    SMOOTH_TOL = "{option}: the tolerance must be a finite number > 0 (in the file's units), got {value!r}"
 
 
 class SimulationError(StewartError):
@@ -833,3 +844,9 @@ def short_text(value, limit: int = MAX_ECHO) -> str:
     """``value`` as text for a message, cut to ``limit`` characters with an ellipsis."""
     s = value if isinstance(value, str) else repr(value)
     return s if len(s) <= limit else s[: limit - 1] + "…"
+
+
+OPTION_LEG_DAMPING_RESOLVE = (
+    "--leg-damping {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
+    "this overdamped are not resolved in double precision (one root per mode runs to ~0, the other to ~infinity)"
+)

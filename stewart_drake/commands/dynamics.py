@@ -12,6 +12,7 @@ from scipy.interpolate import CubicSpline
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
+from stewart_drake.core.quantisation import check_quantisation, smooth_tolerance, smoothing_spline
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import (
     check_file_rows,
@@ -57,6 +58,14 @@ def register(sub) -> None:
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV positions (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
     p.add_argument(
+        "--smooth",
+        type=float,
+        default=None,
+        metavar="TOL",
+        help="differentiate a CSV through a smoothing spline within TOL (RMS, in the file's units) of its samples: "
+        "for files rounded so coarsely that their second differences are noise (refused without it)",
+    )
+    p.add_argument(
         "--allow-out-of-stroke",
         action="store_true",
         help="compute forces even where a leg leaves the stroke (a warning, also in the JSON 'warnings'); default: exit 1",
@@ -67,8 +76,10 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad"):
-    """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (see ``CSV_HELP``). Errors name the line."""
+def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad", smooth=None):
+    """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (see ``CSV_HELP``). Errors name the line. Poses
+    alone are differentiated by a cubic spline, or by a smoothing spline within ``smooth`` (the file's
+    units) RMS of the samples; a file whose second differences are rounding noise is refused without it."""
     check_file_rows(path, "--trajectory", BYTES_PER_SAMPLE + 600, 14)
     a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
     width = a.shape[1]
@@ -81,6 +92,10 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     scale = np.r_[np.full(3, length_scale(length_unit)), np.full(3, angle_scale(angle_unit))]
     if width == 19:
         return t, a[:, 1:7] * scale, a[:, 7:13] * scale, a[:, 13:19] * scale
+    if smooth is not None:
+        f = smoothing_spline(t, a[:, 1:7] * scale, smooth_tolerance(smooth) * scale)
+        return t, f(t), f(t, 1), f(t, 2)
+    check_quantisation(path, t, a[:, 1:7] * scale)
     spline = CubicSpline(t, a[:, 1:7] * scale, axis=0)
     return t, spline(t), spline(t, 1), spline(t, 2)
 
@@ -114,7 +129,9 @@ def seed_times(t_end: float, dt: float) -> np.ndarray:
 def run(args) -> int:
     seed = args.trajectory == "seed"
     reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
-    reject_unused(args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn")
+    reject_unused(
+        args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn", smooth=None
+    )
     platform = platform_from_args(args)
     require_plate(platform, "dynamics")
     gravity = check_gravity(args.gravity)
@@ -123,7 +140,7 @@ def run(args) -> int:
         q, qd, qdd = seed_trajectory(t)
         convention = "utn"
     else:
-        t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
+        t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit, args.smooth)
         convention = args.convention
     what = "the seed trajectory" if args.trajectory == "seed" else f"trajectory {args.trajectory}"
     warnings = check_trajectory(platform, t, q, convention, what, args.allow_out_of_stroke)

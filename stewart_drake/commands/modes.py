@@ -3,11 +3,26 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from stewart_drake.commands._common import print_json
 from stewart_drake.commands.stiffness import NAMES, add_pose_args, prepare, require_analysable_pose
-from stewart_drake.errors import OPTION_LEG_DAMPING, OPTION_SAMPLE_RATE, OptionError
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.design.load_limits import (
+    MAX_DAMPING_RATIO,
+    damping_ratio_scale,
+    rigid_body_limit_hz,
+    unstable_direction,
+)
+from stewart_drake.errors import (
+    OPTION_LEG_DAMPING,
+    OPTION_LEG_DAMPING_RESOLVE,
+    OPTION_SAMPLE_RATE,
+    GeometryError,
+    OptionError,
+)
 
 
 def register(sub) -> None:
@@ -49,6 +64,11 @@ def run(args) -> int:
     K = stiffness_matrix(platform, q, k, args.convention, args.gravity, legs)
     M = spatial_inertia(platform, q, args.convention, legs)
     C = damping_matrix(platform, q, args.leg_damping, args.convention) if args.leg_damping > 0 else None
+    if not np.linalg.eigvalsh(0.5 * (M + M.T))[0] > 0:  # a zero or singular inertia: LAPACK's "not positive definite"
+        raise GeometryError(GeometryError.INERTIA_SINGULAR.format(name=platform.name, mass=platform.mass))
+    zeta = damping_ratio_scale(K, M, C)
+    if zeta > MAX_DAMPING_RATIO:
+        raise OptionError(OPTION_LEG_DAMPING_RESOLVE.format(value=args.leg_damping, zeta=zeta, limit=MAX_DAMPING_RATIO))
     m = analytic_modes(K, M, C)
     f1 = float(m.frequencies_hz[0])
     T = 1.0 / args.sample_rate
@@ -83,9 +103,32 @@ def run(args) -> int:
             "equilibrium_residual": d["residual"],
             "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize",
         }
+    v = unstable_direction(K)
+    limits = (
+        []
+        if v is None
+        else [
+            "the loaded platform is unstable at this pose: its stiffness K is not positive definite, it falls away along "
+            f"[{' '.join(f'{x:+.3f}' for x in v)}] (x y z m, rx ry rz rad); a mode of 0 Hz is that fall, not a frequency"
+        ]
+    )
+    # beyond the legs' own axial resonance the rigid-plate model does not hold: a warning (the model's range,
+    # not the platform's limit); a 1e-30 kg plate printed 1e18 Hz as if it were a result
+    f_rigid = rigid_body_limit_hz(leg_lengths(platform, q, args.convention))
+    warnings = []
+    if m.frequencies_hz[-1] > f_rigid:
+        warnings.append(
+            f"mode 6 at {m.frequencies_hz[-1]:.4g} Hz is above the legs' own axial resonance (~{f_rigid:.4g} Hz, c/2L "
+            f"for steel legs): the rigid-plate, massless-leg model does not hold there; check plate.mass "
+            f"({platform.mass:g} kg), plate.inertia and the leg stiffness"
+        )
+    for w in warnings:
+        print(f"stewart-drake modes: warning: {w}", file=sys.stderr)
+    out["warnings"] = warnings
+    out["limits"] = limits
     if args.json:
         print_json(out)
-        return 0
+        return _report(limits)
     print(
         f"platform {platform.name}, pose {args.pose}; legs {'with' if legs else 'without'} mass, k = {k[0]:.6g} N/m, c = {args.leg_damping} N·s/m"
     )
@@ -114,4 +157,11 @@ def run(args) -> int:
             f"lowest mode {f1:.4g} Hz: {c['samples_per_lowest_period']:.4g} controller samples per period at {args.sample_rate:g} Hz; "
             f"a {delay * 1e3:.3g} ms loop delay lags it by {c['phase_lag_at_lowest_deg']:.3g}°"
         )
-    return 0
+    return _report(limits)
+
+
+def _report(limits: list[str]) -> int:
+    """Each limit on stderr; exit 1 if there is one (the modes above are still shown)."""
+    for m in limits:
+        print(f"stewart-drake modes: {m}", file=sys.stderr)
+    return 1 if limits else 0

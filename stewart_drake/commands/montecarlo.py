@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
+from stewart_drake.commands._common import add_platform_arg, dumps_strict, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import load_platform
@@ -223,7 +223,7 @@ def replay(args) -> int:
             files += log.save(tmp) + write_plots(log, log.length_error(ref, _plant_platform(study, args.replay)), tmp)
             if not args.no_animation:
                 files.append(write_animation(_plant_platform(study, args.replay), log, tmp / "animation.html"))
-        (tmp / "row.json").write_text(json.dumps(result, indent=2))
+        (tmp / "row.json").write_text(dumps_strict(result))
         result["files"] = [str(folder / p.name) for p in files + [tmp / "row.json"]]
     if args.json:
         print_json(result)

@@ -32,6 +32,7 @@ from stewart_drake.errors import (
     OPTION_FIRMWARE_ENGINE,
     SIMULATION_GAP_WARNING,
     OptionError,
+    PhysicalLimitError,
     UsageError,
 )
 from stewart_drake.firmware.engine import ENGINES
@@ -75,6 +76,14 @@ def register(sub) -> None:
     )
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
+    p.add_argument(
+        "--smooth",
+        type=float,
+        default=None,
+        metavar="TOL",
+        help="differentiate a CSV through a smoothing spline within TOL (RMS, in the file's units) of its samples: "
+        "for files rounded so coarsely that their second differences are noise (refused without it)",
+    )
     add_loop_args(p)
     p.add_argument(
         "--firmware",
@@ -158,6 +167,7 @@ def add_loop_args(p) -> None:
 def run(args) -> int:
     from stewart_drake.control import ControllerConfig, DspTiming, check_timing
     from stewart_drake.control.chatter import loop_verdict
+    from stewart_drake.control.feasibility import infeasible_motion
     from stewart_drake.control.simulation_log import tracking_verdict
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
@@ -167,7 +177,12 @@ def run(args) -> int:
     from stewart_drake.firmware.module import check_source
 
     reject_unused(
-        args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
+        args,
+        "--trajectory FILE.csv",
+        args.trajectory not in ("seed", "rotating"),
+        length_unit="m",
+        angle_unit="rad",
+        smooth=None,
     )
     out_folder = output_folder(args)
     if args.firmware is not None:
@@ -180,7 +195,8 @@ def run(args) -> int:
         check_positive(args.duration, "--duration", "seconds")
     if args.trajectory not in ("seed", "rotating"):
         check_file_rows(args.trajectory, "--trajectory", 700, 14)
-    traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)
+    units = {"length_unit": args.length_unit, "angle_unit": args.angle_unit}
+    traj = get_trajectory(args.trajectory, **units, **({"smooth": args.smooth} if args.smooth is not None else {}))
     if args.fit:
         traj = fit_trajectory(traj, platform)
     duration = args.duration if args.duration is not None else (traj.duration or 1.0)
@@ -202,6 +218,9 @@ def run(args) -> int:
     )
     for w in warnings:
         print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
+    why = infeasible_motion(platform, traj, ticks, period)
+    if why:  # before the run: no controller follows it (it ended in raw solver messages)
+        raise PhysicalLimitError(why)
     # command range and gains designed for the platform over the poses of the run
     config = ControllerConfig.for_platform(
         platform, timing, poses=design_poses(traj, max(duration, traj.duration or 0.0))

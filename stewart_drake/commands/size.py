@@ -58,6 +58,14 @@ def register(sub) -> None:
         "--length-unit", choices=["m", "mm"], default="m", help="CSV positions and --payload-com (default m)"
     )
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
+    p.add_argument(
+        "--smooth",
+        type=float,
+        default=None,
+        metavar="TOL",
+        help="differentiate a CSV through a smoothing spline within TOL (RMS, in the file's units) of its samples: "
+        "for files rounded so coarsely that their second differences are noise (refused without it)",
+    )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
 
@@ -79,7 +87,7 @@ def _trajectory(args, platform):
         t = np.arange(n) * args.dt
         q, qd, qdd = (seed_trajectory if args.trajectory == "seed" else rotating_trajectory)(t)
         return args.trajectory, t, q, qd, qdd, "utn"
-    t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit)
+    t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit, args.smooth)
     return args.trajectory, t, q, qd, qdd, args.convention
 
 

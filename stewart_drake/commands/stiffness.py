@@ -3,20 +3,24 @@ principal stiffnesses and directions, the compliance and the static deflection u
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.commands._design import add_payload_args, platform_with_payload
-from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
+from stewart_drake.core.kinematics import inverse_kinematics, leg_lengths, require_nonsingular
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si, rotation_matrix
 from stewart_drake.core.sanity import check_poses
+from stewart_drake.design.load_limits import beyond_linear_range, unstable_direction
 from stewart_drake.design.maps import MAX_POINTS, slice_maps
 from stewart_drake.design.payload import payload_wrench
 from stewart_drake.design.plots import plot_slice_maps
 from stewart_drake.design.stiffness import (
     compliance,
     deflection,
+    displace,
     leg_stiffness_vector,
     principal_stiffness,
     stiffness_matrix,
@@ -103,6 +107,26 @@ def run(args) -> int:
     w = payload_wrench(platform, rotation_matrix(q[3:], args.convention), args.payload, p_TP, args.gravity)
     d = deflection(K, w)
     kl, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
+    # an unstable loaded platform, or a deflection beyond the linear range: a result outside limits (exit 1),
+    # and the deflection is not a number to print
+    limits = []
+    v = unstable_direction(K)
+    if v is not None:
+        limits.append(
+            "the loaded platform is unstable at this pose: its stiffness K is not positive definite, it falls away "
+            f"along [{' '.join(f'{x:+.3f}' for x in v)}] (x y z m, rx ry rz rad): the load's geometric stiffness "
+            "exceeds the legs'"
+        )
+    else:
+        why = beyond_linear_range(
+            leg_lengths(platform, q, args.convention),
+            leg_lengths(platform, displace(q, d, args.convention), args.convention),
+            d,
+        )
+        if why:
+            limits.append(f"the deflection under the payload is beyond the linear range: {why}")
+    if limits:
+        d = None
     out = {
         "platform": platform.name,
         "pose": args.pose,
@@ -125,13 +149,14 @@ def run(args) -> int:
         },
         "payload_wrench": w,
         "deflection": d,
-        "deflection_edge_units": np.r_[d[:3] / kl, d[3:] / ka],
+        "deflection_edge_units": None if d is None else np.r_[d[:3] / kl, d[3:] / ka],
+        "limits": limits,
     }
     if args.map:
         write_maps(args, platform, q, k)
     if args.json:
         print_json(out)
-        return 0
+        return _report_limits(limits)
     print(
         f"platform {platform.name}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
         + ("" if np.all(k == k[0]) else " ...")
@@ -147,11 +172,19 @@ def run(args) -> int:
         print(f"principal {label} stiffness ({unit}), softest first:")
         for v, e in zip(vals, dirs.T):
             print(f"  {v:12.5g}  along [{e[0]:+.4f} {e[1]:+.4f} {e[2]:+.4f}]")
-    print(
-        f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
-        f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}"
-    )
-    return 0
+    if d is not None:
+        print(
+            f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
+            f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}"
+        )
+    return _report_limits(limits)
+
+
+def _report_limits(limits: list[str]) -> int:
+    """Each limit on stderr; exit 1 if there is one (the results above are still shown)."""
+    for m in limits:
+        print(f"stewart-drake stiffness: {m}", file=sys.stderr)
+    return 1 if limits else 0
 
 
 def write_maps(args, platform, q, k) -> None:

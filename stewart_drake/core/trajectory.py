@@ -20,6 +20,7 @@ import numpy as np
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.quantisation import check_quantisation, smooth_columns, smooth_tolerance
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.errors import TrajectoryError
 
@@ -111,9 +112,11 @@ def _fitted_pose(trajectory: Trajectory, home, s: float, centre, t):
     return q
 
 
-def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad", smooth=None) -> Trajectory:
     """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line."""
+    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line. A file rounded
+    so coarsely that its second differences are noise is refused (``quantisation``) unless ``smooth`` (a
+    tolerance in the file's units) replaces the samples by a smoothing spline's."""
     data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
@@ -121,7 +124,13 @@ def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -
         raise TrajectoryError(
             TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0])
         )
-    return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
+    t, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+    if smooth is None:
+        check_quantisation(path, t, poses)
+    else:
+        scale = pose_to_si(np.ones(6), length_unit, angle_unit)
+        poses = smooth_columns(t, poses, smooth_tolerance(smooth) * scale)
+    return table_trajectory(Path(path).stem, t, poses)
 
 
 def table_trajectory(name: str, ts, poses) -> Trajectory:

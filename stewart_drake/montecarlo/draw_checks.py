@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from stewart_drake.control import counts_per_lsb
+from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.gains import FixedGains
 from stewart_drake.control.timing import check_timing
 from stewart_drake.core.sanity import check_trajectory, require_plate
@@ -49,6 +50,9 @@ def check_draw(study, index: int, reference, duration: float, gains=None) -> Non
             FixedGains.from_si(sc.config.gains, timing)
         ticks = np.arange(int(math.floor(duration / timing.sample_period + 1e-9)) + 1) * timing.sample_period
         check_trajectory(plant, ticks, reference.pose(ticks), "utn", f"the {reference.name} reference", False)
+        why = infeasible_motion(plant, reference, ticks, timing.sample_period, d.force_limit)
+        if why:
+            raise StewartError(why)
     except (StewartError, ZeroDivisionError, OverflowError) as e:
         drawn = _drawn(study, d)
         raise StudyError(

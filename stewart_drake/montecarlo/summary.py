@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.montecarlo.spec import LATENCY_MODES
 
 METRICS = (
@@ -168,7 +169,7 @@ def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
         (tmp / "study.json").write_text(
             json.dumps({"key": summary["key"], "runs": summary["runs"], "settings": summary["settings"]}, indent=2)
         )
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
+        (tmp / "summary.json").write_text(dumps_strict(summary))  # NaN metrics of failed runs: null, strict JSON
         written += [tmp / "study.json", tmp / "summary.json"]
         names = [p.name for p in written]
     return [out / n for n in names]
