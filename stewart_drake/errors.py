@@ -400,6 +400,10 @@ class UsageError(StewartError):
     """Options that contradict each other or are ignored (e.g. ``--json`` without ``--inspect``)."""
 
     NEEDS = "{option} only applies with {needs}"
+    FIRMWARE_OPTIONS = (
+        "{file} was generated with other options ({mismatch}): the check would compare it with another module's "
+        "emulation; leave the option out to use the recorded one"
+    )
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     # argparse prefixes these with "argument --option:" (option values that are not numbers)
     NOT_A_NUMBER = "not a number: {value!r}"
@@ -637,6 +641,11 @@ class GainError(StewartError):
         "sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts "
         "for the fixed-point controller"
     )
+    COUNTS_PER_LSB = (
+        "the IK's length LSB {lsb:g} m (--length-lsb) is {cpl:.4g} sensor counts of {r:g} m (--sensor-resolution): "
+        "one LSB step would not fit the firmware's 16-bit error word (at most {limit} counts); use a smaller "
+        "--length-lsb or a coarser sensor resolution"
+    )
 
 
 # DspTiming fields (``control.timing``), raised as ``TimingError``.
@@ -658,6 +667,10 @@ class TrajectoryError(InputError):
         "noise (RMS(Δ⁴)/RMS(Δ²) = {ratio:.3g}; a smooth motion gives << 1), {noise:.3g} {unit} of acceleration noise; "
         "give {option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
         "rounding step) or write more decimals"
+    )
+    RATE = (
+        "{path}: column {column} goes from {a} to {b} (SI) between t = {t0} and {t1} s: its rate is not a finite "
+        "number (a value in the wrong unit or a corrupt cell?)"
     )
     SMOOTH_TOL = "{option}: the tolerance must be a finite number > 0 (in the file's units), got {value!r}"
 

@@ -83,7 +83,9 @@ def _tracking(section, platform, duration):
                 ]
             )
             ax = axes[i, j]
-            ax.plot(log.t, e * 1e3, lw=0.8)
+            ax.plot(log.t, e * 1e3, lw=0.8, label=[f"leg {k}" for k in range(1, 7)])
+            if i == j == 0:
+                ax.legend(ncol=6, fontsize=6)
             ax.set_title(f"{traj.name} trajectory, {kind} controller", fontsize=9)
             ax.set_ylabel("L − IK(ref) [mm]")
         d_ik, lsb, r, v_max, t_delay = _bound_terms(platform, traj, logs[traj.name, "float"], duration, cfg)

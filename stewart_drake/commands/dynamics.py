@@ -12,7 +12,7 @@ from scipy.interpolate import CubicSpline
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
-from stewart_drake.core.quantisation import check_quantisation, smooth_tolerance, smoothing_spline
+from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_tolerance, smoothing_spline
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import (
     check_file_rows,
@@ -92,6 +92,7 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     scale = np.r_[np.full(3, length_scale(length_unit)), np.full(3, angle_scale(angle_unit))]
     if width == 19:
         return t, a[:, 1:7] * scale, a[:, 7:13] * scale, a[:, 13:19] * scale
+    check_finite_rates(path, t, a[:, 1:7] * scale)
     if smooth is not None:
         f = smoothing_spline(t, a[:, 1:7] * scale, smooth_tolerance(smooth) * scale)
         return t, f(t), f(t, 1), f(t, 2)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -243,7 +244,9 @@ def run(args) -> int:
         duration=duration,
     )
     sim = build_simulation(scenario)
+    t_wall = time.perf_counter()
     log = sim.run(duration, progress=not args.no_progress)
+    t_wall = time.perf_counter() - t_wall
     gap = sim.max_constraint_gap()
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -268,6 +271,8 @@ def run(args) -> int:
         "integrator": scenario.integrator,
         "max_constraint_gap_m": gap,
         "duration_s": duration,
+        "wall_s": t_wall,
+        "real_time_factor": duration / t_wall if t_wall > 0 else None,
         "ticks": int(len(log.tick_times())),
         "max_leg_error_mm": float(np.abs(e).max() * 1e3),
         "rms_leg_error_mm": float(np.sqrt(np.mean(e**2)) * 1e3),
@@ -289,6 +294,12 @@ def run(args) -> int:
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
         (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
+    rtf = summary["real_time_factor"]
+    print(
+        f"stewart-drake simulate: simulated {duration:g} s in {t_wall:.3g} s of wall time"
+        + (f" ({rtf:.3g} × real time)" if rtf else ""),
+        file=sys.stderr,
+    )
     if verdict["failures"]:
         for f in verdict["failures"]:
             print(f"stewart-drake simulate: {f}", file=sys.stderr)
@@ -309,6 +320,7 @@ def write_plots(log, length_error, out: Path) -> list[Path]:
     ax[0].legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
     ax[1].plot(log.t, log.force)
     ax[1].set_ylabel("actuator force [N]")
+    ax[1].legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
     ax[1].set_xlabel("t [s]")
     fig.suptitle(
         f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace('$', r'\$')}, T = {log.sample_period * 1e3:g} ms"

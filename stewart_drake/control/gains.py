@@ -285,4 +285,10 @@ def counts_per_lsb(config: ControllerConfig) -> int:
     cpl = lsb / r
     if abs(cpl - round(cpl)) > 1e-9 * cpl or round(cpl) < 1:
         raise GainError(GainError.SENSOR_COUNTS.format(r=r, lsb=lsb))
+    if cpl > MAX_COUNTS_PER_LSB:  # one LSB step must fit the firmware's 16-bit error word (a C overflow before)
+        raise GainError(GainError.COUNTS_PER_LSB.format(r=r, lsb=lsb, cpl=cpl, limit=MAX_COUNTS_PER_LSB))
     return int(round(cpl))
+
+
+# The firmware's error word is 16 bits: a set-point step of one LSB, in sensor counts, must fit it.
+MAX_COUNTS_PER_LSB = 32767

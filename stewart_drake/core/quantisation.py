@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import UnivariateSpline
 
-from stewart_drake.errors import TrajectoryError
+from stewart_drake.errors import TrajectoryError, short_number
 
 NOISE_RATIO = 1.0
 DENSE_FRACTION = 0.1
@@ -102,6 +102,28 @@ def smoothing_spline(t, values, tol):
 
 
 COLUMNS = ("px", "py", "pz", "a_x", "a_y", "a_z")
+
+
+def check_finite_rates(path, t, values) -> None:
+    """``TrajectoryError`` naming ``path``, the column and the two samples when a rate (difference over the
+    time step) of ``values`` (n, 6) at ``t`` (n,) s is not finite: a 1e308 cell passes as a number but its
+    rate overflows (scipy's "`dydx` must contain only finite values" before)."""
+    t, v = np.asarray(t, dtype=float), np.asarray(values, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        rate = np.diff(v, axis=0) / np.diff(t)[:, None]
+    bad = ~np.isfinite(rate)
+    if bad.any():
+        k, j = np.unravel_index(int(np.argmax(bad)), bad.shape)
+        raise TrajectoryError(
+            TrajectoryError.RATE.format(
+                path=path,
+                column=COLUMNS[j],
+                a=short_number(v[k, j], 6),
+                b=short_number(v[k + 1, j], 6),
+                t0=short_number(t[k], 6),
+                t1=short_number(t[k + 1], 6),
+            )
+        )
 
 
 def check_quantisation(path, t, values, option: str = "--smooth") -> None:

@@ -20,7 +20,7 @@ import numpy as np
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.quantisation import check_quantisation, smooth_columns, smooth_tolerance
+from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_columns, smooth_tolerance
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.errors import TrajectoryError
 
@@ -125,6 +125,7 @@ def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad", s
             TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0])
         )
     t, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+    check_finite_rates(path, t, poses)
     if smooth is None:
         check_quantisation(path, t, poses)
     else:
