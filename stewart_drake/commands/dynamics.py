@@ -23,7 +23,8 @@ from stewart_drake.core.sanity import (
     fmt_value,
     require_plate,
 )
-from stewart_drake.errors import CsvError, OptionError, UsageError
+from stewart_drake.core.unit_hint import other_unit_hint
+from stewart_drake.errors import CsvError, OptionError, PhysicalLimitError, UsageError
 
 CSV_HELP = (
     "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
@@ -144,7 +145,11 @@ def run(args) -> int:
         t, q, qd, qdd = read_trajectory_csv(args.trajectory, args.length_unit, args.angle_unit, args.smooth)
         convention = args.convention
     what = "the seed trajectory" if args.trajectory == "seed" else f"trajectory {args.trajectory}"
-    warnings = check_trajectory(platform, t, q, convention, what, args.allow_out_of_stroke)
+    try:
+        warnings = check_trajectory(platform, t, q, convention, what, args.allow_out_of_stroke)
+    except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
+        hint = "" if seed else other_unit_hint(platform, q, args.length_unit, args.angle_unit, convention)
+        raise PhysicalLimitError(str(e) + hint) from None
     for w in warnings:
         print(f"stewart-drake dynamics: warning: {w}", file=sys.stderr)
     if args.legs == "on":
@@ -161,6 +166,7 @@ def run(args) -> int:
                 "coriolis": args.coriolis == "on",
                 "legs": args.legs == "on",
                 "gravity": gravity,
+                "read_units": None if seed else {"length": args.length_unit, "angle": args.angle_unit},
                 "unit": "N",
                 "t": t,
                 "forces": F,
@@ -175,7 +181,9 @@ def run(args) -> int:
             w.writerow([f"{tk:.9g}"] + [f"{x:.12g}" for x in Fk])
     else:
         print(
-            f"platform {platform.name}, trajectory {args.trajectory}, Coriolis {args.coriolis}, legs {args.legs}; forces in N"
+            f"platform {platform.name}, trajectory {args.trajectory}"
+            + ("" if seed else f" (read in {args.length_unit} and {args.angle_unit})")
+            + f", Coriolis {args.coriolis}, legs {args.legs}; forces in N"
         )
         print(f"{'t (s)':>8} " + " ".join(f"{'F' + str(i):>10}" for i in range(1, 7)))
         for tk, Fk in zip(t, F):

@@ -105,6 +105,7 @@ def _homotopy_all(platform, L, args, k: float) -> dict:
                 uniqueness_radius=hm.uniqueness,
                 position_bound=hm.position_bound / k,
                 angle_bound=hm.angle_bound / angle_scale(args.angle_unit),
+                singular=hm.singular,
             )
         )
     sols.sort(key=lambda d: d["distance_to_home"])
@@ -211,6 +212,7 @@ def run(args) -> int:
                 if s["certified"]
                 else []
             )
+            flags += ["SINGULAR (a multiple root: rank-deficient, not certified)"] if s.get("singular") else []
             print(
                 f"{i:3d}",
                 " ".join(f"{x:11.5f}" for x in s["pose"]),
@@ -224,6 +226,14 @@ def run(args) -> int:
         print(
             f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
             f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})",
+            file=sys.stderr,
+        )
+        return 1
+    singular = [i for i, s in enumerate(out["solutions"], 1) if s.get("singular")]
+    if singular:  # a pose on a singularity is found and shown; it is a physical limit
+        print(
+            f"fk --all: mode(s) {', '.join(map(str, singular))} lie on a singularity (several homotopy paths meet there; "
+            "the platform loses stiffness in some direction at that pose)",
             file=sys.stderr,
         )
         return 1

@@ -12,6 +12,7 @@ from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.rotations import length_scale, pose_to_si
 from stewart_drake.core.sanity import below_base_message, check_file_rows, check_poses, plate_anchor_heights
+from stewart_drake.core.unit_hint import other_unit_hint
 
 # Bytes per CSV row while reading (Python lists of floats) and per result printed as JSON (estimates).
 BYTES_PER_ROW = 600
@@ -84,6 +85,7 @@ def run(args) -> int:
                 "pose": rows[i],
                 "lengths": lengths[i],
                 "length_unit": args.length_unit,
+                "angle_unit": args.angle_unit,
                 "within_stroke": bool(within[i]),
                 "above_base": bool(above[i]),
                 "violations": viol.get(i, []),
@@ -101,7 +103,10 @@ def run(args) -> int:
                 + "\n]}\n"
             )
     else:
-        print(f"platform {platform.name}, convention {args.convention}, lengths in {args.length_unit}")
+        print(
+            f"platform {platform.name}, convention {args.convention}, poses read in {args.length_unit} and "
+            f"{args.angle_unit}, lengths in {args.length_unit}"
+        )
         flags = np.full(len(q), "ok", dtype=object)
         for i, vs in viol.items():
             flags[i] = "; ".join(
@@ -115,4 +120,7 @@ def run(args) -> int:
         cells[:, :6], cells[:, 6] = Lu, flags
         # one formatting pass over all rows (a Python loop per row costs ~10 µs a row)
         sys.stdout.write((("%10.3f " * 6 + "  %s\n") * len(q)) % tuple(cells.ravel().tolist()))
+    hint = "" if bool(np.all(ok)) else other_unit_hint(platform, q, args.length_unit, args.angle_unit, args.convention)
+    if hint:
+        print(f"stewart-drake ik: outside the workspace{hint}", file=sys.stderr)
     return 0 if bool(np.all(ok)) else 1

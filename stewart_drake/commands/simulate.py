@@ -173,6 +173,7 @@ def run(args) -> int:
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
+    from stewart_drake.core.unit_hint import other_unit_hint
     from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation
     from stewart_drake.firmware.engine import default_engine
     from stewart_drake.firmware.module import check_source
@@ -214,9 +215,14 @@ def run(args) -> int:
         raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
     check_simulation_size(duration, plant_step, "--duration", args.duration if args.duration is not None else duration)
     ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
-    warnings = check_trajectory(
-        platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", args.allow_out_of_stroke
-    )
+    try:
+        warnings = check_trajectory(
+            platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", args.allow_out_of_stroke
+        )
+    except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
+        csv = args.trajectory not in ("seed", "rotating") and not args.fit
+        hint = other_unit_hint(platform, traj.pose(ticks), args.length_unit, args.angle_unit) if csv else ""
+        raise PhysicalLimitError(str(e) + hint) from None
     for w in warnings:
         print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)
     why = infeasible_motion(platform, traj, ticks, period)
@@ -257,6 +263,9 @@ def run(args) -> int:
     summary = {
         "platform": platform.name,
         "trajectory": traj.name,
+        "read_units": {"length": args.length_unit, "angle": args.angle_unit}
+        if args.trajectory not in ("seed", "rotating")
+        else None,
         "controller": args.controller,
         "engine": engine,
         "firmware": args.firmware,

@@ -141,6 +141,9 @@ def run(args) -> int:
     out = dict(
         header,
         source=source,
+        read_units=None
+        if args.trajectory in ("seed", "rotating") or args.program
+        else {"length": args.length_unit, "angle": args.angle_unit},
         samples=len(t),
         duration_s=float(t[-1] - t[0]) if len(t) else 0.0,
         convention=convention,
@@ -153,7 +156,9 @@ def run(args) -> int:
         print_json(out)
     else:
         print(
-            f"platform {base.name}, {source}: {len(t)} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
+            f"platform {base.name}, {source}"
+            + (f" (read in {args.length_unit} and {args.angle_unit})" if out["read_units"] else "")
+            + f": {len(t)} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
         )
         _print_table(legs_json, with_times=True)
     if viol is None:
