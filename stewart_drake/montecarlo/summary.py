@@ -55,8 +55,13 @@ def sensitivity(rows: list[dict], metric: str = WORST_BY) -> list[dict]:
         return []
     y = _numeric(ok, metric)
     out = []
+    if np.ptp(y) == 0:  # a metric no parameter moved: no correlation (scipy warned on stderr)
+        return out
     for k in parameter_columns(ok):
-        rho, p = spearmanr(_numeric(ok, k), y)
+        x = _numeric(ok, k)
+        if np.ptp(x) == 0:
+            continue
+        rho, p = spearmanr(x, y)
         if math.isfinite(rho):
             out.append({"parameter": k, "spearman": float(rho), "p_value": float(p)})
     return sorted(out, key=lambda d: -abs(d["spearman"]))

@@ -106,3 +106,16 @@ def test_negative_gain_scale_names_no_internal_class(tmp_path, capsys):
     )
     err = capsys.readouterr().err
     assert rc == 2 and "PidGains" not in err and "kp gain must be a finite number >= 0" in err and "gain_scale" in err
+
+
+def test_a_metric_no_parameter_moved_has_no_sensitivity_and_no_warning():
+    """force_limit=4kN..6kN on a platform that never reaches 4 kN: the leg error is the same in every run;
+    scipy's ConstantInputWarning was printed among the study's output (found trying it by hand)."""
+    import warnings
+
+    from stewart_drake.montecarlo.summary import sensitivity
+
+    rows = [{"run": i, "seed": i, "force_limit_N": 4000.0 + i, "max_leg_error_m": 1e-3} for i in range(4)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sensitivity(rows) == []
