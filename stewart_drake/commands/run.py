@@ -178,10 +178,13 @@ def simulate(platform, result, args) -> dict:
     """Controller in the loop (``drake.simulation``) along the program's trajectory."""
     from dataclasses import replace
 
+    from stewart_drake.control import ControllerConfig
+    from stewart_drake.control.chatter import loop_verdict
     from stewart_drake.control.simulation_log import tracking_verdict
     from stewart_drake.core.sanity import require_plate
+    from stewart_drake.core.trajectory import design_poses
     from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
-    from stewart_drake.drake.simulation import Scenario
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario
     from stewart_drake.drake.simulation import simulate as sim_run
     from stewart_drake.firmware.engine import default_engine
 
@@ -193,10 +196,20 @@ def simulate(platform, result, args) -> dict:
     reference = replace(traj, name=Path(args.program).stem)
     require_plate(platform, "run --simulate")
     engine = default_engine(None, args.controller, "stewart-drake run")  # simulate's default: the compiled firmware
-    scenario = Scenario(platform, reference, args.controller, engine=engine, duration=traj.duration + SETTLE)
+    duration = traj.duration + SETTLE
+    # the configuration simulate's default designs (gains over the run's poses, the actuators' lag), made here
+    # so that the loop verdict (chatter) can use it
+    config = ControllerConfig.for_platform(
+        platform, actuator_lag=ActuatorModel().time_constant, poses=design_poses(reference, duration)
+    )
+    scenario = Scenario(platform, reference, args.controller, config, engine=engine, duration=duration)
     log = sim_run(scenario, progress=True)
     err = log.length_error(reference, platform)
     verdict = tracking_verdict(platform, err, log.pose_error(reference), log)
+    loop = loop_verdict(platform, reference, log, config)
+    verdict["failures"] += loop.pop("failures")
+    verdict["warnings"] = loop.pop("warnings")
+    verdict.update(loop)
     return {
         "log": log,
         "length_error": err,
