@@ -34,8 +34,9 @@ def _of_key(column: str, keys) -> bool:
     return any(column == k or column.startswith(k + "_") or column.startswith(k) and k == "anchor" for k in keys)
 
 
-def check_draw(study, index: int, reference, duration: float, gains=None) -> None:
-    """``StudyError`` (exit 2) naming run ``index`` when its scenario fails a check ``simulate`` makes."""
+def check_draw(study, index: int, reference, duration: float, gains=None, infeasible=None) -> None:
+    """``StudyError`` (exit 2) naming run ``index`` when its scenario fails a check ``simulate`` makes;
+    ``infeasible(force_limit, period)``: the motion's feasibility (``nominal_feasibility``), or None."""
     seed, d = draw(study, index)
     try:
         sc = scenario(study, index, reference, gains)[2]
@@ -50,7 +51,7 @@ def check_draw(study, index: int, reference, duration: float, gains=None) -> Non
             FixedGains.from_si(sc.config.gains, timing)
         ticks = np.arange(int(math.floor(duration / timing.sample_period + 1e-9)) + 1) * timing.sample_period
         check_trajectory(plant, ticks, reference.pose(ticks), "utn", f"the {reference.name} reference", False)
-        why = infeasible_motion(plant, reference, ticks, timing.sample_period, d.force_limit)
+        why = infeasible(d.force_limit, timing.sample_period) if infeasible else None
         if why:
             raise StewartError(why)
     except (StewartError, ZeroDivisionError, OverflowError) as e:
@@ -60,10 +61,29 @@ def check_draw(study, index: int, reference, duration: float, gains=None) -> Non
         ) from None
 
 
+def nominal_feasibility(study, reference, duration: float):
+    """``f(force_limit, period) -> reason or None``: ``feasibility.infeasible_motion`` of the reference on the
+    nominal platform, computed once per (limit, period) a study draws. The drawn plants' forces differ from the
+    nominal by their mass and geometry tolerances; checking each plant would cost as much as the feed-forward
+    table of its run again (~15 % of a study's time), and a draw near the limit shows as saturation in its run."""
+    cache: dict = {}
+
+    def f(force_limit: float, period: float):
+        key = (force_limit, period)
+        if key not in cache:
+            ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
+            cache[key] = infeasible_motion(study.platform, reference, ticks, period, force_limit)
+        return cache[key]
+
+    return f
+
+
 def check_draws(study) -> None:
-    """``check_draw`` for every run of ``study`` (the reference built once)."""
+    """``check_draw`` for every run of ``study`` (the reference, the nominal gains and the motion's
+    feasibility computed once)."""
     reference = study.reference()
     duration = study.run_duration(reference)
     gains = nominal_gains(study, reference)
+    infeasible = nominal_feasibility(study, reference, duration)
     for i in range(study.runs):
-        check_draw(study, i, reference, duration, gains)
+        check_draw(study, i, reference, duration, gains, infeasible)
