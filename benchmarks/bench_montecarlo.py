@@ -6,7 +6,7 @@ start to the last row (runs per second), prints the ratio to the first entry and
 (wall time excluded) equals the first entry's.
 
     PYTHONPATH=. python benchmarks/bench_montecarlo.py --runs 200 --workers 1,2 --out /tmp/mc-bench \
-        --vary anchor=±0.5mm sensor_resolution=10um latency_jitter=200us payload_mass=±20%
+        --vary anchor=±0.5mm sensor_resolution=10um latency_jitter=200us plate_mass=±20%
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--vary",
         nargs="+",
-        default=["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "payload_mass=±20%"],
+        default=["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "plate_mass=±20%"],
     )
     ap.add_argument("--engine", choices=ENGINES, default=None, help="default: the montecarlo command's")
     ap.add_argument("--integrator", choices=INTEGRATORS, default=DEFAULT_INTEGRATOR)

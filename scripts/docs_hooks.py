@@ -141,12 +141,18 @@ def public_names() -> list[str]:
     return [n for n in getattr(stewart_drake, "__all__", []) if not n.startswith("_")]
 
 
+def public_object(name: str):
+    """The object behind public name ``name``: a name that is also an internal subpackage (``sd.firmware``,
+    ``sd.workspace``, ...) is a shadow whose ``__public__`` is the public function or namespace module."""
+    obj = getattr(stewart_drake, name)
+    return getattr(obj, "__public__", obj)
+
+
 def api_target(name: str) -> str:
     """Where public name ``name`` is defined (``module.qualname``, or the module's name for a namespace such as
     ``sd.firmware``): the names are loaded lazily by the package's ``__getattr__``, so mkdocstrings, which reads
     the sources statically, is pointed at their definitions."""
-    obj = getattr(stewart_drake, name)
-    obj = getattr(obj, "__public__", obj)  # a name shared with an internal subpackage: its public object
+    obj = public_object(name)
     return obj.__name__ if inspect.ismodule(obj) else f"{obj.__module__}.{obj.__qualname__}"
 
 
@@ -176,7 +182,7 @@ def undocumented(names) -> list[str]:
                 visit(member, f"{shown}.{attr}", depth + 1)
 
     for n in names:
-        visit(getattr(stewart_drake, n), n, 0)
+        visit(public_object(n), n, 0)
     return missing
 
 

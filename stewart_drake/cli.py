@@ -134,11 +134,18 @@ def command_module(name: str):
     return importlib.import_module(f"{commands.__name__}.{COMMANDS[name][0]}")
 
 
+DESCRIPTION = (
+    "Model, size and verify Stewart platforms and the fixed-point controllers that drive them. "
+    "Run `stewart-drake COMMAND --help` for a command's options; exit 0: a good result, 1: a result outside "
+    "physical limits (still shown), 2: bad input."
+)
+
+
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The whole command line. ``only=None``: every command's full parser (imports every command
     module); otherwise only the command named ``only`` (if it is one) gets its full parser and the others
     a bare entry with their help, so that only that command's module is imported."""
-    parser = Parser(prog="stewart-drake", description=__doc__.split("\n")[0])
+    parser = Parser(prog="stewart-drake", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"stewart-drake {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, (_, help_text) in COMMANDS.items():

@@ -26,6 +26,10 @@ class StewartError(ValueError):
 class GeometryError(StewartError):
     """A platform description is inconsistent (shapes, values, anchors, limits)."""
 
+    INERTIA_SINGULAR = (
+        "platform {name!r}: the plate's mass matrix is not positive definite (plate.mass {mass:g} kg, plate.inertia): "
+        "a plate without mass or inertia has no natural frequencies"
+    )
     TOP_SHAPE = "top_anchors must have shape (k, 3) with 3 <= k <= 6, got {shape}"
     LEG_TOP = "leg_top must list 6 integer top-anchor indices (one per leg), got {value!r}"
     LEG_TOP_RANGE = "leg_top: leg {leg} refers to top anchor {anchor}, but there are {n} top anchors (0..{last})"
@@ -396,6 +400,10 @@ class UsageError(StewartError):
     """Options that contradict each other or are ignored (e.g. ``--json`` without ``--inspect``)."""
 
     NEEDS = "{option} only applies with {needs}"
+    FIRMWARE_OPTIONS = (
+        "{file} was generated with other options ({mismatch}): the check would compare it with another module's "
+        "emulation; leave the option out to use the recorded one"
+    )
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     # argparse prefixes these with "argument --option:" (option values that are not numbers)
     NOT_A_NUMBER = "not a number: {value!r}"
@@ -619,21 +627,31 @@ class SamplingError(StewartError):
 class GainError(StewartError):
     """Controller gains or their design inputs are not usable (``control.gains``)."""
 
-    PID_NEGATIVE = "PidGains.{name} must be a finite number >= 0, got {value!r}"
-    PID_FILTER = "PidGains.{name} must be in (0, 1], got {value!r}"
+    PID_NEGATIVE = "the controller's {name} gain must be a finite number >= 0, got {value!r}{hint}"
+    PID_FILTER = "the controller's {name} must be in (0, 1], got {value!r}"
     ACTUATOR_LAG = "actuator_lag must be >= 0 s, got {value!r}"
     INERTIA = "platform {name!r}: the leg-space inertia is not positive definite (smallest eigenvalue {m_min:.3g} kg)"
     DESIGN_POSE = "design pose {index} is not finite: {value!r}"
     GAIN = "a gain must be a finite number >= 0, got {value!r}"
     Q15_RANGE = "gain {value!r} is too large for a Q15 mantissa with a 32-bit shift"
+    Q15_SCALE = (
+        "the {name} gain {value:.4g} (SI) does not fit the firmware's Q15 words with a command range of "
+        "{range:.4g} N (legs.max_force), a sensor count of {r:.4g} m and a period of {T:.4g} s; "
+        "a command range this small (or a count this large) is not a usable actuator"
+    )
     SENSOR_COUNTS = (
         "sensor_resolution {r} m must divide the IK's length LSB {lsb} m into a whole number of counts "
         "for the fixed-point controller"
     )
+    COUNTS_PER_LSB = (
+        "the IK's length LSB {lsb:g} m (--length-lsb) is {cpl:.4g} sensor counts of {r:g} m (--sensor-resolution): "
+        "one LSB step would not fit the firmware's 16-bit error word (at most {limit} counts); use a smaller "
+        "--length-lsb or a coarser sensor resolution"
+    )
 
 
 # DspTiming fields (``control.timing``), raised as ``TimingError``.
-TIMING_POSITIVE = "DspTiming.{name} must be a positive number, got {value!r}"
+TIMING_POSITIVE = "the controller's {name} must be a positive number, got {value!r}"
 TIMING_LATENCY = "DspTiming.latency must be one of {valid}, got {value!r}"
 TIMING_CYCLES = "DspTiming.computation_cycles must be a positive integer, got {value!r}"
 
@@ -646,6 +664,17 @@ class TrajectoryError(InputError):
     TIME_ORDER = "{path}:{line}: time {t} s is not after the previous sample's {t_prev} s"
     DESIGN_DURATION = "design duration must be a number of seconds >= 0, got {value!r}"
     UNKNOWN = "unknown trajectory {value!r}: not one of {valid} and not a CSV file"
+    QUANTISED = (
+        "{path}: column {column} is rounded too coarsely for its accelerations: its second differences are rounding "
+        "noise (RMS(Δ⁴)/RMS(Δ²) = {ratio:.3g}; a smooth motion gives << 1), {noise:.3g} {unit} of acceleration noise; "
+        "give {option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
+        "rounding step) or write more decimals"
+    )
+    RATE = (
+        "{path}: column {column} goes from {a} to {b} (SI) between t = {t0} and {t1} s: its rate is not a finite "
+        "number (a value in the wrong unit or a corrupt cell?)"
+    )
+    SMOOTH_TOL = "{option}: the tolerance must be a finite number > 0 (in the file's units), got {value!r}"
 
 
 class SimulationError(StewartError):
@@ -736,6 +765,9 @@ class SpecError(StewartError):
     NOT_YAML = "{path}:{line}: not YAML ({problem})"
     NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
     NOT_SCALAR = "{where}: {key}: the value must be one scalar (e.g. ±0.5mm)"
+    KEY_NOT_TEXT = "{where}: a key must be a name (one of the keys), got {key}"
+    RENAMED = "{where}: the key {key!r} is no longer read: {why}"
+    VECTOR_3 = "{where}: {key}: {text!r}: a fixed vector is three numbers X,Y,Z"
     SWEEP_VECTOR = "sweep: {key} is a per-component key; sweep scalar keys"
     SWEEP_EMPTY = "sweep: {key} has no values"
 
@@ -764,6 +796,10 @@ class StudyError(StewartError):
     )
     RESOLUTION_DIVIDE = (
         "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
+    )
+    DRAW = (
+        "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; "
+        "no run was started — narrow the --vary ranges"
     )
     OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
     OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
@@ -921,3 +957,28 @@ class CertifyError(UsageError):
     CELLS = "--max-cells must be in {lo}..{hi}, got {value}"
     BUDGET = "--error-budget must be a positive length such as 0.5mm, got {value!r}"
     IMPLEMENTATION = "--implementation tp17 certifies the seed's DSP firmware, whose platform is utn-kinematic; got --platform {value!r}"
+
+
+# ----------------------------------------------------------------------------------------------
+# Values echoed in messages: shortened the same way everywhere (a 1e300 length is not 300 digits).
+
+MAX_ECHO = 60
+
+
+def short_number(v, decimals: int = 3) -> str:
+    """A number for a message: ``decimals`` places while it is below 1e9 in size, else 6 significant
+    digits (``1e+300``, not 301 digits); ``nan``/``inf`` as such."""
+    v = float(v)
+    return f"{v:.{decimals}f}" if abs(v) < 1e9 else f"{v:.6g}"
+
+
+def short_text(value, limit: int = MAX_ECHO) -> str:
+    """``value`` as text for a message, cut to ``limit`` characters with an ellipsis."""
+    s = value if isinstance(value, str) else repr(value)
+    return s if len(s) <= limit else s[: limit - 1] + "…"
+
+
+OPTION_LEG_DAMPING_RESOLVE = (
+    "--leg-damping {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
+    "this overdamped are not resolved in double precision (one root per mode runs to ~0, the other to ~infinity)"
+)

@@ -24,7 +24,7 @@ VARY = [
     "sensor_resolution=10um",
     "sensor_noise=2um",
     "latency_jitter=200us",
-    "payload_mass=±20%",
+    "plate_mass=±20%",
     "actuator_lag=1.5ms..2.5ms",
     "gain_scale=±10%",
 ]

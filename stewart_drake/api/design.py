@@ -2,23 +2,32 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import inverse_kinematics, require_nonsingular
+from stewart_drake.core.kinematics import inverse_kinematics, leg_lengths, require_nonsingular
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import check_poses
+from stewart_drake.design.load_limits import (
+    MAX_DAMPING_RATIO,
+    beyond_linear_range,
+    damping_ratio_scale,
+    rigid_body_limit_hz,
+    unstable_direction,
+)
 from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
 from stewart_drake.design.payload import payload_wrench, with_payload
-from stewart_drake.design.stiffness import compliance, deflection, leg_stiffness_vector, principal_stiffness
+from stewart_drake.design.stiffness import compliance, deflection, displace, leg_stiffness_vector, principal_stiffness
 from stewart_drake.design.stiffness import stiffness_matrix as cartesian_stiffness
 from stewart_drake.errors import (
     OPTION_LEG_DAMPING,
+    OPTION_LEG_DAMPING_RESOLVE,
     OPTION_SAMPLE_RATE,
+    GeometryError,
     OptionError,
     PayloadError,
     PhysicalLimitError,
@@ -107,7 +116,8 @@ class StiffnessResult(Result):
         principal: principal translational (N/m) and rotational (N·m/rad) stiffnesses, softest first, and
             their directions (one per row).
         payload_wrench: ``(6,)`` the payload's weight as a wrench about the rotation centre (N, N·m).
-        deflection: ``(6,)`` the static deflection under it (m, rad).
+        deflection: ``(6,)`` the static deflection under it (m, rad); None when the loaded platform is unstable
+            or the deflection is beyond the linear range (then it is not a number to trust).
         pose: ``(6,)`` the pose (m, rad).
         leg_stiffness: ``(6,)`` N/m.
         platform: the platform's name.
@@ -116,6 +126,8 @@ class StiffnessResult(Result):
         payload: kg.
         payload_com: ``(3,)`` m, in the plate frame.
         gravity: m/s².
+        limits: the physical limits reached (the loaded platform unstable, the deflection beyond the linear
+            range), one sentence each; ``ok`` is False when there is one.
     """
 
     matrix: np.ndarray
@@ -132,6 +144,12 @@ class StiffnessResult(Result):
     payload: float
     payload_com: np.ndarray
     gravity: float
+    limits: list = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """What ``stiffness`` exits 0 for: the loaded platform stable and its deflection within the linear range."""
+        return not self.limits
 
     def _fields(self) -> dict:
         return {
@@ -152,6 +170,7 @@ class StiffnessResult(Result):
             "payload_wrench": self.payload_wrench,
             "deflection": self.deflection,
             "deflection_edge_units": self.deflection,
+            "limits": self.limits,
         }
 
 
@@ -181,7 +200,8 @@ def stiffness(
         gravity: m/s².
 
     Returns:
-        The stiffness, compliance, principal stiffnesses and deflection.
+        The stiffness, compliance, principal stiffnesses and deflection; ``limits`` (and ``ok`` False) when the
+        loaded platform is unstable or the deflection is beyond the linear range.
 
     Raises:
         StewartError: bad options or a pose that is not analysable; ``PhysicalLimitError`` outside the stroke or
@@ -204,9 +224,25 @@ def stiffness_at(load: Load) -> StiffnessResult:
         "rotational_nm_per_rad": pr.rotational,
         "rotational_directions": pr.rotational_dirs.T,
     }
+    d = deflection(K, w)
+    # an unstable loaded platform, or a deflection beyond the linear range: a result outside limits, and the
+    # deflection is not a number to print
+    limits = []
+    v = unstable_direction(K)
+    if v is not None:
+        limits.append(
+            "the loaded platform is unstable at this pose: its stiffness K is not positive definite, it falls away "
+            f"along [{' '.join(f'{x:+.3f}' for x in v)}] (x y z m, rx ry rz rad): the load's geometric stiffness "
+            "exceeds the legs'"
+        )
+    else:
+        why = beyond_linear_range(leg_lengths(p, q, c), leg_lengths(p, displace(q, d, c), c), d)
+        if why:
+            limits.append(f"the deflection under the payload is beyond the linear range: {why}")
     return StiffnessResult(
-        K, K0, compliance(K), principal, w, deflection(K, w), q, k, p.name, c, load.legs, load.payload, load.p_TP, g
-    )
+        K, K0, compliance(K), principal, w, None if limits else d, q, k, p.name, c, load.legs, load.payload,
+        load.p_TP, g, limits,
+    )  # fmt: skip
 
 
 @dataclass(repr=False)
@@ -224,6 +260,9 @@ class ModesResult(Result):
         leg_damping: N·s/m.
         legs: the legs' masses are included.
         platform: the platform's name.
+        warnings: model-range warnings (a mode above the legs' own axial resonance).
+        limits: the physical limits reached (the loaded platform unstable: a 0 Hz mode is that fall), one
+            sentence each; ``ok`` is False when there is one.
     """
 
     frequencies_hz: np.ndarray
@@ -236,6 +275,13 @@ class ModesResult(Result):
     leg_damping: float
     legs: bool
     platform: str
+    warnings: list = field(default_factory=list)
+    limits: list = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """What ``modes`` exits 0 for: the loaded platform stable at the pose."""
+        return not self.limits
 
     def _fields(self) -> dict:
         out = {
@@ -251,6 +297,8 @@ class ModesResult(Result):
         }
         if self.drake is not None:
             out["drake"] = self.drake
+        out["warnings"] = self.warnings
+        out["limits"] = self.limits
         return out
 
 
@@ -285,10 +333,12 @@ def modes(
         drake: also linearise the Drake plant and compare (needs pydrake).
 
     Returns:
-        The frequencies, damping ratios, shapes and the controller's view of the lowest mode.
+        The frequencies, damping ratios, shapes and the controller's view of the lowest mode; ``limits`` (and
+        ``ok`` False) when the loaded platform is unstable, ``warnings`` beyond the rigid-plate model's range.
 
     Raises:
-        StewartError: bad options or a pose that is not analysable.
+        StewartError: bad options or a pose that is not analysable; a singular mass matrix; a damping the
+            eigen-solve cannot resolve.
     """
     load = load_at_pose(
         platform, pose, leg_stiffness, convention, legs, payload, payload_com, gravity, check_pose=False
@@ -312,6 +362,11 @@ def modes_at(load: Load, leg_damping: float, sample_rate: float, drake: bool) ->
     K = cartesian_stiffness(p, q, k, c, load.gravity, legs)
     M = spatial_inertia(p, q, c, legs)
     C = damping_matrix(p, q, leg_damping, c) if leg_damping > 0 else None
+    if not np.linalg.eigvalsh(0.5 * (M + M.T))[0] > 0:  # a zero or singular inertia: LAPACK's "not positive definite"
+        raise GeometryError(GeometryError.INERTIA_SINGULAR.format(name=p.name, mass=p.mass))
+    zeta = damping_ratio_scale(K, M, C)
+    if zeta > MAX_DAMPING_RATIO:
+        raise OptionError(OPTION_LEG_DAMPING_RESOLVE.format(value=leg_damping, zeta=zeta, limit=MAX_DAMPING_RATIO))
     m = analytic_modes(K, M, C)
     f1 = float(m.frequencies_hz[0])
     delay = 1.5 / sample_rate  # one sample of output delay + half a sample of zero-order hold
@@ -336,6 +391,26 @@ def modes_at(load: Load, leg_damping: float, sample_rate: float, drake: bool) ->
             "equilibrium_residual": d["residual"],
             "method": "closed-loop plant, reduced by finite differences" if legs else "spring plant, Drake Linearize",
         }
-    return ModesResult(
-        m.frequencies_hz, m.damping_ratio, m.shapes, controller, checked, q, k, leg_damping, legs, p.name
+    v = unstable_direction(K)
+    limits = (
+        []
+        if v is None
+        else [
+            "the loaded platform is unstable at this pose: its stiffness K is not positive definite, it falls away along "
+            f"[{' '.join(f'{x:+.3f}' for x in v)}] (x y z m, rx ry rz rad); a mode of 0 Hz is that fall, not a frequency"
+        ]
     )
+    # beyond the legs' own axial resonance the rigid-plate model does not hold: a warning (the model's range,
+    # not the platform's limit); a 1e-30 kg plate printed 1e18 Hz as if it were a result
+    f_rigid = rigid_body_limit_hz(leg_lengths(p, q, c))
+    warnings = []
+    if m.frequencies_hz[-1] > f_rigid:
+        warnings.append(
+            f"mode 6 at {m.frequencies_hz[-1]:.4g} Hz is above the legs' own axial resonance (~{f_rigid:.4g} Hz, c/2L "
+            f"for steel legs): the rigid-plate, massless-leg model does not hold there; check plate.mass "
+            f"({p.mass:g} kg), plate.inertia and the leg stiffness"
+        )
+    return ModesResult(
+        m.frequencies_hz, m.damping_ratio, m.shapes, controller, checked, q, k, leg_damping, legs, p.name, warnings,
+        limits,
+    )  # fmt: skip

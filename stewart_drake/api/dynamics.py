@@ -14,6 +14,7 @@ from stewart_drake.api.result import Result
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_tolerance, smoothing_spline
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import (
     check_file_rows,
@@ -25,7 +26,8 @@ from stewart_drake.core.sanity import (
     require_plate,
 )
 from stewart_drake.core.trajectory import Trajectory
-from stewart_drake.errors import CsvError, OptionError, UsageError
+from stewart_drake.core.unit_hint import other_unit_hint
+from stewart_drake.errors import CsvError, OptionError, PhysicalLimitError, UsageError
 
 # Memory per trajectory sample while computing forces ((6, 6) Jacobians, mass matrices and their
 # temporaries) and the most samples one run takes (~10 s of vectorised inverse dynamics).
@@ -46,6 +48,7 @@ class DynamicsResult(Result):
         legs: the legs' masses are included.
         gravity: m/s².
         warnings: stroke warnings (with ``allow_out_of_stroke``).
+        read_units: a CSV's units as read (``{"length": ..., "angle": ...}``); None for other trajectories.
     """
 
     t: np.ndarray
@@ -56,6 +59,7 @@ class DynamicsResult(Result):
     legs: bool
     gravity: float
     warnings: list
+    read_units: dict | None = None
 
     @property
     def max_abs_force(self) -> np.ndarray:
@@ -69,6 +73,7 @@ class DynamicsResult(Result):
             "coriolis": self.coriolis,
             "legs": self.legs,
             "gravity": self.gravity,
+            "read_units": self.read_units,
             "unit": "N",
             "t": self.t,
             "forces": self.forces,
@@ -90,6 +95,7 @@ def inverse_dynamics(
     length_unit: str = "m",
     angle_unit: str = "rad",
     allow_out_of_stroke: bool = False,
+    smooth: float | None = None,
     on_warning: Callable[[str], None] | None = None,
 ) -> DynamicsResult:
     """The leg forces that move the plate along a trajectory (rigid-body inverse dynamics).
@@ -108,6 +114,9 @@ def inverse_dynamics(
         length_unit: unit of a CSV's positions (``"m"`` or ``"mm"``).
         angle_unit: unit of a CSV's angles (``"rad"``, ``"deg"`` or ``"pi"``).
         allow_out_of_stroke: compute forces where a leg leaves the stroke (a warning) instead of raising.
+        smooth: a 7-column CSV is differentiated through a smoothing spline within this RMS tolerance (the
+            file's units) of its samples; without it, a file rounded so coarsely that its second differences
+            are noise is refused.
         on_warning: called with each warning as it is found.
 
     Returns:
@@ -119,6 +128,7 @@ def inverse_dynamics(
     """
     require_plate(platform, "dynamics")
     gravity = check_gravity(gravity)
+    read_units = None
     if isinstance(trajectory, Trajectory) and trajectory.t is not None and t_end is None:  # a program's samples
         t, q, qd, qdd = trajectory.t, trajectory.q, trajectory.qd, trajectory.qdd
         convention, name, what = "utn", trajectory.name, f"trajectory {trajectory.name}"
@@ -130,9 +140,14 @@ def inverse_dynamics(
         t = sample_times(4.0 if t_end is None else t_end, dt)
         (q, qd, qdd), convention, name, what = seed_trajectory(t), "utn", "seed", "the seed trajectory"
     else:
-        t, q, qd, qdd = read_trajectory_csv(str(trajectory), length_unit, angle_unit)
+        t, q, qd, qdd = read_trajectory_csv(str(trajectory), length_unit, angle_unit, smooth)
         name, what = str(trajectory), f"trajectory {trajectory}"
-    warnings = check_trajectory(platform, t, q, convention, what, allow_out_of_stroke)
+        read_units = {"length": length_unit, "angle": angle_unit}
+    try:
+        warnings = check_trajectory(platform, t, q, convention, what, allow_out_of_stroke)
+    except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
+        hint = "" if read_units is None else other_unit_hint(platform, q, length_unit, angle_unit, convention)
+        raise PhysicalLimitError(str(e) + hint) from None
     for w in warnings:
         if on_warning:
             on_warning(w)
@@ -142,7 +157,7 @@ def inverse_dynamics(
         F = leg_forces_with_legs(platform, q, qd, qdd, convention, gravity=gravity)
     else:
         F = leg_forces(platform, q, qd, qdd, convention, coriolis=coriolis, gravity=gravity)
-    return DynamicsResult(t, F, platform.name, name, bool(coriolis), bool(legs), gravity, warnings)
+    return DynamicsResult(t, F, platform.name, name, bool(coriolis), bool(legs), gravity, warnings, read_units)
 
 
 def trajectory_rates(trajectory: Trajectory, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -154,8 +169,10 @@ def trajectory_rates(trajectory: Trajectory, t) -> tuple[np.ndarray, np.ndarray,
     return spline(t), spline(t, 1), spline(t, 2)
 
 
-def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad"):
-    """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (7 or 19 columns). Errors name the line."""
+def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad", smooth=None):
+    """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (7 or 19 columns). Errors name the line. Poses
+    alone are differentiated by a cubic spline, or by a smoothing spline within ``smooth`` (the file's
+    units) RMS of the samples; a file whose second differences are rounding noise is refused without it."""
     check_file_rows(path, "--trajectory", BYTES_PER_SAMPLE + 600, 14)
     a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
     width = a.shape[1]
@@ -168,6 +185,11 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     scale = np.r_[np.full(3, length_scale(length_unit)), np.full(3, angle_scale(angle_unit))]
     if width == 19:
         return t, a[:, 1:7] * scale, a[:, 7:13] * scale, a[:, 13:19] * scale
+    check_finite_rates(path, t, a[:, 1:7] * scale)
+    if smooth is not None:
+        f = smoothing_spline(t, a[:, 1:7] * scale, smooth_tolerance(smooth) * scale)
+        return t, f(t), f(t, 1), f(t, 2)
+    check_quantisation(path, t, a[:, 1:7] * scale)
     spline = CubicSpline(t, a[:, 1:7] * scale, axis=0)
     return t, spline(t), spline(t, 1), spline(t, 2)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from stewart_drake.api.result import Result
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.c_build import compiler_by_name, compilers
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, load_platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.trajectory import Trajectory, design_poses, get_trajectory
 from stewart_drake.errors import (
@@ -21,8 +21,11 @@ from stewart_drake.errors import (
     OPTION_OUT_NOT_FOLDER,
     OptionError,
     OutputError,
+    StewartError,
     UsageError,
 )
+from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
+from stewart_drake.firmware.fingerprint import read_fingerprint, resolve_options, stamp
 from stewart_drake.firmware.generate import FILES
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
@@ -100,6 +103,7 @@ def generate(
     trajectory: str | Trajectory | None = None,
     compile: bool = True,
     on_note: Callable[[str], None] | None = None,
+    platform_source: str | None = None,
 ) -> GenerateResult:
     """Generate the C firmware (``sd_firmware.h``, ``sd_firmware.c``, README) for a platform into a folder.
 
@@ -115,6 +119,8 @@ def generate(
         trajectory: design the gains over this reference's poses (default: home only).
         compile: compile-check the C with every C compiler found.
         on_note: called with a note (no compiler found).
+        platform_source: how the platform is named (a preset name or a YAML path), recorded with the other
+            options in the files (a fingerprint ``check`` reads back); default the platform's name.
 
     Returns:
         The summary and the files written.
@@ -125,6 +131,17 @@ def generate(
     config = controller_config(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
     out = check_out_folder(out)
     g = generate_sources(platform, config)
+    options = dict(
+        platform=platform.name if platform_source is None else str(platform_source),
+        word_bits=word_bits,
+        length_lsb=length_lsb,
+        trig=trig,
+        convention=convention,
+        rate=rate,
+        sensor_resolution=sensor_resolution,
+        trajectory=trajectory if trajectory is None or isinstance(trajectory, str) else trajectory.name,
+    )
+    g.files = stamp(g.files, options)  # the options, for `firmware check`
     compiled = []
     if compile:
         for cc in compilers():
@@ -178,27 +195,32 @@ class CheckResult(Result):
 
 def check(
     path: str | Path,
-    platform: Platform,
+    platform: Platform | str | None = None,
     *,
     poses: int = 100_000,
     seed: int = 0,
     trace: bool = False,
     duration: float = 0.5,
     compiler: str | None = None,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
 ) -> CheckResult:
     """Compile a C firmware against the header generated for the platform and compare it with the bit-exact
     emulation: ``sd_ik`` over random workspace poses and ``sd_tick`` over a recorded closed-loop stream.
 
+    The module's options default to those recorded in the file (or in the ``sd_firmware.h`` next to it) by
+    ``generate`` (a fingerprint), else to ``generate``'s defaults; an option given that differs from the
+    recorded one is refused, naming both (the check would compare the C with another module's emulation).
+
     Args:
         path: the C file (implementing ``sd_firmware.h``).
-        platform: the platform it was generated for.
+        platform: the platform it was generated for (a Platform, a preset name or a YAML path; default as
+            recorded).
         poses: workspace poses compared.
         seed: random seed of the poses.
         trace: trace the first differing pose word by word.
@@ -216,13 +238,49 @@ def check(
         The comparison; ``identical`` when bit-exact.
 
     Raises:
-        StewartError: a missing or unreadable file, a firmware that does not compile, bad options.
+        StewartError: a missing or unreadable file, a firmware that does not compile, bad options, an option
+            that differs from the one recorded in the file.
     """
     # deferred: only check needs Drake (it records a closed loop); generate runs without pydrake
     from stewart_drake.drake.firmware_check import check_firmware
 
     check_source(path)
-    config = controller_config(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    given = dict(
+        platform=None,  # compared below by the platform's name (a preset, a path or an API platform's name)
+        word_bits=word_bits,
+        length_lsb=length_lsb,
+        trig=trig,
+        convention=convention,
+        rate=rate,
+        sensor_resolution=sensor_resolution,
+        trajectory=trajectory if trajectory is None or isinstance(trajectory, str) else None,
+    )
+    names = {k: "--" + k.replace("_", "-") for k in FP_DEFAULTS}
+    o, mismatch = resolve_options(given, path, names)
+    if mismatch:  # the check would compare the C with another module's emulation
+        raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
+    rec = read_fingerprint(path)
+    if platform is None:
+        platform = load_platform(o["platform"])
+    else:
+        platform = load_platform(platform)
+        if rec and _platform_name(rec[0]["platform"]) != platform.name:
+            mismatch = f"--platform {platform.name} here, {rec[0]['platform']} in {rec[1]}"
+            raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
+    if isinstance(trajectory, Trajectory):
+        o["trajectory"] = trajectory
+    config = controller_config(
+        platform, o["word_bits"], o["length_lsb"], o["trig"], o["convention"], o["rate"], o["sensor_resolution"],
+        o["trajectory"],
+    )  # fmt: skip
     cc = compiler_by_name(compiler) if compiler else None
     r = check_firmware(Path(path), platform, config, poses, seed, trace, duration, cc)
     return CheckResult(r["ik"], r["tick"], r["identical"], r)
+
+
+def _platform_name(recorded: str) -> str:
+    """The name of the platform a fingerprint records (a preset name, a YAML path, or an API platform's name)."""
+    try:
+        return load_platform(recorded).name
+    except StewartError:
+        return recorded

@@ -74,6 +74,7 @@ class IKResult(Result):
                 "lengths": lengths[i],
                 **({"readings": readings[i]} if readings is not None else {}),
                 "length_unit": "m",
+                "angle_unit": "rad",
                 "within_stroke": bool(within[i]),
                 "above_base": bool(above[i]),
                 "violations": self.violations[i],
@@ -162,7 +163,7 @@ class FKSolution(Result):
         distance_to_home: distance of the pose from home (m and rad combined).
         method: ``"newton"``, ``"homotopy"`` or ``"multi-start"``.
         extra: method-specific numbers (iterations; path, certified_radius, uniqueness_radius,
-            position_bound (m), angle_bound (rad)).
+            position_bound (m), angle_bound (rad), singular: a multiple root on a singularity, not certified).
     """
 
     pose: np.ndarray
@@ -222,8 +223,11 @@ class FKResult(Result):
     @property
     def ok(self) -> bool:
         """What ``fk`` exits 0 for: a complete answer (homotopy: at least one mode), every mode within the
-        stroke, and the plate above the base (one mode: in it; all modes: in at least one)."""
+        stroke, and the plate above the base (one mode: in it; all modes: in at least one); no mode on a
+        singularity (homotopy: a multiple root, ``extra["singular"]``)."""
         if self.method == "homotopy" and not (self.complete and self.solutions):
+            return False
+        if any(s.extra.get("singular") for s in self.solutions):  # a pose on a singularity: a physical limit
             return False
         above = [s.above_base or self.below_base_allowed for s in self.solutions]
         physical = any(above) if self.method in ("homotopy", "multi-start") else all(above)
@@ -391,6 +395,7 @@ def _homotopy_all(platform, L, convention: str, seed: int, common, allowed) -> F
                 uniqueness_radius=hm.uniqueness,
                 position_bound=hm.position_bound,
                 angle_bound=hm.angle_bound,
+                singular=hm.singular,
             )
         )
     sols.sort(key=lambda s: s.distance_to_home)

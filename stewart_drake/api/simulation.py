@@ -10,6 +10,7 @@ Imports pydrake (through ``drake.simulation``): ``import stewart_drake`` loads t
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,6 +19,8 @@ import numpy as np
 
 from stewart_drake.api.result import Result, plain
 from stewart_drake.control import ControllerConfig, DspTiming, check_timing
+from stewart_drake.control.chatter import loop_verdict
+from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.simulation_log import SimulationLog, tracking_verdict
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.sanity import (
@@ -29,6 +32,7 @@ from stewart_drake.core.sanity import (
     require_plate,
 )
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory
+from stewart_drake.core.unit_hint import other_unit_hint
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.errors import (
@@ -38,6 +42,7 @@ from stewart_drake.errors import (
     OPTION_FIRMWARE_ENGINE,
     SIMULATION_GAP_WARNING,
     OptionError,
+    PhysicalLimitError,
     UsageError,
 )
 from stewart_drake.firmware.engine import default_engine
@@ -77,12 +82,14 @@ def tick_count(duration: float, period: float) -> int:
 @dataclass(frozen=True)
 class RunPlan:
     """A checked closed-loop run: its ``scenario`` (what ``drake.simulation.build_simulation`` builds), the
-    controller's ``timing``, the ``duration`` (s) and the ``warnings`` found while checking."""
+    controller's ``timing``, the ``duration`` (s), the ``warnings`` found while checking and the units a CSV
+    reference was read in (``read_units``, None for others)."""
 
     scenario: Scenario
     timing: DspTiming
     duration: float
     warnings: tuple = ()
+    read_units: dict | None = None
 
     @property
     def config(self) -> ControllerConfig:
@@ -108,11 +115,13 @@ def plan_run(
     allow_out_of_stroke: bool = False,
     length_unit: str = "m",
     angle_unit: str = "rad",
+    smooth: float | None = None,
     actuators: ActuatorModel | None = None,
     sensor: SensorModel | None = None,
     plant_platform: Platform | None = None,
     gain_scale: float = 1.0,
     nominal_gains: bool = False,
+    gains=None,
     command_range: float | None = None,
     checks: bool = True,
     command: str = "simulate",
@@ -122,7 +131,8 @@ def plan_run(
 
     ``actuators``, ``sensor``, ``plant_platform``: a perturbed run (Monte Carlo); ``gain_scale`` multiplies
     the designed gains; ``nominal_gains``: design them for the nominal timing (``DspTiming()``: what the
-    firmware was built for) rather than this run's; ``command_range``: the Q15 command's full scale, N (default the
+    firmware was built for) rather than this run's (``gains``: those nominal gains, computed once by the caller,
+    e.g. a Monte Carlo study); ``command_range``: the Q15 command's full scale, N (default the
     platform's ``legs.max_force``); ``checks=False`` skips the per-run sanity checks (the
     caller has checked the study); ``command``: how messages name the caller; ``duration_shown``: the
     duration as the user wrote it.
@@ -137,7 +147,9 @@ def plan_run(
         check_positive(duration, "--duration", "seconds")
     if isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating"):
         check_file_rows(str(trajectory), "--trajectory", 700, 14)
-    traj = get_trajectory(trajectory, length_unit=length_unit, angle_unit=angle_unit)
+    csv = isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating")
+    units = {"length_unit": length_unit, "angle_unit": angle_unit}
+    traj = get_trajectory(trajectory, **units, **({"smooth": smooth} if smooth is not None else {}))
     if fit:
         traj = fit_trajectory(traj, platform)
     duration = duration if duration is not None else (traj.duration or 1.0)
@@ -159,13 +171,20 @@ def plan_run(
         shown = duration_shown if duration_shown is not None else duration
         check_simulation_size(duration, plant_step, "--duration", shown)
         ticks = np.arange(tick_count(duration, period)) * period
-        warnings = check_trajectory(
-            platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", allow_out_of_stroke
-        )
+        try:
+            warnings = check_trajectory(
+                platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", allow_out_of_stroke
+            )
+        except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
+            hint = other_unit_hint(platform, traj.pose(ticks), length_unit, angle_unit) if csv and not fit else ""
+            raise PhysicalLimitError(str(e) + hint) from None
+        why = infeasible_motion(platform, traj, ticks, period)
+        if why:  # before the run: no controller follows it (it ended in raw solver messages)
+            raise PhysicalLimitError(why)
     # the gains designed for the platform over the poses of the whole run (and the reference's own length)
     poses = design_poses(traj, max(duration, traj.duration or 0.0))
     if nominal_gains:
-        g = ControllerConfig.for_platform(platform, poses=poses).gains
+        g = gains if gains is not None else ControllerConfig.for_platform(platform, poses=poses).gains
         gains = replace(g, kp=g.kp * gain_scale, ki=g.ki * gain_scale, kd=g.kd * gain_scale, kv=g.kv * gain_scale)
         config = ControllerConfig.for_platform(platform, timing, gains=gains)
     else:
@@ -190,7 +209,8 @@ def plan_run(
         sensor=sensor,
         duration=duration,
     )
-    return RunPlan(scenario, timing, duration, tuple(warnings))
+    read_units = {"length": length_unit, "angle": angle_unit} if csv else None
+    return RunPlan(scenario, timing, duration, tuple(warnings), read_units)
 
 
 @dataclass(frozen=True)
@@ -361,6 +381,7 @@ def simulate(
     allow_out_of_stroke: bool = False,
     length_unit: str = "m",
     angle_unit: str = "rad",
+    smooth: float | None = None,
     progress: bool = False,
 ) -> SimulationResult:
     """Run the fixed-point (or float) controller in the loop with the Drake plant.
@@ -385,6 +406,9 @@ def simulate(
         allow_out_of_stroke: simulate a reference that leaves the stroke (a warning) instead of raising.
         length_unit: unit of a CSV reference's positions.
         angle_unit: unit of a CSV reference's angles.
+        smooth: replace a CSV reference's samples by a smoothing spline's within this RMS tolerance (the
+            file's units); without it, a file rounded so coarsely that its second differences are noise is
+            refused.
         progress: show a progress bar.
 
     Returns:
@@ -392,7 +416,8 @@ def simulate(
 
     Raises:
         StewartError: bad settings (a period too slow for the dynamics, a run too large, an engine that does
-            not fit the controller, ...); ``PhysicalLimitError`` when the reference leaves the stroke.
+            not fit the controller, ...); ``PhysicalLimitError`` when the reference leaves the stroke or is
+            beyond the actuators (force or speed), before the run.
     """
     plan = plan_run(
         platform,
@@ -411,6 +436,7 @@ def simulate(
         allow_out_of_stroke=allow_out_of_stroke,
         length_unit=length_unit,
         angle_unit=angle_unit,
+        smooth=smooth,
     )
     return run_plan(plan, progress=progress)
 
@@ -424,7 +450,9 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
             on_warning(w)
     sc, timing = plan.scenario, plan.timing
     sim = build_simulation(sc, meshcat=meshcat)
+    t_wall = time.perf_counter()
     log = sim.run(plan.duration, progress=progress)
+    t_wall = time.perf_counter() - t_wall
     gap = sim.max_constraint_gap()
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -438,6 +466,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
     summary = {
         "platform": sc.platform.name,
         "trajectory": traj.name,
+        "read_units": plan.read_units,
         "controller": sc.controller,
         "engine": sc.engine,
         "firmware": sc.firmware,
@@ -452,6 +481,8 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "integrator": sc.integrator,
         "max_constraint_gap_m": gap,
         "duration_s": plan.duration,
+        "wall_s": t_wall,
+        "real_time_factor": plan.duration / t_wall if t_wall > 0 else None,
         "ticks": int(len(log.tick_times())),
         "max_leg_error_mm": float(np.abs(e).max() * 1e3),
         "rms_leg_error_mm": float(np.sqrt(np.mean(e**2)) * 1e3),
@@ -460,6 +491,15 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
     verdict = tracking_verdict(truth, e, pe, log)
+    # the loop's own verdict: chatter (force ripple about the inverse-dynamics force) and saturation at the
+    # reference's ends (control/chatter.py)
+    loop = loop_verdict(sc.platform, traj, log, config)
+    verdict["failures"] += loop.pop("failures")
+    for w in loop.pop("warnings"):
+        warnings.append(w)
+        if on_warning:
+            on_warning(w)
+    summary.update(loop)
     summary.update(verdict)
     summary["warnings"] = warnings
     return SimulationResult(plain(summary), Log(log, e, pe), verdict, warnings, plan)

@@ -17,7 +17,14 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
-from stewart_drake.design.sizing import UNITS, first_violation, limits_of, rotating_trajectory, size_trajectory
+from stewart_drake.design.sizing import (
+    UNITS,
+    first_violation,
+    limits_of,
+    rotating_trajectory,
+    size_trajectory,
+    with_peak,
+)
 from stewart_drake.errors import API_SIZE_SOURCE, OptionError
 from stewart_drake.script import run_program
 from stewart_drake.script.source import read_program
@@ -35,13 +42,16 @@ class SizingResult(Result):
         summary: per leg (peak and RMS force N, speed m/s, acceleration m/s², power W, length range m, with
             when or where each peak occurs), the set's worst, the limits and the first violation (the dict
             ``stewart-drake size --json`` prints).
-        violation: the first limit exceeded (``quantity``, ``leg``, ``value``, ``limit``), or None.
-        where: where the violation occurs, as text ("at t = 1.2 s", an envelope pose).
+        violation: the first limit exceeded (``quantity``, ``leg``, ``value``, ``limit``) and the peak the
+            table shows for that quantity (``peak_leg``, ``peak``, ``peak_limit``), or None.
+        where: where the violation first occurs, as text ("at t = 1.2 s", an envelope pose).
+        peak_where: where the peak occurs, as text.
     """
 
     summary: dict
     violation: dict | None
     where: str
+    peak_where: str = ""
 
     @property
     def ok(self) -> bool:
@@ -49,15 +59,17 @@ class SizingResult(Result):
         return self.violation is None
 
     def violation_message(self) -> str | None:
-        """The violation as one line, or None."""
+        """The violation as one line: the worst excess (the peak the table shows) and where the limit is first
+        exceeded; or None."""
         v = self.violation
         if v is None:
             return None
-        name = {"force": "max_force", "speed": "max_speed", "power": "max_power", "length": "stroke"}[v["quantity"]]
-        unit = UNITS[v["quantity"]]
+        qty = v["quantity"]
+        name = "stroke" if qty == "length" else f"legs.max_{qty}"
+        u = UNITS[qty]
         return (
-            f"leg {v['leg']} {v['quantity']} {v['value']:.6g} {unit} exceeds legs.{name} {v['limit']:.6g} {unit} "
-            f"{self.where}"
+            f"leg {v['peak_leg']} {qty} peaks at {v['peak']:.6g} {u}, beyond {name} {v['peak_limit']:.6g} {u} "
+            f"{self.peak_where}; first exceeded by leg {v['leg']} ({v['value']:.6g} {u}) {self.where}"
         )
 
     def _fields(self) -> dict:
@@ -80,6 +92,7 @@ def size(
     convention: str = "utn",
     length_unit: str = "m",
     angle_unit: str = "rad",
+    smooth: float | None = None,
 ) -> SizingResult:
     """Actuator sizing for one source of motion: a trajectory, a motion program or a duty envelope.
 
@@ -99,6 +112,8 @@ def size(
         convention: Euler convention of a program's or CSV's angles.
         length_unit: a CSV's length unit.
         angle_unit: a CSV's angle unit.
+        smooth: differentiate a 7-column CSV through a smoothing spline within this RMS tolerance (the file's
+            units); without it, a file rounded so coarsely that its second differences are noise is refused.
 
     Returns:
         The sizing and the first violation of a limit.
@@ -112,13 +127,13 @@ def size(
     loaded, p_TP = carrying(platform, payload, payload_com, gravity)
     return size_loaded(
         platform, loaded, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-        length_unit, angle_unit,
+        length_unit, angle_unit, smooth=smooth,
     )  # fmt: skip
 
 
 def size_loaded(
     base, platform, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-    length_unit, angle_unit, envelope_shown=None,
+    length_unit, angle_unit, envelope_shown=None, smooth=None,
 ) -> SizingResult:  # fmt: skip
     """``size`` of a platform already carrying its payload (``base``: as loaded, for its name)."""
     header = {
@@ -131,12 +146,14 @@ def size_loaded(
     if envelope is not None:
         return _envelope(platform, header, bool(legs), str(envelope), gravity)
     source, t, q, qd, qdd, convention = _samples(
-        platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit
+        platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit, smooth
     )
+    from_csv = program is None and not isinstance(trajectory, Trajectory) and trajectory not in ("seed", "rotating")
     check_poses(platform, q, convention, what=f"the {source} trajectory", times=t)  # finite, near, above the base
     s = size_trajectory(platform, t, q, qd, qdd, convention, legs, gravity)
     limits = limits_of(platform)
-    viol = first_violation(limits, {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length})
+    peaks = {"force": s.force, "speed": s.speed, "power": s.power, "length": s.length}
+    viol = with_peak(first_violation(limits, peaks), limits, peaks)
     legs_json = [
         {
             "leg": r["leg"],
@@ -159,10 +176,11 @@ def size_loaded(
         for r in s.legs()
     ]
     if viol is not None:
-        viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]])
+        viol = dict(viol, t_s=float(t[viol["index"]]), pose=q[viol["index"]], peak_t_s=float(t[viol["peak_index"]]))
     out = dict(
         header,
         source=source,
+        read_units={"length": length_unit, "angle": angle_unit} if from_csv else None,
         samples=len(t),
         duration_s=float(t[-1] - t[0]) if len(t) else 0.0,
         convention=convention,
@@ -171,10 +189,12 @@ def size_loaded(
         limits=limits,
         violation=viol,
     )
-    return SizingResult(out, viol, "at t = {t:.4f} s".format(t=viol["t_s"]) if viol else "")
+    if viol is None:
+        return SizingResult(out, None, "")
+    return SizingResult(out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s")
 
 
-def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit):
+def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit, smooth=None):
     """``(source name, t, q, q̇, q̈, convention)`` of the motion to size."""
     if program is not None:
         if not (np.isfinite(rate) and rate > 0):
@@ -190,7 +210,7 @@ def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_
         t = _times(t_end, dt)
         q, qd, qdd = (seed_trajectory if trajectory == "seed" else rotating_trajectory)(t)
         return trajectory, t, q, qd, qdd, "utn"
-    t, q, qd, qdd = read_trajectory_csv(str(trajectory), length_unit, angle_unit)
+    t, q, qd, qdd = read_trajectory_csv(str(trajectory), length_unit, angle_unit, smooth)
     return str(trajectory), t, q, qd, qdd, convention
 
 
@@ -219,7 +239,8 @@ def set_summary(legs_json) -> dict:
 
 def _envelope(platform, header, legs: bool, path: str, gravity: float) -> SizingResult:
     env = load_envelope(path)
-    es = envelope_sizing(platform, env, legs=legs, gravity=gravity)
+    # a pose outside the stroke is a result outside limits (a violation, the table shown), not bad input
+    es = envelope_sizing(platform, env, legs=legs, gravity=gravity, stroke=False)
     legs_json = []
     for i in range(6):
         w = es.worst[i]
@@ -246,9 +267,12 @@ def _envelope(platform, header, legs: bool, path: str, gravity: float) -> Sizing
             }
         )
     limits = limits_of(platform)
-    viol = first_violation(limits, {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power})
+    peaks = {"force": es.peak_force, "speed": es.peak_speed, "power": es.peak_power, "length": es.length}
+    viol = with_peak(first_violation(limits, peaks), limits, peaks)
     if viol is not None:
-        viol = dict(viol, pose_index=viol["index"], pose=env.poses[viol["index"]])
+        viol = dict(
+            viol, pose_index=viol["index"], pose=env.poses[viol["index"]], peak_pose=env.poses[viol["peak_index"]]
+        )
     allowed = {
         "axes": list(AXES),
         "units": ["m/s²"] * 3 + ["rad/s²"] * 3,
@@ -276,9 +300,9 @@ def _envelope(platform, header, legs: bool, path: str, gravity: float) -> Sizing
             "rms_force_n": "undefined for an envelope",
         },
     )
-    where = ""
-    if viol:
-        where = f"at envelope {env.shown(viol['index'])}"
-        if viol["quantity"] == "power":
-            where += " (power over an envelope is an upper bound: peak |F| x peak |L̇|)"
-    return SizingResult(out, viol, where)
+    if viol is None:
+        return SizingResult(out, None, "")
+    note = " (power over an envelope is an upper bound: peak |F| x peak |L̇|)" if viol["quantity"] == "power" else ""
+    return SizingResult(
+        out, viol, f"at envelope {env.shown(viol['index'])}", f"at envelope {env.shown(viol['peak_index'])}{note}"
+    )

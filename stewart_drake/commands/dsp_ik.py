@@ -10,7 +10,7 @@ import numpy as np
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.rotations import angle_scale
-from stewart_drake.core.sanity import check_poses
+from stewart_drake.core.sanity import above_base, below_base_message, plate_anchor_heights
 from stewart_drake.errors import DspPoseError
 from stewart_drake.firmware.engine import ENGINES, resolve_engine
 from stewart_drake.firmware.host import tp17_leg_lengths_c
@@ -62,15 +62,18 @@ def run(args) -> int:
         if abs(q[3 + k]) > 1.0:
             raise DspPoseError(DspPoseError.ANGLE_OPTION.format(name=name, value=raw[3 + k], unit=args.angle_unit))
     check_dsp_poses(q)
-    # the firmware's platform is utn-kinematic's (a = 612 vs 612.5 mm): its plate must be above its base
-    check_poses(load_preset("utn-kinematic"), np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi], "utn", what="--pose")
+    # the firmware's platform is utn-kinematic's (a = 612 vs 612.5 mm). An emulator shows what the firmware
+    # computes: a pose whose plate dips below the base is computed, shown and flagged (exit 1), as ik does
+    # for a pose outside the stroke
+    # Any pose of the DSP's range (16-bit mm, one turn: ``check_dsp_poses``) is computed.
+    kin = load_preset("utn-kinematic")
+    pose_si = np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi]
+    flags = [] if above_base(kin, pose_si) else [below_base_message("--pose", plate_anchor_heights(kin, pose_si))]
     with SaturationCounter() as sat:
         tr = tp17_trace(q)
     if sat.total:
-        print(
-            f"stewart-drake dsp-ik: warning: the firmware's arithmetic saturated ({dict(sat.counts)}); "
-            "its lengths for this pose are clipped, not geometric",
-            file=sys.stderr,
+        flags.append(
+            f"the firmware's arithmetic saturated ({dict(sat.counts)}); its lengths for this pose are clipped, not geometric"
         )
     res = tp17_error_stages(q)
     engine = resolve_engine(args.engine, "stewart-drake dsp-ik")
@@ -92,6 +95,7 @@ def run(args) -> int:
         "float_lengths_mm": [round(float(v), 4) for v in flt],
         "difference_mm": [round(float(v), 4) for v in dsp - flt],
         "saturations": dict(sat.counts),
+        "flags": flags,
     }
     if args.trace:
         out["trace"] = {
@@ -105,7 +109,7 @@ def run(args) -> int:
         }
     if args.json:
         print_json(out)
-        return 0
+        return _flagged(flags)
     p = out["pose"]
     print(
         f"pose: px={p['px_mm']} py={p['py_mm']} pz={p['pz_mm']} mm; alpha={p['alpha_pi']:g}π beta={p['beta_pi']:g}π "
@@ -118,4 +122,11 @@ def run(args) -> int:
     if args.trace:
         for k, v in out["trace"].items():
             print(f"{k}: {v}")
-    return 0
+    return _flagged(flags)
+
+
+def _flagged(flags: list[str]) -> int:
+    """Each flag on stderr; exit 1 when there is one (a result outside limits, still shown), else 0."""
+    for f in flags:
+        print(f"stewart-drake dsp-ik: {f}", file=sys.stderr)
+    return 1 if flags else 0

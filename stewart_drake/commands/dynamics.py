@@ -41,6 +41,14 @@ def register(sub) -> None:
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV positions (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
     p.add_argument(
+        "--smooth",
+        type=float,
+        default=None,
+        metavar="TOL",
+        help="differentiate a CSV through a smoothing spline within TOL (RMS, in the file's units) of its samples: "
+        "for files rounded so coarsely that their second differences are noise (refused without it)",
+    )
+    p.add_argument(
         "--allow-out-of-stroke",
         action="store_true",
         help="compute forces even where a leg leaves the stroke (a warning, also in the JSON 'warnings'); default: exit 1",
@@ -54,7 +62,9 @@ def register(sub) -> None:
 def run(args) -> int:
     seed = args.trajectory == "seed"
     reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
-    reject_unused(args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn")
+    reject_unused(
+        args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn", smooth=None
+    )
     r = inverse_dynamics(
         platform_from_args(args),
         args.trajectory,
@@ -67,6 +77,7 @@ def run(args) -> int:
         length_unit=args.length_unit,
         angle_unit=args.angle_unit,
         allow_out_of_stroke=args.allow_out_of_stroke,
+        smooth=args.smooth,
         on_warning=lambda w: print(f"stewart-drake dynamics: warning: {w}", file=sys.stderr),
     )
     if args.json:
@@ -78,7 +89,9 @@ def run(args) -> int:
             w.writerow([f"{tk:.9g}"] + [f"{x:.12g}" for x in Fk])
     else:
         print(
-            f"platform {r.platform}, trajectory {args.trajectory}, Coriolis {args.coriolis}, legs {args.legs}; forces in N"
+            f"platform {r.platform}, trajectory {args.trajectory}"
+            + ("" if seed else f" (read in {args.length_unit} and {args.angle_unit})")
+            + f", Coriolis {args.coriolis}, legs {args.legs}; forces in N"
         )
         print(f"{'t (s)':>8} " + " ".join(f"{'F' + str(i):>10}" for i in range(1, 7)))
         for tk, Fk in zip(r.t, r.forces):

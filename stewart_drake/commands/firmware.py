@@ -10,28 +10,55 @@ from stewart_drake.api import firmware
 from stewart_drake.commands._certify import register as register_certify
 from stewart_drake.commands._common import add_platform_arg, print_json
 from stewart_drake.core.geometry import load_platform
+from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 
 
-def _format_args(p) -> None:
-    add_platform_arg(p, default="utn-dynamic")
+def _format_args(p, recorded: bool = False) -> None:
+    """The module's options; with ``recorded`` (``check``) their defaults are those recorded in the file
+    (``firmware.fingerprint``), the generator's defaults for a file without a record."""
+    d = (lambda k: None) if recorded else FP_DEFAULTS.get
+    note = " (default: as recorded in FILE.c's header" if recorded else ""
+    add_platform_arg(p, default=d("platform"))
     p.add_argument(
-        "--word-bits", type=int, default=16, metavar="N", help="data word width, 8..16 (default 16, the DSP)"
+        "--word-bits",
+        type=int,
+        default=d("word_bits"),
+        metavar="N",
+        help="data word width, 8..16" + (note + ", else 16)" if recorded else " (default 16, the DSP)"),
     )
     p.add_argument(
-        "--length-lsb", type=float, default=1e-3, metavar="M", help="metres per length LSB (default 1e-3: integer mm)"
+        "--length-lsb",
+        type=float,
+        default=d("length_lsb"),
+        metavar="M",
+        help="metres per length LSB" + (note + ", else 1e-3)" if recorded else " (default 1e-3: integer mm)"),
     )
     p.add_argument(
         "--trig",
         choices=["tfr16", "exact"],
-        default="tfr16",
-        help="sin/cos: tfr16 (the DSP library polynomial, 16-bit words; default) or exact (a correctly rounded table)",
+        default=d("trig"),
+        help="sin/cos: tfr16 (the DSP library polynomial, 16-bit words) or exact (a correctly rounded table)"
+        + (note + ", else tfr16)" if recorded else "; default tfr16"),
     )
     p.add_argument(
-        "--convention", choices=["utn", "zyx"], default="utn", help="Euler convention of the pose angles (default utn)"
+        "--convention",
+        choices=["utn", "zyx"],
+        default=d("convention"),
+        help="Euler convention of the pose angles" + (note + ", else utn)" if recorded else " (default utn)"),
     )
-    p.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="controller rate, Hz (default 1000)")
     p.add_argument(
-        "--sensor-resolution", type=float, default=1e-5, metavar="M", help="leg sensor, m per count (default 1e-5)"
+        "--rate",
+        type=float,
+        default=d("rate"),
+        metavar="HZ",
+        help="controller rate, Hz" + (note + ", else 1000)" if recorded else " (default 1000)"),
+    )
+    p.add_argument(
+        "--sensor-resolution",
+        type=float,
+        default=d("sensor_resolution"),
+        metavar="M",
+        help="leg sensor, m per count" + (note + ", else 1e-5)" if recorded else " (default 1e-5)"),
     )
     p.add_argument(
         "--trajectory",
@@ -62,7 +89,7 @@ def register(sub) -> None:
         metavar="FILE.c",
         help='C source including "sd_firmware.h" and defining sd_ik (and optionally sd_init/sd_tick/sd_ik_trace)',
     )
-    _format_args(c)
+    _format_args(c, recorded=True)
     c.add_argument("--poses", type=int, default=100_000, metavar="N", help="workspace poses for sd_ik (default 100000)")
     c.add_argument("--seed", type=int, default=0, help="random seed of the poses (default 0)")
     c.add_argument(
@@ -104,7 +131,9 @@ def _config(args, platform):
 def run_generate(args) -> int:
     note = lambda n: print(f"stewart-drake firmware generate: note: {n}", file=sys.stderr)  # noqa: E731
     platform = load_platform(args.platform)
-    r = firmware.generate(platform, args.out, compile=not args.no_compile, on_note=note, **_format(args))
+    r = firmware.generate(
+        platform, args.out, compile=not args.no_compile, on_note=note, platform_source=args.platform, **_format(args)
+    )
     summary, out, compiled, written = r.to_dict(), Path(args.out), r.summary["compiled_with"], r.files
     clock_hz = r.config.timing.clock_hz
     if args.json:
@@ -126,7 +155,7 @@ def run_generate(args) -> int:
 def run_check(args) -> int:
     result = firmware.check(
         args.file,
-        load_platform(args.platform),
+        args.platform,  # None: as recorded in the file
         poses=args.poses,
         seed=args.seed,
         trace=args.trace,

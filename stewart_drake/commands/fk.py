@@ -137,6 +137,7 @@ def run(args) -> int:
                     if s["branch_certified"]
                     else "branch from the initial pose NOT certified (another assembly mode may have been reached)"
                 )
+            flags += ["SINGULAR (a multiple root: rank-deficient, not certified)"] if s.get("singular") else []
             print(
                 f"{i:3d}",
                 " ".join(f"{x:11.5f}" for x in s["pose"]),
@@ -149,6 +150,13 @@ def run(args) -> int:
         print(
             f"fk --all: no real assembly mode: all {out['max_solutions']} paths end complex or at infinity, so the legs "
             f"cannot be assembled on platform {platform.name!r} (complete: {out['guarantee']})",
+            file=sys.stderr,
+        )
+    singular = [i for i, s in enumerate(out["solutions"], 1) if s.get("singular")]
+    if singular:  # a pose on a singularity is found and shown; it is a physical limit (FKResult.ok is False)
+        print(
+            f"fk --all: mode(s) {', '.join(map(str, singular))} lie on a singularity (several homotopy paths meet there; "
+            "the platform loses stiffness in some direction at that pose)",
             file=sys.stderr,
         )
     return 0 if result.ok else 1

@@ -12,6 +12,7 @@ from stewart_drake.commands._common import add_platform_arg, add_unit_args, plat
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.rotations import length_scale, pose_to_si
 from stewart_drake.core.sanity import check_file_rows
+from stewart_drake.core.unit_hint import other_unit_hint
 
 # Bytes per CSV row while reading (Python lists of floats) and per result printed as JSON (estimates).
 BYTES_PER_ROW = 600
@@ -47,11 +48,14 @@ def run(args) -> int:
         check_file_rows(args.poses, "--poses", BYTES_PER_ROW + (BYTES_PER_JSON_ROW if args.json else 0), MIN_ROW_BYTES)
         raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g")
     what = "--pose" if lines is None else f"{args.poses}: pose"
-    r = solve_ik(platform, pose_to_si(raw, args.length_unit, args.angle_unit), args.convention, what, lines)
+    q = pose_to_si(raw, args.length_unit, args.angle_unit)
+    r = solve_ik(platform, q, args.convention, what, lines)
     k = length_scale(args.length_unit)
     results = [r.to_dict()] if args.pose is not None else r.to_dict()["results"]
     for res, row in zip(results, raw.reshape(-1, 6).tolist()):  # the CLI's units: lengths as asked, pose as typed
-        res.update(pose=row, lengths=[v / k for v in res["lengths"]], length_unit=args.length_unit)
+        res.update(
+            pose=row, lengths=[v / k for v in res["lengths"]], length_unit=args.length_unit, angle_unit=args.angle_unit
+        )
         if "readings" in res:
             res["readings"] = [v / k for v in res["readings"]]
         for v in res["violations"]:
@@ -68,13 +72,16 @@ def run(args) -> int:
                 + "\n]}\n"
             )
     else:
-        print_table(r, results, args.length_unit, args.convention)
+        print_table(r, results, args.length_unit, args.angle_unit, args.convention)
+    hint = "" if r.ok else other_unit_hint(platform, q, args.length_unit, args.angle_unit, args.convention)
+    if hint:
+        print(f"stewart-drake ik: outside the workspace{hint}", file=sys.stderr)
     return 0 if r.ok else 1
 
 
-def print_table(r, results: list, unit: str, convention: str) -> None:
-    """The lengths, one row per pose, with each failing pose's reason."""
-    print(f"platform {r.platform}, convention {convention}, lengths in {unit}")
+def print_table(r, results: list, unit: str, angle_unit: str, convention: str) -> None:
+    """The lengths, one row per pose, with each failing pose's reason; the header names the units read."""
+    print(f"platform {r.platform}, convention {convention}, poses read in {unit} and {angle_unit}, lengths in {unit}")
     flags = np.full(len(results), "ok", dtype=object)
     for i, res in enumerate(results):
         if res["violations"] or i in r.notes:

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from stewart_drake.api.design import check_modes_options, modes_at, require_analysable
@@ -44,9 +46,11 @@ def run(args) -> int:
         out["drake"] = out.pop("drake")
     m, k, legs, f1 = r, r.leg_stiffness, r.legs, float(r.frequencies_hz[0])
     delay = r.controller["loop_delay_s"]
+    for w in r.warnings:
+        print(f"stewart-drake modes: warning: {w}", file=sys.stderr)
     if args.json:
         print_json(out)
-        return 0
+        return _report(r.limits)
     print(
         f"platform {r.platform}, pose {args.pose}; legs {'with' if legs else 'without'} mass, k = {k[0]:.6g} N/m, c = {args.leg_damping} N·s/m"
     )
@@ -75,4 +79,11 @@ def run(args) -> int:
             f"lowest mode {f1:.4g} Hz: {c['samples_per_lowest_period']:.4g} controller samples per period at {args.sample_rate:g} Hz; "
             f"a {delay * 1e3:.3g} ms loop delay lags it by {c['phase_lag_at_lowest_deg']:.3g}°"
         )
-    return 0
+    return _report(r.limits)
+
+
+def _report(limits: list[str]) -> int:
+    """Each limit on stderr; exit 1 if there is one (the modes above are still shown)."""
+    for m in limits:
+        print(f"stewart-drake modes: {m}", file=sys.stderr)
+    return 1 if limits else 0

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
+from stewart_drake.commands._common import add_platform_arg, dumps_strict, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
@@ -54,7 +54,7 @@ def register(sub) -> None:
         default=[],
         metavar="SPEC",
         help="what varies: key=value words or one YAML file (keys: anchor, leg_offset, sensor_resolution, sensor_noise, "
-        "latency, latency_jitter, actuator_lag, force_limit, payload_mass, payload_com, gain_scale; values X, ±T, ±P%%, A..B, a|b; "
+        "latency, latency_jitter, actuator_lag, force_limit, plate_mass, plate_com, gain_scale, sample_period, payload, payload_position; values X, ±T, ±P%%, A..B, a|b; "
         "units m mm um s ms us N kg g)",
     )
     add_loop_args(p)
@@ -193,7 +193,7 @@ def replay(args) -> int:
             files += log.save(tmp) + write_plots(log, log.length_error(ref, _plant_platform(study, args.replay)), tmp)
             if not args.no_animation:
                 files.append(write_animation(_plant_platform(study, args.replay), log, tmp / "animation.html"))
-        (tmp / "row.json").write_text(json.dumps(result, indent=2))
+        (tmp / "row.json").write_text(dumps_strict(result))
         result["files"] = [str(folder / p.name) for p in files + [tmp / "row.json"]]
     if args.json:
         print_json(result)

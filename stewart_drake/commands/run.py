@@ -206,8 +206,14 @@ def simulate(platform, result, args) -> dict:
             "max_abs_length_error_mm": np.abs(err).max(axis=0) * 1e3,
             "max_abs_actuator_force_N": np.abs(log.force).max(axis=0),
             **sim.verdict,
+            "warnings": sim.warnings,
+            **{k: sim.summary[k] for k in LOOP_MEASURES},  # the loop verdict's measures (control/chatter.py)
         },
     }
+
+
+# the chatter measure's numbers in the run's summary (``control.chatter.chatter_measure``)
+LOOP_MEASURES = ("force_ripple_N", "working_force_rms_N", "chatter_ratio", "ripple_range_fraction", "chatter_cause")
 
 
 def segment_ends(traj) -> dict:

@@ -37,6 +37,14 @@ def register(sub) -> None:
     )
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angle unit (default rad)")
+    p.add_argument(
+        "--smooth",
+        type=float,
+        default=None,
+        metavar="TOL",
+        help="differentiate a CSV through a smoothing spline within TOL (RMS, in the file's units) of its samples: "
+        "for files rounded so coarsely that their second differences are noise (refused without it)",
+    )
     add_loop_args(p)
     p.add_argument(
         "--firmware",
@@ -119,7 +127,12 @@ def add_loop_args(p) -> None:
 
 def run(args) -> int:
     reject_unused(
-        args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
+        args,
+        "--trajectory FILE.csv",
+        args.trajectory not in ("seed", "rotating"),
+        length_unit="m",
+        angle_unit="rad",
+        smooth=None,
     )
     out_folder = output_folder(args)
     plan = plan_run(
@@ -139,6 +152,7 @@ def run(args) -> int:
         allow_out_of_stroke=args.allow_out_of_stroke,
         length_unit=args.length_unit,
         angle_unit=args.angle_unit,
+        smooth=args.smooth,
         duration_shown=args.duration,
     )
     warn = lambda w: print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)  # noqa: E731
@@ -151,6 +165,12 @@ def run(args) -> int:
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
         (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
+    rtf = summary["real_time_factor"]
+    print(
+        f"stewart-drake simulate: simulated {summary['duration_s']:g} s in {summary['wall_s']:.3g} s of wall time"
+        + (f" ({rtf:.3g} × real time)" if rtf else ""),
+        file=sys.stderr,
+    )
     for f in result.verdict["failures"]:
         print(f"stewart-drake simulate: {f}", file=sys.stderr)
     return 0 if result.ok else 1
@@ -169,6 +189,7 @@ def write_plots(log, length_error, out: Path) -> list[Path]:
     ax[0].legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
     ax[1].plot(log.t, log.force)
     ax[1].set_ylabel("actuator force [N]")
+    ax[1].legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
     ax[1].set_xlabel("t [s]")
     fig.suptitle(
         f"{log.kind} controller, {log.trajectory} trajectory on {log.platform.replace('$', r'\$')}, T = {log.sample_period * 1e3:g} ms"

@@ -42,6 +42,14 @@ def register(sub) -> None:
         "--length-unit", choices=["m", "mm"], default="m", help="CSV positions and --payload-com (default m)"
     )
     p.add_argument("--angle-unit", choices=["rad", "deg", "pi"], default="rad", help="CSV angles (default rad)")
+    p.add_argument(
+        "--smooth",
+        type=float,
+        default=None,
+        metavar="TOL",
+        help="differentiate a CSV through a smoothing spline within TOL (RMS, in the file's units) of its samples: "
+        "for files rounded so coarsely that their second differences are noise (refused without it)",
+    )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
 
@@ -61,6 +69,7 @@ def run(args) -> int:
         r = size_loaded(
             base, platform, p_TP, args.trajectory, args.program, args.envelope, args.legs == "on", args.payload,
             args.gravity, args.rate, args.t_end, args.dt, args.convention, args.length_unit, args.angle_unit,
+            smooth=args.smooth,
         )  # fmt: skip
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
@@ -80,7 +89,9 @@ def run(args) -> int:
         )
     else:
         print(
-            f"platform {base.name}, {out['source']}: {out['samples']} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
+            f"platform {base.name}, {out['source']}"
+            + (f" (read in {args.length_unit} and {args.angle_unit})" if out["read_units"] else "")
+            + f": {out['samples']} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
         )
         _print_table(out["legs"], with_times=True)
     if r.violation is not None:

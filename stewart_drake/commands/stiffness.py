@@ -3,6 +3,8 @@ principal stiffnesses and directions, the compliance and the static deflection u
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from stewart_drake.api.design import Load, load_at_pose, stiffness_at
@@ -82,18 +84,19 @@ def run(args) -> int:
     ld = load(args)
     r = stiffness_at(ld)
     kl, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
-    d = r.deflection
+    d = r.deflection  # None when the loaded platform is unstable or the deflection beyond the linear range
     out = r.to_dict() | {
         "pose": args.pose,
         "length_unit": args.length_unit,
         "angle_unit": args.angle_unit,
-        "deflection_edge_units": np.r_[d[:3] / kl, d[3:] / ka],
+        "deflection_edge_units": None if d is None else np.r_[d[:3] / kl, d[3:] / ka],
+        "limits": r.limits,
     }
     if args.map:
         write_maps(args, ld.platform, ld.q, ld.k)
     if args.json:
         print_json(out)
-        return 0
+        return _report_limits(r.limits)
     k, K, pr = r.leg_stiffness, r.matrix, r.principal
     print(
         f"platform {r.platform}, pose {args.pose} ({args.length_unit}, {args.angle_unit}, {args.convention}); legs {k[0]:.6g} N/m"
@@ -110,11 +113,19 @@ def run(args) -> int:
         print(f"principal {label} stiffness ({unit}), softest first:")
         for v, e in zip(vals, dirs):
             print(f"  {v:12.5g}  along [{e[0]:+.4f} {e[1]:+.4f} {e[2]:+.4f}]")
-    print(
-        f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
-        f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}"
-    )
-    return 0
+    if d is not None:
+        print(
+            f"deflection under the payload ({args.payload} kg): δp = {np.array2string(d[:3] / kl, precision=5)} {args.length_unit}, "
+            f"δθ = {np.array2string(d[3:] / ka, precision=5)} {args.angle_unit}"
+        )
+    return _report_limits(r.limits)
+
+
+def _report_limits(limits: list[str]) -> int:
+    """Each limit on stderr; exit 1 if there is one (the results above are still shown)."""
+    for m in limits:
+        print(f"stewart-drake stiffness: {m}", file=sys.stderr)
+    return 1 if limits else 0
 
 
 def write_maps(args, platform, q, k) -> None:

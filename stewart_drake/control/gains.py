@@ -56,11 +56,12 @@ class PidGains:
         for name in ("kp", "ki", "kd", "kv"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 0):
-                raise GainError(GainError.PID_NEGATIVE.format(name=name, value=v))
+                hint = " (a negative --vary gain_scale?)" if v < 0 else ""
+                raise GainError(GainError.PID_NEGATIVE.format(name=name, value=v, hint=hint))
         for name in ("derivative_filter", "feedforward_filter"):
             v = getattr(self, name)
             if not 0 < v <= 1:
-                raise GainError(GainError.PID_FILTER.format(name=name, value=v))
+                raise GainError(GainError.PID_FILTER.format(name=name.replace("_", " "), value=v))
 
 
 @dataclass(frozen=True)
@@ -222,7 +223,7 @@ def q15_gain(x: float) -> Q15Gain:
     if not (math.isfinite(x) and x >= 0):
         raise GainError(GainError.GAIN.format(value=x))
     shift = 0
-    while round(x / 2.0**shift * 32768.0) > 32767:
+    while shift <= 30 and x / 2.0**shift * 32768.0 >= 32767.5:  # compared as floats: x may be ~1e308
         shift += 1
     if shift > 30:
         raise GainError(GainError.Q15_RANGE.format(value=x))
@@ -250,11 +251,28 @@ class FixedGains:
         # command fraction per error fraction: k_phys · (2^15 counts · resolution) / command_range
         scale = 32768.0 * timing.sensor_resolution / timing.command_range
         T = timing.sample_period
+        words = {
+            "kp": gains.kp * scale,
+            "ki": gains.ki * T * scale,
+            "kd": gains.kd / T * scale / 2**DIFF_SHIFT,
+            "kv": gains.kv / T * scale / 2**DIFF_SHIFT,
+        }
+        for name, x in words.items():  # name the gain and the inputs that scale it, not a bare number
+            if not (math.isfinite(x) and x < 32768.0 * 2.0**30):
+                raise GainError(
+                    GainError.Q15_SCALE.format(
+                        name=name,
+                        value=getattr(gains, name),
+                        range=timing.command_range,
+                        r=timing.sensor_resolution,
+                        T=T,
+                    )
+                )
         return cls(
-            kp=q15_gain(gains.kp * scale),
-            ki=q15_gain(gains.ki * T * scale),
-            kd=q15_gain(gains.kd / T * scale / 2**DIFF_SHIFT),
-            kv=q15_gain(gains.kv / T * scale / 2**DIFF_SHIFT),
+            kp=q15_gain(words["kp"]),
+            ki=q15_gain(words["ki"]),
+            kd=q15_gain(words["kd"]),
+            kv=q15_gain(words["kv"]),
             alpha=min(32767, int(round(gains.derivative_filter * 32768.0))),
             alpha_ff=min(32767, int(round(gains.feedforward_filter * 32768.0))),
         )
@@ -267,4 +285,10 @@ def counts_per_lsb(config: ControllerConfig) -> int:
     cpl = lsb / r
     if abs(cpl - round(cpl)) > 1e-9 * cpl or round(cpl) < 1:
         raise GainError(GainError.SENSOR_COUNTS.format(r=r, lsb=lsb))
+    if cpl > MAX_COUNTS_PER_LSB:  # one LSB step must fit the firmware's 16-bit error word (a C overflow before)
+        raise GainError(GainError.COUNTS_PER_LSB.format(r=r, lsb=lsb, cpl=cpl, limit=MAX_COUNTS_PER_LSB))
     return int(round(cpl))
+
+
+# The firmware's error word is 16 bits: a set-point step of one LSB, in sensor counts, must fit it.
+MAX_COUNTS_PER_LSB = 32767

@@ -65,6 +65,15 @@ PHASE_BUDGET = 1.2
 CROSSOVER_MARGIN = 2.0
 
 
+# The fields a user sets, named as the options and keys that set them (not the class's attribute names).
+TIMING_FIELDS = {
+    "clock_hz": "clock (Hz)",
+    "sample_period": "sample period (--period, --vary sample_period; s)",
+    "sensor_resolution": "sensor resolution (--sensor-resolution, --vary sensor_resolution; m per count)",
+    "command_range": "command range (legs.max_force, --vary force_limit; N)",
+}
+
+
 @dataclass(frozen=True)
 class DspTiming:
     """The DSP's timing, sensor and actuator interface (SI units).
@@ -85,10 +94,10 @@ class DspTiming:
     command_range: float = 200.0
 
     def __post_init__(self):
-        for name in ("clock_hz", "sample_period", "sensor_resolution", "command_range"):
+        for name in TIMING_FIELDS:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise TimingError(TIMING_POSITIVE.format(name=name, value=v))
+                raise TimingError(TIMING_POSITIVE.format(name=TIMING_FIELDS[name], value=v))
         if self.latency not in LATENCY_MODES:
             raise TimingError(TIMING_LATENCY.format(valid=", ".join(LATENCY_MODES), value=self.latency))
         if self.computation_cycles is not None and not (

@@ -52,7 +52,7 @@ from stewart_drake.core.newton_fk import (
     validate_lengths,
 )
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, quaternion_to_matrix, rotation_matrix
-from stewart_drake.errors import FkInputError, ForwardKinematicsError
+from stewart_drake.errors import FkInputError, ForwardKinematicsError, short_number
 
 # m: base anchors this close are one point to the polynomial system. The 16-solution family needs exact
 # coincidence, so this is rounding level, not the platform's MIN_ANCHOR_SEPARATION: a pair 1e-7 m apart
@@ -244,7 +244,7 @@ def assembly_modes(
         t_newton += time.perf_counter() - t0
     if len(P) == 0:
         raise ForwardKinematicsError(
-            f"forward kinematics: no assembly found for lengths ({', '.join(f'{v * 1e3:.3f}' for v in L)}) mm "
+            f"forward kinematics: no assembly found for lengths ({', '.join(short_number(v * 1e3) for v in L)}) mm "
             f"from {starts} starts — the legs probably cannot be assembled on platform {platform.name!r}"
         )
     t0 = time.perf_counter()

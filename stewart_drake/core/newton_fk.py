@@ -30,7 +30,14 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius, inverse_jacobian, scaled_jacobian, singular_value_condition
 from stewart_drake.core.rotations import angles_from_matrix, check_convention, rotation_matrix
-from stewart_drake.errors import FkInputError, ForwardKinematicsError, SingularityWarning, SingularPoseError, counted
+from stewart_drake.errors import (
+    FkInputError,
+    ForwardKinematicsError,
+    SingularityWarning,
+    SingularPoseError,
+    counted,
+    short_number,
+)
 
 # Per-sample status codes (FKResult.status).
 CONVERGED = 0
@@ -202,7 +209,7 @@ class FKResult:
             hint = " — the lengths may admit no assembly (legs too long or too short for the geometry), or the initial pose is too far"
         return NOT_CONVERGED_TEMPLATE.format(
             index=counted(index),
-            lengths_mm=", ".join(f"{v * 1e3:.3f}" for v in self.lengths[index]),
+            lengths_mm=", ".join(short_number(v * 1e3) for v in self.lengths[index]),
             reason=STATUS_TEXT[st],
             iterations=int(self.iterations[index]),
             residual_mm=float(self.residual[index]) * 1e3,

@@ -21,6 +21,7 @@ import numpy as np
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_columns, smooth_tolerance
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.errors import API_FIT_PLATFORM, TrajectoryError
 
@@ -94,21 +95,25 @@ class Trajectory:
         return _fitted(ROTATING, platform, fit)
 
     @classmethod
-    def from_csv(cls, path: str | Path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+    def from_csv(
+        cls, path: str | Path, length_unit: str = "m", angle_unit: str = "rad", smooth: float | None = None
+    ) -> Trajectory:
         """A table of ``t, px, py, pz, a, b, g`` rows (header optional; times increasing), interpolated linearly.
 
         Args:
             path: the CSV file.
             length_unit: unit of its positions (``"m"`` or ``"mm"``).
             angle_unit: unit of its angles (``"rad"``, ``"deg"`` or ``"pi"``).
+            smooth: replace the samples by a smoothing spline's within this RMS tolerance (the file's units);
+                without it, a file rounded so coarsely that its second differences are noise is refused.
 
         Returns:
             The reference, named after the file.
 
         Raises:
-            StewartError: the file's first bad line, named.
+            StewartError: the file's first bad line, named; a noise-dominated file without ``smooth``.
         """
-        return load_trajectory_csv(path, length_unit, angle_unit)
+        return load_trajectory_csv(path, length_unit, angle_unit, smooth)
 
     @classmethod
     def from_program(
@@ -189,9 +194,11 @@ def _fitted_pose(trajectory: Trajectory, home, s: float, centre, t):
     return q
 
 
-def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad", smooth=None) -> Trajectory:
     """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line."""
+    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line. A file rounded
+    so coarsely that its second differences are noise is refused (``quantisation``) unless ``smooth`` (a
+    tolerance in the file's units) replaces the samples by a smoothing spline's."""
     data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
@@ -199,7 +206,14 @@ def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -
         raise TrajectoryError(
             TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0])
         )
-    return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
+    t, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+    check_finite_rates(path, t, poses)
+    if smooth is None:
+        check_quantisation(path, t, poses)
+    else:
+        scale = pose_to_si(np.ones(6), length_unit, angle_unit)
+        poses = smooth_columns(t, poses, smooth_tolerance(smooth) * scale)
+    return table_trajectory(Path(path).stem, t, poses)
 
 
 def table_trajectory(name: str, ts, poses) -> Trajectory:

@@ -177,15 +177,16 @@ def load_envelope(path) -> Envelope:
     return envelope_from_config(cfg, str(path))
 
 
-def check_in_workspace(platform: Platform, env: Envelope) -> np.ndarray:
+def check_in_workspace(platform: Platform, env: Envelope, stroke: bool = True) -> np.ndarray:
     """``(n, 6)`` leg lengths of the envelope's poses; ``EnvelopeError`` naming the first pose outside the
-    stroke, on (or near) a singularity or at the convention's gimbal lock."""
+    stroke (unless ``stroke`` is False: the caller reports it as a result outside limits), on (or near) a
+    singularity or at the convention's gimbal lock."""
     try:
         check_poses(platform, env.poses, env.convention, what=f"{env.source}: pose")  # finite, near, above the base
     except StewartError as e:
         raise EnvelopeError(str(e)) from None
     L = leg_lengths(platform, env.poses, env.convention)
-    v = check_stroke(platform, L).violations()
+    v = check_stroke(platform, L).violations() if stroke else None
     if v:
         v = v[0]
         k = v["pose"][0]
@@ -349,11 +350,17 @@ def _allowed(c, G, qmax, qmin, fmax):
 
 
 def envelope_sizing(
-    platform: Platform, env: Envelope, legs: bool = False, gravity: float = G_EARTH, chunk: int = CHUNK
+    platform: Platform,
+    env: Envelope,
+    legs: bool = False,
+    gravity: float = G_EARTH,
+    chunk: int = CHUNK,
+    stroke: bool = True,
 ) -> EnvelopeSizing:
     """Worst case over the envelope (see the module docstring). Raises ``EnvelopeError`` if a pose leaves
-    the workspace. Work is chunked over poses."""
-    L_all = check_in_workspace(platform, env)
+    the workspace (with ``stroke`` False a pose outside the stroke is sized; its lengths are in the result).
+    Work is chunked over poses."""
+    L_all = check_in_workspace(platform, env, stroke)
     n = len(env.poses)
     out = {
         k: np.empty((n, 6))

@@ -140,6 +140,24 @@ def first_violation(limits: dict, peaks: dict) -> dict | None:
     return best
 
 
+def with_peak(violation: dict | None, limits: dict, peaks: dict) -> dict | None:
+    """``violation`` (of ``first_violation``) with the worst excess of its quantity over every sample and
+    leg, the number a table of peaks shows: ``peak`` (the value), ``peak_leg`` (1..6), ``peak_index``,
+    ``peak_limit`` (for lengths, the stroke end it passes)."""
+    if violation is None:
+        return None
+    qty = violation["quantity"]
+    arr = np.asarray(peaks[qty], dtype=float)
+    if qty == "length":
+        lo, hi = limits["length"]
+        excess = np.maximum(lo - arr, arr - hi)
+    else:
+        excess = np.abs(arr) - limits[qty]
+    k, i = np.unravel_index(int(np.argmax(excess)), excess.shape)
+    limit = (lo if arr[k, i] < lo else hi) if qty == "length" else limits[qty]
+    return dict(violation, peak=float(arr[k, i]), peak_leg=int(i) + 1, peak_index=int(k), peak_limit=float(limit))
+
+
 ROTATING_AMPLITUDE = np.radians([0.0, 0.0, 0.0, 5.0, 0.0, 15.0])
 ROTATING_OMEGA = np.array([0.0, 0.0, 0.0, 3.0, 0.0, 2.0])
 

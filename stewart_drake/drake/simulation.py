@@ -176,10 +176,18 @@ class Simulation:
             self.visualizer.StartRecording()
         if progress:
             steps = max(1, int(round(duration / 0.05)))
-            with tqdm(total=steps, desc=f"simulate {self.kind} {duration:g} s", unit=" × 50 ms", leave=False) as bar:
+            # counted in simulated seconds: the rate tqdm shows (simulated s per wall s) is the real-time factor
+            fmt = "{desc}: {n:.2f}/{total:.2f} simulated s [{elapsed}<{remaining}, {rate_fmt}]"
+            with tqdm(
+                total=duration,
+                desc=f"simulate {self.kind}",
+                unit=" simulated s",
+                bar_format=fmt,
+                leave=False,
+            ) as bar:
                 for k in range(1, steps + 1):
                     sim.AdvanceTo(duration * k / steps)
-                    bar.update(1)
+                    bar.update(duration / steps)
         else:
             sim.AdvanceTo(duration)
         if self.meshcat is not None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import json
+import textwrap
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +30,7 @@ from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings
 from stewart_drake.errors import ReplayError, SimulationError, StewartError
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
+MAX_LABEL = 28  # characters of a readout line (a Meshcat button label) that the control panel shows
 # Above this condition number a pose counts as singular (kinematics.require_nonsingular's default).
 MAX_CONDITION = 1e8
 # Assembly modes closer than this (|Δp| / anchor radius + rotation angle in rad) count as "near" the pose.
@@ -159,7 +161,12 @@ def labels(r: Readout, length_unit: str = "mm") -> list[str]:
         bad = [str(i + 1) for i in np.flatnonzero(r.margin < 0)]
         out.append(f"UNREACHABLE: {'legs ' + ','.join(bad) + ' out of stroke' if bad else 'singular'}")
         out.append(f"ghost: nearest reachable, {r.fraction * 100:.0f} % from home")
-    return out
+    # Meshcat's control panel cuts a button label at its width (~30 characters): longer lines are wrapped
+    # at words, the continuation indented (the unreachable lines were cut off)
+    wrapped = []
+    for line in out:
+        wrapped += textwrap.wrap(line, MAX_LABEL, subsequent_indent="  ") if len(line) > MAX_LABEL else [line]
+    return wrapped
 
 
 def open_meshcat(port: int | None = None) -> Meshcat:

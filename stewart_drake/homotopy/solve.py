@@ -40,6 +40,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.newton_fk import leg_geometry, validate_lengths
 from stewart_drake.errors import SHAPE, FkInputError, ShapeError
 from stewart_drake.homotopy.certify import certify, newton_real, pose_bounds, real_forms
+from stewart_drake.homotopy.singular import resolve as resolve_singular
 from stewart_drake.homotopy.start import load_start_system
 from stewart_drake.homotopy.study import (
     SIX_THREE,
@@ -83,6 +84,7 @@ class CertifiedMode:
     position_bound: float
     angle_bound: float
     path: int
+    singular: bool = False  # a singular root resolved from a singular end point (``singular``): not certified
 
 
 @dataclass(frozen=True)
@@ -339,8 +341,17 @@ def solve_batch(
         Q, c = real_forms(hessian_forms(B1.real, s[j]))
         ridx = np.flatnonzero(cj == REAL)
         xr = newton_real(y[sl][ridx].real, Q, c)
+        # singular end points (several paths meeting at a multiple root): resolved, not dropped
+        sidx = np.flatnonzero(cj == SINGULAR)
+        rs = resolve_singular(y[sl][sidx], sidx, Q, c)
+        nonsing = ~np.isin(np.arange(len(rs.real)), np.flatnonzero(rs.singular))
+        if len(rs.real):  # a regular root the end game reached poorly is certified as any other
+            xr = np.concatenate([xr, rs.real])
+            ridx = np.concatenate([ridx, rs.paths])
+        singular_flag = np.r_[np.zeros(len(xr) - len(rs.real), bool), ~nonsing]
         cert = certify(xr, Q, c)
-        dup = _duplicates(y[sl], np.flatnonzero((cj == REAL) | (cj == COMPLEX) | (cj == SINGULAR)))
+        # coinciding end points reveal a path jump, except singular ones (a multiple root is several paths' end)
+        dup = _duplicates(y[sl], np.flatnonzero((cj == REAL) | (cj == COMPLEX)))
         failed = [int(k) for k in np.flatnonzero(cj == FAIL)]
         p_BC, R_BT = pose_from_study(xr, scale, arch.kind)
         _, _, Lp = leg_geometry(platform, p_BC, R_BT)
@@ -359,10 +370,11 @@ def solve_batch(
                 float(dp[k] * scale),
                 float(da[k]),
                 int(ridx[k]),
+                bool(singular_flag[k]),
             )
             for k in range(len(ridx))
         ]
-        complete = not failed and not dup
+        complete = not failed and not dup and not rs.unresolved_paths
         what = (
             f"{st.total} paths"
             if st.stage == "direct"
@@ -371,6 +383,13 @@ def solve_batch(
                 f"infinity), then {N} paths per length set"
             )
         )
+        n_sing = len(sidx)
+        if n_sing:
+            what += (
+                f"; {n_sing} path(s) ended at singular roots, resolved by Gauss–Newton on the real system: "
+                f"{int((~nonsing).sum())} singular real mode(s) (rank-deficient, listed uncertified), "
+                f"{int(nonsing.sum())} regular real, {len(rs.complex_paths)} complex"
+            )
         guarantee = (
             COMPLETE_TEXT.format(kind=arch.kind, what=what)
             if complete
@@ -385,6 +404,14 @@ def solve_batch(
                         else []
                     )
                     + ([f"paths {', '.join(map(str, dup))} reached the same finite end point"] if dup else [])
+                    + (
+                        [
+                            f"path(s) {', '.join(map(str, rs.unresolved_paths))} end at a singular point neither "
+                            "real (Gauss–Newton found no real root) nor clearly complex"
+                        ]
+                        if rs.unresolved_paths
+                        else []
+                    )
                 )
                 + " — an isolated solution may be missing"
             )

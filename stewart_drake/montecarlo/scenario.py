@@ -11,7 +11,9 @@ What a draw changes (the controller keeps the nominal model: it is what the firm
 
 - the plant is built from the platform with every physical joint moved (``anchor``: one offset per
   distinct base joint and per distinct plate anchor, so that legs sharing a joint keep sharing it) and the
-  plate's mass and centre of mass changed (``payload_mass``: the inertia scales with the mass; ``payload_com``);
+  plate's own mass and centre of mass changed (``plate_mass``: the inertia scales with the mass; ``plate_com``),
+  and a point mass ``payload`` added at ``payload_position`` in the plate frame (``design.payload.with_payload``,
+  as ``size --payload``);
 - the sensor reads L + offset (``leg_offset``) + white noise σ (``sensor_noise``) − j_k·dL/dt, the
   first-order effect of sampling tick k late by j_k ~ U[0, ``latency_jitter``], then quantises with the
   drawn ``sensor_resolution`` (in the controller);
@@ -28,8 +30,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from stewart_drake.api.simulation import plan_run, tick_count
+from stewart_drake.control import ControllerConfig
 from stewart_drake.core.geometry import Platform, base_joints
-from stewart_drake.core.trajectory import Trajectory, fit_trajectory, get_trajectory, table_trajectory
+from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
+from stewart_drake.design.payload import with_payload
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.montecarlo.spec import KEYS, VarySpec
@@ -116,10 +120,12 @@ class Draw:
     latency_jitter: float
     actuator_lag: float
     force_limit: float
-    payload_mass: float
-    payload_com_offset: np.ndarray
+    plate_mass: float
+    plate_com_offset: np.ndarray
     gain_scale: float
     sample_period: float
+    payload: float = 0.0
+    payload_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def columns(self) -> dict:
         """The drawn parameters as flat ``{column: value}`` (SI, names with their unit)."""
@@ -137,12 +143,14 @@ class Draw:
                 "latency_jitter_s": self.latency_jitter,
                 "actuator_lag_s": self.actuator_lag,
                 "force_limit_N": self.force_limit,
-                "payload_mass_kg": self.payload_mass,
+                "plate_mass_kg": self.plate_mass,
             }
         )
-        out.update({f"payload_com_{a}_m": float(x) for a, x in zip(AXES, self.payload_com_offset)})
+        out.update({f"plate_com_{a}_m": float(x) for a, x in zip(AXES, self.plate_com_offset)})
         out["gain_scale"] = self.gain_scale
         out["sample_period_s"] = self.sample_period
+        out["payload_kg"] = self.payload
+        out.update({f"payload_position_{a}_m": float(x) for a, x in zip(AXES, self.payload_position)})
         return out
 
 
@@ -151,6 +159,8 @@ def _draw_one(rng, law, nominal, shape=()):
     if law is None:
         return np.full(shape, nominal) if shape else nominal
     if law.kind == "fixed":
+        if len(law.values) == 3 and shape == (3,):  # X,Y,Z
+            return np.asarray(law.values, dtype=float)
         v = law.values[0]
         return np.full(shape, v) if shape else v
     if law.kind == "plusminus":
@@ -184,12 +194,14 @@ def draw(study: Study, index: int) -> tuple[int, Draw]:
             vals[key] = (_draw_one(rng, law, 0.0, (6, 3))[first], _draw_one(rng, law, 0.0, (k, 3)))
         elif key == "leg_offset":
             vals[key] = _draw_one(rng, law, 0.0, (6,))
-        elif key == "payload_com":
+        elif key in ("plate_com", "payload_position"):
             vals[key] = _draw_one(rng, law, 0.0, (3,))
         elif key == "force_limit":
             vals[key] = float(_draw_one(rng, law, float(p.legs.max_force)))
-        elif key == "payload_mass":
+        elif key == "plate_mass":
             vals[key] = float(_draw_one(rng, law, float(p.mass)))
+        elif key == "payload":
+            vals[key] = float(_draw_one(rng, law, 0.0))
         elif key == "latency":
             vals[key] = str(_draw_one(rng, law, NOMINAL[key]))
         else:
@@ -207,24 +219,28 @@ def draw(study: Study, index: int) -> tuple[int, Draw]:
         latency_jitter=vals["latency_jitter"],
         actuator_lag=vals["actuator_lag"],
         force_limit=vals["force_limit"],
-        payload_mass=vals["payload_mass"],
-        payload_com_offset=np.asarray(vals["payload_com"], float),
+        plate_mass=vals["plate_mass"],
+        plate_com_offset=np.asarray(vals["plate_com"], float),
         gain_scale=vals["gain_scale"],
         sample_period=vals["sample_period"],
+        payload=vals["payload"],
+        payload_position=np.asarray(vals["payload_position"], float),
     )
 
 
 def plant_platform(platform: Platform, d: Draw) -> Platform:
     """The platform the plant is built from: each base joint and plate anchor moved by its offset (legs
-    on one joint move together), plate mass (inertia scaled alike) and centre of mass changed."""
-    scale = d.payload_mass / platform.mass if platform.mass > 0 else 1.0
-    return platform.replace(
+    on one joint move together), the plate's own mass (inertia scaled alike) and centre of mass changed,
+    then the payload added (``with_payload``: a point mass at ``payload_position`` in the plate frame)."""
+    scale = d.plate_mass / platform.mass if platform.mass > 0 else 1.0
+    plant = platform.replace(
         base_anchors=platform.base_anchors + d.base_anchor_offset[d.base_leg_joint],
         top_anchors=platform.top_anchors + d.top_anchor_offset,
-        mass=d.payload_mass,
+        mass=d.plate_mass,
         inertia=platform.inertia * scale,
-        com=platform.com + d.payload_com_offset,
+        com=platform.com + d.plate_com_offset,
     )
+    return with_payload(plant, d.payload, d.payload_position, option="--vary payload")
 
 
 def sensor_model(d: Draw, seed: int, period: float, n_ticks: int) -> SensorModel:
@@ -236,12 +252,19 @@ def sensor_model(d: Draw, seed: int, period: float, n_ticks: int) -> SensorModel
     return SensorModel(d.leg_offset, noise, jitter, period)
 
 
-def scenario(study: Study, index: int, reference: Trajectory | None = None) -> tuple[int, Draw, Scenario]:
+def nominal_gains(study: Study, reference: Trajectory):
+    """The gains designed for the nominal platform, timing and actuator lag over the reference's poses (as
+    ``simulate`` and ``api.simulation.plan_run`` design them): the same for every run of a study."""
+    duration = study.run_duration(reference)
+    poses = design_poses(reference, max(duration, reference.duration or 0.0))
+    return ControllerConfig.for_platform(study.platform, poses=poses).gains
+
+
+def scenario(study: Study, index: int, reference: Trajectory | None = None, gains=None) -> tuple[int, Draw, Scenario]:
     """``(run seed, Draw, Scenario)`` of run ``index``, built by ``api.simulation.plan_run`` (the one home of a
-    closed-loop run): the controller keeps the nominal model with the gains designed for the nominal timing
-    and actuator lag over the run's poses (as ``simulate`` does), scaled by the draw's ``gain_scale``; the plant,
-    actuators and sensor are the draw's. The study was checked as a whole (``study.check_study``), so the
-    per-run checks are skipped."""
+    closed-loop run): the controller keeps the nominal model with the ``nominal_gains`` (computed unless
+    given), scaled by the draw's ``gain_scale``; the plant, actuators and sensor are the draw's. Every draw was
+    checked before the study runs (``draw_checks``), so the per-run checks are skipped."""
     seed, d = draw(study, index)
     ref = reference or study.reference()
     duration = study.run_duration(ref)
@@ -262,6 +285,7 @@ def scenario(study: Study, index: int, reference: Trajectory | None = None) -> t
         plant_platform=plant_platform(study.platform, d),
         gain_scale=d.gain_scale,
         nominal_gains=True,
+        gains=gains,
         checks=False,
         command="montecarlo",
     )

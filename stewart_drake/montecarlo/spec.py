@@ -19,10 +19,17 @@ Keys (nominal in brackets):
     latency_jitter     the largest lag of a tick's sampling instant, s (per tick uniform in [0, J]) [0]
     actuator_lag       actuator time constant, s [2e-3]
     force_limit        actuator force limit, N [the platform's legs.max_force]
-    payload_mass       plate mass, kg [the platform's]
-    payload_com        plate centre of mass offset, per axis, m [0]
+    plate_mass         the plate's own total mass, kg [the platform's] (its inertia scales alike)
+    plate_com          the plate's centre of mass offset, per axis, m [0]
     gain_scale         factor on every PID gain [1]
     sample_period      controller sample period, s [1e-3] (the gains stay those designed for the nominal)
+    payload            a point mass added to the plate, kg [0] (as ``size --payload``)
+    payload_position   where that payload sits in the plate frame T, m [0 0 0]; ``X,Y,Z`` fixes it
+                       (as ``size --payload-com``), ±T draws each component in ±T
+
+The keys ``payload_mass`` and ``payload_com`` of earlier versions set the plate's own mass and centre of
+mass (not an added payload); they are refused with a message naming ``plate_mass``/``plate_com`` and
+``payload``/``payload_position``.
 
 ``sensor_noise`` and ``latency_jitter`` set the size of per-tick random processes (drawn from the run's
 seed); the other keys are drawn once per run.
@@ -34,10 +41,10 @@ import difflib
 import math
 import re
 from dataclasses import dataclass, field
-from decimal import Decimal
+from decimal import Decimal, DecimalException
 from pathlib import Path
 
-from stewart_drake.errors import SpecError
+from stewart_drake.errors import SpecError, short_text
 
 # key: (dimension, vector length or 0 for a scalar, nominal zero?)
 KEYS = {
@@ -49,10 +56,20 @@ KEYS = {
     "latency_jitter": ("time", 0, True),
     "actuator_lag": ("time", 0, False),
     "force_limit": ("force", 0, False),
-    "payload_mass": ("mass", 0, False),
-    "payload_com": ("length", 3, True),
+    "plate_mass": ("mass", 0, False),
+    "plate_com": ("length", 3, True),
     "gain_scale": ("ratio", 0, False),
     "sample_period": ("time", 0, False),
+    "payload": ("mass", 0, True),
+    "payload_position": ("length", 3, True),
+}
+# Keys of earlier versions whose names said something else than what they varied: refused, naming the keys
+# that replace them (a study written for the old names must not run with another meaning).
+RENAMED = {
+    "payload_mass": "it set the plate's own total mass: use plate_mass for that, or payload=KG (with "
+    "payload_position=X,Y,Z) for a mass added to the plate",
+    "payload_com": "it moved the plate's own centre of mass: use plate_com for that, or payload_position for "
+    "where an added payload sits",
 }
 # Keys that configure a per-tick process: a fixed value only.
 PROCESS_KEYS = ("sensor_noise", "latency_jitter")
@@ -101,7 +118,10 @@ def _number(text: str, key: str, where: str) -> float:
     if not m or m.group(2) not in units:
         allowed = ", ".join(u for u in units if u) or "none"
         raise SpecError(SpecError.NUMBER.format(where=where, key=key, text=text, allowed=allowed))
-    v = float(Decimal(m.group(1)).scaleb(units[m.group(2)]))
+    try:
+        v = float(Decimal(m.group(1)).scaleb(units[m.group(2)]))
+    except (DecimalException, OverflowError):  # an exponent beyond Decimal's context (1e999999999999999999)
+        v = math.inf
     if not math.isfinite(v):
         raise SpecError(SpecError.NOT_FINITE.format(where=where, key=key, text=text))
     return v
@@ -135,6 +155,11 @@ def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
         if w < 0:
             raise SpecError(SpecError.HALF_WIDTH.format(where=where, key=key, text=text))
         return Distribution("plusminus", (w,), text)
+    if KEYS[key][1] == 3 and "," in text:  # X,Y,Z: a fixed vector
+        parts = text.split(",")
+        if len(parts) != 3:
+            raise SpecError(SpecError.VECTOR_3.format(where=where, key=key, text=text))
+        return Distribution("fixed", tuple(_number(s, key, where) for s in parts), text)
     if ".." in text:
         lo, hi = (_number(s, key, where) for s in text.split("..", 1))
         if not lo <= hi:
@@ -145,7 +170,13 @@ def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
     return Distribution("fixed", (_number(text, key, where),), text)
 
 
-def check_key(key: str, where: str) -> None:
+def check_key(key, where: str) -> None:
+    """``SpecError`` unless ``key`` is one of ``KEYS``: a renamed key says what it meant and what to use, an
+    unknown one the nearest key."""
+    if not isinstance(key, str):
+        raise SpecError(SpecError.KEY_NOT_TEXT.format(where=where, key=short_text(key)))
+    if key in RENAMED:
+        raise SpecError(SpecError.RENAMED.format(where=where, key=key, why=RENAMED[key]))
     if key not in KEYS:
         near = difflib.get_close_matches(key, KEYS, n=1)
         hint = f" (did you mean {near[0]!r}?)" if near else f" (keys: {', '.join(KEYS)})"
@@ -196,6 +227,10 @@ def _parse_yaml(path: Path) -> VarySpec:
     laws = {}
     for k, v in node.value:
         where = _where(str(path), k.start_mark.line + 1)
+        if not isinstance(k, yaml.ScalarNode):  # a list or mapping as a key ([a, b]: 1)
+            raise SpecError(
+                SpecError.KEY_NOT_TEXT.format(where=where, key=short_text(text[k.start_mark.index : k.end_mark.index]))
+            )
         if not isinstance(v, yaml.ScalarNode):
             raise SpecError(SpecError.NOT_SCALAR.format(where=where, key=k.value))
         check_key(k.value, where)

@@ -25,6 +25,7 @@ import numpy as np
 from stewart_drake.core.geometry import base_joints
 from stewart_drake.core.output_folder import claim_in_manifest
 from stewart_drake.errors import StudyError
+from stewart_drake.montecarlo.draw_checks import check_draws
 from stewart_drake.montecarlo.scenario import Study, run_scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
@@ -131,7 +132,8 @@ def settings_key(settings: dict) -> str:
 
 
 def check_study(study: Study) -> float:
-    """Raise ``StudyError`` if the study is too large or inconsistent; return the seconds per run."""
+    """Raise ``StudyError`` if the study is too large or inconsistent, or a run's draw fails ``simulate``'s
+    checks (``draw_checks``); return the seconds per run."""
     from stewart_drake.drake.integrators import check_integrator
 
     check_integrator(study.integrator)
@@ -166,9 +168,9 @@ def check_study(study: Study) -> float:
         if law is not None and law.kind not in ("fixed", "choice"):
             raise StudyError(StudyError.RESOLUTION_RANGE)
         for r in law.values if law is not None else ():
-            c = 1e-3 / r
-            if not (r > 0 and abs(c - round(c)) <= 1e-9 * c):
+            if not (r > 0 and abs(1e-3 / r - round(1e-3 / r)) <= 1e-9 * 1e-3 / r):  # r > 0 first: no 1e-3 / 0
                 raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r))
+    check_draws(study)
     return duration
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.montecarlo.spec import LATENCY_MODES
 
 METRICS = (
@@ -54,8 +55,13 @@ def sensitivity(rows: list[dict], metric: str = WORST_BY) -> list[dict]:
         return []
     y = _numeric(ok, metric)
     out = []
+    if np.ptp(y) == 0:  # a metric no parameter moved: no correlation (scipy warned on stderr)
+        return out
     for k in parameter_columns(ok):
-        rho, p = spearmanr(_numeric(ok, k), y)
+        x = _numeric(ok, k)
+        if np.ptp(x) == 0:
+            continue
+        rho, p = spearmanr(x, y)
         if math.isfinite(rho):
             out.append({"parameter": k, "spearman": float(rho), "p_value": float(p)})
     return sorted(out, key=lambda d: -abs(d["spearman"]))
@@ -167,7 +173,7 @@ def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
         (tmp / "study.json").write_text(
             json.dumps({"key": summary["key"], "runs": summary["runs"], "settings": summary["settings"]}, indent=2)
         )
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))
+        (tmp / "summary.json").write_text(dumps_strict(summary))  # NaN metrics of failed runs: null, strict JSON
         written += [tmp / "study.json", tmp / "summary.json"]
         names = [p.name for p in written]
     return [out / n for n in names]

@@ -24,6 +24,7 @@ import multiprocessing
 import os
 import shlex
 import sys
+import textwrap
 import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -256,10 +257,14 @@ def _build_in_worker(path: str, quick: bool) -> Section:
     return build_section(load_analysis(Path(path)), quick)
 
 
-def _progress(k: int, n: int, s: Section, log) -> None:
+def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
+    """One line per finished section: its number in the report's order ``k`` of ``n`` (and, when sections
+    finish out of order, how many are done), its title shortened at a word, its checks and time."""
     ok = sum(c.passed for c in s.checks)
     cpu = "" if s.cpu is None else f" (CPU {s.cpu:.1f} s)"
-    print(f"[{k}/{n}] {s.title[:70]}: {ok}/{len(s.checks)} checks passed, {s.elapsed:.1f} s{cpu}", file=log, flush=True)
+    count = f"section {k}/{n}" + ("" if done is None else f", {done} done")
+    title = textwrap.shorten(s.title, 70, placeholder=" …")
+    print(f"[{count}] {title}: {ok}/{len(s.checks)} checks passed, {s.elapsed:.1f} s{cpu}", file=log, flush=True)
     for w in s.warnings:
         print(f"      warning: {w}", file=log, flush=True)
 
@@ -298,7 +303,7 @@ def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: 
                 s.elapsed = 0.0
                 sections[i] = s
             done += 1
-            _progress(done, n, sections[i], log)
+            _progress(i + 1, n, sections[i], log, done)
     return sections
 
 

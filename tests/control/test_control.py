@@ -55,10 +55,16 @@ def test_infeasible_timing_is_refused_with_both_numbers():
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        (dict(sample_period=0.0), "sample_period must be a positive number, got 0.0"),
+        (
+            dict(sample_period=0.0),
+            r"sample period \(--period, --vary sample_period; s\) must be a positive number, got 0.0",
+        ),
         (dict(latency="late"), "latency must be one of sample, computation, none, got 'late'"),
         (dict(computation_cycles=-3), "computation_cycles must be a positive integer, got -3"),
-        (dict(sensor_resolution=float("nan")), "sensor_resolution must be a positive number"),
+        (
+            dict(sensor_resolution=float("nan")),
+            r"sensor resolution \(--sensor-resolution, --vary sensor_resolution; m per count\) must be a positive number",
+        ),
     ],
 )
 def test_bad_timing_values_are_named(kwargs, match):
@@ -67,9 +73,9 @@ def test_bad_timing_values_are_named(kwargs, match):
 
 
 def test_bad_gains_and_sensor_resolution_are_named():
-    with pytest.raises(ValueError, match="PidGains.kd must be a finite number >= 0, got -1"):
+    with pytest.raises(ValueError, match="the controller.s kd gain must be a finite number >= 0, got -1"):
         PidGains(kd=-1)
-    with pytest.raises(ValueError, match=r"PidGains.feedforward_filter must be in \(0, 1\], got 0"):
+    with pytest.raises(ValueError, match=r"the controller.s feedforward filter must be in \(0, 1\], got 0"):
         PidGains(feedforward_filter=0)
     with pytest.raises(ValueError, match="sensor_resolution 0.0003 m must divide the IK's length LSB 0.001 m"):
         FixedPointLaw(PLATFORM, ControllerConfig(timing=DspTiming(sensor_resolution=3e-4)))

@@ -218,8 +218,28 @@ def test_cli_size_violation_is_the_first(tmp_path, capsys):
     leg = int(np.argmax(np.abs(F[k]) > 2.5)) + 1
     v = out["violation"]
     assert (v["index"], v["leg"], v["quantity"]) == (k, leg, "force")
-    assert f"leg {leg} force" in cap.err and "legs.max_force 2.5 N" in cap.err and f"t = {t[k]:.4f} s" in cap.err
+    assert f"first exceeded by leg {leg} " in cap.err and f"t = {t[k]:.4f} s" in cap.err
+    # the message's number is the peak the table shows (issue 24, item 8: it was the first sample's value)
+    kp, lp = np.unravel_index(int(np.argmax(np.abs(F))), F.shape)
+    peak = max(r["peak_force_n"] for r in out["legs"])
+    assert v["peak"] == pytest.approx(peak, rel=1e-12) and (v["peak_index"], v["peak_leg"]) == (kp, lp + 1)
+    assert f"leg {lp + 1} force peaks at {peak:.6g} N, beyond legs.max_force 2.5 N at t = {t[kp]:.4f} s" in cap.err
     assert cap.err.count("\n") == 1
+
+
+def test_cli_envelope_outside_the_stroke_is_a_result_outside_limits(tmp_path, capsys):
+    """An envelope pose outside the stroke: the sizing is shown and the stroke named, exit 1 (it was exit 2,
+    bad input); the library call without ``stroke=False`` still refuses it."""
+    env = _write(tmp_path, "env.yaml", ENV_YAML.replace("[-40, -40, 690", "[-400, -40, 690"))
+    assert main(["size", "--envelope", env, "--json"]) == 1
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    v = out["violation"]
+    assert v["quantity"] == "length" and len(out["legs"]) == 6 and "beyond stroke" in cap.err
+    L = np.array([[r["min_length_m"], r["max_length_m"]] for r in out["legs"]])
+    assert v["peak"] in L and (v["peak"] < 0.55 or v["peak"] > 0.95)
+    with pytest.raises(EnvelopeError, match="leaves the workspace: leg"):
+        envelope_sizing(load_platform("utn-dynamic"), load_envelope(env))
 
 
 def test_cli_size_speed_limit_on_envelope(tmp_path, capsys):
@@ -227,14 +247,13 @@ def test_cli_size_speed_limit_on_envelope(tmp_path, capsys):
     env = _write(tmp_path, "env.yaml", ENV_YAML)
     assert main(["size", "--platform", f, "--envelope", env]) == 1
     err = capsys.readouterr().err
-    assert "speed" in err and "legs.max_speed 0.1 m/s" in err and "envelope pose 1 " in err
+    assert "speed peaks at" in err and "legs.max_speed 0.1 m/s" in err and "envelope pose 1 " in err
 
 
 @pytest.mark.parametrize(
     "text, needle",
     [
         (ENV_YAML.replace("[2, 2, 2, 2, 2, 2]", "[2, 2, 2, 2, 2, 0]"), "box.steps must be >= 1"),
-        (ENV_YAML.replace("[-40, -40, 690", "[-400, -40, 690"), "leaves the workspace: leg"),
         (
             ENV_YAML.replace("linear: [200, 200, 100]", "linear: [200, -200, 100]"),
             "velocity.linear bounds are magnitudes",

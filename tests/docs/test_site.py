@@ -63,7 +63,7 @@ def test_every_public_name_is_in_the_api_reference(site):
     assert len(public_names()) >= 15
     for n in public_names():
         obj = getattr(stewart_drake, n)
-        obj = getattr(obj, "__public__", obj)  # a name shared with an internal subpackage: its public object
+        obj = getattr(obj, "__public__", obj)  # a name shadowing a subpackage (sd.firmware): its public object
         where = obj.__name__ if inspect.ismodule(obj) else f"{obj.__module__}.{obj.__qualname__}"
         assert f'id="{where}"' in page, n
         assert f"sd.{n}" in page, n

@@ -13,7 +13,15 @@ import pytest
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.drake.animation import _frames, leg_warnings, log_saturating, stroke_margin
-from stewart_drake.drake.viewer import ReplayError, labels, load_replay, nearest_reachable, reachable, readout
+from stewart_drake.drake.viewer import (
+    MAX_LABEL,
+    ReplayError,
+    labels,
+    load_replay,
+    nearest_reachable,
+    reachable,
+    readout,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -58,6 +66,10 @@ def test_nearest_reachable_lies_on_the_boundary(utn):
     assert not r.reachable and r.modes is None
     text = labels(r)
     assert any(t.startswith("UNREACHABLE: legs") for t in text) and any(t.startswith("ghost:") for t in text)
+    # every line fits the panel (the two unreachable lines were cut off), and the wrapped text is all there
+    assert max(map(len, text)) <= MAX_LABEL and len(set(text)) == len(text)
+    joined = " ".join(t.strip() for t in text)
+    assert f"{r.fraction * 100:.0f} % from home" in joined and "out of stroke" in joined
 
 
 def test_leg_warnings_band(utn):

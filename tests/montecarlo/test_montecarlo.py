@@ -14,7 +14,7 @@ from stewart_drake.montecarlo.scenario import Study, draw, run_scenario, run_see
 from stewart_drake.montecarlo.spec import SpecError, parse_spec
 from stewart_drake.montecarlo.summary import read_table, sensitivity
 
-VARY = ["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "payload_mass=±20%"]
+VARY = ["anchor=±0.5mm", "sensor_resolution=10um", "latency_jitter=200us", "plate_mass=±20%"]
 # Short runs: 0.15 s of the seed trajectory (150 controller ticks).
 SHORT = ["--duration", "0.15", "--no-progress"]
 
@@ -26,20 +26,20 @@ def platform():
 
 def test_spec_values_units_and_laws():
     s = parse_spec(
-        "anchor=±0.5mm sensor_resolution=10um latency=sample|none actuator_lag=1ms..3ms payload_mass=±20% force_limit=150|200"
+        "anchor=±0.5mm sensor_resolution=10um latency=sample|none actuator_lag=1ms..3ms plate_mass=±20% force_limit=150|200"
     )
     assert s.laws["anchor"].kind == "plusminus" and s.laws["anchor"].values == (0.0005,)
     assert s.laws["sensor_resolution"].values == (1e-05,)  # decimal scaling: exactly the float 1e-05
     assert s.laws["latency"].values == ("sample", "none")
     assert s.laws["actuator_lag"].values == (0.001, 0.003)
-    assert s.laws["payload_mass"].kind == "relative" and s.laws["payload_mass"].values == (0.2,)
+    assert s.laws["plate_mass"].kind == "relative" and s.laws["plate_mass"].values == (0.2,)
     assert s.laws["force_limit"].values == (150.0, 200.0)
 
 
 def test_spec_yaml_names_the_line(tmp_path):
     f = tmp_path / "vary.yaml"
-    f.write_text("anchor: ±0.5mm\npayload_mas: ±20%\n")
-    with pytest.raises(SpecError, match=r"vary.yaml:2: unknown key 'payload_mas' \(did you mean 'payload_mass'\?\)"):
+    f.write_text("anchor: ±0.5mm\nplate_mas: ±20%\n")
+    with pytest.raises(SpecError, match=r"vary.yaml:2: unknown key 'plate_mas' \(did you mean 'plate_mass'\?\)"):
         parse_spec([str(f)])
     f.write_text("anchor: ±0.5mm\nsensor_noise: 2um\n")
     assert parse_spec([str(f)]).laws["sensor_noise"].values == (2e-06,)
@@ -94,12 +94,12 @@ def test_each_run_redraws_alone(platform):
     assert seed3 == draws[3][0] == run_seed(11, 3)
     assert (
         np.array_equal(d3.base_anchor_offset, draws[3][1].base_anchor_offset)
-        and d3.payload_mass == draws[3][1].payload_mass
+        and d3.plate_mass == draws[3][1].plate_mass
     )
     assert len({s for s, _ in draws}) == 5 and run_seed(12, 3) != seed3
     for _, d in draws:
         assert np.abs(d.base_anchor_offset).max() <= 0.5e-3 and np.abs(d.top_anchor_offset).max() <= 0.5e-3
-        assert 0.8 * platform.mass <= d.payload_mass <= 1.2 * platform.mass
+        assert 0.8 * platform.mass <= d.plate_mass <= 1.2 * platform.mass
         assert np.all(d.leg_offset == 0) and d.gain_scale == 1.0
 
 

@@ -26,11 +26,23 @@ VARY = [
     "leg_offset=±0.1mm",
     "latency=sample|none",
     "actuator_lag=1ms..3ms",
-    "payload_mass=±20%",
-    "payload_com=±1mm",
+    "plate_mass=±20%",
+    "plate_com=±1mm",
     "gain_scale=0.9..1.1",
 ]
 BEFORE = Path(__file__).with_name("draws_before_joints.json")
+# The stored table predates the keys' renaming (payload_mass/payload_com set the plate's own mass and centre
+# of mass, now plate_mass/plate_com) and the added payload (nominal 0 kg at the plate origin, drawn last).
+RENAMES = (("payload_mass", "plate_mass"), ("payload_com", "plate_com"))
+NEW_COLUMNS = {"payload_kg": 0.0, "payload_position_x_m": 0.0, "payload_position_y_m": 0.0, "payload_position_z_m": 0.0}
+
+
+def _renamed(text: str) -> str:
+    for old, new in RENAMES:
+        text = text.replace(old, new)
+    return text
+
+
 LEG_BASE = [0, 0, 1, 1, 2, 2]
 
 
@@ -56,8 +68,8 @@ def _old_stream(platform, seed: int, index: int) -> dict:
         "leg_offset": rng.uniform(-1e-4, 1e-4, size=6),
         "latency": ("sample", "none")[int(rng.integers(2))],
         "actuator_lag": rng.uniform(1e-3, 3e-3),
-        "payload_mass": platform.mass * (1 + rng.uniform(-0.2, 0.2)),
-        "payload_com": rng.uniform(-1e-3, 1e-3, size=3),
+        "plate_mass": platform.mass * (1 + rng.uniform(-0.2, 0.2)),
+        "plate_com": rng.uniform(-1e-3, 1e-3, size=3),
         "gain_scale": rng.uniform(0.9, 1.1),
     }
 
@@ -65,11 +77,11 @@ def _old_stream(platform, seed: int, index: int) -> dict:
 def _assert_later_keys_equal(d, old):
     np.testing.assert_array_equal(d.top_anchor_offset, old["top"])
     np.testing.assert_array_equal(d.leg_offset, old["leg_offset"])
-    np.testing.assert_array_equal(d.payload_com_offset, old["payload_com"])
-    assert (d.latency, d.actuator_lag, d.payload_mass, d.gain_scale) == (
+    np.testing.assert_array_equal(d.plate_com_offset, old["plate_com"])
+    assert (d.latency, d.actuator_lag, d.plate_mass, d.gain_scale) == (
         old["latency"],
         old["actuator_lag"],
-        old["payload_mass"],
+        old["plate_mass"],
         old["gain_scale"],
     )
 
@@ -83,11 +95,12 @@ def test_distinct_base_anchors_draw_as_before(name):
     first, leg_joint = base_joints(p)
     assert first.tolist() == leg_joint.tolist() == list(range(6))
     stored = json.loads(BEFORE.read_text())
-    assert stored["vary"] == VARY
+    assert [_renamed(v) for v in stored["vary"]] == VARY
     st = Study(p, parse_spec(VARY), seed=stored["seed"], runs=2)
     for i, want in enumerate(stored["draws"][name]):
         _, d = draw(st, i)
         got = d.columns()
+        want = {_renamed(k): v for k, v in want.items()} | NEW_COLUMNS
         assert list(got) == list(want)  # same columns, same order
         assert all(got[k] == want[k] for k in want), [k for k in want if got[k] != want[k]]
         old = _old_stream(p, stored["seed"], i)

@@ -24,7 +24,7 @@ def _rows_without_wall_time(rows):
 
 def test_a_killed_worker_s_run_is_rerun_and_the_rows_are_unchanged(tmp_path):
     distributed = pytest.importorskip("distributed")
-    spec = parse_spec(["anchor=±0.5mm", "payload_mass=±20%"])
+    spec = parse_spec(["anchor=±0.5mm", "plate_mass=±20%"])
     study = Study(load_platform("utn-dynamic"), spec, seed=3, runs=RUNS, duration=0.5)
     expected = _rows_without_wall_time(run_study(study, None, workers=0, progress=False))
     killed = {}

@@ -98,12 +98,29 @@ def test_parallel_analyses_keep_their_order(tmp_path):
     assert [s.title for s in sections] == ["a_slow", "b_fast", "c_fast"]
     assert all(s.elapsed is not None for s in sections) and sections[0].elapsed >= 1.0
     lines = log.getvalue().splitlines()
-    assert len(lines) == 3 and lines[-1].startswith("[3/3] a_slow: 1/1 checks passed")
+    # numbered in the report's order (a_slow is section 1, finished third), not in completion order (issue 24, 9)
+    assert len(lines) == 3 and lines[-1].startswith("[section 1/3, 3 done] a_slow: 1/1 checks passed")
+
     page = render.render_html(
         sections, "t", render.default_meta(sections, "stewart-drake report", 1.0, ("utn-dynamic",))
     )
     assert page.index("Verdict") < page.index("All checks") < page.index('<section id="s0">')
     assert "a_slow headline" in page and "stewart-drake report" in page and "utn-dynamic" in page
+
+
+def test_progress_titles_are_cut_at_a_word(tmp_path):
+    """A long title was cut mid-word ("…driving the clo"): now shortened at a word, with an ellipsis."""
+    import io
+
+    title = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
+    (tmp_path / "long.py").write_text(
+        f"TITLE = {title!r}\nORDER = 1\ndef build(section):\n    section.check('ran', 0.0, 1.0)\n"
+    )
+    log = io.StringIO()
+    run_analyses(discover_analyses(tmp_path), log=log)
+    assert log.getvalue().startswith(
+        "[section 1/1] Controller in the loop: the fixed-point DSP controller driving the …: 1/1 checks passed"
+    )
 
 
 def test_tightest_check_is_the_default_headline():
