@@ -142,8 +142,8 @@ def test_an_identification_that_does_not_converge_exits_1(flow, capsys, tmp_path
 
 
 def test_simulate_measurements_refuses_keys_that_are_not_geometric(capsys, tmp_path, flow):
-    rc, _, err = cli(capsys, "simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--errors", "payload_mass=±10%", "--out", tmp_path / "o")  # fmt: skip
-    assert rc == 2 and "--errors: key 'payload_mass' is not a geometric error (keys: anchor, leg_offset)" in err
+    rc, _, err = cli(capsys, "simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--errors", "plate_mass=±10%", "--out", tmp_path / "o")  # fmt: skip
+    assert rc == 2 and "--errors: key 'plate_mass' is not a geometric error (keys: anchor, leg_offset)" in err
 
 
 def test_the_calibration_commands_run_without_pydrake(flow, tmp_path):
