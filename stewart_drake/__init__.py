@@ -35,6 +35,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.montecarlo.api import MonteCarloResult, montecarlo
     from stewart_drake.montecarlo.measurements_api import MeasurementsResult, simulate_measurements
     from stewart_drake.report.api import ReportResult, report
+    from stewart_drake.synthesis.api import OptimizeResult, WorkspaceProof, load_requirements, optimize, prove_workspace
 
 __version__ = "0.2.0"
 
@@ -78,6 +79,11 @@ _PUBLIC = {
     "PlanMeasurementsResult": ("stewart_drake.api.calibration", "PlanMeasurementsResult"),
     "simulate_measurements": ("stewart_drake.montecarlo.measurements_api", "simulate_measurements"),
     "MeasurementsResult": ("stewart_drake.montecarlo.measurements_api", "MeasurementsResult"),
+    "load_requirements": ("stewart_drake.synthesis.api", "load_requirements"),
+    "optimize": ("stewart_drake.synthesis.api", "optimize"),
+    "OptimizeResult": ("stewart_drake.synthesis.api", "OptimizeResult"),
+    "prove_workspace": ("stewart_drake.synthesis.api", "prove_workspace"),
+    "WorkspaceProof": ("stewart_drake.synthesis.api", "WorkspaceProof"),
 }
 
 __all__ = [
@@ -119,6 +125,11 @@ __all__ = [
     "PlanMeasurementsResult",
     "simulate_measurements",
     "MeasurementsResult",
+    "load_requirements",
+    "optimize",
+    "OptimizeResult",
+    "prove_workspace",
+    "WorkspaceProof",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,
