@@ -396,6 +396,7 @@ class UsageError(StewartError):
     """Options that contradict each other or are ignored (e.g. ``--json`` without ``--inspect``)."""
 
     NEEDS = "{option} only applies with {needs}"
+    NOT_BOTH = "give {first} or {second}, not both"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     # argparse prefixes these with "argument --option:" (option values that are not numbers)
     NOT_A_NUMBER = "not a number: {value!r}"

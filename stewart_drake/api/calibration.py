@@ -155,7 +155,7 @@ def calibrate(
         StewartError: an unreadable measurement file, too few poses, a bad noise word or split.
     """
     if holdout is not None and validate is not None:
-        raise UsageError("give holdout (--holdout) or validate (--validate), not both")
+        raise UsageError(UsageError.NOT_BOTH.format(first="holdout (--holdout)", second="validate (--validate)"))
     nominal = load_platform(platform)
     sigma = parse_noise(noise)
     data = read_measurements(str(measurements), nominal, type, length_unit, angle_unit)

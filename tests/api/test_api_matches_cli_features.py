@@ -76,6 +76,8 @@ def test_plan_and_simulate_measurements_and_calibrate(capsys, platform_arg, tmp_
                        "--holdout", 0.25, "--seed", 1, "--no-plots", "--out", tmp_path / "cal", "--json")  # fmt: skip
     assert rc == 0 and cal.converged
     assert_same(cal.to_dict(), cli)
+    with pytest.raises(sd.StewartError, match=r"--holdout 0\.7: give a fraction in \(0, 0\.5\]"):
+        sd.calibrate(platform_arg, measured, holdout=0.7)
     v = cal.to_dict()["validation"]
     assert v["calibrated"]["position"]["rms"] < 0.1 * v["nominal"]["position"]["rms"]
     # the calibrated platform: the command's file and Platform.to_yaml give the same anchors
@@ -87,7 +89,8 @@ def test_plan_and_simulate_measurements_and_calibrate(capsys, platform_arg, tmp_
 
 
 def test_calibrate_bad_split_is_one_error(tmp_path):
-    """``holdout`` and ``validate`` together, and a holdout outside (0, 0.5], are refused by the API itself."""
+    """``holdout`` and ``validate`` together are refused by the API itself (the CLI's argparse group is not
+    there to do it)."""
     with pytest.raises(sd.UsageError, match="not both"):
         sd.calibrate("utn-dynamic", tmp_path / "m.csv", holdout=0.2, validate=tmp_path / "v.csv")
 
