@@ -20,6 +20,7 @@ import typing
 # The same names as _PUBLIC, for type checkers and the docs (at run time each is loaded on first use).
 if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
+    from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
     from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
@@ -28,10 +29,13 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
     from stewart_drake.core.geometry import Platform
+    from stewart_drake.core.realtime_fk import RealtimeFK, RealtimeResult
     from stewart_drake.core.trajectory import Trajectory
     from stewart_drake.errors import PhysicalLimitError, StewartError, UsageError
     from stewart_drake.montecarlo.api import MonteCarloResult, montecarlo
+    from stewart_drake.montecarlo.measurements_api import MeasurementsResult, simulate_measurements
     from stewart_drake.report.api import ReportResult, report
+    from stewart_drake.synthesis.api import OptimizeResult, WorkspaceProof, load_requirements, optimize, prove_workspace
 
 __version__ = "0.2.0"
 
@@ -50,6 +54,8 @@ _PUBLIC = {
     "fk": ("stewart_drake.api.kinematics", "fk"),
     "FKResult": ("stewart_drake.api.kinematics", "FKResult"),
     "FKSolution": ("stewart_drake.api.kinematics", "FKSolution"),
+    "RealtimeFK": ("stewart_drake.core.realtime_fk", "RealtimeFK"),
+    "RealtimeResult": ("stewart_drake.core.realtime_fk", "RealtimeResult"),
     "inverse_dynamics": ("stewart_drake.api.dynamics", "inverse_dynamics"),
     "DynamicsResult": ("stewart_drake.api.dynamics", "DynamicsResult"),
     "stiffness": ("stewart_drake.api.design", "stiffness"),
@@ -67,6 +73,17 @@ _PUBLIC = {
     "firmware": ("stewart_drake.api.firmware", None),
     "report": ("stewart_drake.report.api", "report"),
     "ReportResult": ("stewart_drake.report.api", "ReportResult"),
+    "calibrate": ("stewart_drake.api.calibration", "calibrate"),
+    "CalibrateResult": ("stewart_drake.api.calibration", "CalibrateResult"),
+    "plan_measurements": ("stewart_drake.api.calibration", "plan_measurements"),
+    "PlanMeasurementsResult": ("stewart_drake.api.calibration", "PlanMeasurementsResult"),
+    "simulate_measurements": ("stewart_drake.montecarlo.measurements_api", "simulate_measurements"),
+    "MeasurementsResult": ("stewart_drake.montecarlo.measurements_api", "MeasurementsResult"),
+    "load_requirements": ("stewart_drake.synthesis.api", "load_requirements"),
+    "optimize": ("stewart_drake.synthesis.api", "optimize"),
+    "OptimizeResult": ("stewart_drake.synthesis.api", "OptimizeResult"),
+    "prove_workspace": ("stewart_drake.synthesis.api", "prove_workspace"),
+    "WorkspaceProof": ("stewart_drake.synthesis.api", "WorkspaceProof"),
 }
 
 __all__ = [
@@ -83,6 +100,8 @@ __all__ = [
     "fk",
     "FKResult",
     "FKSolution",
+    "RealtimeFK",
+    "RealtimeResult",
     "inverse_dynamics",
     "DynamicsResult",
     "stiffness",
@@ -100,6 +119,17 @@ __all__ = [
     "firmware",
     "report",
     "ReportResult",
+    "calibrate",
+    "CalibrateResult",
+    "plan_measurements",
+    "PlanMeasurementsResult",
+    "simulate_measurements",
+    "MeasurementsResult",
+    "load_requirements",
+    "optimize",
+    "OptimizeResult",
+    "prove_workspace",
+    "WorkspaceProof",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

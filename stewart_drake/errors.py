@@ -404,6 +404,7 @@ class UsageError(StewartError):
         "{file} was generated with other options ({mismatch}): the check would compare it with another module's "
         "emulation; leave the option out to use the recorded one"
     )
+    NOT_BOTH = "give {first} or {second}, not both"
     NOT_FINITE = "{option}: must be a finite number, got {value}"
     # argparse prefixes these with "argument --option:" (option values that are not numbers)
     NOT_A_NUMBER = "not a number: {value!r}"

@@ -3,14 +3,16 @@ C firmware with the bit-exact emulation. ``sd.firmware.generate(...)``, ``sd.fir
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.c_build import compiler_by_name, compilers
-from stewart_drake.core.geometry import Platform, load_platform
+from stewart_drake.core.geometry import Platform
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.trajectory import Trajectory, design_poses, get_trajectory
 from stewart_drake.errors import (
@@ -19,11 +21,21 @@ from stewart_drake.errors import (
     OPTION_FIRMWARE_WORD_BITS,
     OPTION_OUT_FOREIGN,
     OPTION_OUT_NOT_FOLDER,
+    CertifyError,
     OptionError,
     OutputError,
     StewartError,
     UsageError,
 )
+from stewart_drake.firmware.certify.box import parse_box
+from stewart_drake.firmware.certify.certificate import Certificate
+from stewart_drake.firmware.certify.certificate import certify as certify_ik
+from stewart_drake.firmware.certify.optimize import OptimizeResult as CertifiedFormats
+from stewart_drake.firmware.certify.optimize import optimize as choose_formats
+from stewart_drake.firmware.certify.optimize import parse_budget
+from stewart_drake.firmware.certify.search import MAX_CELLS
+from stewart_drake.firmware.certify.tick import TickCertificate
+from stewart_drake.firmware.certify.tick import certify_tick as certify_tick_words
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.firmware.fingerprint import read_fingerprint, resolve_options, stamp
 from stewart_drake.firmware.generate import FILES
@@ -31,7 +43,18 @@ from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.fixedpoint.generic import QFormat
 
-__all__ = ["generate", "check", "GenerateResult", "CheckResult"]
+__all__ = [
+    "generate",
+    "check",
+    "certify",
+    "certify_tick",
+    "optimize",
+    "GenerateResult",
+    "CheckResult",
+    "CertifyResult",
+    "TickResult",
+    "OptimizeResult",
+]
 
 
 def controller_config(
@@ -284,3 +307,248 @@ def _platform_name(recorded: str) -> str:
         return load_platform(recorded).name
     except StewartError:
         return recorded
+
+
+# -- the firmware certificate ------------------------------------------------------------------------------------
+@dataclass(repr=False)
+class CertifyResult(Result):
+    """The firmware certificate over a pose box (``firmware.certify``).
+
+    Attributes:
+        certificate: every ``sd_ik`` word's proven range and saturation, the proven bound on
+            ``|L_firmware - L_float|`` per leg, a saturating witness pose if one was found.
+        tick: the ``sd_tick`` words' certificate (``tick=True``), else None.
+    """
+
+    certificate: Certificate
+    tick: TickCertificate | None = None
+
+    @property
+    def saturation_possible(self) -> bool:
+        """Whether some arithmetic word may saturate in the box (a witness, or cells left undecided)."""
+        return bool(self.certificate.saturation_possible)
+
+    def _fields(self) -> dict:
+        d = self.certificate.to_dict()
+        if self.tick is not None:
+            d["tick"] = self.tick.to_dict()
+        return d
+
+
+@dataclass(repr=False)
+class TickResult(Result):
+    """The controller tick's certificate (``firmware.certify_tick``): each ``sd_tick`` word's proven range and
+    saturation, and whether the anti-windup keeps the integrator inside its rails (``certificate``)."""
+
+    certificate: TickCertificate
+
+    def _fields(self) -> dict:
+        return self.certificate.to_dict()
+
+
+@dataclass(repr=False)
+class OptimizeResult(Result):
+    """The word formats chosen by the proof (``firmware.optimize``).
+
+    Attributes:
+        search: the chosen formats (``chosen``: None when no format meets the budget), the default format's
+            and the simulation-only choice's certificates, every format tried, the generated firmware.
+        out: the folder the chosen firmware was written to (None when not asked or nothing was chosen).
+    """
+
+    search: CertifiedFormats
+    out: Path | None = None
+
+    @property
+    def chosen(self):
+        """The chosen format and its certificate, or None when no format meets the budget."""
+        return self.search.chosen
+
+    def summary(self) -> str:
+        """The comparison as text (what ``stewart-drake firmware optimize`` prints)."""
+        return self.search.summary()
+
+    def _fields(self) -> dict:
+        return self.search.to_dict()
+
+
+def _shown(platform) -> str:
+    return str(platform) if isinstance(platform, (str, Path)) else platform.name
+
+
+def certify(
+    platform: str | Path | Platform,
+    *,
+    box: Sequence[str] | None = None,
+    length_unit: str = "mm",
+    angle_unit: str = "pi",
+    max_cells: int | None = None,
+    implementation: str = "generated",
+    tick: bool = False,
+    tick_error: float = 5e-3,
+    tick_speed: float = 0.1,
+    tick_feedforward: float = 0.0,
+    word_bits: int = 16,
+    length_lsb: float = 1e-3,
+    trig: str = "tfr16",
+    convention: str = "utn",
+    rate: float = 1000.0,
+    sensor_resolution: float = 1e-5,
+    trajectory: str | Trajectory | None = None,
+) -> CertifyResult:
+    """Prove, over every pose of a box, each ``sd_ik`` word's range, whether it can saturate, and a bound on
+    ``|L_firmware - L_float|`` per leg (interval branch and bound, memory bounded); optionally the
+    ``sd_tick`` words too.
+
+    Args:
+        platform: a preset name, a platform file or a ``Platform``.
+        box: pose box words ``KEY=LO..HI`` (KEY one of px py pz a b g, in ``length_unit``/``angle_unit``);
+            keys not given keep the workspace box's range (None: the workspace box).
+        length_unit: unit of px py pz in ``box``.
+        angle_unit: unit of a b g in ``box`` (``"pi"``: fractions of π).
+        max_cells: branch-and-bound budget, cells evaluated (default 200000).
+        implementation: ``"generated"`` (the ``sd_ik`` of ``generate`` in this format) or ``"tp17"`` (the
+            seed's DSP firmware; platform ``utn-kinematic``).
+        tick: also certify ``sd_tick``'s words for the bounds below.
+        tick_error: bound on ``|set-point - measured|``, m.
+        tick_speed: bound on the legs' speed, m/s.
+        tick_feedforward: bound on ``|feed-forward|``, N.
+        word_bits: data word width, 8..16.
+        length_lsb: metres per length LSB.
+        trig: the trigonometry (``"tfr16"`` needs 16-bit words).
+        convention: Euler convention of the pose angles.
+        rate: controller rate, Hz.
+        sensor_resolution: leg sensor, m per count.
+        trajectory: design the gains over this reference's poses (default: home only).
+
+    Returns:
+        The certificate; ``saturation_possible`` says whether a word may saturate.
+
+    Raises:
+        StewartError: a bad box, budget or format; ``tp17`` on another platform.
+    """
+    p = load_platform(platform)
+    config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    pose_box = parse_box(box, p, length_unit, angle_unit)
+    fmt = config.ik_format
+    if implementation == "tp17":
+        if p.name != "utn-kinematic":
+            raise CertifyError(CertifyError.IMPLEMENTATION.format(value=_shown(platform)))
+        fmt = QFormat(16, 1e-3, "tfr16")
+    cells = MAX_CELLS if max_cells is None else max_cells
+    cert = certify_ik(p, fmt, pose_box, config.convention, cells, length_unit, angle_unit, implementation)
+    ticked = _certify_tick(config, tick_error, tick_speed, tick_feedforward) if tick else None
+    return CertifyResult(cert, ticked)
+
+
+def _certify_tick(config: ControllerConfig, error: float, speed: float, feedforward: float) -> TickCertificate:
+    """The tick certificate after the bounds' checks (the message shows ``--tick-error`` in mm, the option's
+    unit)."""
+    for opt, v, shown in (
+        ("--tick-error", error, error * 1e3),
+        ("--tick-speed", speed, speed),
+        ("--tick-feedforward", feedforward, feedforward),
+    ):
+        if not (math.isfinite(v) and v >= 0):
+            raise OptionError(OptionError.AT_LEAST.format(option=opt, min=0, value=f"{shown:g}"))
+    return certify_tick_words(config, error, speed, feedforward)
+
+
+def certify_tick(
+    platform: str | Path | Platform,
+    *,
+    tick_error: float = 5e-3,
+    tick_speed: float = 0.1,
+    tick_feedforward: float = 0.0,
+    word_bits: int = 16,
+    length_lsb: float = 1e-3,
+    trig: str = "tfr16",
+    convention: str = "utn",
+    rate: float = 1000.0,
+    sensor_resolution: float = 1e-5,
+    trajectory: str | Trajectory | None = None,
+) -> TickResult:
+    """Prove the ranges of ``sd_tick``'s PID words (and whether the anti-windup keeps the integrator inside its
+    rails) for stated bounds on the error, the legs' speed and the feed-forward.
+
+    Args:
+        platform: a preset name, a platform file or a ``Platform``.
+        tick_error: bound on ``|set-point - measured|``, m.
+        tick_speed: bound on the legs' speed, m/s.
+        tick_feedforward: bound on ``|feed-forward|``, N.
+        word_bits: data word width, 8..16.
+        length_lsb: metres per length LSB.
+        trig: the trigonometry.
+        convention: Euler convention.
+        rate: controller rate, Hz.
+        sensor_resolution: leg sensor, m per count.
+        trajectory: design the gains over this reference's poses (default: home only).
+
+    Returns:
+        The tick's certificate.
+
+    Raises:
+        StewartError: a negative or non-finite bound, a bad format.
+    """
+    p = load_platform(platform)
+    config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    return TickResult(_certify_tick(config, tick_error, tick_speed, tick_feedforward))
+
+
+def optimize(
+    platform: str | Path | Platform,
+    *,
+    error_budget: str | float,
+    objective: str = "bits",
+    out: str | Path | None = None,
+    box: Sequence[str] | None = None,
+    length_unit: str = "mm",
+    angle_unit: str = "pi",
+    max_cells: int | None = None,
+    word_bits: int = 16,
+    length_lsb: float = 1e-3,
+    trig: str = "tfr16",
+    convention: str = "utn",
+    rate: float = 1000.0,
+    sensor_resolution: float = 1e-5,
+    trajectory: str | Trajectory | None = None,
+) -> OptimizeResult:
+    """Choose the length LSB, word bits and trigonometry so that the proven ``sd_ik`` error meets a budget
+    without saturation over a pose box (``objective``: fewest bits or fewest cycles), and generate that
+    firmware; compared with the default format and with a simulation-only choice.
+
+    Args:
+        platform: a preset name, a platform file or a ``Platform``.
+        error_budget: the bound to meet: metres, or text such as ``"0.5mm"``, ``"500um"``.
+        objective: ``"bits"`` or ``"cycles"``.
+        out: write the chosen firmware (``sd_firmware.h``/``.c``, README) into this folder.
+        box: pose box words as for ``certify`` (None: the workspace box).
+        length_unit: unit of px py pz in ``box``.
+        angle_unit: unit of a b g in ``box``.
+        max_cells: the final certificate's budget, cells evaluated (default 200000).
+        word_bits: the default format's word width (the comparison's baseline), and the gains' design.
+        length_lsb: the default format's metres per LSB.
+        trig: the default format's trigonometry.
+        convention: Euler convention.
+        rate: controller rate, Hz.
+        sensor_resolution: leg sensor, m per count.
+        trajectory: design the gains over this reference's poses (default: home only).
+
+    Returns:
+        The chosen formats (``chosen`` None when none meets the budget) and the comparison.
+
+    Raises:
+        StewartError: a bad budget, box or format, or an output folder that holds other files.
+    """
+    budget = parse_budget(error_budget)
+    folder = None if out is None else check_out_folder(out)
+    p = load_platform(platform)
+    config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    pose_box = parse_box(box, p, length_unit, angle_unit)
+    res = choose_formats(p, config, pose_box, budget, objective, MAX_CELLS if max_cells is None else max_cells)
+    written = None
+    if folder is not None and res.chosen is not None:
+        with atomic_folder(folder) as tmp:
+            res.firmware.write(tmp)
+        written = folder
+    return OptimizeResult(res, written)

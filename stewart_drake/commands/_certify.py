@@ -4,12 +4,9 @@ by that proof."""
 
 from __future__ import annotations
 
-import math
-
+from stewart_drake.api import firmware
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
-from stewart_drake.errors import CertifyError, OptionError
-from stewart_drake.fixedpoint.generic import QFormat
 
 
 def add_box_args(p) -> None:
@@ -39,10 +36,9 @@ def add_box_args(p) -> None:
     )
 
 
-def register(fs, format_args, make_config, check_out) -> None:
+def register(fs, format_args, format_kwargs) -> None:
     """Add ``certify`` and ``optimize`` to the ``firmware`` subparsers ``fs``; ``format_args`` adds
-    generate's format options, ``make_config(args, platform)`` turns them into a ``ControllerConfig``,
-    ``check_out(path)`` vets an output folder for generated firmware."""
+    generate's format options, ``format_kwargs(args)`` turns them into the API's keywords."""
     c = fs.add_parser(
         "certify",
         help="prove every sd_ik word's range, saturation and a bound on |L_firmware - L_float| over a pose box",
@@ -65,7 +61,7 @@ def register(fs, format_args, make_config, check_out) -> None:
     c.add_argument("--tick-speed", type=float, default=0.1, metavar="M/S", help="leg speed bound, m/s (0.1)")
     c.add_argument("--tick-feedforward", type=float, default=0.0, metavar="N", help="|feed-forward| bound, N (0: none)")
     c.add_argument("--json", action="store_true", help="print JSON")
-    c.set_defaults(func=run_certify, make_config=make_config)
+    c.set_defaults(func=run_certify, format_kwargs=format_kwargs)
     o = fs.add_parser(
         "optimize",
         help="choose the length LSB, word bits and trig so the proven error meets a budget without saturation",
@@ -76,57 +72,37 @@ def register(fs, format_args, make_config, check_out) -> None:
     o.add_argument("--objective", choices=["bits", "cycles"], default="bits", help="minimise word bits or sd_ik cycles")
     o.add_argument("--out", default=None, metavar="DIR", help="write the chosen firmware (sd_firmware.h/.c, README)")
     o.add_argument("--json", action="store_true", help="print JSON")
-    o.set_defaults(func=run_optimize, make_config=make_config, check_out=check_out)
+    o.set_defaults(func=run_optimize, format_kwargs=format_kwargs)
 
 
-def _box(args, platform):
-    from stewart_drake.firmware.certify.box import parse_box
-
-    return parse_box(args.box, platform, args.length_unit, args.angle_unit)
-
-
-def _max_cells(args) -> int:
-    from stewart_drake.firmware.certify.search import MAX_CELLS
-
-    return MAX_CELLS if args.max_cells is None else args.max_cells
+def _common(args) -> dict:
+    """The keywords ``certify`` and ``optimize`` share: the format options, the box and its units, the budget."""
+    return dict(
+        args.format_kwargs(args),
+        box=args.box,
+        length_unit=args.length_unit,
+        angle_unit=args.angle_unit,
+        max_cells=args.max_cells,
+    )
 
 
 def run_certify(args) -> int:
-    from stewart_drake.core.geometry import load_platform
-    from stewart_drake.firmware.certify.certificate import certify
-    from stewart_drake.firmware.certify.tick import certify_tick
-
-    platform = load_platform(args.platform)
-    config = args.make_config(args, platform)
-    box = _box(args, platform)
-    fmt = config.ik_format
-    if args.implementation == "tp17":
-        if platform.name != "utn-kinematic":
-            raise CertifyError(CertifyError.IMPLEMENTATION.format(value=args.platform))
-        fmt = QFormat(16, 1e-3, "tfr16")
-    cert = certify(
-        platform, fmt, box, config.convention, _max_cells(args), args.length_unit, args.angle_unit, args.implementation
+    r = firmware.certify(
+        args.platform,
+        implementation=args.implementation,
+        tick=args.tick,
+        tick_error=args.tick_error * 1e-3,
+        tick_speed=args.tick_speed,
+        tick_feedforward=args.tick_feedforward,
+        **_common(args),
     )
-    tick = None
-    if args.tick:
-        for opt, v in (
-            ("--tick-error", args.tick_error),
-            ("--tick-speed", args.tick_speed),
-            ("--tick-feedforward", args.tick_feedforward),
-        ):
-            if not (math.isfinite(v) and v >= 0):
-                raise OptionError(OptionError.AT_LEAST.format(option=opt, min=0, value=v))
-        tick = certify_tick(config, args.tick_error * 1e-3, args.tick_speed, args.tick_feedforward)
     if args.json:
-        d = cert.to_dict()
-        if tick is not None:
-            d["tick"] = tick.to_dict()
-        print_json(d)
+        print_json(r.to_dict())
     else:
-        print(format_certificate(cert))
-        if tick is not None:
-            print(format_tick(tick))
-    return 1 if cert.saturation_possible else 0
+        print(format_certificate(r.certificate))
+        if r.tick is not None:
+            print(format_tick(r.tick))
+    return 1 if r.saturation_possible else 0
 
 
 def format_tick(tick) -> str:
@@ -186,21 +162,11 @@ def format_certificate(cert) -> str:
 
 
 def run_optimize(args) -> int:
-    from stewart_drake.core.geometry import load_platform
-    from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.firmware.certify.optimize import optimize, parse_budget
-
-    budget = parse_budget(args.error_budget)
-    out = None if args.out is None else args.check_out(args.out)
-    platform = load_platform(args.platform)
-    config = args.make_config(args, platform)
-    box = _box(args, platform)
-    res = optimize(platform, config, box, budget, args.objective, _max_cells(args))
-    if out is not None and res.chosen is not None:
-        with atomic_folder(out) as tmp:
-            res.firmware.write(tmp)
+    r = firmware.optimize(
+        args.platform, error_budget=args.error_budget, objective=args.objective, out=args.out, **_common(args)
+    )
     if args.json:
-        print_json(res.to_dict())
+        print_json(r.to_dict())
     else:
-        print(res.summary())
-    return 0 if res.chosen is not None else 1
+        print(r.summary())
+    return 0 if r.chosen is not None else 1

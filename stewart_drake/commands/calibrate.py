@@ -3,26 +3,17 @@ platform file, the full result and its plots."""
 
 from __future__ import annotations
 
-import datetime
-
-import numpy as np
-
-from stewart_drake.calibration.identify import CalibrationResult, identify, min_poses
-from stewart_drake.calibration.measurements import TYPES, read_measurements
-from stewart_drake.calibration.model import Layout
-from stewart_drake.calibration.noise import parse_noise
-from stewart_drake.calibration.validate import validation_errors
+from stewart_drake.api.calibration import calibrate
+from stewart_drake.calibration.identify import CalibrationResult
+from stewart_drake.calibration.measurements import TYPES
 from stewart_drake.commands._common import (
     add_force_arg,
     output_folder,
-    platform_from_args,
     print_json,
 )
-from stewart_drake.core.geometry import CalibrationRecord
 from stewart_drake.core.jsonout import dumps_strict
-from stewart_drake.core.platform_file import platform_yaml
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
-from stewart_drake.errors import CalibrationError, CalibrationLimitError
+from stewart_drake.errors import CalibrationLimitError
 
 HELP = "identify a built platform's geometry from measured poses; write a calibrated platform file"
 
@@ -64,87 +55,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _split(args, data, layout: Layout):
-    """``(fit, validation or None)`` from --holdout / --validate."""
-    need = min_poses(layout)
-    if args.validate is not None:
-        platform = layout.nominal
-        val = read_measurements(args.validate, platform, data.kind, args.length_unit, args.angle_unit)
-        if val.n_targets != data.n_targets:
-            raise CalibrationError(
-                CalibrationError.VALIDATE_TARGETS.format(
-                    path=args.validate, got=val.n_targets, fit=args.measurements, want=data.n_targets
-                )
-            )
-        return data, val
-    if args.holdout is None:
-        return data, None
-    if not 0 < args.holdout <= 0.5:
-        raise CalibrationError(CalibrationError.HOLDOUT.format(value=args.holdout))
-    n = len(data)
-    held = max(1, int(round(args.holdout * n)))
-    if n - held < need:
-        raise CalibrationError(
-            CalibrationError.HOLDOUT_TOO_FEW.format(value=args.holdout, held=held, n=n, left=n - held, need=need)
-        )
-    order = np.random.default_rng(args.seed).permutation(n)
-    return data.subset(np.sort(order[held:])), data.subset(np.sort(order[:held]))
-
-
-def calibrate(args) -> tuple[CalibrationResult, dict]:
-    """Read, check, identify and validate as the options say; returns the result and its JSON dict."""
-    platform = platform_from_args(args)
-    noise = parse_noise(args.noise)
-    data = read_measurements(args.measurements, platform, args.type, args.length_unit, args.angle_unit)
-    layout = Layout(platform, data.kind, data.n_targets, args.gains)
-    fit, val = _split(args, data, layout)
-    need = min_poses(layout)
-    if len(fit) < need:
-        per = layout.rows()
-        raise CalibrationError(
-            CalibrationError.TOO_FEW.format(
-                path=args.measurements,
-                n=len(fit),
-                equations=len(fit) * per,
-                unknowns=layout.size + len(fit) * layout.nuisance,
-                parameters=layout.size,
-                nuisance=f" + {layout.nuisance} per pose" if layout.nuisance else "",
-                need=need,
-            )
-        )
-    result = identify(platform, fit, noise, args.convention, args.gains)
-    if val is not None:
-        targets0 = layout.split(result.theta0)[3]
-        result.validation = {
-            "poses": len(val),
-            "lines": val.lines.tolist() if args.validate is None else None,
-            "source": val.source,
-            "nominal": validation_errors(platform, targets0, val, args.convention),
-            "calibrated": validation_errors(result.calibrated, result.targets, val, args.convention),
-        }
-    return result, result.to_dict()
-
-
-def record(result: CalibrationResult) -> CalibrationRecord:
-    """The ``calibration:`` block of the calibrated platform file."""
-    unit = {"pose": ("leg_length", "m"), "points": ("target", "m"), "inclinometer": ("tilt", "rad")}[result.layout.kind]
-    v = result.validation
-    vkey = "position" if result.layout.kind == "pose" else unit[0]
-    return CalibrationRecord(
-        source=result.source,
-        sha256=result.sha256,
-        date=datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        measurement_type=result.layout.kind,
-        poses=len(result.lines),
-        residual_rms_before=result.fit_before[unit[0]]["rms"],
-        residual_rms_after=result.fit_after[unit[0]]["rms"],
-        residual_unit=unit[1],
-        validation_rms_m=v["calibrated"][vkey]["rms"] if v and unit[1] == "m" else None,
-        parameters=list(result.layout.names),
-        sigma=[float(s * k) for s, k in zip(result.sigma, result.layout.scales())],
-    )
-
-
 def _summary(d: dict, result: CalibrationResult) -> str:
     ident = d["identifiability"]
     out = [
@@ -183,17 +93,25 @@ def _fmt(s: dict, key: str = "rms") -> str:
 
 def run(args) -> int:
     out = output_folder(args)
-    result, d = calibrate(args)
-    if not result.converged:
+    cal = calibrate(
+        args.platform,
+        args.measurements,
+        type=args.type,
+        length_unit=args.length_unit,
+        angle_unit=args.angle_unit,
+        holdout=args.holdout,
+        validate=args.validate,
+        seed=args.seed,
+        gains=args.gains,
+        noise=args.noise,
+        convention=args.convention,
+    )
+    result, d = cal.identified, cal.to_dict()
+    if not cal.converged:
         print_json(d) if args.json else print(_summary(d, result))
         raise CalibrationLimitError(CalibrationLimitError.NOT_CONVERGED.format(reason=result.message))
-    rec = record(result)
-    header = (
-        f"{result.calibrated.name}: calibrated by stewart-drake calibrate from {result.source} "
-        f"({d['poses']} {d['measurement_type']} poses), nominal {result.nominal.name}."
-    )
     with out.writing() as tmp:
-        (tmp / "calibrated.yaml").write_text(platform_yaml(result.calibrated, rec, header), encoding="utf-8")
+        (tmp / "calibrated.yaml").write_text(cal.platform_yaml(), encoding="utf-8")
         (tmp / "calibration.json").write_text(dumps_strict(d) + "\n", encoding="utf-8")
         if not args.no_plots:
             import matplotlib  # noqa: PLC0415 -- deferred: plotting only when asked, and Agg chosen first

@@ -107,7 +107,7 @@ def register(sub) -> None:
     )
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_check)
-    register_certify(fs, _format_args, _config, firmware.check_out_folder)
+    register_certify(fs, _format_args, _format)
 
 
 def _format(args) -> dict:
@@ -121,11 +121,6 @@ def _format(args) -> dict:
         sensor_resolution=args.sensor_resolution,
         trajectory=args.trajectory,
     )
-
-
-def _config(args, platform):
-    """The controller configuration (number format, timing, gains) the format options give."""
-    return firmware.controller_config(platform, **_format(args))
 
 
 def run_generate(args) -> int:

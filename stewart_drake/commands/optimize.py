@@ -2,17 +2,14 @@
 
 from __future__ import annotations
 
-import os
 import sys
 
 from stewart_drake.commands._common import add_force_arg, output_folder, print_json
-from stewart_drake.core.sanity import check_work
-from stewart_drake.errors import OptionError
+from stewart_drake.synthesis.api import optimize
 from stewart_drake.synthesis.outputs import write_outputs
 from stewart_drake.synthesis.proof import MAX_CELLS
-from stewart_drake.synthesis.requirements import OBJECTIVES, load_requirements
+from stewart_drake.synthesis.requirements import OBJECTIVES
 from stewart_drake.synthesis.search import CACHE, DEFAULT_POP
-from stewart_drake.synthesis.synthesize import synthesize
 
 HELP = "design synthesis: the geometry with the smallest actuators that meets a requirements file, proven"
 
@@ -70,31 +67,19 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = output_folder(args)
-    req = load_requirements(args.requirements)
-    if args.workers is not None and args.workers < 0:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=args.workers))
-    if args.workers:
-        check_work(
-            "--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1)
-        )
-    if args.pop_size < 2:
-        raise OptionError(OptionError.AT_LEAST.format(option="--pop-size", min=2, value=args.pop_size))
-    if not 1 <= args.max_cells <= 10_000_000:
-        raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=10_000_000, value=args.max_cells))
-    if args.seed < 0:
-        raise OptionError(OptionError.AT_LEAST.format(option="--seed", min=0, value=args.seed))
-    result = synthesize(
-        req,
-        out.path,
-        args.budget,
-        args.seed,
-        args.workers or 0,
-        args.scheduler,
-        args.pick,
-        progress=not args.no_progress and sys.stderr.isatty(),
-        max_cells=args.max_cells,
+    r = optimize(
+        args.requirements,
+        budget=args.budget,
+        seed=args.seed,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        pick=args.pick,
         pop_size=args.pop_size,
+        max_cells=args.max_cells,
+        cache=out.path,
+        progress=not args.no_progress and sys.stderr.isatty(),
     )
+    result = r.synthesis
     with out.writing() as tmp:
         write_outputs(result, tmp, args.requirements, cache_from=out.path / CACHE)
     if args.json:

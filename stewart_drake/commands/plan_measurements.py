@@ -3,26 +3,18 @@ random poses of the same count; written as a CSV and as a motion program (.stw) 
 
 from __future__ import annotations
 
-import numpy as np
-
-from stewart_drake.calibration.identify import min_poses
+from stewart_drake.api.calibration import plan_measurements, poses_csv
 from stewart_drake.calibration.measurements import TYPES
-from stewart_drake.calibration.model import Layout
-from stewart_drake.calibration.noise import parse_noise
-from stewart_drake.calibration.plan import MAX_POSES, Box, plan_measurements, stw_program
 from stewart_drake.commands._common import (
     add_force_arg,
     add_platform_arg,
     output_folder,
-    platform_from_args,
     print_json,
 )
 from stewart_drake.core.jsonout import dumps_strict
-from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS, angle_scale, length_scale
-from stewart_drake.errors import CalibrationError
+from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 
 HELP = "plan calibration poses (D-optimal) inside a workspace box; CSV and a .stw program that visits them"
-MAX_CANDIDATES = 20_000
 
 
 def register(sub) -> None:
@@ -52,68 +44,33 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def poses_csv(poses) -> str:
-    """``px,py,pz,a,b,g`` rows in m and rad (what simulate-measurements --poses and ik --poses read)."""
-    return "px,py,pz,a,b,g\n" + "".join(",".join(repr(float(v)) for v in q) + "\n" for q in np.asarray(poses))
-
-
 def run(args) -> int:
     out = output_folder(args)
-    platform = platform_from_args(args)
-    if not 1 <= args.poses <= MAX_POSES:
-        raise CalibrationError(CalibrationError.POSES.format(value=args.poses, lo=1, hi=MAX_POSES))
-    if not 1 <= args.candidates <= MAX_CANDIDATES or args.candidates < 2 * args.poses:
-        raise CalibrationError(
-            CalibrationError.CANDIDATE_COUNT.format(value=args.candidates, lo=max(2 * args.poses, 1), hi=MAX_CANDIDATES)
-        )
-    if not 1 <= args.targets <= 8:
-        raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=args.targets))
-    layout = Layout(platform, args.type, args.targets if args.type == "points" else 0, args.gains)
-    if args.poses < min_poses(layout):
-        raise CalibrationError(
-            CalibrationError.PLAN_TOO_FEW.format(
-                value=args.poses,
-                kind=args.type,
-                need=min_poses(layout),
-                name=platform.name,
-                unknowns=f"{layout.size} + {layout.nuisance} per pose" if layout.nuisance else layout.size,
-                per=layout.rows(),
-            )
-        )
-    box = None
-    if args.workspace is not None:
-        x, y, z, rot = args.workspace
-        if not all(v > 0 for v in args.workspace):
-            raise CalibrationError(
-                CalibrationError.WORKSPACE.format(
-                    value=" ".join(str(v) for v in args.workspace), unit=args.length_unit, angle=args.angle_unit
-                )
-            )
-        k, a = length_scale(args.length_unit), angle_scale(args.angle_unit)
-        box = Box(x * k, y * k, z * k, rot * a)
     plan = plan_measurements(
-        platform,
+        args.platform,
         args.poses,
-        args.type,
-        box,
-        parse_noise(args.noise),
-        args.seed,
-        args.convention,
-        args.candidates,
-        args.targets,
-        args.gains,
+        type=args.type,
+        workspace=args.workspace,
+        noise=args.noise,
+        targets=args.targets,
+        gains=args.gains,
+        candidates=args.candidates,
+        seed=args.seed,
+        length_unit=args.length_unit,
+        angle_unit=args.angle_unit,
+        convention=args.convention,
     )
     d = plan.to_dict()
     with out.writing() as tmp:
         (tmp / "poses.csv").write_text(poses_csv(plan.poses), encoding="utf-8")
         (tmp / "random.csv").write_text(poses_csv(plan.random), encoding="utf-8")
-        (tmp / "plan.stw").write_text(stw_program(plan.poses, platform.name), encoding="utf-8")
+        (tmp / "plan.stw").write_text(plan.program(), encoding="utf-8")
         (tmp / "plan.json").write_text(dumps_strict(d) + "\n", encoding="utf-8")
     if args.json:
         print_json(d)
         return 0
     print(
-        f"platform {platform.name}: {args.poses} {args.type} poses from {d['candidates']} candidates; criterion {d['criterion']}"
+        f"platform {d['platform']}: {args.poses} {args.type} poses from {d['candidates']} candidates; criterion {d['criterion']}"
     )
     for side in ("planned", "random"):
         s = d[side]

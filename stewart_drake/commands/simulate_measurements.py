@@ -4,30 +4,19 @@ apart, for checking a calibration."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from stewart_drake.calibration.measurements import TYPES, measurements_csv
-from stewart_drake.calibration.noise import parse_noise
-from stewart_drake.calibration.simulate import simulate_measurements
 from stewart_drake.commands._common import (
     add_force_arg,
     add_platform_arg,
     output_folder,
-    platform_from_args,
     print_json,
 )
-from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.jsonout import dumps_strict
-from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.platform_file import platform_yaml
-from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS, pose_to_si
-from stewart_drake.core.sanity import check_poses
-from stewart_drake.errors import CalibrationError
-from stewart_drake.montecarlo.spec import parse_spec
+from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
+from stewart_drake.montecarlo.measurements_api import simulate_measurements
 
 HELP = "synthetic calibration measurements of a machine drawn around the nominal (truth written apart)"
-GEOMETRIC_KEYS = ("anchor", "leg_offset")
-MAX_POSES = 10_000
 
 
 def register(sub) -> None:
@@ -61,54 +50,31 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = output_folder(args)
-    platform = platform_from_args(args)
-    spec = parse_spec(args.errors)
-    bad = [k for k in spec.laws if k not in GEOMETRIC_KEYS]
-    if bad:
-        raise CalibrationError(CalibrationError.ERRORS_KEY.format(key=bad[0]))
-    noise = parse_noise(args.noise)
-    if not 1 <= args.targets <= 8:
-        raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=args.targets))
-    raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g")
-    if len(raw) > MAX_POSES:
-        raise CalibrationError(CalibrationError.POSE_COUNT.format(path=args.poses, limit=MAX_POSES))
-    q = pose_to_si(raw, args.length_unit, args.angle_unit)
-    check_poses(platform, q, args.convention, what=f"{args.poses}: pose", lines=lines)
-    L = leg_lengths(platform, q, args.convention)
-    bad = np.argwhere((L < platform.L_min) | (L > platform.L_max))
-    if bad.size:
-        r, leg = bad[0]
-        raise CalibrationError(
-            CalibrationError.POSE_STROKE.format(
-                path=args.poses, line=lines[r], leg=leg + 1, length=L[r, leg], lmin=platform.L_min, lmax=platform.L_max
-            )
-        )
-    data, truth = simulate_measurements(
-        platform, spec.laws, q, args.type, noise, args.seed, args.convention, args.targets
+    sim = simulate_measurements(
+        args.platform,
+        args.poses,
+        errors=args.errors,
+        noise=args.noise,
+        type=args.type,
+        targets=args.targets,
+        seed=args.seed,
+        length_unit=args.length_unit,
+        angle_unit=args.angle_unit,
+        convention=args.convention,
     )
-    info = {
-        "platform": platform.name,
-        "errors": spec.to_dict(),
-        "noise": noise.to_dict(),
-        "seed": args.seed,
-        "measurement_type": args.type,
-        "convention": args.convention,
-        "note": "leg_offset is what each sensor reads beyond the joint-to-joint length (as in montecarlo); "
-        "the true legs.length_offset is the nominal's minus it",
-        **truth.to_dict(),
-    }
+    info, noise = sim.to_dict(), sim.info["noise"]
     with out.writing() as tmp:
-        (tmp / "measurements.csv").write_text(measurements_csv(data), encoding="utf-8")
+        (tmp / "measurements.csv").write_text(measurements_csv(sim.measurements), encoding="utf-8")
         (tmp / "truth").mkdir()
         header = f"The true machine drawn by stewart-drake simulate-measurements (seed {args.seed}): for checking only."
-        (tmp / "truth" / "platform.yaml").write_text(platform_yaml(truth.platform, None, header), encoding="utf-8")
+        (tmp / "truth" / "platform.yaml").write_text(platform_yaml(sim.truth, None, header), encoding="utf-8")
         (tmp / "truth" / "truth.json").write_text(dumps_strict(info) + "\n", encoding="utf-8")
     if args.json:
         print_json(info)
     else:
         print(
-            f"platform {platform.name}: {len(q)} {args.type} measurements of a machine drawn with {' '.join(args.errors)} "
-            f"(seed {args.seed}); noise σ: length {noise.length:g} m, position {noise.position:g} m, angle {noise.angle:g} rad"
+            f"platform {info['platform']}: {len(sim.measurements)} {args.type} measurements of a machine drawn with {' '.join(args.errors)} "
+            f"(seed {args.seed}); noise σ: length {noise['length_m']:g} m, position {noise['position_m']:g} m, angle {noise['angle_rad']:g} rad"
         )
         print(f"wrote {args.out}/measurements.csv (m, rad) and, apart, {args.out}/truth/platform.yaml, truth.json")
     return 0

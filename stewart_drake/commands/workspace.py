@@ -17,12 +17,10 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
-from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from stewart_drake.core.sanity import check_finite
 from stewart_drake.errors import OptionError, SynthesisError
-from stewart_drake.synthesis.proof import prove_requirements_box
+from stewart_drake.synthesis.api import prove_workspace
 from stewart_drake.workspace import AXES, view_figures
 
 BOX_AXES = ("px", "py", "pz", "a", "b", "g")
@@ -198,50 +196,27 @@ def write_outputs(w, result: dict, out) -> None:
 def run_proof(args) -> int:
     """``--prove``: the proof of ``--require-box`` alone (``synthesis.proof``); exit 1 unless proven."""
     reject_unused(args, "the workspace sweep (without --prove)", False, out=None, centre=None, workers=1)
-    names = [n.strip() for n in args.limits.split(",") if n.strip()]
-    other = [n for n in names if n not in ("stroke", "joints", "collision")]
-    if other:
-        raise OptionError(
-            OptionError.UNKNOWN_LIMIT.format(
-                option="--limits (with --prove)", value=other[0], valid="stroke, joints, collision"
-            )
-        )
     if args.require_box is None:
         raise OptionError(SynthesisError.BOX_OPTION_COUNT.format(n=0))
-    platform = platform_from_args(args)
-    box = np.asarray(args.require_box, dtype=float).reshape(6, 2)
-    check_finite(box, "--require-box")
-    for j, (lo, hi) in enumerate(box):
-        if lo > hi:
-            raise OptionError(
-                SynthesisError.BOX_OPTION.format(axis=BOX_AXES[j], lo=lo, hi=hi, problem="low is above high")
-            )
-    if not 1 <= args.max_cells <= 10_000_000:
-        raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=10_000_000, value=args.max_cells))
-    box[3:] = to_radians(box[3:], args.angle_unit)
-    if np.any(np.abs(box[3:]) > np.radians(80.0)):
-        raise OptionError(SynthesisError.BOX_OPTION.format(axis="a/b/g", lo="", hi="", problem="angles beyond 80 deg"))
+    names = [n.strip() for n in args.limits.split(",") if n.strip()]
     reject_unused(args, "--limits ...,joints", "joints" in names, joint_cone=45.0)
     reject_unused(args, "--limits ...,collision", "collision" in names, leg_diameter=None)
-    cone = float(to_radians(args.joint_cone, args.angle_unit)) if "joints" in names else None
-    diameter = None
-    if "collision" in names:
-        diameter = (
-            args.leg_diameter if args.leg_diameter is not None else 2 * leg_dimensions(platform)["cylinder_radius"]
-        )
-        if not (math.isfinite(diameter) and diameter > 0):
-            raise OptionError(OptionError.POSITIVE.format(option="--leg-diameter", unit="metres", value=diameter))
-    result = prove_requirements_box(
+    box = np.asarray(args.require_box, dtype=float).reshape(6, 2)
+    platform = platform_from_args(args)
+    r = prove_workspace(
         platform,
         box[:, 0],
         box[:, 1],
-        args.convention,
+        limits=args.limits,
+        angle_unit=args.angle_unit,
+        joint_cone=args.joint_cone,
+        leg_diameter=args.leg_diameter,
+        convention=args.convention,
         max_cells=args.max_cells,
-        joint_cone=cone,
-        leg_diameter=diameter,
     )
+    result, cone, diameter = r.proof, r.joint_cone, r.leg_diameter
     if args.json:
-        print_json({"platform": platform.name, "convention": args.convention, **result.to_dict()})
+        print_json(r.to_dict())
     else:
         print(
             f"platform {platform.name}: proof that every pose of the box (relative to home "
