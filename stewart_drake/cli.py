@@ -12,6 +12,7 @@ import sys
 import numpy as np
 
 from stewart_drake import __version__, commands
+from stewart_drake.core import output_folder
 from stewart_drake.errors import StewartError, UsageError
 
 # Every subcommand: its name -> (its module in ``stewart_drake.commands``, the one-line help that
@@ -148,6 +149,8 @@ def main(argv=None) -> int:
     except SystemExit as e:  # --help, --version, or a usage error already printed
         return e.code if isinstance(e.code, int) else 2
     name = args.command + (f" {args.op}" if getattr(args, "op", None) else "")
+    # recorded per file in output manifests: a command replaces only its own outputs
+    output_folder.set_command(" ".join(filter(None, (name, getattr(args, "firmware_command", None)))))
     try:
         # Intermediate overflow/NaN in numpy is not reported as a multi-line RuntimeWarning: every result
         # is checked (finite inputs and outputs, strict JSON, the sanity checks) before it is printed.

@@ -353,6 +353,14 @@ class OutputError(StewartError):
         "{option} {typed!r}: the file exists and was not written by stewart-drake; "
         "remove it or choose another name (it is never overwritten)"
     )
+    MANIFEST_DAMAGED = (
+        "{option} {typed!r}: its manifest {manifest} is damaged ({reason}); nothing there can be verified as "
+        "written by stewart-drake: give a new folder, or remove the manifest yourself"
+    )
+    OTHER_COMMAND = (
+        "{option} {typed!r}: {name!r} was written by `stewart-drake {other}` ({count} file(s)); `{command}` "
+        "replaces only its own files: give another folder, or --force to write beside them"
+    )
 
 
 class YamlError(GeometryError, InputError):
@@ -773,8 +781,6 @@ OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {v
 OPTION_FIRMWARE_TFR16 = (
     "--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {value} (or use --trig exact)"
 )
-OPTION_OUT_NOT_FOLDER = "--out {out}: exists and is not a folder"
-OPTION_OUT_FOREIGN = "--out {out}: holds files this command did not write ({names}); choose another folder"
 OPTION_RUN_RATE = "--rate must be a positive number of samples per second, got {value}"
 OPTION_NEEDS_BRANCHES = "--{option} needs --check-branches"
 OPTION_MAX_ITER = "--max-iter must be >= 1, got {value}"

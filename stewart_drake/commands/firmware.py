@@ -11,10 +11,7 @@ from stewart_drake.errors import (
     OPTION_FIRMWARE_RATE,
     OPTION_FIRMWARE_TFR16,
     OPTION_FIRMWARE_WORD_BITS,
-    OPTION_OUT_FOREIGN,
-    OPTION_OUT_NOT_FOLDER,
     OptionError,
-    OutputError,
     UsageError,
 )
 
@@ -116,19 +113,14 @@ def _config(args, platform):
 def run_generate(args) -> int:
     from stewart_drake.core.c_build import compilers
     from stewart_drake.core.geometry import load_platform
-    from stewart_drake.core.output_folder import atomic_folder
-    from stewart_drake.firmware.generate import FILES, generate
+    from stewart_drake.core.output_folder import OutputFolder, atomic_folder
+    from stewart_drake.firmware.generate import generate
     from stewart_drake.firmware.module import compile_generated
 
     platform = load_platform(args.platform)
     config = _config(args, platform)
     out = Path(args.out)
-    if out.exists():
-        if not out.is_dir():
-            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=args.out))
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
-        if foreign:
-            raise OutputError(OPTION_OUT_FOREIGN.format(out=args.out, names=", ".join(foreign[:3])))
+    folder = OutputFolder(args.out)  # the policy, before any work: new, empty, or this command's own
     g = generate(platform, config)
     compiled = []
     if not args.no_compile:
@@ -140,7 +132,7 @@ def run_generate(args) -> int:
                 "stewart-drake firmware generate: note: no C compiler found; the module was not compile-checked",
                 file=sys.stderr,
             )
-    with atomic_folder(out) as tmp:
+    with atomic_folder(folder) as tmp:
         written = g.write(tmp)
     ik = g.ik_cycles
     summary = {
