@@ -332,6 +332,11 @@ class InputError(StewartError):
     PROGRAM_TOO_LARGE = "{path}: larger than the {limit}-byte limit for a program"
     PROGRAM_NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
     PROGRAM_NUL = "{path}:{line}: a NUL byte; not a program text file"
+    INPUT_MISSING = "{kind} file {path!r} does not exist"
+    INPUT_FOLDER = "{kind} file {path!r} is a folder, not a file"
+    INPUT_UNREADABLE = "{kind} file {path!r}: cannot read it ({reason})"
+    INPUT_TOO_LARGE = "{kind} file {path!r}: larger than the {limit}-byte limit for a {kind} file (read that far)"
+    INPUT_NOT_TEXT = "{path}:{line}: not UTF-8 text (byte {offset}); not a {kind} file?"
 
 
 class OutputError(StewartError):
@@ -367,7 +372,7 @@ class YamlError(GeometryError, InputError):
     """A YAML file is unreadable, too large, too deep, or not in the schema. Messages start with
     ``file:line:`` where known and name the field (``plate.mass``) and the value as written."""
 
-    TOO_LARGE = "{path}: {size} bytes is larger than the {limit}-byte limit for a {kind} file"
+    TOO_LARGE = "{path}: larger than the {limit}-byte limit for a {kind} file"
     SYNTAX = "{path}:{line}: YAML syntax error: {problem}"
     NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
     TOO_DEEP = "{path}:{line}: nesting deeper than {limit} levels"
@@ -398,6 +403,7 @@ class CsvError(InputError):
     IS_FOLDER = "{kind} file {path!r} is a folder, not a file"
     TOO_FEW = "{path}: need at least {need} samples, got {got}"
     TIMES = "{path}: times must increase; sample {k} (t = {t} s) does not follow t = {t_prev} s"
+    LINE_TOO_LONG = "{path}:{line}: a line longer than {limit} bytes; not a {kind} file?"
 
 
 class UsageError(StewartError):
@@ -735,6 +741,7 @@ class SpecError(StewartError):
     MISSING_FILE = "--vary: file {path!r} does not exist"
     NOT_YAML = "{path}:{line}: not YAML ({problem})"
     NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
+    DUPLICATE = "{where}: {key!r} is given twice (first on line {first}); give each key once"
     NOT_SCALAR = "{where}: {key}: the value must be one scalar (e.g. ±0.5mm)"
     SWEEP_VECTOR = "sweep: {key} is a per-component key; sweep scalar keys"
     SWEEP_EMPTY = "sweep: {key} has no values"

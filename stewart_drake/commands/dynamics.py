@@ -14,7 +14,6 @@ from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import (
-    check_file_rows,
     check_finite,
     check_gravity,
     check_trajectory,
@@ -69,8 +68,9 @@ def register(sub) -> None:
 
 def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad"):
     """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (see ``CSV_HELP``). Errors name the line."""
-    check_file_rows(path, "--trajectory", BYTES_PER_SAMPLE + 600, 14)
-    a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
+    a, _ = read_numeric_csv(
+        path, "trajectory", (7, 19), "see --help", option="--trajectory", bytes_per_row=BYTES_PER_SAMPLE + 600
+    )
     width = a.shape[1]
     if len(a) < (2 if width == 19 else 4):
         raise CsvError(CsvError.TOO_FEW.format(path=path, need=2 if width == 19 else 4, got=len(a)))

@@ -9,11 +9,10 @@ from pathlib import Path
 
 from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
-from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import atomic_folder
-from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
+from stewart_drake.core.processes import check_workers
+from stewart_drake.core.trajectory import TRAJECTORIES, read_trajectory_table
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, StewartError, UsageError
@@ -114,8 +113,8 @@ def build_study(args):
     platform = load_platform(args.platform)
     spec = parse_spec(args.vary)
     program = (args.program, read_program(args.program)) if args.program else None
-    if args.workers is not None and args.workers < 0:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=args.workers))
+    if args.workers is not None:
+        check_workers("--workers", args.workers, minimum=0)  # the one rule for worker counts (core.processes)
     if args.engine == "c" and args.controller != "fixed":
         raise UsageError(UsageError.ENGINE_C.format(controller=args.controller))
     engine = default_engine(args.engine, args.controller, "stewart-drake montecarlo")
@@ -146,10 +145,9 @@ def build_study(args):
 
 def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
     """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
-    (``load_trajectory_csv`` checks it and names a bad line)."""
-    traj = load_trajectory_csv(path, length_unit, angle_unit)
-    data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
-    return (traj.name, data[:, 0].tolist(), pose_to_si(data[:, 1:], length_unit, angle_unit).tolist())
+    (``read_trajectory_table`` checks it and names a bad line; a FIFO works)."""
+    name, ts, poses = read_trajectory_table(path, length_unit, angle_unit)
+    return (name, ts.tolist(), poses.tolist())
 
 
 def run(args) -> int:

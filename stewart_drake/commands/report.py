@@ -8,7 +8,7 @@ import time
 
 from stewart_drake.commands._common import add_force_arg, output_folder
 from stewart_drake.core.geometry import PRESETS
-from stewart_drake.errors import OptionError
+from stewart_drake.core.processes import check_workers
 from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
 
 
@@ -31,8 +31,7 @@ def register(sub) -> None:
 def run(args) -> int:
     out = output_folder(args)
     jobs = args.jobs if args.jobs is not None else min(4, os.cpu_count() or 1)
-    if not 1 <= jobs <= 64:
-        raise OptionError(OptionError.BETWEEN.format(option="--jobs", lo=1, hi=64, value=jobs))
+    check_workers("--jobs", jobs)  # the one rule for worker counts (core.processes)
     t0 = time.perf_counter()
     analyses = discover_analyses(only=args.only)
     print(f"running {len(analyses)} analyses in {jobs} process{'es' if jobs > 1 else ''}", file=sys.stderr, flush=True)

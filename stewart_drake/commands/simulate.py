@@ -17,7 +17,6 @@ from stewart_drake.commands._common import (
     reject_unused,
 )
 from stewart_drake.core.sanity import (
-    check_file_rows,
     check_positive,
     check_trajectory,
     check_work,
@@ -177,8 +176,6 @@ def run(args) -> int:
     plant_step = args.plant_step if args.plant_step is not None else min(period, 1e-3)
     if args.duration is not None:
         check_positive(args.duration, "--duration", "seconds")
-    if args.trajectory not in ("seed", "rotating"):
-        check_file_rows(args.trajectory, "--trajectory", 700, 14)
     traj = get_trajectory(args.trajectory, length_unit=args.length_unit, angle_unit=args.angle_unit)
     if args.fit:
         traj = fit_trajectory(traj, platform)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import os
 import sys
 
 import numpy as np
@@ -20,8 +19,9 @@ from stewart_drake.commands._common import (
 )
 from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.processes import check_workers
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
-from stewart_drake.core.sanity import check_centre, check_finite, check_work
+from stewart_drake.core.sanity import check_centre, check_finite
 from stewart_drake.errors import OptionError
 from stewart_drake.workspace import Limits, view_figures
 
@@ -131,12 +131,7 @@ def run(args) -> int:
     if args.centre is not None:
         check_centre(platform, args.centre)
     check_finite(args.orientation, "--orientation")
-    # each worker is a Python process with numpy (~150 MB); more than 4 per CPU only adds overhead
-    check_work(
-        "--workers", str(args.workers), args.workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1)
-    )
-    if args.workers < 1:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=1, value=args.workers))
+    check_workers("--workers", args.workers)  # the one rule for worker counts (core.processes)
     orientation = to_radians(args.orientation, args.angle_unit)
     cone = float(to_radians(args.joint_cone, args.angle_unit))
     limits = parse_limits(args.limits, platform, cone, args.leg_diameter, args.max_condition)

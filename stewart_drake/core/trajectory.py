@@ -111,17 +111,30 @@ def _fitted_pose(trajectory: Trajectory, home, s: float, centre, t):
     return q
 
 
-def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
-    """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line."""
-    data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
+# bytes a command holds per trajectory sample beyond the CSV row (the Drake run's logs and plots)
+BYTES_PER_SAMPLE = 700.0
+
+
+def read_trajectory_table(
+    path, length_unit: str = "m", angle_unit: str = "rad", *, option: str = "--trajectory"
+) -> tuple[str, np.ndarray, np.ndarray]:
+    """``(name, times (n,) s, poses (n, 6) SI)`` of a ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row
+    optional; times strictly increasing, seconds), read once as a stream (``csvio``). Errors name the line."""
+    data, lines = read_numeric_csv(
+        path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z", option=option, bytes_per_row=BYTES_PER_SAMPLE
+    )
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
         k = late[0] + 1
         raise TrajectoryError(
             TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0])
         )
-    return table_trajectory(Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit))
+    return Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+
+
+def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad") -> Trajectory:
+    """A trajectory CSV (``read_trajectory_table``) as a piecewise-linear Trajectory (``table_trajectory``)."""
+    return table_trajectory(*read_trajectory_table(path, length_unit, angle_unit))
 
 
 def table_trajectory(name: str, ts, poses) -> Trajectory:

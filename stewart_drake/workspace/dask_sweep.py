@@ -46,6 +46,7 @@ import distributed
 import numpy as np
 
 import stewart_drake.workspace as _ws
+from stewart_drake.core.processes import quiet_resource_tracker
 from stewart_drake.workspace.grid import grid_axes
 
 # Dask settings for the workers of ``local_client`` (see the module docstring): no statistical profiler,
@@ -53,6 +54,8 @@ from stewart_drake.workspace.grid import grid_axes
 WORKER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.nanny.pre-spawn-environ": {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
+    # each worker dies with this process (even by SIGKILL) and leaves Ctrl-C to it (core.processes)
+    "distributed.worker.preload": ["stewart_drake.core.processes"],
 }
 # At least this many tasks per worker thread (load balance: the last wave of tasks is a small share).
 TASKS_PER_WORKER = 8
@@ -78,6 +81,7 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
     reach the root's handler instead."""
     distributed_logger = logging.getLogger("distributed")
     distributed_logger.setLevel(max(distributed_logger.getEffectiveLevel(), logging.WARNING))
+    quiet_resource_tracker()
     held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
     try:
         with dask.config.set(WORKER_CONFIG):

@@ -393,8 +393,7 @@ def test_yaml_size_limit(here, capsys):
     rc, _, err = cli(capsys, "fk", "--platform", "big.yaml", "--lengths", *["700"] * 6)
     assert (
         rc == 2
-        and err.strip()
-        == "stewart-drake fk: error: big.yaml: 1000001 bytes is larger than the 1000000-byte limit for a platform file"
+        and err.strip() == "stewart-drake fk: error: big.yaml: larger than the 1000000-byte limit for a platform file"
     )
 
 
