@@ -43,9 +43,9 @@ def check_workers(option: str, value: int, minimum: int = 1) -> int:
     """``value`` if it is a number of worker processes this machine can hold (``minimum`` ..
     ``max_workers()``, and their memory within the budget); else ``OptionError``/``WorkTooLargeError``
     naming ``option`` and the value."""
-    if value < minimum:
-        raise OptionError(OptionError.AT_LEAST.format(option=option, min=minimum, value=value))
-    check_work(option, str(value), value, "worker processes", BYTES_PER_WORKER, max_count=max_workers())
+    if not minimum <= value <= max_workers():
+        raise OptionError(OptionError.BETWEEN.format(option=option, lo=minimum, hi=max_workers(), value=value))
+    check_work(option, str(value), value, "worker processes", BYTES_PER_WORKER)
     return value
 
 
