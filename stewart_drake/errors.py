@@ -777,6 +777,7 @@ class StudyError(StewartError):
     OUT_NOT_OURS = (
         "--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to overwrite it"
     )
+    OUT_DAMAGED = "{path}: damaged ({reason}); not a study stewart-drake wrote: remove it or choose another --out"
     OUT_OTHER_PARTIAL = (
         "--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose another folder"
     )

@@ -10,7 +10,7 @@ from pathlib import Path
 from stewart_drake.commands._common import add_platform_arg, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import check_workers
 from stewart_drake.core.trajectory import TRAJECTORIES, read_trajectory_table
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
@@ -30,6 +30,8 @@ from stewart_drake.montecarlo.study import (
 from stewart_drake.montecarlo.summary import read_table, summarise, write_outputs
 from stewart_drake.script import ScriptError
 from stewart_drake.script.source import read_program
+
+REPLAY_COMMAND = "montecarlo --replay"  # a replay's files are recorded under "montecarlo --replay K"
 
 
 def register(sub) -> None:
@@ -160,9 +162,11 @@ def run(args) -> int:
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
         return 2
+    # --out checked before any run: new, empty, or this study's own (its replays kept beside it)
+    folder = OutputFolder(args.out, companions=(f"{REPLAY_COMMAND}",))
     rows = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
     summary = summarise(rows, study_settings(study), study_key(study))
-    summary["files"] = [str(p) for p in write_outputs(args.out, rows, summary)]
+    summary["files"] = [str(p) for p in write_outputs(folder, rows, summary)]
     if args.json:
         print_json(summary)
     else:
@@ -206,6 +210,9 @@ def replay(args) -> int:
     if not 0 <= args.replay < len(rows):
         raise OptionError(OptionError.NO_RUN.format(run=args.replay, out=str(out), last=len(rows) - 1))
     _check_replay_options(args, study, settings)
+    # written into the study's folder as this replay's own files (replay-K/), beside the study's and any
+    # others (force: never touched, a name clash refused); checked before the run
+    study_folder = OutputFolder(out, command=f"{REPLAY_COMMAND} {args.replay}", force=True)
     # the C engine without a compiler here: Python, with the note (bit-identical, so the check still holds)
     study = dataclasses.replace(study, engine=resolve_engine(study.engine, "stewart-drake montecarlo"))
     row = run_scenario(study, args.replay, keep_log=True)
@@ -214,7 +221,9 @@ def replay(args) -> int:
     differ = [k for k in want if k != "wall_s" and not _same(want[k], row.get(k))]
     folder = out / f"replay-{args.replay}"
     result = {"run": args.replay, "bit_identical": not differ, "differing_columns": differ, "row": row}
-    with atomic_folder(folder) as tmp:
+    with atomic_folder(study_folder) as top:
+        tmp = top / folder.name
+        tmp.mkdir()
         files = []
         if log is not None:
             ref = study.reference()

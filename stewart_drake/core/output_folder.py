@@ -194,13 +194,15 @@ def _hash_file(path: Path, limit: int | None = None) -> tuple[str, int]:
 
 def _no_link_between(root: Path, rel: str) -> bool:
     """True when no component of ``root/rel`` below ``root`` is a symbolic link and every folder on the
-    way is a real folder."""
+    way is a real folder (or does not exist yet: then nothing lies beyond it)."""
     p = root
     for part in Path(rel).parts[:-1]:
         p = p / part
         try:
             if not stat.S_ISDIR(os.lstat(p).st_mode):
                 return False
+        except FileNotFoundError:
+            return True
         except OSError:
             return False
     return True
