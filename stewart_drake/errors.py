@@ -688,6 +688,20 @@ class SimulationError(StewartError):
     PORT = "--port {port}: Meshcat could not listen there ({reason})"
 
 
+class IsolationError(StewartError):
+    """User code run in a child process (``core.isolate``) failed: it hung, ended the process, or crashed."""
+
+    HUNG = (
+        "{path}: the firmware did not return within {limit:g} s (an endless loop in sd_ik, sd_tick or a "
+        "constructor?); stopped"
+    )
+    EXITED = (
+        "{path}: the firmware ended the process (exit status {code}) instead of returning; a firmware must "
+        "not call exit() (in sd_ik, sd_tick or a constructor)"
+    )
+    CRASHED = "{path}: the firmware crashed ({signal}: e.g. a bad pointer or an array index out of range)"
+
+
 class FirmwareError(StewartError):
     """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
 

@@ -82,8 +82,38 @@ def register(sub) -> None:
     c.add_argument(
         "--compiler", default=None, metavar="NAME", help="gcc, clang, cc or zig (default: the first available)"
     )
+    add_time_limit_arg(c)
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_check)
+
+
+FIRMWARE_TIME_LIMIT_S = 120.0  # the whole check: compile, 100000 poses, 0.5 s closed loop (~10 s here)
+
+
+def add_time_limit_arg(p, default: float = FIRMWARE_TIME_LIMIT_S, what: str = "the check") -> None:
+    """``--time-limit S``: how long the user's firmware (compiled and run in a child process) may take."""
+    p.add_argument(
+        "--time-limit",
+        type=float,
+        default=default,
+        metavar="S",
+        help=f"seconds {what} may run the firmware without progress (default {default:g}); the firmware runs in "
+        "a child process: a hang, exit() or crash is one line naming the file",
+    )
+
+
+def _check_in_child(beat, *args) -> dict:
+    """``check_firmware(*args)``, run by ``core.isolate`` in a child process."""
+    from stewart_drake.drake.firmware_check import check_firmware
+
+    return check_firmware(*args)
+
+
+def check_time_limit(value: float) -> float:
+    """``--time-limit`` as given, if it is a positive number of seconds (at most a day)."""
+    if not 0 < value <= 86400:
+        raise OptionError(OptionError.BETWEEN.format(option="--time-limit", lo="0 (excluded)", hi=86400, value=value))
+    return float(value)
 
 
 def _config(args, platform):
@@ -172,14 +202,28 @@ def run_generate(args) -> int:
 def run_check(args) -> int:
     from stewart_drake.core.c_build import compiler_by_name
     from stewart_drake.core.geometry import load_platform
-    from stewart_drake.drake.firmware_check import check_firmware
+    from stewart_drake.core.isolate import run_isolated
     from stewart_drake.firmware.module import check_source
 
     check_source(args.file)
+    limit = check_time_limit(args.time_limit)
     platform = load_platform(args.platform)
     config = _config(args, platform)
     cc = compiler_by_name(args.compiler) if args.compiler else None
-    r = check_firmware(Path(args.file), platform, config, args.poses, args.seed, args.trace, args.duration, cc)
+    # the user's code runs in a child process: a hang, an exit() or a crash is one line naming the file
+    r = run_isolated(
+        _check_in_child,
+        Path(args.file),
+        platform,
+        config,
+        args.poses,
+        args.seed,
+        args.trace,
+        args.duration,
+        cc,
+        path=args.file,
+        limit=limit,
+    )
     if args.json:
         print_json(r)
     else:

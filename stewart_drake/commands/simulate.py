@@ -16,6 +16,7 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
+from stewart_drake.commands.firmware import add_time_limit_arg, check_time_limit
 from stewart_drake.core.sanity import (
     check_positive,
     check_trajectory,
@@ -34,6 +35,8 @@ from stewart_drake.errors import (
     UsageError,
 )
 from stewart_drake.firmware.engine import ENGINES
+
+FIRMWARE_IDLE_LIMIT_S = 60.0  # --firmware: seconds the simulated time may stand still (a tick takes µs)
 
 # Memory per plant step of the logs (state, command, set-point, force, status: ~100 doubles) and of
 # log.csv's rows while they are written, and wall time per plant step (the fixed-point controller and
@@ -81,6 +84,7 @@ def register(sub) -> None:
         metavar="FILE.c",
         help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`) as the controller tick",
     )
+    add_time_limit_arg(p, FIRMWARE_IDLE_LIMIT_S, "--firmware")
     p.add_argument(
         "--period", type=float, default=1e-3, metavar="S", help="controller sample period, s (default 0.001)"
     )
@@ -160,7 +164,8 @@ def run(args) -> int:
     from stewart_drake.core.geometry import load_platform
     from stewart_drake.core.output_folder import atomic_folder
     from stewart_drake.core.trajectory import design_poses, fit_trajectory, get_trajectory
-    from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation
+    from stewart_drake.drake.firmware_run import run_closed_loop, run_user_firmware
+    from stewart_drake.drake.simulation import ActuatorModel, Scenario
     from stewart_drake.firmware.engine import default_engine
     from stewart_drake.firmware.module import check_source
 
@@ -168,8 +173,10 @@ def run(args) -> int:
         args, "--trajectory FILE.csv", args.trajectory not in ("seed", "rotating"), length_unit="m", angle_unit="rad"
     )
     out_folder = output_folder(args)
+    reject_unused(args, "--firmware", args.firmware is not None, time_limit=FIRMWARE_IDLE_LIMIT_S)
     if args.firmware is not None:
         check_source(args.firmware, "--firmware")
+    limit = check_time_limit(args.time_limit)
     platform = load_platform(args.platform)
     require_plate(platform, "simulate")
     period = check_positive(args.period, "--period", "seconds")
@@ -219,9 +226,10 @@ def run(args) -> int:
         integrator=args.integrator or DEFAULT_INTEGRATOR,
         duration=duration,
     )
-    sim = build_simulation(scenario)
-    log = sim.run(duration, progress=not args.no_progress)
-    gap = sim.max_constraint_gap()
+    if args.firmware:  # the user's C runs in a child process with a time limit (drake.firmware_run)
+        log, gap = run_user_firmware(scenario, duration, not args.no_progress, args.firmware, limit)
+    else:
+        log, gap = run_closed_loop(scenario, duration, not args.no_progress)
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
         print(f"stewart-drake simulate: warning: {warnings[-1]}", file=sys.stderr)
