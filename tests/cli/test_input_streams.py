@@ -126,3 +126,13 @@ def _file(folder: Path, text: str) -> str:
     p = folder / f"f{abs(hash(text))}.csv"
     p.write_text(text)
     return str(p)
+
+
+@pytest.mark.parametrize("keep", [0.5, 0.05, 0.9])
+def test_truncated_replay_npz_is_one_line(here, capsys, keep):
+    """`view --replay` of a truncated npz printed a BadZipFile traceback."""
+    np.savez(here / "log.npz", t=np.arange(50.0), pose=np.zeros((50, 6)), status=np.zeros((50, 4)), platform="p")
+    data = (here / "log.npz").read_bytes()
+    (here / "cut.npz").write_bytes(data[: int(len(data) * keep)])
+    rc, out, err = cli(capsys, "view", "--replay", "cut.npz")
+    assert rc == 2 and out == "" and err.startswith("stewart-drake view: error: --replay cut.npz: not a simulate log (")
