@@ -170,3 +170,15 @@ def test_compile_dash_means_standard_output(here, capsys):
     assert not (here / "-").exists() and list(here.iterdir()) == []
     rc, expected, _ = cli(capsys, "compile", prog, "--emit", "python")
     assert out == expected and "def " in out
+
+
+def test_disk_full_names_the_option_and_the_file(here):
+    """Disk full said only "No space left on device" (which file? which option?)."""
+    import errno
+
+    with pytest.raises(OutputError) as e:
+        with atomic_folder(OutputFolder("d", command="alpha")) as tmp:
+            (tmp / "ok.txt").write_text("x")
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(tmp / "sub" / "big.csv"))
+    assert str(e.value) == f"--out 'd': cannot write there ({here / 'd' / 'sub' / 'big.csv'}: No space left on device)"
+    assert list(here.iterdir()) == []  # nothing half-written, no temporary
