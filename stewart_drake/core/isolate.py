@@ -25,6 +25,7 @@ from stewart_drake.errors import IsolationError
 def _child(conn, fn, args) -> None:
     child_setup()
     faulthandler.disable()  # a crash in the user's code is the parent's one line, not a Python stack dump
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # the CLI's handler (processes.Terminated) is the parent's
     os.setpgid(0, 0)  # its own group: a compiler it starts is stopped with it
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # a printf in the user's code must not reach our standard output

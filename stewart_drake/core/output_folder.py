@@ -531,7 +531,7 @@ def _remove_verified(root: Path, manifest: dict[str, dict], rels: list[str], kee
     if keep_root:
         return
     try:
-        if stat.S_ISREG(os.lstat(root / MANIFEST).st_mode):
+        if os.path.lexists(root / MANIFEST) and stat.S_ISREG(os.lstat(root / MANIFEST).st_mode):
             os.unlink(root / MANIFEST)
         os.rmdir(root)
     except OSError:
