@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import logging
 import math
 from pathlib import Path
 
@@ -338,7 +339,7 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
 
     from stewart_drake.workspace.dask_sweep import local_cluster
 
-    cluster = None
+    cluster, interrupted = None, False
     if scheduler is None:
         cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
         client = Client(cluster)
@@ -350,7 +351,12 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         for fut in as_completed(futures):
             yield fut.result()
             fut.release()
+    except KeyboardInterrupt:  # Ctrl-C/SIGTERM: no orderly close (its workers' and scheduler's complaints
+        interrupted = True  # are not the user's): the command exits now, its workers die with it
+        logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
+        raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if not interrupted:
+            client.close()
+            if cluster is not None:
+                cluster.close()

@@ -58,16 +58,18 @@ def workers(pgid: int) -> list[int]:
     return out
 
 
-def wait_for_workers(p: subprocess.Popen, n: int, timeout: float = 90.0) -> None:
+def wait_for_workers(p: subprocess.Popen, n: int, busy: float, timeout: float = 90.0) -> None:
     t0 = time.monotonic()
     while len(workers(p.pid)) < n:
         assert p.poll() is None, f"the command ended before its workers started: {p.stderr.read()}"
         assert time.monotonic() - t0 < timeout, "the workers did not start"
         time.sleep(0.2)
-    time.sleep(1.0)  # the workers are busy
+    time.sleep(busy)  # the workers are busy (the Dask runs started)
 
 
-def wait_gone(pgid: int, timeout: float = 20.0) -> list[int]:
+def wait_gone(pgid: int, timeout: float = 3.0) -> list[int]:
+    """The group's processes left ``timeout`` s after the parent ended (dying *with* it: at once, not when
+    their task is done)."""
     t0 = time.monotonic()
     while (left := group_members(pgid)) and time.monotonic() - t0 < timeout:
         time.sleep(0.2)
@@ -101,7 +103,7 @@ RUNS = {
 def test_children_die_with_the_parent_quietly(tmp_path, kind, sig, to_group):
     p = start(RUNS[kind], tmp_path)
     try:
-        wait_for_workers(p, 2)
+        wait_for_workers(p, 2, busy=4.0 if kind == "dask" else 1.0)
         if to_group:
             os.killpg(p.pid, sig)
         else:
