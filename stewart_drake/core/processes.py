@@ -104,6 +104,11 @@ def mark_cli() -> None:
 def exit_now(code: int) -> None:
     """End this process now with ``code`` after flushing its output, without the exit hooks (an interrupted
     Dask cluster's atexit close prints tracebacks); its workers die with it (``die_with_parent``)."""
+    for p in multiprocessing.active_children():  # first, so that none logs the lost connection
+        try:
+            os.kill(p.pid, signal.SIGKILL)
+        except OSError:
+            pass
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()

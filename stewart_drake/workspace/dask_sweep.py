@@ -89,7 +89,7 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
                 n_workers=n_workers,
                 threads_per_worker=threads_per_worker,
                 processes=processes,
-                dashboard_address=None,
+                dashboard_address="127.0.0.1:0",  # a free port: no "Port 8787 is already in use" warning
                 **kwargs,
             )
     finally:
