@@ -108,9 +108,11 @@ def test_children_die_with_the_parent_quietly(tmp_path, kind, sig, to_group):
             os.killpg(p.pid, sig)
         else:
             p.send_signal(sig)
-        p.wait(timeout=60)
+        try:  # its output pipe closes when the command and every child of it have ended
+            _, err = p.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"processes outlived the command (holding its stderr): {group_members(p.pid)}")
         left = wait_gone(p.pid)
-        err = p.stderr.read()
     finally:
         for pid in group_members(p.pid):
             os.kill(pid, signal.SIGKILL)
