@@ -13,6 +13,8 @@ only ``simulate``, ``montecarlo``, ``firmware.check`` and ``report`` import Drak
 """
 
 import importlib
+import os
+import signal
 import sys
 import types
 import typing
@@ -38,6 +40,13 @@ if typing.TYPE_CHECKING:
     from stewart_drake.synthesis.api import OptimizeResult, WorkspaceProof, load_requirements, optimize, prove_workspace
 
 __version__ = "0.2.0"
+
+# A worker process that the command line started (a spawned pool or Dask worker: it imports this package
+# first): Ctrl-C reaches the whole process group, and the parent alone stops the work and says so in one
+# line. Ignored here, as early as possible, so that a Ctrl-C while the worker starts is no traceback
+# (``core.processes``: the parent sets STEWART_DRAKE_CLI_PID; the worker's setup also dies with it).
+if os.environ.get("STEWART_DRAKE_CLI_PID", str(os.getpid())) != str(os.getpid()):
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 # public name -> (module that defines it, its name there). The module is imported on first use of the name:
 # the Drake-backed names import pydrake at their module top, and the numpy names must work without it.

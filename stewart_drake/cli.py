@@ -12,6 +12,7 @@ import sys
 import numpy as np
 
 from stewart_drake import __version__, commands
+from stewart_drake.core import output_folder, processes
 from stewart_drake.errors import StewartError, UsageError
 
 # Every subcommand: its name -> (its module in ``stewart_drake.commands``, the one-line help that
@@ -164,6 +165,7 @@ def _command_in(argv: list[str]) -> str:
 
 def main(argv=None) -> int:
     """Run one command; return its exit status (0 ok, 1 a result outside physical limits, 2 bad input)."""
+    from_shell = argv is None
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(only=_command_in(argv))
     try:
@@ -171,6 +173,10 @@ def main(argv=None) -> int:
     except SystemExit as e:  # --help, --version, or a usage error already printed
         return e.code if isinstance(e.code, int) else 2
     name = args.command + (f" {args.op}" if getattr(args, "op", None) else "")
+    # recorded per file in output manifests: a command replaces only its own outputs
+    processes.handle_sigterm()  # SIGTERM unwinds like Ctrl-C: temporaries removed, worker processes stopped
+    processes.mark_cli()  # the worker processes it starts leave Ctrl-C to it
+    output_folder.set_command(" ".join(filter(None, (name, getattr(args, "firmware_command", None)))))
     try:
         # Intermediate overflow/NaN in numpy is not reported as a multi-line RuntimeWarning: every result
         # is checked (finite inputs and outputs, strict JSON, the sanity checks) before it is printed.
@@ -185,9 +191,12 @@ def main(argv=None) -> int:
             return 0
         print(f"stewart-drake {name}: error: {_os_message(e)}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"stewart-drake {name}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as e:  # Ctrl-C, or SIGTERM (processes.Terminated): cleanup ran, children stopped
+        term = isinstance(e, processes.Terminated)
+        print(f"stewart-drake {name}: {'terminated' if term else 'interrupted'}", file=sys.stderr)
+        if from_shell:  # the finally blocks have run; skip the libraries' exit hooks (Dask's half-started
+            processes.exit_now(143 if term else 130)  # cluster closing prints tracebacks); workers die with us
+        return 143 if term else 130
     except (MemoryError, RecursionError, OverflowError, TypeError, ArithmeticError, AssertionError, RuntimeError) as e:
         detail = _one_line(e)
         print(

@@ -336,6 +336,11 @@ class InputError(StewartError):
     PROGRAM_TOO_LARGE = "{path}: larger than the {limit}-byte limit for a program"
     PROGRAM_NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
     PROGRAM_NUL = "{path}:{line}: a NUL byte; not a program text file"
+    INPUT_MISSING = "{kind} file {path!r} does not exist"
+    INPUT_FOLDER = "{kind} file {path!r} is a folder, not a file"
+    INPUT_UNREADABLE = "{kind} file {path!r}: cannot read it ({reason})"
+    INPUT_TOO_LARGE = "{kind} file {path!r}: larger than the {limit}-byte limit for a {kind} file (read that far)"
+    INPUT_NOT_TEXT = "{path}:{line}: not UTF-8 text (byte {offset}); not a {kind} file?"
 
 
 class OutputError(StewartError):
@@ -357,13 +362,21 @@ class OutputError(StewartError):
         "{option} {typed!r}: the file exists and was not written by stewart-drake; "
         "remove it or choose another name (it is never overwritten)"
     )
+    MANIFEST_DAMAGED = (
+        "{option} {typed!r}: its manifest {manifest} is damaged ({reason}); nothing there can be verified as "
+        "written by stewart-drake: give a new folder, or remove the manifest yourself"
+    )
+    OTHER_COMMAND = (
+        "{option} {typed!r}: {name!r} was written by `stewart-drake {other}` ({count} file(s)); `{command}` "
+        "replaces only its own files: give another folder, or --force to write beside them"
+    )
 
 
 class YamlError(GeometryError, InputError):
     """A YAML file is unreadable, too large, too deep, or not in the schema. Messages start with
     ``file:line:`` where known and name the field (``plate.mass``) and the value as written."""
 
-    TOO_LARGE = "{path}: {size} bytes is larger than the {limit}-byte limit for a {kind} file"
+    TOO_LARGE = "{path}: larger than the {limit}-byte limit for a {kind} file"
     SYNTAX = "{path}:{line}: YAML syntax error: {problem}"
     NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"
     TOO_DEEP = "{path}:{line}: nesting deeper than {limit} levels"
@@ -394,6 +407,7 @@ class CsvError(InputError):
     IS_FOLDER = "{kind} file {path!r} is a folder, not a file"
     TOO_FEW = "{path}: need at least {need} samples, got {got}"
     TIMES = "{path}: times must increase; sample {k} (t = {t} s) does not follow t = {t_prev} s"
+    LINE_TOO_LONG = "{path}:{line}: a line longer than {limit} bytes; not a {kind} file?"
 
 
 class UsageError(StewartError):
@@ -706,6 +720,20 @@ class SimulationError(StewartError):
     PORT = "--port {port}: Meshcat could not listen there ({reason})"
 
 
+class IsolationError(StewartError):
+    """User code run in a child process (``core.isolate``) failed: it hung, ended the process, or crashed."""
+
+    HUNG = (
+        "{path}: the firmware did not return within {limit:g} s (an endless loop in sd_ik, sd_tick or a "
+        "constructor?); stopped"
+    )
+    EXITED = (
+        "{path}: the firmware ended the process (exit status {code}) instead of returning; a firmware must "
+        "not call exit() (in sd_ik, sd_tick or a constructor)"
+    )
+    CRASHED = "{path}: the firmware crashed ({signal}: e.g. a bad pointer or an array index out of range)"
+
+
 class FirmwareError(StewartError):
     """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
 
@@ -765,6 +793,7 @@ class SpecError(StewartError):
     MISSING_FILE = "--vary: file {path!r} does not exist"
     NOT_YAML = "{path}:{line}: not YAML ({problem})"
     NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
+    DUPLICATE = "{where}: {key!r} is given twice (first on line {first}); give each key once"
     NOT_SCALAR = "{where}: {key}: the value must be one scalar (e.g. ±0.5mm)"
     KEY_NOT_TEXT = "{where}: a key must be a name (one of the keys), got {key}"
     RENAMED = "{where}: the key {key!r} is no longer read: {why}"
@@ -807,6 +836,7 @@ class StudyError(StewartError):
     OUT_NOT_OURS = (
         "--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to overwrite it"
     )
+    OUT_DAMAGED = "{path}: damaged ({reason}); not a study stewart-drake wrote: remove it or choose another --out"
     OUT_OTHER_PARTIAL = (
         "--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose another folder"
     )
@@ -818,8 +848,6 @@ OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {v
 OPTION_FIRMWARE_TFR16 = (
     "--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {value} (or use --trig exact)"
 )
-OPTION_OUT_NOT_FOLDER = "--out {out}: exists and is not a folder"
-OPTION_OUT_FOREIGN = "--out {out}: holds files this command did not write ({names}); choose another folder"
 OPTION_RUN_RATE = "--rate must be a positive number of samples per second, got {value}"
 OPTION_NEEDS_BRANCHES = "--{option} needs --check-branches"
 OPTION_MAX_ITER = "--max-iter must be >= 1, got {value}"

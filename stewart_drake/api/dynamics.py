@@ -17,7 +17,6 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_tolerance, smoothing_spline
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import (
-    check_file_rows,
     check_finite,
     check_gravity,
     check_trajectory,
@@ -172,9 +171,11 @@ def trajectory_rates(trajectory: Trajectory, t) -> tuple[np.ndarray, np.ndarray,
 def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "rad", smooth=None):
     """``(t, q, qd, qdd)`` in SI units from a trajectory CSV (7 or 19 columns). Errors name the line. Poses
     alone are differentiated by a cubic spline, or by a smoothing spline within ``smooth`` (the file's
-    units) RMS of the samples; a file whose second differences are rounding noise is refused without it."""
-    check_file_rows(path, "--trajectory", BYTES_PER_SAMPLE + 600, 14)
-    a, _ = read_numeric_csv(path, "trajectory", (7, 19), "see --help")
+    units) RMS of the samples; a file whose second differences are rounding noise is refused without it. The
+    file is read once as a stream (a FIFO works) within the memory budget."""
+    a, _ = read_numeric_csv(
+        path, "trajectory", (7, 19), "see --help", option="--trajectory", bytes_per_row=BYTES_PER_SAMPLE + 600
+    )
     width = a.shape[1]
     if len(a) < (2 if width == 19 else 4):
         raise CsvError(CsvError.TOO_FEW.format(path=path, need=2 if width == 19 else 4, got=len(a)))

@@ -13,17 +13,15 @@ from stewart_drake.api.result import Result
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.c_build import compiler_by_name, compilers
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S, check_time_limit, run_isolated
+from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.trajectory import Trajectory, design_poses, get_trajectory
 from stewart_drake.errors import (
     OPTION_FIRMWARE_RATE,
     OPTION_FIRMWARE_TFR16,
     OPTION_FIRMWARE_WORD_BITS,
-    OPTION_OUT_FOREIGN,
-    OPTION_OUT_NOT_FOLDER,
     CertifyError,
     OptionError,
-    OutputError,
     StewartError,
     UsageError,
 )
@@ -38,7 +36,6 @@ from stewart_drake.firmware.certify.tick import TickCertificate
 from stewart_drake.firmware.certify.tick import certify_tick as certify_tick_words
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.firmware.fingerprint import read_fingerprint, resolve_options, stamp
-from stewart_drake.firmware.generate import FILES
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.fixedpoint.generic import QFormat
@@ -101,18 +98,6 @@ class GenerateResult(Result):
         return self.summary
 
 
-def check_out_folder(out: str | Path) -> Path:
-    """``out`` for generated firmware: new, or a folder holding only the generator's files (exit 2 otherwise)."""
-    shown, out = out, Path(out)
-    if out.exists():
-        if not out.is_dir():
-            raise OutputError(OPTION_OUT_NOT_FOLDER.format(out=shown))
-        foreign = sorted(p.name for p in out.iterdir() if p.name not in FILES)
-        if foreign:
-            raise OutputError(OPTION_OUT_FOREIGN.format(out=shown, names=", ".join(foreign[:3])))
-    return out
-
-
 def generate(
     platform: Platform,
     out: str | Path,
@@ -152,7 +137,8 @@ def generate(
         StewartError: bad options, or an output folder that holds other files.
     """
     config = controller_config(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
-    out = check_out_folder(out)
+    folder = OutputFolder(out)  # the policy, before any work: new, empty, or this command's own verified files
+    out = Path(out)
     g = generate_sources(platform, config)
     options = dict(
         platform=platform.name if platform_source is None else str(platform_source),
@@ -172,7 +158,7 @@ def generate(
             compiled.append(cc.name)
         if not compiled and on_note:
             on_note("no C compiler found; the module was not compile-checked")
-    with atomic_folder(out) as tmp:
+    with atomic_folder(folder) as tmp:
         written = g.write(tmp)
     ik = g.ik_cycles
     summary = {
@@ -225,6 +211,7 @@ def check(
     trace: bool = False,
     duration: float = 0.5,
     compiler: str | None = None,
+    time_limit: float = FIRMWARE_TIME_LIMIT_S,
     word_bits: int | None = None,
     length_lsb: float | None = None,
     trig: str | None = None,
@@ -249,6 +236,8 @@ def check(
         trace: trace the first differing pose word by word.
         duration: seconds of closed loop recorded for ``sd_tick``.
         compiler: a compiler name (default the first found).
+        time_limit: seconds the check may run the firmware (compiled and run in a child process: a hang,
+            ``exit()`` or crash in it is one ``StewartError`` naming the file).
         word_bits: data word width (as generated).
         length_lsb: metres per length LSB (as generated).
         trig: the trigonometry (as generated).
@@ -264,10 +253,8 @@ def check(
         StewartError: a missing or unreadable file, a firmware that does not compile, bad options, an option
             that differs from the one recorded in the file.
     """
-    # deferred: only check needs Drake (it records a closed loop); generate runs without pydrake
-    from stewart_drake.drake.firmware_check import check_firmware
-
     check_source(path)
+    limit = check_time_limit(time_limit)
     given = dict(
         platform=None,  # compared below by the platform's name (a preset, a path or an API platform's name)
         word_bits=word_bits,
@@ -297,8 +284,19 @@ def check(
         o["trajectory"],
     )  # fmt: skip
     cc = compiler_by_name(compiler) if compiler else None
-    r = check_firmware(Path(path), platform, config, poses, seed, trace, duration, cc)
+    # the user's code runs in a child process: a hang, an exit() or a crash is one line naming the file
+    r = run_isolated(
+        _check_in_child, Path(path), platform, config, poses, seed, trace, duration, cc, path=str(path), limit=limit
+    )
     return CheckResult(r["ik"], r["tick"], r["identical"], r)
+
+
+def _check_in_child(beat, *args) -> dict:
+    """``drake.firmware_check.check_firmware(*args)``, run by ``core.isolate`` in a child process (deferred
+    import: only check needs Drake, it records a closed loop; generate runs without pydrake)."""
+    from stewart_drake.drake.firmware_check import check_firmware
+
+    return check_firmware(*args)
 
 
 def _platform_name(recorded: str) -> str:
@@ -541,7 +539,7 @@ def optimize(
         StewartError: a bad budget, box or format, or an output folder that holds other files.
     """
     budget = parse_budget(error_budget)
-    folder = None if out is None else check_out_folder(out)
+    folder = None if out is None else OutputFolder(out)
     p = load_platform(platform)
     config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)

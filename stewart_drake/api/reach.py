@@ -4,7 +4,6 @@ limits from home and the mobility of a platform."""
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -14,7 +13,8 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg_bodies import leg_dimensions
-from stewart_drake.core.sanity import check_centre, check_finite, check_work
+from stewart_drake.core.processes import check_workers
+from stewart_drake.core.sanity import check_centre, check_finite
 from stewart_drake.errors import OptionError
 from stewart_drake.workspace import (
     AXES,
@@ -126,10 +126,7 @@ def solve_workspace(
     if centre is not None:
         check_centre(platform, centre)
     check_finite(orientation if orientation_shown is None else orientation_shown, "--orientation")
-    # each worker is a Python process with numpy (~150 MB); more than 4 per CPU only adds overhead
-    check_work("--workers", str(workers), workers, "worker processes", 150e6, max_count=4 * (os.cpu_count() or 1))
-    if workers < 1:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=1, value=workers))
+    check_workers("--workers", workers)  # the one rule for worker counts (core.processes)
     orientation = np.asarray(orientation, dtype=float)
     lim = parse_limits(limits, platform, joint_cone, leg_diameter, max_condition)
     w = constant_orientation_workspace(

@@ -23,8 +23,8 @@ from stewart_drake.control.chatter import loop_verdict
 from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.simulation_log import SimulationLog, tracking_verdict
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S, check_time_limit
 from stewart_drake.core.sanity import (
-    check_file_rows,
     check_positive,
     check_trajectory,
     check_work,
@@ -33,6 +33,7 @@ from stewart_drake.core.sanity import (
 )
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory
 from stewart_drake.core.unit_hint import other_unit_hint
+from stewart_drake.drake.firmware_run import run_user_firmware
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.errors import (
@@ -90,6 +91,7 @@ class RunPlan:
     duration: float
     warnings: tuple = ()
     read_units: dict | None = None
+    time_limit: float = 60.0  # a user's firmware: seconds the simulated time may stand still (drake.firmware_run)
 
     @property
     def config(self) -> ControllerConfig:
@@ -110,6 +112,7 @@ def plan_run(
     feedforward: bool = True,
     engine: str | None = None,
     firmware: str | None = None,
+    time_limit: float = FIRMWARE_IDLE_LIMIT_S,
     integrator: str | None = None,
     fit: bool = False,
     allow_out_of_stroke: bool = False,
@@ -139,14 +142,13 @@ def plan_run(
     """
     if firmware is not None:
         check_source(firmware, "--firmware")
+    time_limit = check_time_limit(time_limit)
     if checks:
         require_plate(platform, command)
     period = check_positive(period, "--period", "seconds")
     plant_step = plant_step if plant_step is not None else min(period, 1e-3)
     if duration is not None:
         check_positive(duration, "--duration", "seconds")
-    if isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating"):
-        check_file_rows(str(trajectory), "--trajectory", 700, 14)
     csv = isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating")
     units = {"length_unit": length_unit, "angle_unit": angle_unit}
     traj = get_trajectory(trajectory, **units, **({"smooth": smooth} if smooth is not None else {}))
@@ -210,7 +212,7 @@ def plan_run(
         duration=duration,
     )
     read_units = {"length": length_unit, "angle": angle_unit} if csv else None
-    return RunPlan(scenario, timing, duration, tuple(warnings), read_units)
+    return RunPlan(scenario, timing, duration, tuple(warnings), read_units, time_limit)
 
 
 @dataclass(frozen=True)
@@ -376,6 +378,7 @@ def simulate(
     feedforward: bool = True,
     engine: str | None = None,
     firmware: str | None = None,
+    time_limit: float = FIRMWARE_IDLE_LIMIT_S,
     integrator: str | None = None,
     fit: bool = False,
     allow_out_of_stroke: bool = False,
@@ -400,7 +403,9 @@ def simulate(
         feedforward: connect the model-based force feed-forward.
         engine: the fixed-point tick: ``"c"`` (the generated firmware, compiled) or ``"python"`` (the
             emulation); default ``"c"`` where a C compiler is found.
-        firmware: a C file implementing the firmware ABI, run as the controller tick.
+        firmware: a C file implementing the firmware ABI, run as the controller tick (in a child process:
+            a hang, ``exit()`` or crash in it is one ``StewartError`` naming the file).
+        time_limit: seconds the simulated time may stand still while ``firmware`` runs.
         integrator: ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"``.
         fit: move and scale the reference to the platform's home height and stroke.
         allow_out_of_stroke: simulate a reference that leaves the stroke (a warning) instead of raising.
@@ -431,6 +436,7 @@ def simulate(
         feedforward=feedforward,
         engine=engine,
         firmware=firmware,
+        time_limit=time_limit,
         integrator=integrator,
         fit=fit,
         allow_out_of_stroke=allow_out_of_stroke,
@@ -449,11 +455,14 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         if on_warning:
             on_warning(w)
     sc, timing = plan.scenario, plan.timing
-    sim = build_simulation(sc, meshcat=meshcat)
     t_wall = time.perf_counter()
-    log = sim.run(plan.duration, progress=progress)
+    if sc.firmware and meshcat is None:  # the user's C runs in a child process with a time limit
+        log, gap = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
+    else:
+        sim = build_simulation(sc, meshcat=meshcat)
+        log = sim.run(plan.duration, progress=progress)
+        gap = sim.max_constraint_gap()
     t_wall = time.perf_counter() - t_wall
-    gap = sim.max_constraint_gap()
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
         if on_warning:

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.errors import CalibrationError
 
@@ -32,6 +33,7 @@ READINGS = tuple(f"l{i}" for i in range(1, 7))
 POSE = ("px", "py", "pz", "a", "b", "g")
 TILTS = ("tilt_x", "tilt_y")
 MAX_ROWS = 100_000
+MAX_BYTES = MAX_ROWS * 1000  # a row: a kind, up to 8 targets' readings, weights (~200 bytes)
 MAX_TARGETS = 8
 _TARGET = re.compile(r"^t(\d+)_([xyz])$")
 
@@ -119,9 +121,10 @@ def read_measurements(
     shown = str(path)
     if not f.exists():
         raise CalibrationError(CalibrationError.MISSING.format(path=shown))
-    if not f.is_file():
+    if f.is_dir():
         raise CalibrationError(CalibrationError.NOT_A_FILE.format(path=shown))
-    data = f.read_bytes()
+    # read once as a stream (a FIFO works), bounded: MAX_ROWS rows of a few hundred bytes
+    data = read_input(path, kind="measurements", limit=MAX_BYTES)
     digest = hashlib.sha256(data).hexdigest()
     try:
         text = data.decode("utf-8-sig")

@@ -24,7 +24,9 @@ def register(sub) -> None:
     )
     p.add_argument("program", metavar="PROGRAM.stw", help="motion-language source file")
     p.add_argument("--emit", choices=["python", "matlab"], required=True, help="back end")
-    p.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")
+    p.add_argument(
+        "-o", "--output", metavar="FILE", help="write here instead of standard output ('-': standard output)"
+    )
     add_platform_arg(p)
     p.add_argument("--convention", choices=list(CONVENTIONS), default="utn", help="Euler convention (default utn)")
     p.add_argument("--rate", type=float, default=100.0, help="python: trajectory samples per second (default 100)")
@@ -33,6 +35,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     text = read_program(args.program)
+    if args.output == "-":  # the usual convention: "-" is standard output, never a file named "-"
+        args.output = None
     if args.output:
         check_output_file(args.output, option="--output")
     platform = platform_from_args(args)

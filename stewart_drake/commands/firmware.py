@@ -10,6 +10,7 @@ from stewart_drake.api import firmware
 from stewart_drake.commands._certify import register as register_certify
 from stewart_drake.commands._common import add_platform_arg, print_json
 from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 
 
@@ -105,9 +106,22 @@ def register(sub) -> None:
     c.add_argument(
         "--compiler", default=None, metavar="NAME", help="gcc, clang, cc or zig (default: the first available)"
     )
+    add_time_limit_arg(c)
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_check)
     register_certify(fs, _format_args, _format)
+
+
+def add_time_limit_arg(p, default: float = FIRMWARE_TIME_LIMIT_S, what: str = "the check") -> None:
+    """``--time-limit S``: how long the user's firmware (compiled and run in a child process) may take."""
+    p.add_argument(
+        "--time-limit",
+        type=float,
+        default=default,
+        metavar="S",
+        help=f"seconds {what} may run the firmware without progress (default {default:g}); the firmware runs in "
+        "a child process: a hang, exit() or crash is one line naming the file",
+    )
 
 
 def _format(args) -> dict:
@@ -156,6 +170,7 @@ def run_check(args) -> int:
         trace=args.trace,
         duration=args.duration,
         compiler=args.compiler,
+        time_limit=args.time_limit,
         **_format(args),
     )
     r = result.to_dict()

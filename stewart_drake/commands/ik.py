@@ -11,13 +11,11 @@ from stewart_drake.api.kinematics import solve_ik
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.rotations import length_scale, pose_to_si
-from stewart_drake.core.sanity import check_file_rows
 from stewart_drake.core.unit_hint import other_unit_hint
 
 # Bytes per CSV row while reading (Python lists of floats) and per result printed as JSON (estimates).
 BYTES_PER_ROW = 600
 BYTES_PER_JSON_ROW = 1500
-MIN_ROW_BYTES = 12  # "0,0,0,0,0,0\n": the shortest row a file can hold
 
 
 def register(sub) -> None:
@@ -45,8 +43,8 @@ def run(args) -> int:
     if args.pose is not None:
         raw, lines = np.array(args.pose), None
     else:
-        check_file_rows(args.poses, "--poses", BYTES_PER_ROW + (BYTES_PER_JSON_ROW if args.json else 0), MIN_ROW_BYTES)
-        raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g")
+        cost = BYTES_PER_ROW + (BYTES_PER_JSON_ROW if args.json else 0)
+        raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g", option="--poses", bytes_per_row=cost)
     what = "--pose" if lines is None else f"{args.poses}: pose"
     q = pose_to_si(raw, args.length_unit, args.angle_unit)
     r = solve_ik(platform, q, args.convention, what, lines)

@@ -10,11 +10,11 @@ from pathlib import Path
 from stewart_drake.commands._common import add_platform_arg, dumps_strict, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, StewartError
 from stewart_drake.firmware.engine import resolve_engine
-from stewart_drake.montecarlo.api import make_study, run_montecarlo
+from stewart_drake.montecarlo.api import REPLAY_COMMAND, make_study, run_montecarlo
 from stewart_drake.montecarlo.scenario import draw, plant_platform, run_scenario
 from stewart_drake.montecarlo.study import (
     STUDY_FILE,
@@ -178,6 +178,9 @@ def replay(args) -> int:
     if not 0 <= args.replay < len(rows):
         raise OptionError(OptionError.NO_RUN.format(run=args.replay, out=str(out), last=len(rows) - 1))
     _check_replay_options(args, study, settings)
+    # written into the study's folder as this replay's own files (replay-K/), beside the study's and any
+    # others (force: never touched, a name clash refused); checked before the run
+    study_folder = OutputFolder(out, command=f"{REPLAY_COMMAND} {args.replay}", force=True)
     # the C engine without a compiler here: Python, with the note (bit-identical, so the check still holds)
     study = dataclasses.replace(study, engine=resolve_engine(study.engine, "stewart-drake montecarlo"))
     row = run_scenario(study, args.replay, keep_log=True)
@@ -186,7 +189,9 @@ def replay(args) -> int:
     differ = [k for k in want if k != "wall_s" and not _same(want[k], row.get(k))]
     folder = out / f"replay-{args.replay}"
     result = {"run": args.replay, "bit_identical": not differ, "differing_columns": differ, "row": row}
-    with atomic_folder(folder) as tmp:
+    with atomic_folder(study_folder) as top:
+        tmp = top / folder.name
+        tmp.mkdir()
         files = []
         if log is not None:
             ref = study.reference()

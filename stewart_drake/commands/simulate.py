@@ -14,7 +14,9 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
+from stewart_drake.commands.firmware import add_time_limit_arg
 from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
 from stewart_drake.firmware.engine import ENGINES
@@ -52,6 +54,7 @@ def register(sub) -> None:
         metavar="FILE.c",
         help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`) as the controller tick",
     )
+    add_time_limit_arg(p, FIRMWARE_IDLE_LIMIT_S, "--firmware")
     p.add_argument(
         "--period", type=float, default=1e-3, metavar="S", help="controller sample period, s (default 0.001)"
     )
@@ -135,6 +138,7 @@ def run(args) -> int:
         smooth=None,
     )
     out_folder = output_folder(args)
+    reject_unused(args, "--firmware", args.firmware is not None, time_limit=FIRMWARE_IDLE_LIMIT_S)
     plan = plan_run(
         load_platform(args.platform),
         args.trajectory,
@@ -147,6 +151,7 @@ def run(args) -> int:
         feedforward=not args.no_feedforward,
         engine=args.engine,
         firmware=args.firmware,
+        time_limit=args.time_limit,
         integrator=args.integrator,
         fit=args.fit,
         allow_out_of_stroke=args.allow_out_of_stroke,

@@ -23,6 +23,7 @@ import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -37,6 +38,9 @@ CACHE_ENV = "STEWART_DRAKE_CACHE"
 CC_ENV = "STEWART_DRAKE_CC"
 BASE_FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared")
 STRICT_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
+
+
+COMPILE_TIMEOUT_S = 300.0  # one source file; the generated firmware takes ~1 s
 
 
 class CompilerUnavailable(StewartError):
@@ -222,7 +226,7 @@ def build(
             files.append(str(s.path if s.path is not None else tmp / s.name))
         target = tmp / "lib.so"
         cmd = [*compiler.argv, *cflags, f"-I{tmp}", f"-I{C_DIR}", "-o", str(target), *files]
-        r = subprocess.run(cmd, capture_output=True, text=True)
+        r = run_compiler(cmd, sources[0].name)
         if r.returncode != 0:
             msg = (r.stderr or r.stdout).replace(str(tmp) + os.sep, "")
             raise CompileError(_first_error(msg, compiler))
@@ -232,6 +236,28 @@ def build(
             )
         os.replace(target, out)
     return out
+
+
+def run_compiler(cmd: list[str], what: str, timeout: float | None = None) -> subprocess.CompletedProcess:
+    """Run a compiler command with a time limit (``COMPILE_TIMEOUT_S``), in its own process group so that
+    its own children (cc1, ld) stop with it; its output decoded leniently (a binary "source" makes the
+    compiler echo bytes that are not UTF-8). ``CompileError`` naming ``what`` when it does not finish."""
+    timeout = COMPILE_TIMEOUT_S if timeout is None else timeout
+    p = subprocess.Popen(
+        cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, encoding="utf-8", errors="replace"
+    )
+    try:
+        out, err = p.communicate(timeout=timeout)
+    except BaseException as e:  # the time limit, Ctrl-C, SIGTERM: the compiler's whole group goes
+        try:
+            os.killpg(p.pid, signal.SIGKILL)
+        except OSError:
+            pass
+        p.wait()
+        if isinstance(e, subprocess.TimeoutExpired):
+            raise CompileError(f"{what}: the C compiler did not finish within {timeout:g} s; stopped") from None
+        raise
+    return subprocess.CompletedProcess(cmd, p.returncode, out, err)
 
 
 def _first_error(msg: str, compiler: Compiler) -> str:

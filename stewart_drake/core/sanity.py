@@ -381,25 +381,6 @@ def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
     return c
 
 
-def check_file_rows(path, option: str, bytes_per_row: float, min_row_bytes: int = 12) -> None:
-    """Refuse a CSV file whose rows could not be held in memory (``bytes_per_row`` each), before reading
-    it: judged first by its size (at most size / ``min_row_bytes`` rows), then, if that is not enough to
-    accept it, by counting its lines. A missing file is left to the reader to report."""
-    try:
-        size = os.path.getsize(path)
-        check_work(
-            option, repr(str(path)), size / min_row_bytes, "rows at most", bytes_per_row, hint="; split the file"
-        )
-    except OSError:
-        return
-    except WorkTooLargeError:
-        if size > memory_budget():
-            raise
-        with open(path, "rb") as fh:  # count the rows (bounded memory, ~1 GB/s) before judging by size
-            rows = sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 24), b"")) + 1
-        check_work(option, repr(str(path)), rows, "rows", bytes_per_row, hint="; split the file")
-
-
 # ----------------------------------------------------------------------------------------------
 # RC servos.
 

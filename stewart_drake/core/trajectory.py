@@ -194,26 +194,40 @@ def _fitted_pose(trajectory: Trajectory, home, s: float, centre, t):
     return q
 
 
-def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad", smooth=None) -> Trajectory:
-    """A ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row optional; times strictly increasing,
-    seconds) as a piecewise-linear Trajectory (``table_trajectory``). Errors name the line. A file rounded
-    so coarsely that its second differences are noise is refused (``quantisation``) unless ``smooth`` (a
-    tolerance in the file's units) replaces the samples by a smoothing spline's."""
-    data, lines = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
+# bytes a command holds per trajectory sample beyond the CSV row (the Drake run's logs and plots)
+BYTES_PER_SAMPLE = 700.0
+
+
+def read_trajectory_table(
+    path, length_unit: str = "m", angle_unit: str = "rad", *, option: str = "--trajectory"
+) -> tuple[str, np.ndarray, np.ndarray]:
+    """``(name, times (n,) s, poses (n, 6) SI)`` of a ``(t, px, py, pz, a_x, a_y, a_z)`` CSV (header row
+    optional; times strictly increasing, seconds), read once as a stream (``csvio``). Errors name the line."""
+    data, lines = read_numeric_csv(
+        path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z", option=option, bytes_per_row=BYTES_PER_SAMPLE
+    )
     late = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if late.size:
         k = late[0] + 1
         raise TrajectoryError(
             TrajectoryError.TIME_ORDER.format(path=path, line=lines[k], t=data[k, 0], t_prev=data[k - 1, 0])
         )
-    t, poses = data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+    return Path(path).stem, data[:, 0], pose_to_si(data[:, 1:], length_unit, angle_unit)
+
+
+def load_trajectory_csv(path, length_unit: str = "m", angle_unit: str = "rad", smooth=None) -> Trajectory:
+    """A trajectory CSV (``read_trajectory_table``: read once as a stream, errors name the line) as a
+    piecewise-linear Trajectory (``table_trajectory``). A file rounded so coarsely that its second differences
+    are noise is refused (``quantisation``) unless ``smooth`` (a tolerance in the file's units) replaces the
+    samples by a smoothing spline's."""
+    name, t, poses = read_trajectory_table(path, length_unit, angle_unit)
     check_finite_rates(path, t, poses)
     if smooth is None:
         check_quantisation(path, t, poses)
     else:
         scale = pose_to_si(np.ones(6), length_unit, angle_unit)
         poses = smooth_columns(t, poses, smooth_tolerance(smooth) * scale)
-    return table_trajectory(Path(path).stem, t, poses)
+    return table_trajectory(name, t, poses)
 
 
 def table_trajectory(name: str, ts, poses) -> Trajectory:

@@ -17,12 +17,12 @@ import types
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import yaml
 
-from stewart_drake.errors import YamlError
+from stewart_drake.core.input_stream import read_input
+from stewart_drake.errors import InputError, YamlError
 
 MAX_BYTES = 1_000_000  # a platform file is a few hundred bytes
 MAX_DEPTH = 32  # nesting levels of mappings/sequences
@@ -73,23 +73,7 @@ def load_yaml_typed(path, schema, kind: str, check: Callable[[Any, dict], None] 
     ``kind`` names what the file should hold ("platform"), for messages. ``check(cfg, where)`` may
     validate values further; ``where`` maps field paths (tuples of keys and 0-based indices) to their
     ``Where``. Raises ``YamlError``."""
-    p = Path(path)
-    shown = str(path)
-    if not p.exists():
-        raise YamlError(YamlError.MISSING.format(kind=kind, path=shown))
-    if not p.is_file():
-        raise YamlError(YamlError.NOT_A_FILE.format(kind=kind, path=shown))
-    size = p.stat().st_size
-    if size > MAX_BYTES:
-        raise YamlError(YamlError.TOO_LARGE.format(path=shown, size=size, limit=MAX_BYTES, kind=kind))
-    with p.open("rb") as fh:
-        data = fh.read(MAX_BYTES + 1)
-    if len(data) > MAX_BYTES:
-        raise YamlError(YamlError.TOO_LARGE.format(path=shown, size=len(data), limit=MAX_BYTES, kind=kind))
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        raise YamlError(YamlError.NOT_TEXT.format(path=shown, offset=e.start)) from None
+    text, shown = read_yaml_text(path, kind)
     root = compose(text, shown)
     if root is None:
         raise YamlError(YamlError.TOP.format(path=shown, kind=kind, got="an empty file"))
@@ -102,6 +86,27 @@ def load_yaml_typed(path, schema, kind: str, check: Callable[[Any, dict], None] 
     if check is not None:
         check(cfg, where)
     return cfg
+
+
+def read_yaml_text(path, kind: str, limit: int = MAX_BYTES) -> tuple[str, str]:
+    """``(text, path as shown)`` of a YAML input, read once as a stream of at most ``limit`` bytes
+    (``input_stream``: a FIFO works, ``/dev/zero`` is refused by the budget); ``YamlError`` naming it."""
+    shown = str(path)
+    try:
+        data = read_input(
+            path,
+            kind=kind,
+            limit=limit,
+            missing=YamlError.MISSING.format(kind=kind, path=shown),
+            folder=YamlError.NOT_A_FILE.format(kind=kind, path=shown),
+            too_large=YamlError.TOO_LARGE.format(path=shown, limit=limit, kind=kind),
+        )
+    except InputError as e:
+        raise YamlError(str(e)) from None
+    try:
+        return data.decode("utf-8-sig"), shown
+    except UnicodeDecodeError as e:
+        raise YamlError(YamlError.NOT_TEXT.format(path=shown, offset=e.start)) from None
 
 
 def compose(text: str, shown: str):

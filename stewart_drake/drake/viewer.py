@@ -9,9 +9,12 @@ nearest reachable pose on the straight line from home ghosted beside it.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import textwrap
 import time
+import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,11 +24,13 @@ from pydrake.math import RigidTransform, RotationMatrix
 
 from stewart_drake.core.assembly_modes import assembly_modes
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.input_stream import decode_text, read_input
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.leg_bodies import leg_visual_dimensions
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
 from stewart_drake.core.realtime_fk import certificate
 from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length_scale, rotation_matrix
+from stewart_drake.core.sanity import memory_budget
 from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
 from stewart_drake.errors import ReplayError, SimulationError, StewartError
 
@@ -307,23 +312,25 @@ def load_replay(path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str]:
         raise ReplayError(ReplayError.EMPTY_FOLDER.format(path=path))
     if not p.exists():
         raise ReplayError(ReplayError.MISSING.format(path=path))
+    # read once, bounded (core.input_stream): a FIFO works, /dev/zero stops at the budget
+    data = read_input(p, kind="replay log", limit=memory_budget(), missing=ReplayError.MISSING.format(path=path))
     if p.suffix == ".npz":
         try:
-            with np.load(p, allow_pickle=False) as z:
+            with np.load(io.BytesIO(data), allow_pickle=False) as z:
                 return (
                     np.asarray(z["t"], float),
                     np.asarray(z["pose"], float),
                     log_saturating(z["status"]),
                     str(z["platform"]),
                 )
-        except (KeyError, ValueError, OSError) as e:
-            raise ReplayError(ReplayError.NOT_LOG.format(path=path, reason=e)) from None
-    return _load_csv(p)
+        # a truncated or damaged archive: zipfile's BadZipFile, zlib's error, EOFError, ...
+        except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as e:
+            raise ReplayError(ReplayError.NOT_LOG.format(path=path, reason=str(e) or type(e).__name__)) from None
+    return _load_csv(p, decode_text(data, p, "replay log"))
 
 
-def _load_csv(p: Path):
-    with p.open(newline="") as fh:
-        rows = list(csv.reader(fh))
+def _load_csv(p: Path, text: str):
+    rows = list(csv.reader(io.StringIO(text, newline="")))
     if not rows:
         raise ReplayError(ReplayError.EMPTY.format(path=p))
     header = rows[0]

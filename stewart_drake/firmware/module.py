@@ -11,10 +11,12 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.c_build import Compiler, Source, build, library_sources, load
+from stewart_drake.core.input_stream import decode_text, read_input
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
 
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
+MAX_SOURCE_BYTES = 16_000_000  # a firmware source file; the generated one is ~15 kB
 
 
 def _cdef(word: str, counting: bool) -> str:
@@ -162,6 +164,8 @@ def check_source(path, what: str = "firmware file") -> Path:
         raise FirmwareError(FirmwareError.FILE_MISSING.format(what=what, path=text))
     if not p.is_file():
         raise FirmwareError(FirmwareError.FILE_SPECIAL.format(what=what, path=text))
+    # C source is text: a binary file is one line naming it, not a codec error from the compiler's messages
+    decode_text(read_input(p, kind="C source", limit=MAX_SOURCE_BYTES), text, "C source")
     return p
 
 

@@ -9,10 +9,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from stewart_drake.api.result import Result
-from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.rotations import pose_to_si
-from stewart_drake.core.trajectory import TRAJECTORIES, load_trajectory_csv
+from stewart_drake.core.output_folder import OutputFolder
+from stewart_drake.core.processes import check_workers
+from stewart_drake.core.quantisation import check_finite_rates, check_quantisation
+from stewart_drake.core.trajectory import TRAJECTORIES, read_trajectory_table
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import default_engine
@@ -24,6 +25,9 @@ from stewart_drake.script.source import read_program
 
 if TYPE_CHECKING:  # annotations only: pandas is optional
     import pandas
+
+
+REPLAY_COMMAND = "montecarlo --replay"  # a replay's files are recorded under "montecarlo --replay K"
 
 
 def make_study(
@@ -50,8 +54,8 @@ def make_study(
     as the user wrote it, in mm)."""
     spec = parse_spec(vary)
     program_text = (program, read_program(program)) if program else None
-    if workers is not None and workers < 0:
-        raise OptionError(OptionError.AT_LEAST.format(option="--workers", min=0, value=workers))
+    if workers is not None:
+        check_workers("--workers", workers, minimum=0)  # the one rule for worker counts (core.processes)
     if engine == "c" and controller != "fixed":
         raise UsageError(UsageError.ENGINE_C.format(controller=controller))
     engine = default_engine(engine, controller, "stewart-drake montecarlo")
@@ -82,11 +86,13 @@ def make_study(
 
 
 def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
-    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once
-    (``load_trajectory_csv`` checks it and names a bad line)."""
-    traj = load_trajectory_csv(path, length_unit, angle_unit)
-    data, _ = read_numeric_csv(path, "trajectory", (7,), "t, px, py, pz, a_x, a_y, a_z")
-    return (traj.name, data[:, 0].tolist(), pose_to_si(data[:, 1:], length_unit, angle_unit).tolist())
+    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once as a
+    stream (``read_trajectory_table`` names a bad line; a FIFO works) and checked as ``load_trajectory_csv``
+    checks it (finite rates; rounding noise refused)."""
+    name, ts, poses = read_trajectory_table(path, length_unit, angle_unit)
+    check_finite_rates(path, ts, poses)
+    check_quantisation(path, ts, poses)
+    return (name, ts.tolist(), poses.tolist())
 
 
 @dataclass(repr=False)
@@ -199,8 +205,10 @@ def montecarlo(
 
 def run_montecarlo(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = False):
     """Run a checked ``Study`` into ``out`` and summarise it (``MonteCarloResult``)."""
+    # --out checked before any run: new, empty, or this study's own (its replays kept beside it)
+    folder = OutputFolder(out, companions=(REPLAY_COMMAND,))
     study.reference()  # the reference (program compiled, CSV read) checked here, before any run starts
     rows = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress)
     summary = summarise(rows, study_settings(study), study_key(study))
-    summary["files"] = [str(p) for p in write_outputs(out, rows, summary)]
+    summary["files"] = [str(p) for p in write_outputs(folder, rows, summary)]
     return MonteCarloResult(summary, rows, Path(out))

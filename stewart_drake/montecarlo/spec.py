@@ -44,7 +44,8 @@ from dataclasses import dataclass, field
 from decimal import Decimal, DecimalException
 from pathlib import Path
 
-from stewart_drake.errors import SpecError, short_text
+from stewart_drake.core.yamlio import compose, read_yaml_text
+from stewart_drake.errors import SpecError, YamlError, short_text
 
 # key: (dimension, vector length or 0 for a scalar, nominal zero?)
 KEYS = {
@@ -209,28 +210,32 @@ def parse_spec(words) -> VarySpec:
     return VarySpec(laws, " ".join(words))
 
 
+MAX_SPEC_BYTES = 100_000
+
+
 def _parse_yaml(path: Path) -> VarySpec:
     import yaml
 
-    if not path.is_file():
+    if not path.exists():
         raise SpecError(SpecError.MISSING_FILE.format(path=str(path)))
-    text = path.read_text(encoding="utf-8")
+    # read once, bounded (a spec is a few lines), with the platform files' safe composer (nesting bounded)
+    text, shown = read_yaml_text(path, "--vary spec", limit=MAX_SPEC_BYTES)
     try:
-        node = yaml.compose(text)
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        raise SpecError(
-            SpecError.NOT_YAML.format(path=path, line=mark.line + 1 if mark else "?", problem=getattr(e, "problem", e))
-        ) from None
+        node = compose(text, shown)
+    except YamlError as e:
+        raise SpecError(str(e)) from None
     if node is None or not isinstance(node, yaml.MappingNode):
         raise SpecError(SpecError.NOT_MAPPING.format(path=path))
-    laws = {}
+    laws, first = {}, {}
     for k, v in node.value:
         where = _where(str(path), k.start_mark.line + 1)
         if not isinstance(k, yaml.ScalarNode):  # a list or mapping as a key ([a, b]: 1)
             raise SpecError(
                 SpecError.KEY_NOT_TEXT.format(where=where, key=short_text(text[k.start_mark.index : k.end_mark.index]))
             )
+        if k.value in first:  # YAML keeps the last silently: refused
+            raise SpecError(SpecError.DUPLICATE.format(where=where, key=k.value, first=first[k.value]))
+        first[k.value] = k.start_mark.line + 1
         if not isinstance(v, yaml.ScalarNode):
             raise SpecError(SpecError.NOT_SCALAR.format(where=where, key=k.value))
         check_key(k.value, where)

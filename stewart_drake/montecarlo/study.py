@@ -17,14 +17,15 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import logging
 import math
 from pathlib import Path
 
 import numpy as np
 
 from stewart_drake.core.geometry import base_joints
-from stewart_drake.core.output_folder import claim_in_manifest
-from stewart_drake.errors import StudyError
+from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
+from stewart_drake.errors import OutputError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
 from stewart_drake.montecarlo.scenario import Study, run_scenario
 
@@ -195,21 +196,24 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
     partial = out / PARTIAL
     previous = out / STUDY_FILE
     if previous.exists():
-        old = json.loads(previous.read_text())
-        old_key = settings_key(old["settings"]) if "settings" in old else old.get("key")
+        old = _damaged_unless(previous, lambda: json.loads(previous.read_text()), dict)
+        old_key = _damaged_unless(
+            previous, lambda: settings_key(old["settings"]) if "settings" in old else old.get("key"), str
+        )
         if old_key != key:
             raise StudyError(StudyError.OUT_OTHER_STUDY.format(out=str(out), old_key=old_key, key=key))
         results = out / "results.parquet"
         if results.exists():
             import pyarrow.parquet as pq
 
-            for r in pq.read_table(results).to_pylist():
-                rows[int(r["run"])] = r
+            table = _damaged_unless(results, lambda: pq.read_table(results).to_pylist(), list)
+            for r in table:
+                rows[_run_index(results, r)] = r
     elif not partial.exists() and any(out.iterdir()):
         raise StudyError(StudyError.OUT_NOT_OURS.format(out=str(out), study_file=STUDY_FILE, partial=PARTIAL))
     if partial.exists():
-        lines = partial.read_text().splitlines()
-        head = json.loads(lines[0]) if lines else {}
+        lines = partial.read_text(encoding="utf-8", errors="replace").splitlines()
+        head = _damaged_unless(partial, lambda: json.loads(lines[0]) if lines else None, dict)
         if head.get("key") != key:
             raise StudyError(StudyError.OUT_OTHER_PARTIAL.format(out=str(out), old_key=head.get("key"), key=key))
         for line in lines[1:]:
@@ -217,28 +221,79 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
                 r = json.loads(line)
             except json.JSONDecodeError:  # a line cut short by an interruption: that run is re-run
                 continue
-            rows[int(r["run"])] = r
+            rows[_run_index(partial, r)] = r
     return rows
 
 
-class PartialWriter:
-    """Appends finished rows to ``out/montecarlo.partial.jsonl`` (header first), one flushed line each."""
+def _damaged_unless(path: Path, read, kind: type):
+    """``read()`` if it gives a ``kind``; else ``StudyError`` naming ``path`` as damaged (a resume folder
+    edited or cut short: one line, never a traceback)."""
+    try:
+        value = read()
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as e:  # pyarrow's errors are ValueErrors
+        reason = str(e).splitlines()[0][:100] if str(e) else type(e).__name__
+    else:
+        if isinstance(value, kind):
+            return value
+        reason = f"{type(value).__name__} where a {kind.__name__} belongs"
+    raise StudyError(StudyError.OUT_DAMAGED.format(path=str(path), reason=reason))
 
-    def __init__(self, out: Path, key: str):
-        out.mkdir(parents=True, exist_ok=True)
-        path = out / PARTIAL
-        new = not path.exists() or path.stat().st_size == 0
-        self.fh = path.open("a", encoding="utf-8")
-        if new:
-            self.write({"key": key})
-            claim_in_manifest(out, [PARTIAL])  # the folder stays ours: the final write replaces it
+
+def _run_index(path: Path, row) -> int:
+    """The run index of a stored row (a JSON object with an integer "run"), else ``StudyError`` naming ``path``."""
+    run = row.get("run") if isinstance(row, dict) else None
+    if type(run) is not int or run < 0:
+        raise StudyError(
+            StudyError.OUT_DAMAGED.format(path=str(path), reason=f"a row without a run index: {str(row)[:60]}")
+        )
+    return run
+
+
+class PartialWriter:
+    """Appends finished rows to ``out/montecarlo.partial.jsonl``, one flushed line each. The file is made
+    at the first row (a study that fails before any run leaves no folder), with its header written whole
+    (a temporary and a rename: never a file without its key) and claimed in the folder's manifest as an
+    append-only journal of this command (verified by its header's hash)."""
+
+    def __init__(self, out: Path, key: str, option: str = "--out"):
+        self.out, self.key, self.option, self.fh = out, key, option, None
 
     def write(self, obj: dict) -> None:
-        self.fh.write(json.dumps(obj) + "\n")
-        self.fh.flush()
+        path = self.out / PARTIAL
+        try:
+            if self.fh is None:
+                if not path.exists():
+                    self._start(path)
+                self.fh = path.open("a", encoding="utf-8")
+            self.fh.write(json.dumps(obj) + "\n")
+            self.fh.flush()
+        except OSError as e:  # disk full, ...: one line naming the file and the option
+            raise OutputError(
+                OutputError.UNWRITABLE.format(
+                    option=self.option, typed=str(self.out), reason=f"{path}: {e.strerror or e}"
+                )
+            ) from None
+
+    def _start(self, path: Path) -> None:
+        """The header, then its claim; if the claim cannot be written, neither is left (nor the folder, if
+        made here): the rerun finds the folder as it was."""
+        made = not self.out.exists()
+        self.out.mkdir(parents=True, exist_ok=True)
+        try:
+            write_text_atomic(path, json.dumps({"key": self.key}) + "\n")
+            claim_in_manifest(self.out, [PARTIAL], prefix=True)  # the final write replaces it
+        except OSError:
+            path.unlink(missing_ok=True)  # written just now by this process, not yet claimed
+            if made:
+                try:
+                    self.out.rmdir()
+                except OSError:
+                    pass
+            raise
 
     def close(self) -> None:
-        self.fh.close()
+        if self.fh is not None:
+            self.fh.close()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -286,7 +341,7 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
 
     from stewart_drake.workspace.dask_sweep import local_cluster
 
-    cluster = None
+    cluster, interrupted = None, False
     if scheduler is None:
         cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
         client = Client(cluster)
@@ -298,7 +353,12 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         for fut in as_completed(futures):
             yield fut.result()
             fut.release()
+    except KeyboardInterrupt:  # Ctrl-C/SIGTERM: no orderly close (its workers' and scheduler's complaints
+        interrupted = True  # are not the user's): the command exits now, its workers die with it
+        logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
+        raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if not interrupted:
+            client.close()
+            if cluster is not None:
+                cluster.close()

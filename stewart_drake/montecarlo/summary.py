@@ -164,11 +164,12 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
 
 
 def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
-    """Replace ``out`` atomically with the table, ``summary.json``, ``study.json`` and the plots."""
-    from stewart_drake.core.output_folder import atomic_folder
+    """Replace ``out`` atomically with the table, ``summary.json``, ``study.json`` and the plots. ``out``: a
+    path, or an ``output_folder.OutputFolder`` checked before the runs."""
+    from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 
-    out = Path(out)
-    with atomic_folder(out) as tmp:
+    folder, out = out, Path(out.typed if isinstance(out, OutputFolder) else out)
+    with atomic_folder(folder) as tmp:
         written = write_table(rows, tmp) + write_plots(rows, summary, tmp)
         (tmp / "study.json").write_text(
             json.dumps({"key": summary["key"], "runs": summary["runs"], "settings": summary["settings"]}, indent=2)

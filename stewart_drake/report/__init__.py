@@ -20,19 +20,19 @@ import base64
 import html
 import importlib.util
 import io
-import multiprocessing
 import os
 import shlex
 import sys
 import textwrap
 import time
 import warnings
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
+from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
 from stewart_drake.report import render
 
@@ -230,8 +230,7 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
     jobs = min(len(items), jobs or os.cpu_count() or 1)
     if jobs <= 1:
         return [_call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+    with worker_pool(jobs) as pool:  # spawned, dying with this process, terminated on Ctrl-C/SIGTERM
         return list(
             pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
         )
@@ -281,8 +280,7 @@ def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: 
             sections.append(build_section(a, quick))
             _progress(k, n, sections[-1], log)
         return sections
-    ctx = multiprocessing.get_context("spawn")  # no fork of a process that may hold Drake's threads
-    with ProcessPoolExecutor(max_workers=min(jobs, n), mp_context=ctx) as pool:
+    with worker_pool(min(jobs, n)) as pool:  # spawned (no fork of Drake's threads), dying with this process
         # The slowest first (ORDER is no guide; COST, when an analysis declares it, is), so that the
         # workers finish together.
         order = sorted(range(n), key=lambda i: -getattr(analyses[i], "cost", 0.0))

@@ -11,7 +11,7 @@ from pathlib import Path
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import PRESETS
 from stewart_drake.core.output_folder import OutputFolder
-from stewart_drake.errors import OptionError
+from stewart_drake.core.processes import check_workers
 from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
 
 
@@ -79,8 +79,7 @@ def report(
     """
     folder = out if isinstance(out, OutputFolder) else OutputFolder(str(out), force=force, option="--out")
     jobs = jobs if jobs is not None else min(4, os.cpu_count() or 1)
-    if not 1 <= jobs <= 64:
-        raise OptionError(OptionError.BETWEEN.format(option="--jobs", lo=1, hi=64, value=jobs))
+    check_workers("--jobs", jobs)  # the one rule for worker counts (core.processes)
     t0 = time.perf_counter()
     analyses = discover_analyses(only=only)
     if on_start:

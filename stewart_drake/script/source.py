@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
+from stewart_drake.core.input_stream import read_input
 from stewart_drake.errors import InputError
 
 MAX_PROGRAM_BYTES = 1_000_000
@@ -12,16 +11,14 @@ MAX_PROGRAM_BYTES = 1_000_000
 def read_program(path: str) -> str:
     """The text of a program file (UTF-8, at most ``MAX_PROGRAM_BYTES``); ``InputError`` naming the file
     (and the line of a NUL byte) otherwise."""
-    f = Path(path)
-    if not f.exists():
-        raise InputError(InputError.PROGRAM_MISSING.format(path=path))
-    if not f.is_file():
-        what = "a folder" if f.is_dir() else "not a regular file"
-        raise InputError(InputError.PROGRAM_NOT_FILE.format(path=path, what=what))
-    with f.open("rb") as fh:
-        data = fh.read(MAX_PROGRAM_BYTES + 1)
-    if len(data) > MAX_PROGRAM_BYTES:
-        raise InputError(InputError.PROGRAM_TOO_LARGE.format(path=path, limit=MAX_PROGRAM_BYTES))
+    data = read_input(  # once, as a stream: a FIFO or <(...) works, /dev/zero stops at the limit
+        path,
+        kind="program",
+        limit=MAX_PROGRAM_BYTES,
+        missing=InputError.PROGRAM_MISSING.format(path=path),
+        folder=InputError.PROGRAM_NOT_FILE.format(path=path, what="a folder"),
+        too_large=InputError.PROGRAM_TOO_LARGE.format(path=path, limit=MAX_PROGRAM_BYTES),
+    )
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:

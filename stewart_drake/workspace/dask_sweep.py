@@ -45,6 +45,7 @@ import dask
 import distributed
 import numpy as np
 
+from stewart_drake.core.processes import quiet_resource_tracker
 from stewart_drake.workspace.executors import default_workers
 from stewart_drake.workspace.grid import constant_orientation_workspace, default_bounds, grid_axes
 from stewart_drake.workspace.maps import count_reachable
@@ -54,6 +55,8 @@ from stewart_drake.workspace.maps import count_reachable
 WORKER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.nanny.pre-spawn-environ": {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
+    # each worker dies with this process (even by SIGKILL) and leaves Ctrl-C to it (core.processes)
+    "distributed.worker.preload": ["stewart_drake.core.processes"],
 }
 # At least this many tasks per worker thread (load balance: the last wave of tasks is a small share).
 TASKS_PER_WORKER = 8
@@ -79,6 +82,7 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
     reach the root's handler instead."""
     distributed_logger = logging.getLogger("distributed")
     distributed_logger.setLevel(max(distributed_logger.getEffectiveLevel(), logging.WARNING))
+    quiet_resource_tracker()
     held = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
     try:
         with dask.config.set(WORKER_CONFIG):
@@ -86,7 +90,7 @@ def local_cluster(n_workers: int, threads_per_worker: int = 1, processes: bool =
                 n_workers=n_workers,
                 threads_per_worker=threads_per_worker,
                 processes=processes,
-                dashboard_address=None,
+                dashboard_address="127.0.0.1:0",  # a free port: no "Port 8787 is already in use" warning
                 **kwargs,
             )
     finally:

@@ -4,14 +4,14 @@ any ``concurrent.futures.Executor`` (e.g. Dask's, see ``workspace_dask``), with 
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import sys
 from collections import deque
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor
 
 from tqdm import tqdm
 
+from stewart_drake.core.processes import worker_pool
 from stewart_drake.workspace.limits import WorkspaceError
 
 
@@ -22,7 +22,7 @@ def run_tasks(fn, tasks, executor, workers, progress, desc):
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, file=sys.stderr, leave=False)
     try:
         if executor is None and workers > 1 and len(tasks) > 1:
-            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as ex:
+            with worker_pool(workers) as ex:  # spawned, dying with this process, terminated on Ctrl-C/SIGTERM
                 yield from _drain(ex, fn, tasks, bar, window=4 * workers)
         elif executor is not None:
             if not isinstance(executor, Executor) and not hasattr(executor, "submit"):

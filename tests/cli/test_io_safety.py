@@ -184,13 +184,25 @@ def test_stale_temp_of_dead_run_cleaned_live_one_kept(here):
     stale = here / f".w.sd-tmp-{dead.pid}-0123abcd"
     stale.mkdir()
     (stale / "partial.csv").write_text("1,2")
+    (stale / ".sd-tmp").write_text(json.dumps({"pid": dead.pid, "token": "0123abcd"}))  # the tool's marker
     alive = here / f".w.sd-tmp-{os.getppid()}-89abcdef"
     alive.mkdir()
+    (alive / ".sd-tmp").write_text(json.dumps({"pid": os.getppid(), "token": "89abcdef"}))
     other = here / ".w.old-12345"  # not ours by name: never touched
     other.mkdir()
+    # named like a temporary of a dead run, but without the marker (or a marker of another name): the user's
+    lookalike = here / f".w.sd-tmp-{dead.pid}-fedcba98"
+    lookalike.mkdir()
+    (lookalike / "mine.txt").write_text("user data")
+    forged = here / f".w.sd-tmp-{dead.pid}-00000000"
+    forged.mkdir()
+    (forged / ".sd-tmp").write_text(json.dumps({"pid": dead.pid, "token": "11111111"}))
+    lookalike_file = here / f".w.sd-tmp-{dead.pid}-abcdef01"
+    lookalike_file.write_text("a user's file")
     with atomic_folder("w") as tmp:
         (tmp / "r.txt").write_text("ok")
     assert not stale.exists() and alive.exists() and other.exists()
+    assert (lookalike / "mine.txt").read_text() == "user data" and forged.exists() and lookalike_file.exists()
 
 
 def test_safe_file_stem_confines_names():
@@ -382,8 +394,7 @@ def test_yaml_size_limit(here, capsys):
     rc, _, err = cli(capsys, "fk", "--platform", "big.yaml", "--lengths", *["700"] * 6)
     assert (
         rc == 2
-        and err.strip()
-        == "stewart-drake fk: error: big.yaml: 1000001 bytes is larger than the 1000000-byte limit for a platform file"
+        and err.strip() == "stewart-drake fk: error: big.yaml: larger than the 1000000-byte limit for a platform file"
     )
 
 

@@ -158,7 +158,7 @@ def test_cli_generate_writes_module_and_refuses_foreign_folder(tmp_path, capsys)
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "notes.txt").write_text("x")
     assert main(["firmware", "generate", "--out", str(tmp_path / "mine")]) == 2
-    assert "did not write (notes.txt)" in capsys.readouterr().err
+    assert "not written by stewart-drake (no manifest) (e.g. 'notes.txt'" in capsys.readouterr().err
     assert (tmp_path / "mine" / "notes.txt").read_text() == "x"
     assert main(["firmware", "generate", "--out", str(tmp_path / "x"), "--word-bits", "20"]) == 2
     assert "--word-bits" in capsys.readouterr().err

@@ -187,7 +187,7 @@ def test_study_resumes_without_repeating_finished_runs(tmp_path, monkeypatch, ca
 def test_refuses_a_folder_it_did_not_write(tmp_path, capsys):
     (tmp_path / "mine.txt").write_text("keep")
     assert main(_study_args(tmp_path, 1, "--workers", "0")) == 2
-    assert "did not write" in capsys.readouterr().err and (tmp_path / "mine.txt").read_text() == "keep"
+    assert "not written by stewart-drake" in capsys.readouterr().err and (tmp_path / "mine.txt").read_text() == "keep"
 
 
 def test_rows_same_with_one_or_two_dask_workers(tmp_path):

@@ -1,0 +1,134 @@
+"""Child processes: how many a command may start, and that they die with their parent, quietly.
+
+- ``check_workers``: the one rule for ``--workers``/``--jobs`` (each worker is a Python process with
+  numpy, ~150 MB; more than 4 per CPU only adds overhead).
+- ``child_setup``: run first in every worker process (``multiprocessing`` pools, Dask workers through
+  ``dask_setup``, the isolated firmware child): the kernel kills it when its parent dies, even by
+  SIGKILL (``PR_SET_PDEATHSIG``), and it ignores SIGINT: Ctrl-C reaches the whole process group, and the
+  parent alone stops the work and says so in one line (no traceback per worker).
+- ``mark_cli``: the command line's PID in the environment (``STEWART_DRAKE_CLI_PID``): a worker process it
+  starts ignores SIGINT from the moment it imports this package (``stewart_drake/__init__``), so that a
+  Ctrl-C while the worker starts is not a traceback either.
+- ``worker_pool``: a spawn ``ProcessPoolExecutor`` whose workers run ``child_setup`` and are terminated,
+  not waited for, when the parent is interrupted.
+- ``Terminated`` / ``handle_sigterm``: SIGTERM raises in the main thread like Ctrl-C, so that the
+  ``finally`` blocks run (temporary folders removed, clusters closed) before the process exits 143.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import multiprocessing
+import os
+import signal
+import sys
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
+
+from stewart_drake.core.sanity import check_work
+from stewart_drake.errors import OptionError
+
+BYTES_PER_WORKER = 150e6
+WORKERS_PER_CPU = 4
+_PR_SET_PDEATHSIG = 1
+
+
+def max_workers() -> int:
+    """The most worker processes one command may start on this machine."""
+    return WORKERS_PER_CPU * (os.cpu_count() or 1)
+
+
+def check_workers(option: str, value: int, minimum: int = 1) -> int:
+    """``value`` if it is a number of worker processes this machine can hold (``minimum`` ..
+    ``max_workers()``, and their memory within the budget); else ``OptionError``/``WorkTooLargeError``
+    naming ``option`` and the value."""
+    if not minimum <= value <= max_workers():
+        raise OptionError(OptionError.BETWEEN.format(option=option, lo=minimum, hi=max_workers(), value=value))
+    check_work(option, str(value), value, "worker processes", BYTES_PER_WORKER)
+    return value
+
+
+def die_with_parent(sig: int = signal.SIGKILL) -> None:
+    """Ask the kernel to send ``sig`` to this process when its parent dies (Linux; elsewhere nothing)."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, int(sig), 0, 0, 0)
+    except (OSError, AttributeError):
+        return
+    if os.getppid() == 1:  # the parent died before the request: follow it now
+        os._exit(1)
+
+
+def child_setup() -> None:
+    """Run first in a worker process: die with the parent, leave SIGINT to the parent."""
+    die_with_parent()
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread: the parent's cleanup still stops this worker
+        return
+
+
+@contextmanager
+def worker_pool(n: int) -> Iterator[ProcessPoolExecutor]:
+    """A ``ProcessPoolExecutor`` of ``n`` spawned workers (no fork of a process that may hold Drake's
+    threads) running ``child_setup``; on an error or interrupt the workers are terminated at once."""
+    quiet_resource_tracker()
+    ctx = multiprocessing.get_context("spawn")
+    before = set(multiprocessing.active_children())
+    pool = ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=child_setup)
+    try:
+        yield pool
+    except BaseException:
+        for p in set(multiprocessing.active_children()) - before:
+            p.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
+def quiet_resource_tracker() -> None:
+    """The resource tracker (started with the first pool) outlives a parent killed by SIGKILL for a moment
+    and then warns of "leaked semaphore objects" on the terminal: it takes this process's warning options
+    (``sys.warnoptions``) when it starts, so the warning is filtered there."""
+    option = "ignore::UserWarning:multiprocessing.resource_tracker"
+    if option not in sys.warnoptions:
+        sys.warnoptions.append(option)
+
+
+def mark_cli() -> None:
+    """Record this process as the command line that owns the worker processes it starts."""
+    os.environ["STEWART_DRAKE_CLI_PID"] = str(os.getpid())
+
+
+def exit_now(code: int) -> None:
+    """End this process now with ``code`` after flushing its output, without the exit hooks (an interrupted
+    Dask cluster's atexit close prints tracebacks); its workers die with it (``die_with_parent``)."""
+    for p in multiprocessing.active_children():  # first, so that none logs the lost connection
+        try:
+            os.kill(p.pid, signal.SIGKILL)
+        except OSError:
+            pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(code)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread so that cleanup runs as for Ctrl-C (exit status 143)."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a second SIGTERM ends the process at once
+    raise Terminated()
+
+
+def handle_sigterm() -> None:
+    """Make SIGTERM raise ``Terminated`` in the main thread (nothing when called from another thread)."""
+    try:
+        signal.signal(signal.SIGTERM, _raise_terminated)
+    except ValueError:
+        pass
