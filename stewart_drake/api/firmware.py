@@ -117,7 +117,8 @@ def generate(
 
     Args:
         platform: the platform.
-        out: the output folder (created; only the firmware's own files are replaced).
+        out: the output folder: new, empty, or holding only files this command wrote (the manifest records each
+            with its sha256; another command's file or a changed one is refused, never replaced).
         word_bits: data word width, 8..16.
         length_lsb: metres per length LSB.
         trig: the trigonometry (``"tfr16"``: the DSP's; needs 16-bit words).

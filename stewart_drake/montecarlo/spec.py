@@ -231,7 +231,9 @@ def _parse_yaml(path: Path) -> VarySpec:
         where = _where(str(path), k.start_mark.line + 1)
         if not isinstance(k, yaml.ScalarNode):  # a list or mapping as a key ([a, b]: 1)
             raise SpecError(
-                SpecError.KEY_NOT_TEXT.format(where=where, key=short_text(text[k.start_mark.index : k.end_mark.index]))
+                SpecError.KEY_NOT_TEXT.format(
+                    where=where, key=short_text(" ".join(text[k.start_mark.index : k.end_mark.index].split()))
+                )
             )
         if k.value in first:  # YAML keeps the last silently: refused
             raise SpecError(SpecError.DUPLICATE.format(where=where, key=k.value, first=first[k.value]))

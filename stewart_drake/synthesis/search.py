@@ -115,7 +115,7 @@ class CacheWriter:
             self.fh.write("\n")
         if new:
             self.write({"key": key})
-            claim_in_manifest(out, [CACHE])
+            claim_in_manifest(out, [CACHE], prefix=True)  # append-only: verified by its first bytes
 
     def write(self, obj: dict) -> None:
         self.fh.write(json.dumps(obj) + "\n")
