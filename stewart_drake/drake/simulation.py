@@ -48,7 +48,7 @@ from stewart_drake.drake.integrators import (
     constraint_gaps,
 )
 from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
+from stewart_drake.drake.systems import Actuators, LegLengthSensor, TickTableSource, make_controller
 from stewart_drake.errors import SimulationError
 
 # ----------------------------------------------------------------------------------------------
@@ -154,6 +154,7 @@ class Simulation:
     feedforward: object = None
     integrator: str = "sap"
     source: object = None
+    feedforward_source: object = None
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> SimulationLog:
@@ -167,11 +168,15 @@ class Simulation:
         T = self.config.timing.sample_period
         n = int(math.floor(duration / T + 1e-9)) + 1
         ticks = np.arange(n) * T
-        poses = self.source.prime(ticks)  # the reference at the ticks, in one batch (speed only)
+        # the reference and the feed-forward at every tick of the run, in one batch each, as tables the
+        # Diagram reads in C++ (the pose functions are elementwise over times: the numbers of one at a time)
+        poses = self.trajectory.pose(ticks)
+        self.source.set_rows(poses)
         if hasattr(self.controller.law, "prime"):  # and the IK of those poses (speed only)
             self.controller.law.prime(poses)
-        if self.feedforward is not None:  # the feed-forward table at the ticks, in one batch
+        if self.feedforward is not None:
             self.feedforward.prime(ticks)
+            self.feedforward_source.set_rows([self.feedforward.table[float(t)] for t in ticks])
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
@@ -251,7 +256,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
     ctrl = builder.AddSystem(make_controller(s.controller, platform, config, s.engine, s.firmware))
     ctrl.set_name(f"{s.controller}_controller")
-    src = builder.AddSystem(PoseSource(trajectory))
+    T = config.timing.sample_period
+    # the reference at the ticks; until ``run`` fills the table, the pose at t = 0 (read by Initialize)
+    src = builder.AddSystem(TickTableSource(T, trajectory.pose(np.zeros(1))))
     src.set_name("reference")
     max_force = actuators.max_force or float(platform.legs.max_force)
     act = builder.AddSystem(Actuators(max_force, actuators.time_constant, plant_time_step))
@@ -281,18 +288,16 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         )
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
-    ff = None
+    ff = ffs = None
     if s.feedforward:
-        T = config.timing.sample_period
         ff = FeedforwardTable(platform, trajectory, feedforward_lead(config, actuators.time_constant), T)
-        ffs = builder.AddSystem(FeedforwardSource(ff))
+        ffs = builder.AddSystem(TickTableSource(T, ff.force(0.0)))
         ffs.set_name("feedforward_table")
         builder.Connect(ffs.get_output_port(), ctrl.GetInputPort("feedforward"))
     builder.Connect(plant.get_state_output_port(), sensor.get_input_port())
     builder.Connect(sensor.get_output_port(), ctrl.GetInputPort("leg_lengths"))
     builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
     builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
-    T = config.timing.sample_period
     # the discrete plant logs at its steps; the continuous one at the same period (not at every integrator step)
     lp = () if integrator == "sap" else (plant_time_step,)
     loggers = {
@@ -340,6 +345,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         ff,
         integrator,
         src,
+        ffs,
     )
 
 
