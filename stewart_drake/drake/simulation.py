@@ -165,18 +165,7 @@ class Simulation:
             raise RuntimeError("a Simulation runs once; build a new one")
         self._ran = True
         sim = self.simulator
-        T = self.config.timing.sample_period
-        n = int(math.floor(duration / T + 1e-9)) + 1
-        ticks = np.arange(n) * T
-        # the reference and the feed-forward at every tick of the run, in one batch each, as tables the
-        # Diagram reads in C++ (the pose functions are elementwise over times: the numbers of one at a time)
-        poses = self.trajectory.pose(ticks)
-        self.source.set_rows(poses)
-        if hasattr(self.controller.law, "prime"):  # and the IK of those poses (speed only)
-            self.controller.law.prime(poses)
-        if self.feedforward is not None:
-            self.feedforward.prime(ticks)
-            self.feedforward_source.set_rows([self.feedforward.table[float(t)] for t in ticks])
+        self.prepare(duration)
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
@@ -191,6 +180,21 @@ class Simulation:
             self.visualizer.StopRecording()
             self.visualizer.PublishRecording()
         return self._collect()
+
+    def prepare(self, duration: float) -> None:
+        """Fill the tables the run reads (``run`` calls it): the reference and the feed-forward at every
+        tick of ``duration`` seconds, in one batch each, as the tables the Diagram reads in C++ (the pose
+        functions are elementwise over times: the numbers of one time at a time), and the law's IK of
+        those poses (speed only). What a host computes and downloads before the DSP starts."""
+        T = self.config.timing.sample_period
+        ticks = np.arange(int(math.floor(duration / T + 1e-9)) + 1) * T
+        poses = self.trajectory.pose(ticks)
+        self.source.set_rows(poses)
+        if hasattr(self.controller.law, "prime"):
+            self.controller.law.prime(poses)
+        if self.feedforward is not None:
+            self.feedforward.prime(ticks)
+            self.feedforward_source.set_rows([self.feedforward.table[float(t)] for t in ticks])
 
     def max_constraint_gap(self, samples: int = 1000) -> float:
         """The largest ball-constraint gap (m) of this run: how far the loop closures opened, over up to
