@@ -3,15 +3,17 @@
 One typed, picklable ``Scenario`` describes a run (platform, reference, controller kind and engine, timing
 and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram::
 
-    PoseSource ──reference──▶ ControllerSystem (fixed | float law, discrete, period T) ──command──▶ Actuators
-        ▲  FeedforwardSource ──▶    ▲ leg_lengths                                                 │ force
+    reference table ──▶ ControllerSystem (fixed | float law, discrete, period T) ──command──▶ Actuators
+        ▲  feed-forward table ──▶    ▲ leg_lengths                                               │ force
         │                           └──────── sensor (prismatic positions) ◀──── plant ◀──────────┘
         └ (core.trajectory: seed, rotating, a (t, pose) CSV, a motion program)
 
 The feed-forward table (``control.feedforward``) holds, per tick, the leg forces of the inverse dynamics
 (plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
 with the pose table and download to the DSP. Without it (``feedforward=False``) the PID alone carries
-the plate.
+the plate. Both tables are filled for every tick of the run before it starts (``Simulation.prepare``) and
+read by Drake's ``TrajectorySource`` (``systems.TickTableSource``): per tick, the only Python is the
+controller's one callback around its law.
 
 Loggers record, at every plant step, the plant state (pose and leg lengths come from it), the
 controller's held command and set-point, its status (tick count, tick time, saturation counts) and the
