@@ -1,9 +1,9 @@
 """The report's result cache: a section is recomputed only when its inputs or the code changed.
 
 A section's key is the SHA-256 of: the code version (``code_version``: every source and data file of the
-installed ``stewart_drake`` package, by relative path and content, plus the Python, NumPy and Drake
-versions), the analysis' name, the content of its script when it lies outside the package, the ``quick``
-flag, and the compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an
+installed ``stewart_drake`` package, by relative path and content, plus the versions of Python and of the
+libraries that draw or compute, ``DEPENDENCIES``), the analysis' name, the content of its script when it
+lies outside the package, the ``quick`` flag, and the compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an
 input of the sections that run it). The analyses read only the built-in presets (package files, so part of
 the code version) and their own fixed seeds: nothing else is an input.
 
@@ -26,26 +26,29 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1]
 FORMAT = 1  # bump when the entry's layout changes
+# the libraries whose versions can change a section's numbers or figures (part of the code version)
+DEPENDENCIES = ("drake", "numpy", "scipy", "matplotlib", "pymoo", "python-flint", "cffi")
 
 
 @cache
 def code_version(root: Path = PACKAGE) -> str:
     """SHA-256 (hex) of every file of the package under ``root`` but the bytecode caches (relative path and
-    bytes, in sorted order: sources, C files, presets, grammars, tables) and of the Python, NumPy and Drake
-    versions: any edit of the code or its data changes it."""
+    bytes, in sorted order: sources, C files, presets, grammars, tables), of the Python version and of the
+    ``DEPENDENCIES``' versions: any edit of the code or its data, or an upgrade, changes it."""
     import numpy as np
 
     h = hashlib.sha256()
     for p in sorted(q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix != ".pyc"):
         h.update(str(p.relative_to(root)).encode() + b"\0")
         h.update(hashlib.sha256(p.read_bytes()).digest())
-    try:
-        from importlib.metadata import version
+    from importlib.metadata import PackageNotFoundError, version
 
-        drake = version("drake")
-    except Exception:  # noqa: BLE001 - not installed as a distribution: the import path is the best name
-        drake = "unknown"
-    h.update(f"{sys.version}|{np.__version__}|{drake}|{FORMAT}".encode())
+    for dist in DEPENDENCIES:
+        try:
+            h.update(f"|{dist}={version(dist)}".encode())
+        except PackageNotFoundError:
+            h.update(f"|{dist}=absent".encode())
+    h.update(f"{sys.version}|{np.__version__}|{FORMAT}".encode())
     return h.hexdigest()
 
 
