@@ -24,9 +24,10 @@ import numpy as np
 
 from stewart_drake.core.geometry import base_joints
 from stewart_drake.core.output_folder import claim_in_manifest
+from stewart_drake.drake.systems import make_law
 from stewart_drake.errors import StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
-from stewart_drake.montecarlo.scenario import Study, run_scenario
+from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -174,6 +175,15 @@ def check_study(study: Study) -> float:
     return duration
 
 
+def compile_firmware(study: Study, index: int) -> None:
+    """With the C engine, compile run ``index``'s firmware into the C build cache here, before the workers
+    start: they load it instead of each compiling the same module at once on a cold cache (a run whose
+    gains or timing differ still compiles its own, once, in its worker)."""
+    if study.engine == "c" and study.controller == "fixed":
+        sc = scenario(study, index)[2]
+        make_law(sc.controller, sc.platform, sc.config, sc.engine, sc.firmware)
+
+
 def run_row(study: Study, index: int) -> dict:
     """The Dask task: run ``index`` of ``study`` and return its row (no log)."""
     return run_scenario(study, index)
@@ -286,6 +296,7 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
 
     from stewart_drake.workspace.dask_sweep import local_cluster
 
+    compile_firmware(study, todo[0])
     cluster = None
     if scheduler is None:
         cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
