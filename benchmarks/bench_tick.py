@@ -55,10 +55,22 @@ def plant(p, duration: float) -> float:
     return (time.process_time() - c0) / duration
 
 
+PREPARE: dict[str, float] = {}  # CPU s per simulated s of Simulation.prepare (the tick tables), per loop
+
+
 def loop(p, kind: str, engine: str, duration: float, null_step: bool = False) -> float:
-    """CPU seconds per simulated second of one closed-loop run (build excluded); ``null_step``: the law's
-    step returns its first result every tick (the LeafSystem's Python around it still runs)."""
+    """CPU seconds per simulated second of one closed-loop run (build excluded; the tick tables that
+    ``run`` fills first included, their share noted in ``PREPARE``); ``null_step``: the law's step
+    returns its first result every tick (the LeafSystem's Python around it still runs)."""
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
+    real_prepare = sim.prepare
+
+    def prepare(d):
+        c = time.process_time()
+        real_prepare(d)
+        PREPARE[kind] = min(PREPARE.get(kind, np.inf), (time.process_time() - c) / duration)
+
+    sim.prepare = prepare
     if null_step:
         law = sim.controller.law
         real = law.step
@@ -118,11 +130,13 @@ def main(argv=None) -> int:
         ("fixed/C", "fixed, C engine", "fixed, C, null step"),
         ("float", "float", "float, null step"),
     ):
-        sys_us = us[null] - us["plant"]
+        prep_us = 1e3 * PREPARE[kind.split("/")[0]]
+        sys_us = us[null] - us["plant"] - prep_us
         law_us = us[full] - us[null]
         print(
-            f"{kind:8s} tick {us[full]:6.1f} µs = plant {us['plant']:6.1f} + rest of the Diagram (controller callback, "
-            f"sources, sensor, actuators, loggers) {sys_us:5.1f} + law.step {law_us:5.1f}"
+            f"{kind:8s} tick {us[full]:6.1f} µs = plant {us['plant']:6.1f} + tick tables (reference, IK words, "
+            f"feed-forward: before the run) {prep_us:5.1f} + rest of the Diagram (controller callback, sources, "
+            f"sensor, actuators, loggers) {sys_us:5.1f} + law.step {law_us:5.1f}"
         )
     print(f"law.step alone, C engine: {step_us(p, 'c'):.1f} µs per call (of it the sd_host_tick C call is < 1 µs)")
     print(f"# {load()}")

@@ -20,6 +20,11 @@ def register(sub) -> None:
         metavar="N",
         help="analyses run in N worker processes (default: the number of CPUs, at most 4; 1: in this process)",
     )
+    p.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="recompute every section (default: a section whose inputs and code are unchanged comes from the cache)",
+    )
     add_force_arg(p)
     p.set_defaults(func=run)
 
@@ -27,7 +32,7 @@ def register(sub) -> None:
 def run(args) -> int:
     out = output_folder(args)
     say = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
-    r = report(out, only=args.only, quick=args.quick, jobs=args.jobs, on_start=say)
+    r = report(out, only=args.only, quick=args.quick, jobs=args.jobs, on_start=say, cache=not args.no_cache)
     print(f"wrote {r.index}: {len(r.checks)} checks, {len(r.failed)} failed, {r.elapsed_s:.0f} s")
     for c in r.failed:
         print(f"  FAIL {c.section}: {c.what}: worst {c.worst:.4g} {c.unit} > tolerance {c.tolerance:.4g} {c.unit}")

@@ -15,7 +15,9 @@ configuration is given):
 
 from __future__ import annotations
 
+import hashlib
 import math
+import pickle
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -173,11 +175,9 @@ def design_gains(
         raise GainError(GainError.ACTUATOR_LAG.format(value=actuator_lag))
     q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float).reshape(6)
     visited = np.concatenate([q0[None], design_pose_subset(poses)])
-    m = np.linalg.eigvalsh(leg_space_inertia(platform, visited))
-    m_min, m_max = float(m[:, 0].min()), float(m[:, -1].max())
+    m_min, m_max, K = _mass_and_stiffness_extremes(platform, visited)
     if not m_min > 0:
         raise GainError(GainError.INERTIA.format(name=platform.name, m_min=m_min))
-    K = float(strut_stiffness(platform, visited).max())
     if poses is None:
         K *= UNKNOWN_POSE_STIFFNESS_FACTOR
     w_c = PHASE_BUDGET / loop_delay(timing, actuator_lag)
@@ -187,6 +187,30 @@ def design_gains(
     kp = max(min(kd**2 / (4 * HEAVY_MODE_DAMPING**2 * m_max), kd * w_c / 3), STIFFNESS_MARGIN * K)
     ki = min(kp * math.sqrt(kp / m_max) / 4, ROUTH_FRACTION * kd * (kp - K) / m_max)
     return PidGains(kp=kp, ki=ki, kd=kd, kv=kd)
+
+
+_EXTREMES: dict[bytes, tuple[float, float, float]] = {}  # content hash -> (m_min, m_max, K), newest last
+_EXTREMES_KEPT = 16
+
+
+def _mass_and_stiffness_extremes(platform: Platform, visited) -> tuple[float, float, float]:
+    """``(m_min, m_max, K)`` over the poses ``visited`` ``(n, 6)``: the lightest and heaviest leg-space
+    modes (kg) and the struts' largest negative stiffness (N/m), the costly part of ``design_gains``.
+    Remembered by content (the platform's pickle and the poses' bytes, the last ``_EXTREMES_KEPT``), so that
+    the runs of a study, which design for the same nominal platform and reference, compute it once per
+    process: the same numbers, computed once."""
+    key = hashlib.sha256(pickle.dumps(platform, protocol=4) + np.ascontiguousarray(visited, float).tobytes()).digest()
+    hit = _EXTREMES.get(key)
+    if hit is None:
+        m = np.linalg.eigvalsh(leg_space_inertia(platform, visited))
+        m_min, m_max = float(m[:, 0].min()), float(m[:, -1].max())
+        if not m_min > 0:  # refused by the caller before the stiffness is asked for
+            return m_min, m_max, math.nan
+        hit = (m_min, m_max, float(strut_stiffness(platform, visited).max()))
+        _EXTREMES[key] = hit
+        while len(_EXTREMES) > _EXTREMES_KEPT:
+            del _EXTREMES[next(iter(_EXTREMES))]
+    return hit
 
 
 def design_pose_subset(poses) -> np.ndarray:

@@ -3,15 +3,17 @@
 One typed, picklable ``Scenario`` describes a run (platform, reference, controller kind and engine, timing
 and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram::
 
-    PoseSource ──reference──▶ ControllerSystem (fixed | float law, discrete, period T) ──command──▶ Actuators
-        ▲  FeedforwardSource ──▶    ▲ leg_lengths                                                 │ force
+    reference table ──▶ ControllerSystem (fixed | float law, discrete, period T) ──command──▶ Actuators
+        ▲  feed-forward table ──▶    ▲ leg_lengths                                               │ force
         │                           └──────── sensor (prismatic positions) ◀──── plant ◀──────────┘
         └ (core.trajectory: seed, rotating, a (t, pose) CSV, a motion program)
 
 The feed-forward table (``control.feedforward``) holds, per tick, the leg forces of the inverse dynamics
 (plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
 with the pose table and download to the DSP. Without it (``feedforward=False``) the PID alone carries
-the plate.
+the plate. Both tables are filled for every tick of the run before it starts (``Simulation.prepare``) and
+read by Drake's ``TrajectorySource`` (``systems.TickTableSource``): per tick, the only Python is the
+controller's one callback around its law.
 
 Loggers record, at every plant step, the plant state (pose and leg lengths come from it), the
 controller's held command and set-point, its status (tick count, tick time, saturation counts) and the
@@ -48,7 +50,7 @@ from stewart_drake.drake.integrators import (
     constraint_gaps,
 )
 from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.drake.systems import Actuators, FeedforwardSource, LegLengthSensor, PoseSource, make_controller
+from stewart_drake.drake.systems import Actuators, LegLengthSensor, TickTableSource, make_controller
 from stewart_drake.errors import SimulationError
 
 # ----------------------------------------------------------------------------------------------
@@ -154,6 +156,7 @@ class Simulation:
     feedforward: object = None
     integrator: str = "sap"
     source: object = None
+    feedforward_source: object = None
     _ran: bool = False
 
     def run(self, duration: float, progress: bool = False) -> SimulationLog:
@@ -164,14 +167,7 @@ class Simulation:
             raise RuntimeError("a Simulation runs once; build a new one")
         self._ran = True
         sim = self.simulator
-        T = self.config.timing.sample_period
-        n = int(math.floor(duration / T + 1e-9)) + 1
-        ticks = np.arange(n) * T
-        poses = self.source.prime(ticks)  # the reference at the ticks, in one batch (speed only)
-        if hasattr(self.controller.law, "prime"):  # and the IK of those poses (speed only)
-            self.controller.law.prime(poses)
-        if self.feedforward is not None:  # the feed-forward table at the ticks, in one batch
-            self.feedforward.prime(ticks)
+        self.prepare(duration)
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
@@ -194,6 +190,21 @@ class Simulation:
             self.visualizer.StopRecording()
             self.visualizer.PublishRecording()
         return self._collect()
+
+    def prepare(self, duration: float) -> None:
+        """Fill the tables the run reads (``run`` calls it): the reference and the feed-forward at every
+        tick of ``duration`` seconds, in one batch each, as the tables the Diagram reads in C++ (the pose
+        functions are elementwise over times: the numbers of one time at a time), and the law's IK of
+        those poses (speed only). What a host computes and downloads before the DSP starts."""
+        T = self.config.timing.sample_period
+        ticks = np.arange(int(math.floor(duration / T + 1e-9)) + 1) * T
+        poses = self.trajectory.pose(ticks)
+        self.source.set_rows(poses)
+        if hasattr(self.controller.law, "prime"):
+            self.controller.law.prime(poses)
+        if self.feedforward is not None:
+            self.feedforward.prime(ticks)
+            self.feedforward_source.set_rows([self.feedforward.table[float(t)] for t in ticks])
 
     def max_constraint_gap(self, samples: int = 1000) -> float:
         """The largest ball-constraint gap (m) of this run: how far the loop closures opened, over up to
@@ -259,7 +270,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
     ctrl = builder.AddSystem(make_controller(s.controller, platform, config, s.engine, s.firmware))
     ctrl.set_name(f"{s.controller}_controller")
-    src = builder.AddSystem(PoseSource(trajectory))
+    T = config.timing.sample_period
+    # the reference at the ticks; until ``run`` fills the table, the pose at t = 0 (read by Initialize)
+    src = builder.AddSystem(TickTableSource(T, trajectory.pose(np.zeros(1))))
     src.set_name("reference")
     max_force = actuators.max_force or float(platform.legs.max_force)
     act = builder.AddSystem(Actuators(max_force, actuators.time_constant, plant_time_step))
@@ -289,18 +302,16 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         )
     sensor.set_name("leg_length_sensor")
     builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
-    ff = None
+    ff = ffs = None
     if s.feedforward:
-        T = config.timing.sample_period
         ff = FeedforwardTable(platform, trajectory, feedforward_lead(config, actuators.time_constant), T)
-        ffs = builder.AddSystem(FeedforwardSource(ff))
+        ffs = builder.AddSystem(TickTableSource(T, ff.force(0.0)))
         ffs.set_name("feedforward_table")
         builder.Connect(ffs.get_output_port(), ctrl.GetInputPort("feedforward"))
     builder.Connect(plant.get_state_output_port(), sensor.get_input_port())
     builder.Connect(sensor.get_output_port(), ctrl.GetInputPort("leg_lengths"))
     builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
     builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
-    T = config.timing.sample_period
     # the discrete plant logs at its steps; the continuous one at the same period (not at every integrator step)
     lp = () if integrator == "sap" else (plant_time_step,)
     loggers = {
@@ -348,6 +359,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         ff,
         integrator,
         src,
+        ffs,
     )
 
 

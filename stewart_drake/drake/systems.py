@@ -3,8 +3,9 @@
 - ``ControllerSystem``: a control law (``control.FloatLaw``, ``control.FixedPointLaw`` or the compiled
   ``firmware.sil.CFixedPointLaw``) ticking at exactly t = k·T, with the DSP's output latency and a
   zero-order hold on its outputs;
-- ``PoseSource``: a ``core.trajectory.Trajectory`` as an output port;
-- ``FeedforwardSource``: the feed-forward table (``control.FeedforwardTable``) as an output port;
+- ``PoseSource``: a ``core.trajectory.Trajectory`` as an output port (computed in Python at any time);
+- ``TickTableSource``: rows of values at the controller's ticks as an output port read in C++ (Drake's
+  ``TrajectorySource`` of a ``DiscreteTimeTrajectory``): the closed loop's reference and feed-forward;
 - ``Actuators``: saturation and a first-order lag, discretised exactly at the plant's step (Drake primitives);
 - ``LegLengthSensor``: the plant state's leg lengths plus an offset, white noise and the first-order
   effect of a late sample (a Monte Carlo draw's sensor).
@@ -17,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import LinearSystem, Saturation
+from pydrake.systems.primitives import LinearSystem, Saturation, TrajectorySource
+from pydrake.trajectories import DiscreteTimeTrajectory
 
-from stewart_drake.control.feedforward import FeedforwardTable
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.laws import CONTROLLER_KINDS, STATUS, FixedPointLaw, FloatLaw
 from stewart_drake.core.geometry import Platform
@@ -40,9 +41,9 @@ class ControllerSystem(LeafSystem):
     outputs read discrete state, so between releases the command is held (zero-order hold).
 
     Discrete state groups: ``command`` (6: the released command, N) and ``setpoint`` (6: the released
-    set-point, m), each its output port as it is (read in C++, no Python call per sample); ``pending`` (12:
-    command and set-point computed but not yet released), ``pid`` (30: the law's state), ``status``
-    (``STATUS``).
+    set-point, m), each its output port as it is (read in C++, no Python call per sample); ``memory`` (42:
+    ``pending``, the command and set-point computed but not yet released (12), then ``pid``, the law's
+    state (30): one group, read and written once per tick), ``status`` (``STATUS``).
     """
 
     def __init__(self, law):
@@ -50,13 +51,12 @@ class ControllerSystem(LeafSystem):
         self.law = law
         self.platform, self.config, self.timing = law.platform, law.config, law.timing
         T = self.timing.sample_period
-        self.DeclareVectorInputPort("reference", 6)
-        self.DeclareVectorInputPort("leg_lengths", 6)
+        self._ref_port = self.DeclareVectorInputPort("reference", 6)
+        self._L_port = self.DeclareVectorInputPort("leg_lengths", 6)
         self._ff_port = self.DeclareVectorInputPort("feedforward", 6)
         self._command = self.DeclareDiscreteState(6)
         self._setpoint = self.DeclareDiscreteState(6)
-        self._pending = self.DeclareDiscreteState(12)
-        self._pid = self.DeclareDiscreteState(30)
+        self._memory = self.DeclareDiscreteState(42)  # pending (12) | pid (30)
         self._status = self.DeclareDiscreteState(len(STATUS))
         self.DeclareStateOutputPort("command", self._command)
         self.DeclareStateOutputPort("setpoint", self._setpoint)
@@ -64,44 +64,46 @@ class ControllerSystem(LeafSystem):
         self.DeclarePeriodicDiscreteUpdateEvent(T, 0.0, self._Tick)
         d = self.timing.output_delay
         self._release_separately = 0.0 < d < T
+        self._latency = self.timing.latency
+        self._release_at_tick = self._latency == "sample" or not self._release_separately
         if self._release_separately:
             self.DeclarePeriodicDiscreteUpdateEvent(T, d, self._Release)
 
     def _hold(self, discrete_state, released) -> None:
-        """Release ``released`` (12: command N, set-point m) to the output ports."""
+        """Release ``released`` (12 or more: command N, set-point m) to the output ports."""
         discrete_state.set_value(self._command, released[:6])
-        discrete_state.set_value(self._setpoint, released[6:])
+        discrete_state.set_value(self._setpoint, released[6:12])
 
     def _Tick(self, context, discrete_state):
-        ref = self.get_input_port(0).Eval(context)
-        L = self.get_input_port(1).Eval(context)
+        # one Python call per tick: the ports are read once each, the status row updated in place
+        ref = self._ref_port.Eval(context)
+        L = self._L_port.Eval(context)
         ff = self._ff_port.Eval(context) if self._ff_port.HasValue(context) else None
-        pid = context.get_discrete_state(self._pid).value()
-        command, setpoint, pid_new, saturated = self.law.step(pid, ref, L, ff)
+        memory = context.get_discrete_state(self._memory).value()
+        command, setpoint, pid_new, saturated = self.law.step(memory[12:], ref, L, ff)
         st = context.get_discrete_state(self._status).value().copy()
         t = context.get_time()
         st[0] += 1
         st[1] = t
-        st[3] += float(np.any(saturated))
+        st[3] += float(saturated.any())
         st[4:10] += saturated
-        out = np.concatenate([command, setpoint])
-        if self.timing.latency == "none":
-            self._hold(discrete_state, out)
+        new = np.concatenate([command, setpoint, pid_new])
+        if self._latency == "none":
+            self._hold(discrete_state, new)
             st[2] = t
-        elif self.timing.latency == "sample" or not self._release_separately:
+        elif self._release_at_tick:
             # release the previous tick's result now, (k+1)·T, then compute the next one
             if st[0] > 1:
-                self._hold(discrete_state, context.get_discrete_state(self._pending).value())
+                self._hold(discrete_state, memory)
                 st[2] = t
-        discrete_state.set_value(self._pending, out)
-        discrete_state.set_value(self._pid, pid_new)
+        discrete_state.set_value(self._memory, new)
         discrete_state.set_value(self._status, st)
 
     def _Release(self, context, discrete_state):
         st = context.get_discrete_state(self._status).value().copy()
         if st[0] < 1:
             return
-        self._hold(discrete_state, context.get_discrete_state(self._pending).value())
+        self._hold(discrete_state, context.get_discrete_state(self._memory).value())
         st[2] = context.get_time()
         discrete_state.set_value(self._status, st)
 
@@ -115,11 +117,10 @@ class ControllerSystem(LeafSystem):
         F = np.zeros(6) if hold_forces is None else np.asarray(hold_forces, dtype=float).reshape(6)
         ff = np.zeros(6) if feedforward is None else np.asarray(feedforward, dtype=float).reshape(6)
         pid = self.law.initial_pid_state(lengths, F - ff, rates)
-        context.SetDiscreteState(self._pid, pid)
         held = np.concatenate([self.law.command_from_integrator(pid[:6], ff), lengths])
         context.SetDiscreteState(self._command, held[:6])
         context.SetDiscreteState(self._setpoint, held[6:])
-        context.SetDiscreteState(self._pending, held)
+        context.SetDiscreteState(self._memory, np.concatenate([held, pid]))
         context.SetDiscreteState(self._status, np.zeros(len(STATUS)))
 
 
@@ -160,42 +161,37 @@ def make_controller(
 
 
 class PoseSource(LeafSystem):
-    """Output ``pose`` (6) = ``trajectory.pose(t)`` (any 6-vector function of time: also leg lengths);
-    ``prime(times)`` evaluates the times a run will ask for (the ticks) in one batch beforehand."""
+    """Output ``pose`` (6) = ``trajectory.pose(t)`` (any 6-vector function of time: also leg lengths),
+    computed in Python at the context's time (for any time; the closed loop uses ``TickTableSource``)."""
 
     def __init__(self, trajectory: Trajectory):
         super().__init__()
         self.trajectory = trajectory
-        self._table: dict[float, np.ndarray] = {}
         self.DeclareVectorOutputPort("pose", 6, self._CalcPose)
 
-    def prime(self, times) -> np.ndarray:
-        """Remember (and return, ``(n, 6)``) the poses at ``times`` (n,) s, computed in one batch (the pose
-        functions are elementwise over times: the same numbers as one at a time). A speed-up only; other
-        times are computed."""
-        times = np.asarray(times, dtype=float).reshape(-1)
-        poses = self.trajectory.pose(times)
-        for t, q in zip(times, poses):
-            self._table[float(t)] = q
-        return poses
-
     def _CalcPose(self, context, output):
-        t = context.get_time()
-        q = self._table.get(t)
         # evaluated on a 1-element array, the same code path as a batch of times
-        output.SetFromVector(q if q is not None else self.trajectory.pose(np.array([t]))[0])
+        output.SetFromVector(self.trajectory.pose(np.array([context.get_time()]))[0])
 
 
-class FeedforwardSource(LeafSystem):
-    """Output ``force`` (6, N) = ``table.force(t)`` at the context's time."""
+class TickTableSource(TrajectorySource):
+    """Output (6) = row k of a table at tick k·``period`` (Drake's ``TrajectorySource`` of a
+    ``DiscreteTimeTrajectory``: looked up in C++, no Python per tick). Asked at a time that is not a tick
+    within the table, it raises (Drake's error) instead of returning a neighbour. ``rows`` ``(n, 6)``: the
+    values at ticks 0 … n−1."""
 
-    def __init__(self, table: FeedforwardTable):
-        super().__init__()
-        self.table = table
-        self.DeclareVectorOutputPort("force", 6, self._CalcForce)
+    def __init__(self, period: float, rows):
+        self.period = period
+        super().__init__(self._table(rows))
 
-    def _CalcForce(self, context, output):
-        output.SetFromVector(self.table.force(context.get_time()))
+    def _table(self, rows) -> DiscreteTimeTrajectory:
+        rows = np.asarray(rows, dtype=float).reshape(-1, 6)
+        # k·T as numpy computes it: the times of Drake's periodic events with offset 0, bit for bit
+        return DiscreteTimeTrajectory(np.arange(len(rows)) * self.period, list(rows[:, :, None]))
+
+    def set_rows(self, rows) -> None:
+        """Replace the table by ``rows`` ``(n, 6)`` (before a run: the values it will read, in one batch)."""
+        self.UpdateTrajectory(self._table(rows))
 
 
 class Actuators(Diagram):

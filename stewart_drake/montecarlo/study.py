@@ -25,9 +25,10 @@ import numpy as np
 
 from stewart_drake.core.geometry import base_joints
 from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
+from stewart_drake.drake.systems import make_law
 from stewart_drake.errors import OutputError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
-from stewart_drake.montecarlo.scenario import Study, run_scenario
+from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -173,6 +174,15 @@ def check_study(study: Study) -> float:
                 raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r))
     check_draws(study)
     return duration
+
+
+def compile_firmware(study: Study, index: int) -> None:
+    """With the C engine, compile run ``index``'s firmware into the C build cache here, before the workers
+    start: they load it instead of each compiling the same module at once on a cold cache (a run whose
+    gains or timing differ still compiles its own, once, in its worker)."""
+    if study.engine == "c" and study.controller == "fixed":
+        sc = scenario(study, index)[2]
+        make_law(sc.controller, sc.platform, sc.config, sc.engine, sc.firmware)
 
 
 def run_row(study: Study, index: int) -> dict:
@@ -341,6 +351,7 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
 
     from stewart_drake.workspace.dask_sweep import local_cluster
 
+    compile_firmware(study, todo[0])
     cluster, interrupted = None, False
     if scheduler is None:
         cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc

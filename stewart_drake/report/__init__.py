@@ -67,6 +67,8 @@ class Section:
     elapsed: float | None = None  # wall seconds to build
     cpu: float | None = None  # CPU seconds of the process that built it (not of pools it started)
     warnings: list[str] = field(default_factory=list)
+    crashed: bool = False  # the analysis raised (never cached)
+    cached: bool = False  # given back by the result cache (``report.cache``), not computed in this run
 
     def headline(self, text: str) -> None:
         """The one figure that sums the section up, shown in the report's verdict table (default: the
@@ -245,6 +247,7 @@ def build_section(analysis: Analysis, quick: bool = False) -> Section:
     except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
         s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
         s.check(f"{analysis.name} ran to completion", 1.0, 0.0)
+        s.crashed = True
     s.elapsed, s.cpu = time.perf_counter() - t0, time.process_time() - c0
     return s
 
@@ -261,6 +264,7 @@ def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
     finish out of order, how many are done), its title shortened at a word, its checks and time."""
     ok = sum(c.passed for c in s.checks)
     cpu = "" if s.cpu is None else f" (CPU {s.cpu:.1f} s)"
+    cpu += ", from the cache (--no-cache to recompute)" if s.cached else ""
     count = f"section {k}/{n}" + ("" if done is None else f", {done} done")
     title = textwrap.shorten(s.title, 70, placeholder=" …")
     print(f"[{count}] {title}: {ok}/{len(s.checks)} checks passed, {s.elapsed:.1f} s{cpu}", file=log, flush=True)
@@ -268,11 +272,16 @@ def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
         print(f"      warning: {w}", file=log, flush=True)
 
 
-def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1) -> list[Section]:
+def run_analyses(
+    analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1, cache: bool = False
+) -> list[Section]:
     """Build each analysis's section, in ``jobs`` worker processes (1: in this process), printing a
     line per analysis as it finishes to ``log`` (default: the current stderr, not the one at import
-    time); the sections come back in the analyses' order."""
+    time); the sections come back in the analyses' order. ``cache``: take a section whose inputs and
+    code are unchanged from the result cache (``report.cache``) and store each one computed."""
     log = log or sys.stderr
+    if cache:
+        return _run_cached(analyses, quick, log, jobs)
     n = len(analyses)
     if jobs <= 1 or n <= 1:
         sections = []
@@ -298,10 +307,30 @@ def run_analyses(analyses: list[Analysis], quick: bool = False, log=None, jobs: 
                     f'<p class="fail">This analysis failed in its worker: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>'
                 )
                 s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
-                s.elapsed = 0.0
+                s.elapsed, s.crashed = 0.0, True
                 sections[i] = s
             done += 1
             _progress(i + 1, n, sections[i], log, done)
+    return sections
+
+
+def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int) -> list[Section]:
+    """``run_analyses`` through the result cache: hits first, then the misses computed and stored."""
+    from stewart_drake.report import cache
+
+    keys = [cache.section_key(a, quick) for a in analyses]
+    sections: list[Section | None] = [cache.load(k) for k in keys]
+    for s in sections:
+        if s is not None:
+            s.cached = True
+    hits = [i for i, s in enumerate(sections) if s is not None]
+    for k, i in enumerate(hits, 1):
+        _progress(k, len(analyses), sections[i], log)
+    todo = [i for i, s in enumerate(sections) if s is None]
+    for i, s in zip(todo, run_analyses([analyses[i] for i in todo], quick, log, jobs)):
+        sections[i] = s
+        if not s.crashed:
+            cache.store(keys[i], s)
     return sections
 
 

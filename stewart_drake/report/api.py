@@ -60,6 +60,7 @@ def report(
     jobs: int | None = None,
     force: bool = False,
     on_start: Callable[[str], None] | None = None,
+    cache: bool = True,
 ) -> ReportResult:
     """Run the analyses on the built-in presets and write the HTML report (``index.html``, ``checks.json``).
 
@@ -70,6 +71,9 @@ def report(
         jobs: analyses run in this many worker processes (default the CPUs, at most 4; 1: in this process).
         force: write into an existing folder that holds other files (they are never touched).
         on_start: called with a line saying how many analyses run in how many processes.
+        cache: take a section whose inputs and code version are unchanged from the result cache under
+            ``$STEWART_DRAKE_CACHE`` (``report.cache``: checks and figures exactly as computed) and store
+            each section computed; False: every section computed, the cache neither read nor written.
 
     Returns:
         The report's index and its checks.
@@ -84,7 +88,7 @@ def report(
     analyses = discover_analyses(only=only)
     if on_start:
         on_start(f"running {len(analyses)} analyses in {jobs} process{'es' if jobs > 1 else ''}")
-    sections = run_analyses(analyses, quick=quick, jobs=jobs)
+    sections = run_analyses(analyses, quick=quick, jobs=jobs, cache=cache)
     elapsed = time.perf_counter() - t0
     meta = render.default_meta(sections, command_line(), elapsed, PRESETS)
     index = write_report(sections, folder, meta=meta)

@@ -242,7 +242,8 @@ def verdicts_html(sections, anchor: dict) -> str:
         t = getattr(s, "elapsed", None)
         rows.append(
             f'<tr><td><a href="#{anchor[id(s)]}">{html.escape(s.title)}</a></td><td class="num {cls}">{ok}/{n}</td>'
-            f"<td>{html.escape(headline(s))}</td><td class=num>{'' if t is None else f'{t:.1f}'}</td></tr>"
+            f"<td>{html.escape(headline(s))}</td><td class=num>{'' if t is None else f'{t:.1f}'}"
+            f"{' (cached)' if getattr(s, 'cached', False) else ''}</td></tr>"
         )
     return (
         '<div class="scroll"><table class="verdicts"><thead><tr><th>section</th><th class=num>checks passed</th>'

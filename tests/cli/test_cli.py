@@ -1,3 +1,4 @@
+import importlib
 import json
 import subprocess
 import sys
@@ -116,7 +117,9 @@ def test_model_write(tmp_path, capsys):
 
 
 def test_report_writes_atomically(tmp_path, capsys, monkeypatch):
-    from stewart_drake import report
+    # the report package itself (``from stewart_drake import report`` is the public sd.report, whose instance
+    # dict monkeypatch would consult to restore the attribute)
+    report = importlib.import_module("stewart_drake.report")
 
     out = tmp_path / "rep"
     rc, stdout, err = run(capsys, "report", "--only", "seed_table", "--out", str(out), "--quick")

@@ -341,3 +341,23 @@ assert not any(m.startswith("pydrake") for m in sys.modules)
     cmd = law.step(law.initial_pid_state(L, np.full(6, 5.0)), pose, L, np.full(6, 3.0))[0]
     assert out[0] == repr(cmd.tolist())
     assert len(out) == 2
+
+
+def test_design_gains_remembered_by_content_gives_the_computed_numbers():
+    """``design_gains`` remembers its costly extremes by content (a study's runs share the nominal design):
+    a repeat gives the gains computed afresh bit for bit, and a platform differing in one mass is a
+    different design (no collision)."""
+    from stewart_drake.control import gains as G
+    from stewart_drake.core.trajectory import design_poses, get_trajectory
+
+    p = load_preset("utn-dynamic")
+    poses = design_poses(get_trajectory("seed"))
+    G._EXTREMES.clear()
+    fresh = G.design_gains(p, poses=poses)
+    assert len(G._EXTREMES) == 1
+    assert G.design_gains(p, poses=poses) == fresh and len(G._EXTREMES) == 1
+    heavier = p.replace(mass=p.mass * 1.5)
+    g2 = G.design_gains(heavier, poses=poses)
+    assert len(G._EXTREMES) == 2 and g2 != fresh
+    G._EXTREMES.clear()
+    assert G.design_gains(heavier, poses=poses) == g2  # as computed with nothing remembered

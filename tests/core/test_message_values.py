@@ -15,6 +15,7 @@ def test_short_number_and_text():
 
 
 def test_fk_does_not_echo_a_300_digit_length(capsys):
+    pytest.importorskip("pydrake")  # runs a Drake-backed command; the numpy-layer run (no pydrake) skips it
     rc = main(["fk", "--lengths", "1e300", "1", "1", "1", "1", "1"])
     err = capsys.readouterr().err
     assert rc in (1, 2) and "1e+300" in err and len(err) < 400
@@ -29,6 +30,7 @@ def test_tiny_command_range_names_the_gain_and_max_force():
 def test_a_1e308_cell_names_the_column_and_samples(tmp_path, capsys):
     """A 1e308 cell is a number, but its rate overflows: scipy's "`dydx` must contain only finite values"
     before; now the file, column and samples."""
+    pytest.importorskip("pydrake")  # runs a Drake-backed command; the numpy-layer run (no pydrake) skips it
     f = tmp_path / "big.csv"
     f.write_text(
         "t,px,py,pz,ax,ay,az\n" + "".join(f"{i * 0.1},0,0,{1e308 if i == 2 else 0.7},0,0,0\n" for i in range(5))

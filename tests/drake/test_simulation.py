@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.control import ControllerConfig, DspTiming, TimingError
+from stewart_drake.control.feedforward import feedforward_forces
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import SEED, fit_trajectory, get_trajectory, load_trajectory_csv
@@ -93,17 +94,29 @@ def test_two_identical_runs_give_identical_logs(runs):
 
 
 @pytest.mark.parametrize("kind", ["float", "fixed"])
-def test_primed_tables_change_no_bit(kind):
-    """The reference, IK and feed-forward tables primed at the ticks are a speed-up only: with every
-    table left empty (each tick computes its own pose, IK and forces) the logs are the same bit for bit."""
+def test_tick_tables_hold_the_values_of_one_time_at_a_time(kind):
+    """The reference and feed-forward tables the Diagram reads in C++ are filled in one batch before the
+    run: a speed-up only. Each tick's row equals the pose / forces computed for that time alone, bit for
+    bit (the logged reference; the feed-forward source's output at tick times), the IK cache changes no
+    bit (a run with it emptied gives the same logs), and a time between ticks is refused, not rounded."""
     traj = fit_trajectory(get_trajectory("rotating"), PLATFORM)
-    primed = build_simulation(Scenario(PLATFORM, traj, kind)).run(0.1)
+    primed_sim = build_simulation(Scenario(PLATFORM, traj, kind))
+    primed = primed_sim.run(0.1)
+    for t, q in zip(primed.t_ref, primed.reference):
+        np.testing.assert_array_equal(q, traj.pose(np.array([t]))[0])
+    ffs, table = primed_sim.feedforward_source, primed_sim.feedforward
+    ctx = ffs.CreateDefaultContext()
+    for t in primed.t_ref[:-1]:
+        ctx.SetTime(t)
+        alone = feedforward_forces(PLATFORM, traj, [t], table.lead, table.h)[0]
+        np.testing.assert_array_equal(ffs.get_output_port().Eval(ctx), alone)
+    ctx.SetTime(primed.t_ref[1] / 2)
+    with pytest.raises(RuntimeError, match="does not match any of the trajectory times"):
+        ffs.get_output_port().Eval(ctx)
     sim = build_simulation(Scenario(PLATFORM, traj, kind))
-    sim.source.prime = lambda times: traj.pose(np.asarray(times, dtype=float))  # nothing remembered
     sim.controller.law.prime = lambda poses: None
-    sim.feedforward.prime = lambda times: None
     bare = sim.run(0.1)
-    assert sim.source._table == {} and sim.controller.law._cache == {} and sim.feedforward.table == {}
+    assert sim.controller.law._cache == {}
     for name in SimulationLog.ARRAYS:
         np.testing.assert_array_equal(getattr(bare, name), getattr(primed, name), err_msg=name)
 

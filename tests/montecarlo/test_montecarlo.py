@@ -327,3 +327,23 @@ def test_replay_runs_the_stored_study_and_refuses_other_options(tmp_path, capsys
     (out / "study.json").write_text("{")
     assert main(replay) == 2
     assert capsys.readouterr().err.strip().startswith(f"stewart-drake montecarlo: error: --replay: {out}/study.json is")
+
+
+def test_the_parent_compiles_the_firmware_the_workers_load(platform, tmp_path, monkeypatch):
+    """``study.compile_firmware`` (called before the workers start) leaves run 0's compiled firmware in the
+    C build cache: a run then builds its C engine without calling the compiler at all."""
+    from stewart_drake.core import c_build
+
+    if not c_build.compilers():
+        pytest.skip("no C compiler")
+    monkeypatch.setenv("STEWART_DRAKE_CACHE", str(tmp_path / "cache"))
+    study = Study(platform=platform, spec=parse_spec(VARY), seed=3, runs=2, duration=0.02, engine="c")
+    study_mod.compile_firmware(study, 0)
+    assert len(list((tmp_path / "cache").glob("sd-*.so"))) >= 1
+
+    def no_compiler(*args, **kwargs):
+        raise AssertionError(f"compiled again: {args[0]}")
+
+    monkeypatch.setattr(c_build.subprocess, "run", no_compiler)
+    row = run_scenario(study, 1)  # another draw of the same study: the same firmware
+    assert row["error"] == "" and np.isfinite(row["max_leg_error_m"])

@@ -1,0 +1,104 @@
+"""The report's result cache: a section is recomputed only when its inputs or the code changed.
+
+A section's key is the SHA-256 of: the code version (``code_version``: every source and data file of the
+installed ``stewart_drake`` package, by relative path and content, plus the versions of Python and of the
+libraries that draw or compute, ``DEPENDENCIES``), the analysis' name, the content of its script when it
+lies outside the package, the ``quick`` flag, and the compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an
+input of the sections that run it). The analyses read only the built-in presets (package files, so part of
+the code version) and their own fixed seeds: nothing else is an input.
+
+The entry is the pickled ``Section`` (its text, tables, figures' PNG bytes, checks, warnings, original run
+time), so a hit gives back the section exactly as it was computed. Entries live in
+``c_build.cache_dir() / "report"`` (``$STEWART_DRAKE_CACHE``), written atomically; a section whose analysis
+raised is not stored (the failure may be transient); an unreadable entry counts as a miss. Where the cache
+folder cannot be used the report runs without it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+from functools import cache
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1]
+FORMAT = 1  # bump when the entry's layout changes
+# the libraries whose versions can change a section's numbers or figures (part of the code version)
+DEPENDENCIES = ("drake", "numpy", "scipy", "matplotlib", "pymoo", "python-flint", "cffi")
+
+
+@cache
+def code_version(root: Path = PACKAGE) -> str:
+    """SHA-256 (hex) of every file of the package under ``root`` but the bytecode caches (relative path and
+    bytes, in sorted order: sources, C files, presets, grammars, tables), of the Python version and of the
+    ``DEPENDENCIES``' versions: any edit of the code or its data, or an upgrade, changes it."""
+    import numpy as np
+
+    h = hashlib.sha256()
+    for p in sorted(q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix != ".pyc"):
+        h.update(str(p.relative_to(root)).encode() + b"\0")
+        h.update(hashlib.sha256(p.read_bytes()).digest())
+    from importlib.metadata import PackageNotFoundError, version
+
+    for dist in DEPENDENCIES:
+        try:
+            h.update(f"|{dist}={version(dist)}".encode())
+        except PackageNotFoundError:
+            h.update(f"|{dist}=absent".encode())
+    h.update(f"{sys.version}|{np.__version__}|{FORMAT}".encode())
+    return h.hexdigest()
+
+
+def section_key(analysis, quick: bool) -> str:
+    """The cache key (hex) of ``analysis``' section (see the module docstring)."""
+    h = hashlib.sha256(code_version().encode())
+    h.update(f"|{analysis.name}|{bool(quick)}".encode())
+    path = Path(analysis.path).resolve() if analysis.path is not None else None
+    if path is not None and PACKAGE not in path.parents:
+        h.update(b"|script|" + hashlib.sha256(path.read_bytes()).digest())
+    for var in ("STEWART_DRAKE_CC", "CC"):
+        h.update(f"|{var}={os.environ.get(var, '')}".encode())
+    return h.hexdigest()
+
+
+def folder() -> Path | None:
+    """The cache folder (created), or None where it cannot be used."""
+    from stewart_drake.core.c_build import CacheUnavailable, cache_dir
+
+    try:
+        d = cache_dir() / "report"
+        d.mkdir(parents=True, exist_ok=True)
+        return d
+    except (CacheUnavailable, OSError):
+        return None
+
+
+def load(key: str):
+    """The cached ``Section`` of ``key``, or None (absent, unreadable, or the cache unusable)."""
+    d = folder()
+    if d is None:
+        return None
+    try:
+        with open(d / f"{key}.pickle", "rb") as f:
+            return pickle.load(f)
+    except FileNotFoundError:
+        return None
+    except Exception:  # noqa: BLE001 - a truncated or foreign entry is a miss, recomputed and rewritten
+        return None
+
+
+def store(key: str, section) -> None:
+    """Write ``section`` under ``key`` (atomically: a reader never sees half an entry)."""
+    d = folder()
+    if d is None:
+        return
+    fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            pickle.dump(section, f, protocol=pickle.HIGHEST_PROTOCOL)
+        os.replace(tmp, d / f"{key}.pickle")
+    except OSError:
+        Path(tmp).unlink(missing_ok=True)
