@@ -22,6 +22,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
     from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
+    from stewart_drake.api.dsp import DspIKResult, dsp_ik
     from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
     from stewart_drake.api.platform import load_platform, presets
@@ -84,6 +85,8 @@ _PUBLIC = {
     "OptimizeResult": ("stewart_drake.synthesis.api", "OptimizeResult"),
     "prove_workspace": ("stewart_drake.synthesis.api", "prove_workspace"),
     "WorkspaceProof": ("stewart_drake.synthesis.api", "WorkspaceProof"),
+    "dsp_ik": ("stewart_drake.api.dsp", "dsp_ik"),
+    "DspIKResult": ("stewart_drake.api.dsp", "DspIKResult"),
 }
 
 __all__ = [
@@ -130,6 +133,8 @@ __all__ = [
     "OptimizeResult",
     "prove_workspace",
     "WorkspaceProof",
+    "dsp_ik",
+    "DspIKResult",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,
