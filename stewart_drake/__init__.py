@@ -27,6 +27,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
     from stewart_drake.api.platform import load_platform, presets
     from stewart_drake.api.reach import WorkspaceResult, workspace
+    from stewart_drake.api.servo import ServoResult, servo
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
     from stewart_drake.core.geometry import Platform
@@ -87,6 +88,8 @@ _PUBLIC = {
     "WorkspaceProof": ("stewart_drake.synthesis.api", "WorkspaceProof"),
     "dsp_ik": ("stewart_drake.api.dsp", "dsp_ik"),
     "DspIKResult": ("stewart_drake.api.dsp", "DspIKResult"),
+    "servo": ("stewart_drake.api.servo", "servo"),
+    "ServoResult": ("stewart_drake.api.servo", "ServoResult"),
 }
 
 __all__ = [
@@ -135,6 +138,8 @@ __all__ = [
     "WorkspaceProof",
     "dsp_ik",
     "DspIKResult",
+    "servo",
+    "ServoResult",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

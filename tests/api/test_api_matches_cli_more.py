@@ -1,9 +1,9 @@
 """The API and the command line give the same numbers for the remaining commands with ``--json``: ``dsp-ik``
-(more to come: each command's API function is called in SI, the CLI in its own units, and the API's numbers
+and ``servo`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
 converted here, independently of the CLI's code).
 
 Tolerances: a number the CLI prints unrounded is the API's times 1e3 or π/180 once: a few ulps (1e-12
-relative). ``dsp-ik`` rounds its float lengths and differences to 1e-4 mm, so those agree within half that,
+relative; a pulse in µs is the API's seconds times 1e6). ``dsp-ik`` rounds its float lengths and differences to 1e-4 mm, so those agree within half that,
 5e-5 mm, plus the ulps.
 """
 
@@ -70,3 +70,85 @@ def test_dsp_ik_case_below_base_is_flagged():
 def test_dsp_ik_refuses_angle_beyond_half_turn():
     with pytest.raises(sd.StewartError, match="beyond ±180°"):
         sd.dsp_ik([0, 0, 0.7, 3.2, 0, 0])
+
+
+SERVO_YAML = """\
+name: api-test-servo
+length_unit: mm
+arm_length: 30.0
+rod_length: 130.0
+paired:
+  base_radius: 70.0
+  pair_spacing: 56.0
+  platform_radius: 58.0
+  anchor_half_angle_deg: 12.0
+servo:
+  neutral_us: [1500, 1520, 1480, 1500, 1510, 1490]
+  rate_us: 400.0
+  rate_deg: 45.0
+  travel_deg: 40.0
+"""
+DEG = math.pi / 180
+
+
+@pytest.fixture(params=["hobby-servo", "own"])
+def servo_platform(request, tmp_path):
+    if request.param == "own":
+        path = tmp_path / "servo.yaml"
+        path.write_text(SERVO_YAML)
+        return str(path)
+    return request.param
+
+
+# (typed pose in mm and degrees or None, from_home, trim µs or None): home, a reachable pose, one beyond the
+# travel (exit 1), and a trimmed pose
+SERVO_CASES = [
+    (None, False, None),
+    ((4, -3, 2, 3, -2, 5), True, None),
+    ((0, 0, 0, 40, 0, 0), True, None),
+    ((2, 1, -4, 0, 4, -3), True, (1490, 1500, 1510, 1500, 1505, 1495)),
+]
+
+
+@pytest.mark.parametrize(("typed", "from_home", "trim"), SERVO_CASES)
+def test_servo_matches_cli(capsys, servo_platform, typed, from_home, trim):
+    argv = ["servo", "--platform", servo_platform, "--json"]
+    argv += ["--pose", *map(str, typed)] if typed is not None else []
+    argv += ["--from-home"] if from_home else []
+    argv += ["--trim", *map(str, trim)] if trim is not None else []
+    rc, cli = cli_json(capsys, *argv)
+    si = None if typed is None else [v * f for v, f in zip(typed, [1e-3] * 3 + [DEG] * 3)]
+    api = sd.servo(
+        si, platform=servo_platform, from_home=from_home, trim=None if trim is None else np.array(trim) * 1e-6
+    )
+    d = api.to_dict()
+    assert rc == (0 if api.ok else 1) and cli["ok"] == d["ok"]
+    assert cli["preset"] == d["preset"] and cli["units"]["convention"] == d["convention"]
+    if typed is None:  # home: the CLI shows the home pose in its units
+        np.testing.assert_allclose(cli["pose"], np.array(d["pose"]) * ([MM] * 3 + [1 / DEG] * 3), rtol=RTOL, atol=1e-12)
+    else:
+        assert cli["pose"] == list(typed)
+        z = d["pose"][2] - (d["home_height"] if from_home else 0.0)
+        np.testing.assert_allclose(np.r_[d["pose"][:2], z, d["pose"][3:]], si, rtol=RTOL, atol=1e-15)
+    assert math.isclose(cli["home_height"], d["home_height"] * MM, rel_tol=RTOL)
+    for key, api_key in (("alpha0_deg", "alpha0"), ("angles_deg", "angles")):
+        np.testing.assert_allclose(cli[key], np.degrees(d[api_key]), rtol=RTOL, atol=1e-12)
+    for key in ("pulse", "pulse_raw"):
+        np.testing.assert_allclose(cli[f"{key}_us"], np.array(d[key]) * 1e6, rtol=RTOL)
+    assert len(cli["violations"]) == len(d["violations"])
+    for c, a in zip(cli["violations"], d["violations"]):
+        assert (c["servo"], c["kind"]) == (a["servo"], a["kind"])
+        for k in ("angle", "limit", "excess"):
+            if k in a:
+                assert math.isclose(c[f"{k}_deg"], math.degrees(a[k]), rel_tol=RTOL, abs_tol=1e-12)
+
+
+def test_servo_cases_include_a_travel_violation(servo_platform):
+    """The third servo case is beyond the travel on both platforms: the exit-1 path is compared too."""
+    assert not sd.servo([0, 0, 0, 40 * DEG, 0, 0], from_home=True, platform=servo_platform).ok
+    assert sd.servo([0.004, -0.003, 0.002, 3 * DEG, -2 * DEG, 5 * DEG], from_home=True).ok
+
+
+def test_servo_refuses_trim_without_room_for_travel():
+    with pytest.raises(sd.StewartError, match="--trim|trim"):
+        sd.servo(trim=[1500e-6] * 5 + [9000e-6])
