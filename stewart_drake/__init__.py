@@ -25,6 +25,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.dsp import DspIKResult, dsp_ik
     from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
+    from stewart_drake.api.leg import LegFKResult, LegIKResult, leg_fk, leg_ik
     from stewart_drake.api.platform import load_platform, presets
     from stewart_drake.api.reach import WorkspaceResult, workspace
     from stewart_drake.api.servo import ServoResult, servo
@@ -90,6 +91,10 @@ _PUBLIC = {
     "DspIKResult": ("stewart_drake.api.dsp", "DspIKResult"),
     "servo": ("stewart_drake.api.servo", "servo"),
     "ServoResult": ("stewart_drake.api.servo", "ServoResult"),
+    "leg_fk": ("stewart_drake.api.leg", "leg_fk"),
+    "LegFKResult": ("stewart_drake.api.leg", "LegFKResult"),
+    "leg_ik": ("stewart_drake.api.leg", "leg_ik"),
+    "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
 }
 
 __all__ = [
@@ -140,6 +145,10 @@ __all__ = [
     "DspIKResult",
     "servo",
     "ServoResult",
+    "leg_fk",
+    "LegFKResult",
+    "leg_ik",
+    "LegIKResult",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

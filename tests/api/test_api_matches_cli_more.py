@@ -1,5 +1,5 @@
 """The API and the command line give the same numbers for the remaining commands with ``--json``: ``dsp-ik``
-and ``servo`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
+``servo``, ``leg fk`` and ``leg ik`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
 converted here, independently of the CLI's code).
 
 Tolerances: a number the CLI prints unrounded is the API's times 1e3 or π/180 once: a few ulps (1e-12
@@ -152,3 +152,57 @@ def test_servo_cases_include_a_travel_violation(servo_platform):
 def test_servo_refuses_trim_without_room_for_travel():
     with pytest.raises(sd.StewartError, match="--trim|trim"):
         sd.servo(trim=[1500e-6] * 5 + [9000e-6])
+
+
+# leg: the default leg and a leg of the test's own (--l1 --l2 --l3, mm at the CLI, m in the API)
+LEGS = [{}, {"l1": 95.0, "l2": 70.0, "l3": 25.0}]
+
+
+def leg_argv(dims: dict) -> list[str]:
+    return [a for n, v in dims.items() for a in (f"--{n}", str(v))]
+
+
+def leg_si(dims: dict) -> dict:
+    return {n: v * 1e-3 for n, v in dims.items()}
+
+
+@pytest.mark.parametrize("dims", LEGS)
+@pytest.mark.parametrize("q", [(30.0, -45.0), (100.0, -150.0)])  # the second is outside both joint limits
+def test_leg_fk_matches_cli(capsys, dims, q):
+    rc, cli = cli_json(capsys, "leg", "fk", *map(str, q), *leg_argv(dims), "--json")
+    api = sd.leg_fk(*(v * DEG for v in q), **leg_si(dims))
+    d = api.to_dict()
+    assert rc == (0 if api.ok else 1) and cli["within_limits"] == d["within_limits"]
+    assert cli["q"] == list(q)
+    np.testing.assert_allclose(cli["foot"], np.array(d["foot"]) * MM, rtol=RTOL)
+    assert math.isclose(cli["gamma"], math.degrees(d["gamma"]), rel_tol=RTOL)
+    np.testing.assert_allclose(cli["T03"], d["T03"], rtol=RTOL, atol=1e-15)
+    assert len(cli["limit_violations"]) == len(d["limit_violations"]) == (0 if api.ok else 2)
+    for c, a in zip(cli["limit_violations"], d["limit_violations"]):
+        assert c["joint"] == a["joint"]
+        for k in ("value_rad", "limit_rad", "excess_rad"):
+            assert math.isclose(c[k], a[k], rel_tol=RTOL, abs_tol=1e-15)
+
+
+@pytest.mark.parametrize("dims", LEGS)
+@pytest.mark.parametrize(("target", "gamma"), [((100.0, -50.0), None), ((90.0, -60.0), -30.0)])
+def test_leg_ik_matches_cli(capsys, dims, target, gamma):
+    argv = ["leg", "ik", *map(str, target), *leg_argv(dims), "--json"]
+    argv += [] if gamma is None else ["--gamma", str(gamma)]
+    rc, cli = cli_json(capsys, *argv)
+    api = sd.leg_ik(*(v * 1e-3 for v in target), gamma=None if gamma is None else gamma * DEG, **leg_si(dims))
+    d = api.to_dict()
+    assert rc == (0 if api.ok else 1)
+    assert cli["target"] == list(target) and cli["gamma"] == gamma
+    np.testing.assert_allclose(d["target"], np.array(target) * 1e-3, rtol=RTOL)
+    assert set(cli["solutions"]) == set(d["solutions"]) == {"a", "b"}
+    for b, c in cli["solutions"].items():
+        a = d["solutions"][b]
+        assert c["within_limits"] == a["within_limits"]
+        assert len(c["q"]) == (2 if gamma is None else 3)
+        np.testing.assert_allclose(c["q"], np.degrees(a["q"]), rtol=RTOL, atol=1e-12)
+    if gamma is not None:  # the seed's 3R method frees q3: leg_fk (q1, q2, fixed ankle) is no round trip for it
+        return
+    # a round trip, independent of the CLI: the API's branch a puts the foot back on the target
+    fk = sd.leg_fk(*d["solutions"]["a"]["q"][:2], **leg_si(dims))
+    np.testing.assert_allclose(fk.foot, np.array(target) * 1e-3, rtol=0, atol=1e-12)
