@@ -9,7 +9,7 @@ and may move between releases.
 
 ``import stewart_drake`` is light: the names are loaded when first used (module ``__getattr__``), so that the
 numpy functions (``ik``, ``fk``, ``inverse_dynamics``, ``stiffness``, ...) work where pydrake is not installed and
-only ``simulate``, ``montecarlo``, ``firmware.check`` and ``report`` import Drake.
+only ``simulate``, ``montecarlo``, ``firmware.check``, ``report`` and ``inspect_model`` import Drake.
 """
 
 import importlib
@@ -26,6 +26,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
     from stewart_drake.api.leg import LegFKResult, LegIKResult, leg_fk, leg_ik
+    from stewart_drake.api.model import ModelInspection, inspect_model
     from stewart_drake.api.platform import load_platform, presets
     from stewart_drake.api.reach import WorkspaceResult, workspace
     from stewart_drake.api.servo import ServoResult, servo
@@ -95,6 +96,8 @@ _PUBLIC = {
     "LegFKResult": ("stewart_drake.api.leg", "LegFKResult"),
     "leg_ik": ("stewart_drake.api.leg", "leg_ik"),
     "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
+    "inspect_model": ("stewart_drake.api.model", "inspect_model"),
+    "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
 }
 
 __all__ = [
@@ -149,6 +152,8 @@ __all__ = [
     "LegFKResult",
     "leg_ik",
     "LegIKResult",
+    "inspect_model",
+    "ModelInspection",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

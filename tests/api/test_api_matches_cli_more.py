@@ -1,5 +1,5 @@
 """The API and the command line give the same numbers for the remaining commands with ``--json``: ``dsp-ik``
-``servo``, ``leg fk`` and ``leg ik`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
+``servo``, ``leg fk``, ``leg ik`` and ``model --inspect`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
 converted here, independently of the CLI's code).
 
 Tolerances: a number the CLI prints unrounded is the API's times 1e3 or π/180 once: a few ulps (1e-12
@@ -17,6 +17,7 @@ import pytest
 
 import stewart_drake as sd
 from stewart_drake.cli import main
+from tests.api.test_api_matches_cli import OWN_YAML
 
 RTOL = 1e-12
 MM = 1e3
@@ -206,3 +207,31 @@ def test_leg_ik_matches_cli(capsys, dims, target, gamma):
     # a round trip, independent of the CLI: the API's branch a puts the foot back on the target
     fk = sd.leg_fk(*d["solutions"]["a"]["q"][:2], **leg_si(dims))
     np.testing.assert_allclose(fk.foot, np.array(target) * 1e-3, rtol=0, atol=1e-12)
+
+
+@pytest.fixture(params=["utn-dynamic", "own"])
+def platform_arg(request, tmp_path):
+    """The ``--platform`` value: a preset, or a YAML platform of the tests' own (a 6-6 radial one)."""
+    if request.param == "own":
+        path = tmp_path / "mine.yaml"
+        path.write_text(OWN_YAML)
+        return str(path)
+    return request.param
+
+
+def test_inspect_model_matches_cli(capsys, platform_arg, tmp_path):
+    """``model --inspect --json`` is already SI: the API's dict is the CLI's, key for key (``--write`` too)."""
+    rc, cli = cli_json(
+        capsys, "model", "--platform", platform_arg, "--inspect", "--json", "--write", str(tmp_path / "a")
+    )
+    api = sd.inspect_model(platform_arg, write=tmp_path / "b")
+    d = api.to_dict()
+    assert rc == 0 and api.ok
+    assert set(cli) == set(d)
+    for k in d:
+        if k == "sdf_file":  # two folders, the same file name and the same SDF text
+            assert cli[k].rsplit("/", 1)[1] == d[k].rsplit("/", 1)[1]
+            assert open(cli[k]).read() == open(d[k]).read()
+        else:
+            assert cli[k] == d[k], k
+    assert len(api.actuators) == 6 and api.anchor_error < 1e-6  # six legs; anchors as the geometry's
