@@ -9,7 +9,8 @@ and may move between releases.
 
 ``import stewart_drake`` is light: the names are loaded when first used (module ``__getattr__``), so that the
 numpy functions (``ik``, ``fk``, ``inverse_dynamics``, ``stiffness``, ...) work where pydrake is not installed and
-only ``simulate``, ``montecarlo``, ``firmware.check``, ``report`` and ``inspect_model`` import Drake.
+only ``simulate``, ``montecarlo``, ``firmware.check``, ``report``, ``inspect_model`` and ``viewer_readout`` import
+Drake.
 """
 
 import importlib
@@ -32,6 +33,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.servo import ServoResult, servo
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
+    from stewart_drake.api.viewer import ViewerReadout, viewer_readout
     from stewart_drake.core.geometry import Platform
     from stewart_drake.core.realtime_fk import RealtimeFK, RealtimeResult
     from stewart_drake.core.trajectory import Trajectory
@@ -98,6 +100,8 @@ _PUBLIC = {
     "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
     "inspect_model": ("stewart_drake.api.model", "inspect_model"),
     "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
+    "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
+    "ViewerReadout": ("stewart_drake.api.viewer", "ViewerReadout"),
 }
 
 __all__ = [
@@ -154,6 +158,8 @@ __all__ = [
     "LegIKResult",
     "inspect_model",
     "ModelInspection",
+    "viewer_readout",
+    "ViewerReadout",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

@@ -1,5 +1,5 @@
 """The API and the command line give the same numbers for the remaining commands with ``--json``: ``dsp-ik``
-``servo``, ``leg fk``, ``leg ik`` and ``model --inspect`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
+``servo``, ``leg fk``, ``leg ik``, ``model --inspect`` and ``view --json`` (each command's API function is called in SI, the CLI in its own units, and the API's numbers
 converted here, independently of the CLI's code).
 
 Tolerances: a number the CLI prints unrounded is the API's times 1e3 or π/180 once: a few ulps (1e-12
@@ -235,3 +235,36 @@ def test_inspect_model_matches_cli(capsys, platform_arg, tmp_path):
         else:
             assert cli[k] == d[k], k
     assert len(api.actuators) == 6 and api.anchor_error < 1e-6  # six legs; anchors as the geometry's
+
+
+# view: a reachable pose (exit 0) and one beyond the stroke (exit 1: the readout still printed), in mm and degrees
+VIEW_POSES = [(10.0, 0.0, 720.0, 0.0, 5.0, 0.0), (0.0, 0.0, 1100.0, 0.0, 0.0, 0.0)]
+
+
+@pytest.mark.parametrize("typed", VIEW_POSES)
+def test_viewer_readout_matches_cli(capsys, platform_arg, typed):
+    """``view --duration 0 --json`` draws once and prints the readout; ``viewer_readout`` computes it without
+    a viewer. Both already SI: equal within the ulps of the typed pose's mm/deg → SI products."""
+    rc, cli = cli_json(capsys, "view", "--platform", platform_arg, "--duration", "0", "--json", "--no-modes", "--pose", *map(str, typed))  # fmt: skip
+    si = [v * f for v, f in zip(typed, [1e-3] * 3 + [DEG] * 3)]
+    api = sd.viewer_readout(platform_arg, si, modes=False)
+    d = api.to_dict()
+    assert rc == (0 if api.ok else 1)
+    assert set(cli) == set(d)
+    for k in d:
+        if isinstance(d[k], (bool, type(None))):
+            assert cli[k] == d[k], k
+        else:
+            np.testing.assert_allclose(cli[k], d[k], rtol=1e-9, atol=1e-12, err_msg=k)
+
+
+def test_viewer_readout_cases_cover_both_exits(platform_arg):
+    """The second pose is beyond the stroke on both platforms (so the exit-1 readout is compared too)."""
+    oks = [sd.viewer_readout(platform_arg, [v * f for v, f in zip(p, [1e-3] * 3 + [DEG] * 3)], modes=False).ok for p in VIEW_POSES]  # fmt: skip
+    assert oks == [True, False]
+
+
+def test_viewer_readout_counts_modes_and_defaults_to_home():
+    r = sd.viewer_readout("utn-dynamic")
+    np.testing.assert_array_equal(r.pose, sd.load_platform("utn-dynamic").home_pose())
+    assert r.ok and r.fraction == 1.0 and r.modes >= 1 and r.modes_near >= 1  # home is one of its own modes
