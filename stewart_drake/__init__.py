@@ -9,7 +9,8 @@ and may move between releases.
 
 ``import stewart_drake`` is light: the names are loaded when first used (module ``__getattr__``), so that the
 numpy functions (``ik``, ``fk``, ``inverse_dynamics``, ``stiffness``, ...) work where pydrake is not installed and
-only ``simulate``, ``montecarlo``, ``firmware.check`` and ``report`` import Drake.
+only ``simulate``, ``montecarlo``, ``firmware.check``, ``report``, ``inspect_model`` and ``viewer_readout`` import
+Drake.
 """
 
 import importlib
@@ -24,12 +25,17 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
     from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
+    from stewart_drake.api.dsp import DspIKResult, dsp_ik
     from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
+    from stewart_drake.api.leg import LegFKResult, LegIKResult, leg_fk, leg_ik
+    from stewart_drake.api.model import ModelInspection, inspect_model
     from stewart_drake.api.platform import load_platform, presets
     from stewart_drake.api.reach import WorkspaceResult, workspace
+    from stewart_drake.api.servo import ServoResult, servo
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
+    from stewart_drake.api.viewer import ViewerReadout, viewer_readout
     from stewart_drake.core.geometry import Platform
     from stewart_drake.core.realtime_fk import RealtimeFK, RealtimeResult
     from stewart_drake.core.trajectory import Trajectory
@@ -93,6 +99,18 @@ _PUBLIC = {
     "OptimizeResult": ("stewart_drake.synthesis.api", "OptimizeResult"),
     "prove_workspace": ("stewart_drake.synthesis.api", "prove_workspace"),
     "WorkspaceProof": ("stewart_drake.synthesis.api", "WorkspaceProof"),
+    "dsp_ik": ("stewart_drake.api.dsp", "dsp_ik"),
+    "DspIKResult": ("stewart_drake.api.dsp", "DspIKResult"),
+    "servo": ("stewart_drake.api.servo", "servo"),
+    "ServoResult": ("stewart_drake.api.servo", "ServoResult"),
+    "leg_fk": ("stewart_drake.api.leg", "leg_fk"),
+    "LegFKResult": ("stewart_drake.api.leg", "LegFKResult"),
+    "leg_ik": ("stewart_drake.api.leg", "leg_ik"),
+    "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
+    "inspect_model": ("stewart_drake.api.model", "inspect_model"),
+    "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
+    "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
+    "ViewerReadout": ("stewart_drake.api.viewer", "ViewerReadout"),
 }
 
 __all__ = [
@@ -139,6 +157,18 @@ __all__ = [
     "OptimizeResult",
     "prove_workspace",
     "WorkspaceProof",
+    "dsp_ik",
+    "DspIKResult",
+    "servo",
+    "ServoResult",
+    "leg_fk",
+    "LegFKResult",
+    "leg_ik",
+    "LegIKResult",
+    "inspect_model",
+    "ModelInspection",
+    "viewer_readout",
+    "ViewerReadout",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

@@ -5,17 +5,10 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-
+from stewart_drake.api.dsp import FLOAT_GEOMETRY_MM, dsp_ik_firmware, firmware_pose
 from stewart_drake.commands._common import print_json
-from stewart_drake.core.geometry import load_preset
-from stewart_drake.core.rotations import angle_scale
-from stewart_drake.core.sanity import above_base, below_base_message, plate_anchor_heights
-from stewart_drake.errors import DspPoseError
-from stewart_drake.firmware.engine import ENGINES, resolve_engine
-from stewart_drake.firmware.host import tp17_leg_lengths_c
-from stewart_drake.fixedpoint.q15 import SaturationCounter
-from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
+from stewart_drake.firmware.engine import ENGINES
+from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM
 
 ANGLE_UNITS = ("pi", "deg", "rad")
 
@@ -54,59 +47,30 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    raw = np.asarray(args.pose, dtype=float)
-    q = raw.copy()
-    with np.errstate(over="ignore"):  # 1e308 deg is inf pi: refused just below as beyond ±180°
-        q[3:] = raw[3:] * angle_scale(args.angle_unit) / np.pi  # -> fractions of pi
-    for k, name in enumerate(("A", "B", "G")):
-        if abs(q[3 + k]) > 1.0:
-            raise DspPoseError(DspPoseError.ANGLE_OPTION.format(name=name, value=raw[3 + k], unit=args.angle_unit))
-    check_dsp_poses(q)
-    # the firmware's platform is utn-kinematic's (a = 612 vs 612.5 mm). An emulator shows what the firmware
-    # computes: a pose whose plate dips below the base is computed, shown and flagged (exit 1), as ik does
-    # for a pose outside the stroke
-    # Any pose of the DSP's range (16-bit mm, one turn: ``check_dsp_poses``) is computed.
-    kin = load_preset("utn-kinematic")
-    pose_si = np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi]
-    flags = [] if above_base(kin, pose_si) else [below_base_message("--pose", plate_anchor_heights(kin, pose_si))]
-    with SaturationCounter() as sat:
-        tr = tp17_trace(q)
-    if sat.total:
-        flags.append(
-            f"the firmware's arithmetic saturated ({dict(sat.counts)}); its lengths for this pose are clipped, not geometric"
-        )
-    res = tp17_error_stages(q)
-    engine = resolve_engine(args.engine, "stewart-drake dsp-ik")
-    dsp = tp17_leg_lengths_c(q) if engine == "c" else tr.lengths.astype(int)
-    flt = res["float"]
+    q = firmware_pose(args.pose, args.angle_unit, what="--pose")
+    res = dsp_ik_firmware(q, engine=args.engine, trace=args.trace)
+    dsp, flt, flags = res.dsp_words, res.float_lengths * 1e3, res.flags
+    fp = res.firmware_pose
     out = {
         "pose": {
-            "px_mm": int(np.trunc(q[0])),
-            "py_mm": int(np.trunc(q[1])),
-            "pz_mm": int(np.trunc(q[2])),
-            "alpha_pi": float(q[3]),
-            "beta_pi": float(q[4]),
-            "gamma_pi": float(q[5]),
-            "angle_words": tr.angle_words.tolist(),
+            "px_mm": int(fp[0]),
+            "py_mm": int(fp[1]),
+            "pz_mm": int(fp[2]),
+            "alpha_pi": float(fp[3]),
+            "beta_pi": float(fp[4]),
+            "gamma_pi": float(fp[5]),
+            "angle_words": res.angle_words,
         },
-        "geometry_mm": {"firmware": dict(TP17_GEOMETRY_MM), "float": {"a": 612.5, "b": 925, "d": 150}},
-        "engine": engine,
+        "geometry_mm": {"firmware": dict(TP17_GEOMETRY_MM), "float": dict(FLOAT_GEOMETRY_MM)},
+        "engine": res.engine,
         "dsp_lengths_mm": dsp.tolist(),
         "float_lengths_mm": [round(float(v), 4) for v in flt],
         "difference_mm": [round(float(v), 4) for v in dsp - flt],
-        "saturations": dict(sat.counts),
+        "saturations": res.saturations,
         "flags": flags,
     }
-    if args.trace:
-        out["trace"] = {
-            "sin_q15": tr.sin.tolist(),
-            "cos_q15": tr.cos.tolist(),
-            "R_q15": tr.R.tolist(),
-            "plate_joints_T_mm": tr.top_T.tolist(),
-            "plate_joints_B_mm": tr.top_B.tolist(),
-            "leg_vectors_mm": tr.leg.tolist(),
-            "L32": tr.L32.tolist(),
-        }
+    if res.trace is not None:
+        out["trace"] = res.trace
     if args.json:
         print_json(out)
         return _flagged(flags)

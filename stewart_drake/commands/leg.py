@@ -4,19 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.api.leg import leg_ik, make_leg, solve_leg_fk
 from stewart_drake.commands._common import print_json
-from stewart_drake.core.leg3r import (
-    Leg3R,
-    foot,
-    forward_kinematics,
-    inverse_kinematics,
-    inverse_kinematics_3r,
-    limit_violations,
-    within_limits,
-)
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sdf_models import sdf_text, write_sdf
-from stewart_drake.errors import OPTION_JOINT_ANGLES, OPTION_JOINT_OVERFLOW, OPTION_TARGET, LegError
+from stewart_drake.errors import OPTION_TARGET, LegError
 
 
 def register(sub) -> None:
@@ -49,13 +41,13 @@ def register(sub) -> None:
 
 def _leg(args):
     k = length_scale(args.length_unit)
-    dims = {n: getattr(args, n) * k for n in ("l1", "l2", "l3") if getattr(args, n) is not None}
-    return Leg3R(**dims)
+    return {n: getattr(args, n) * k for n in ("l1", "l2", "l3") if getattr(args, n) is not None}
 
 
 def run(args) -> int:
-    leg = _leg(args)
+    dims = _leg(args)
     if args.op == "sdf":
+        leg = make_leg(**dims)
         if args.write:
             print(write_sdf(leg, args.write, option="--write"))
         else:
@@ -65,20 +57,15 @@ def run(args) -> int:
     units = {"length": args.length_unit, "angle": args.angle_unit}
     if args.op == "fk":
         args.q = [args.q1, args.q2]
-        q = np.array(args.q) * ka
-        if not np.all(np.isfinite(q)):
-            raise LegError(OPTION_JOINT_ANGLES.format(value=args.q))
-        f = foot(leg, q)
-        if not np.isfinite(f[2] / ka):  # angles near the float range: their sum in the user's unit is no number
-            raise LegError(OPTION_JOINT_OVERFLOW.format(value=args.q, unit=args.angle_unit))
+        res = solve_leg_fk(np.array(args.q) * ka, make_leg(**dims), args.q, args.angle_unit, ka)
         out = {
             "q": list(args.q),
-            "foot": [f[0] / k, f[1] / k],
-            "gamma": f[2] / ka,
+            "foot": [res.foot[0] / k, res.foot[1] / k],
+            "gamma": res.gamma / ka,
             "units": units,
-            "T03": forward_kinematics(leg, q).tolist(),
-            "within_limits": bool(within_limits(leg, q)),
-            "limit_violations": limit_violations(leg, q),
+            "T03": res.T03.tolist(),
+            "within_limits": res.within_limits,
+            "limit_violations": res.limit_violations,
         }
         if args.json:
             print_json(out)
@@ -93,13 +80,8 @@ def run(args) -> int:
     t = np.array(args.target) * k
     if not np.all(np.isfinite(t)):
         raise LegError(OPTION_TARGET.format(value=args.target))
-    sols = {}
-    for b in ("a", "b") if args.branch == "both" else (args.branch,):
-        if args.gamma is None:
-            q = inverse_kinematics(leg, t, b)
-        else:
-            q = inverse_kinematics_3r(leg, np.r_[t, args.gamma * ka], b)
-        sols[b] = {"q": (q / ka).tolist(), "within_limits": bool(within_limits(leg, q[:2]))}
+    res = leg_ik(*t, gamma=None if args.gamma is None else args.gamma * ka, branch=args.branch, **dims)
+    sols = {b: {"q": (v["q"] / ka).tolist(), "within_limits": v["within_limits"]} for b, v in res.solutions.items()}
     out = {"target": list(args.target), "gamma": args.gamma, "units": units, "solutions": sols}
     if args.json:
         print_json(out)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
-from stewart_drake.core.sdf_models import platform_model_name, sdf_text, write_sdf
+from stewart_drake.core.sdf_models import sdf_text, write_sdf
 from stewart_drake.errors import UsageError
 
 
@@ -26,41 +26,19 @@ def run(args) -> int:
     if args.json and not args.inspect:
         raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))
     platform = platform_from_args(args)
-    if args.write:
-        written = write_sdf(platform, args.write, option="--write")
-        if not args.inspect:
-            print(written)
     if args.inspect:
         # Deferred: only --inspect needs Drake, and cli.py imports every command module at start-up;
         # writing or printing the SDF works without pydrake.
-        from stewart_drake.drake.verify_kinematics import anchor_frames, make_plant
+        from stewart_drake.api.model import inspect_model
 
-        h = make_plant(platform)
-        plant = h.plant
-        info = {
-            "platform": platform.name,
-            "bodies": [
-                plant.get_body(b).name()
-                for b in plant.GetBodyIndices(plant.GetModelInstanceByName(platform_model_name(platform)))
-            ],
-            "joints": {plant.get_joint(j).name(): plant.get_joint(j).type_name() for j in plant.GetJointIndices()},
-            "actuators": [plant.get_joint_actuator(a).name() for a in plant.GetJointActuatorIndices()],
-            "num_positions": plant.num_positions(),
-            "num_velocities": plant.num_velocities(),
-            "constraints": plant.num_constraints(),
-            "time_step_s": plant.time_step(),
-        }
-        base, top = anchor_frames(h)
-        if args.write:
-            info["sdf_file"] = str(written)
-        info["anchor_error_m"] = float(
-            max(abs(base - platform.base_anchors).max(), abs(top - platform.top_anchors_per_leg).max())
-        )
+        info = inspect_model(platform, write=args.write).to_dict()
         if args.json:
             print_json(info)
         else:
             for k, v in info.items():
                 print(f"{k}: {v}")
-    if not args.write and not args.inspect:
+    elif args.write:
+        print(write_sdf(platform, args.write, option="--write"))
+    else:
         print(sdf_text(platform), end="")
     return 0

@@ -6,11 +6,10 @@ import argparse
 
 import numpy as np
 
+from stewart_drake.api.servo import US, solve_servo
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from stewart_drake.core.sanity import check_finite, check_servo_neutrals
-from stewart_drake.core.sdf_models import write_sdf
-from stewart_drake.core.servo import SERVO_PRESETS, load_servo_hexapod, solve
+from stewart_drake.core.servo import SERVO_PRESETS
 from stewart_drake.errors import OPTION_SERVO_POSE, ServoPoseError
 
 
@@ -42,46 +41,47 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    hexapod = load_servo_hexapod(args.platform)
-    check_servo_neutrals(hexapod, f"{args.platform}: servo.neutral_us")
-    if args.trim is not None:
-        check_servo_neutrals(hexapod.replace(neutral_us=check_finite(args.trim, "--trim (µs)")), "--trim")
-        hexapod = hexapod.replace(neutral_us=args.trim)
-    if args.write_sdf:
-        sdf_file = write_sdf(hexapod, args.write_sdf, option="--write-sdf")
-        if not args.json:
-            print(sdf_file)
     k, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     scale = np.r_[[k] * 3, [ka] * 3]
-    if args.pose is None:
-        raw = np.zeros(6) if args.from_home else hexapod.home_pose() / scale
+    if args.pose is not None and not np.all(np.isfinite(args.pose)):
+        raise ServoPoseError(OPTION_SERVO_POSE.format(value=list(args.pose)))
+    res = solve_servo(
+        args.platform,
+        None if args.pose is None else np.asarray(args.pose, dtype=float) * scale,
+        from_home=args.from_home,
+        trim_us=args.trim,
+        write_sdf=args.write_sdf,
+        what="--pose",
+    )
+    if res.sdf_file is not None and not args.json:
+        print(res.sdf_file)
+    if args.pose is not None:
+        raw = list(args.pose)
     else:
-        raw = np.array(args.pose, dtype=float)
-        if not np.all(np.isfinite(raw)):
-            raise ServoPoseError(OPTION_SERVO_POSE.format(value=raw.tolist()))
-    pose = raw * scale
-    if args.from_home:
-        pose[2] += hexapod.home_height
-    sol = solve(hexapod, pose)
+        raw = (np.zeros(6) if args.from_home else res.pose / scale).tolist()
+    violations = []
+    for v in res.violations:
+        d = {key: (float(np.degrees(x)) if key in ("angle", "limit", "excess") else x) for key, x in v.items()}
+        violations.append({(f"{key}_deg" if key in ("angle", "limit", "excess") else key): x for key, x in d.items()})
     result = {
-        "preset": hexapod.name,
-        "pose": raw.tolist(),
+        "preset": res.platform,
+        "pose": raw,
         "units": {"length": args.length_unit, "angle": args.angle_unit, "convention": "zyx"},
-        "home_height": hexapod.home_height / k,
-        "alpha0_deg": np.degrees(hexapod.home_angles).tolist(),
-        "angles_deg": np.degrees(sol.angles).tolist(),
-        "pulse_us": sol.pulse.tolist(),
-        "pulse_raw_us": sol.pulse_raw.tolist(),
-        "ok": bool(sol.ok),
-        "violations": [dict((key, v) for key, v in d.items() if key != "pose") for d in sol.violations()],
+        "home_height": res.home_height / k,
+        "alpha0_deg": np.degrees(res.home_angles).tolist(),
+        "angles_deg": np.degrees(res.angles).tolist(),
+        "pulse_us": (res.pulse / US).tolist(),
+        "pulse_raw_us": (res.pulse_raw / US).tolist(),
+        "ok": res.ok,
+        "violations": violations,
     }
-    if args.write_sdf:
-        result["sdf_file"] = str(sdf_file)
+    if res.sdf_file is not None:
+        result["sdf_file"] = str(res.sdf_file)
     if args.json:
         print_json(result)
     else:
         print(
-            f"{hexapod.name}: h0 = {result['home_height']:.3f} {args.length_unit}, alpha0 = {result['alpha0_deg'][0]:.3f} deg"
+            f"{res.platform}: h0 = {result['home_height']:.3f} {args.length_unit}, alpha0 = {result['alpha0_deg'][0]:.3f} deg"
         )
         print("servo   angle (deg)   pulse (us)")
         for i in range(6):
@@ -93,4 +93,4 @@ def run(args) -> int:
                 print(
                     f"servo {v['servo']}: travel limit, {v['angle_deg']:.3f} deg from home, {v['excess_deg']:.3f} deg beyond ±{abs(v['limit_deg']):.0f}"
                 )
-    return 0 if sol.ok else 1
+    return 0 if res.ok else 1

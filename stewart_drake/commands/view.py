@@ -55,6 +55,7 @@ def register(sub) -> None:
 def run(args) -> int:
     # Deferred: this command needs Drake (Meshcat), and cli.py imports every command module at start-up,
     # so a top-level import would make the numpy commands need pydrake too.
+    from stewart_drake.api.viewer import ViewerReadout
     from stewart_drake.drake.viewer import Viewer, load_replay, open_meshcat
 
     platform = platform_from_args(args)
@@ -93,7 +94,7 @@ def run(args) -> int:
     except KeyboardInterrupt:
         r = viewer.readout
     if args.json and r is not None:
-        print_json(r.to_dict())
+        print_json(ViewerReadout.from_readout(r).to_dict())
     if r is not None and not r.reachable and args.duration is not None:
         print(f"stewart-drake view: the last pose is unreachable: {'; '.join(l for l in _why(r))}", file=sys.stderr)
         return 1
