@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import ctypes
 import errno
+import fcntl
 import hashlib
 import json
 import os
@@ -139,16 +140,30 @@ def _write_manifest(folder: Path, entries: dict[str, dict]) -> None:
     _write_file_atomic(folder / MANIFEST, (json.dumps(data, indent=2) + "\n").encode("utf-8"))
 
 
+@contextmanager
+def commit_lock(folder: Path) -> Iterator[None]:
+    """Writers of one folder change its content and manifest one at a time: an exclusive ``flock`` on the
+    folder's parent directory (held for the commit only; no lock file is left behind). Without it two
+    concurrent commits could interleave their checks and renames, and the manifest name the wrong writer."""
+    fd = os.open(Path(folder).parent, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing the descriptor releases the lock
+
+
 def claim_in_manifest(folder, names, *, prefix: bool = False, command: str | None = None) -> None:
     """Record ``names`` (relative paths the caller has just written in ``folder``) as this command's.
     ``prefix``: the file is an append-only journal, verified by the hash of the bytes written so far
     (a resumable work file that grows after the claim)."""
     folder = Path(folder)
-    entries = load_manifest(folder) or {}
-    for rel in names:
-        digest, size = _hash_file(folder / rel)
-        entries[rel] = {"command": command or _command, "sha256": digest} | ({"prefix": size} if prefix else {})
-    _write_manifest(folder, entries)
+    with commit_lock(folder):
+        entries = load_manifest(folder) or {}
+        for rel in names:
+            digest, size = _hash_file(folder / rel)
+            entries[rel] = {"command": command or _command, "sha256": digest} | ({"prefix": size} if prefix else {})
+        _write_manifest(folder, entries)
 
 
 def _is_relative_inside(rel) -> bool:
@@ -445,7 +460,8 @@ class OutputFolder:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             tmp = make_temp_dir(self.path)
             yield tmp
-            self._commit(tmp)
+            with commit_lock(self.path):
+                self._commit(tmp)
             committed = True  # what may be left at tmp now is the previous result, kept on purpose
         except OSError as e:
             raise self._write_error(e, tmp) from None
