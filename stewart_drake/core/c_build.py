@@ -281,6 +281,22 @@ def _ffi(cdef: str):
 _LOADED: dict[tuple[str, str], object] = {}
 
 
+def source_keyed_library(source: Path, cdef: str, prefix: str, opt: str = "-O2", flags: tuple[str, ...] = ()) -> Path:
+    """A one-file kernel's shared library in the cache, keyed on its source, declarations and options alone.
+    ``build`` keys its cache on the compiler's identity too, which costs a probe of every compiler (≈ 0.15 s
+    per process); a kernel whose result does not depend on which C99 compiler built it is looked up here first
+    (``prefix`` names the cached copy)."""
+    key = hashlib.sha256(source.read_bytes() + cdef.encode() + " ".join((opt, *flags)).encode()).hexdigest()[:32]
+    fast = cache_dir() / f"{prefix}-{key}.so"
+    if not fast.exists():
+        built = build([Source(source.name, path=source)], opt=opt, flags=flags)
+        fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
+        os.close(fd)
+        shutil.copyfile(built, tmp)
+        os.replace(tmp, fast)
+    return fast
+
+
 def load(path: Path, cdef: str):
     """``(ffi, lib)`` for the shared library at ``path`` with the declarations ``cdef`` (loaded once)."""
     ffi = _ffi(cdef)

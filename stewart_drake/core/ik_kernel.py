@@ -12,17 +12,13 @@ with a one-line note on stderr.
 
 from __future__ import annotations
 
-import hashlib
-import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from stewart_drake.core.argcheck import as_poses
-from stewart_drake.core.c_build import UNAVAILABLE, Source, build, cache_dir, load
+from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths as numpy_leg_lengths
 from stewart_drake.core.rotations import CONVENTIONS, check_convention
@@ -35,24 +31,11 @@ NO_COMPILER_NOTE = "note: no C compiler: IK runs the numpy path (~6x slower)"
 _LIB: list = []
 
 
-def _shared_library() -> Path:
-    """The compiled kernel, keyed on its source alone (as ``homotopy.ctrack``: no compiler probe per process)."""
-    key = hashlib.sha256(SOURCE.read_bytes() + CDEF.encode() + OPT.encode()).hexdigest()[:32]
-    fast = cache_dir() / f"sd-ik-kernel-{key}.so"
-    if not fast.exists():
-        built = build([Source(SOURCE.name, path=SOURCE)], opt=OPT)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
-        os.close(fd)
-        shutil.copyfile(built, tmp)
-        os.replace(tmp, fast)
-    return fast
-
-
 def library():
     """``(ffi, lib)`` of the compiled kernel, or None without a compiler or cache (noted once on stderr)."""
     if not _LIB:
         try:
-            _LIB.append(load(_shared_library(), CDEF))
+            _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-ik-kernel", OPT), CDEF))
         except UNAVAILABLE:
             print(NO_COMPILER_NOTE, file=sys.stderr)
             _LIB.append(None)

@@ -33,17 +33,13 @@ shown", not "wrong": the caller may retry with smaller steps, or run the complet
 
 from __future__ import annotations
 
-import hashlib
-import os
-import shutil
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import UNAVAILABLE, Source, build, cache_dir, load
+from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius
 from stewart_drake.core.newton_fk import CONVERGED, leg_geometry, newton_core, validate_lengths
@@ -63,24 +59,11 @@ NO_COMPILER_NOTE = "note: no C compiler: real-time FK runs the numpy Newton (~10
 _LIB: list = []
 
 
-def _shared_library() -> Path:
-    """The compiled kernel, keyed on its source alone (as ``homotopy.ctrack``: no compiler probe per process)."""
-    key = hashlib.sha256(SOURCE.read_bytes() + CDEF.encode() + " ".join((OPT, *FLAGS)).encode()).hexdigest()[:32]
-    fast = cache_dir() / f"sd-realtime-fk-{key}.so"
-    if not fast.exists():
-        built = build([Source(SOURCE.name, path=SOURCE)], opt=OPT, flags=FLAGS)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
-        os.close(fd)
-        shutil.copyfile(built, tmp)
-        os.replace(tmp, fast)
-    return fast
-
-
 def library():
     """``(ffi, lib)`` of the compiled kernel, or None without a compiler or cache (noted once on stderr)."""
     if not _LIB:
         try:
-            _LIB.append(load(_shared_library(), CDEF))
+            _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-realtime-fk", OPT, flags=FLAGS), CDEF))
         except UNAVAILABLE:
             print(NO_COMPILER_NOTE, file=sys.stderr)
             _LIB.append(None)

@@ -10,15 +10,11 @@ end points. Used when a C compiler is available (``TrackOptions.engine = "auto"`
 
 from __future__ import annotations
 
-import hashlib
-import os
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import UNAVAILABLE, Source, build, cache_dir, load
+from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 
 SOURCE = Path(__file__).with_name("track.c")
 CDEF = """
@@ -32,28 +28,13 @@ _LIB: list = []  # [(ffi, lib)] once built, or [the UNAVAILABLE error] when it c
 OPT = "-O2"
 
 
-def _shared_library() -> Path:
-    """The compiled tracker in the build cache. ``build`` keys its cache on the compiler's identity too,
-    which costs a probe of every compiler (≈ 0.15 s per process); the tracker's result does not depend
-    on which C99 compiler built it, so a copy keyed on the source alone is looked up first."""
-    key = hashlib.sha256(SOURCE.read_bytes() + CDEF.encode() + OPT.encode()).hexdigest()[:32]
-    fast = cache_dir() / f"sd-homotopy-track-{key}.so"
-    if not fast.exists():
-        built = build([Source(SOURCE.name, path=SOURCE)], opt=OPT)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
-        os.close(fd)
-        shutil.copyfile(built, tmp)
-        os.replace(tmp, fast)
-    return fast
-
-
 def library():
     """``(ffi, lib)`` of the compiled tracker, built on first use. Raises CompilerUnavailable without a
     C compiler, CacheUnavailable without a usable cache (remembered: not tried again), CompileError if the source does not compile (a
     bug, never hidden by a fallback)."""
     if not _LIB:
         try:
-            _LIB.append(load(_shared_library(), CDEF))
+            _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-homotopy-track", OPT), CDEF))
         except UNAVAILABLE as err:
             _LIB.append(err)
     if isinstance(_LIB[0], UNAVAILABLE):
