@@ -234,7 +234,7 @@ def run_proof(args) -> int:
         elif result.witness:
             w = result.witness
             print(
-                f"  witness pose {np.round(w['pose'], 9).tolist()} (m, rad): leg {w['leg']} {w['what']} "
+                f"  witness pose {np.round(w['pose'], 9).tolist()} (in the base frame, not relative to home; m, rad): leg {w['leg']} {w['what']} "
                 f"(length {w['length_m']:.6f} m, checked by the IK)"
             )
         else:
