@@ -26,10 +26,23 @@ enum { I_RES = 0, I_ITER, I_STATUS, I_CERT, I_RADIUS, I_ETA, I_STEP, I_SUB, N_IN
 #define MAX_STEP_M 0.1
 #define MAX_STEP_RAD 0.5
 #define MARGIN 1e-9
+/* A Newton step reuses the previous iterate's factorisation (a chord step) when the predicted chord residual is
+ * below tol / REUSE_MARGIN: the chord's rate is beta * gamma * |dy| with |dy| ~ beta * res_prev, which is also
+ * Newton's observed rate res / res_prev, so the chord leaves ~ res^2 / res_prev. Convergence is still decided by
+ * res <= tol at the true lengths; only when the prediction is far off does an iteration more run. */
+#define REUSE_MARGIN 100.0
 
 /* g: base anchors (6x3), plate anchors relative to the rotation centre in T (6x3), anchor radius a,
  * size0 = max(|base anchors|max, |top anchors|max) (the numpy divergence test's scale), |t_i| (6). */
 enum { G_BASE = 0, G_TOP = 18, G_A = 36, G_SIZE = 37, G_RT = 38, N_GEOM = 44 }; /* G_RT: |t_i| */
+
+/* The 6x6 matrices are kept as rows of six doubles in three SIMD pairs (the GCC/Clang vector extension: SSE2
+ * on x86-64, NEON on arm64), so that a row operation is three paired multiplies and subtracts; element j of a
+ * row is v[j >> 1][j & 1]. Each element sees the same operations, in the same order, as in scalar code. */
+typedef double v2 __attribute__((vector_size(16)));
+typedef long long m2 __attribute__((vector_size(16)));
+typedef struct { v2 v[3]; } row6;
+#define EL(row, j) ((row).v[(j) >> 1][(j) & 1])
 
 static void rotation(int conv, const double *ang, double R[9]) {
     double ca = cos(ang[0]), cb = cos(ang[1]), cg = cos(ang[2]);
@@ -81,69 +94,89 @@ static void legs(const double *g, const double p[3], const double R[9], double r
     }
 }
 
-/* Rows [u_i, (r_i x u_i) / a] (a = 1: the unscaled J^-1 of newton_fk). */
-static void jac(double r[6][3], double l[6][3], const double L[6], double a, double J[6][6]) {
+/* Rows [u_i, r_i x u_i] (the unscaled J^-1 of newton_fk). */
+static void jac(double r[6][3], double l[6][3], const double L[6], row6 J[6]) {
     for (int i = 0; i < 6; i++) {
         double ux = l[i][0] / L[i], uy = l[i][1] / L[i], uz = l[i][2] / L[i];
-        J[i][0] = ux; J[i][1] = uy; J[i][2] = uz;
-        J[i][3] = (r[i][1] * uz - r[i][2] * uy) / a;
-        J[i][4] = (r[i][2] * ux - r[i][0] * uz) / a;
-        J[i][5] = (r[i][0] * uy - r[i][1] * ux) / a;
+        J[i].v[0] = (v2){ux, uy};
+        J[i].v[1] = (v2){uz, r[i][1] * uz - r[i][2] * uy};
+        J[i].v[2] = (v2){r[i][2] * ux - r[i][0] * uz, r[i][0] * uy - r[i][1] * ux};
     }
 }
 
-/* LU with partial pivoting in place (multipliers below the diagonal, rows swapped whole); 0 when a pivot
- * is exactly zero (numpy's LinAlgError). The updates run over all six columns (fixed trip counts the
- * compiler unrolls): row k is zero left of its pivot, so columns < k are unchanged but for column k,
- * whose multiplier is written after the update. */
-static int lu(double A[6][6], int piv[6]) {
-    for (int k = 0; k < 6; k++) {
-        int m = k;
-        double big = fabs(A[k][k]);
-        for (int i = k + 1; i < 6; i++)
-            if (fabs(A[i][k]) > big) { m = i; big = fabs(A[i][k]); }
-        piv[k] = m;
-        if (big == 0.0) return 0;
-        if (m != k)
-            for (int j = 0; j < 6; j++) { double t = A[k][j]; A[k][j] = A[m][j]; A[m][j] = t; }
-        double inv = 1.0 / A[k][k], row[6];
-        for (int j = 0; j < 6; j++) row[j] = j > k ? A[k][j] : 0.0;
-        for (int i = k + 1; i < 6; i++) {
-            double f = A[i][k] * inv;
-            for (int j = 0; j < 6; j++) A[i][j] -= f * row[j];
-            A[i][k] = f;
-        }
+/* LU with partial pivoting in place (LAPACK's dgetf2: multipliers below the diagonal, rows swapped whole);
+ * 0 when a pivot is exactly zero (numpy's LinAlgError). Each update runs over the whole row with the pivot
+ * row's columns <= k masked to zero (so those columns of the updated row are unchanged), then column k takes
+ * the multiplier. The pivot search selects rather than jumps, and the swap is unconditional (a row with
+ * itself when m == k): no mispredicted branches. */
+static inline int lu_column(row6 A[6], int piv[6], double dinv[6], int k) { /* called with constant k: unrolled */
+    int m = k;
+    double big = fabs(EL(A[k], k));
+    for (int i = k + 1; i < 6; i++) {
+        double v = fabs(EL(A[i], k));
+        int gt = v > big;
+        m = gt ? i : m;
+        big = gt ? v : big;
+    }
+    piv[k] = m;
+    if (big == 0.0) return 0;
+    row6 t = A[k];
+    A[k] = A[m];
+    A[m] = t;
+    double inv = dinv[k] = 1.0 / EL(A[k], k);
+    m2 kk = {k, k};
+    v2 u0 = (v2)((m2)A[k].v[0] & ((m2){0, 1} > kk)), u1 = (v2)((m2)A[k].v[1] & ((m2){2, 3} > kk)),
+       u2 = (v2)((m2)A[k].v[2] & ((m2){4, 5} > kk));
+    for (int i = k + 1; i < 6; i++) {
+        double f = EL(A[i], k) * inv;
+        v2 fv = {f, f};
+        A[i].v[0] -= fv * u0;
+        A[i].v[1] -= fv * u1;
+        A[i].v[2] -= fv * u2;
+        EL(A[i], k) = f;
     }
     return 1;
 }
 
-static void lu_solve(double A[6][6], const int piv[6], double x[6]) {
+static int lu(row6 A[6], int piv[6], double dinv[6]) {
+    return lu_column(A, piv, dinv, 0) && lu_column(A, piv, dinv, 1) && lu_column(A, piv, dinv, 2) &&
+           lu_column(A, piv, dinv, 3) && lu_column(A, piv, dinv, 4) && lu_column(A, piv, dinv, 5);
+}
+
+static void lu_solve(const row6 A[6], const int piv[6], const double dinv[6], double x[6]) {
     for (int k = 0; k < 6; k++) { /* rows were swapped whole (multipliers too): permute first */
         double t = x[k]; x[k] = x[piv[k]]; x[piv[k]] = t;
     }
     for (int k = 0; k < 6; k++)
-        for (int i = k + 1; i < 6; i++) x[i] -= A[i][k] * x[k];
+        for (int i = k + 1; i < 6; i++) x[i] -= EL(A[i], k) * x[k];
     for (int k = 5; k >= 0; k--) {
-        for (int j = k + 1; j < 6; j++) x[k] -= A[k][j] * x[j];
-        x[k] /= A[k][k];
+        for (int j = k + 1; j < 6; j++) x[k] -= EL(A[k], j) * x[j];
+        x[k] *= dinv[k]; /* the pivots' reciprocals: no division on the substitution's critical path */
     }
 }
 
-/* The inverse from the LU: all six right-hand sides at once (rows of X, the inner loops over columns). */
-static void lu_inverse(double A[6][6], const int piv[6], double X[6][6]) {
-    for (int i = 0; i < 6; i++)
-        for (int j = 0; j < 6; j++) X[i][j] = (i == j);
+/* The inverse from the LU: all six right-hand sides at once (rows of X, a row operation per multiplier). */
+static void lu_inverse(const row6 A[6], const int piv[6], const double dinv[6], row6 X[6]) {
+    for (int i = 0; i < 6; i++) {
+        X[i].v[0] = X[i].v[1] = X[i].v[2] = (v2){0.0, 0.0};
+        EL(X[i], i) = 1.0;
+    }
     for (int k = 0; k < 6; k++)
-        if (piv[k] != k)
-            for (int j = 0; j < 6; j++) { double t = X[k][j]; X[k][j] = X[piv[k]][j]; X[piv[k]][j] = t; }
+        if (piv[k] != k) { row6 t = X[k]; X[k] = X[piv[k]]; X[piv[k]] = t; }
     for (int k = 0; k < 6; k++)
-        for (int i = k + 1; i < 6; i++)
-            for (int j = 0; j < 6; j++) X[i][j] -= A[i][k] * X[k][j];
+        for (int i = k + 1; i < 6; i++) {
+            double f = EL(A[i], k);
+            v2 fv = {f, f};
+            for (int q = 0; q < 3; q++) X[i].v[q] -= fv * X[k].v[q];
+        }
     for (int k = 5; k >= 0; k--) {
-        for (int i = k + 1; i < 6; i++)
-            for (int j = 0; j < 6; j++) X[k][j] -= A[k][i] * X[i][j];
-        double inv = 1.0 / A[k][k];
-        for (int j = 0; j < 6; j++) X[k][j] *= inv;
+        for (int i = k + 1; i < 6; i++) {
+            double f = EL(A[k], i);
+            v2 fv = {f, f};
+            for (int q = 0; q < 3; q++) X[k].v[q] -= fv * X[i].v[q];
+        }
+        v2 iv = {dinv[k], dinv[k]};
+        for (int q = 0; q < 3; q++) X[k].v[q] *= iv;
     }
 }
 
@@ -180,26 +213,35 @@ static double lipschitz(double a, const double rt[6], const double L0[6], double
 /* The certificate at y0 from the unscaled J(y0) (LU-factorised in F, original in J0), the leg lengths L0 at
  * y0, the first Newton step d0 = J^-1 (Lt - L0) and |Lt - L0|: uniqueness radius rho (0 when J(y0) is too
  * badly conditioned to bound) and eta. The scaled J_s = J D^-1, D = diag(1, 1, 1, a, a, a): J_s^-1 = D J^-1. */
-static void certificate(const double *g, double J0[6][6], double F[6][6], const int piv[6], const double L0[6],
+static void certificate(const double *g, const row6 J0[6], const row6 F[6], const int piv[6], const double dinv[6],
+                        const double L0[6],
                         const double d0[6], double nf, double *rho_out, double *eta_out) {
-    double a = g[G_A], X[6][6], Y[6][6], D[6] = {1, 1, 1, a, a, a}, Dinv[6] = {1, 1, 1, 1 / a, 1 / a, 1 / a};
+    double a = g[G_A], D[6] = {1, 1, 1, a, a, a};
+    row6 X[6], Y[6], Dinv = {{{1, 1}, {1, 1 / a}, {1 / a, 1 / a}}};
     const double *rt = g + G_RT;
     *rho_out = 0.0;
     *eta_out = INFINITY;
-    lu_inverse(F, piv, Y); /* Y = J^-1 */
-    for (int i = 0; i < 6; i++)
-        for (int j = 0; j < 6; j++) X[i][j] = D[i] * Y[i][j]; /* X = J_s^-1 = D J^-1 */
-    double xf = 0.0, df = 0.0;
+    lu_inverse(F, piv, dinv, Y); /* Y = J^-1 */
     for (int i = 0; i < 6; i++) {
-        double row[6] = {0, 0, 0, 0, 0, 0};
-        for (int k = 0; k < 6; k++)
-            for (int j = 0; j < 6; j++) row[j] += X[i][k] * J0[k][j];
-        for (int j = 0; j < 6; j++) {
-            double d = (i == j) - row[j] * Dinv[j]; /* I - X J_s */
-            df += d * d;
-            xf += X[i][j] * X[i][j];
+        v2 di = {D[i], D[i]};
+        for (int q = 0; q < 3; q++) X[i].v[q] = di * Y[i].v[q]; /* X = J_s^-1 = D J^-1 */
+    }
+    v2 dfv = {0, 0}, xfv = {0, 0};
+    for (int i = 0; i < 6; i++) {
+        row6 row = {{{0, 0}, {0, 0}, {0, 0}}}, eye = row;
+        EL(eye, i) = 1.0;
+        for (int k = 0; k < 6; k++) {
+            double x = EL(X[i], k);
+            v2 xv = {x, x};
+            for (int q = 0; q < 3; q++) row.v[q] += xv * J0[k].v[q];
+        }
+        for (int q = 0; q < 3; q++) {
+            v2 d = eye.v[q] - row.v[q] * Dinv.v[q]; /* I - X J_s */
+            dfv += d * d;
+            xfv += X[i].v[q] * X[i].v[q];
         }
     }
+    double df = dfv[0] + dfv[1], xf = xfv[0] + xfv[1];
     double delta = sqrt(df) * (1.0 + MARGIN) + 1e-15;
     if (!(delta < 0.5)) return;
     double beta = sqrt(xf) * (1.0 + MARGIN) / (1.0 - delta), xd = 0.0;
@@ -224,9 +266,11 @@ static int newton(const double *g, const double *Lt, double tol, int max_iter, d
                   int *its_out, double *cert) {
     double size = g[G_SIZE];
     for (int i = 0; i < 6; i++) size = Lt[i] > size ? Lt[i] : size;
-    double r[6][3], l[6][3], L[6], J[6][6], J0[6][6], e[6];
+    double r[6][3], l[6][3], L[6], e[6];
+    row6 J[6], J0[6];
+    double dinv[6];
     int piv[6], its = 0, st = MAX_ITER;
-    double res = INFINITY;
+    double res = INFINITY, res_prev = INFINITY;
     if (cert) { cert[0] = 0.0; cert[1] = INFINITY; }
     for (int k = 0; k <= max_iter; k++) {
         legs(g, p, R, r, l, L);
@@ -244,13 +288,12 @@ static int newton(const double *g, const double *Lt, double tol, int max_iter, d
             break;
         }
         if (k == 0 && cert) { /* the certificate needs J(y0) and the first step even when y0 already fits */
-            jac(r, l, L, 1.0, J);
-            for (int i = 0; i < 6; i++)
-                for (int j = 0; j < 6; j++) J0[i][j] = J[i][j];
-            if (lu(J, piv)) {
+            jac(r, l, L, J);
+            for (int i = 0; i < 6; i++) J0[i] = J[i];
+            if (lu(J, piv, dinv)) {
                 double d0[6] = {e[0], e[1], e[2], e[3], e[4], e[5]};
-                lu_solve(J, piv, d0);
-                certificate(g, J0, J, piv, L, d0, sqrt(nf), cert, cert + 1);
+                lu_solve(J, piv, dinv, d0);
+                certificate(g, J0, J, piv, dinv, L, d0, sqrt(nf), cert, cert + 1);
                 if (!done) for (int i = 0; i < 6; i++) e[i] = d0[i];
             } else if (!done) {
                 st = SINGULAR;
@@ -260,9 +303,11 @@ static int newton(const double *g, const double *Lt, double tol, int max_iter, d
         if (done) { st = CONVERGED; break; }
         if (k == max_iter) break;
         if (!(k == 0 && cert)) {
-            jac(r, l, L, 1.0, J);
-            if (!lu(J, piv)) { st = SINGULAR; break; }
-            lu_solve(J, piv, e);
+            if (k == 0 || REUSE_MARGIN * res * res > tol * res_prev) {
+                jac(r, l, L, J);
+                if (!lu(J, piv, dinv)) { st = SINGULAR; break; }
+            }
+            lu_solve(J, piv, dinv, e);
         }
         double ndp = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]), nw = sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]);
         double s = 1.0;
@@ -272,6 +317,7 @@ static int newton(const double *g, const double *Lt, double tol, int max_iter, d
         double w[3] = {s * e[3], s * e[4], s * e[5]};
         rotate(w, R);
         its++;
+        res_prev = res;
     }
     *res_out = res;
     *its_out = its;
