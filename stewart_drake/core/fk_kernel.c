@@ -29,8 +29,10 @@ enum { I_RES = 0, I_ITER, I_STATUS, I_CERT, I_RADIUS, I_ETA, I_STEP, I_SUB, N_IN
 /* A Newton step reuses the previous iterate's factorisation (a chord step) when the predicted chord residual is
  * below tol / REUSE_MARGIN: the chord's rate is beta * gamma * |dy| with |dy| ~ beta * res_prev, which is also
  * Newton's observed rate res / res_prev, so the chord leaves ~ res^2 / res_prev. Convergence is still decided by
- * res <= tol at the true lengths; only when the prediction is far off does an iteration more run. */
-#define REUSE_MARGIN 100.0
+ * res <= tol at the true lengths; only when the prediction is far off does an iteration more run. The margin
+ * 1e3 puts the chord's residual below rounding, so the pose is the full Newton's to rounding where certified
+ * (1e-15 m on the presets, 1e5 workspace solves each; with 1e2 it was 1e-13 m). */
+#define REUSE_MARGIN 1e3
 
 /* g: base anchors (6x3), plate anchors relative to the rotation centre in T (6x3), anchor radius a,
  * size0 = max(|base anchors|max, |top anchors|max) (the numpy divergence test's scale), |t_i| (6). */
@@ -200,11 +202,11 @@ static void rotate(const double w[3], double R[9]) {
  * with E = e^(rho / a), |l| >= |l0| - c1 rho; |D^2 |l|| <= c1^2 / |l| + |t| E / a^2; gamma = sqrt(sum M_i^2).
  * rt: |t_i|, the plate anchors' distances from the rotation centre. */
 static double lipschitz(double a, const double rt[6], const double L0[6], double rho) {
-    double E = exp(rho / a), s = 0.0;
+    double ia = 1.0 / a, q = exp(rho * ia) * ia, s = 0.0; /* reciprocals: a few ulps, well inside MARGIN */
     for (int i = 0; i < 6; i++) {
-        double c1sq = 1.0 + (rt[i] * E / a) * (rt[i] * E / a), lmin = L0[i] - sqrt(c1sq) * rho;
+        double c1sq = 1.0 + (rt[i] * q) * (rt[i] * q), lmin = L0[i] - sqrt(c1sq) * rho;
         if (!(lmin > 0)) return INFINITY;
-        double M = c1sq / lmin + rt[i] * E / (a * a);
+        double M = c1sq / lmin + rt[i] * q * ia;
         s += M * M;
     }
     return sqrt(s) * (1.0 + MARGIN);
@@ -310,9 +312,9 @@ static int newton(const double *g, const double *Lt, double tol, int max_iter, d
             lu_solve(J, piv, dinv, e);
         }
         double ndp = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]), nw = sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]);
-        double s = 1.0;
-        if (ndp > 0 && MAX_STEP_M / ndp < s) s = MAX_STEP_M / ndp;
-        if (nw > 0 && MAX_STEP_RAD / nw < s) s = MAX_STEP_RAD / nw;
+        double s = 1.0; /* min(1, max_step_m / |dp|, max_step_rad / |w|), dividing only when a bound binds */
+        if (ndp > MAX_STEP_M) s = MAX_STEP_M / ndp;
+        if (nw > MAX_STEP_RAD && MAX_STEP_RAD / nw < s) s = MAX_STEP_RAD / nw;
         for (int j = 0; j < 3; j++) p[j] += s * e[j];
         double w[3] = {s * e[3], s * e[4], s * e[5]};
         rotate(w, R);
