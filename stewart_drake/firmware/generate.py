@@ -34,7 +34,7 @@ from stewart_drake.control.laws import check_no_sensor_gains
 from stewart_drake.control.timing import FEEDFORWARD_OPS_PER_LEG, ISR_OVERHEAD_CYCLES, PID_OPS_PER_LEG
 from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import FirmwareError
-from stewart_drake.firmware.fk_gen import contraction, fk_ops, fk_prototype, fk_readme, fk_source
+from stewart_drake.firmware.fk_gen import fk_ops, fk_prototype, fk_readme, fk_source
 from stewart_drake.fixedpoint.cycles import CYCLE_TABLE, CycleEstimate, estimate_cycles
 from stewart_drake.fixedpoint.generic import QFormat, platform_words, rotation_monomials, trig_words
 
@@ -56,6 +56,7 @@ OPS = (
     "tfr16SinPIx",
     "tfr16CosPIx",
     "table",
+    "div_s",  # sd_fk's divisions (firmware.fk_gen)
 )
 # cycles of a quarter-wave table look-up (fold, index, load, sign): exact trig only
 TABLE_CYCLES = 6.0
@@ -290,8 +291,8 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     g.fk_ops = fk_ops(ik_ops)
     end = "\n#endif /* SD_FIRMWARE_H */"
     g.files["sd_firmware.h"] = g.files["sd_firmware.h"].replace(end, "\n" + fk_prototype() + end, 1)
-    g.files["sd_firmware.c"] += fk_source(platform, config)
-    g.files["README.md"] += fk_readme(g.fk_cycles, config.timing.clock_hz, contraction(platform, config))
+    g.files["sd_firmware.c"] += fk_source(platform, config, TRACE_AT)
+    g.files["README.md"] += fk_readme(g.fk_cycles, config.timing.clock_hz)
     return g
 
 
