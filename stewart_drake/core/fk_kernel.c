@@ -186,7 +186,10 @@ static void lu_inverse(const row6 A[6], const int piv[6], const double dinv[6], 
 static void rotate(const double w[3], double R[9]) {
     double th2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], th = sqrt(th2), A, B;
     if (th < 1e-6) { A = 1.0 - th2 / 6.0; B = 0.5 - th2 / 24.0; }
-    else { A = sin(th) / th; B = (1.0 - cos(th)) / (th * th); }
+    else if (th < 1e-2) { /* the series to th^6: the next terms are below 3e-22, under the rounding of sin, cos */
+        A = 1.0 - th2 * (1.0 / 6.0 - th2 * (1.0 / 120.0 - th2 * (1.0 / 5040.0)));
+        B = 0.5 - th2 * (1.0 / 24.0 - th2 * (1.0 / 720.0 - th2 * (1.0 / 40320.0)));
+    } else { A = sin(th) / th; B = (1.0 - cos(th)) / (th * th); }
     double K[9] = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0}, E[9], out[9];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
@@ -332,7 +335,13 @@ static double distance(double a, const double p0[3], const double R0[9], const d
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) M[3 * i + j] = R1[3 * i] * R0[3 * j] + R1[3 * i + 1] * R0[3 * j + 1] + R1[3 * i + 2] * R0[3 * j + 2];
     double vx = M[7] - M[5], vy = M[2] - M[6], vz = M[3] - M[1];
-    double th = atan2(0.5 * sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (M[0] + M[4] + M[8] - 1.0));
+    double s = 0.5 * sqrt(vx * vx + vy * vy + vz * vz), c = 0.5 * (M[0] + M[4] + M[8] - 1.0), th;
+    if (c > 0.0 && s <= 0.1 * c) { /* atan(s / c) by its series to x^15: the rest is below 1e-18 relative */
+        double x = s / c, x2 = x * x;
+        th = x * (1.0 - x2 * (1.0 / 3 - x2 * (1.0 / 5 - x2 * (1.0 / 7 - x2 * (1.0 / 9 - x2 * (1.0 / 11 - x2 * (1.0 / 13 - x2 / 15)))))));
+    } else {
+        th = atan2(s, c);
+    }
     double dx = p1[0] - p0[0], dy = p1[1] - p0[1], dz = p1[2] - p0[2];
     return sqrt(dx * dx + dy * dy + dz * dz + a * a * th * th);
 }
