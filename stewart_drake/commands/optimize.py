@@ -108,8 +108,13 @@ def run(args) -> int:
                 room = f" (least stroke margin {r['margin'] * 1e3:.2f} mm)" if r["margin"] is not None else ""
                 print(f"  {mark:7s} {r['requirement']}: {r['achieved']}{room}")
             else:
+                proof = ""
+                if "status" in r:  # the performance proof's verdict
+                    proof = f"; {r['status']}" + (f", bound {r['bound']:.6g}" if r["bound"] is not None else "")
+                    if r.get("witness"):
+                        proof += f" (witness pose {r['witness']['pose']}: {r['witness']['value']:.6g})"
                 print(
-                    f"  {mark:7s} {r['requirement']}: required {r['required']:g}, achieved {r['achieved']:.6g} {r['unit']}"
+                    f"  {mark:7s} {r['requirement']}: required {r['required']:g}, achieved {r['achieved']:.6g} {r['unit']}{proof}"
                 )
         print(f"  wrote {args.out}/ (design.yaml, pareto.parquet/.csv/.png, requirements.json)")
     return 0 if result.ok else 1

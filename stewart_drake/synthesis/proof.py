@@ -343,6 +343,36 @@ def _witness(
     }
 
 
+def initial_cells(platform: Platform, lo, hi, initial: int | None = None) -> Cells:
+    """The box [lo, hi] ((6,) m, rad) cut into cells: ``initial`` splits per angle axis (default: cells of about
+    5°), positions whole."""
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    splits = np.ones(6, dtype=int)
+    width = hi - lo
+    splits[3:] = np.maximum(1, np.ceil(width[3:] / np.radians(5.0)).astype(int)) if initial is None else initial
+    splits[3:] = np.where(width[3:] > 0, splits[3:], 1)
+    axes = [(lo[j] + (np.arange(splits[j]) + 0.5) * width[j] / splits[j]) for j in range(6)]
+    c = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
+    return Cells(c, np.broadcast_to(width / (2 * splits), c.shape).copy())
+
+
+def split_cells(platform: Platform, cells: Cells) -> Cells:
+    """Each cell halved across its widest side (positions in metres, angles times the plate's anchor radius):
+    twice as many cells covering the same poses."""
+    rmax = float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
+    scale = np.r_[np.ones(3), np.full(3, max(rmax, 1e-9))]
+    j = np.argmax(cells.h * scale, axis=1)
+    rows = np.arange(len(cells))
+    h2 = cells.h.copy()
+    h2[rows, j] /= 2
+    halves = []
+    for sgn in (-1.0, 1.0):
+        c2 = cells.c.copy()
+        c2[rows, j] += sgn * h2[rows, j]
+        halves.append(c2)
+    return Cells(np.concatenate(halves), np.concatenate([h2, h2]))
+
+
 def prove_box(
     platform: Platform,
     lo,
@@ -360,15 +390,7 @@ def prove_box(
     check_convention(convention)
     t0 = time.perf_counter()
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    rmax = float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
-    scale = np.r_[np.ones(3), np.full(3, max(rmax, 1e-9))]
-    splits = np.ones(6, dtype=int)
-    width = hi - lo
-    splits[3:] = np.maximum(1, np.ceil(width[3:] / np.radians(5.0)).astype(int)) if initial is None else initial
-    splits[3:] = np.where(width[3:] > 0, splits[3:], 1)
-    axes = [(lo[j] + (np.arange(splits[j]) + 0.5) * width[j] / splits[j]) for j in range(6)]
-    c = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
-    pending = Cells(c, np.broadcast_to(width / (2 * splits), c.shape).copy())
+    pending = initial_cells(platform, lo, hi, initial)
     examined = proven = 0
     lmin_b, lmax_b, margin, zmin = np.inf, -np.inf, np.inf, np.inf
     while len(pending):
@@ -409,16 +431,9 @@ def prove_box(
                 return ProofResult(
                     "violated", lo, hi, examined, proven, max_cells, witness=w, seconds=time.perf_counter() - t0
                 )
-            cb, hb = cells.c[bad], cells.h[bad]
-            j = np.argmax(hb * scale, axis=1)
-            rows = np.arange(len(cb))
-            h2 = hb.copy()
-            h2[rows, j] /= 2
-            for sgn in (-1.0, 1.0):
-                c2 = cb.copy()
-                c2[rows, j] += sgn * h2[rows, j]
-                nxt_c.append(c2)
-                nxt_h.append(h2)
+            halves = split_cells(platform, Cells(cells.c[bad], cells.h[bad]))
+            nxt_c.append(halves.c)
+            nxt_h.append(halves.h)
         pending = (
             Cells(np.concatenate(nxt_c), np.concatenate(nxt_h)) if nxt_c else Cells(np.zeros((0, 6)), np.zeros((0, 6)))
         )
