@@ -61,6 +61,7 @@ from stewart_drake.design.boxquad import box_quadratic_max
 from stewart_drake.design.envelope import Envelope, envelope_sizing, plate_wrench_terms, spatial_inertia_about_C
 from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.stiffness import stiffness_matrix
+from stewart_drake.errors import StewartError
 from stewart_drake.synthesis.proof import BATCH, COVER_PAD, Cells, initial_cells, rotation_derivatives, split_cells
 
 REL_SLACK = 1e-9  # relative widening of each bound for rounding (module docstring)
@@ -362,7 +363,10 @@ def _confirm(platform, name, poses, limit, v_max, a_max, stiffness, convention) 
     if not len(poses):
         return None
     poses = poses[:16]
-    vals = sampled_performance(platform, poses, v_max, a_max, stiffness, convention)[name]
+    try:
+        vals = sampled_performance(platform, poses, v_max, a_max, stiffness, convention)[name]
+    except StewartError:  # a centre off the workspace (the box's own proof says so): no witness here, split on
+        return None
     bad = vals < limit if name == "frequency" else vals > limit
     if not bad.any():
         return None
