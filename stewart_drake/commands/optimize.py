@@ -57,7 +57,7 @@ def register(sub) -> None:
         type=int,
         default=MAX_CELLS,
         metavar="N",
-        help=f"cells the proof may examine (default {MAX_CELLS})",
+        help=f"cells each proof may examine: the box's, and force/speed/frequency/condition's (default {MAX_CELLS})",
     )
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

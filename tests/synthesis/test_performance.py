@@ -10,6 +10,7 @@ from importlib import resources
 import numpy as np
 import pytest
 
+from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.synthesis.families import design_platform
 from stewart_drake.synthesis.performance import (
     NAMES,
@@ -118,3 +119,20 @@ def test_too_few_cells_is_unresolved(req, design):
     r = proof.results["force"]
     assert r["status"] == "unresolved" and r["unresolved_count"] > 0 and len(r["unresolved_cells"]) > 0
     assert r["bound"] is None
+
+
+def test_derived_constants_hold():
+    """The two constants the bounds rest on, on random draws: ‖R(θ+δ) − R(θ)‖₂ <= ‖δ‖₁ for both conventions (and not
+    loose: the ratio reaches 0.9), and |a/|a| − b/|b|| <= |a − b| / min(|a|, |b|) (normalising is 1-Lipschitz
+    outside the unit ball)."""
+    rng = np.random.default_rng(5)
+    th = rng.uniform(-1, 1, (20_000, 3))
+    d = rng.uniform(-0.3, 0.3, (20_000, 3)) * rng.random((20_000, 1))
+    for convention in ("utn", "zyx"):
+        diff = np.linalg.norm(rotation_matrix(th + d, convention) - rotation_matrix(th, convention), 2, axis=(1, 2))
+        ratio = diff / np.sum(np.abs(d), 1)
+        assert np.all(ratio <= 1 + 1e-12) and ratio.max() > 0.9
+    a, b = rng.normal(size=(2, 20_000, 3)) * rng.uniform(0.1, 2, (2, 20_000, 1))
+    na, nb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
+    lhs = np.linalg.norm(a / na[:, None] - b / nb[:, None], axis=1)
+    assert np.all(lhs <= np.linalg.norm(a - b, axis=1) / np.minimum(na, nb) * (1 + 1e-12))
