@@ -168,7 +168,11 @@ def performance_bounds(
     near = peak_c + b_norm * dw[:, None]  # |F'_i| over the cell × envelope
     rel = np.where(regular, d / np.where(regular, sig_s[:, -1] - d, 1.0), np.inf)  # δ/(σ_min − δ)
     f_norm = np.minimum(np.linalg.norm(near, axis=-1), beta * W)  # |F'|₂ <= ‖A_s(c)⁻¹‖ |D w| too
-    force = np.minimum(near + (rel * f_norm)[:, None], near + dB[:, None] * W) + slack[:, None] * scale_F
+    # leg by leg: (A_s(c) − A_s(x))ᵀ F' = Σ_k F'_k Δa_k, |Δa_k| <= ε_k, and row i of A_s(x)⁻ᵀ is within ΔB of b_i(c)
+    eps_leg = np.sqrt(e_u**2 + (e_w / s) ** 2)  # (n, 6)
+    per_leg = (b_norm + dB[:, None]) * np.sum(near * eps_leg, -1)[:, None]
+    jac = np.minimum(np.minimum(rel * f_norm, dB * W)[:, None], per_leg)
+    force = near + jac + slack[:, None] * scale_F
     # frequency: K ⪰ k A(c)ᵀA(c) − ε_K 1 and M ⪯ M_C(c) + ε_M 1
     W_g = m * gravity * np.hypot(1.0, cm / s)
     near_g = np.abs(cF) + b_norm * (m * gravity * dr_cm / s)[:, None]
