@@ -9,30 +9,33 @@ l_i = p + r_i − b_i, u_i = l_i/|l_i| and J⁻¹'s rows a_i = [u_i; r_i × u_i]
   product of rotations adds the factors' differences);
 - |r_i − r_i(c)| <= e_r = min(ε_R |t_i|, Σ_j |∂r_i/∂θ_j| h_θ,j + ½ |t_i| ‖h_θ‖₁²) (``proof``'s Taylor constant);
   |l_i − l_i(c)| <= e_l = |h_p| + e_r;
-- |u_i − u_i(c)| <= e_u = 2 e_l / |l_i(c)| (from a/|a| − b/|b| = (a − b)/|b| + a (1/|a| − 1/|b|));
-  |r_i × u_i − r_i(c) × u_i(c)| <= e_w = e_r + |r_i(c)| e_u;
-- ‖A(x) − A(c)‖₂ <= δ = (Σ_i e_u² + e_w²)^½ (the Frobenius norm), and for the scaled J⁻¹ (rotation columns
-  divided by the anchor radius s, ``core.kinematics.scaled_jacobian``) δ_s = (Σ_i e_u² + (e_w/s)²)^½.
+- |u_i − u_i(c)| <= e_u = min(2 e_l / |l_i(c)|, e_l / (|l_i(c)| − e_l)) (from a/|a| − b/|b| = (a − b)/|b|
+  + a (1/|a| − 1/|b|), and normalising is 1-Lipschitz outside the unit ball); |r_i × u_i − r_i(c) × u_i(c)| <= e_w
+  = e_r + |t_i| e_u;
+- everything is done in the scaled J⁻¹ A_s = A D, D = diag(1, 1, 1, 1/s, 1/s, 1/s) (s the anchor radius, as
+  ``core.kinematics.condition_number``): row i changes by at most ε_i = (e_u² + (e_w/s)²)^½ and
+  ‖A_s(x) − A_s(c)‖₂ <= δ = (Σ_i ε_i²)^½ (the Frobenius norm); σ_min, σ_max, β = 1/σ_min are A_s(c)'s.
 
 From these:
 
-- **condition number** (scaled J⁻¹, ``core.kinematics.condition_number``): by Weyl's inequalities
-  σ_max(x) <= σ_max(c) + δ_s and σ_min(x) >= σ_min(c) − δ_s, so cond <= (σ_max + δ_s)/(σ_min − δ_s);
-- **non-singularity and J⁻ᵀ**: with β = ‖A(c)⁻¹‖₂ = 1/σ_min(c) and βδ < 1, A(x) is invertible on the cell and
-  ‖A(x)⁻ᵀ − A(c)⁻ᵀ‖₂ <= β² δ / (1 − βδ) =: ΔB (Neumann series);
+- **condition number**: by Weyl's inequalities cond <= (σ_max + δ)/(σ_min − δ);
+- **non-singularity**: βδ < 1 proves A_s(x) invertible on the cell, and ‖A_s(x)⁻ᵀ − A_s(c)⁻ᵀ‖₂ <= ΔB = β²δ/(1 − βδ)
+  (Neumann series);
 - **leg speed** over the velocity box |V_j| <= v_j (``design.envelope``): |a_i·V| <= Σ_j |a_ij(c)| v_j
   + e_u |v_lin| + e_w |v_ang| (Cauchy–Schwarz on the change);
-- **leg force** F = A⁻ᵀ w, w = w_g + M_C [a_C; ω̇] + H(ω) the plate's wrench (``design.envelope.
-  plate_wrench_terms``): |F_i| <= P_i(c) + |b_i(c)| Δw + ΔB W, where P_i(c) is the exact envelope peak at the
-  centre pose (the envelope method), b_i(c) row i of A(c)⁻ᵀ, Δw >= |w(θ) − w(c)| (the orientation enters
-  through r_cm = R c_m and I_W = R I Rᵀ: |Δr_cm| <= ε_R |c_m|, ‖ΔI_W‖ <= 2 ε_R ‖I‖, term by term below) and
-  W >= |w| over the envelope (orientation-free norms);
+- **leg force** F = A⁻ᵀ w = A_s⁻ᵀ D w, w = w_g + M_C [a_C; ω̇] + H(ω) the plate's wrench (``design.envelope.
+  plate_wrench_terms``). F' = A_s(c)⁻ᵀ D w(x) has |F'_i| <= P_i(c) + |b_i(c)| |D Δw| =: near_i, with P_i(c) the exact
+  envelope peak at the centre pose (the envelope method), b_i(c) row i of A_s(c)⁻ᵀ and |D Δw| bounded term by term
+  (the orientation enters through r_cm = R c_m and I_W = R I Rᵀ: |Δr_cm| <= ε_R |c_m|, ‖ΔI_W‖ <= 2 ε_R ‖I‖). Then
+  A_s(x)ᵀ(F − F') = (A_s(c) − A_s(x))ᵀ F' = −Σ_k F'_k Δa_k bounds |F_i − F'_i| by the least of δ/(σ_min − δ) |near|,
+  ΔB W (W >= |D w| over the envelope, orientation-free norms) and (|b_i(c)| + ΔB) Σ_k near_k ε_k;
 - **lowest natural frequency** of K v = ω² M_C v with K = k AᵀA − Σ_i F_i D_i − [f_g]×[r_cm]× (the loaded
-  stiffness of ``design.stiffness``/``synthesis.batch``, F the static leg forces, ‖D_i‖ <= ((1 + 2|t_i|²)/L² +
-  (|t_i| + |t_i|²/L)²)^½ with L >= |l_i(c)| − e_l): K(x) ⪰ K_lo = k A(c)ᵀA(c) − ε_K 1 with ε_K = k (2 σ_max δ + δ²)
-  + Σ_i |F_i|max ‖D_i‖ + m g |c_m|, and M_C(x) ⪯ M_hi = M_C(c) + ε_M 1; when the pencil's least eigenvalue λ_lo
-  of (K_lo, M_hi) is >= 0, K_lo ⪰ 0 and vᵀK v / vᵀM v >= vᵀK_lo v / vᵀM_hi v >= λ_lo for every v: ω² >= λ_lo
-  (computed by ``design.maps.lowest_frequency``).
+  stiffness of ``design.stiffness``/``synthesis.batch``, F the static leg forces): in y = D⁻¹ v the pencil is
+  (k A_sᵀA_s − D G D, D M_C D) with the same eigenvalues. |A_s(x) y| >= |A_s(c) y| − δ|y| >= (1 − βδ) |A_s(c) y|, so
+  k A_sᵀA_s(x) ⪰ (1 − βδ)² k A_sᵀA_s(c); ‖D G D‖ <= Σ_i |F_i|max ‖D D_i D‖ + m g |c_m| / s² (|F_i|max as the force,
+  ‖D D_i D‖ from its blocks' norms with |l_i| >= |l_i(c)| − e_l); D M_C(x) D ⪯ D M_C(c) D + ε_M 1. With K_lo and M_hi
+  those, when the pencil's least eigenvalue λ_lo is >= 0, K_lo ⪰ 0 and vᵀK v / vᵀM v >= vᵀK_lo v / vᵀM_hi v >=
+  λ_lo for every v: ω² >= λ_lo (computed by ``design.maps.lowest_frequency``).
 
 Floating point: the centre quantities (SVD, solves, the envelope maximum, the eigenvalues) are computed in binary64;
 each bound is widened by a relative ``REL_SLACK`` (1e-9) of its scale times the centre's condition, orders of
