@@ -57,7 +57,7 @@ def register(sub) -> None:
         type=int,
         default=MAX_CELLS,
         metavar="N",
-        help=f"cells the proof may examine (default {MAX_CELLS})",
+        help=f"cells each proof may examine: the box's, and force/speed/frequency/condition's (default {MAX_CELLS})",
     )
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -108,8 +108,13 @@ def run(args) -> int:
                 room = f" (least stroke margin {r['margin'] * 1e3:.2f} mm)" if r["margin"] is not None else ""
                 print(f"  {mark:7s} {r['requirement']}: {r['achieved']}{room}")
             else:
+                proof = ""
+                if "status" in r:  # the performance proof's verdict
+                    proof = f"; {r['status']}" + (f", bound {r['bound']:.6g}" if r["bound"] is not None else "")
+                    if r.get("witness"):
+                        proof += f" (witness pose {r['witness']['pose']}: {r['witness']['value']:.6g})"
                 print(
-                    f"  {mark:7s} {r['requirement']}: required {r['required']:g}, achieved {r['achieved']:.6g} {r['unit']}"
+                    f"  {mark:7s} {r['requirement']}: required {r['required']:g}, achieved {r['achieved']:.6g} {r['unit']}{proof}"
                 )
         print(f"  wrote {args.out}/ (design.yaml, pareto.parquet/.csv/.png, requirements.json)")
     return 0 if result.ok else 1

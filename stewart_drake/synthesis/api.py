@@ -116,7 +116,7 @@ def optimize(
         scheduler: the address of an existing Dask scheduler instead (``tcp://HOST:PORT``).
         pick: the design chosen: ``"knee"``, the best of an objective, or a row of the front.
         pop_size: NSGA-II population.
-        max_cells: cells the proof may examine.
+        max_cells: cells each proof may examine (the box's, and the force, speed, frequency and condition one's).
         cache: a folder whose evaluations (of the same requirements and seed) are reused and extended.
         progress: show a progress bar.
 

@@ -65,6 +65,33 @@ def leg_ranges(req, base, top, h) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return L_low, L_high, z_low
 
 
+_POSE_TERMS: dict = {}  # per process: the terms of the last requirements seen (a search's every batch)
+
+
+def pose_terms(req, payload, gravity: float = G_EARTH) -> tuple:
+    """``(rel (P, 6), R (P, 3, 3), wrench terms (P, 6, 16), M_C (P, 6, 6))`` at the box's vertices and centre: they
+    depend on the box, the convention and the payload only, not on the design, so each process computes them once
+    per requirements (a fixed per-batch cost otherwise: small batches, as on several workers, paid it each time)."""
+    key = (
+        req.box_lo.tobytes(),
+        req.box_hi.tobytes(),
+        req.convention,
+        float(payload.mass),
+        payload.com.tobytes(),
+        payload.inertia.tobytes(),
+        payload.rotation_centre.tobytes(),
+        gravity,
+    )
+    hit = _POSE_TERMS.get(key)
+    if hit is None:
+        rel = box_vertices(req.box_lo, req.box_hi)
+        R = rotation_matrix(rel[:, 3:], req.convention)
+        hit = (rel, R, plate_wrench_terms(payload, R, gravity), spatial_inertia_about_C(payload, R))
+        _POSE_TERMS.clear()
+        _POSE_TERMS[key] = hit
+    return hit
+
+
 def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     """``[evaluate_design(req, x) for x in X]`` computed for the whole batch at once (same metrics, f, g)."""
     X = np.atleast_2d(np.asarray(X, dtype=float))
@@ -83,8 +110,7 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     top = np.stack([t[lt] for _, t, lt in geo])  # per leg, relative to the rotation centre (the plate origin)
     h = X[good, -1]
     L_low, L_high, z_low = leg_ranges(req, base, top, h)
-    rel = box_vertices(req.box_lo, req.box_hi)
-    R = rotation_matrix(rel[:, 3:], req.convention)  # (P, 3, 3)
+    rel, R, rhs, M = pose_terms(req, plats[0], gravity)
     p = rel[None, :, :3] + h[:, None, None] * np.array([0.0, 0.0, 1.0])  # (D, P, 3)
     r = np.einsum("pij,dlj->dpli", R, top)  # (D, P, 6, 3)
     l = p[:, :, None] + r - base[:, None]
@@ -101,7 +127,6 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     A, u, r, L, base, top, h = A[ok], u[ok], r[ok], L[ok], base[ok], top[ok], h[ok]
     idx = [good[k] for k in np.flatnonzero(ok)]
     payload = plats[0]
-    rhs = plate_wrench_terms(payload, R, gravity)  # (P, 6, 16)
     Xs = np.linalg.solve(np.swapaxes(A, -1, -2), np.broadcast_to(rhs, A.shape[:2] + rhs.shape[1:]))
     c, G, Q = Xs[..., 0], Xs[..., 1:7], Xs[..., 7:].reshape(Xs.shape[:-1] + (3, 3))
     vel = np.flatnonzero(req.v_max[3:] > 0)
@@ -124,7 +149,6 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     r_cm = np.einsum("pij,j->pi", R, payload.com - payload.rotation_centre)
     f_g = np.broadcast_to(np.array([0.0, 0.0, -payload.mass * gravity]), r_cm.shape)
     K[..., 3:, 3:] -= skew(f_g) @ skew(r_cm)
-    M = spatial_inertia_about_C(payload, R)
     freq = lowest_frequency(K, np.broadcast_to(M, K.shape)).min(-1)
     radius = np.hypot(base[..., 0], base[..., 1]).max(-1)
     joint = joint_angles(l[ok], np.broadcast_to(R, l[ok].shape[:2] + (3, 3))).max(axis=(1, 2))

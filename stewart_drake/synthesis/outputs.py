@@ -129,6 +129,7 @@ def write_outputs(result, tmp: Path, source: str, cache_from: Path | None = None
                 "ok": result.ok,
                 "requirements": result.table,
                 "proof": result.proof.to_dict(),
+                "performance_proof": result.performance.to_dict(),
                 "design": {k: v for k, v in result.design.items() if k not in ("g", "f")},
                 "requirements_si": result.search.requirements.to_dict(),
             }

@@ -57,7 +57,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import plate_anchor_heights
-from stewart_drake.workspace.limits import Limits, leg_pairs, limit_margins
+from stewart_drake.workspace.limits import Limits, leg_pairs, limit_margins, segment_gaps
 
 FP_SLACK = 1e-9  # m: each bound widened by this (rounding; see the module docstring)
 COVER_PAD = 1e-12  # each cell's half-widths grown by this × (1 + |centre|): adjacent cells overlap
@@ -177,14 +177,19 @@ def cell_bounds(
         n_abs = np.abs(n_c) + np.einsum("nji,nj->ni", np.abs(Jn), h[:, 3:]) + rn[:, None]  # (n, 3) max |n_k|
         out.normal_lower = first - np.sum(h[:, :3] * n_abs, -1)[:, None] + t[None, :, 2] - FP_SLACK
     if clearance:
-        out.clearance_lower = _clearance_lower(platform, lc + platform.base_anchors, G, r2)
+        # how far each plate anchor moves over the cell: |l_i − l_i(c)| <= |h_p| + min(ε_R |t_i|, Σ_j |∂q_i/∂θ_j| h_θ,j
+        # + r_i), ε_R = Σ_j h_θ,j bounding ‖R(θ) − R(c)‖₂ (each elementary rotation is 1-Lipschitz in its angle)
+        tn = np.linalg.norm(t, axis=1)
+        first = np.einsum("nlk,nk->nl", np.linalg.norm(Jq, axis=-2), h[:, 3:]) + r2
+        move = np.linalg.norm(h[:, :3], axis=1)[:, None] + np.minimum(np.sum(h[:, 3:], 1)[:, None] * tn, first)
+        out.clearance_lower = _clearance_lower(platform, lc + platform.base_anchors, G, r2, move)
     return out
 
 
 PIECES = 4  # each leg cut into this many pieces for the clearance bound
 
 
-def _clearance_lower(platform: Platform, P_c, G, r2) -> np.ndarray:
+def _clearance_lower(platform: Platform, P_c, G, r2, move) -> np.ndarray:
     """``(n, k)`` lower bounds of the distance between the legs of each ``leg_pairs`` row over each cell.
 
     Leg i's points are b_i + s l_i, s in [0, 1], with l_i = l_i(c) + G_i u + e_i, |u_g| <= 1 (the cell's
@@ -192,15 +197,26 @@ def _clearance_lower(platform: Platform, P_c, G, r2) -> np.ndarray:
     leg j and a unit n, n·(y_j − y_i) = n·(b_j − b_i) + t n·l_j(c) − s n·l_i(c) + Σ_g (t n·g_j − s n·g_i) u_g
     + n·(t e_j − s e_i) >= n·(b_j − b_i) + t n·l_j(c) − s n·l_i(c) − Σ_g |t n·g_j − s n·g_i| − t r_j − s r_i,
     and the distance is at least that. Cut s and t into ``PIECES`` intervals; on a pair of pieces the right side
-    is concave in (s, t), so its minimum is at one of the four corners. n: from the closest of 3 × 3 points of
-    the two centre-pose pieces (any n gives a valid bound). The bound is the least over the piece pairs."""
+    is concave in (s, t), so its minimum is at one of the four corners. n: the unit vector between the closest
+    points of the two centre-pose pieces (any n gives a valid bound; this one separates the pieces' difference set,
+    a convex parallelogram, from the origin at their distance, so at a zero-width cell the bound is the distance).
+    The bound is the least over the piece pairs.
+
+    That bound does not tend to the distance as the cell shrinks (the pieces and their directions n stay fixed), so
+    the larger of it and a second one is taken: the exact segment distance at the centre pose minus how far the two
+    plate anchors can move over the cell (``move`` (n, 6), m). Leg i is the segment from its fixed base anchor to its
+    plate anchor; moving the plate anchor by ε moves the point at parameter s by s ε <= ε, so the distance between two
+    legs changes by at most ε_i + ε_j (the bound is first order in the cell and tends to the distance)."""
     pairs = leg_pairs(platform)
     if not len(pairs):
         return np.full((len(P_c), 1), np.inf)
     out = np.empty((len(P_c), len(pairs)))
     for s in range(0, len(P_c), 256):
         out[s : s + 256] = _clearance_chunk(platform, pairs, P_c[s : s + 256], G[s : s + 256], r2[s : s + 256])
-    return out
+    i, j = pairs[:, 0], pairs[:, 1]
+    B = platform.base_anchors
+    centre = np.linalg.norm(segment_gaps(B[i], P_c[:, i], B[j], P_c[:, j]), axis=-1)  # (n, k)
+    return np.maximum(out, centre - move[:, i] - move[:, j] - FP_SLACK)
 
 
 def _clearance_chunk(platform: Platform, pairs, P_c, G, r2) -> np.ndarray:
@@ -208,14 +224,10 @@ def _clearance_chunk(platform: Platform, pairs, P_c, G, r2) -> np.ndarray:
     B = platform.base_anchors
     edges = np.linspace(0.0, 1.0, PIECES + 1)
     s0, s1 = edges[:-1], edges[1:]
-    pts = np.stack([s0, 0.5 * (s0 + s1), s1], -1)  # (m, 3) sample parameters per piece
     lc = P_c - B  # (n, 6, 3) centre leg vectors
-    pi = B[i][None, :, None, None] + pts[None, None, :, :, None] * lc[:, i][:, :, None, None]  # (n, k, m, 3, 3)
-    pj = B[j][None, :, None, None] + pts[None, None, :, :, None] * lc[:, j][:, :, None, None]
-    d = pj[:, :, None, :, None] - pi[:, :, :, None, :, None]  # (n, k, m, m, 3 pts, 3 pts, 3)
-    d = d.reshape(d.shape[:4] + (9, 3))
-    best = np.argmin(np.linalg.norm(d, axis=-1), -1)
-    v = np.take_along_axis(d, best[..., None, None], -2)[..., 0, :]  # (n, k, m, m, 3)
+    ends = [B[leg][None, :, None] + e[None, None, :, None] * lc[:, leg][:, :, None] for leg in (i, j) for e in (s0, s1)]
+    a0, a1, b0, b1 = (x[:, :, :, None] if k < 2 else x[:, :, None, :] for k, x in enumerate(ends))  # (n, k, m|1, ...)
+    v = -segment_gaps(*np.broadcast_arrays(a0, a1, b0, b1))  # (n, k, m, m, 3): between the pieces' closest points
     norm = np.linalg.norm(v, axis=-1)
     n = v / np.where(norm > 0, norm, 1.0)[..., None]
     Ai = np.einsum("nkabx,nkxg->nkabg", n, G[:, i])  # n·g for leg i's generators (shared coefficients u)
@@ -343,6 +355,36 @@ def _witness(
     }
 
 
+def initial_cells(platform: Platform, lo, hi, initial: int | None = None) -> Cells:
+    """The box [lo, hi] ((6,) m, rad) cut into cells: ``initial`` splits per angle axis (default: cells of about
+    5°), positions whole."""
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    splits = np.ones(6, dtype=int)
+    width = hi - lo
+    splits[3:] = np.maximum(1, np.ceil(width[3:] / np.radians(5.0)).astype(int)) if initial is None else initial
+    splits[3:] = np.where(width[3:] > 0, splits[3:], 1)
+    axes = [(lo[j] + (np.arange(splits[j]) + 0.5) * width[j] / splits[j]) for j in range(6)]
+    c = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
+    return Cells(c, np.broadcast_to(width / (2 * splits), c.shape).copy())
+
+
+def split_cells(platform: Platform, cells: Cells) -> Cells:
+    """Each cell halved across its widest side (positions in metres, angles times the plate's anchor radius):
+    twice as many cells covering the same poses."""
+    rmax = float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
+    scale = np.r_[np.ones(3), np.full(3, max(rmax, 1e-9))]
+    j = np.argmax(cells.h * scale, axis=1)
+    rows = np.arange(len(cells))
+    h2 = cells.h.copy()
+    h2[rows, j] /= 2
+    halves = []
+    for sgn in (-1.0, 1.0):
+        c2 = cells.c.copy()
+        c2[rows, j] += sgn * h2[rows, j]
+        halves.append(c2)
+    return Cells(np.concatenate(halves), np.concatenate([h2, h2]))
+
+
 def prove_box(
     platform: Platform,
     lo,
@@ -360,15 +402,7 @@ def prove_box(
     check_convention(convention)
     t0 = time.perf_counter()
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    rmax = float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
-    scale = np.r_[np.ones(3), np.full(3, max(rmax, 1e-9))]
-    splits = np.ones(6, dtype=int)
-    width = hi - lo
-    splits[3:] = np.maximum(1, np.ceil(width[3:] / np.radians(5.0)).astype(int)) if initial is None else initial
-    splits[3:] = np.where(width[3:] > 0, splits[3:], 1)
-    axes = [(lo[j] + (np.arange(splits[j]) + 0.5) * width[j] / splits[j]) for j in range(6)]
-    c = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 6)
-    pending = Cells(c, np.broadcast_to(width / (2 * splits), c.shape).copy())
+    pending = initial_cells(platform, lo, hi, initial)
     examined = proven = 0
     lmin_b, lmax_b, margin, zmin = np.inf, -np.inf, np.inf, np.inf
     while len(pending):
@@ -409,16 +443,9 @@ def prove_box(
                 return ProofResult(
                     "violated", lo, hi, examined, proven, max_cells, witness=w, seconds=time.perf_counter() - t0
                 )
-            cb, hb = cells.c[bad], cells.h[bad]
-            j = np.argmax(hb * scale, axis=1)
-            rows = np.arange(len(cb))
-            h2 = hb.copy()
-            h2[rows, j] /= 2
-            for sgn in (-1.0, 1.0):
-                c2 = cb.copy()
-                c2[rows, j] += sgn * h2[rows, j]
-                nxt_c.append(c2)
-                nxt_h.append(h2)
+            halves = split_cells(platform, Cells(cells.c[bad], cells.h[bad]))
+            nxt_c.append(halves.c)
+            nxt_h.append(halves.h)
         pending = (
             Cells(np.concatenate(nxt_c), np.concatenate(nxt_h)) if nxt_c else Cells(np.zeros((0, 6)), np.zeros((0, 6)))
         )

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from stewart_drake.core.geometry import Platform
 from stewart_drake.synthesis.evaluate import box_vertices
 from stewart_drake.synthesis.families import design_platform
+from stewart_drake.synthesis.performance import PerformanceProof, prove_requirements_performance
 from stewart_drake.synthesis.proof import MAX_CELLS, ProofResult, prove_requirements_box
 from stewart_drake.synthesis.requirements import Requirements
 from stewart_drake.synthesis.search import SearchResult, pick_design, run_search
@@ -20,13 +21,16 @@ from stewart_drake.synthesis.search import SearchResult, pick_design, run_search
 @dataclass
 class SynthesisResult:
     """The search, the chosen row (index into ``search.rows``), the chosen design's ``platform``, its
-    ``proof`` and the ``requirements`` table (see ``requirement_table``); ``ok``: every requirement met."""
+    ``proof`` (the box's poses within the stroke, cones, clearance), its ``performance`` proof (force, speed,
+    frequency, condition over the box) and the ``requirements`` table (see ``requirement_table``); ``ok``: every
+    requirement met."""
 
     search: SearchResult
     chosen: int
     pick: str
     platform: Platform
     proof: ProofResult
+    performance: PerformanceProof
     table: list
 
     @property
@@ -44,6 +48,7 @@ class SynthesisResult:
             "design": {k: v for k, v in self.design.items() if k not in ("g", "f")},
             "variables": dict(zip(self.search.requirements.variables, self.design["x"], strict=True)),
             "proof": self.proof.to_dict(),
+            "performance_proof": self.performance.to_dict(),
             "requirements": self.table,
             "search": self.search.to_dict(),
         }
@@ -52,11 +57,14 @@ class SynthesisResult:
 SAMPLE_NOTE = "the box's {n} vertices and centre (a sample of the box)"
 
 
-def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[dict]:
+def requirement_table(req: Requirements, row: dict, proof: ProofResult, performance: PerformanceProof) -> list[dict]:
     """Each requirement: ``required``, ``achieved``, ``margin`` (positive: met with room), ``unit``, ``met`` and
-    ``established`` (how: proof, exact, or a sample, said so)."""
+    ``established`` (how: proof, exact, or a sample, said so). Force, speed, frequency and condition carry the
+    performance proof's ``status`` and ``bound``; ``met`` only when proven."""
     n = len(box_vertices(req.box_lo, req.box_hi))
     sample = SAMPLE_NOTE.format(n=n - 1)
+    perf = performance.results
+    cells = performance.cells_examined
     out = [
         {
             "requirement": "workspace: every pose of the box within the stroke, plate above the base",
@@ -73,7 +81,9 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
             row["peak_force"],
             "N",
             "<=",
-            "peak leg force: exact worst case over the motion envelope at " + sample,
+            "peak leg force over the motion envelope: the search's exact worst case at " + sample,
+            perf["force"],
+            cells,
         ),
     ]
     if req.max_speed is not None:
@@ -84,7 +94,9 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
                 row["peak_speed"],
                 "m/s",
                 "<=",
-                "peak leg speed: exact worst case over the motion envelope at " + sample,
+                "peak leg speed over the motion envelope: the search's exact worst case at " + sample,
+                perf["speed"],
+                cells,
             )
         )
     if req.stroke_ratio is not None:
@@ -132,7 +144,9 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
                 row["frequency"],
                 "Hz",
                 ">=",
-                "lowest natural frequency at " + sample,
+                "lowest natural frequency: the search's value at " + sample,
+                perf["frequency"],
+                cells,
             )
         )
     if req.joint_cone is not None:
@@ -171,15 +185,19 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult) -> list[
                 row["condition"],
                 "",
                 "<=",
-                "worst condition number at " + sample,
+                "worst condition number: the search's value at " + sample,
+                perf["condition"],
+                cells,
             )
         )
     return out
 
 
-def _row(name, required, achieved, unit, sense, how) -> dict:
+def _row(name, required, achieved, unit, sense, how, proven: dict | None = None, cells: int = 0) -> dict:
+    """A table row; with ``proven`` (a performance proof's entry) the row's ``status``, ``bound`` (the proven
+    worst over the box), ``witness`` and ``met`` come from the proof, ``achieved`` stays the search's sample."""
     margin = required - achieved if sense == "<=" else achieved - required
-    return {
+    out = {
         "requirement": name,
         "required": float(required),
         "achieved": float(achieved),
@@ -188,6 +206,20 @@ def _row(name, required, achieved, unit, sense, how) -> dict:
         "met": bool(margin >= 0),
         "established": how,
     }
+    if proven is not None:
+        out.update(status=proven["status"], bound=proven["bound"], met=proven["status"] == "proven")
+        if proven["status"] == "proven":
+            out["established"] = (
+                f"proof over every pose of the box ({cells} cells, synthesis.performance): "
+                f"{'at most' if sense == '<=' else 'at least'} {proven['bound']:.6g} {unit}".rstrip()
+                + f"; {how}"
+            )
+        elif proven["status"] == "violated":
+            out["witness"] = proven["witness"]
+            out["established"] = f"violated at a witness pose (the toolkit's value {proven['witness']['value']:.6g})"
+        else:
+            out["established"] = f"unresolved: {proven.get('unresolved_count', 0)} cells left at the cell limit; {how}"
+    return out
 
 
 def chosen_platform(req: Requirements, row: dict, name: str = "synthesised") -> Platform:
@@ -223,4 +255,7 @@ def synthesize(
         joint_cone=req.joint_cone,
         leg_diameter=req.leg_diameter,
     )
-    return SynthesisResult(result, k, pick, platform, proof, requirement_table(req, row, proof))
+    performance = prove_requirements_performance(platform, req, max_cells=max_cells)
+    return SynthesisResult(
+        result, k, pick, platform, proof, performance, requirement_table(req, row, proof, performance)
+    )

@@ -80,6 +80,18 @@ def segment_distances(P1, Q1, P2, Q2) -> np.ndarray:
     Clamped closest-point parameters (Ericson, *Real-Time Collision Detection* §5.1.9); parallel
     segments take s = 0. Segments must have non-zero length.
     """
+    gap = _closest_gap(P1, Q1, P2, Q2)
+    return np.sqrt(gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2])
+
+
+def segment_gaps(P1, Q1, P2, Q2) -> np.ndarray:
+    """``(..., 3)`` the vector from segment P2Q2's closest point to P1Q1's (``segment_distances``' points): its
+    direction separates the two segments (the synthesis proof's clearance bound uses it)."""
+    return np.moveaxis(_closest_gap(P1, Q1, P2, Q2), 0, -1)
+
+
+def _closest_gap(P1, Q1, P2, Q2) -> np.ndarray:
+    """``(3, ...)`` components first: closest point of P1Q1 minus closest point of P2Q2."""
     P1, Q1, P2, Q2 = (
         np.moveaxis(v, -1, 0) for v in np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (P1, Q1, P2, Q2)))
     )
@@ -95,8 +107,7 @@ def segment_distances(P1, Q1, P2, Q2) -> np.ndarray:
     t = (b * s + f) / e
     s = np.where(t < 0, np.clip(-c / a, 0.0, 1.0), np.where(t > 1, np.clip((b - c) / a, 0.0, 1.0), s))
     t = np.clip(t, 0.0, 1.0)
-    gap = r + s * d1 - t * d2
-    return np.sqrt(dot(gap, gap))
+    return r + s * d1 - t * d2
 
 
 def leg_pairs(platform: Platform) -> np.ndarray:

@@ -80,3 +80,18 @@ def test_prove_unresolved_exits_1(capsys):
                "--require-box", *box])  # fmt: skip
     out = json.loads(capsys.readouterr().out)
     assert rc == 1 and out["status"] == "unresolved" and out["unresolved_count"] > 0
+
+
+def test_optimize_exits_1_when_the_performance_proof_is_unresolved(tmp_path, capsys):
+    """``--max-cells 60``: the box's stroke is proven in 48 cells, force/speed/frequency/condition need more: each
+    says ``unresolved`` in requirements.json (``met`` false, the cells left counted) and the exit status is 1."""
+    out = tmp_path / "o"
+    rc = main(["optimize", "--requirements", SEED_001, "--out", str(out), "--budget", "48", "--pop-size", "16",
+               "--workers", "0", "--max-cells", "60"])  # fmt: skip
+    text = capsys.readouterr().out
+    assert rc == 1 and "proof of the box: proven" in text and "unresolved" in text
+    doc = json.loads((out / "requirements.json").read_text())
+    perf = {r["requirement"]: r for r in doc["requirements"] if "status" in r}
+    assert set(perf) == {"actuator.max_force", "actuator.max_speed", "limits.min_frequency_hz", "limits.max_condition"}
+    assert all(r["status"] == "unresolved" and not r["met"] for r in perf.values())
+    assert doc["performance_proof"]["requirements"]["force"]["unresolved_count"] > 0 and not doc["ok"]
