@@ -32,11 +32,8 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput
 from tqdm import tqdm
 
 from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
@@ -54,8 +51,9 @@ from stewart_drake.drake.integrators import (
     check_integrator,
     constraint_gaps,
 )
-from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.drake.systems import Actuators, make_law
+from stewart_drake.drake.loop_diagram import VISUALIZER_PERIOD, loop_diagram
+from stewart_drake.drake.platform_model import set_pose
+from stewart_drake.drake.systems import make_law
 from stewart_drake.drake.tick_loop import SensorReading, TickLoop, periodic_times
 from stewart_drake.errors import SimulationError
 
@@ -141,9 +139,6 @@ def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: 
 
 # ----------------------------------------------------------------------------------------------
 # The Diagram.
-
-
-VISUALIZER_PERIOD = 1 / 32  # s: the Meshcat animation's frame period
 
 
 @dataclass
@@ -291,13 +286,11 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         poses = design_poses(trajectory, s.design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
     law = make_law(s.controller, platform, config, s.engine, s.firmware)
-    builder = DiagramBuilder()
-    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
     T = config.timing.sample_period
     max_force = actuators.max_force or float(platform.legs.max_force)
-    act = builder.AddSystem(Actuators(max_force, actuators.time_constant, plant_time_step))
-    act.set_name("actuators")
-    builder.ExportInput(act.get_input_port(), "command")
+    # the plant and actuators: reused from an earlier run of this process with the same ones (``loop_diagram``)
+    built = loop_diagram(plant_platform, plant_time_step, integrator, max_force, actuators.time_constant, meshcat)
+    diagram, plant, act, loggers = built.diagram, built.plant, built.actuators, built.loggers
     joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
     sensor_model = s.sensor
     if np.any(plant_platform.length_offset):  # a sensor reads the joint-to-joint length − legs.length_offset
@@ -319,21 +312,6 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     ff = None
     if s.feedforward:
         ff = FeedforwardTable(platform, trajectory, feedforward_lead(config, actuators.time_constant), T)
-    builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
-    # the continuous plant logs at its step (not at every integrator step); the discrete one at every
-    # simulator step, by the loop (``tick_loop.TickLoop``)
-    loggers = {}
-    if integrator != "sap":
-        loggers = {
-            "state": LogVectorOutput(plant.get_state_output_port(), builder, plant_time_step),
-            "force": LogVectorOutput(act.get_output_port(), builder, plant_time_step),
-        }
-    visualizer = None
-    if meshcat is not None:
-        visualizer = MeshcatVisualizer.AddToBuilder(
-            builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=VISUALIZER_PERIOD)
-        )
-    diagram = builder.Build()
     simulator = Simulator(diagram)
     apply_integrator(simulator, integrator, plant_time_step)
     root = simulator.get_mutable_context()
@@ -365,7 +343,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         loggers,
         simulator,
         meshcat,
-        visualizer,
+        built.visualizer,
         plant_time_step,
         ff,
         integrator,

@@ -5,6 +5,8 @@ order differs (a lagged or direct actuator, a tick with or without a separate re
 that steps before the tick reads it). Short runs (50 ms) of the seed trajectory on ``utn-dynamic``.
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
@@ -18,7 +20,7 @@ from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import SEED
 from stewart_drake.drake.integrators import CONTINUOUS, apply_integrator
 from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation, set_velocity
+from stewart_drake.drake.simulation import ActuatorModel, Scenario, SimulationLog, build_simulation, set_velocity
 from stewart_drake.drake.systems import Actuators, PoseSource, make_controller
 from stewart_drake.drake.tick_loop import schedule
 
@@ -125,3 +127,24 @@ def test_schedule_stops_at_every_event_and_logs_at_the_plant_steps():
     assert sum(s.release) == 3 and sum(s.boundary) == 1
     assert sum(s.log) == 6  # the six plant steps, not the releases or the boundary
     assert all(schedule(0.003, 0.5e-3, 1e-3, 0.25e-3, True).log)  # a discrete plant logs at every stop
+
+
+def test_a_reused_diagram_gives_the_logs_of_a_fresh_one():
+    """``loop_diagram.DIAGRAM_CACHE``: a second run of the same plant and actuators reuses the Diagram
+    (with its own context and Simulator) and logs what a freshly built one logs, bit for bit, also after
+    a run of another plant in between; another plant (a heavier plate) gets its own Diagram."""
+    from stewart_drake.drake.loop_diagram import DIAGRAM_CACHE
+
+    sc = Scenario(PLATFORM, SEED, "float")
+    heavier = replace(PLATFORM, mass=PLATFORM.mass * 1.2)
+    DIAGRAM_CACHE.clear()
+    fresh_sim = build_simulation(sc)
+    fresh = fresh_sim.run(DURATION)
+    other = build_simulation(replace(sc, plant_platform=heavier))
+    assert other.diagram is not fresh_sim.diagram
+    other.run(DURATION)
+    again_sim = build_simulation(sc)
+    assert again_sim.diagram is fresh_sim.diagram
+    again = again_sim.run(DURATION)
+    for name in SimulationLog.ARRAYS:
+        np.testing.assert_array_equal(getattr(again, name), getattr(fresh, name), err_msg=name)
