@@ -141,7 +141,7 @@ def make_controller(
 
 class PoseSource(LeafSystem):
     """Output ``pose`` (6) = ``trajectory.pose(t)`` (any 6-vector function of time: also leg lengths),
-    computed in Python at the context's time (for any time; the closed loop uses ``TickTableSource``)."""
+    computed in Python at the context's time (for any time; the closed loop reads its tables by tick index)."""
 
     def __init__(self, trajectory: Trajectory):
         super().__init__()
