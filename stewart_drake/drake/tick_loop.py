@@ -13,7 +13,10 @@ Why the logs are those of the all-Drake Diagram (a ``ControllerSystem`` wired to
 steps; at each stop Drake has published (the plant loggers sampled) before the loop's updates, as the
 Simulator publishes at t before the discrete updates at t; and the actuators' discrete update at t reads
 the command held *before* the controller's update at t (simultaneous discrete updates read the old
-state), except for a continuous plant without lag, which integrates with the command just released.
+state), except for a continuous plant without lag, which integrates with the command just released. A
+discrete (SAP) plant steps by an unrestricted update, which Drake runs before the discrete ones: its tick
+reads the state after the plant's step at t, so the loop advances halfway to the next stop first (nothing
+happens there) and logs the plant state and forces itself at every stop (Drake's per-step logging).
 """
 
 from __future__ import annotations
