@@ -30,9 +30,9 @@ import stewart_drake.montecarlo.study as study_module
 import stewart_drake.montecarlo.summary as summary_module
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
-from stewart_drake.drake.simulation import build_simulation
+from stewart_drake.drake.simulation import Simulation
 from stewart_drake.firmware.engine import ENGINES, default_engine
-from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
+from stewart_drake.montecarlo.scenario import Study, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import run_study, study_key, study_settings
 from stewart_drake.montecarlo.summary import summarise, write_outputs
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
     if base.exists():
         raise SystemExit(f"{base} exists: give a new folder")
     print(f"load average {', '.join(f'{x:.2f}' for x in os.getloadavg())}", flush=True)
-    alone, whole = loop_alone(study, min(args.alone, args.runs))
+    alone, whole = loop_alone(study, max(1, min(args.alone, args.runs - 1)))
     print(f"a run (draw, build, loop, metrics) vs the loop alone, CPU: {whole / alone:.3f} × (target <= 1.1)")
     for k in counts:
         out = base / f"workers-{k}"
@@ -114,21 +114,30 @@ def main(argv=None) -> int:
 
 
 def loop_alone(study, n: int) -> tuple[float, float]:
-    """CPU seconds of the first ``n`` runs: ``(the loops alone, the whole runs)``, after one run that fills
-    this process's caches (the feed-forward table, the Diagram when the plant repeats) as a worker's first
-    run does: both then read the same caches."""
+    """CPU seconds of runs 1 … ``n`` (after run 0, which fills this process's caches as a worker's first run
+    does): ``(their loops alone, the whole runs)``, the loop (``Simulation.run``) timed inside each run, so
+    that both figures come from the same calls (on a loaded machine separate calls differ by more than
+    the build)."""
     run_scenario(study, 0)
-    alone = whole = 0.0
-    for i in range(n):
-        sc = scenario(study, i)[2]
-        sim = build_simulation(sc)
-        c0 = time.process_time()
-        sim.run(sc.duration)
-        alone += time.process_time() - c0
-        c0 = time.process_time()
-        run_scenario(study, i)
-        whole += time.process_time() - c0
-    return alone, whole
+    inner, real_run = [0.0], Simulation.run
+
+    def timed_run(sim, *a, **kw):
+        c = time.process_time()
+        try:
+            return real_run(sim, *a, **kw)
+        finally:
+            inner[0] += time.process_time() - c
+
+    whole = 0.0
+    Simulation.run = timed_run
+    try:
+        for i in range(1, n + 1):
+            c0 = time.process_time()
+            run_scenario(study, i)
+            whole += time.process_time() - c0
+    finally:
+        Simulation.run = real_run
+    return inner[0], whole
 
 
 class _timed:
