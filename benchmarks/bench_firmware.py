@@ -27,9 +27,11 @@ from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 
 
 def loop_rtf(p, engine, duration):
+    from stewart_drake.control.feedforward import TABLE_CACHE
     from stewart_drake.drake.simulation import Scenario, build_simulation
 
     sim = build_simulation(Scenario(p, "seed", "fixed", engine=engine))
+    TABLE_CACHE.clear()  # a run's own feed-forward table, not one remembered from the run before
     t0 = time.perf_counter()
     sim.run(duration)
     return duration / (time.perf_counter() - t0), sim

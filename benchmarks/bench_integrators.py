@@ -41,7 +41,7 @@ def closed_loop(platform, trajectory, controller, integrator, duration, engine="
     t0 = time.perf_counter()
     log = sim.run(duration)
     wall = time.perf_counter() - t0
-    X = sim.loggers["state"].FindLog(sim.simulator.get_context()).data().T
+    X = sim.states()
     err = log.length_error(sim.trajectory, platform)
     return log, {
         "realtime_factor": duration / wall,

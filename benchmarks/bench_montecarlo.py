@@ -5,6 +5,15 @@ Runs the same study (``stewart-drake montecarlo`` settings) once per ``--workers
 start to the last row (runs per second), prints the ratio to the first entry and checks that every row
 (wall time excluded) equals the first entry's.
 
+Where a study's wall time goes, per worker count (rows' arrival times recorded by wrapping the study's
+row loop): ``start`` (from the call to the first row's start: cluster, worker processes importing pydrake,
+the study scattered), ``runs`` (Σ the rows' own wall times / workers: the ideal parallel time),
+``bookkeeping`` (the partial journal written per row, then the Parquet/CSV table, summary and plots), and
+the rest (``idle``: waiting for the last runs while other workers have none left, scheduling). And the
+reference the issue asks for: a run (``run_scenario``: draw, build, loop, metrics) against the loop alone
+(``Simulation.run`` of the same scenario), by process CPU time, over the first ``--alone`` runs, in this
+process.
+
     PYTHONPATH=. python benchmarks/bench_montecarlo.py --runs 200 --workers 1,2 --out /tmp/mc-bench \
         --vary anchor=±0.5mm sensor_resolution=10um latency_jitter=200us plate_mass=±20%
 """
@@ -13,13 +22,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 from pathlib import Path
 
+import stewart_drake.montecarlo.study as study_module
+import stewart_drake.montecarlo.summary as summary_module
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
+from stewart_drake.drake.simulation import Simulation
 from stewart_drake.firmware.engine import ENGINES, default_engine
-from stewart_drake.montecarlo.scenario import Study
+from stewart_drake.montecarlo.scenario import Study, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import run_study, study_key, study_settings
 from stewart_drake.montecarlo.summary import summarise, write_outputs
@@ -42,6 +55,7 @@ def main(argv=None) -> int:
     ap.add_argument("--integrator", choices=INTEGRATORS, default=DEFAULT_INTEGRATOR)
     ap.add_argument("--workers", default="1,2", help="comma-separated worker counts")
     ap.add_argument("--out", required=True, help="a new folder; one study folder per worker count inside")
+    ap.add_argument("--alone", type=int, default=5, help="runs timed against the loop alone (default 5)")
     args = ap.parse_args(argv)
     study = Study(
         load_platform(args.platform),
@@ -59,13 +73,29 @@ def main(argv=None) -> int:
     base, first, report = Path(args.out), None, {}
     if base.exists():
         raise SystemExit(f"{base} exists: give a new folder")
+    print(f"load average {', '.join(f'{x:.2f}' for x in os.getloadavg())}", flush=True)
+    alone, whole = loop_alone(study, max(1, min(args.alone, args.runs - 1)))
+    print(f"a run (draw, build, loop, metrics) vs the loop alone, CPU: {whole / alone:.3f} × (target <= 1.1)")
     for k in counts:
         out = base / f"workers-{k}"
+        arrivals, journal, plots = [], [0.0], [0.0]
         t0 = time.perf_counter()
-        rows = run_study(study, out, workers=k, progress=False)
+        with _timed(arrivals, journal, plots):
+            rows = run_study(study, out, workers=k, progress=False)
+            wall_runs = time.perf_counter() - t0
+            summary = summarise(rows, study_settings(study), study_key(study))
+            write_outputs(out, rows, summary)
         wall = time.perf_counter() - t0
-        summary = summarise(rows, study_settings(study), study_key(study))
-        write_outputs(out, rows, summary)
+        first = min(range(len(arrivals)), key=lambda i: arrivals[i][0])
+        start = arrivals[first][0] - arrivals[first][1] - t0
+        busy = sum(r["wall_s"] for r in rows) / k
+        books = journal[0] + (wall - wall_runs) - plots[0]
+        print(
+            f"  workers {k}: wall {wall:.1f} s = start {start:.1f} + runs {busy:.1f} + bookkeeping (journal, "
+            f"Parquet/CSV, summary) {books:.2f} ({100 * books / wall:.1f} %, target <= 2 %) + plots {plots[0]:.2f} "
+            f"+ idle/scheduling {wall - start - busy - books - plots[0]:.1f}",
+            flush=True,
+        )
         same = [{c: v for c, v in r.items() if c != "wall_s"} for r in rows]
         first = first or same
         report[k] = {
@@ -81,6 +111,71 @@ def main(argv=None) -> int:
         )
     print(json.dumps(report, indent=2))
     return 0 if all(r["rows_equal_first"] for r in report.values()) else 1
+
+
+def loop_alone(study, n: int) -> tuple[float, float]:
+    """CPU seconds of runs 1 … ``n`` (after run 0, which fills this process's caches as a worker's first run
+    does): ``(their loops alone, the whole runs)``, the loop (``Simulation.run``) timed inside each run, so
+    that both figures come from the same calls (on a loaded machine separate calls differ by more than
+    the build)."""
+    run_scenario(study, 0)
+    inner, real_run = [0.0], Simulation.run
+
+    def timed_run(sim, *a, **kw):
+        c = time.process_time()
+        try:
+            return real_run(sim, *a, **kw)
+        finally:
+            inner[0] += time.process_time() - c
+
+    whole = 0.0
+    Simulation.run = timed_run
+    try:
+        for i in range(1, n + 1):
+            c0 = time.process_time()
+            run_scenario(study, i)
+            whole += time.process_time() - c0
+    finally:
+        Simulation.run = real_run
+    return inner[0], whole
+
+
+class _timed:
+    """Record each row's (arrival time, its own wall time), the journal's write time and the plots' time."""
+
+    def __init__(self, arrivals: list, journal: list, plots: list):
+        self.arrivals, self.journal, self.plots = arrivals, journal, plots
+
+    def __enter__(self):
+        self.results, self.write = study_module._results, study_module.PartialWriter.write
+        self.write_plots = summary_module.write_plots
+        arrivals, journal, results, write = self.arrivals, self.journal, self.results, self.write
+        plots, write_plots = self.plots, self.write_plots
+
+        def timed_plots(*a, **kw):
+            c = time.perf_counter()
+            try:
+                return write_plots(*a, **kw)
+            finally:
+                plots[0] += time.perf_counter() - c
+
+        summary_module.write_plots = timed_plots
+
+        def timed_results(*a, **kw):
+            for row in results(*a, **kw):
+                arrivals.append((time.perf_counter(), row["wall_s"]))
+                yield row
+
+        def timed_write(writer, obj):
+            c = time.perf_counter()
+            write(writer, obj)
+            journal[0] += time.perf_counter() - c
+
+        study_module._results, study_module.PartialWriter.write = timed_results, timed_write
+
+    def __exit__(self, *exc):
+        study_module._results, study_module.PartialWriter.write = self.results, self.write
+        summary_module.write_plots = self.write_plots
 
 
 def _equal(a, b) -> bool:

@@ -1,8 +1,13 @@
 """Where a closed-loop tick's microseconds go (item 1 of the speed issue): the plant alone, the loop with
 the compiled firmware (C engine) and with the float law, and the same loop with the law's ``step``
-replaced by a constant (what is left beyond the plant is the rest of the Diagram: the controller's Python
-callback with its port reads and state writes, the pose, feed-forward and sensor LeafSystems, the
-actuators and the loggers) — all in one run, interleaved, best of ``--repeat``.
+replaced by a constant — all in one run, interleaved, best of ``--repeat``.
+
+The loop's ticks run outside the Diagram (``drake.tick_loop``): Drake advances the plant and the
+actuators with ``AdvanceTo`` from tick to tick, one Python loop does the DSP's side. Two plant references:
+the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the plant the loop
+actually drives ("plant + actuators, input changing every tick": the actuators' lag and its loggers, an
+``AdvanceTo`` per tick and a command that changes every tick, so the integrator cannot reuse what it
+computed for the previous step; no Python law) — the ceiling of any loop with this Diagram.
 
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
 millisecond is one tick, so µs per tick = 1000 / real-time factor. Prints the load (``uptime``) first and
@@ -20,6 +25,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 import numpy as np  # noqa: E402
 from bench_integrators import CONTINUOUS, apply_integrator  # noqa: E402  (benchmarks/ is the script's folder)
 
+from stewart_drake.control.feedforward import TABLE_CACHE  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
@@ -55,6 +61,42 @@ def plant(p, duration: float) -> float:
     return (time.process_time() - c0) / duration
 
 
+def driven_plant(p, duration: float) -> float:
+    """CPU seconds per simulated second of the plant with the loop's actuators (lag) and loggers, advanced
+    tick by tick with a leg-force command that changes every tick (±1e-6 relative about home's static
+    forces, written in place into the fixed input): the loop without its Python."""
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import LogVectorOutput
+
+    from stewart_drake.core.dynamics import leg_forces_with_legs
+    from stewart_drake.drake.platform_model import build_plant, set_pose
+    from stewart_drake.drake.systems import Actuators
+
+    builder = DiagramBuilder()
+    mbp, _ = build_plant(p, 1e-3, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    act = builder.AddSystem(Actuators(float(p.legs.max_force), 2e-3, 1e-3))
+    builder.Connect(act.get_output_port(), mbp.get_actuation_input_port())
+    builder.ExportInput(act.get_input_port(), "command")
+    LogVectorOutput(mbp.get_state_output_port(), builder, 1e-3)
+    LogVectorOutput(act.get_output_port(), builder, 1e-3)
+    diagram = builder.Build()
+    sim = Simulator(diagram)
+    apply_integrator(sim, DEFAULT_INTEGRATOR, 1e-3)
+    root = sim.get_mutable_context()
+    set_pose(mbp, mbp.GetMyMutableContextFromRoot(root), p, p.home_pose())
+    F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
+    act.set_force(root, F)
+    fixed = diagram.GetInputPort("command").FixValue(root, F)
+    commands = [F * (1 + 1e-6), F * (1 - 1e-6)]
+    sim.Initialize()
+    c0 = time.process_time()
+    for k in range(1, int(round(duration / 1e-3)) + 1):
+        fixed.GetMutableData().get_mutable_value().SetFromVector(commands[k % 2])
+        sim.AdvanceTo(k * 1e-3)
+    return (time.process_time() - c0) / duration
+
+
 PREPARE: dict[str, float] = {}  # CPU s per simulated s of Simulation.prepare (the tick tables), per loop
 
 
@@ -82,9 +124,21 @@ def loop(p, kind: str, engine: str, duration: float, null_step: bool = False) ->
             return first[0]
 
         law.step = step
+    TABLE_CACHE.clear()  # the run's tables computed, not remembered from an earlier run of this process
     c0 = time.process_time()
     sim.run(duration)
     return (time.process_time() - c0) / duration
+
+
+def warm_tables_us(p, kind: str, engine: str, duration: float) -> float:
+    """CPU µs per tick of ``Simulation.prepare`` when this process has computed the same feed-forward table
+    before (``control.feedforward.TABLE_CACHE``: a Monte Carlo worker's runs after its first, a report's
+    repeated loops)."""
+    sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
+    sim.prepare(duration)
+    c0 = time.process_time()
+    sim.prepare(duration)
+    return 1e3 * (time.process_time() - c0) / duration
 
 
 def step_us(p, engine: str, n: int = 3000) -> float:
@@ -112,6 +166,7 @@ def main(argv=None) -> int:
     loop(p, "fixed", "c", 0.01)  # compile and cache the firmware before timing
     runs = {
         "plant": lambda: plant(p, args.duration),
+        "plant + actuators, input changing every tick": lambda: driven_plant(p, args.duration),
         "fixed, C engine": lambda: loop(p, "fixed", "c", args.duration),
         "fixed, C, null step": lambda: loop(p, "fixed", "c", args.duration, null_step=True),
         "float": lambda: loop(p, "float", "python", args.duration),
@@ -125,19 +180,29 @@ def main(argv=None) -> int:
     print("(process CPU time, best of the repetitions: on a loaded machine wall time includes waiting for a core)")
     for k, v in us.items():
         extra = "" if k == "plant" else f"  ({us['plant'] / v:.2f} × plant's real-time factor; target >= {TARGET})"
-        print(f"{k:22s} {v:6.1f} CPU µs per tick = real-time factor {1e3 / v:6.2f}x{extra}")
+        print(f"{k:45s} {v:6.1f} CPU µs per tick = real-time factor {1e3 / v:6.2f}x{extra}")
     for kind, full, null in (
         ("fixed/C", "fixed, C engine", "fixed, C, null step"),
         ("float", "float", "float, null step"),
     ):
         prep_us = 1e3 * PREPARE[kind.split("/")[0]]
-        sys_us = us[null] - us["plant"] - prep_us
+        driven = us["plant + actuators, input changing every tick"]
+        loop_us = us[null] - driven - prep_us
         law_us = us[full] - us[null]
         print(
-            f"{kind:8s} tick {us[full]:6.1f} µs = plant {us['plant']:6.1f} + tick tables (reference, IK words, "
-            f"feed-forward: before the run) {prep_us:5.1f} + rest of the Diagram (controller callback, sources, "
-            f"sensor, actuators, loggers) {sys_us:5.1f} + law.step {law_us:5.1f}"
+            f"{kind:8s} tick {us[full]:6.1f} µs = plant {us['plant']:6.1f} + driving it (actuators, loggers, an "
+            f"AdvanceTo per tick, a changing input) {driven - us['plant']:5.1f} + tick tables (reference, IK "
+            f"words, feed-forward: before the run) {prep_us:5.1f} + the loop's Python (state read, sensor, "
+            f"status, release, input, logs) {loop_us:5.1f} + law.step {law_us:5.1f}"
         )
+    print(
+        f"tick tables when remembered from an earlier run of the process: {warm_tables_us(p, 'fixed', 'c', args.duration):.1f}"
+        " µs per tick (fixed/C)"
+    )
+    print(
+        f"ceiling of this Diagram (no Python at all): {us['plant'] / us['plant + actuators, input changing every tick']:.2f}"
+        " × plant's real-time factor"
+    )
     print(f"law.step alone, C engine: {step_us(p, 'c'):.1f} µs per call (of it the sd_host_tick C call is < 1 µs)")
     print(f"# {load()}")
     return 0

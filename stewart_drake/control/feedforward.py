@@ -11,6 +11,10 @@ is several thousand cycles, more than the IK).
 
 from __future__ import annotations
 
+import hashlib
+import pickle
+from collections import OrderedDict
+
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
@@ -30,10 +34,49 @@ def feedforward_forces(platform: Platform, trajectory: Trajectory, times, lead: 
     """``(n, 6)`` feed-forward leg forces (N) at ``times`` (n,): ``dynamics.leg_forces_with_legs`` at the
     reference pose of t + ``lead``, with its rates from central differences of step ``h`` (the sample
     period: the second difference of the sampled reference, bounded also for piecewise-linear CSV
-    references)."""
+    references). Tables of more than one row are remembered (``TABLE_CACHE``)."""
     t = np.asarray(times, dtype=float).reshape(-1) + lead
     qm, q0, qp = trajectory.pose(t - h), trajectory.pose(t), trajectory.pose(t + h)
-    return leg_forces_with_legs(platform, q0, (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2)
+    qd, qdd = (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2
+    if len(t) < 2:
+        return leg_forces_with_legs(platform, q0, qd, qdd)
+    return TABLE_CACHE.forces(platform, q0, qd, qdd)
+
+
+class _TableCache:
+    """The last ``size`` feed-forward tables of this process, keyed by a digest of their inputs (the
+    platform pickled, the poses, rates and accelerations, bit for bit): the runs of a Monte Carlo worker or
+    of a report share the nominal model and the reference, so all but the first reuse the table (about a
+    sixth of a loop's time) instead of recomputing the same inverse dynamics. Same inputs, same function:
+    the same numbers. The tables are read-only."""
+
+    def __init__(self, size: int = 8):
+        self.size = size
+        self._tables: OrderedDict[bytes, np.ndarray] = OrderedDict()
+
+    def forces(self, platform: Platform, q, qd, qdd) -> np.ndarray:
+        digest = hashlib.blake2b(pickle.dumps(platform, protocol=5), digest_size=32)
+        for a in (q, qd, qdd):
+            a = np.ascontiguousarray(a, dtype=float)
+            digest.update(repr(a.shape).encode())
+            digest.update(a.data)
+        key = digest.digest()
+        table = self._tables.get(key)
+        if table is None:
+            table = leg_forces_with_legs(platform, q, qd, qdd)
+            table.flags.writeable = False
+            self._tables[key] = table
+            if len(self._tables) > self.size:
+                self._tables.popitem(last=False)
+        else:
+            self._tables.move_to_end(key)
+        return table
+
+    def clear(self) -> None:
+        self._tables.clear()
+
+
+TABLE_CACHE = _TableCache()
 
 
 class FeedforwardTable:

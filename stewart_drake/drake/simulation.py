@@ -1,21 +1,26 @@
 """Controller-in-the-loop simulation: trajectory source → DSP controller → actuators → closed-loop plant.
 
 One typed, picklable ``Scenario`` describes a run (platform, reference, controller kind and engine, timing
-and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram::
+and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram and the
+loop that drives it::
 
-    reference table ──▶ ControllerSystem (fixed | float law, discrete, period T) ──command──▶ Actuators
-        ▲  feed-forward table ──▶    ▲ leg_lengths                                               │ force
-        │                           └──────── sensor (prismatic positions) ◀──── plant ◀──────────┘
+    reference rows ──▶ DSP tick (fixed | float law, period T) ──command (fixed input)──▶ Actuators
+        ▲  feed-forward rows ──▶ ▲ leg_lengths                                             │ force
+        │                        └──────── sensor (prismatic positions) ◀──── plant ◀──────┘
         └ (core.trajectory: seed, rotating, a (t, pose) CSV, a motion program)
+
+The Diagram holds what runs in C++: the plant, the actuators (saturation and lag) and the plant's
+loggers; the DSP's side runs between ``Simulator.AdvanceTo`` calls in one tight loop
+(``drake.tick_loop``: the same numbers as a ``drake.systems.ControllerSystem`` wired into the Diagram,
+bit for bit, without a Python call inside the simulator's step).
 
 The feed-forward table (``control.feedforward``) holds, per tick, the leg forces of the inverse dynamics
 (plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
 with the pose table and download to the DSP. Without it (``feedforward=False``) the PID alone carries
-the plate. Both tables are filled for every tick of the run before it starts (``Simulation.prepare``) and
-read by Drake's ``TrajectorySource`` (``systems.TickTableSource``): per tick, the only Python is the
-controller's one callback around its law.
+the plate. Both tables are filled for every tick of the run before it starts (``Simulation.prepare``)
+and read by tick index.
 
-Loggers record, at every plant step, the plant state (pose and leg lengths come from it), the
+Logs record, at every plant step, the plant state (pose and leg lengths come from it), the
 controller's held command and set-point, its status (tick count, tick time, saturation counts) and the
 actuator forces; the reference is logged at the controller's ticks. Everything is deterministic: the
 same inputs give the same logs bit for bit (no randomness, no threads in the loop).
@@ -27,11 +32,8 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput, MatrixGain
 from tqdm import tqdm
 
 from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
@@ -49,8 +51,10 @@ from stewart_drake.drake.integrators import (
     check_integrator,
     constraint_gaps,
 )
-from stewart_drake.drake.platform_model import build_plant, set_pose
-from stewart_drake.drake.systems import Actuators, LegLengthSensor, TickTableSource, make_controller
+from stewart_drake.drake.loop_diagram import VISUALIZER_PERIOD, loop_diagram
+from stewart_drake.drake.platform_model import set_pose
+from stewart_drake.drake.systems import make_law
+from stewart_drake.drake.tick_loop import SensorReading, TickLoop, periodic_times
 from stewart_drake.errors import SimulationError
 
 # ----------------------------------------------------------------------------------------------
@@ -139,7 +143,10 @@ def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: 
 
 @dataclass
 class Simulation:
-    """A built controller-in-the-loop Diagram, ready to run (see ``build_simulation``)."""
+    """A built controller-in-the-loop Diagram and the loop that drives it, ready to run (see
+    ``build_simulation``). ``controller``: the ``tick_loop.TickLoop`` (its ``law``, its tables
+    ``reference`` and ``feedforward`` once ``prepare`` has filled them); ``loggers``: the plant's
+    ``state`` and the actuators' ``force`` (Drake loggers)."""
 
     platform: Platform
     trajectory: Trajectory
@@ -147,7 +154,7 @@ class Simulation:
     config: ControllerConfig
     diagram: object
     plant: object
-    controller: object
+    controller: TickLoop
     loggers: dict
     simulator: object = None
     meshcat: object = None
@@ -155,9 +162,8 @@ class Simulation:
     plant_time_step: float = 1e-3
     feedforward: object = None
     integrator: str = "sap"
-    source: object = None
-    feedforward_source: object = None
     _ran: bool = False
+    _logs: dict = field(default_factory=dict)
 
     def run(self, duration: float, progress: bool = False) -> SimulationLog:
         """Simulate ``duration`` seconds from t = 0 (once per Simulation) and return the logs."""
@@ -166,8 +172,9 @@ class Simulation:
         if self._ran:
             raise RuntimeError("a Simulation runs once; build a new one")
         self._ran = True
-        sim = self.simulator
         self.prepare(duration)
+        # the visualizer's frames are Diagram events: the loop stops there too (a discrete plant logs there)
+        frames = periodic_times(0.0, VISUALIZER_PERIOD, duration) if self.meshcat is not None else ()
         if self.meshcat is not None:
             self.visualizer.StartRecording()
         if progress:
@@ -181,45 +188,54 @@ class Simulation:
                 bar_format=fmt,
                 leave=False,
             ) as bar:
-                for k in range(1, steps + 1):
-                    sim.AdvanceTo(duration * k / steps)
-                    bar.update(duration / steps)
+                marks = [duration * k / steps for k in range(1, steps + 1)]
+                at_mark = set(marks)
+                self._logs = self.controller.run(
+                    duration, [*frames, *marks], lambda t: bar.update(duration / steps) if t in at_mark else None
+                )
         else:
-            sim.AdvanceTo(duration)
+            self._logs = self.controller.run(duration, frames)
         if self.meshcat is not None:
             self.visualizer.StopRecording()
             self.visualizer.PublishRecording()
-        return self._collect()
+        return self._collect(duration)
 
     def prepare(self, duration: float) -> None:
         """Fill the tables the run reads (``run`` calls it): the reference and the feed-forward at every
-        tick of ``duration`` seconds, in one batch each, as the tables the Diagram reads in C++ (the pose
-        functions are elementwise over times: the numbers of one time at a time), and the law's IK of
-        those poses (speed only). What a host computes and downloads before the DSP starts."""
+        tick of ``duration`` seconds, in one batch each, as rows read by tick index (the pose functions
+        are elementwise over times: the numbers of one time at a time), and the law's IK of those poses
+        (speed only). What a host computes and downloads before the DSP starts."""
         T = self.config.timing.sample_period
         ticks = np.arange(int(math.floor(duration / T + 1e-9)) + 1) * T
         poses = self.trajectory.pose(ticks)
-        self.source.set_rows(poses)
+        self.controller.reference = np.ascontiguousarray(poses, dtype=float)
         if hasattr(self.controller.law, "prime"):
             self.controller.law.prime(poses)
         if self.feedforward is not None:
             self.feedforward.prime(ticks)
-            self.feedforward_source.set_rows([self.feedforward.table[float(t)] for t in ticks])
+            self.controller.feedforward = np.array([self.feedforward.table[float(t)] for t in ticks], dtype=float)
+
+    def states(self) -> np.ndarray:
+        """``(n, nx)`` the plant states logged by the run (``plant.get_state_output_port()``'s layout)."""
+        if "state" in self._logs:
+            return self._logs["state"]
+        return self.loggers["state"].FindLog(self.simulator.get_context()).data().T
 
     def max_constraint_gap(self, samples: int = 1000) -> float:
         """The largest ball-constraint gap (m) of this run: how far the loop closures opened, over up to
         ``samples`` evenly spaced logged plant states (every state of a shorter run), first and last
         included (``integrators.constraint_gaps``; a state costs ~50 µs)."""
-        X = self.loggers["state"].FindLog(self.simulator.get_context()).data().T
+        X = self.states()
         idx = np.unique(np.linspace(0, len(X) - 1, min(len(X), samples)).round().astype(int))
         return float(constraint_gaps(self.plant, X[idx]).max())
 
-    def _collect(self) -> SimulationLog:
-        ctx = self.simulator.get_context()
-        logs = {k: lg.FindLog(ctx) for k, lg in self.loggers.items()}
-        x = logs["state"]
-        t = x.sample_times().copy()
-        X = x.data().T
+    def _collect(self, duration: float) -> SimulationLog:
+        logs, ctx = self._logs, self.simulator.get_context()
+        if "state" in logs:  # a discrete plant: logged at every simulator step by the loop
+            t, X, force = logs["times"], logs["state"], logs["force"]
+        else:
+            t = self.loggers["state"].FindLog(ctx).sample_times().copy()
+            X, force = self.states(), self.loggers["force"].FindLog(ctx).data().T.copy()
         top = self.plant.GetBodyByName("top")
         i0 = top.floating_positions_start()
         quat = X[:, i0 : i0 + 4]
@@ -230,29 +246,32 @@ class Simulation:
         pose = np.concatenate([p_WC, angles], axis=1)
         joints = [self.plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
         L = X[:, [j.position_start() for j in joints]]
-        ref = logs["reference"]
-        status = logs["status"].data().T
+        if len(logs["status"]) != len(t):  # the loop's stops are the Diagram's steps: a bug otherwise
+            raise RuntimeError(f"controller logs {len(logs['status'])} rows, plant logs {len(t)}")
+        T = self.config.timing.sample_period
+        t_ref = periodic_times(0.0, T, duration)  # the reference at the ticks 0 … k·T <= duration
         return SimulationLog(
             kind=self.kind,
             platform=self.platform.name,
             trajectory=self.trajectory.name,
-            sample_period=self.config.timing.sample_period,
+            sample_period=T,
             t=t,
             pose=pose,
             lengths=L,
-            command=logs["command"].data().T.copy(),
-            setpoint=logs["setpoint"].data().T.copy(),
-            force=logs["force"].data().T.copy(),
-            status=status.copy(),
-            t_ref=ref.sample_times().copy(),
-            reference=ref.data().T.copy(),
+            command=logs["command"].copy(),
+            setpoint=logs["setpoint"].copy(),
+            force=force,
+            status=logs["status"],
+            t_ref=np.r_[0.0, t_ref],
+            reference=self.controller.reference[: len(t_ref) + 1].copy(),
         )
 
 
 def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
-    """Assemble ``scenario``'s controller-in-the-loop Diagram and its Simulator, with the plant at the
-    reference's initial pose, legs at the matching lengths and the controller holding them against
-    gravity. ``meshcat``: a ``Meshcat`` to record an animation (not part of the scenario: it does not pickle)."""
+    """Assemble ``scenario``'s Diagram (plant, actuators, loggers) and the loop that drives it, with the
+    plant at the reference's initial pose, legs at the matching lengths and the controller holding them
+    against gravity. ``meshcat``: a ``Meshcat`` to record an animation (not part of the scenario: it does
+    not pickle)."""
     s = scenario
     platform = s.platform
     integrator = check_integrator(s.integrator or DEFAULT_INTEGRATOR)
@@ -266,18 +285,12 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     if config is None:
         poses = design_poses(trajectory, s.design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
-    builder = DiagramBuilder()
-    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
-    ctrl = builder.AddSystem(make_controller(s.controller, platform, config, s.engine, s.firmware))
-    ctrl.set_name(f"{s.controller}_controller")
+    law = make_law(s.controller, platform, config, s.engine, s.firmware)
     T = config.timing.sample_period
-    # the reference at the ticks; until ``run`` fills the table, the pose at t = 0 (read by Initialize)
-    src = builder.AddSystem(TickTableSource(T, trajectory.pose(np.zeros(1))))
-    src.set_name("reference")
     max_force = actuators.max_force or float(platform.legs.max_force)
-    act = builder.AddSystem(Actuators(max_force, actuators.time_constant, plant_time_step))
-    act.set_name("actuators")
-    nx = plant.num_multibody_states()
+    # the plant and actuators: reused from an earlier run of this process with the same ones (``loop_diagram``)
+    built = loop_diagram(plant_platform, plant_time_step, integrator, max_force, actuators.time_constant, meshcat)
+    diagram, plant, act, loggers = built.diagram, built.plant, built.actuators, built.loggers
     joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
     sensor_model = s.sensor
     if np.any(plant_platform.length_offset):  # a sensor reads the joint-to-joint length − legs.length_offset
@@ -287,47 +300,18 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
             if s.sensor is None
             else replace(s.sensor, offset=np.asarray(s.sensor.offset) + o)
         )
+    pos = np.array([j.position_start() for j in joints])
     if sensor_model is None:
-        D = np.zeros((6, nx))
-        for i in range(6):
-            D[i, joints[i].position_start()] = 1.0
-        sensor = builder.AddSystem(MatrixGain(D))
+        sensor = lambda t, x: x[pos]  # noqa: E731  (the ideal sensor: the prismatic positions)
     else:
-        pos = np.array([j.position_start() for j in joints])
         vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
-        sensor = builder.AddSystem(
-            LegLengthSensor(
-                nx, pos, vel, sensor_model.offset, sensor_model.noise, sensor_model.jitter, sensor_model.period
-            )
+        m = sensor_model
+        sensor = SensorReading(
+            pos, vel, np.asarray(m.offset, float), np.asarray(m.noise, float), np.asarray(m.jitter, float), m.period
         )
-    sensor.set_name("leg_length_sensor")
-    builder.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
-    ff = ffs = None
+    ff = None
     if s.feedforward:
         ff = FeedforwardTable(platform, trajectory, feedforward_lead(config, actuators.time_constant), T)
-        ffs = builder.AddSystem(TickTableSource(T, ff.force(0.0)))
-        ffs.set_name("feedforward_table")
-        builder.Connect(ffs.get_output_port(), ctrl.GetInputPort("feedforward"))
-    builder.Connect(plant.get_state_output_port(), sensor.get_input_port())
-    builder.Connect(sensor.get_output_port(), ctrl.GetInputPort("leg_lengths"))
-    builder.Connect(ctrl.GetOutputPort("command"), act.get_input_port())
-    builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
-    # the discrete plant logs at its steps; the continuous one at the same period (not at every integrator step)
-    lp = () if integrator == "sap" else (plant_time_step,)
-    loggers = {
-        "state": LogVectorOutput(plant.get_state_output_port(), builder, *lp),
-        "command": LogVectorOutput(ctrl.GetOutputPort("command"), builder, *lp),
-        "setpoint": LogVectorOutput(ctrl.GetOutputPort("setpoint"), builder, *lp),
-        "status": LogVectorOutput(ctrl.GetOutputPort("status"), builder, *lp),
-        "force": LogVectorOutput(act.get_output_port(), builder, *lp),
-        "reference": LogVectorOutput(src.get_output_port(), builder, T),
-    }
-    visualizer = None
-    if meshcat is not None:
-        visualizer = MeshcatVisualizer.AddToBuilder(
-            builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 32)
-        )
-    diagram = builder.Build()
     simulator = Simulator(diagram)
     apply_integrator(simulator, integrator, plant_time_step)
     root = simulator.get_mutable_context()
@@ -340,7 +324,12 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
-    ctrl.initialize(ctrl.GetMyMutableContextFromRoot(root), L0, F0, None if ff is None else ff.force(0.0), rates0)
+    # a continuous plant without the actuators' lag integrates with the command released at a tick
+    after = integrator in CONTINUOUS and act.lag is None
+    force = None if loggers else (act.get_output_port(), act.GetMyContextFromRoot(root))
+    loop = TickLoop(simulator, plant, pc, diagram.GetInputPort("command"), law, sensor, plant_time_step, after, force)
+    loop.reference = trajectory.pose(np.zeros(1))  # until ``run`` fills the tables: the pose at t = 0
+    loop.initialize(L0, F0, None if ff is None else ff.force(0.0), rates0)
     act.set_force(root, F0)
     simulator.Initialize()
     return Simulation(
@@ -350,16 +339,14 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         config,
         diagram,
         plant,
-        ctrl,
+        loop,
         loggers,
         simulator,
         meshcat,
-        visualizer,
+        built.visualizer,
         plant_time_step,
         ff,
         integrator,
-        src,
-        ffs,
     )
 
 

@@ -31,7 +31,7 @@ def runs():
     for integ in INTEGRATORS:
         sim = build_simulation(Scenario(p, "seed", "fixed", integrator=integ, design_duration=4.0))
         log = sim.run(DURATION)
-        X = sim.loggers["state"].FindLog(sim.simulator.get_context()).data().T
+        X = sim.states()
         out[integ] = (sim, log, constraint_gaps(sim.plant, X))
     return p, out
 

@@ -1,0 +1,106 @@
+"""The closed loop's Diagram: what runs in C++ between the controller's ticks — the plant (with its scene
+graph), the actuators (saturation and lag) with their command as the Diagram's input ``command``, the
+continuous plant's loggers and, for an animation, the Meshcat visualizer.
+
+Built once per structure and reused (``DIAGRAM_CACHE``): a Diagram holds no state (every run has its own
+context and Simulator), so the runs of a process whose plant platform, plant step, integrator and actuators
+are the same share one — a Monte Carlo study varying only the sensor, the latency, the sample period or the
+gains builds it once per worker; a draw that moves an anchor or changes the plate's mass or payload changes
+the plant (its SDF) and builds its own. Not cached with a visualizer (it holds the user's Meshcat).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import pickle
+from collections import OrderedDict
+from dataclasses import dataclass
+
+from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
+
+from stewart_drake.core.geometry import Platform
+from stewart_drake.drake.integrators import CONTINUOUS
+from stewart_drake.drake.platform_model import build_plant
+from stewart_drake.drake.systems import Actuators
+
+VISUALIZER_PERIOD = 1 / 32  # s: the Meshcat animation's frame period
+
+
+@dataclass(frozen=True)
+class LoopDiagram:
+    """A built loop Diagram: ``diagram``, its ``plant`` and ``actuators``, ``loggers`` (``state``, ``force``:
+    the continuous plant's, empty for a discrete plant whose loop logs itself) and ``visualizer`` (or None)."""
+
+    diagram: object
+    plant: object
+    actuators: object
+    loggers: dict
+    visualizer: object = None
+
+
+def loop_diagram(
+    plant_platform: Platform,
+    plant_time_step: float,
+    integrator: str,
+    max_force: float,
+    time_constant: float,
+    meshcat=None,
+) -> LoopDiagram:
+    """The loop Diagram of a plant of ``plant_platform`` stepped at ``plant_time_step`` s under
+    ``integrator``, driven by actuators limited to ``max_force`` N with lag ``time_constant`` s (from the
+    cache when one with the same inputs was built in this process and ``meshcat`` is None)."""
+    if meshcat is not None:
+        return _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat)
+    return DIAGRAM_CACHE.get(plant_platform, plant_time_step, integrator, max_force, time_constant)
+
+
+def _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat) -> LoopDiagram:
+    builder = DiagramBuilder()
+    plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
+    act = builder.AddSystem(Actuators(max_force, time_constant, plant_time_step))
+    act.set_name("actuators")
+    builder.ExportInput(act.get_input_port(), "command")
+    builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
+    # the continuous plant logs at its step (not at every integrator step); the discrete one at every
+    # simulator step, by the loop (``tick_loop.TickLoop``)
+    loggers = {}
+    if integrator in CONTINUOUS:
+        loggers = {
+            "state": LogVectorOutput(plant.get_state_output_port(), builder, plant_time_step),
+            "force": LogVectorOutput(act.get_output_port(), builder, plant_time_step),
+        }
+    visualizer = None
+    if meshcat is not None:
+        visualizer = MeshcatVisualizer.AddToBuilder(
+            builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=VISUALIZER_PERIOD)
+        )
+    return LoopDiagram(builder.Build(), plant, act, loggers, visualizer)
+
+
+class _DiagramCache:
+    """The last ``size`` loop Diagrams built in this process, keyed by a digest of their inputs."""
+
+    def __init__(self, size: int = 2):
+        self.size = size
+        self._diagrams: OrderedDict[bytes, LoopDiagram] = OrderedDict()
+
+    def get(self, plant_platform, plant_time_step, integrator, max_force, time_constant) -> LoopDiagram:
+        inputs = (plant_platform, float(plant_time_step), integrator, float(max_force), float(time_constant))
+        key = hashlib.blake2b(pickle.dumps(inputs, protocol=5), digest_size=32).digest()
+        built = self._diagrams.get(key)
+        if built is None:
+            built = _build(*inputs, None)
+            self._diagrams[key] = built
+            if len(self._diagrams) > self.size:
+                self._diagrams.popitem(last=False)
+        else:
+            self._diagrams.move_to_end(key)
+        return built
+
+    def clear(self) -> None:
+        self._diagrams.clear()
+
+
+DIAGRAM_CACHE = _DiagramCache()
