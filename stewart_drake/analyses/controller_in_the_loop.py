@@ -75,8 +75,7 @@ def _fixed_bound(e_float, d_ik, lsb, r, gain):
 
 def _tracking(section, platform, duration, done: dict):
     """The float and fixed-point loops on both trajectories; ``done``: ``{(trajectory, kind): log}`` and
-    ``{(trajectory, "gain"): ‖h‖₁}`` already computed by the presets' cases (the same loops at the same
-    duration: not run twice)."""
+    ``{(trajectory, "gain"): ‖h‖₁}``, run by the utn-dynamic presets' cases (the same loops: not run twice)."""
     import matplotlib.pyplot as plt
 
     rows, logs = [], {}
@@ -84,7 +83,7 @@ def _tracking(section, platform, duration, done: dict):
     for j, traj in enumerate((SEED, ROTATING)):
         cfg = loop_plan(platform, traj, "float", duration).config  # the gains every loop of this trajectory runs
         for i, kind in enumerate(("float", "fixed")):
-            log = done[traj.name, kind] if (traj.name, kind) in done else simulate_log(platform, traj, kind, duration)
+            log = done[traj.name, kind]
             logs[traj.name, kind] = log
             e = log.length_error(traj, platform)
             pe = log.pose_error(traj)
@@ -115,7 +114,7 @@ def _tracking(section, platform, duration, done: dict):
             v_max * t_delay * 1e3,
             "mm",
         )
-        g = done[traj.name, "gain"] if (traj.name, "gain") in done else _l1_gain(platform, cfg, section.quick)
+        g = done[traj.name, "gain"]
         section.check(
             f"{traj.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r) (quantisation bound, ‖h‖₁ = {g['coupled']:.2f})",
             e_fixed * 1e3,
@@ -149,7 +148,12 @@ def _tracking(section, platform, duration, done: dict):
 
 def _preset_cases(quick: bool) -> list[tuple]:
     """The presets table's (preset, trajectory, duration, quick) cases."""
-    return [(name, base.name, 0.3 if quick else 4.0, quick) for name in PRESETS for base in (SEED, ROTATING)]
+    return [(name, base.name, _duration(quick), quick) for name in PRESETS for base in (SEED, ROTATING)]
+
+
+def _duration(quick: bool) -> float:
+    """The loops' duration (s): the trajectories' 4 s; 0.3 s in quick mode (a smoke test)."""
+    return 0.3 if quick else 4.0
 
 
 def _sweep_cases(quick: bool) -> list[tuple]:
@@ -276,7 +280,7 @@ SWEEP_PLANT_STEP = 2.5e-4
 
 def _sweep_grid(quick: bool):
     """The sweep's sample periods (s) and duration (s)."""
-    return ([5e-4, 1e-3, 2e-3], 0.5) if quick else ([2.5e-4, 5e-4, 1e-3, 1.5e-3, 2e-3], 1.5)
+    return ([5e-4, 1e-3, 2e-3], 0.3) if quick else ([2.5e-4, 5e-4, 1e-3, 1.5e-3, 2e-3], 1.5)
 
 
 def _sweep_study(periods, duration):
@@ -367,7 +371,7 @@ def _animation(section, platform, log, duration):
 def build(section) -> None:
     platform = load_preset(PLATFORM)
     quick = section.quick
-    duration = 1.0 if quick else 4.0
+    duration = _duration(quick)
     section.text(
         "The controller runs as a discrete Drake system with the DSP's timing: a periodic update at exactly k·T "
         "reads the pose reference and the six leg lengths quantised to the sensor's 10 µm counts, computes the "
@@ -390,9 +394,8 @@ def build(section) -> None:
     )
     presets = parallel_map(__file__, "_preset_case", _preset_cases(quick))
     shared = {k: v for _, _, done in presets for k, v in done.items()}
-    # the tracking loops are the utn-dynamic presets' when they run as long (the full report), else their own
-    logs = _tracking(section, platform, duration, shared if _preset_cases(quick)[0][2] == duration else {})
-    prows = _presets(section, presets, 0.3 if quick else 4.0)
+    logs = _tracking(section, platform, duration, shared)  # the utn-dynamic presets' loops
+    prows = _presets(section, presets, duration)
     # the presets table's columns kp, ‖h‖₁ all legs, step peak and the measured excess (fixed − float)/A
     kps, gains, peaks, excess = (np.array([r[k] for r in prows]) for k in (5, 14, 15, 16))
     section.text(
