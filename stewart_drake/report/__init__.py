@@ -225,7 +225,7 @@ def unlabelled_axes(fig) -> list[str]:
 _MODULES: dict = {}
 
 
-def _call_in_analysis(path: str, name: str, item):
+def call_in_analysis(path: str, name: str, item):
     """``name(item)`` of the analysis script at ``path`` (loaded once per worker process)."""
     import matplotlib
 
@@ -247,10 +247,10 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
         return done
     jobs = 1 if parts.IN_WORKER else min(len(items), jobs or os.cpu_count() or 1)
     if jobs <= 1:
-        return [_call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
+        return [call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
     with worker_pool(jobs) as pool:  # spawned, dying with this process, terminated on Ctrl-C/SIGTERM
         return list(
-            pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
+            pool.map(call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
         )
 
 

@@ -42,10 +42,10 @@ def precomputed(module_file, name: str, items: list) -> list | None:
 
 def run_part(path: str, name: str, item):
     """A part in a worker: ``(result, wall s, CPU s)``."""
-    from stewart_drake.report import _call_in_analysis
+    from stewart_drake.report import call_in_analysis
 
     t0, c0 = time.perf_counter(), time.process_time()
-    result = _call_in_analysis(path, name, item)
+    result = call_in_analysis(path, name, item)
     return result, time.perf_counter() - t0, time.process_time() - c0
 
 

@@ -38,7 +38,9 @@ def test_parts_run_once_in_the_report_pool(tmp_path):
     # pool runs them (once each) and the section's parallel_map gives their results back.
     log = tmp_path / "calls.txt"
     (tmp_path / "a.py").write_text(ANALYSIS.format(log=str(log)))
-    (tmp_path / "b.py").write_text("TITLE = 'plain'\nORDER = 2\ndef build(section):\n    section.check('ran', 0.0, 1.0)\n")
+    (tmp_path / "b.py").write_text(
+        "TITLE = 'plain'\nORDER = 2\ndef build(section):\n    section.check('ran', 0.0, 1.0)\n"
+    )
     out = io.StringIO()
     sections = run_analyses(discover_analyses(tmp_path), jobs=2, log=out)
     assert [s.title for s in sections] == ["with parts", "plain"]
