@@ -301,14 +301,15 @@ def _sweep_run(case):
     return run_row(_sweep_study(periods, duration), k)
 
 
-def _sweep(section, periods, duration):
+def _sweep(section):
     import matplotlib.pyplot as plt
 
     rows = []
     res = {}
     plant_step = SWEEP_PLANT_STEP
+    periods, duration = _sweep_grid(section.quick)
     check_study(_sweep_study(periods, duration))  # the bounds run_sweep checks before it runs
-    for r in parallel_map(__file__, "_sweep_run", [(tuple(periods), duration, k) for k in range(2 * len(periods))]):
+    for r in parallel_map(__file__, "_sweep_run", _sweep_cases(section.quick)):
         lat, T = r["latency"], r["sample_period_s"]
         e = r["max_leg_error_m"] * 1e3
         res[lat, T] = e
@@ -400,7 +401,7 @@ def build(section) -> None:
     kps, gains, peaks, excess = (np.array([r[k] for r in prows]) for k in (5, 14, 15, 16))
     section.text(
         "The same defaults on the two other presets (the trajectories moved to each platform's home height and "
-        "scaled to its stroke): utn-kinematic, a 12.8 kg plate on almost flat legs, has leg-space masses from "
+        "scaled to its stroke; utn-dynamic's rows are the very runs of the tracking table above): utn-kinematic, a 12.8 kg plate on almost flat legs, has leg-space masses from "
         "0.8 to 52 kg and struts whose negative stiffness (~5 kN/m at home, up to ~15 kN/m along the rotating "
         "trajectory) the stiffness floor of kp must beat. A design from home alone (kp = 3 × 5.1 kN/m, "
         "ki = kp·ω_h/4 = 66 kN/(m·s)) let the heaviest mode (~50–65 kg) grow at ~2 Hz: kp − K shrank along the "
@@ -437,8 +438,8 @@ def build(section) -> None:
         "larger than leg errors: this tall, narrow platform (0.7 m high on a 0.4 m base) turns small leg-length "
         "errors into larger sideways displacements (the inverse Jacobian's small singular values)."
     )
-    periods, sweep_duration = _sweep_grid(quick)
-    res = _sweep(section, periods, sweep_duration)
+    periods = _sweep_grid(quick)[0]
+    res = _sweep(section)
 
     def longest(lat):
         ok = [T for T in periods if res[lat, T] < 5.0]
