@@ -230,10 +230,15 @@ def call_in_analysis(path: str, name: str, item):
     import matplotlib
 
     matplotlib.use("Agg")
-    parts.IN_WORKER = True  # a worker of a pool: no pool of its own
     if path not in _MODULES:
         _MODULES[path] = _module_at(Path(path))
     return getattr(_MODULES[path], name)(item)
+
+
+def _call_in_pool(path: str, name: str, item):
+    """``call_in_analysis`` in a worker of ``parallel_map``'s pool (which starts no pool of its own)."""
+    parts.IN_WORKER = True
+    return call_in_analysis(path, name, item)
 
 
 def parallel_map(module_file: str, name: str, items: list, jobs: int | None = None) -> list:
@@ -250,7 +255,7 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
         return [call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
     with worker_pool(jobs) as pool:  # spawned, dying with this process, terminated on Ctrl-C/SIGTERM
         return list(
-            pool.map(call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
+            pool.map(_call_in_pool, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
         )
 
 

@@ -44,6 +44,8 @@ def run_part(path: str, name: str, item):
     """A part in a worker: ``(result, wall s, CPU s)``."""
     from stewart_drake.report import call_in_analysis
 
+    global IN_WORKER
+    IN_WORKER = True  # a worker of the report's pool: no pool of its own
     t0, c0 = time.perf_counter(), time.process_time()
     result = call_in_analysis(path, name, item)
     return result, time.perf_counter() - t0, time.process_time() - c0

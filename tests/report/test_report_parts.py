@@ -5,7 +5,7 @@ import io
 from concurrent.futures import Future
 from types import SimpleNamespace
 
-from stewart_drake.report import discover_analyses, parts, run_analyses
+from stewart_drake.report import discover_analyses, parallel_map, parts, run_analyses
 
 ANALYSIS = """
 from pathlib import Path
@@ -55,6 +55,8 @@ def test_parts_without_the_report_are_computed_by_the_section(tmp_path):
     (tmp_path / "a.py").write_text(ANALYSIS.format(log=str(log)))
     (s,) = run_analyses(discover_analyses(tmp_path), jobs=1, log=io.StringIO())
     assert all(c.passed for c in s.checks) and sorted(log.read_text().split()) == ["0", "1", "2", "3"]
+    # a one-item map runs in this process, which stays a parent: a later map here may start its pool
+    assert parallel_map(str(tmp_path / "a.py"), "square", [3]) == [9] and not parts.IN_WORKER
 
 
 class _Inline:
