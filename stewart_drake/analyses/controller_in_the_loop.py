@@ -16,12 +16,13 @@ from stewart_drake.drake.animation import log_saturating, record_animation
 from stewart_drake.drake.simulation import ActuatorModel, build_simulation, setpoint_step_gain
 from stewart_drake.firmware.engine import resolve_engine
 from stewart_drake.fixedpoint import fixed_point_leg_lengths
-from stewart_drake.montecarlo.sweep import run_sweep, sweep_study
+from stewart_drake.montecarlo.study import check_study, run_row
+from stewart_drake.montecarlo.sweep import sweep_study
 from stewart_drake.report import parallel_map, run_standalone
 
 TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
 ORDER = 90
-COST = 100  # relative run time: the report's workers start the costliest analyses first
+COST = 45  # CPU seconds (full report, measured): the report's workers start the costliest first
 
 PLATFORM = "utn-dynamic"
 # the fixed-point controller's tick as compiled C (bit-identical to the Python engine, several times faster)
@@ -72,7 +73,9 @@ def _fixed_bound(e_float, d_ik, lsb, r, gain):
     return e_float + gain * (d_ik + lsb + r)
 
 
-def _tracking(section, platform, duration):
+def _tracking(section, platform, duration, done: dict):
+    """The float and fixed-point loops on both trajectories; ``done``: ``{(trajectory, kind): log}`` and
+    ``{(trajectory, "gain"): ‖h‖₁}``, run by the utn-dynamic presets' cases (the same loops: not run twice)."""
     import matplotlib.pyplot as plt
 
     rows, logs = [], {}
@@ -80,7 +83,7 @@ def _tracking(section, platform, duration):
     for j, traj in enumerate((SEED, ROTATING)):
         cfg = loop_plan(platform, traj, "float", duration).config  # the gains every loop of this trajectory runs
         for i, kind in enumerate(("float", "fixed")):
-            log = simulate_log(platform, traj, kind, duration)
+            log = done[traj.name, kind]
             logs[traj.name, kind] = log
             e = log.length_error(traj, platform)
             pe = log.pose_error(traj)
@@ -111,7 +114,7 @@ def _tracking(section, platform, duration):
             v_max * t_delay * 1e3,
             "mm",
         )
-        g = _l1_gain(platform, cfg, section.quick)
+        g = done[traj.name, "gain"]
         section.check(
             f"{traj.name}: fixed-point leg error <= float + ‖h‖₁·(Δ_IK + LSB + r) (quantisation bound, ‖h‖₁ = {g['coupled']:.2f})",
             e_fixed * 1e3,
@@ -143,13 +146,37 @@ def _tracking(section, platform, duration):
     return logs
 
 
+def _preset_cases(quick: bool) -> list[tuple]:
+    """The presets table's (preset, trajectory, duration, quick) cases."""
+    return [(name, base.name, _duration(quick), quick) for name in PRESETS for base in (SEED, ROTATING)]
+
+
+def _duration(quick: bool) -> float:
+    """The loops' duration (s): the trajectories' 4 s; 0.3 s in quick mode (a smoke test)."""
+    return 0.3 if quick else 4.0
+
+
+def _sweep_cases(quick: bool) -> list[tuple]:
+    """The sweep's runs: (sample periods, duration, run index) for each point of its grid."""
+    periods, duration = _sweep_grid(quick)
+    return [(tuple(periods), duration, k) for k in range(2 * len(periods))]
+
+
+def parts(quick: bool) -> list[tuple[str, tuple]]:
+    """The independent heavy cases (``report.parts``): the presets' loops and the sweep's runs."""
+    return [("_preset_case", c) for c in _preset_cases(quick)] + [("_sweep_run", c) for c in _sweep_cases(quick)]
+
+
 def _preset_case(case):
-    """One (preset, trajectory) of ``_presets``, in a worker process: its checks and its table row."""
+    """One (preset, trajectory) of ``_presets``, in a worker process: its checks and its table row, and for
+    utn-dynamic its float and fixed-point logs and ‖h‖₁ (the tracking section's loops, the same runs)."""
     name, base_name, duration, quick = case
     platform = load_preset(name)
     m = np.linalg.eigvalsh(leg_space_inertia(platform))
     base = {"seed": SEED, "rotating": ROTATING}[base_name]
-    traj = fit_trajectory(base, platform)
+    # the trajectories are made for utn-dynamic: their fit to it is the identity (to 3e-17 m of rounding),
+    # so its loops are exactly the tracking section's, which reuses them
+    traj = base if name == PLATFORM else fit_trajectory(base, platform)
     plans = {kind: loop_plan(platform, traj, kind, duration) for kind in ("float", "fixed")}
     cfg = plans["float"].config
     poses = design_poses(traj, max(duration, traj.duration or 0.0))  # the poses the gains were designed over
@@ -200,16 +227,16 @@ def _preset_case(case):
         max(chat["force_ripple_N"]),
         chat["chatter_ratio"],
     ]
-    return checks, row
+    shared = {(base.name, "float"): logs["float"], (base.name, "fixed"): logs["fixed"], (base.name, "gain"): h}
+    return checks, row, shared if name == PLATFORM else {}
 
 
-def _presets(section, duration):
+def _presets(section, results, duration):
     """The default controller (gains designed per platform, force feed-forward) on every preset, the
-    trajectories fitted to each platform's home height and stroke; the same two bounds as above. The
-    six cases are independent: they run in worker processes."""
-    cases = [(name, base.name, duration, section.quick) for name in PRESETS for base in (SEED, ROTATING)]
+    trajectories fitted to each platform's home height and stroke; the same two bounds as above.
+    ``results``: the six independent cases' (``_preset_case``, run in worker processes)."""
     rows = []
-    for checks, row in parallel_map(__file__, "_preset_case", cases):
+    for checks, row, _ in results:
         for c in checks:
             section.check(*c)
         rows.append(row)
@@ -248,21 +275,41 @@ def _presets(section, duration):
     return rows
 
 
-def _sweep(section, platform, periods, duration):
+SWEEP_PLANT_STEP = 2.5e-4
+
+
+def _sweep_grid(quick: bool):
+    """The sweep's sample periods (s) and duration (s)."""
+    return ([5e-4, 1e-3, 2e-3], 0.3) if quick else ([2.5e-4, 5e-4, 1e-3, 1.5e-3, 2e-3], 1.5)
+
+
+def _sweep_study(periods, duration):
+    """The Monte Carlo machinery's grid sweep: one run per (latency, T), gains designed for 1 kHz kept fixed."""
+    return sweep_study(
+        load_preset(PLATFORM),
+        {"latency": ["computation", "sample"], "sample_period": list(periods)},
+        duration=duration,
+        plant_step=SWEEP_PLANT_STEP,
+        engine=ENGINE,
+    )
+
+
+def _sweep_run(case):
+    """Run ``k`` of the sweep, in a worker process (its row is the row ``run_sweep`` gives: each run depends
+    on the study and its index only)."""
+    periods, duration, k = case
+    return run_row(_sweep_study(periods, duration), k)
+
+
+def _sweep(section):
     import matplotlib.pyplot as plt
 
     rows = []
     res = {}
-    plant_step = 2.5e-4
-    # the Monte Carlo machinery's grid sweep: one run per (latency, T), gains designed for 1 kHz kept fixed
-    study = sweep_study(
-        platform,
-        {"latency": ["computation", "sample"], "sample_period": periods},
-        duration=duration,
-        plant_step=plant_step,
-        engine=ENGINE,
-    )
-    for r in run_sweep(study):
+    plant_step = SWEEP_PLANT_STEP
+    periods, duration = _sweep_grid(section.quick)
+    check_study(_sweep_study(periods, duration))  # the bounds run_sweep checks before it runs
+    for r in parallel_map(__file__, "_sweep_run", _sweep_cases(section.quick)):
         lat, T = r["latency"], r["sample_period_s"]
         e = r["max_leg_error_m"] * 1e3
         res[lat, T] = e
@@ -325,7 +372,7 @@ def _animation(section, platform, log, duration):
 def build(section) -> None:
     platform = load_preset(PLATFORM)
     quick = section.quick
-    duration = 1.0 if quick else 4.0
+    duration = _duration(quick)
     section.text(
         "The controller runs as a discrete Drake system with the DSP's timing: a periodic update at exactly k·T "
         "reads the pose reference and the six leg lengths quantised to the sensor's 10 µm counts, computes the "
@@ -346,12 +393,15 @@ def build(section) -> None:
         "legs along the reference, a table per tick as the host would download it, advanced by the loop's "
         "delays) carries the plate; the PID corrects the rest. The command range is the actuators' force."
     )
-    logs = _tracking(section, platform, duration)
-    prows = _presets(section, 0.3 if quick else 4.0)
-    kps, gains, peaks, excess = (np.array([r[k] for r in prows]) for k in (5, -5, -4, -3))
+    presets = parallel_map(__file__, "_preset_case", _preset_cases(quick))
+    shared = {k: v for _, _, done in presets for k, v in done.items()}
+    logs = _tracking(section, platform, duration, shared)  # the utn-dynamic presets' loops
+    prows = _presets(section, presets, duration)
+    # the presets table's columns kp, ‖h‖₁ all legs, step peak and the measured excess (fixed − float)/A
+    kps, gains, peaks, excess = (np.array([r[k] for r in prows]) for k in (5, 14, 15, 16))
     section.text(
         "The same defaults on the two other presets (the trajectories moved to each platform's home height and "
-        "scaled to its stroke): utn-kinematic, a 12.8 kg plate on almost flat legs, has leg-space masses from "
+        "scaled to its stroke; utn-dynamic's rows are the very runs of the tracking table above): utn-kinematic, a 12.8 kg plate on almost flat legs, has leg-space masses from "
         "0.8 to 52 kg and struts whose negative stiffness (~5 kN/m at home, up to ~15 kN/m along the rotating "
         "trajectory) the stiffness floor of kp must beat. A design from home alone (kp = 3 × 5.1 kN/m, "
         "ki = kp·ω_h/4 = 66 kN/(m·s)) let the heaviest mode (~50–65 kg) grow at ~2 Hz: kp − K shrank along the "
@@ -388,8 +438,8 @@ def build(section) -> None:
         "larger than leg errors: this tall, narrow platform (0.7 m high on a 0.4 m base) turns small leg-length "
         "errors into larger sideways displacements (the inverse Jacobian's small singular values)."
     )
-    periods = [5e-4, 1e-3, 2e-3] if quick else [2.5e-4, 5e-4, 1e-3, 1.5e-3, 2e-3]
-    res = _sweep(section, platform, periods, 0.5 if quick else 1.5)
+    periods = _sweep_grid(quick)[0]
+    res = _sweep(section)
 
     def longest(lat):
         ok = [T for T in periods if res[lat, T] < 5.0]

@@ -21,6 +21,7 @@ from stewart_drake.report import run_standalone
 
 TITLE = "Firmware certificate (proven word ranges, saturation and error bound over the workspace)"
 ORDER = 96
+COST = 9  # CPU seconds (full report, measured): the report's workers start the costliest first
 
 DEFAULT = QFormat(16, 1e-3, "tfr16")
 # the formats compared on utn-kinematic: the default, the issue's 20 µm and 100 µm LSBs, and the formats
@@ -103,7 +104,7 @@ def build(section) -> None:
         )
         section.check(f"{name}: sampled words outside their proven ranges", 0 if inside else 1, 0, "")
         if name == "utn-kinematic":
-            table = cert.words
+            table, default_cert = cert.words, cert  # the formats' table below starts with this one
     section.table(
         [
             "preset",
@@ -181,7 +182,8 @@ def build(section) -> None:
 
     rows = []
     for label, fmt in COMPARED:
-        cert = certify(p, fmt, box, max_cells=cells)
+        # the default format on this box was certified above (same platform, box and budget): not again
+        cert = default_cert if fmt == DEFAULT else certify(p, fmt, box, max_cells=cells)
         bound = None if cert.saturation_possible else max(cert.error_bound_mm)
         wt = cert.witness
         rows.append(

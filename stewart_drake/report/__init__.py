@@ -10,8 +10,9 @@ keeps the analyses' order whatever order they finish in.
 An analysis script in ``analyses/`` defines ``TITLE``, ``ORDER`` (position in the report) and
 ``build(section)``, optionally ``COST`` (its relative run time: the costliest start first); its ``main()``
 calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
-out with ``parallel_map(__file__, "function_name", items)``. ``section.headline(text)`` sets the figure
-shown beside the section's verdict.
+out with ``parallel_map(__file__, "function_name", items)``, and declare them with ``parts(quick)`` so that
+the report runs them in its own pool beside the other sections (``report.parts``). ``section.headline(text)``
+sets the figure shown beside the section's verdict.
 """
 
 from __future__ import annotations
@@ -26,7 +27,6 @@ import sys
 import textwrap
 import time
 import warnings
-from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,7 +34,7 @@ from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
-from stewart_drake.report import render
+from stewart_drake.report import parts, render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 
@@ -64,8 +64,9 @@ class Section:
     checks: list[Check] = field(default_factory=list)
     files: dict[str, bytes] = field(default_factory=dict)
     headline_text: str = ""
-    elapsed: float | None = None  # wall seconds to build
-    cpu: float | None = None  # CPU seconds of the process that built it (not of pools it started)
+    elapsed: float | None = None  # wall seconds to build (and its parts', summed: ``report.parts``)
+    cpu: float | None = None  # CPU seconds of the process that built it and of its parts (not of pools it started)
+    parts: int = 0  # how many of its heavy parts the report ran in its shared pool (``report.parts``)
     warnings: list[str] = field(default_factory=list)
     crashed: bool = False  # the analysis raised (never cached)
     cached: bool = False  # given back by the result cache (``report.cache``), not computed in this run
@@ -149,6 +150,7 @@ class Analysis:
     build: object
     path: Path | None = None
     cost: float = 0.0  # the module's optional COST (relative run time): workers take the costliest first
+    parts: object = None  # the module's optional parts(quick): its heavy cases, run in the report's pool
 
 
 def _module_at(path: Path):
@@ -168,7 +170,15 @@ def load_analysis(path: Path) -> Analysis:
     for attr in ("TITLE", "ORDER", "build"):
         if not hasattr(mod, attr):
             raise ValueError(f"analysis {path} lacks {attr}")  # internal: the analyses are package modules
-    return Analysis(path.stem, mod.TITLE, float(mod.ORDER), mod.build, path, float(getattr(mod, "COST", 0.0)))
+    return Analysis(
+        path.stem,
+        mod.TITLE,
+        float(mod.ORDER),
+        mod.build,
+        path,
+        float(getattr(mod, "COST", 0.0)),
+        getattr(mod, "parts", None),
+    )
 
 
 def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = None) -> list[Analysis]:
@@ -215,7 +225,7 @@ def unlabelled_axes(fig) -> list[str]:
 _MODULES: dict = {}
 
 
-def _call_in_analysis(path: str, name: str, item):
+def call_in_analysis(path: str, name: str, item):
     """``name(item)`` of the analysis script at ``path`` (loaded once per worker process)."""
     import matplotlib
 
@@ -225,16 +235,27 @@ def _call_in_analysis(path: str, name: str, item):
     return getattr(_MODULES[path], name)(item)
 
 
+def _call_in_pool(path: str, name: str, item):
+    """``call_in_analysis`` in a worker of ``parallel_map``'s pool (which starts no pool of its own)."""
+    parts.IN_WORKER = True
+    return call_in_analysis(path, name, item)
+
+
 def parallel_map(module_file: str, name: str, items: list, jobs: int | None = None) -> list:
     """``[f(item) for item in items]`` where ``f`` is the function ``name`` of the analysis script
-    ``module_file`` (pass ``__file__``), computed in ``jobs`` worker processes (default: the CPUs).
-    For an analysis's independent heavy cases; ``item`` and the results must be picklable. In order."""
-    jobs = min(len(items), jobs or os.cpu_count() or 1)
+    ``module_file`` (pass ``__file__``), computed in ``jobs`` worker processes (default: the CPUs; in a
+    worker of the report: in this process, the report's pool keeping the CPUs busy). For an analysis's
+    independent heavy cases; ``item`` and the results must be picklable. In order. Parts the report already
+    ran in its shared pool (``report.parts``) are given back, not computed again."""
+    done = parts.precomputed(module_file, name, items)
+    if done is not None:
+        return done
+    jobs = 1 if parts.IN_WORKER else min(len(items), jobs or os.cpu_count() or 1)
     if jobs <= 1:
-        return [_call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
+        return [call_in_analysis(str(Path(module_file).resolve()), name, it) for it in items]
     with worker_pool(jobs) as pool:  # spawned, dying with this process, terminated on Ctrl-C/SIGTERM
         return list(
-            pool.map(_call_in_analysis, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
+            pool.map(_call_in_pool, [str(Path(module_file).resolve())] * len(items), [name] * len(items), items)
         )
 
 
@@ -252,11 +273,18 @@ def build_section(analysis: Analysis, quick: bool = False) -> Section:
     return s
 
 
-def _build_in_worker(path: str, quick: bool) -> Section:
+def _build_in_worker(path: str, quick: bool, done: dict | None = None) -> Section:
+    """A section in a report worker; ``done``: its parts, computed already (``report.parts``)."""
     import matplotlib
 
     matplotlib.use("Agg")
-    return build_section(load_analysis(Path(path)), quick)
+    parts.IN_WORKER = True
+    parts._DONE.clear()
+    parts._DONE.update(done or {})
+    try:
+        return build_section(load_analysis(Path(path)), quick)
+    finally:
+        parts._DONE.clear()
 
 
 def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
@@ -265,6 +293,7 @@ def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
     ok = sum(c.passed for c in s.checks)
     cpu = "" if s.cpu is None else f" (CPU {s.cpu:.1f} s)"
     cpu += ", from the cache (--no-cache to recompute)" if s.cached else ""
+    cpu += f", {s.parts} parts in the shared pool" if s.parts else ""
     count = f"section {k}/{n}" + ("" if done is None else f", {done} done")
     title = textwrap.shorten(s.title, 70, placeholder=" …")
     print(f"[{count}] {title}: {ok}/{len(s.checks)} checks passed, {s.elapsed:.1f} s{cpu}", file=log, flush=True)
@@ -289,28 +318,30 @@ def run_analyses(
             sections.append(build_section(a, quick))
             _progress(k, n, sections[-1], log)
         return sections
-    with worker_pool(min(jobs, n)) as pool:  # spawned (no fork of Drake's threads), dying with this process
-        # The slowest first (ORDER is no guide; COST, when an analysis declares it, is), so that the
-        # workers finish together.
-        order = sorted(range(n), key=lambda i: -getattr(analyses[i], "cost", 0.0))
-        futures = {i: pool.submit(_build_in_worker, str(analyses[i].path), quick) for i in order}
-        done = 0
-        index = {f: i for i, f in futures.items()}
-        sections: list[Section | None] = [None] * n
-        for f in as_completed(futures.values()):
-            i = index[f]
-            try:
-                sections[i] = f.result()
-            except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
-                s = Section(analyses[i].title, quick=quick)
-                s.html(
-                    f'<p class="fail">This analysis failed in its worker: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>'
-                )
-                s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
-                s.elapsed, s.crashed = 0.0, True
-                sections[i] = s
-            done += 1
-            _progress(i + 1, n, sections[i], log, done)
+    sections: list[Section | None] = [None] * n
+    finished = [0]
+
+    def on_section(i, f, parts_wall, parts_cpu):
+        try:
+            s = f.result()
+        except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
+            s = Section(analyses[i].title, quick=quick)
+            s.html(
+                f'<p class="fail">This analysis failed in its worker: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>'
+            )
+            s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
+            s.elapsed, s.crashed = 0.0, True
+        s.parts = sum(1 for _ in (analyses[i].parts(quick) if analyses[i].parts else ()))
+        s.elapsed = (s.elapsed or 0.0) + parts_wall
+        s.cpu = (s.cpu or 0.0) + parts_cpu
+        sections[i] = s
+        finished[0] += 1
+        _progress(i + 1, n, s, log, finished[0])
+
+    # spawned workers (no fork of Drake's threads), dying with this process; one pool for the sections and
+    # their parts, the costliest ready task first (ORDER is no guide; COST is), so the workers finish together
+    with worker_pool(jobs) as pool:
+        parts.schedule(pool, analyses, quick, jobs, _build_in_worker, on_section)
     return sections
 
 
