@@ -21,10 +21,10 @@ Before Python installs its own handler (the first milliseconds of the interprete
 default action: the process ends by the signal, also quietly (a shell reports 130).
 """
 
-from __future__ import annotations
-
+# Only modules the interpreter has loaded before it runs any program (``_signal`` is the C module under
+# ``signal``, whose import takes milliseconds, enum included): this module runs first and must be instant.
+import _signal
 import os
-import signal
 import sys
 
 CLI_PID_ENV = "STEWART_DRAKE_CLI_PID"
@@ -76,7 +76,7 @@ def _end_now(signum, frame) -> None:
 
 def _set(handler) -> None:
     try:
-        signal.signal(signal.SIGINT, handler)
+        _signal.signal(_signal.SIGINT, handler)
     except ValueError:  # not the main thread: the main thread's handler stays
         pass
 
@@ -88,12 +88,12 @@ def end_at_once() -> None:
 
 def unwind() -> None:
     """From now on an interrupt raises ``KeyboardInterrupt`` (the command's cleanup runs)."""
-    _set(signal.default_int_handler)
+    _set(_signal.default_int_handler)
 
 
 def ignore() -> None:
     """This process ignores SIGINT (a worker; or the command line once it is ending)."""
-    _set(signal.SIG_IGN)
+    _set(_signal.SIG_IGN)
 
 
 def at_import() -> None:

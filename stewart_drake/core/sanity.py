@@ -10,7 +10,8 @@ Every command calls these checks before it computes or prints anything:
   (``above_base``), unless the platform declares ``plate_below_base_allowed: true``;
 - legs must stay within the stroke along a trajectory (``check_trajectory``: the first offending
   time, leg and amount);
-- dynamics and simulation need the plate's mass properties (``require_plate``);
+- dynamics and simulation need the plate's mass properties (``require_plate``), and the Drake plant a
+  plate that is not negligible against the legs it joins (``require_plant_plate``);
 - a platform must not be singular at its home pose (``check_home``, called when a platform is loaded);
 - user-sized work (grid nodes, samples, steps, rows, iterations) is estimated against a memory and time
   budget before anything is allocated (``check_work``).
@@ -37,6 +38,7 @@ from stewart_drake.errors import (
     NOT_FINITE,
     NOT_POSITIVE,
     OUT_OF_STROKE,
+    PLATE_TOO_LIGHT,
     SERVO_NEUTRAL,
     SINGULAR_HOME,
     WORK_TOO_LARGE,
@@ -256,6 +258,43 @@ def require_plate(platform, command: str) -> None:
     (dynamics, simulation) and the platform has none (a massless plate makes every force 0)."""
     if not has_plate(platform):
         raise GeometryError(NO_PLATE.format(name=platform.name, command=command))
+
+
+# The Drake plant's plate must weigh at least this fraction of the legs' moving mass (six cylinders and
+# pistons). Why: the plate closes the six loops through ball joints that Drake solves as near-rigid
+# constraints, whose compliance is set from the mass they join: with a plate much lighter than the legs, a
+# joint opens by about K·m_legs·h²/m_plate (h the plant step) under the legs' own weight and inertia, which
+# the plate then carries. Measured (utn-dynamic, m_legs 1.8 kg, h = 1 ms, float controller, 1 s): the
+# largest joint gap was 3.0e-8 m at the seed's 1.36 kg, 5.9e-8 m at 10 g, 4.5e-6 m at 0.1 g and 5.0e-4 m
+# at 1 mg and below (the joints open until the plate hangs in them; the Monte Carlo leg error tripled):
+# K ≈ 2.5e-4 m/s². At 1/1000 of the legs' mass the gap is ~0.25 µm at a 1 ms step, a fortieth of the
+# 10 µm sensor count the controller reads; a lighter plate is not the platform any more (a longer plant
+# step opens the joints as h², which ``max_constraint_gap_m`` reports).
+MIN_PLATE_TO_LEGS = 1e-3
+
+
+def legs_moving_mass(platform) -> float:
+    """The six legs' moving mass, kg: cylinders (turning on their base joints) and pistons."""
+    return 6.0 * (float(platform.legs.cylinder_mass) + float(platform.legs.piston_mass))
+
+
+def require_plant_plate(platform, command: str) -> None:
+    """``require_plate``, and ``GeometryError`` when the plate is lighter than ``MIN_PLATE_TO_LEGS`` of the
+    legs' moving mass (the Drake plant's ball joints would open: see ``MIN_PLATE_TO_LEGS``)."""
+    require_plate(platform, command)
+    legs = legs_moving_mass(platform)
+    minimum = MIN_PLATE_TO_LEGS * legs
+    if platform.mass < minimum:
+        raise GeometryError(
+            PLATE_TOO_LIGHT.format(
+                name=platform.name,
+                mass=platform.mass,
+                ratio=MIN_PLATE_TO_LEGS,
+                legs=legs,
+                command=command,
+                minimum=minimum,
+            )
+        )
 
 
 def _collinear(points: np.ndarray, tol: float) -> bool:

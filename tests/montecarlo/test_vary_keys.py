@@ -50,6 +50,7 @@ def test_plate_mass_sets_the_plate_mass():
     "vary, reason",
     [
         ("plate_mass=0kg", r"no plate mass properties"),
+        ("plate_mass=1e-30kg", r"plate's mass 1e-30 kg .*below 0\.001 of the legs' moving mass"),
         ("payload=5kg payload_position=0,0,-10mm", r"below the plate"),
         ("gain_scale=1e9", r"too large for a Q15"),
         ("anchor=±100mm", r"leaves the stroke"),
