@@ -2,10 +2,12 @@
 
 - ``check_workers``: the one rule for ``--workers``/``--jobs`` (each worker is a Python process with
   numpy, ~150 MB; more than 4 per CPU only adds overhead).
-- ``child_setup``: run first in every worker process (``multiprocessing`` pools, Dask workers through
-  ``dask_setup``, the isolated firmware child): the kernel kills it when its parent dies, even by
-  SIGKILL (``PR_SET_PDEATHSIG``), and it ignores SIGINT: Ctrl-C reaches the whole process group, and the
-  parent alone stops the work and says so in one line (no traceback per worker).
+- ``child_setup``: run first in every ``multiprocessing`` pool worker and in the isolated firmware child:
+  the kernel kills it when its parent dies, even by SIGKILL (``PR_SET_PDEATHSIG``), and it ignores SIGINT:
+  Ctrl-C reaches the whole process group, and the parent alone stops the work and says so in one line (no
+  traceback per worker). Dask's worker processes ignore SIGINT from their first import of this package
+  (``mark_cli``; ``dask_sweep.WORKER_CONFIG`` preloads this module) and end within a second of their
+  parent's SIGKILL by themselves (their nanny's pipe closes; measured on a 2-worker study).
 - ``mark_cli``: the command line's PID in the environment (``STEWART_DRAKE_CLI_PID``): a worker process it
   starts (its child) ignores SIGINT from the moment it imports this package (``core.interrupts``), so that
   a Ctrl-C while the worker starts is not a traceback either; ``mark_cli`` returns what restores the
