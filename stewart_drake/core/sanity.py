@@ -110,6 +110,29 @@ def platform_size(platform) -> float:
     return max(platform.L_max, r_base, r_top)
 
 
+def servo_hexapod_size(hexapod) -> float:
+    """A length scale of an RC-servo hexapod (m): the largest of its pivot and anchor radii, arm plus rod, and
+    its home height (the servo counterpart of ``platform_size``)."""
+    r_base = float(np.max(np.linalg.norm(hexapod.base_pivots, axis=1)))
+    r_top = float(np.max(np.linalg.norm(hexapod.platform_anchors, axis=1)))
+    return max(r_base, r_top, hexapod.arm_length + hexapod.rod_length, hexapod.home_height)
+
+
+def check_servo_pose(hexapod, pose, what: str = "--pose") -> None:
+    """``StewartError`` when the position of ``pose`` (6,) (m, rad; finite) lies farther than ``FAR_FACTOR`` ×
+    ``servo_hexapod_size`` from the base centre: a unit mistake, as for a platform (``check_poses``), not a
+    pose to call unreachable with a 150-digit ratio."""
+    size = servo_hexapod_size(hexapod)
+    p = np.asarray(pose, dtype=float)[:3]
+    r = math.hypot(*p)  # no overflow in the squares (inf only where |p| itself is)
+    if r > FAR_FACTOR * size:
+        raise StewartError(
+            FAR_POSITION.format(
+                what=what, pos_m=[float(f"{x:.6g}") for x in p], ratio=r / size, size_m=size, limit=FAR_FACTOR
+            )
+        )
+
+
 def plate_anchor_heights(platform, poses, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` z of each leg's plate anchor in B (m) for ``(..., 6)`` poses."""
     return plate_anchors(platform, poses, convention)[..., 2]
