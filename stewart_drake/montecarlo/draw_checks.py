@@ -18,7 +18,7 @@ from stewart_drake.control import counts_per_lsb
 from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.gains import FixedGains
 from stewart_drake.control.timing import check_timing
-from stewart_drake.core.sanity import check_trajectory, check_work, require_plant_plate
+from stewart_drake.core.sanity import check_positive, check_trajectory, check_work, require_plant_plate
 from stewart_drake.errors import StewartError, StudyError, short_text
 from stewart_drake.montecarlo.scenario import draw, nominal_gains, scenario
 
@@ -40,18 +40,19 @@ def check_draw(study, index: int, reference, duration: float, gains=None, infeas
     ``infeasible(force_limit, period)``: the motion's feasibility (``nominal_feasibility``), or None."""
     seed, d = draw(study, index)
     try:
-        if d.sample_period > 0:  # the run's size before any of it is allocated (a period of 1e-123 s: 1e121 ticks)
-            step = min(d.sample_period, study.plant_step)
-            check_work(
-                "--vary sample_period",
-                f"{d.sample_period:.6g} s",
-                duration / step,
-                f"steps of {step:.6g} s in its {duration:.6g} s",
-                BYTES_PER_STEP,
-                seconds_per=SECONDS_PER_STEP,
-                max_seconds=MAX_RUN_SECONDS,
-                hint="; draw a longer sample_period",
-            )
+        # the period, then the run's size, before any of it is allocated (a period of 1e-123 s: 1e121 ticks)
+        check_positive(d.sample_period, "--vary sample_period", "seconds")
+        step = min(d.sample_period, study.plant_step)
+        check_work(
+            "--vary sample_period",
+            f"{d.sample_period:.6g} s",
+            duration / step,
+            f"steps of {step:.6g} s in its {duration:.6g} s",
+            BYTES_PER_STEP,
+            seconds_per=SECONDS_PER_STEP,
+            max_seconds=MAX_RUN_SECONDS,
+            hint="; draw a longer sample_period",
+        )
         sc = scenario(study, index, reference, gains)[2]
         plant = sc.plant_platform
         require_plant_plate(plant, "montecarlo")
