@@ -22,8 +22,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-# a command that imports pydrake and then runs for several seconds
-SIMULATE = ["simulate", "--platform", "utn-dynamic", "--duration", "2", "--no-progress"]
+# a command that imports pydrake and then runs for a minute (it is always interrupted before it ends)
+SIMULATE = ["simulate", "--platform", "utn-dynamic", "--duration", "60", "--no-progress"]
 DELAYS_S = (0.0, 0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.8, 1.2, 2.5)
 ENTRIES = {
     "module-cli": [sys.executable, "-m", "stewart_drake.cli"],
@@ -69,5 +69,7 @@ def test_ctrl_c_at_any_moment_ends_quietly(tmp_path, entry):
         assert "Traceback" not in err and "KeyboardInterrupt" not in err, where
         assert code == 130, where
         lines = [ln for ln in err.splitlines() if ln.strip()]
-        assert len(lines) == 1 and LINE.fullmatch(lines[0]), where
-    assert list(tmp_path.iterdir()) == []  # nothing written (simulate without --out)
+        assert lines and LINE.fullmatch(lines[-1]), where  # the last line says so
+        # before it, at most the run's own one-line warnings (printed as the run goes)
+        assert all(ln.startswith("stewart-drake simulate: warning: ") for ln in lines[:-1]), where
+    assert list(tmp_path.iterdir()) == []  # nothing written: the run's folder is complete or absent
