@@ -13,12 +13,16 @@ only ``simulate``, ``montecarlo``, ``firmware.check``, ``report``, ``inspect_mod
 Drake.
 """
 
-import importlib
-import os
-import signal
-import sys
-import types
-import typing
+# First, before any other import: Ctrl-C from the first moment (``core.interrupts``): the command line, while
+# it starts, ends at once with one line and status 130; a worker process it started ignores it.
+from stewart_drake.core import interrupts  # isort: skip
+
+interrupts.at_import()
+
+import importlib  # noqa: E402
+import sys  # noqa: E402
+import types  # noqa: E402
+import typing  # noqa: E402
 
 # The same names as _PUBLIC, for type checkers and the docs (at run time each is loaded on first use).
 if typing.TYPE_CHECKING:
@@ -47,12 +51,6 @@ if typing.TYPE_CHECKING:
 
 __version__ = "0.2.0"
 
-# A worker process that the command line started (a spawned pool or Dask worker: it imports this package
-# first): Ctrl-C reaches the whole process group, and the parent alone stops the work and says so in one
-# line. Ignored here, as early as possible, so that a Ctrl-C while the worker starts is no traceback
-# (``core.processes``: the parent sets STEWART_DRAKE_CLI_PID; the worker's setup also dies with it).
-if os.environ.get("STEWART_DRAKE_CLI_PID", str(os.getpid())) != str(os.getpid()):
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 # public name -> (module that defines it, its name there). The module is imported on first use of the name:
 # the Drake-backed names import pydrake at their module top, and the numpy names must work without it.

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 
 from stewart_drake import __version__, commands
-from stewart_drake.core import output_folder, processes
+from stewart_drake.core import interrupts, output_folder, processes
 from stewart_drake.errors import StewartError, UsageError
 
 # Every subcommand: its name -> (its module in ``stewart_drake.commands``, the one-line help that
@@ -175,9 +175,11 @@ def main(argv=None) -> int:
     name = args.command + (f" {args.op}" if getattr(args, "op", None) else "")
     # recorded per file in output manifests: a command replaces only its own outputs
     processes.handle_sigterm()  # SIGTERM unwinds like Ctrl-C: temporaries removed, worker processes stopped
-    processes.mark_cli()  # the worker processes it starts leave Ctrl-C to it
+    restore_environment = processes.mark_cli()  # the worker processes it starts leave Ctrl-C to it
     output_folder.set_command(" ".join(filter(None, (name, getattr(args, "firmware_command", None)))))
     try:
+        if from_shell:  # Ctrl-C now unwinds (the command's cleanup runs); while starting it ended at once
+            interrupts.unwind()
         # Intermediate overflow/NaN in numpy is not reported as a multi-line RuntimeWarning: every result
         # is checked (finite inputs and outputs, strict JSON, the sanity checks) before it is printed.
         with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
@@ -192,6 +194,8 @@ def main(argv=None) -> int:
         print(f"stewart-drake {name}: error: {_os_message(e)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as e:  # Ctrl-C, or SIGTERM (processes.Terminated): cleanup ran, children stopped
+        if from_shell:
+            interrupts.ignore()  # a second Ctrl-C while it says so is no traceback
         term = isinstance(e, processes.Terminated)
         print(f"stewart-drake {name}: {'terminated' if term else 'interrupted'}", file=sys.stderr)
         if from_shell:  # the finally blocks have run; skip the libraries' exit hooks (Dask's half-started
@@ -204,6 +208,10 @@ def main(argv=None) -> int:
             file=sys.stderr,
         )
         return 2
+    finally:
+        restore_environment()
+        if from_shell:  # the command has returned: a Ctrl-C in the exit hooks ends it at once, quietly
+            interrupts.end_at_once()
 
 
 def _one_line(e: BaseException) -> str:

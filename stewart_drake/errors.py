@@ -350,9 +350,12 @@ class OutputError(StewartError):
     NOT_A_FOLDER = "{option} {typed!r}: {part!r} exists and is not a folder"
     SYMLINK = "{option} {typed!r}: is a symbolic link; give the real folder"
     NOT_OURS = (
-        "{option} {typed!r}: the folder {why} (e.g. {example!r}, {count} file(s)); give a new or empty "
-        "folder, or --force to write beside them (files not written by stewart-drake are never touched)"
+        "{option} {typed!r}: the folder {why} (e.g. {example!r}, {count} file(s)); {remedy} "
+        "(files not written by stewart-drake are never touched)"
     )
+    # what the refused command offers instead: its --force (or the API's force=True), else a folder of its own
+    REMEDY_FORCE = "give a new or empty folder, or {force} to write beside them"
+    REMEDY_OWN = "give a new or empty folder, or one that `{command}` wrote itself"
     UNWRITABLE = "{option} {typed!r}: cannot write there ({reason})"
     BAD_PATH = "{option} {typed!r}: not a usable path"
     CLASH = "{option} {typed!r}: {name!r} exists and was not written by stewart-drake; nothing was written"
@@ -368,7 +371,7 @@ class OutputError(StewartError):
     )
     OTHER_COMMAND = (
         "{option} {typed!r}: {name!r} was written by `stewart-drake {other}` ({count} file(s)); `{command}` "
-        "replaces only its own files: give another folder, or --force to write beside them"
+        "replaces only its own files: {remedy}"
     )
 
 
@@ -566,6 +569,11 @@ OUT_OF_STROKE = (
 NO_PLATE = (
     "platform {name!r} has no plate mass properties (YAML key 'plate' missing, or its mass is 0): "
     "'{command}' needs plate.mass and plate.inertia (or plate.thickness and plate.density for a utn platform)"
+)
+PLATE_TOO_LIGHT = (
+    "platform {name!r}: the plate's mass {mass:.6g} kg (plate.mass, or plate.thickness x plate.density) is below "
+    "{ratio:g} of the legs' moving mass {legs:.6g} kg (6 x (legs.cylinder_mass + legs.piston_mass)): the plant's "
+    "ball joints would open instead of carrying the legs; '{command}' needs at least {minimum:.3g} kg"
 )
 SINGULAR_HOME = (
     "platform {name!r} is singular at its home pose (Jacobian condition number {cond:.3g} > {limit:.0e}): {why}"

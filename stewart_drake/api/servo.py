@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
-from stewart_drake.core.sanity import check_finite, check_servo_neutrals
+from stewart_drake.core.sanity import check_finite, check_servo_neutrals, check_servo_pose
 from stewart_drake.core.sdf_models import write_sdf as write_sdf_file
 from stewart_drake.core.servo import load_servo_hexapod, solve
 from stewart_drake.errors import API_POSE_SHAPE, OPTION_SERVO_POSE, ServoPoseError, UsageError
@@ -119,6 +119,7 @@ def solve_servo(platform, pose, *, from_home=False, trim_us=None, write_sdf=None
             raise ServoPoseError(OPTION_SERVO_POSE.format(value=q.tolist()).replace("--pose", what, 1))
     if from_home:
         q[2] += hexapod.home_height
+    check_servo_pose(hexapod, q, what)  # far away: a unit mistake (exit 2), not "unreachable"
     sol = solve(hexapod, q)
     violations = []
     for v in sol.violations():

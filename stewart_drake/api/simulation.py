@@ -29,7 +29,7 @@ from stewart_drake.core.sanity import (
     check_trajectory,
     check_work,
     fmt_value,
-    require_plate,
+    require_plant_plate,
 )
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory
 from stewart_drake.core.unit_hint import other_unit_hint
@@ -144,7 +144,7 @@ def plan_run(
         check_source(firmware, "--firmware")
     time_limit = check_time_limit(time_limit)
     if checks:
-        require_plate(platform, command)
+        require_plant_plate(platform, command)  # the plate carries the legs: not negligible against them
     period = check_positive(period, "--period", "seconds")
     plant_step = plant_step if plant_step is not None else min(period, 1e-3)
     if duration is not None:

@@ -58,7 +58,10 @@ def output_folder(args, option: str = "--out") -> OutputFolder | None:
     """The checked ``--out`` destination (``atomic.OutputFolder``), or None when none was given.
     Call it before any work so that a refused destination costs nothing."""
     value = getattr(args, option.lstrip("-").replace("-", "_"))
-    return None if value is None else OutputFolder(value, force=getattr(args, "force", False), option=option)
+    if value is None:
+        return None
+    offered = "--force" if hasattr(args, "force") else None  # a refusal names --force only where it exists
+    return OutputFolder(value, force=getattr(args, "force", False), option=option, force_option=offered)
 
 
 def print_json(obj) -> None:

@@ -81,7 +81,7 @@ def run(args) -> int:
     reject_unused(args, "--simulate", args.simulate, controller="fixed")
     text = read_program(args.program)
     out = Path(args.out) if args.out else Path("runs") / Path(args.program).stem
-    out_folder = OutputFolder(str(out), force=args.force)
+    out_folder = OutputFolder(str(out), force=args.force, force_option="--force")
     platform = platform_from_args(args)
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise OptionError(OPTION_RUN_RATE.format(value=args.rate))

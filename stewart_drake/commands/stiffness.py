@@ -10,7 +10,7 @@ import numpy as np
 from stewart_drake.api.design import Load, load_at_pose, stiffness_at
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.commands._design import add_payload_args
-from stewart_drake.core.output_folder import atomic_folder
+from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si
 from stewart_drake.design.maps import MAX_POINTS, slice_maps
 from stewart_drake.design.plots import plot_slice_maps
@@ -82,6 +82,8 @@ def load(args, check_pose: bool = True) -> Load:
 
 def run(args) -> int:
     ld = load(args)
+    # the --map folder's policy before the work (a refusal names --map, and what this command offers)
+    maps = None if args.map is None else OutputFolder(args.map, option="--map")
     r = stiffness_at(ld)
     kl, ka = length_scale(args.length_unit), angle_scale(args.angle_unit)
     d = r.deflection  # None when the loaded platform is unstable or the deflection beyond the linear range
@@ -92,8 +94,8 @@ def run(args) -> int:
         "deflection_edge_units": None if d is None else np.r_[d[:3] / kl, d[3:] / ka],
         "limits": r.limits,
     }
-    if args.map:
-        write_maps(args, ld.platform, ld.q, ld.k)
+    if maps is not None:
+        write_maps(args, maps, ld.platform, ld.q, ld.k)
     if args.json:
         print_json(out)
         return _report_limits(r.limits)
@@ -128,8 +130,8 @@ def _report_limits(limits: list[str]) -> int:
     return 1 if limits else 0
 
 
-def write_maps(args, platform, q, k) -> None:
-    """Maps over the x-y slice through pose q, written atomically into ``args.map``."""
+def write_maps(args, folder: OutputFolder, platform, q, k) -> None:
+    """Maps over the x-y slice through pose q, written atomically into ``folder`` (``--map``)."""
     hw = args.map_half_width * length_scale(args.length_unit)
     if not (np.isfinite(hw) and hw > 0):
         raise OptionError(OptionError.POSITIVE_LENGTH.format(option="--map-half-width", value=args.map_half_width))
@@ -147,7 +149,7 @@ def write_maps(args, platform, q, k) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    with atomic_folder(args.map) as tmp:
+    with atomic_folder(folder) as tmp:
         fig = plot_slice_maps(m, args.length_unit)
         fig.savefig(tmp / "maps.png", dpi=110, bbox_inches="tight")
         plt.close(fig)

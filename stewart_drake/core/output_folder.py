@@ -372,7 +372,9 @@ class OutputFolder:
 
     ``typed`` is the path as the user wrote it (used in messages), ``option`` the option's name,
     ``command`` the writing command (default: the CLI's, ``set_command``), ``companions`` the commands
-    whose files this one keeps beside its own without ``--force``.
+    whose files this one keeps beside its own without ``--force``; ``force_option`` how the caller asks
+    for ``force`` (``"--force"``, ``"force=True"``), None when it cannot: a refusal suggests only what the
+    caller offers.
     """
 
     def __init__(
@@ -383,8 +385,9 @@ class OutputFolder:
         option: str = "--out",
         command: str | None = None,
         companions: tuple[str, ...] = (),
+        force_option: str | None = None,
     ):
-        self.typed, self.force, self.option = str(typed), force, option
+        self.typed, self.force, self.option, self.force_option = str(typed), force, option, force_option
         self.command, self.companions = command or _command, tuple(companions)
         if not self.typed or "\0" in self.typed:
             raise OutputError(OutputError.BAD_PATH.format(option=option, typed=self.typed))
@@ -426,6 +429,7 @@ class OutputFolder:
                             other=cmd,
                             command=self.command,
                             count=len(found.other),
+                            remedy=self.remedy(),
                         )
                     )
                 if found.user:
@@ -439,13 +443,24 @@ class OutputFolder:
                     )
                     raise OutputError(
                         OutputError.NOT_OURS.format(
-                            option=option, typed=typed, why=why, example=found.user[0], count=len(found.user)
+                            option=option,
+                            typed=typed,
+                            why=why,
+                            example=found.user[0],
+                            count=len(found.user),
+                            remedy=self.remedy(),
                         )
                     )
             if not os.access(path, os.W_OK | os.X_OK):
                 raise OutputError(OutputError.UNWRITABLE.format(option=option, typed=typed, reason="permission denied"))
         _probe_writable(path, typed, option)
         return found
+
+    def remedy(self) -> str:
+        """What a refusal suggests: the caller's ``force_option``, else a folder this command wrote."""
+        if self.force_option:
+            return OutputError.REMEDY_FORCE.format(force=self.force_option)
+        return OutputError.REMEDY_OWN.format(command=self.command)
 
     @contextmanager
     def writing(self) -> Iterator[Path]:
@@ -586,10 +601,16 @@ def _exchange(a: Path, b: Path) -> bool:
 
 
 @contextmanager
-def atomic_folder(out_dir, *, force: bool = False, command: str | None = None) -> Iterator[Path]:
+def atomic_folder(
+    out_dir, *, force: bool = False, command: str | None = None, force_option: str | None = None
+) -> Iterator[Path]:
     """Check ``out_dir`` against the policy and yield a temporary folder that becomes it on success
     (``OutputFolder(out_dir).writing()``). ``out_dir`` may also be an ``OutputFolder`` already checked."""
-    out = out_dir if isinstance(out_dir, OutputFolder) else OutputFolder(out_dir, force=force, command=command)
+    out = (
+        out_dir
+        if isinstance(out_dir, OutputFolder)
+        else OutputFolder(out_dir, force=force, command=command, force_option=force_option)
+    )
     with out.writing() as tmp:
         yield tmp
 

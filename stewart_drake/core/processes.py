@@ -2,13 +2,16 @@
 
 - ``check_workers``: the one rule for ``--workers``/``--jobs`` (each worker is a Python process with
   numpy, ~150 MB; more than 4 per CPU only adds overhead).
-- ``child_setup``: run first in every worker process (``multiprocessing`` pools, Dask workers through
-  ``dask_setup``, the isolated firmware child): the kernel kills it when its parent dies, even by
-  SIGKILL (``PR_SET_PDEATHSIG``), and it ignores SIGINT: Ctrl-C reaches the whole process group, and the
-  parent alone stops the work and says so in one line (no traceback per worker).
+- ``child_setup``: run first in every ``multiprocessing`` pool worker and in the isolated firmware child:
+  the kernel kills it when its parent dies, even by SIGKILL (``PR_SET_PDEATHSIG``), and it ignores SIGINT:
+  Ctrl-C reaches the whole process group, and the parent alone stops the work and says so in one line (no
+  traceback per worker). Dask's worker processes ignore SIGINT from their first import of this package
+  (``mark_cli``; ``dask_sweep.WORKER_CONFIG`` preloads this module) and end within a second of their
+  parent's SIGKILL by themselves (their nanny's pipe closes; measured on a 2-worker study).
 - ``mark_cli``: the command line's PID in the environment (``STEWART_DRAKE_CLI_PID``): a worker process it
-  starts ignores SIGINT from the moment it imports this package (``stewart_drake/__init__``), so that a
-  Ctrl-C while the worker starts is not a traceback either.
+  starts (its child) ignores SIGINT from the moment it imports this package (``core.interrupts``), so that
+  a Ctrl-C while the worker starts is not a traceback either; ``mark_cli`` returns what restores the
+  environment (a command run in-process must not mark the caller's later children).
 - ``worker_pool``: a spawn ``ProcessPoolExecutor`` whose workers run ``child_setup`` and are terminated,
   not waited for, when the parent is interrupted.
 - ``Terminated`` / ``handle_sigterm``: SIGTERM raises in the main thread like Ctrl-C, so that the
@@ -22,10 +25,11 @@ import multiprocessing
 import os
 import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
+from stewart_drake.core.interrupts import CLI_PID_ENV
 from stewart_drake.core.sanity import check_work
 from stewart_drake.errors import OptionError
 
@@ -96,9 +100,19 @@ def quiet_resource_tracker() -> None:
         sys.warnoptions.append(option)
 
 
-def mark_cli() -> None:
-    """Record this process as the command line that owns the worker processes it starts."""
-    os.environ["STEWART_DRAKE_CLI_PID"] = str(os.getpid())
+def mark_cli() -> Callable[[], None]:
+    """Record this process as the command line that owns the worker processes it starts; return the
+    function that puts the environment back as it was."""
+    before = os.environ.get(CLI_PID_ENV)
+    os.environ[CLI_PID_ENV] = str(os.getpid())
+
+    def restore() -> None:
+        if before is None:
+            os.environ.pop(CLI_PID_ENV, None)
+        else:
+            os.environ[CLI_PID_ENV] = before
+
+    return restore
 
 
 def exit_now(code: int) -> None:

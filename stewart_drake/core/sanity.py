@@ -10,7 +10,8 @@ Every command calls these checks before it computes or prints anything:
   (``above_base``), unless the platform declares ``plate_below_base_allowed: true``;
 - legs must stay within the stroke along a trajectory (``check_trajectory``: the first offending
   time, leg and amount);
-- dynamics and simulation need the plate's mass properties (``require_plate``);
+- dynamics and simulation need the plate's mass properties (``require_plate``), and the Drake plant a
+  plate that is not negligible against the legs it joins (``require_plant_plate``);
 - a platform must not be singular at its home pose (``check_home``, called when a platform is loaded);
 - user-sized work (grid nodes, samples, steps, rows, iterations) is estimated against a memory and time
   budget before anything is allocated (``check_work``).
@@ -37,6 +38,7 @@ from stewart_drake.errors import (
     NOT_FINITE,
     NOT_POSITIVE,
     OUT_OF_STROKE,
+    PLATE_TOO_LIGHT,
     SERVO_NEUTRAL,
     SINGULAR_HOME,
     WORK_TOO_LARGE,
@@ -106,6 +108,29 @@ def platform_size(platform) -> float:
     r_base = float(np.max(np.linalg.norm(platform.base_anchors, axis=1)))
     r_top = float(np.max(np.linalg.norm(platform.top_anchors - platform.rotation_centre, axis=1)))
     return max(platform.L_max, r_base, r_top)
+
+
+def servo_hexapod_size(hexapod) -> float:
+    """A length scale of an RC-servo hexapod (m): the largest of its pivot and anchor radii, arm plus rod, and
+    its home height (the servo counterpart of ``platform_size``)."""
+    r_base = float(np.max(np.linalg.norm(hexapod.base_pivots, axis=1)))
+    r_top = float(np.max(np.linalg.norm(hexapod.platform_anchors, axis=1)))
+    return max(r_base, r_top, hexapod.arm_length + hexapod.rod_length, hexapod.home_height)
+
+
+def check_servo_pose(hexapod, pose, what: str = "--pose") -> None:
+    """``StewartError`` when the position of ``pose`` (6,) (m, rad; finite) lies farther than ``FAR_FACTOR`` ×
+    ``servo_hexapod_size`` from the base centre: a unit mistake, as for a platform (``check_poses``), not a
+    pose to call unreachable with a 150-digit ratio."""
+    size = servo_hexapod_size(hexapod)
+    p = np.asarray(pose, dtype=float)[:3]
+    r = math.hypot(*p)  # no overflow in the squares (inf only where |p| itself is)
+    if r > FAR_FACTOR * size:
+        raise StewartError(
+            FAR_POSITION.format(
+                what=what, pos_m=[float(f"{x:.6g}") for x in p], ratio=r / size, size_m=size, limit=FAR_FACTOR
+            )
+        )
 
 
 def plate_anchor_heights(platform, poses, convention: str = "utn") -> np.ndarray:
@@ -256,6 +281,43 @@ def require_plate(platform, command: str) -> None:
     (dynamics, simulation) and the platform has none (a massless plate makes every force 0)."""
     if not has_plate(platform):
         raise GeometryError(NO_PLATE.format(name=platform.name, command=command))
+
+
+# The Drake plant's plate must weigh at least this fraction of the legs' moving mass (six cylinders and
+# pistons). Why: the plate closes the six loops through ball joints that Drake solves as near-rigid
+# constraints, whose compliance is set from the mass they join: with a plate much lighter than the legs, a
+# joint opens by about K·m_legs·h²/m_plate (h the plant step) under the legs' own weight and inertia, which
+# the plate then carries. Measured (utn-dynamic, m_legs 1.8 kg, h = 1 ms, float controller, 1 s): the
+# largest joint gap was 3.0e-8 m at the seed's 1.36 kg, 5.9e-8 m at 10 g, 4.5e-6 m at 0.1 g and 5.0e-4 m
+# at 1 mg and below (the joints open until the plate hangs in them; the Monte Carlo leg error tripled):
+# K ≈ 2.5e-4 m/s². At 1/1000 of the legs' mass the gap is ~0.25 µm at a 1 ms step, a fortieth of the
+# 10 µm sensor count the controller reads; a lighter plate is not the platform any more (a longer plant
+# step opens the joints as h², which ``max_constraint_gap_m`` reports).
+MIN_PLATE_TO_LEGS = 1e-3
+
+
+def legs_moving_mass(platform) -> float:
+    """The six legs' moving mass, kg: cylinders (turning on their base joints) and pistons."""
+    return 6.0 * (float(platform.legs.cylinder_mass) + float(platform.legs.piston_mass))
+
+
+def require_plant_plate(platform, command: str) -> None:
+    """``require_plate``, and ``GeometryError`` when the plate is lighter than ``MIN_PLATE_TO_LEGS`` of the
+    legs' moving mass (the Drake plant's ball joints would open: see ``MIN_PLATE_TO_LEGS``)."""
+    require_plate(platform, command)
+    legs = legs_moving_mass(platform)
+    minimum = MIN_PLATE_TO_LEGS * legs
+    if platform.mass < minimum:
+        raise GeometryError(
+            PLATE_TOO_LIGHT.format(
+                name=platform.name,
+                mass=platform.mass,
+                ratio=MIN_PLATE_TO_LEGS,
+                legs=legs,
+                command=command,
+                minimum=minimum,
+            )
+        )
 
 
 def _collinear(points: np.ndarray, tol: float) -> bool:

@@ -1,7 +1,7 @@
 """Every drawn scenario of a study passes ``simulate``'s sanity checks before any run starts.
 
 A draw is a platform, a controller and actuators as ``simulate`` would build them from options; a draw that
-``simulate`` would refuse (a massless plate, a zero sensor count, gains that do not fit the firmware's
+``simulate`` would refuse (a massless plate or one negligible against the legs, a zero sensor count, gains that do not fit the firmware's
 words, a period too slow for the plate, a reference that leaves the drawn legs' stroke) is refused here,
 naming the run, its seed and the drawn values of the keys the SPEC varies, instead of running and being
 reported as "lost tracking" among the results.
@@ -13,11 +13,12 @@ import math
 
 import numpy as np
 
+from stewart_drake.api.simulation import BYTES_PER_STEP, MAX_RUN_SECONDS, SECONDS_PER_STEP
 from stewart_drake.control import counts_per_lsb
 from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.gains import FixedGains
 from stewart_drake.control.timing import check_timing
-from stewart_drake.core.sanity import check_trajectory, require_plate
+from stewart_drake.core.sanity import check_positive, check_trajectory, check_work, require_plant_plate
 from stewart_drake.errors import StewartError, StudyError, short_text
 from stewart_drake.montecarlo.scenario import draw, nominal_gains, scenario
 
@@ -39,9 +40,22 @@ def check_draw(study, index: int, reference, duration: float, gains=None, infeas
     ``infeasible(force_limit, period)``: the motion's feasibility (``nominal_feasibility``), or None."""
     seed, d = draw(study, index)
     try:
+        # the period, then the run's size, before any of it is allocated (a period of 1e-123 s: 1e121 ticks)
+        check_positive(d.sample_period, "--vary sample_period", "seconds")
+        step = min(d.sample_period, study.plant_step)
+        check_work(
+            "--vary sample_period",
+            f"{d.sample_period:.6g} s",
+            duration / step,
+            f"steps of {step:.6g} s in its {duration:.6g} s",
+            BYTES_PER_STEP,
+            seconds_per=SECONDS_PER_STEP,
+            max_seconds=MAX_RUN_SECONDS,
+            hint="; draw a longer sample_period",
+        )
         sc = scenario(study, index, reference, gains)[2]
         plant = sc.plant_platform
-        require_plate(plant, "montecarlo")
+        require_plant_plate(plant, "montecarlo")
         timing = sc.config.timing.check()
         if not (math.isfinite(d.force_limit) and d.force_limit > 0):
             raise StewartError(f"force_limit must be a positive number of N, got {d.force_limit:.6g}")

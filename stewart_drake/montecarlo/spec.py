@@ -125,7 +125,7 @@ def _number(text: str, key: str, where: str) -> float:
         v = math.inf
     if not math.isfinite(v):
         raise SpecError(SpecError.NOT_FINITE.format(where=where, key=key, text=text))
-    return v
+    return v + 0.0  # -0 is 0: numpy's uniform refuses a range from 0.0 to -0.0 ('±-0', '0..-0')
 
 
 def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:

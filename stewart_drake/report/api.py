@@ -81,7 +81,11 @@ def report(
     Raises:
         StewartError: a refused output folder, an unknown analysis, ``jobs`` out of range.
     """
-    folder = out if isinstance(out, OutputFolder) else OutputFolder(str(out), force=force, option="--out")
+    folder = (
+        out
+        if isinstance(out, OutputFolder)
+        else OutputFolder(str(out), force=force, option="--out", force_option="force=True")
+    )
     jobs = jobs if jobs is not None else min(4, os.cpu_count() or 1)
     check_workers("--jobs", jobs)  # the one rule for worker counts (core.processes)
     t0 = time.perf_counter()

@@ -50,6 +50,13 @@ def test_plate_mass_sets_the_plate_mass():
     "vary, reason",
     [
         ("plate_mass=0kg", r"no plate mass properties"),
+        ("plate_mass=1e-30kg", r"plate's mass 1e-30 kg .*below 0\.001 of the legs' moving mass"),
+        # found by the spec fuzz at 5000 examples: 1e121 ticks allocated ("Maximum allowed dimension exceeded")
+        (
+            "sample_period=2.9e-123",
+            r"--vary sample_period 2\.9e-123 s would need .* steps.*draw a longer sample_period",
+        ),
+        ("sample_period=-0.015625", r"--vary sample_period must be a positive number of seconds, got -0\.015625"),
         ("payload=5kg payload_position=0,0,-10mm", r"below the plate"),
         ("gain_scale=1e9", r"too large for a Q15"),
         ("anchor=±100mm", r"leaves the stroke"),
