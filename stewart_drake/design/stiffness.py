@@ -78,6 +78,20 @@ def legs_weight_wrench(platform: Platform, q, convention: str = "utn", gravity: 
     return -np.einsum("...ji,...j->...i", A, dF)
 
 
+def geometric_stiffness(u, r, L) -> np.ndarray:
+    """``(..., 6, 6, 6)``: each leg's geometric-stiffness matrix D_i (per unit axial force, the loaded
+    stiffness is K − Σ F_i D_i) from its unit vectors ``u`` (..., 6, 3), plate-anchor arms ``r`` (..., 6, 3) m
+    and lengths ``L`` (..., 6) m."""
+    P = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
+    Sr, Su = skew(r), skew(u)
+    D = np.zeros(u.shape[:-1] + (6, 6))
+    D[..., :3, :3] = P
+    D[..., :3, 3:] = -P @ Sr
+    D[..., 3:, :3] = Sr @ P
+    D[..., 3:, 3:] = Su @ Sr - Sr @ P @ Sr
+    return D
+
+
 def stiffness_matrix(
     platform: Platform, q, k, convention: str = "utn", gravity: float = G_EARTH, legs: bool = False, loaded: bool = True
 ) -> np.ndarray:
@@ -95,14 +109,7 @@ def stiffness_matrix(
     if not loaded:
         return K
     F = static_leg_forces(platform, q, convention, legs, gravity)
-    P = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
-    Sr, Su = skew(r), skew(u)
-    D = np.zeros(u.shape[:-1] + (6, 6))
-    D[..., :3, :3] = P
-    D[..., :3, 3:] = -P @ Sr
-    D[..., 3:, :3] = Sr @ P
-    D[..., 3:, 3:] = Su @ Sr - Sr @ P @ Sr
-    K = K - np.einsum("...k,...kij->...ij", F, D)
+    K = K - np.einsum("...k,...kij->...ij", F, geometric_stiffness(u, r, L))
     r_cm = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     f_g = np.array([0.0, 0.0, -platform.mass * gravity])
     K[..., 3:, 3:] -= skew(np.broadcast_to(f_g, r_cm.shape)) @ skew(r_cm)

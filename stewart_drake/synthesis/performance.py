@@ -63,7 +63,7 @@ from stewart_drake.core.rotations import check_convention, rotation_matrix
 from stewart_drake.design.boxquad import box_quadratic_max
 from stewart_drake.design.envelope import Envelope, envelope_sizing, plate_wrench_terms, spatial_inertia_about_C
 from stewart_drake.design.maps import lowest_frequency
-from stewart_drake.design.stiffness import stiffness_matrix
+from stewart_drake.design.stiffness import geometric_stiffness, stiffness_matrix
 from stewart_drake.errors import StewartError
 from stewart_drake.synthesis.proof import BATCH, COVER_PAD, Cells, initial_cells, rotation_derivatives, split_cells
 
@@ -200,7 +200,7 @@ def performance_bounds(
         widen = slack * stiffness * sig_s[:, 0] ** 2 * _kappa_sym(M_s)
         K_lo = shrink[ok, None, None] * K_c[ok] - (eps_K + widen)[ok, None, None] * I6
         freq[ok] = lowest_frequency(K_lo, M_s[ok] + eps_M[ok, None, None] * I6)
-    K_full = stiffness * np.einsum("nki,nkj->nij", A, A) - np.einsum("nk,nkij->nij", cF, _D(u, r, Lc))
+    K_full = stiffness * np.einsum("nki,nkj->nij", A, A) - np.einsum("nk,nkij->nij", cF, geometric_stiffness(u, r, Lc))
     r_cm = np.einsum("nij,j->ni", R, platform.com - platform.rotation_centre)
     K_full[:, 3:, 3:] -= skew(np.broadcast_to([0.0, 0.0, -m * gravity], r_cm.shape)) @ skew(r_cm)
     freq_c = lowest_frequency(K_full, M_c)
@@ -220,18 +220,6 @@ def _kappa_sym(M) -> np.ndarray:
     """``(n,)`` the 2-norm condition number of symmetric positive definite (n, 6, 6) M."""
     w = np.linalg.eigvalsh(M)
     return w[:, -1] / w[:, 0]
-
-
-def _D(u, r, L) -> np.ndarray:
-    """``(n, 6, 6, 6)`` each leg's geometric-stiffness matrix D_i (``design.stiffness``)."""
-    P = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
-    Sr, Su = skew(r), skew(u)
-    D = np.zeros(u.shape[:-1] + (6, 6))
-    D[..., :3, :3] = P
-    D[..., :3, 3:] = -P @ Sr
-    D[..., 3:, :3] = Sr @ P
-    D[..., 3:, 3:] = Su @ Sr - Sr @ P @ Sr
-    return D
 
 
 def sampled_performance(platform: Platform, poses, v_max, a_max, stiffness: float, convention: str = "utn") -> dict:
