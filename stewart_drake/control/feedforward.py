@@ -11,15 +11,14 @@ is several thousand cycles, more than the IK).
 
 from __future__ import annotations
 
-import hashlib
 import pickle
-from collections import OrderedDict
 
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.memo import Memo, digest
 from stewart_drake.core.trajectory import Trajectory
 
 
@@ -40,43 +39,26 @@ def feedforward_forces(platform: Platform, trajectory: Trajectory, times, lead: 
     qd, qdd = (qp - qm) / (2 * h), (qp - 2 * q0 + qm) / h**2
     if len(t) < 2:
         return leg_forces_with_legs(platform, q0, qd, qdd)
-    return TABLE_CACHE.forces(platform, q0, qd, qdd)
+    return _remembered_forces(platform, q0, qd, qdd)
 
 
-class _TableCache:
-    """The last ``size`` feed-forward tables of this process, keyed by a digest of their inputs (the
-    platform pickled, the poses, rates and accelerations, bit for bit): the runs of a Monte Carlo worker or
-    of a report share the nominal model and the reference, so all but the first reuse the table (about a
-    sixth of a loop's time) instead of recomputing the same inverse dynamics. Same inputs, same function:
-    the same numbers. The tables are read-only."""
+def _remembered_forces(platform: Platform, q, qd, qdd) -> np.ndarray:
+    """``leg_forces_with_legs`` remembered by a digest of its inputs (the platform pickled, the poses, rates and
+    accelerations, bit for bit, in ``TABLE_CACHE``): the runs of a Monte Carlo worker or of a report share the
+    nominal model and the reference, so all but the first reuse the table (about a sixth of a loop's time)
+    instead of recomputing the same inverse dynamics. The tables are read-only."""
+    arrays = [np.ascontiguousarray(a, dtype=float) for a in (q, qd, qdd)]
+    key = digest(pickle.dumps(platform, protocol=5), *(p for a in arrays for p in (repr(a.shape).encode(), a.data)))
 
-    def __init__(self, size: int = 8):
-        self.size = size
-        self._tables: OrderedDict[bytes, np.ndarray] = OrderedDict()
-
-    def forces(self, platform: Platform, q, qd, qdd) -> np.ndarray:
-        digest = hashlib.blake2b(pickle.dumps(platform, protocol=5), digest_size=32)
-        for a in (q, qd, qdd):
-            a = np.ascontiguousarray(a, dtype=float)
-            digest.update(repr(a.shape).encode())
-            digest.update(a.data)
-        key = digest.digest()
-        table = self._tables.get(key)
-        if table is None:
-            table = leg_forces_with_legs(platform, q, qd, qdd)
-            table.flags.writeable = False
-            self._tables[key] = table
-            if len(self._tables) > self.size:
-                self._tables.popitem(last=False)
-        else:
-            self._tables.move_to_end(key)
+    def compute() -> np.ndarray:
+        table = leg_forces_with_legs(platform, q, qd, qdd)
+        table.flags.writeable = False
         return table
 
-    def clear(self) -> None:
-        self._tables.clear()
+    return TABLE_CACHE.get(key, compute)
 
 
-TABLE_CACHE = _TableCache()
+TABLE_CACHE = Memo(8)  # the last 8 feed-forward tables of this process
 
 
 class FeedforwardTable:

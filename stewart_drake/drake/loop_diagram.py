@@ -11,9 +11,7 @@ the plant (its SDF) and builds its own. Not cached with a visualizer (it holds t
 
 from __future__ import annotations
 
-import hashlib
 import pickle
-from collections import OrderedDict
 from dataclasses import dataclass
 
 from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
@@ -21,6 +19,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput
 
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.memo import Memo, digest
 from stewart_drake.drake.integrators import CONTINUOUS
 from stewart_drake.drake.platform_model import build_plant
 from stewart_drake.drake.systems import Actuators
@@ -53,7 +52,8 @@ def loop_diagram(
     cache when one with the same inputs was built in this process and ``meshcat`` is None)."""
     if meshcat is not None:
         return _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat)
-    return DIAGRAM_CACHE.get(plant_platform, plant_time_step, integrator, max_force, time_constant)
+    inputs = (plant_platform, float(plant_time_step), integrator, float(max_force), float(time_constant))
+    return DIAGRAM_CACHE.get(digest(pickle.dumps(inputs, protocol=5)), lambda: _build(*inputs, None))
 
 
 def _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat) -> LoopDiagram:
@@ -79,28 +79,4 @@ def _build(plant_platform, plant_time_step, integrator, max_force, time_constant
     return LoopDiagram(builder.Build(), plant, act, loggers, visualizer)
 
 
-class _DiagramCache:
-    """The last ``size`` loop Diagrams built in this process, keyed by a digest of their inputs."""
-
-    def __init__(self, size: int = 2):
-        self.size = size
-        self._diagrams: OrderedDict[bytes, LoopDiagram] = OrderedDict()
-
-    def get(self, plant_platform, plant_time_step, integrator, max_force, time_constant) -> LoopDiagram:
-        inputs = (plant_platform, float(plant_time_step), integrator, float(max_force), float(time_constant))
-        key = hashlib.blake2b(pickle.dumps(inputs, protocol=5), digest_size=32).digest()
-        built = self._diagrams.get(key)
-        if built is None:
-            built = _build(*inputs, None)
-            self._diagrams[key] = built
-            if len(self._diagrams) > self.size:
-                self._diagrams.popitem(last=False)
-        else:
-            self._diagrams.move_to_end(key)
-        return built
-
-    def clear(self) -> None:
-        self._diagrams.clear()
-
-
-DIAGRAM_CACHE = _DiagramCache()
+DIAGRAM_CACHE = Memo(2)  # the last 2 loop Diagrams built in this process
