@@ -14,13 +14,7 @@ from stewart_drake.calibration.plan import Box, candidate_poses
 from stewart_drake.calibration.validate import truth_errors
 from stewart_drake.cli import main
 from stewart_drake.core.geometry import load_platform, load_preset
-
-
-def cli(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
+from tests.cli._inprocess import cli
 
 
 @pytest.fixture(scope="module")

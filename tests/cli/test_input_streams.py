@@ -12,25 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.cli import main
 from stewart_drake.core.processes import max_workers
 from stewart_drake.core.trajectory import read_trajectory_table
+from tests.cli._inprocess import cli
 
 POSES = "px,py,pz,a,b,g\n0,0,0.7,0,0,0\n0.01,0,0.71,0,0,0\n"
 TRAJ = "t,x,y,z,a,b,c\n0,0,0,0.70,0,0,0\n0.5,0,0,0.71,0,0,0\n1,0,0,0.72,0,0,0\n1.5,0,0,0.71,0,0,0\n"
-
-
-@pytest.fixture
-def here(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
-
-
-def cli(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
 
 
 def pipe_path(text: str) -> str:

@@ -20,29 +20,16 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake.cli import main
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from stewart_drake.errors import OPTION_JOINT_OVERFLOW, OutputError
+from tests.cli._inprocess import cli
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "circle.stw"
 PLATFORM = (
     "utn: {b: 0.4, d: 0.1, a: 0.2}\nstroke: [0.55, 0.95]\nplate: {mass: 1.5, inertia: [0.01, 0.01, 0.02, 0, 0, 0]}\n"
 )
-
-
-def cli(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
-
-
-@pytest.fixture
-def here(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
 
 
 def user_folder(path: Path) -> Path:

@@ -14,25 +14,12 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake.cli import main
 from stewart_drake.errors import StudyError
 from stewart_drake.montecarlo.study import PARTIAL, PartialWriter, load_partial
+from tests.cli._inprocess import cli
 
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = ["montecarlo", "--runs", "2", "--workers", "0", "--duration", "0.2", "--no-progress"]
-
-
-@pytest.fixture
-def here(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
-
-
-def cli(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
 
 
 def test_out_dot_refused_before_any_run(here, capsys):

@@ -13,22 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake.cli import main
 from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, load_manifest
 from stewart_drake.errors import OutputError
-
-
-@pytest.fixture
-def here(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
-
-
-def cli(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
+from tests.cli._inprocess import cli
 
 
 def write(folder, files: dict, command: str, force: bool = False):

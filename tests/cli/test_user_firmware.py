@@ -15,6 +15,7 @@ import pytest
 
 from stewart_drake.cli import main
 from stewart_drake.core import c_build
+from tests.cli._inprocess import cli
 
 pytestmark = pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
 
@@ -63,13 +64,6 @@ def folder(tmp_path_factory):
     (d / "printf.c").write_text(IK + printing + "for (int i = 0; i < 6; i++) l[i] = 0; return 0; }\n")
     (d / "t_loop.c").write_text(WRAP.replace("BODY", "for (;;) { }"))
     return d
-
-
-def cli(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
 
 
 @pytest.mark.parametrize("name", list(FILES))
