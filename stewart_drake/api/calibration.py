@@ -29,13 +29,6 @@ from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.errors import CalibrationError, UsageError
 
 MAX_CANDIDATES = 20_000
-MAX_MEASURED_POSES = 10_000
-GEOMETRIC_KEYS = ("anchor", "leg_offset")
-DEFAULT_ERRORS = ("anchor=±1mm", "leg_offset=±0.5mm")
-NOTE_LEG_OFFSET = (
-    "leg_offset is what each sensor reads beyond the joint-to-joint length (as in montecarlo); "
-    "the true legs.length_offset is the nominal's minus it"
-)
 
 
 # -- calibrate ---------------------------------------------------------------------------------------------------
