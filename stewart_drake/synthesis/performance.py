@@ -66,8 +66,12 @@ from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.stiffness import geometric_stiffness, stiffness_matrix
 from stewart_drake.errors import StewartError
 from stewart_drake.synthesis.proof import BATCH, COVER_PAD, Cells, initial_cells, rotation_derivatives, split_cells
+from stewart_drake.synthesis.verified import U, certified_min_eig, down, gamma, quad_box_max_upper, up
 
-REL_SLACK = 1e-9  # relative widening of each bound for rounding (module docstring)
+EPS_ROT = 64 * U  # ‖R~ − R(c)‖₂ for the computed rotation (module docstring)
+EPS_DROT = 128 * U  # ‖∂R~/∂θ_j − ∂R/∂θ_j(c)‖₂ for the computed derivatives
+FP_W = 2.0**-40  # each computed wrench / inertia entry within FP_W × S_w of its value at R~ (module docstring)
+TWO_PI_UP = float(up(2 * np.pi))  # >= 2π (np.pi < π)
 MAX_CELLS = 200_000
 TIGHTEN_CELLS = 60_000  # cells examined while bounds that meet their limits are still refined (TIGHT)
 TIGHT = 0.1  # bounds within this fraction of the worst centre value seen are tight enough
@@ -102,124 +106,221 @@ def performance_bounds(
 ) -> PerformanceBounds:
     """Rigorous bounds of peak leg force and speed (over ``v_max``/``a_max`` (6,), SI, the envelope's box), lowest
     natural frequency (leg stiffness ``stiffness`` N/m) and scaled condition number on each cell (the module
-    docstring derives them). The plate alone carries mass (legs massless), as the synthesis's evaluation."""
+    docstring derives them, rounding included). The plate alone carries mass (legs massless), as the synthesis's
+    evaluation. A cell whose centre cannot be certified non-singular gets force inf, frequency 0, condition inf."""
     v_max, a_max = np.asarray(v_max, float), np.asarray(a_max, float)
     c = cells.c
     h = cells.h + COVER_PAD * (1.0 + np.abs(c))
     hp, ht = h[:, :3], h[:, 3:]
-    t = platform.top_anchors_per_leg - platform.rotation_centre  # (6, 3)
-    tn = np.linalg.norm(t, axis=1)  # (6,)
+    top, rc, base = platform.top_anchors_per_leg, platform.rotation_centre, platform.base_anchors
+    t = top - rc  # (6, 3)
+    fp_t = 2.0 * U * (np.linalg.norm(top, axis=1) + np.linalg.norm(rc))  # |t~ − t| (6,)
+    tn = up(np.linalg.norm(t, axis=1) + fp_t)  # >= |t| (6,)
     R, dR = rotation_derivatives(c[:, 3:], convention)
     r = np.einsum("nij,lj->nli", R, t)  # (n, 6, 3)
     dr = np.einsum("nkij,lj->nlki", dR, t)  # (n, 6, 3 [k], 3)
-    eps_R = np.sum(ht, 1)  # (n,)
-    taylor = np.einsum("nlk,nk->nl", np.linalg.norm(dr, axis=-1), ht) + 0.5 * tn * eps_R[:, None] ** 2
-    e_r = np.minimum(eps_R[:, None] * tn, taylor)  # (n, 6)
-    l = c[:, None, :3] + r - platform.base_anchors
+    lip = up(np.sum(ht, 1))  # (n,) ‖R(x) − R(c)‖₂
+    eps_R = up(lip + EPS_ROT)  # ‖R(x) − R~‖₂, R~ the computed R(c)
+    taylor = up(
+        np.einsum("nlk,nk->nl", np.linalg.norm(dr, axis=-1) + EPS_DROT * tn[:, None], ht) + 0.5 * tn * lip[:, None] ** 2
+    )
+    e_r = np.minimum(up(lip[:, None] * tn), taylor)  # (n, 6) |r(x) − r(c)|
+    fp_r = up((EPS_ROT + 8 * U) * tn + fp_t)  # (6,) |r~ − r(c)|
+    l = c[:, None, :3] + r - base
     Lc = np.linalg.norm(l, axis=-1)
     u = l / Lc[..., None]
-    e_l = np.linalg.norm(hp, axis=1)[:, None] + e_r
-    with np.errstate(divide="ignore"):
-        e_u = np.minimum(2.0 * e_l / Lc, np.where(Lc > e_l, e_l / (Lc - e_l), 2.0))
-    e_w = e_r + tn * e_u
-    A = np.concatenate([u, np.cross(r, u)], -1)  # (n, 6, 6) J⁻¹ at the centre
+    fp_l = up(fp_r + 3 * U * (np.linalg.norm(c[:, :3], axis=1)[:, None] + tn + np.linalg.norm(base, axis=1)))
+    L_lo = np.maximum(down(down(Lc * (1 - 6 * U)) - fp_l), 0.0)  # <= |l(c)|
+    e_l = up(np.linalg.norm(hp, axis=1)[:, None] + e_r)  # |l(x) − l(c)|
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gap = down(L_lo - e_l)
+        e_u = np.minimum(up(2.0 * e_l / L_lo), np.where(gap > 0, up(e_l / gap), 2.0))  # |u(x) − u(c)|
+        fp_u = np.where(L_lo > 0, up(2.0 * fp_l / L_lo + 8 * U), 2.0)  # |u(c) − u~|
+    e_w = up(e_r + tn * e_u)  # |w(x) − w(c)|, w = r × u
+    fp_w = up(fp_r + tn * fp_u + 5 * U * tn)  # |w(c) − w~|
+    e_u, e_w = up(e_u + fp_u), up(e_w + fp_w)  # from now on: the changes from the computed centre row a~_i
+    A = np.concatenate([u, np.cross(r, u)], -1)  # (n, 6, 6) J⁻¹ at the centre, computed
     s = anchor_radius(platform)
-    Dg = np.r_[np.ones(3), np.full(3, 1.0 / s)]  # the scaling D: A_s = A D
+    Dg = np.r_[np.ones(3), np.full(3, 1.0 / s)]  # the scaling D: A_s = A D (D of these floats)
     As = A * Dg
-    delta_s = np.sqrt(np.sum(e_u**2 + (e_w / s) ** 2, -1))
-    sig_s = np.linalg.svd(As, compute_uv=False)
+    eps_leg = up(np.sqrt(e_u**2 + (e_w * Dg[3]) ** 2) + 2 * U * (1.0 + tn * Dg[3]))  # (n, 6) row changes of A_s
+    d = up(np.sqrt(np.sum(eps_leg**2, -1)))  # ‖A_s(x) − A_s~‖₂ <= ‖·‖_F
+    # singular values of the float A_s~ (exact data from here on): certified bounds of λ(A_s~ᵀA_s~)
+    Gm = np.einsum("nki,nkj->nij", As, As)
+    Gm = 0.5 * (Gm + np.swapaxes(Gm, -1, -2))
+    fro2 = up(np.sum(As**2, axis=(-2, -1)))  # ‖A_s~‖_F²
+    e_G = up(gamma(8) * fro2)  # ‖Gm − A_s~ᵀA_s~‖₂
+    sig_s = np.linalg.svd(As, compute_uv=False)  # trial values only
+    margin = 4.0 * up(e_G + gamma(8) * fro2)
+    lam_lo = certified_min_eig(Gm, e_G, sig_s[:, -1] ** 2 * (1 - 1e-12) - margin)
+    lam_hi = -certified_min_eig(-Gm, e_G, -(sig_s[:, 0] ** 2 * (1 + 1e-12) + margin))
+    sig_lo = np.where(lam_lo > 0, down(np.sqrt(np.maximum(lam_lo, 0.0))), 0.0)
+    sig_hi = np.where(np.isfinite(lam_hi), up(np.sqrt(np.abs(lam_hi))), up(np.sqrt(fro2)))
     with np.errstate(divide="ignore", invalid="ignore"):
         kappa_c = np.where(sig_s[:, -1] > 0, sig_s[:, 0] / sig_s[:, -1], np.inf)
-        slack = REL_SLACK * np.minimum(kappa_c, 1e12)  # (n,) relative rounding widening
-        d = delta_s + slack * sig_s[:, 0]
-        cond = np.where(sig_s[:, -1] > d, (sig_s[:, 0] + d) / (sig_s[:, -1] - d), np.inf)
-        cond_c = kappa_c
-        beta = 1.0 / sig_s[:, -1]
-        regular = beta * d < 1.0
-        dB = np.where(regular, beta**2 * d / np.where(regular, 1.0 - beta * d, 1.0), np.inf)  # ‖ΔA_s⁻ᵀ‖₂
+        invertible = kappa_c < 1e12  # the centre pose itself (its values are a sample, bounds need ``regular``)
+        regular = invertible & (sig_lo > d)  # ‖A_s~⁻¹‖ δ < 1: A_s(x) invertible on the cell
+        den = np.where(regular, down(sig_lo - d), 1.0)  # <= σ_min − δ
+        cond = np.where(regular, up(up(sig_hi + d) / den * (1 + 4 * U)), np.inf)
+        beta = np.where(regular, up(1.0 / np.where(regular, sig_lo, 1.0)), np.inf)  # >= ‖A_s~⁻¹‖₂
+        rel = np.where(regular, up(d / den), np.inf)  # δ/(σ_min − δ)
+        dB = np.where(regular, up(d / down(np.where(regular, sig_lo, 1.0) * den)), np.inf)  # ‖ΔA_s⁻ᵀ‖₂
     # speed
-    vl, va = np.linalg.norm(v_max[:3]), np.linalg.norm(v_max[3:])
+    vl, va = up(np.linalg.norm(v_max[:3])), up(np.linalg.norm(v_max[3:]))
     speed_c = np.abs(A) @ v_max  # (n, 6)
-    speed = (speed_c + e_u * vl + e_w * va) * (1.0 + REL_SLACK)
+    speed = up(speed_c + e_u * vl + e_w * va)
     # force: the exact envelope peak at the centre, plus the orientation's and the Jacobian's changes
-    invertible = kappa_c < 1e12  # the centre pose itself (its values are a sample, bounds need ``regular``)
     Binv = np.linalg.inv(np.where(invertible[:, None, None], As, np.eye(6)))  # row i of A_s⁻ᵀ: column i of A_s⁻¹
+    res = np.einsum("nij,njk->nik", As, Binv) - np.eye(6)
+    rho = up(
+        np.linalg.norm(res, axis=(-2, -1)) * (1 + 2 * U)
+        + gamma(7) * np.sqrt(fro2) * np.linalg.norm(Binv, axis=(-2, -1))
+    )  # >= ‖A_s~ B~ − 1‖₂
+    b_inv = up(beta * rho)  # >= ‖B~ − A_s~⁻¹‖₂
     b_norm = np.linalg.norm(Binv, axis=-2)  # (n, 6)
+    b_hi = up(b_norm + b_inv[:, None])  # >= |row i of A_s~⁻ᵀ|
     rhs = plate_wrench_terms(platform, R, gravity) * Dg[:, None]  # D w: F = A⁻ᵀ w = A_s⁻ᵀ D w
     X = np.einsum("nji,njk->nik", Binv, rhs)
+    # |X − A_s~⁻ᵀ rhs~| <= γ₆ |B~|ᵀ|rhs~| + ‖B~ − A_s~⁻¹‖ |rhs~_k| entrywise, contracted with the envelope's weights
+    # (1, a_max, v_i v_j >= |1|, |acc|, |ω_i ω_j|) for the peak and with column 0 alone for the weight
+    weights = np.r_[1.0, a_max, np.outer(v_max[3:], v_max[3:]).ravel()]  # (16,)
+    rhs_abs = np.abs(rhs)
+    col_norm = np.linalg.norm(rhs, axis=-2)  # (n, 16)
+    Babs = np.abs(Binv)
+    e_P = up(
+        gamma(6) * np.einsum("nji,nj->ni", Babs, rhs_abs @ weights) + (b_inv * (col_norm @ weights))[:, None]
+    )  # (n, 6) the envelope peak's change from X's rounding
+    e_X0 = up(gamma(6) * np.einsum("nji,nj->ni", Babs, rhs_abs[..., 0]) + (b_inv * col_norm[:, 0])[:, None])
     cF, G, Q = X[..., 0], X[..., 1:7], X[..., 7:].reshape(X.shape[:-1] + (3, 3))
     vel = np.flatnonzero(v_max[3:] > 0)
     Qv = Q[..., vel, :][..., :, vel]
-    qmax, _ = box_quadratic_max(Qv, v_max[3:][vel])
+    qmax, _ = box_quadratic_max(Qv, v_max[3:][vel])  # the centre's value (a sample)
     qmin, _ = box_quadratic_max(-Qv, v_max[3:][vel])
     lin = np.abs(G) @ a_max
-    peak_c = np.maximum(cF + lin + qmax, -(cF - lin - qmin))  # (n, 6) exact at the centre
+    peak_c = np.maximum(cF + lin + qmax, -(cF - lin - qmin))  # (n, 6) the centre's value
+    qmax_hi = quad_box_max_upper(Qv, v_max[3:][vel])
+    qmin_hi = quad_box_max_upper(-Qv, v_max[3:][vel])
+    lin_hi = up(lin)
+    peak_hi = up(
+        np.maximum(cF + lin_hi + qmax_hi, -cF + lin_hi + qmin_hi)
+        + gamma(3) * (np.abs(cF) + lin_hi + np.maximum(np.abs(qmax_hi), np.abs(qmin_hi)))
+        + e_P
+    )  # >= the exact envelope peak of A_s~⁻ᵀ D w(R~)
     m = platform.mass
-    cm = np.linalg.norm(platform.com - platform.rotation_centre)
-    In = np.linalg.norm(platform.inertia, 2)
-    al, aa = np.linalg.norm(a_max[:3]), np.linalg.norm(a_max[3:])
-    dr_cm = eps_R * cm  # (n,)
-    dI = 2.0 * eps_R * In
+    c_m = platform.com - rc
+    fp_cm = 2.0 * U * (np.linalg.norm(platform.com) + np.linalg.norm(rc))
+    cm = up(np.linalg.norm(c_m) + fp_cm)
+    In = _sym_norm_upper(platform.inertia)
+    al, aa = up(np.linalg.norm(a_max[:3])), up(np.linalg.norm(a_max[3:]))
+    dr_cm = up(eps_R * cm + fp_cm)  # (n,) |r_cm(x) − R~ c_m~|
+    dI = up(eps_R * In * (2.0 + EPS_ROT))  # ‖R I Rᵀ − R~ I R~ᵀ‖₂
+    dSS = up(m * dr_cm * cm * (2.0 + EPS_ROT))  # m ‖[r]×² − [r~]×²‖₂
     dw_f = m * dr_cm * aa + m * va**2 * dr_cm
-    dw_t = m * gravity * dr_cm + m * dr_cm * al + (dI + 2 * m * cm * dr_cm) * (aa + va**2)
-    dw = np.hypot(dw_f, dw_t / s)  # |D Δw|
-    W = np.hypot(
-        m * (gravity + al + cm * aa + cm * va**2), (m * cm * (gravity + al) + (In + m * cm**2) * (aa + va**2)) / s
+    dw_t = m * gravity * dr_cm + m * dr_cm * al + (dI + dSS) * (aa + va**2)
+    scale_w = max(1.0, Dg[3])
+    e_ent = FP_W * _wrench_scale(platform, gravity) * scale_w  # each computed entry of rhs (module docstring)
+    envelope_weight = up(1.0 + np.sum(a_max) + np.sum(v_max[3:]) ** 2)
+    dw = up(np.hypot(dw_f, dw_t / s) + np.sqrt(6.0) * e_ent * envelope_weight)  # |D Δw|
+    W = up(
+        np.hypot(
+            m * (gravity + al + cm * aa + cm * va**2), (m * cm * (gravity + al) + (In + m * cm**2) * (aa + va**2)) / s
+        )
     )  # |D w|
-    scale_F = np.abs(cF) + lin + np.maximum(np.abs(qmax), np.abs(qmin))
-    # F = A_s(c)⁻ᵀ D w(x) + e with A_s(x)ᵀ e = (A_s(c) − A_s(x))ᵀ A_s(c)⁻ᵀ D w(x): |e| <= δ/(σ_min − δ) |F'|
-    near = peak_c + b_norm * dw[:, None]  # |F'_i| over the cell × envelope
-    rel = np.where(regular, d / np.where(regular, sig_s[:, -1] - d, 1.0), np.inf)  # δ/(σ_min − δ)
-    f_norm = np.minimum(np.linalg.norm(near, axis=-1), beta * W)  # |F'|₂ <= ‖A_s(c)⁻¹‖ |D w| too
-    # leg by leg: (A_s(c) − A_s(x))ᵀ F' = Σ_k F'_k Δa_k, |Δa_k| <= ε_k, and row i of A_s(x)⁻ᵀ is within ΔB of b_i(c)
-    eps_leg = np.sqrt(e_u**2 + (e_w / s) ** 2)  # (n, 6)
-    per_leg = (b_norm + dB[:, None]) * np.sum(near * eps_leg, -1)[:, None]
-    jac = np.minimum(np.minimum(rel * f_norm, dB * W)[:, None], per_leg)
-    force = near + jac + slack[:, None] * scale_F
-    # frequency: K ⪰ k A(c)ᵀA(c) − ε_K 1 and M ⪯ M_C(c) + ε_M 1
-    W_g = m * gravity * np.hypot(1.0, cm / s)
-    near_g = np.abs(cF) + b_norm * (m * gravity * dr_cm / s)[:, None]
-    static = near_g + np.minimum(rel * np.linalg.norm(near_g, axis=-1), dB * W_g)[:, None]  # (n, 6) |F_static| max
-    L_lo = Lc - e_l
+    near = up(peak_hi + b_hi * dw[:, None])  # |F'_i| over the cell × envelope
+    f_norm = np.minimum(up(np.linalg.norm(near, axis=-1)), up(beta * W))  # |F'|₂ <= ‖A_s~⁻¹‖ |D w| too
+    per_leg = up((b_hi + dB[:, None]) * np.sum(near * eps_leg, -1)[:, None])
+    jac = np.minimum(np.minimum(up(rel * f_norm), up(dB * W))[:, None], per_leg)
+    force = up(near + jac)
+    # frequency: K ⪰ K_lo, M ⪯ M_s~ + ε_M 1 (the pencil in y = D⁻¹ v)
+    W_g = up(m * gravity * np.hypot(1.0, cm / s))
+    dw_g = up(m * gravity * dr_cm / s + np.sqrt(6.0) * e_ent)
+    near_g = up(np.abs(cF) + e_X0 + b_hi * dw_g[:, None])
+    static = up(near_g + np.minimum(up(rel * up(np.linalg.norm(near_g, axis=-1))), up(dB * W_g))[:, None])
+    L_x = down(L_lo - e_l)  # |l(x)| >= it
     with np.errstate(divide="ignore", invalid="ignore"):  # ‖D D_i D‖ from its blocks' norms
         D_norm = np.where(
-            L_lo > 0, np.sqrt(1 / L_lo**2 + 2 * (tn / (L_lo * s)) ** 2 + ((tn + tn**2 / L_lo) / s**2) ** 2), np.inf
+            L_x > 0,
+            up(np.sqrt(1 / L_x**2 + 2 * (tn / (L_x * s)) ** 2 + ((tn + tn**2 / L_x) / s**2) ** 2)),
+            np.inf,
         )
-    g_sup = np.sum(static * D_norm, -1) + m * gravity * cm / s**2
-    # the pencil in y = D⁻¹ v: (k A_sᵀA_s − D G D, D M D), the same eigenvalues
-    shrink = np.where(regular, 1.0 - d * beta, 0.0) ** 2  # |A v| >= |A_c v| − δ|v| >= (1 − δ/σ_min) |A_c v|
-    eps_K = g_sup
-    eps_M = np.hypot(np.sqrt(2.0) * m * dr_cm / s, (dI + 2 * m * cm * dr_cm) / s**2)
-    K_c = stiffness * np.einsum("nki,nkj->nij", As, As)
+    g_sup = up(np.sum(static * D_norm, -1) + m * gravity * cm / s**2)
+    one_minus = np.maximum(down(1.0 - up(d * np.where(regular, beta, 0.0))), 0.0)  # <= 1 − δ‖A_s~⁻¹‖
+    shrink = np.where(regular, down(one_minus**2), 0.0)  # (1 − δ/σ_min)²
     M_c = spatial_inertia_about_C(platform, R)
     M_s = M_c * Dg[:, None] * Dg
-    I6 = np.eye(6)
-    ok = np.isfinite(eps_K)
+    eps_M = up(
+        np.hypot(np.sqrt(2.0) * m * dr_cm / s, (dI + dSS) / s**2)
+        + 36.0 * FP_W * _wrench_scale(platform, gravity) * scale_w**2
+    )
     freq = np.zeros(len(c))
+    ok = regular & np.isfinite(g_sup)
     if ok.any():
-        widen = slack * stiffness * sig_s[:, 0] ** 2 * _kappa_sym(M_s)
-        K_lo = shrink[ok, None, None] * K_c[ok] - (eps_K + widen)[ok, None, None] * I6
-        freq[ok] = lowest_frequency(K_lo, M_s[ok] + eps_M[ok, None, None] * I6)
+        freq[ok] = _certified_frequency(stiffness * shrink[ok], Gm[ok], e_G[ok], g_sup[ok], M_s[ok], eps_M[ok])
     K_full = stiffness * np.einsum("nki,nkj->nij", A, A) - np.einsum("nk,nkij->nij", cF, geometric_stiffness(u, r, Lc))
-    r_cm = np.einsum("nij,j->ni", R, platform.com - platform.rotation_centre)
+    r_cm = np.einsum("nij,j->ni", R, c_m)
     K_full[:, 3:, 3:] -= skew(np.broadcast_to([0.0, 0.0, -m * gravity], r_cm.shape)) @ skew(r_cm)
     freq_c = lowest_frequency(K_full, M_c)
     return PerformanceBounds(
         np.where(regular, force.max(-1), np.inf),
         speed.max(-1),
-        np.where(regular, freq, 0.0),
+        freq,
         cond,
         np.where(invertible, peak_c.max(-1), np.inf),
         speed_c.max(-1),
         np.where(invertible, freq_c, 0.0),
-        cond_c,
+        kappa_c,
     )
 
 
-def _kappa_sym(M) -> np.ndarray:
-    """``(n,)`` the 2-norm condition number of symmetric positive definite (n, 6, 6) M."""
-    w = np.linalg.eigvalsh(M)
-    return w[:, -1] / w[:, 0]
+def _certified_frequency(k_shrink, Gm, e_G, eps_K, M_s, eps_M) -> np.ndarray:
+    """``(n,)`` a certified lower bound (Hz) of the pencil (K, M)'s least eigenvalue for every K ⪰ k_shrink A_s~ᵀA_s~
+    − eps_K 1 and M ⪯ M_s + eps_M 1 (``Gm`` the computed A_s~ᵀA_s~, within ``e_G``): λ from the float pencil, a hair
+    lowered, then K_lo − λ (M_s + eps_M 1) ⪰ 0 certified by floating-point Cholesky (module docstring); 0 where the
+    certificate fails or λ <= 0."""
+    n = len(Gm)
+    I6 = np.eye(6)
+    K_lo = k_shrink[:, None, None] * Gm - eps_K[:, None, None] * I6
+    e_K = up(k_shrink * e_G + gamma(3) * (k_shrink * np.linalg.norm(Gm, axis=(-2, -1)) + 3.0 * eps_K))
+    M_hi = M_s + eps_M[:, None, None] * I6
+    lam_f = (2 * np.pi * lowest_frequency(K_lo, M_hi)) ** 2
+    # estimate of λ_min(M_hi), for the trial only: M_s's spectrum does not depend on the orientation (D commutes
+    # with diag(R, R), and M_C(R) = diag(R, R) M_C(1) diag(R, R)ᵀ)
+    mu = np.linalg.eigvalsh(M_s[:1])[0, 0] + eps_M
+    tr = np.abs(np.einsum("nii->n", K_lo)) + lam_f * np.abs(np.einsum("nii->n", M_s))
+    lam = lam_f * (1 - 1e-9) - 4.0 * (e_K + gamma(8) * tr) / mu
+    out = np.zeros(n)
+    pos = lam > 0
+    if not pos.any():
+        return out
+    lam, K_lo, M_s, M_hi = lam[pos], K_lo[pos], M_s[pos], M_hi[pos]
+    Xm = K_lo - lam[:, None, None] * M_s  # the float K_lo − λ M_s
+    abs_err = up(
+        e_K[pos] + gamma(2) * (np.linalg.norm(K_lo, axis=(-2, -1)) + lam * np.linalg.norm(M_s, axis=(-2, -1)))
+    )  # ‖Xm − (K_lo − λ M_s)‖₂, K_lo the exact one
+    need = up(lam * eps_M[pos])  # K_lo − λ M_s ⪰ need·1 gives K_lo − λ M_hi ⪰ 0
+    shift = up(need + 2.0 * (abs_err + gamma(8) * np.abs(np.einsum("nii->n", Xm))))
+    lb = certified_min_eig(Xm, abs_err, shift)
+    good = lb >= need
+    out[np.flatnonzero(pos)[good]] = down(down(np.sqrt(lam[good])) / TWO_PI_UP)
+    return out
+
+
+def _sym_norm_upper(S) -> float:
+    """A rigorous upper bound of ‖S‖₂ for a symmetric positive semidefinite float matrix (the inertia): its largest
+    eigenvalue certified by floating-point Cholesky (``verified.certified_min_eig``), else the Frobenius norm."""
+    S = np.asarray(S, float)
+    w = float(np.linalg.eigvalsh(S)[-1])
+    lb = certified_min_eig(-S[None], 0.0, np.array([-(w * (1 + 1e-9) + 1e-300)]))[0]
+    fro = float(up(np.linalg.norm(S)))
+    return min(float(up(-lb)), fro) if np.isfinite(lb) else fro
+
+
+def _wrench_scale(platform: Platform, gravity: float) -> float:
+    """S_w (module docstring): a bound of the absolute-value expressions of ``plate_wrench_terms``' and
+    ``spatial_inertia_about_C``'s entries."""
+    m = platform.mass
+    cm1 = float(np.sum(np.abs(platform.com - platform.rotation_centre)))
+    return float(16.0 * (m * (1.0 + gravity) * (1.0 + cm1) ** 2 + 9.0 * np.max(np.abs(platform.inertia))))
 
 
 def sampled_performance(platform: Platform, poses, v_max, a_max, stiffness: float, convention: str = "utn") -> dict:
