@@ -152,10 +152,15 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
         a, c, e = q[f0][f0], q[f0][f1], q[f1][f1]
         g0, g1, eg0, eg1 = g[0], g[1], eg[0], eg[1]
         b0, b1 = b[f0], b[f1]
-        ae, cc = a * e, c * c
-        e_det = _up_pos(gamma(2) * (np.abs(ae) + cc))
-        det = ae - cc
-        det_lo, det_hi = down(det - e_det), up(det + e_det)
+        # det = ae − c² nearly exactly: ae = p₁ + e₁, c² = p₂ + e₂ without error (TwoProduct), then
+        # det = (p₁ − p₂) + (e₁ − e₂) with two roundings of at most u each (an exact tie gives det = 0 exactly)
+        p1, e1 = _two_product(a, e)
+        p2, e2 = _two_product(c, c)
+        s1, s2 = p1 - p2, e1 - e2
+        det = s1 + s2
+        e_det = 2.0 * U * (np.abs(s1) + np.abs(s2)) * (1.0 + 4.0 * U)
+        det_lo = np.where(e_det > 0, down(det - e_det), det)
+        det_hi = np.where(e_det > 0, up(det + e_det), det)
         neg = a < 0
         nd = neg & (det_lo > 0)
         undecided = neg & ~nd & (det_hi > 0)
@@ -180,6 +185,21 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
         best = np.where(undecided, np.maximum(best, box), best)
     sym = U * sum(qa[j][k] * (b[j] * b[k]) for j in range(d) for k in range(d))  # the symmetrisation's rounding
     return up(best + sym)
+
+
+def _two_product(a, b):
+    """``(p, e)`` with p = fl(a b) and p + e = a b exactly (Dekker's TwoProduct with Veltkamp's splitting; no
+    overflow: |a|, |b| < 1e150 here)."""
+    p = a * b
+    ah, al = _split(a)
+    bh, bl = _split(b)
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+def _split(a):
+    c = 134217729.0 * a  # 2²⁷ + 1
+    ah = c - (c - a)
+    return ah, a - ah
 
 
 def _up_pos(x):
