@@ -107,7 +107,9 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
     - vertices: the value α, plus γ₁₂ times its absolute-value expression;
     - one free coordinate (a = Q_ff): if a >= 0 (the sign of a float is exact) the maximum is at an end (a vertex);
       else the stationary value α + g²/|a|, skipped when |y*| = |g|/|a| > b_f certainly (with g's error);
-    - two free (d = 3): negative definite when a < 0 and det = ae − c² > 0, det's error bounded by γ₂(|ae| + c²).
+    - two free (d = 3): negative definite when a < 0 and det = ae − c² > 0; det = (p₁ − p₂) + (e₁ − e₂) from the
+      error-free products ae = p₁ + e₁, c² = p₂ + e₂ (Dekker's TwoProduct), within 2u(|p₁ − p₂| + |e₁ − e₂|) (1 + 4u)
+      (an exact tie, such as integer data with det = 0, is decided exactly).
       Certified definite: α + gᵀ(−Q_FF)⁻¹g, the numerator N = −e g₀² + 2c g₀g₁ − a g₁² with γ₅ of its absolute
       expression over a lower bound of det, plus ‖(−Q_FF)⁻¹‖ (2|g||Δg| + |Δg|²) for g's error (‖(−Q_FF)⁻¹‖ <=
       −tr/det, the larger eigenvalue being at most the trace); skipped when y* = (−Q_FF)⁻¹g is certainly outside.
@@ -115,8 +117,8 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
       Undecided: the interval bound α + 2Σ(|g_j| + Δg_j) b_j + 2|c| b₀b₁ + max(e, 0) b₁² (a < 0 there).
 
     Each α and g carries γ₁₂ of its absolute expression; every candidate is widened by ``up``. Taking the largest
-    of upper bounds of each face's maximum bounds the box's maximum. All faces are evaluated at once (one matrix
-    product for the α's, one for the g's)."""
+    of upper bounds of each face's maximum bounds the box's maximum. Vectorised over the batch, a Python loop over
+    the ≤ 13 faces (elementwise arithmetic on the entries: tiny matrix products are slow in BLAS)."""
     Q = np.asarray(Q, dtype=float)
     Q = 0.5 * (Q + np.swapaxes(Q, -1, -2))
     b = np.asarray(b, dtype=float)
