@@ -67,7 +67,7 @@ widening of every bound computed from rigorous operands by 1e-12 relative, above
   with entries <= 1); ``FP_W`` = 2⁻⁴⁰ > 80 γ₁₀₀. Over the envelope D w's error is at most √6 FP_W S_w max(1, 1/s)
   (1 + Σa + (Σv)²), added to |D Δw|; the scaled inertia's to ε_M (36 FP_W S_w max(1, 1/s)²).
 - **Envelope maximum**: the centre's exact envelope peak for the data X is bounded above by |G|·a (rounded up), the
-  quadratic part's maximum over the velocity box by ``verified.quad_box_max_upper`` (every face of the box, its
+  quadratic part's maximum over the velocity box by ``verified.quad_box_max`` (every face of the box, its
   stationary point and definiteness decided with stated error terms, an interval bound where undecided), γ₃ of the
   sum's absolute values, and X's error above.
 - **Pencil**: K_lo~ = fl(shrink k G~ − ε_K 1) is within e_K = shrink k e_G + γ₃(shrink k ‖G~‖_F + 3 ε_K) of the exact
@@ -100,13 +100,12 @@ from stewart_drake.core.dynamics import G_EARTH, skew
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius, condition_number
 from stewart_drake.core.rotations import check_convention, rotation_matrix
-from stewart_drake.design.boxquad import box_quadratic_max
 from stewart_drake.design.envelope import Envelope, envelope_sizing, plate_wrench_terms, spatial_inertia_about_C
 from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.stiffness import geometric_stiffness, stiffness_matrix
 from stewart_drake.errors import StewartError
 from stewart_drake.synthesis.proof import BATCH, COVER_PAD, Cells, initial_cells, rotation_derivatives, split_cells
-from stewart_drake.synthesis.verified import U, certified_min_eig, down, gamma, quad_box_max_upper, up
+from stewart_drake.synthesis.verified import U, certified_min_eig, down, gamma, quad_box_max, up
 
 EPS_ROT = 64 * U  # ‖R~ − R(c)‖₂ for the computed rotation (module docstring)
 EPS_DROT = 128 * U  # ‖∂R~/∂θ_j − ∂R/∂θ_j(c)‖₂ for the computed derivatives
@@ -234,12 +233,10 @@ def performance_bounds(
     cF, G, Q = X[..., 0], X[..., 1:7], X[..., 7:].reshape(X.shape[:-1] + (3, 3))
     vel = np.flatnonzero(v_max[3:] > 0)
     Qv = Q[..., vel, :][..., :, vel]
-    qmax, _ = box_quadratic_max(Qv, v_max[3:][vel])  # the centre's value (a sample)
-    qmin, _ = box_quadratic_max(-Qv, v_max[3:][vel])
+    qmax, qmax_hi = quad_box_max(Qv, v_max[3:][vel])  # the centre's value (a sample) and a rigorous bound
+    qmin, qmin_hi = quad_box_max(-Qv, v_max[3:][vel])
     lin = np.abs(G) @ a_max
     peak_c = np.maximum(cF + lin + qmax, -(cF - lin - qmin))  # (n, 6) the centre's value
-    qmax_hi = quad_box_max_upper(Qv, v_max[3:][vel])
-    qmin_hi = quad_box_max_upper(-Qv, v_max[3:][vel])
     lin_hi = up(lin)
     peak_hi = up(
         np.maximum(cF + lin_hi + qmax_hi, -cF + lin_hi + qmin_hi)

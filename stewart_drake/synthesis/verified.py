@@ -19,7 +19,7 @@ Lemmas (stated here, used there):
   ‖ΔH‖₂ <= γ_{k+1} ‖R‖_F² <= γ_{k+1}/(1 − γ_{k+1}) tr H and H ⪰ −(γ_{k+1}/(1 − γ_{k+1})) tr H · 1. ``certified_min_eig``
   applies it to H = fl(X − s 1): fl(x_jj − s) is within u|H_jj|/(1 − u) of x_jj − s, so
   X ⪰ (s − γ_{k+1}/(1 − γ_{k+1}) tr H − 2u max_j |H_jj|) 1.
-- **Quadratic maximum** (``quad_box_max_upper``): see its docstring.
+- **Quadratic maximum** (``quad_box_max``): see its docstring.
 """
 
 from __future__ import annotations
@@ -96,9 +96,11 @@ def _faces(d: int, b) -> list:
     return out
 
 
-def quad_box_max_upper(Q, b) -> np.ndarray:
-    """``(...)`` a rigorous upper bound of max xᵀQx over |x_j| <= b_j, for float (..., d, d) Q taken as exact data
-    (symmetrised first: fl(½(Q + Qᵀ)) is within u|·| of the exact symmetric part, added) and (d,) b >= 0, d <= 3.
+def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
+    """``(value (...), upper (...))``: max xᵀQx over |x_j| <= b_j for float (..., d, d) Q taken as exact data and
+    (d,) b >= 0, d <= 3; ``value`` the maximum evaluated in floating point (``design.boxquad``'s enumeration: a
+    sample, not a bound), ``upper`` a rigorous upper bound (Q symmetrised first: fl(½(Q + Qᵀ)) is within u|·| of the
+    exact symmetric part, added).
 
     The maximum lies in the relative interior of a face (free set F, the others at x_C = ±b_C) at a local maximum
     of the face's restriction h(y) = α + 2gᵀy + yᵀQ_FF y, α = x_CᵀQ_CC x_C, g = Q_FC x_C (``design.boxquad``'s
@@ -124,8 +126,9 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
     b = np.asarray(b, dtype=float)
     d = b.shape[0]
     if d > 3:
-        raise ValueError("quad_box_max_upper: at most 3 dimensions")
+        raise ValueError("quad_box_max: at most 3 dimensions")
     best = np.zeros(Q.shape[:-2])  # the interior's candidate x = 0
+    value = best.copy()
     q = [[np.ascontiguousarray(Q[..., j, k]) for k in range(d)] for j in range(d)]  # entries as (...) arrays
     qa = [[np.abs(x) for x in row] for row in q]
     g12 = gamma(12)
@@ -137,6 +140,7 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
         alpha_hi = up(alpha + g12 * alpha_abs)
         if not free:
             best = np.maximum(best, alpha_hi)
+            value = np.maximum(value, alpha)
             continue
         g = [sum(q[i][k] * x[k] for k in fixed) for i in free]  # Q_FC x_C
         eg = [_up_pos(g12 * sum(qa[i][k] * b[k] for k in fixed)) for i in free]
@@ -149,6 +153,7 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
             gh = _up_pos(ga + eg[0])
             cand = up(alpha_hi + _up_pos(gh * gh / aa))
             best = np.where(neg & inside, np.maximum(best, cand), best)
+            value = np.where(neg & (ga <= b[f] * aa), np.maximum(value, alpha + ga * ga / aa), value)
             continue
         f0, f1 = free
         a, c, e = q[f0][f0], q[f0][f1], q[f1][f1]
@@ -185,8 +190,12 @@ def quad_box_max_upper(Q, b) -> np.ndarray:
         )
         best = np.where(nd & ~out, np.maximum(best, cand), best)
         best = np.where(undecided, np.maximum(best, box), best)
+        ok = neg & (det > 0)
+        dv = np.where(ok, det, 1.0)
+        ok &= (np.abs(c * g1 - e * g0) <= b0 * dv) & (np.abs(c * g0 - a * g1) <= b1 * dv)
+        value = np.where(ok, np.maximum(value, alpha + (2.0 * cg - e * g00 - a * g11) / dv), value)
     sym = U * sum(qa[j][k] * (b[j] * b[k]) for j in range(d) for k in range(d))  # the symmetrisation's rounding
-    return up(best + sym)
+    return value, up(best + sym)
 
 
 def _two_product(a, b):

@@ -24,7 +24,7 @@ from stewart_drake.synthesis.performance import (
 )
 from stewart_drake.synthesis.proof import Cells, rotation_derivatives
 from stewart_drake.synthesis.requirements import load_requirements
-from stewart_drake.synthesis.verified import U, certified_min_eig, gamma, quad_box_max_upper
+from stewart_drake.synthesis.verified import U, certified_min_eig, gamma, quad_box_max
 
 SEED_001 = resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml"
 X = np.array([0.4237, 0.1567, np.radians(5.737), np.radians(3.179), 0.8729])  # as test_performance
@@ -201,10 +201,10 @@ def test_rotation_rounding_within_the_derived_constants():
 
 
 def test_quadratic_maximum_upper_bound_contains_the_exact_rational_maximum():
-    """``quad_box_max_upper`` against the exact maximum in rationals on 400 quadratic forms: random ones, integer
+    """``quad_box_max`` against the exact maximum in rationals on 400 quadratic forms: random ones, integer
     ones (stationary points exactly on the box's faces, exact ties), and nearly singular free blocks (det of Q_FF
-    a few ulp from 0, where the float decision of definiteness is undecided). Never below the exact maximum, and
-    within 1e-9 of its scale Σ|Q_jk| b_j b_k above it (tight)."""
+    a few ulp from 0, where the float decision of definiteness is undecided). The bound is never below the exact
+    maximum and within 1e-9 of its scale Σ|Q_jk| b_j b_k above it (tight); the float value within 1e-9 of it."""
     rng = np.random.default_rng(12)
     cases = []
     for _ in range(150):
@@ -220,10 +220,11 @@ def test_quadratic_maximum_upper_bound_contains_the_exact_rational_maximum():
     for d in (1, 2):
         cases += [(rng.normal(size=(d, d)), rng.uniform(0.1, 1.0, d)) for _ in range(20)]
     for Q, b in cases:
-        bound = float(quad_box_max_upper(Q[None], b)[0])
+        value, bound = (float(v[0]) for v in quad_box_max(Q[None], b))
         exact = exact_box_max(Q.tolist(), b.tolist())
         scale = float(np.sum(np.abs(Q) * np.outer(b, b)))
         assert Fraction(bound) >= exact, (Q, b)
+        assert abs(value - float(exact)) <= 1e-9 * scale  # the float value: the centre's sample
         assert bound - float(exact) <= 1e-9 * scale, (Q, b, bound, float(exact))
 
 
