@@ -109,16 +109,18 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
     - vertices: the value α, plus γ₁₂ times its absolute-value expression;
     - one free coordinate (a = Q_ff): if a >= 0 (the sign of a float is exact) the maximum is at an end (a vertex);
       else the stationary value α + g²/|a|, skipped when |y*| = |g|/|a| > b_f certainly (with g's error);
-    - two free (d = 3): negative definite when a < 0 and det = ae − c² > 0; det = (p₁ − p₂) + (e₁ − e₂) from the
-      error-free products ae = p₁ + e₁, c² = p₂ + e₂ (Dekker's TwoProduct), within 2u(|p₁ − p₂| + |e₁ − e₂|) (1 + 4u)
-      (an exact tie, such as integer data with det = 0, is decided exactly).
+    - two free (d = 3): negative definite when a < 0 and det = ae − c² > 0; fl(ae − c²) is within γ₂(|ae| + c²);
+      where that leaves the sign undecided, det = (p₁ − p₂) + (e₁ − e₂) from the error-free products ae = p₁ + e₁,
+      c² = p₂ + e₂ (Dekker's TwoProduct), within 2u(|p₁ − p₂| + |e₁ − e₂|)(1 + 4u) (an exact tie, such as integer
+      data with det = 0, is decided exactly).
       Certified definite: α + gᵀ(−Q_FF)⁻¹g, the numerator N = −e g₀² + 2c g₀g₁ − a g₁² with γ₅ of its absolute
       expression over a lower bound of det, plus ‖(−Q_FF)⁻¹‖ (2|g||Δg| + |Δg|²) for g's error (‖(−Q_FF)⁻¹‖ <=
       −tr/det, the larger eigenvalue being at most the trace); skipped when y* = (−Q_FF)⁻¹g is certainly outside.
       Certified not definite (a >= 0 or det <= 0 certainly): the maximum is on the face's boundary (skipped).
       Undecided: the interval bound α + 2Σ(|g_j| + Δg_j) b_j + 2|c| b₀b₁ + max(e, 0) b₁² (a < 0 there).
 
-    Each α and g carries γ₁₂ of its absolute expression; every candidate is widened by ``up``. Taking the largest
+    Each α and g carries γ₁₂ of its absolute expression (bounded by Σ_jk |Q_jk| b_j b_k and Σ_k |Q_ik| b_k); every
+    candidate is widened by ``up``. Taking the largest
     of upper bounds of each face's maximum bounds the box's maximum. Vectorised over the batch, a Python loop over
     the ≤ 13 faces (elementwise arithmetic on the entries: tiny matrix products are slow in BLAS)."""
     Q = np.asarray(Q, dtype=float)
@@ -132,18 +134,23 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
     q = [[np.ascontiguousarray(Q[..., j, k]) for k in range(d)] for j in range(d)]  # entries as (...) arrays
     qa = [[np.abs(x) for x in row] for row in q]
     g12 = gamma(12)
+    # the absolute-value expressions, bounded once for every face: Σ_jk |Q_jk| b_j b_k for the α's, and
+    # Σ_k |Q_ik| b_k for the g's (over all k: more than the fixed ones, by at most γ₁₂ of the box's scale)
+    rows = [sum(qa[i][k] * b[k] for k in range(d)) for i in range(d)]
+    scale = sum(rows[i] * b[i] for i in range(d))
+    e_alpha = _up_pos(g12 * scale)
+    e_row = [_up_pos(g12 * r) for r in rows]
     for p in _faces(d, b):
         free, fixed = [j for j in range(d) if p[j] == 0], [j for j in range(d) if p[j] != 0]
         x = p * b
         alpha = sum(q[j][k] * (x[j] * x[k]) for j in fixed for k in fixed)
-        alpha_abs = sum(qa[j][k] * (b[j] * b[k]) for j in fixed for k in fixed)
-        alpha_hi = up(alpha + g12 * alpha_abs)
+        alpha_hi = up(alpha + e_alpha)
         if not free:
             best = np.maximum(best, alpha_hi)
             value = np.maximum(value, alpha)
             continue
         g = [sum(q[i][k] * x[k] for k in fixed) for i in free]  # Q_FC x_C
-        eg = [_up_pos(g12 * sum(qa[i][k] * b[k] for k in fixed)) for i in free]
+        eg = [e_row[i] for i in free]
         if len(free) == 1:
             (f,) = free
             a, ga = q[f][f], np.abs(g[0])
@@ -159,16 +166,20 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
         a, c, e = q[f0][f0], q[f0][f1], q[f1][f1]
         g0, g1, eg0, eg1 = g[0], g[1], eg[0], eg[1]
         b0, b1 = b[f0], b[f1]
-        # det = ae − c² nearly exactly: ae = p₁ + e₁, c² = p₂ + e₂ without error (TwoProduct), then
-        # det = (p₁ − p₂) + (e₁ − e₂) with two roundings of at most u each (an exact tie gives det = 0 exactly)
-        p1, e1 = _two_product(a, e)
-        p2, e2 = _two_product(c, c)
-        s1, s2 = p1 - p2, e1 - e2
-        det = s1 + s2
-        e_det = 2.0 * U * (np.abs(s1) + np.abs(s2)) * (1.0 + 4.0 * U)
+        ae, cc = a * e, c * c
+        det = ae - cc
+        e_det = gamma(2) * (np.abs(ae) + cc) * (1.0 + 4.0 * U)  # |fl(ae − c²) − (ae − c²)|
+        neg = a < 0
+        if np.any(neg & (np.abs(det) <= e_det)):
+            # the sign undecided somewhere: det nearly exactly, ae = p₁ + e₁, c² = p₂ + e₂ without error
+            # (TwoProduct), det = (p₁ − p₂) + (e₁ − e₂) with two roundings (an exact tie gives det = 0 exactly)
+            p1, e1 = _two_product(a, e)
+            p2, e2 = _two_product(c, c)
+            s1, s2 = p1 - p2, e1 - e2
+            det = s1 + s2
+            e_det = 2.0 * U * (np.abs(s1) + np.abs(s2)) * (1.0 + 4.0 * U)
         det_lo = np.where(e_det > 0, down(det - e_det), det)
         det_hi = np.where(e_det > 0, up(det + e_det), det)
-        neg = a < 0
         nd = neg & (det_lo > 0)
         undecided = neg & ~nd & (det_hi > 0)
         dl, dh = np.where(nd, det_lo, 1.0), np.where(nd, det_hi, 1.0)
@@ -194,8 +205,7 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
         dv = np.where(ok, det, 1.0)
         ok &= (np.abs(c * g1 - e * g0) <= b0 * dv) & (np.abs(c * g0 - a * g1) <= b1 * dv)
         value = np.where(ok, np.maximum(value, alpha + (2.0 * cg - e * g00 - a * g11) / dv), value)
-    sym = U * sum(qa[j][k] * (b[j] * b[k]) for j in range(d) for k in range(d))  # the symmetrisation's rounding
-    return value, up(best + sym)
+    return value, up(best + _up_pos(U * scale))  # and the symmetrisation's rounding over the box
 
 
 def _two_product(a, b):
