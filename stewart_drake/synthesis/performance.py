@@ -45,8 +45,9 @@ widening of every bound computed from rigorous operands by 1e-12 relative, above
 - **Inputs** (the computed centre is taken as the exact data from here on; its distance from the true centre is
   added to the cell's perturbation). numpy's sin and cos are within 4 ulp (8u relative, as ``proof`` assumes); an
   elementary rotation's |R_e| has 2-norm <= √2, so the three factors' errors and the two rounded 3 × 3 products give
-  ‖R~ − R(c)‖₂ <= 3·8√2u(1 + 8√2u)² + γ₃(2 + 2√2) < ``EPS_ROT`` = 64u, and ``EPS_DROT`` = 128u for ∂R/∂θ_j (one more
-  product). t~ = fl(p_TTi − p_TC) is within 2u(|p_TTi| + |p_TC|); r~ = fl(R~ t~) within fp_r = (EPS_ROT + 8u)|t| + that
+  ‖R~ − R(c)‖₂ <= 3·8√2u(1 + 8√2u)² + γ₃(2 + 2√2) < ``EPS_ROT`` = 64u, and ``EPS_DROT`` = 128u for ∂R/∂θ_j and its
+  product with t~ (one more product with a [e]×: 3·8√2u(1 + ...) + γ₃(2 + 2 + 2√2) + γ₃√3 < 64u, doubled), plus the
+  rounded t's error in the Taylor term. t~ = fl(p_TTi − p_TC) is within 2u(|p_TTi| + |p_TC|); r~ = fl(R~ t~) within fp_r = (EPS_ROT + 8u)|t| + that
   of r(c); l~ within fp_l = fp_r + 3u(|p| + |t| + |b_i|) (two additions); |l(c)| >= |l~|(1 − 6u) − fp_l (the norm's
   γ₅); u~ within 2 fp_l/|l(c)| + 8u; fl(r~ × u~) within fp_r + |t| fp_u + 5u|t|; A_s~ = fl(A~ D) within u|·|. These
   are added to e_u and e_w, so δ bounds ‖A_s(x) − A_s~‖₂ and the speed bound holds for the computed rows. ε_R = Σh_θ
@@ -161,7 +162,8 @@ def performance_bounds(
     lip = up(np.sum(ht, 1))  # (n,) ‖R(x) − R(c)‖₂
     eps_R = up(lip + EPS_ROT)  # ‖R(x) − R~‖₂, R~ the computed R(c)
     taylor = up(
-        np.einsum("nlk,nk->nl", np.linalg.norm(dr, axis=-1) + EPS_DROT * tn[:, None], ht) + 0.5 * tn * lip[:, None] ** 2
+        np.einsum("nlk,nk->nl", np.linalg.norm(dr, axis=-1) + (EPS_DROT * tn + fp_t)[:, None], ht)
+        + 0.5 * tn * lip[:, None] ** 2
     )
     e_r = np.minimum(up(lip[:, None] * tn), taylor)  # (n, 6) |r(x) − r(c)|
     fp_r = up((EPS_ROT + 8 * U) * tn + fp_t)  # (6,) |r~ − r(c)|
@@ -292,7 +294,8 @@ def performance_bounds(
     freq = np.zeros(len(c))
     ok = regular & np.isfinite(g_sup)
     if ok.any():
-        freq[ok] = _certified_frequency(stiffness * shrink[ok], Gm[ok], e_G[ok], g_sup[ok], M_s[ok], eps_M[ok])
+        k_lo = down(stiffness * shrink[ok])  # <= k (1 − δβ)²
+        freq[ok] = _certified_frequency(k_lo, Gm[ok], e_G[ok], g_sup[ok], M_s[ok], eps_M[ok])
     K_full = stiffness * np.einsum("nki,nkj->nij", A, A) - np.einsum("nk,nkij->nij", cF, geometric_stiffness(u, r, Lc))
     r_cm = np.einsum("nij,j->ni", R, c_m)
     K_full[:, 3:, 3:] -= skew(np.broadcast_to([0.0, 0.0, -m * gravity], r_cm.shape)) @ skew(r_cm)
