@@ -47,12 +47,12 @@ widening of every bound computed from rigorous operands by 1e-12 relative, above
   elementary rotation's |R_e| has 2-norm <= √2, so the three factors' errors and the two rounded 3 × 3 products give
   ‖R~ − R(c)‖₂ <= 3·8√2u(1 + 8√2u)² + γ₃(2 + 2√2) < ``EPS_ROT`` = 64u, and ``EPS_DROT`` = 128u for ∂R/∂θ_j and its
   product with t~ (one more product with a [e]×: 3·8√2u(1 + ...) + γ₃(2 + 2 + 2√2) + γ₃√3 < 64u, doubled), plus the
-  rounded t's error in the Taylor term. t~ = fl(p_TTi − p_TC) is within 2u(|p_TTi| + |p_TC|); r~ = fl(R~ t~) within fp_r = (EPS_ROT + 8u)|t| + that
-  of r(c); l~ within fp_l = fp_r + 3u(|p| + |t| + |b_i|) (two additions); |l(c)| >= |l~|(1 − 6u) − fp_l (the norm's
-  γ₅); u~ within 2 fp_l/|l(c)| + 8u; fl(r~ × u~) within fp_r + |t| fp_u + 5u|t|; A_s~ = fl(A~ D) within u|·|. These
-  are added to e_u and e_w, so δ bounds ‖A_s(x) − A_s~‖₂ and the speed bound holds for the computed rows. ε_R = Σh_θ
-  + EPS_ROT bounds ‖R(x) − R~‖₂ (‖R~ I R~ᵀ − R I Rᵀ‖ <= ε_R ‖I‖ (2 + EPS_ROT), the same for [r]×²), with the rounded
-  c_m − p_C's 2u(|p_cm| + |p_C|). D holds the floats (1, 1, 1, fl(1/s)): the toolkit's condition number differs by at
+  rounded t's error in the Taylor term. t~ = fl(p_TTi − p_TC) is within 2u(|p_TTi| + |p_TC|); r~ = fl(R~ t~) is
+  within fp_r = (EPS_ROT + 8u)|t| + that of r(c); l~ within fp_l = fp_r + 3u(|p| + |t| + |b_i|) (two additions);
+  |l(c)| >= |l~|(1 − 6u) − fp_l (the norm's γ₅); u~ within 2 fp_l/|l(c)| + 8u; fl(r~ × u~) within fp_r + |t| fp_u
+  + 5u|t|; A_s~ = fl(A~ D) within u|·|. These are added to e_u and e_w, so δ bounds ‖A_s(x) − A_s~‖₂ and the speed
+  bound holds for the computed rows. ε_R = Σh_θ + EPS_ROT bounds ‖R(x) − R~‖₂ (‖R~ I R~ᵀ − R I Rᵀ‖ <= ε_R ‖I‖
+  (2 + EPS_ROT), the same for [r]×²), with the rounded c_m − p_C's 2u(|p_cm| + |p_C|). D holds the floats (1, 1, 1, fl(1/s)): the toolkit's condition number differs by at
   most (1 + u)/(1 − u), covered by a factor 1 + 4u.
 - **Singular values**: G~ = fl(A_s~ᵀA_s~) (symmetrised) is within e_G = γ₈ ‖A_s~‖_F²; Cholesky of G~ − s 1 with s a
   little below the float SVD's σ_min² (by 4 times the rounding terms) certifies λ_min >= s − e_G − the Cholesky
