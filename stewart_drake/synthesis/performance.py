@@ -52,8 +52,8 @@ widening of every bound computed from rigorous operands by 1e-12 relative, above
   |l(c)| >= |l~|(1 − 6u) − fp_l (the norm's γ₅); u~ within 2 fp_l/|l(c)| + 8u; fl(r~ × u~) within fp_r + |t| fp_u
   + 5u|t|; A_s~ = fl(A~ D) within u|·|. These are added to e_u and e_w, so δ bounds ‖A_s(x) − A_s~‖₂ and the speed
   bound holds for the computed rows. ε_R = Σh_θ + EPS_ROT bounds ‖R(x) − R~‖₂ (‖R~ I R~ᵀ − R I Rᵀ‖ <= ε_R ‖I‖
-  (2 + EPS_ROT), the same for [r]×²), with the rounded c_m − p_C's 2u(|p_cm| + |p_C|). D holds the floats (1, 1, 1, fl(1/s)): the toolkit's condition number differs by at
-  most (1 + u)/(1 − u), covered by a factor 1 + 4u.
+  (2 + EPS_ROT), the same for [r]×²), with the rounded c_m − p_C's 2u(|p_cm| + |p_C|). D holds the floats
+  (1, 1, 1, fl(1/s)): the toolkit's condition number differs by at most (1 + u)/(1 − u), covered by a factor 1 + 4u.
 - **Singular values**: G~ = fl(A_s~ᵀA_s~) (symmetrised) is within e_G = γ₈ ‖A_s~‖_F²; Cholesky of G~ − s 1 with s a
   little below the float SVD's σ_min² (by 4 times the rounding terms) certifies λ_min >= s − e_G − the Cholesky
   lemma's terms, and of s' 1 − G~ likewise λ_max (else the Frobenius norm). A centre whose certificate fails (a
