@@ -54,7 +54,7 @@ from stewart_drake.drake.integrators import (
 from stewart_drake.drake.loop_diagram import VISUALIZER_PERIOD, loop_diagram
 from stewart_drake.drake.platform_model import set_pose
 from stewart_drake.drake.systems import make_law
-from stewart_drake.drake.tick_loop import SensorReading, TickLoop, periodic_times
+from stewart_drake.drake.tick_loop import IdealSensor, SensorReading, TickLoop, periodic_times
 from stewart_drake.errors import SimulationError
 
 # ----------------------------------------------------------------------------------------------
@@ -209,8 +209,7 @@ class Simulation:
         ticks = np.arange(int(math.floor(duration / T + 1e-9)) + 1) * T
         poses = self.trajectory.pose(ticks)
         self.controller.reference = np.ascontiguousarray(poses, dtype=float)
-        if hasattr(self.controller.law, "prime"):
-            self.controller.law.prime(poses)
+        self.controller.prime(poses)
         if self.feedforward is not None:
             self.feedforward.prime(ticks)
             self.controller.feedforward = np.array([self.feedforward.table[float(t)] for t in ticks], dtype=float)
@@ -302,7 +301,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         )
     pos = np.array([j.position_start() for j in joints])
     if sensor_model is None:
-        sensor = lambda t, x: x[pos]  # noqa: E731  (the ideal sensor: the prismatic positions)
+        sensor = IdealSensor(pos)  # the prismatic positions
     else:
         vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
         m = sensor_model

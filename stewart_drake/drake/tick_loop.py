@@ -26,28 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.control import dsp_state
+from stewart_drake.control.loop_sensor import IdealSensor, SensorReading
+from stewart_drake.firmware.loop_kernel import make_kernel
 
-
-@dataclass(frozen=True, eq=False)
-class SensorReading:
-    """A leg-length sensor on the plant state ``x``: L + ``offset`` (6, m) + ``noise[k]`` − ``jitter[k]``·dL/dt
-    at tick k = round(t / ``period``) (rows ``(n_ticks, 6)`` m and ``(n_ticks,)`` s, the last row reused
-    beyond the table); ``positions``, ``velocities``: the six prismatic joints' indices in the state."""
-
-    positions: np.ndarray
-    velocities: np.ndarray
-    offset: np.ndarray
-    noise: np.ndarray
-    jitter: np.ndarray
-    period: float
-
-    def __call__(self, t: float, x) -> np.ndarray:
-        k = min(int(round(t / self.period)), len(self.jitter) - 1)
-        return x[self.positions] + self.offset + self.noise[k] - self.jitter[k] * x[self.velocities]
-
-    def initial_reading(self, L):
-        """The reading of true lengths ``L`` (6, m) at rest before t = 0: L + offset."""
-        return np.asarray(L, float) + self.offset
+__all__ = ["IdealSensor", "SensorReading", "TickLoop", "periodic_times", "schedule"]
 
 
 @dataclass(frozen=True)
@@ -117,6 +99,16 @@ class TickLoop:
         self.reference = self.feedforward = None
         root = simulator.get_mutable_context()
         self._fixed = command_input.FixValue(root, np.zeros(6))
+        # the compiled DSP side (one C call per stop), None: the Python loop below (``firmware.loop_kernel``)
+        self.kernel = make_kernel(law, sensor)
+
+    def prime(self, poses) -> None:
+        """The law's tables for the reference ``(n_ticks, 6)`` poses of the ticks 0, 1, … (one batch; speed
+        only): the compiled kernel's set-points or pose words, else the law's own ``prime``."""
+        if self.kernel is not None:
+            self.kernel.tables(poses)
+        elif hasattr(self.law, "prime"):
+            self.law.prime(poses)
 
     def initialize(self, lengths, hold_forces=None, feedforward=None, rates=None) -> None:
         """The controller's state as if it had been holding ``lengths`` (``dsp_state.initial_state``)."""
@@ -137,6 +129,8 @@ class TickLoop:
         T = self.timing.sample_period
         delay = None if self.at_tick else self.timing.output_delay
         s = schedule(duration, self.step, T, delay, self.discrete, boundaries)
+        if self.kernel is not None:
+            return self._run_kernel(duration, s, on_boundary)
         n = 1 + sum(s.log)
         held_log, status_log = np.empty((n, 12)), np.empty((n, len(self.status)))
         ref, ff = self.reference, self.feedforward
@@ -195,3 +189,89 @@ class TickLoop:
         return logs
 
     _input_held = None
+
+    def _views(self):
+        """Numpy views of the plant state and of the command input where Drake keeps them (no copies):
+        the plant context's continuous (or, for a discrete plant, discrete) state vector — positions then
+        velocities, ``GetPositionsAndVelocities``'s layout — and the fixed input's vector. Drake writes a
+        step's result into the same memory, so the views hold for the run (``tests/drake/test_tick_loop.py``)."""
+        pc = self.plant_context
+        state = pc.get_discrete_state(0) if self.discrete else pc.get_continuous_state_vector()
+        x = state.get_value()
+        if x.shape != (self.plant.num_multibody_states(),):  # a plant with other state: not this loop's
+            raise RuntimeError(f"plant state of {x.shape} values, {self.plant.num_multibody_states()} expected")
+        return x, self._fixed.GetMutableData().get_mutable_value().get_mutable_value()
+
+    def _run_kernel(self, duration: float, s: Schedule, on_boundary) -> dict:
+        """``run`` with the compiled DSP side (``firmware.loop_kernel``): per stop one ``AdvanceTo`` and one C
+        call (log, tick or release, the command written in Drake's memory), and Drake told of a new command
+        (``GetMutableData``) only when it changed. The stops that need Python — a boundary with a callback,
+        a discrete plant's step before its tick — split the call in two around it."""
+        n = 1 + sum(s.log)
+        logs = {"held": np.empty((n, 12)), "status": np.empty((n, len(self.status)))}
+        if self.discrete:
+            logs["x"] = np.empty((n, self.plant.num_multibody_states()))
+            force_log = np.empty((n, 6))
+            force_port, force_context = self.force
+        x, command = self._views()
+        kern, after = self.kernel, self.input_after_update or self.discrete
+        kern.start(x, command, s, self.feedforward, self.held, self.memory, self.status, self.at_tick, after, logs)
+        notify, advance, stop = self._fixed.GetMutableData, self.simulator.AdvanceTo, kern.stop
+        times, last = s.times, len(s.times) - 1
+        split = {i for i in range(len(times)) if s.boundary[i] and on_boundary is not None}
+        half = {}
+        if self.discrete:
+            steps = set(periodic_times(0.0, self.step, duration).tolist()) | {0.0}
+            half = {
+                i: 0.5 * (times[i] + times[i + 1])
+                for i in range(last)
+                if (s.tick[i] >= 0 or s.release[i]) and times[i] in steps
+            }
+            split = set(range(len(times)))  # the forces are logged by Drake's port at every stop
+            if 0.0 in steps:  # the tick at t = 0 after the plant's step at 0
+                half[-1] = 0.5 * times[0]
+        kern.log(kern.s, -1)
+        if self.discrete:
+            force_log[0] = force_port.Eval(force_context)
+        if -1 in half:
+            advance(half[-1])
+        self._kernel_update(-1)
+        for i in range(last):
+            advance(times[i])
+            if i in split:
+                kern.log(kern.s, i)
+                if self.discrete:
+                    force_log[kern.s.row - 1] = force_port.Eval(force_context)
+                if s.boundary[i] and on_boundary is not None:
+                    on_boundary(times[i])
+                if i in half:
+                    advance(half[i])
+                self._kernel_update(i)
+            else:
+                r = stop(kern.s, i)
+                if r:
+                    if r < 0:
+                        kern.raise_error(r)
+                    notify()
+        advance(times[last])  # the updates at the end time are not run (Drake's AdvanceTo stops before them)
+        kern.log(kern.s, last)
+        if self.discrete:
+            force_log[kern.s.row - 1] = force_port.Eval(force_context)
+        if s.boundary[last] and on_boundary is not None:
+            on_boundary(times[last])
+        if kern.s.row != n:
+            raise RuntimeError(f"the loop logged {kern.s.row} rows of {n}")  # a bug
+        self.held, self.memory, self.status = kern.state()
+        held = logs["held"]
+        out = {"command": held[:, :6], "setpoint": held[:, 6:], "status": logs["status"]}
+        if self.discrete:
+            t = np.array([0.0] + [t for t, logged in zip(times, s.log) if logged])
+            out |= {"times": t, "state": logs["x"], "force": force_log}
+        return out
+
+    def _kernel_update(self, i: int) -> None:
+        r = self.kernel.update(self.kernel.s, i)
+        if r < 0:
+            self.kernel.raise_error(r)
+        if r:
+            self._fixed.GetMutableData()
