@@ -32,7 +32,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import SQRT3, Platform
-from stewart_drake.core.kinematics import length_jacobian, scaled_condition
+from stewart_drake.core.kinematics import condition_at_most, length_jacobian, scaled_condition
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
 from stewart_drake.errors import SINGULAR_SAMPLE, SingularPoseError, counted
@@ -276,10 +276,10 @@ def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.nd
     """``(..., 6)`` F (N) with Jᵀ(q) F = Q; raises ``SingularPoseError`` naming the first sample whose J
     has a scaled condition number above ``MAX_CONDITION``."""
     J = length_jacobian(platform, q, convention)
-    k = scaled_condition(platform, J)
-    idx = first_index(~(k <= MAX_CONDITION))
+    idx = first_index(~condition_at_most(platform, J, MAX_CONDITION))
     if idx is not None:
-        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=float(k[idx]), limit=MAX_CONDITION))
+        k = scaled_condition(platform, J[idx])
+        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=float(k), limit=MAX_CONDITION))
     Q = np.broadcast_to(Q, J.shape[:-1])
     return np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
 

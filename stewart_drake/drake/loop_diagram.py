@@ -1,6 +1,7 @@
 """The closed loop's Diagram: what runs in C++ between the controller's ticks — the plant (with its scene
-graph), the actuators (saturation and lag) with their command as the Diagram's input ``command``, the
-continuous plant's loggers and, for an animation, the Meshcat visualizer.
+graph), the actuators (saturation and lag) with their command as the Diagram's input ``command`` and, for an
+animation, the Meshcat visualizer. No loggers: the loop stops at every plant step and logs the plant state
+and the actuators' force itself (``tick_loop.TickLoop``), as the loggers did, without their events.
 
 Built once per structure and reused (``DIAGRAM_CACHE``): a Diagram holds no state (every run has its own
 context and Simulator), so the runs of a process whose plant platform, plant step, integrator and actuators
@@ -16,7 +17,6 @@ from dataclasses import dataclass
 
 from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.memo import Memo, digest
@@ -29,13 +29,11 @@ VISUALIZER_PERIOD = 1 / 32  # s: the Meshcat animation's frame period
 
 @dataclass(frozen=True)
 class LoopDiagram:
-    """A built loop Diagram: ``diagram``, its ``plant`` and ``actuators``, ``loggers`` (``state``, ``force``:
-    the continuous plant's, empty for a discrete plant whose loop logs itself) and ``visualizer`` (or None)."""
+    """A built loop Diagram: ``diagram``, its ``plant`` and ``actuators`` and ``visualizer`` (or None)."""
 
     diagram: object
     plant: object
     actuators: object
-    loggers: dict
     visualizer: object = None
 
 
@@ -63,20 +61,12 @@ def _build(plant_platform, plant_time_step, integrator, max_force, time_constant
     act.set_name("actuators")
     builder.ExportInput(act.get_input_port(), "command")
     builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
-    # the continuous plant logs at its step (not at every integrator step); the discrete one at every
-    # simulator step, by the loop (``tick_loop.TickLoop``)
-    loggers = {}
-    if integrator in CONTINUOUS:
-        loggers = {
-            "state": LogVectorOutput(plant.get_state_output_port(), builder, plant_time_step),
-            "force": LogVectorOutput(act.get_output_port(), builder, plant_time_step),
-        }
     visualizer = None
     if meshcat is not None:
         visualizer = MeshcatVisualizer.AddToBuilder(
             builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=VISUALIZER_PERIOD)
         )
-    return LoopDiagram(builder.Build(), plant, act, loggers, visualizer)
+    return LoopDiagram(builder.Build(), plant, act, visualizer)
 
 
 DIAGRAM_CACHE = Memo(2)  # the last 2 loop Diagrams built in this process

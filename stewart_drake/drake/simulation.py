@@ -145,8 +145,8 @@ def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: 
 class Simulation:
     """A built controller-in-the-loop Diagram and the loop that drives it, ready to run (see
     ``build_simulation``). ``controller``: the ``tick_loop.TickLoop`` (its ``law``, its tables
-    ``reference`` and ``feedforward`` once ``prepare`` has filled them); ``loggers``: the plant's
-    ``state`` and the actuators' ``force`` (Drake loggers)."""
+    ``reference`` and ``feedforward`` once ``prepare`` has filled them; it logs the plant's state and the
+    actuators' force at every plant step)."""
 
     platform: Platform
     trajectory: Trajectory
@@ -155,7 +155,6 @@ class Simulation:
     diagram: object
     plant: object
     controller: TickLoop
-    loggers: dict
     simulator: object = None
     meshcat: object = None
     visualizer: object = None
@@ -211,14 +210,11 @@ class Simulation:
         self.controller.reference = np.ascontiguousarray(poses, dtype=float)
         self.controller.prime(poses)
         if self.feedforward is not None:
-            self.feedforward.prime(ticks)
-            self.controller.feedforward = np.array([self.feedforward.table[float(t)] for t in ticks], dtype=float)
+            self.controller.feedforward = self.feedforward.prime(ticks)  # the rows of the ticks, in order
 
     def states(self) -> np.ndarray:
         """``(n, nx)`` the plant states logged by the run (``plant.get_state_output_port()``'s layout)."""
-        if "state" in self._logs:
-            return self._logs["state"]
-        return self.loggers["state"].FindLog(self.simulator.get_context()).data().T
+        return self._logs["state"]
 
     def max_constraint_gap(self, samples: int = 1000) -> float:
         """The largest ball-constraint gap (m) of this run: how far the loop closures opened, over up to
@@ -229,12 +225,8 @@ class Simulation:
         return float(constraint_gaps(self.plant, X[idx]).max())
 
     def _collect(self, duration: float) -> SimulationLog:
-        logs, ctx = self._logs, self.simulator.get_context()
-        if "state" in logs:  # a discrete plant: logged at every simulator step by the loop
-            t, X, force = logs["times"], logs["state"], logs["force"]
-        else:
-            t = self.loggers["state"].FindLog(ctx).sample_times().copy()
-            X, force = self.states(), self.loggers["force"].FindLog(ctx).data().T.copy()
+        logs = self._logs
+        t, X, force = logs["times"], logs["state"], logs["force"]
         top = self.plant.GetBodyByName("top")
         i0 = top.floating_positions_start()
         quat = X[:, i0 : i0 + 4]
@@ -245,8 +237,6 @@ class Simulation:
         pose = np.concatenate([p_WC, angles], axis=1)
         joints = [self.plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
         L = X[:, [j.position_start() for j in joints]]
-        if len(logs["status"]) != len(t):  # the loop's stops are the Diagram's steps: a bug otherwise
-            raise RuntimeError(f"controller logs {len(logs['status'])} rows, plant logs {len(t)}")
         T = self.config.timing.sample_period
         t_ref = periodic_times(0.0, T, duration)  # the reference at the ticks 0 … k·T <= duration
         return SimulationLog(
@@ -289,7 +279,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     max_force = actuators.max_force or float(platform.legs.max_force)
     # the plant and actuators: reused from an earlier run of this process with the same ones (``loop_diagram``)
     built = loop_diagram(plant_platform, plant_time_step, integrator, max_force, actuators.time_constant, meshcat)
-    diagram, plant, act, loggers = built.diagram, built.plant, built.actuators, built.loggers
+    diagram, plant, act = built.diagram, built.plant, built.actuators
     joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
     sensor_model = s.sensor
     if np.any(plant_platform.length_offset):  # a sensor reads the joint-to-joint length − legs.length_offset
@@ -325,8 +315,10 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
     # a continuous plant without the actuators' lag integrates with the command released at a tick
     after = integrator in CONTINUOUS and act.lag is None
-    force = None if loggers else (act.get_output_port(), act.GetMyContextFromRoot(root))
-    loop = TickLoop(simulator, plant, pc, diagram.GetInputPort("command"), law, sensor, plant_time_step, after, force)
+    discrete = integrator not in CONTINUOUS
+    loop = TickLoop(
+        simulator, plant, pc, diagram.GetInputPort("command"), law, sensor, plant_time_step, after, act, discrete
+    )
     loop.reference = trajectory.pose(np.zeros(1))  # until ``run`` fills the tables: the pose at t = 0
     loop.initialize(L0, F0, None if ff is None else ff.force(0.0), rates0)
     act.set_force(root, F0)
@@ -339,7 +331,6 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         diagram,
         plant,
         loop,
-        loggers,
         simulator,
         meshcat,
         built.visualizer,

@@ -64,15 +64,17 @@ def schedule(
     releases = periodic_times(delay, period, duration) if delay is not None else np.zeros(0)
     extra = np.asarray([t for t in extra if 0 < t <= duration], dtype=float)
     times = np.unique(np.concatenate([steps, ticks, releases, extra, [duration]]))
-    tick_of = {float(t): int(k) for k, t in zip(np.round(ticks / period).astype(int), ticks)}
-    steps_set, release_set, extra_set = set(steps.tolist()), set(releases.tolist()), set(extra.tolist())
-    tl = times.tolist()
+    # membership by exact equality, as Drake's event times and these are the same doubles (numpy, no
+    # Python per stop: a run has a stop per plant step)
+    log = np.ones(len(times), dtype=bool) if log_every_stop else np.isin(times, steps)
+    tick = np.full(len(times), -1, dtype=np.int64)
+    tick[np.searchsorted(times, ticks)] = np.round(ticks / period).astype(np.int64)
     return Schedule(
-        tl,
-        [log_every_stop or t in steps_set for t in tl],
-        [tick_of.get(t, -1) for t in tl],
-        [t in release_set for t in tl],
-        [t in extra_set for t in tl],
+        times.tolist(),
+        log.tolist(),
+        tick.tolist(),
+        np.isin(times, releases).tolist(),
+        np.isin(times, extra).tolist(),
     )
 
 
@@ -83,22 +85,24 @@ class TickLoop:
     the actuators' command input port of the Diagram (fixed here); ``law``: the control law;
     ``sensor``: ``(t, x) -> (6,)`` readings of the plant state ``x``; ``step`` (s): the plant step;
     ``input_after_update``: the plant integrates with the command released at a stop (continuous plant,
-    no actuator lag) rather than the actuators sampling the command held before it; ``force``: for a
-    discrete plant, ``(port, context)`` of the actuators' force, logged here with the plant state at
-    every stop (a discrete plant's per-step logs; the continuous plant's are Drake loggers)."""
+    no actuator lag) rather than the actuators sampling the command held before it; ``actuators``: the
+    Diagram's ``systems.Actuators``, whose force is logged here with the plant state at every plant step
+    (the Diagram has no loggers); ``discrete``: the plant is discrete (it logs at every stop)."""
 
-    def __init__(self, simulator, plant, plant_context, command_input, law, sensor, step, input_after_update, force):
+    def __init__(
+        self, simulator, plant, plant_context, command_input, law, sensor, step, input_after_update, actuators, discrete
+    ):
         self.simulator, self.plant, self.plant_context = simulator, plant, plant_context
         self.law, self.sensor, self.step = law, sensor, step
         self.timing = law.timing
         self.at_tick = dsp_state.releases_at_tick(self.timing)
         self.input_after_update = input_after_update
-        self.force = force
-        self.discrete = force is not None
+        self.actuators, self.discrete = actuators, discrete
         self.held = self.memory = self.status = None
         self.reference = self.feedforward = None
         root = simulator.get_mutable_context()
         self._fixed = command_input.FixValue(root, np.zeros(6))
+        self.force = (actuators.get_output_port(), actuators.GetMyContextFromRoot(root))
         # the compiled DSP side (one C call per stop), None: the Python loop below (``firmware.loop_kernel``)
         self.kernel = make_kernel(law, sensor)
 
@@ -123,16 +127,34 @@ class TickLoop:
 
     def run(self, duration: float, boundaries=(), on_boundary=None) -> dict:
         """Advance from t = 0 to ``duration`` s; ``on_boundary(t)`` is called at each of ``boundaries``.
-        Returns the logs at the plant loggers' times (the held values, before the updates at each time):
-        ``command`` (n, 6) N, ``setpoint`` (n, 6) m, ``status`` (n, len(STATUS)); for a discrete plant
-        also ``state`` (n, nx) and ``force`` (n, 6) N."""
+        Returns the logs at the plant steps (every stop of a discrete plant), each the values before the
+        updates at that time: ``times`` (n,) s, ``command`` (n, 6) N, ``setpoint`` (n, 6) m, ``status``
+        (n, len(STATUS)), ``state`` (n, nx) and ``force`` (n, 6) N."""
         T = self.timing.sample_period
         delay = None if self.at_tick else self.timing.output_delay
         s = schedule(duration, self.step, T, delay, self.discrete, boundaries)
-        if self.kernel is not None:
-            return self._run_kernel(duration, s, on_boundary)
+        logs = (
+            self._run_kernel(duration, s, on_boundary)
+            if self.kernel is not None
+            else self._run_python(duration, s, on_boundary)
+        )
+        held = logs.pop("held")
+        times = np.array([0.0] + [t for t, logged in zip(s.times, s.log) if logged])
+        return logs | {"times": times, "command": held[:, :6], "setpoint": held[:, 6:]}
+
+    def _log_arrays(self, s: Schedule) -> dict:
         n = 1 + sum(s.log)
-        held_log, status_log = np.empty((n, 12)), np.empty((n, len(self.status)))
+        return {
+            "held": np.empty((n, 12)),
+            "status": np.empty((n, len(self.status))),
+            "state": np.empty((n, self.plant.num_multibody_states())),
+            "force": np.empty((n, 6)),
+        }
+
+    def _run_python(self, duration: float, s: Schedule, on_boundary) -> dict:
+        """``run`` in Python: the reference and the fallback of the compiled kernel (``_run_kernel``)."""
+        logs = self._log_arrays(s)
+        held_log, status_log, x_log, force_log = logs["held"], logs["status"], logs["state"], logs["force"]
         ref, ff = self.reference, self.feedforward
         law, at_tick, sensor = self.law, self.at_tick, self.sensor
         # which command the Diagram reads until the next stop: the one held before this stop's updates
@@ -140,14 +162,13 @@ class TickLoop:
         # without lag integrates with it; a discrete plant has already stepped, see below)
         after = self.input_after_update or self.discrete
         pc, get_x = self.plant_context, self.plant.GetPositionsAndVelocities
+        force_port, force_context = self.force
         advance = self.simulator.AdvanceTo
         held, memory, status = self.held, self.memory, self.status
         if self.discrete:
-            x_log, force_log = np.empty((n, self.plant.num_multibody_states())), np.empty((n, 6))
-            force_port, force_context = self.force
-            x_log[0], force_log[0] = get_x(pc), force_port.Eval(force_context)
             steps = set(periodic_times(0.0, self.step, duration).tolist()) | {0.0}
         held_log[0], status_log[0] = held[:12], status
+        x_log[0], force_log[0] = get_x(pc), force_port.Eval(force_context)
         row, last = 1, len(s.times) - 1
         t, k, rel = 0.0, 0, False  # t = 0: Initialize has published; the tick at 0 is next
         for i in range(-1, last + 1):
@@ -156,8 +177,7 @@ class TickLoop:
                 advance(t)
                 if s.log[i]:
                     held_log[row, :], status_log[row, :] = held[:12], status
-                    if self.discrete:
-                        x_log[row, :], force_log[row, :] = get_x(pc), force_port.Eval(force_context)
+                    x_log[row, :], force_log[row, :] = get_x(pc), force_port.Eval(force_context)
                     row += 1
                 if s.boundary[i] and on_boundary is not None:
                     on_boundary(t)
@@ -182,92 +202,89 @@ class TickLoop:
             if now is not self._input_held:
                 self._set_input(now)
         self.held, self.memory, self.status = held, memory, status
-        logs = {"command": held_log[:, :6], "setpoint": held_log[:, 6:], "status": status_log}
-        if self.discrete:
-            times = np.array([0.0] + [t for t, logged in zip(s.times, s.log) if logged])
-            logs |= {"times": times, "state": x_log, "force": force_log}
         return logs
 
     _input_held = None
 
     def _views(self):
-        """Numpy views of the plant state and of the command input where Drake keeps them (no copies):
-        the plant context's continuous (or, for a discrete plant, discrete) state vector — positions then
-        velocities, ``GetPositionsAndVelocities``'s layout — and the fixed input's vector. Drake writes a
-        step's result into the same memory, so the views hold for the run (``tests/drake/test_tick_loop.py``)."""
+        """Numpy views of Drake's memory (no copies): the plant state — the plant context's continuous (or,
+        for a discrete plant, discrete) state vector, positions then velocities, ``GetPositionsAndVelocities``'s
+        layout —, the fixed command input's vector and the actuators' lag state (None without a lag: their
+        output is then the saturated command). Drake writes a step's result into the same memory, so the
+        views hold for the run (``tests/drake/test_loop_kernel.py``)."""
         pc = self.plant_context
         state = pc.get_discrete_state(0) if self.discrete else pc.get_continuous_state_vector()
         x = state.get_value()
         if x.shape != (self.plant.num_multibody_states(),):  # a plant with other state: not this loop's
             raise RuntimeError(f"plant state of {x.shape} values, {self.plant.num_multibody_states()} expected")
-        return x, self._fixed.GetMutableData().get_mutable_value().get_mutable_value()
+        command = self._fixed.GetMutableData().get_mutable_value().get_mutable_value()
+        lag = self.actuators.lag
+        if lag is not None:
+            root = self.simulator.get_context()
+            lag = lag.GetMyContextFromRoot(root).get_discrete_state(0).get_value()
+        return x, command, lag
 
     def _run_kernel(self, duration: float, s: Schedule, on_boundary) -> dict:
         """``run`` with the compiled DSP side (``firmware.loop_kernel``): per stop one ``AdvanceTo`` and one C
         call (log, tick or release, the command written in Drake's memory), and Drake told of a new command
         (``GetMutableData``) only when it changed. The stops that need Python — a boundary with a callback,
         a discrete plant's step before its tick — split the call in two around it."""
-        n = 1 + sum(s.log)
-        logs = {"held": np.empty((n, 12)), "status": np.empty((n, len(self.status)))}
-        if self.discrete:
-            logs["x"] = np.empty((n, self.plant.num_multibody_states()))
-            force_log = np.empty((n, 6))
-            force_port, force_context = self.force
-        x, command = self._views()
+        logs = self._log_arrays(s)
+        x, command, lag = self._views()
         kern, after = self.kernel, self.input_after_update or self.discrete
-        kern.start(x, command, s, self.feedforward, self.held, self.memory, self.status, self.at_tick, after, logs)
-        notify, advance, stop = self._fixed.GetMutableData, self.simulator.AdvanceTo, kern.stop
+        kern.start(
+            x,
+            command,
+            lag,
+            self.actuators.max_force,
+            s,
+            self.feedforward,
+            self.held,
+            self.memory,
+            self.status,
+            self.at_tick,
+            after,
+            logs,
+        )
+        notify, advance, stop, ks = self._fixed.GetMutableData, self.simulator.AdvanceTo, kern.stop, kern.s
         times, last = s.times, len(s.times) - 1
         split = {i for i in range(len(times)) if s.boundary[i] and on_boundary is not None}
         half = {}
-        if self.discrete:
+        if self.discrete:  # the plant's step at t before the tick at t
             steps = set(periodic_times(0.0, self.step, duration).tolist()) | {0.0}
-            half = {
+            half = {-1: 0.5 * times[0]} | {
                 i: 0.5 * (times[i] + times[i + 1])
                 for i in range(last)
                 if (s.tick[i] >= 0 or s.release[i]) and times[i] in steps
             }
-            split = set(range(len(times)))  # the forces are logged by Drake's port at every stop
-            if 0.0 in steps:  # the tick at t = 0 after the plant's step at 0
-                half[-1] = 0.5 * times[0]
-        kern.log(kern.s, -1)
-        if self.discrete:
-            force_log[0] = force_port.Eval(force_context)
+            split |= set(half)
+        kern.log(ks, -1)
         if -1 in half:
             advance(half[-1])
         self._kernel_update(-1)
         for i in range(last):
             advance(times[i])
             if i in split:
-                kern.log(kern.s, i)
-                if self.discrete:
-                    force_log[kern.s.row - 1] = force_port.Eval(force_context)
+                kern.log(ks, i)
                 if s.boundary[i] and on_boundary is not None:
                     on_boundary(times[i])
                 if i in half:
                     advance(half[i])
                 self._kernel_update(i)
             else:
-                r = stop(kern.s, i)
+                r = stop(ks, i)
                 if r:
                     if r < 0:
                         kern.raise_error(r)
                     notify()
         advance(times[last])  # the updates at the end time are not run (Drake's AdvanceTo stops before them)
-        kern.log(kern.s, last)
-        if self.discrete:
-            force_log[kern.s.row - 1] = force_port.Eval(force_context)
+        kern.log(ks, last)
         if s.boundary[last] and on_boundary is not None:
             on_boundary(times[last])
-        if kern.s.row != n:
-            raise RuntimeError(f"the loop logged {kern.s.row} rows of {n}")  # a bug
+        if ks.row != len(logs["held"]):
+            raise RuntimeError(f"the loop logged {ks.row} rows of {len(logs['held'])}")  # a bug
         self.held, self.memory, self.status = kern.state()
-        held = logs["held"]
-        out = {"command": held[:, :6], "setpoint": held[:, 6:], "status": logs["status"]}
-        if self.discrete:
-            t = np.array([0.0] + [t for t, logged in zip(times, s.log) if logged])
-            out |= {"times": t, "state": logs["x"], "force": force_log}
-        return out
+        return logs
 
     def _kernel_update(self, i: int) -> None:
         r = self.kernel.update(self.kernel.s, i)

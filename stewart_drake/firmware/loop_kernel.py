@@ -113,6 +113,13 @@ class LoopKernel:
         self._keep.append(a)
         return self.ffi.cast(ctype, a.__array_interface__["data"][0])
 
+    def _view(self, ctype: str, a: np.ndarray):
+        """A C pointer into ``a`` itself (a view of Drake's memory: never a copy)."""
+        if not (a.flags["C_CONTIGUOUS"] and a.dtype == np.float64):
+            raise RuntimeError("a view of Drake's memory is not a contiguous float64 vector")  # a bug
+        self._keep.append(a)
+        return self.ffi.cast(ctype, a.__array_interface__["data"][0])
+
     def tables(self, poses) -> None:
         """The law's side of the tick tables for the reference ``(n_ticks, 6)`` poses, in one batch: the
         float law's set-points (``FloatLaw.setpoints`` of each row: the IK is elementwise over poses), the
@@ -131,15 +138,18 @@ class LoopKernel:
             s.setpoint = self._ptr("double *", np.asarray(sp, dtype=float))
         s.n_ticks = len(poses)
 
-    def start(self, x, command, schedule, feedforward, held, memory, status, at_tick, input_after, logs) -> None:
-        """Point the struct at Drake's plant state ``x`` and command input ``command`` (numpy views of the
-        context's memory, valid for the run), the ``schedule`` (``tick_loop.Schedule``), the feed-forward
-        rows (``(n_ticks, 6)`` N, or None), the controller's state and the ``logs`` (``held`` (n, 12),
-        ``status`` (n, len(STATUS)), ``x`` (n, nx) or None)."""
+    def start(
+        self, x, command, lag, max_force, schedule, feedforward, held, memory, status, at_tick, input_after, logs
+    ) -> None:
+        """Point the struct at Drake's memory — the plant state ``x``, the command input ``command``, the
+        actuators' lag state ``lag`` (None: no lag, the force is the command saturated at ``max_force`` N);
+        numpy views valid for the run —, the ``schedule`` (``tick_loop.Schedule``), the feed-forward rows
+        (``(n_ticks, 6)`` N, or None), the controller's state and the ``logs`` (``held`` (n, 12), ``status``
+        (n, len(STATUS)), ``state`` (n, nx), ``force`` (n, 6))."""
         s = self.s
-        s.x = self.ffi.cast("double *", x.__array_interface__["data"][0])
-        s.input = self.ffi.cast("double *", command.__array_interface__["data"][0])
-        self._keep += [x, command]
+        s.x, s.input = self._view("double *", x), self._view("double *", command)
+        s.lag = self.ffi.NULL if lag is None else self._view("double *", lag)
+        s.max_force = max_force
         s.times = self._ptr("double *", np.asarray(schedule.times, dtype=float))
         s.tick = self._ptr("int32_t *", np.asarray(schedule.tick, dtype=np.int32))
         s.release = self._ptr("int8_t *", np.asarray(schedule.release, dtype=np.int8))
@@ -156,10 +166,9 @@ class LoopKernel:
         s.status[0 : len(STATUS)] = np.asarray(status, dtype=float).tolist()
         s.held_log = self._ptr("double *", logs["held"])
         s.status_log = self._ptr("double *", logs["status"])
-        s.n_rows = len(logs["held"])
-        if logs.get("x") is not None:
-            s.x_log = self._ptr("double *", logs["x"])
-            s.nx = logs["x"].shape[1]
+        s.x_log = self._ptr("double *", logs["state"])
+        s.force_log = self._ptr("double *", logs["force"])
+        s.n_rows, s.nx = logs["state"].shape
         s.row = 0
 
     def state(self) -> tuple:

@@ -87,26 +87,31 @@ def all_drake_run(sc: Scenario, duration: float) -> dict:
 
 
 @pytest.mark.parametrize(
-    "integrator, latency, time_constant",
+    "kind, integrator, latency, time_constant",
     [
-        ("cenic-fixed", "sample", 2e-3),  # the default loop
-        ("cenic-fixed", "computation", 0.0),  # a release between ticks; the plant integrates the new command
-        ("sap", "computation", 2e-3),  # a discrete plant steps before the tick reads it
-        ("sap", "none", 0.0),
+        ("float", "cenic-fixed", "sample", 2e-3),  # the default loop
+        ("fixed", "cenic-fixed", "sample", 2e-3),  # the compiled firmware in the loop's C kernel
+        ("float", "cenic-fixed", "computation", 0.0),  # a release between ticks; the plant integrates the new command
+        ("float", "sap", "computation", 2e-3),  # a discrete plant steps before the tick reads it
+        ("float", "sap", "none", 0.0),
     ],
 )
-def test_tick_loop_logs_equal_the_all_drake_diagram(integrator, latency, time_constant):
+def test_tick_loop_logs_equal_the_all_drake_diagram(kind, integrator, latency, time_constant):
+    """The loop (its compiled kernel here: ``firmware.loop_kernel``) against the all-Drake Diagram, whose
+    LeafSystem runs the law's numpy ``step`` (the firmware's ``sd_tick`` through ``CFixedPointLaw.step``)."""
     timing = DspTiming(latency=latency, computation_cycles=15000)
     cfg = ControllerConfig.for_platform(PLATFORM, timing, actuator_lag=time_constant)
     sc = Scenario(
         PLATFORM,
         SEED,
-        "float",
+        kind,
         cfg,
+        engine="c",
         actuators=ActuatorModel(time_constant=time_constant),
         integrator=integrator,
     )
     sim = build_simulation(sc)
+    assert sim.controller.kernel is not None  # a compiler is found here
     log = sim.run(DURATION)
     ref = all_drake_run(sc, DURATION)
     np.testing.assert_array_equal(log.t, ref["t"])

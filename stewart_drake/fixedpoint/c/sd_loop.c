@@ -113,14 +113,21 @@ static int tick(sd_loop *L, long k, double t)
 }
 
 /* The log row of stop i (i = -1: t = 0), if it logs there: the held values and status before its updates,
- * and the plant state. Returns 0. */
+ * the plant state and the actuators' force (what Drake's loggers sampled there: the lag's state, or the
+ * saturated command). Returns 0. */
 int sd_loop_log(sd_loop *L, long i)
 {
     if (i >= 0 && !L->log[i]) return 0;
     if (L->row >= L->n_rows) return -2;
     memcpy(L->held_log + 12 * L->row, L->held, 12 * sizeof(double));
     memcpy(L->status_log + 10 * L->row, L->status, 10 * sizeof(double));
-    if (L->x_log) memcpy(L->x_log + L->nx * L->row, L->x, L->nx * sizeof(double));
+    memcpy(L->x_log + L->nx * L->row, L->x, L->nx * sizeof(double));
+    if (L->lag) {
+        memcpy(L->force_log + 6 * L->row, L->lag, 6 * sizeof(double));
+    } else {
+        int j;
+        for (j = 0; j < 6; j++) L->force_log[6 * L->row + j] = clip(L->input[j], L->max_force);
+    }
     L->row++;
     return 0;
 }

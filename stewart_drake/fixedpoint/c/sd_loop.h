@@ -1,7 +1,7 @@
 /* sd_loop.h -- the closed loop's DSP side in one call per stop (``firmware.loop_kernel``, driven by
  * ``drake.tick_loop.TickLoop``): read the plant state in Drake's memory, the sensor, the law's tick (the float
  * law, or the compiled firmware's ``sd_host_tick``), the output release, the actuators' command written in
- * Drake's memory, the logs appended. Not part of the firmware. The block between the CDEF markers is
+ * Drake's memory, the logs (with the plant state and the actuators' force) appended. Not part of the firmware. The block between the CDEF markers is
  * also the cffi declaration (read by ``loop_kernel``): plain C, no macros. */
 #ifndef SD_LOOP_H
 #define SD_LOOP_H
@@ -42,7 +42,10 @@ typedef struct {
     double status[10];        /* control.STATUS */
     double *held_log;         /* (n_rows, 12) */
     double *status_log;       /* (n_rows, 10) */
-    double *x_log;            /* (n_rows, nx), or 0 */
+    double *x_log;            /* (n_rows, nx) */
+    double *force_log;        /* (n_rows, 6): the actuators' output */
+    const double *lag;        /* the actuators' lag state in Drake's context (6, N; its output), or 0: */
+    double max_force;         /* without a lag the output is the command saturated at +-max_force (N) */
     long nx;
     long row;
     long n_rows;
