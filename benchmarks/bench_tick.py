@@ -1,17 +1,23 @@
-"""Where a closed-loop tick's microseconds go (item 1 of the speed issue): the plant alone, the loop with
-the compiled firmware (C engine) and with the float law, and the same loop with the law's ``step``
-replaced by a constant — all in one run, interleaved, best of ``--repeat``.
+"""Where a closed-loop tick's microseconds go (item 1 of the speed issue), each target beside its figure and
+its reference, all measured in one run, interleaved, best of ``--repeat``:
 
-The loop's ticks run outside the Diagram (``drake.tick_loop``): Drake advances the plant and the
-actuators with ``AdvanceTo`` from tick to tick, one Python loop does the DSP's side. Two plant references:
-the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the plant the loop
-actually drives ("plant + actuators, input changing every tick": the actuators' lag and its loggers, an
-``AdvanceTo`` per tick and a command that changes every tick, so the integrator cannot reuse what it
-computed for the previous step; no Python law) — the ceiling of any loop with this Diagram.
+- references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the plant
+  the loop drives — the loop's own Diagram (``loop_diagram``: plant and actuators' lag, no loggers) advanced
+  tick by tick with a command that changes every tick, written through a view of Drake's memory (no law, no
+  logs): the ceiling of any loop on this Diagram;
+- the loops with their compiled DSP side (``firmware.loop_kernel``: one C call per stop): the fixed-point
+  law with the generated firmware (C engine) and the float law, each with its tick tables computed cold
+  (``TABLE_CACHE`` cleared: a report's or a study's first run) and remembered (every later run of the same
+  reference and model in the process); target ≥ 0.8 × the bare plant's real-time factor;
+- the same loops with the Python ticks (``TickLoop._run_python``, the reference and the fallback) for
+  comparison;
+- the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it),
+  against the ceiling's own Python per tick (write the command, notify Drake).
 
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
-millisecond is one tick, so µs per tick = 1000 / real-time factor. Prints the load (``uptime``) first and
-last; on a shared machine the ratios are what travel. Measures only: it changes nothing in the loop.
+millisecond is one tick, so µs per tick = 1000 / real-time factor. Process CPU time (on a loaded machine wall
+time includes waiting for a core); prints the load first and last: on a shared machine the ratios are what
+travel. Measures only: it changes nothing in the loop.
 """
 
 from __future__ import annotations
@@ -28,9 +34,10 @@ from bench_integrators import CONTINUOUS, apply_integrator  # noqa: E402  (bench
 from stewart_drake.control.feedforward import TABLE_CACHE  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
-from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
+from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation  # noqa: E402
 
 TARGET = 0.8  # the loop's real-time factor over the bare plant's
+PERIOD = 1e-3  # s: the plant step and the controller's sample period of the default loop
 
 
 def load() -> str:
@@ -38,8 +45,8 @@ def load() -> str:
 
 
 def plant(p, duration: float) -> float:
-    """CPU seconds per simulated second of the plant alone (``bench_integrators.bare_plant``'s set-up: the
-    legs pushed with home's static forces; build excluded)."""
+    """CPU µs per tick of the plant alone (``bench_integrators.bare_plant``'s set-up: the legs pushed with
+    home's static forces; build excluded)."""
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource
@@ -48,112 +55,125 @@ def plant(p, duration: float) -> float:
     from stewart_drake.drake.platform_model import build_plant, set_pose
 
     builder = DiagramBuilder()
-    mbp, _ = build_plant(p, 1e-3, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
     src = builder.AddSystem(ConstantVectorSource(F))
     builder.Connect(src.get_output_port(), mbp.get_actuation_input_port())
     sim = Simulator(builder.Build())
-    apply_integrator(sim, DEFAULT_INTEGRATOR, 1e-3)
+    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
     set_pose(mbp, mbp.GetMyMutableContextFromRoot(sim.get_mutable_context()), p, p.home_pose())
     sim.Initialize()
     c0 = time.process_time()
     sim.AdvanceTo(duration)
-    return (time.process_time() - c0) / duration
+    return 1e6 * PERIOD * (time.process_time() - c0) / duration
 
 
 def driven_plant(p, duration: float) -> float:
-    """CPU seconds per simulated second of the plant with the loop's actuators (lag) and loggers, advanced
-    tick by tick with a leg-force command that changes every tick (±1e-6 relative about home's static
-    forces, written in place into the fixed input): the loop without its Python."""
+    """CPU µs per tick of the loop's own Diagram (``loop_diagram``) advanced tick by tick, with a leg-force
+    command that changes every tick (±1e-6 relative about home's static forces) written through a view of
+    the fixed input and Drake notified (``GetMutableData``), as the loop does: the loop without its DSP side."""
     from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import LogVectorOutput
 
     from stewart_drake.core.dynamics import leg_forces_with_legs
-    from stewart_drake.drake.platform_model import build_plant, set_pose
-    from stewart_drake.drake.systems import Actuators
+    from stewart_drake.drake.loop_diagram import loop_diagram
+    from stewart_drake.drake.platform_model import set_pose
 
-    builder = DiagramBuilder()
-    mbp, _ = build_plant(p, 1e-3, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
-    act = builder.AddSystem(Actuators(float(p.legs.max_force), 2e-3, 1e-3))
-    builder.Connect(act.get_output_port(), mbp.get_actuation_input_port())
-    builder.ExportInput(act.get_input_port(), "command")
-    LogVectorOutput(mbp.get_state_output_port(), builder, 1e-3)
-    LogVectorOutput(act.get_output_port(), builder, 1e-3)
-    diagram = builder.Build()
-    sim = Simulator(diagram)
-    apply_integrator(sim, DEFAULT_INTEGRATOR, 1e-3)
+    built = loop_diagram(p, PERIOD, DEFAULT_INTEGRATOR, float(p.legs.max_force), ActuatorModel().time_constant)
+    sim = Simulator(built.diagram)
+    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
     root = sim.get_mutable_context()
-    set_pose(mbp, mbp.GetMyMutableContextFromRoot(root), p, p.home_pose())
+    set_pose(built.plant, built.plant.GetMyMutableContextFromRoot(root), p, p.home_pose())
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
-    act.set_force(root, F)
-    fixed = diagram.GetInputPort("command").FixValue(root, F)
+    built.actuators.set_force(root, F)
+    fixed = built.diagram.GetInputPort("command").FixValue(root, F)
+    view = fixed.GetMutableData().get_mutable_value().get_mutable_value()
     commands = [F * (1 + 1e-6), F * (1 - 1e-6)]
+    notify, advance = fixed.GetMutableData, sim.AdvanceTo
     sim.Initialize()
+    n = int(round(duration / PERIOD))
     c0 = time.process_time()
-    for k in range(1, int(round(duration / 1e-3)) + 1):
-        fixed.GetMutableData().get_mutable_value().SetFromVector(commands[k % 2])
-        sim.AdvanceTo(k * 1e-3)
-    return (time.process_time() - c0) / duration
+    for k in range(1, n + 1):
+        view[:] = commands[k % 2]
+        notify()
+        advance(k * PERIOD)
+    return 1e6 * (time.process_time() - c0) / n
 
 
-PREPARE: dict[str, float] = {}  # CPU s per simulated s of Simulation.prepare (the tick tables), per loop
+TABLES: dict[str, float] = {}  # CPU µs per tick of Simulation.prepare (the tick tables), per loop label
 
 
-def loop(p, kind: str, engine: str, duration: float, null_step: bool = False) -> float:
-    """CPU seconds per simulated second of one closed-loop run (build excluded; the tick tables that
-    ``run`` fills first included, their share noted in ``PREPARE``); ``null_step``: the law's step
-    returns its first result every tick (the LeafSystem's Python around it still runs)."""
+def loop(p, label: str, kind: str, engine: str, duration: float, cold: bool, python: bool = False) -> float:
+    """CPU µs per tick of one closed-loop run (build excluded; the tick tables that ``run`` fills first
+    included, their share noted in ``TABLES``). ``cold``: the feed-forward table computed, not remembered
+    from an earlier run of the process; ``python``: the Python ticks instead of the compiled kernel."""
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
-    real_prepare = sim.prepare
-
-    def prepare(d):
-        c = time.process_time()
-        real_prepare(d)
-        PREPARE[kind] = min(PREPARE.get(kind, np.inf), (time.process_time() - c) / duration)
-
-    sim.prepare = prepare
-    if null_step:
-        law = sim.controller.law
-        real = law.step
-        first = []
-
-        def step(state, reference, measured, feedforward=None):
-            if not first:
-                first.append(real(state, reference, measured, feedforward))
-            return first[0]
-
-        law.step = step
-    TABLE_CACHE.clear()  # the run's tables computed, not remembered from an earlier run of this process
+    if python:
+        sim.controller.kernel = None
+    if cold:
+        TABLE_CACHE.clear()
+    else:
+        sim.prepare(duration)  # remembered from here on (the cache keeps the table, not the Simulation)
     c0 = time.process_time()
+    sim.prepare(duration)
+    c1 = time.process_time()
+    sim.prepare = lambda d: None  # filled above
     sim.run(duration)
-    return (time.process_time() - c0) / duration
+    c2 = time.process_time()
+    n = duration / PERIOD
+    TABLES[label] = min(TABLES.get(label, np.inf), 1e6 * (c1 - c0) / n)
+    return 1e6 * (c2 - c0) / n
 
 
-def warm_tables_us(p, kind: str, engine: str, duration: float) -> float:
-    """CPU µs per tick of ``Simulation.prepare`` when this process has computed the same feed-forward table
-    before (``control.feedforward.TABLE_CACHE``: a Monte Carlo worker's runs after its first, a report's
-    repeated loops)."""
+class _NoAdvance:
+    """A Simulator whose ``AdvanceTo`` does nothing (the plant stays put): the loop's DSP side alone."""
+
+    def __init__(self, simulator):
+        self._simulator = simulator
+
+    def AdvanceTo(self, t):  # noqa: N802  (Drake's name)
+        pass
+
+    def get_context(self):
+        return self._simulator.get_context()
+
+
+def dsp_side(p, kind: str, engine: str, duration: float) -> float:
+    """Wall µs per tick of the loop without Drake's work (``AdvanceTo`` a no-op, tables filled before): the
+    compiled kernel's call, Drake's notification and the Python ``for`` per stop."""
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
     sim.prepare(duration)
-    c0 = time.process_time()
-    sim.prepare(duration)
-    return 1e3 * (time.process_time() - c0) / duration
-
-
-def step_us(p, engine: str, n: int = 3000) -> float:
-    """µs of one ``law.step`` alone (the C engine's: one sd_host_tick call and its Python)."""
-    sim = build_simulation(Scenario(p, "seed", "fixed", engine=engine))
-    law = sim.controller.law
-    ref, L = p.home_pose(), np.full(6, 0.7)
-    pid, ff = law.initial_pid_state(L, np.zeros(6)), np.zeros(6)
-    if hasattr(law, "prime"):
-        law.prime(ref[None])
-    law.step(pid, ref, L, ff)
+    sim.controller.simulator = _NoAdvance(sim.simulator)
     t0 = time.perf_counter()
-    for _ in range(n):
-        law.step(pid, ref, L, ff)
+    sim.controller.run(duration)
+    return 1e6 * (time.perf_counter() - t0) / (duration / PERIOD)
+
+
+def ceiling_python(p, duration: float) -> float:
+    """Wall µs per tick of the ceiling's own Python (write the command through the view, notify Drake, a
+    no-op ``AdvanceTo``): what ``driven_plant`` spends per tick besides Drake's work."""
+    sim = build_simulation(Scenario(p, "seed", "float"))
+    fixed = sim.controller._fixed
+    view = fixed.GetMutableData().get_mutable_value().get_mutable_value()
+    commands = [np.ones(6), np.full(6, 2.0)]
+    notify, advance = fixed.GetMutableData, _NoAdvance(None).AdvanceTo
+    n = int(round(duration / PERIOD))
+    t0 = time.perf_counter()
+    for k in range(1, n + 1):
+        view[:] = commands[k % 2]
+        notify()
+        advance(k * PERIOD)
     return 1e6 * (time.perf_counter() - t0) / n
+
+
+LOOPS = {  # label: (kind, engine, cold tables, Python ticks)
+    "fixed/C, cold tables": ("fixed", "c", True, False),
+    "fixed/C, remembered tables": ("fixed", "c", False, False),
+    "float, cold tables": ("float", "python", True, False),
+    "float, remembered tables": ("float", "python", False, False),
+    "fixed/C, Python ticks, remembered tables": ("fixed", "c", False, True),
+    "float, Python ticks, remembered tables": ("float", "python", False, True),
+}
+PLANT, DRIVEN = "bare plant (the reference)", "the loop's Diagram driven tick by tick (ceiling)"
 
 
 def main(argv=None) -> int:
@@ -161,49 +181,43 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=2.0)
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
-    print(f"# closed-loop tick breakdown, utn-dynamic, seed trajectory, {DEFAULT_INTEGRATOR}; {load()}")
+    D = args.duration
+    print(f"# closed-loop tick breakdown, utn-dynamic, seed trajectory, {DEFAULT_INTEGRATOR}, 1 kHz; {load()}")
     p = load_preset("utn-dynamic")
-    loop(p, "fixed", "c", 0.01)  # compile and cache the firmware before timing
-    runs = {
-        "plant": lambda: plant(p, args.duration),
-        "plant + actuators, input changing every tick": lambda: driven_plant(p, args.duration),
-        "fixed, C engine": lambda: loop(p, "fixed", "c", args.duration),
-        "fixed, C, null step": lambda: loop(p, "fixed", "c", args.duration, null_step=True),
-        "float": lambda: loop(p, "float", "python", args.duration),
-        "float, null step": lambda: loop(p, "float", "python", args.duration, null_step=True),
-    }
+    loop(p, "warm-up", "fixed", "c", 0.01, True)  # compile and cache the firmware and the kernel before timing
+    loop(p, "warm-up", "float", "python", 0.01, True)
+    runs = {PLANT: lambda: plant(p, D), DRIVEN: lambda: driven_plant(p, D)}
+    runs |= {label: (lambda a=a, label=label: loop(p, label, a[0], a[1], D, a[2], a[3])) for label, a in LOOPS.items()}
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
         for k, f in runs.items():
             best[k] = min(best[k], f())
-    us = {k: 1e3 * v for k, v in best.items()}  # CPU µs per simulated ms = per tick
-    print("(process CPU time, best of the repetitions: on a loaded machine wall time includes waiting for a core)")
+    us = best  # CPU µs per tick
+    print("(process CPU µs per tick, best of the repetitions; real-time factor = 1e3 / µs)")
     for k, v in us.items():
-        extra = "" if k == "plant" else f"  ({us['plant'] / v:.2f} × plant's real-time factor; target >= {TARGET})"
-        print(f"{k:45s} {v:6.1f} CPU µs per tick = real-time factor {1e3 / v:6.2f}x{extra}")
-    for kind, full, null in (
-        ("fixed/C", "fixed, C engine", "fixed, C, null step"),
-        ("float", "float", "float, null step"),
-    ):
-        prep_us = 1e3 * PREPARE[kind.split("/")[0]]
-        driven = us["plant + actuators, input changing every tick"]
-        loop_us = us[null] - driven - prep_us
-        law_us = us[full] - us[null]
+        extra = ""
+        if k != PLANT:
+            ratio = us[PLANT] / v
+            target = f"; target >= {TARGET}: {'met' if ratio >= TARGET else 'NOT met'}" if k in LOOPS else ""
+            extra = f"  {ratio:.2f} × the bare plant's real-time factor{target}"
+        print(f"  {k:48s} {v:6.1f} µs = real-time factor {1e3 / v:6.2f}x{extra}")
+    driven = us[DRIVEN]
+    print("where a tick's µs go (the loop = plant + driving it + tick tables + the DSP side):")
+    for label in LOOPS:
+        tables = TABLES[label]
+        rest = us[label] - driven - tables
         print(
-            f"{kind:8s} tick {us[full]:6.1f} µs = plant {us['plant']:6.1f} + driving it (actuators, loggers, an "
-            f"AdvanceTo per tick, a changing input) {driven - us['plant']:5.1f} + tick tables (reference, IK "
-            f"words, feed-forward: before the run) {prep_us:5.1f} + the loop's Python (state read, sensor, "
-            f"status, release, input, logs) {loop_us:5.1f} + law.step {law_us:5.1f}"
+            f"  {label:48s} {us[label]:6.1f} = plant {us[PLANT]:5.1f} + driving it (actuators' lag, an AdvanceTo "
+            f"per tick, a changing input) {driven - us[PLANT]:4.1f} + tick tables {tables:4.1f} + DSP side {rest:5.1f}"
         )
-    print(
-        f"tick tables when remembered from an earlier run of the process: {warm_tables_us(p, 'fixed', 'c', args.duration):.1f}"
-        " µs per tick (fixed/C)"
-    )
-    print(
-        f"ceiling of this Diagram (no Python at all): {us['plant'] / us['plant + actuators, input changing every tick']:.2f}"
-        " × plant's real-time factor"
-    )
-    print(f"law.step alone, C engine: {step_us(p, 'c'):.1f} µs per call (of it the sd_host_tick C call is < 1 µs)")
+    print("the DSP side alone, AdvanceTo a no-op (wall µs per tick, best of the repetitions):")
+    alone = {
+        "fixed/C, compiled kernel": lambda: dsp_side(p, "fixed", "c", D),
+        "float, compiled kernel": lambda: dsp_side(p, "float", "python", D),
+        "the ceiling's own Python (write, notify)": lambda: ceiling_python(p, D),
+    }
+    for k, f in alone.items():
+        print(f"  {k:48s} {min(f() for _ in range(args.repeat)):6.2f} µs")
     print(f"# {load()}")
     return 0
 

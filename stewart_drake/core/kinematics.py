@@ -15,6 +15,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
 if TYPE_CHECKING:  # annotations only: geometry imports sanity, which imports this module
@@ -78,7 +79,7 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
     r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
     u = l / np.linalg.norm(l, axis=-1, keepdims=True)
-    return np.concatenate([u, np.cross(r, u)], axis=-1)
+    return np.concatenate([u, cross(r, u)], axis=-1)
 
 
 def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
