@@ -1,22 +1,24 @@
 """The closed loop's ticks run outside the Diagram: Drake advances the plant (and the actuators' lag) from
-one event time to the next with ``Simulator.AdvanceTo``; between two calls, one tight Python loop does
-what the DSP does at that instant — read the plant state once, the sensor, the law's tick
-(``control.dsp_state``: the same code as ``drake.systems.ControllerSystem``), the output release —
-reads the reference and feed-forward rows of the tick by index, writes the held command to the
-actuators' fixed input in place, and logs the controller's outputs into preallocated arrays. No Python
-runs inside ``AdvanceTo``.
+one event time to the next with ``Simulator.AdvanceTo``; between two calls the loop does what the DSP does
+at that instant — read the plant state, the sensor, the law's tick (``control.dsp_state``: the same code as
+``drake.systems.ControllerSystem``), the output release — reading the reference and feed-forward rows of the
+tick by index, writes the held command to the actuators' fixed input and logs the controller's outputs, the
+plant state and the actuators' force into preallocated arrays (the Diagram has no loggers). No Python runs
+inside ``AdvanceTo``. All of a stop's work is one call into C (``firmware.loop_kernel``: the float law or the
+compiled firmware, reading and writing Drake's memory through numpy views obtained once); the Python loop
+(``_run_python``) is the reference and the fallback (the firmware's Python emulation, no C compiler).
 
 Why the logs are those of the all-Drake Diagram (a ``ControllerSystem`` wired to the plant), bit for bit
 (``tests/drake/test_tick_loop.py`` runs both): the loop stops at every time the Diagram had an event
 (plant steps m·h, ticks k·T, releases k·T + delay, each computed as Drake computes periodic times,
 ``offset + k·period``; the progress bar's and the visualizer's times), so the integrator takes the same
-steps; at each stop Drake has published (the plant loggers sampled) before the loop's updates, as the
-Simulator publishes at t before the discrete updates at t; and the actuators' discrete update at t reads
+steps; at each stop the loop logs what the Diagram's loggers sampled (a publish at t comes before the
+discrete updates at t; the actuators' force is their lag's state, or the saturated command) before its updates; and the actuators' discrete update at t reads
 the command held *before* the controller's update at t (simultaneous discrete updates read the old
 state), except for a continuous plant without lag, which integrates with the command just released. A
 discrete (SAP) plant steps by an unrestricted update, which Drake runs before the discrete ones: its tick
 reads the state after the plant's step at t, so the loop advances halfway to the next stop first (nothing
-happens there) and logs the plant state and forces itself at every stop (Drake's per-step logging).
+happens there) and logs at every stop (Drake's per-step logging).
 """
 
 from __future__ import annotations

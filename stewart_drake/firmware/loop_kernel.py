@@ -65,6 +65,10 @@ def make_kernel(law, sensor) -> LoopKernel | None:
 
     if type(sensor) not in (IdealSensor, SensorReading):
         return None
+    if isinstance(sensor, SensorReading):  # rows the C code may index: the Python loop raises on others
+        n = len(sensor.jitter)
+        if n < 1 or np.shape(sensor.noise) != (n, 6) or np.shape(sensor.offset) not in ((6,), (1, 6)):
+            return None
     if isinstance(law, CFixedPointLaw) and _own_step(law, CFixedPointLaw):
         # every module with a tick links the kernel (``module.compile_generated``, ``compile_user``)
         return LoopKernel(law.module.ffi, law.module.lib, law, sensor)
@@ -80,7 +84,7 @@ class LoopKernel:
     ``stop(i)``, ``log(i)``, ``update(i)``: the C functions on this run's struct (``sd_loop.h``)."""
 
     def __init__(self, ffi, lib, law, sensor):
-        self.ffi, self.lib, self.law = ffi, lib, law
+        self.ffi, self.lib, self.law, self.sensor = ffi, lib, law, sensor
         self.s = s = ffi.new("sd_loop *")
         self._keep: list = []  # the arrays the struct points into
         self.fixed = not isinstance(law, FloatLaw)
@@ -147,6 +151,9 @@ class LoopKernel:
         (``(n_ticks, 6)`` N, or None), the controller's state and the ``logs`` (``held`` (n, 12), ``status``
         (n, len(STATUS)), ``state`` (n, nx), ``force`` (n, 6))."""
         s = self.s
+        indices = [self.sensor.positions] + ([self.sensor.velocities] if isinstance(self.sensor, SensorReading) else [])
+        if not all(0 <= i < len(x) for i in np.concatenate(indices).tolist()):
+            raise RuntimeError("sensor indices outside the plant state")  # a bug: they are the plant's joints
         s.x, s.input = self._view("double *", x), self._view("double *", command)
         s.lag = self.ffi.NULL if lag is None else self._view("double *", lag)
         s.max_force = max_force

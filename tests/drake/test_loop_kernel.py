@@ -135,3 +135,20 @@ def test_float_loop_without_a_compiler_runs_python_with_one_note(tmp_path):
     compiled = build_simulation(Scenario(PLATFORM, "seed", "float"))
     assert compiled.controller.kernel is not None
     np.testing.assert_array_equal(np.load(out), compiled.run(0.02).command)
+
+
+def test_kernel_leaves_sensor_tables_it_cannot_index_to_python():
+    """Noise rows that do not match the jitter rows, or none at all: the C code would read outside them, so
+    the Python loop runs (and raises where numpy does)."""
+    from stewart_drake.control.laws import FloatLaw
+    from stewart_drake.control.loop_sensor import SensorReading
+    from stewart_drake.firmware.loop_kernel import make_kernel
+
+    law, pos = FloatLaw(PLATFORM), np.arange(6)
+
+    def sensor(noise_rows, jitter_rows):
+        return SensorReading(pos, pos + 6, np.zeros(6), np.zeros((noise_rows, 6)), np.zeros(jitter_rows), 1e-3)
+
+    assert make_kernel(law, sensor(3, 3)) is not None
+    assert make_kernel(law, sensor(2, 3)) is None
+    assert make_kernel(law, sensor(0, 0)) is None
