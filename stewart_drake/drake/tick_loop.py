@@ -289,6 +289,7 @@ class TickLoop:
         return logs
 
     def _kernel_update(self, i: int) -> None:
+        """The compiled updates of stop ``i`` alone (its log taken before), Drake told of a new command."""
         r = self.kernel.update(self.kernel.s, i)
         if r < 0:
             self.kernel.raise_error(r)
