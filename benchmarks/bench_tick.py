@@ -2,9 +2,9 @@
 its reference, all measured in one run, interleaved, best of ``--repeat``:
 
 - references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the plant
-  the loop drives — the loop's own Diagram (``loop_diagram``: plant and actuators' lag, no loggers) advanced
-  tick by tick with a command that changes every tick, written through a view of Drake's memory (no law, no
-  logs): the ceiling of any loop on this Diagram;
+  the loop drives — the loop's own Diagram (``loop_diagram``: the plant alone, its actuation a fixed input)
+  advanced tick by tick with the actuators' lag stepped on a command that changes every tick, the force
+  written through a view of Drake's memory (no law, no logs): the ceiling of any loop on this Diagram;
 - the loops with their compiled DSP side (``firmware.loop_kernel``: one C call per stop): the fixed-point
   law with the generated firmware (C engine) and the float law, each with its tick tables computed cold
   (``TABLE_CACHE`` cleared: a report's or a study's first run) and remembered (every later run of the same
@@ -69,23 +69,25 @@ def plant(p, duration: float) -> float:
 
 
 def driven_plant(p, duration: float) -> float:
-    """CPU µs per tick of the loop's own Diagram (``loop_diagram``) advanced tick by tick, with a leg-force
-    command that changes every tick (±1e-6 relative about home's static forces) written through a view of
-    the fixed input and Drake notified (``GetMutableData``), as the loop does: the loop without its DSP side."""
+    """CPU µs per tick of the loop's own Diagram (``loop_diagram``: the plant, its actuation a fixed input)
+    advanced tick by tick, the actuators' lag stepped in numpy on a leg-force command that changes every tick
+    (±1e-6 relative about home's static forces) and the force written through a view of the fixed input with
+    Drake notified (``GetMutableData``), as the loop does: the loop without its DSP side."""
     from pydrake.systems.analysis import Simulator
 
+    from stewart_drake.control.actuation import Actuation
     from stewart_drake.core.dynamics import leg_forces_with_legs
     from stewart_drake.drake.loop_diagram import loop_diagram
     from stewart_drake.drake.platform_model import set_pose
 
-    built = loop_diagram(p, PERIOD, DEFAULT_INTEGRATOR, float(p.legs.max_force), ActuatorModel().time_constant)
+    built = loop_diagram(p, PERIOD, DEFAULT_INTEGRATOR)
+    act = Actuation.from_time_constant(float(p.legs.max_force), ActuatorModel().time_constant, PERIOD)
     sim = Simulator(built.diagram)
     apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
     root = sim.get_mutable_context()
     set_pose(built.plant, built.plant.GetMyMutableContextFromRoot(root), p, p.home_pose())
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
-    built.actuators.set_force(root, F)
-    fixed = built.diagram.GetInputPort("command").FixValue(root, F)
+    fixed = built.diagram.GetInputPort("actuation").FixValue(root, F)
     view = fixed.GetMutableData().get_mutable_value().get_mutable_value()
     commands = [F * (1 + 1e-6), F * (1 - 1e-6)]
     notify, advance = fixed.GetMutableData, sim.AdvanceTo
@@ -93,7 +95,8 @@ def driven_plant(p, duration: float) -> float:
     n = int(round(duration / PERIOD))
     c0 = time.process_time()
     for k in range(1, n + 1):
-        view[:] = commands[k % 2]
+        F = act.step(F, commands[k % 2])
+        view[:] = F
         notify()
         advance(k * PERIOD)
     return 1e6 * (time.process_time() - c0) / n
@@ -149,17 +152,18 @@ def dsp_side(p, kind: str, engine: str, duration: float) -> float:
 
 
 def ceiling_python(p, duration: float) -> float:
-    """Wall µs per tick of the ceiling's own Python (write the command through the view, notify Drake, a
-    no-op ``AdvanceTo``): what ``driven_plant`` spends per tick besides Drake's work."""
+    """Wall µs per tick of the ceiling's own Python (the lag stepped in numpy, the force written through the
+    view, Drake notified, a no-op ``AdvanceTo``): what ``driven_plant`` spends per tick besides Drake's work."""
     sim = build_simulation(Scenario(p, "seed", "float"))
-    fixed = sim.controller._fixed
+    fixed, act = sim.controller._fixed, sim.controller.actuators
     view = fixed.GetMutableData().get_mutable_value().get_mutable_value()
-    commands = [np.ones(6), np.full(6, 2.0)]
+    commands, F = [np.ones(6), np.full(6, 2.0)], np.zeros(6)
     notify, advance = fixed.GetMutableData, _NoAdvance(None).AdvanceTo
     n = int(round(duration / PERIOD))
     t0 = time.perf_counter()
     for k in range(1, n + 1):
-        view[:] = commands[k % 2]
+        F = act.step(F, commands[k % 2])
+        view[:] = F
         notify()
         advance(k * PERIOD)
     return 1e6 * (time.perf_counter() - t0) / n
@@ -202,19 +206,22 @@ def main(argv=None) -> int:
             extra = f"  {ratio:.2f} × the bare plant's real-time factor{target}"
         print(f"  {k:48s} {v:6.1f} µs = real-time factor {1e3 / v:6.2f}x{extra}")
     driven = us[DRIVEN]
-    print("where a tick's µs go (the loop = plant + driving it + tick tables + the DSP side):")
+    print(
+        "where a tick's µs go (the loop = plant + driving it + tick tables + the rest: the DSP side, see below, and\n"
+        "  the plant's extra work along the reference — the bare plant and the ceiling rest at home):"
+    )
     for label in LOOPS:
         tables = TABLES[label]
         rest = us[label] - driven - tables
         print(
-            f"  {label:48s} {us[label]:6.1f} = plant {us[PLANT]:5.1f} + driving it (actuators' lag, an AdvanceTo "
-            f"per tick, a changing input) {driven - us[PLANT]:4.1f} + tick tables {tables:4.1f} + DSP side {rest:5.1f}"
+            f"  {label:48s} {us[label]:6.1f} = plant {us[PLANT]:5.1f} + driving it (an AdvanceTo per tick, a "
+            f"changing force) {driven - us[PLANT]:4.1f} + tick tables {tables:4.1f} + DSP side and motion {rest:5.1f}"
         )
     print("the DSP side alone, AdvanceTo a no-op (wall µs per tick, best of the repetitions):")
     alone = {
         "fixed/C, compiled kernel": lambda: dsp_side(p, "fixed", "c", D),
         "float, compiled kernel": lambda: dsp_side(p, "float", "python", D),
-        "the ceiling's own Python (write, notify)": lambda: ceiling_python(p, D),
+        "the ceiling's own Python (lag, write, notify)": lambda: ceiling_python(p, D),
     }
     for k, f in alone.items():
         print(f"  {k:48s} {min(f() for _ in range(args.repeat)):6.2f} µs")

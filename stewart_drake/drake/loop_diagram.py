@@ -1,12 +1,13 @@
 """The closed loop's Diagram: what runs in C++ between the controller's ticks — the plant (with its scene
-graph), the actuators (saturation and lag) with their command as the Diagram's input ``command`` and, for an
-animation, the Meshcat visualizer. No loggers: the loop stops at every plant step and logs the plant state
-and the actuators' force itself (``tick_loop.TickLoop``), as the loggers did, without their events.
+graph), its actuation as the Diagram's input ``actuation`` and, for an animation, the Meshcat visualizer.
+No actuators and no loggers: the loop stops at every plant step, steps the actuators' saturation and lag
+there itself (``control.actuation``: Drake's ``Saturation`` and ``LinearSystem``'s numbers) and logs the
+plant state and their force (``tick_loop.TickLoop``), without two more systems and their events per step.
 
 Built once per structure and reused (``DIAGRAM_CACHE``): a Diagram holds no state (every run has its own
-context and Simulator), so the runs of a process whose plant platform, plant step, integrator and actuators
-are the same share one — a Monte Carlo study varying only the sensor, the latency, the sample period or the
-gains builds it once per worker; a draw that moves an anchor or changes the plate's mass or payload changes
+context and Simulator), so the runs of a process whose plant platform, plant step and integrator are the same
+share one — a Monte Carlo study varying only the sensor, the latency, the sample period, the gains or the
+actuators builds it once per worker; a draw that moves an anchor or changes the plate's mass or payload changes
 the plant (its SDF) and builds its own. Not cached with a visualizer (it holds the user's Meshcat).
 """
 
@@ -22,51 +23,38 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.memo import Memo, digest
 from stewart_drake.drake.integrators import CONTINUOUS
 from stewart_drake.drake.platform_model import build_plant
-from stewart_drake.drake.systems import Actuators
 
 VISUALIZER_PERIOD = 1 / 32  # s: the Meshcat animation's frame period
 
 
 @dataclass(frozen=True)
 class LoopDiagram:
-    """A built loop Diagram: ``diagram``, its ``plant`` and ``actuators`` and ``visualizer`` (or None)."""
+    """A built loop Diagram: ``diagram``, its ``plant`` and ``visualizer`` (or None)."""
 
     diagram: object
     plant: object
-    actuators: object
     visualizer: object = None
 
 
-def loop_diagram(
-    plant_platform: Platform,
-    plant_time_step: float,
-    integrator: str,
-    max_force: float,
-    time_constant: float,
-    meshcat=None,
-) -> LoopDiagram:
-    """The loop Diagram of a plant of ``plant_platform`` stepped at ``plant_time_step`` s under
-    ``integrator``, driven by actuators limited to ``max_force`` N with lag ``time_constant`` s (from the
-    cache when one with the same inputs was built in this process and ``meshcat`` is None)."""
+def loop_diagram(plant_platform: Platform, plant_time_step: float, integrator: str, meshcat=None) -> LoopDiagram:
+    """The loop Diagram of a plant of ``plant_platform`` stepped at ``plant_time_step`` s under ``integrator``
+    (from the cache when one with the same inputs was built in this process and ``meshcat`` is None)."""
     if meshcat is not None:
-        return _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat)
-    inputs = (plant_platform, float(plant_time_step), integrator, float(max_force), float(time_constant))
+        return _build(plant_platform, plant_time_step, integrator, meshcat)
+    inputs = (plant_platform, float(plant_time_step), integrator)
     return DIAGRAM_CACHE.get(digest(pickle.dumps(inputs, protocol=5)), lambda: _build(*inputs, None))
 
 
-def _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat) -> LoopDiagram:
+def _build(plant_platform, plant_time_step, integrator, meshcat) -> LoopDiagram:
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
-    act = builder.AddSystem(Actuators(max_force, time_constant, plant_time_step))
-    act.set_name("actuators")
-    builder.ExportInput(act.get_input_port(), "command")
-    builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
+    builder.ExportInput(plant.get_actuation_input_port(), "actuation")
     visualizer = None
     if meshcat is not None:
         visualizer = MeshcatVisualizer.AddToBuilder(
             builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=VISUALIZER_PERIOD)
         )
-    return LoopDiagram(builder.Build(), plant, act, visualizer)
+    return LoopDiagram(builder.Build(), plant, visualizer)
 
 
 DIAGRAM_CACHE = Memo(2)  # the last 2 loop Diagrams built in this process

@@ -4,15 +4,15 @@ One typed, picklable ``Scenario`` describes a run (platform, reference, controll
 and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram and the
 loop that drives it::
 
-    reference rows ──▶ DSP tick (fixed | float law, period T) ──command (fixed input)──▶ Actuators
-        ▲  feed-forward rows ──▶ ▲ leg_lengths                                             │ force
-        │                        └──────── sensor (prismatic positions) ◀──── plant ◀──────┘
+    reference rows ──▶ DSP tick (fixed | float law, period T) ──command──▶ actuators ──force (fixed input)──┐
+        ▲  feed-forward rows ──▶ ▲ leg_lengths                                                              │
+        │                        └──────── sensor (prismatic positions) ◀──── plant ◀─────────────────────┘
         └ (core.trajectory: seed, rotating, a (t, pose) CSV, a motion program)
 
-The Diagram holds what runs in C++: the plant, the actuators (saturation and lag) and the plant's
-loggers; the DSP's side runs between ``Simulator.AdvanceTo`` calls in one tight loop
-(``drake.tick_loop``: the same numbers as a ``drake.systems.ControllerSystem`` wired into the Diagram,
-bit for bit, without a Python call inside the simulator's step).
+The Diagram holds what runs in C++: the plant; the DSP's side and the actuators (saturation and lag,
+``control.actuation``) run between ``Simulator.AdvanceTo`` calls, one compiled call per stop
+(``drake.tick_loop``: the same numbers as a ``drake.systems.ControllerSystem`` and ``drake.systems.Actuators``
+wired into the Diagram, bit for bit, without a Python call inside the simulator's step).
 
 The feed-forward table (``control.feedforward``) holds, per tick, the leg forces of the inverse dynamics
 (plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
@@ -36,6 +36,7 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.analysis import Simulator
 from tqdm import tqdm
 
+from stewart_drake.control.actuation import Actuation
 from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.simulation_log import SimulationLog
@@ -277,9 +278,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     law = make_law(s.controller, platform, config, s.engine, s.firmware)
     T = config.timing.sample_period
     max_force = actuators.max_force or float(platform.legs.max_force)
-    # the plant and actuators: reused from an earlier run of this process with the same ones (``loop_diagram``)
-    built = loop_diagram(plant_platform, plant_time_step, integrator, max_force, actuators.time_constant, meshcat)
-    diagram, plant, act = built.diagram, built.plant, built.actuators
+    # the plant: reused from an earlier run of this process with the same one (``loop_diagram``)
+    built = loop_diagram(plant_platform, plant_time_step, integrator, meshcat)
+    diagram, plant = built.diagram, built.plant
     joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
     sensor_model = s.sensor
     if np.any(plant_platform.length_offset):  # a sensor reads the joint-to-joint length − legs.length_offset
@@ -313,15 +314,14 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
-    # a continuous plant without the actuators' lag integrates with the command released at a tick
-    after = integrator in CONTINUOUS and act.lag is None
+    # the actuators (saturation, lag) are stepped by the loop at the plant steps, their lag starting at F0
+    act = Actuation.from_time_constant(max_force, actuators.time_constant, plant_time_step)
     discrete = integrator not in CONTINUOUS
     loop = TickLoop(
-        simulator, plant, pc, diagram.GetInputPort("command"), law, sensor, plant_time_step, after, act, discrete
+        simulator, plant, pc, diagram.GetInputPort("actuation"), law, sensor, plant_time_step, act, discrete
     )
     loop.reference = trajectory.pose(np.zeros(1))  # until ``run`` fills the tables: the pose at t = 0
     loop.initialize(L0, F0, None if ff is None else ff.force(0.0), rates0)
-    act.set_force(root, F0)
     simulator.Initialize()
     return Simulation(
         platform,

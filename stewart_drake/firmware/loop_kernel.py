@@ -1,7 +1,8 @@
 """The closed loop's DSP side in compiled C, one call per stop (``fixedpoint/c/sd_loop.c``): what
 ``drake.tick_loop.TickLoop`` does between two ``AdvanceTo`` calls — the plant state read where Drake keeps
 it, the sensor, the law's tick, the output release, the actuators' command written where Drake reads it,
-the logs appended to preallocated arrays — without a Python operation per tick.
+the actuators (``control.actuation``) and the logs appended to preallocated arrays — without a Python
+operation per tick.
 
 Two laws: the fixed-point law with the compiled firmware (``firmware.sil.CFixedPointLaw``: ``sd_loop.c`` is
 linked into the firmware module and calls the same ``sd_host_tick``), and the float law
@@ -143,31 +144,34 @@ class LoopKernel:
         s.n_ticks = len(poses)
 
     def start(
-        self, x, command, lag, max_force, schedule, feedforward, held, memory, status, at_tick, input_after, logs
+        self, x, actuation, actuators, lag_force, schedule, feedforward, held, memory, status, at_tick, logs
     ) -> None:
-        """Point the struct at Drake's memory — the plant state ``x``, the command input ``command``, the
-        actuators' lag state ``lag`` (None: no lag, the force is the command saturated at ``max_force`` N);
-        numpy views valid for the run —, the ``schedule`` (``tick_loop.Schedule``), the feed-forward rows
-        (``(n_ticks, 6)`` N, or None), the controller's state and the ``logs`` (``held`` (n, 12), ``status``
-        (n, len(STATUS)), ``state`` (n, nx), ``force`` (n, 6))."""
+        """Point the struct at Drake's memory — the plant state ``x`` and its actuation input ``actuation``
+        (numpy views valid for the run) —, the ``actuators`` (``control.actuation.Actuation``) with their lag
+        state ``lag_force`` (6, N; None without a lag), the ``schedule`` (``tick_loop.Schedule``), the
+        feed-forward rows (``(n_ticks, 6)`` N, or None), the controller's state (``at_tick``: ``dsp_state.releases_at_tick``) and the ``logs`` (``held``
+        (n, 12), ``status`` (n, len(STATUS)), ``state`` (n, nx), ``force`` (n, 6))."""
         s = self.s
         indices = [self.sensor.positions] + ([self.sensor.velocities] if isinstance(self.sensor, SensorReading) else [])
         if not all(0 <= i < len(x) for i in np.concatenate(indices).tolist()):
             raise RuntimeError("sensor indices outside the plant state")  # a bug: they are the plant's joints
-        s.x, s.input = self._view("double *", x), self._view("double *", command)
-        s.lag = self.ffi.NULL if lag is None else self._view("double *", lag)
-        s.max_force = max_force
+        s.x, s.input = self._view("double *", x), self._view("double *", actuation)
+        s.max_force, s.has_lag = actuators.max_force, int(actuators.has_lag)
+        if actuators.has_lag:
+            s.lag_a, s.lag_b = actuators.a, actuators.b
+            s.lag_force[0:6] = np.asarray(lag_force, dtype=float).tolist()
         s.times = self._ptr("double *", np.asarray(schedule.times, dtype=float))
         s.tick = self._ptr("int32_t *", np.asarray(schedule.tick, dtype=np.int32))
         s.release = self._ptr("int8_t *", np.asarray(schedule.release, dtype=np.int8))
         s.log = self._ptr("int8_t *", np.asarray(schedule.log, dtype=np.int8))
+        s.step = self._ptr("int8_t *", np.asarray(schedule.step, dtype=np.int8))
         s.n_stops = len(schedule.times)
         if feedforward is not None:
             ff = np.asarray(feedforward, dtype=float)
             if len(ff) < s.n_ticks:
                 raise RuntimeError(f"feed-forward table of {len(ff)} rows for {s.n_ticks} ticks")  # a bug
             s.ff = self._ptr("double *", ff)
-        s.at_tick, s.input_after = int(at_tick), int(input_after)
+        s.at_tick = int(at_tick)
         s.held[0:12] = np.asarray(held, dtype=float)[:12].tolist()
         s.memory[0:42] = np.asarray(memory, dtype=float).tolist()
         s.status[0 : len(STATUS)] = np.asarray(status, dtype=float).tolist()
@@ -179,9 +183,10 @@ class LoopKernel:
         s.row = 0
 
     def state(self) -> tuple:
-        """``(held (12,), memory (42,), status)`` now (copies)."""
+        """``(held (12,), memory (42,), status, lag_force (6,))`` now (copies)."""
         s = self.s
-        return np.array(list(s.held)), np.array(list(s.memory)), np.array(list(s.status))[: len(STATUS)]
+        held, memory, status = np.array(list(s.held)), np.array(list(s.memory)), np.array(list(s.status))
+        return held, memory, status[: len(STATUS)], np.array(list(s.lag_force))
 
     def raise_error(self, code: int) -> None:
         """The error of a failed ``stop``/``update`` (``code`` < 0)."""

@@ -85,28 +85,31 @@ def test_kernel_with_boundaries_and_without_feedforward():
 
 @pytest.mark.parametrize("integrator", ["cenic-fixed", "sap"])
 def test_views_of_drake_memory_hold_across_advance(integrator):
-    """The plant state view (the context's continuous or discrete state vector) and the actuators' lag view
-    are the memory Drake writes each step into: after ``AdvanceTo`` they show the new state — equal to
-    ``GetPositionsAndVelocities`` and to the actuators' output port — at the same addresses; a command written
-    through the input view, then ``GetMutableData`` (Drake told), is what the Diagram's input port evaluates to."""
-    sim = build_simulation(Scenario(PLATFORM, "seed", "float", integrator=integrator))
-    loop = sim.controller
-    x, command, lag = loop._views()
-    addresses, before = [a.__array_interface__["data"][0] for a in (x, lag)], (x.copy(), lag.copy())
-    command[:] = np.linspace(-50.0, 50.0, 6)  # a new command, so that the lag moves too
-    loop._fixed.GetMutableData()
-    port = sim.diagram.GetInputPort("command")
-    np.testing.assert_array_equal(port.Eval(sim.simulator.get_context()), np.linspace(-50.0, 50.0, 6))
-    sim.simulator.AdvanceTo(0.003)
-    assert [a.__array_interface__["data"][0] for a in (x, lag)] == addresses
-    assert not np.array_equal(x, before[0]) and not np.array_equal(lag, before[1])  # they moved with Drake
-    np.testing.assert_array_equal(x, sim.plant.GetPositionsAndVelocities(loop.plant_context))
-    force_port, force_context = loop.force
-    np.testing.assert_array_equal(lag, force_port.Eval(force_context))
-    again = loop._views()
-    assert [a.__array_interface__["data"][0] for a in again] == [
-        a.__array_interface__["data"][0] for a in (x, command, lag)
-    ]
+    """The plant state view (the context's continuous or discrete state vector) is the memory Drake writes each
+    step into: after ``AdvanceTo`` it shows the new state — equal to ``GetPositionsAndVelocities`` — at the same
+    address; a force written through the actuation view, then ``GetMutableData`` (Drake told), is what the
+    plant's actuation port evaluates to, and what the plant integrates with (a different force, a different
+    motion)."""
+    runs = []
+    for push in (0.0, 50.0):
+        sim = build_simulation(Scenario(PLATFORM, "seed", "float", integrator=integrator))
+        loop = sim.controller
+        x, actuation = loop._views()
+        address, x0 = x.__array_interface__["data"][0], x.copy()
+        actuation[:] = loop.lag_force + push
+        loop._fixed.GetMutableData()
+        port = sim.plant.get_actuation_input_port()
+        np.testing.assert_array_equal(port.Eval(loop.plant_context), loop.lag_force + push)
+        sim.simulator.AdvanceTo(0.003)
+        assert x.__array_interface__["data"][0] == address
+        assert not np.array_equal(x, x0)  # it moved with the plant
+        np.testing.assert_array_equal(x, sim.plant.GetPositionsAndVelocities(loop.plant_context))
+        again = loop._views()
+        assert [a.__array_interface__["data"][0] for a in again] == [
+            a.__array_interface__["data"][0] for a in (x, actuation)
+        ]
+        runs.append(x.copy())
+    assert not np.array_equal(*runs)
 
 
 def test_float_loop_without_a_compiler_runs_python_with_one_note(tmp_path):

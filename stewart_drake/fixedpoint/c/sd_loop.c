@@ -14,7 +14,7 @@ int sd_host_tick(sd_state *s, const sd_word pose[6], const double L[6], double r
                  double lsb, double state[30], double out[18]);
 #endif
 
-/* np.minimum(np.maximum(v, -lim), lim), NaN passing through as in numpy */
+/* np.minimum(np.maximum(v, -lim), lim), NaN passing through as in numpy (and Drake's Saturation of finite values) */
 static double clip(double v, double lim)
 {
     v = v < -lim ? -lim : v;
@@ -113,8 +113,7 @@ static int tick(sd_loop *L, long k, double t)
 }
 
 /* The log row of stop i (i = -1: t = 0), if it logs there: the held values and status before its updates,
- * the plant state and the actuators' force (what Drake's loggers sampled there: the lag's state, or the
- * saturated command). Returns 0. */
+ * the plant state and the actuators' force (what the plant integrates with). Returns 0. */
 int sd_loop_log(sd_loop *L, long i)
 {
     if (i >= 0 && !L->log[i]) return 0;
@@ -122,25 +121,22 @@ int sd_loop_log(sd_loop *L, long i)
     memcpy(L->held_log + 12 * L->row, L->held, 12 * sizeof(double));
     memcpy(L->status_log + 10 * L->row, L->status, 10 * sizeof(double));
     memcpy(L->x_log + L->nx * L->row, L->x, L->nx * sizeof(double));
-    if (L->lag) {
-        memcpy(L->force_log + 6 * L->row, L->lag, 6 * sizeof(double));
-    } else {
-        int j;
-        for (j = 0; j < 6; j++) L->force_log[6 * L->row + j] = clip(L->input[j], L->max_force);
-    }
+    memcpy(L->force_log + 6 * L->row, L->input, 6 * sizeof(double));
     L->row++;
     return 0;
 }
 
-/* The updates at stop i (i = -1: the tick at t = 0): the tick or the separate release, then the input the
- * plant's Diagram reads until the next stop. Returns 1 if the input changed (the caller notifies Drake),
- * 0 if not, < 0 on an error (-1: a reading the firmware cannot take, see error_lengths). */
+/* The updates at stop i (i = -1: the tick at t = 0): the tick or the separate release, then the actuators
+ * (control.actuation.Actuation): at a plant step their lag takes the command held before the
+ * controller's update there, F <- a F + b sat(u) (simultaneous discrete updates read the old state); without
+ * a lag the force is the command just held, saturated. Returns 1 if the force changed (the caller notifies
+ * Drake), 0 if not, < 0 on an error (-1: a reading the firmware cannot take, see error_lengths). */
 int sd_loop_update(sd_loop *L, long i)
 {
-    double before[12];
-    const double *now;
+    double before[12], force[6];
     long k = i < 0 ? 0 : L->tick[i];
     double t = i < 0 ? 0.0 : L->times[i];
+    int j, step = i < 0 ? 1 : L->step[i];
     memcpy(before, L->held, sizeof before);
     if (k >= 0) {
         int r = tick(L, k, t);
@@ -149,9 +145,15 @@ int sd_loop_update(sd_loop *L, long i)
         memcpy(L->held, L->memory, 12 * sizeof(double));
         L->status[2] = t;
     }
-    now = L->input_after ? L->held : before;
-    if (memcmp(L->input, now, 6 * sizeof(double)) == 0) return 0;
-    memcpy(L->input, now, 6 * sizeof(double));
+    if (L->has_lag) {
+        if (!step) return 0;
+        for (j = 0; j < 6; j++) L->lag_force[j] = L->lag_a * L->lag_force[j] + L->lag_b * clip(before[j], L->max_force);
+        memcpy(force, L->lag_force, sizeof force);
+    } else {
+        for (j = 0; j < 6; j++) force[j] = clip(L->held[j], L->max_force);
+    }
+    if (memcmp(L->input, force, sizeof force) == 0) return 0;
+    memcpy(L->input, force, sizeof force);
     return 1;
 }
 
