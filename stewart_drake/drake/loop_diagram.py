@@ -1,8 +1,8 @@
 """The closed loop's Diagram: what runs in C++ between the controller's ticks — the plant (with its scene
-graph), its actuation as the Diagram's input ``actuation`` and, for an animation, the Meshcat visualizer.
-No actuators and no loggers: the loop stops at every plant step, steps the actuators' saturation and lag
-there itself (``control.actuation``: Drake's ``Saturation`` and ``LinearSystem``'s numbers) and logs the
-plant state and their force (``tick_loop.TickLoop``), without two more systems and their events per step.
+graph), its actuation as the Diagram's input ``actuation``, a periodic event at every plant step and, for an
+animation, the Meshcat visualizer. No actuators and no loggers: the loop stops at every plant step, steps the
+actuators' saturation and lag there itself (``control.actuation``: Drake's ``Saturation`` and
+``LinearSystem``'s numbers) and logs the plant state and their force (``tick_loop.TickLoop``).
 
 Built once per structure and reused (``DIAGRAM_CACHE``): a Diagram holds no state (every run has its own
 context and Simulator), so the runs of a process whose plant platform, plant step and integrator are the same
@@ -16,8 +16,10 @@ from __future__ import annotations
 import pickle
 from dataclasses import dataclass
 
+import numpy as np
 from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource, ZeroOrderHold
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.memo import Memo, digest
@@ -49,6 +51,12 @@ def _build(plant_platform, plant_time_step, integrator, meshcat) -> LoopDiagram:
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
     builder.ExportInput(plant.get_actuation_input_port(), "actuation")
+    # A periodic discrete update at every plant step (a one-value hold of a constant: nothing to compute), as
+    # the actuators' lag had: Drake's Simulator ends a step at an event time otherwise than at an AdvanceTo
+    # boundary alone (without these events the states of a run drift by an ulp from t = 1 s on), so the
+    # loop keeps the Diagram's event times and its integration bit for bit.
+    clock = builder.AddSystem(ZeroOrderHold(plant_time_step, 1))
+    builder.Connect(builder.AddSystem(ConstantVectorSource(np.zeros(1))).get_output_port(), clock.get_input_port())
     visualizer = None
     if meshcat is not None:
         visualizer = MeshcatVisualizer.AddToBuilder(

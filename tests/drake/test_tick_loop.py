@@ -121,6 +121,20 @@ def test_tick_loop_logs_equal_the_all_drake_diagram(kind, integrator, latency, t
     assert log.saturations().sum() == 0 and np.ptp(log.command, axis=0).min() > 0.1  # the command moved
 
 
+def test_tick_loop_logs_equal_the_all_drake_diagram_past_one_second():
+    """The default loop for 1.01 s: past t = 1 s, where a Diagram without an event at every plant step (an
+    ``AdvanceTo`` boundary alone) integrates to a slightly different state (``loop_diagram``'s clock)."""
+    sc = Scenario(
+        PLATFORM, SEED, "float", ControllerConfig.for_platform(PLATFORM), engine="c", integrator="cenic-fixed"
+    )
+    sim = build_simulation(sc)
+    log = sim.run(1.01)
+    ref = all_drake_run(sc, 1.01)
+    np.testing.assert_array_equal(sim.states(), ref["state"])
+    for name in ("command", "force"):
+        np.testing.assert_array_equal(getattr(log, name), ref[name], err_msg=name)
+
+
 def test_schedule_stops_at_every_event_and_logs_at_the_plant_steps():
     """Plant steps 0.5 ms, ticks 1 ms, releases 0.25 ms after each tick, an extra boundary: every stop in
     order, once, the ticks numbered, and a continuous plant logs only at its steps."""
