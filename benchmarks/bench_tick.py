@@ -1,18 +1,18 @@
 """Where a closed-loop tick's microseconds go (item 1 of the speed issue), each target beside its figure and
 its reference, all measured in one run, interleaved, best of ``--repeat``:
 
-- references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the plant
-  the loop drives — the loop's own Diagram (``loop_diagram``: the plant alone, its actuation a fixed input)
-  advanced tick by tick with the actuators' lag stepped on a command that changes every tick, the force
-  written through a view of Drake's memory (no law, no logs): the ceiling of any loop on this Diagram;
+- references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the loop's
+  own Diagram (``loop_diagram``: the plant, its actuation a fixed input, an event every plant step) at rest,
+  advanced tick by tick: the cost of stopping at every tick;
 - the loops with their compiled DSP side (``firmware.loop_kernel``: one C call per stop): the fixed-point
   law with the generated firmware (C engine) and the float law, each with its tick tables computed cold
   (``TABLE_CACHE`` cleared: a report's or a study's first run) and remembered (every later run of the same
   reference and model in the process); target ≥ 0.8 × the bare plant's real-time factor;
 - the same loops with the Python ticks (``TickLoop._run_python``, the reference and the fallback) for
   comparison;
-- the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it),
-  against the ceiling's own Python per tick (write the command, notify Drake).
+- where a loop's tick goes: the tables, the thread CPU inside Drake's ``AdvanceTo`` (beside the bare plant's
+  and the stopped plant's: the rest is the plant's own work along the moving reference) and outside it;
+- the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it).
 
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
 millisecond is one tick, so µs per tick = 1000 / real-time factor. Process CPU time (on a loaded machine wall
@@ -34,7 +34,7 @@ from bench_integrators import CONTINUOUS, apply_integrator  # noqa: E402  (bench
 from stewart_drake.control.feedforward import TABLE_CACHE  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
-from stewart_drake.drake.simulation import ActuatorModel, Scenario, build_simulation  # noqa: E402
+from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 
 TARGET = 0.8  # the loop's real-time factor over the bare plant's
 PERIOD = 1e-3  # s: the plant step and the controller's sample period of the default loop
@@ -68,36 +68,28 @@ def plant(p, duration: float) -> float:
     return 1e6 * PERIOD * (time.process_time() - c0) / duration
 
 
-def driven_plant(p, duration: float) -> float:
-    """CPU µs per tick of the loop's own Diagram (``loop_diagram``: the plant, its actuation a fixed input)
-    advanced tick by tick, the actuators' lag stepped in numpy on a leg-force command that changes every tick
-    (±1e-6 relative about home's static forces) and the force written through a view of the fixed input with
-    Drake notified (``GetMutableData``), as the loop does: the loop without its DSP side."""
+def stopped_plant(p, duration: float) -> float:
+    """CPU µs per tick of the loop's own Diagram (``loop_diagram``: the plant, its actuation a fixed input, the
+    clock's event at every plant step) held at home by constant leg forces and advanced tick by tick: the cost
+    of stopping at every tick, without a law, a changing force or motion."""
     from pydrake.systems.analysis import Simulator
 
-    from stewart_drake.control.actuation import Actuation
     from stewart_drake.core.dynamics import leg_forces_with_legs
     from stewart_drake.drake.loop_diagram import loop_diagram
     from stewart_drake.drake.platform_model import set_pose
 
     built = loop_diagram(p, PERIOD, DEFAULT_INTEGRATOR)
-    act = Actuation.from_time_constant(float(p.legs.max_force), ActuatorModel().time_constant, PERIOD)
     sim = Simulator(built.diagram)
     apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
     root = sim.get_mutable_context()
     set_pose(built.plant, built.plant.GetMyMutableContextFromRoot(root), p, p.home_pose())
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
-    fixed = built.diagram.GetInputPort("actuation").FixValue(root, F)
-    view = fixed.GetMutableData().get_mutable_value().get_mutable_value()
-    commands = [F * (1 + 1e-6), F * (1 - 1e-6)]
-    notify, advance = fixed.GetMutableData, sim.AdvanceTo
+    built.diagram.GetInputPort("actuation").FixValue(root, F)
+    advance = sim.AdvanceTo
     sim.Initialize()
     n = int(round(duration / PERIOD))
     c0 = time.process_time()
     for k in range(1, n + 1):
-        F = act.step(F, commands[k % 2])
-        view[:] = F
-        notify()
         advance(k * PERIOD)
     return 1e6 * (time.process_time() - c0) / n
 
@@ -140,6 +132,36 @@ class _NoAdvance:
         return self._simulator.get_context()
 
 
+class _TimedAdvance(_NoAdvance):
+    """A Simulator whose ``AdvanceTo`` adds its thread CPU time to ``inside``."""
+
+    inside = 0.0
+
+    def AdvanceTo(self, t):  # noqa: N802  (Drake's name)
+        c = time.thread_time()
+        self._simulator.AdvanceTo(t)
+        self.inside += time.thread_time() - c
+
+
+def split(p, kind: str, engine: str, duration: float) -> tuple[float, float]:
+    """``(inside, outside)``: thread CPU µs per tick of one loop run (tables filled before) spent inside Drake's
+    ``AdvanceTo`` and outside it (the DSP side and the Python loop), the two timer reads per call (calibrated)
+    taken out of the outside share."""
+    c = time.thread_time()
+    for _ in range(10000):
+        time.thread_time()
+    read = (time.thread_time() - c) / 10000  # one timer read
+    sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
+    sim.prepare(duration)
+    timed = _TimedAdvance(sim.simulator)
+    sim.controller.simulator = timed
+    c = time.thread_time()
+    sim.controller.run(duration)
+    total = time.thread_time() - c
+    n = duration / PERIOD
+    return 1e6 * timed.inside / n, 1e6 * (total - timed.inside - 2 * read * n) / n
+
+
 def dsp_side(p, kind: str, engine: str, duration: float) -> float:
     """Wall µs per tick of the loop without Drake's work (``AdvanceTo`` a no-op, tables filled before): the
     compiled kernel's call, Drake's notification and the Python ``for`` per stop."""
@@ -151,24 +173,6 @@ def dsp_side(p, kind: str, engine: str, duration: float) -> float:
     return 1e6 * (time.perf_counter() - t0) / (duration / PERIOD)
 
 
-def ceiling_python(p, duration: float) -> float:
-    """Wall µs per tick of the ceiling's own Python (the lag stepped in numpy, the force written through the
-    view, Drake notified, a no-op ``AdvanceTo``): what ``driven_plant`` spends per tick besides Drake's work."""
-    sim = build_simulation(Scenario(p, "seed", "float"))
-    fixed, act = sim.controller._fixed, sim.controller.actuators
-    view = fixed.GetMutableData().get_mutable_value().get_mutable_value()
-    commands, F = [np.ones(6), np.full(6, 2.0)], np.zeros(6)
-    notify, advance = fixed.GetMutableData, _NoAdvance(None).AdvanceTo
-    n = int(round(duration / PERIOD))
-    t0 = time.perf_counter()
-    for k in range(1, n + 1):
-        F = act.step(F, commands[k % 2])
-        view[:] = F
-        notify()
-        advance(k * PERIOD)
-    return 1e6 * (time.perf_counter() - t0) / n
-
-
 LOOPS = {  # label: (kind, engine, cold tables, Python ticks)
     "fixed/C, cold tables": ("fixed", "c", True, False),
     "fixed/C, remembered tables": ("fixed", "c", False, False),
@@ -177,7 +181,7 @@ LOOPS = {  # label: (kind, engine, cold tables, Python ticks)
     "fixed/C, Python ticks, remembered tables": ("fixed", "c", False, True),
     "float, Python ticks, remembered tables": ("float", "python", False, True),
 }
-PLANT, DRIVEN = "bare plant (the reference)", "the loop's Diagram driven tick by tick (ceiling)"
+PLANT, STOPPED = "bare plant (the reference)", "the loop's Diagram stopped every tick, at rest"
 
 
 def main(argv=None) -> int:
@@ -190,7 +194,7 @@ def main(argv=None) -> int:
     p = load_preset("utn-dynamic")
     loop(p, "warm-up", "fixed", "c", 0.01, True)  # compile and cache the firmware and the kernel before timing
     loop(p, "warm-up", "float", "python", 0.01, True)
-    runs = {PLANT: lambda: plant(p, D), DRIVEN: lambda: driven_plant(p, D)}
+    runs = {PLANT: lambda: plant(p, D), STOPPED: lambda: stopped_plant(p, D)}
     runs |= {label: (lambda a=a, label=label: loop(p, label, a[0], a[1], D, a[2], a[3])) for label, a in LOOPS.items()}
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
@@ -205,23 +209,30 @@ def main(argv=None) -> int:
             target = f"; target >= {TARGET}: {'met' if ratio >= TARGET else 'NOT met'}" if k in LOOPS else ""
             extra = f"  {ratio:.2f} × the bare plant's real-time factor{target}"
         print(f"  {k:48s} {v:6.1f} µs = real-time factor {1e3 / v:6.2f}x{extra}")
-    driven = us[DRIVEN]
     print(
-        "where a tick's µs go (the loop = plant + driving it + tick tables + the rest: the DSP side, see below, and\n"
-        "  the plant's extra work along the reference — the bare plant and the ceiling rest at home):"
+        "where a tick's µs go (the loop = tick tables + Drake's AdvanceTo + the rest; thread CPU, best of the repetitions):"
     )
-    for label in LOOPS:
-        tables = TABLES[label]
-        rest = us[label] - driven - tables
+    splits = {"fixed/C": ("fixed", "c"), "float": ("float", "python")}
+    best_split = {}
+    for _ in range(args.repeat):
+        for label, (kind, engine) in splits.items():
+            inside, outside = split(p, kind, engine, D)
+            if label not in best_split or inside + outside < sum(best_split[label]):
+                best_split[label] = (inside, outside)
+    for label, (inside, outside) in best_split.items():
+        cold, warm = TABLES[f"{label}, cold tables"], TABLES[f"{label}, remembered tables"]
         print(
-            f"  {label:48s} {us[label]:6.1f} = plant {us[PLANT]:5.1f} + driving it (an AdvanceTo per tick, a "
-            f"changing force) {driven - us[PLANT]:4.1f} + tick tables {tables:4.1f} + DSP side and motion {rest:5.1f}"
+            f"  {label:8s} tables {cold:5.1f} cold / {warm:4.1f} remembered + inside AdvanceTo {inside:6.1f} + outside "
+            f"{outside:4.1f} (the DSP side, the Python loop)"
         )
+    print(
+        f"  (inside AdvanceTo: the bare plant's {us[PLANT]:.1f} at rest, {us[STOPPED]:.1f} stopped every tick at rest;"
+        " the rest is the plant's own work along the moving reference)"
+    )
     print("the DSP side alone, AdvanceTo a no-op (wall µs per tick, best of the repetitions):")
     alone = {
         "fixed/C, compiled kernel": lambda: dsp_side(p, "fixed", "c", D),
         "float, compiled kernel": lambda: dsp_side(p, "float", "python", D),
-        "the ceiling's own Python (lag, write, notify)": lambda: ceiling_python(p, D),
     }
     for k, f in alone.items():
         print(f"  {k:48s} {min(f() for _ in range(args.repeat)):6.2f} µs")
