@@ -10,8 +10,9 @@ its reference, all measured in one run, interleaved, best of ``--repeat``:
   reference and model in the process); target ≥ 0.8 × the bare plant's real-time factor;
 - the same loops with the Python ticks (``TickLoop._run_python``, the reference and the fallback) for
   comparison;
-- where a loop's tick goes: the tables, the thread CPU inside Drake's ``AdvanceTo`` (beside the bare plant's
-  and the stopped plant's: the rest is the plant's own work along the moving reference) and outside it;
+- where a loop's tick goes: the tables, the thread CPU inside Drake's ``AdvanceTo`` (beside the bare plant's,
+  the stopped plant's and the plant alone replaying the loop's own forces: the plant's work along the moving
+  reference) and outside it;
 - the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it).
 
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
@@ -92,6 +93,39 @@ def stopped_plant(p, duration: float) -> float:
     for k in range(1, n + 1):
         advance(k * PERIOD)
     return 1e6 * (time.process_time() - c0) / n
+
+
+def replayed_plant(p, kind: str, engine: str, duration: float) -> float:
+    """CPU µs per tick of the plant alone (one ``AdvanceTo``, no loop) replaying a closed loop's own forces
+    (its log, held over each plant step by a Drake ``TrajectorySource``) from the loop's initial state: the
+    plant's work along the moving reference, which the bare plant at rest does not do."""
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import TrajectorySource
+    from pydrake.trajectories import PiecewisePolynomial
+
+    from stewart_drake.core.trajectory import get_trajectory
+    from stewart_drake.drake.platform_model import build_plant, set_pose
+    from stewart_drake.drake.simulation import set_velocity
+
+    log = build_simulation(Scenario(p, "seed", kind, engine=engine)).run(duration)
+    builder = DiagramBuilder()
+    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    # the force logged at t_k acted over (t_k-1, t_k]: row k + 1 acts over (t_k, t_k+1]
+    hold = PiecewisePolynomial.ZeroOrderHold(log.t[:-1], log.force[1:].T)
+    src = builder.AddSystem(TrajectorySource(hold))
+    builder.Connect(src.get_output_port(), mbp.get_actuation_input_port())
+    sim = Simulator(builder.Build())
+    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
+    pc = mbp.GetMyMutableContextFromRoot(sim.get_mutable_context())
+    trajectory = get_trajectory("seed")
+    set_pose(mbp, pc, p, trajectory.pose(0.0))
+    set_velocity(mbp, pc, p, trajectory, 0.0)
+    sim.Initialize()
+    end = float(log.t[-1])
+    c0 = time.process_time()
+    sim.AdvanceTo(end)
+    return 1e6 * PERIOD * (time.process_time() - c0) / end
 
 
 TABLES: dict[str, float] = {}  # CPU µs per tick of Simulation.prepare (the tick tables), per loop label
@@ -225,9 +259,17 @@ def main(argv=None) -> int:
             f"  {label:8s} tables {cold:5.1f} cold / {warm:4.1f} remembered + inside AdvanceTo {inside:6.1f} + outside "
             f"{outside:4.1f} (the DSP side, the Python loop)"
         )
+    replay = {
+        label: min(replayed_plant(p, kind, engine, D) for _ in range(args.repeat))
+        for label, (kind, engine) in splits.items()
+    }
     print(
-        f"  (inside AdvanceTo: the bare plant's {us[PLANT]:.1f} at rest, {us[STOPPED]:.1f} stopped every tick at rest;"
-        " the rest is the plant's own work along the moving reference)"
+        f"  (inside AdvanceTo: the bare plant's {us[PLANT]:.1f} at rest, {us[STOPPED]:.1f} stopped every tick at rest; the "
+        "plant alone replaying the loop's own forces along its motion, one AdvanceTo: "
+        + ", ".join(
+            f"{label} {v:.1f} = {us[PLANT] / v:.2f} × the bare plant's real-time factor" for label, v in replay.items()
+        )
+        + ")"
     )
     print("the DSP side alone, AdvanceTo a no-op (wall µs per tick, best of the repetitions):")
     alone = {
