@@ -1,17 +1,24 @@
-"""Where a closed-loop tick's microseconds go (item 1 of the speed issue): the plant alone, the loop with
-the compiled firmware (C engine) and with the float law, and the same loop with the law's ``step``
-replaced by a constant — all in one run, interleaved, best of ``--repeat``.
+"""Where a closed-loop tick's microseconds go (item 1 of the speed issue), each target beside its figure and
+its reference, all measured in one run, interleaved, best of ``--repeat``:
 
-The loop's ticks run outside the Diagram (``drake.tick_loop``): Drake advances the plant and the
-actuators with ``AdvanceTo`` from tick to tick, one Python loop does the DSP's side. Two plant references:
-the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the plant the loop
-actually drives ("plant + actuators, input changing every tick": the actuators' lag and its loggers, an
-``AdvanceTo`` per tick and a command that changes every tick, so the integrator cannot reuse what it
-computed for the previous step; no Python law) — the ceiling of any loop with this Diagram.
+- references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the loop's
+  own Diagram (``loop_diagram``: the plant, its actuation a fixed input, an event every plant step) at rest,
+  advanced tick by tick: the cost of stopping at every tick;
+- the loops with their compiled DSP side (``firmware.loop_kernel``: one C call per stop): the fixed-point
+  law with the generated firmware (C engine) and the float law, each with its tick tables computed cold
+  (``TABLE_CACHE`` cleared: a report's or a study's first run) and remembered (every later run of the same
+  reference and model in the process); target ≥ 0.8 × the bare plant's real-time factor;
+- the same loops with the Python ticks (``TickLoop._run_python``, the reference and the fallback) for
+  comparison;
+- where a loop's tick goes: the tables, the thread CPU inside Drake's ``AdvanceTo`` (beside the bare plant's,
+  the stopped plant's and the plant alone replaying the loop's own forces: the plant's work along the moving
+  reference) and outside it;
+- the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it).
 
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
-millisecond is one tick, so µs per tick = 1000 / real-time factor. Prints the load (``uptime``) first and
-last; on a shared machine the ratios are what travel. Measures only: it changes nothing in the loop.
+millisecond is one tick, so µs per tick = 1000 / real-time factor. Process CPU time (on a loaded machine wall
+time includes waiting for a core); prints the load first and last: on a shared machine the ratios are what
+travel. Measures only: it changes nothing in the loop.
 """
 
 from __future__ import annotations
@@ -31,6 +38,7 @@ from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 
 TARGET = 0.8  # the loop's real-time factor over the bare plant's
+PERIOD = 1e-3  # s: the plant step and the controller's sample period of the default loop
 
 
 def load() -> str:
@@ -38,8 +46,8 @@ def load() -> str:
 
 
 def plant(p, duration: float) -> float:
-    """CPU seconds per simulated second of the plant alone (``bench_integrators.bare_plant``'s set-up: the
-    legs pushed with home's static forces; build excluded)."""
+    """CPU µs per tick of the plant alone (``bench_integrators.bare_plant``'s set-up: the legs pushed with
+    home's static forces; build excluded)."""
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource
@@ -48,112 +56,166 @@ def plant(p, duration: float) -> float:
     from stewart_drake.drake.platform_model import build_plant, set_pose
 
     builder = DiagramBuilder()
-    mbp, _ = build_plant(p, 1e-3, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
     src = builder.AddSystem(ConstantVectorSource(F))
     builder.Connect(src.get_output_port(), mbp.get_actuation_input_port())
     sim = Simulator(builder.Build())
-    apply_integrator(sim, DEFAULT_INTEGRATOR, 1e-3)
+    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
     set_pose(mbp, mbp.GetMyMutableContextFromRoot(sim.get_mutable_context()), p, p.home_pose())
     sim.Initialize()
     c0 = time.process_time()
     sim.AdvanceTo(duration)
-    return (time.process_time() - c0) / duration
+    return 1e6 * PERIOD * (time.process_time() - c0) / duration
 
 
-def driven_plant(p, duration: float) -> float:
-    """CPU seconds per simulated second of the plant with the loop's actuators (lag) and loggers, advanced
-    tick by tick with a leg-force command that changes every tick (±1e-6 relative about home's static
-    forces, written in place into the fixed input): the loop without its Python."""
+def stopped_plant(p, duration: float) -> float:
+    """CPU µs per tick of the loop's own Diagram (``loop_diagram``: the plant, its actuation a fixed input, the
+    clock's event at every plant step) held at home by constant leg forces and advanced tick by tick: the cost
+    of stopping at every tick, without a law, a changing force or motion."""
     from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import LogVectorOutput
 
     from stewart_drake.core.dynamics import leg_forces_with_legs
-    from stewart_drake.drake.platform_model import build_plant, set_pose
-    from stewart_drake.drake.systems import Actuators
+    from stewart_drake.drake.loop_diagram import loop_diagram
+    from stewart_drake.drake.platform_model import set_pose
 
-    builder = DiagramBuilder()
-    mbp, _ = build_plant(p, 1e-3, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
-    act = builder.AddSystem(Actuators(float(p.legs.max_force), 2e-3, 1e-3))
-    builder.Connect(act.get_output_port(), mbp.get_actuation_input_port())
-    builder.ExportInput(act.get_input_port(), "command")
-    LogVectorOutput(mbp.get_state_output_port(), builder, 1e-3)
-    LogVectorOutput(act.get_output_port(), builder, 1e-3)
-    diagram = builder.Build()
-    sim = Simulator(diagram)
-    apply_integrator(sim, DEFAULT_INTEGRATOR, 1e-3)
+    built = loop_diagram(p, PERIOD, DEFAULT_INTEGRATOR)
+    sim = Simulator(built.diagram)
+    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
     root = sim.get_mutable_context()
-    set_pose(mbp, mbp.GetMyMutableContextFromRoot(root), p, p.home_pose())
+    set_pose(built.plant, built.plant.GetMyMutableContextFromRoot(root), p, p.home_pose())
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
-    act.set_force(root, F)
-    fixed = diagram.GetInputPort("command").FixValue(root, F)
-    commands = [F * (1 + 1e-6), F * (1 - 1e-6)]
+    built.diagram.GetInputPort("actuation").FixValue(root, F)
+    advance = sim.AdvanceTo
     sim.Initialize()
+    n = int(round(duration / PERIOD))
     c0 = time.process_time()
-    for k in range(1, int(round(duration / 1e-3)) + 1):
-        fixed.GetMutableData().get_mutable_value().SetFromVector(commands[k % 2])
-        sim.AdvanceTo(k * 1e-3)
-    return (time.process_time() - c0) / duration
+    for k in range(1, n + 1):
+        advance(k * PERIOD)
+    return 1e6 * (time.process_time() - c0) / n
 
 
-PREPARE: dict[str, float] = {}  # CPU s per simulated s of Simulation.prepare (the tick tables), per loop
+def replayed_plant(p, kind: str, engine: str, duration: float) -> float:
+    """CPU µs per tick of the plant alone (one ``AdvanceTo``, no loop) replaying a closed loop's own forces
+    (its log, held over each plant step by a Drake ``TrajectorySource``) from the loop's initial state: the
+    plant's work along the moving reference, which the bare plant at rest does not do."""
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import TrajectorySource
+    from pydrake.trajectories import PiecewisePolynomial
+
+    from stewart_drake.core.trajectory import get_trajectory
+    from stewart_drake.drake.platform_model import build_plant, set_pose
+    from stewart_drake.drake.simulation import set_velocity
+
+    log = build_simulation(Scenario(p, "seed", kind, engine=engine)).run(duration)
+    builder = DiagramBuilder()
+    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    # the force logged at t_k acted over (t_k-1, t_k]: row k + 1 acts over (t_k, t_k+1]
+    hold = PiecewisePolynomial.ZeroOrderHold(log.t[:-1], log.force[1:].T)
+    src = builder.AddSystem(TrajectorySource(hold))
+    builder.Connect(src.get_output_port(), mbp.get_actuation_input_port())
+    sim = Simulator(builder.Build())
+    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
+    pc = mbp.GetMyMutableContextFromRoot(sim.get_mutable_context())
+    trajectory = get_trajectory("seed")
+    set_pose(mbp, pc, p, trajectory.pose(0.0))
+    set_velocity(mbp, pc, p, trajectory, 0.0)
+    sim.Initialize()
+    end = float(log.t[-1])
+    c0 = time.process_time()
+    sim.AdvanceTo(end)
+    return 1e6 * PERIOD * (time.process_time() - c0) / end
 
 
-def loop(p, kind: str, engine: str, duration: float, null_step: bool = False) -> float:
-    """CPU seconds per simulated second of one closed-loop run (build excluded; the tick tables that
-    ``run`` fills first included, their share noted in ``PREPARE``); ``null_step``: the law's step
-    returns its first result every tick (the LeafSystem's Python around it still runs)."""
+TABLES: dict[str, float] = {}  # CPU µs per tick of Simulation.prepare (the tick tables), per loop label
+
+
+def loop(p, label: str, kind: str, engine: str, duration: float, cold: bool, python: bool = False) -> float:
+    """CPU µs per tick of one closed-loop run (build excluded; the tick tables that ``run`` fills first
+    included, their share noted in ``TABLES``). ``cold``: the feed-forward table computed, not remembered
+    from an earlier run of the process; ``python``: the Python ticks instead of the compiled kernel."""
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
-    real_prepare = sim.prepare
-
-    def prepare(d):
-        c = time.process_time()
-        real_prepare(d)
-        PREPARE[kind] = min(PREPARE.get(kind, np.inf), (time.process_time() - c) / duration)
-
-    sim.prepare = prepare
-    if null_step:
-        law = sim.controller.law
-        real = law.step
-        first = []
-
-        def step(state, reference, measured, feedforward=None):
-            if not first:
-                first.append(real(state, reference, measured, feedforward))
-            return first[0]
-
-        law.step = step
-    TABLE_CACHE.clear()  # the run's tables computed, not remembered from an earlier run of this process
+    if python:
+        sim.controller.kernel = None
+    if cold:
+        TABLE_CACHE.clear()
+    else:
+        sim.prepare(duration)  # remembered from here on (the cache keeps the table, not the Simulation)
     c0 = time.process_time()
+    sim.prepare(duration)
+    c1 = time.process_time()
+    sim.prepare = lambda d: None  # filled above
     sim.run(duration)
-    return (time.process_time() - c0) / duration
+    c2 = time.process_time()
+    n = duration / PERIOD
+    TABLES[label] = min(TABLES.get(label, np.inf), 1e6 * (c1 - c0) / n)
+    return 1e6 * (c2 - c0) / n
 
 
-def warm_tables_us(p, kind: str, engine: str, duration: float) -> float:
-    """CPU µs per tick of ``Simulation.prepare`` when this process has computed the same feed-forward table
-    before (``control.feedforward.TABLE_CACHE``: a Monte Carlo worker's runs after its first, a report's
-    repeated loops)."""
+class _NoAdvance:
+    """A Simulator whose ``AdvanceTo`` does nothing (the plant stays put): the loop's DSP side alone."""
+
+    def __init__(self, simulator):
+        self._simulator = simulator
+
+    def AdvanceTo(self, t):  # noqa: N802  (Drake's name)
+        pass
+
+    def get_context(self):
+        return self._simulator.get_context()
+
+
+class _TimedAdvance(_NoAdvance):
+    """A Simulator whose ``AdvanceTo`` adds its thread CPU time to ``inside``."""
+
+    inside = 0.0
+
+    def AdvanceTo(self, t):  # noqa: N802  (Drake's name)
+        c = time.thread_time()
+        self._simulator.AdvanceTo(t)
+        self.inside += time.thread_time() - c
+
+
+def split(p, kind: str, engine: str, duration: float) -> tuple[float, float]:
+    """``(inside, outside)``: thread CPU µs per tick of one loop run (tables filled before) spent inside Drake's
+    ``AdvanceTo`` and outside it (the DSP side and the Python loop), the two timer reads per call (calibrated)
+    taken out of the outside share."""
+    c = time.thread_time()
+    for _ in range(10000):
+        time.thread_time()
+    read = (time.thread_time() - c) / 10000  # one timer read
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
     sim.prepare(duration)
-    c0 = time.process_time()
+    timed = _TimedAdvance(sim.simulator)
+    sim.controller.simulator = timed
+    c = time.thread_time()
+    sim.controller.run(duration)
+    total = time.thread_time() - c
+    n = duration / PERIOD
+    return 1e6 * timed.inside / n, 1e6 * (total - timed.inside - 2 * read * n) / n
+
+
+def dsp_side(p, kind: str, engine: str, duration: float) -> float:
+    """Wall µs per tick of the loop without Drake's work (``AdvanceTo`` a no-op, tables filled before): the
+    compiled kernel's call, Drake's notification and the Python ``for`` per stop."""
+    sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
     sim.prepare(duration)
-    return 1e3 * (time.process_time() - c0) / duration
-
-
-def step_us(p, engine: str, n: int = 3000) -> float:
-    """µs of one ``law.step`` alone (the C engine's: one sd_host_tick call and its Python)."""
-    sim = build_simulation(Scenario(p, "seed", "fixed", engine=engine))
-    law = sim.controller.law
-    ref, L = p.home_pose(), np.full(6, 0.7)
-    pid, ff = law.initial_pid_state(L, np.zeros(6)), np.zeros(6)
-    if hasattr(law, "prime"):
-        law.prime(ref[None])
-    law.step(pid, ref, L, ff)
+    sim.controller.simulator = _NoAdvance(sim.simulator)
     t0 = time.perf_counter()
-    for _ in range(n):
-        law.step(pid, ref, L, ff)
-    return 1e6 * (time.perf_counter() - t0) / n
+    sim.controller.run(duration)
+    return 1e6 * (time.perf_counter() - t0) / (duration / PERIOD)
+
+
+LOOPS = {  # label: (kind, engine, cold tables, Python ticks)
+    "fixed/C, cold tables": ("fixed", "c", True, False),
+    "fixed/C, remembered tables": ("fixed", "c", False, False),
+    "float, cold tables": ("float", "python", True, False),
+    "float, remembered tables": ("float", "python", False, False),
+    "fixed/C, Python ticks, remembered tables": ("fixed", "c", False, True),
+    "float, Python ticks, remembered tables": ("float", "python", False, True),
+}
+PLANT, STOPPED = "bare plant (the reference)", "the loop's Diagram stopped every tick, at rest"
 
 
 def main(argv=None) -> int:
@@ -161,49 +223,61 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=2.0)
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
-    print(f"# closed-loop tick breakdown, utn-dynamic, seed trajectory, {DEFAULT_INTEGRATOR}; {load()}")
+    D = args.duration
+    print(f"# closed-loop tick breakdown, utn-dynamic, seed trajectory, {DEFAULT_INTEGRATOR}, 1 kHz; {load()}")
     p = load_preset("utn-dynamic")
-    loop(p, "fixed", "c", 0.01)  # compile and cache the firmware before timing
-    runs = {
-        "plant": lambda: plant(p, args.duration),
-        "plant + actuators, input changing every tick": lambda: driven_plant(p, args.duration),
-        "fixed, C engine": lambda: loop(p, "fixed", "c", args.duration),
-        "fixed, C, null step": lambda: loop(p, "fixed", "c", args.duration, null_step=True),
-        "float": lambda: loop(p, "float", "python", args.duration),
-        "float, null step": lambda: loop(p, "float", "python", args.duration, null_step=True),
-    }
+    loop(p, "warm-up", "fixed", "c", 0.01, True)  # compile and cache the firmware and the kernel before timing
+    loop(p, "warm-up", "float", "python", 0.01, True)
+    runs = {PLANT: lambda: plant(p, D), STOPPED: lambda: stopped_plant(p, D)}
+    runs |= {label: (lambda a=a, label=label: loop(p, label, a[0], a[1], D, a[2], a[3])) for label, a in LOOPS.items()}
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
         for k, f in runs.items():
             best[k] = min(best[k], f())
-    us = {k: 1e3 * v for k, v in best.items()}  # CPU µs per simulated ms = per tick
-    print("(process CPU time, best of the repetitions: on a loaded machine wall time includes waiting for a core)")
+    us = best  # CPU µs per tick
+    print("(process CPU µs per tick, best of the repetitions; real-time factor = 1e3 / µs)")
     for k, v in us.items():
-        extra = "" if k == "plant" else f"  ({us['plant'] / v:.2f} × plant's real-time factor; target >= {TARGET})"
-        print(f"{k:45s} {v:6.1f} CPU µs per tick = real-time factor {1e3 / v:6.2f}x{extra}")
-    for kind, full, null in (
-        ("fixed/C", "fixed, C engine", "fixed, C, null step"),
-        ("float", "float", "float, null step"),
-    ):
-        prep_us = 1e3 * PREPARE[kind.split("/")[0]]
-        driven = us["plant + actuators, input changing every tick"]
-        loop_us = us[null] - driven - prep_us
-        law_us = us[full] - us[null]
+        extra = ""
+        if k != PLANT:
+            ratio = us[PLANT] / v
+            target = f"; target >= {TARGET}: {'met' if ratio >= TARGET else 'NOT met'}" if k in LOOPS else ""
+            extra = f"  {ratio:.2f} × the bare plant's real-time factor{target}"
+        print(f"  {k:48s} {v:6.1f} µs = real-time factor {1e3 / v:6.2f}x{extra}")
+    print(
+        "where a tick's µs go (the loop = tick tables + Drake's AdvanceTo + the rest; thread CPU, best of the repetitions):"
+    )
+    splits = {"fixed/C": ("fixed", "c"), "float": ("float", "python")}
+    best_split = {}
+    for _ in range(args.repeat):
+        for label, (kind, engine) in splits.items():
+            inside, outside = split(p, kind, engine, D)
+            if label not in best_split or inside + outside < sum(best_split[label]):
+                best_split[label] = (inside, outside)
+    for label, (inside, outside) in best_split.items():
+        cold, warm = TABLES[f"{label}, cold tables"], TABLES[f"{label}, remembered tables"]
         print(
-            f"{kind:8s} tick {us[full]:6.1f} µs = plant {us['plant']:6.1f} + driving it (actuators, loggers, an "
-            f"AdvanceTo per tick, a changing input) {driven - us['plant']:5.1f} + tick tables (reference, IK "
-            f"words, feed-forward: before the run) {prep_us:5.1f} + the loop's Python (state read, sensor, "
-            f"status, release, input, logs) {loop_us:5.1f} + law.step {law_us:5.1f}"
+            f"  {label:8s} tables {cold:5.1f} cold / {warm:4.1f} remembered + inside AdvanceTo {inside:6.1f} + outside "
+            f"{outside:4.1f} (the DSP side, the Python loop)"
         )
+    replay = {
+        label: min(replayed_plant(p, kind, engine, D) for _ in range(args.repeat))
+        for label, (kind, engine) in splits.items()
+    }
     print(
-        f"tick tables when remembered from an earlier run of the process: {warm_tables_us(p, 'fixed', 'c', args.duration):.1f}"
-        " µs per tick (fixed/C)"
+        f"  (inside AdvanceTo: the bare plant's {us[PLANT]:.1f} at rest, {us[STOPPED]:.1f} stopped every tick at rest; the "
+        "plant alone replaying the loop's own forces along its motion, one AdvanceTo: "
+        + ", ".join(
+            f"{label} {v:.1f} = {us[PLANT] / v:.2f} × the bare plant's real-time factor" for label, v in replay.items()
+        )
+        + ")"
     )
-    print(
-        f"ceiling of this Diagram (no Python at all): {us['plant'] / us['plant + actuators, input changing every tick']:.2f}"
-        " × plant's real-time factor"
-    )
-    print(f"law.step alone, C engine: {step_us(p, 'c'):.1f} µs per call (of it the sd_host_tick C call is < 1 µs)")
+    print("the DSP side alone, AdvanceTo a no-op (wall µs per tick, best of the repetitions):")
+    alone = {
+        "fixed/C, compiled kernel": lambda: dsp_side(p, "fixed", "c", D),
+        "float, compiled kernel": lambda: dsp_side(p, "float", "python", D),
+    }
+    for k, f in alone.items():
+        print(f"  {k:48s} {min(f() for _ in range(args.repeat)):6.2f} µs")
     print(f"# {load()}")
     return 0
 

@@ -67,16 +67,22 @@ class FeedforwardTable:
 
     def __init__(self, platform: Platform, trajectory: Trajectory, lead: float, h: float):
         self.platform, self.trajectory, self.lead, self.h = platform, trajectory, lead, h
-        self.table: dict[float, np.ndarray] = {}
+        self._primed: tuple = (np.zeros(0), np.zeros((0, 6)))
+        self._table: dict[float, np.ndarray] | None = None
 
-    def prime(self, times) -> None:
+    def prime(self, times) -> np.ndarray:
+        """Compute the rows at ``times`` (n,) s in one batch and remember them; returns them, ``(n, 6)`` N
+        (read-only: a table shared through ``TABLE_CACHE``)."""
         times = np.asarray(times, dtype=float)
-        for t, F in zip(times, feedforward_forces(self.platform, self.trajectory, times, self.lead, self.h)):
-            self.table[float(t)] = F
+        rows = feedforward_forces(self.platform, self.trajectory, times, self.lead, self.h)
+        self._primed, self._table = (times, rows), None
+        return rows
 
     def force(self, t: float) -> np.ndarray:
         """``(6,)`` N at time ``t`` (s)."""
-        F = self.table.get(float(t))
+        if self._table is None:  # looked up by time only where asked to (a Drake source per tick)
+            self._table = {float(ti): F for ti, F in zip(*self._primed)}
+        F = self._table.get(float(t))
         return F if F is not None else feedforward_forces(self.platform, self.trajectory, [t], self.lead, self.h)[0]
 
 

@@ -32,9 +32,10 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import SQRT3, Platform
-from stewart_drake.core.kinematics import length_jacobian, scaled_condition
+from stewart_drake.core.kinematics import condition_at_most, length_jacobian, scaled_condition
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
+from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_SAMPLE, SingularPoseError, counted
 
 G_EARTH = 9.81  # m/s², the seed's Matlab value (its text also quotes 9.8066)
@@ -141,7 +142,7 @@ def euler_rate_derivative(angles, rates, convention: str = "utn") -> np.ndarray:
     w_before = np.zeros_like(out)
     for k in _ORDER[convention]:
         w_k = E[..., :, k] * rates[..., k : k + 1]
-        out = out + np.cross(w_before, w_k)
+        out = out + cross(w_before, w_k)
         w_before = w_before + w_k
     return out
 
@@ -157,9 +158,9 @@ def plate_motion(platform: Platform, q, qd, qdd, convention: str = "utn") -> dic
     wd_bias = euler_rate_derivative(q[..., 3:], qd[..., 3:], convention)
     wd = np.einsum("...ij,...j->...i", E, qdd[..., 3:]) + wd_bias
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
-    centripetal = np.cross(w, np.cross(w, r))
-    a_bias = np.cross(wd_bias, r) + centripetal
-    a = qdd[..., :3] + np.cross(wd, r) + centripetal
+    centripetal = cross(w, cross(w, r))
+    a_bias = cross(wd_bias, r) + centripetal
+    a = qdd[..., :3] + cross(wd, r) + centripetal
     return {
         "R": R,
         "E": E,
@@ -219,8 +220,8 @@ def _generalized_force(platform: Platform, mo: dict, gravity: float, bias_only: 
     a = mo["a_cm_bias"] if bias_only else mo["a_cm"]
     I_W = R @ platform.inertia @ np.swapaxes(R, -1, -2)
     f = platform.mass * (a + np.array([0.0, 0.0, gravity]))
-    tau = np.einsum("...ij,...j->...i", I_W, wd) + np.cross(w, np.einsum("...ij,...j->...i", I_W, w))
-    tau_C = tau + np.cross(mo["r_cm"], f)
+    tau = np.einsum("...ij,...j->...i", I_W, wd) + cross(w, np.einsum("...ij,...j->...i", I_W, w))
+    tau_C = tau + cross(mo["r_cm"], f)
     return np.concatenate([f, np.einsum("...ji,...j->...i", mo["E"], tau_C)], axis=-1)
 
 
@@ -276,10 +277,10 @@ def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.nd
     """``(..., 6)`` F (N) with Jᵀ(q) F = Q; raises ``SingularPoseError`` naming the first sample whose J
     has a scaled condition number above ``MAX_CONDITION``."""
     J = length_jacobian(platform, q, convention)
-    k = scaled_condition(platform, J)
-    idx = first_index(~(k <= MAX_CONDITION))
+    idx = first_index(~condition_at_most(platform, J, MAX_CONDITION))
     if idx is not None:
-        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=float(k[idx]), limit=MAX_CONDITION))
+        k = scaled_condition(platform, J[idx])
+        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=float(k), limit=MAX_CONDITION))
     Q = np.broadcast_to(Q, J.shape[:-1])
     return np.linalg.solve(np.swapaxes(J, -1, -2), Q[..., None])[..., 0]
 
@@ -333,8 +334,8 @@ def leg_forces_with_legs(
     )  # (...,6,3) p_CTi
     # Leg vectors base anchor -> plate anchor and their first two time derivatives.
     l = q[..., None, :3] + r - platform.base_anchors
-    ld = qd[..., None, :3] + np.cross(w, r)
-    ldd = qdd[..., None, :3] + np.cross(wd, r) + np.cross(w, np.cross(w, r))
+    ld = qd[..., None, :3] + cross(w, r)
+    ldd = qdd[..., None, :3] + cross(wd, r) + cross(w, cross(w, r))
     L = np.linalg.norm(l, axis=-1, keepdims=True)
     u = l / L
     Ld = np.sum(u * ld, -1, keepdims=True)
@@ -343,14 +344,14 @@ def leg_forces_with_legs(
     udd = (ldd - Ldd * u - 2 * Ld * ud) / L
     # Universal joint i: first axis a1 fixed in the base (x of the home leg frame), second a2 ⊥ a1, u.
     a1 = np.broadcast_to(home_leg_frames(platform)[:, :, 0], u.shape)
-    a2 = np.cross(u, a1)
+    a2 = cross(u, a1)
     a2 = a2 / np.linalg.norm(a2, axis=-1, keepdims=True)
-    B = np.stack([np.cross(a1, u), np.cross(a2, u)], -1)  # (...,6,3,2): u̇ = B [q̇0, q̇1]
+    B = np.stack([cross(a1, u), cross(a2, u)], -1)  # (...,6,3,2): u̇ = B [q̇0, q̇1]
     BtB = np.swapaxes(B, -1, -2) @ B
     rates = np.linalg.solve(BtB, np.einsum("...ji,...j->...i", B, ud)[..., None])[..., 0]
     omega_c = rates[..., :1] * a1 + rates[..., 1:] * a2
-    a12 = rates[..., :1] * rates[..., 1:] * np.cross(a1, a2)  # ω̇ part from the moving second axis
-    rhs = udd - np.cross(a12, u) - np.cross(omega_c, np.cross(omega_c, u))
+    a12 = rates[..., :1] * rates[..., 1:] * cross(a1, a2)  # ω̇ part from the moving second axis
+    rhs = udd - cross(a12, u) - cross(omega_c, cross(omega_c, u))
     acc = np.linalg.solve(BtB, np.einsum("...ji,...j->...i", B, rhs)[..., None])[..., 0]
     omega_c_dot = acc[..., :1] * a1 + acc[..., 1:] * a2 + a12
 
@@ -371,18 +372,18 @@ def leg_forces_with_legs(
             e, ed, edd = L - length / 2, Ld, Ldd
         a_cm = edd * u + 2 * ed * ud + e * udd
         f = mass * (a_cm + g_vec)
-        tau = np.einsum("...ij,...j->...i", I_W, omega_c_dot) + np.cross(
+        tau = np.einsum("...ij,...j->...i", I_W, omega_c_dot) + cross(
             omega_c, np.einsum("...ij,...j->...i", I_W, omega_c)
         )
-        M_B = M_B + tau + np.cross(e * u, f)
+        M_B = M_B + tau + cross(e * u, f)
         f_piston = f
     tau_leg = np.stack([np.sum(a1 * M_B, -1), np.sum(a2 * M_B, -1), np.sum(u * f_piston, -1)], -1)
-    J_tip = np.stack([np.cross(a1, l), np.cross(a2, l), u], -1)  # ṗ_tip = J_tip [q̇0, q̇1, L̇]
+    J_tip = np.stack([cross(a1, l), cross(a2, l), u], -1)  # ṗ_tip = J_tip [q̇0, q̇1, L̇]
     f_tip = np.linalg.solve(np.swapaxes(J_tip, -1, -2), tau_leg[..., None])[..., 0]  # J_tipᵀ f = τ_leg
     # The plate must carry f_tip at each anchor on top of its own inertia and weight.
     Q = _generalized_force(platform, mo, gravity)
     f_sum = f_tip.sum(-2)
-    m_sum = np.cross(r, f_tip).sum(-2)
+    m_sum = cross(r, f_tip).sum(-2)
     Q = Q + np.concatenate([f_sum, np.einsum("...ji,...j->...i", mo["E"], m_sum)], -1)
     return solve_leg_forces(platform, q, Q, convention)
 

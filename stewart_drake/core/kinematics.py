@@ -15,6 +15,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
 if TYPE_CHECKING:  # annotations only: geometry imports sanity, which imports this module
@@ -78,7 +79,7 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
     r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
     l = q[..., None, :3] + r - platform.base_anchors
     u = l / np.linalg.norm(l, axis=-1, keepdims=True)
-    return np.concatenate([u, np.cross(r, u)], axis=-1)
+    return np.concatenate([u, cross(r, u)], axis=-1)
 
 
 def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
@@ -115,6 +116,30 @@ def scaled_condition(platform: Platform, J) -> np.ndarray:
     inf on a singularity."""
     s = np.linalg.svd(scaled_jacobian(J, anchor_radius(platform)), compute_uv=False)
     return singular_value_condition(s)
+
+
+def condition_at_most(platform: Platform, J, limit: float) -> np.ndarray:
+    """``(...)`` bool: ``scaled_condition(platform, J) <= limit`` for ``(..., 6, 6)`` Jacobians — the same
+    answers, about a quarter of the cost. Most matrices are decided by an a-posteriori bound from the
+    inverse X of the scaled J (A): with r = ‖I − X A‖_F < 1, ‖A⁻¹‖₂ ≤ ‖X‖_F / (1 − r), so κ₂(A) ≤
+    ‖A‖_F ‖X‖_F / (1 − r). Where that bound is ≤ ``limit``/4 (r ≤ 1/2), κ₂ is well below ``limit`` — the
+    factor 4 covers the rounding of the bound (relative ~1e-8 at κ ~ 1e8) and of the SVD's own κ — so the SVD
+    answers yes there too; every other matrix (near-singular, not finite) is decided by the SVD as before."""
+    A = scaled_jacobian(J, anchor_radius(platform))
+    ok = np.zeros(A.shape[:-2], dtype=bool)
+    with np.errstate(all="ignore"):
+        try:
+            X = np.linalg.inv(A)
+        except np.linalg.LinAlgError:  # an exactly singular matrix in the batch: the SVD decides all
+            X = None
+        if X is not None:
+            r = np.sqrt(np.sum((np.eye(A.shape[-1]) - X @ A) ** 2, axis=(-2, -1)))
+            norms = np.sqrt(np.sum(A**2, axis=(-2, -1))) * np.sqrt(np.sum(X**2, axis=(-2, -1)))
+            ok = (r <= 0.5) & (norms / (1.0 - r) <= limit / 4)
+    rest = ~ok
+    if rest.any():
+        ok[rest] = scaled_condition(platform, J[rest]) <= limit  # per matrix, as in one batch
+    return ok
 
 
 def condition_number(platform: Platform, poses, convention: str = "utn") -> np.ndarray:

@@ -1,11 +1,13 @@
 """The closed loop's Diagram: what runs in C++ between the controller's ticks — the plant (with its scene
-graph), the actuators (saturation and lag) with their command as the Diagram's input ``command``, the
-continuous plant's loggers and, for an animation, the Meshcat visualizer.
+graph), its actuation as the Diagram's input ``actuation``, a periodic event at every plant step and, for an
+animation, the Meshcat visualizer. No actuators and no loggers: the loop stops at every plant step, steps the
+actuators' saturation and lag there itself (``control.actuation``: Drake's ``Saturation`` and
+``LinearSystem``'s numbers) and logs the plant state and their force (``tick_loop.TickLoop``).
 
 Built once per structure and reused (``DIAGRAM_CACHE``): a Diagram holds no state (every run has its own
-context and Simulator), so the runs of a process whose plant platform, plant step, integrator and actuators
-are the same share one — a Monte Carlo study varying only the sensor, the latency, the sample period or the
-gains builds it once per worker; a draw that moves an anchor or changes the plate's mass or payload changes
+context and Simulator), so the runs of a process whose plant platform, plant step and integrator are the same
+share one — a Monte Carlo study varying only the sensor, the latency, the sample period, the gains or the
+actuators builds it once per worker; a draw that moves an anchor or changes the plate's mass or payload changes
 the plant (its SDF) and builds its own. Not cached with a visualizer (it holds the user's Meshcat).
 """
 
@@ -14,69 +16,53 @@ from __future__ import annotations
 import pickle
 from dataclasses import dataclass
 
+import numpy as np
 from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import LogVectorOutput
+from pydrake.systems.primitives import ConstantVectorSource, ZeroOrderHold
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.memo import Memo, digest
 from stewart_drake.drake.integrators import CONTINUOUS
 from stewart_drake.drake.platform_model import build_plant
-from stewart_drake.drake.systems import Actuators
 
 VISUALIZER_PERIOD = 1 / 32  # s: the Meshcat animation's frame period
 
 
 @dataclass(frozen=True)
 class LoopDiagram:
-    """A built loop Diagram: ``diagram``, its ``plant`` and ``actuators``, ``loggers`` (``state``, ``force``:
-    the continuous plant's, empty for a discrete plant whose loop logs itself) and ``visualizer`` (or None)."""
+    """A built loop Diagram: ``diagram``, its ``plant`` and ``visualizer`` (or None)."""
 
     diagram: object
     plant: object
-    actuators: object
-    loggers: dict
     visualizer: object = None
 
 
-def loop_diagram(
-    plant_platform: Platform,
-    plant_time_step: float,
-    integrator: str,
-    max_force: float,
-    time_constant: float,
-    meshcat=None,
-) -> LoopDiagram:
-    """The loop Diagram of a plant of ``plant_platform`` stepped at ``plant_time_step`` s under
-    ``integrator``, driven by actuators limited to ``max_force`` N with lag ``time_constant`` s (from the
-    cache when one with the same inputs was built in this process and ``meshcat`` is None)."""
+def loop_diagram(plant_platform: Platform, plant_time_step: float, integrator: str, meshcat=None) -> LoopDiagram:
+    """The loop Diagram of a plant of ``plant_platform`` stepped at ``plant_time_step`` s under ``integrator``
+    (from the cache when one with the same inputs was built in this process and ``meshcat`` is None)."""
     if meshcat is not None:
-        return _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat)
-    inputs = (plant_platform, float(plant_time_step), integrator, float(max_force), float(time_constant))
+        return _build(plant_platform, plant_time_step, integrator, meshcat)
+    inputs = (plant_platform, float(plant_time_step), integrator)
     return DIAGRAM_CACHE.get(digest(pickle.dumps(inputs, protocol=5)), lambda: _build(*inputs, None))
 
 
-def _build(plant_platform, plant_time_step, integrator, max_force, time_constant, meshcat) -> LoopDiagram:
+def _build(plant_platform, plant_time_step, integrator, meshcat) -> LoopDiagram:
     builder = DiagramBuilder()
     plant, scene_graph = build_plant(plant_platform, plant_time_step, builder, continuous=integrator in CONTINUOUS)
-    act = builder.AddSystem(Actuators(max_force, time_constant, plant_time_step))
-    act.set_name("actuators")
-    builder.ExportInput(act.get_input_port(), "command")
-    builder.Connect(act.get_output_port(), plant.get_actuation_input_port())
-    # the continuous plant logs at its step (not at every integrator step); the discrete one at every
-    # simulator step, by the loop (``tick_loop.TickLoop``)
-    loggers = {}
-    if integrator in CONTINUOUS:
-        loggers = {
-            "state": LogVectorOutput(plant.get_state_output_port(), builder, plant_time_step),
-            "force": LogVectorOutput(act.get_output_port(), builder, plant_time_step),
-        }
+    builder.ExportInput(plant.get_actuation_input_port(), "actuation")
+    # A periodic discrete update at every plant step (a one-value hold of a constant: nothing to compute), as
+    # the actuators' lag had: Drake's Simulator ends a step at an event time otherwise than at an AdvanceTo
+    # boundary alone (without these events the states of a run drift by an ulp from t = 1 s on), so the
+    # loop keeps the Diagram's event times and its integration bit for bit.
+    clock = builder.AddSystem(ZeroOrderHold(plant_time_step, 1))
+    builder.Connect(builder.AddSystem(ConstantVectorSource(np.zeros(1))).get_output_port(), clock.get_input_port())
     visualizer = None
     if meshcat is not None:
         visualizer = MeshcatVisualizer.AddToBuilder(
             builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=VISUALIZER_PERIOD)
         )
-    return LoopDiagram(builder.Build(), plant, act, loggers, visualizer)
+    return LoopDiagram(builder.Build(), plant, visualizer)
 
 
 DIAGRAM_CACHE = Memo(2)  # the last 2 loop Diagrams built in this process

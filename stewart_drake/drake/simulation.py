@@ -4,15 +4,15 @@ One typed, picklable ``Scenario`` describes a run (platform, reference, controll
 and gains, actuators, integrator, sensor); ``build_simulation(scenario)`` assembles its Diagram and the
 loop that drives it::
 
-    reference rows ──▶ DSP tick (fixed | float law, period T) ──command (fixed input)──▶ Actuators
-        ▲  feed-forward rows ──▶ ▲ leg_lengths                                             │ force
-        │                        └──────── sensor (prismatic positions) ◀──── plant ◀──────┘
+    reference rows ──▶ DSP tick (fixed | float law, period T) ──command──▶ actuators ──force (fixed input)──┐
+        ▲  feed-forward rows ──▶ ▲ leg_lengths                                                              │
+        │                        └──────── sensor (prismatic positions) ◀──── plant ◀─────────────────────┘
         └ (core.trajectory: seed, rotating, a (t, pose) CSV, a motion program)
 
-The Diagram holds what runs in C++: the plant, the actuators (saturation and lag) and the plant's
-loggers; the DSP's side runs between ``Simulator.AdvanceTo`` calls in one tight loop
-(``drake.tick_loop``: the same numbers as a ``drake.systems.ControllerSystem`` wired into the Diagram,
-bit for bit, without a Python call inside the simulator's step).
+The Diagram holds what runs in C++: the plant; the DSP's side and the actuators (saturation and lag,
+``control.actuation``) run between ``Simulator.AdvanceTo`` calls, one compiled call per stop
+(``drake.tick_loop``: the same numbers as a ``drake.systems.ControllerSystem`` and ``drake.systems.Actuators``
+wired into the Diagram, bit for bit, without a Python call inside the simulator's step).
 
 The feed-forward table (``control.feedforward``) holds, per tick, the leg forces of the inverse dynamics
 (plate and legs) along the reference, advanced by the loop's known delays: what a host would compute
@@ -36,6 +36,7 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.analysis import Simulator
 from tqdm import tqdm
 
+from stewart_drake.control.actuation import Actuation
 from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.simulation_log import SimulationLog
@@ -54,7 +55,7 @@ from stewart_drake.drake.integrators import (
 from stewart_drake.drake.loop_diagram import VISUALIZER_PERIOD, loop_diagram
 from stewart_drake.drake.platform_model import set_pose
 from stewart_drake.drake.systems import make_law
-from stewart_drake.drake.tick_loop import SensorReading, TickLoop, periodic_times
+from stewart_drake.drake.tick_loop import IdealSensor, SensorReading, TickLoop, periodic_times
 from stewart_drake.errors import SimulationError
 
 # ----------------------------------------------------------------------------------------------
@@ -145,8 +146,8 @@ def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: 
 class Simulation:
     """A built controller-in-the-loop Diagram and the loop that drives it, ready to run (see
     ``build_simulation``). ``controller``: the ``tick_loop.TickLoop`` (its ``law``, its tables
-    ``reference`` and ``feedforward`` once ``prepare`` has filled them); ``loggers``: the plant's
-    ``state`` and the actuators' ``force`` (Drake loggers)."""
+    ``reference`` and ``feedforward`` once ``prepare`` has filled them; it logs the plant's state and the
+    actuators' force at every plant step)."""
 
     platform: Platform
     trajectory: Trajectory
@@ -155,7 +156,6 @@ class Simulation:
     diagram: object
     plant: object
     controller: TickLoop
-    loggers: dict
     simulator: object = None
     meshcat: object = None
     visualizer: object = None
@@ -209,17 +209,13 @@ class Simulation:
         ticks = np.arange(int(math.floor(duration / T + 1e-9)) + 1) * T
         poses = self.trajectory.pose(ticks)
         self.controller.reference = np.ascontiguousarray(poses, dtype=float)
-        if hasattr(self.controller.law, "prime"):
-            self.controller.law.prime(poses)
+        self.controller.prime(poses)
         if self.feedforward is not None:
-            self.feedforward.prime(ticks)
-            self.controller.feedforward = np.array([self.feedforward.table[float(t)] for t in ticks], dtype=float)
+            self.controller.feedforward = self.feedforward.prime(ticks)  # the rows of the ticks, in order
 
     def states(self) -> np.ndarray:
         """``(n, nx)`` the plant states logged by the run (``plant.get_state_output_port()``'s layout)."""
-        if "state" in self._logs:
-            return self._logs["state"]
-        return self.loggers["state"].FindLog(self.simulator.get_context()).data().T
+        return self._logs["state"]
 
     def max_constraint_gap(self, samples: int = 1000) -> float:
         """The largest ball-constraint gap (m) of this run: how far the loop closures opened, over up to
@@ -230,12 +226,8 @@ class Simulation:
         return float(constraint_gaps(self.plant, X[idx]).max())
 
     def _collect(self, duration: float) -> SimulationLog:
-        logs, ctx = self._logs, self.simulator.get_context()
-        if "state" in logs:  # a discrete plant: logged at every simulator step by the loop
-            t, X, force = logs["times"], logs["state"], logs["force"]
-        else:
-            t = self.loggers["state"].FindLog(ctx).sample_times().copy()
-            X, force = self.states(), self.loggers["force"].FindLog(ctx).data().T.copy()
+        logs = self._logs
+        t, X, force = logs["times"], logs["state"], logs["force"]
         top = self.plant.GetBodyByName("top")
         i0 = top.floating_positions_start()
         quat = X[:, i0 : i0 + 4]
@@ -246,8 +238,6 @@ class Simulation:
         pose = np.concatenate([p_WC, angles], axis=1)
         joints = [self.plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
         L = X[:, [j.position_start() for j in joints]]
-        if len(logs["status"]) != len(t):  # the loop's stops are the Diagram's steps: a bug otherwise
-            raise RuntimeError(f"controller logs {len(logs['status'])} rows, plant logs {len(t)}")
         T = self.config.timing.sample_period
         t_ref = periodic_times(0.0, T, duration)  # the reference at the ticks 0 … k·T <= duration
         return SimulationLog(
@@ -288,9 +278,9 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     law = make_law(s.controller, platform, config, s.engine, s.firmware)
     T = config.timing.sample_period
     max_force = actuators.max_force or float(platform.legs.max_force)
-    # the plant and actuators: reused from an earlier run of this process with the same ones (``loop_diagram``)
-    built = loop_diagram(plant_platform, plant_time_step, integrator, max_force, actuators.time_constant, meshcat)
-    diagram, plant, act, loggers = built.diagram, built.plant, built.actuators, built.loggers
+    # the plant: reused from an earlier run of this process with the same one (``loop_diagram``)
+    built = loop_diagram(plant_platform, plant_time_step, integrator, meshcat)
+    diagram, plant = built.diagram, built.plant
     joints = [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
     sensor_model = s.sensor
     if np.any(plant_platform.length_offset):  # a sensor reads the joint-to-joint length − legs.length_offset
@@ -302,7 +292,7 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         )
     pos = np.array([j.position_start() for j in joints])
     if sensor_model is None:
-        sensor = lambda t, x: x[pos]  # noqa: E731  (the ideal sensor: the prismatic positions)
+        sensor = IdealSensor(pos)  # the prismatic positions
     else:
         vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
         m = sensor_model
@@ -324,13 +314,14 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
-    # a continuous plant without the actuators' lag integrates with the command released at a tick
-    after = integrator in CONTINUOUS and act.lag is None
-    force = None if loggers else (act.get_output_port(), act.GetMyContextFromRoot(root))
-    loop = TickLoop(simulator, plant, pc, diagram.GetInputPort("command"), law, sensor, plant_time_step, after, force)
+    # the actuators (saturation, lag) are stepped by the loop at the plant steps, their lag starting at F0
+    act = Actuation.from_time_constant(max_force, actuators.time_constant, plant_time_step)
+    discrete = integrator not in CONTINUOUS
+    loop = TickLoop(
+        simulator, plant, pc, diagram.GetInputPort("actuation"), law, sensor, plant_time_step, act, discrete
+    )
     loop.reference = trajectory.pose(np.zeros(1))  # until ``run`` fills the tables: the pose at t = 0
     loop.initialize(L0, F0, None if ff is None else ff.force(0.0), rates0)
-    act.set_force(root, F0)
     simulator.Initialize()
     return Simulation(
         platform,
@@ -340,7 +331,6 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         diagram,
         plant,
         loop,
-        loggers,
         simulator,
         meshcat,
         built.visualizer,

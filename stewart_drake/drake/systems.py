@@ -158,7 +158,8 @@ class Actuators(Diagram):
     lag with time constant ``time_constant`` (s) discretised exactly at ``period`` (the plant's step),
     F ← a·F + (1−a)·u, a = exp(−period/τ); with τ = 0 the saturated command passes straight through.
     Drake's ``Saturation`` and a discrete ``LinearSystem``: no Python runs per step. ``lag``: the
-    ``LinearSystem`` (None without a lag)."""
+    ``LinearSystem`` (None without a lag). The closed loop steps the same numbers itself
+    (``control.actuation``; ``tests/drake/test_actuation.py``)."""
 
     def __init__(self, max_force: float, time_constant: float, period: float):
         super().__init__()

@@ -14,7 +14,16 @@ from stewart_drake.core.c_build import Compiler, Source, build, library_sources,
 from stewart_drake.core.input_stream import decode_text, read_input
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
+from stewart_drake.firmware.loop_kernel import CDEF as LOOP_CDEF
 
+# the closed loop's kernel (``loop_kernel``), linked with the host glue of the tick: its fixed-point law calls
+# sd_host_tick; -ffp-contract=off keeps its float arithmetic numpy's (the firmware's own code is integer)
+LOOP_SOURCES, LOOP_HEADERS, LOOP_DEFINES, LOOP_FLAGS = (
+    ("sd_loop.c",),
+    ("sd_loop.h",),
+    ("SD_LOOP_FIXED",),
+    ("-ffp-contract=off",),
+)
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
 MAX_SOURCE_BYTES = 16_000_000  # a firmware source file; the generated one is ~15 kB
 
@@ -33,6 +42,7 @@ void sd_ik_batch(const sd_word *poses, long n, sd_word *lengths, int32_t *nsat);
 int sd_host_tick(sd_state *s, const sd_word pose[6], const double L[6], double res, const double *ff, double range,
                  double lsb, double state[30], double out[18]);
 """
+    s += LOOP_CDEF  # the closed loop's kernel, linked with the tick (``loop_kernel``)
     if counting:
         s += f"extern long sd_op_counts[{len(OPS)}];\n"
     return s
@@ -118,16 +128,19 @@ def compile_generated(
     g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O3"
 ) -> FirmwareModule:
     """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
-    sources = [Source("sd_firmware.c", g.files["sd_firmware.c"]), *library_sources("sd_host.c", "sd_host_tick.c")]
-    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"])]
+    sources = [
+        Source("sd_firmware.c", g.files["sd_firmware.c"]),
+        *library_sources("sd_host.c", "sd_host_tick.c", *LOOP_SOURCES),
+    ]
+    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"]), *library_sources(*LOOP_HEADERS)]
     path = build(
         sources,
         headers=headers,
         compiler=compiler,
         strict=True,
-        defines=("SD_COUNT_OPS",) if counting else (),
+        defines=(*LOOP_DEFINES, *(("SD_COUNT_OPS",) if counting else ())),
         opt=opt,
-        flags=("-lm",),
+        flags=("-lm", *LOOP_FLAGS),
     )
     word = "int16_t"
     ffi, lib = load(path, _cdef(word, counting))
@@ -144,7 +157,11 @@ def compile_user(path: Path, g: GeneratedFirmware, compiler: Compiler | None = N
     m = _load_user(build(sources, headers=headers, compiler=compiler, flags=("-lm",)), path)
     if m.has_tick:  # then link the tick's host glue too (it calls sd_tick)
         lib_path = build(
-            sources + library_sources("sd_host_tick.c"), headers=headers, compiler=compiler, flags=("-lm",)
+            sources + library_sources("sd_host_tick.c", *LOOP_SOURCES),
+            headers=headers + library_sources(*LOOP_HEADERS),
+            compiler=compiler,
+            defines=LOOP_DEFINES,
+            flags=("-lm",),
         )
         m = _load_user(lib_path, path)
     return m

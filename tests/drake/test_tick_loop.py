@@ -87,26 +87,31 @@ def all_drake_run(sc: Scenario, duration: float) -> dict:
 
 
 @pytest.mark.parametrize(
-    "integrator, latency, time_constant",
+    "kind, integrator, latency, time_constant",
     [
-        ("cenic-fixed", "sample", 2e-3),  # the default loop
-        ("cenic-fixed", "computation", 0.0),  # a release between ticks; the plant integrates the new command
-        ("sap", "computation", 2e-3),  # a discrete plant steps before the tick reads it
-        ("sap", "none", 0.0),
+        ("float", "cenic-fixed", "sample", 2e-3),  # the default loop
+        ("fixed", "cenic-fixed", "sample", 2e-3),  # the compiled firmware in the loop's C kernel
+        ("float", "cenic-fixed", "computation", 0.0),  # a release between ticks; the plant integrates the new command
+        ("float", "sap", "computation", 2e-3),  # a discrete plant steps before the tick reads it
+        ("float", "sap", "none", 0.0),
     ],
 )
-def test_tick_loop_logs_equal_the_all_drake_diagram(integrator, latency, time_constant):
+def test_tick_loop_logs_equal_the_all_drake_diagram(kind, integrator, latency, time_constant):
+    """The loop (its compiled kernel here: ``firmware.loop_kernel``) against the all-Drake Diagram, whose
+    LeafSystem runs the law's numpy ``step`` (the firmware's ``sd_tick`` through ``CFixedPointLaw.step``)."""
     timing = DspTiming(latency=latency, computation_cycles=15000)
     cfg = ControllerConfig.for_platform(PLATFORM, timing, actuator_lag=time_constant)
     sc = Scenario(
         PLATFORM,
         SEED,
-        "float",
+        kind,
         cfg,
+        engine="c",
         actuators=ActuatorModel(time_constant=time_constant),
         integrator=integrator,
     )
     sim = build_simulation(sc)
+    assert sim.controller.kernel is not None  # a compiler is found here
     log = sim.run(DURATION)
     ref = all_drake_run(sc, DURATION)
     np.testing.assert_array_equal(log.t, ref["t"])
@@ -114,6 +119,20 @@ def test_tick_loop_logs_equal_the_all_drake_diagram(integrator, latency, time_co
     for name in ("command", "setpoint", "status", "force"):
         np.testing.assert_array_equal(getattr(log, name), ref[name], err_msg=name)
     assert log.saturations().sum() == 0 and np.ptp(log.command, axis=0).min() > 0.1  # the command moved
+
+
+def test_tick_loop_logs_equal_the_all_drake_diagram_past_one_second():
+    """The default loop for 1.01 s: past t = 1 s, where a Diagram without an event at every plant step (an
+    ``AdvanceTo`` boundary alone) integrates to a slightly different state (``loop_diagram``'s clock)."""
+    sc = Scenario(
+        PLATFORM, SEED, "float", ControllerConfig.for_platform(PLATFORM), engine="c", integrator="cenic-fixed"
+    )
+    sim = build_simulation(sc)
+    log = sim.run(1.01)
+    ref = all_drake_run(sc, 1.01)
+    np.testing.assert_array_equal(sim.states(), ref["state"])
+    for name in ("command", "force"):
+        np.testing.assert_array_equal(getattr(log, name), ref[name], err_msg=name)
 
 
 def test_schedule_stops_at_every_event_and_logs_at_the_plant_steps():

@@ -1,0 +1,54 @@
+"""``kinematics.condition_at_most``: the cheap a-posteriori bound that decides most Jacobians of the
+feed-forward table must give the SVD's answer (``scaled_condition <= limit``) on every matrix — poses about
+home, matrices built with condition numbers from 1 to 1e20 and a dense band around the limit, a zero matrix
+— and the inverse dynamics must still name the first singular sample with the SVD's condition number."""
+
+import re
+
+import numpy as np
+import pytest
+
+from stewart_drake.core import kinematics as kin
+from stewart_drake.core.dynamics import MAX_CONDITION, leg_forces_with_legs
+from stewart_drake.core.geometry import load_preset
+from stewart_drake.errors import SingularPoseError
+
+PLATFORM = load_preset("utn-dynamic")
+
+
+def test_poses_about_home_agree_with_the_svd():
+    rng = np.random.default_rng(0)
+    q = PLATFORM.home_pose() + rng.normal(0, [0.05, 0.05, 0.05, 0.2, 0.2, 0.2], (5000, 6))
+    J = kin.length_jacobian(PLATFORM, q)
+    np.testing.assert_array_equal(
+        kin.condition_at_most(PLATFORM, J, MAX_CONDITION), kin.scaled_condition(PLATFORM, J) <= MAX_CONDITION
+    )
+
+
+def test_constructed_condition_numbers_agree_with_the_svd():
+    """Random orthogonal U, V and singular values (1, …, 1/√κ, …, 1/κ): κ from 1 to 1e20, and ±90 % about
+    the limit where the bound (≤ limit/4 to decide) hands over to the SVD; one all-zero matrix (inv fails)."""
+    rng = np.random.default_rng(1)
+    kappas = np.concatenate([np.logspace(0, 20, 1500), MAX_CONDITION * (1 + np.linspace(-0.9, 0.9, 1500))])
+    U, _, Vt = np.linalg.svd(rng.normal(size=(len(kappas), 6, 6)))
+    S = np.ones((len(kappas), 6))
+    S[:, -1], S[:, 2] = 1 / kappas, 1 / np.sqrt(kappas)
+    A = U @ (S[..., None] * Vt)
+    J = np.concatenate([A[..., :3], A[..., 3:] * kin.anchor_radius(PLATFORM)], axis=-1)  # scaled back: A
+    expect = kin.scaled_condition(PLATFORM, J) <= MAX_CONDITION
+    assert 0 < expect.sum() < len(expect)  # both answers occur
+    np.testing.assert_array_equal(kin.condition_at_most(PLATFORM, J, MAX_CONDITION), expect)
+    J[17] = 0.0
+    expect[17] = False
+    np.testing.assert_array_equal(kin.condition_at_most(PLATFORM, J, MAX_CONDITION), expect)
+
+
+def test_singular_sample_named_with_the_svd_condition():
+    """A table whose third sample is in the Euler angles' gimbal lock (a quarter turn of the first angle:
+    dL/dq loses rank) names sample 3 and the SVD's condition number of that sample."""
+    q = np.tile(PLATFORM.home_pose(), (4, 1))
+    q[2, 3] = np.pi / 2
+    k = float(kin.scaled_condition(PLATFORM, kin.length_jacobian(PLATFORM, q[2])))
+    assert k > MAX_CONDITION
+    with pytest.raises(SingularPoseError, match="^sample 3: .*" + re.escape(f"condition number {k:.3g} > ")):
+        leg_forces_with_legs(PLATFORM, q, np.zeros(6), np.zeros(6))
