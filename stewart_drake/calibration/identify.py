@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import chi2
 
 from stewart_drake.calibration.identifiability import Identifiability, analyse, stacked
 from stewart_drake.calibration.measurements import Measurements
@@ -203,6 +202,10 @@ def identify(
     message = "converged" if converged else f"solver stopped: {second.message}"
     # outliers: a pose's whitened residual beyond the χ² test (quadratic part only: Huber keeps it bounded)
     k = r.shape[1]
+    # imported here: scipy.stats takes ~0.5 s CPU to import, which the report's main process (it imports every
+    # analysis to list them) would pay without ever identifying
+    from scipy.stats import chi2
+
     limit = chi2.isf(OUTLIER_P / problem.n, k)
     per_pose = np.sum(r**2, axis=1)
     bad = np.flatnonzero(per_pose > limit)

@@ -37,6 +37,9 @@ from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
 from stewart_drake.report import parts, render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
+# zlib level 1 for the figures' PNGs: measured on a report figure (four panels of 4,000-point lines), the
+# encoding took 0.17 s of its 0.88 s at matplotlib's default level 6 and ~0 s at level 1, for a file 5 % larger
+PNG = {"format": "png", "dpi": 110, "bbox_inches": "tight", "pil_kwargs": {"compress_level": 1}}
 
 
 @dataclass
@@ -108,12 +111,12 @@ class Section:
             try:
                 with warnings.catch_warnings():
                     warnings.filterwarnings("error", message=".*constrained_layout not applied")  # then do without
-                    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+                    fig.savefig(buf, **PNG)
             except (ZeroDivisionError, ValueError, UserWarning):  # a layout it cannot solve: the figure as drawn
                 fig.set_layout_engine("none")
                 buf = io.BytesIO()
         if not buf.getvalue():
-            fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+            fig.savefig(buf, **PNG)
         plt.close(fig)
         data = buf.getvalue()
         self.files[f"{name}.png"] = data
