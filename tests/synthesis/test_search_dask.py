@@ -53,6 +53,7 @@ def test_scheduler_address_and_a_two_thread_worker(req):
         try:
             assert len(engine.actors) == 2 and not engine.client.direct_to_workers
             assert engine(X) == ref
+            assert all(a.cpu_seconds > 0 for a in engine.actors)  # both threads evaluated (the benchmark reads it)
             assert engine(X[:12]) == Evaluations(req, 0)(X[:12])  # fewer chunks than actors
         finally:
             engine.close()
