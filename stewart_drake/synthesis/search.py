@@ -137,7 +137,7 @@ CHUNK_DESIGNS = 12  # designs per evaluation call, whatever the worker count (se
 # Settings of the search's own LocalCluster: the event loops' health tick (every 20 ms by default) and the system
 # and memory monitors (0.5 s, 0.1 s) woke the scheduler, the nannies and the workers ~100 times a second: an idle
 # 2-worker cluster took 0.11 CPU second per second of the 2-core machine, 0.02 with these (measured). They watch
-# for a blocked event loop and for memory; a search's tasks are small and bounded before they run.
+# for a blocked event loop and for memory; a search's calls are small and bounded before they run.
 CLUSTER_CONFIG = {
     "distributed.admin.tick.interval": "1s",
     "distributed.admin.system-monitor.interval": "5s",
@@ -204,8 +204,8 @@ class Evaluations:
     at its start: imports, caches); chunk i goes to slot i mod n, and a slot's chunks of a generation travel as
     one actor call, client to worker and back. Measured on 2 workers (2-core machine, loaded): a generation's round
     trip of two trivial calls took 2.0 ms of this process's CPU and 1.1 ms of each worker's as actor calls, 12.9
-    ms and 5.0 ms as tasks (the scheduler's and the workers' task states, ~12 messages per task), which is what held
-    the 2-worker speed-up of the default 24-design generation at 1.17x. On a LocalCluster the calls go straight to
+    ms and 5.0 ms as tasks (the scheduler's and the workers' task states, ~12 messages per task): the tasks' round
+    trip was most of what held the 2-worker speed-up of the default 24-design generation at 1.17x. On a LocalCluster the calls go straight to
     the workers; through ``scheduler`` Dask's default applies (the scheduler relays them). A lost worker (its
     actor with it) gets the generation sent again to new actors on the workers left, up to ``WORKER_LOSSES`` times.
     """
