@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 
 from stewart_drake.commands._common import add_force_arg, output_folder, print_json
+from stewart_drake.core.output_folder import claim_in_manifest
 from stewart_drake.synthesis.api import optimize
 from stewart_drake.synthesis.outputs import write_outputs
 from stewart_drake.synthesis.proof import MAX_CELLS
@@ -82,6 +83,9 @@ def run(args) -> int:
     result = r.synthesis
     with out.writing() as tmp:
         write_outputs(result, tmp, args.requirements, cache_from=out.path / CACHE)
+    # the journal stays append-only: a later run with a larger --budget continues it (claimed whole, its growth
+    # read as a change and the run refused at its end)
+    claim_in_manifest(out.path, [CACHE], prefix=True)
     if args.json:
         print_json(result.to_dict())
     else:

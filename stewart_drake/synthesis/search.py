@@ -12,7 +12,8 @@ nothing else; a design's evaluation depends only on the design and the requireme
 gathered in order. So the same seed gives the same generations and the same front with any number of
 workers (a test runs 1 and 2).
 
-Resume: every evaluated design is appended (flushed) to ``evaluations.jsonl`` in the output folder, under a
+Resume: every evaluated design is appended to ``evaluations.jsonl`` in the output folder (a generation's new
+designs flushed together, as soon as they are evaluated), under a
 header with the search's key (a hash of the requirements, the seed and the population size). A search
 started again with the same key replays the algorithm from the seed and takes each design it asks for
 from that file when present (JSON keeps every float bit for bit), evaluating only the rest: an
@@ -21,9 +22,11 @@ interrupted search picks up where it stopped, and a larger ``--budget`` continue
 
 from __future__ import annotations
 
+import asyncio
 import hashlib
 import json
 import math
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +34,7 @@ import numpy as np
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.evaluator import Evaluator
 from pymoo.core.problem import Problem
+from pymoo.core.termination import NoTermination
 from pymoo.problems.static import StaticProblem
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
@@ -118,7 +122,11 @@ class CacheWriter:
             claim_in_manifest(out, [CACHE], prefix=True)  # append-only: verified by its first bytes
 
     def write(self, obj: dict) -> None:
-        self.fh.write(json.dumps(obj) + "\n")
+        self.write_lines([json.dumps(obj)])
+
+    def write_lines(self, lines: list[str]) -> None:
+        """Appends rows already encoded (``journal_lines``), one flush for them all."""
+        self.fh.write("".join(line + "\n" for line in lines))
         self.fh.flush()
 
     def close(self) -> None:
@@ -126,11 +134,60 @@ class CacheWriter:
 
 
 CHUNK_DESIGNS = 12  # designs per evaluation call, whatever the worker count (see Evaluations)
+# Settings of the search's own LocalCluster: the event loops' health tick (every 20 ms by default) and the system
+# and memory monitors (0.5 s, 0.1 s) woke the scheduler, the nannies and the workers ~100 times a second: an idle
+# 2-worker cluster took 0.11 CPU second per second of the 2-core machine, 0.02 with these (measured). They watch
+# for a blocked event loop and for memory; a search's calls are small and bounded before they run.
+CLUSTER_CONFIG = {
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+WORKER_LOSSES = 3  # a generation is sent again at most this many times when a worker holding an evaluator is lost
 
 
-def evaluate_chunks(req: Requirements, chunks: list[np.ndarray]) -> list[list[dict]]:
-    """``evaluate_designs`` of each chunk ``(n_i, n_vars)`` in turn: one task's share of a generation."""
-    return [evaluate_designs(req, c) for c in chunks]
+def journal_lines(rows: list[dict]) -> list[str]:
+    """The rows as the journal's JSON lines (every float bit for bit)."""
+    return [json.dumps(r) for r in rows]
+
+
+def evaluate_chunks(req: Requirements, chunks: list[np.ndarray]) -> list[tuple[list[dict], list[str]]]:
+    """``evaluate_designs`` of each chunk ``(n_i, n_vars)`` in turn, with the rows' journal lines (encoded where
+    they are computed: on the workers, in parallel, not in the search's serial loop): one slot's share of a
+    generation."""
+    out = []
+    for c in chunks:
+        rows = evaluate_designs(req, c)
+        out.append((rows, journal_lines(rows)))
+    return out
+
+
+class SlotEvaluator:
+    """The search's evaluator on one worker thread, a Dask actor: it holds the requirements (sent once) and runs
+    its share of each generation on its worker's thread pool. A call goes from the client to the worker and back,
+    not through the scheduler's task states."""
+
+    cpu_seconds = 0.0  # CPU seconds spent in evaluate_chunks (a benchmark tells them from Dask's share)
+
+    def __init__(self, req: Requirements):
+        from distributed import get_worker  # deferred: only on a Dask worker
+
+        self.req = req
+        self.pool = get_worker().executors["default"]  # the worker's threads (the actors' own executor has one)
+        evaluate_designs(req, (req.lower + req.upper)[None] / 2)  # warm-up: imports, the pose terms' cache
+
+    async def evaluate(self, chunks: list[np.ndarray]) -> list[tuple[list[dict], list[str]]]:
+        """``evaluate_chunks`` of ``chunks`` on one of the worker's threads."""
+        done, cpu = await asyncio.get_running_loop().run_in_executor(self.pool, _timed_chunks, self.req, chunks)
+        self.cpu_seconds += cpu
+        return done
+
+
+def _timed_chunks(req: Requirements, chunks: list[np.ndarray]) -> tuple[list, float]:
+    """``evaluate_chunks`` and the CPU seconds of the thread that ran it."""
+    t0 = time.thread_time()
+    done = evaluate_chunks(req, chunks)
+    return done, time.thread_time() - t0
 
 
 class Evaluations:
@@ -141,62 +198,82 @@ class Evaluations:
     evaluates the same pieces: each design is computed in the same vectorised batch shapes with 0, 1 or K
     workers, so the results are bitwise the same (not only up to rounding) and the search deterministic. 12 is
     where ``evaluate_designs``' fixed cost per call (~3 ms, the pose terms cached per process) is a tenth of
-    the call. Chunk i goes to worker slot i mod n, and a slot's chunks of a generation travel as one task: one
-    scheduler round trip per slot and generation, whatever the population (per chunk, the scheduler's and the
-    client's CPU held the 2-worker speed-up of a 96-design generation at 1.37×). The requirements are scattered to every worker once, and
-    every worker evaluates one design before the search (imports, the pose terms' cache), so no generation
-    pays a worker's warm-up.
+    the call.
 
-    Placement: the tasks go one per slot to the workers' threads (a loose restriction: another worker may take
-    one if its worker leaves). Left to the scheduler (its queue of tasks and its work stealing), both tasks of a
-    generation sometimes ran one after the other on one worker while the other idled: 3 of 20 generations of a
-    search, and in one search 2.15 s against 0.3 s of CPU on the two workers (the loaded 2-core machine);
-    placed, 0 of 60 generations.
+    On Dask, each worker thread holds a ``SlotEvaluator`` actor (the requirements sent once, one design evaluated
+    at its start: imports, caches); chunk i goes to slot i mod n, and a slot's chunks of a generation travel as
+    one actor call, client to worker and back. Measured on 2 workers (2-core machine, loaded): a generation's round
+    trip of two trivial calls took 2.0 ms of this process's CPU and 1.1 ms of each worker's as actor calls, 12.9
+    ms and 5.0 ms as tasks (the scheduler's and the workers' task states, ~12 messages per task): the tasks' round
+    trip was most of what held the 2-worker speed-up of the default 24-design generation at 1.17x. On a LocalCluster the calls go straight to
+    the workers; through ``scheduler`` Dask's default applies (the scheduler relays them). A lost worker (its
+    actor with it) gets the generation sent again to new actors on the workers left, up to ``WORKER_LOSSES`` times.
     """
 
     def __init__(self, req: Requirements, workers: int = 0, scheduler: str | None = None):
-        self.req, self.client, self.cluster = req, None, None
+        self.req, self.client, self.cluster, self.actors = req, None, None, []
         if scheduler is None and workers == 0:
             return
         # deferred: Dask is imported (and a cluster started) only when the search runs on it
+        import dask
         from distributed import Client
 
-        from stewart_drake.workspace.dask_sweep import local_cluster, worker_threads
+        from stewart_drake.workspace.dask_sweep import local_cluster
 
         if scheduler is None:
-            self.cluster = local_cluster(workers)
-            self.client = Client(self.cluster)
+            with dask.config.set(CLUSTER_CONFIG):
+                self.cluster = local_cluster(workers)
+            self.client = Client(self.cluster, direct_to_workers=True)
         else:
             self.client = Client(scheduler)
-        self.threads = worker_threads(self.client)
-        self.slots = [w for w, n in sorted(self.client.nthreads().items()) for _ in range(n)]
-        self.req_future = self.client.scatter(req, broadcast=True)
-        self.client.run(evaluate_designs, req, (req.lower + req.upper)[None] / 2)  # warm-up on every worker
+        self._start_actors()
 
-    def __call__(self, X: np.ndarray) -> list[dict]:
+    def _start_actors(self) -> None:
+        """One ``SlotEvaluator`` per worker thread of the cluster now (round robin over the workers)."""
+        self.client.wait_for_workers(1)
+        slots = [w for w, n in sorted(self.client.nthreads().items()) for _ in range(n)]
+        self.futures = [
+            self.client.submit(SlotEvaluator, self.req, actor=True, pure=False, workers=[w], allow_other_workers=True)
+            for w in slots
+        ]
+        self.actors = [f.result() for f in self.futures]
+
+    def _lost(self, wait: float = 10.0) -> bool:
+        """Whether a worker holding an actor has left (the scheduler's view; a call can fail before the scheduler
+        knows, so it is asked again for up to ``wait`` seconds)."""
+        end = time.monotonic() + wait
+        while True:
+            workers, held = self.client.nthreads(), self.client.who_has(self.futures)
+            if any(f.status != "finished" or not set(held.get(f.key, ())) & set(workers) for f in self.futures):
+                return True
+            if time.monotonic() > end:
+                return False
+            time.sleep(0.1)
+
+    async def _round(self, chunks: list[np.ndarray]) -> list[list[tuple[list[dict], list[str]]]]:
+        n = len(self.actors)
+        calls = [a.evaluate(chunks[j::n]) for j, a in enumerate(self.actors[: len(chunks)])]
+        return [await c for c in calls]
+
+    def __call__(self, X: np.ndarray) -> tuple[list[dict], list[str]]:
+        """The rows of designs ``X`` (n, n_vars), in order, and their journal lines."""
         chunks = [X[s : s + CHUNK_DESIGNS] for s in range(0, len(X), CHUNK_DESIGNS)]
         if self.client is None or len(X) == 0:
-            return [row for part in evaluate_chunks(self.req, chunks) for row in part]
-        # chunk i goes to slot i mod n; each slot's chunks travel as one task (one scheduler round trip per
-        # slot and generation, not per chunk) and come back in the original order
-        n = len(self.slots)
-        futures = [
-            self.client.submit(
-                evaluate_chunks,
-                self.req_future,
-                chunks[j::n],
-                pure=False,
-                workers=[slot],
-                allow_other_workers=True,
-            )
-            for j, slot in enumerate(self.slots[: len(chunks)])
-        ]
-        parts = self.client.gather(futures)
-        rows = [None] * len(X)
+            done = evaluate_chunks(self.req, chunks)
+            return [r for rows, _ in done for r in rows], [t for _, lines in done for t in lines]
+        for attempt in range(WORKER_LOSSES + 1):
+            try:
+                parts = self.client.sync(self._round, chunks)
+                break
+            except (OSError, RuntimeError):  # a worker lost with its actor (else: raised again)
+                if attempt == WORKER_LOSSES or not self._lost():
+                    raise
+                self._start_actors()
+        n = len(self.actors)  # those of the round that answered
+        done = [None] * len(chunks)
         for j, part in enumerate(parts):
-            for i, c in enumerate(range(j, len(chunks), n)):
-                rows[c * CHUNK_DESIGNS : c * CHUNK_DESIGNS + len(chunks[c])] = part[i]
-        return rows
+            done[j::n] = part
+        return [r for rows, _ in done for r in rows], [t for _, lines in done for t in lines]
 
     def close(self) -> None:
         if self.client is not None:
@@ -245,7 +322,9 @@ def run_search(
         n_var=len(req.lower), n_obj=len(req.objectives), n_ieq_constr=len(CONSTRAINTS), xl=req.lower, xu=req.upper
     )
     algorithm = NSGA2(pop_size=pop_size)
-    algorithm.setup(problem, seed=seed, verbose=False)
+    # the loop below runs the generations; pymoo's default termination (tolerances on the front, updated every
+    # generation: a quarter of tell's CPU) would only be computed and ignored
+    algorithm.setup(problem, seed=seed, verbose=False, termination=NoTermination())
     writer = CacheWriter(out, key) if out is not None else None
     bar = None
     if progress:
@@ -261,10 +340,10 @@ def run_search(
             X = pop.get("X")
             keys = [tuple(x.tolist()) for x in X]
             todo = [k for k in dict.fromkeys(keys) if k not in cache]
-            for k, r in zip(todo, engine(np.array(todo).reshape(-1, X.shape[1])), strict=True):
-                cache[k] = r
-                if writer is not None:
-                    writer.write(r)
+            new, lines = engine(np.array(todo).reshape(-1, X.shape[1]))
+            cache.update(zip(todo, new, strict=True))
+            if writer is not None and lines:
+                writer.write_lines(lines)
             evaluated += len(todo)
             cached += len(X) - len(todo)
             batch = [cache[k] for k in keys]

@@ -95,3 +95,18 @@ def test_optimize_exits_1_when_the_performance_proof_is_unresolved(tmp_path, cap
     assert set(perf) == {"actuator.max_force", "actuator.max_speed", "limits.min_frequency_hz", "limits.max_condition"}
     assert all(r["status"] == "unresolved" and not r["met"] for r in perf.values())
     assert doc["performance_proof"]["requirements"]["force"]["unresolved_count"] > 0 and not doc["ok"]
+
+
+def test_a_finished_search_continues_with_a_larger_budget(tmp_path, capsys):
+    """The same folder with a larger ``--budget``: the first run's 24 designs come from its journal, 12 more are
+    evaluated and appended, and the run writes its outputs (the journal stays claimed as append-only: claimed whole,
+    its growth was read as a change and the run refused at its end, exit 2)."""
+    out = tmp_path / "o"
+    args = ["optimize", "--requirements", SEED_001, "--out", str(out), "--pop-size", "12", "--workers", "0",
+            "--max-cells", "60", "--json"]  # fmt: skip
+    assert main(args + ["--budget", "24"]) in (0, 1)
+    capsys.readouterr()
+    assert main(args + ["--budget", "36"]) in (0, 1)
+    search = json.loads(capsys.readouterr().out)["search"]
+    assert (search["evaluated_now"], search["from_cache"], search["designs"]) == (12, 24, 36)
+    assert len((out / "evaluations.jsonl").read_text().splitlines()) == 1 + 36
