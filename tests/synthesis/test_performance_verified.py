@@ -8,14 +8,12 @@ from __future__ import annotations
 
 import itertools
 from fractions import Fraction
-from importlib import resources
 
 import numpy as np
 import pytest
 from flint import acb_mat, arb, arb_mat, ctx
 
 from stewart_drake.core.dynamics import G_EARTH
-from stewart_drake.synthesis.families import design_platform
 from stewart_drake.synthesis.performance import (
     EPS_DROT,
     EPS_ROT,
@@ -23,11 +21,7 @@ from stewart_drake.synthesis.performance import (
     performance_bounds,
 )
 from stewart_drake.synthesis.proof import Cells, rotation_derivatives
-from stewart_drake.synthesis.requirements import load_requirements
 from stewart_drake.synthesis.verified import U, certified_min_eig, gamma, quad_box_max
-
-SEED_001 = resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml"
-X = np.array([0.4237, 0.1567, np.radians(5.737), np.radians(3.179), 0.8729])  # as test_performance
 
 
 @pytest.fixture(autouse=True)
@@ -36,16 +30,6 @@ def prec200():
     ctx.prec = 200
     yield
     ctx.prec = old
-
-
-@pytest.fixture(scope="module")
-def req():
-    return load_requirements(SEED_001)
-
-
-@pytest.fixture(scope="module")
-def design(req):
-    return design_platform(req, X, [0.80, 1.09])
 
 
 # --- arb oracles -------------------------------------------------------------------------------------------------
