@@ -11,32 +11,19 @@ import numpy as np
 import pytest
 
 from stewart_drake.core import realtime_fk
-from stewart_drake.core.geometry import load_platform, load_preset
+from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import anchor_radius, leg_lengths
 from stewart_drake.core.newton_fk import forward_kinematics, leg_geometry, newton_core
 from stewart_drake.core.realtime_fk import RealtimeFK, certificate, pose_distance
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.errors import FkInputError
-
-OWN = """
-name: speed-test-radial
-length_unit: mm
-radial:
-  base_radius: 500.0
-  base_angles_deg: [280.0, 20.0, 40.0, 140.0, 160.0, 260.0]
-  top_radius: 300.0
-  top_angles_deg: [310.0, 350.0, 70.0, 110.0, 190.0, 230.0]
-stroke: [450.0, 850.0]
-rotation_centre: [10.0, -20.0, 30.0]
-"""
+from tests._own_platform import own_radial
 
 
 @pytest.fixture(scope="module")
 def own_platform(tmp_path_factory):
-    path = tmp_path_factory.mktemp("rtfk") / "radial.yaml"
-    path.write_text(OWN)
-    return load_platform(str(path))
+    return own_radial(tmp_path_factory.mktemp("rtfk"))
 
 
 def platforms(own):

@@ -6,25 +6,15 @@ import numpy as np
 import pytest
 
 from stewart_drake.control.gains import ControllerConfig
-from stewart_drake.core.geometry import load_platform, load_preset
+from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.firmware.fk_gen import FK_ITERATIONS, pose_jacobian, word_scales
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import compile_generated
 from stewart_drake.fixedpoint.generic import pose_words
+from tests._own_platform import own_radial
 
-OWN = """
-name: fk-own-radial
-length_unit: mm
-radial:
-  base_radius: 500.0
-  base_angles_deg: [280.0, 20.0, 40.0, 140.0, 160.0, 260.0]
-  top_radius: 300.0
-  top_angles_deg: [310.0, 350.0, 70.0, 110.0, 190.0, 230.0]
-stroke: [450.0, 850.0]
-rotation_centre: [10.0, -20.0, 30.0]
-"""
 # a tick of fast motion (±3 length LSB, ±30 angle words) and ten times that in position, three in angle
 STARTS = {"tick": np.r_[3, 3, 3, 30, 30, 30], "far": np.r_[30, 30, 30, 100, 100, 100]}
 
@@ -42,9 +32,7 @@ def run_fk(m, measured, start):
 def platform(name, tmp_path):
     if name != "own":
         return load_preset(name)
-    path = tmp_path / "own.yaml"
-    path.write_text(OWN)
-    return load_platform(str(path))
+    return own_radial(tmp_path)
 
 
 def fk_over_workspace(p, start_offset):
