@@ -66,15 +66,11 @@ _GAINS: dict = {}
 
 def _l1_gain(platform, cfg, quick):
     """The loop's ℓ1 gains from set-point errors to leg lengths (``simulation.setpoint_step_gain``: a 1 mm
-    set-point step on leg 1 at home in the float twin, ``L1_S`` doubled until settled or ``L1_MAX_S``),
-    cached per gains."""
+    set-point step on leg 1 at home in the float twin, ``L1_S`` continued to twice as long until settled or
+    ``L1_MAX_S``), cached per gains."""
     key = (platform.name, cfg.gains)
-    duration = L1_S
-    while key not in _GAINS:
-        gain = setpoint_step_gain(platform, cfg, duration=duration)
-        if gain["settled"] <= L1_SETTLED or 2 * duration > L1_MAX_S:
-            _GAINS[key] = gain
-        duration *= 2
+    if key not in _GAINS:
+        _GAINS[key] = setpoint_step_gain(platform, cfg, duration=L1_S, settle=L1_SETTLED, max_duration=L1_MAX_S)
     return _GAINS[key]
 
 

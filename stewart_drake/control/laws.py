@@ -73,7 +73,9 @@ class FloatLaw:
             self._cache[q.tobytes()] = L
 
     def setpoints(self, ref) -> np.ndarray:
-        """``(6,)`` leg set-points (m) of the pose ``ref`` (from the primed cache or computed), plus the probe's offset."""
+        """``(..., 6)`` leg set-points (m) of the poses ``ref`` (..., 6) (one pose from the primed cache, else
+        computed), plus the probe's offset: the one home of that rule (the compiled loop's table is this of its
+        ticks' poses, ``firmware.loop_kernel``)."""
         ref = np.ascontiguousarray(ref, dtype=float)
         sp = self._cache.get(ref.tobytes())
         if sp is None:

@@ -163,6 +163,7 @@ class Simulation:
     feedforward: object = None
     integrator: str = "sap"
     _ran: bool = False
+    _duration: float = 0.0
     _logs: dict = field(default_factory=dict)
 
     def run(self, duration: float, progress: bool = False) -> SimulationLog:
@@ -171,7 +172,7 @@ class Simulation:
             raise SimulationError(SimulationError.DURATION.format(value=duration))
         if self._ran:
             raise RuntimeError("a Simulation runs once; build a new one")
-        self._ran = True
+        self._ran, self._duration = True, duration
         self.prepare(duration)
         # the visualizer's frames are Diagram events: the loop stops there too (a discrete plant logs there)
         frames = periodic_times(0.0, VISUALIZER_PERIOD, duration) if self.meshcat is not None else ()
@@ -198,6 +199,21 @@ class Simulation:
         if self.meshcat is not None:
             self.visualizer.StopRecording()
             self.visualizer.PublishRecording()
+        return self._collect(duration)
+
+    def extend(self, duration: float) -> SimulationLog:
+        """Continue the run (``run``, or an earlier ``extend``) to ``duration`` seconds from t = 0 and return the
+        logs from t = 0: the same numbers, bit for bit, as one ``run(duration)`` of a fresh Simulation when the
+        run's end was a plant step or a tick (``TickLoop.extend``). For a caller that decides from the logs
+        whether the run was long enough: it continues instead of simulating the start again. Not with an
+        animation (its recording ended with the run)."""
+        if not (math.isfinite(duration) and duration > 0):
+            raise SimulationError(SimulationError.DURATION.format(value=duration))
+        if not self._ran or self.meshcat is not None or not duration > self._duration:
+            raise RuntimeError(f"a Simulation extended to {duration} s after {self._duration} s")  # a caller's bug
+        self._duration = duration
+        self.prepare(duration)
+        self._logs = self.controller.extend(duration)
         return self._collect(duration)
 
     def prepare(self, duration: float) -> None:
@@ -355,28 +371,52 @@ def setpoint_step_response(
     1 nm: the sensor's counts are a separate term of the bounds, and a 10 µm quantiser would add its own
     chatter to a small-signal measurement). Samples at the plant steps (the controller's period by
     default), so s[n] is the sampled step response of the discrete loop from set-point words to lengths."""
+    sims = _setpoint_step_runs(platform, config, leg, step, actuators)
+    return _step_of([sim.run(duration) for sim in sims], step)
+
+
+def _setpoint_step_runs(platform, config, leg, step, actuators) -> list[Simulation]:
+    """``setpoint_step_response``'s two Simulations, built: the rest run and the stepped run (the float law's
+    ``setpoint_offset``: the compiled loop adds it to its set-point table, ``firmware.loop_kernel``)."""
     if not (isinstance(leg, (int, np.integer)) and 0 <= leg < 6):
         raise SimulationError(SimulationError.LEG.format(value=leg))
     if not (math.isfinite(step) and step != 0):
         raise SimulationError(SimulationError.STEP.format(value=step))
     cfg = config or ControllerConfig.for_platform(platform)
     cfg = replace(cfg, timing=replace(cfg.timing, sensor_resolution=1e-9))
-    rest = constant_trajectory("home", platform.home_pose(), duration)
-    runs = []
+    rest = constant_trajectory("home", platform.home_pose())  # for all times: the runs may be extended
+    sims = []
     for delta in (0.0, step):
         sim = build_simulation(Scenario(platform, rest, "float", config=cfg, actuators=actuators or ActuatorModel()))
         off = np.zeros(6)
         off[leg] = delta
         sim.controller.law.setpoint_offset = off
-        runs.append(sim.run(duration))
-    return runs[1].t, (runs[1].lengths - runs[0].lengths) / step
+        sims.append(sim)
+    return sims
 
 
-def setpoint_step_gain(platform: Platform, config: ControllerConfig | None = None, leg: int = 0, **kwargs) -> dict:
+def _step_of(logs: list[SimulationLog], step: float) -> tuple[np.ndarray, np.ndarray]:
+    """``setpoint_step_response``'s ``(t, s)`` of the rest and stepped runs' logs."""
+    return logs[1].t, (logs[1].lengths - logs[0].lengths) / step
+
+
+def setpoint_step_gain(
+    platform: Platform,
+    config: ControllerConfig | None = None,
+    leg: int = 0,
+    step: float = 1e-3,
+    duration: float = 0.3,
+    actuators: ActuatorModel | None = None,
+    settle: float | None = None,
+    max_duration: float | None = None,
+) -> dict:
     """The ℓ1 gain ‖h‖₁ of the closed loop from a leg's set-point to leg lengths, from the float twin's
-    set-point step response (``setpoint_step_response``; ``kwargs`` go there): h[n] = s[n] − s[n−1] is the
+    set-point step response (``setpoint_step_response`` of ``duration`` s): h[n] = s[n] − s[n−1] is the
     sampled impulse response, ‖h‖₁ = Σ|h[n]| the total variation of the step response (plus
     |1 − s_end|, the least variation still to come before the stepped leg settles at its DC gain 1).
+    With ``settle`` and ``max_duration`` (s): while the last quarter of the run added more than ``settle``
+    of ‖h‖₁ and twice the duration is at most ``max_duration``, the runs are continued to twice as long
+    (``Simulation.extend``: the numbers of fresh runs that long, without simulating the start again).
 
     Why it bounds the fixed-point controller's extra error: the fixed-point set-points are the float
     twin's plus an error sequence ε[k] (the 16-bit IK's error, the 1 mm LSB steps, and the sensor's counts
@@ -395,7 +435,18 @@ def setpoint_step_gain(platform: Platform, config: ControllerConfig | None = Non
 
     Returns ``{"diagonal": ‖h_jj‖₁, "coupled": Σ_i ‖h_ij‖₁, "tail": |1 − s_jj(end)|, "peak": max s_jj,
     "settled": the last quarter's share of ``coupled``, "t": t, "s": s}``."""
-    t, s = setpoint_step_response(platform, config, leg, **kwargs)
+    sims = _setpoint_step_runs(platform, config, leg, step, actuators)
+    logs = [sim.run(duration) for sim in sims]
+    while True:
+        gain = _gain_of(*_step_of(logs, step), leg)
+        if settle is None or max_duration is None or gain["settled"] <= settle or 2 * duration > max_duration:
+            return gain
+        duration *= 2
+        logs = [sim.extend(duration) for sim in sims]
+
+
+def _gain_of(t: np.ndarray, s: np.ndarray, leg: int) -> dict:
+    """``setpoint_step_gain``'s dict of the step response ``s`` (n, 6) at times ``t`` (n,)."""
     diag, coupled, tail = _l1_sums(s, leg)
     head = _l1_sums(s[: max(1, (3 * len(s)) // 4)], leg)[1]
     settled = (coupled - head) / coupled

@@ -104,6 +104,7 @@ class TickLoop:
         self._fixed = actuation_input.FixValue(simulator.get_mutable_context(), np.zeros(6))
         # the compiled DSP side (one C call per stop), None: the Python loop below (``firmware.loop_kernel``)
         self.kernel = make_kernel(law, sensor)
+        self._end, self._boundaries, self._raw = 0.0, (), None  # the last run's end, extra stops and raw logs
 
     def prime(self, poses) -> None:
         """The law's tables for the reference ``(n_ticks, 6)`` poses of the ticks 0, 1, … (one batch; speed
@@ -136,13 +137,49 @@ class TickLoop:
         Returns the logs at the plant steps (every stop of a discrete plant), each the values before the
         updates at that time: ``times`` (n,) s, ``command`` (n, 6) N, ``setpoint`` (n, 6) m, ``status``
         (n, len(STATUS)), ``state`` (n, nx) and ``force`` (n, 6) N."""
+        s = self._schedule(duration, boundaries)
+        self._end, self._boundaries = duration, tuple(boundaries)
+        return self._logs_of(s, self._advance(duration, s, on_boundary, self._log_arrays(s), -1, 0))
+
+    def extend(self, duration: float) -> dict:
+        """Continue the run that ended at the last ``run``/``extend``'s end time to ``duration`` s: the updates
+        at that time (which the run did not take: Drake's ``AdvanceTo`` stops before them), then the stops up to
+        ``duration`` of ``run(duration)``'s schedule. Returns the logs from t = 0, ``run``'s: the same numbers
+        as one run to ``duration`` when the end time was a stop of that run (a plant step or a tick; else
+        the continued run has a stop there that one run has not: ``tests/drake/test_loop_kernel.py``). The
+        tables (``reference``, ``feedforward``, ``prime``) must cover the ticks up to ``duration``."""
+        end = self._end
+        if self._raw is None or not duration > end:
+            raise RuntimeError(f"a run that ended at {end} s extended to {duration} s")  # a bug of the caller
+        s = self._schedule(duration, (*self._boundaries, end))  # the same stops up to ``end``, ``end`` included
+        first = s.times.index(end)
+        old = self._raw
+        n_old = 1 + sum(s.log[: first + 1])
+        if n_old != len(old["held"]):
+            raise RuntimeError(f"{len(old['held'])} rows logged up to {end} s, {n_old} expected")  # a bug
+        logs = self._log_arrays(s)
+        for name, rows in old.items():
+            logs[name][:n_old] = rows
+        self._end, self._boundaries = duration, (*self._boundaries, end)
+        return self._logs_of(s, self._advance(duration, s, None, logs, first, n_old))
+
+    def _schedule(self, duration: float, boundaries) -> Schedule:
         T = self.timing.sample_period
         delay = None if self.at_tick else self.timing.output_delay
-        s = schedule(duration, self.step, T, delay, self.discrete, boundaries)
+        return schedule(duration, self.step, T, delay, self.discrete, boundaries)
+
+    def _advance(self, duration: float, s: Schedule, on_boundary, logs: dict, first: int, row: int) -> dict:
+        """Run the stops of ``s`` from ``first`` on (-1: from t = 0, logging there; else resuming after the
+        log of stop ``first``), writing ``logs`` from ``row`` on; the raw logs, kept for ``extend``."""
         run = self._run_python if self.kernel is None else self._run_kernel
-        logs = run(duration, s, on_boundary)
-        held = logs.pop("held")
+        self._raw = run(duration, s, on_boundary, logs, first, row)
+        return self._raw
+
+    @staticmethod
+    def _logs_of(s: Schedule, raw: dict) -> dict:
+        held = raw["held"]
         times = np.array([0.0] + [t for t, logged in zip(s.times, s.log) if logged])
+        logs = {k: v for k, v in raw.items() if k != "held"}
         return logs | {"times": times, "command": held[:, :6], "setpoint": held[:, 6:]}
 
     def _log_arrays(self, s: Schedule) -> dict:
@@ -164,20 +201,23 @@ class TickLoop:
         times = s.times
         return {-1: 0.5 * times[0]} | {i: 0.5 * (times[i] + times[i + 1]) for i in range(len(times) - 1) if s.step[i]}
 
-    def _run_python(self, duration: float, s: Schedule, on_boundary) -> dict:
-        """``run`` in Python: the reference and the fallback of the compiled kernel (``_run_kernel``)."""
-        logs = self._log_arrays(s)
+    def _run_python(self, duration: float, s: Schedule, on_boundary, logs: dict, first: int, row: int) -> dict:
+        """``_advance`` in Python: the reference and the fallback of the compiled kernel (``_run_kernel``)."""
         held_log, status_log, x_log, force_log = logs["held"], logs["status"], logs["state"], logs["force"]
         ref, ff = self.reference, self.feedforward
         law, at_tick, sensor, act = self.law, self.at_tick, self.sensor, self.actuators
         pc, get_x = self.plant_context, self.plant.GetPositionsAndVelocities
         advance, half = self.simulator.AdvanceTo, self._half_steps(s)
         held, memory, status = self.held, self.memory, self.status
-        held_log[0], status_log[0], x_log[0], force_log[0] = held[:12], status, get_x(pc), self._force
-        row, last = 1, len(s.times) - 1
+        if first < 0:
+            held_log[0], status_log[0], x_log[0], force_log[0] = held[:12], status, get_x(pc), self._force
+            row = 1
+        last = len(s.times) - 1
         t, k, rel, step = 0.0, 0, False, True  # t = 0: Initialize has published; the tick at 0 is next
-        for i in range(-1, last + 1):
-            if i >= 0:
+        for i in range(first, last + 1):
+            if i == first >= 0:  # resuming: the run that ended at stop ``first`` logged there
+                t, k, rel, step = s.times[i], s.tick[i], s.release[i], s.step[i]
+            elif i >= 0:
                 t, k, rel, step = s.times[i], s.tick[i], s.release[i], s.step[i]
                 advance(t)
                 if s.log[i]:
@@ -226,12 +266,11 @@ class TickLoop:
             raise RuntimeError(f"plant state of {x.shape} values, {self.plant.num_multibody_states()} expected")
         return x, self._fixed.GetMutableData().get_mutable_value().get_mutable_value()
 
-    def _run_kernel(self, duration: float, s: Schedule, on_boundary) -> dict:
-        """``run`` with the compiled DSP side (``firmware.loop_kernel``): per stop one ``AdvanceTo`` and one C
+    def _run_kernel(self, duration: float, s: Schedule, on_boundary, logs: dict, first: int, row: int) -> dict:
+        """``_advance`` with the compiled DSP side (``firmware.loop_kernel``): per stop one ``AdvanceTo`` and one C
         call (log, tick or release, the actuators' force written in Drake's memory), and Drake told of a new
         force (``GetMutableData``) only when it changed. The stops that need Python — a boundary with a
         callback, a discrete plant's step before the loop's updates — split the call in two around it."""
-        logs = self._log_arrays(s)
         x, actuation = self._views()
         kern = self.kernel
         kern.start(
@@ -246,17 +285,19 @@ class TickLoop:
             self.status,
             self.at_tick,
             logs,
+            row,
         )
         notify, advance, stop, ks = self._fixed.GetMutableData, self.simulator.AdvanceTo, kern.stop, kern.s
         times, last = s.times, len(s.times) - 1
         split = {i for i in range(len(times)) if s.boundary[i] and on_boundary is not None}
         half = self._half_steps(s)
         split |= set(half)
-        kern.log(ks, -1)
-        if -1 in half:
-            advance(half[-1])
-        self._kernel_update(-1)
-        for i in range(last):
+        if first < 0:
+            kern.log(ks, -1)
+        if first in half:
+            advance(half[first])
+        self._kernel_update(first)
+        for i in range(first + 1, last):
             advance(times[i])
             if i in split:
                 kern.log(ks, i)

@@ -22,7 +22,6 @@ import numpy as np
 from stewart_drake.control.laws import STATUS, FloatLaw
 from stewart_drake.control.loop_sensor import IdealSensor, SensorReading
 from stewart_drake.core.c_build import C_DIR, UNAVAILABLE, load, source_keyed_library
-from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.errors import FirmwareError
 
 SOURCE = C_DIR / "sd_loop.c"
@@ -127,7 +126,7 @@ class LoopKernel:
 
     def tables(self, poses) -> None:
         """The law's side of the tick tables for the reference ``(n_ticks, 6)`` poses, in one batch: the
-        float law's set-points (``FloatLaw.setpoints`` of each row: the IK is elementwise over poses), the
+        float law's set-points (``FloatLaw.setpoints`` of the rows: the IK is elementwise over poses), the
         firmware's pose words (``CFixedPointLaw.step``'s)."""
         law, s = self.law, self.s
         poses = np.ascontiguousarray(np.asarray(poses, dtype=float).reshape(-1, 6))
@@ -137,20 +136,18 @@ class LoopKernel:
             words = pose_words(poses, law.config.ik_format).astype(law.module.word_dtype)
             s.pose_words = self._ptr("void *", words)
         else:
-            sp = leg_lengths(law.platform, poses, law.config.convention)
-            if law.setpoint_offset is not None:
-                sp = sp + law.setpoint_offset
-            s.setpoint = self._ptr("double *", np.asarray(sp, dtype=float))
+            s.setpoint = self._ptr("double *", np.asarray(law.setpoints(poses), dtype=float).reshape(-1, 6))
         s.n_ticks = len(poses)
 
     def start(
-        self, x, actuation, actuators, lag_force, schedule, feedforward, held, memory, status, at_tick, logs
+        self, x, actuation, actuators, lag_force, schedule, feedforward, held, memory, status, at_tick, logs, row=0
     ) -> None:
         """Point the struct at Drake's memory — the plant state ``x`` and its actuation input ``actuation``
         (numpy views valid for the run) —, the ``actuators`` (``control.actuation.Actuation``) with their lag
         state ``lag_force`` (6, N; None without a lag), the ``schedule`` (``tick_loop.Schedule``), the
         feed-forward rows (``(n_ticks, 6)`` N, or None), the controller's state (``at_tick``: ``dsp_state.releases_at_tick``) and the ``logs`` (``held``
-        (n, 12), ``status`` (n, len(STATUS)), ``state`` (n, nx), ``force`` (n, 6))."""
+        (n, 12), ``status`` (n, len(STATUS)), ``state`` (n, nx), ``force`` (n, 6)), written from ``row`` on (the rows before it:
+        an earlier run's, ``TickLoop.extend``)."""
         s = self.s
         indices = [self.sensor.positions] + ([self.sensor.velocities] if isinstance(self.sensor, SensorReading) else [])
         if not all(0 <= i < len(x) for i in np.concatenate(indices).tolist()):
@@ -180,7 +177,7 @@ class LoopKernel:
         s.x_log = self._ptr("double *", logs["state"])
         s.force_log = self._ptr("double *", logs["force"])
         s.n_rows, s.nx = logs["state"].shape
-        s.row = 0
+        s.row = row
 
     def state(self) -> tuple:
         """``(held (12,), memory (42,), status, lag_force (6,))`` now (copies)."""

@@ -27,11 +27,12 @@ def noisy_sensor(seed: int = 3) -> SensorModel:
     return SensorModel(rng.normal(0, 2e-5, 6), rng.normal(0, 1.5e-5, (n, 6)), rng.normal(0, 5e-6, n), 1e-3)
 
 
-def run_both(sc: Scenario, boundaries=False) -> tuple:
-    """The logs (and plant states) of ``sc`` with the compiled kernel and with the Python loop."""
+def run_both(sc: Scenario, boundaries=False, prepare=lambda sim: sim) -> tuple:
+    """The logs (and plant states) of ``sc`` with the compiled kernel and with the Python loop (``prepare``:
+    applied to each built Simulation)."""
     out = []
     for compiled in (True, False):
-        sim = build_simulation(sc)
+        sim = prepare(build_simulation(sc))
         assert sim.controller.kernel is not None  # a compiler is found here
         if not compiled:
             sim.controller.kernel = None
@@ -81,6 +82,71 @@ def test_kernel_with_boundaries_and_without_feedforward():
     np.testing.assert_array_equal(xa, xb)
     for name in SimulationLog.ARRAYS:
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_kernel_adds_the_float_laws_setpoint_offset():
+    """The float law's ``setpoint_offset`` (the probe of ``setpoint_step_gain``): the compiled loop adds it to
+    its set-point table, the Python loop per tick (``FloatLaw.setpoints``); the logs are equal bit for bit, and
+    the logged set-points are those of a run without the offset plus the offset (the rest run's IK, one addition)."""
+    offset = np.array([1e-3, 0.0, -2e-4, 0.0, 0.0, 3e-5])
+
+    def with_offset(sim):
+        sim.controller.law.setpoint_offset = offset
+        return sim
+
+    sc = Scenario(PLATFORM, "seed", "float", sensor=noisy_sensor(7))
+    (a, xa, _), (b, xb, _) = run_both(sc, prepare=with_offset)
+    np.testing.assert_array_equal(xa, xb)
+    for name in SimulationLog.ARRAYS:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    plain = build_simulation(sc).run(DURATION)
+    released = plain.status[:, 2] > 0  # rows after the first release: the held set-points are the ticks'
+    assert released.sum() > 30
+    np.testing.assert_array_equal(a.setpoint[released], plain.setpoint[released] + offset)
+
+
+@pytest.mark.parametrize(
+    "kind, integrator, latency, compiled",
+    [
+        ("float", "cenic-fixed", "sample", True),
+        ("fixed", "cenic-fixed", "computation", True),  # separate releases
+        ("fixed", "sap", "sample", True),  # a discrete plant: a step before the tick at the resumed stop
+        ("float", "sap", "computation", False),  # the Python loop
+        ("fixed", "cenic-fixed", "sample", False),
+    ],
+)
+def test_extended_run_equals_one_run(kind, integrator, latency, compiled):
+    """``Simulation.extend``: a run of 20 ms continued to 40 ms logs what one 40 ms run logs, bit for bit (plant
+    states included: the integrator took the same steps), with the compiled loop and the Python one. And a
+    run ended between stops (20.5 ms, 31 ms) and continued is the one run with stops there (``run``'s
+    boundaries): the continuation adds no other difference."""
+    cfg = ControllerConfig.for_platform(PLATFORM, DspTiming(latency=latency, computation_cycles=15000))
+    sc = Scenario(PLATFORM, "seed", kind, cfg, engine="c", integrator=integrator, sensor=noisy_sensor(11))
+
+    def built():
+        sim = build_simulation(sc)
+        assert sim.controller.kernel is not None
+        if not compiled:
+            sim.controller.kernel = None
+        return sim
+
+    extended, one = built(), built()
+    extended.run(0.02)
+    a, b = extended.extend(DURATION), one.run(DURATION)
+    assert len(a.t) == len(b.t) >= 41  # every plant step (and, for a discrete plant, every stop)
+    np.testing.assert_array_equal(extended.states(), one.states())
+    for name in SimulationLog.ARRAYS:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    off_grid, stops = built(), built()
+    off_grid.run(0.0205)
+    off_grid.extend(0.031)
+    off_grid.extend(DURATION)
+    stops.prepare(DURATION)
+    raw = stops.controller.run(DURATION, [0.0205, 0.031])
+    for name in ("times", "command", "setpoint", "status", "state", "force"):
+        np.testing.assert_array_equal(off_grid._logs[name], raw[name], err_msg=name)
+    with pytest.raises(RuntimeError, match="extended to 0.03 s after 0.04 s"):
+        off_grid.extend(0.03)
 
 
 @pytest.mark.parametrize("integrator", ["cenic-fixed", "sap"])

@@ -379,3 +379,18 @@ def test_l1_gain_reports_how_far_it_has_settled():
     assert _l1_sums(long["s"][:n], 0)[1] == short["coupled"]
     assert short["coupled"] < 0.95 * long["coupled"], (short["coupled"], long["coupled"])
     assert short["settled"] > 0.05 > 0.01 > long["settled"], (short["settled"], long["settled"])
+
+
+def test_l1_gain_continues_its_runs_until_settled():
+    """``setpoint_step_gain`` with ``settle``: a run not settled is continued to twice as long
+    (``Simulation.extend``) up to ``max_duration``, and gives what fresh runs that long give, bit for bit;
+    a settled one stops at its first duration."""
+    from stewart_drake.drake.simulation import setpoint_step_gain
+
+    platform = load_preset("utn-dynamic")
+    doubled = setpoint_step_gain(platform, duration=0.25, settle=0.0, max_duration=1.0)  # 0.25, 0.5, 1 s
+    fresh = setpoint_step_gain(platform, duration=1.0)
+    assert doubled["t"][-1] == 1.0 and doubled["settled"] > 0.0
+    for k in fresh:
+        np.testing.assert_array_equal(doubled[k], fresh[k], err_msg=k)
+    assert setpoint_step_gain(platform, duration=0.25, settle=1.0, max_duration=1.0)["t"][-1] == 0.25
