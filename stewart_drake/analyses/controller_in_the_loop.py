@@ -30,7 +30,8 @@ ENGINE = resolve_engine("c", "analysis controller_in_the_loop")
 PRESETS = ("utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009")
 # The ℓ1 gain's step response (s), quick mode too: the loops ring down over seconds (utn-dynamic's ‖h‖₁ is
 # 10.2 after 1.5 s, 11.27 after 6 s), and a shorter run underestimates the bound's gain. A loop that has not
-# settled in L1_S is run twice as long, up to L1_MAX_S (utn-kinematic's rotating gains need 12 s).
+# settled in L1_S is continued to twice as long (not re-run from t = 0: the same numbers), up to L1_MAX_S
+# (utn-kinematic's rotating gains need 12 s).
 L1_S, L1_MAX_S = 6.0, 24.0
 L1_SETTLED = 0.01  # the most of ‖h‖₁ the step response's last quarter may add (the bound's convergence check)
 

@@ -7,6 +7,7 @@ plant state and the actuators' force into preallocated arrays (the Diagram has n
 inside ``AdvanceTo``. All of a stop's work is one call into C (``firmware.loop_kernel``: the float law or the
 compiled firmware, reading and writing Drake's memory through numpy views obtained once); the Python loop
 (``_run_python``) is the reference and the fallback (the firmware's Python emulation, no C compiler).
+A run can be continued (``TickLoop.extend``): the same stops and numbers as one longer run.
 
 Why the logs are those of the all-Drake Diagram (a ``ControllerSystem`` wired to the plant), bit for bit
 (``tests/drake/test_tick_loop.py`` runs both): the loop stops at every time the Diagram had an event
