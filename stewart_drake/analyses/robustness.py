@@ -112,7 +112,7 @@ def build(section) -> None:
         f"Runs that lost tracking (a leg more than 5 mm off, or a failed simulation): {len(lost)} of {runs}"
         + (f" ({', '.join(map(str, lost))})." if lost else ".")
     )
-    ranking = {m: sensitivity(rows, m) for m in ("max_leg_error_m", "max_position_error_m")}
+    ranking = {m: sensitivity(rows, m, p_values=False) for m in ("max_leg_error_m", "max_position_error_m")}
     names = [d["parameter"] for d in ranking["max_leg_error_m"][:10]]
     rho = {m: {d["parameter"]: d["spearman"] for d in r} for m, r in ranking.items()}
     section.table(
