@@ -60,7 +60,8 @@ def bare_plant(platform, integrator, duration):
     from stewart_drake.drake.platform_model import build_plant, set_pose
 
     builder = DiagramBuilder()
-    plant, _ = build_plant(platform, 1e-3, builder, continuous=integrator in CONTINUOUS)
+    # built as the closed loop builds its plant when nothing is shown (no SceneGraph): a fair reference
+    plant, _ = build_plant(platform, 1e-3, builder, continuous=integrator in CONTINUOUS, visuals=False)
     home = platform.home_pose()
     F = leg_forces_with_legs(platform, home, np.zeros(6), np.zeros(6))
     src = builder.AddSystem(ConstantVectorSource(F))

@@ -56,7 +56,8 @@ def plant(p, duration: float) -> float:
     from stewart_drake.drake.platform_model import build_plant, set_pose
 
     builder = DiagramBuilder()
-    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    # built as the closed loop builds its plant when nothing is shown (no SceneGraph): a fair reference
+    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS, visuals=False)
     F = leg_forces_with_legs(p, p.home_pose(), np.zeros(6), np.zeros(6))
     src = builder.AddSystem(ConstantVectorSource(F))
     builder.Connect(src.get_output_port(), mbp.get_actuation_input_port())
@@ -110,7 +111,8 @@ def replayed_plant(p, kind: str, engine: str, duration: float) -> float:
 
     log = build_simulation(Scenario(p, "seed", kind, engine=engine)).run(duration)
     builder = DiagramBuilder()
-    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS)
+    # built as the closed loop builds its plant when nothing is shown (no SceneGraph): a fair reference
+    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS, visuals=False)
     # the force logged at t_k acted over (t_k-1, t_k]: row k + 1 acts over (t_k, t_k+1]
     hold = PiecewisePolynomial.ZeroOrderHold(log.t[:-1], log.force[1:].T)
     src = builder.AddSystem(TrajectorySource(hold))
