@@ -457,11 +457,12 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
     sc, timing = plan.scenario, plan.timing
     t_wall = time.perf_counter()
     if sc.firmware and meshcat is None:  # the user's C runs in a child process with a time limit
-        log, gap = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
+        log, gap, tick_loop = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
     else:
         sim = build_simulation(sc, meshcat=meshcat)
         log = sim.run(plan.duration, progress=progress)
         gap = sim.max_constraint_gap()
+        tick_loop = sim.tick_loop
     t_wall = time.perf_counter() - t_wall
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -478,6 +479,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "read_units": plan.read_units,
         "controller": sc.controller,
         "engine": sc.engine,
+        "tick_loop": tick_loop,  # "compiled" for either law where the loop kernel runs; "engine" is the firmware's
         "firmware": sc.firmware,
         "sample_period_s": timing.sample_period,
         "latency": timing.latency,

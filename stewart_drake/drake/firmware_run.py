@@ -21,12 +21,13 @@ def run_closed_loop(scenario: Scenario, duration: float, progress: bool) -> tupl
     """``(SimulationLog, max constraint gap m)`` of ``scenario`` run for ``duration`` s, in this process."""
     sim = build_simulation(scenario)
     log = sim.run(duration, progress=progress)
-    return log, sim.max_constraint_gap()
+    return log, sim.max_constraint_gap(), sim.tick_loop
 
 
 def run_user_firmware(scenario: Scenario, duration: float, progress: bool, path: str, limit: float) -> tuple:
     """``run_closed_loop`` in a child process, stopped when the simulated time has not advanced for
-    ``limit`` seconds (building, i.e. compiling and loading the firmware, included)."""
+    ``limit`` seconds (building, i.e. compiling and loading the firmware, included): ``(log, the largest
+    constraint gap (m), Simulation.tick_loop)``."""
     return run_isolated(_in_child, scenario, duration, progress, path=path, limit=limit)
 
 
@@ -50,4 +51,4 @@ def _in_child(beat, scenario: Scenario, duration: float, progress: bool) -> tupl
     finally:
         stop.set()
         watcher.join()
-    return log, sim.max_constraint_gap()
+    return log, sim.max_constraint_gap(), sim.tick_loop

@@ -166,6 +166,12 @@ class Simulation:
     _duration: float = 0.0
     _logs: dict = field(default_factory=dict)
 
+    @property
+    def tick_loop(self) -> str:
+        """Where the ticks run: ``"compiled"`` (one C call per tick, ``firmware.loop_kernel``: the float law or
+        the compiled firmware) or ``"python"`` (the reference loop: engine python, a replaced law, no compiler)."""
+        return "python" if self.controller.kernel is None else "compiled"
+
     def run(self, duration: float, progress: bool = False) -> SimulationLog:
         """Simulate ``duration`` seconds from t = 0 (once per Simulation) and return the logs."""
         if not (math.isfinite(duration) and duration > 0):

@@ -155,3 +155,15 @@ def test_size_and_dynamics_take_a_trajectory_object():
     assert abs(splined["peak_force_n"]["value"] / named["peak_force_n"]["value"] - 1) < 1e-6
     forces = sd.inverse_dynamics(p, sd.Trajectory.seed(), dt=0.1).forces
     assert np.array_equal(forces, sd.inverse_dynamics(p, "seed").forces)
+
+
+def test_summary_says_where_the_ticks_ran():
+    """``tick_loop`` names the loop that ran the ticks: the compiled kernel for the float law too (where a C
+    compiler is found), the Python loop for engine python (``engine`` alone names the firmware's engine)."""
+    from stewart_drake.core.c_build import compilers
+
+    p = sd.load_platform("utn-dynamic")
+    float_run = sd.simulate(p, "seed", duration=0.02, controller="float").to_dict()
+    emulated = sd.simulate(p, "seed", duration=0.02, controller="fixed", engine="python").to_dict()
+    assert float_run["tick_loop"] == ("compiled" if compilers() else "python")
+    assert emulated["tick_loop"] == "python" and emulated["engine"] == "python"
