@@ -32,7 +32,7 @@ from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
-from stewart_drake.report import figures, parts, render
+from stewart_drake.report import figures, metadata, parts, render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 
@@ -154,7 +154,22 @@ def _module_at(path: Path):
 
 
 def load_analysis(path: Path) -> Analysis:
-    mod = _module_at(path)
+    """The analysis script at ``path``: its metadata read from the source (``report.metadata``, no import:
+    the report's parent process only schedules), its ``build`` and ``parts`` imported when first called; a
+    script whose metadata are not plain literals is imported now."""
+    path = Path(path)
+    meta = metadata.read(path)
+    if meta is not None:
+        return Analysis(
+            path.stem,
+            meta["TITLE"],
+            float(meta["ORDER"]),
+            FromScript(path, "build"),
+            path,
+            float(meta["COST"]),
+            FromScript(path, "parts") if meta["parts"] else None,
+        )
+    mod = loaded(path)
     for attr in ("TITLE", "ORDER", "build"):
         if not hasattr(mod, attr):
             raise ValueError(f"analysis {path} lacks {attr}")  # internal: the analyses are package modules
@@ -167,6 +182,17 @@ def load_analysis(path: Path) -> Analysis:
         float(getattr(mod, "COST", 0.0)),
         getattr(mod, "parts", None),
     )
+
+
+@dataclass(frozen=True)
+class FromScript:
+    """The function ``name`` of the analysis script at ``path``, imported when first called."""
+
+    path: Path
+    name: str
+
+    def __call__(self, *args):
+        return getattr(loaded(self.path), self.name)(*args)
 
 
 def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = None) -> list[Analysis]:
@@ -213,14 +239,22 @@ def unlabelled_axes(fig) -> list[str]:
 _MODULES: dict = {}
 
 
+def loaded(path) -> object:
+    """The analysis script at ``path`` as a module, imported once per process (a script outside the package:
+    once per content, so an edited script is run as it now reads)."""
+    path = Path(path).resolve()
+    key = (str(path), None if path.parent == ANALYSES_DIR else path.read_bytes())
+    if key not in _MODULES:
+        _MODULES[key] = _module_at(path)
+    return _MODULES[key]
+
+
 def call_in_analysis(path: str, name: str, item):
     """``name(item)`` of the analysis script at ``path`` (loaded once per worker process)."""
     import matplotlib
 
     matplotlib.use("Agg")
-    if path not in _MODULES:
-        _MODULES[path] = _module_at(Path(path))
-    return getattr(_MODULES[path], name)(item)
+    return getattr(loaded(path), name)(item)
 
 
 def _call_in_pool(path: str, name: str, item):
@@ -249,6 +283,11 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
 
 def build_section(analysis: Analysis, quick: bool = False) -> Section:
     """Run one analysis into a new ``Section`` (timed); an analysis that raises becomes a failed check."""
+    if isinstance(analysis.build, FromScript):  # its import is not the section's time (as when it was discovered)
+        try:
+            loaded(analysis.build.path)
+        except Exception:  # noqa: BLE001, S110 - raised again by the build below, and reported as its failure
+            pass
     t0, c0 = time.perf_counter(), time.process_time()
     s = Section(analysis.title, quick=quick)
     try:
@@ -309,7 +348,7 @@ def run_analyses(
     sections: list[Section | None] = [None] * n
     finished = [0]
 
-    def on_section(i, f, parts_wall, parts_cpu):
+    def on_section(i, f, parts_wall, parts_cpu, n_parts):
         try:
             s = f.result()
         except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
@@ -319,7 +358,7 @@ def run_analyses(
             )
             s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
             s.elapsed, s.crashed = 0.0, True
-        s.parts = sum(1 for _ in (analyses[i].parts(quick) if analyses[i].parts else ()))
+        s.parts = n_parts
         s.elapsed = (s.elapsed or 0.0) + parts_wall
         s.cpu = (s.cpu or 0.0) + parts_cpu
         sections[i] = s
