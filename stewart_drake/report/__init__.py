@@ -8,7 +8,8 @@ Analyses run in worker processes (``jobs``), each returning its picklable ``Sect
 keeps the analyses' order whatever order they finish in.
 
 An analysis script in ``analyses/`` defines ``TITLE``, ``ORDER`` (position in the report) and
-``build(section)``, optionally ``COST`` (its relative run time: the costliest start first); its ``main()``
+``build(section)``, optionally ``COST`` (its relative run time: the costliest start first), as plain literals at
+its top level so that the report's parent reads them without importing the script (``report.metadata``); its ``main()``
 calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
 out with ``parallel_map(__file__, "function_name", items)``, and declare them with ``parts(quick)`` so that
 the report runs them in its own pool beside the other sections (``report.parts``). ``section.headline(text)``
