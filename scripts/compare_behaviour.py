@@ -23,6 +23,7 @@ from pathlib import Path
 VOLATILE_KEYS = {
     "run_wall_s": "montecarlo summary: sum/mean of the runs' wall-clock times",
     "wall_s": "montecarlo row (row.json, montecarlo.partial.jsonl): one run's wall-clock time",
+    "real_time_factor": "simulate summary (stdout JSON, summary.json): duration_s / wall_s, a wall-clock rate",
 }
 # Columns removed from recorded CSV files (``csv_header``/``csv_rows``) and Parquet tables (``parquet``).
 VOLATILE_COLUMNS = {
@@ -39,6 +40,12 @@ TEXT_SUBSTITUTIONS = [
         re.compile(r"http://(localhost|127\.0\.0\.1):\d+"),
         r"http://\1:<PORT>",
         "view / Meshcat: the port is the first free one from 7000, which depends on other processes",
+    ),
+    (
+        re.compile(r"in [0-9.e+-]+ s of wall time \([0-9.e+-]+ × real time\)"),
+        "in <WALL> s of wall time (<RATE> × real time)",
+        "simulate's last stderr line: the run's wall-clock time and real-time factor (summary.json's wall_s and "
+        "real_time_factor)",
     ),
 ]
 

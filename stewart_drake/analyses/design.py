@@ -274,7 +274,9 @@ def maps(section, p, k) -> None:
     import matplotlib.pyplot as plt
 
     n = 31 if section.quick else 81
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    # constrained from the start: colorbars added before the layout engine is set leave it unsolvable (the
+    # figure was then saved as drawn, the yaw axis label under the left colorbar's)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), layout="constrained")
     xy = ((-0.45, 0.45), (-0.45, 0.45))
     for ax, axes_, ranges, scale, labels in (
         (axes[0], (0, 1), xy, (1e3, 1e3), ("x (mm)", "y (mm)")),
@@ -303,7 +305,7 @@ def maps(section, p, k) -> None:
 
     m = slice_maps(with_payload(p, PAYLOAD_KG, PAYLOAD_COM), (0, 1), xy, n, k=k, modes=True)
     X, Y = np.meshgrid(m.u * 1e3, m.v * 1e3, indexing="ij")
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), layout="constrained")
     c = axes[0].pcolormesh(X, Y, m.k_min / 1e3, shading="auto", cmap="magma")
     s = slice(None, None, max(1, n // 15))
     axes[0].quiver(

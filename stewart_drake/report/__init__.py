@@ -8,7 +8,8 @@ Analyses run in worker processes (``jobs``), each returning its picklable ``Sect
 keeps the analyses' order whatever order they finish in.
 
 An analysis script in ``analyses/`` defines ``TITLE``, ``ORDER`` (position in the report) and
-``build(section)``, optionally ``COST`` (its relative run time: the costliest start first); its ``main()``
+``build(section)``, optionally ``COST`` (its relative run time: the costliest start first), as plain literals at
+its top level so that the report's parent reads them without importing the script (``report.metadata``); its ``main()``
 calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
 out with ``parallel_map(__file__, "function_name", items)``, and declare them with ``parts(quick)`` so that
 the report runs them in its own pool beside the other sections (``report.parts``). ``section.headline(text)``
@@ -20,13 +21,11 @@ from __future__ import annotations
 import base64
 import html
 import importlib.util
-import io
 import os
 import shlex
 import sys
 import textwrap
 import time
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,12 +33,9 @@ from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
-from stewart_drake.report import parts, render
+from stewart_drake.report import figures, metadata, parts, render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
-# zlib level 1 for the figures' PNGs: measured on a report figure (four panels of 4,000-point lines), the
-# encoding took 0.17 s of its 0.88 s at matplotlib's default level 6 and ~0 s at level 1, for a file 5 % larger
-PNG = {"format": "png", "dpi": 110, "bbox_inches": "tight", "pil_kwargs": {"compress_level": 1}}
 
 
 @dataclass
@@ -101,24 +97,14 @@ class Section:
         self.blocks.append(render.table_html(header, rows, caption, nan_reason))
 
     def figure(self, fig, name: str, caption: str = "") -> None:
-        """A matplotlib figure, inlined and saved as ``name.png``; the figure is closed."""
+        """A matplotlib figure, inlined and saved as ``name.png`` (``report.figures``); the figure is closed."""
         import matplotlib.pyplot as plt
 
         self.warnings += [f"figure {name}: {w}" for w in unlabelled_axes(fig)]
-        buf = io.BytesIO()
-        if fig.get_layout_engine() is None:  # lay labels, titles and legends out without overlaps or clipping
-            fig.set_layout_engine("constrained")
-            try:
-                with warnings.catch_warnings():
-                    warnings.filterwarnings("error", message=".*constrained_layout not applied")  # then do without
-                    fig.savefig(buf, **PNG)
-            except (ZeroDivisionError, ValueError, UserWarning):  # a layout it cannot solve: the figure as drawn
-                fig.set_layout_engine("none")
-                buf = io.BytesIO()
-        if not buf.getvalue():
-            fig.savefig(buf, **PNG)
-        plt.close(fig)
-        data = buf.getvalue()
+        try:
+            data = figures.png_bytes(fig)
+        finally:
+            plt.close(fig)
         self.files[f"{name}.png"] = data
         b64 = base64.b64encode(data).decode()
         cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
@@ -169,7 +155,22 @@ def _module_at(path: Path):
 
 
 def load_analysis(path: Path) -> Analysis:
-    mod = _module_at(path)
+    """The analysis script at ``path``: its metadata read from the source (``report.metadata``, no import:
+    the report's parent process only schedules), its ``build`` and ``parts`` imported when first called; a
+    script whose metadata are not plain literals is imported now."""
+    path = Path(path)
+    meta = metadata.read(path)
+    if meta is not None:
+        return Analysis(
+            path.stem,
+            meta["TITLE"],
+            float(meta["ORDER"]),
+            FromScript(path, "build"),
+            path,
+            float(meta["COST"]),
+            FromScript(path, "parts") if meta["parts"] else None,
+        )
+    mod = loaded(path)
     for attr in ("TITLE", "ORDER", "build"):
         if not hasattr(mod, attr):
             raise ValueError(f"analysis {path} lacks {attr}")  # internal: the analyses are package modules
@@ -182,6 +183,17 @@ def load_analysis(path: Path) -> Analysis:
         float(getattr(mod, "COST", 0.0)),
         getattr(mod, "parts", None),
     )
+
+
+@dataclass(frozen=True)
+class FromScript:
+    """The function ``name`` of the analysis script at ``path``, imported when first called."""
+
+    path: Path
+    name: str
+
+    def __call__(self, *args):
+        return getattr(loaded(self.path), self.name)(*args)
 
 
 def discover_analyses(directory: Path = ANALYSES_DIR, only: list[str] | None = None) -> list[Analysis]:
@@ -228,14 +240,22 @@ def unlabelled_axes(fig) -> list[str]:
 _MODULES: dict = {}
 
 
+def loaded(path) -> object:
+    """The analysis script at ``path`` as a module, imported once per process (a script outside the package:
+    once per content, so an edited script is run as it now reads)."""
+    path = Path(path).resolve()
+    key = (str(path), None if path.parent == ANALYSES_DIR else path.read_bytes())
+    if key not in _MODULES:
+        _MODULES[key] = _module_at(path)
+    return _MODULES[key]
+
+
 def call_in_analysis(path: str, name: str, item):
     """``name(item)`` of the analysis script at ``path`` (loaded once per worker process)."""
     import matplotlib
 
     matplotlib.use("Agg")
-    if path not in _MODULES:
-        _MODULES[path] = _module_at(Path(path))
-    return getattr(_MODULES[path], name)(item)
+    return getattr(loaded(path), name)(item)
 
 
 def _call_in_pool(path: str, name: str, item):
@@ -264,6 +284,11 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
 
 def build_section(analysis: Analysis, quick: bool = False) -> Section:
     """Run one analysis into a new ``Section`` (timed); an analysis that raises becomes a failed check."""
+    if isinstance(analysis.build, FromScript):  # its import is not the section's time (as when it was discovered)
+        try:
+            loaded(analysis.build.path)
+        except Exception:  # noqa: BLE001, S110 - raised again by the build below, and reported as its failure
+            pass
     t0, c0 = time.perf_counter(), time.process_time()
     s = Section(analysis.title, quick=quick)
     try:
@@ -324,7 +349,7 @@ def run_analyses(
     sections: list[Section | None] = [None] * n
     finished = [0]
 
-    def on_section(i, f, parts_wall, parts_cpu):
+    def on_section(i, f, parts_wall, parts_cpu, n_parts):
         try:
             s = f.result()
         except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
@@ -334,7 +359,7 @@ def run_analyses(
             )
             s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
             s.elapsed, s.crashed = 0.0, True
-        s.parts = sum(1 for _ in (analyses[i].parts(quick) if analyses[i].parts else ()))
+        s.parts = n_parts
         s.elapsed = (s.elapsed or 0.0) + parts_wall
         s.cpu = (s.cpu or 0.0) + parts_cpu
         sections[i] = s

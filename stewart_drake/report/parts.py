@@ -9,7 +9,8 @@ parts' results handed to its worker: ``parallel_map`` there returns them instead
 A part that raised is simply not handed over (the section computes it again and reports the error).
 
 ``schedule`` keeps at most ``jobs`` tasks in flight and always starts the most expensive ready one (the
-analyses' ``COST``; a section whose parts are done goes first), so that the workers finish together.
+analyses' ``COST``; a section whose parts are done goes first), so that the workers finish together. The
+parts are declared in the workers (the parent reads the scripts' constants without importing them).
 """
 
 from __future__ import annotations
@@ -54,24 +55,37 @@ def run_part(path: str, name: str, item):
 def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_section) -> None:
     """Run every analysis (and its declared parts) on ``pool``, at most ``jobs`` tasks at a time, the
     costliest ready task first. ``build_in_worker(path, quick, done)`` builds a section in a worker;
-    ``on_section(i, future, parts_wall, parts_cpu)`` is called as each section's future completes."""
+    ``on_section(i, future, parts_wall, parts_cpu, n_parts)`` is called as each section's future completes.
+
+    An analysis whose ``parts`` is still in its unimported script (``report.FromScript``) declares them in a
+    worker, first of all tasks (the costliest first): that worker imports the script, which it needs anyway
+    to run the parts, and the parent imports nothing."""
+    from stewart_drake.report import FromScript
+
     order = itertools.count()
     ready: list = []  # heap of (-priority, order, kind, analysis index, payload)
-    waiting, done = {}, {}
+    waiting, done, declared = {}, {}, {}
     spent = {i: [0.0, 0.0] for i in range(len(analyses))}  # parts' wall and CPU seconds
-    for i, a in enumerate(analyses):
-        declared = list(a.parts(quick)) if getattr(a, "parts", None) else []
-        waiting[i], done[i] = len(declared), {}
-        for name, item in declared:
-            heapq.heappush(ready, (-a.cost, next(order), "part", i, (name, item)))
-        if not declared:
-            heapq.heappush(ready, (-a.cost, next(order), "section", i, None))
+
+    def add_parts(i, items):
+        declared[i], waiting[i], done[i] = len(items), len(items), {}
+        for name, item in items:
+            heapq.heappush(ready, (-analyses[i].cost, next(order), "part", i, (name, item)))
+        if not items:
+            heapq.heappush(ready, (-analyses[i].cost, next(order), "section", i, None))
+
+    for i, a in sorted(enumerate(analyses), key=lambda ia: -ia[1].cost):
+        found = getattr(a, "parts", None)
+        if isinstance(found, FromScript):
+            heapq.heappush(ready, (-float("inf"), next(order), "declare", i, ("parts", quick)))
+        else:
+            add_parts(i, list(found(quick)) if found else [])
     running: dict = {}
     while ready or running:
         while ready and len(running) < jobs:
             _, _, kind, i, payload = heapq.heappop(ready)
             path = str(analyses[i].path)
-            if kind == "part":
+            if kind in ("part", "declare"):
                 running[pool.submit(run_part, path, *payload)] = (kind, i, payload)
             else:
                 running[pool.submit(build_in_worker, path, quick, done[i])] = (kind, i, None)
@@ -79,7 +93,10 @@ def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_s
         for f in finished:
             kind, i, payload = running.pop(f)
             if kind == "section":
-                on_section(i, f, *spent[i])
+                on_section(i, f, *spent[i], declared[i])
+                continue
+            if kind == "declare":  # a script that fails to import has no parts: its section says why
+                add_parts(i, list(f.result()[0]) if f.exception() is None else [])
                 continue
             if f.exception() is None:  # a part that raised is recomputed by its section, which reports it
                 result, wall, cpu = f.result()

@@ -84,7 +84,12 @@ def test_schedule_costliest_first_and_a_section_right_after_its_parts():
     ]
     pool, got = _Inline(), {}
     parts.schedule(
-        pool, analyses, False, 1, lambda path, quick, done: done, lambda i, f, w, c: got.update({i: (f.result(), w, c)})
+        pool,
+        analyses,
+        False,
+        1,
+        lambda path, quick, done: done,
+        lambda i, f, w, c, n: got.update({i: (f.result(), w, c, n)}),
     )
     assert pool.order == [
         ("part", "heavy", 1),
@@ -96,4 +101,4 @@ def test_schedule_costliest_first_and_a_section_right_after_its_parts():
     ]
     # each section got its own parts' results, keyed by (script, function, item), and their time summed
     assert got[1][0] == {parts.part_key("heavy", "f", 1): 1, parts.part_key("heavy", "f", 2): 2}
-    assert got[1][1:] == (1.0, 0.5) and got[0] == ({}, 0.0, 0.0)
+    assert got[1][1:] == (1.0, 0.5, 2) and got[0] == ({}, 0.0, 0.0, 0)
