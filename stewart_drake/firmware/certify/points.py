@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.firmware.certify.recipe import AXES, CellEval, Model, Recorder, _entry, isqrt_nearest
+from stewart_drake.firmware.certify.recipe import AXES, CellEval, Model, Recorder, isqrt_nearest, rotation_entry
 
 
 def point_words(model: Model, w: np.ndarray) -> CellEval:
@@ -29,7 +29,7 @@ def point_words(model: Model, w: np.ndarray) -> CellEval:
     R = {}
     for i in range(3):  # rotation entries: products and sums as rotation_from_words forms them
         for j in range(3):
-            acc, inner = _entry(model, words, i, j)
+            acc, inner = rotation_entry(model, words, i, j)
             k = rec.index[f"R[{i}][{j}]"]
             rec.possible[:, k] |= inner
             R[(i, j)] = rec.sat(f"R[{i}][{j}]", acc, acc, lo, hi, final=True)[0]

@@ -418,7 +418,7 @@ def _legs(m: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, R: dict, r_sat: np
 ENUMERATION_LIMIT = 4096  # angle-word pairs enumerated per cell for an exact rotation hull
 
 
-def _entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+def rotation_entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
     """R[i][j] before its final clamp, from sine/cosine words (arrays), as rotation_from_words forms it,
     and where a product or a partial sum on the way clamped."""
     f = model.fmt.frac_bits
@@ -453,7 +453,7 @@ def exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec: 
     the free angle's factor extremes gives the exact hull (and where no product or partial sum clamps, its
     clamp is decided exactly). ``entry(model, words, i, j) -> (word before its final clamp, inner clamp)``:
     the entry as the firmware forms it from sine/cosine words (default: ``rotation_from_words``' way)."""
-    entry = entry or _entry
+    entry = entry or rotation_entry
     names = [f"R[{i}][{j}]" for i in range(3) for j in range(3)]
     cols = [rec.index[nm] for nm in names]
     flagged = np.flatnonzero(rec.possible[:, cols].any(axis=1))
