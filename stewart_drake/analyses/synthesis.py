@@ -189,7 +189,11 @@ def build(section) -> None:
             + ", ".join(f"{k} {v:.2f}×" for k, v in factors.items())
             + " (bound / sampled worst; for the frequency sampled / bound). The proof refines cells while a bound "
             f"could exceed the worst seen by 10 % (branch and bound, up to {tighten:,} cells"
-            + (", the full report's 60,000 tighten them by at most 12 %" if quick else "")
+            + (
+                " in quick mode: 60,000, the full report's budget, tighten this design's by at most 12 %"
+                if quick
+                else ""
+            )
             + ") and stops there: every "
             "bound meets its requirement with room, so no finer cells are needed."
         )
