@@ -16,7 +16,7 @@ import numpy as np
 
 from stewart_drake import workspace as ws
 from stewart_drake.core.geometry import load_preset
-from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.core.kinematics import leg_lengths, leg_vectors
 from stewart_drake.report import run_standalone
 
 TITLE = "Workspace of the 6-6 platform (González Acuña & Dutra 2009)"
@@ -145,7 +145,13 @@ def build(section) -> None:
 
     # --- volume: grid estimate, bound, convergence, independent column integral
     levels = [0.04, 0.02] if quick else [0.02, 0.01]
-    conv = [(hh, ws.constant_orientation_workspace(p, resolution=hh, refine=False)) for hh in levels] + [(h, w)]
+    h_beyond = levels[-1]  # the limits' study below sweeps this grid too: its stroke-only case is swept once,
+    # with refined extents (which the table below does not use: its volumes are the grid's own)
+    stroke_beyond = ws.constant_orientation_workspace(p, resolution=h_beyond, limits=ws.Limits())
+    conv = [
+        (hh, stroke_beyond if hh == h_beyond else ws.constant_orientation_workspace(p, resolution=hh, refine=False))
+        for hh in levels
+    ] + [(h, w)]
     # 2 mm columns: within 0.001 L of the 1 mm integral (error O(h^1.5) from the rim), 1000 × below the grid's
     # bound, at a quarter of the cost
     h_col = 0.004 if quick else 0.002
@@ -219,7 +225,7 @@ def build(section) -> None:
         "",
     )
 
-    beyond(section, p, 0.02 if quick else 0.01)
+    beyond(section, p, h_beyond, stroke_beyond)
 
 
 def reachable_nodes(p, h: float, w=None) -> np.ndarray:
@@ -234,11 +240,23 @@ def reachable_nodes(p, h: float, w=None) -> np.ndarray:
     X, Y, Z = np.meshgrid(*g, indexing="ij")
     q = np.zeros(X.shape + (6,))
     q[..., 0], q[..., 1], q[..., 2] = X, Y, Z
-    return q[ws.classify(p, q)]
+    # ``classify`` only where the stroke may hold: the translation enters each leg additively (l_i = p + l_i(0)),
+    # so nodes whose legs all miss [L_min, L_max] by more than PREFILTER_M (far above any rounding) are outside
+    # and are not classified; the nodes kept and their order are those of classifying every node
+    l0 = leg_vectors(p, np.zeros(6))  # (6, 3) l_i(0), m
+    d = np.sqrt(sum((q[..., None, k] + l0[:, k]) ** 2 for k in range(3)))  # (..., 6) leg lengths, m
+    near = np.all((d >= p.L_min - PREFILTER_M) & (d <= p.L_max + PREFILTER_M), axis=-1)
+    inside = np.zeros(near.shape, bool)
+    inside[near] = ws.classify(p, q[near])
+    return q[inside]
 
 
-def beyond(section, p, h) -> None:
-    """The limits the paper names as next steps, each reported by name when it binds."""
+PREFILTER_M = 1e-6  # the prefilter's margin (m): rounding differs between two forms of |l_i| by ~1e-15 m
+
+
+def beyond(section, p, h, stroke_only=None) -> None:
+    """The limits the paper names as next steps, each reported by name when it binds. ``stroke_only``: the
+    stroke-only workspace at ``h`` when the caller swept it already (the first case's)."""
     cases = [
         ("stroke only", ws.Limits()),
         ("joint cones 40° (base and top)", ws.Limits(base_cone=math.radians(40), top_cone=math.radians(40))),
@@ -246,9 +264,12 @@ def beyond(section, p, h) -> None:
         ("leg collision, Ø 0.145 m", ws.Limits(leg_diameter=0.145)),
         ("dexterity κ ≤ 3", ws.Limits(max_condition=3.0)),
     ]
-    rows, removed, stroke_only = [], {}, None
+    rows, removed = [], {}
     for name, lim in cases:
-        w = ws.constant_orientation_workspace(p, resolution=h, limits=lim)
+        if stroke_only is not None and name == "stroke only":
+            w = stroke_only
+        else:
+            w = ws.constant_orientation_workspace(p, resolution=h, limits=lim)
         removed[name] = w.removed_m3
         stroke_only = stroke_only or w  # the first case: the stroke alone
         rot = ws.orientation_limits(p, limits=lim)

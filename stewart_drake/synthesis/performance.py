@@ -511,7 +511,9 @@ def _confirm(platform, name, poses, limit, v_max, a_max, stiffness, convention) 
     return {"pose": poses[k].tolist(), "value": float(vals[k]), "limit": float(limit)}
 
 
-def prove_requirements_performance(platform: Platform, req, max_cells: int = MAX_CELLS) -> PerformanceProof:
+def prove_requirements_performance(
+    platform: Platform, req, max_cells: int = MAX_CELLS, tighten_cells: int = TIGHTEN_CELLS
+) -> PerformanceProof:
     """``prove_performance`` of a ``Requirements``' actuator and limits over its box (relative to home)."""
     limits = {
         "force": req.max_force,
@@ -522,5 +524,5 @@ def prove_requirements_performance(platform: Platform, req, max_cells: int = MAX
     home = platform.home_pose()
     return prove_performance(
         platform, home + req.box_lo, home + req.box_hi, limits, req.v_max, req.a_max, req.stiffness, req.convention,
-        max_cells,
+        max_cells, tighten_cells=tighten_cells,
     )  # fmt: skip

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from stewart_drake.core.geometry import Platform
 from stewart_drake.synthesis.evaluate import box_vertices
 from stewart_drake.synthesis.families import design_platform
-from stewart_drake.synthesis.performance import PerformanceProof, prove_requirements_performance
+from stewart_drake.synthesis.performance import TIGHTEN_CELLS, PerformanceProof, prove_requirements_performance
 from stewart_drake.synthesis.proof import MAX_CELLS, ProofResult, prove_requirements_box
 from stewart_drake.synthesis.requirements import Requirements
 from stewart_drake.synthesis.search import SearchResult, pick_design, run_search
@@ -238,6 +238,7 @@ def synthesize(
     progress: bool = False,
     max_cells: int = MAX_CELLS,
     pop_size: int | None = None,
+    tighten_cells: int = TIGHTEN_CELLS,
 ) -> SynthesisResult:
     """Search (``search.run_search``), pick a design of the front (``search.pick_design``), prove the box on it
     (``proof.prove_requirements_box``) and tabulate the requirements."""
@@ -255,7 +256,7 @@ def synthesize(
         joint_cone=req.joint_cone,
         leg_diameter=req.leg_diameter,
     )
-    performance = prove_requirements_performance(platform, req, max_cells=max_cells)
+    performance = prove_requirements_performance(platform, req, max_cells=max_cells, tighten_cells=tighten_cells)
     return SynthesisResult(
         result, k, pick, platform, proof, performance, requirement_table(req, row, proof, performance)
     )

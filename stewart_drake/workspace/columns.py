@@ -22,16 +22,27 @@ def stroke_column_lengths(
     l0 = leg_vectors(platform, np.r_[0.0, 0.0, 0.0, check_orientation(orientation)], convention)
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
     rho2 = (x[..., None] + l0[:, 0]) ** 2 + (y[..., None] + l0[:, 1]) ** 2  # (..., 6)
+    reach = np.all(rho2 <= platform.L_max**2, axis=-1)
+    out = np.zeros(x.shape)
+    # a column some leg cannot reach has length exactly 0 (no z passes that leg): only the others are measured
+    out[reach] = _column_lengths(platform, rho2[reach], l0, z_bounds)
+    return out
+
+
+def _column_lengths(platform: Platform, rho2, l0, z_bounds) -> np.ndarray:
+    """``(m,)`` the column lengths of ``stroke_column_lengths`` from each column's squared horizontal leg
+    distances ``rho2`` (m, 6) (m²)."""
     a = np.sqrt(np.maximum(platform.L_min**2 - rho2, 0.0))
     b = np.sqrt(np.maximum(platform.L_max**2 - rho2, 0.0))
-    reach = rho2 <= platform.L_max**2
     cz = -l0[:, 2]
     z0, z1 = z_bounds
-    ends = np.concatenate([cz - b, cz - a, cz + a, cz + b, np.broadcast_to([z0, min(z1, 1e9)], x.shape + (2,))], -1)
+    ends = np.concatenate(
+        [cz - b, cz - a, cz + a, cz + b, np.broadcast_to([z0, min(z1, 1e9)], rho2.shape[:-1] + (2,))], -1
+    )
     ends = np.sort(np.clip(ends, z0, min(z1, 1e9)), axis=-1)
     mid = 0.5 * (ends[..., 1:] + ends[..., :-1])  # (..., 25)
     dz = np.abs(mid[..., None] - cz)  # (..., 25, 6)
-    ok = np.all(reach[..., None, :] & (dz >= a[..., None, :]) & (dz <= b[..., None, :]), axis=-1)
+    ok = np.all((dz >= a[..., None, :]) & (dz <= b[..., None, :]), axis=-1)  # every leg reaches these columns
     return np.sum(np.where(ok, ends[..., 1:] - ends[..., :-1], 0.0), axis=-1)
 
 

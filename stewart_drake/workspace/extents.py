@@ -4,10 +4,13 @@ extreme refined by a constrained optimisation (SLSQP on the limit margins) with 
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 from scipy.optimize import minimize
 
-from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.core.kinematics import scaled_condition
+from stewart_drake.core.vec3 import cross
 from stewart_drake.workspace.limits import raw_margins
 from stewart_drake.workspace.slabs import GridSpec
 
@@ -45,6 +48,31 @@ def _extreme_plane_nodes(axes, top, front, side, k, idx) -> np.ndarray:
     return pts
 
 
+def plate_offsets(spec: GridSpec) -> np.ndarray:
+    """``(6, 3)`` r_i = R (p_TTi − p_TC) at the sweep's orientation (m), as ``leg_vectors`` and
+    ``inverse_jacobian`` compute it (the same einsum of the same R: the same bits)."""
+    platform = spec.platform
+    return np.einsum("...jk,ik->...ij", spec.R, platform.top_anchors_per_leg - platform.rotation_centre)
+
+
+def point_margins(spec: GridSpec, p, offsets: np.ndarray) -> np.ndarray:
+    """Every margin at one position ``p`` (3,) (m) of the sweep's orientation: ``raw_margins`` of ``leg_vectors``
+    at the pose, then the half-space above the base, bit for bit, with the orientation's part (``offsets``,
+    ``plate_offsets``) computed once instead of at every call of the refinement's optimiser."""
+    platform, o = spec.platform, spec.orientation
+    q = np.r_[p, o]
+    l = q[..., None, :3] + offsets - platform.base_anchors  # leg_vectors' (p + r) − b
+    limits = copy.copy(spec.limits)  # without the dexterity (a copy: ``replace`` would normalise the axes again)
+    object.__setattr__(limits, "max_condition", None)
+    ms = [m.ravel() for m in raw_margins(platform, l, spec.R, limits, q, spec.convention).values()]
+    if spec.limits.max_condition is not None:  # raw_margins' last entry, by inverse_jacobian's formula
+        u = l / np.linalg.norm(l, axis=-1, keepdims=True)
+        J = np.concatenate([u, cross(offsets, u)], axis=-1)
+        ms.append((spec.limits.max_condition - scaled_condition(platform, J))[..., None].ravel())
+    above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
+    return np.concatenate(ms + above)
+
+
 def refine_extents(spec: GridSpec, extents, top, front, side, h, feas_tol: float = 1e-9):
     """Each extreme found by a constrained optimisation (SLSQP on the per-leg margins, all smooth
     pieces) from the extreme grid node; kept only if the optimum is feasible (every margin >=
@@ -63,15 +91,12 @@ def refine_extents(spec: GridSpec, extents, top, front, side, h, feas_tol: float
         above = [P[:, 2:3] - spec.z_floor] if np.isfinite(spec.z_floor) else []  # the half-space above the base
         return np.concatenate([m.reshape(len(P), -1) for m in ms.values()] + above, axis=1)
 
+    offsets = plate_offsets(spec)
+
     def margins(p):
-        """Every margin at one position ``p`` (3,), through ``leg_vectors``: SLSQP's finite-difference
-        Jacobian of this form converges where the batched one above stalled (gonzalez-dutra-2009, z_min)."""
-        q = np.r_[p, o]
-        l = leg_vectors(spec.platform, q, spec.convention)
-        above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
-        return np.concatenate(
-            [m.ravel() for m in raw_margins(spec.platform, l, spec.R, spec.limits, q, spec.convention).values()] + above
-        )
+        """Every margin at one position ``p`` (3,) (``point_margins``): SLSQP's finite-difference Jacobian of
+        this form converges where the batched one above stalled (gonzalez-dutra-2009, z_min)."""
+        return point_margins(spec, p, offsets)
 
     for k, (i_lo, i_hi) in enumerate(_extreme_indices((top, front, side))):
         for side_i, (idx, sign) in enumerate(((i_lo, -1), (i_hi, 1))):

@@ -229,7 +229,20 @@ class Recorder:
         self.certain[:, k] |= (lo > whi) | (hi < wlo)
         if final:
             self.pre_lo[:, k], self.pre_hi[:, k] = lo, hi
-        return np.clip(lo, wlo, whi), np.clip(hi, wlo, whi)
+        # np.minimum/np.maximum: the same clamp as np.clip without its per-call overhead (hot: ~100 calls a cell batch)
+        return np.minimum(np.maximum(lo, wlo), whi), np.minimum(np.maximum(hi, wlo), whi)
+
+    def sat_legs(self, idx, lo, hi, wlo: int, whi: int, final: bool = False, mask=None):
+        """``sat`` of the six words ``idx`` (6,) at once on (6, n) hulls (legs first); only the legs where ``mask``
+        (6, 1) record their clamp flags (all when None)."""
+        possible, certain = (hi > whi) | (lo < wlo), (lo > whi) | (hi < wlo)
+        if mask is not None:
+            possible, certain = possible & mask, certain & mask
+        self.possible[:, idx] |= possible.T
+        self.certain[:, idx] |= certain.T
+        if final:
+            self.pre_lo[:, idx], self.pre_hi[:, idx] = lo.T, hi.T
+        return np.minimum(np.maximum(lo, wlo), whi), np.minimum(np.maximum(hi, wlo), whi)
 
     def flag(self, name: str):
         return self.possible[:, self.index[name]]
@@ -317,74 +330,95 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
     for i in range(3):
         for j in range(3):
             r_sat |= rec.flag(f"R[{i}][{j}]")
-    # -- legs: v = p + sum_k floor(R_rk c_ik / 2^f) - b, saturated; sq = sum v^2; L = isqrt_near(sq)
-    err_lo = np.full((n, 6), -np.inf)
-    err_hi = np.full((n, 6), np.inf)
-    for i in range(6):
-        sq_w = zero_i
-        sq_e = zero_f
-        sq_t = zero_f
-        for r in range(3):
-            name = f"leg{i + 1}.{AXES[r]}"
-            pf = (cell_lo[:, r].astype(float), cell_hi[:, r].astype(float))
-            v = IV((cell_lo[:, r], cell_hi[:, r]), zero_f, pf)
-            for k in range(3):
-                c = int(m.r_T[i, k])
-                ct = (m.r_T_true[0][i, k], m.r_T_true[1][i, k])
-                Rk = R[(r, k)]
-                contrib_t = fmul(Rk.t, ct)
-                contrib_t = fscale(contrib_t, 2.0**-f)
-                if c:
-                    lo, hi = imul(Rk.w, (np.int64(c), np.int64(c)))
-                    # error: (R_true (c - ct) + eR c) / 2^f - t
-                    dc = fsub((float(c), float(c)), ct)
-                    e = fscale(fadd(fmul(Rk.t, dc), fscale(Rk.e, float(c))), 2.0**-f)
-                    e = fsub(e, (0.0, 1.0))
-                    term = IV((lo >> f, hi >> f), e, contrib_t)
-                    v = addw(v, term, 1, rec, name, m, final=False)
-                else:  # the firmware omits a term that rounds to zero: its true value is all error
-                    v = IV(v.w, fsub(v.e, contrib_t), fadd(v.t, contrib_t))
-            b = int(m.B[i, r])
-            bt = (m.B_true[0][i, r], m.B_true[1][i, r])
-            if b:
-                lo, hi = v.w[0] - b, v.w[1] - b
-                w = rec.sat(name, lo, hi, m.lo, m.hi, final=True)
-            else:
-                w = v.w
-                rec.pre_lo[:, rec.index[name]], rec.pre_hi[:, rec.index[name]] = v.w
-            # word - true: the word subtracts b, the truth bt
-            v = IV(w, fadd(v.e, fsub(bt, (float(b), float(b)))), fsub(v.t, bt))
-            # sq += v^2, saturating at the accumulator
-            v2 = isquare(v.w)
-            sq_lo, sq_hi = sq_w[0] + v2[0], sq_w[1] + v2[1]
-            sq_w = rec.sat(f"sq{i + 1}", sq_lo, sq_hi, -m.acc_hi - 1, m.acc_hi, final=r == 2)
-            sq_e = fadd(sq_e, fadd(fscale(fmul(v.t, v.e), 2.0), fsquare(v.e)))
-            sq_t = fadd(sq_t, fsquare(v.t))
-        # the length: nearest integer root, saturated to the word
-        y_lo, y_hi = isqrt_nearest(sq_w[0]), isqrt_nearest(sq_w[1])
-        rec.sat(f"length{i + 1}", y_lo, y_hi, m.lo, m.hi, final=True)
-        s_f = (sq_w[0].astype(float), sq_w[1].astype(float))
-        den = fadd(fsqrt(s_f), fsqrt(sq_t))
-        ok = den[0] > 0
-        den_safe = (np.where(ok, den[0], 1.0), np.where(ok, den[1], 1.0))
-        prop = fdiv_pos(sq_e, den_safe)
-        yfloor = np.floor(np.sqrt(sq_w[0].astype(float))) - 1.0  # a lower bound on y, safe against rounding
-        rnd_hi = up(0.5 + 0.125 / (np.maximum(yfloor, 0.0) + 0.5))
-        e = fadd(prop, (np.full(n, -0.5), rnd_hi))
-        chain = r_sat.copy()
-        for r in range(3):
-            chain |= rec.flag(f"leg{i + 1}.{AXES[r]}")
-        chain |= rec.flag(f"sq{i + 1}") | rec.flag(f"length{i + 1}")
-        good = ok & ~chain
-        err_lo[:, i] = np.where(good, e[0], -np.inf)
-        err_hi[:, i] = np.where(good, e[1], np.inf)
+    # -- legs: v = p + sum_k floor(R_rk c_ik / 2^f) - b, saturated; sq = sum v^2; L = isqrt_near(sq).
+    # The six legs at once, (6, n) arrays: every operation is elementwise, so each leg's words and enclosures
+    # are bit for bit those of a loop over the legs; a leg whose constant is 0 takes the other branch by mask
+    # (its clamp is not recorded), as the loop's ``if`` did.
+    err_lo, err_hi = _legs(m, cell_lo, cell_hi, R, r_sat, rec)
     return CellEval(rec.pre_lo, rec.pre_hi, rec.possible, rec.certain, err_lo, err_hi)
+
+
+def _legs(m: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, R: dict, r_sat: np.ndarray, rec: Recorder):
+    """The leg chains of ``evaluate`` for all six legs at once: ``(err_lo, err_hi)`` (n, 6), infinite where a
+    saturation is possible in the leg's chain (recorded in ``rec``). Arrays are (6, n), legs first, so that
+    numpy's inner loops run over the cells (an inner axis of 6 is slow to broadcast)."""
+    n, f = cell_lo.shape[0], m.fmt.frac_bits
+    zero_i = (np.zeros((6, n), dtype=np.int64), np.zeros((6, n), dtype=np.int64))
+    zero_f = (np.zeros((6, n)), np.zeros((6, n)))
+    col = {
+        k: IV(tuple(x[None, :] for x in R[k].w), tuple(x[None, :] for x in R[k].e), tuple(x[None, :] for x in R[k].t))
+        for k in R
+    }
+    sq_w, sq_e, sq_t = zero_i, zero_f, zero_f
+    idx_of = rec.index
+    flags = np.zeros((6, n), dtype=bool)  # a clamp possible in the leg's own words (legs, sq, length)
+    for r in range(3):
+        idx = np.array([idx_of[f"leg{i + 1}.{AXES[r]}"] for i in range(6)])
+        pw = (np.broadcast_to(cell_lo[None, :, r], (6, n)), np.broadcast_to(cell_hi[None, :, r], (6, n)))
+        v = IV(pw, zero_f, (pw[0].astype(float), pw[1].astype(float)))
+        for k in range(3):
+            c = m.r_T[:, k, None].astype(np.int64)  # (6, 1)
+            nz = c != 0
+            ct = (m.r_T_true[0][:, k, None], m.r_T_true[1][:, k, None])
+            Rk = col[(r, k)]
+            contrib_t = fscale(fmul(Rk.t, ct), 2.0**-f)
+            # c == 0: the firmware omits a term that rounds to zero: its true value is all error
+            omit = IV(v.w, fsub(v.e, contrib_t), fadd(v.t, contrib_t)) if not nz.all() else None
+            if nz.any():  # c != 0: the term floor(R c / 2^f), error (R_true (c - ct) + eR c) / 2^f - t, added
+                lo, hi = imul(Rk.w, (c, c))
+                cf = c.astype(float)
+                dc = fsub((cf, cf), ct)
+                e_lo, e_hi = Rk.e[0] * cf, Rk.e[1] * cf  # fscale(Rk.e, c) with the sign of each leg's c
+                eRc = (down(np.where(cf < 0, e_hi, e_lo)), up(np.where(cf < 0, e_lo, e_hi)))
+                e = fsub(fscale(fadd(fmul(Rk.t, dc), eRc), 2.0**-f), (0.0, 1.0))
+                w = rec.sat_legs(idx, v.w[0] + (lo >> f), v.w[1] + (hi >> f), m.lo, m.hi, mask=nz)
+                v = IV(w, fadd(v.e, e), fadd(v.t, contrib_t))
+                if omit is not None:  # legs of both kinds: each takes its own branch
+                    v = IV(
+                        *(
+                            tuple(np.where(nz, a, b) for a, b in zip(x, y, strict=True))
+                            for x, y in ((v.w, omit.w), (v.e, omit.e), (v.t, omit.t))
+                        )
+                    )
+            else:
+                v = omit
+        b = m.B[:, r, None].astype(np.int64)
+        nzb = b != 0
+        bt = (m.B_true[0][:, r, None], m.B_true[1][:, r, None])
+        lo, hi = v.w[0] - b, v.w[1] - b  # b == 0: the word itself, recorded, never clamped
+        w = rec.sat_legs(idx, lo, hi, m.lo, m.hi, final=True, mask=nzb)
+        if not nzb.all():
+            w = (np.where(nzb, w[0], lo), np.where(nzb, w[1], hi))
+        bf = b.astype(float)
+        # word - true: the word subtracts b, the truth bt
+        v = IV(w, fadd(v.e, fsub(bt, (bf, bf))), fsub(v.t, bt))
+        # sq += v^2, saturating at the accumulator
+        v2 = isquare(v.w)
+        sq_idx = np.array([idx_of[f"sq{i + 1}"] for i in range(6)])
+        sq_w = rec.sat_legs(sq_idx, sq_w[0] + v2[0], sq_w[1] + v2[1], -m.acc_hi - 1, m.acc_hi, final=r == 2)
+        sq_e = fadd(sq_e, fadd(fscale(fmul(v.t, v.e), 2.0), fsquare(v.e)))
+        sq_t = fadd(sq_t, fsquare(v.t))
+        flags |= rec.possible[:, idx].T
+    # the length: nearest integer root, saturated to the word
+    len_idx = np.array([idx_of[f"length{i + 1}"] for i in range(6)])
+    rec.sat_legs(len_idx, isqrt_nearest(sq_w[0]), isqrt_nearest(sq_w[1]), m.lo, m.hi, final=True)
+    s_f = (sq_w[0].astype(float), sq_w[1].astype(float))
+    den = fadd(fsqrt(s_f), fsqrt(sq_t))
+    ok = den[0] > 0
+    den_safe = (np.where(ok, den[0], 1.0), np.where(ok, den[1], 1.0))
+    prop = fdiv_pos(sq_e, den_safe)
+    yfloor = np.floor(np.sqrt(sq_w[0].astype(float))) - 1.0  # a lower bound on y, safe against rounding
+    rnd_hi = up(0.5 + 0.125 / (np.maximum(yfloor, 0.0) + 0.5))
+    e = fadd(prop, (np.full((6, n), -0.5), rnd_hi))
+    chain = r_sat[None, :] | flags | rec.possible[:, sq_idx].T | rec.possible[:, len_idx].T
+    good = ok & ~chain
+    return np.ascontiguousarray(np.where(good, e[0], -np.inf).T), np.ascontiguousarray(np.where(good, e[1], np.inf).T)
 
 
 ENUMERATION_LIMIT = 4096  # angle-word pairs enumerated per cell for an exact rotation hull
 
 
-def _entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+def rotation_entry(model: Model, words: dict, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
     """R[i][j] before its final clamp, from sine/cosine words (arrays), as rotation_from_words forms it,
     and where a product or a partial sum on the way clamped."""
     f = model.fmt.frac_bits
@@ -419,7 +453,7 @@ def exact_rotation(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray, rec: 
     the free angle's factor extremes gives the exact hull (and where no product or partial sum clamps, its
     clamp is decided exactly). ``entry(model, words, i, j) -> (word before its final clamp, inner clamp)``:
     the entry as the firmware forms it from sine/cosine words (default: ``rotation_from_words``' way)."""
-    entry = entry or _entry
+    entry = entry or rotation_entry
     names = [f"R[{i}][{j}]" for i in range(3) for j in range(3)]
     cols = [rec.index[nm] for nm in names]
     flagged = np.flatnonzero(rec.possible[:, cols].any(axis=1))

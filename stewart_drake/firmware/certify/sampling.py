@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.firmware.certify.recipe import BENIGN, Model, evaluate, word_names
+from stewart_drake.firmware.certify.points import point_words
+from stewart_drake.firmware.certify.recipe import BENIGN, Model, word_names
 from stewart_drake.fixedpoint.generic import leg_length_words
 
 CHUNK = 1 << 16
@@ -77,7 +78,7 @@ def sample_box(model: Model, lo, hi, n: int, seed: int = 0, adversarial: int = 0
 
 def measure_words(model: Model, w: np.ndarray) -> Sampled:
     """Sampled extremes over the ``(n, 6)`` pose words ``w`` (one chunk)."""
-    ev = evaluate(model, w, w)  # at a single pose the recipe is the emulation (pinned by a test)
+    ev = point_words(model, w)  # the recipe at single poses (= the emulation, pinned by a test), integers only
     post_lo, _ = ev.post(model)
     arith_sat = (ev.possible & ~BENIGN_MASK).any(axis=1)  # the trig clamp is within its certified error
     err = np.abs(length_errors(model, w))

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stewart_drake.firmware.certify.points import point_words
 from stewart_drake.firmware.certify.recipe import BENIGN, CellEval, Model, word_names
 from stewart_drake.firmware.certify.recipe import evaluate as evaluate_generic
 from stewart_drake.firmware.certify.tp17_recipe import evaluate_tp17, tp17_word_names
@@ -181,7 +182,7 @@ def run_search(
             pts.append(np.array([[hi[0, k] if (c >> k) & 1 else lo[0, k] for k in range(6)] for c in range(64)]))
         pts.append(lo[flagged] + (rng.random(lo[flagged].shape) * (hi[flagged] - lo[flagged] + 1)).astype(np.int64))
         cand = np.concatenate(pts)
-        pe = evaluate(model, cand, cand)
+        pe = evaluate(model, cand, cand) if implementation == "tp17" else point_words(model, cand)  # single poses
         for k in np.flatnonzero((pe.possible & arith & ~shown).any(axis=1))[:8]:
             new = pe.possible[k] & arith & ~shown
             if not new.any():
