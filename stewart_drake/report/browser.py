@@ -11,7 +11,9 @@ from __future__ import annotations
 import base64
 import io
 import json
+import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -80,6 +82,7 @@ class Browser:
             ],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
+            start_new_session=True,  # its own process group: its helpers (zygote, crashpad) end with it
         )
         port_file = Path(self._dir.name) / "DevToolsActivePort"
         deadline = time.monotonic() + self.timeout
@@ -106,13 +109,23 @@ class Browser:
     def __exit__(self, *exc) -> None:
         if getattr(self, "_ws", None) is not None:
             self._ws.close()
-        self._proc.terminate()
+        self._signal_group(signal.SIGTERM)
         try:
             self._proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
-            self._proc.kill()
-            self._proc.wait()
+            pass
+        # Chromium's helper processes may still be writing the profile after the browser exits (a teardown once
+        # failed with "Directory not empty: 'Default'" under load): end the whole group before removing it
+        self._signal_group(signal.SIGKILL)
+        self._proc.wait()
         self._dir.cleanup()
+
+    def _signal_group(self, sig) -> None:
+        """Send ``sig`` to Chromium's process group (gone already: nothing to do)."""
+        try:
+            os.killpg(self._proc.pid, sig)
+        except ProcessLookupError:
+            pass
 
     # -- protocol ------------------------------------------------------------------------------
 
