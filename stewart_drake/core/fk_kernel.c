@@ -432,19 +432,17 @@ static void nt_p2_pair(nstate *A, nstate *B) {
             A->Y[i].v[0] = A->Y[i].v[1] = A->Y[i].v[2] = B->Y[i].v[0] = B->Y[i].v[1] = B->Y[i].v[2] = (v2){0.0, 0.0};
             EL(A->Y[i], i) = EL(B->Y[i], i) = 1.0;
         }
-        int a = 1, b = 1;
-        for (int k = 0; k < 6; k++) { /* unrolled by -funroll-loops; gj_column stops a matrix at a zero pivot */
-            a = a && gj_column(A->J, A->Y, k);
-            b = b && gj_column(B->J, B->Y, k);
-        }
+        int a = 1, b = 1; /* constant columns (inlined and specialised); a matrix stops at a zero pivot */
+#define GJ2(k) a = a && gj_column(A->J, A->Y, k); b = b && gj_column(B->J, B->Y, k)
+        GJ2(0); GJ2(1); GJ2(2); GJ2(3); GJ2(4); GJ2(5);
+#undef GJ2
         A->ok = a;
         B->ok = b;
     } else {
         int a = 1, b = 1;
-        for (int k = 0; k < 6; k++) {
-            a = a && lu_column(A->J, A->piv, A->dinv, k);
-            b = b && lu_column(B->J, B->piv, B->dinv, k);
-        }
+#define LU2(k) a = a && lu_column(A->J, A->piv, A->dinv, k); b = b && lu_column(B->J, B->piv, B->dinv, k)
+        LU2(0); LU2(1); LU2(2); LU2(3); LU2(4); LU2(5);
+#undef LU2
         A->ok = a;
         B->ok = b;
     }
