@@ -3,18 +3,28 @@
  *
  * Newton is the numpy reference's (newton_fk.newton_core) step for step: iterate on the rotation centre's
  * position p and the orientation R, solve J d = L* - L(p, R) with rows [u_i, r_i x u_i], scale the step so
- * that |dp| <= max_step_m and |w| <= max_step_rad, update p += dp, R = exp([w]x) R.
+ * that |dp| <= max_step_m and |w| <= max_step_rad, update p += dp, R = exp([w]x) R. The first step uses the
+ * inverse of J(y0) the certificate needs (one Gauss-Jordan pass), later steps an LU (a last chord step may
+ * reuse it, see REUSE_MARGIN): each step is Newton's to rounding.
  *
  * Certificate (see realtime_fk.py for the argument): in the coordinates y = (p, a w) around the previous
  * pose y0 (a the anchor radius, R = exp([w]x) R0), F(y) = L(y) - L*. With beta >= |J(y0)^-1| (2-norm, from
  * the computed inverse X and its residual |I - X J|_F), gamma(rho) a Lipschitz constant of F' on the ball
  * B(y0, rho) (from |d exp([w]x) r| <= |r| e^|w| |dw| and its second derivative bound, term by term of the
  * series) and eta >= |J^-1 F(y0)|:
- *   uniqueness: beta gamma(rho) rho < 1  => F has at most one zero in B(y0, rho), for every L*;
+ *   uniqueness (lemma): beta gamma(rho) rho < 1  => F has at most one zero in B(y0, rho), for every L*
+ *               (two zeros y1, y2: 0 = (J(y0) + E)(y1 - y2), |J(y0)^-1 E| <= beta gamma rho < 1);
  *   branch:     2 eta <= rho              => along L(s) = L(y0) + s (L* - L(y0)), s in [0, 1], the zero
- *               in B(y0, rho) exists (Kantorovich), is unique and moves continuously: it is y0's branch.
+ *               in B(y0, rho) exists (Kantorovich, h(s) = s beta gamma eta <= 1/2), is unique and moves
+ *               continuously: it is y0's branch.
+ * rho is the largest radius found by three trials (rho_s, c = 0.999 / (beta gamma(rho_s)), and 2 eta when the
+ * first two fall below it: gamma is taken on the smallest ball the branch test needs).
  * The Newton result is accepted as that zero when it lies in B(y0, rho). Evaluated in double precision
  * with the rounding of the 6x6 products covered by a relative margin (MARGIN), not interval arithmetic.
+ *
+ * Speed: independent length sets run two at a time (newton_pair), their factorisations interleaved column by
+ * column, so that one solve's chain of dependent operations fills the other's waits; each set sees exactly
+ * the operations it sees alone (the same bits, tests/core/test_realtime_fk_pairs.py).
  */
 #include <math.h>
 #include <stdint.h>
