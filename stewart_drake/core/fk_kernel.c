@@ -3,18 +3,28 @@
  *
  * Newton is the numpy reference's (newton_fk.newton_core) step for step: iterate on the rotation centre's
  * position p and the orientation R, solve J d = L* - L(p, R) with rows [u_i, r_i x u_i], scale the step so
- * that |dp| <= max_step_m and |w| <= max_step_rad, update p += dp, R = exp([w]x) R.
+ * that |dp| <= max_step_m and |w| <= max_step_rad, update p += dp, R = exp([w]x) R. The first step uses the
+ * inverse of J(y0) the certificate needs (one Gauss-Jordan pass), later steps an LU (a last chord step may
+ * reuse it, see REUSE_MARGIN): each step is Newton's to rounding.
  *
  * Certificate (see realtime_fk.py for the argument): in the coordinates y = (p, a w) around the previous
  * pose y0 (a the anchor radius, R = exp([w]x) R0), F(y) = L(y) - L*. With beta >= |J(y0)^-1| (2-norm, from
  * the computed inverse X and its residual |I - X J|_F), gamma(rho) a Lipschitz constant of F' on the ball
  * B(y0, rho) (from |d exp([w]x) r| <= |r| e^|w| |dw| and its second derivative bound, term by term of the
  * series) and eta >= |J^-1 F(y0)|:
- *   uniqueness: beta gamma(rho) rho < 1  => F has at most one zero in B(y0, rho), for every L*;
+ *   uniqueness (lemma): beta gamma(rho) rho < 1  => F has at most one zero in B(y0, rho), for every L*
+ *               (two zeros y1, y2: 0 = (J(y0) + E)(y1 - y2), |J(y0)^-1 E| <= beta gamma rho < 1);
  *   branch:     2 eta <= rho              => along L(s) = L(y0) + s (L* - L(y0)), s in [0, 1], the zero
- *               in B(y0, rho) exists (Kantorovich), is unique and moves continuously: it is y0's branch.
+ *               in B(y0, rho) exists (Kantorovich, h(s) = s beta gamma eta <= 1/2), is unique and moves
+ *               continuously: it is y0's branch.
+ * rho is the largest radius found by three trials (rho_s, c = 0.999 / (beta gamma(rho_s)), and 2 eta when the
+ * first two fall below it: gamma is taken on the smallest ball the branch test needs).
  * The Newton result is accepted as that zero when it lies in B(y0, rho). Evaluated in double precision
  * with the rounding of the 6x6 products covered by a relative margin (MARGIN), not interval arithmetic.
+ *
+ * Speed: independent length sets run two at a time (newton_pair), their factorisations interleaved column by
+ * column, so that one solve's chain of dependent operations fills the other's waits; each set sees exactly
+ * the operations it sees alone (the same bits, tests/core/test_realtime_fk_pairs.py).
  */
 #include <math.h>
 #include <stdint.h>
@@ -33,6 +43,9 @@ enum { I_RES = 0, I_ITER, I_STATUS, I_CERT, I_RADIUS, I_ETA, I_STEP, I_SUB, N_IN
  * 1e3 puts the chord's residual below rounding, so the pose is the full Newton's to rounding where certified
  * (1e-15 m on the presets, 1e5 workspace solves each; with 1e2 it was 1e-13 m). */
 #define REUSE_MARGIN 1e3
+/* The factorisation at hand: none, the inverse Y of J(y0) (computed for the certificate and the first step), or an
+ * LU of J at a later iterate (the only one a chord step reuses: a chord with Y would leave Newton's path). */
+enum { NONE = 0, INVERSE = 1, LU = 2 };
 
 /* g: base anchors (6x3), plate anchors relative to the rotation centre in T (6x3), anchor radius a,
  * size0 = max(|base anchors|max, |top anchors|max) (the numpy divergence test's scale), |t_i| (6). */
@@ -84,25 +97,46 @@ static void angles(int conv, const double R[9], double *ang) {
     }
 }
 
-/* Leg vectors l_i = p + R t_i - b_i, lengths, plate vectors r_i = R t_i. */
-static void legs(const double *g, const double p[3], const double R[9], double r[6][3], double l[6][3], double L[6]) {
-    for (int i = 0; i < 6; i++) {
-        const double *t = g + G_TOP + 3 * i, *b = g + G_BASE + 3 * i;
-        for (int k = 0; k < 3; k++) {
-            r[i][k] = R[3 * k] * t[0] + R[3 * k + 1] * t[1] + R[3 * k + 2] * t[2];
-            l[i][k] = p[k] + r[i][k] - b[k];
+/* The geometry for the hot loop: g, and the plate and base anchors by coordinate in leg pairs (t[k][j] holds
+ * coordinate k of legs 2j and 2j + 1), so that the leg vectors are computed two legs at a time. */
+typedef struct { const double *g; v2 t[3][3], b[3][3]; } geom;
+
+static void geom_init(geom *G, const double *g) {
+    G->g = g;
+    for (int k = 0; k < 3; k++)
+        for (int j = 0; j < 3; j++) {
+            G->t[k][j] = (v2){g[G_TOP + 6 * j + k], g[G_TOP + 6 * j + 3 + k]};
+            G->b[k][j] = (v2){g[G_BASE + 6 * j + k], g[G_BASE + 6 * j + 3 + k]};
         }
-        L[i] = sqrt(l[i][0] * l[i][0] + l[i][1] * l[i][1] + l[i][2] * l[i][2]);
+}
+
+/* Leg vectors l_i = p + R t_i - b_i, lengths, plate vectors r_i = R t_i, two legs a lane pair: r[k][j], l[k][j]
+ * hold coordinate k of legs 2j, 2j + 1. Each lane sees the scalar expression's operations in its order. */
+static void legs(const geom *G, const double p[3], const double R[9], v2 r[3][3], v2 l[3][3], double L[6]) {
+    for (int k = 0; k < 3; k++) { /* each entry of R and p broadcast once */
+        v2 R0 = {R[3 * k], R[3 * k]}, R1 = {R[3 * k + 1], R[3 * k + 1]}, R2 = {R[3 * k + 2], R[3 * k + 2]};
+        v2 pk = {p[k], p[k]};
+        for (int j = 0; j < 3; j++) {
+            r[k][j] = R0 * G->t[0][j] + R1 * G->t[1][j] + R2 * G->t[2][j];
+            l[k][j] = pk + r[k][j] - G->b[k][j];
+        }
+    }
+    for (int j = 0; j < 3; j++) {
+        v2 s = l[0][j] * l[0][j] + l[1][j] * l[1][j] + l[2][j] * l[2][j];
+        L[2 * j] = sqrt(s[0]);
+        L[2 * j + 1] = sqrt(s[1]);
     }
 }
 
 /* Rows [u_i, r_i x u_i] (the unscaled J^-1 of newton_fk). */
-static void jac(double r[6][3], double l[6][3], const double L[6], row6 J[6]) {
+static void jac(v2 r[3][3], v2 l[3][3], const double L[6], row6 J[6]) {
     for (int i = 0; i < 6; i++) {
-        double ux = l[i][0] / L[i], uy = l[i][1] / L[i], uz = l[i][2] / L[i];
+        int j = i >> 1, h = i & 1;
+        double rx = r[0][j][h], ry = r[1][j][h], rz = r[2][j][h];
+        double il = 1.0 / L[i], ux = l[0][j][h] * il, uy = l[1][j][h] * il, uz = l[2][j][h] * il; /* one division */
         J[i].v[0] = (v2){ux, uy};
-        J[i].v[1] = (v2){uz, r[i][1] * uz - r[i][2] * uy};
-        J[i].v[2] = (v2){r[i][2] * ux - r[i][0] * uz, r[i][0] * uy - r[i][1] * ux};
+        J[i].v[1] = (v2){uz, ry * uz - rz * uy};
+        J[i].v[2] = (v2){rz * ux - rx * uz, rx * uy - ry * ux};
     }
 }
 
@@ -157,45 +191,63 @@ static void lu_solve(const row6 A[6], const int piv[6], const double dinv[6], do
     }
 }
 
-/* The inverse from the LU: all six right-hand sides at once (rows of X, a row operation per multiplier). */
-static void lu_inverse(const row6 A[6], const int piv[6], const double dinv[6], row6 X[6]) {
+/* The inverse by Gauss-Jordan elimination with partial pivoting on [A | I] (the same pivot choice as lu), rows
+ * swapped whole, the pivot row scaled by the pivot's reciprocal, every other row cleared: X = A^-1 in one pass
+ * (half the operations of lu and two triangular solves). 0 when a pivot is exactly zero. A is overwritten. */
+static inline int gj_column(row6 A[6], row6 X[6], int k) { /* called with constant k: unrolled */
+    int m = k;
+    double big = fabs(EL(A[k], k));
+    for (int i = k + 1; i < 6; i++) {
+        double v = fabs(EL(A[i], k));
+        int gt = v > big;
+        m = gt ? i : m;
+        big = gt ? v : big;
+    }
+    if (big == 0.0) return 0;
+    row6 t = A[k], u = X[k];
+    A[k] = A[m];
+    A[m] = t;
+    X[k] = X[m];
+    X[m] = u;
+    double inv = 1.0 / EL(A[k], k);
+    v2 iv = {inv, inv};
+    for (int q = 0; q < 3; q++) {
+        A[k].v[q] *= iv;
+        X[k].v[q] *= iv;
+    }
+    for (int i = 0; i < 6; i++) {
+        if (i == k) continue;
+        double f = EL(A[i], k);
+        v2 fv = {f, f};
+        for (int q = k >> 1; q < 3; q++) A[i].v[q] -= fv * A[k].v[q]; /* columns < k are never read again */
+        for (int q = 0; q < 3; q++) X[i].v[q] -= fv * X[k].v[q];
+    }
+    return 1;
+}
+
+static int gj_inverse(row6 A[6], row6 X[6]) {
     for (int i = 0; i < 6; i++) {
         X[i].v[0] = X[i].v[1] = X[i].v[2] = (v2){0.0, 0.0};
         EL(X[i], i) = 1.0;
     }
-    for (int k = 0; k < 6; k++)
-        if (piv[k] != k) { row6 t = X[k]; X[k] = X[piv[k]]; X[piv[k]] = t; }
-    for (int k = 0; k < 6; k++)
-        for (int i = k + 1; i < 6; i++) {
-            double f = EL(A[i], k);
-            v2 fv = {f, f};
-            for (int q = 0; q < 3; q++) X[i].v[q] -= fv * X[k].v[q];
-        }
-    for (int k = 5; k >= 0; k--) {
-        for (int i = k + 1; i < 6; i++) {
-            double f = EL(A[k], i);
-            v2 fv = {f, f};
-            for (int q = 0; q < 3; q++) X[k].v[q] -= fv * X[i].v[q];
-        }
-        v2 iv = {dinv[k], dinv[k]};
-        for (int q = 0; q < 3; q++) X[k].v[q] *= iv;
-    }
+    return gj_column(A, X, 0) && gj_column(A, X, 1) && gj_column(A, X, 2) && gj_column(A, X, 3) &&
+           gj_column(A, X, 4) && gj_column(A, X, 5);
 }
 
 /* R <- exp([w]x) R (Rodrigues, the numpy _exp_so3's series below 1e-6 rad). */
 static void rotate(const double w[3], double R[9]) {
-    double th2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], th = sqrt(th2), A, B;
-    if (th < 1e-6) { A = 1.0 - th2 / 6.0; B = 0.5 - th2 / 24.0; }
-    else if (th < 1e-2) { /* the series to th^6: the next terms are below 3e-22, under the rounding of sin, cos */
+    /* th < 1e-6 and th < 1e-2 tested on th^2: the square root only where sin and cos need th */
+    double th2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], A, B;
+    if (th2 < 1e-12) { A = 1.0 - th2 / 6.0; B = 0.5 - th2 / 24.0; }
+    else if (th2 < 1e-4) { /* the series to th^6: the next terms are below 3e-22, under the rounding of sin, cos */
         A = 1.0 - th2 * (1.0 / 6.0 - th2 * (1.0 / 120.0 - th2 * (1.0 / 5040.0)));
         B = 0.5 - th2 * (1.0 / 24.0 - th2 * (1.0 / 720.0 - th2 * (1.0 / 40320.0)));
-    } else { A = sin(th) / th; B = (1.0 - cos(th)) / (th * th); }
-    double K[9] = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0}, E[9], out[9];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            double kk = K[3 * i] * K[j] + K[3 * i + 1] * K[3 + j] + K[3 * i + 2] * K[6 + j];
-            E[3 * i + j] = (i == j) + A * K[3 * i + j] + B * kk;
-        }
+    } else { double th = sqrt(th2); A = sin(th) / th; B = (1.0 - cos(th)) / (th * th); }
+    /* E = I + A [w]x + B [w]x^2 with [w]x^2 = w w^T - th^2 I written out (the zeros of [w]x not multiplied) */
+    double Ax = A * w[0], Ay = A * w[1], Az = A * w[2], Bxy = B * w[0] * w[1], Bxz = B * w[0] * w[2], Byz = B * w[1] * w[2];
+    double E[9] = {1.0 - B * (w[1] * w[1] + w[2] * w[2]), Bxy - Az, Bxz + Ay,
+                   Bxy + Az, 1.0 - B * (w[0] * w[0] + w[2] * w[2]), Byz - Ax,
+                   Bxz - Ay, Byz + Ax, 1.0 - B * (w[0] * w[0] + w[1] * w[1])}, out[9];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) out[3 * i + j] = E[3 * i] * R[j] + E[3 * i + 1] * R[3 + j] + E[3 * i + 2] * R[6 + j];
     for (int k = 0; k < 9; k++) R[k] = out[k];
@@ -215,18 +267,25 @@ static double lipschitz(double a, const double rt[6], const double L0[6], double
     return sqrt(s) * (1.0 + MARGIN);
 }
 
-/* The certificate at y0 from the unscaled J(y0) (LU-factorised in F, original in J0), the leg lengths L0 at
- * y0, the first Newton step d0 = J^-1 (Lt - L0) and |Lt - L0|: uniqueness radius rho (0 when J(y0) is too
- * badly conditioned to bound) and eta. The scaled J_s = J D^-1, D = diag(1, 1, 1, a, a, a): J_s^-1 = D J^-1. */
-static void certificate(const double *g, const row6 J0[6], const row6 F[6], const int piv[6], const double dinv[6],
-                        const double L0[6],
-                        const double d0[6], double nf, double *rho_out, double *eta_out) {
+/* d = X e for a 6x6 X kept in rows (the chord step with the explicit inverse). */
+static void matvec(const row6 X[6], const double e[6], double d[6]) {
+    v2 e0 = {e[0], e[1]}, e1 = {e[2], e[3]}, e2 = {e[4], e[5]};
+    for (int i = 0; i < 6; i++) {
+        v2 t = X[i].v[0] * e0 + X[i].v[1] * e1 + X[i].v[2] * e2;
+        d[i] = t[0] + t[1];
+    }
+}
+
+/* The certificate at y0 from the unscaled J(y0) (J0) and its computed inverse Y, the leg lengths L0 at y0, the
+ * first Newton step d0 = Y (Lt - L0) and |Lt - L0|: uniqueness radius rho (0 when J(y0) is too badly conditioned
+ * to bound) and eta. The scaled J_s = J D^-1, D = diag(1, 1, 1, a, a, a): J_s^-1 = D J^-1. */
+static void certificate(const double *g, const row6 J0[6], const row6 Y[6], const double L0[6], const double d0[6],
+                        double nf, double *rho_out, double *eta_out) {
     double a = g[G_A], D[6] = {1, 1, 1, a, a, a};
-    row6 X[6], Y[6], Dinv = {{{1, 1}, {1, 1 / a}, {1 / a, 1 / a}}};
+    row6 X[6], Dinv = {{{1, 1}, {1, 1 / a}, {1 / a, 1 / a}}};
     const double *rt = g + G_RT;
     *rho_out = 0.0;
     *eta_out = INFINITY;
-    lu_inverse(F, piv, dinv, Y); /* Y = J^-1 */
     for (int i = 0; i < 6; i++) {
         v2 di = {D[i], D[i]};
         for (int q = 0; q < 3; q++) X[i].v[q] = di * Y[i].v[q]; /* X = J_s^-1 = D J^-1 */
@@ -262,71 +321,156 @@ static void certificate(const double *g, const row6 J0[6], const row6 F[6], cons
         c = c < rho_max ? c : rho_max;
         if (beta * lipschitz(a, rt, L0, c) * c < 1.0) best = c;
     }
+    /* the branch test asks for 2 eta <= rho: when the radius found is smaller, rho = 2 eta itself is tried (a third
+     * bound; gamma(2 eta) < gamma(rho_s) when 2 eta < rho_s, so it can succeed where the fixed trials fell short) */
+    double r2 = 2.0 * *eta_out;
+    if (best < r2 && r2 <= rho_max && beta * lipschitz(a, rt, L0, r2) * r2 < 1.0) best = r2;
     *rho_out = best;
 }
 
-/* Newton from (p, R) to lengths Lt; (p, R) updated in place; returns the status, writes residual, iterations
- * and (cert != NULL) the certificate at the start (rho, eta), sharing the first iteration's LU. */
-static int newton(const double *g, const double *Lt, double tol, int max_iter, double p[3], double R[9], double *res_out,
-                  int *its_out, double *cert) {
-    double size = g[G_SIZE];
-    for (int i = 0; i < 6; i++) size = Lt[i] > size ? Lt[i] : size;
-    double r[6][3], l[6][3], L[6], e[6];
-    row6 J[6], J0[6];
-    double dinv[6];
-    int piv[6], its = 0, st = MAX_ITER;
-    double res = INFINITY, res_prev = INFINITY;
+/* Newton from (p, R) to lengths Lt as a state machine, one iteration in three phases: P1 the leg lengths, the
+ * residual and the decisions (stop, or which factorisation this iteration needs), P2 the factorisation, P3 the
+ * step. newton runs one solve; newton_pair runs two independent solves phase by phase, their factorisations
+ * column by column: one solve's chain of dependent operations (pivot, reciprocal, update, next pivot) waits on
+ * latencies the other's fills, and each solve sees exactly the operations it sees alone (the same bits). */
+enum { NEED_NONE = 0, NEED_GJ = 1, NEED_LU = 2 };
+typedef struct {
+    const double *Lt;
+    double *p, *R, *cert, size, res, res_prev, nf;
+    v2 r[3][3], l[3][3];
+    double L[6], e[6], dinv[6];
+    row6 J[6], J0[6], Y[6];
+    int piv[6], its, st, fac, k, max_iter, need, ok, done, fin;
+} nstate;
+
+static void nt_init(nstate *S, const geom *G, const double *Lt, int max_iter, double p[3], double R[9], double *cert) {
+    S->Lt = Lt; S->p = p; S->R = R; S->cert = cert; S->max_iter = max_iter;
+    S->size = G->g[G_SIZE];
+    for (int i = 0; i < 6; i++) S->size = Lt[i] > S->size ? Lt[i] : S->size;
+    S->its = 0; S->st = MAX_ITER; S->fac = NONE; S->k = 0; S->fin = 0;
+    S->res = INFINITY; S->res_prev = INFINITY;
     if (cert) { cert[0] = 0.0; cert[1] = INFINITY; }
-    for (int k = 0; k <= max_iter; k++) {
-        legs(g, p, R, r, l, L);
-        res = 0.0;
-        double nf = 0.0;
-        for (int i = 0; i < 6; i++) {
-            e[i] = Lt[i] - L[i];
-            double a = fabs(e[i]);
-            res = (a > res || a != a) ? a : res;
-            nf += e[i] * e[i];
-        }
-        int done = res <= tol;
-        if (!done && (!isfinite(res) || sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) > DIVERGENCE_FACTOR * size)) {
-            st = DIVERGED;
-            break;
-        }
-        if (k == 0 && cert) { /* the certificate needs J(y0) and the first step even when y0 already fits */
-            jac(r, l, L, J);
-            for (int i = 0; i < 6; i++) J0[i] = J[i];
-            if (lu(J, piv, dinv)) {
-                double d0[6] = {e[0], e[1], e[2], e[3], e[4], e[5]};
-                lu_solve(J, piv, dinv, d0);
-                certificate(g, J0, J, piv, dinv, L, d0, sqrt(nf), cert, cert + 1);
-                if (!done) for (int i = 0; i < 6; i++) e[i] = d0[i];
-            } else if (!done) {
-                st = SINGULAR;
-                break;
-            }
-        }
-        if (done) { st = CONVERGED; break; }
-        if (k == max_iter) break;
-        if (!(k == 0 && cert)) {
-            if (k == 0 || REUSE_MARGIN * res * res > tol * res_prev) {
-                jac(r, l, L, J);
-                if (!lu(J, piv, dinv)) { st = SINGULAR; break; }
-            }
-            lu_solve(J, piv, dinv, e);
-        }
-        double ndp = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]), nw = sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]);
-        double s = 1.0; /* min(1, max_step_m / |dp|, max_step_rad / |w|), dividing only when a bound binds */
-        if (ndp > MAX_STEP_M) s = MAX_STEP_M / ndp;
-        if (nw > MAX_STEP_RAD && MAX_STEP_RAD / nw < s) s = MAX_STEP_RAD / nw;
-        for (int j = 0; j < 3; j++) p[j] += s * e[j];
-        double w[3] = {s * e[3], s * e[4], s * e[5]};
-        rotate(w, R);
-        its++;
-        res_prev = res;
+}
+
+static void nt_p1(nstate *S, const geom *G, double tol) {
+    double *p = S->p;
+    legs(G, p, S->R, S->r, S->l, S->L);
+    double res = 0.0, nf = 0.0;
+    for (int i = 0; i < 6; i++) {
+        S->e[i] = S->Lt[i] - S->L[i];
+        double a = fabs(S->e[i]);
+        res = (a > res || a != a) ? a : res;
+        nf += S->e[i] * S->e[i];
     }
-    *res_out = res;
-    *its_out = its;
-    return st;
+    S->res = res;
+    S->nf = nf;
+    int done = S->done = res <= tol;
+    double pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2], big = DIVERGENCE_FACTOR * S->size; /* |p| > big, squared */
+    S->need = NEED_NONE;
+    if (!done && (!isfinite(res) || pp > big * big)) { S->st = DIVERGED; S->fin = 1; return; }
+    if (S->k == 0 && S->cert) { /* the certificate needs J(y0), its inverse and the first step even when y0 fits */
+        jac(S->r, S->l, S->L, S->J);
+        for (int i = 0; i < 6; i++) S->J0[i] = S->J[i];
+        S->need = NEED_GJ;
+        return;
+    }
+    if (done) { S->st = CONVERGED; S->fin = 1; return; }
+    if (S->k == S->max_iter) { S->fin = 1; return; }
+    if (S->fac != LU || REUSE_MARGIN * res * res > tol * S->res_prev) { /* Newton; chord only as said above */
+        jac(S->r, S->l, S->L, S->J);
+        S->need = NEED_LU;
+    }
+}
+
+static void nt_p2(nstate *S) {
+    if (S->need == NEED_GJ) S->ok = gj_inverse(S->J, S->Y);
+    else if (S->need == NEED_LU) S->ok = lu(S->J, S->piv, S->dinv);
+}
+
+static void nt_p3(nstate *S, const geom *G) {
+    double *e = S->e;
+    if (S->need == NEED_GJ) {
+        if (S->ok) {
+            double d0[6];
+            matvec(S->Y, e, d0);
+            certificate(G->g, S->J0, S->Y, S->L, d0, sqrt(S->nf), S->cert, S->cert + 1);
+            S->fac = INVERSE;
+            if (!S->done) for (int i = 0; i < 6; i++) e[i] = d0[i];
+        } else if (!S->done) { S->st = SINGULAR; S->fin = 1; return; }
+        if (S->done) { S->st = CONVERGED; S->fin = 1; return; }
+        if (S->k == S->max_iter) { S->fin = 1; return; }
+    } else {
+        if (S->need == NEED_LU) {
+            if (!S->ok) { S->st = SINGULAR; S->fin = 1; return; }
+            S->fac = LU;
+        }
+        lu_solve(S->J, S->piv, S->dinv, e);
+    }
+    double ndp2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2], nw2 = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
+    double s = 1.0; /* min(1, max_step_m / |dp|, max_step_rad / |w|): roots and divisions only when a bound binds */
+    if (ndp2 > MAX_STEP_M * MAX_STEP_M) s = MAX_STEP_M / sqrt(ndp2);
+    if (nw2 > MAX_STEP_RAD * MAX_STEP_RAD && MAX_STEP_RAD / sqrt(nw2) < s) s = MAX_STEP_RAD / sqrt(nw2);
+    for (int j = 0; j < 3; j++) S->p[j] += s * e[j];
+    double w[3] = {s * e[3], s * e[4], s * e[5]};
+    rotate(w, S->R);
+    S->its++;
+    S->res_prev = S->res;
+    S->k++;
+}
+
+/* One solve: (p, R) updated in place; returns the status, writes residual, iterations and (cert != NULL) the
+ * certificate at the start (rho, eta), sharing the first iteration's factorisation. */
+static int newton(const geom *G, const double *Lt, double tol, int max_iter, double p[3], double R[9], double *res_out,
+                  int *its_out, double *cert) {
+    nstate S;
+    nt_init(&S, G, Lt, max_iter, p, R, cert);
+    while (!S.fin) {
+        nt_p1(&S, G, tol);
+        if (S.fin) break;
+        nt_p2(&S);
+        nt_p3(&S, G);
+    }
+    *res_out = S.res;
+    *its_out = S.its;
+    return S.st;
+}
+
+/* Two factorisations of the same kind, interleaved column by column (each as it would run alone). */
+static void nt_p2_pair(nstate *A, nstate *B) {
+    if (A->need == NEED_GJ) {
+        for (int i = 0; i < 6; i++) {
+            A->Y[i].v[0] = A->Y[i].v[1] = A->Y[i].v[2] = B->Y[i].v[0] = B->Y[i].v[1] = B->Y[i].v[2] = (v2){0.0, 0.0};
+            EL(A->Y[i], i) = EL(B->Y[i], i) = 1.0;
+        }
+        int a = 1, b = 1; /* constant columns (inlined and specialised); a matrix stops at a zero pivot */
+#define GJ2(k) a = a && gj_column(A->J, A->Y, k); b = b && gj_column(B->J, B->Y, k)
+        GJ2(0); GJ2(1); GJ2(2); GJ2(3); GJ2(4); GJ2(5);
+#undef GJ2
+        A->ok = a;
+        B->ok = b;
+    } else {
+        int a = 1, b = 1;
+#define LU2(k) a = a && lu_column(A->J, A->piv, A->dinv, k); b = b && lu_column(B->J, B->piv, B->dinv, k)
+        LU2(0); LU2(1); LU2(2); LU2(3); LU2(4); LU2(5);
+#undef LU2
+        A->ok = a;
+        B->ok = b;
+    }
+}
+
+/* Two solves at once (see nstate): the same results as two calls of newton. */
+static void newton_pair(const geom *G, double tol, nstate *A, nstate *B) {
+    while (!A->fin || !B->fin) {
+        if (!A->fin) nt_p1(A, G, tol);
+        if (!B->fin) nt_p1(B, G, tol);
+        if (!A->fin && !B->fin && A->need == B->need && A->need != NEED_NONE) nt_p2_pair(A, B);
+        else {
+            if (!A->fin) nt_p2(A);
+            if (!B->fin) nt_p2(B);
+        }
+        if (!A->fin) nt_p3(A, G);
+        if (!B->fin) nt_p3(B, G);
+    }
 }
 
 /* Distance sqrt(|dp|^2 + (a theta)^2) between two poses, theta the angle of R1 R0^T. */
@@ -346,14 +490,11 @@ static double distance(double a, const double p0[3], const double R0[9], const d
     return sqrt(dx * dx + dy * dy + dz * dz + a * a * th * th);
 }
 
-/* One certified step from (p, R) to Lt (both updated in place on success of Newton). */
-static int step(const double *g, const double *Lt, double tol, int max_iter, double p[3], double R[9], double *info) {
-    double p0[3] = {p[0], p[1], p[2]}, R0[9], c[2], res;
-    int its;
-    for (int k = 0; k < 9; k++) R0[k] = R[k];
-    int st = newton(g, Lt, tol, max_iter, p, R, &res, &its, c);
+/* The info of a step from (p0, R0) that Newton took to (p, R): status, residual, iterations, the certificate c. */
+static void step_info(const geom *G, const double p0[3], const double R0[9], const double p[3], const double R[9],
+                      int st, double res, int its, const double c[2], double *info) {
     double rho = c[0], eta = c[1];
-    double d = distance(g[G_A], p0, R0, p, R);
+    double d = distance(G->g[G_A], p0, R0, p, R);
     info[I_RES] = res;
     info[I_ITER] += its;
     info[I_STATUS] = st;
@@ -361,21 +502,41 @@ static int step(const double *g, const double *Lt, double tol, int max_iter, dou
     info[I_ETA] = eta;
     info[I_STEP] = d;
     info[I_CERT] = (st == CONVERGED && 2.0 * eta <= rho && d < rho) ? 1.0 : 0.0;
+}
+
+/* One certified step from (p, R) to Lt (both updated in place on success of Newton). */
+static int step(const geom *G, const double *Lt, double tol, int max_iter, double p[3], double R[9], double *info) {
+    double p0[3] = {p[0], p[1], p[2]}, R0[9], c[2], res;
+    int its;
+    for (int k = 0; k < 9; k++) R0[k] = R[k];
+    int st = newton(G, Lt, tol, max_iter, p, R, &res, &its, c);
+    step_info(G, p0, R0, p, R, st, res, its, c, info);
     return st;
 }
 
+static void subdivide(const geom *G, const double *Lt, double tol, int max_iter, int max_sub, double pk[3], double Rk[9],
+                      double p[3], double R[9], double *info);
+
 /* Solve from (p, R) to Lt; with max_sub > 0, an uncertified step is split along the straight length path
  * L(s) = L(y0) + s (Lt - L(y0)) (halving, at most max_sub accepted sub-steps): certified when every sub-step is. */
-static void solve_one(const double *g, const double *Lt, double tol, int max_iter, int max_sub, double p[3], double R[9],
+static void solve_one(const geom *G, const double *Lt, double tol, int max_iter, int max_sub, double p[3], double R[9],
                       double *info) {
     for (int k = 0; k < N_INFO; k++) info[k] = 0.0;
     double pk[3] = {p[0], p[1], p[2]}, Rk[9];
     for (int k = 0; k < 9; k++) Rk[k] = R[k];
-    step(g, Lt, tol, max_iter, p, R, info);
+    step(G, Lt, tol, max_iter, p, R, info);
     info[I_SUB] = 1;
     if (info[I_CERT] == 1.0 || max_sub <= 0) return;
-    double r[6][3], l[6][3], L0[6];
-    legs(g, pk, Rk, r, l, L0);
+    subdivide(G, Lt, tol, max_iter, max_sub, pk, Rk, p, R, info);
+}
+
+/* The halving of solve_one for an uncertified first step from (pk, Rk) (the start, copied): on success every
+ * sub-step certified, (p, R) and info replaced. */
+static void subdivide(const geom *G, const double *Lt, double tol, int max_iter, int max_sub, double pk[3], double Rk[9],
+                      double p[3], double R[9], double *info) {
+    v2 r[3][3], l[3][3];
+    double L0[6];
+    legs(G, pk, Rk, r, l, L0);
     double s = 0.0, ds = 0.5, sub[N_INFO], rho0 = -1.0, eta_total = 0.0;
     int n = 0, iters = (int)info[I_ITER];
     while (s < 1.0 && n < max_sub && ds > 1e-6) {
@@ -383,7 +544,7 @@ static void solve_one(const double *g, const double *Lt, double tol, int max_ite
         for (int i = 0; i < 6; i++) Ls[i] = sn >= 1.0 ? Lt[i] : L0[i] + sn * (Lt[i] - L0[i]);
         for (int k = 0; k < 9; k++) Rt[k] = Rk[k];
         for (int k = 0; k < N_INFO; k++) sub[k] = 0.0;
-        step(g, Ls, tol, max_iter, pt, Rt, sub);
+        step(G, Ls, tol, max_iter, pt, Rt, sub);
         iters += (int)sub[I_ITER];
         if (sub[I_CERT] == 1.0) {
             if (rho0 < 0) rho0 = sub[I_RADIUS];
@@ -416,7 +577,34 @@ void sd_rtfk(int64_t n, const double *g, int conv, const double *L, const double
              double tol, int max_iter, int max_sub, double *q_out, double *info) {
     double p[3] = {0, 0, 0}, R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     int have = 0;
-    for (int64_t k = 0; k < n; k++) {
+    geom G;
+    geom_init(&G, g);
+    int64_t k = 0;
+    if (!track) /* independent sets: two at a time (newton_pair), each as solve_one would solve it */
+        for (; k + 1 < n; k += 2) {
+            double P[2][3], RR[2][9], P0[2][3], R0[2][9], c[2][2];
+            nstate S[2];
+            for (int h = 0; h < 2; h++) {
+                const double *q = q0 + (k + h) * q0_stride;
+                P[h][0] = P0[h][0] = q[0]; P[h][1] = P0[h][1] = q[1]; P[h][2] = P0[h][2] = q[2];
+                rotation(conv, q + 3, RR[h]);
+                for (int j = 0; j < 9; j++) R0[h][j] = RR[h][j];
+                nt_init(&S[h], &G, L + 6 * (k + h), max_iter, P[h], RR[h], c[h]);
+            }
+            newton_pair(&G, tol, &S[0], &S[1]);
+            for (int h = 0; h < 2; h++) {
+                double *inf = info + N_INFO * (k + h);
+                for (int j = 0; j < N_INFO; j++) inf[j] = 0.0;
+                step_info(&G, P0[h], R0[h], P[h], RR[h], S[h].st, S[h].res, S[h].its, c[h], inf);
+                inf[I_SUB] = 1;
+                if (inf[I_CERT] != 1.0 && max_sub > 0)
+                    subdivide(&G, L + 6 * (k + h), tol, max_iter, max_sub, P0[h], R0[h], P[h], RR[h], inf);
+                double *q = q_out + 6 * (k + h);
+                q[0] = P[h][0]; q[1] = P[h][1]; q[2] = P[h][2];
+                angles(conv, RR[h], q + 3);
+            }
+        }
+    for (; k < n; k++) {
         if (!(track && have)) {
             const double *q = q0 + k * q0_stride;
             p[0] = q[0]; p[1] = q[1]; p[2] = q[2];
@@ -425,7 +613,7 @@ void sd_rtfk(int64_t n, const double *g, int conv, const double *L, const double
         double pp[3] = {p[0], p[1], p[2]}, RR[9];
         for (int j = 0; j < 9; j++) RR[j] = R[j];
         double *inf = info + N_INFO * k;
-        solve_one(g, L + 6 * k, tol, max_iter, max_sub, pp, RR, inf);
+        solve_one(&G, L + 6 * k, tol, max_iter, max_sub, pp, RR, inf);
         double *q = q_out + 6 * k;
         q[0] = pp[0]; q[1] = pp[1]; q[2] = pp[2];
         angles(conv, RR, q + 3);
