@@ -1,9 +1,10 @@
 """Where a closed-loop tick's microseconds go (item 1 of the speed issue), each target beside its figure and
 its reference, all measured in one run, interleaved, best of ``--repeat``:
 
-- references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference) and the loop's
+- references: the bare plant (constant leg forces, one ``AdvanceTo``: the issue's reference), the loop's
   own Diagram (``loop_diagram``: the plant, its actuation a fixed input, an event every plant step) at rest,
-  advanced tick by tick: the cost of stopping at every tick;
+  advanced tick by tick: the cost of stopping at every tick, and Drake's work in each loop alone (its Diagram
+  and stops replaying its logged forces, no DSP side: the loop's states bit for bit, ``replayed_plant``);
 - the loops with their compiled DSP side (``firmware.loop_kernel``: one C call per stop): the fixed-point
   law with the generated firmware (C engine) and the float law, each with its tick tables computed cold
   (``TABLE_CACHE`` cleared: a report's or a study's first run) and remembered (every later run of the same
@@ -11,8 +12,7 @@ its reference, all measured in one run, interleaved, best of ``--repeat``:
 - the same loops with the Python ticks (``TickLoop._run_python``, the reference and the fallback) for
   comparison;
 - where a loop's tick goes: the tables, the thread CPU inside Drake's ``AdvanceTo`` (beside the bare plant's,
-  the stopped plant's and the plant alone replaying the loop's own forces: the plant's work along the moving
-  reference) and outside it;
+  the stopped plant's and the replay's: the plant's work along the loop's own motion) and outside it;
 - the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it).
 
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
@@ -38,6 +38,15 @@ from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 
 TARGET = 0.8  # the loop's real-time factor over the bare plant's
+NEWTON: dict[str, float] = {}  # CENIC's Newton iterations (Hessian factorisations) per step, per reference
+
+
+def newton(label: str, sim) -> None:
+    """Note ``sim``'s CENIC solver iterations per integrator step under ``label`` (``NEWTON``)."""
+    stats = dict(sim.get_integrator().GetStatisticsSummary())
+    NEWTON[label] = stats.get("cenic_total_solver_iterations", np.nan) / stats["integrator_num_steps_taken"]
+
+
 PERIOD = 1e-3  # s: the plant step and the controller's sample period of the default loop
 
 
@@ -67,7 +76,9 @@ def plant(p, duration: float) -> float:
     sim.Initialize()
     c0 = time.process_time()
     sim.AdvanceTo(duration)
-    return 1e6 * PERIOD * (time.process_time() - c0) / duration
+    us = 1e6 * PERIOD * (time.process_time() - c0) / duration
+    newton(PLANT, sim)
+    return us
 
 
 def stopped_plant(p, duration: float) -> float:
@@ -93,41 +104,51 @@ def stopped_plant(p, duration: float) -> float:
     c0 = time.process_time()
     for k in range(1, n + 1):
         advance(k * PERIOD)
-    return 1e6 * (time.process_time() - c0) / n
+    us = 1e6 * (time.process_time() - c0) / n
+    newton(STOPPED, sim)
+    return us
 
 
 def replayed_plant(p, kind: str, engine: str, duration: float) -> float:
-    """CPU µs per tick of the plant alone (one ``AdvanceTo``, no loop) replaying a closed loop's own forces
-    (its log, held over each plant step by a Drake ``TrajectorySource``) from the loop's initial state: the
-    plant's work along the moving reference, which the bare plant at rest does not do."""
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import TrajectorySource
-    from pydrake.trajectories import PiecewisePolynomial
+    """CPU µs per tick of Drake's work in one closed-loop run, without its DSP side: the loop's own Diagram,
+    initial state and stops (a fresh ``build_simulation`` of the same scenario), its actuation input written
+    (and Drake notified) only where the force the loop logged changes, as the compiled kernel does. The
+    plant's states are the loop's bit for bit (checked: else a RuntimeError), so this is the plant's work
+    along the loop's own motion — the floor of the loop's cost inside ``AdvanceTo``.
 
-    from stewart_drake.core.trajectory import get_trajectory
-    from stewart_drake.drake.platform_model import build_plant, set_pose
-    from stewart_drake.drake.simulation import set_velocity
-
-    log = build_simulation(Scenario(p, "seed", kind, engine=engine)).run(duration)
-    builder = DiagramBuilder()
-    # built as the closed loop builds its plant when nothing is shown (no SceneGraph): a fair reference
-    mbp, _ = build_plant(p, PERIOD, builder, continuous=DEFAULT_INTEGRATOR in CONTINUOUS, visuals=False)
-    # the force logged at t_k acted over (t_k-1, t_k]: row k + 1 acts over (t_k, t_k+1]
-    hold = PiecewisePolynomial.ZeroOrderHold(log.t[:-1], log.force[1:].T)
-    src = builder.AddSystem(TrajectorySource(hold))
-    builder.Connect(src.get_output_port(), mbp.get_actuation_input_port())
-    sim = Simulator(builder.Build())
-    apply_integrator(sim, DEFAULT_INTEGRATOR, PERIOD)
-    pc = mbp.GetMyMutableContextFromRoot(sim.get_mutable_context())
-    trajectory = get_trajectory("seed")
-    set_pose(mbp, pc, p, trajectory.pose(0.0))
-    set_velocity(mbp, pc, p, trajectory, 0.0)
-    sim.Initialize()
-    end = float(log.t[-1])
+    (Why not the plant alone replaying those forces in one ``AdvanceTo`` from a ``TrajectorySource``: without
+    the loop's clock events its integration is not the loop's — Drake reaches a time that is no event time by
+    an extra short step after t = 1 s, 2496 steps for 2000 plant steps when stopped every tick — and an
+    open-loop replay's states leave the loop's: not the same motion.)"""
+    loop_run = build_simulation(Scenario(p, "seed", kind, engine=engine))
+    loop_run.prepare(duration)
+    logged = loop_run.controller.run(duration)
+    sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
+    loop = sim.controller
+    s = loop._schedule(duration, ())
+    x, actuation = loop._views()
+    # the force logged at a plant step t_r acted over (t_r-1, t_r]: write row r before advancing to t_r (and to
+    # the stops between, where it does not change); None where it equals the force already written
+    force, rows, row = logged["force"], [], 1
+    for logs_here in s.log:
+        rows.append(row)
+        row += logs_here
+    writes, written = [], actuation.copy()
+    for r in rows:
+        writes.append(None if np.array_equal(force[r], written) else force[r])
+        written = force[r]
+    notify, advance = loop._fixed.GetMutableData, sim.simulator.AdvanceTo
     c0 = time.process_time()
-    sim.AdvanceTo(end)
-    return 1e6 * PERIOD * (time.process_time() - c0) / end
+    for t, f in zip(s.times, writes):
+        if f is not None:
+            actuation[:] = f
+            notify()
+        advance(t)
+    us = 1e6 * PERIOD * (time.process_time() - c0) / duration
+    if not np.array_equal(x, logged["state"][-1]):
+        raise RuntimeError("the replay left the loop's states: not a reference for its Drake work")
+    newton(f"{kind} loop", sim.simulator)
+    return us
 
 
 TABLES: dict[str, float] = {}  # CPU µs per tick of Simulation.prepare (the tick tables), per loop label
@@ -218,6 +239,10 @@ LOOPS = {  # label: (kind, engine, cold tables, Python ticks)
     "float, Python ticks, remembered tables": ("float", "python", False, True),
 }
 PLANT, STOPPED = "bare plant (the reference)", "the loop's Diagram stopped every tick, at rest"
+REPLAYS = {  # label: (kind, engine) of the loop whose Drake work is replayed
+    "Drake's work in the fixed/C loop (replayed)": ("fixed", "c"),
+    "Drake's work in the float loop (replayed)": ("float", "python"),
+}
 
 
 def main(argv=None) -> int:
@@ -231,6 +256,7 @@ def main(argv=None) -> int:
     loop(p, "warm-up", "fixed", "c", 0.01, True)  # compile and cache the firmware and the kernel before timing
     loop(p, "warm-up", "float", "python", 0.01, True)
     runs = {PLANT: lambda: plant(p, D), STOPPED: lambda: stopped_plant(p, D)}
+    runs |= {label: (lambda a=a: replayed_plant(p, a[0], a[1], D)) for label, a in REPLAYS.items()}
     runs |= {label: (lambda a=a, label=label: loop(p, label, a[0], a[1], D, a[2], a[3])) for label, a in LOOPS.items()}
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
@@ -261,17 +287,16 @@ def main(argv=None) -> int:
             f"  {label:8s} tables {cold:5.1f} cold / {warm:4.1f} remembered + inside AdvanceTo {inside:6.1f} + outside "
             f"{outside:4.1f} (the DSP side, the Python loop)"
         )
-    replay = {
-        label: min(replayed_plant(p, kind, engine, D) for _ in range(args.repeat))
-        for label, (kind, engine) in splits.items()
-    }
+    fixed_replay, float_replay = (us[k] for k in REPLAYS)
     print(
-        f"  (inside AdvanceTo: the bare plant's {us[PLANT]:.1f} at rest, {us[STOPPED]:.1f} stopped every tick at rest; the "
-        "plant alone replaying the loop's own forces along its motion, one AdvanceTo: "
-        + ", ".join(
-            f"{label} {v:.1f} = {us[PLANT] / v:.2f} × the bare plant's real-time factor" for label, v in replay.items()
-        )
-        + ")"
+        f"  (inside AdvanceTo: the bare plant's {us[PLANT]:.1f} at rest, {us[STOPPED]:.1f} stopped every tick at rest; "
+        f"Drake's work along each loop's own motion, replayed: fixed/C {fixed_replay:.1f}, float {float_replay:.1f}; "
+        "the loop beyond it: the DSP side, the Python loop and the tables)"
+    )
+    print(
+        "  CENIC's Newton iterations (each one Hessian factorisation) per plant step: "
+        + ", ".join(f"{label} {v:.2f}" for label, v in NEWTON.items())
+        + " (at rest a warm start often needs none; along the reference every step needs one)"
     )
     print("the DSP side alone, AdvanceTo a no-op (wall µs per tick, best of the repetitions):")
     alone = {
