@@ -71,7 +71,7 @@ def _build(plant_platform, plant_time_step, integrator, meshcat) -> LoopDiagram:
     # boundary alone (without these events the states of a run drift by an ulp from t = 1 s on), so the
     # loop keeps the Diagram's event times and its integration bit for bit. It also saves time: without it,
     # stopped at every plant step, Drake reaches a stop that is no event time by an extra short step from
-    # t = 1 s on (2496 integrator steps for 2000 plant steps, 12–15 µs more per tick; with it one step per plant
+    # t = 1 s on (2496 integrator steps for 2000 plant steps, 11–15 µs more per tick; with it one step per plant
     # step: ``tests/drake/test_loop_steps.py``).
     clock = builder.AddSystem(ZeroOrderHold(plant_time_step, 1))
     builder.Connect(builder.AddSystem(ConstantVectorSource(np.zeros(1))).get_output_port(), clock.get_input_port())

@@ -21,20 +21,19 @@ discrete (SAP) plant steps by an unrestricted update, which Drake runs before th
 reads the state after the plant's step at t, so the loop advances halfway to the next stop first (nothing
 happens there) and logs at every stop (Drake's per-step logging).
 
-Where a tick's time goes (2 s of the seed on utn-dynamic, cenic-fixed; process CPU µs per plant step, best of
-5, the configurations interleaved in one process; 2-core machine at load ~2): Drake's work inside
-``AdvanceTo`` is the plant's along the loop's own motion, nothing more. The bare plant at rest 62.7; with the
-loop's clock event (``loop_diagram``) 65.2; stopped at every step (2000 ``AdvanceTo``) 65.1; its force a fixed
-input 64.8, notified (``GetMutableData``) at every step 66.0 (no Newton iteration more: 962 in 2000 steps
-either way); moving along the reference (the loop's forces from a ``TrajectorySource``, one ``AdvanceTo``)
-73.2, stopped at every step 73.9, through the fixed input notified at every step 73.4; the fixed-point loop
-with the compiled firmware 78.0 (the float loop 75.0 beside 71.8 / 72.3). The motion's 8–10 µs are CENIC's
-Newton iterations (each a Hessian factorisation): 0.48 per step at rest (a warm start often needs none), 1.00
-along the reference. Replaying the loop's logged forces through its own Diagram and stops gives its states bit
-for bit (``tests/drake/test_loop_steps.py``) at 74.5 beside the loop's 76.1 (best of 12): the DSP side, the
-Python ``for`` and the logs are the loop's 2–4 µs beyond its plant. The kernel notifies Drake only when the
-force changed (with a lag: at every plant step). Tried for the clock, bit-identical and within ±1 µs (noise):
-a hold of no values, a log sink's publish.
+Where a tick's time goes (``benchmarks/bench_loop_drake.py --duration 2 --repeat 8``: process CPU µs per plant
+step, best of 8, interleaved in one process; 2-core machine at load ~3): Drake's work inside ``AdvanceTo`` is
+the plant's along the loop's own motion, nothing more. The bare plant at rest 63.5; with the loop's clock
+event (``loop_diagram``) 64.5; stopped at every step (2000 ``AdvanceTo``) 66.6; its force a fixed input 64.6,
+notified (``GetMutableData``) at every step 67.8 (no Newton iteration more: 0.48 per step either way); moving
+along the reference (the loop's forces from a ``TrajectorySource``, one ``AdvanceTo``) 72.3, stopped at every
+step 75.2, through the fixed input notified at every step — the loop's states bit for bit
+(``tests/drake/test_loop_steps.py``) — 74.8 beside the fixed-point loop's 75.4 (float: 73.0 beside 77.1). The
+motion's ~8 µs are CENIC's Newton iterations (each a Hessian factorisation): 0.48 per step at rest (a warm
+start often needs none), 1.00 along the reference; so the loop's ceiling is ~0.85–0.88 × the bare plant's
+real-time factor, and the DSP side, the Python ``for`` and the logs are its 1–4 µs beyond. The kernel notifies
+Drake only when the force changed (with a lag: at every plant step). Tried for the clock, bit-identical and
+within ±1 µs (noise): a hold of no values, a log sink's publish.
 """
 
 from __future__ import annotations
