@@ -15,6 +15,8 @@ its reference, all measured in one run, interleaved, best of ``--repeat``:
   the stopped plant's and the replay's: the plant's work along the loop's own motion) and outside it;
 - the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it).
 
+Inside ``AdvanceTo``, one change at a time from the bare plant to the loop: ``bench_loop_drake.py``.
+
 Run by hand: ``python benchmarks/bench_tick.py [--duration 2] [--repeat 3]``. At 1 kHz a simulated
 millisecond is one tick, so µs per tick = 1000 / real-time factor. Process CPU time (on a loaded machine wall
 time includes waiting for a core); prints the load first and last: on a shared machine the ratios are what
