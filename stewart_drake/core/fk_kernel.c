@@ -128,15 +128,18 @@ static void legs(const geom *G, const double p[3], const double R[9], v2 r[3][3]
     }
 }
 
-/* Rows [u_i, r_i x u_i] (the unscaled J^-1 of newton_fk). */
+/* Rows [u_i, r_i x u_i] (the unscaled J^-1 of newton_fk), two legs a lane pair (each lane the scalar expression's
+ * operations: one division, the cross product), the rows assembled from the lanes. */
 static void jac(v2 r[3][3], v2 l[3][3], const double L[6], row6 J[6]) {
-    for (int i = 0; i < 6; i++) {
-        int j = i >> 1, h = i & 1;
-        double rx = r[0][j][h], ry = r[1][j][h], rz = r[2][j][h];
-        double il = 1.0 / L[i], ux = l[0][j][h] * il, uy = l[1][j][h] * il, uz = l[2][j][h] * il; /* one division */
-        J[i].v[0] = (v2){ux, uy};
-        J[i].v[1] = (v2){uz, ry * uz - rz * uy};
-        J[i].v[2] = (v2){rz * ux - rx * uz, rx * uy - ry * ux};
+    for (int j = 0; j < 3; j++) {
+        v2 il = (v2){1.0, 1.0} / (v2){L[2 * j], L[2 * j + 1]};
+        v2 ux = l[0][j] * il, uy = l[1][j] * il, uz = l[2][j] * il;
+        v2 cx = r[1][j] * uz - r[2][j] * uy, cy = r[2][j] * ux - r[0][j] * uz, cz = r[0][j] * uy - r[1][j] * ux;
+        for (int h = 0; h < 2; h++) {
+            J[2 * j + h].v[0] = (v2){ux[h], uy[h]};
+            J[2 * j + h].v[1] = (v2){uz[h], cx[h]};
+            J[2 * j + h].v[2] = (v2){cy[h], cz[h]};
+        }
     }
 }
 
@@ -365,13 +368,15 @@ static void nt_init(nstate *S, const geom *G, const double *Lt, int max_iter, do
 static void nt_p1(nstate *S, const geom *G, double tol) {
     double *p = S->p;
     legs(G, p, S->R, S->r, S->l, S->L);
-    double res = 0.0, nf = 0.0;
+    double res = 0.0, nf = 0.0, *e = S->e;
+    const double *Lt = S->Lt, *L = S->L;
     for (int i = 0; i < 6; i++) {
-        S->e[i] = S->Lt[i] - S->L[i];
-        double a = fabs(S->e[i]);
-        res = (a > res || a != a) ? a : res;
-        nf += S->e[i] * S->e[i];
+        e[i] = Lt[i] - L[i];
+        double a = fabs(e[i]);
+        res = a > res ? a : res;
+        nf += e[i] * e[i];
     }
+    if (nf != nf) res = nf; /* a NaN length: nf is NaN exactly then (an infinite one makes res and nf infinite) */
     S->res = res;
     S->nf = nf;
     int done = S->done = res <= tol;
