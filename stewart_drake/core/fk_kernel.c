@@ -24,7 +24,10 @@
  *
  * Speed: independent length sets run two at a time (newton_pair), their factorisations interleaved column by
  * column, so that one solve's chain of dependent operations fills the other's waits; each set sees exactly
- * the operations it sees alone (the same bits, tests/core/test_realtime_fk_pairs.py).
+ * the operations it sees alone (the same bits, tests/core/test_realtime_fk_pairs.py). The Gauss-Jordan inverse runs
+ * in place (the pivot's column takes the inverse's column), the Jacobian rows are built two legs a lane pair, and
+ * the module is built with -fno-math-errno (sqrt one instruction): each a change of the work's shape, not of any
+ * operation, so every output keeps its bits.
  */
 #include <math.h>
 #include <stdint.h>
