@@ -234,11 +234,8 @@ static inline int gj_column(row6 A[6], int orig[6], int k) { /* called with cons
 }
 
 static void gj_unscramble(const row6 A[6], const int orig[6], row6 X[6]) {
-    for (int i = 0; i < 6; i++) {
-        const double *a = (const double *)&A[i];
-        double *x = (double *)&X[i];
-        for (int k = 0; k < 6; k++) x[orig[k]] = a[k];
-    }
+    for (int i = 0; i < 6; i++)
+        for (int k = 0; k < 6; k++) EL(X[i], orig[k]) = EL(A[i], k);
 }
 
 static int gj_inverse(row6 A[6], row6 X[6]) {
