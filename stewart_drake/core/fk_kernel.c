@@ -149,8 +149,8 @@ static void jac(v2 r[3][3], v2 l[3][3], const double L[6], row6 J[6]) {
 /* LU with partial pivoting in place (LAPACK's dgetf2: multipliers below the diagonal, rows swapped whole);
  * 0 when a pivot is exactly zero (numpy's LinAlgError). Each update runs over the whole row with the pivot
  * row's columns <= k masked to zero (so those columns of the updated row are unchanged; pairs wholly left of
- * column k are skipped), then column k takes the multiplier. The pivot search selects rather than jumps, and the swap is unconditional (a row with
- * itself when m == k): no mispredicted branches. */
+ * column k are skipped), then column k takes the multiplier. The pivot search selects rather than jumps, and the
+ * swap is unconditional (a row with itself when m == k): no mispredicted branches. */
 static inline int lu_column(row6 A[6], int piv[6], double dinv[6], int k) { /* called with constant k: unrolled */
     int m = k;
     double big = fabs(EL(A[k], k));
