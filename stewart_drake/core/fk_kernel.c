@@ -24,7 +24,10 @@
  *
  * Speed: independent length sets run two at a time (newton_pair), their factorisations interleaved column by
  * column, so that one solve's chain of dependent operations fills the other's waits; each set sees exactly
- * the operations it sees alone (the same bits, tests/core/test_realtime_fk_pairs.py).
+ * the operations it sees alone (the same bits, tests/core/test_realtime_fk_pairs.py). The Gauss-Jordan inverse runs
+ * in place (the pivot's column takes the inverse's column), the Jacobian rows are built two legs a lane pair, and
+ * the module is built with -fno-math-errno (sqrt one instruction): each a change of the work's shape, not of any
+ * operation, so every output keeps its bits.
  */
 #include <math.h>
 #include <stdint.h>
@@ -128,23 +131,26 @@ static void legs(const geom *G, const double p[3], const double R[9], v2 r[3][3]
     }
 }
 
-/* Rows [u_i, r_i x u_i] (the unscaled J^-1 of newton_fk). */
+/* Rows [u_i, r_i x u_i] (the unscaled J^-1 of newton_fk), two legs a lane pair (each lane the scalar expression's
+ * operations: one division, the cross product), the rows assembled from the lanes. */
 static void jac(v2 r[3][3], v2 l[3][3], const double L[6], row6 J[6]) {
-    for (int i = 0; i < 6; i++) {
-        int j = i >> 1, h = i & 1;
-        double rx = r[0][j][h], ry = r[1][j][h], rz = r[2][j][h];
-        double il = 1.0 / L[i], ux = l[0][j][h] * il, uy = l[1][j][h] * il, uz = l[2][j][h] * il; /* one division */
-        J[i].v[0] = (v2){ux, uy};
-        J[i].v[1] = (v2){uz, ry * uz - rz * uy};
-        J[i].v[2] = (v2){rz * ux - rx * uz, rx * uy - ry * ux};
+    for (int j = 0; j < 3; j++) {
+        v2 il = (v2){1.0, 1.0} / (v2){L[2 * j], L[2 * j + 1]};
+        v2 ux = l[0][j] * il, uy = l[1][j] * il, uz = l[2][j] * il;
+        v2 cx = r[1][j] * uz - r[2][j] * uy, cy = r[2][j] * ux - r[0][j] * uz, cz = r[0][j] * uy - r[1][j] * ux;
+        for (int h = 0; h < 2; h++) {
+            J[2 * j + h].v[0] = (v2){ux[h], uy[h]};
+            J[2 * j + h].v[1] = (v2){uz[h], cx[h]};
+            J[2 * j + h].v[2] = (v2){cy[h], cz[h]};
+        }
     }
 }
 
 /* LU with partial pivoting in place (LAPACK's dgetf2: multipliers below the diagonal, rows swapped whole);
  * 0 when a pivot is exactly zero (numpy's LinAlgError). Each update runs over the whole row with the pivot
- * row's columns <= k masked to zero (so those columns of the updated row are unchanged), then column k takes
- * the multiplier. The pivot search selects rather than jumps, and the swap is unconditional (a row with
- * itself when m == k): no mispredicted branches. */
+ * row's columns <= k masked to zero (so those columns of the updated row are unchanged; pairs wholly left of
+ * column k are skipped), then column k takes the multiplier. The pivot search selects rather than jumps, and the
+ * swap is unconditional (a row with itself when m == k): no mispredicted branches. */
 static inline int lu_column(row6 A[6], int piv[6], double dinv[6], int k) { /* called with constant k: unrolled */
     int m = k;
     double big = fabs(EL(A[k], k));
@@ -166,8 +172,8 @@ static inline int lu_column(row6 A[6], int piv[6], double dinv[6], int k) { /* c
     for (int i = k + 1; i < 6; i++) {
         double f = EL(A[i], k) * inv;
         v2 fv = {f, f};
-        A[i].v[0] -= fv * u0;
-        A[i].v[1] -= fv * u1;
+        if (k < 2) A[i].v[0] -= fv * u0; /* pairs wholly left of column k: multipliers, left as they are */
+        if (k < 4) A[i].v[1] -= fv * u1;
         A[i].v[2] -= fv * u2;
         EL(A[i], k) = f;
     }
@@ -191,10 +197,13 @@ static void lu_solve(const row6 A[6], const int piv[6], const double dinv[6], do
     }
 }
 
-/* The inverse by Gauss-Jordan elimination with partial pivoting on [A | I] (the same pivot choice as lu), rows
- * swapped whole, the pivot row scaled by the pivot's reciprocal, every other row cleared: X = A^-1 in one pass
- * (half the operations of lu and two triangular solves). 0 when a pivot is exactly zero. A is overwritten. */
-static inline int gj_column(row6 A[6], row6 X[6], int k) { /* called with constant k: unrolled */
+/* The inverse by Gauss-Jordan elimination with partial pivoting (the same pivot choice as lu), in place: rows swapped
+ * whole, the pivot row scaled by the pivot's reciprocal, every other row cleared, and the pivot's column k, no longer
+ * needed for A, takes the inverse's column orig[k] (the pivot row's unit column of [A | I], orig tracking the row
+ * swaps): each inverse entry sees exactly the operations of the elimination on [A | I] (0 - f inv for the new
+ * column, x - f y for the others), with half the row operations; gj_unscramble puts the columns in order. One pass,
+ * half the operations of lu and two triangular solves. 0 when a pivot is exactly zero. A is overwritten. */
+static inline int gj_column(row6 A[6], int orig[6], int k) { /* called with constant k: unrolled */
     int m = k;
     double big = fabs(EL(A[k], k));
     for (int i = k + 1; i < 6; i++) {
@@ -204,34 +213,38 @@ static inline int gj_column(row6 A[6], row6 X[6], int k) { /* called with consta
         big = gt ? v : big;
     }
     if (big == 0.0) return 0;
-    row6 t = A[k], u = X[k];
+    row6 t = A[k];
     A[k] = A[m];
     A[m] = t;
-    X[k] = X[m];
-    X[m] = u;
+    int o = orig[k];
+    orig[k] = orig[m];
+    orig[m] = o;
     double inv = 1.0 / EL(A[k], k);
     v2 iv = {inv, inv};
-    for (int q = 0; q < 3; q++) {
-        A[k].v[q] *= iv;
-        X[k].v[q] *= iv;
-    }
+    EL(A[k], k) = 1.0; /* the unit entry of [A | I] */
+    for (int q = 0; q < 3; q++) A[k].v[q] *= iv;
     for (int i = 0; i < 6; i++) {
         if (i == k) continue;
         double f = EL(A[i], k);
         v2 fv = {f, f};
-        for (int q = k >> 1; q < 3; q++) A[i].v[q] -= fv * A[k].v[q]; /* columns < k are never read again */
-        for (int q = 0; q < 3; q++) X[i].v[q] -= fv * X[k].v[q];
+        EL(A[i], k) = 0.0;
+        for (int q = 0; q < 3; q++) A[i].v[q] -= fv * A[k].v[q];
     }
     return 1;
 }
 
+static void gj_unscramble(const row6 A[6], const int orig[6], row6 X[6]) {
+    for (int i = 0; i < 6; i++)
+        for (int k = 0; k < 6; k++) EL(X[i], orig[k]) = EL(A[i], k);
+}
+
 static int gj_inverse(row6 A[6], row6 X[6]) {
-    for (int i = 0; i < 6; i++) {
-        X[i].v[0] = X[i].v[1] = X[i].v[2] = (v2){0.0, 0.0};
-        EL(X[i], i) = 1.0;
-    }
-    return gj_column(A, X, 0) && gj_column(A, X, 1) && gj_column(A, X, 2) && gj_column(A, X, 3) &&
-           gj_column(A, X, 4) && gj_column(A, X, 5);
+    int orig[6] = {0, 1, 2, 3, 4, 5};
+    if (!(gj_column(A, orig, 0) && gj_column(A, orig, 1) && gj_column(A, orig, 2) && gj_column(A, orig, 3) &&
+          gj_column(A, orig, 4) && gj_column(A, orig, 5)))
+        return 0;
+    gj_unscramble(A, orig, X);
+    return 1;
 }
 
 /* R <- exp([w]x) R (Rodrigues, the numpy _exp_so3's series below 1e-6 rad). */
@@ -355,13 +368,15 @@ static void nt_init(nstate *S, const geom *G, const double *Lt, int max_iter, do
 static void nt_p1(nstate *S, const geom *G, double tol) {
     double *p = S->p;
     legs(G, p, S->R, S->r, S->l, S->L);
-    double res = 0.0, nf = 0.0;
+    double res = 0.0, nf = 0.0, *e = S->e;
+    const double *Lt = S->Lt, *L = S->L;
     for (int i = 0; i < 6; i++) {
-        S->e[i] = S->Lt[i] - S->L[i];
-        double a = fabs(S->e[i]);
-        res = (a > res || a != a) ? a : res;
-        nf += S->e[i] * S->e[i];
+        e[i] = Lt[i] - L[i];
+        double a = fabs(e[i]);
+        res = a > res ? a : res;
+        nf += e[i] * e[i];
     }
+    if (nf != nf) res = nf; /* a NaN length: nf is NaN exactly then (an infinite one makes res and nf infinite) */
     S->res = res;
     S->nf = nf;
     int done = S->done = res <= tol;
@@ -438,14 +453,13 @@ static int newton(const geom *G, const double *Lt, double tol, int max_iter, dou
 /* Two factorisations of the same kind, interleaved column by column (each as it would run alone). */
 static void nt_p2_pair(nstate *A, nstate *B) {
     if (A->need == NEED_GJ) {
-        for (int i = 0; i < 6; i++) {
-            A->Y[i].v[0] = A->Y[i].v[1] = A->Y[i].v[2] = B->Y[i].v[0] = B->Y[i].v[1] = B->Y[i].v[2] = (v2){0.0, 0.0};
-            EL(A->Y[i], i) = EL(B->Y[i], i) = 1.0;
-        }
-        int a = 1, b = 1; /* constant columns (inlined and specialised); a matrix stops at a zero pivot */
-#define GJ2(k) a = a && gj_column(A->J, A->Y, k); b = b && gj_column(B->J, B->Y, k)
+        int a = 1, b = 1, oa[6] = {0, 1, 2, 3, 4, 5}, ob[6] = {0, 1, 2, 3, 4, 5};
+        /* constant columns (inlined and specialised); a matrix stops at a zero pivot */
+#define GJ2(k) a = a && gj_column(A->J, oa, k); b = b && gj_column(B->J, ob, k)
         GJ2(0); GJ2(1); GJ2(2); GJ2(3); GJ2(4); GJ2(5);
 #undef GJ2
+        if (a) gj_unscramble(A->J, oa, A->Y);
+        if (b) gj_unscramble(B->J, ob, B->Y);
         A->ok = a;
         B->ok = b;
     } else {
