@@ -7,10 +7,9 @@ import numpy as np
 
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.core.newton_fk import leg_geometry, newton_core
 from stewart_drake.core.realtime_fk import RealtimeFK
-from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 from stewart_drake.core.sampling import random_poses
+from tests.core.test_realtime_fk import continuation
 
 FIELDS = ("poses", "residual", "iterations", "status", "certified", "radius", "eta", "step", "substeps")
 
@@ -42,15 +41,6 @@ def test_pairs_give_each_set_the_bits_it_gets_alone():
                 one = fk.solve_batch(L[k : k + 1], q0[k : k + 1])
                 for f in FIELDS:
                     assert np.array_equal(getattr(r, f)[k : k + 1], getattr(one, f), equal_nan=True), (name, sub, k, f)
-
-
-def continuation(p, q0, L_target, steps=400):
-    """The branch of q0 followed by the numpy Newton along L(s) = L(q0) + s (L* − L(q0)) in ``steps`` steps."""
-    P, R = q0[:, :3].copy(), rotation_matrix(q0[:, 3:])
-    _, _, L0 = leg_geometry(p, P, R)
-    for s in np.linspace(0, 1, steps + 1)[1:]:
-        P, R, _, _, st = newton_core(p, P, R, L0 + s * (L_target - L0))
-    return np.c_[P, angles_from_matrix(R)], st
 
 
 def test_sets_certified_by_the_third_trial_are_on_the_branch():
