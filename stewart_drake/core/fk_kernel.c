@@ -146,20 +146,29 @@ static void jac(v2 r[3][3], v2 l[3][3], const double L[6], row6 J[6]) {
     }
 }
 
+/* The partial pivot of column k: the first row i >= k of largest |A[i][k]|, that value in *big. It selects rather
+ * than jumps: no mispredicted branches. Shared by lu_column and gj_column (the same pivot choice). */
+static inline int pivot_row(const row6 A[6], int k, double *big) {
+    int m = k;
+    double b = fabs(EL(A[k], k));
+    for (int i = k + 1; i < 6; i++) {
+        double v = fabs(EL(A[i], k));
+        int gt = v > b;
+        m = gt ? i : m;
+        b = gt ? v : b;
+    }
+    *big = b;
+    return m;
+}
+
 /* LU with partial pivoting in place (LAPACK's dgetf2: multipliers below the diagonal, rows swapped whole);
  * 0 when a pivot is exactly zero (numpy's LinAlgError). Each update runs over the whole row with the pivot
  * row's columns <= k masked to zero (so those columns of the updated row are unchanged; pairs wholly left of
- * column k are skipped), then column k takes the multiplier. The pivot search selects rather than jumps, and the
- * swap is unconditional (a row with itself when m == k): no mispredicted branches. */
+ * column k are skipped), then column k takes the multiplier. The swap is unconditional (a row with itself when
+ * m == k): no mispredicted branches. */
 static inline int lu_column(row6 A[6], int piv[6], double dinv[6], int k) { /* called with constant k: unrolled */
-    int m = k;
-    double big = fabs(EL(A[k], k));
-    for (int i = k + 1; i < 6; i++) {
-        double v = fabs(EL(A[i], k));
-        int gt = v > big;
-        m = gt ? i : m;
-        big = gt ? v : big;
-    }
+    double big;
+    int m = pivot_row(A, k, &big);
     piv[k] = m;
     if (big == 0.0) return 0;
     row6 t = A[k];
@@ -204,14 +213,8 @@ static void lu_solve(const row6 A[6], const int piv[6], const double dinv[6], do
  * column, x - f y for the others), with half the row operations; gj_unscramble puts the columns in order. One pass,
  * half the operations of lu and two triangular solves. 0 when a pivot is exactly zero. A is overwritten. */
 static inline int gj_column(row6 A[6], int orig[6], int k) { /* called with constant k: unrolled */
-    int m = k;
-    double big = fabs(EL(A[k], k));
-    for (int i = k + 1; i < 6; i++) {
-        double v = fabs(EL(A[i], k));
-        int gt = v > big;
-        m = gt ? i : m;
-        big = gt ? v : big;
-    }
+    double big;
+    int m = pivot_row(A, k, &big);
     if (big == 0.0) return 0;
     row6 t = A[k];
     A[k] = A[m];
