@@ -77,7 +77,12 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
     q = as_poses(poses)
     R = rotation_matrix(q[..., 3:], convention)
     r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
-    l = q[..., None, :3] + r - platform.base_anchors
+    return inverse_jacobian_of_legs(q[..., None, :3] + r - platform.base_anchors, r)
+
+
+def inverse_jacobian_of_legs(l, r) -> np.ndarray:
+    """``(..., 6, 6)`` J⁻¹ (``inverse_jacobian``) from the leg vectors ``l`` (..., 6, 3) (m) and the plate
+    offsets ``r`` (..., 6, 3) (m, r_i = R (p_TTi − p_TC)): rows [u_iᵀ, (r_i × u_i)ᵀ], for a caller that has them."""
     u = l / np.linalg.norm(l, axis=-1, keepdims=True)
     return np.concatenate([u, cross(r, u)], axis=-1)
 

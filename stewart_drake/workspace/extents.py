@@ -4,13 +4,9 @@ extreme refined by a constrained optimisation (SLSQP on the limit margins) with 
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 from scipy.optimize import minimize
 
-from stewart_drake.core.kinematics import scaled_condition
-from stewart_drake.core.vec3 import cross
 from stewart_drake.workspace.limits import raw_margins
 from stewart_drake.workspace.slabs import GridSpec
 
@@ -59,16 +55,11 @@ def point_margins(spec: GridSpec, p, offsets: np.ndarray) -> np.ndarray:
     """Every margin at one position ``p`` (3,) (m) of the sweep's orientation: ``raw_margins`` of ``leg_vectors``
     at the pose, then the half-space above the base, bit for bit, with the orientation's part (``offsets``,
     ``plate_offsets``) computed once instead of at every call of the refinement's optimiser."""
-    platform, o = spec.platform, spec.orientation
-    q = np.r_[p, o]
+    platform = spec.platform
+    q = np.r_[p, spec.orientation]
     l = q[..., None, :3] + offsets - platform.base_anchors  # leg_vectors' (p + r) − b
-    limits = copy.copy(spec.limits)  # without the dexterity (a copy: ``replace`` would normalise the axes again)
-    object.__setattr__(limits, "max_condition", None)
-    ms = [m.ravel() for m in raw_margins(platform, l, spec.R, limits, q, spec.convention).values()]
-    if spec.limits.max_condition is not None:  # raw_margins' last entry, by inverse_jacobian's formula
-        u = l / np.linalg.norm(l, axis=-1, keepdims=True)
-        J = np.concatenate([u, cross(offsets, u)], axis=-1)
-        ms.append((spec.limits.max_condition - scaled_condition(platform, J))[..., None].ravel())
+    margins = raw_margins(platform, l, spec.R, spec.limits, q, spec.convention, offsets=offsets)
+    ms = [m.ravel() for m in margins.values()]
     above = [np.array([p[2] - spec.z_floor])] if np.isfinite(spec.z_floor) else []  # the half-space above the base
     return np.concatenate(ms + above)
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.core.geometry import Platform, base_joints
-from stewart_drake.core.kinematics import condition_number, leg_vectors
+from stewart_drake.core.kinematics import condition_number, inverse_jacobian_of_legs, leg_vectors, scaled_condition
 from stewart_drake.core.rotations import check_convention, rotation_matrix
 from stewart_drake.errors import WorkspaceError
 
@@ -119,10 +119,11 @@ def leg_pairs(platform: Platform) -> np.ndarray:
     return np.stack([i[apart], j[apart]], axis=-1).astype(np.intp)
 
 
-def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention: str = "utn") -> dict:
+def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention: str = "utn", offsets=None) -> dict:
     """Per-element margins ``{name: (..., k)}`` (>= 0 inside) from leg vectors ``l`` ``(..., 6, 3)`` and
     plate rotations ``R`` ``(..., 3, 3)`` (or one ``(3, 3)``): k = 6 legs (stroke, joints), the rows of
-    ``leg_pairs`` (collision), or 1 (dexterity, which needs ``poses``)."""
+    ``leg_pairs`` (collision), or 1 (dexterity, which needs ``poses``, or the plate offsets ``offsets``
+    ``(..., 6, 3)`` r_i = R (p_TTi − p_TC) of those ``l``: the same numbers without recomputing R)."""
     out = {}
     L = np.sqrt(np.einsum("...k,...k->...", l, l))
     if limits.stroke:
@@ -153,9 +154,13 @@ def raw_margins(platform: Platform, l, R, limits: Limits, poses=None, convention
         else:
             out["collision"] = np.full(L.shape[:-1] + (1,), np.inf)
     if limits.max_condition is not None:
-        if poses is None:
+        if offsets is not None:
+            kappa = scaled_condition(platform, inverse_jacobian_of_legs(l, offsets))
+        elif poses is not None:
+            kappa = condition_number(platform, poses, convention)
+        else:
             raise WorkspaceError(WorkspaceError.DEXTERITY_POSES)
-        out["dexterity"] = (limits.max_condition - condition_number(platform, poses, convention))[..., None]
+        out["dexterity"] = (limits.max_condition - kappa)[..., None]
     return out
 
 
