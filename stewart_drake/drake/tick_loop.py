@@ -230,10 +230,9 @@ class TickLoop:
         last = len(s.times) - 1
         t, k, rel, step = 0.0, 0, False, True  # t = 0: Initialize has published; the tick at 0 is next
         for i in range(first, last + 1):
-            if i == first >= 0:  # resuming: the run that ended at stop ``first`` logged there
+            if i >= 0:
                 t, k, rel, step = s.times[i], s.tick[i], s.release[i], s.step[i]
-            elif i >= 0:
-                t, k, rel, step = s.times[i], s.tick[i], s.release[i], s.step[i]
+            if i > first:  # not the stop a resumed run ended at (and logged)
                 advance(t)
                 if s.log[i]:
                     held_log[row, :], status_log[row, :] = held[:12], status
