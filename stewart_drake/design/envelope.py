@@ -428,3 +428,23 @@ def envelope_sizing(
         out["allowed_accel"],
         worst,
     )
+
+
+def envelope_peaks(platform: Platform, env: Envelope, gravity: float = G_EARTH, stroke: bool = True) -> tuple:
+    """``(peak_force, peak_speed)`` (n, 6), N and m/s: the plate-only ``envelope_sizing``'s two exact peaks, the
+    same arithmetic on the same chunks (bit for bit), without its acceleration bounds and worst-case bookkeeping
+    (a third of its cost), for callers that need only these (``synthesis.performance.sampled_performance``)."""
+    check_in_workspace(platform, env, stroke)
+    n = len(env.poses)
+    force, speed = np.empty((n, 6)), np.empty((n, 6))
+    vel_axes = 3 + np.flatnonzero(env.v_max[3:] > 0)
+    b = env.v_max[vel_axes]
+    for s in range(0, n, CHUNK):
+        c, G, Q, (_, _, _, _, Jinv) = _plate_terms(platform, env.poses[s : s + CHUNK], env.convention, gravity)
+        Qv = Q[..., vel_axes - 3, :][..., :, vel_axes - 3]
+        qmax, _ = box_quadratic_max(Qv, b)
+        qmin_neg, _ = box_quadratic_max(-Qv, b)
+        lin = np.abs(G) @ env.a_max
+        force[s : s + CHUNK] = np.maximum(c + lin + qmax, -(c - lin - qmin_neg))
+        speed[s : s + CHUNK] = np.abs(Jinv) @ env.v_max
+    return force, speed

@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
@@ -107,6 +106,8 @@ def slice_maps(
     sign_home = np.sign(np.linalg.det(inverse_jacobian(platform, platform.home_pose(), convention)))
     same = np.sign(np.linalg.det(A)) == sign_home
     ok = within & same & (cond <= max_condition)
+    from scipy import ndimage  # here: its import costs ~0.3 s CPU, and most users of this module never label
+
     labels, _ = ndimage.label(ok)
     home = platform.home_pose()[list(axes)]
     i0 = (int(np.argmin(np.abs(x - home[0]))), int(np.argmin(np.abs(y - home[1]))))

@@ -101,7 +101,7 @@ from stewart_drake.core.dynamics import G_EARTH, skew
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius, condition_number
 from stewart_drake.core.rotations import check_convention, rotation_matrix
-from stewart_drake.design.envelope import Envelope, envelope_sizing, plate_wrench_terms, spatial_inertia_about_C
+from stewart_drake.design.envelope import Envelope, envelope_peaks, plate_wrench_terms, spatial_inertia_about_C
 from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.stiffness import geometric_stiffness, stiffness_matrix
 from stewart_drake.errors import StewartError
@@ -365,16 +365,16 @@ def _wrench_scale(platform: Platform, gravity: float) -> float:
 
 def sampled_performance(platform: Platform, poses, v_max, a_max, stiffness: float, convention: str = "utn") -> dict:
     """``{name: (m,)}`` the requirements' quantities at poses (m, 6) by the toolkit's per-platform functions:
-    peak leg force and speed (``envelope_sizing``, exact over the envelope), lowest frequency (``stiffness_matrix``
+    peak leg force and speed (``envelope_peaks``: ``envelope_sizing``'s, exact over the envelope), lowest frequency (``stiffness_matrix``
     and ``spatial_inertia_about_C`` through ``lowest_frequency``) and ``condition_number``. The independent check."""
     poses = np.atleast_2d(np.asarray(poses, float))
     env = Envelope(poses, np.asarray(v_max, float), np.asarray(a_max, float), convention, "box")
-    sz = envelope_sizing(platform, env, stroke=False)
+    force, speed = envelope_peaks(platform, env, stroke=False)  # envelope_sizing's peaks, bit for bit
     K = stiffness_matrix(platform, poses, stiffness, convention)
     M = spatial_inertia_about_C(platform, rotation_matrix(poses[:, 3:], convention))
     return {
-        "force": sz.peak_force.max(-1),
-        "speed": sz.peak_speed.max(-1),
+        "force": force.max(-1),
+        "speed": speed.max(-1),
         "frequency": lowest_frequency(K, M),
         "condition": condition_number(platform, poses, convention),
     }

@@ -5,7 +5,6 @@ extreme refined by a constrained optimisation (SLSQP on the limit margins) with 
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize
 
 from stewart_drake.workspace.limits import raw_margins
 from stewart_drake.workspace.slabs import GridSpec
@@ -70,6 +69,8 @@ def refine_extents(spec: GridSpec, extents, top, front, side, h, feas_tol: float
     -``feas_tol``) and at least as far out as the node. Returns (extents, error) where error is the
     largest gap between a refined extreme and its grid bracket's far end (node ± h): under the grid
     assumption (the boundary is resolved at h) the true extreme lies in that gap."""
+    from scipy.optimize import minimize  # here: ~0.1 s CPU to import, and the package's importers rarely refine
+
     axes, o = spec.axes, spec.orientation
     out = extents.copy()
     gaps = []
