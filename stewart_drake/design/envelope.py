@@ -177,10 +177,11 @@ def load_envelope(path) -> Envelope:
     return envelope_from_config(cfg, str(path))
 
 
-def check_in_workspace(platform: Platform, env: Envelope, stroke: bool = True) -> np.ndarray:
+def check_in_workspace(platform: Platform, env: Envelope, stroke: bool = True, conditions: bool = False):
     """``(n, 6)`` leg lengths of the envelope's poses; ``EnvelopeError`` naming the first pose outside the
     stroke (unless ``stroke`` is False: the caller reports it as a result outside limits), on (or near) a
-    singularity or at the convention's gimbal lock."""
+    singularity or at the convention's gimbal lock. With ``conditions`` also the ``(n,)`` scaled condition
+    numbers it checked (``core.kinematics.condition_number``): ``(lengths, conditions)``."""
     try:
         check_poses(platform, env.poses, env.convention, what=f"{env.source}: pose")  # finite, near, above the base
     except StewartError as e:
@@ -200,13 +201,15 @@ def check_in_workspace(platform: Platform, env: Envelope, stroke: bool = True) -
                 side="below" if v["side"] == "min" else "above",
             )
         )
+    cond = np.empty(len(env.poses))
     for s in range(0, len(env.poses), 1 << 16):
         k = condition_number(platform, env.poses[s : s + (1 << 16)], env.convention)
         bad = ~(k <= MAX_CONDITION)
         if bad.any():
             j = s + int(np.argmax(bad))
             raise EnvelopeError(EnvelopeError.SINGULAR.format(source=env.source, pose=env.shown(j), cond=k[j - s]))
-    return L
+        cond[s : s + len(k)] = k
+    return (L, cond) if conditions else L
 
 
 # ----------------------------------------------------------------------------------------------
@@ -431,10 +434,11 @@ def envelope_sizing(
 
 
 def envelope_peaks(platform: Platform, env: Envelope, gravity: float = G_EARTH, stroke: bool = True) -> tuple:
-    """``(peak_force, peak_speed)`` (n, 6), N and m/s: the plate-only ``envelope_sizing``'s two exact peaks, the
-    same arithmetic on the same chunks (bit for bit), without its acceleration bounds and worst-case bookkeeping
-    (a third of its cost), for callers that need only these (``synthesis.performance.sampled_performance``)."""
-    check_in_workspace(platform, env, stroke)
+    """``(peak_force, peak_speed, condition)``, (n, 6) N and m/s and (n,): the plate-only ``envelope_sizing``'s two
+    exact peaks, the same arithmetic on the same chunks (bit for bit), without its acceleration bounds and
+    worst-case bookkeeping (a third of its cost), and the scaled condition numbers its workspace check computed
+    (``condition_number``), for callers that need only these (``synthesis.performance.sampled_performance``)."""
+    _, cond = check_in_workspace(platform, env, stroke, conditions=True)
     n = len(env.poses)
     force, speed = np.empty((n, 6)), np.empty((n, 6))
     vel_axes = 3 + np.flatnonzero(env.v_max[3:] > 0)
@@ -447,4 +451,4 @@ def envelope_peaks(platform: Platform, env: Envelope, gravity: float = G_EARTH, 
         lin = np.abs(G) @ env.a_max
         force[s : s + CHUNK] = np.maximum(c + lin + qmax, -(c - lin - qmin_neg))
         speed[s : s + CHUNK] = np.abs(Jinv) @ env.v_max
-    return force, speed
+    return force, speed, cond

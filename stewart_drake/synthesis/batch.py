@@ -25,6 +25,7 @@ from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.design.boxquad import box_quadratic_max
 from stewart_drake.design.envelope import MAX_CONDITION, plate_wrench_terms, spatial_inertia_about_C
 from stewart_drake.design.maps import lowest_frequency
+from stewart_drake.design.stiffness import geometric_load_term
 from stewart_drake.errors import StewartError
 from stewart_drake.synthesis.evaluate import (
     ANGLE_SAMPLES,
@@ -138,14 +139,7 @@ def evaluate_designs(req, X, gravity: float = G_EARTH) -> list[dict]:
     speed = (np.abs(A) @ req.v_max).max(axis=(1, 2))
     # loaded stiffness about C (design.stiffness.stiffness_matrix's expression) and the lowest frequency
     K = np.einsum("dpki,dpkj->dpij", A * req.stiffness, A)
-    Pm = (np.eye(3) - u[..., :, None] * u[..., None, :]) / L[..., None, None]
-    Sr, Su = skew(r), skew(u)
-    D = np.zeros(u.shape[:-1] + (6, 6))
-    D[..., :3, :3] = Pm
-    D[..., :3, 3:] = -Pm @ Sr
-    D[..., 3:, :3] = Sr @ Pm
-    D[..., 3:, 3:] = Su @ Sr - Sr @ Pm @ Sr
-    K = K - np.einsum("dpk,dpkij->dpij", c, D)
+    K = K - geometric_load_term(c, u, r, L)
     r_cm = np.einsum("pij,j->pi", R, payload.com - payload.rotation_centre)
     f_g = np.broadcast_to(np.array([0.0, 0.0, -payload.mass * gravity]), r_cm.shape)
     K[..., 3:, 3:] -= skew(f_g) @ skew(r_cm)

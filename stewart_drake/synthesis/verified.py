@@ -143,69 +143,89 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
     for p in _faces(d, b):
         free, fixed = [j for j in range(d) if p[j] == 0], [j for j in range(d) if p[j] != 0]
         x = p * b
-        alpha = sum(q[j][k] * (x[j] * x[k]) for j in fixed for k in fixed)
-        alpha_hi = up(alpha + e_alpha)
         if not free:
-            best = np.maximum(best, alpha_hi)
+            alpha = sum(q[j][k] * (x[j] * x[k]) for j in fixed for k in fixed)
+            best = np.maximum(best, up(alpha + e_alpha))
             value = np.maximum(value, alpha)
             continue
-        g = [sum(q[i][k] * x[k] for k in fixed) for i in free]  # Q_FC x_C
-        eg = [e_row[i] for i in free]
-        if len(free) == 1:
-            (f,) = free
-            a, ga = q[f][f], np.abs(g[0])
-            neg = a < 0
-            aa = np.where(neg, -a, 1.0)
-            inside = down((ga - eg[0]) / aa) <= b[f]  # else |y*| > b_f certainly
-            gh = _up_pos(ga + eg[0])
-            cand = up(alpha_hi + _up_pos(gh * gh / aa))
-            best = np.where(neg & inside, np.maximum(best, cand), best)
-            value = np.where(neg & (ga <= b[f] * aa), np.maximum(value, alpha + ga * ga / aa), value)
+        # a face's interior holds a candidate only where its leading entry a = Q_ff (f the first free coordinate)
+        # is negative: the face is evaluated there alone (the same arithmetic per entry) and merged back
+        neg = q[free[0]][free[0]] < 0
+        if not neg.any():
             continue
-        f0, f1 = free
-        a, c, e = q[f0][f0], q[f0][f1], q[f1][f1]
-        g0, g1, eg0, eg1 = g[0], g[1], eg[0], eg[1]
-        b0, b1 = b[f0], b[f1]
-        ae, cc = a * e, c * c
-        det = ae - cc
-        e_det = gamma(2) * (np.abs(ae) + cc) * (1.0 + 4.0 * U)  # |fl(ae − c²) − (ae − c²)|
-        neg = a < 0
-        if np.any(neg & (np.abs(det) <= e_det)):
-            # the sign undecided somewhere: det nearly exactly, ae = p₁ + e₁, c² = p₂ + e₂ without error
-            # (TwoProduct), det = (p₁ − p₂) + (e₁ − e₂) with two roundings (an exact tie gives det = 0 exactly)
-            p1, e1 = _two_product(a, e)
-            p2, e2 = _two_product(c, c)
-            s1, s2 = p1 - p2, e1 - e2
-            det = s1 + s2
-            e_det = 2.0 * U * (np.abs(s1) + np.abs(s2)) * (1.0 + 4.0 * U)
-        det_lo = np.where(e_det > 0, down(det - e_det), det)
-        det_hi = np.where(e_det > 0, up(det + e_det), det)
-        nd = neg & (det_lo > 0)
-        undecided = neg & ~nd & (det_hi > 0)
-        dl, dh = np.where(nd, det_lo, 1.0), np.where(nd, det_hi, 1.0)
-        g00, g11, cg = g0 * g0, g1 * g1, c * g0 * g1
-        ea, ca, aab = np.abs(e), np.abs(c), np.abs(a)
-        N_hi = up(2.0 * cg - e * g00 - a * g11 + gamma(5) * (ea * g00 + 2.0 * np.abs(cg) + aab * g11))
-        g_norm, eg_norm = np.hypot(g0, g1), np.hypot(eg0, eg1)
-        extra = -(a + e) / dl * (2.0 * g_norm * eg_norm + eg_norm * eg_norm)  # ‖(−Q_FF)⁻¹‖ (2|g||Δg| + |Δg|²)
-        cand = up(alpha_hi + _up_pos(np.maximum(N_hi, 0.0) / dl + extra))
-        # y* = (−Q_FF)⁻¹ g = [−e g₀ + c g₁, c g₀ − a g₁] / det: skipped if some |y*_j| > b_j certainly
-        a0, a1 = np.abs(g0), np.abs(g1)
-        y0_err = _up_pos(gamma(3) * (ea * a0 + ca * a1) + ea * eg0 + ca * eg1)
-        y1_err = _up_pos(gamma(3) * (ca * a0 + aab * a1) + ca * eg0 + aab * eg1)
-        out = (down((np.abs(c * g1 - e * g0) - y0_err) / dh) > b0) | (
-            down((np.abs(c * g0 - a * g1) - y1_err) / dh) > b1
-        )
-        box = up(
-            alpha_hi + _up_pos(2.0 * ((a0 + eg0) * b0 + (a1 + eg1) * b1 + ca * (b0 * b1)) + np.maximum(e, 0.0) * b1**2)
-        )
-        best = np.where(nd & ~out, np.maximum(best, cand), best)
-        best = np.where(undecided, np.maximum(best, box), best)
-        ok = neg & (det > 0)
-        dv = np.where(ok, det, 1.0)
-        ok &= (np.abs(c * g1 - e * g0) <= b0 * dv) & (np.abs(c * g0 - a * g1) <= b1 * dv)
-        value = np.where(ok, np.maximum(value, alpha + (2.0 * cg - e * g00 - a * g11) / dv), value)
+        sel = None if neg.all() else np.flatnonzero(neg)
+
+        def take(z, sel=sel):
+            return z if sel is None else z.reshape(-1)[sel]
+
+        qs = {(j, k): take(q[j][k]) for j in range(d) for k in range(d)}
+        eg = [take(e_row[i]) for i in free]
+        bs, vs = _face(qs, x, b, free, fixed, eg, take(e_alpha), take(best), take(value))
+        if sel is None:
+            best, value = bs, vs
+        else:  # best and value are C-contiguous arrays here (np.zeros, np.maximum, np.where): reshape is a view
+            best.reshape(-1)[sel], value.reshape(-1)[sel] = bs, vs
     return value, up(best + _up_pos(U * scale))  # and the symmetrisation's rounding over the box
+
+
+def _face(q, x, b, free, fixed, eg, e_alpha, best, value):
+    """``quad_box_max``'s update of ``(best, value)`` by one face with free coordinates ``free`` (one or two) at the
+    vertex coordinates ``x`` on ``fixed``, for entries where its leading entry a = Q_ff is negative (the only ones it
+    can change): ``q`` the entries ``{(j, k): (m,)}``, ``eg`` g's error terms, ``e_alpha`` α's (the module's lemma)."""
+    alpha = sum(q[j, k] * (x[j] * x[k]) for j in fixed for k in fixed)
+    alpha_hi = up(alpha + e_alpha)
+    g = [sum(q[i, k] * x[k] for k in fixed) for i in free]  # Q_FC x_C
+    if len(free) == 1:
+        (f,) = free
+        a, ga = q[f, f], np.abs(g[0])
+        aa = -a
+        inside = down((ga - eg[0]) / aa) <= b[f]  # else |y*| > b_f certainly
+        gh = _up_pos(ga + eg[0])
+        cand = up(alpha_hi + _up_pos(gh * gh / aa))
+        best = np.where(inside, np.maximum(best, cand), best)
+        value = np.where(ga <= b[f] * aa, np.maximum(value, alpha + ga * ga / aa), value)
+        return best, value
+    f0, f1 = free
+    a, c, e = q[f0, f0], q[f0, f1], q[f1, f1]
+    g0, g1, eg0, eg1 = g[0], g[1], eg[0], eg[1]
+    b0, b1 = b[f0], b[f1]
+    ae, cc = a * e, c * c
+    det = ae - cc
+    e_det = gamma(2) * (np.abs(ae) + cc) * (1.0 + 4.0 * U)  # |fl(ae − c²) − (ae − c²)|
+    if np.any(np.abs(det) <= e_det):
+        # the sign undecided somewhere: det nearly exactly, ae = p₁ + e₁, c² = p₂ + e₂ without error
+        # (TwoProduct), det = (p₁ − p₂) + (e₁ − e₂) with two roundings (an exact tie gives det = 0 exactly)
+        p1, e1 = _two_product(a, e)
+        p2, e2 = _two_product(c, c)
+        s1, s2 = p1 - p2, e1 - e2
+        det = s1 + s2
+        e_det = 2.0 * U * (np.abs(s1) + np.abs(s2)) * (1.0 + 4.0 * U)
+    det_lo = np.where(e_det > 0, down(det - e_det), det)
+    det_hi = np.where(e_det > 0, up(det + e_det), det)
+    nd = det_lo > 0
+    undecided = ~nd & (det_hi > 0)
+    dl, dh = np.where(nd, det_lo, 1.0), np.where(nd, det_hi, 1.0)
+    g00, g11, cg = g0 * g0, g1 * g1, c * g0 * g1
+    ea, ca, aab = np.abs(e), np.abs(c), np.abs(a)
+    N_hi = up(2.0 * cg - e * g00 - a * g11 + gamma(5) * (ea * g00 + 2.0 * np.abs(cg) + aab * g11))
+    g_norm, eg_norm = np.hypot(g0, g1), np.hypot(eg0, eg1)
+    extra = -(a + e) / dl * (2.0 * g_norm * eg_norm + eg_norm * eg_norm)  # ‖(−Q_FF)⁻¹‖ (2|g||Δg| + |Δg|²)
+    cand = up(alpha_hi + _up_pos(np.maximum(N_hi, 0.0) / dl + extra))
+    # y* = (−Q_FF)⁻¹ g = [−e g₀ + c g₁, c g₀ − a g₁] / det: skipped if some |y*_j| > b_j certainly
+    a0, a1 = np.abs(g0), np.abs(g1)
+    y0_err = _up_pos(gamma(3) * (ea * a0 + ca * a1) + ea * eg0 + ca * eg1)
+    y1_err = _up_pos(gamma(3) * (ca * a0 + aab * a1) + ca * eg0 + aab * eg1)
+    out = (down((np.abs(c * g1 - e * g0) - y0_err) / dh) > b0) | (down((np.abs(c * g0 - a * g1) - y1_err) / dh) > b1)
+    box = up(
+        alpha_hi + _up_pos(2.0 * ((a0 + eg0) * b0 + (a1 + eg1) * b1 + ca * (b0 * b1)) + np.maximum(e, 0.0) * b1**2)
+    )
+    best = np.where(nd & ~out, np.maximum(best, cand), best)
+    best = np.where(undecided, np.maximum(best, box), best)
+    ok = det > 0
+    dv = np.where(ok, det, 1.0)
+    ok &= (np.abs(c * g1 - e * g0) <= b0 * dv) & (np.abs(c * g0 - a * g1) <= b1 * dv)
+    value = np.where(ok, np.maximum(value, alpha + (2.0 * cg - e * g00 - a * g11) / dv), value)
+    return best, value
 
 
 def _two_product(a, b):

@@ -1,5 +1,6 @@
 """``envelope_peaks``: the plate-only ``envelope_sizing``'s peak force and speed without its acceleration bounds,
-bit for bit (the synthesis's sampled check relies on it being the same function's numbers)."""
+and ``condition_number``'s values, bit for bit (the synthesis's sampled check relies on them being those functions'
+numbers)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.geometry import load_platform
+from stewart_drake.core.kinematics import condition_number
 from stewart_drake.design.envelope import CHUNK, Envelope, EnvelopeError, envelope_peaks, envelope_sizing
 from stewart_drake.design.payload import with_payload
 
@@ -20,9 +22,10 @@ def test_envelope_peaks_are_envelope_sizings_bit_for_bit(v_max):
     poses = p.home_pose() + (2 * rng.random((CHUNK + 777, 6)) - 1) * span
     env = Envelope(poses, np.array(v_max), np.array([3.0, 4.0, 6.0, 12.0, 10.0, 20.0]))
     es = envelope_sizing(p, env, stroke=False)
-    force, speed = envelope_peaks(p, env, stroke=False)
+    force, speed, cond = envelope_peaks(p, env, stroke=False)
     assert force.tobytes() == es.peak_force.tobytes()  # identical bits, not merely close
     assert speed.tobytes() == es.peak_speed.tobytes()
+    assert cond.tobytes() == condition_number(p, poses).tobytes()
 
 
 def test_envelope_peaks_checks_the_workspace_as_envelope_sizing():
