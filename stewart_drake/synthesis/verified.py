@@ -140,6 +140,9 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
     scale = sum(rows[i] * b[i] for i in range(d))
     e_alpha = _up_pos(g12 * scale)
     e_row = [_up_pos(g12 * r) for r in rows]
+    # per leading free coordinate f, where Q_ff < 0: everywhere (None), nowhere (skipped), mostly (a mask: the face
+    # evaluated on every entry and merged where it holds) or on fewer than half (their indices: evaluated there)
+    subsets = {}
     for p in _faces(d, b):
         free, fixed = [j for j in range(d) if p[j] == 0], [j for j in range(d) if p[j] != 0]
         x = p * b
@@ -148,30 +151,42 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
             best = np.maximum(best, up(alpha + e_alpha))
             value = np.maximum(value, alpha)
             continue
-        # a face's interior holds a candidate only where its leading entry a = Q_ff (f the first free coordinate)
-        # is negative: the face is evaluated there alone (the same arithmetic per entry) and merged back
-        neg = q[free[0]][free[0]] < 0
-        if not neg.any():
+        if free[0] not in subsets:
+            neg = q[free[0]][free[0]] < 0
+            n_neg = np.count_nonzero(neg)
+            subsets[free[0]] = (
+                (None if n_neg == neg.size else neg if 2 * n_neg >= neg.size else np.flatnonzero(neg)),
+                {},
+            )
+        sel, got = subsets[free[0]]
+        if sel is not None and sel.size == 0:
             continue
-        sel = None if neg.all() else np.flatnonzero(neg)
+        if sel is None or sel.dtype == bool:
+            qs = {(j, k): q[j][k] for j in range(d) for k in range(d)}
+            with np.errstate(all="ignore"):  # entries outside the mask may divide by 0: they are discarded
+                bs, vs = _face(qs, x, b, free, fixed, [e_row[i] for i in free], e_alpha, best, value, sel)
+            best, value = (bs, vs) if sel is None else (np.where(sel, bs, best), np.where(sel, vs, value))
+            continue
 
-        def take(z, sel=sel):
-            return z if sel is None else z.reshape(-1)[sel]
+        def take(key, z, sel=sel, got=got):  # z at the indices sel, gathered once per leading coordinate
+            if key not in got:
+                got[key] = z.reshape(-1)[sel]
+            return got[key]
 
-        qs = {(j, k): take(q[j][k]) for j in range(d) for k in range(d)}
-        eg = [take(e_row[i]) for i in free]
-        bs, vs = _face(qs, x, b, free, fixed, eg, take(e_alpha), take(best), take(value))
-        if sel is None:
-            best, value = bs, vs
-        else:  # best and value are C-contiguous arrays here (np.zeros, np.maximum, np.where): reshape is a view
-            best.reshape(-1)[sel], value.reshape(-1)[sel] = bs, vs
+        qs = {(j, k): take((j, k), q[j][k]) for j in range(d) for k in range(d) if j in free or k in fixed}
+        eg = [take(i, e_row[i]) for i in free]
+        bs, vs = _face(qs, x, b, free, fixed, eg, take("alpha", e_alpha), take(0, best, got={}), take(0, value, got={}))
+        # best and value are C-contiguous arrays here (np.zeros, np.maximum, np.where): reshape(-1) is a view
+        best.reshape(-1)[sel], value.reshape(-1)[sel] = bs, vs
     return value, up(best + _up_pos(U * scale))  # and the symmetrisation's rounding over the box
 
 
-def _face(q, x, b, free, fixed, eg, e_alpha, best, value):
+def _face(q, x, b, free, fixed, eg, e_alpha, best, value, mask=None):
     """``quad_box_max``'s update of ``(best, value)`` by one face with free coordinates ``free`` (one or two) at the
     vertex coordinates ``x`` on ``fixed``, for entries where its leading entry a = Q_ff is negative (the only ones it
-    can change): ``q`` the entries ``{(j, k): (m,)}``, ``eg`` g's error terms, ``e_alpha`` α's (the module's lemma)."""
+    can change): ``q`` the entries ``{(j, k): (m,)}``, ``eg`` g's error terms, ``e_alpha`` α's (the module's lemma).
+    With ``mask`` (those entries among more) the result holds where it is true, and only those entries decide
+    whether the determinants are recomputed exactly."""
     alpha = sum(q[j, k] * (x[j] * x[k]) for j in fixed for k in fixed)
     alpha_hi = up(alpha + e_alpha)
     g = [sum(q[i, k] * x[k] for k in fixed) for i in free]  # Q_FC x_C
@@ -192,7 +207,7 @@ def _face(q, x, b, free, fixed, eg, e_alpha, best, value):
     ae, cc = a * e, c * c
     det = ae - cc
     e_det = gamma(2) * (np.abs(ae) + cc) * (1.0 + 4.0 * U)  # |fl(ae − c²) − (ae − c²)|
-    if np.any(np.abs(det) <= e_det):
+    if np.any(np.abs(det) <= e_det if mask is None else mask & (np.abs(det) <= e_det)):
         # the sign undecided somewhere: det nearly exactly, ae = p₁ + e₁, c² = p₂ + e₂ without error
         # (TwoProduct), det = (p₁ − p₂) + (e₁ − e₂) with two roundings (an exact tie gives det = 0 exactly)
         p1, e1 = _two_product(a, e)

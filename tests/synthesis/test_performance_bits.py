@@ -39,7 +39,8 @@ def test_a_cells_bounds_do_not_depend_on_its_batch(req, design):
 
 
 def test_quad_box_max_per_entry_whatever_the_batch():
-    # entries whose faces are evaluated (a < 0) mixed with entries where they are skipped, in every proportion
+    # entries whose faces are evaluated (a < 0) mixed with entries where they are skipped, in every proportion: all
+    # (0:100), none (100:200), most (0:133, a mask) and a minority (50:250, gathered indices) for Q_00
     rng = np.random.default_rng(5)
     Q = rng.normal(size=(400, 3, 3))
     Q[:100, 0, 0] = -np.abs(Q[:100, 0, 0])  # the first free coordinate's entry negative here, positive below
@@ -53,7 +54,7 @@ def test_quad_box_max_per_entry_whatever_the_batch():
             v1, u1 = quad_box_max(Qb[k], b)
             assert v1.tobytes() == value[k].tobytes() and u1.tobytes() == upper[k].tobytes()
         for part in (
-            (slice(0, 100), slice(100, 200), slice(0, 260))
+            (slice(0, 100), slice(100, 200), slice(0, 133), slice(50, 250), slice(0, 260))
             if len(Qb) == len(Q)
             else (slice(0, 1), slice(0, 260), slice(151, 402))
         ):
