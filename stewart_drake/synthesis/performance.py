@@ -158,7 +158,7 @@ def performance_bounds(
     tn = up(np.linalg.norm(t, axis=1) + fp_t)  # >= |t| (6,)
     # what depends on the orientation alone is computed once per distinct angle centre (cells split across the
     # positions share theirs: ~2 % are distinct in the synthesis's proofs) and gathered: the same arithmetic per pose
-    angles, inv = _distinct_rows(c[:, 3:])
+    angles, inv = distinct_rows(c[:, 3:])
     R_u, dR_u = rotation_derivatives(angles, convention)
     r = np.einsum("nij,lj->nli", R_u, t)[inv]  # (n, 6, 3)
     dr_norm = np.linalg.norm(np.einsum("nkij,lj->nlki", dR_u, t), axis=-1)[inv]  # (n, 6, 3 [k]) |∂r_i/∂θ_k|
@@ -312,12 +312,18 @@ def performance_bounds(
     )
 
 
-def _distinct_rows(x) -> tuple[np.ndarray, np.ndarray]:
+def distinct_rows(x) -> tuple[np.ndarray, np.ndarray]:
     """``(rows (m, k), inverse (n,))``: the distinct rows of the float (n, k) ``x``, told apart by their bits (so
     −0.0 and 0.0 stay apart and a gathered result is the one of the row itself), with ``rows[inverse] == x``."""
     x = np.ascontiguousarray(x, dtype=float)
-    _, first, inverse = np.unique(x.view(np.int64), axis=0, return_index=True, return_inverse=True)
-    return x[first], inverse.reshape(-1)
+    bits = x.view(np.int64)
+    order = np.lexsort(bits.T[::-1])  # rows sorted by their bits (np.unique(axis=0) is 7x slower here)
+    ranked = bits[order]
+    first = np.ones(len(x), bool)
+    first[1:] = np.any(ranked[1:] != ranked[:-1], axis=1)
+    inverse = np.empty(len(x), np.intp)
+    inverse[order] = np.cumsum(first) - 1
+    return x[order[first]], inverse
 
 
 def _certified_frequency(k_shrink, Gm, e_G, eps_K, M_s, eps_M) -> np.ndarray:
