@@ -59,7 +59,6 @@ def box_quadratic_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
         nf = len(free)
         if nf == 0 or np.any(b[free] == 0):
             continue  # vertices done; a zero-width coordinate is never free (the same points are a smaller face)
-        x = np.broadcast_to((p * b).astype(float), batch + (d,)).copy()
         g = np.sum(Q[..., free, :][..., :, fixed] * (p[fixed] * b[fixed]), axis=-1)  # (..., nf): Q_FC x_C
         if nf == 1:
             a = Q[..., free[0], free[0]]
@@ -79,6 +78,17 @@ def box_quadratic_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
         ok &= np.all(np.abs(xf) <= b[free] * (1 + 1e-12), axis=-1)
         if not ok.any():
             continue
+        if batch:  # the face's point and value only where it is a candidate (the same arithmetic per entry)
+            sel = np.flatnonzero(ok)
+            x = np.broadcast_to((p * b).astype(float), (len(sel), d)).copy()
+            x[:, free] = np.clip(xf.reshape(-1, nf)[sel], -b[free], b[free])
+            val = _value(Qf.reshape(-1, Qf.shape[-1])[sel], iu, x)
+            better = val > best.reshape(-1)[sel]
+            # best and arg are C-contiguous arrays made here (np.maximum, np.where): reshape is a view
+            best.reshape(-1)[sel[better]] = val[better]
+            arg.reshape(-1, d)[sel[better]] = x[better]
+            continue
+        x = np.broadcast_to((p * b).astype(float), batch + (d,)).copy()
         x[..., free] = np.clip(xf, -b[free], b[free])
         val = _value(Qf, iu, x)
         better = ok & (val > best)
