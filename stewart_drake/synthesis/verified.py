@@ -122,7 +122,9 @@ def quad_box_max(Q, b) -> tuple[np.ndarray, np.ndarray]:
     Each α and g carries γ₁₂ of its absolute expression (bounded by Σ_jk |Q_jk| b_j b_k and Σ_k |Q_ik| b_k); every
     candidate is widened by ``up``. Taking the largest
     of upper bounds of each face's maximum bounds the box's maximum. Vectorised over the batch, a Python loop over
-    the ≤ 13 faces (elementwise arithmetic on the entries: tiny matrix products are slow in BLAS)."""
+    the ≤ 13 faces (elementwise arithmetic on the entries: tiny matrix products are slow in BLAS); a face with free
+    coordinates is evaluated only on the entries whose a = Q_ff (f its first free coordinate) is negative, the only
+    ones it can change (``_face``), with the same arithmetic per entry as on the whole batch."""
     Q = np.asarray(Q, dtype=float)
     Q = 0.5 * (Q + np.swapaxes(Q, -1, -2))
     b = np.asarray(b, dtype=float)
