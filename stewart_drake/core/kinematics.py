@@ -208,6 +208,14 @@ def check_stroke(platform: Platform, lengths) -> StrokeCheck:
     return StrokeCheck(L, np.maximum(platform.L_min - L, 0.0), np.maximum(L - platform.L_max, 0.0))
 
 
+def stroke_within(platform: Platform, lengths) -> np.ndarray:
+    """``(...)`` bool: ``check_stroke(platform, lengths).within`` for ``(..., 6)`` lengths (m) without the check's
+    three arrays (a sampler's test): L_min − L > 0 exactly when L < L_min (and L − L_max > 0 when L > L_max), so a
+    leg is out only where it compares out; a NaN length compares out of neither, as there."""
+    L = np.asarray(lengths, dtype=float)
+    return ~np.any((L < platform.L_min) | (L > platform.L_max), axis=-1)
+
+
 def inverse_kinematics(platform: Platform, poses, convention: str = "utn", check: bool = True) -> np.ndarray:
     """``(..., 6)`` leg lengths (metres); with ``check`` raise ``UnreachablePoseError`` naming the first
     pose and leg outside the stroke and by how much."""
