@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.core.kinematics import condition_above, inverse_jacobian, leg_vectors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import plate_floor
 from stewart_drake.workspace.limits import Limits, check_orientation, margins_from_legs
@@ -74,12 +74,15 @@ def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
         pos = np.stack([xs[idx[0]], ys[idx[1]], zs[idx[2]]], -1)
         l = pos[:, None, :] + spec.offsets
         poses = np.concatenate([pos, np.broadcast_to(spec.orientation, pos.shape)], -1)
-        margins = margins_from_legs(
-            p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention
-        )
+        valued = dataclasses.replace(spec.limits, stroke=False, max_condition=None)
+        margins = margins_from_legs(p, l, spec.R, valued, poses, spec.convention) if valued.active else {}
+        outside = {name: margins[name][0] < 0 for name in valued.active}
+        if spec.limits.max_condition is not None:  # its margin max_condition − κ < 0 exactly where κ > max_condition
+            J = inverse_jacobian(p, poses, spec.convention)  # the J of the margin's ``condition_number``
+            outside["dexterity"] = condition_above(p, J, spec.limits.max_condition)
         keep = np.ones(len(pos), bool)
         for name in others:
-            bad = margins[name][0] < 0
+            bad = outside[name]
             removed[name] = np.bincount(idx[0][bad], minlength=shape[0])
             keep &= ~bad
         ok[idx] = keep
