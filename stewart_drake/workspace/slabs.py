@@ -13,9 +13,10 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import condition_above, inverse_jacobian, leg_vectors
+from stewart_drake.core.memo import Memo, digest
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import plate_floor
-from stewart_drake.workspace.limits import Limits, check_orientation, margins_from_legs
+from stewart_drake.workspace.limits import Limits, check_orientation, leg_axis_distances, leg_pairs, margins_from_legs
 
 
 @dataclass(frozen=True)
@@ -89,6 +90,23 @@ def stroke_window(spec: GridSpec, xs, ys, zs) -> tuple[int, int, int, int]:
     return (j0, j1, k0, k1) if k0 < k1 else (0, 0, 0, 0)
 
 
+# the last blocks' closest leg-axis distances: sweeps of one grid at several leg diameters (the report's two
+# collision rows) measure the same stroke nodes' distances once
+AXIS_DISTANCES = Memo(4)
+
+
+def closest_leg_axes(platform: Platform, l: np.ndarray) -> np.ndarray:
+    """``(n,)`` the closest two leg axes come (m) at each of ``n`` leg-vector sets ``l`` ``(n, 6, 3)``
+    (``limits.leg_axis_distances``' minimum), remembered by the bytes of ``l``, the base anchors and the pairs."""
+    key = digest(
+        str(l.shape).encode(),
+        np.ascontiguousarray(l).tobytes(),
+        platform.base_anchors.tobytes(),
+        leg_pairs(platform).tobytes(),
+    )
+    return AXIS_DISTANCES.get(key, lambda: leg_axis_distances(platform, l).min(axis=-1))
+
+
 def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
     """Classify the grid block xs × ys × zs: ``(inside, removed)`` where ``removed``
     counts, per optional limit, the stroke-feasible nodes it rejects in each x-plane ``(nx,)``.
@@ -119,9 +137,11 @@ def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
         pos = np.stack([xs[idx[0]], ys[idx[1]], zs[idx[2]]], -1)
         l = pos[:, None, :] + spec.offsets
         poses = np.concatenate([pos, np.broadcast_to(spec.orientation, pos.shape)], -1)
-        valued = dataclasses.replace(spec.limits, stroke=False, max_condition=None)
+        valued = dataclasses.replace(spec.limits, stroke=False, max_condition=None, leg_diameter=None)
         margins = margins_from_legs(p, l, spec.R, valued, poses, spec.convention) if valued.active else {}
         outside = {name: margins[name][0] < 0 for name in valued.active}
+        if spec.limits.leg_diameter is not None:  # min(d − D) = min(d) − D: rounding is monotone
+            outside["collision"] = closest_leg_axes(p, l) - spec.limits.leg_diameter < 0
         if spec.limits.max_condition is not None:  # its margin max_condition − κ < 0 exactly where κ > max_condition
             J = inverse_jacobian(p, poses, spec.convention)  # the J of the margin's ``condition_number``
             outside["dexterity"] = condition_above(p, J, spec.limits.max_condition)
