@@ -175,12 +175,20 @@ def _mirror(p: np.ndarray, R: np.ndarray):
 
 
 def _dedupe(p: np.ndarray, R: np.ndarray, scale: float, tol: float) -> np.ndarray:
-    """Indices of distinct solutions (keeps the first of each cluster)."""
+    """Indices of distinct solutions (keeps the first of each cluster): solution i is kept when its key
+    (p / scale, R) is farther than ``tol`` (largest coordinate difference) from every solution kept before it.
+    One pass per kept solution, over all later candidates at once (thousands of starts reach a few dozen
+    modes): the first candidate still standing is kept and those within ``tol`` of it drop out, which keeps
+    and drops exactly what testing each solution in turn against the kept ones does (a NaN distance is not
+    farther, as there)."""
     key = np.concatenate([p / scale, R.reshape(len(R), 9)], axis=-1)
     keep = []
-    for i in range(len(key)):
-        if not keep or np.min(np.max(np.abs(key[keep] - key[i]), axis=-1)) > tol:
-            keep.append(i)
+    cand = np.arange(len(key))
+    while len(cand):
+        i = cand[0]
+        keep.append(i)
+        rest = cand[1:]
+        cand = rest[np.max(np.abs(key[rest] - key[i]), axis=-1) > tol]
     return np.array(keep, dtype=np.intp)
 
 

@@ -147,6 +147,34 @@ def condition_at_most(platform: Platform, J, limit: float) -> np.ndarray:
     return ok
 
 
+def condition_above(platform: Platform, J, limit: float) -> np.ndarray:
+    """``(...)`` bool: ``scaled_condition(platform, J) > limit`` for ``(..., 6, 6)`` Jacobians — the same answers,
+    about half the cost where only the side of a bound is wanted (a workspace's dexterity limit). κ² comes from
+    the eigenvalues of AᵀA (A the scaled J, ``np.linalg.eigvalsh``): their error is a few tens of ε·λ_max
+    (forming AᵀA and the symmetric solver, both backward stable), so κ² is off by a relative ~1e-14 · κ², and
+    any matrix whose κ² lies outside limit² (1 ± δ) with δ = max(1e-6, 1e-11 · limit²) — thousands of times
+    that error, and of the SVD's own — is on the same side of the limit for both. The SVD decides the band, a
+    matrix whose smallest eigenvalue is not positive, and every matrix when the eigenvalues fail."""
+    A = scaled_jacobian(J, anchor_radius(platform))
+    out = np.zeros(A.shape[:-2], dtype=bool)
+    rest = np.ones(A.shape[:-2], dtype=bool)
+    with np.errstate(all="ignore"):
+        try:
+            lam = np.linalg.eigvalsh(np.swapaxes(A, -1, -2) @ A)  # ascending
+        except np.linalg.LinAlgError:  # a matrix that is not finite: the SVD decides all (and says so)
+            lam = None
+        if lam is not None:
+            lim2 = float(limit) ** 2
+            slack = max(1e-6, 1e-11 * lim2)
+            k2 = lam[..., -1] / lam[..., 0]
+            sure = lam[..., 0] > 0
+            out = sure & (k2 >= lim2 * (1 + slack))
+            rest = ~(out | (sure & (k2 <= lim2 * (1 - slack))))
+    if rest.any():
+        out[rest] = scaled_condition(platform, J[rest]) > limit  # per matrix, as in one batch
+    return out
+
+
 def condition_number(platform: Platform, poses, convention: str = "utn") -> np.ndarray:
     """``(...)`` scaled condition number (``scaled_condition``) of J⁻¹ at ``(..., 6)`` poses (dL/dt =
     J⁻¹ [v_BC; ω_B]): the platform's own singularities; inf on one."""
@@ -206,6 +234,14 @@ def check_stroke(platform: Platform, lengths) -> StrokeCheck:
     """Compare ``(..., 6)`` leg lengths (metres) with the platform's stroke."""
     L = np.asarray(lengths, dtype=float)
     return StrokeCheck(L, np.maximum(platform.L_min - L, 0.0), np.maximum(L - platform.L_max, 0.0))
+
+
+def stroke_within(platform: Platform, lengths) -> np.ndarray:
+    """``(...)`` bool: ``check_stroke(platform, lengths).within`` for ``(..., 6)`` lengths (m) without the check's
+    three arrays (a sampler's test): L_min − L > 0 exactly when L < L_min (and L − L_max > 0 when L > L_max), so a
+    leg is out only where it compares out; a NaN length compares out of neither, as there."""
+    L = np.asarray(lengths, dtype=float)
+    return ~np.any((L < platform.L_min) | (L > platform.L_max), axis=-1)
 
 
 def inverse_kinematics(platform: Platform, poses, convention: str = "utn", check: bool = True) -> np.ndarray:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import check_stroke, leg_lengths, plate_anchors
+from stewart_drake.core.kinematics import CHUNK, leg_lengths, plate_anchors, stroke_within
 from stewart_drake.errors import SamplingError
 
 REGIONS = ("box", "workspace")
@@ -48,12 +48,7 @@ def random_poses(
         if region == "box":
             t = 0.1 * span if translation is None else translation
             r = np.radians(15) if rotation is None else rotation
-            q = home + np.c_[rng.uniform(-t, t, (2 * n, 3)), rng.uniform(-r, r, (2 * n, 3))]
-            ok = (
-                check_stroke(platform, leg_lengths(platform, q, convention)).within
-                if within_stroke
-                else np.ones(len(q), bool)
-            )
+            q = home + np.concatenate([rng.uniform(-t, t, (2 * n, 3)), rng.uniform(-r, r, (2 * n, 3))], axis=1)
         else:
             t = 0.3 * span if translation is None else translation
             r = np.radians(20.0) if rotation is None else rotation
@@ -63,10 +58,18 @@ def random_poses(
             q[:, :2] = rng.uniform(-t, t, (m, 2))
             q[:, 2] = rng.uniform(max(h - t, 0.5 * h), h + t, m)
             q[:, 3:] = rng.uniform(-r, r, (m, 3))
-            ok = check_stroke(platform, leg_lengths(platform, q, convention)).within
-            ok &= np.all(plate_anchors(platform, q, convention)[..., 2] > 0, axis=-1)
-        out.append(q[ok])
-        have += int(ok.sum())
-        if have >= n:
-            return np.concatenate(out)[:n]
+        # a round's draws are all made (the next round's depend on them); they are tested in the blocks
+        # ``leg_lengths`` takes (the same numbers) until ``n`` are accepted, since the poses after the n-th
+        # accepted one are dropped
+        for s in range(0, max(len(q), 1), CHUNK):  # one empty block when n = 0: an empty sample, as always
+            blk = q[s : s + CHUNK]
+            if region == "box":
+                ok = stroke_within(platform, leg_lengths(platform, blk, convention)) if within_stroke else None
+            else:
+                ok = stroke_within(platform, leg_lengths(platform, blk, convention))
+                ok &= np.all(plate_anchors(platform, blk, convention)[..., 2] > 0, axis=-1)
+            out.append(blk if ok is None else blk[ok])
+            have += len(out[-1])
+            if have >= n:
+                return np.concatenate(out)[:n]
     raise SamplingError(SamplingError.TOO_FEW.format(name=platform.name, n=n, region=region))

@@ -55,7 +55,7 @@ def point_margins(spec: GridSpec, p, offsets: np.ndarray) -> np.ndarray:
     at the pose, then the half-space above the base, bit for bit, with the orientation's part (``offsets``,
     ``plate_offsets``) computed once instead of at every call of the refinement's optimiser."""
     platform = spec.platform
-    q = np.r_[p, spec.orientation]
+    q = np.concatenate([np.asarray(p, dtype=float), spec.orientation])  # np.r_'s numbers without its parsing
     l = q[..., None, :3] + offsets - platform.base_anchors  # leg_vectors' (p + r) − b
     margins = raw_margins(platform, l, spec.R, spec.limits, q, spec.convention, offsets=offsets)
     ms = [m.ravel() for m in margins.values()]

@@ -12,10 +12,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import leg_vectors
+from stewart_drake.core.kinematics import condition_above, inverse_jacobian, leg_vectors
+from stewart_drake.core.memo import Memo, digest
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import plate_floor
-from stewart_drake.workspace.limits import Limits, check_orientation, margins_from_legs
+from stewart_drake.workspace.limits import Limits, check_orientation, leg_axis_distances, leg_pairs, margins_from_legs
 
 
 @dataclass(frozen=True)
@@ -49,24 +50,86 @@ def grid_spec(platform, orientation, convention, limits, axes) -> GridSpec:
     )
 
 
+# m²: what the window adds to L_max² before it bounds a coordinate. A node outside the window has some leg with
+# |l_i|² > L_max² + WINDOW_SLACK_M2 exactly, while rounding moves the kernel's |l_i|² by ~1e-15 m² at most: the
+# kernel rejects it too. (The bounds' own rounding, ~1e-16 m, is far inside the 5e-13 m the slack adds to them.)
+WINDOW_SLACK_M2 = 1e-12
+
+
+def _reach(room: np.ndarray) -> np.ndarray | None:
+    """Half-widths sqrt(room) of the legs' reach along one axis, or None when some leg cannot reach (room < 0)."""
+    return None if np.any(room < 0) else np.sqrt(room)
+
+
+def _min_square(lo: float, hi: float, c: np.ndarray) -> np.ndarray:
+    """``(6,)`` the least (v + c_i)² over v in [lo, hi] (m²)."""
+    a, b = lo + c, hi + c
+    return np.where((a <= 0) & (b >= 0), 0.0, np.minimum(a * a, b * b))
+
+
+def stroke_window(spec: GridSpec, xs, ys, zs) -> tuple[int, int, int, int]:
+    """``(j0, j1, k0, k1)``: the nodes ys[j0:j1] × zs[k0:k1] of the block xs × ys × zs (ascending node coordinates,
+    m) outside which no node has every leg within L_max: per leg, the block's least (x + c_x)² leaves
+    (y + c_y)² ≤ L_max² + ``WINDOW_SLACK_M2`` − that, a y interval; the z interval likewise from the least x and
+    y parts. Typically a fifth of the block or less, and empty (j0 = j1) when a leg cannot reach the block."""
+    c = spec.offsets  # (6, 3) l_i(0, R): leg i is p + c_i
+    top = spec.platform.L_max**2 + WINDOW_SLACK_M2
+    mx = _min_square(xs[0], xs[-1], c[:, 0])
+    ry = _reach(top - mx)
+    if ry is None:
+        return 0, 0, 0, 0
+    y_lo, y_hi = np.max(-c[:, 1] - ry), np.min(-c[:, 1] + ry)
+    j0, j1 = int(np.searchsorted(ys, y_lo, "left")), int(np.searchsorted(ys, y_hi, "right"))
+    if j0 >= j1:
+        return 0, 0, 0, 0
+    rz = _reach(top - mx - _min_square(ys[j0], ys[j1 - 1], c[:, 1]))
+    if rz is None:
+        return 0, 0, 0, 0
+    z_lo, z_hi = np.max(-c[:, 2] - rz), np.min(-c[:, 2] + rz)
+    k0, k1 = int(np.searchsorted(zs, z_lo, "left")), int(np.searchsorted(zs, z_hi, "right"))
+    return (j0, j1, k0, k1) if k0 < k1 else (0, 0, 0, 0)
+
+
+# the last blocks' closest leg-axis distances: sweeps of one grid at several leg diameters (the report's two
+# collision rows) measure the same stroke nodes' distances once
+AXIS_DISTANCES = Memo(4)
+
+
+def closest_leg_axes(platform: Platform, l: np.ndarray) -> np.ndarray:
+    """``(n,)`` the closest two leg axes come (m) at each of ``n`` leg-vector sets ``l`` ``(n, 6, 3)``
+    (``limits.leg_axis_distances``' minimum), remembered by the bytes of ``l``, the base anchors and the pairs."""
+    key = digest(
+        str(l.shape).encode(),
+        np.ascontiguousarray(l).tobytes(),
+        platform.base_anchors.tobytes(),
+        leg_pairs(platform).tobytes(),
+    )
+    return AXIS_DISTANCES.get(key, lambda: leg_axis_distances(platform, l).min(axis=-1))
+
+
 def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
     """Classify the grid block xs × ys × zs: ``(inside, removed)`` where ``removed``
     counts, per optional limit, the stroke-feasible nodes it rejects in each x-plane ``(nx,)``.
     ``inside`` is bool ``(nx, ny, nz)``."""
     p = spec.platform
     shape = (len(xs), len(ys), len(zs))
-    ok = np.ones(shape, bool)
-    ok &= (np.asarray(zs) > spec.z_floor)[None, None, :]
+    ok = np.zeros(shape, bool)
+    # the stroke's nodes lie in a window of the block's y and z (``stroke_window``): only the window is tested
+    j0, j1, k0, k1 = stroke_window(spec, xs, ys, zs) if spec.limits.stroke else (0, len(ys), 0, len(zs))
+    win = ok[:, j0:j1, k0:k1]  # a view: the window's answers land in ``ok``
+    win[...] = True
+    ys_w, zs_w = ys[j0:j1], zs[k0:k1]
+    win &= (np.asarray(zs_w) > spec.z_floor)[None, None, :]
     lo2, hi2 = p.L_min**2, p.L_max**2
     if spec.limits.stroke:
         for i in range(6):
             c = spec.offsets[i]
             d2 = (
                 ((xs + c[0]) ** 2)[:, None, None]
-                + ((ys + c[1]) ** 2)[None, :, None]
-                + ((zs + c[2]) ** 2)[None, None, :]
+                + ((ys_w + c[1]) ** 2)[None, :, None]
+                + ((zs_w + c[2]) ** 2)[None, None, :]
             )
-            ok &= (d2 >= lo2) & (d2 <= hi2)
+            win &= (d2 >= lo2) & (d2 <= hi2)
     removed = {}
     others = [n for n in spec.limits.active if n != "stroke"]
     if others:
@@ -74,12 +137,17 @@ def inside_block(spec: GridSpec, xs, ys, zs) -> tuple[np.ndarray, dict]:
         pos = np.stack([xs[idx[0]], ys[idx[1]], zs[idx[2]]], -1)
         l = pos[:, None, :] + spec.offsets
         poses = np.concatenate([pos, np.broadcast_to(spec.orientation, pos.shape)], -1)
-        margins = margins_from_legs(
-            p, l, spec.R, dataclasses.replace(spec.limits, stroke=False), poses, spec.convention
-        )
+        valued = dataclasses.replace(spec.limits, stroke=False, max_condition=None, leg_diameter=None)
+        margins = margins_from_legs(p, l, spec.R, valued, poses, spec.convention) if valued.active else {}
+        outside = {name: margins[name][0] < 0 for name in valued.active}
+        if spec.limits.leg_diameter is not None:  # min(d − D) = min(d) − D: rounding is monotone
+            outside["collision"] = closest_leg_axes(p, l) - spec.limits.leg_diameter < 0
+        if spec.limits.max_condition is not None:  # its margin max_condition − κ < 0 exactly where κ > max_condition
+            J = inverse_jacobian(p, poses, spec.convention)  # the J of the margin's ``condition_number``
+            outside["dexterity"] = condition_above(p, J, spec.limits.max_condition)
         keep = np.ones(len(pos), bool)
         for name in others:
-            bad = margins[name][0] < 0
+            bad = outside[name]
             removed[name] = np.bincount(idx[0][bad], minlength=shape[0])
             keep &= ~bad
         ok[idx] = keep

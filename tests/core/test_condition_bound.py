@@ -52,3 +52,34 @@ def test_singular_sample_named_with_the_svd_condition():
     assert k > MAX_CONDITION
     with pytest.raises(SingularPoseError, match="^sample 3: .*" + re.escape(f"condition number {k:.3g} > ")):
         leg_forces_with_legs(PLATFORM, q, np.zeros(6), np.zeros(6))
+
+
+@pytest.mark.parametrize("limit", [3.0, 1e3, MAX_CONDITION])
+def test_condition_above_gives_the_svds_side_of_the_limit(limit):
+    """``condition_above`` (κ² from the eigenvalues of AᵀA outside a band about the limit, the SVD inside it)
+    answers ``scaled_condition > limit`` on every matrix: κ from 1 to 1e20, a dense band of ±1e-4 about the
+    limit with some at ±1e-9 (inside the band: the SVD's call) and exactly at it, a zero matrix; at a large
+    limit (1e8: κ² lost to rounding) the band covers the eigenvalue path's error, so the SVD decides there."""
+    rng = np.random.default_rng(2)
+    near = limit * (1 + np.concatenate([np.linspace(-1e-4, 1e-4, 400), np.linspace(-1e-9, 1e-9, 101)]))
+    kappas = np.concatenate([np.logspace(0, 20, 1000), near])
+    U, _, Vt = np.linalg.svd(rng.normal(size=(len(kappas), 6, 6)))
+    S = np.ones((len(kappas), 6))
+    S[:, -1], S[:, 2] = 1 / kappas, 1 / np.sqrt(kappas)
+    A = U @ (S[..., None] * Vt)
+    A[0] = 0.0
+    J = np.concatenate([A[..., :3], A[..., 3:] * kin.anchor_radius(PLATFORM)], axis=-1)
+    expect = kin.scaled_condition(PLATFORM, J) > limit
+    assert expect[0] and 0 < expect[1000:].sum() < len(near)  # both sides occur in the band
+    np.testing.assert_array_equal(kin.condition_above(PLATFORM, J, limit), expect)
+
+
+def test_condition_above_on_workspace_jacobians():
+    """The J⁻¹ of poses over gonzalez-dutra-2009's workspace at the report's dexterity bound κ ≤ 3: the SVD's answers."""
+    g = load_preset("gonzalez-dutra-2009")
+    rng = np.random.default_rng(3)
+    q = g.home_pose() + rng.uniform(-1, 1, (20000, 6)) * [0.3, 0.3, 0.15, 0.3, 0.3, 0.3]
+    J = kin.inverse_jacobian(g, q)
+    expect = kin.scaled_condition(g, J) > 3.0
+    assert 0.05 < expect.mean() < 0.95
+    np.testing.assert_array_equal(kin.condition_above(g, J, 3.0), expect)
