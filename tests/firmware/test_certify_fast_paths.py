@@ -124,3 +124,24 @@ def test_point_words_are_evaluate_on_one_pose_cells(name, fmt):
     arith = np.array([n not in recipe.BENIGN for n in recipe.word_names()])
     if fmt.length_lsb < 1e-4:
         assert (ref.possible & arith).any()  # arithmetic clamps are exercised, not only the benign trig ones
+
+
+def test_fmul_in_place_is_the_four_corner_formula():
+    """``fmul`` reuses its products' buffers; its ends are still down(min of the four corner products) and
+    up(max), operand order included (signed zeros, infinities, 0 × inf = NaN), on large and small arrays."""
+    rng = np.random.default_rng(8)
+    for n in (3000, 40):
+        a0 = np.r_[rng.standard_normal(n - len(SPECIAL)), SPECIAL]
+        b0 = np.r_[SPECIAL, rng.standard_normal(n - len(SPECIAL))]
+        a, b = (a0, a0 + np.abs(rng.standard_normal(n))), (b0, np.where(rng.random(n) < 0.2, b0, b0 + 1.0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            p = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
+            ref = (
+                np.nextafter(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3])), -np.inf),
+                np.nextafter(np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3])), np.inf),
+            )
+            got = intervals.fmul(a, b)
+        for r, g in zip(ref, got, strict=True):
+            nan = np.isnan(r)
+            assert np.array_equal(nan, np.isnan(g)) and np.array_equal(_bits(r)[~nan], _bits(g)[~nan])

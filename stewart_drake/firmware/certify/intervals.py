@@ -72,9 +72,17 @@ def fsub(a, b):
 def fmul(a, b):
     """Enclosure of a * b (the four corner products, each rounded outward)."""
     p = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
-    return down(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))), up(
-        np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
-    )
+    if not all(isinstance(x, np.ndarray) and x.shape == p[0].shape for x in p):  # scalars or broadcast shapes
+        return down(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))), up(
+            np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
+        )
+    # the same minima and maxima, in the same operand order, into the products' own buffers (fewer
+    # temporaries: the large leg arrays stay in cache)
+    hi = np.maximum(p[0], p[1])
+    lo = np.minimum(p[0], p[1], out=p[0])
+    np.minimum(lo, np.minimum(p[2], p[3], out=p[1]), out=lo)
+    np.maximum(hi, np.maximum(p[2], p[3], out=p[2]), out=hi)
+    return down(lo), up(hi)
 
 
 def fscale(a, c: float):
