@@ -91,6 +91,27 @@ def analyse(layout: Layout, J: np.ndarray, theta, fixed: list[int] | None = None
     ``fixed``: keep these parameters fixed (the convention chosen at the start of a fit) instead of choosing
     again, when they still fix every null direction."""
     names = layout.names
+    s_full, N, fixed, free = _null_space(J, fixed)
+    if fixed:
+        N = N @ np.linalg.inv(N[fixed])  # 1 at its own fixed parameter, 0 at the others
+    sf = np.linalg.svd(J[:, free], compute_uv=False) if free.any() else np.zeros(0)
+    ident = Identifiability(names, sf, N, fixed, free)
+    ident.frame_freedoms = _frame_freedoms(layout, J, s_full[0], theta)
+    ident.combinations = [_name(N[:, j], names) for j in range(N.shape[1])]
+    return ident
+
+
+def free_parameters(J: np.ndarray, fixed: list[int] | None = None) -> tuple[list[int], np.ndarray]:
+    """``(fixed, free)`` of ``analyse(layout, J, theta, fixed)`` alone: the parameters held by the convention
+    and the ``(P,)`` mask of the others, without the free part's singular values, the frame freedoms and the
+    names, for a caller that needs only which parameters to fit (one SVD instead of two)."""
+    _, _, fixed, free = _null_space(J, fixed)
+    return fixed, free
+
+
+def _null_space(J: np.ndarray, fixed: list[int] | None):
+    """``(s_full (P,), N (P, d), fixed, free (P,))``: the singular values, the null basis of the scaled
+    Jacobian ``J`` (m, P), the parameters that fix it (``fixed`` kept where it still does) and the free mask."""
     P = J.shape[1]
     _, s, Vt = np.linalg.svd(J, full_matrices=J.shape[0] < P)
     s_full = np.zeros(P)
@@ -101,13 +122,7 @@ def analyse(layout: Layout, J: np.ndarray, theta, fixed: list[int] | None = None
         fixed = _pivots(N)
     free = np.ones(P, bool)
     free[fixed] = False
-    if fixed:
-        N = N @ np.linalg.inv(N[fixed])  # 1 at its own fixed parameter, 0 at the others
-    sf = np.linalg.svd(J[:, free], compute_uv=False) if free.any() else np.zeros(0)
-    ident = Identifiability(names, sf, N, fixed, free)
-    ident.frame_freedoms = _frame_freedoms(layout, J, s_full[0], theta)
-    ident.combinations = [_name(N[:, j], names) for j in range(N.shape[1])]
-    return ident
+    return s_full, N, fixed, free
 
 
 def _pivots(N: np.ndarray) -> list[int]:

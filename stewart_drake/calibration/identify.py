@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from stewart_drake.calibration.identifiability import Identifiability, analyse, stacked
+from stewart_drake.calibration.identifiability import Identifiability, analyse, free_parameters, stacked
 from stewart_drake.calibration.measurements import Measurements
 from stewart_drake.calibration.model import (
     Layout,
@@ -159,8 +159,7 @@ def identify(
     targets0 = initial_targets(problem) if data.kind == "points" else None
     theta0 = layout.theta(nominal, targets0)
     Jg, Jn = pose_blocks(problem, theta0)
-    ident0 = analyse(layout, stacked(reduced_blocks(Jg, Jn), noise.length), theta0)
-    free = ident0.free
+    fixed0, free = free_parameters(stacked(reduced_blocks(Jg, Jn), noise.length))  # the convention, at the nominal
     pack, unpack = _variables(problem, free)
 
     def fun(z):
@@ -191,7 +190,7 @@ def identify(
     # covariance of θ at the solution, poses' unknowns eliminated
     Jg, Jn = pose_blocks(problem, theta, xi)
     A = reduced_blocks(Jg, Jn)
-    ident = analyse(layout, stacked(A, noise.length), theta, fixed=ident0.fixed)
+    ident = analyse(layout, stacked(A, noise.length), theta, fixed=fixed0)
     free = ident.free
     Af = A[:, :, free].reshape(-1, free.sum())
     cov = np.linalg.pinv(Af.T @ Af)

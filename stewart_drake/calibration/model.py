@@ -26,6 +26,7 @@ Jacobians are central differences of these vectorised residuals (``pose_blocks``
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -89,10 +90,13 @@ class Layout:
     n_targets: int = 0
     gains: bool = False
 
-    @property
+    @cached_property
     def base(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(first leg of each base joint, base joint of each leg)`` (``geometry.base_joints``)."""
-        return base_joints(self.nominal)
+        """``(first leg of each base joint, base joint of each leg)`` (``geometry.base_joints``), found once
+        per layout (the residuals read it at every evaluation); read-only."""
+        first, leg_joint = base_joints(self.nominal)
+        first.flags.writeable = leg_joint.flags.writeable = False
+        return first, leg_joint
 
     @property
     def n_base(self) -> int:

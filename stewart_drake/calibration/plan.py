@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.calibration.identifiability import Identifiability, analyse, stacked
+from stewart_drake.calibration.identifiability import Identifiability, analyse, free_parameters, stacked
 from stewart_drake.calibration.measurements import Measurements
 from stewart_drake.calibration.model import Layout, Noise, Problem, make_problem, measure, pose_blocks, reduced_blocks
 from stewart_drake.calibration.simulate import default_targets
@@ -200,8 +200,8 @@ def plan_measurements(
         )
     layout, problem, theta = design_problem(platform, cand, kind, noise, convention, n_targets, gains)
     A = reduced_blocks(*pose_blocks(problem, theta)) * noise.length
-    whole = analyse(layout, A.reshape(-1, A.shape[-1]), theta)
-    chosen = d_optimal(A[:, :, whole.free], n)
+    _, free = free_parameters(A.reshape(-1, A.shape[-1]))  # what the whole candidate set can identify
+    chosen = d_optimal(A[:, :, free], n)
     rand = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,))).choice(len(cand), n, replace=False)
     planned = analyse(layout, stacked(A[chosen], 1.0), theta)
     baseline = analyse(layout, stacked(A[rand], 1.0), theta)

@@ -21,7 +21,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import UnivariateSpline
 
 from stewart_drake.errors import TrajectoryError, short_number
 
@@ -75,7 +74,7 @@ def smooth_columns(t, values, tol) -> np.ndarray:
         if np.ptp(v[:, j]) == 0:
             out[:, j] = v[:, j]
             continue
-        out[:, j] = UnivariateSpline(t, v[:, j], k=k, s=len(t) * float(tol[j]) ** 2)(t)
+        out[:, j] = _spline(t, v[:, j], k, len(t) * float(tol[j]) ** 2)(t)
     return out
 
 
@@ -86,8 +85,7 @@ def smoothing_spline(t, values, tol):
     tol = np.broadcast_to(np.asarray(tol, dtype=float), (v.shape[1],))
     k = 5 if len(t) > 5 else max(1, len(t) - 1)
     splines = [
-        None if np.ptp(v[:, j]) == 0 else UnivariateSpline(t, v[:, j], k=k, s=len(t) * float(tol[j]) ** 2)
-        for j in range(v.shape[1])
+        None if np.ptp(v[:, j]) == 0 else _spline(t, v[:, j], k, len(t) * float(tol[j]) ** 2) for j in range(v.shape[1])
     ]
 
     def f(x, nu: int = 0) -> np.ndarray:
@@ -151,3 +149,12 @@ def smooth_tolerance(value, option: str = "--smooth") -> float:
     if not (np.isfinite(v) and v > 0):
         raise TrajectoryError(TrajectoryError.SMOOTH_TOL.format(option=option, value=value))
     return v
+
+
+def _spline(t, y, k: int, s: float):
+    """``scipy.interpolate.UnivariateSpline(t, y, k=k, s=s)``, imported here: scipy.interpolate takes ~1 s of CPU
+    to import, which every importer of the trajectories (the controller, the report's sections) would pay
+    without ever smoothing."""
+    from scipy.interpolate import UnivariateSpline
+
+    return UnivariateSpline(t, y, k=k, s=s)

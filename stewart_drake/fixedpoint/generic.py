@@ -31,9 +31,10 @@ from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import check_convention
 from stewart_drake.errors import FixedPointError, counted
-from stewart_drake.fixedpoint.q15 import saturate, tfr16CosPIx, tfr16SinPIx
+from stewart_drake.fixedpoint.q15 import counting, saturate, tfr16CosPIx, tfr16SinPIx
 
 TRIG_MODES = ("exact", "tfr16")
+BLOCK = 8192  # poses per block of leg_length_words: its (n,) int64 temporaries (64 kB) stay in cache
 
 
 @dataclass(frozen=True)
@@ -222,9 +223,23 @@ def leg_length_words(
     """``(..., 6)`` int64 leg-length words from ``(..., 6)`` pose words (``pose_words``): steps 3–5 of
     the recipe. ``consts``: ``platform_words`` if already computed. A length beyond the word saturates."""
     w = np.asarray(words, dtype=np.int64)
+    consts = platform_words(platform, fmt) if consts is None else consts
+    if w.ndim > 1 and w.size > 6 * BLOCK and not counting():
+        # every step is per pose: blocks of poses give the same words with their temporaries in cache
+        flat = w.reshape(-1, 6)
+        out = np.empty(flat.shape, dtype=np.int64)
+        for s in range(0, flat.shape[0], BLOCK):
+            out[s : s + BLOCK] = _leg_length_words(flat[s : s + BLOCK], fmt, convention, consts)
+        return out.reshape(w.shape)
+    return _leg_length_words(w, fmt, convention, consts)
+
+
+def _leg_length_words(
+    w: np.ndarray, fmt: QFormat, convention: str, consts: tuple[np.ndarray, np.ndarray]
+) -> np.ndarray:
     f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
-    r_T, B = platform_words(platform, fmt) if consts is None else consts
+    r_T, B = consts
     pos = w[..., :3]
     R = rotation_from_words(w[..., 3:], fmt, convention)  # (..., 3, 3)
     S = w.shape[:-1]

@@ -104,6 +104,12 @@ class SaturationCounter:
         _ACTIVE.remove(self)
 
 
+def counting() -> bool:
+    """Whether a ``SaturationCounter`` is active (a caller may then not split its arrays: a counter's mask
+    maps flags of its own shape)."""
+    return bool(_ACTIVE)
+
+
 def saturate(x: np.ndarray, lo: int, hi: int, op: str) -> np.ndarray:
     """``x`` (int64, any shape) clipped to [lo, hi]; the elements that saturated are recorded under the
     operation name ``op`` by every active ``SaturationCounter``."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stewart_drake.calibration.identifiability import analyse, stacked
+from stewart_drake.calibration.identifiability import analyse, free_parameters, stacked
 from stewart_drake.calibration.model import Layout, make_problem, pose_blocks, reduced_blocks
 from stewart_drake.calibration.simulate import default_targets
 from stewart_drake.core.geometry import load_preset
@@ -73,3 +73,20 @@ def test_full_poses_identify_every_parameter():
     ident = _analyse("gonzalez-dutra-2009", "pose", random_poses(p, 20, seed=4))
     assert ident.fixed == [] and ident.free.all() and ident.frame_freedoms == []
     assert ident.to_dict()["identifiable"] == 42
+
+
+@pytest.mark.parametrize("kind", ["inclinometer", "pose"])
+def test_free_parameters_is_analyse_s_convention(kind):
+    """The light call (one SVD) holds the same parameters as the full analysis, chosen afresh or kept from a
+    previous fit; inclinometer data loses 7 (a non-trivial convention), full poses none."""
+    p = load_preset("gonzalez-dutra-2009")
+    layout = Layout(p, kind)
+    problem = make_problem(layout, clean_data(p, random_poses(p, 30, seed=1), kind), NOISE)
+    theta = layout.theta(p)
+    J = stacked(reduced_blocks(*pose_blocks(problem, theta)), NOISE.length)
+    ident = analyse(layout, J, theta)
+    fixed, free = free_parameters(J)
+    assert fixed == ident.fixed and np.array_equal(free, ident.free)
+    assert len(fixed) == (7 if kind == "inclinometer" else 0)
+    kept = list(reversed(ident.fixed))  # a convention that still fixes every null direction is kept as given
+    assert free_parameters(J, kept)[0] == kept == analyse(layout, J, theta, fixed=kept).fixed

@@ -94,3 +94,18 @@ def test_exp_so3_is_rodrigues():
         R = exp_so3(w)
         assert np.allclose(R @ R.T, np.eye(3), atol=1e-14) and np.allclose(R @ w, w, atol=1e-14)
         assert np.isclose(np.arccos((np.trace(R) - 1) / 2), np.linalg.norm(w), atol=1e-7)
+
+
+@pytest.mark.parametrize("name", ["utn-dynamic", "gonzalez-dutra-2009"])
+def test_layout_base_is_found_once_and_read_only(name):
+    """The residuals read ``Layout.base`` at every evaluation: it is the platform's base joints, kept from the
+    first read, and read-only so that no caller can change it for the others."""
+    from stewart_drake.core.geometry import base_joints
+
+    lay = Layout(load_preset(name), "pose")
+    first, leg_joint = lay.base
+    ref = base_joints(lay.nominal)
+    assert np.array_equal(first, ref[0]) and np.array_equal(leg_joint, ref[1]) and lay.n_base == 6
+    assert lay.base[0] is first and lay.base[1] is leg_joint
+    with pytest.raises(ValueError):
+        leg_joint[0] = 1

@@ -78,3 +78,17 @@ def test_commands_refuse_and_smooth(tmp_path, capsys, command):
         )
         # smoothed peak force within 1 % of the analytic motion's (it was ~100x it from the rounded file)
         assert max(r["peak_force_n"] for r in out["legs"]) == pytest.approx(np.abs(true.force).max(), rel=0.01)
+
+
+def test_the_controller_and_trajectories_import_without_scipy_interpolate():
+    """scipy.interpolate (~1 s of CPU to import) loads only when a trajectory is smoothed: importing the
+    controller, the trajectories and the firmware certificate's section (a fresh interpreter) does not."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, stewart_drake.control, stewart_drake.core.trajectory, stewart_drake.analyses.firmware_certificate;"
+        "print('scipy.interpolate' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False"]

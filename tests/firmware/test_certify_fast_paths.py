@@ -42,6 +42,40 @@ def test_bit_rounding_is_nextafter_on_every_class_of_float():
             assert np.array_equal(_bits(ref)[~nan], _bits(got)[~nan])
 
 
+@pytest.mark.parametrize("special", [None, *SPECIAL])
+def test_bit_rounding_of_finite_values_with_one_special_class(special):
+    """Finite non-zero values alone take the fast path (no special case checked element by element); one
+    special value among them (±0, ±inf, NaN, subnormals, extremes) must still round as nextafter does."""
+    rng = np.random.default_rng(1)
+    x = rng.standard_normal(4_000) * 10.0 ** rng.integers(-300, 300, 4_000)
+    if special is not None:
+        x[1234] = special
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for fast, direction in ((intervals.down, -np.inf), (intervals.up, np.inf)):
+            ref, got = np.nextafter(x, direction), fast(x)
+            nan = np.isnan(ref)
+            assert np.array_equal(nan, np.isnan(got))
+            assert np.array_equal(_bits(ref)[~nan], _bits(got)[~nan])
+
+
+def test_range_table_positions_serve_every_table_of_its_size():
+    """One ``positions`` (the angle words' runs) gives each table's own exact min and max, at run lengths of
+    every power of two and between (the level choice), as slicing the values does."""
+    rng = np.random.default_rng(7)
+    values = [rng.integers(-(2**20), 2**20, 1000) for _ in range(3)]
+    tables = [intervals.RangeTable(v, offset=-500) for v in values]
+    a = rng.integers(-500, 500, 400)
+    n = np.r_[1 << rng.integers(0, 9, 200), rng.integers(1, 500, 200)]
+    b = np.minimum(a + n - 1, 499)
+    pos = tables[0].positions(a, b)
+    for v, t in zip(values, tables, strict=True):
+        mn, mx = t.min_at(pos), t.max_at(pos)
+        assert mn.dtype == mx.dtype == np.int64
+        assert all(mn[k] == v[a[k] + 500 : b[k] + 501].min() for k in range(a.size))
+        assert all(mx[k] == v[a[k] + 500 : b[k] + 501].max() for k in range(a.size))
+
+
 @pytest.mark.parametrize(
     ("name", "fmt"),
     [("utn-kinematic", QFormat(16, 1e-3, "tfr16")), ("utn-dynamic", QFormat(16, 2e-5, "tfr16"))],
@@ -90,3 +124,24 @@ def test_point_words_are_evaluate_on_one_pose_cells(name, fmt):
     arith = np.array([n not in recipe.BENIGN for n in recipe.word_names()])
     if fmt.length_lsb < 1e-4:
         assert (ref.possible & arith).any()  # arithmetic clamps are exercised, not only the benign trig ones
+
+
+def test_fmul_in_place_is_the_four_corner_formula():
+    """``fmul`` reuses its products' buffers; its ends are still down(min of the four corner products) and
+    up(max), operand order included (signed zeros, infinities, 0 × inf = NaN), on large and small arrays."""
+    rng = np.random.default_rng(8)
+    for n in (3000, 40):
+        a0 = np.r_[rng.standard_normal(n - len(SPECIAL)), SPECIAL]
+        b0 = np.r_[SPECIAL, rng.standard_normal(n - len(SPECIAL))]
+        a, b = (a0, a0 + np.abs(rng.standard_normal(n))), (b0, np.where(rng.random(n) < 0.2, b0, b0 + 1.0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            p = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
+            ref = (
+                np.nextafter(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3])), -np.inf),
+                np.nextafter(np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3])), np.inf),
+            )
+            got = intervals.fmul(a, b)
+        for r, g in zip(ref, got, strict=True):
+            nan = np.isnan(r)
+            assert np.array_equal(nan, np.isnan(g)) and np.array_equal(_bits(r)[~nan], _bits(g)[~nan])

@@ -27,22 +27,36 @@ _NEG_INF = np.float64(-np.inf).view(np.int64)
 def down(x):
     """One ulp toward -inf: the lower end of an enclosure of a correctly rounded result (bit for bit
     ``np.nextafter(x, -inf)``, a test pins it on every class of float)."""
-    if np.size(x) < _BITS_FROM:
+    if (x.size if isinstance(x, np.ndarray) else np.size(x)) < _BITS_FROM:  # np.size's dispatch costs ~1 µs
         return np.nextafter(x, -_INF)
     i = np.asarray(x, dtype=np.float64).view(np.int64)
-    # x > 0: bits − 1; x < 0 (sign bit: i < 0): bits + 1; ±0 → −tiny; −inf stays (NaN stays NaN either way)
-    r = i - ((i >> 63) | 1)
-    return np.where(i == 0, _MIN + 1, np.where(i == _NEG_INF, i, r)).view(np.float64)
+    # x > 0: bits − 1; x < 0 (sign bit: i < 0): bits + 1 (in place: one temporary, three passes)
+    r = i >> 63
+    r |= 1
+    np.subtract(i, r, out=r)
+    f = r.view(np.float64)
+    # +0 (→ bits −1) and −inf (→ bits + 1) land on NaN patterns, as NaN inputs do: only then the special cases
+    if np.isnan(f.min()):
+        # ±0 → −tiny; −inf stays (NaN stays NaN either way)
+        f = np.where(i == 0, _MIN + 1, np.where(i == _NEG_INF, i, r)).view(np.float64)
+    return f
 
 
 def up(x):
     """One ulp toward +inf (bit for bit ``np.nextafter(x, inf)``)."""
-    if np.size(x) < _BITS_FROM:
+    if (x.size if isinstance(x, np.ndarray) else np.size(x)) < _BITS_FROM:  # np.size's dispatch costs ~1 µs
         return np.nextafter(x, _INF)
     i = np.asarray(x, dtype=np.float64).view(np.int64)
-    # x >= +0: bits + 1; x < 0: bits − 1 (toward zero); −0 → +tiny; +inf stays
-    r = i + ((i >> 63) | 1)
-    return np.where(i == _MIN, 1, np.where(i == _POS_INF, i, r)).view(np.float64)
+    # x >= +0: bits + 1; x < 0: bits − 1 (toward zero)
+    r = i >> 63
+    r |= 1
+    np.add(i, r, out=r)
+    f = r.view(np.float64)
+    # −0 (→ bits of int64 max) and +inf (→ bits + 1) land on NaN patterns, as NaN inputs do
+    if np.isnan(f.min()):
+        # −0 → +tiny; +inf stays
+        f = np.where(i == _MIN, 1, np.where(i == _POS_INF, i, r)).view(np.float64)
+    return f
 
 
 def fadd(a, b):
@@ -58,9 +72,17 @@ def fsub(a, b):
 def fmul(a, b):
     """Enclosure of a * b (the four corner products, each rounded outward)."""
     p = (a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1])
-    return down(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))), up(
-        np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
-    )
+    if not all(isinstance(x, np.ndarray) and x.shape == p[0].shape for x in p):  # scalars or broadcast shapes
+        return down(np.minimum(np.minimum(p[0], p[1]), np.minimum(p[2], p[3]))), up(
+            np.maximum(np.maximum(p[0], p[1]), np.maximum(p[2], p[3]))
+        )
+    # the same minima and maxima, in the same operand order, into the products' own buffers (fewer
+    # temporaries: the large leg arrays stay in cache)
+    hi = np.maximum(p[0], p[1])
+    lo = np.minimum(p[0], p[1], out=p[0])
+    np.minimum(lo, np.minimum(p[2], p[3], out=p[1]), out=lo)
+    np.maximum(hi, np.maximum(p[2], p[3], out=p[2]), out=hi)
+    return down(lo), up(hi)
 
 
 def fscale(a, c: float):
@@ -110,34 +132,46 @@ def isquare(a):
 class RangeTable:
     """Range minimum and maximum queries on a fixed integer array (a sparse table: O(1) per query,
     ``len(values) * log2(len(values))`` int32 of memory). Used for the sine/cosine words and their
-    errors over every angle-word interval: the exact hull, not a bound by monotone pieces."""
+    errors over every angle-word interval: the exact hull, not a bound by monotone pieces.
+
+    Level ``k`` holds the min (max) of every run of ``2^k`` values; the levels lie end to end in one flat
+    array (level k from ``start[k]``), so a batch of queries is two gathers, whatever their lengths."""
 
     def __init__(self, values: np.ndarray, offset: int):
         v = np.asarray(values, dtype=np.int64)
         self.offset = offset
-        self.mins = [v.astype(np.int32)]
-        self.maxs = [v.astype(np.int32)]
+        self.size = v.size
+        mins, maxs = [v.astype(np.int32)], [v.astype(np.int32)]
         k = 1
         while (1 << k) <= v.size:
-            a, b = self.mins[-1], self.maxs[-1]
+            a, b = mins[-1], maxs[-1]
             h = 1 << (k - 1)
-            self.mins.append(np.minimum(a[:-h], a[h:]))
-            self.maxs.append(np.maximum(b[:-h], b[h:]))
+            mins.append(np.minimum(a[:-h], a[h:]))
+            maxs.append(np.maximum(b[:-h], b[h:]))
             k += 1
+        self.start = np.cumsum([0] + [x.size for x in mins[:-1]]).astype(np.int64)
+        self.flat_min = np.concatenate(mins)
+        self.flat_max = np.concatenate(maxs)
+
+    def positions(self, lo, hi) -> tuple[np.ndarray, np.ndarray]:
+        """The flat indices of the two overlapping runs covering ``values[lo - offset .. hi - offset]``
+        (inclusive; lo <= hi): valid for every table of this size and offset."""
+        i = np.asarray(lo, dtype=np.int64) - self.offset
+        j = np.asarray(hi, dtype=np.int64) - self.offset
+        # floor(log2(n)) exactly: frexp gives n = m 2^e with m in [0.5, 1) (n < 2^53 is a float exactly)
+        k = np.frexp(j - i + 1)[1].astype(np.int64) - 1
+        base = self.start[k]
+        return base + i, base + j - (np.int64(1) << k) + 1
+
+    def min_at(self, pos) -> np.ndarray:
+        """The range minima at ``positions`` (int64)."""
+        return np.minimum(self.flat_min[pos[0]], self.flat_min[pos[1]]).astype(np.int64)
+
+    def max_at(self, pos) -> np.ndarray:
+        """The range maxima at ``positions`` (int64)."""
+        return np.maximum(self.flat_max[pos[0]], self.flat_max[pos[1]]).astype(np.int64)
 
     def query(self, lo, hi):
         """``(min, max)`` of ``values[lo - offset .. hi - offset]`` (inclusive), vectorised; lo <= hi."""
-        i = np.asarray(lo, dtype=np.int64) - self.offset
-        j = np.asarray(hi, dtype=np.int64) - self.offset
-        n = j - i + 1
-        k = np.floor(np.log2(n)).astype(np.int64)
-        k -= ((1 << k) > n).astype(np.int64)  # guard the float log at powers of two
-        k += ((1 << (k + 1)) <= n).astype(np.int64)
-        mn = np.empty(i.shape, dtype=np.int64)
-        mx = np.empty(i.shape, dtype=np.int64)
-        for lev in np.unique(k):
-            sel = k == lev
-            a, b = i[sel], j[sel] - (1 << int(lev)) + 1
-            mn[sel] = np.minimum(self.mins[lev][a], self.mins[lev][b])
-            mx[sel] = np.maximum(self.maxs[lev][a], self.maxs[lev][b])
-        return mn, mx
+        pos = self.positions(lo, hi)
+        return self.min_at(pos), self.max_at(pos)

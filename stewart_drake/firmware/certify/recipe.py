@@ -62,7 +62,8 @@ def isqrt_nearest(S: np.ndarray) -> np.ndarray:
 @dataclass
 class TrigTables:
     """Range tables over every angle word: the sine/cosine words before their clamp (``pre``) and their
-    errors against 2^f sin(pi w / 2^f) in ``ERR_UNIT`` (floor for the lower table, ceil for the upper)."""
+    errors against 2^f sin(pi w / 2^f) in ``ERR_UNIT`` (floor for the lower table, ceil for the upper).
+    All six have the same size and offset: one ``positions`` serves them all."""
 
     sin_pre: RangeTable
     cos_pre: RangeTable
@@ -213,14 +214,22 @@ def _bounds(model: Model):
 
 
 class Recorder:
+    """Per cell and trace word: the hull before saturation and the clamp flags, as (n, W) arrays.
+
+    They are the transposes of word-major (W, n) arrays: the recipe writes one word (or six) over all cells
+    at a time, and a word's column is then contiguous in memory (a cell-major column is strided by W)."""
+
     def __init__(self, n: int, model: Model):
-        self.names = word_names()
+        self._allocate(n, word_names())
+
+    def _allocate(self, n: int, names: list[str]) -> None:
+        self.names = names
         self.index = {k: i for i, k in enumerate(self.names)}
         W = len(self.names)
-        self.pre_lo = np.zeros((n, W), dtype=np.int64)
-        self.pre_hi = np.zeros((n, W), dtype=np.int64)
-        self.possible = np.zeros((n, W), dtype=bool)
-        self.certain = np.zeros((n, W), dtype=bool)
+        self.pre_lo = np.zeros((W, n), dtype=np.int64).T
+        self.pre_hi = np.zeros((W, n), dtype=np.int64).T
+        self.possible = np.zeros((W, n), dtype=bool).T
+        self.certain = np.zeros((W, n), dtype=bool).T
 
     def sat(self, name: str, lo, hi, wlo: int, whi: int, final: bool = False):
         """Clamp the hull [lo, hi] to [wlo, whi], recording the flags (and the hull when ``final``)."""
@@ -292,15 +301,14 @@ def evaluate(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> CellEval
     tb = m.tables
     trig = {}
     for k, ax in enumerate(AXES):
-        a_lo, a_hi = cell_lo[:, 3 + k], cell_hi[:, 3 + k]
+        pos = tb.sin_pre.positions(cell_lo[:, 3 + k], cell_hi[:, 3 + k])  # the same for the six tables
         for name, pre, elo_t, ehi_t in (
             ("s", tb.sin_pre, tb.sin_err_lo, tb.sin_err_hi),
             ("c", tb.cos_pre, tb.cos_err_lo, tb.cos_err_hi),
         ):
-            plo, phi = pre.query(a_lo, a_hi)
             label = f"{'sin' if name == 's' else 'cos'}.{ax}"
-            w = rec.sat(label, plo, phi, m.lo, m.hi, final=True)
-            e = (elo_t.query(a_lo, a_hi)[0] * ERR_UNIT, ehi_t.query(a_lo, a_hi)[1] * ERR_UNIT)
+            w = rec.sat(label, pre.min_at(pos), pre.max_at(pos), m.lo, m.hi, final=True)
+            e = (elo_t.min_at(pos) * ERR_UNIT, ehi_t.max_at(pos) * ERR_UNIT)
             t = fsub((w[0].astype(float), w[1].astype(float)), e)
             trig[f"{name}{ax}"] = IV(w, e, t)
     # -- rotation entries: sums of truncated products, as rotation_from_words forms them

@@ -44,13 +44,7 @@ def tp17_word_names() -> list[str]:
 
 class _Rec(Recorder):
     def __init__(self, n: int):
-        self.names = tp17_word_names()
-        self.index = {k: i for i, k in enumerate(self.names)}
-        W = len(self.names)
-        self.pre_lo = np.zeros((n, W), dtype=np.int64)
-        self.pre_hi = np.zeros((n, W), dtype=np.int64)
-        self.possible = np.zeros((n, W), dtype=bool)
-        self.certain = np.zeros((n, W), dtype=bool)
+        self._allocate(n, tp17_word_names())
 
 
 def tp17_entry(model: Model, w: dict, i: int, j: int):
@@ -97,13 +91,13 @@ def evaluate_tp17(model: Model, cell_lo: np.ndarray, cell_hi: np.ndarray) -> Cel
     tb = m.tables
     s, c = [], []
     for k, ax in enumerate(AXES):
-        a_lo, a_hi = cell_lo[:, 3 + k], cell_hi[:, 3 + k]
+        pos = tb.sin_pre.positions(cell_lo[:, 3 + k], cell_hi[:, 3 + k])  # the same for the six tables
         for out, pre, elo, ehi, label in (
             (s, tb.sin_pre, tb.sin_err_lo, tb.sin_err_hi, f"sin.{ax}"),
             (c, tb.cos_pre, tb.cos_err_lo, tb.cos_err_hi, f"cos.{ax}"),
         ):
-            w = rec.sat(label, *pre.query(a_lo, a_hi), m.lo, m.hi, final=True)
-            e = (elo.query(a_lo, a_hi)[0] * ERR_UNIT, ehi.query(a_lo, a_hi)[1] * ERR_UNIT)
+            w = rec.sat(label, pre.min_at(pos), pre.max_at(pos), m.lo, m.hi, final=True)
+            e = (elo.min_at(pos) * ERR_UNIT, ehi.max_at(pos) * ERR_UNIT)
             out.append(IV(w, e, fsub((w[0].astype(float), w[1].astype(float)), e)))
     sA, sB, sG = s
     cA, cB, cG = c
