@@ -96,16 +96,30 @@ class ServoPlant:
         p = self.plant
         self.servos = [p.GetJointByName(f"servo_{i + 1}") for i in range(6)]
         self.rods = [p.GetJointByName(f"rod_joint_{i + 1}") for i in range(6)]
+        # looked up once: the pose loops of the cross-checks use them for every pose
+        self.platform_body = p.GetBodyByName("platform")
+        self.arms = [p.GetBodyByName(f"arm_{i + 1}") for i in range(6)]
+        self.rod_frames = [  # each ball joint's fixed R_AF (on the arm) and R_RM (on the rod)
+            (
+                j.frame_on_parent().GetFixedPoseInBodyFrame().rotation().matrix(),
+                j.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix(),
+            )
+            for j in self.rods
+        ]
+        self._frames = {}
 
     def frame_pose(self, name: str) -> np.ndarray:
         """``(3,)`` position of frame ``name`` in the world (= base) frame, metres."""
-        return self.plant.GetFrameByName(name).CalcPoseInWorld(self.context).translation()
+        frame = self._frames.get(name)
+        if frame is None:
+            frame = self._frames[name] = self.plant.GetFrameByName(name)
+        return frame.CalcPoseInWorld(self.context).translation()
 
     def set_platform(self, pose) -> None:
         """Put the platform at a seed-002 pose [x, y, z, phi, theta, psi] (Rz·Ry·Rx)."""
         pose = np.asarray(pose, dtype=float)
         X = RigidTransform(RotationMatrix(rotation_matrix(pose[3:], "zyx")), pose[:3])
-        self.plant.SetFreeBodyPose(self.context, self.plant.GetBodyByName("platform"), X)
+        self.plant.SetFreeBodyPose(self.context, self.platform_body, X)
 
     def set_servos(self, angles) -> None:
         """Servo joint angles (radians, the servo's own sense); each rod is then pointed at its anchor."""
@@ -114,11 +128,10 @@ class ServoPlant:
         for i, j in enumerate(self.rods):
             tip = self.frame_pose(f"arm_tip_{i + 1}")
             d = self.frame_pose(f"platform_anchor_{i + 1}") - tip
-            R_WA = self.plant.GetBodyByName(f"arm_{i + 1}").EvalPoseInWorld(self.context).rotation().matrix()
+            R_WA = self.arms[i].EvalPoseInWorld(self.context).rotation().matrix()
             R_Wrod = frame_from_zx(d, R_WA[:, 0])
             # Ball joint: R_FM with F fixed on the arm (its model-zero orientation relative to the arm).
-            X_AF = j.frame_on_parent().GetFixedPoseInBodyFrame().rotation().matrix()
-            X_RM = j.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix()
+            X_AF, X_RM = self.rod_frames[i]
             R_FM = (R_WA @ X_AF).T @ R_Wrod @ X_RM
             j.set_angles(self.context, rpy(R_FM))
 
