@@ -125,10 +125,13 @@ class ServoPlant:
         """Servo joint angles (radians, the servo's own sense); each rod is then pointed at its anchor."""
         for i, j in enumerate(self.servos):
             j.set_angle(self.context, float(angles[i]))
+        # Arm tips, anchors and arm frames do not depend on the rods' angles: read them all from one evaluation
+        # of the kinematics before any rod is set (setting a rod first would make Drake recompute it per rod).
+        tips = [self.frame_pose(f"arm_tip_{i + 1}") for i in range(6)]
+        d_all = [self.frame_pose(f"platform_anchor_{i + 1}") - tips[i] for i in range(6)]
+        R_WAs = [arm.EvalPoseInWorld(self.context).rotation().matrix() for arm in self.arms]
         for i, j in enumerate(self.rods):
-            tip = self.frame_pose(f"arm_tip_{i + 1}")
-            d = self.frame_pose(f"platform_anchor_{i + 1}") - tip
-            R_WA = self.arms[i].EvalPoseInWorld(self.context).rotation().matrix()
+            d, R_WA = d_all[i], R_WAs[i]
             R_Wrod = frame_from_zx(d, R_WA[:, 0])
             # Ball joint: R_FM with F fixed on the arm (its model-zero orientation relative to the arm).
             X_AF, X_RM = self.rod_frames[i]
