@@ -7,6 +7,8 @@ Frames ``dh_0`` .. ``dh_3`` of the model are the DH frames; ``dh_3`` is the foot
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import Parser
@@ -51,10 +53,16 @@ class LegPlant:
         )
 
 
+@lru_cache(maxsize=4)
+def leg_plant(leg: Leg3R) -> LegPlant:
+    """The ``LegPlant`` of ``leg``, parsed once per process (the checks below set every joint before they read)."""
+    return LegPlant(leg)
+
+
 def drake_fk_errors(leg: Leg3R, q) -> np.ndarray:
     """``(n,)`` worst element-wise difference between Drake's X_{dh_0, dh_i} and the numpy DH products
     T_0^i (i = 0..3) for joint angles ``q`` (n, 2)."""
-    h = LegPlant(leg)
+    h = leg_plant(leg)
     q = np.atleast_2d(q)
     ours = frame_transforms(leg, q)
     return np.array([np.abs(h.frame_transforms(q[k]) - ours[k]).max() for k in range(len(q))])
@@ -72,7 +80,7 @@ def drake_ik(leg: Leg3R, targets, branch: str, tol: float = 1e-14) -> tuple[np.n
     """
     sign = check_branch(branch)
     _, phi = leg.shank
-    h = LegPlant(leg)
+    h = leg_plant(leg)
     solver, options = SnoptSolver(), SolverOptions()
     options.SetOption(solver.solver_id(), "Major feasibility tolerance", tol)
     options.SetOption(solver.solver_id(), "Major optimality tolerance", tol)

@@ -1,5 +1,6 @@
-"""``leg_model.drake_ik`` solves every target with one program whose bounds it resets: the answers must be
-those of a program built afresh per target (as it did before), bit for bit — the same problem, the same SNOPT."""
+"""``leg_model.drake_ik`` solves every target with one program whose bounds it resets, on the leg's plant shared
+within the process (``leg_plant``): the answers must be those of a program built afresh per target on a fresh
+plant (as it did before), bit for bit — the same problem, the same SNOPT."""
 
 import numpy as np
 import pytest
@@ -7,7 +8,7 @@ from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import SnoptSolver, SolverOptions
 
 from stewart_drake.core.leg3r import Leg3R, check_branch, foot, random_configurations
-from stewart_drake.drake.leg_model import LegPlant, drake_ik
+from stewart_drake.drake.leg_model import LegPlant, drake_fk_errors, drake_ik, leg_plant
 
 LEG = Leg3R()
 
@@ -34,6 +35,8 @@ def _fresh_program_per_target(targets, branch, tol=1e-14):
 @pytest.mark.parametrize("branch", ["a", "b"])
 def test_one_program_equals_a_program_per_target(branch):
     targets = foot(LEG, random_configurations(LEG, 40, seed=9))[:, :2]
+    drake_fk_errors(LEG, random_configurations(LEG, 3, seed=1))  # leaves the shared plant's joints elsewhere
+    assert leg_plant(LEG) is leg_plant(Leg3R())  # one plant per leg and process, shared by the checks
     q, _ = drake_ik(LEG, targets, branch)
     assert np.ptp(q[:, 0]) > 0.5  # the targets differ: each solve starts from another bound and guess
     np.testing.assert_array_equal(q, _fresh_program_per_target(targets, branch))
