@@ -12,7 +12,7 @@ from stewart_drake.report import run_standalone
 
 TITLE = "Inverse dynamics: the seed's Lagrangian model, completed, and checked against Drake"
 ORDER = 40
-COST = 4.5  # CPU seconds (full report, measured): the report's workers start the costliest first
+COST = 4  # CPU seconds (full report, measured): the report's workers start the costliest first
 OPEN_LOOP_S = 2.5  # the open-loop runs' length (s): see section 5
 TOL_N = 1e-9  # leg-force agreement with Drake (N): rounding is ~1e-14 N on forces of ~5 N
 

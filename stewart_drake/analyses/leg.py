@@ -23,7 +23,7 @@ from stewart_drake.report import run_standalone
 
 TITLE = "3R planar leg (seed 003): DH kinematics"
 ORDER = 70
-COST = 2.5  # CPU seconds (full report, measured): the report's workers start the costliest first
+COST = 2  # CPU seconds (full report, measured): the report's workers start the costliest first
 
 
 def build(section) -> None:

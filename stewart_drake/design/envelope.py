@@ -26,9 +26,25 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stewart_drake.core.dynamics import G_EARTH, euler_rate_derivative, leg_forces, leg_forces_with_legs, skew
+from stewart_drake.core import dynamics
+from stewart_drake.core.argcheck import as_poses, first_index
+from stewart_drake.core.dynamics import (
+    G_EARTH,
+    euler_rate_derivative,
+    generalized_force,
+    leg_forces,
+    leg_forces_with_legs,
+    skew,
+)
 from stewart_drake.core.geometry import Platform, load_yaml_config
-from stewart_drake.core.kinematics import check_stroke, condition_number, leg_lengths
+from stewart_drake.core.kinematics import (
+    check_stroke,
+    condition_at_most,
+    condition_number,
+    leg_lengths,
+    length_jacobian,
+    scaled_condition,
+)
 from stewart_drake.core.rotations import (
     angle_scale,
     angular_velocity_map,
@@ -38,7 +54,7 @@ from stewart_drake.core.rotations import (
 )
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.design.boxquad import box_quadratic_max
-from stewart_drake.errors import EnvelopeError, StewartError
+from stewart_drake.errors import SINGULAR_SAMPLE, EnvelopeError, SingularPoseError, StewartError, counted
 
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
 MAX_CONDITION = 1e8  # as dynamics.MAX_CONDITION: leg forces are meaningless beyond it
@@ -293,6 +309,33 @@ def cartesian_leg_forces(
     qd, qdd = cartesian_to_euler(q, V, Vd, convention)
     fn = leg_forces_with_legs if legs else leg_forces
     return fn(platform, q, qd, qdd, convention, gravity=gravity)
+
+
+def cartesian_leg_forces_at(
+    platform: Platform, poses, k, V, Vd, convention: str = "utn", gravity: float = G_EARTH
+) -> np.ndarray:
+    """``(n, 6)`` leg forces (N) of the plate alone at poses ``poses[k]`` for n samples that share a few
+    distinct ``poses`` (m, 6) (``k`` (n,) indices into them): ``cartesian_leg_forces(platform, poses[k], V, Vd)``
+    bit for bit, its pose-only work (E_W, J = ∂L/∂q and J's condition check) done once per distinct pose and
+    gathered (each step works matrix by matrix, so a gathered row is the row computed in place). For a random
+    check of an envelope's poses, where that work was most of the cost."""
+    check_convention(convention)
+    poses = as_poses(poses)
+    k = np.asarray(k)
+    q = poses[k]
+    V, Vd = (as_poses(a, name, f"{name} sample") for a, name in ((V, "V"), (Vd, "Vd")))
+    E = angular_velocity_map(poses[:, 3:], convention)[k]
+    rates = np.linalg.solve(E, V[..., 3:, None])[..., 0]
+    acc = np.linalg.solve(E, (Vd[..., 3:] - euler_rate_derivative(q[..., 3:], rates, convention))[..., None])[..., 0]
+    qd, qdd = np.concatenate([V[..., :3], rates], -1), np.concatenate([Vd[..., :3], acc], -1)
+    Q = generalized_force(platform, q, qd, qdd, convention, True, gravity)
+    J = length_jacobian(platform, poses, convention)  # as dynamics.solve_leg_forces, once per distinct pose
+    limit = dynamics.MAX_CONDITION
+    idx = first_index(~condition_at_most(platform, J, limit)[k])
+    if idx is not None:
+        cond = float(scaled_condition(platform, J[k[idx]]))
+        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=cond, limit=limit))
+    return np.linalg.solve(np.swapaxes(J[k], -1, -2), Q[..., None])[..., 0]
 
 
 def _generic_terms(platform: Platform, q, convention, gravity):

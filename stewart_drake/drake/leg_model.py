@@ -7,6 +7,8 @@ Frames ``dh_0`` .. ``dh_3`` of the model are the DH frames; ``dh_3`` is the foot
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import Parser
@@ -38,6 +40,11 @@ class LegPlant:
         for j, v in zip(self.joints, q):
             j.set_angle(self.context, float(v))
 
+    def foot_transform(self, q) -> np.ndarray:
+        """``(4, 4)`` X_{dh_0, dh_3} (the foot) computed by Drake at joint angles ``q`` (2,)."""
+        self.set_q(q)
+        return self.plant.CalcRelativeTransform(self.context, self.frames[0], self.frames[3]).GetAsMatrix4()
+
     def frame_transforms(self, q) -> np.ndarray:
         """``(4, 4, 4)`` X_{dh_0, dh_i} computed by Drake at joint angles ``q`` (2,)."""
         self.set_q(q)
@@ -46,10 +53,16 @@ class LegPlant:
         )
 
 
+@lru_cache(maxsize=4)
+def leg_plant(leg: Leg3R) -> LegPlant:
+    """The ``LegPlant`` of ``leg``, parsed once per process (the checks below set every joint before they read)."""
+    return LegPlant(leg)
+
+
 def drake_fk_errors(leg: Leg3R, q) -> np.ndarray:
     """``(n,)`` worst element-wise difference between Drake's X_{dh_0, dh_i} and the numpy DH products
     T_0^i (i = 0..3) for joint angles ``q`` (n, 2)."""
-    h = LegPlant(leg)
+    h = leg_plant(leg)
     q = np.atleast_2d(q)
     ours = frame_transforms(leg, q)
     return np.array([np.abs(h.frame_transforms(q[k]) - ours[k]).max() for k in range(len(q))])
@@ -67,24 +80,28 @@ def drake_ik(leg: Leg3R, targets, branch: str, tol: float = 1e-14) -> tuple[np.n
     """
     sign = check_branch(branch)
     _, phi = leg.shank
-    h = LegPlant(leg)
+    h = leg_plant(leg)
     solver, options = SnoptSolver(), SolverOptions()
     options.SetOption(solver.solver_id(), "Major feasibility tolerance", tol)
     options.SetOption(solver.solver_id(), "Major optimality tolerance", tol)
     targets = np.atleast_2d(targets)
     out, gaps = np.empty((len(targets), 2)), np.empty(len(targets))
+    # One program for every target, its two constraints' bounds set per target: the same problem as a program
+    # built per target (the same variables and constraints in the same order), without rebuilding it.
+    ik = InverseKinematics(h.plant, with_joint_limits=False)
+    foot_at = ik.AddPositionConstraint(h.frames[3], np.zeros(3), h.frames[0], np.zeros(3), np.zeros(3)).evaluator()
+    prog = ik.get_mutable_prog()
+    box = prog.AddBoundingBoxConstraint(np.zeros(2), np.zeros(2), ik.q()).evaluator()
     for k, t in enumerate(targets):
         guess = np.array([np.arctan2(t[0], -t[1]), -phi + sign * np.pi / 2])
         lo = np.array([guess[0] - np.pi, -phi if sign > 0 else -phi - np.pi])
         hi = np.array([guess[0] + np.pi, -phi + np.pi if sign > 0 else -phi])
-        ik = InverseKinematics(h.plant, with_joint_limits=False)
         p = np.array([t[0], t[1], 0.0])
-        ik.AddPositionConstraint(h.frames[3], np.zeros(3), h.frames[0], p, p)
-        prog = ik.get_mutable_prog()
-        prog.AddBoundingBoxConstraint(lo, hi, ik.q())
+        foot_at.set_bounds(p, p)
+        box.set_bounds(lo, hi)
         result = solver.Solve(prog, guess, options)
         qk = result.GetSolution(ik.q())
-        gap = np.linalg.norm(h.frame_transforms(qk)[3][:2, 3] - t) if np.all(np.isfinite(qk)) else np.inf
+        gap = np.linalg.norm(h.foot_transform(qk)[:2, 3] - t) if np.all(np.isfinite(qk)) else np.inf
         if not gap <= GAP_TOL_M:
             raise RuntimeError(
                 f"Drake InverseKinematics failed at target {k} {t.tolist()} (branch {branch}): "

@@ -66,17 +66,36 @@ def build_plant(
 
 def set_pose(plant, context, platform: Platform, pose, convention: str = "utn") -> None:
     """Set the plate to ``pose`` (6,) and every leg joint to the closed-form solution, in ``context``."""
-    pose = np.asarray(pose, dtype=float).reshape(6)
-    R = rotation_matrix(pose[3:], convention)
-    p_WT = pose[:3] - R @ platform.rotation_centre
+    for _ in set_poses(plant, context, platform, np.asarray(pose, dtype=float).reshape(1, 6), convention):
+        pass
+
+
+def set_poses(plant, context, platform: Platform, poses, convention: str = "utn"):
+    """For a loop over ``(n, 6)`` poses: set ``context`` to pose k as ``set_pose`` does, then yield k. The
+    rotations and closed-form joint positions are computed for all poses at once (elementwise numpy: the same
+    bits as pose by pose) and the joints looked up once."""
+    poses = np.asarray(poses, dtype=float).reshape(-1, 6)
+    R = rotation_matrix(poses[:, 3:], convention)
+    angles, L = leg_joint_positions(platform, poses, convention)
     top = plant.GetBodyByName("top")
-    plant.SetFreeBodyPose(context, top, RigidTransform(RotationMatrix(R), p_WT))
-    angles, L = leg_joint_positions(platform, pose, convention)
-    for i in range(6):
-        plant.GetJointByName(f"universal_{i + 1}").set_angles(context, angles[i])
-        plant.GetJointByName(f"prismatic_{i + 1}").set_translation(context, L[i])
+    universals = [plant.GetJointByName(f"universal_{i + 1}") for i in range(6)]
+    prismatics = prismatic_joints(plant)
+    for k in range(len(poses)):
+        plant.SetFreeBodyPose(
+            context, top, RigidTransform(RotationMatrix(R[k]), poses[k, :3] - R[k] @ platform.rotation_centre)
+        )
+        for i in range(6):
+            universals[i].set_angles(context, angles[k, i])
+            prismatics[i].set_translation(context, L[k, i])
+        yield k
 
 
-def prismatic_positions(plant, context) -> np.ndarray:
-    """``(6,)`` the prismatic joint positions (leg lengths, metres) in ``context``."""
-    return np.array([plant.GetJointByName(f"prismatic_{i + 1}").get_translation(context) for i in range(6)])
+def prismatic_joints(plant) -> list:
+    """The six ``prismatic_i`` joints of the plant, leg order (looked up once for a loop over samples)."""
+    return [plant.GetJointByName(f"prismatic_{i + 1}") for i in range(6)]
+
+
+def prismatic_positions(plant, context, joints=None) -> np.ndarray:
+    """``(6,)`` the prismatic joint positions (leg lengths, metres) in ``context``; ``joints``: the plant's
+    ``prismatic_joints`` when the caller already holds them."""
+    return np.array([j.get_translation(context) for j in joints or prismatic_joints(plant)])

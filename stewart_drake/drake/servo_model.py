@@ -10,11 +10,13 @@ its end onto ``platform_anchor_i`` (a discrete SAP plant, as ball constraints ne
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, DiscreteContactApproximation
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, DiscreteContactApproximation, MultibodyPlant
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.solvers import SnoptSolver, SolverOptions
 from pydrake.systems.analysis import Simulator
@@ -54,14 +56,19 @@ def _simulate_and_read_logs(diagram, logs: dict, t_end: float) -> dict:
     return out
 
 
-def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd_gains=None):
+def build_plant(hexapod: ServoHexapod, time_step: float = 1e-3, builder=None, pd_gains=None, visuals: bool = True):
     """A finalized discrete (SAP) closed-loop ``MultibodyPlant`` of the hexapod and its ``SceneGraph``.
     ``pd_gains`` = (kp N·m/rad, kd N·m·s/rad) makes every servo a PD-controlled actuator (Drake's
-    implicit PD, clamped to the servo's effort limit, driven by the desired-state input port)."""
+    implicit PD, clamped to the servo's effort limit, driven by the desired-state input port).
+    ``visuals=False``: the plant alone (SceneGraph None; the parser then registers no geometry): the same
+    dynamics (the model has no collision geometry), built and stepped faster, for what shows nothing."""
     if not time_step > 0:
         raise SimulationError(SimulationError.DISCRETE_STEP.format(value=time_step))
     builder = builder or DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step)
+    if visuals:
+        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step)
+    else:
+        plant, scene_graph = builder.AddSystem(MultibodyPlant(time_step)), None
     plant.set_discrete_contact_approximation(DiscreteContactApproximation.kLagged)
     Parser(plant).AddModelsFromString(servo_hexapod_sdf(hexapod), "sdf")
     home = servo_joint_home(hexapod)
@@ -84,34 +91,50 @@ class ServoPlant:
 
     def __init__(self, hexapod: ServoHexapod, time_step: float = 1e-3):
         self.hexapod = hexapod
-        self.plant, _ = build_plant(hexapod, time_step)
+        self.plant, _ = build_plant(hexapod, time_step, visuals=False)  # poses and IK only: nothing shown
         self.context = self.plant.CreateDefaultContext()
         p = self.plant
         self.servos = [p.GetJointByName(f"servo_{i + 1}") for i in range(6)]
         self.rods = [p.GetJointByName(f"rod_joint_{i + 1}") for i in range(6)]
+        # looked up once: the pose loops of the cross-checks use them for every pose
+        self.platform_body = p.GetBodyByName("platform")
+        self.arms = [p.GetBodyByName(f"arm_{i + 1}") for i in range(6)]
+        self.rod_frames = [  # each ball joint's fixed R_AF (on the arm) and R_RM (on the rod)
+            (
+                j.frame_on_parent().GetFixedPoseInBodyFrame().rotation().matrix(),
+                j.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix(),
+            )
+            for j in self.rods
+        ]
+        self._frames = {}
 
     def frame_pose(self, name: str) -> np.ndarray:
         """``(3,)`` position of frame ``name`` in the world (= base) frame, metres."""
-        return self.plant.GetFrameByName(name).CalcPoseInWorld(self.context).translation()
+        frame = self._frames.get(name)
+        if frame is None:
+            frame = self._frames[name] = self.plant.GetFrameByName(name)
+        return frame.CalcPoseInWorld(self.context).translation()
 
     def set_platform(self, pose) -> None:
         """Put the platform at a seed-002 pose [x, y, z, phi, theta, psi] (Rz·Ry·Rx)."""
         pose = np.asarray(pose, dtype=float)
         X = RigidTransform(RotationMatrix(rotation_matrix(pose[3:], "zyx")), pose[:3])
-        self.plant.SetFreeBodyPose(self.context, self.plant.GetBodyByName("platform"), X)
+        self.plant.SetFreeBodyPose(self.context, self.platform_body, X)
 
     def set_servos(self, angles) -> None:
         """Servo joint angles (radians, the servo's own sense); each rod is then pointed at its anchor."""
         for i, j in enumerate(self.servos):
             j.set_angle(self.context, float(angles[i]))
+        # Arm tips, anchors and arm frames do not depend on the rods' angles: read them all from one evaluation
+        # of the kinematics before any rod is set (setting a rod first would make Drake recompute it per rod).
+        tips = [self.frame_pose(f"arm_tip_{i + 1}") for i in range(6)]
+        d_all = [self.frame_pose(f"platform_anchor_{i + 1}") - tips[i] for i in range(6)]
+        R_WAs = [arm.EvalPoseInWorld(self.context).rotation().matrix() for arm in self.arms]
         for i, j in enumerate(self.rods):
-            tip = self.frame_pose(f"arm_tip_{i + 1}")
-            d = self.frame_pose(f"platform_anchor_{i + 1}") - tip
-            R_WA = self.plant.GetBodyByName(f"arm_{i + 1}").EvalPoseInWorld(self.context).rotation().matrix()
+            d, R_WA = d_all[i], R_WAs[i]
             R_Wrod = frame_from_zx(d, R_WA[:, 0])
             # Ball joint: R_FM with F fixed on the arm (its model-zero orientation relative to the arm).
-            X_AF = j.frame_on_parent().GetFixedPoseInBodyFrame().rotation().matrix()
-            X_RM = j.frame_on_child().GetFixedPoseInBodyFrame().rotation().matrix()
+            X_AF, X_RM = self.rod_frames[i]
             R_FM = (R_WA @ X_AF).T @ R_Wrod @ X_RM
             j.set_angles(self.context, rpy(R_FM))
 
@@ -314,8 +337,9 @@ class ServoDrive(LeafSystem):
     def _CalcUpdate(self, context, state):
         q = context.get_discrete_state(self._xd).value()[:6]
         target = pulse_joint_angles(self.hexapod, self._pulse.Eval(context), self.joint_home)
-        dq = np.clip(target - q, -self.max_step, self.max_step)
-        state.get_mutable_vector(self._xd).SetFromVector(np.r_[q + dq, dq / self.time_step])
+        # np.clip's arithmetic (max, then min) without its per-call overhead: this runs every time step
+        dq = np.minimum(np.maximum(target - q, -self.max_step), self.max_step)
+        state.get_mutable_vector(self._xd).SetFromVector(np.concatenate((q + dq, dq / self.time_step)))
 
 
 def run_closed_loop(
@@ -346,7 +370,7 @@ def run_closed_loop(
     if not time_step > 0:
         raise SimulationError(SimulationError.TIME_STEP.format(value=time_step))
     builder = DiagramBuilder()
-    plant, _ = build_plant(hexapod, time_step, builder, pd_gains=servo_gains(hexapod))
+    plant, _ = build_plant(hexapod, time_step, builder, pd_gains=servo_gains(hexapod), visuals=False)
     home = servo_joint_home(hexapod)
     src = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, poses.T)))
     ctrl = builder.AddSystem(ServoController(hexapod, frame_rate_hz, resolution_us))
@@ -376,19 +400,17 @@ def run_closed_loop(
     anchors = [plant.GetFrameByName(f"platform_anchor_{i + 1}") for i in range(6)]
     nq = plant.num_positions()
     k = len(out["t"])
-    pose, joints, gap = np.empty((k, 6)), np.empty((k, 6)), np.empty((k, 6))
+    pose, R, joints, gap = np.empty((k, 6)), np.empty((k, 3, 3)), np.empty((k, 6)), np.empty((k, 6))
     for j, x in enumerate(out.pop("state")):
         plant.SetPositions(pc, x[:nq])
         X = plant.EvalBodyPoseInWorld(pc, body)
-        pose[j] = np.r_[X.translation(), angles_from_matrix(X.rotation().matrix(), "zyx")]
+        pose[j, :3] = X.translation()
+        R[j] = X.rotation().matrix()
         joints[j] = [sj.get_angle(pc) for sj in servos]
-        gap[j] = [
-            abs(
-                np.linalg.norm(anchors[i].CalcPoseInWorld(pc).translation() - tips[i].CalcPoseInWorld(pc).translation())
-                - hexapod.rod_length
-            )
-            for i in range(6)
-        ]
+        for i in range(6):
+            d = anchors[i].CalcPoseInWorld(pc).translation() - tips[i].CalcPoseInWorld(pc).translation()
+            gap[j, i] = abs(math.sqrt(d.dot(d)) - hexapod.rod_length)  # np.linalg.norm's own sum for a vector
+    pose[:, 3:] = angles_from_matrix(R, "zyx")  # elementwise: the same bits as one matrix at a time
     out.update(
         pose=pose,
         arm_angle=joint_arm_angles(hexapod, joints),

@@ -40,7 +40,7 @@ from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import check_convention, rotation_matrix
-from stewart_drake.drake.platform_model import build_plant, prismatic_positions, set_pose
+from stewart_drake.drake.platform_model import build_plant, prismatic_joints, prismatic_positions, set_pose
 
 # Joints of the Euler chain, outermost first: (name, axis, index in q).
 _CHAIN = {
@@ -192,7 +192,7 @@ class ClosedLoopInverseDynamics:
     def __init__(self, platform: Platform, convention: str = "utn", time_step: float = 1e-3):
         self.platform, self.convention = platform, convention
         self.kinematics = PlateKinematics(platform, convention)
-        self.plant, _ = build_plant(platform, time_step)
+        self.plant, _ = build_plant(platform, time_step, visuals=False)
         plant = self.plant
         g = np.linalg.norm(plant.gravity_field().gravity_vector())
         if abs(g - G_EARTH) > 1e-12:
@@ -275,7 +275,7 @@ def simulate_open_loop(
     ID = ClosedLoopInverseDynamics(platform, convention, time_step)
     ID.set_state(q[0], qd[0])
     builder = DiagramBuilder()
-    plant, _ = build_plant(platform, time_step, builder)
+    plant, _ = build_plant(platform, time_step, builder, visuals=False)
     u = np.zeros((len(t), plant.num_actuators()))
     u[:, ID.order] = forces
     src = builder.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, u.T)))
@@ -291,15 +291,16 @@ def simulate_open_loop(
     top = plant.GetBodyByName("top")
     tips = [plant.GetFrameByName(f"piston_{i + 1}") for i in range(6)]
     anchors = [plant.GetFrameByName(f"top_anchor_{i + 1}") for i in range(6)]
+    legs = prismatic_joints(plant)
     idx = np.arange(0, len(t), record_every)
+    R_plans = rotation_matrix(q[idx, 3:], convention)  # elementwise: the same bits as one pose at a time
     out = {k: [] for k in ("position_error", "angle_error", "constraint", "lengths")}
     t0 = time.perf_counter()
-    for k in idx:
+    for k, R_plan in zip(idx, R_plans):
         if k > 0:  # the first AdvanceTo also fires the update at t[0]; the state then belongs to t[k]
             sim.AdvanceTo(t[k])
         X = plant.EvalBodyPoseInWorld(pctx, top)
         R = X.rotation().matrix()
-        R_plan = rotation_matrix(q[k, 3:], convention)
         p_C = X.translation() + R @ platform.rotation_centre
         out["position_error"].append(np.linalg.norm(p_C - q[k, :3]))
         c = np.clip((np.trace(R @ R_plan.T) - 1) / 2, -1.0, 1.0)
@@ -310,7 +311,7 @@ def simulate_open_loop(
                 for a, b in zip(tips, anchors)
             )
         )
-        out["lengths"].append(prismatic_positions(plant, pctx))
+        out["lengths"].append(prismatic_positions(plant, pctx, legs))
     res = {k: np.array(v) for k, v in out.items()}
     res["t"] = t[idx]
     res["wall_time"] = time.perf_counter() - t0

@@ -17,7 +17,7 @@ from pydrake.solvers import SnoptSolver, SolverOptions
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.drake.platform_model import build_plant, prismatic_positions, set_pose
+from stewart_drake.drake.platform_model import build_plant, prismatic_joints, prismatic_positions, set_pose, set_poses
 
 
 @dataclass
@@ -30,7 +30,8 @@ class PlantHandle:
 
 
 def make_plant(platform: Platform) -> PlantHandle:
-    plant, _ = build_plant(platform)
+    """The platform's closed-loop plant without visual geometry (nothing is shown: the same kinematics)."""
+    plant, _ = build_plant(platform, visuals=False)
     return PlantHandle(platform, plant, plant.CreateDefaultContext())
 
 
@@ -48,12 +49,13 @@ def anchor_frames(h: PlantHandle) -> tuple[np.ndarray, np.ndarray]:
 def drake_fk_tip_errors(h: PlantHandle, poses, convention: str = "utn") -> np.ndarray:
     """``(n, 6)`` |p_W piston tip − p_W plate anchor| (metres) with every joint set by ``model.set_pose``."""
     poses = np.atleast_2d(poses)
+    tips = [h.plant.GetFrameByName(f"piston_{i + 1}") for i in range(6)]
+    anchors = [h.plant.GetFrameByName(f"top_anchor_{i + 1}") for i in range(6)]
     out = np.empty((len(poses), 6))
-    for k, pose in enumerate(poses):
-        set_pose(h.plant, h.context, h.platform, pose, convention)
+    for k in set_poses(h.plant, h.context, h.platform, poses, convention):
         for i in range(6):
-            tip = h.plant.GetFrameByName(f"piston_{i + 1}").CalcPoseInWorld(h.context).translation()
-            anchor = h.plant.GetFrameByName(f"top_anchor_{i + 1}").CalcPoseInWorld(h.context).translation()
+            tip = tips[i].CalcPoseInWorld(h.context).translation()
+            anchor = anchors[i].CalcPoseInWorld(h.context).translation()
             out[k, i] = np.linalg.norm(tip - anchor)
     return out
 
@@ -72,29 +74,29 @@ def drake_ik_lengths(h: PlantHandle, poses, convention: str = "utn", tol: float 
     options = SolverOptions()
     options.SetOption(solver.solver_id(), "Major feasibility tolerance", tol)
     options.SetOption(solver.solver_id(), "Major optimality tolerance", tol)
+    set_pose(plant, ctx, p, p.home_pose())  # set_pose sets every position: the home state is the same for all poses
+    q_home = plant.GetPositions(ctx).copy()
+    leg_idx = np.r_[
+        [plant.GetJointByName(f"universal_{i + 1}").position_start() + j for i in range(6) for j in range(2)],
+        [plant.GetJointByName(f"prismatic_{i + 1}").position_start() for i in range(6)],
+    ]
+    legs = prismatic_joints(plant)
     out = np.empty((len(poses), 6))
-    for k, pose in enumerate(poses):
-        set_pose(plant, ctx, p, p.home_pose())
-        q_home = plant.GetPositions(ctx).copy()
-        set_pose(plant, ctx, p, pose, convention)  # the plate at the pose (legs too, overwritten below)
+    for k in set_poses(plant, ctx, p, poses, convention):  # the plate at pose k (legs too, overwritten below)
         top.Lock(ctx)
         ik = InverseKinematics(plant, ctx)
         q = ik.q()
         guess = plant.GetPositions(ctx).copy()
-        leg_idx = np.r_[
-            [plant.GetJointByName(f"universal_{i + 1}").position_start() + j for i in range(6) for j in range(2)],
-            [plant.GetJointByName(f"prismatic_{i + 1}").position_start() for i in range(6)],
-        ]
         guess[leg_idx] = q_home[leg_idx]
         ik.get_mutable_prog().AddQuadraticErrorCost(np.eye(len(leg_idx)) * 1e-6, q_home[leg_idx], q[leg_idx])
         result = solver.Solve(ik.prog(), guess, options)
         top.Unlock(ctx)
         if not result.is_success():
             raise RuntimeError(
-                f"Drake InverseKinematics failed at pose {k} {pose.tolist()}: {result.get_solution_result()}"
+                f"Drake InverseKinematics failed at pose {k} {poses[k].tolist()}: {result.get_solution_result()}"
             )
         plant.SetPositions(ctx, result.GetSolution(q))
-        out[k] = prismatic_positions(plant, ctx)
+        out[k] = prismatic_positions(plant, ctx, legs)
     return out
 
 
