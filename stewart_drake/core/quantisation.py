@@ -66,8 +66,6 @@ def noisy_columns(t, values) -> list[NoisyColumn]:
 def smooth_columns(t, values, tol) -> np.ndarray:
     """``(n, 6)`` the samples of the quintic smoothing spline through each column of ``values`` (n, 6) at
     ``t`` (n,), RMS deviation at most ``tol`` (6,) (or a scalar) in the values' units."""
-    from scipy.interpolate import UnivariateSpline  # here: ~0.2 s CPU to import, for the few runs that smooth
-
     t, v = np.asarray(t, dtype=float), np.asarray(values, dtype=float)
     tol = np.broadcast_to(np.asarray(tol, dtype=float), (v.shape[1],))
     k = 5 if len(t) > 5 else max(1, len(t) - 1)
@@ -83,8 +81,6 @@ def smooth_columns(t, values, tol) -> np.ndarray:
 def smoothing_spline(t, values, tol):
     """The per-column quintic smoothing splines (``smooth_columns``), as a callable ``f(t, nu)`` returning
     the ``nu``-th derivative ``(m, 6)`` at times ``t`` (m,)."""
-    from scipy.interpolate import UnivariateSpline  # here: ~0.2 s CPU to import, for the few runs that smooth
-
     t, v = np.asarray(t, dtype=float), np.asarray(values, dtype=float)
     tol = np.broadcast_to(np.asarray(tol, dtype=float), (v.shape[1],))
     k = 5 if len(t) > 5 else max(1, len(t) - 1)
