@@ -13,7 +13,7 @@
   a Ctrl-C while the worker starts is not a traceback either; ``mark_cli`` returns what restores the
   environment (a command run in-process must not mark the caller's later children).
 - ``worker_pool``: a spawn ``ProcessPoolExecutor`` whose workers run ``child_setup`` and are terminated,
-  not waited for, when the parent is interrupted.
+  not waited for, when the parent is interrupted; its workers' BLAS is single-threaded (``ONE_BLAS_THREAD``).
 - ``Terminated`` / ``handle_sigterm``: SIGTERM raises in the main thread like Ctrl-C, so that the
   ``finally`` blocks run (temporary folders removed, clusters closed) before the process exits 143.
 """
@@ -36,6 +36,12 @@ from stewart_drake.errors import OptionError
 BYTES_PER_WORKER = 150e6
 WORKERS_PER_CPU = 4
 _PR_SET_PDEATHSIG = 1
+# The environment of every worker process this package starts (``worker_pool``, Dask's nannies): one BLAS thread.
+# The workers already fill the CPUs, and OpenBLAS's own threads on top of them spin for the small (6 × 6 … 6000 × 42)
+# matrices of these analyses: measured in the report's calibration section, 4.9–6.0 s of CPU with 2 threads per
+# process against 2.1–2.8 s with 1 (2-core machine), the same numbers. One thread also makes the results
+# independent of the machine's core count (a threaded product may sum in another order).
+ONE_BLAS_THREAD = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 
 
 def max_workers() -> int:
@@ -76,10 +82,14 @@ def child_setup() -> None:
 @contextmanager
 def worker_pool(n: int) -> Iterator[ProcessPoolExecutor]:
     """A ``ProcessPoolExecutor`` of ``n`` spawned workers (no fork of a process that may hold Drake's
-    threads) running ``child_setup``; on an error or interrupt the workers are terminated at once."""
+    threads) running ``child_setup`` with ``ONE_BLAS_THREAD`` in their environment (the workers start at the
+    first task, so the parent's environment carries it for the pool's life, then is put back); on an error or
+    interrupt the workers are terminated at once."""
     quiet_resource_tracker()
     ctx = multiprocessing.get_context("spawn")
     before = set(multiprocessing.active_children())
+    held = {k: os.environ.get(k) for k in ONE_BLAS_THREAD}
+    os.environ.update(ONE_BLAS_THREAD)
     pool = ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=child_setup)
     try:
         yield pool
@@ -88,6 +98,12 @@ def worker_pool(n: int) -> Iterator[ProcessPoolExecutor]:
             p.terminate()
         pool.shutdown(wait=False, cancel_futures=True)
         raise
+    finally:
+        for k, v in held.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
     pool.shutdown(wait=True)
 
 

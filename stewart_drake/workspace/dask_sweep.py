@@ -45,7 +45,7 @@ import dask
 import distributed
 import numpy as np
 
-from stewart_drake.core.processes import quiet_resource_tracker
+from stewart_drake.core.processes import ONE_BLAS_THREAD, quiet_resource_tracker
 from stewart_drake.workspace.executors import default_workers
 from stewart_drake.workspace.grid import constant_orientation_workspace, default_bounds, grid_axes
 from stewart_drake.workspace.maps import count_reachable
@@ -54,7 +54,7 @@ from stewart_drake.workspace.maps import count_reachable
 # and Dask's default worker environment without MALLOC_TRIM_THRESHOLD_ (numpy temporaries reuse the heap).
 WORKER_CONFIG = {
     "distributed.worker.profile.enabled": False,
-    "distributed.nanny.pre-spawn-environ": {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1},
+    "distributed.nanny.pre-spawn-environ": ONE_BLAS_THREAD,
     # each worker dies with this process (even by SIGKILL) and leaves Ctrl-C to it (core.processes)
     "distributed.worker.preload": ["stewart_drake.core.processes"],
 }
