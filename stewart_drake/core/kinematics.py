@@ -140,7 +140,7 @@ def condition_at_most(platform: Platform, J, limit: float) -> np.ndarray:
         if X is not None:
             r = np.sqrt(np.sum((np.eye(A.shape[-1]) - X @ A) ** 2, axis=(-2, -1)))
             norms = np.sqrt(np.sum(A**2, axis=(-2, -1))) * np.sqrt(np.sum(X**2, axis=(-2, -1)))
-            ok = (r <= 0.5) & (norms / (1.0 - r) <= limit / 4)
+            ok = np.asarray((r <= 0.5) & (norms / (1.0 - r) <= limit / 4))  # an array also for one matrix
     rest = ~ok
     if rest.any():
         ok[rest] = scaled_condition(platform, J[rest]) <= limit  # per matrix, as in one batch
