@@ -75,9 +75,14 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
     plate's angular velocity, both in the base frame. Row i is [u_iᵀ, (r_i × u_i)ᵀ], r_i = R (p_TTi - p_TC).
     """
     q = as_poses(poses)
-    R = rotation_matrix(q[..., 3:], convention)
-    r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
+    r = plate_offsets(platform, rotation_matrix(q[..., 3:], convention))
     return inverse_jacobian_of_legs(q[..., None, :3] + r - platform.base_anchors, r)
+
+
+def plate_offsets(platform: Platform, R) -> np.ndarray:
+    """``(..., 6, 3)`` r_i = R (p_TTi − p_TC) (m, base frame): each leg's plate anchor from the rotation centre,
+    for ``(..., 3, 3)`` plate orientations R_BT (one home for the Jacobians and the inverse dynamics)."""
+    return np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
 
 
 def inverse_jacobian_of_legs(l, r) -> np.ndarray:
@@ -91,8 +96,12 @@ def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.nd
     """``(..., 6, 6)`` J = ∂L/∂q: leg-length derivatives with respect to the pose coordinates
     (the seeds' Jacobian, used by the Lagrangian dynamics): J = J⁻¹ · blockdiag(I, E_W(angles))."""
     q = as_poses(poses)
-    Jinv = inverse_jacobian(platform, q, convention)
-    E = angular_velocity_map(q[..., 3:], convention)
+    return length_jacobian_of(inverse_jacobian(platform, q, convention), angular_velocity_map(q[..., 3:], convention))
+
+
+def length_jacobian_of(Jinv, E) -> np.ndarray:
+    """``(..., 6, 6)`` J = ∂L/∂q (``length_jacobian``) from J⁻¹ ``(..., 6, 6)`` and E_W ``(..., 3, 3)``
+    (``rotations.angular_velocity_map``), for a caller that has them (the inverse dynamics)."""
     return np.concatenate([Jinv[..., :3], Jinv[..., 3:] @ E], axis=-1)
 
 
