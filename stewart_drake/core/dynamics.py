@@ -42,7 +42,7 @@ from stewart_drake.core.kinematics import (
 )
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
-from stewart_drake.core.small_solve import Solver2, gram, solve3
+from stewart_drake.core.small_linalg import Solver2, gram, matmul, solve3
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_SAMPLE, SingularPoseError, counted
 
@@ -226,7 +226,7 @@ def _generalized_force(platform: Platform, mo: dict, gravity: float, bias_only: 
     R, w = mo["R"], mo["omega"]
     wd = mo["omega_dot_bias"] if bias_only else mo["omega_dot"]
     a = mo["a_cm_bias"] if bias_only else mo["a_cm"]
-    I_W = R @ platform.inertia @ np.swapaxes(R, -1, -2)
+    I_W = matmul(matmul(R, platform.inertia), np.swapaxes(R, -1, -2))  # numpy's R I Rᵀ, one C loop each
     f = platform.mass * (a + np.array([0.0, 0.0, gravity]))
     tau = np.einsum("...ij,...j->...i", I_W, wd) + cross(w, np.einsum("...ij,...j->...i", I_W, w))
     tau_C = tau + cross(mo["r_cm"], f)
@@ -357,7 +357,7 @@ def leg_forces_with_legs(
     a2 = cross(u, a1)
     a2 = a2 / np.linalg.norm(a2, axis=-1, keepdims=True)
     B = np.stack([cross(a1, u), cross(a2, u)], -1)  # (...,6,3,2): u̇ = B [q̇0, q̇1]
-    BtB = Solver2(gram(B))  # numpy's Bᵀ B and solves, one C loop each (``small_solve``)
+    BtB = Solver2(gram(B))  # numpy's Bᵀ B and solves, one C loop each (``small_linalg``)
     rates = BtB.solve(np.einsum("...ji,...j->...i", B, ud))
     omega_c = rates[..., :1] * a1 + rates[..., 1:] * a2
     a12 = rates[..., :1] * rates[..., 1:] * cross(a1, a2)  # ω̇ part from the moving second axis

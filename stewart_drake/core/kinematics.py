@@ -15,6 +15,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+from stewart_drake.core.small_linalg import matmul
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
@@ -102,7 +103,7 @@ def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.nd
 def length_jacobian_of(Jinv, E) -> np.ndarray:
     """``(..., 6, 6)`` J = ∂L/∂q (``length_jacobian``) from J⁻¹ ``(..., 6, 6)`` and E_W ``(..., 3, 3)``
     (``rotations.angular_velocity_map``), for a caller that has them (the inverse dynamics)."""
-    return np.concatenate([Jinv[..., :3], Jinv[..., 3:] @ E], axis=-1)
+    return np.concatenate([Jinv[..., :3], matmul(Jinv[..., 3:], E)], axis=-1)  # numpy's product, one C loop
 
 
 def anchor_radius(platform: Platform) -> float:

@@ -1,7 +1,9 @@
-/* Batched 2 x 2 algebra of stewart_drake.core.small_solve, with the operations, in the order and with the fused
+/* Batched small-matrix algebra of stewart_drake.core.small_linalg, with the operations, in the order and with the fused
  * multiply-adds, of what numpy.linalg runs per matrix for it (its OpenBLAS on x86-64 with FMA; the module checks
  * the bits against numpy at load and uses numpy where they differ):
  *
+ * - products C = A B of small matrices (numpy's matmul: the dgemm/dgemv kernels' fused chain over k from +0:
+ *   c_ij = fma(a_i,k-1 b_k-1,j, ... fma(a_i0, b_0j, +0)));
  * - the Gram matrix G = B^T B of a k x 2 matrix B (numpy's matmul: the dsyrk/dgemm kernel sums over k as a
  *   fused chain, fma(b_k0, b_k1, ... fma(b_10, b_11, b_00 b_01)));
  * - A x = y by dgesv (dgetf2 with partial pivoting: the pivot of larger magnitude, the multiplier l = c * (1/a),
@@ -18,11 +20,25 @@
 #include <math.h>
 #include <stdint.h>
 
+/* C (nb, m, n) = A (nb, m, k) B (nb, k, n), all row-major. */
+void sd_matmul(int64_t nb, int64_t m, int64_t k, int64_t n, const double *A, const double *B, double *C) {
+    for (int64_t b = 0; b < nb; b++, A += m * k, B += k * n) {
+        for (int64_t i = 0; i < m; i++) {
+            for (int64_t j = 0; j < n; j++, C++) {
+                double acc = 0.0; /* the kernels' accumulators start at +0: a -0 product sums to +0 */
+                for (int64_t l = 0; l < k; l++)
+                    acc = fma(A[i * k + l], B[l * n + j], acc);
+                *C = acc;
+            }
+        }
+    }
+}
+
 /* G (n, 2, 2) = B^T B for B (n, k, 2), both row-major. */
 void sd_gram2(int64_t n, int64_t k, const double *B, double *G) {
     for (int64_t i = 0; i < n; i++, B += 2 * k, G += 4) {
-        double g00 = B[0] * B[0], g01 = B[0] * B[1], g11 = B[1] * B[1];
-        for (int64_t j = 1; j < k; j++) {
+        double g00 = 0.0, g01 = 0.0, g11 = 0.0; /* from +0, as the kernels' accumulators */
+        for (int64_t j = 0; j < k; j++) {
             double b0 = B[2 * j], b1 = B[2 * j + 1];
             g00 = fma(b0, b0, g00);
             g01 = fma(b0, b1, g01);
