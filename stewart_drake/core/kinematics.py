@@ -15,7 +15,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
-from stewart_drake.core.small_linalg import matmul
+from stewart_drake.core.small_linalg import approximate_inverse, matmul
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
@@ -135,20 +135,20 @@ def scaled_condition(platform: Platform, J) -> np.ndarray:
 
 def condition_at_most(platform: Platform, J, limit: float) -> np.ndarray:
     """``(...)`` bool: ``scaled_condition(platform, J) <= limit`` for ``(..., 6, 6)`` Jacobians — the same
-    answers, about a quarter of the cost. Most matrices are decided by an a-posteriori bound from the
-    inverse X of the scaled J (A): with r = ‖I − X A‖_F < 1, ‖A⁻¹‖₂ ≤ ‖X‖_F / (1 − r), so κ₂(A) ≤
-    ‖A‖_F ‖X‖_F / (1 − r). Where that bound is ≤ ``limit``/4 (r ≤ 1/2), κ₂ is well below ``limit`` — the
+    answers, about a quarter of the cost. Most matrices are decided by an a-posteriori bound from an approximate
+    inverse X (any X: ``small_linalg.approximate_inverse``) of the scaled J (A): with r = ‖I − X A‖_F < 1,
+    ‖A⁻¹‖₂ ≤ ‖X‖_F / (1 − r), so κ₂(A) ≤ ‖A‖_F ‖X‖_F / (1 − r). Where that bound is ≤ ``limit``/4 (r ≤ 1/2), κ₂ is well below ``limit`` — the
     factor 4 covers the rounding of the bound (relative ~1e-8 at κ ~ 1e8) and of the SVD's own κ — so the SVD
     answers yes there too; every other matrix (near-singular, not finite) is decided by the SVD as before."""
     A = scaled_jacobian(J, anchor_radius(platform))
     ok = np.zeros(A.shape[:-2], dtype=bool)
     with np.errstate(all="ignore"):
         try:
-            X = np.linalg.inv(A)
+            X = approximate_inverse(A)  # any X: the bound is a-posteriori (one C loop, else np.linalg.inv)
         except np.linalg.LinAlgError:  # an exactly singular matrix in the batch: the SVD decides all
             X = None
         if X is not None:
-            r = np.sqrt(np.sum((np.eye(A.shape[-1]) - X @ A) ** 2, axis=(-2, -1)))
+            r = np.sqrt(np.sum((np.eye(A.shape[-1]) - matmul(X, A)) ** 2, axis=(-2, -1)))
             norms = np.sqrt(np.sum(A**2, axis=(-2, -1))) * np.sqrt(np.sum(X**2, axis=(-2, -1)))
             ok = np.asarray((r <= 0.5) & (norms / (1.0 - r) <= limit / 4))  # an array also for one matrix
     rest = ~ok

@@ -143,3 +143,50 @@ int sd_solve3(int64_t n, const double *A, const double *y, double *x) {
     }
     return unusual;
 }
+
+/* X (nb, n, n) ~ A^-1 of A (nb, n, n) row-major, n <= 8, by Gauss-Jordan elimination with partial pivoting (an
+ * approximate inverse for an a-posteriori bound: not numpy's bits); 1 if a pivot is zero or a result not finite. */
+int sd_inverse(int64_t nb, int64_t n, const double *A, double *X) {
+    int unusual = 0;
+    double M[8][16];
+    for (int64_t b = 0; b < nb; b++, A += n * n, X += n * n) {
+        for (int64_t i = 0; i < n; i++)
+            for (int64_t j = 0; j < n; j++) {
+                M[i][j] = A[i * n + j];
+                M[i][n + j] = i == j ? 1.0 : 0.0;
+            }
+        for (int64_t c = 0; c < n; c++) {
+            int64_t p = c;
+            for (int64_t i = c + 1; i < n; i++)
+                if (fabs(M[i][c]) > fabs(M[p][c]))
+                    p = i;
+            if (!(M[p][c] != 0.0 && isfinite(M[p][c]))) {
+                unusual = 1;
+                break;
+            }
+            if (p != c)
+                for (int64_t j = 0; j < 2 * n; j++) {
+                    double t = M[c][j];
+                    M[c][j] = M[p][j];
+                    M[p][j] = t;
+                }
+            double inv = 1.0 / M[c][c];
+            for (int64_t j = 0; j < 2 * n; j++)
+                M[c][j] *= inv;
+            for (int64_t i = 0; i < n; i++) {
+                double f = M[i][c];
+                if (i == c || f == 0.0)
+                    continue;
+                for (int64_t j = 0; j < 2 * n; j++)
+                    M[i][j] -= f * M[c][j];
+            }
+        }
+        for (int64_t i = 0; i < n; i++)
+            for (int64_t j = 0; j < n; j++) {
+                X[i * n + j] = M[i][n + j];
+                if (!isfinite(M[i][n + j]))
+                    unusual = 1;
+            }
+    }
+    return unusual;
+}

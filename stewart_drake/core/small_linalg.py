@@ -29,6 +29,7 @@ void sd_gram2(int64_t n, int64_t k, const double *B, double *G);
 int sd_lu2(int64_t n, const double *A, double *F);
 int sd_solve2(int64_t n, const double *F, const double *y, double *x);
 int sd_solve3(int64_t n, const double *A, const double *y, double *x);
+int sd_inverse(int64_t nb, int64_t n, const double *A, double *X);
 """
 FLAGS = ("-ffp-contract=off",)
 PROBE_SIZE = 4096
@@ -129,6 +130,22 @@ def solve3(A, y) -> np.ndarray:
         if not lib.sd_solve3(len(flat), fb("double[]", flat), fb("double[]", rhs), fb("double[]", x)):
             return x.reshape(y.shape)
     return np.linalg.solve(A, y[..., None])[..., 0]
+
+
+def approximate_inverse(A) -> np.ndarray:
+    """``(..., n, n)`` X ≈ A⁻¹ for float ``(..., n, n)`` A (n ≤ 8), for an a-posteriori bound that holds for any X
+    (``kinematics.condition_at_most``): Gauss–Jordan with partial pivoting in one C loop, not numpy's bits;
+    ``np.linalg.inv`` (its answers and errors) where a pivot is zero or not finite, or without the loop."""
+    A = np.asarray(A, dtype=float)
+    c = library()
+    n = A.shape[-1] if A.ndim >= 2 else 0
+    if c is not None and 1 <= n <= 8 and A.shape[-2] == n:
+        ffi, lib = c
+        flat = np.ascontiguousarray(A.reshape(-1, n, n))
+        X = np.empty_like(flat)
+        if not lib.sd_inverse(len(flat), n, ffi.from_buffer("double[]", flat), ffi.from_buffer("double[]", X)):
+            return X.reshape(A.shape)
+    return np.linalg.inv(A)
 
 
 def _probe(c) -> bool:
