@@ -42,7 +42,7 @@ from stewart_drake.core.kinematics import (
 )
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
-from stewart_drake.core.small_linalg import Solver2, gram, matmul, solve3
+from stewart_drake.core.small_linalg import Solver2, gram, solve3
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_SAMPLE, SingularPoseError, counted
 
@@ -226,7 +226,7 @@ def _generalized_force(platform: Platform, mo: dict, gravity: float, bias_only: 
     R, w = mo["R"], mo["omega"]
     wd = mo["omega_dot_bias"] if bias_only else mo["omega_dot"]
     a = mo["a_cm_bias"] if bias_only else mo["a_cm"]
-    I_W = matmul(matmul(R, platform.inertia), np.swapaxes(R, -1, -2))  # numpy's R I Rᵀ, one C loop each
+    I_W = R @ platform.inertia @ np.swapaxes(R, -1, -2)
     f = platform.mass * (a + np.array([0.0, 0.0, gravity]))
     tau = np.einsum("...ij,...j->...i", I_W, wd) + cross(w, np.einsum("...ij,...j->...i", I_W, w))
     tau_C = tau + cross(mo["r_cm"], f)

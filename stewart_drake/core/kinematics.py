@@ -15,7 +15,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
-from stewart_drake.core.small_linalg import approximate_inverse, matmul
+from stewart_drake.core.small_linalg import approximate_inverse
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
@@ -103,7 +103,7 @@ def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.nd
 def length_jacobian_of(Jinv, E) -> np.ndarray:
     """``(..., 6, 6)`` J = ∂L/∂q (``length_jacobian``) from J⁻¹ ``(..., 6, 6)`` and E_W ``(..., 3, 3)``
     (``rotations.angular_velocity_map``), for a caller that has them (the inverse dynamics)."""
-    return np.concatenate([Jinv[..., :3], matmul(Jinv[..., 3:], E)], axis=-1)  # numpy's product, one C loop
+    return np.concatenate([Jinv[..., :3], Jinv[..., 3:] @ E], axis=-1)
 
 
 def anchor_radius(platform: Platform) -> float:
@@ -148,7 +148,7 @@ def condition_at_most(platform: Platform, J, limit: float) -> np.ndarray:
         except np.linalg.LinAlgError:  # an exactly singular matrix in the batch: the SVD decides all
             X = None
         if X is not None:
-            r = np.sqrt(np.sum((np.eye(A.shape[-1]) - matmul(X, A)) ** 2, axis=(-2, -1)))
+            r = np.sqrt(np.sum((np.eye(A.shape[-1]) - X @ A) ** 2, axis=(-2, -1)))
             norms = np.sqrt(np.sum(A**2, axis=(-2, -1))) * np.sqrt(np.sum(X**2, axis=(-2, -1)))
             ok = np.asarray((r <= 0.5) & (norms / (1.0 - r) <= limit / 4))  # an array also for one matrix
     rest = ~ok

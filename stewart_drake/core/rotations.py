@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.small_linalg import matmul
 from stewart_drake.errors import RotationError
 
 CONVENTIONS = ("utn", "zyx")
@@ -168,17 +167,16 @@ def angular_velocity_map(angles, convention: str = "utn") -> np.ndarray:
     ex = np.broadcast_to(np.array([1.0, 0.0, 0.0]), angles.shape)
     ey = np.broadcast_to(np.array([0.0, 1.0, 0.0]), angles.shape)
     ez = np.broadcast_to(np.array([0.0, 0.0, 1.0]), angles.shape)
-    # the products as numpy's BLAS computes them, one C loop for the batch (``small_linalg.matmul``)
     if convention == "utn":  # Ry(b) Rx(a) Rz(g): b about Y_B; a about Ry·X; g about Ry·Rx·Z
         Ry = _ry(ay)
-        w_a = matmul(Ry, ex[..., None])
+        w_a = Ry @ ex[..., None]
         w_b = ey[..., None]
-        w_g = matmul(matmul(Ry, _rx(ax)), ez[..., None])
+        w_g = Ry @ _rx(ax) @ ez[..., None]
     else:  # Rz(psi) Ry(theta) Rx(phi): psi about Z_B; theta about Rz·Y; phi about Rz·Ry·X
         Rz = _rz(az)
         w_g = ez[..., None]
-        w_b = matmul(Rz, ey[..., None])
-        w_a = matmul(matmul(Rz, _ry(ay)), ex[..., None])
+        w_b = Rz @ ey[..., None]
+        w_a = Rz @ _ry(ay) @ ex[..., None]
     return np.concatenate([w_a, w_b, w_g], axis=-1)
 
 

@@ -1,38 +1,22 @@
-/* Batched small-matrix algebra of stewart_drake.core.small_linalg, with the operations, in the order and with the fused
- * multiply-adds, of what numpy.linalg runs per matrix for it (its OpenBLAS on x86-64 with FMA; the module checks
- * the bits against numpy at load and uses numpy where they differ):
+/* Batched small-matrix algebra of stewart_drake.core.small_linalg, with the operations, in the order and with the
+ * fused multiply-adds, of what numpy runs per matrix for it (its OpenBLAS on x86-64 with FMA; the module checks the
+ * bits against numpy at load and uses numpy where they differ):
  *
- * - products C = A B of small matrices (numpy's matmul: the dgemm/dgemv kernels' fused chain over k from +0:
- *   c_ij = fma(a_i,k-1 b_k-1,j, ... fma(a_i0, b_0j, +0)));
- * - the Gram matrix G = B^T B of a k x 2 matrix B (numpy's matmul: the dsyrk/dgemm kernel sums over k as a
- *   fused chain, fma(b_k0, b_k1, ... fma(b_10, b_11, b_00 b_01)));
- * - A x = y by dgesv (dgetf2 with partial pivoting: the pivot of larger magnitude, the multiplier l = c * (1/a),
- *   u = d - l b unfused; dgetrs: z1 = fma(-l, y0, y1), x1 = z1 / u, x0 = fma(-b, x1, y0) / a).
- *
+ * - the Gram matrix G = B^T B of a k x 2 matrix B (numpy's matmul: the dsyrk kernel sums over k as a fused chain
+ *   from +0, fma(b_k0, b_k1, ... fma(b_00, b_01, +0)));
+ * - A x = y by dgesv for 2 x 2 A (dgetf2 with partial pivoting: the pivot of larger magnitude, the multiplier
+ *   l = c * (1/a), u = d - l b unfused; dgetrs: z1 = fma(-l, y0, y1), x1 = z1 / u, x0 = fma(-b, x1, y0) / a);
  * - the same for 3 x 3 (dgetf2's second column u = b - l a unfused, its third c - fma(l21, u12, l20 u02), the
- *   rows swapped in the columns already factored; dgetrs's forward and back substitutions as fused axpys).
+ *   rows swapped in the columns already factored; dgetrs's substitutions as fused axpys).
  *
- * Only LAPACK's usual branch is written: a pivot that is zero, below DBL_MIN or not finite makes sd_lu2 return 1,
- * and the caller runs numpy on the batch (which raises or takes LAPACK's other branches itself). Built with
+ * Only LAPACK's usual branch is written: a pivot that is zero, below DBL_MIN or not finite makes a function return
+ * 1, and the caller runs numpy on the batch (which raises or takes LAPACK's other branches itself). Built with
  * -ffp-contract=off: every product and sum not written as fma() is rounded on its own, as in the kernels.
+ * sd_inverse is not numpy's: an approximate inverse for an a-posteriori bound (any inverse will do).
  */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
-
-/* C (nb, m, n) = A (nb, m, k) B (nb, k, n), all row-major. */
-void sd_matmul(int64_t nb, int64_t m, int64_t k, int64_t n, const double *A, const double *B, double *C) {
-    for (int64_t b = 0; b < nb; b++, A += m * k, B += k * n) {
-        for (int64_t i = 0; i < m; i++) {
-            for (int64_t j = 0; j < n; j++, C++) {
-                double acc = 0.0; /* the kernels' accumulators start at +0: a -0 product sums to +0 */
-                for (int64_t l = 0; l < k; l++)
-                    acc = fma(A[i * k + l], B[l * n + j], acc);
-                *C = acc;
-            }
-        }
-    }
-}
 
 /* G (n, 2, 2) = B^T B for B (n, k, 2), both row-major. */
 void sd_gram2(int64_t n, int64_t k, const double *B, double *G) {
