@@ -26,7 +26,7 @@ from stewart_drake.control.timing import PHASE_BUDGET, DspTiming, loop_delay
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import length_jacobian
-from stewart_drake.errors import GainError
+from stewart_drake.errors import GainError, SingularPoseError
 from stewart_drake.fixedpoint import QFormat
 
 # The measurement difference is scaled up by 2^DIFF_SHIFT before its 16-bit filter, so that a
@@ -118,8 +118,8 @@ def leg_space_inertia(platform: Platform, pose=None) -> np.ndarray:
 
     q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float)
     z = np.zeros_like(q0)
-    JtM = np.stack([leg_forces_with_legs(platform, q0, z, z + e, gravity=0.0) for e in np.eye(6)], -1)  # J⁻ᵀ M
-    M_L = JtM @ np.linalg.inv(length_jacobian(platform, q0))
+    JtM = _columns(leg_forces_with_legs(platform, _tiled(q0, 6), _tiled(z, 6), z + _steps(np.eye(6), q0), gravity=0.0))
+    M_L = JtM @ np.linalg.inv(length_jacobian(platform, q0))  # JtM: J⁻ᵀ M
     return (M_L + np.swapaxes(M_L, -1, -2)) / 2
 
 
@@ -132,17 +132,35 @@ def strut_stiffness(platform: Platform, pose=None, h: float = 1e-6):
     differences of step ``h``."""
     q0 = platform.home_pose() if pose is None else np.asarray(pose, dtype=float)
     z = np.zeros_like(q0)
-    dFdq = np.stack(
-        [
-            (leg_forces_with_legs(platform, q0 + h * e, z, z) - leg_forces_with_legs(platform, q0 - h * e, z, z))
-            / (2 * h)
-            for e in np.eye(6)
-        ],
-        -1,
-    )
+    steps = _steps(h * np.eye(6), q0)
+    try:  # the twelve poses in one batch: the inverse dynamics is row by row, so the same numbers as twelve calls
+        F = leg_forces_with_legs(platform, np.concatenate([q0 + steps, q0 - steps]), _tiled(z, 12), _tiled(z, 12))
+    except SingularPoseError:  # named by its index in the call it came from, as always
+        for e in np.eye(6):
+            leg_forces_with_legs(platform, q0 + h * e, z, z)
+            leg_forces_with_legs(platform, q0 - h * e, z, z)
+        raise
+    dFdq = _columns((F[:6] - F[6:]) / (2 * h))
     K = dFdq @ np.linalg.inv(length_jacobian(platform, q0))
     k = np.maximum(0.0, np.linalg.eigvalsh(-(K + np.swapaxes(K, -1, -2)) / 2)[..., -1])
     return float(k) if k.ndim == 0 else k
+
+
+def _steps(rows, q0) -> np.ndarray:
+    """``(6, ..., 6)``: row k of ``rows`` (6, 6) as a step for each pose of ``q0`` (``(..., 6)``), contiguous."""
+    return np.ascontiguousarray(
+        np.broadcast_to(rows.reshape((6,) + (1,) * (np.ndim(q0) - 1) + (6,)), (6, *np.shape(q0)))
+    )
+
+
+def _tiled(a, n: int) -> np.ndarray:
+    """``(n, ...)`` contiguous copies of ``a``: a batch whose rows are laid out as ``a``'s own."""
+    return np.ascontiguousarray(np.broadcast_to(a, (n, *np.shape(a))))
+
+
+def _columns(F) -> np.ndarray:
+    """``(..., 6, k)`` contiguous from ``(k, ..., 6)``: the k batched results as columns, as ``np.stack(…, -1)`` lays them out."""
+    return np.ascontiguousarray(np.moveaxis(F, 0, -1))
 
 
 def design_gains(

@@ -32,9 +32,17 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.geometry import SQRT3, Platform
-from stewart_drake.core.kinematics import condition_at_most, length_jacobian, scaled_condition
+from stewart_drake.core.kinematics import (
+    condition_at_most,
+    inverse_jacobian_of_legs,
+    length_jacobian,
+    length_jacobian_of,
+    plate_offsets,
+    scaled_condition,
+)
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
 from stewart_drake.core.rotations import angular_velocity_map, check_convention, rotation_matrix
+from stewart_drake.core.small_linalg import Solver2, gram, solve3
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_SAMPLE, SingularPoseError, counted
 
@@ -131,12 +139,12 @@ def _states(q, qd, qdd):
     return q, qd, qdd
 
 
-def euler_rate_derivative(angles, rates, convention: str = "utn") -> np.ndarray:
+def euler_rate_derivative(angles, rates, convention: str = "utn", E=None) -> np.ndarray:
     """``(..., 3)`` Ė_W(angles) · rates, the part of the angular acceleration ω̇_B = E_W θ̈ + Ė_W θ̇ that
     does not depend on θ̈ (rad/s²). Column k of E_W is the axis of the k-th rotation; it is carried by
-    the angular velocity of the rotations composed before it."""
+    the angular velocity of the rotations composed before it. ``E``: E_W(angles) where the caller has it."""
     check_convention(convention)
-    E = angular_velocity_map(angles, convention)
+    E = angular_velocity_map(angles, convention) if E is None else E
     rates = np.asarray(rates, dtype=float)
     out = np.zeros(np.broadcast_shapes(E.shape[:-1], rates.shape))
     w_before = np.zeros_like(out)
@@ -155,7 +163,7 @@ def plate_motion(platform: Platform, q, qd, qdd, convention: str = "utn") -> dic
     R = rotation_matrix(q[..., 3:], convention)
     E = angular_velocity_map(q[..., 3:], convention)
     w = np.einsum("...ij,...j->...i", E, qd[..., 3:])
-    wd_bias = euler_rate_derivative(q[..., 3:], qd[..., 3:], convention)
+    wd_bias = euler_rate_derivative(q[..., 3:], qd[..., 3:], convention, E)
     wd = np.einsum("...ij,...j->...i", E, qdd[..., 3:]) + wd_bias
     r = np.einsum("...ij,j->...i", R, platform.com - platform.rotation_centre)
     centripetal = cross(w, cross(w, r))
@@ -276,7 +284,11 @@ def jacobian_condition(platform: Platform, q, convention: str = "utn") -> np.nda
 def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` F (N) with Jᵀ(q) F = Q; raises ``SingularPoseError`` naming the first sample whose J
     has a scaled condition number above ``MAX_CONDITION``."""
-    J = length_jacobian(platform, q, convention)
+    return _solve_transposed(platform, length_jacobian(platform, q, convention), Q)
+
+
+def _solve_transposed(platform: Platform, J, Q) -> np.ndarray:
+    """``(..., 6)`` F with Jᵀ F = Q for the length Jacobians ``J`` (``solve_leg_forces``)."""
     idx = first_index(~condition_at_most(platform, J, MAX_CONDITION))
     if idx is not None:
         k = scaled_condition(platform, J[idx])
@@ -329,9 +341,7 @@ def leg_forces_with_legs(
     q, qd, qdd = _states(q, qd, qdd)
     mo = plate_motion(platform, q, qd, qdd, convention)
     w, wd = mo["omega"][..., None, :], mo["omega_dot"][..., None, :]
-    r = np.einsum(
-        "...ij,kj->...ki", mo["R"], platform.top_anchors_per_leg - platform.rotation_centre
-    )  # (...,6,3) p_CTi
+    r = plate_offsets(platform, mo["R"])  # (...,6,3) p_CTi
     # Leg vectors base anchor -> plate anchor and their first two time derivatives.
     l = q[..., None, :3] + r - platform.base_anchors
     ld = qd[..., None, :3] + cross(w, r)
@@ -347,12 +357,12 @@ def leg_forces_with_legs(
     a2 = cross(u, a1)
     a2 = a2 / np.linalg.norm(a2, axis=-1, keepdims=True)
     B = np.stack([cross(a1, u), cross(a2, u)], -1)  # (...,6,3,2): u̇ = B [q̇0, q̇1]
-    BtB = np.swapaxes(B, -1, -2) @ B
-    rates = np.linalg.solve(BtB, np.einsum("...ji,...j->...i", B, ud)[..., None])[..., 0]
+    BtB = Solver2(gram(B))  # numpy's Bᵀ B and solves, one C loop each (``small_linalg``)
+    rates = BtB.solve(np.einsum("...ji,...j->...i", B, ud))
     omega_c = rates[..., :1] * a1 + rates[..., 1:] * a2
     a12 = rates[..., :1] * rates[..., 1:] * cross(a1, a2)  # ω̇ part from the moving second axis
     rhs = udd - cross(a12, u) - cross(omega_c, cross(omega_c, u))
-    acc = np.linalg.solve(BtB, np.einsum("...ji,...j->...i", B, rhs)[..., None])[..., 0]
+    acc = BtB.solve(np.einsum("...ji,...j->...i", B, rhs))
     omega_c_dot = acc[..., :1] * a1 + acc[..., 1:] * a2 + a12
 
     dims = leg_dimensions(platform)
@@ -379,13 +389,14 @@ def leg_forces_with_legs(
         f_piston = f
     tau_leg = np.stack([np.sum(a1 * M_B, -1), np.sum(a2 * M_B, -1), np.sum(u * f_piston, -1)], -1)
     J_tip = np.stack([cross(a1, l), cross(a2, l), u], -1)  # ṗ_tip = J_tip [q̇0, q̇1, L̇]
-    f_tip = np.linalg.solve(np.swapaxes(J_tip, -1, -2), tau_leg[..., None])[..., 0]  # J_tipᵀ f = τ_leg
+    f_tip = solve3(np.swapaxes(J_tip, -1, -2), tau_leg)  # J_tipᵀ f = τ_leg
     # The plate must carry f_tip at each anchor on top of its own inertia and weight.
     Q = _generalized_force(platform, mo, gravity)
     f_sum = f_tip.sum(-2)
     m_sum = cross(r, f_tip).sum(-2)
     Q = Q + np.concatenate([f_sum, np.einsum("...ji,...j->...i", mo["E"], m_sum)], -1)
-    return solve_leg_forces(platform, q, Q, convention)
+    # J = ∂L/∂q from the legs and E_W at hand: ``length_jacobian``'s numbers without its second pass over the poses
+    return _solve_transposed(platform, length_jacobian_of(inverse_jacobian_of_legs(l, r), mo["E"]), Q)
 
 
 def skew(v) -> np.ndarray:

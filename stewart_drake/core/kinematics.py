@@ -15,6 +15,7 @@ import numpy as np
 
 from stewart_drake.core.argcheck import as_poses, first_index
 from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+from stewart_drake.core.small_linalg import approximate_inverse
 from stewart_drake.core.vec3 import cross
 from stewart_drake.errors import SINGULAR_POSE, SingularPoseError, UnreachablePoseError, counted
 
@@ -75,9 +76,14 @@ def inverse_jacobian(platform: Platform, poses, convention: str = "utn") -> np.n
     plate's angular velocity, both in the base frame. Row i is [u_iᵀ, (r_i × u_i)ᵀ], r_i = R (p_TTi - p_TC).
     """
     q = as_poses(poses)
-    R = rotation_matrix(q[..., 3:], convention)
-    r = np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
+    r = plate_offsets(platform, rotation_matrix(q[..., 3:], convention))
     return inverse_jacobian_of_legs(q[..., None, :3] + r - platform.base_anchors, r)
+
+
+def plate_offsets(platform: Platform, R) -> np.ndarray:
+    """``(..., 6, 3)`` r_i = R (p_TTi − p_TC) (m, base frame): each leg's plate anchor from the rotation centre,
+    for ``(..., 3, 3)`` plate orientations R_BT (one home for the Jacobians and the inverse dynamics)."""
+    return np.einsum("...jk,ik->...ij", R, platform.top_anchors_per_leg - platform.rotation_centre)
 
 
 def inverse_jacobian_of_legs(l, r) -> np.ndarray:
@@ -91,8 +97,12 @@ def length_jacobian(platform: Platform, poses, convention: str = "utn") -> np.nd
     """``(..., 6, 6)`` J = ∂L/∂q: leg-length derivatives with respect to the pose coordinates
     (the seeds' Jacobian, used by the Lagrangian dynamics): J = J⁻¹ · blockdiag(I, E_W(angles))."""
     q = as_poses(poses)
-    Jinv = inverse_jacobian(platform, q, convention)
-    E = angular_velocity_map(q[..., 3:], convention)
+    return length_jacobian_of(inverse_jacobian(platform, q, convention), angular_velocity_map(q[..., 3:], convention))
+
+
+def length_jacobian_of(Jinv, E) -> np.ndarray:
+    """``(..., 6, 6)`` J = ∂L/∂q (``length_jacobian``) from J⁻¹ ``(..., 6, 6)`` and E_W ``(..., 3, 3)``
+    (``rotations.angular_velocity_map``), for a caller that has them (the inverse dynamics)."""
     return np.concatenate([Jinv[..., :3], Jinv[..., 3:] @ E], axis=-1)
 
 
@@ -125,22 +135,22 @@ def scaled_condition(platform: Platform, J) -> np.ndarray:
 
 def condition_at_most(platform: Platform, J, limit: float) -> np.ndarray:
     """``(...)`` bool: ``scaled_condition(platform, J) <= limit`` for ``(..., 6, 6)`` Jacobians — the same
-    answers, about a quarter of the cost. Most matrices are decided by an a-posteriori bound from the
-    inverse X of the scaled J (A): with r = ‖I − X A‖_F < 1, ‖A⁻¹‖₂ ≤ ‖X‖_F / (1 − r), so κ₂(A) ≤
-    ‖A‖_F ‖X‖_F / (1 − r). Where that bound is ≤ ``limit``/4 (r ≤ 1/2), κ₂ is well below ``limit`` — the
+    answers, about a quarter of the cost. Most matrices are decided by an a-posteriori bound from an approximate
+    inverse X (any X: ``small_linalg.approximate_inverse``) of the scaled J (A): with r = ‖I − X A‖_F < 1,
+    ‖A⁻¹‖₂ ≤ ‖X‖_F / (1 − r), so κ₂(A) ≤ ‖A‖_F ‖X‖_F / (1 − r). Where that bound is ≤ ``limit``/4 (r ≤ 1/2), κ₂ is well below ``limit`` — the
     factor 4 covers the rounding of the bound (relative ~1e-8 at κ ~ 1e8) and of the SVD's own κ — so the SVD
     answers yes there too; every other matrix (near-singular, not finite) is decided by the SVD as before."""
     A = scaled_jacobian(J, anchor_radius(platform))
     ok = np.zeros(A.shape[:-2], dtype=bool)
     with np.errstate(all="ignore"):
         try:
-            X = np.linalg.inv(A)
+            X = approximate_inverse(A)  # any X: the bound is a-posteriori (one C loop, else np.linalg.inv)
         except np.linalg.LinAlgError:  # an exactly singular matrix in the batch: the SVD decides all
             X = None
         if X is not None:
             r = np.sqrt(np.sum((np.eye(A.shape[-1]) - X @ A) ** 2, axis=(-2, -1)))
             norms = np.sqrt(np.sum(A**2, axis=(-2, -1))) * np.sqrt(np.sum(X**2, axis=(-2, -1)))
-            ok = (r <= 0.5) & (norms / (1.0 - r) <= limit / 4)
+            ok = np.asarray((r <= 0.5) & (norms / (1.0 - r) <= limit / 4))  # an array also for one matrix
     rest = ~ok
     if rest.any():
         ok[rest] = scaled_condition(platform, J[rest]) <= limit  # per matrix, as in one batch

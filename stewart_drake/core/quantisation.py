@@ -63,6 +63,15 @@ def noisy_columns(t, values) -> list[NoisyColumn]:
     return out
 
 
+def _spline(t, y, k: int, tol: float):
+    """The degree-``k`` smoothing spline of ``y`` (n,) at ``t`` (n,) with RMS deviation at most ``tol``."""
+    # deferred: scipy.interpolate takes ~0.5 s to import and only a smoothed CSV needs it, while every closed-loop
+    # run imports this module (through core.trajectory)
+    from scipy.interpolate import UnivariateSpline
+
+    return UnivariateSpline(t, y, k=k, s=len(t) * tol**2)
+
+
 def smooth_columns(t, values, tol) -> np.ndarray:
     """``(n, 6)`` the samples of the quintic smoothing spline through each column of ``values`` (n, 6) at
     ``t`` (n,), RMS deviation at most ``tol`` (6,) (or a scalar) in the values' units."""
@@ -74,7 +83,7 @@ def smooth_columns(t, values, tol) -> np.ndarray:
         if np.ptp(v[:, j]) == 0:
             out[:, j] = v[:, j]
             continue
-        out[:, j] = _spline(t, v[:, j], k, len(t) * float(tol[j]) ** 2)(t)
+        out[:, j] = _spline(t, v[:, j], k, float(tol[j]))(t)
     return out
 
 
@@ -84,9 +93,7 @@ def smoothing_spline(t, values, tol):
     t, v = np.asarray(t, dtype=float), np.asarray(values, dtype=float)
     tol = np.broadcast_to(np.asarray(tol, dtype=float), (v.shape[1],))
     k = 5 if len(t) > 5 else max(1, len(t) - 1)
-    splines = [
-        None if np.ptp(v[:, j]) == 0 else _spline(t, v[:, j], k, len(t) * float(tol[j]) ** 2) for j in range(v.shape[1])
-    ]
+    splines = [None if np.ptp(v[:, j]) == 0 else _spline(t, v[:, j], k, float(tol[j])) for j in range(v.shape[1])]
 
     def f(x, nu: int = 0) -> np.ndarray:
         x = np.asarray(x, dtype=float)
@@ -149,12 +156,3 @@ def smooth_tolerance(value, option: str = "--smooth") -> float:
     if not (np.isfinite(v) and v > 0):
         raise TrajectoryError(TrajectoryError.SMOOTH_TOL.format(option=option, value=value))
     return v
-
-
-def _spline(t, y, k: int, s: float):
-    """``scipy.interpolate.UnivariateSpline(t, y, k=k, s=s)``, imported here: scipy.interpolate takes ~1 s of CPU
-    to import, which every importer of the trajectories (the controller, the report's sections) would pay
-    without ever smoothing."""
-    from scipy.interpolate import UnivariateSpline
-
-    return UnivariateSpline(t, y, k=k, s=s)

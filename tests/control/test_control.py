@@ -253,6 +253,35 @@ def test_strut_stiffness_and_inertia_are_vectorised_over_poses():
     np.testing.assert_allclose(leg_space_inertia(p, q), [leg_space_inertia(p, qi) for qi in q], rtol=1e-12)
 
 
+def test_strut_stiffness_and_inertia_batched_equal_one_call_per_direction(tmp_path):
+    """``strut_stiffness`` and ``leg_space_inertia`` run their twelve (six) inverse-dynamics poses as one batch:
+    bit for bit the numbers of one ``leg_forces_with_legs`` call per direction (their former code, here as the
+    reference), which the gains, and so the fixed-point firmware's words, depend on."""
+    from stewart_drake.control import leg_space_inertia, strut_stiffness
+    from stewart_drake.core.dynamics import leg_forces_with_legs
+    from stewart_drake.core.kinematics import length_jacobian
+    from tests._own_platform import own_radial
+
+    def reference(p, q0, h=1e-6):
+        z, Jinv = np.zeros_like(q0), np.linalg.inv(length_jacobian(p, q0))
+        pairs = [
+            (leg_forces_with_legs(p, q0 + h * e, z, z), leg_forces_with_legs(p, q0 - h * e, z, z)) for e in np.eye(6)
+        ]
+        K = np.stack([(a - b) / (2 * h) for a, b in pairs], -1) @ Jinv
+        k = np.maximum(0.0, np.linalg.eigvalsh(-(K + np.swapaxes(K, -1, -2)) / 2)[..., -1])
+        M_L = np.stack([leg_forces_with_legs(p, q0, z, z + e, gravity=0.0) for e in np.eye(6)], -1) @ Jinv
+        return k, (M_L + np.swapaxes(M_L, -1, -2)) / 2
+
+    rng = np.random.default_rng(11)
+    for p in (load_preset("utn-dynamic"), load_preset("gonzalez-dutra-2009"), own_radial(tmp_path)):
+        home = p.home_pose()
+        poses = home + rng.uniform(-1, 1, (40, 6)) * [0.02, 0.02, 0.02, 0.05, 0.05, 0.05]
+        for q in (home, poses, poses.reshape(2, 20, 6)):
+            k, M_L = reference(p, q)
+            assert np.array_equal(strut_stiffness(p, q), k)
+            assert np.array_equal(leg_space_inertia(p, q), M_L)
+
+
 def test_strut_stiffness_matches_the_open_loop_growth():
     """The negative stiffness K of the struts and the open-loop growth rate λ (``dynamics``) describe the
     same instability: the fastest growth needs λ² ≤ K / m_min (a stiffness K on the lightest mass), and

@@ -83,3 +83,18 @@ def test_condition_above_on_workspace_jacobians():
     expect = kin.scaled_condition(g, J) > 3.0
     assert 0.05 < expect.mean() < 0.95
     np.testing.assert_array_equal(kin.condition_above(g, J, 3.0), expect)
+
+
+def test_one_matrix_gives_the_answer_of_a_batch():
+    """One ``(6, 6)`` matrix that the bound leaves to the SVD (near the limit; exactly singular) is decided as in
+    a batch, not refused with a numpy error (its answer was a 0-d array turned scalar): the leg forces at one
+    pose a ten-millionth of a radian off the gimbal lock (κ ≈ 7.7e7 < 1e8) exist, those at the lock are named."""
+    q = PLATFORM.home_pose() + [0.0, 0.0, 0.0, np.pi / 2 - 1e-7, 0.0, 0.0]
+    J = kin.length_jacobian(PLATFORM, q)
+    assert MAX_CONDITION / 4 < kin.scaled_condition(PLATFORM, J) <= MAX_CONDITION  # the SVD decides, yes
+    assert (
+        kin.condition_at_most(PLATFORM, J, MAX_CONDITION) == kin.condition_at_most(PLATFORM, J[None], MAX_CONDITION)[0]
+    )
+    assert kin.condition_at_most(PLATFORM, np.zeros((6, 6)), MAX_CONDITION) == np.False_
+    F = leg_forces_with_legs(PLATFORM, q, np.zeros(6), np.zeros(6))
+    assert np.array_equal(F, leg_forces_with_legs(PLATFORM, q[None], np.zeros(6), np.zeros(6))[0])
