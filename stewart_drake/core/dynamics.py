@@ -284,12 +284,17 @@ def jacobian_condition(platform: Platform, q, convention: str = "utn") -> np.nda
 def solve_leg_forces(platform: Platform, q, Q, convention: str = "utn") -> np.ndarray:
     """``(..., 6)`` F (N) with Jᵀ(q) F = Q; raises ``SingularPoseError`` naming the first sample whose J
     has a scaled condition number above ``MAX_CONDITION``."""
-    return _solve_transposed(platform, length_jacobian(platform, q, convention), Q)
+    return leg_forces_from_jacobians(platform, length_jacobian(platform, q, convention), Q)
 
 
-def _solve_transposed(platform: Platform, J, Q) -> np.ndarray:
-    """``(..., 6)`` F with Jᵀ F = Q for the length Jacobians ``J`` (``solve_leg_forces``)."""
-    idx = first_index(~condition_at_most(platform, J, MAX_CONDITION))
+def leg_forces_from_jacobians(platform: Platform, J, Q, rows=None) -> np.ndarray:
+    """``(..., 6)`` F with Jᵀ F = Q for the length Jacobians ``J`` (``solve_leg_forces``, for a caller that has
+    them); ``SingularPoseError`` naming the first sample above ``MAX_CONDITION``. ``rows``: ``(n,)`` indices into
+    ``(m, 6, 6)`` J, sample k's Jacobian being ``J[rows[k]]``: each distinct J's condition is checked once."""
+    ok = condition_at_most(platform, J, MAX_CONDITION)
+    if rows is not None:
+        ok, J = ok[rows], J[rows]
+    idx = first_index(~ok)
     if idx is not None:
         k = scaled_condition(platform, J[idx])
         raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=float(k), limit=MAX_CONDITION))
@@ -396,7 +401,7 @@ def leg_forces_with_legs(
     m_sum = cross(r, f_tip).sum(-2)
     Q = Q + np.concatenate([f_sum, np.einsum("...ji,...j->...i", mo["E"], m_sum)], -1)
     # J = ∂L/∂q from the legs and E_W at hand: ``length_jacobian``'s numbers without its second pass over the poses
-    return _solve_transposed(platform, length_jacobian_of(inverse_jacobian_of_legs(l, r), mo["E"]), Q)
+    return leg_forces_from_jacobians(platform, length_jacobian_of(inverse_jacobian_of_legs(l, r), mo["E"]), Q)
 
 
 def skew(v) -> np.ndarray:

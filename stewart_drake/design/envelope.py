@@ -26,24 +26,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stewart_drake.core import dynamics
-from stewart_drake.core.argcheck import as_poses, first_index
+from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.dynamics import (
     G_EARTH,
     euler_rate_derivative,
     generalized_force,
     leg_forces,
+    leg_forces_from_jacobians,
     leg_forces_with_legs,
     skew,
 )
 from stewart_drake.core.geometry import Platform, load_yaml_config
 from stewart_drake.core.kinematics import (
     check_stroke,
-    condition_at_most,
     condition_number,
     leg_lengths,
     length_jacobian,
-    scaled_condition,
 )
 from stewart_drake.core.rotations import (
     angle_scale,
@@ -54,7 +52,7 @@ from stewart_drake.core.rotations import (
 )
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.design.boxquad import box_quadratic_max
-from stewart_drake.errors import SINGULAR_SAMPLE, EnvelopeError, SingularPoseError, StewartError, counted
+from stewart_drake.errors import EnvelopeError, StewartError
 
 MAX_POSES = 10_000_000  # envelope poses held in memory at once (work is chunked; results are (n, 6) arrays)
 MAX_CONDITION = 1e8  # as dynamics.MAX_CONDITION: leg forces are meaningless beyond it
@@ -326,16 +324,10 @@ def cartesian_leg_forces_at(
     V, Vd = (as_poses(a, name, f"{name} sample") for a, name in ((V, "V"), (Vd, "Vd")))
     E = angular_velocity_map(poses[:, 3:], convention)[k]
     rates = np.linalg.solve(E, V[..., 3:, None])[..., 0]
-    acc = np.linalg.solve(E, (Vd[..., 3:] - euler_rate_derivative(q[..., 3:], rates, convention))[..., None])[..., 0]
+    acc = np.linalg.solve(E, (Vd[..., 3:] - euler_rate_derivative(q[..., 3:], rates, convention, E))[..., None])[..., 0]
     qd, qdd = np.concatenate([V[..., :3], rates], -1), np.concatenate([Vd[..., :3], acc], -1)
     Q = generalized_force(platform, q, qd, qdd, convention, True, gravity)
-    J = length_jacobian(platform, poses, convention)  # as dynamics.solve_leg_forces, once per distinct pose
-    limit = dynamics.MAX_CONDITION
-    idx = first_index(~condition_at_most(platform, J, limit)[k])
-    if idx is not None:
-        cond = float(scaled_condition(platform, J[k[idx]]))
-        raise SingularPoseError(SINGULAR_SAMPLE.format(index=counted(idx), cond=cond, limit=limit))
-    return np.linalg.solve(np.swapaxes(J[k], -1, -2), Q[..., None])[..., 0]
+    return leg_forces_from_jacobians(platform, length_jacobian(platform, poses, convention), Q, rows=k)
 
 
 def _generic_terms(platform: Platform, q, convention, gravity):
