@@ -16,6 +16,7 @@ import pickle
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.memo import Memo, digest
@@ -63,12 +64,10 @@ def _forces_of_distinct_rows(platform: Platform, q, qd, qdd) -> np.ndarray:
     ``(n, 6)`` rows (the same numbers: it is elementwise over rows; rows compared bit for bit): a held
     reference — the set-point step's rest pose (``drake.simulation.setpoint_step_gain``), a CSV that pauses —
     costs one row per distinct state, not one per tick."""
-    rows = np.concatenate([q, qd, qdd], axis=1)
-    keys = rows.view(np.dtype((np.void, rows.itemsize * rows.shape[1]))).ravel()
-    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
-    if len(first) == len(rows):
+    rows, inverse = distinct_rows(np.concatenate([q, qd, qdd], axis=1))
+    if len(rows) == len(q):
         return leg_forces_with_legs(platform, q, qd, qdd)
-    return leg_forces_with_legs(platform, q[first], qd[first], qdd[first])[inverse.reshape(-1)]
+    return leg_forces_with_legs(platform, *(np.ascontiguousarray(rows[:, k : k + 6]) for k in (0, 6, 12)))[inverse]
 
 
 TABLE_CACHE = Memo(8)  # the last 8 feed-forward tables of this process

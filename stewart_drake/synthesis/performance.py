@@ -97,6 +97,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.dynamics import G_EARTH, skew
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius
@@ -310,20 +311,6 @@ def performance_bounds(
         np.where(invertible, freq_c, 0.0),
         kappa_c,
     )
-
-
-def distinct_rows(x) -> tuple[np.ndarray, np.ndarray]:
-    """``(rows (m, k), inverse (n,))``: the distinct rows of the float (n, k) ``x``, told apart by their bits (so
-    −0.0 and 0.0 stay apart and a gathered result is the one of the row itself), with ``rows[inverse] == x``."""
-    x = np.ascontiguousarray(x, dtype=float)
-    bits = x.view(np.int64)
-    order = np.lexsort(bits.T[::-1])  # rows sorted by their bits (np.unique(axis=0) is 7x slower here)
-    ranked = bits[order]
-    first = np.ones(len(x), bool)
-    first[1:] = np.any(ranked[1:] != ranked[:-1], axis=1)
-    inverse = np.empty(len(x), np.intp)
-    inverse[order] = np.cumsum(first) - 1
-    return x[order[first]], inverse
 
 
 def _certified_frequency(k_shrink, Gm, e_G, eps_K, M_s, eps_M) -> np.ndarray:

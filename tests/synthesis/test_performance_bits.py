@@ -10,7 +10,7 @@ import dataclasses
 
 import numpy as np
 
-from stewart_drake.synthesis.performance import distinct_rows, performance_bounds
+from stewart_drake.synthesis.performance import performance_bounds
 from stewart_drake.synthesis.proof import Cells
 from stewart_drake.synthesis.verified import quad_box_max
 
@@ -60,13 +60,3 @@ def test_quad_box_max_per_entry_whatever_the_batch():
         ):
             v2, u2 = quad_box_max(Qb[part], b)
             assert v2.tobytes() == value[part].tobytes() and u2.tobytes() == upper[part].tobytes()
-
-
-def test_distinct_rows_tell_rows_apart_by_their_bits():
-    rng = np.random.default_rng(4)
-    x = rng.normal(size=(7, 3))[rng.integers(0, 7, 300)]  # 300 rows, at most 7 distinct
-    x[::50, 1] = -0.0
-    x[1::50, 1] = 0.0  # equal as numbers, different bits: kept apart (a gathered result is the row's own)
-    rows, inverse = distinct_rows(x)
-    assert rows[inverse].tobytes() == x.tobytes()
-    assert len({r.tobytes() for r in rows}) == len(rows) == len({r.tobytes() for r in x})
