@@ -330,16 +330,19 @@ def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
 
 
 def run_analyses(
-    analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1, cache: bool = False
+    analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1, cache: bool = False, on_start=None
 ) -> list[Section]:
     """Build each analysis's section, in ``jobs`` worker processes (1: in this process), printing a
     line per analysis as it finishes to ``log`` (default: the current stderr, not the one at import
     time); the sections come back in the analyses' order. ``cache``: take a section whose inputs and
-    code are unchanged from the result cache (``report.cache``) and store each one computed."""
+    code are unchanged from the result cache (``report.cache``) and store each one computed.
+    ``on_start``: called with a line saying how many analyses run, and in how many processes."""
     log = log or sys.stderr
     if cache:
-        return _run_cached(analyses, quick, log, jobs)
+        return _run_cached(analyses, quick, log, jobs, on_start)
     n = len(analyses)
+    if on_start:
+        on_start(_start_line(n, jobs))
     if jobs <= 1 or n <= 1:
         sections = []
         for k, a in enumerate(analyses, 1):
@@ -373,7 +376,14 @@ def run_analyses(
     return sections
 
 
-def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int) -> list[Section]:
+def _start_line(n: int, jobs: int, cached: int = 0) -> str:
+    """'running N analyses in J processes' (in this process where one runs, or with one job), and how many
+    sections come from the cache."""
+    where = f"in {jobs} processes" if jobs > 1 and n > 1 else "in this process"
+    return f"running {n} analys{'es' if n != 1 else 'is'} {where}" + (f", {cached} from the cache" if cached else "")
+
+
+def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int, on_start=None) -> list[Section]:
     """``run_analyses`` through the result cache: hits first, then the misses computed and stored."""
     from stewart_drake.report import cache
 
@@ -383,9 +393,11 @@ def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int) -> list[S
         if s is not None:
             s.cached = True
     hits = [i for i, s in enumerate(sections) if s is not None]
+    todo = [i for i, s in enumerate(sections) if s is None]
+    if on_start:
+        on_start(_start_line(len(todo), jobs, len(hits)))
     for k, i in enumerate(hits, 1):
         _progress(k, len(analyses), sections[i], log)
-    todo = [i for i, s in enumerate(sections) if s is None]
     for i, s in zip(todo, run_analyses([analyses[i] for i in todo], quick, log, jobs)):
         sections[i] = s
         if not s.crashed:

@@ -70,7 +70,8 @@ def report(
         quick: smaller samples (a smoke test).
         jobs: analyses run in this many worker processes (default the CPUs, at most 4; 1: in this process).
         force: write into an existing folder that holds other files (they are never touched).
-        on_start: called with a line saying how many analyses run in how many processes.
+        on_start: called with a line saying how many analyses run in how many processes, how many come
+            from the cache.
         cache: take a section whose inputs and code version are unchanged from the result cache under
             ``$STEWART_DRAKE_CACHE`` (``report.cache``: checks and figures exactly as computed) and store
             each section computed; False: every section computed, the cache neither read nor written.
@@ -90,9 +91,7 @@ def report(
     check_workers("--jobs", jobs)  # the one rule for worker counts (core.processes)
     t0 = time.perf_counter()
     analyses = discover_analyses(only=only)
-    if on_start:
-        on_start(f"running {len(analyses)} analyses in {jobs} process{'es' if jobs > 1 else ''}")
-    sections = run_analyses(analyses, quick=quick, jobs=jobs, cache=cache)
+    sections = run_analyses(analyses, quick=quick, jobs=jobs, cache=cache, on_start=on_start)
     elapsed = time.perf_counter() - t0
     meta = render.default_meta(sections, command_line(), elapsed, PRESETS)
     index = write_report(sections, folder, meta=meta)

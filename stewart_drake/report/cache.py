@@ -1,11 +1,13 @@
-"""The report's result cache: a section is recomputed only when its inputs or the code changed.
+"""The report's result cache: a section is recomputed only when its inputs or its code changed.
 
-A section's key is the SHA-256 of: the code version (``code_version``: every source and data file of the
-installed ``stewart_drake`` package, by relative path and content, plus the versions of Python and of the
-libraries that draw or compute, ``DEPENDENCIES``), the analysis' name, the content of its script when it
-lies outside the package, the ``quick`` flag, and the compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an
-input of the sections that run it). The analyses read only the built-in presets (package files, so part of
-the code version) and their own fixed seeds: nothing else is an input.
+A section's key is the SHA-256 of: its code version (``code_version``: the package sources its analysis reaches
+by imports, ``code_deps.closure``, and every data file of the installed ``stewart_drake`` package, by relative
+path and content, plus the versions of Python and of the libraries that draw or compute, ``DEPENDENCIES``), the
+analysis' name, the content of its script when it lies outside the package, the ``quick`` flag, and the
+compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an input of the
+sections that run it). The analyses read only the built-in presets (package files, so part of the code version)
+and their own fixed seeds: nothing else is an input. So an edit of a module recomputes the sections whose
+analyses import it, directly or not, and no other.
 
 The entry is the pickled ``Section`` (its text, tables, figures' PNG bytes, checks, warnings, original run
 time), so a hit gives back the section exactly as it was computed. Entries live in
@@ -30,17 +32,26 @@ FORMAT = 1  # bump when the entry's layout changes
 DEPENDENCIES = ("drake", "numpy", "scipy", "matplotlib", "pymoo", "python-flint", "cffi")
 
 
+def _digest(p: Path) -> bytes:
+    """SHA-256 of file ``p``'s bytes."""
+    return hashlib.sha256(p.read_bytes()).digest()
+
+
+_package_digest = cache(_digest)  # a package file's: read once per process (the package does not change under it)
+
+
 @cache
-def code_version(root: Path = PACKAGE) -> str:
-    """SHA-256 (hex) of every file of the package under ``root`` but the bytecode caches (relative path and
-    bytes, in sorted order: sources, C files, presets, grammars, tables), of the Python version and of the
-    ``DEPENDENCIES``' versions: any edit of the code or its data, or an upgrade, changes it."""
+def data_version(root: Path = PACKAGE) -> str:
+    """SHA-256 (hex) of every package file under ``root`` but the Python sources and the bytecode caches
+    (relative path and bytes, in sorted order: C files, presets, grammars, tables), of the Python version and
+    of the ``DEPENDENCIES``' versions: an edit of any data, or an upgrade, changes every section's key."""
     import numpy as np
 
     h = hashlib.sha256()
-    for p in sorted(q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix != ".pyc"):
-        h.update(str(p.relative_to(root)).encode() + b"\0")
-        h.update(hashlib.sha256(p.read_bytes()).digest())
+    for p in sorted(
+        q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix not in (".py", ".pyc")
+    ):
+        h.update(str(p.relative_to(root)).encode() + b"\0" + _package_digest(p))
     from importlib.metadata import PackageNotFoundError, version
 
     for dist in DEPENDENCIES:
@@ -52,13 +63,30 @@ def code_version(root: Path = PACKAGE) -> str:
     return h.hexdigest()
 
 
+@cache
+def code_version(path: Path | None, root: Path = PACKAGE) -> str:
+    """SHA-256 (hex) of the code a section of the analysis script at ``path`` runs: ``data_version`` and the
+    package sources its imports reach (``code_deps.closure``; every package source when ``path`` is None)."""
+    from stewart_drake.report.code_deps import closure
+
+    sources = (
+        closure(path, root)
+        if path is not None
+        else sorted(p for p in root.rglob("*.py") if "__pycache__" not in p.parts)
+    )
+    h = hashlib.sha256(data_version(root).encode())
+    for p in sources:
+        h.update(str(p.relative_to(root)).encode() + b"\0" + _package_digest(p))
+    return h.hexdigest()
+
+
 def section_key(analysis, quick: bool) -> str:
     """The cache key (hex) of ``analysis``' section (see the module docstring)."""
-    h = hashlib.sha256(code_version().encode())
-    h.update(f"|{analysis.name}|{bool(quick)}".encode())
     path = Path(analysis.path).resolve() if analysis.path is not None else None
+    h = hashlib.sha256(code_version(path).encode())
+    h.update(f"|{analysis.name}|{bool(quick)}".encode())
     if path is not None and PACKAGE not in path.parents:
-        h.update(b"|script|" + hashlib.sha256(path.read_bytes()).digest())
+        h.update(b"|script|" + _digest(path))
     for var in ("STEWART_DRAKE_CC", "CC"):
         h.update(f"|{var}={os.environ.get(var, '')}".encode())
     return h.hexdigest()

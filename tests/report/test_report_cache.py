@@ -62,27 +62,29 @@ def test_a_hit_gives_the_section_back_exactly_without_running_it(counted):
 
 def test_a_new_code_version_or_script_is_a_miss(counted, monkeypatch):
     _run(counted)
-    real = cache.code_version()
-    monkeypatch.setattr(cache, "code_version", lambda: real[::-1])  # any edit of the package
+    real = cache.code_version((counted / "counted.py").resolve())
+    monkeypatch.setattr(cache, "code_version", lambda path: real[::-1])  # an edit of the code it runs
     s, _ = _run(counted)
     assert _runs(counted) == 2 and not s.cached and s.checks[0].what == "run 2"
-    monkeypatch.setattr(cache, "code_version", lambda: real)
+    monkeypatch.setattr(cache, "code_version", lambda path: real)
     assert _run(counted)[0].cached  # the first version's entry is still there
     (counted / "counted.py").write_text(ANALYSIS + "\n# edited\n")  # an analysis outside the package: its own text
     s, _ = _run(counted)
     assert _runs(counted) == 3 and not s.cached
 
 
-def test_code_version_follows_every_package_file(tmp_path):
+def test_data_version_follows_every_package_data_file(tmp_path):
     (tmp_path / "a.py").write_text("x = 1\n")
     (tmp_path / "data").mkdir()
     (tmp_path / "data" / "p.yaml").write_text("name: p\n")
-    v0 = cache.code_version.__wrapped__(tmp_path)
+    v0 = cache.data_version.__wrapped__(tmp_path)
     (tmp_path / "data" / "p.yaml").write_text("name: q\n")
-    v1 = cache.code_version.__wrapped__(tmp_path)
+    cache._package_digest.cache_clear()
+    v1 = cache.data_version.__wrapped__(tmp_path)
     (tmp_path / "__pycache__").mkdir()
     (tmp_path / "__pycache__" / "a.cpython-312.pyc").write_bytes(b"\0")
-    assert v0 != v1 == cache.code_version.__wrapped__(tmp_path)  # bytecode is not code
+    (tmp_path / "a.py").write_text("x = 2\n")  # a source: in the versions of the sections that reach it
+    assert v0 != v1 == cache.data_version.__wrapped__(tmp_path)  # bytecode is not code
 
 
 def test_no_cache_recomputes_and_a_crash_is_not_stored(counted):
@@ -107,6 +109,12 @@ def test_report_command_no_cache(tmp_path, monkeypatch, capsys):
     checks = [json.loads((tmp_path / f"r{k}" / "checks.json").read_text()) for k in range(3)]
     assert checks[0] == checks[1] == checks[2] and checks[0]
     assert ["from the cache" in e for e in logs] == [False, True, False]
+    # the first line says what runs where: nothing runs on the second
+    assert [e.splitlines()[0] for e in logs] == [
+        "running 1 analysis in this process",
+        "running 0 analyses in this process, 1 from the cache",
+        "running 1 analysis in this process",
+    ]
     assert (tmp_path / "r0" / "seed_table_matlab.png").read_bytes() == (
         tmp_path / "r1" / "seed_table_matlab.png"
     ).read_bytes()
