@@ -20,6 +20,7 @@ from stewart_drake.report import cache, code_deps
 from stewart_drake.report.code_deps import PACKAGE, closure, import_targets, module_name, package_of, resolve
 
 ANALYSES = sorted((PACKAGE / "analyses").glob("[!_]*.py"))
+CODE_DEPS_MEMOS = (code_deps._modules, code_deps._public, code_deps._graph)
 
 
 def _parsed_targets(text: str, package: str) -> set:
@@ -77,6 +78,9 @@ def test_the_scan_reads_the_forms_of_import():
     assert {"stewart_drake", "stewart_drake.core.geometry", "stewart_drake.design.stiffness"} <= reached
     assert "stewart_drake.api.simulation" not in reached  # only under TYPE_CHECKING
     # the lazy public API: a name reaches its module; the bound top name reaches every module of the API
+    import stewart_drake
+
+    assert code_deps._public(PACKAGE) == {name: module for name, (module, _) in stewart_drake._PUBLIC.items()}
     assert "stewart_drake.api.simulation" in resolve({("stewart_drake", ("simulate",))})
     assert "stewart_drake.synthesis.api" in resolve({("stewart_drake", ("",))})
 
@@ -132,12 +136,12 @@ def package_copy(tmp_path):
     root = tmp_path / "stewart_drake"
     shutil.copytree(PACKAGE, root, ignore=shutil.ignore_patterns("__pycache__", "*.so", "*.pyc"))
     yield root
-    for f in (cache._package_digest, cache.data_version, cache.code_version, code_deps._modules, code_deps._graph):
+    for f in (cache._package_digest, cache.data_version, cache.code_version, *CODE_DEPS_MEMOS):
         f.cache_clear()
 
 
 def _versions(root: Path) -> dict:
-    for f in (cache._package_digest, cache.data_version, cache.code_version, code_deps._modules, code_deps._graph):
+    for f in (cache._package_digest, cache.data_version, cache.code_version, *CODE_DEPS_MEMOS):
         f.cache_clear()
     return {name: cache.code_version(root / "analyses" / f"{name}.py", root) for name in ("seed_table", "synthesis")}
 
