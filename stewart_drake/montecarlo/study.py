@@ -7,8 +7,9 @@ it and runs only the missing indices (JSON keeps every float bit for bit). At th
 replaced atomically by the final files (``summary.write_outputs``).
 
 Dask: ``--workers K`` starts a ``LocalCluster`` of K single-threaded worker processes; ``--scheduler``
-connects to an existing one. The ``Study`` is scattered to the workers once; each task is one run index
-(``retries``: a run on a worker that dies is re-run elsewhere). Each run's result depends only on the
+connects to an existing one. Each task is the ``Study`` (a few kB pickled) and one run index, so a run on a worker
+that dies is re-run elsewhere (``retries``); a scattered study would be lost for good with a worker holding its
+only replica (distributed: "lost scattered data, which can't be recovered"). Each run's result depends only on the
 study and its index, so the rows are the same with any number of workers.
 """
 
@@ -359,8 +360,9 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
     else:
         client = Client(scheduler)
     try:
-        s = client.scatter(study, broadcast=True)
-        futures = [client.submit(run_row, s, i, retries=RETRIES, pure=False) for i in todo]
+        # each task carries the study (~2 kB pickled) rather than a scattered copy: a worker killed while it
+        # held the only replica would lose scattered data for good, and every run waiting on it would fail
+        futures = [client.submit(run_row, study, i, retries=RETRIES, pure=False) for i in todo]
         for fut in as_completed(futures):
             yield fut.result()
             fut.release()
