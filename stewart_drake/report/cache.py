@@ -67,13 +67,9 @@ def data_version(root: Path = PACKAGE) -> str:
 def code_version(path: Path | None, root: Path = PACKAGE) -> str:
     """SHA-256 (hex) of the code a section of the analysis script at ``path`` runs: ``data_version`` and the
     package sources its imports reach (``code_deps.closure``; every package source when ``path`` is None)."""
-    from stewart_drake.report.code_deps import closure
+    from stewart_drake.report.code_deps import all_sources, closure
 
-    sources = (
-        closure(path, root)
-        if path is not None
-        else sorted(p for p in root.rglob("*.py") if "__pycache__" not in p.parts)
-    )
+    sources = closure(path, root) if path is not None else all_sources(root)
     h = hashlib.sha256(data_version(root).encode())
     for p in sources:
         h.update(str(p.relative_to(root)).encode() + b"\0" + _package_digest(p))

@@ -94,6 +94,11 @@ def _modules(root: Path) -> dict[str, Path]:
     return {module_name(p, root): p for p in sorted(root.rglob("*.py")) if "__pycache__" not in p.parts}
 
 
+def all_sources(root: Path = PACKAGE) -> list[Path]:
+    """Every package source under ``root``, sorted: what a section of unknown imports can depend on."""
+    return sorted(_modules(root).values())
+
+
 @cache
 def _public(root: Path) -> dict[str, str]:
     """The lazy public API of the top package: public name -> the module that defines it (its ``_PUBLIC`` table,

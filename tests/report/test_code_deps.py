@@ -20,7 +20,14 @@ from stewart_drake.report import cache, code_deps
 from stewart_drake.report.code_deps import PACKAGE, closure, import_targets, module_name, package_of, resolve
 
 ANALYSES = sorted((PACKAGE / "analyses").glob("[!_]*.py"))
-CODE_DEPS_MEMOS = (code_deps._modules, code_deps._public, code_deps._graph)
+
+
+def _forget() -> None:
+    """Forget the memoised reads of the package (a test edits a copy of it)."""
+    for f in (cache._package_digest, cache.data_version, cache.code_version):
+        f.cache_clear()
+    for f in (code_deps._modules, code_deps._public, code_deps._graph):
+        f.cache_clear()
 
 
 def _parsed_targets(text: str, package: str) -> set:
@@ -136,13 +143,11 @@ def package_copy(tmp_path):
     root = tmp_path / "stewart_drake"
     shutil.copytree(PACKAGE, root, ignore=shutil.ignore_patterns("__pycache__", "*.so", "*.pyc"))
     yield root
-    for f in (cache._package_digest, cache.data_version, cache.code_version, *CODE_DEPS_MEMOS):
-        f.cache_clear()
+    _forget()
 
 
 def _versions(root: Path) -> dict:
-    for f in (cache._package_digest, cache.data_version, cache.code_version, *CODE_DEPS_MEMOS):
-        f.cache_clear()
+    _forget()
     return {name: cache.code_version(root / "analyses" / f"{name}.py", root) for name in ("seed_table", "synthesis")}
 
 
