@@ -33,7 +33,7 @@ from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
-from stewart_drake.report import figures, metadata, parts, render
+from stewart_drake.report import figures, metadata, parts, reads, render
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 
@@ -69,6 +69,7 @@ class Section:
     warnings: list[str] = field(default_factory=list)
     crashed: bool = False  # the analysis raised (never cached)
     cached: bool = False  # given back by the result cache (``report.cache``), not computed in this run
+    inputs: dict[str, str] = field(default_factory=dict)  # files it read outside the package (``report.reads``)
 
     def headline(self, text: str) -> None:
         """The one figure that sums the section up, shown in the report's verdict table (default: the
@@ -284,20 +285,22 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
 
 def build_section(analysis: Analysis, quick: bool = False) -> Section:
     """Run one analysis into a new ``Section`` (timed); an analysis that raises becomes a failed check."""
-    if isinstance(analysis.build, FromScript):  # its import is not the section's time (as when it was discovered)
+    with reads.recording() as opened:  # the files it reads, its import's included (``report.reads``)
+        if isinstance(analysis.build, FromScript):  # its import is not the section's time (as when it was discovered)
+            try:
+                loaded(analysis.build.path)
+            except Exception:  # noqa: BLE001, S110 - raised again by the build below, and reported as its failure
+                pass
+        t0, c0 = time.perf_counter(), time.process_time()
+        s = Section(analysis.title, quick=quick)
         try:
-            loaded(analysis.build.path)
-        except Exception:  # noqa: BLE001, S110 - raised again by the build below, and reported as its failure
-            pass
-    t0, c0 = time.perf_counter(), time.process_time()
-    s = Section(analysis.title, quick=quick)
-    try:
-        analysis.build(s)
-    except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
-        s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
-        s.check(f"{analysis.name} ran to completion", 1.0, 0.0)
-        s.crashed = True
-    s.elapsed, s.cpu = time.perf_counter() - t0, time.process_time() - c0
+            analysis.build(s)
+        except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
+            s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
+            s.check(f"{analysis.name} ran to completion", 1.0, 0.0)
+            s.crashed = True
+        s.elapsed, s.cpu = time.perf_counter() - t0, time.process_time() - c0
+    s.inputs = reads.digests(opened)
     return s
 
 
@@ -352,7 +355,7 @@ def run_analyses(
     sections: list[Section | None] = [None] * n
     finished = [0]
 
-    def on_section(i, f, parts_wall, parts_cpu, n_parts):
+    def on_section(i, f, parts_wall, parts_cpu, n_parts, parts_inputs):
         try:
             s = f.result()
         except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
@@ -363,6 +366,7 @@ def run_analyses(
             s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
             s.elapsed, s.crashed = 0.0, True
         s.parts = n_parts
+        s.inputs.update(parts_inputs)
         s.elapsed = (s.elapsed or 0.0) + parts_wall
         s.cpu = (s.cpu or 0.0) + parts_cpu
         sections[i] = s

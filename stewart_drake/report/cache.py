@@ -6,8 +6,9 @@ path and content, plus the versions of Python and of the libraries that draw or 
 analysis' name, the content of its script when it lies outside the package, the ``quick`` flag, and the
 compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an input of the
 sections that run it). The analyses read only the built-in presets (package files, so part of the code version)
-and their own fixed seeds: nothing else is an input. So an edit of a module recomputes the sections whose
-analyses import it, directly or not, and no other.
+and their own fixed seeds. So an edit of a module recomputes the sections whose analyses import it, directly or
+not, and no other. A script of the user's may read files of its own: each entry carries the files its section
+read outside the package (``report.reads``), and is given back only while they are unchanged.
 
 The entry is the pickled ``Section`` (its text, tables, figures' PNG bytes, checks, warnings, original run
 time), so a hit gives back the section exactly as it was computed. Entries live in
@@ -26,8 +27,10 @@ import tempfile
 from functools import cache
 from pathlib import Path
 
+from stewart_drake.report import reads
+
 PACKAGE = Path(__file__).resolve().parents[1]
-FORMAT = 1  # bump when the entry's layout changes
+FORMAT = 2  # bump when the entry's layout changes (2: a section carries the files it read, ``report.reads``)
 # the libraries whose versions can change a section's numbers or figures (part of the code version)
 DEPENDENCIES = ("drake", "numpy", "scipy", "matplotlib", "pymoo", "python-flint", "cffi")
 
@@ -101,17 +104,19 @@ def folder() -> Path | None:
 
 
 def load(key: str):
-    """The cached ``Section`` of ``key``, or None (absent, unreadable, or the cache unusable)."""
+    """The cached ``Section`` of ``key``, or None (absent, unreadable, a file it read changed, or the cache
+    unusable)."""
     d = folder()
     if d is None:
         return None
     try:
         with open(d / f"{key}.pickle", "rb") as f:
-            return pickle.load(f)
+            section = pickle.load(f)
     except FileNotFoundError:
         return None
     except Exception:  # noqa: BLE001 - a truncated or foreign entry is a miss, recomputed and rewritten
         return None
+    return section if reads.unchanged(section.inputs) else None  # a file it read was edited or removed
 
 
 def store(key: str, section) -> None:

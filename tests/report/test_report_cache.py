@@ -3,6 +3,7 @@ analysis; a change of the code version or of the analysis' script is a miss; ``-
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 
@@ -118,3 +119,32 @@ def test_report_command_no_cache(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "r0" / "seed_table_matlab.png").read_bytes() == (
         tmp_path / "r1" / "seed_table_matlab.png"
     ).read_bytes()
+
+
+# An analysis of the user's that reads a file of its own (its platform, say): the file is an input of its section.
+READER = """
+from pathlib import Path
+import stewart_drake
+TITLE, ORDER = "reader", 1
+DATA = Path(__file__).with_name("data.txt")
+def build(section):
+    stewart_drake.load_platform("utn-dynamic")  # a package file read: keyed by the code version, not recorded
+    section.check("the value in data.txt", float(DATA.read_text()), 10.0, "1")
+"""
+
+
+def test_a_file_the_section_read_is_an_input(tmp_path, monkeypatch):
+    monkeypatch.setenv("STEWART_DRAKE_CACHE", str(tmp_path / "cache"))
+    d = tmp_path / "analyses"
+    d.mkdir()
+    (d / "reader.py").write_text(READER)
+    (d / "data.txt").write_text("1.5")
+    first, _ = _run(d)
+    assert first.inputs == {str((d / "data.txt").resolve()): hashlib.sha256(b"1.5").hexdigest()}
+    assert _run(d)[0].cached
+    (d / "data.txt").write_text("2.5")  # edited: computed again, with the new value
+    s, _ = _run(d)
+    assert not s.cached and s.checks[0].worst == 2.5 and _run(d)[0].cached
+    (d / "data.txt").unlink()  # removed: computed again (and it fails, saying why)
+    s, _ = _run(d)
+    assert not s.cached and s.crashed
