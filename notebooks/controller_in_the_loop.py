@@ -1,3 +1,11 @@
+# ---
+# jupyter:
+#   kernelspec:
+#     display_name: Python 3 (ipykernel)
+#     language: python
+#     name: python3
+# ---
+
 # %% [markdown]
 # # Controller in the loop: fixed point vs float, and the sample period
 #
@@ -7,6 +15,7 @@
 # run recorded as a Meshcat animation. Runs are kept short (0.3 s) so that the notebook runs in seconds.
 
 # %%
+# %matplotlib inline
 import tempfile
 from pathlib import Path
 
@@ -15,7 +24,8 @@ import numpy as np
 
 import stewart_drake as sd
 
-OUT = Path(tempfile.mkdtemp(prefix="stewart-drake-loop-"))  # everything this notebook writes goes here
+WORK = tempfile.TemporaryDirectory(prefix="stewart-drake-loop-")  # removed by the last cell, or when the kernel ends
+OUT = Path(WORK.name)  # everything this notebook writes goes here
 platform = sd.load_platform("utn-dynamic")
 reference = sd.Trajectory.seed()
 DURATION = 0.3  # s
@@ -81,3 +91,9 @@ animation = runs["fixed"].animate()
 path = animation.save(OUT / "fixed.html")
 print(path, f"{path.stat().st_size / 1e3:.0f} kB")
 animation  # noqa: B018 (a notebook shows the last expression: the animation, inline)
+
+# %% [markdown]
+# The notebook's temporary folder is removed.
+
+# %%
+WORK.cleanup()

@@ -1,3 +1,11 @@
+# ---
+# jupyter:
+#   kernelspec:
+#     display_name: Python 3 (ipykernel)
+#     language: python
+#     name: python3
+# ---
+
 # %% [markdown]
 # # Design check of a platform of your own
 #
@@ -6,6 +14,7 @@
 # frequencies. Everything is SI (m, rad, s, N, kg); the figures convert to mm and degrees for reading.
 
 # %%
+# %matplotlib inline
 import tempfile
 from pathlib import Path
 
@@ -15,7 +24,8 @@ import pandas as pd
 
 import stewart_drake as sd
 
-OUT = Path(tempfile.mkdtemp(prefix="stewart-drake-design-"))  # everything this notebook writes goes here
+WORK = tempfile.TemporaryDirectory(prefix="stewart-drake-design-")  # removed by the last cell, or when the kernel ends
+OUT = Path(WORK.name)  # everything this notebook writes goes here
 
 # %% [markdown]
 # ## The platform
@@ -136,3 +146,9 @@ ax[0].set(title="log10 |K|", xticks=range(6), yticks=range(6))
 ax[1].bar(range(1, 7), m.frequencies_hz)
 ax[1].set(xlabel="mode", ylabel="frequency [Hz]", title="natural frequencies at home")
 plt.show()
+
+# %% [markdown]
+# The notebook's temporary folder is removed.
+
+# %%
+WORK.cleanup()

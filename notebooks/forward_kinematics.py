@@ -1,3 +1,11 @@
+# ---
+# jupyter:
+#   kernelspec:
+#     display_name: Python 3 (ipykernel)
+#     language: python
+#     name: python3
+# ---
+
 # %% [markdown]
 # # Forward kinematics: every assembly mode
 #
@@ -8,6 +16,7 @@
 # the UTN 3-6 preset, each mode drawn.
 
 # %%
+# %matplotlib inline
 import subprocess
 import sys
 import tempfile
@@ -18,7 +27,8 @@ import numpy as np
 
 import stewart_drake as sd
 
-OUT = Path(tempfile.mkdtemp(prefix="stewart-drake-fk-"))  # everything this notebook writes goes here
+WORK = tempfile.TemporaryDirectory(prefix="stewart-drake-fk-")  # removed by the last cell, or when the kernel ends
+OUT = Path(WORK.name)  # everything this notebook writes goes here
 
 # %% [markdown]
 # The platform file comes from the command line's template, as a user starts one.
@@ -108,3 +118,9 @@ print(f"complete: {modes_utn.complete}; {len(modes_utn.solutions)} real modes; n
 print(np.round(modes_utn.solutions[0].pose, 6), "(the pose we started from:", pose, ")")
 assert np.allclose(modes_utn.solutions[0].pose, pose, atol=1e-9)
 draw_modes(utn, modes_utn, lengths_utn)
+
+# %% [markdown]
+# The notebook's temporary folder is removed.
+
+# %%
+WORK.cleanup()

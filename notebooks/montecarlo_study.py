@@ -1,3 +1,11 @@
+# ---
+# jupyter:
+#   kernelspec:
+#     display_name: Python 3 (ipykernel)
+#     language: python
+#     name: python3
+# ---
+
 # %% [markdown]
 # # A Monte Carlo robustness study, read back with pandas and pyarrow
 #
@@ -7,6 +15,7 @@
 # study's folder holds `results.parquet`, read back below with pandas and with pyarrow.
 
 # %%
+# %matplotlib inline
 import tempfile
 from pathlib import Path
 
@@ -16,7 +25,10 @@ import pyarrow.parquet as pq
 
 import stewart_drake as sd
 
-OUT = Path(tempfile.mkdtemp(prefix="stewart-drake-montecarlo-"))  # everything this notebook writes goes here
+WORK = tempfile.TemporaryDirectory(
+    prefix="stewart-drake-montecarlo-"
+)  # removed by the last cell, or when the kernel ends
+OUT = Path(WORK.name)  # everything this notebook writes goes here
 platform = sd.load_platform("utn-dynamic")
 
 study = sd.montecarlo(
@@ -63,3 +75,9 @@ ax[0].set(xlabel="gain_scale", ylabel="max |leg error| [mm]", title="error vs dr
 ax[1].set(xlabel="max |leg error| [mm]", title="distribution (4 runs: a sample, not a law)")
 plt.show()
 pd.DataFrame(study.summary["metrics"]).T.filter(["p50", "p95", "max"])
+
+# %% [markdown]
+# The notebook's temporary folder is removed.
+
+# %%
+WORK.cleanup()

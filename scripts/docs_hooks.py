@@ -5,7 +5,11 @@ drift from them.
   command's own argparse parser (``stewart_drake.cli.build_parser``);
 - ``api.md``: one mkdocstrings block per name of ``stewart_drake.__all__``; a public name (or a public method or
   property of a public class) without a docstring is a warning, so ``mkdocs build --strict`` fails on it;
-- ``examples/*.md``: the example notebooks (``notebooks/*.py``, jupytext percent scripts) as pages.
+- ``examples/*.py``: the example notebooks (``notebooks/*.py``, jupytext percent scripts), executed and rendered
+  with their outputs and figures by mkdocs-jupyter (``mkdocs.yml``: no cache, so a page never shows an earlier
+  run's output; a notebook that raises fails the build);
+- ``img/*.png``: the figures of the prose pages, drawn by the package at build time (each preset's joints and legs,
+  the pose angles' sense, a workspace).
 """
 
 from __future__ import annotations
@@ -13,10 +17,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import inspect
+import io
 import logging
 from pathlib import Path
 
 import jupytext
+import matplotlib
+from mkdocs.plugins import event_priority
 from mkdocs.structure.files import File
 
 import stewart_drake
@@ -201,34 +208,21 @@ def api_page(names) -> str:
     return "\n".join(out)
 
 
-def notebook_page(path: Path) -> str:
-    """A percent-script notebook as Markdown: its markdown cells as text, its code cells as Python blocks."""
-    nb = jupytext.read(path)
-    out = [
-        f'!!! note "Run it"\n    `notebooks/{path.name}` (a jupytext percent script). Open it as a notebook with '
-        f"`jupytext --to notebook notebooks/{path.name}`, or run it as a script: `python notebooks/{path.name}`.",
-        "",
-    ]
-    for cell in nb.cells:
-        if cell.cell_type == "markdown":
-            out += [cell.source, ""]
-        elif cell.cell_type == "code" and cell.source.strip():
-            out += ["```python", cell.source, "```", ""]
-    return "\n".join(out)
-
-
 def examples_index(paths) -> str:
     rows = ["| notebook | what |", "|---|---|"]
     for path in paths:
         nb = jupytext.read(path)
         title = next((c.source.splitlines()[0].lstrip("# ") for c in nb.cells if c.cell_type == "markdown"), path.stem)
-        rows.append(f"| [`{path.name}`]({path.stem}.md) | {_cell(title)} |")
+        rows.append(f"| [`{path.name}`]({path.name}) | {_cell(title)} |")
     return "\n".join(
         [
             "# Examples",
             "",
-            "Notebooks written as jupytext percent scripts in `notebooks/`; the test suite executes each one as a "
-            "notebook (`tests/docs/test_notebooks.py`). They write only into a temporary folder.",
+            "Notebooks written as jupytext percent scripts in `notebooks/`, shown here as they ran when this site "
+            "was built, outputs and figures included. Open one as a notebook with `jupyter lab` (after `pip install "
+            "jupyterlab`; jupytext's extension opens `notebooks/*.py` as notebooks: right-click, *Open With → "
+            "Notebook*), convert it with `jupytext --to notebook --execute notebooks/NAME.py`, or run it as a "
+            "script: `python notebooks/NAME.py`. They write only into a temporary folder that they remove.",
             "",
             *rows,
             "",
@@ -240,7 +234,7 @@ def on_config(config):
     """Expand the nav's ``Commands`` and ``Examples`` entries into one page per command and notebook."""
     generated = {
         "commands/index.md": ["commands/index.md", *(f"commands/{n}.md" for n in COMMANDS)],
-        "examples/index.md": ["examples/index.md", *(f"examples/{p.stem}.md" for p in sorted(NOTEBOOKS.glob("*.py")))],
+        "examples/index.md": ["examples/index.md", *(f"examples/{p.stem}.py" for p in sorted(NOTEBOOKS.glob("*.py")))],
     }
     for entry in config["nav"]:
         if isinstance(entry, dict):
@@ -250,8 +244,34 @@ def on_config(config):
     return config
 
 
+def figures() -> dict[str, bytes]:
+    """The prose pages' figures, ``{site path: PNG}``, drawn by the package itself."""
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from stewart_drake import workspace as ws
+    from stewart_drake.core.geometry import PRESETS, load_preset
+    from stewart_drake.design.drawings import convention_figure, platform_figure
+    from stewart_drake.workspace.views import view_figures
+
+    def png(fig) -> bytes:
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=90)
+        plt.close(fig)
+        return buf.getvalue()
+
+    out = {f"img/platform-{name}.png": png(platform_figure(load_preset(name))) for name in PRESETS}
+    gd = load_preset("gonzalez-dutra-2009")
+    out["img/convention.png"] = png(convention_figure(gd))
+    views = view_figures(ws.constant_orientation_workspace(gd, resolution=0.02), title="gonzalez-dutra-2009")
+    for name, fig in views.items():
+        out[f"img/workspace-{name}.png"] = png(fig)
+    return out
+
+
+@event_priority(100)  # before mkdocs-jupyter's on_files, which turns the notebooks added here into pages
 def on_files(files, config):
-    """Add the generated pages to the site."""
+    """Add the generated pages and figures, and the example notebooks, to the site."""
     parser = build_parser()
     commands = _subparsers(parser)
     files.append(File.generated(config, "commands/index.md", content=commands_index()))
@@ -266,5 +286,7 @@ def on_files(files, config):
     notebooks = sorted(NOTEBOOKS.glob("*.py"))
     files.append(File.generated(config, "examples/index.md", content=examples_index(notebooks)))
     for path in notebooks:
-        files.append(File.generated(config, f"examples/{path.stem}.md", content=notebook_page(path)))
+        files.append(File.generated(config, f"examples/{path.name}", abs_src_path=str(path)))
+    for name, data in figures().items():
+        files.append(File.generated(config, name, content=data))
     return files

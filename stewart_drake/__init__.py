@@ -29,6 +29,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
     from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
+    from stewart_drake.api.drawing import plot_platform
     from stewart_drake.api.dsp import DspIKResult, dsp_ik
     from stewart_drake.api.dynamics import DynamicsResult, inverse_dynamics
     from stewart_drake.api.kinematics import FKResult, FKSolution, IKResult, fk, ik
@@ -109,6 +110,7 @@ _PUBLIC = {
     "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
     "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
     "ViewerReadout": ("stewart_drake.api.viewer", "ViewerReadout"),
+    "plot_platform": ("stewart_drake.api.drawing", "plot_platform"),
 }
 
 __all__ = [
@@ -167,6 +169,7 @@ __all__ = [
     "ModelInspection",
     "viewer_readout",
     "ViewerReadout",
+    "plot_platform",
 ]
 
 # Public names that are also the names of internal subpackages (stewart_drake.workspace, .montecarlo, .report,

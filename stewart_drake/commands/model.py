@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import io
+
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
+from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.core.sdf_models import sdf_text, write_sdf
 from stewart_drake.errors import UsageError
 
@@ -19,6 +22,11 @@ def register(sub) -> None:
         "--inspect", action="store_true", help="parse into a MultibodyPlant and list bodies, joints, constraints"
     )
     p.add_argument("--json", action="store_true", help="with --inspect: JSON output")
+    p.add_argument(
+        "--figure",
+        metavar="FILE.png",
+        help="draw the platform at home: joints numbered by leg, legs coloured, base axes (a new PNG file)",
+    )
     p.set_defaults(func=run)
 
 
@@ -26,6 +34,8 @@ def run(args) -> int:
     if args.json and not args.inspect:
         raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))
     platform = platform_from_args(args)
+    if args.figure:
+        print(write_output_file(args.figure, _figure_png(platform), option="--figure"))
     if args.inspect:
         # Deferred: only --inspect needs Drake, and cli.py imports every command module at start-up;
         # writing or printing the SDF works without pydrake.
@@ -39,6 +49,19 @@ def run(args) -> int:
                 print(f"{k}: {v}")
     elif args.write:
         print(write_sdf(platform, args.write, option="--write"))
-    else:
+    elif not args.figure:
         print(sdf_text(platform), end="")
     return 0
+
+
+def _figure_png(platform) -> bytes:
+    """The PNG of ``design.drawings.platform_figure`` of ``platform``."""
+    import matplotlib  # deferred: only --figure draws; cli.py imports every command module at start-up
+
+    matplotlib.use("Agg")
+    from stewart_drake.design.drawings import platform_figure
+
+    fig = platform_figure(platform)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    return buf.getvalue()

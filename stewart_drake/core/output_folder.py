@@ -672,14 +672,14 @@ def check_output_file(typed, *, option: str, command: str | None = None) -> Path
     return path
 
 
-def write_output_file(typed, text: str, *, option: str, command: str | None = None) -> Path:
-    """Write ``text`` to the file ``typed`` under the policy (``check_output_file``), atomically, and
-    record it in the folder's manifest; return the path."""
+def write_output_file(typed, text: str | bytes, *, option: str, command: str | None = None) -> Path:
+    """Write ``text`` (UTF-8, or ``bytes`` as they are) to the file ``typed`` under the policy
+    (``check_output_file``), atomically, and record it in the folder's manifest; return the path."""
     path = check_output_file(typed, option=option, command=command)
     clean_stale_temps(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        _write_file_atomic(path, text.encode("utf-8"))
+        _write_file_atomic(path, text if isinstance(text, bytes) else text.encode("utf-8"))
         claim_in_manifest(path.parent, [path.name], command=command)
     except DamagedManifest as e:
         raise _damaged(option, typed, e) from None

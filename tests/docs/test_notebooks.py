@@ -1,23 +1,24 @@
-"""The example notebooks (``notebooks/*.py``, jupytext percent scripts) run as notebooks: each is converted by
-jupytext and executed cell by cell by nbclient in the ``python3`` kernel of this environment, with the working
-tree's package first on the kernel's path, a temporary folder as its working directory and ``TMPDIR``, and the
-source tree checked unchanged afterwards (the notebooks write only into ``tempfile.mkdtemp()`` folders)."""
+"""The example notebooks (``notebooks/*.py``, jupytext percent scripts). The site build executes every one of them
+and shows it with its outputs (``tests/docs/test_site.py``); here, the route a user takes by hand:
+``jupytext --to notebook --execute`` under ``scripts/with-venv``'s environment (``MPLBACKEND=Agg``) finds the
+``python3`` kernel the notebooks name, draws the figures inline, imports the working tree's package, and leaves
+nothing in the temporary directory or the source tree."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import jupytext
-import nbformat
 import pytest
-from nbclient import NotebookClient
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.py"))
 # The kernel reports which package it imported, after the notebook's own cells.
-PROBE = "import stewart_drake as _sd, os as _os; print('PACKAGE', _os.path.dirname(_sd.__file__))"
+PROBE = "\n# %%\nimport stewart_drake as _sd, os as _os; print('PACKAGE', _os.path.dirname(_sd.__file__))\n"
 
 
 def tree_state() -> str:
@@ -34,17 +35,40 @@ def test_the_four_examples_exist():
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
-def test_notebook_executes(path, tmp_path, monkeypatch):
+def test_notebook_names_its_kernel_and_draws_inline(path):
+    """A notebook without a kernelspec makes ``jupytext --execute`` fail ("No kernel found"); one without
+    ``%matplotlib inline`` shows no figure where ``MPLBACKEND=Agg`` is set (as ``scripts/with-venv`` sets it)."""
     nb = jupytext.read(path)
-    nb.cells.append(nbformat.v4.new_code_cell(PROBE))
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
-    monkeypatch.setenv("PYTHONDONTWRITEBYTECODE", "1")
-    monkeypatch.setenv("TMPDIR", str(tmp_path))
-    monkeypatch.delenv("MPLBACKEND", raising=False)  # the kernel's inline backend draws the figures
+    assert nb.metadata["kernelspec"]["name"] == "python3"
+    code = [c.source for c in nb.cells if c.cell_type == "code"]
+    assert code[0].startswith("%matplotlib inline")
+    assert "mkdtemp" not in path.read_text(encoding="utf-8"), "a mkdtemp folder outlives the notebook"
+
+
+def test_jupytext_execute_as_a_user_runs_it(tmp_path):
+    """``jupytext --to notebook --execute`` on the design-check notebook (the quickest) with ``MPLBACKEND=Agg``:
+    figures in the outputs, the working tree's package imported, the temporary directory left empty."""
+    work, scratch = tmp_path / "work", tmp_path / "tmp"
+    work.mkdir()
+    scratch.mkdir()
+    source = work / "design_check.py"
+    source.write_text((ROOT / "notebooks" / "design_check.py").read_text(encoding="utf-8") + PROBE, encoding="utf-8")
+    env = {**os.environ, "MPLBACKEND": "Agg", "TMPDIR": str(scratch), "PYTHONDONTWRITEBYTECODE": "1"}
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])
     before = tree_state()
-    NotebookClient(nb, kernel_name="python3", timeout=300, resources={"metadata": {"path": str(tmp_path)}}).execute()
+    r = subprocess.run(
+        [sys.executable, "-m", "jupytext", "--to", "notebook", "--execute", source.name],
+        cwd=work,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr[-3000:]
     assert tree_state() == before, "the notebook wrote into the source tree"
-    printed = "".join(o.get("text", "") for o in nb.cells[-1].outputs)
+    nb = json.loads((work / "design_check.ipynb").read_text(encoding="utf-8"))
+    outputs = [o for c in nb["cells"] if c["cell_type"] == "code" for o in c.get("outputs", [])]
+    assert sum("image/png" in o.get("data", {}) for o in outputs) >= 1
+    printed = "".join("".join(o.get("text", "")) for o in outputs)
     assert f"PACKAGE {ROOT / 'stewart_drake'}" in printed
-    images = sum("image/png" in o.get("data", {}) for c in nb.cells if c.cell_type == "code" for o in c.outputs)
-    assert images >= 1, "every example draws at least one figure"
+    assert sorted(p.name for p in scratch.iterdir()) == [], "the notebook left files in the temporary directory"

@@ -140,8 +140,9 @@ def test_firmware_abi_page_matches_a_generated_header(word_bits):
 
 
 def shell_commands(page: str) -> list[list[str]]:
-    """The ``stewart-drake`` lines of the page's bash blocks, as argument lists (comments dropped)."""
-    lines = [ln for block in fenced(page, "bash") for ln in block.splitlines()]
+    """The ``stewart-drake`` lines of the page's bash blocks, as argument lists (comments dropped), also those run
+    through ``bash scripts/with-venv``."""
+    lines = [ln.removeprefix("bash scripts/with-venv ") for block in fenced(page, "bash") for ln in block.splitlines()]
     return [shlex.split(ln.split(" #")[0]) for ln in lines if ln.startswith("stewart-drake ")]
 
 
@@ -203,3 +204,14 @@ def test_python_snippets_call_public_names_with_real_keywords(page, block):
                 assert kw.arg in params, (page, ".".join(chain), kw.arg)
         calls += 1
     assert calls >= 1, page
+
+
+def test_readme_python_runs_and_is_short():
+    """The README's Python runs as written, and the README stays a two-minute read (the rest is on the site)."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"^```python\n(.*?)^```$", readme, flags=re.S | re.M)
+    assert blocks
+    for block in blocks:
+        exec(compile(block, "README.md", "exec"), {})
+    assert len(readme.splitlines()) <= 60
+    assert readme.count("```bash") == 1 and "stewart-drake report" in readme and "python -m pytest" in readme
