@@ -14,14 +14,12 @@ Why a moved anchor rebuilds the plant rather than re-parameterising one: a plate
 of a ball constraint, which Drake (1.58) fixes at ``AddBallConstraint`` (a context holds only the constraint's
 active status); a base anchor moves the universal joint's frame, which is a context parameter
 (``FixedOffsetFrame.SetPoseInParentFrame``), but the parsed plant's frame is sdformat's composition of the SDF
-poses, which a parameter would have to reproduce bit for bit. So a perturbed plant is parsed again — cheaply:
+poses, which a parameter would have to reproduce bit for bit. So a perturbed plant is parsed again.
 
 Without a visualizer the plant is built alone (``build_plant(visuals=False)``): no visual geometry (nothing shows
-it) and no SceneGraph (the model has no collision geometry, so SceneGraph never enters the dynamics, but it was
-kept posed at every step). The same states bit for bit (``tests/drake/test_plant_without_scene.py``, and
-``test_tick_loop`` against the all-Drake Diagram built with them); measured on the robustness study's plant
-(utn-dynamic, CENIC, 2-core machine under load): parse and build ~5 ms instead of ~30 ms, and 3.2 s of the
-closed loop ~22 % less CPU.
+it) and no SceneGraph (the model has no collision geometry, so SceneGraph never enters the dynamics). The same
+states bit for bit (``tests/drake/test_plant_without_scene.py``, and ``test_tick_loop`` against the all-Drake
+Diagram built with them).
 """
 
 from __future__ import annotations
