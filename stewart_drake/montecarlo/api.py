@@ -100,9 +100,10 @@ class MonteCarloResult(Result):
     """A robustness study (``montecarlo``).
 
     Attributes:
-        summary: runs, error percentiles, the worst run, sensitivities (Spearman), lost-tracking runs and the
-            files written (the dict ``stewart-drake montecarlo --json`` prints).
-        rows: one dict per run: its seed, drawn parameters (SI) and metrics.
+        summary: runs, error percentiles, the worst run, sensitivities (Spearman), lost-tracking and failed
+            runs and the files written (the dict ``stewart-drake montecarlo --json`` prints).
+        rows: one dict per run: its seed, drawn parameters (SI), metrics and ``simulate``'s verdicts
+            (``force_ripple_rms_N``, ``chatter``, ``saturated``, ``tracking_failed``, ``failures``).
         out: the study's folder (``results.parquet``, ``study.json``, plots).
     """
 
@@ -114,6 +115,12 @@ class MonteCarloResult(Result):
     def lost_tracking_runs(self) -> list:
         """The runs that lost tracking (or failed)."""
         return self.summary["lost_tracking_runs"]
+
+    @property
+    def ok(self) -> bool:
+        """Every run passed: none lost tracking, none failed (its simulation, or one of ``simulate``'s verdicts:
+        chatter, saturation, tracking; ``summary["failed_runs"]`` gives each with its reason)."""
+        return self.summary["ok"]
 
     def _fields(self) -> dict:
         return self.summary

@@ -26,9 +26,24 @@ METRICS = (
     "rms_angle_error_rad",
     "saturated_ticks",
     "saturated_leg_ticks",
+    "force_ripple_rms_N",
+    "chatter_ratio",
+    "longest_saturation_s",
 )
+# The verdict columns of a row: simulate's verdicts on the run (``control.verdict.run_verdict``).
+VERDICT_COLUMNS = (
+    "force_ripple_rms_N",  # the largest leg's force ripple (RMS of force − quasi-static force), N
+    "chatter_ratio",  # ripple / working force, largest over the legs
+    "ripple_range_fraction",  # largest ripple / command range
+    "longest_saturation_s",  # the longest stretch a leg's command stayed saturated, s
+    "chatter",  # the loop chatters (ripple above the working force and the range bound)
+    "saturated",  # a leg saturated too long in one stretch, or at the reference's start or end
+    "tracking_failed",  # a leg or plate position error beyond simulate's bound (a fraction of the stroke)
+    "failures",  # simulate's failure messages, joined by FAILURE_SEPARATOR ("" when none)
+)
+FAILURE_SEPARATOR = " | "
 # Row fields that are not drawn parameters.
-NOT_PARAMETERS = set(METRICS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
+NOT_PARAMETERS = set(METRICS) | set(VERDICT_COLUMNS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
 PERCENTILES = (5, 50, 95, 99)
 WORST_BY = "max_leg_error_m"
 
@@ -97,7 +112,9 @@ def _average_ranks(v: np.ndarray) -> np.ndarray:
 
 def summarise(rows: list[dict], settings: dict, key: str) -> dict:
     """The study's summary: per metric the percentiles, mean and max; the worst run (largest
-    ``WORST_BY``); lost-tracking and failed counts; the sensitivity ranking per leg and pose metric."""
+    ``WORST_BY``); the runs that lost tracking (``lost_tracking_runs``) and those that failed
+    (``failed_runs``: ``{"run", "reason"}``, a run whose simulation failed or that ``simulate``'s verdicts
+    fail: chatter, saturation, tracking); ``ok``: neither; the sensitivity ranking per leg and pose metric."""
     stats = {}
     for m in METRICS:
         v = _numeric(rows, m)
@@ -113,12 +130,15 @@ def summarise(rows: list[dict], settings: dict, key: str) -> dict:
     finite = [r for r in rows if math.isfinite(float(r[WORST_BY]))]
     worst = max(finite, key=lambda r: r[WORST_BY]) if finite else rows[0]
     wall = np.array([r["wall_s"] for r in rows], float)
+    lost = [r["run"] for r in rows if r["lost_tracking"]]
+    failed = [{"run": r["run"], "reason": r["error"] or r["failures"]} for r in rows if r["error"] or r["failures"]]
     return {
         "key": key,
         "runs": len(rows),
         "settings": settings,
-        "lost_tracking_runs": [r["run"] for r in rows if r["lost_tracking"]],
-        "failed_runs": [r["run"] for r in rows if r["error"]],
+        "ok": not lost and not failed,
+        "lost_tracking_runs": lost,
+        "failed_runs": failed,
         "metrics": stats,
         "worst_run": {"run": worst["run"], "seed": worst["seed"], "by": WORST_BY, **{m: worst[m] for m in METRICS}},
         "sensitivity": {m: sensitivity(rows, m) for m in ("max_leg_error_m", "max_position_error_m")},
