@@ -359,6 +359,10 @@ class OutputError(StewartError):
     UNWRITABLE = "{option} {typed!r}: cannot write there ({reason})"
     BAD_PATH = "{option} {typed!r}: not a usable path"
     CLASH = "{option} {typed!r}: {name!r} exists and was not written by stewart-drake; nothing was written"
+    CLASH_OTHER = (
+        "{option} {typed!r}: {name!r} exists, written by `{other}`; files are written beside another command's, "
+        "never over them: nothing was written; give a new or empty folder"
+    )
     FILE_IS_FOLDER = "{option} {typed!r}: is a folder; give a file name"
     FILE_NOT_REGULAR = "{option} {typed!r}: exists and is not a regular file"
     FILE_NOT_OURS = (
@@ -835,9 +839,10 @@ class StudyError(StewartError):
     RESOLUTION_DIVIDE = (
         "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
     )
-    DRAW = (
-        "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; "
-        "no run was started — narrow the --vary ranges"
+    DRAW = "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; no run was started"
+    DRAW_ADVICE = " — narrow the --vary ranges"  # appended to DRAW only when --vary draws something
+    DRAW_NOMINAL = (
+        "the study's nominal scenario (nothing drawn) is one simulate would refuse: {reason}; no run was started"
     )
     OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
     OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
