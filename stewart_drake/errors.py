@@ -823,6 +823,10 @@ class StudyError(StewartError):
     GRID = "a sweep's runs ({runs}) must equal its grid's points ({points})"
     PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
     DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
+    MOTION_NOT_STORED = (
+        "the study was run from a Python Trajectory ({name!r}), which study.json records only by its hash: "
+        "--replay cannot rebuild it; run the study again from Python with the same Trajectory"
+    )
     TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
     STEPS = (
         "--plant-step {step:g} s: {duration:g} s per run is {steps:.3g} plant steps, more than the bound {limit:.3g}; "

@@ -62,7 +62,8 @@ class Study:
     reference read on the client, (name, times (n,), poses (n, 6) SI) as lists, so that workers need no
     file; ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
     the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking; ``grid``: one
-    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length)."""
+    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length);
+    ``motion``: a Python ``Trajectory`` as the reference instead (pickled to the workers with the study)."""
 
     platform: Platform
     spec: VarySpec
@@ -80,10 +81,13 @@ class Study:
     lost_tracking: float = LOST_TRACKING
     grid: tuple | None = None
     extra: dict = field(default_factory=dict)
+    motion: Trajectory | None = None
 
     def reference(self) -> Trajectory:
         """The pose reference (built on the worker)."""
-        if self.table is not None:
+        if self.motion is not None:
+            ref = self.motion
+        elif self.table is not None:
             ref = table_trajectory(*self.table)
         elif self.program is not None:
             name, text = self.program

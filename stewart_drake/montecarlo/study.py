@@ -69,9 +69,20 @@ def study_settings(study: Study) -> dict:
         "plant_step": study.plant_step,
         "lost_tracking": study.lost_tracking,
         "grid": list(study.grid) if study.grid is not None else None,
+        "motion": motion_record(study),
         **shared,
         **study.extra,
     }
+
+
+def motion_record(study: Study) -> dict | None:
+    """A Python ``Trajectory`` reference as ``{"name", "sha256"}``: its name and a hash of its poses at the plant
+    steps of a run (what the runs follow), so that the study's key changes with the motion; None for others."""
+    if study.motion is None:
+        return None
+    t = np.arange(int(math.floor(study.run_duration() / study.plant_step + 1e-9)) + 1) * study.plant_step
+    poses = np.ascontiguousarray(study.reference().pose(t), dtype="<f8")
+    return {"name": study.motion.name, "sha256": hashlib.sha256(poses.tobytes()).hexdigest()}
 
 
 def study_from_settings(settings: dict, runs: int) -> Study:
@@ -79,6 +90,8 @@ def study_from_settings(settings: dict, runs: int) -> Study:
     from stewart_drake.core.geometry import LegConfig, Platform
     from stewart_drake.montecarlo.spec import spec_from_dict
 
+    if settings.get("motion"):  # its poses' hash alone: the Trajectory object stayed in the process that ran it
+        raise StudyError(StudyError.MOTION_NOT_STORED.format(name=settings["motion"].get("name")))
     plat = dict(settings["platform"])
     plat["legs"] = LegConfig(**plat["legs"])
     plat["leg_top"] = np.asarray(plat["leg_top"], dtype=np.intp)
@@ -99,6 +112,7 @@ def study_from_settings(settings: dict, runs: int) -> Study:
         "lost_tracking",
         "grid",
         "base_joints",
+        "motion",
     }
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(
