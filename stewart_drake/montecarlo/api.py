@@ -184,7 +184,9 @@ def montecarlo(
         fit: move the reference to the platform's home.
         length_unit: a CSV reference's length unit.
         angle_unit: a CSV reference's angle unit.
-        workers: Dask worker processes (0: in this process).
+        workers: Dask worker processes (0: in this process). They do not import the caller's ``__main__``: a
+            script calling ``montecarlo`` needs no ``if __name__ == "__main__":`` guard, and the functions it
+            defines (a `Trajectory`'s) reach the workers by value.
         scheduler: a Dask scheduler's address instead of a local cluster.
         progress: show a progress bar.
 

@@ -20,6 +20,8 @@ import hashlib
 import json
 import logging
 import math
+import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -362,17 +364,27 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         for i in todo:
             yield run_row(study, i)
         return
-    from distributed import Client, as_completed
+    from distributed import Client
 
     from stewart_drake.workspace.dask_sweep import local_cluster
 
     compile_firmware(study, todo[0])
-    cluster, interrupted = None, False
-    if scheduler is None:
-        cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
+    cluster = None
+    with main_kept_from_workers():  # open while the cluster lives: a nanny restarting a dead worker spawns too
+        if scheduler is None:
+            cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
+            client = Client(cluster)
+        else:
+            client = Client(scheduler)
+        yield from _gathered(study, todo, client, cluster)
+
+
+def _gathered(study: Study, todo: list[int], client, cluster):
+    """Rows of the runs ``todo`` run on ``client``'s cluster, as they finish; closes the client (and
+    ``cluster``, a ``LocalCluster`` of this study's) at the end, but not on an interrupt."""
+    from distributed import as_completed
+
+    interrupted = False
     try:
         # each task carries the study (~2 kB pickled) rather than a scattered copy: a worker killed while it
         # held the only replica would lose scattered data for good, and every run waiting on it would fail
@@ -389,3 +401,24 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+@contextmanager
+def main_kept_from_workers():
+    """While open, processes that ``multiprocessing`` spawns (Dask's nannies start their workers so, and start
+    a dead worker's replacement so) do not import the caller's ``__main__``: a user's script without an
+    ``if __name__ == "__main__":`` guard would run again in each worker as it starts, and fail there. Its
+    functions and classes still reach the workers, by value (``distributed`` pickles what refers to
+    ``__main__`` with cloudpickle). ``__main__``'s ``__file__`` and ``__spec__`` (what spawn reads to import
+    it) are put back when it closes."""
+    main = sys.modules.get("__main__")
+    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if k in main.__dict__} if main else {}
+    if main is not None:
+        main.__dict__.pop("__file__", None)
+        if "__spec__" in saved:
+            main.__spec__ = None
+    try:
+        yield
+    finally:
+        if main is not None:
+            main.__dict__.update(saved)
