@@ -749,6 +749,11 @@ class IsolationError(StewartError):
 class FirmwareError(StewartError):
     """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
 
+    DESIGN_POSES = (
+        "{path}: {reason}; {where} was generated from the Python Trajectory {name!r}, whose design poses (the gains' "
+        "reference) it holds: keep it beside the module as generated, or give trajectory= that same Trajectory"
+    )
+
     SENSOR_GAINS = (
         "platform {name!r}: legs.length_gain {gains} is not 1: the controller's sensor path (the firmware, its "
         "emulation, the simulated sensor) adds legs.length_offset but has no gain; calibrate without --gains, or "
