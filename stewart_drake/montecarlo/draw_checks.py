@@ -109,10 +109,12 @@ def check_draws(study) -> None:
     duration = study.run_duration(reference)
     gains = nominal_gains(study, reference)
     infeasible = nominal_feasibility(study, reference, duration)
-    # the nominal scenario first: its refusal is the study's settings', which no narrower --vary mends
-    nominal = replace(study, spec=VarySpec(), grid=None, runs=1)
-    found = draw_refusal(nominal, 0, reference, duration, gains, infeasible)
-    if found:
-        raise StudyError(StudyError.DRAW_NOMINAL.format(reason=found[2]))
     for i in range(study.runs):
+        if draw_refusal(study, i, reference, duration, gains, infeasible) is None:
+            continue
+        # refused: when the nominal scenario is too, the study's settings are at fault (no narrower --vary mends it)
+        nominal = replace(study, spec=VarySpec(), grid=None, runs=1)
+        found = draw_refusal(nominal, 0, reference, duration, gains, infeasible)
+        if found:
+            raise StudyError(StudyError.DRAW_NOMINAL.format(reason=found[2]))
         check_draw(study, i, reference, duration, gains, infeasible)

@@ -32,6 +32,7 @@ from stewart_drake.drake.systems import make_law
 from stewart_drake.errors import OutputError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
 from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
+from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -330,10 +331,12 @@ class PartialWriter:
 def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = True) -> list[dict]:
     """Run every run of ``study`` not yet in ``out`` and return all rows in run order. ``workers`` 0
     runs them in this process (no Dask); otherwise a ``LocalCluster`` of ``workers`` processes, or the
-    cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume)."""
+    cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume). A finished row without the
+    verdict columns (``summary.VERDICT_COLUMNS``: written before runs were judged) is run again."""
     check_study(study)
     key = study_key(study)
     rows = load_partial(Path(out), key) if out is not None else {}
+    rows = {i: r for i, r in rows.items() if all(c in r for c in VERDICT_COLUMNS)}
     todo = [i for i in range(study.runs) if i not in rows]
     writer = PartialWriter(Path(out), key) if out is not None else None
     bar = None

@@ -61,3 +61,25 @@ def test_a_study_that_does_not_chatter_passes(tmp_path, capsys):
     rows = read_table(out)
     assert all(not r["chatter"] and not r["saturated"] and not r["tracking_failed"] for r in rows)
     assert all(r["failures"] == "" and r["force_ripple_rms_N"] > 0 for r in rows)
+
+
+def test_a_resumed_row_without_verdicts_is_run_again(tmp_path, monkeypatch):
+    """A journal row written before runs were judged would pass unjudged into the results: it is re-run."""
+    from stewart_drake.montecarlo import study as study_mod
+    from stewart_drake.montecarlo.scenario import Study
+    from stewart_drake.montecarlo.spec import parse_spec
+
+    st = Study(sd.load_platform("utn-dynamic"), parse_spec(["anchor=±0.5mm"]), seed=1, runs=2, duration=0.02)
+    judged = study_mod.run_study(st, None, workers=0, progress=False)
+    out = tmp_path / "mc"
+    w = study_mod.PartialWriter(out, study_mod.study_key(st))
+    for r in judged:
+        w.write({k: v for k, v in r.items() if k not in VERDICT_COLUMNS} if r["run"] == 0 else r)
+    w.close()
+    calls = []
+    real = study_mod.run_row
+    monkeypatch.setattr(study_mod, "run_row", lambda study, i: calls.append(i) or real(study, i))
+    rows = study_mod.run_study(st, out, workers=0, progress=False)
+    assert calls == [0]  # run 1 kept its judged row
+    assert [r["failures"] for r in rows] == [r["failures"] for r in judged]
+    assert [r["force_ripple_rms_N"] for r in rows] == [r["force_ripple_rms_N"] for r in judged]
