@@ -72,13 +72,13 @@ def study_settings(study: Study) -> dict:
         "plant_step": study.plant_step,
         "lost_tracking": study.lost_tracking,
         "grid": list(study.grid) if study.grid is not None else None,
-        "motion": motion_record(study),
+        "motion": motion_settings(study),
         **shared,
         **study.extra,
     }
 
 
-def motion_record(study: Study) -> dict | None:
+def motion_settings(study: Study) -> dict | None:
     """A Python ``Trajectory`` reference as ``{"name", "sha256"}``: its name and a hash of its poses at the plant
     steps of a run (what the runs follow), so that the study's key changes with the motion; None for others."""
     if study.motion is None:
