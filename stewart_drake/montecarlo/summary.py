@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.control.chatter import CHATTER_RANGE_FRACTION
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.montecarlo.spec import LATENCY_MODES
 
@@ -170,15 +171,23 @@ def read_table(folder) -> list[dict]:
 
 
 def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
-    """``distributions.png`` (histograms of the leg and pose errors) and ``sensitivity.png`` (the leg
-    error against the most influential parameter, and the ranking). Drawn on ``Figure`` objects, not pyplot,
-    so that the caller's backend (a notebook's inline figures) is left as it was."""
+    """``distributions.png`` (histograms of the leg and pose errors and of the force ripple, against the chatter
+    bound) and ``sensitivity.png`` (the leg error against the most influential parameter, and the ranking). Drawn
+    on ``Figure`` objects, not pyplot, so that the caller's backend (a notebook's inline figures) is left as it
+    was."""
     # deferred: matplotlib is loaded only when a study writes its plots
     from matplotlib.figure import Figure
 
     paths = []
-    fig = Figure(figsize=(13, 3.6))
-    ax = fig.subplots(1, 3)
+    ripple = "ripple_range_fraction" in rows[0]  # the loop's force ripple, when the runs were judged
+    fig = Figure(figsize=(17 if ripple else 13, 3.6))
+    ax = fig.subplots(1, 4 if ripple else 3)
+    if ripple:  # what the chatter verdict sees: the ripple against its share of the command range
+        v = _numeric(rows, "ripple_range_fraction")
+        ax[3].hist(v[np.isfinite(v)] * 100, bins=max(5, min(40, len(rows) // 5)))
+        ax[3].axvline(CHATTER_RANGE_FRACTION * 100, color="red", linestyle="--", label="chatter bound")
+        ax[3].set_xlabel("force ripple [% of the command range]")
+        ax[3].legend(fontsize=7)
     for a, (m, scale, label) in zip(
         ax,
         [
