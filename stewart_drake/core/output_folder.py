@@ -456,7 +456,8 @@ class OutputFolder:
                     )
             for rel in self.names:  # with force or companions: a name of ours held by another's file
                 if rel in found.other or rel in found.kept or rel in found.user:
-                    other = found.other.get(rel) or (load_manifest(path) or {}).get(rel, {}).get("command")
+                    other = found.other.get(rel) or (found.manifest or {}).get(rel, {}).get("command")
+                    other = other if rel not in found.user else None  # changed since: the user's now
                     raise OutputError(
                         OutputError.CLASH_OTHER.format(option=option, typed=typed, name=rel, other=other)
                         if other
