@@ -62,3 +62,17 @@ def test_a_drawn_scenario_refused_still_advises_narrower_ranges(capsys, tmp_path
     err = capsys.readouterr().err
     assert "run 0 (seed" in err and "leaves the stroke" in err and err.rstrip().endswith(StudyError.DRAW_ADVICE.strip())
     assert "--allow-out-of-stroke" not in err
+
+
+def test_simulate_force_over_a_users_file_is_refused_before_it_runs(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "log.csv").write_text("my notes")
+
+    def must_not_run(*a, **k):
+        raise AssertionError("the simulation ran before the refusal")
+
+    monkeypatch.setattr(simulate_cmd, "run_plan", must_not_run)
+    assert main(["simulate", "--duration", "0.02", "--out", str(out), "--force", "--no-progress"]) == 2
+    assert "'log.csv' exists and was not written by stewart-drake" in capsys.readouterr().err
+    assert (out / "log.csv").read_text() == "my notes"
