@@ -359,6 +359,10 @@ class OutputError(StewartError):
     UNWRITABLE = "{option} {typed!r}: cannot write there ({reason})"
     BAD_PATH = "{option} {typed!r}: not a usable path"
     CLASH = "{option} {typed!r}: {name!r} exists and was not written by stewart-drake; nothing was written"
+    CLASH_OTHER = (
+        "{option} {typed!r}: {name!r} exists, written by `{other}`; files are written beside another command's, "
+        "never over them: nothing was written; give a new or empty folder"
+    )
     FILE_IS_FOLDER = "{option} {typed!r}: is a folder; give a file name"
     FILE_NOT_REGULAR = "{option} {typed!r}: exists and is not a regular file"
     FILE_NOT_OURS = (
@@ -745,6 +749,11 @@ class IsolationError(StewartError):
 class FirmwareError(StewartError):
     """Generated or user firmware that cannot be built, checked or run (``firmware``, ``drake.firmware_check``)."""
 
+    DESIGN_POSES = (
+        "{path}: {reason}; {where} was generated from the Python Trajectory {name!r}, whose design poses (the gains' "
+        "reference) it holds: keep it beside the module as generated, or give trajectory= that same Trajectory"
+    )
+
     SENSOR_GAINS = (
         "platform {name!r}: legs.length_gain {gains} is not 1: the controller's sensor path (the firmware, its "
         "emulation, the simulated sensor) adds legs.length_offset but has no gain; calibrate without --gains, or "
@@ -819,6 +828,10 @@ class StudyError(StewartError):
     GRID = "a sweep's runs ({runs}) must equal its grid's points ({points})"
     PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
     DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
+    MOTION_NOT_STORED = (
+        "the study was run from a Python Trajectory ({name!r}), which study.json records only by its hash: "
+        "--replay cannot rebuild it; run the study again from Python with the same Trajectory"
+    )
     TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
     STEPS = (
         "--plant-step {step:g} s: {duration:g} s per run is {steps:.3g} plant steps, more than the bound {limit:.3g}; "
@@ -835,9 +848,10 @@ class StudyError(StewartError):
     RESOLUTION_DIVIDE = (
         "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
     )
-    DRAW = (
-        "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; "
-        "no run was started — narrow the --vary ranges"
+    DRAW = "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; no run was started"
+    DRAW_ADVICE = " — narrow the --vary ranges"  # appended to DRAW only when --vary draws something
+    DRAW_NOMINAL = (
+        "the study's nominal scenario (nothing drawn) is one simulate would refuse: {reason}; no run was started"
     )
     OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
     OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"

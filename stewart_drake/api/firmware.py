@@ -35,7 +35,15 @@ from stewart_drake.firmware.certify.search import MAX_CELLS
 from stewart_drake.firmware.certify.tick import TickCertificate
 from stewart_drake.firmware.certify.tick import certify_tick as certify_tick_words
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
-from stewart_drake.firmware.fingerprint import read_fingerprint, resolve_options, stamp
+from stewart_drake.firmware.fingerprint import (
+    DESIGN_POSES,
+    motion_record,
+    poses_hash,
+    read_fingerprint,
+    recorded_design_poses,
+    resolve_options,
+    stamp,
+)
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.fixedpoint.generic import QFormat
@@ -63,8 +71,10 @@ def controller_config(
     rate: float = 1000.0,
     sensor_resolution: float = 1e-5,
     trajectory: str | Trajectory | None = None,
+    poses=None,
 ) -> ControllerConfig:
-    """The firmware's number format, timing and gains (designed over ``trajectory``'s poses, else home)."""
+    """The firmware's number format, timing and gains (designed over ``trajectory``'s poses, else over
+    ``poses`` ``(n, 6)`` SI, else home)."""
     if not 8 <= word_bits <= 16:
         raise OptionError(OPTION_FIRMWARE_WORD_BITS.format(value=word_bits))
     if not (rate > 0 and rate <= 1e6):
@@ -75,7 +85,7 @@ def controller_config(
     timing = DspTiming(
         sample_period=1.0 / rate, sensor_resolution=sensor_resolution, command_range=float(platform.legs.max_force)
     ).check()
-    poses = None if trajectory is None else design_poses(get_trajectory(trajectory))
+    poses = poses if trajectory is None else design_poses(get_trajectory(trajectory))
     return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=convention)
 
 
@@ -125,7 +135,9 @@ def generate(
         convention: Euler convention of the pose angles.
         rate: controller rate, Hz.
         sensor_resolution: leg sensor, m per count.
-        trajectory: design the gains over this reference's poses (default: home only).
+        trajectory: design the gains over this reference's poses (default: home only). A `Trajectory` (no
+            name ``check`` can look up) also writes its design poses to ``sd_design_poses.json`` beside the C,
+            which ``check`` reads (their hash is recorded in the fingerprint).
         compile: compile-check the C with every C compiler found.
         on_note: called with a note (no compiler found).
         platform_source: how the platform is named (a preset name or a YAML path), recorded with the other
@@ -149,8 +161,10 @@ def generate(
         convention=convention,
         rate=rate,
         sensor_resolution=sensor_resolution,
-        trajectory=trajectory if trajectory is None or isinstance(trajectory, str) else trajectory.name,
+        trajectory=trajectory,
     )
+    if isinstance(trajectory, Trajectory):  # no name `check` can look up: the design poses beside the C
+        options["trajectory"], g.files[DESIGN_POSES] = motion_record(trajectory.name, design_poses(trajectory))
     g.files = stamp(g.files, options)  # the options, for `firmware check`
     compiled = []
     if compile:
@@ -245,7 +259,9 @@ def check(
         convention: Euler convention (as generated).
         rate: controller rate, Hz (as generated).
         sensor_resolution: m per count (as generated).
-        trajectory: the reference the gains were designed over (as generated).
+        trajectory: the reference the gains were designed over (as generated; a module generated from a
+            `Trajectory` reads its design poses from the ``sd_design_poses.json`` beside it, or takes that
+            same `Trajectory` here).
 
     Returns:
         The comparison; ``identical`` when bit-exact.
@@ -278,11 +294,19 @@ def check(
         if rec and _platform_name(rec[0]["platform"]) != platform.name:
             mismatch = f"--platform {platform.name} here, {rec[0]['platform']} in {rec[1]}"
             raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
+    design, motion = None, o["trajectory"] if isinstance(o["trajectory"], dict) else None
     if isinstance(trajectory, Trajectory):
         o["trajectory"] = trajectory
+        if motion and poses_hash(design_poses(trajectory)) != motion.get("sha256"):
+            mismatch = (
+                f"trajectory={trajectory.name!r} here, other design poses than {motion.get('name')!r} in {rec[1]}"
+            )
+            raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
+    elif motion:  # generated from a Python Trajectory: its design poses, recorded beside the C
+        o["trajectory"], design = None, recorded_design_poses(motion, rec[1])
     config = controller_config(
         platform, o["word_bits"], o["length_lsb"], o["trig"], o["convention"], o["rate"], o["sensor_resolution"],
-        o["trajectory"],
+        o["trajectory"], design,
     )  # fmt: skip
     cc = compiler_by_name(compiler) if compiler else None
     # the user's code runs in a child process: a hang, an exit() or a crash is one line naming the file

@@ -19,9 +19,9 @@ import numpy as np
 
 from stewart_drake.api.result import Result, plain
 from stewart_drake.control import ControllerConfig, DspTiming, check_timing
-from stewart_drake.control.chatter import loop_verdict
 from stewart_drake.control.feasibility import infeasible_motion
-from stewart_drake.control.simulation_log import SimulationLog, tracking_verdict
+from stewart_drake.control.simulation_log import SimulationLog
+from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S, check_time_limit
 from stewart_drake.core.sanity import (
@@ -298,7 +298,8 @@ class SimulationResult(Result):
         summary: the run's settings, gains and errors (the dict ``stewart-drake simulate`` writes to
             summary.json, less its ``files``).
         log: the logs, arrays by name (``log.to_pandas()``).
-        verdict: ``{"tracking_bound_mm", "saturation_bound_s", "longest_saturation_s", "failures"}``.
+        verdict: ``{"tracking_bound_mm", "saturation_bound_s", "longest_saturation_s", "tracking_lost",
+            "saturated_legs", "failures"}`` (``control.verdict.run_verdict``).
         warnings: what was allowed but is worth knowing (a reference outside the stroke, an opened loop).
         plan: the checked run (its ``Scenario``, timing and duration).
     """
@@ -501,11 +502,9 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
-    verdict = tracking_verdict(truth, e, pe, log)
-    # the loop's own verdict: chatter (force ripple about the inverse-dynamics force) and saturation at the
-    # reference's ends (control/chatter.py)
-    loop = loop_verdict(sc.platform, traj, log, config)
-    verdict["failures"] += loop.pop("failures")
+    # tracking, and the loop's own verdict: chatter (force ripple about the inverse-dynamics force) and
+    # saturation at the reference's ends (control/verdict.py; each Monte Carlo run is judged there too)
+    verdict, loop = run_verdict(sc.platform, truth, traj, log, config, e, pe)
     for w in loop.pop("warnings"):
         warnings.append(w)
         if on_warning:

@@ -54,14 +54,16 @@ def add_force_arg(parser) -> None:
     )
 
 
-def output_folder(args, option: str = "--out") -> OutputFolder | None:
+def output_folder(args, option: str = "--out", names: tuple[str, ...] = ()) -> OutputFolder | None:
     """The checked ``--out`` destination (``atomic.OutputFolder``), or None when none was given.
-    Call it before any work so that a refused destination costs nothing."""
+    Call it before any work so that a refused destination costs nothing (``names``: the files the command
+    writes, refused there before the work when another's file holds one)."""
     value = getattr(args, option.lstrip("-").replace("-", "_"))
     if value is None:
         return None
     offered = "--force" if hasattr(args, "force") else None  # a refusal names --force only where it exists
-    return OutputFolder(value, force=getattr(args, "force", False), option=option, force_option=offered)
+    force = getattr(args, "force", False)
+    return OutputFolder(value, force=force, option=option, force_option=offered, names=names)
 
 
 def print_json(obj) -> None:

@@ -139,30 +139,37 @@ def run(args) -> int:
         print_json(summary)
     else:
         print_text(summary)
-    lost = summary["lost_tracking_runs"]
+    lost, failed = summary["lost_tracking_runs"], summary["failed_runs"]
     if lost:
         print(
             f"stewart-drake montecarlo: {len(lost)} of {len(rows)} runs lost tracking (leg error > {args.lost_tracking:g} mm or failed): "
             f"runs {', '.join(map(str, lost[:10]))}{' …' if len(lost) > 10 else ''}",
             file=sys.stderr,
         )
-        return 1
-    return 0
+    if failed:
+        print(f"stewart-drake montecarlo: {len(failed)} of {len(rows)} runs failed:", file=sys.stderr)
+        for f in failed[:10]:
+            print(f"  run {f['run']}: {f['reason']}", file=sys.stderr)
+        if len(failed) > 10:
+            print(f"  … and {len(failed) - 10} more (results.csv, column 'failures')", file=sys.stderr)
+    return 0 if summary["ok"] else 1
 
 
 def print_text(summary: dict) -> None:
-    """The study summary as text: error percentiles (mm, deg), the worst run, the strongest sensitivities, the files."""
+    """The study summary as text: error (mm, deg) and force ripple (N) percentiles, the worst run, the strongest
+    sensitivities, the files."""
     m = summary["metrics"]
     print(f"{summary['runs']} runs (study {summary['key']})")
     for k, scale, unit in (
         ("max_leg_error_m", 1e3, "mm"),
         ("max_position_error_m", 1e3, "mm"),
         ("max_angle_error_rad", 57.29577951308232, "deg"),
+        ("force_ripple_rms_N", 1.0, "N"),
     ):
         s = m[k]
         if s:
             print(
-                f"  {k.rsplit('_', 1)[0]:22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}"
+                f"  {k.rsplit('_', 1)[0].removesuffix('_rms'):22s} p50 {s['p50'] * scale:.4g}  p95 {s['p95'] * scale:.4g}  max {s['max'] * scale:.4g} {unit}"
             )
     w = summary["worst_run"]
     print(f"  worst run {w['run']} (seed {w['seed']}): max leg error {w['max_leg_error_m'] * 1e3:.4g} mm")

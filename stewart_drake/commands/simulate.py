@@ -128,6 +128,10 @@ def add_loop_args(p) -> None:
     )
 
 
+# the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
+FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
+
+
 def run(args) -> int:
     reject_unused(
         args,
@@ -137,7 +141,7 @@ def run(args) -> int:
         angle_unit="rad",
         smooth=None,
     )
-    out_folder = output_folder(args)
+    out_folder = output_folder(args, names=FILES)
     reject_unused(args, "--firmware", args.firmware is not None, time_limit=FIRMWARE_IDLE_LIMIT_S)
     plan = plan_run(
         load_platform(args.platform),

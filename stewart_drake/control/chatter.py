@@ -99,9 +99,10 @@ def end_saturation(log, window: float = END_WINDOW_S) -> list[tuple[int, float]]
 
 
 def loop_verdict(platform: Platform, trajectory: Trajectory, log, config: ControllerConfig) -> dict:
-    """``chatter_measure`` plus ``{"failures": [...], "warnings": [...]}``: chatter (ripple above the
-    working force and above ``CHATTER_RANGE_FRACTION`` of the command range), a ripple above the working
-    force alone (a warning), and saturation within ``END_WINDOW_S`` of the run's ends."""
+    """``chatter_measure`` plus ``{"chatter": bool, "end_saturation": [[leg, t]], "failures": [...],
+    "warnings": [...]}``: chatter (ripple above the working force and above ``CHATTER_RANGE_FRACTION`` of the
+    command range), a ripple above the working force alone (a warning), and saturation within ``END_WINDOW_S``
+    of the run's ends (``end_saturation``: 1-based leg, first such tick's time in s)."""
     m = chatter_measure(platform, trajectory, log, config)
     failures, warnings = [], []
     ripple = max(m["force_ripple_N"])
@@ -109,17 +110,19 @@ def loop_verdict(platform: Platform, trajectory: Trajectory, log, config: Contro
         f"force ripple {ripple:.4g} N RMS about the quasi-static force, {m['chatter_ratio']:.2g} × the working "
         f"force and {m['ripple_range_fraction'] * 100:.3g} % of the {config.timing.command_range:g} N command range"
     )
-    if m["chatter_ratio"] > CHATTER_RATIO and m["ripple_range_fraction"] > CHATTER_RANGE_FRACTION:
+    chatter = m["chatter_ratio"] > CHATTER_RATIO and m["ripple_range_fraction"] > CHATTER_RANGE_FRACTION
+    if chatter:
         failures.append(
             f"chatter: {text} (bound {CHATTER_RANGE_FRACTION * 100:g} %); largest quantisation step: "
             f"{m['chatter_cause']} (a finer IK length LSB or sensor count, or lower kp/kd, reduces it)"
         )
     elif m["chatter_ratio"] > CHATTER_RATIO:
         warnings.append(f"force ripple above the working force: {text}; from {m['chatter_cause']}")
-    for leg, t in end_saturation(log):
+    ends = end_saturation(log)
+    for leg, t in ends:
         failures.append(
             f"leg {leg} saturated at the trajectory's {'start' if t <= float(log.t[0]) + END_WINDOW_S else 'end'} "
             f"(t = {t:.4f} s): the reference starts or stops with a speed or acceleration the actuator cannot follow"
         )
-    m.update(failures=failures, warnings=warnings)
+    m.update(chatter=chatter, end_saturation=[[leg, t] for leg, t in ends], failures=failures, warnings=warnings)
     return m

@@ -119,16 +119,18 @@ def longest_saturation(log: SimulationLog) -> np.ndarray:
 
 def tracking_verdict(platform: Platform, length_error, pose_error, log: SimulationLog) -> dict:
     """Whether a run tracked its reference: ``{"tracking_bound_mm", "saturation_bound_s",
-    "longest_saturation_s" (6,), "failures": [messages]}``; a failure is a leg error or plate position
-    error beyond ``TRACKING_LOST_FRACTION`` × the stroke range (lost tracking, with its first time), or a
-    leg saturated for longer than ``MAX_SATURATION_S`` in one stretch."""
+    "longest_saturation_s" (6,), "tracking_lost": bool, "saturated_legs": [1-based legs], "failures":
+    [messages]}``; a failure is a leg error or plate position error beyond ``TRACKING_LOST_FRACTION`` × the
+    stroke range (lost tracking, with its first time), or a leg saturated for longer than ``MAX_SATURATION_S``
+    in one stretch."""
     bound = TRACKING_LOST_FRACTION * float(platform.L_max - platform.L_min)
-    failures = []
+    failures, lost = [], False
     e = np.abs(np.asarray(length_error))
     pe = np.linalg.norm(np.asarray(pose_error)[:, :3], axis=1)
     for name, err, legwise in (("leg length", e, True), ("plate position", pe, False)):
         bad = (err > bound).reshape(len(err), -1).any(axis=1)
         if np.any(bad):
+            lost = True
             i = int(np.argmax(bad))
             which = f" of leg {int(np.argmax(err[i])) + 1}" if legwise else ""
             failures.append(
@@ -136,7 +138,8 @@ def tracking_verdict(platform: Platform, length_error, pose_error, log: Simulati
                 f"first at t = {log.t[i]:.4f} s, and reaches {err.max() * 1e3:.1f} mm"
             )
     longest = longest_saturation(log)
-    for j in np.flatnonzero(longest > MAX_SATURATION_S):
+    saturated = np.flatnonzero(longest > MAX_SATURATION_S)
+    for j in saturated:
         failures.append(
             f"leg {j + 1} saturated for {longest[j]:.3f} s in one stretch (longer than {MAX_SATURATION_S:g} s): "
             "its actuator cannot follow the reference"
@@ -145,5 +148,7 @@ def tracking_verdict(platform: Platform, length_error, pose_error, log: Simulati
         "tracking_bound_mm": bound * 1e3,
         "saturation_bound_s": MAX_SATURATION_S,
         "longest_saturation_s": longest.tolist(),
+        "tracking_lost": lost,
+        "saturated_legs": [int(j) + 1 for j in saturated],
         "failures": failures,
     }

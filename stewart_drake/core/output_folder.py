@@ -374,7 +374,9 @@ class OutputFolder:
     ``command`` the writing command (default: the CLI's, ``set_command``), ``companions`` the commands
     whose files this one keeps beside its own without ``--force``; ``force_option`` how the caller asks
     for ``force`` (``"--force"``, ``"force=True"``), None when it cannot: a refusal suggests only what the
-    caller offers.
+    caller offers. ``names``: the files the command will write (paths relative to the folder), when known:
+    one that another command or the user holds there is refused here, before any work, even with ``force``
+    (files are written beside others, never over them).
     """
 
     def __init__(
@@ -386,9 +388,10 @@ class OutputFolder:
         command: str | None = None,
         companions: tuple[str, ...] = (),
         force_option: str | None = None,
+        names: tuple[str, ...] = (),
     ):
         self.typed, self.force, self.option, self.force_option = str(typed), force, option, force_option
-        self.command, self.companions = command or _command, tuple(companions)
+        self.command, self.companions, self.names = command or _command, tuple(companions), tuple(names)
         if not self.typed or "\0" in self.typed:
             raise OutputError(OutputError.BAD_PATH.format(option=option, typed=self.typed))
         self.path = Path(os.path.abspath(os.path.expanduser(self.typed)))
@@ -450,6 +453,15 @@ class OutputFolder:
                             count=len(found.user),
                             remedy=self.remedy(),
                         )
+                    )
+            for rel in self.names:  # with force or companions: a name of ours held by another's file
+                if rel in found.other or rel in found.kept or rel in found.user:
+                    other = found.other.get(rel) or (found.manifest or {}).get(rel, {}).get("command")
+                    other = other if rel not in found.user else None  # changed since: the user's now
+                    raise OutputError(
+                        OutputError.CLASH_OTHER.format(option=option, typed=typed, name=rel, other=other)
+                        if other
+                        else OutputError.CLASH.format(option=option, typed=typed, name=rel)
                     )
             if not os.access(path, os.W_OK | os.X_OK):
                 raise OutputError(OutputError.UNWRITABLE.format(option=option, typed=typed, reason="permission denied"))

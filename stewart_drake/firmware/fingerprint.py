@@ -5,9 +5,14 @@ given on its command line that differs from the recorded one."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 from pathlib import Path
+
+import numpy as np
+
+from stewart_drake.errors import FirmwareError
 
 # The options of ``firmware generate`` that define the module (their command-line defaults).
 DEFAULTS = {
@@ -77,3 +82,43 @@ def _same(a, b) -> bool:
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
         return float(a) == float(b)
     return a == b
+
+
+# A module generated from a Python ``Trajectory`` (no name ``check`` can look up) records, as its ``trajectory``
+# option, ``{"name", "design_poses": DESIGN_POSES, "sha256"}``; the poses the gains were designed over are in
+# that file beside the C, and the hash (of their float64 bytes) in every fingerprint ties the file to the module.
+DESIGN_POSES = "sd_design_poses.json"
+
+
+def poses_hash(poses) -> str:
+    """The sha256 of ``(n, 6)`` design poses (SI) as little-endian float64 bytes."""
+    return hashlib.sha256(np.ascontiguousarray(poses, dtype="<f8").tobytes()).hexdigest()
+
+
+def motion_record(name: str, poses) -> tuple[dict, str]:
+    """``(the trajectory option recorded, the DESIGN_POSES file's text)`` of a module whose gains were designed
+    over ``poses`` ``(n, 6)`` (SI) of the Python trajectory ``name`` (JSON keeps every float bit for bit)."""
+    text = json.dumps({"trajectory": name, "poses": np.asarray(poses, dtype=float).tolist()}) + "\n"
+    return {"name": name, "design_poses": DESIGN_POSES, "sha256": poses_hash(poses)}, text
+
+
+def recorded_design_poses(record: dict, where: Path) -> np.ndarray:
+    """The design poses ``(n, 6)`` (SI) a ``motion_record`` names, read from beside ``where`` (the file the
+    fingerprint was read from) and checked against its hash; ``FirmwareError`` naming the file if it is missing,
+    unreadable or not the one generated with the module."""
+    path = Path(where).with_name(str(record.get("design_poses", DESIGN_POSES)))
+    try:
+        poses = np.asarray(json.loads(path.read_text(encoding="utf-8"))["poses"], dtype=float)
+        ok = poses.ndim == 2 and poses.shape[1:] == (6,) and poses_hash(poses) == record.get("sha256")
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        reason = e.strerror if isinstance(e, OSError) and e.strerror else type(e).__name__
+        raise FirmwareError(
+            FirmwareError.DESIGN_POSES.format(path=path, name=record.get("name"), where=where, reason=reason)
+        ) from None
+    if not ok:
+        raise FirmwareError(
+            FirmwareError.DESIGN_POSES.format(
+                path=path, name=record.get("name"), where=where, reason="not the poses it was generated with"
+            )
+        )
+    return poses

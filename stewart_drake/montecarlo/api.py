@@ -13,7 +13,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.processes import check_workers
 from stewart_drake.core.quantisation import check_finite_rates, check_quantisation
-from stewart_drake.core.trajectory import TRAJECTORIES, read_trajectory_table
+from stewart_drake.core.trajectory import TRAJECTORIES, Trajectory, read_trajectory_table
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import default_engine
@@ -32,7 +32,7 @@ REPLAY_COMMAND = "montecarlo --replay"  # a replay's files are recorded under "m
 
 def make_study(
     platform: Platform,
-    trajectory: str = "seed",
+    trajectory: str | Trajectory = "seed",
     *,
     runs: int = 100,
     seed: int = 0,
@@ -63,8 +63,10 @@ def make_study(
         shown = lost_tracking * 1e3 if lost_tracking_shown is None else lost_tracking_shown
         raise OptionError(OptionError.POSITIVE.format(option="--lost-tracking", unit="mm", value=shown))
     trajectory = None if program_text else trajectory
-    table = None
-    if trajectory is not None and trajectory not in TRAJECTORIES:
+    table, motion = None, None
+    if isinstance(trajectory, Trajectory):
+        motion, trajectory = trajectory, None
+    elif trajectory is not None and trajectory not in TRAJECTORIES:
         table = csv_table(str(trajectory), length_unit, angle_unit)
         trajectory = None
     return Study(
@@ -82,6 +84,7 @@ def make_study(
         duration=duration,
         plant_step=plant_step,
         lost_tracking=lost_tracking,
+        motion=motion,
     )
 
 
@@ -100,9 +103,10 @@ class MonteCarloResult(Result):
     """A robustness study (``montecarlo``).
 
     Attributes:
-        summary: runs, error percentiles, the worst run, sensitivities (Spearman), lost-tracking runs and the
-            files written (the dict ``stewart-drake montecarlo --json`` prints).
-        rows: one dict per run: its seed, drawn parameters (SI) and metrics.
+        summary: runs, error percentiles, the worst run, sensitivities (Spearman), lost-tracking and failed
+            runs and the files written (the dict ``stewart-drake montecarlo --json`` prints).
+        rows: one dict per run: its seed, drawn parameters (SI), metrics and ``simulate``'s verdicts
+            (``force_ripple_rms_N``, ``chatter``, ``saturated``, ``tracking_failed``, ``failures``).
         out: the study's folder (``results.parquet``, ``study.json``, plots).
     """
 
@@ -114,6 +118,12 @@ class MonteCarloResult(Result):
     def lost_tracking_runs(self) -> list:
         """The runs that lost tracking (or failed)."""
         return self.summary["lost_tracking_runs"]
+
+    @property
+    def ok(self) -> bool:
+        """Every run passed: none lost tracking, none failed (its simulation, or one of ``simulate``'s verdicts:
+        chatter, saturation, tracking; ``summary["failed_runs"]`` gives each with its reason)."""
+        return self.summary["ok"]
 
     def _fields(self) -> dict:
         return self.summary
@@ -132,7 +142,7 @@ class MonteCarloResult(Result):
 
 def montecarlo(
     platform: Platform,
-    trajectory: str = "seed",
+    trajectory: str | Trajectory = "seed",
     *,
     out: str | Path,
     runs: int = 100,
@@ -156,7 +166,9 @@ def montecarlo(
 
     Args:
         platform: the nominal platform (the controller's model).
-        trajectory: ``"seed"``, ``"rotating"`` or a CSV file of t, pose rows.
+        trajectory: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, or a `Trajectory` (pickled to the
+            workers with the study, by value where its functions are not importable; a study run from one
+            cannot be replayed from the command line: its study.json records the motion by its hash).
         out: the study's folder (a finished or partial study there is resumed).
         runs: number of runs.
         seed: the study's seed (run k's seed derives from it: any run can be replayed alone).
@@ -172,7 +184,9 @@ def montecarlo(
         fit: move the reference to the platform's home.
         length_unit: a CSV reference's length unit.
         angle_unit: a CSV reference's angle unit.
-        workers: Dask worker processes (0: in this process).
+        workers: Dask worker processes (0: in this process). They do not import the caller's ``__main__``: a
+            script calling ``montecarlo`` needs no ``if __name__ == "__main__":`` guard, and the functions it
+            defines (a `Trajectory`'s) reach the workers by value.
         scheduler: a Dask scheduler's address instead of a local cluster.
         progress: show a progress bar.
 

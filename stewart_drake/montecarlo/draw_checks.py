@@ -10,6 +10,7 @@ reported as "lost tracking" among the results.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -21,6 +22,7 @@ from stewart_drake.control.timing import check_timing
 from stewart_drake.core.sanity import check_positive, check_trajectory, check_work, require_plant_plate
 from stewart_drake.errors import StewartError, StudyError, short_text
 from stewart_drake.montecarlo.scenario import draw, nominal_gains, scenario
+from stewart_drake.montecarlo.spec import VarySpec
 
 
 def _drawn(study, d) -> str:
@@ -38,6 +40,15 @@ def _of_key(column: str, keys) -> bool:
 def check_draw(study, index: int, reference, duration: float, gains=None, infeasible=None) -> None:
     """``StudyError`` (exit 2) naming run ``index`` when its scenario fails a check ``simulate`` makes;
     ``infeasible(force_limit, period)``: the motion's feasibility (``nominal_feasibility``), or None."""
+    found = draw_refusal(study, index, reference, duration, gains, infeasible)
+    if found:
+        seed, d, reason = found
+        advice = StudyError.DRAW_ADVICE if study.spec.laws else ""
+        raise StudyError(StudyError.DRAW.format(run=index, seed=seed, drawn=_drawn(study, d), reason=reason) + advice)
+
+
+def draw_refusal(study, index: int, reference, duration: float, gains=None, infeasible=None):
+    """``(run seed, Draw, reason)`` when run ``index``'s scenario fails a check ``simulate`` makes, else None."""
     seed, d = draw(study, index)
     try:
         # the period, then the run's size, before any of it is allocated (a period of 1e-123 s: 1e121 ticks)
@@ -64,15 +75,14 @@ def check_draw(study, index: int, reference, duration: float, gains=None, infeas
             counts_per_lsb(sc.config)
             FixedGains.from_si(sc.config.gains, timing)
         ticks = np.arange(int(math.floor(duration / timing.sample_period + 1e-9)) + 1) * timing.sample_period
-        check_trajectory(plant, ticks, reference.pose(ticks), "utn", f"the {reference.name} reference", False)
-        why = infeasible(d.force_limit, timing.sample_period) if infeasible else None
+        # the stroke violation as a message (simulate's --allow-out-of-stroke hint is no option of a study)
+        why = check_trajectory(plant, ticks, reference.pose(ticks), "utn", f"the {reference.name} reference", True)
+        why = why[0] if why else infeasible(d.force_limit, timing.sample_period) if infeasible else None
         if why:
             raise StewartError(why)
     except (StewartError, ZeroDivisionError, OverflowError) as e:
-        drawn = _drawn(study, d)
-        raise StudyError(
-            StudyError.DRAW.format(run=index, seed=seed, drawn=drawn, reason=short_text(str(e).splitlines()[0], 300))
-        ) from None
+        return seed, d, short_text(str(e).splitlines()[0], 300)
+    return None
 
 
 def nominal_feasibility(study, reference, duration: float):
@@ -100,4 +110,11 @@ def check_draws(study) -> None:
     gains = nominal_gains(study, reference)
     infeasible = nominal_feasibility(study, reference, duration)
     for i in range(study.runs):
+        if draw_refusal(study, i, reference, duration, gains, infeasible) is None:
+            continue
+        # refused: when the nominal scenario is too, the study's settings are at fault (no narrower --vary mends it)
+        nominal = replace(study, spec=VarySpec(), grid=None, runs=1)
+        found = draw_refusal(nominal, 0, reference, duration, gains, infeasible)
+        if found:
+            raise StudyError(StudyError.DRAW_NOMINAL.format(reason=found[2]))
         check_draw(study, i, reference, duration, gains, infeasible)

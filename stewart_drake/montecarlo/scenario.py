@@ -31,12 +31,14 @@ import numpy as np
 
 from stewart_drake.api.simulation import plan_run, tick_count
 from stewart_drake.control import ControllerConfig
+from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import Platform, base_joints
 from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
 from stewart_drake.design.payload import with_payload
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.montecarlo.spec import KEYS, VarySpec
+from stewart_drake.montecarlo.summary import FAILURE_SEPARATOR
 from stewart_drake.script import run_program
 
 # Nominal values of the keys whose nominal is not the platform's.
@@ -60,7 +62,8 @@ class Study:
     reference read on the client, (name, times (n,), poses (n, 6) SI) as lists, so that workers need no
     file; ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
     the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking; ``grid``: one
-    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length)."""
+    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length);
+    ``motion``: a Python ``Trajectory`` as the reference instead (pickled to the workers with the study)."""
 
     platform: Platform
     spec: VarySpec
@@ -78,10 +81,13 @@ class Study:
     lost_tracking: float = LOST_TRACKING
     grid: tuple | None = None
     extra: dict = field(default_factory=dict)
+    motion: Trajectory | None = None
 
     def reference(self) -> Trajectory:
         """The pose reference (built on the worker)."""
-        if self.table is not None:
+        if self.motion is not None:
+            ref = self.motion
+        elif self.table is not None:
             ref = table_trajectory(*self.table)
         elif self.program is not None:
             name, text = self.program
@@ -293,10 +299,11 @@ def scenario(study: Study, index: int, reference: Trajectory | None = None, gain
 
 
 def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None) -> dict:
-    """Run ``index`` of ``study``: its row (``{"run", "seed", drawn parameters..., metrics...}``) and,
-    with ``keep_log``, the ``SimulationLog`` under ``"log"``. Metrics (SI): leg error = true length −
-    the perturbed plant's IK of the reference; pose error = measured − reference pose. A run whose
-    simulation fails keeps its row, with ``error`` set and ``lost_tracking`` true."""
+    """Run ``index`` of ``study``: its row (``{"run", "seed", drawn parameters..., metrics..., verdicts...}``)
+    and, with ``keep_log``, the ``SimulationLog`` under ``"log"``. Metrics (SI): leg error = true length −
+    the perturbed plant's IK of the reference; pose error = measured − reference pose. Verdicts: those
+    ``simulate`` gives (``control.verdict.run_verdict``, see ``VERDICT_COLUMNS``). A run whose simulation
+    fails keeps its row, with ``error`` set and ``lost_tracking`` true."""
     t0 = time.perf_counter()
     ref = study.reference()
     seed, d, sc = scenario(study, index, ref)
@@ -307,10 +314,38 @@ def run_scenario(study: Study, index: int, keep_log: bool = False, meshcat=None)
     except (RuntimeError, ValueError) as e:
         error = f"{type(e).__name__}: {e}".splitlines()[0][:300]
     row.update(_metrics(log, ref, sc.plant_platform, study.lost_tracking, error))
+    row.update(verdict_columns(sc, log))
     row["wall_s"] = time.perf_counter() - t0
     if keep_log:
         row["log"] = log
     return row
+
+
+def verdict_columns(sc: Scenario, log) -> dict:
+    """``VERDICT_COLUMNS`` of a run of ``sc`` from its log (None: the run failed; NaN measures, no verdicts:
+    its ``error`` says why)."""
+    if log is None:
+        nan = float("nan")
+        measures = ("force_ripple_rms_N", "chatter_ratio", "ripple_range_fraction", "longest_saturation_s")
+        return dict.fromkeys(measures, nan) | {
+            "chatter": False,
+            "saturated": False,
+            "tracking_failed": False,
+            "failures": "",
+        }
+    truth = sc.plant_platform or sc.platform
+    e, pe = log.length_error(sc.trajectory, truth), log.pose_error(sc.trajectory)
+    verdict, loop = run_verdict(sc.platform, truth, sc.trajectory, log, sc.config, e, pe)
+    return {
+        "force_ripple_rms_N": float(max(loop["force_ripple_N"])),
+        "chatter_ratio": float(loop["chatter_ratio"]),
+        "ripple_range_fraction": float(loop["ripple_range_fraction"]),
+        "longest_saturation_s": float(max(verdict["longest_saturation_s"])),
+        "chatter": bool(loop["chatter"]),
+        "saturated": bool(verdict["saturated_legs"] or loop["end_saturation"]),
+        "tracking_failed": bool(verdict["tracking_lost"]),
+        "failures": FAILURE_SEPARATOR.join(verdict["failures"]),
+    }
 
 
 def _metrics(log, ref, platform: Platform, lost: float, error: str) -> dict:

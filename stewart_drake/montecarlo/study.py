@@ -20,6 +20,8 @@ import hashlib
 import json
 import logging
 import math
+import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +32,7 @@ from stewart_drake.drake.systems import make_law
 from stewart_drake.errors import OutputError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
 from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
+from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -69,9 +72,20 @@ def study_settings(study: Study) -> dict:
         "plant_step": study.plant_step,
         "lost_tracking": study.lost_tracking,
         "grid": list(study.grid) if study.grid is not None else None,
+        "motion": motion_settings(study),
         **shared,
         **study.extra,
     }
+
+
+def motion_settings(study: Study) -> dict | None:
+    """A Python ``Trajectory`` reference as ``{"name", "sha256"}``: its name and a hash of its poses at the plant
+    steps of a run (what the runs follow), so that the study's key changes with the motion; None for others."""
+    if study.motion is None:
+        return None
+    t = np.arange(int(math.floor(study.run_duration() / study.plant_step + 1e-9)) + 1) * study.plant_step
+    poses = np.ascontiguousarray(study.reference().pose(t), dtype="<f8")
+    return {"name": study.motion.name, "sha256": hashlib.sha256(poses.tobytes()).hexdigest()}
 
 
 def study_from_settings(settings: dict, runs: int) -> Study:
@@ -79,6 +93,8 @@ def study_from_settings(settings: dict, runs: int) -> Study:
     from stewart_drake.core.geometry import LegConfig, Platform
     from stewart_drake.montecarlo.spec import spec_from_dict
 
+    if settings.get("motion"):  # its poses' hash alone: the Trajectory object stayed in the process that ran it
+        raise StudyError(StudyError.MOTION_NOT_STORED.format(name=settings["motion"].get("name")))
     plat = dict(settings["platform"])
     plat["legs"] = LegConfig(**plat["legs"])
     plat["leg_top"] = np.asarray(plat["leg_top"], dtype=np.intp)
@@ -99,6 +115,7 @@ def study_from_settings(settings: dict, runs: int) -> Study:
         "lost_tracking",
         "grid",
         "base_joints",
+        "motion",
     }
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(
@@ -314,10 +331,12 @@ class PartialWriter:
 def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = True) -> list[dict]:
     """Run every run of ``study`` not yet in ``out`` and return all rows in run order. ``workers`` 0
     runs them in this process (no Dask); otherwise a ``LocalCluster`` of ``workers`` processes, or the
-    cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume)."""
+    cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume). A finished row without the
+    verdict columns (``summary.VERDICT_COLUMNS``: written before runs were judged) is run again."""
     check_study(study)
     key = study_key(study)
     rows = load_partial(Path(out), key) if out is not None else {}
+    rows = {i: r for i, r in rows.items() if all(c in r for c in VERDICT_COLUMNS)}
     todo = [i for i in range(study.runs) if i not in rows]
     writer = PartialWriter(Path(out), key) if out is not None else None
     bar = None
@@ -348,17 +367,27 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
         for i in todo:
             yield run_row(study, i)
         return
-    from distributed import Client, as_completed
+    from distributed import Client
 
     from stewart_drake.workspace.dask_sweep import local_cluster
 
     compile_firmware(study, todo[0])
-    cluster, interrupted = None, False
-    if scheduler is None:
-        cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
+    cluster = None
+    with main_kept_from_workers():  # open while the cluster lives: a nanny restarting a dead worker spawns too
+        if scheduler is None:
+            cluster = local_cluster(workers)  # single-threaded worker processes, no profiler, adaptive malloc
+            client = Client(cluster)
+        else:
+            client = Client(scheduler)
+        yield from _gathered(study, todo, client, cluster)
+
+
+def _gathered(study: Study, todo: list[int], client, cluster):
+    """Rows of the runs ``todo`` run on ``client``'s cluster, as they finish; closes the client (and
+    ``cluster``, a ``LocalCluster`` of this study's) at the end, but not on an interrupt."""
+    from distributed import as_completed
+
+    interrupted = False
     try:
         # each task carries the study (~2 kB pickled) rather than a scattered copy: a worker killed while it
         # held the only replica would lose scattered data for good, and every run waiting on it would fail
@@ -375,3 +404,24 @@ def _results(study: Study, todo: list[int], workers: int, scheduler: str | None)
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+@contextmanager
+def main_kept_from_workers():
+    """While open, processes that ``multiprocessing`` spawns (Dask's nannies start their workers so, and start
+    a dead worker's replacement so) do not import the caller's ``__main__``: a user's script without an
+    ``if __name__ == "__main__":`` guard would run again in each worker as it starts, and fail there. Its
+    functions and classes still reach the workers, by value (``distributed`` pickles what refers to
+    ``__main__`` with cloudpickle). ``__main__``'s ``__file__`` and ``__spec__`` (what spawn reads to import
+    it) are put back when it closes."""
+    main = sys.modules.get("__main__")
+    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if k in main.__dict__} if main else {}
+    if main is not None:
+        main.__dict__.pop("__file__", None)
+        if "__spec__" in saved:
+            main.__spec__ = None
+    try:
+        yield
+    finally:
+        if main is not None:
+            main.__dict__.update(saved)

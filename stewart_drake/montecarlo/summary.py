@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.control.chatter import CHATTER_RANGE_FRACTION
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.montecarlo.spec import LATENCY_MODES
 
@@ -26,9 +27,24 @@ METRICS = (
     "rms_angle_error_rad",
     "saturated_ticks",
     "saturated_leg_ticks",
+    "force_ripple_rms_N",
+    "chatter_ratio",
+    "longest_saturation_s",
 )
+# The verdict columns of a row: simulate's verdicts on the run (``control.verdict.run_verdict``).
+VERDICT_COLUMNS = (
+    "force_ripple_rms_N",  # the largest leg's force ripple (RMS of force − quasi-static force), N
+    "chatter_ratio",  # ripple / working force, largest over the legs
+    "ripple_range_fraction",  # largest ripple / command range
+    "longest_saturation_s",  # the longest stretch a leg's command stayed saturated, s
+    "chatter",  # the loop chatters (ripple above the working force and the range bound)
+    "saturated",  # a leg saturated too long in one stretch, or at the reference's start or end
+    "tracking_failed",  # a leg or plate position error beyond simulate's bound (a fraction of the stroke)
+    "failures",  # simulate's failure messages, joined by FAILURE_SEPARATOR ("" when none)
+)
+FAILURE_SEPARATOR = " | "
 # Row fields that are not drawn parameters.
-NOT_PARAMETERS = set(METRICS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
+NOT_PARAMETERS = set(METRICS) | set(VERDICT_COLUMNS) | {"run", "seed", "lost_tracking", "error", "wall_s"}
 PERCENTILES = (5, 50, 95, 99)
 WORST_BY = "max_leg_error_m"
 
@@ -97,7 +113,9 @@ def _average_ranks(v: np.ndarray) -> np.ndarray:
 
 def summarise(rows: list[dict], settings: dict, key: str) -> dict:
     """The study's summary: per metric the percentiles, mean and max; the worst run (largest
-    ``WORST_BY``); lost-tracking and failed counts; the sensitivity ranking per leg and pose metric."""
+    ``WORST_BY``); the runs that lost tracking (``lost_tracking_runs``) and those that failed
+    (``failed_runs``: ``{"run", "reason"}``, a run whose simulation failed or that ``simulate``'s verdicts
+    fail: chatter, saturation, tracking); ``ok``: neither; the sensitivity ranking per leg and pose metric."""
     stats = {}
     for m in METRICS:
         v = _numeric(rows, m)
@@ -113,12 +131,15 @@ def summarise(rows: list[dict], settings: dict, key: str) -> dict:
     finite = [r for r in rows if math.isfinite(float(r[WORST_BY]))]
     worst = max(finite, key=lambda r: r[WORST_BY]) if finite else rows[0]
     wall = np.array([r["wall_s"] for r in rows], float)
+    lost = [r["run"] for r in rows if r["lost_tracking"]]
+    failed = [{"run": r["run"], "reason": r["error"] or r["failures"]} for r in rows if r["error"] or r["failures"]]
     return {
         "key": key,
         "runs": len(rows),
         "settings": settings,
-        "lost_tracking_runs": [r["run"] for r in rows if r["lost_tracking"]],
-        "failed_runs": [r["run"] for r in rows if r["error"]],
+        "ok": not lost and not failed,
+        "lost_tracking_runs": lost,
+        "failed_runs": failed,
         "metrics": stats,
         "worst_run": {"run": worst["run"], "seed": worst["seed"], "by": WORST_BY, **{m: worst[m] for m in METRICS}},
         "sensitivity": {m: sensitivity(rows, m) for m in ("max_leg_error_m", "max_position_error_m")},
@@ -150,15 +171,23 @@ def read_table(folder) -> list[dict]:
 
 
 def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
-    """``distributions.png`` (histograms of the leg and pose errors) and ``sensitivity.png`` (the leg
-    error against the most influential parameter, and the ranking). Drawn on ``Figure`` objects, not pyplot,
-    so that the caller's backend (a notebook's inline figures) is left as it was."""
+    """``distributions.png`` (histograms of the leg and pose errors and of the force ripple, against the chatter
+    bound) and ``sensitivity.png`` (the leg error against the most influential parameter, and the ranking). Drawn
+    on ``Figure`` objects, not pyplot, so that the caller's backend (a notebook's inline figures) is left as it
+    was."""
     # deferred: matplotlib is loaded only when a study writes its plots
     from matplotlib.figure import Figure
 
     paths = []
-    fig = Figure(figsize=(13, 3.6))
-    ax = fig.subplots(1, 3)
+    ripple = "ripple_range_fraction" in rows[0]  # the loop's force ripple, when the runs were judged
+    fig = Figure(figsize=(17 if ripple else 13, 3.6))
+    ax = fig.subplots(1, 4 if ripple else 3)
+    if ripple:  # what the chatter verdict sees: the ripple against its share of the command range
+        v = _numeric(rows, "ripple_range_fraction")
+        ax[3].hist(v[np.isfinite(v)] * 100, bins=max(5, min(40, len(rows) // 5)))
+        ax[3].axvline(CHATTER_RANGE_FRACTION * 100, color="red", linestyle="--", label="chatter bound")
+        ax[3].set_xlabel("force ripple [% of the command range]")
+        ax[3].legend(fontsize=7)
     for a, (m, scale, label) in zip(
         ax,
         [
