@@ -837,8 +837,11 @@ class MachineError(UsageError):
         "{firmware} was generated for platform {recorded} ({recorded_hash}), not for this run's {platform} "
         "({platform_hash}); regenerate it for this platform"
     )
-    FORMAT_ADOPTED = "loop format adopted from the firmware: {what} (the machine said {machine})"
     SOURCE = "load_machine: expected a path, a mapping or a Platform, got {got}"
+
+
+# a warning of a run with a firmware (api.simulation.adopt_firmware)
+FIRMWARE_FORMAT_ADOPTED = "loop format adopted from the firmware: {what} (the machine said {machine})"
 
 
 class StudyError(StewartError):

@@ -35,7 +35,7 @@ from stewart_drake.firmware.certify.search import MAX_CELLS
 from stewart_drake.firmware.certify.tick import TickCertificate
 from stewart_drake.firmware.certify.tick import certify_tick as certify_tick_words
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
-from stewart_drake.firmware.fingerprint import read_fingerprint, resolve_options, stamp
+from stewart_drake.firmware.fingerprint import platform_hash, read_fingerprint, resolve_options, stamp
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.fixedpoint.generic import QFormat
@@ -150,6 +150,7 @@ def generate(
         rate=rate,
         sensor_resolution=sensor_resolution,
         trajectory=trajectory if trajectory is None or isinstance(trajectory, str) else trajectory.name,
+        platform_hash=platform_hash(platform),
     )
     g.files = stamp(g.files, options)  # the options, for `firmware check`
     compiled = []

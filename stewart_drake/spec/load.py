@@ -126,7 +126,7 @@ def _as_written(e: MachineError, text: str) -> str:
     return f"{head}, got {text}" if sep else str(e)
 
 
-def load_machine(source, overrides=()) -> Machine:
+def load_machine(source: Machine | Platform | Mapping | str | Path, overrides: Iterable[str] | Mapping = ()) -> Machine:
     """A ``Machine`` from a machine or platform file (path), a preset name, a mapping (a machine file's
     content), a ``Platform`` (every other section at its defaults) or a ``Machine``; then ``overrides``
     (``PATH=VALUE`` words or a ``{path: value}`` mapping) applied in order.

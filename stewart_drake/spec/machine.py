@@ -174,12 +174,13 @@ class PayloadSpec:
 class RunSpec:
     """How one run is simulated: ``duration`` (s; None: the motion's, else 1 s), ``plant_step`` (s; None:
     the period, at most 1 ms), ``integrator`` (None: the default) and ``fit`` (move and scale the motion to
-    the platform's home height and stroke)."""
+    the platform's home height and stroke) and ``seed`` (of the run's random processes: sensor noise)."""
 
     duration: float | None = None
     plant_step: float | None = None
     integrator: str | None = None
     fit: bool = False
+    seed: int = 0
 
     def __post_init__(self):
         if self.duration is not None:
@@ -188,6 +189,8 @@ class RunSpec:
             _number("run.plant_step", self.plant_step, "> 0 s", lambda v: v > 0)
         if not isinstance(self.fit, bool):
             raise MachineError(MachineError.RANGE.format(path="run.fit", rule="true or false", value=self.fit))
+        if not (isinstance(self.seed, (int, np.integer)) and not isinstance(self.seed, bool) and self.seed >= 0):
+            raise MachineError(MachineError.RANGE.format(path="run.seed", rule="an integer >= 0", value=self.seed))
 
 
 def check_motion(path: str, motion) -> None:
@@ -287,5 +290,6 @@ FIELDS = {
     "run.plant_step": "time?",
     "run.integrator": ("word?", ("cenic-fixed", "cenic", "sap")),
     "run.fit": "bool",
+    "run.seed": "int",
 }
 assert set(FIELDS) == {f"{s}.{f.name}" for s, tp in SECTIONS.items() for f in dataclasses.fields(tp)}
