@@ -12,6 +12,7 @@ from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.core.geometry import load_preset, preset_path
 from stewart_drake.errors import MachineError, QuantityError
 from stewart_drake.spec import ControllerSpec, FirmwareFormat, Machine, PayloadSpec, load_machine
+from stewart_drake.spec.machine import FIELDS
 
 PLATFORM = """\
 name: newcomer-6dof-sim
@@ -141,3 +142,19 @@ def test_a_machine_is_frozen():
     m = Machine(load_preset("utn-dynamic"))
     with pytest.raises(dataclasses.FrozenInstanceError):
         m.controller = ControllerSpec()
+
+
+def test_the_machine_template_holds_every_section_at_its_default(tmp_path, capsys):
+    from stewart_drake.cli import main
+
+    assert main(["init", "--machine-template"]) == 0
+    path = write(tmp_path, capsys.readouterr().out, "template.yaml")
+    m = load_machine(path)
+    default = Machine(m.platform)
+    for name in ("actuators", "sensors", "controller", "firmware", "payload", "run", "motions"):
+        assert getattr(m, name) == getattr(default, name), name
+    text = path.read_text()
+    # every overridable path is written in the template, so that it shows the user every field
+    for path in FIELDS:
+        section, field = path.split(".")
+        assert f"\n{section}:" in text and f"\n  {field}:" in text, path
