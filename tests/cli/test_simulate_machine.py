@@ -109,3 +109,16 @@ def test_api_errors_name_spec_paths():
         sd.simulate(sd.load_platform("utn-dynamic"), period=-1)
     with pytest.raises(MachineError, match=r"^firmware\.length_lsb must be > 0 m, got 0$"):
         sd.simulate(sd.load_platform("utn-dynamic"), **{"firmware.length_lsb": 0})
+
+
+def test_a_firmware_generated_for_the_machine_runs_its_format(tmp_path):
+    machine = sd.load_machine(EXAMPLE)
+    r = sd.firmware.generate(machine, tmp_path / "fw", compile=False)
+    assert r.config.ik_format == machine.firmware.qformat() and r.config.convention == "utn"
+    assert r.config.timing.sample_period == machine.controller.period
+    assert r.config.timing.sensor_resolution == machine.sensors.resolution
+    # the gains are designed with the payload on the plate: those of the 210 kg plate, not of the bare 60 kg one
+    bare = sd.firmware.generate(machine.platform, tmp_path / "bare", compile=False, length_lsb=3e-5)
+    assert r.config.gains.kp != bare.config.gains.kp
+    # the firmware and the machine agree: the loop adopts nothing
+    assert plan_run(machine, duration=0.1, firmware=tmp_path / "fw").warnings == ()
