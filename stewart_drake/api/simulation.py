@@ -202,7 +202,8 @@ def _motion(motion, platform: Platform, rate: float, **units) -> Trajectory:
     """The reference of ``motion``: a ``.stw`` program is run from the platform's home pose and sampled at
     the controller's ``rate``; the others are ``get_trajectory``'s."""
     if isinstance(motion, (str, Path)) and str(motion).endswith(".stw"):
-        return compile_program(read_program(str(motion)), str(motion), platform)[1].trajectory(rate)
+        traj = compile_program(read_program(str(motion)), str(motion), platform)[1].trajectory(rate)
+        return replace(traj, name=Path(motion).stem)
     return get_trajectory(motion, **units)
 
 

@@ -138,9 +138,11 @@ def load_machine(source: Machine | Platform | Mapping | str | Path, overrides: I
         machine = source
     elif isinstance(source, Platform):
         machine = Machine(source)
-    elif isinstance(source, Mapping):
-        text = yaml.safe_dump(_plain(source), sort_keys=False, allow_unicode=True)
-        machine = _from_text(text, "machine mapping", Path.cwd())
+    elif isinstance(source, Mapping):  # a machine file's content; "platform" may hold a Platform
+        rest = dict(source)
+        given = rest.pop("platform") if isinstance(rest.get("platform"), Platform) else None
+        text = yaml.safe_dump(_plain(rest), sort_keys=False, allow_unicode=True)
+        machine = _from_text(text, "machine mapping", Path.cwd(), platform=given)
     elif isinstance(source, (str, Path)):
         s = str(source)
         if s in PRESETS:
@@ -193,8 +195,10 @@ def _describe(node) -> str:
     )
 
 
-def _from_text(text: str, shown: str, base: Path, stem: str = "") -> Machine:
+def _from_text(text: str, shown: str, base: Path, stem: str = "", platform: Platform | None = None) -> Machine:
     root = compose(text, shown)
+    if platform is not None and root is None:  # {"platform": Platform} alone
+        return Machine(platform)
     if not isinstance(root, yaml.MappingNode):
         got = "an empty file" if root is None else _describe(root)
         raise MachineError(MachineError.NOT_MAPPING.format(where=f"{shown}: ", path="a machine file", got=got))
@@ -232,6 +236,15 @@ def _from_text(text: str, shown: str, base: Path, stem: str = "") -> Machine:
             raise MachineError(
                 MachineError.UNKNOWN_KEY.format(where=at, path=key, hint=_hint(key, (*MACHINE_KEYS, *PLATFORM_KEYS)))
             )
+    if platform is not None:
+        if platform_pairs:
+            k = platform_pairs[0][0]
+            raise MachineError(
+                MachineError.UNKNOWN_KEY.format(
+                    where=f"{shown}:{_line(k)}: ", path=k.value, hint=" (the platform is given as a Platform)"
+                )
+            )
+        return Machine(platform, **fields)
     if platform_node is not None and platform_pairs:
         k = platform_pairs[0][0]
         raise MachineError(

@@ -8,6 +8,7 @@ import json
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import stewart_drake as sd
@@ -122,3 +123,23 @@ def test_a_firmware_generated_for_the_machine_runs_its_format(tmp_path):
     assert r.config.gains.kp != bare.config.gains.kp
     # the firmware and the machine agree: the loop adopts nothing
     assert plan_run(machine, duration=0.1, firmware=tmp_path / "fw").warnings == ()
+
+
+def test_the_machine_sensor_noise_is_drawn_from_its_seed():
+    machine = sd.load_machine(EXAMPLE, ["sensors.noise=1um", "run.seed=3"])
+    noise = plan_run(machine, duration=0.1).scenario.sensor.noise
+    assert noise.shape == (102, 6)  # ticks 0..100 and one more (the tick at the run's end)
+    # σ of 612 draws: its relative standard error is 1/sqrt(2·612) ≈ 2.9 %; 15 % is five of them
+    assert abs(noise.std() / 1e-6 - 1) < 0.15
+    assert (plan_run(machine, duration=0.1).scenario.sensor.noise == noise).all()
+    other = plan_run(machine.replace(**{"run.seed": 4}), duration=0.1).scenario.sensor.noise
+    assert not (other == noise).all()
+    assert plan_run(sd.load_machine(EXAMPLE), duration=0.1).scenario.sensor is None  # noise 0: an ideal sensor
+
+
+def test_a_motion_program_is_a_machine_motion():
+    platform = sd.load_platform("utn-dynamic")
+    program = Path(__file__).parents[2] / "examples" / "seed_004.stw"
+    traj = plan_run(platform, program, duration=0.1).scenario.trajectory
+    assert traj.name == "seed_004"
+    assert np.allclose(traj.pose(0.0), platform.home_pose(), atol=1e-12)  # a program starts at home

@@ -158,3 +158,12 @@ def test_the_machine_template_holds_every_section_at_its_default(tmp_path, capsy
     for path in FIELDS:
         section, field = path.split(".")
         assert f"\n{section}:" in text and f"\n  {field}:" in text, path
+
+
+def test_a_mapping_may_hold_a_platform_object():
+    p = load_preset("utn-dynamic")
+    m = load_machine({"platform": p, "controller": {"period": "2ms"}, "firmware": {"length_lsb": "0.5mm"}})
+    assert m.platform is p and m.controller.period == 0.002 and m.firmware.length_lsb == 0.0005
+    assert load_machine({"platform": p}).platform is p
+    with pytest.raises(MachineError, match=r"unknown key 'controler' \(did you mean 'controller'\?\)"):
+        load_machine({"platform": p, "controler": {"period": "2ms"}})
