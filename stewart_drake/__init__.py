@@ -48,6 +48,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.montecarlo.api import MonteCarloResult, montecarlo
     from stewart_drake.montecarlo.measurements_api import MeasurementsResult, simulate_measurements
     from stewart_drake.report.api import ReportResult, report
+    from stewart_drake.spec import Machine, load_machine
     from stewart_drake.synthesis.api import OptimizeResult, WorkspaceProof, load_requirements, optimize, prove_workspace
 
 __version__ = "0.2.0"
@@ -61,6 +62,8 @@ _PUBLIC = {
     "PhysicalLimitError": ("stewart_drake.errors", "PhysicalLimitError"),
     "Platform": ("stewart_drake.core.geometry", "Platform"),
     "load_platform": ("stewart_drake.api.platform", "load_platform"),
+    "load_machine": ("stewart_drake.spec.load", "load_machine"),
+    "Machine": ("stewart_drake.spec.machine", "Machine"),
     "presets": ("stewart_drake.api.platform", "presets"),
     "Trajectory": ("stewart_drake.core.trajectory", "Trajectory"),
     "ik": ("stewart_drake.api.kinematics", "ik"),
@@ -120,6 +123,8 @@ __all__ = [
     "PhysicalLimitError",
     "Platform",
     "load_platform",
+    "load_machine",
+    "Machine",
     "presets",
     "Trajectory",
     "ik",

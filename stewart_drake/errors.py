@@ -819,6 +819,40 @@ class SpecError(StewartError):
     SWEEP_EMPTY = "sweep: {key} has no values"
 
 
+class QuantityError(StewartError):
+    """A quantity that cannot be read (``spec.quantity``: ``0.5mm``, ``±T``, ``±P%``, ``A..B``, ``a|b``, ``X,Y,Z``)."""
+
+    NUMBER = "{where}: cannot read {text!r} as a number with a unit ({allowed})"
+    NOT_FINITE = "{where}: {text!r} is not finite"
+    CHOICE = "{where}: {text!r} is not one of {valid}"
+    VECTOR = "{where}: {text!r}: expected {n} numbers X,Y,Z (or a list of {n})"
+    FORM = "{where}: {text!r}: {form} is not allowed here"
+    PERCENT_RANGE = "{where}: {text!r}: the percentage must be in [0, 100)"
+    HALF_WIDTH = "{where}: {text!r}: the half-width must be >= 0"
+    RANGE_ORDER = "{where}: {text!r}: the range's low end is above its high end"
+
+
+class MachineError(UsageError):
+    """A machine file or override that cannot be read or holds a value out of range (``spec.machine``,
+    ``spec.load``); messages name the spec path (``controller.period``)."""
+
+    RANGE = "{path} must be {rule}, got {value}"
+    UNKNOWN_KEY = "{where}unknown key {path!r}{hint}"
+    NOT_MAPPING = "{where}{path} must be a mapping of key: value, got {got}"
+    OVERRIDE = "{text!r} is not PATH=VALUE (e.g. controller.period=0.5ms)"
+    MOTION = "{path}: {value!r} is not seed, rotating, a .csv file or a .stw script"
+    PLATFORM = "{where}platform must be a preset name, a platform file or an inline mapping, got {got}"
+    FIRMWARE_PLATFORM = (
+        "{firmware} was generated for platform {recorded} ({recorded_hash}), not for this run's {platform} "
+        "({platform_hash}); regenerate it for this platform"
+    )
+    SOURCE = "load_machine: expected a path, a mapping or a Platform, got {got}"
+
+
+# a warning of a run with a firmware (api.simulation.adopt_firmware)
+FIRMWARE_FORMAT_ADOPTED = "loop format adopted from the firmware: {what} (the machine said {machine})"
+
+
 class StudyError(StewartError):
     """A study that cannot start: too large, inconsistent settings, or an output folder that is not its own
     (``montecarlo.study``)."""

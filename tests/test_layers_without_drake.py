@@ -18,6 +18,7 @@ DRAKE_FREE = (
     "tests/script",
     "tests/design",
     "tests/calibration",
+    "tests/spec",
 )
 
 

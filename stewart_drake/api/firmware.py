@@ -38,6 +38,7 @@ from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.firmware.fingerprint import (
     DESIGN_POSES,
     motion_record,
+    platform_hash,
     poses_hash,
     read_fingerprint,
     recorded_design_poses,
@@ -47,6 +48,7 @@ from stewart_drake.firmware.fingerprint import (
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.fixedpoint.generic import QFormat
+from stewart_drake.spec import Machine, load_machine
 
 __all__ = [
     "generate",
@@ -109,15 +111,15 @@ class GenerateResult(Result):
 
 
 def generate(
-    platform: Platform,
+    platform: Platform | Machine,
     out: str | Path,
     *,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
     compile: bool = True,
     on_note: Callable[[str], None] | None = None,
@@ -125,16 +127,20 @@ def generate(
 ) -> GenerateResult:
     """Generate the C firmware (``sd_firmware.h``, ``sd_firmware.c``, README) for a platform into a folder.
 
+    The number format, rate and sensor resolution are the machine's (``firmware``, ``1 / controller.period``,
+    ``sensors.resolution``; for a ``Platform``, those of a machine with defaults: the DSP's 16-bit words,
+    1 mm, tfr16, utn, 1 kHz, 10 µm); a keyword given replaces its value.
+
     Args:
-        platform: the platform.
+        platform: the platform, or a ``Machine`` (its gains are designed with its payload on the plate).
         out: the output folder: new, empty, or holding only files this command wrote (the manifest records each
             with its sha256; another command's file or a changed one is refused, never replaced).
-        word_bits: data word width, 8..16.
-        length_lsb: metres per length LSB.
-        trig: the trigonometry (``"tfr16"``: the DSP's; needs 16-bit words).
-        convention: Euler convention of the pose angles.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
+        word_bits: data word width, 8..16 (``firmware.word_bits``).
+        length_lsb: metres per length LSB (``firmware.length_lsb``).
+        trig: the trigonometry (``"tfr16"``: the DSP's; needs 16-bit words) (``firmware.trig``).
+        convention: Euler convention of the pose angles (``firmware.convention``).
+        rate: controller rate, Hz (``1 / controller.period``).
+        sensor_resolution: leg sensor, m per count (``sensors.resolution``).
         trajectory: design the gains over this reference's poses (default: home only). A `Trajectory` (no
             name ``check`` can look up) also writes its design poses to ``sd_design_poses.json`` beside the C,
             which ``check`` reads (their hash is recorded in the fingerprint).
@@ -149,7 +155,18 @@ def generate(
     Raises:
         StewartError: bad options, or an output folder that holds other files.
     """
-    config = controller_config(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    machine = load_machine(platform)
+    fmt, platform = machine.firmware, machine.platform
+    platform_source = machine.platform_source if platform_source is None else platform_source
+    word_bits = fmt.word_bits if word_bits is None else word_bits
+    length_lsb = fmt.length_lsb if length_lsb is None else length_lsb
+    trig = fmt.trig if trig is None else trig
+    convention = fmt.convention if convention is None else convention
+    rate = 1.0 / machine.controller.period if rate is None else rate
+    sensor_resolution = machine.sensors.resolution if sensor_resolution is None else sensor_resolution
+    config = controller_config(
+        machine.loaded_platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory
+    )
     folder = OutputFolder(out)  # the policy, before any work: new, empty, or this command's own verified files
     out = Path(out)
     g = generate_sources(platform, config)
@@ -162,6 +179,7 @@ def generate(
         rate=rate,
         sensor_resolution=sensor_resolution,
         trajectory=trajectory,
+        platform_hash=platform_hash(platform),
     )
     if isinstance(trajectory, Trajectory):  # no name `check` can look up: the design poses beside the C
         options["trajectory"], g.files[DESIGN_POSES] = motion_record(trajectory.name, design_poses(trajectory))

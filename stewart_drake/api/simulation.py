@@ -20,6 +20,7 @@ import numpy as np
 from stewart_drake.api.result import Result, plain
 from stewart_drake.control import ControllerConfig, DspTiming, check_timing
 from stewart_drake.control.feasibility import infeasible_motion
+from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import Platform
@@ -37,17 +38,23 @@ from stewart_drake.drake.firmware_run import run_user_firmware
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.errors import (
+    FIRMWARE_FORMAT_ADOPTED,
     OPTION_DURATION_PERIOD,
     OPTION_DURATION_POSITIVE,
     OPTION_ENGINE_FIXED,
     OPTION_FIRMWARE_ENGINE,
     SIMULATION_GAP_WARNING,
+    MachineError,
     OptionError,
     PhysicalLimitError,
     UsageError,
 )
 from stewart_drake.firmware.engine import default_engine
+from stewart_drake.firmware.fingerprint import PLATFORM_HASH, platform_hash, read_fingerprint
 from stewart_drake.firmware.module import check_source
+from stewart_drake.script import compile_program
+from stewart_drake.script.source import read_program
+from stewart_drake.spec import Gains, Machine, load_machine
 
 if TYPE_CHECKING:  # annotations only: matplotlib and pandas are loaded when a figure or a table is asked for
     import pandas
@@ -92,6 +99,7 @@ class RunPlan:
     warnings: tuple = ()
     read_units: dict | None = None
     time_limit: float = 60.0  # a user's firmware: seconds the simulated time may stand still (drake.firmware_run)
+    machine: Machine | None = None  # the machine run (with the firmware's format where one was adopted)
 
     @property
     def config(self) -> ControllerConfig:
@@ -99,22 +107,122 @@ class RunPlan:
         return self.scenario.config
 
 
+# plan_run's and simulate's keywords of earlier versions -> the spec path they set (None: the machine's)
+KEYWORD_PATHS = {
+    "controller": "controller.law",
+    "period": "controller.period",
+    "latency": "controller.latency",
+    "sensor_resolution": "sensors.resolution",
+    "feedforward": "controller.feedforward",
+    "engine": "controller.engine",
+    "plant_step": "run.plant_step",
+    "integrator": "run.integrator",
+    "fit": "run.fit",
+}
+
+
+def run_machine(machine: Machine | Platform | str | Path, keywords: dict, overrides: dict) -> Machine:
+    """``machine`` (a ``Machine``, a ``Platform`` with every other section at its defaults, or a machine file)
+    with the given ``keywords`` (``KEYWORD_PATHS``' names; None: the machine's) and ``overrides`` by spec path
+    (``{"controller.period": 5e-4}``, values in SI or as quantity text)."""
+    given = {KEYWORD_PATHS[k]: v for k, v in keywords.items() if v is not None}
+    return load_machine(machine, {**given, **overrides})
+
+
+def firmware_source(path, what: str = "firmware") -> Path:
+    """The C file of ``path``: a file, or a folder holding ``sd_firmware.c`` (``firmware generate``'s); a
+    ``FirmwareError`` naming ``what`` and the path as written otherwise."""
+    p = Path(path) if str(path).strip() else None
+    if p is not None and p.is_dir() and (p / "sd_firmware.c").is_file():
+        p = p / "sd_firmware.c"
+    return check_source(p if p is not None else path, what)
+
+
+def _length(v: float) -> str:
+    return f"{v * 1e3:g} mm" if v >= 1e-3 else f"{v * 1e6:g} µm"
+
+
+def adopt_firmware(machine: Machine, path) -> tuple[Machine, list]:
+    """``(machine, warnings)``: the machine a firmware's loop runs, with the number format, sensor resolution
+    and rate the firmware at ``path`` records (``firmware.fingerprint``) where they differ from the machine's
+    (a warning names each: the loop must compute what the firmware computes). A firmware recorded for another
+    platform (its content hash) raises ``MachineError`` naming both; one without a record runs as is."""
+    rec = read_fingerprint(path)
+    if rec is None:
+        return machine, []
+    opts, where = rec
+    mine = platform_hash(machine.platform)
+    if opts[PLATFORM_HASH] is not None and opts[PLATFORM_HASH] != mine:
+        raise MachineError(
+            MachineError.FIRMWARE_PLATFORM.format(
+                firmware=where,
+                recorded=opts["platform"],
+                recorded_hash=opts[PLATFORM_HASH],
+                platform=machine.platform.name,
+                platform_hash=mine,
+            )
+        )
+    fw, c, r = machine.firmware, machine.controller, machine.sensors
+    length = _length
+    recorded = {  # path: (the firmware's, the machine's, what it is, how it is shown)
+        "firmware.word_bits": (opts["word_bits"], fw.word_bits, "word bits", str),
+        "firmware.length_lsb": (opts["length_lsb"], fw.length_lsb, "length LSB", length),
+        "firmware.trig": (opts["trig"], fw.trig, "trig", str),
+        "firmware.convention": (opts["convention"], fw.convention, "convention", str),
+        "sensors.resolution": (opts["sensor_resolution"], r.resolution, "sensor resolution", length),
+        "controller.period": (1.0 / opts["rate"], c.period, "rate", lambda v: f"{1 / v:g} Hz"),
+    }
+    changed = {k: v for k, v in recorded.items() if v[0] != v[1]}
+    if not changed:
+        return machine, []
+    warnings = [
+        FIRMWARE_FORMAT_ADOPTED.format(what=f"{what} {show(new)}", machine=show(old))
+        for new, old, what, show in changed.values()
+    ]
+    fmt = {k.split(".")[1]: v[0] for k, v in changed.items() if k.startswith("firmware.")}
+    machine = replace(machine, firmware=replace(fw, **fmt)) if fmt else machine
+    if "sensors.resolution" in changed:
+        machine = replace(machine, sensors=replace(r, resolution=changed["sensors.resolution"][0]))
+    if "controller.period" in changed:
+        machine = replace(machine, controller=replace(c, period=changed["controller.period"][0]))
+    return machine, warnings
+
+
+def _sensor(machine: Machine, duration: float) -> SensorModel | None:
+    """The machine's sensor noise as a ``SensorModel`` (drawn from ``run.seed``), None for an ideal sensor."""
+    sigma, period = machine.sensors.noise, machine.controller.period
+    if sigma == 0:
+        return None
+    n = tick_count(duration, period) + 1
+    noise = np.random.default_rng(machine.run.seed).normal(0.0, sigma, (n, 6))
+    return SensorModel(np.zeros(6), noise, np.zeros(n), period)
+
+
+def _motion(motion, platform: Platform, rate: float, **units) -> Trajectory:
+    """The reference of ``motion``: a ``.stw`` program is run from the platform's home pose and sampled at
+    the controller's ``rate``; the others are ``get_trajectory``'s."""
+    if isinstance(motion, (str, Path)) and str(motion).endswith(".stw"):
+        traj = compile_program(read_program(str(motion)), str(motion), platform)[1].trajectory(rate)
+        return replace(traj, name=Path(motion).stem)
+    return get_trajectory(motion, **units)
+
+
 def plan_run(
-    platform: Platform,
-    trajectory: str | Path | Trajectory = "seed",
-    controller: str = "fixed",
+    platform: Machine | Platform | str | Path,
+    trajectory: str | Path | Trajectory | None = None,
+    controller: str | None = None,
     duration: float | None = None,
     *,
-    period: float = 1e-3,
-    latency: str = "sample",
-    sensor_resolution: float = 1e-5,
+    period: float | None = None,
+    latency: str | None = None,
+    sensor_resolution: float | None = None,
     plant_step: float | None = None,
-    feedforward: bool = True,
+    feedforward: bool | None = None,
     engine: str | None = None,
     firmware: str | None = None,
     time_limit: float = FIRMWARE_IDLE_LIMIT_S,
     integrator: str | None = None,
-    fit: bool = False,
+    fit: bool | None = None,
     allow_out_of_stroke: bool = False,
     length_unit: str = "m",
     angle_unit: str = "rad",
@@ -129,9 +237,15 @@ def plan_run(
     checks: bool = True,
     command: str = "simulate",
     duration_shown=None,
+    **overrides,
 ) -> RunPlan:
     """Check a closed-loop run's settings and build its ``Scenario`` (see ``simulate`` for the arguments).
 
+    ``platform``: a ``Machine`` (or a ``Platform`` or machine file: a machine with defaults); the keywords
+    ``controller``, ``period``, ``latency``, ``sensor_resolution``, ``plant_step``, ``feedforward``, ``engine``,
+    ``integrator`` and ``fit`` set their spec paths (``KEYWORD_PATHS``; None keeps the machine's), and
+    ``overrides`` set any spec path (``**{"firmware.length_lsb": "30um"}``). The loop's number format is the
+    machine's ``firmware`` (or, with ``firmware``, the one the firmware records: ``adopt_firmware``).
     ``actuators``, ``sensor``, ``plant_platform``: a perturbed run (Monte Carlo); ``gain_scale`` multiplies
     the designed gains; ``nominal_gains``: design them for the nominal timing (``DspTiming()``: what the
     firmware was built for) rather than this run's (``gains``: those nominal gains, computed once by the caller,
@@ -140,31 +254,51 @@ def plan_run(
     caller has checked the study); ``command``: how messages name the caller; ``duration_shown``: the
     duration as the user wrote it.
     """
+    keywords = dict(
+        controller=controller,
+        period=period,
+        latency=latency,
+        sensor_resolution=sensor_resolution,
+        plant_step=plant_step,
+        feedforward=feedforward,
+        engine=engine,
+        integrator=integrator,
+        fit=fit,
+    )
+    machine = run_machine(platform, keywords, overrides)
+    warnings: list[str] = []
     if firmware is not None:
-        check_source(firmware, "--firmware")
+        firmware = str(firmware_source(firmware))
+        machine, warnings = adopt_firmware(machine, firmware)
     time_limit = check_time_limit(time_limit)
+    platform = machine.loaded_platform
+    ctl, fmt = machine.controller, machine.firmware
+    controller, period, latency = ctl.law, ctl.period, ctl.latency
+    feedforward, engine, sensor_resolution = ctl.feedforward, ctl.engine, machine.sensors.resolution
+    plant_step, integrator, fit = machine.run.plant_step, machine.run.integrator, machine.run.fit
+    duration = duration if duration is not None else machine.run.duration
+    trajectory = machine.motion if trajectory is None else trajectory
     if checks:
         require_plant_plate(platform, command)  # the plate carries the legs: not negligible against them
-    period = check_positive(period, "--period", "seconds")
     plant_step = plant_step if plant_step is not None else min(period, 1e-3)
     if duration is not None:
         check_positive(duration, "--duration", "seconds")
     csv = isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating")
     units = {"length_unit": length_unit, "angle_unit": angle_unit}
-    traj = get_trajectory(trajectory, **units, **({"smooth": smooth} if smooth is not None else {}))
+    traj = _motion(trajectory, platform, 1.0 / period, **units, **({"smooth": smooth} if smooth is not None else {}))
     if fit:
         traj = fit_trajectory(traj, platform)
     duration = duration if duration is not None else (traj.duration or 1.0)
     if not duration > 0:
         raise OptionError(OPTION_DURATION_POSITIVE.format(value=duration_shown))
-    actuators = actuators or ActuatorModel()
+    actuators = actuators or ActuatorModel(machine.actuators.max_force, machine.actuators.time_constant)
+    sensor = sensor if sensor is not None else _sensor(machine, duration)
     timing = DspTiming(
         sample_period=period,
         latency=latency,
         sensor_resolution=sensor_resolution,
         command_range=float(platform.legs.max_force) if command_range is None else command_range,
     )
-    warnings: list[str] = []
     if checks:
         timing.check()
         check_timing(platform, period, plant_step, actuators.time_constant, timing.output_delay)
@@ -174,7 +308,7 @@ def plan_run(
         check_simulation_size(duration, plant_step, "--duration", shown)
         ticks = np.arange(tick_count(duration, period)) * period
         try:
-            warnings = check_trajectory(
+            warnings += check_trajectory(
                 platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", allow_out_of_stroke
             )
         except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
@@ -185,12 +319,17 @@ def plan_run(
             raise PhysicalLimitError(why)
     # the gains designed for the platform over the poses of the whole run (and the reference's own length)
     poses = design_poses(traj, max(duration, traj.duration or 0.0))
-    if nominal_gains:
-        g = gains if gains is not None else ControllerConfig.for_platform(platform, poses=poses).gains
-        gains = replace(g, kp=g.kp * gain_scale, ki=g.ki * gain_scale, kd=g.kd * gain_scale, kv=g.kv * gain_scale)
-        config = ControllerConfig.for_platform(platform, timing, gains=gains)
-    else:
-        config = ControllerConfig.for_platform(platform, timing, poses=poses)
+    form = {"ik_format": fmt.qformat(), "convention": fmt.convention}
+    scale = gain_scale * ctl.gain_scale
+    if isinstance(ctl.gains, Gains):
+        gains = PidGains(kp=ctl.gains.kp, ki=ctl.gains.ki, kd=ctl.gains.kd, kv=ctl.gains.kv)
+    elif nominal_gains and gains is None:
+        gains = ControllerConfig.for_platform(platform, poses=poses).gains
+    elif not nominal_gains:
+        gains = ControllerConfig.for_platform(platform, timing, machine.actuators.time_constant, poses=poses).gains
+    if scale != 1.0:
+        gains = replace(gains, kp=gains.kp * scale, ki=gains.ki * scale, kd=gains.kd * scale, kv=gains.kv * scale)
+    config = ControllerConfig.for_platform(platform, timing, gains=gains, **form)
     if (engine == "c" or firmware) and controller != "fixed":
         raise UsageError(OPTION_ENGINE_FIXED.format(controller=controller))
     if firmware and engine == "python":
@@ -212,7 +351,7 @@ def plan_run(
         duration=duration,
     )
     read_units = {"length": length_unit, "angle": angle_unit} if csv else None
-    return RunPlan(scenario, timing, duration, tuple(warnings), read_units, time_limit)
+    return RunPlan(scenario, timing, duration, tuple(warnings), read_units, time_limit, machine)
 
 
 @dataclass(frozen=True)
@@ -367,48 +506,54 @@ class SimulationResult(Result):
 
 
 def simulate(
-    platform: Platform,
-    trajectory: str | Path | Trajectory = "seed",
-    controller: str = "fixed",
+    machine: Machine | Platform | str | Path,
+    trajectory: str | Path | Trajectory | None = None,
+    controller: str | None = None,
     duration: float | None = None,
     *,
-    period: float = 1e-3,
-    latency: str = "sample",
-    sensor_resolution: float = 1e-5,
+    period: float | None = None,
+    latency: str | None = None,
+    sensor_resolution: float | None = None,
     plant_step: float | None = None,
-    feedforward: bool = True,
+    feedforward: bool | None = None,
     engine: str | None = None,
-    firmware: str | None = None,
+    firmware: str | Path | None = None,
     time_limit: float = FIRMWARE_IDLE_LIMIT_S,
     integrator: str | None = None,
-    fit: bool = False,
+    fit: bool | None = None,
     allow_out_of_stroke: bool = False,
     length_unit: str = "m",
     angle_unit: str = "rad",
     smooth: float | None = None,
     progress: bool = False,
+    **overrides,
 ) -> SimulationResult:
     """Run the fixed-point (or float) controller in the loop with the Drake plant.
 
     Args:
-        platform: the platform (it must have plate mass properties).
-        trajectory: the pose reference: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, or a
-            `Trajectory`.
-        controller: ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin).
-        duration: simulated seconds (default the trajectory's, else 1 s).
-        period: controller sample period, s.
+        machine: the machine (``load_machine``'s), a platform (it must have plate mass properties; every other
+            section at its defaults) or a machine file.
+        trajectory: the pose reference: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, a ``.stw``
+            motion program, or a `Trajectory` (default the machine's first motion).
+        controller: ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin) (spec path
+            ``controller.law``; None here and below: the machine's).
+        duration: simulated seconds (default ``run.duration``, else the trajectory's, else 1 s).
+        period: controller sample period, s (``controller.period``).
         latency: when a tick's output is released: ``"sample"`` (one sample later), ``"computation"`` (after
-            the cycle model's computation time) or ``"none"``.
-        sensor_resolution: leg-length sensor resolution, m per count.
-        plant_step: plant time step, s (default the period, at most 1 ms).
-        feedforward: connect the model-based force feed-forward.
+            the cycle model's computation time) or ``"none"`` (``controller.latency``).
+        sensor_resolution: leg-length sensor resolution, m per count (``sensors.resolution``).
+        plant_step: plant time step, s (default the period, at most 1 ms) (``run.plant_step``).
+        feedforward: connect the model-based force feed-forward (``controller.feedforward``).
         engine: the fixed-point tick: ``"c"`` (the generated firmware, compiled) or ``"python"`` (the
-            emulation); default ``"c"`` where a C compiler is found.
-        firmware: a C file implementing the firmware ABI, run as the controller tick (in a child process:
-            a hang, ``exit()`` or crash in it is one ``StewartError`` naming the file).
+            emulation); default ``"c"`` where a C compiler is found (``controller.engine``).
+        firmware: a C file implementing the firmware ABI, or the folder ``firmware generate`` wrote, run as the
+            controller tick (in a child process: a hang, ``exit()`` or crash in it is one ``StewartError``
+            naming the file). The loop runs the number format, sensor resolution and rate the firmware
+            records (a warning names each that differs from the machine's); a firmware recorded for another
+            platform is refused.
         time_limit: seconds the simulated time may stand still while ``firmware`` runs.
-        integrator: ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"``.
-        fit: move and scale the reference to the platform's home height and stroke.
+        integrator: ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"`` (``run.integrator``).
+        fit: move and scale the reference to the platform's home height and stroke (``run.fit``).
         allow_out_of_stroke: simulate a reference that leaves the stroke (a warning) instead of raising.
         length_unit: unit of a CSV reference's positions.
         angle_unit: unit of a CSV reference's angles.
@@ -416,17 +561,20 @@ def simulate(
             file's units); without it, a file rounded so coarsely that its second differences are noise is
             refused.
         progress: show a progress bar.
+        **overrides: any spec path, ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values
+            in SI or in the quantity grammar).
 
     Returns:
         The summary, logs and verdict of the run.
 
     Raises:
-        StewartError: bad settings (a period too slow for the dynamics, a run too large, an engine that does
-            not fit the controller, ...); ``PhysicalLimitError`` when the reference leaves the stroke or is
-            beyond the actuators (force or speed), before the run.
+        StewartError: bad settings (``MachineError`` naming the spec path, a period too slow for the
+            dynamics, a run too large, an engine that does not fit the controller, ...);
+            ``PhysicalLimitError`` when the reference leaves the stroke or is beyond the actuators (force or
+            speed), before the run.
     """
     plan = plan_run(
-        platform,
+        machine,
         trajectory,
         controller,
         duration,
@@ -444,6 +592,7 @@ def simulate(
         length_unit=length_unit,
         angle_unit=angle_unit,
         smooth=smooth,
+        **overrides,
     )
     return run_plan(plan, progress=progress)
 
@@ -486,6 +635,12 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "latency": timing.latency,
         "feedforward": sc.feedforward,
         "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
+        "firmware_format": {
+            "word_bits": config.ik_format.word_bits,
+            "length_lsb_m": config.ik_format.length_lsb,
+            "trig": config.ik_format.trig,
+            "convention": config.convention,
+        },
         "command_range_N": config.timing.command_range,
         "output_delay_s": timing.output_delay,
         "computation_time_s": timing.computation_time,

@@ -8,16 +8,13 @@ Keys: ``length`` (σ of a leg sensor reading), ``position`` (σ of a tracked pos
 from __future__ import annotations
 
 import dataclasses
-import re
-from decimal import Decimal, InvalidOperation
 
 from stewart_drake.calibration.model import Noise
-from stewart_drake.errors import CalibrationError
+from stewart_drake.errors import CalibrationError, QuantityError
+from stewart_drake.spec.quantity import UNITS, parse_number
 
-_LENGTH = {"": 0, "m": 0, "mm": -3, "um": -6, "µm": -6, "nm": -9}
-_ANGLE = {"": 1.0, "rad": 1.0, "mrad": 1e-3, "urad": 1e-6, "µrad": 1e-6, "deg": 0.017453292519943295}
-KEYS = {"length": _LENGTH, "position": _LENGTH, "angle": _ANGLE}
-_NUM = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zµ]*)\s*")
+# key -> dimension of the quantity grammar
+KEYS = {"length": "length", "position": "length", "angle": "angle"}
 
 
 def parse_noise(words) -> Noise:
@@ -31,18 +28,17 @@ def parse_noise(words) -> Noise:
         key, text = (s.strip() for s in w.split("=", 1))
         if key not in KEYS:
             raise CalibrationError(CalibrationError.NOISE_KEY.format(key=key, keys=", ".join(KEYS)))
-        units = KEYS[key]
-        m = _NUM.fullmatch(text)
+        dim = KEYS[key]
+        bad = CalibrationError(
+            CalibrationError.NOISE_VALUE.format(key=key, text=text, units=" ".join(u for u in UNITS[dim] if u))
+        )
         try:
-            number = Decimal(m.group(1)) if m else None
-        except InvalidOperation:
-            number = None
-        if number is None or m.group(2) not in units or number < 0 or not number.is_finite():
-            raise CalibrationError(
-                CalibrationError.NOISE_VALUE.format(key=key, text=text, units=" ".join(u for u in units if u))
-            )
-        scale = units[m.group(2)]
-        values[key] = float(number.scaleb(scale)) if units is _LENGTH else float(number) * scale
+            v = parse_number(text, dim, f"--noise: {key}")
+        except QuantityError:
+            raise bad from None
+        if v < 0:
+            raise bad
+        values[key] = v
     noise = dataclasses.replace(Noise(), **values)
     for key in KEYS:
         if getattr(noise, key) == 0:

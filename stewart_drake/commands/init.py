@@ -1,5 +1,5 @@
-"""``stewart-drake init``: print a commented, valid starting file (``--platform-template`` or
-``--envelope-template``)."""
+"""``stewart-drake init``: print a commented, valid starting file (``--platform-template``,
+``--machine-template``, ``--envelope-template`` or ``--requirements-template``)."""
 
 from __future__ import annotations
 
@@ -21,6 +21,12 @@ def register(sub) -> None:
         help="utn: the UTN 3-6 family; radial: anchors on two circles; explicit: anchor by anchor",
     )
     which.add_argument(
+        "--machine-template",
+        action="store_true",
+        help="a machine file for `simulate --machine`: a radial platform with every other section (payload, "
+        "controller, firmware format, sensors, actuators, motions, run) at its default, with units",
+    )
+    which.add_argument(
         "--envelope-template",
         action="store_true",
         help="a duty envelope for `size --envelope` (poses + velocity and acceleration bounds), "
@@ -35,9 +41,9 @@ def register(sub) -> None:
 
 
 def template_text(kind: str) -> str:
-    """The text of the platform template ``kind`` (one of ``TEMPLATES``), or of the envelope template when
-    ``kind`` is ``"envelope"``."""
-    name = "envelope.yaml" if kind == "envelope" else f"platform-{kind}.yaml"
+    """The text of the platform template ``kind`` (one of ``TEMPLATES``), or of the envelope or machine
+    template when ``kind`` is ``"envelope"`` or ``"machine"``."""
+    name = {"envelope": "envelope.yaml", "machine": "machine.yaml"}.get(kind, f"platform-{kind}.yaml")
     return (resources.files("stewart_drake") / "templates" / name).read_text(encoding="utf-8")
 
 
@@ -49,6 +55,9 @@ def requirements_template_text() -> str:
 def run(args) -> int:
     if args.requirements_template:
         sys.stdout.write(requirements_template_text())
+        return 0
+    if args.machine_template:
+        sys.stdout.write(template_text("machine"))
         return 0
     sys.stdout.write(template_text("envelope" if args.envelope_template else args.platform_template))
     return 0

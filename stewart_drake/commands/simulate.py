@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from stewart_drake.api.simulation import plan_run, run_plan
+from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
     add_platform_arg,
@@ -15,22 +15,40 @@ from stewart_drake.commands._common import (
     reject_unused,
 )
 from stewart_drake.commands.firmware import add_time_limit_arg
-from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
+from stewart_drake.errors import MachineError, QuantityError, UsageError
 from stewart_drake.firmware.engine import ENGINES
+from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run the fixed-point (or float) controller in the loop with the Drake plant")
-    add_platform_arg(p, default="utn-dynamic")
+    add_platform_arg(p, default=None)
+    p.add_argument(
+        "--machine",
+        default=None,
+        metavar="FILE",
+        help="a machine file: a platform file with controller, firmware, sensors, actuators, payload, run and "
+        "motions sections (`stewart-drake init --machine-template` writes one); default: --platform "
+        "(utn-dynamic) with the defaults",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="PATH=VALUE",
+        help="set one field of the machine by its spec path, e.g. --set controller.period=0.5ms "
+        "--set payload.mass=150kg (repeatable; after the other options)",
+    )
     p.add_argument(
         "--trajectory",
-        default="seed",
-        metavar="seed|rotating|FILE.csv",
-        help="the pose reference: the seed's (px=-0.1, py=0.1 sin 2t, pz=0.7 m), a rotating one, or a CSV "
-        "of t,px,py,pz,ax,ay,az rows (SI unless --length-unit/--angle-unit)",
+        default=None,
+        metavar="seed|rotating|FILE.csv|FILE.stw",
+        help="the pose reference: the seed's (px=-0.1, py=0.1 sin 2t, pz=0.7 m), a rotating one, a CSV "
+        "of t,px,py,pz,ax,ay,az rows (SI unless --length-unit/--angle-unit) or a motion program "
+        "(default: the machine's first motion, seed)",
     )
     p.add_argument(
         "--fit",
@@ -48,34 +66,45 @@ def register(sub) -> None:
         "for files rounded so coarsely that their second differences are noise (refused without it)",
     )
     add_loop_args(p)
+    p.set_defaults(controller=None)  # None: the machine's controller.law (fixed)
     p.add_argument(
         "--firmware",
         default=None,
-        metavar="FILE.c",
-        help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`) as the controller tick",
+        metavar="DIR|FILE.c",
+        help="run your own C firmware (implementing sd_firmware.h's ABI; see `firmware generate`: its folder or "
+        "a C file) as the controller tick; the loop adopts the number format, sensor resolution and rate the "
+        "firmware records (a warning names each that differs), and a firmware for another platform is refused",
+    )
+    p.add_argument("--word-bits", default=None, metavar="N", help="the IK's word width, 8..31 (default 16)")
+    p.add_argument(
+        "--length-lsb", default=None, metavar="LEN", help="the IK's length LSB, e.g. 30um (default 1mm; bare: m)"
+    )
+    p.add_argument(
+        "--trig",
+        default=None,
+        choices=["tfr16", "exact"],
+        help="the IK's sine/cosine (default tfr16; exact for words other than 16 bits)",
     )
     add_time_limit_arg(p, FIRMWARE_IDLE_LIMIT_S, "--firmware")
     p.add_argument(
-        "--period", type=float, default=1e-3, metavar="S", help="controller sample period, s (default 0.001)"
+        "--period", default=None, metavar="T", help="controller sample period, e.g. 0.5ms (default 1ms; bare: s)"
     )
     p.add_argument(
         "--latency",
         choices=["sample", "computation", "none"],
-        default="sample",
+        default=None,
         help="when a tick's output is released: one sample later (default), after the cycle model's computation time, or at once",
     )
     p.add_argument(
         "--sensor-resolution",
-        type=float,
-        default=1e-5,
-        metavar="M",
-        help="leg-length sensor resolution, m per count (default 1e-5; 1e-3: integer mm as the firmware's words)",
+        default=None,
+        metavar="LEN",
+        help="leg-length sensor resolution per count, e.g. 10um (default 1e-5 m; 1mm: integer mm as the firmware's words)",
     )
     p.add_argument(
         "--plant-step",
-        type=float,
         default=None,
-        metavar="S",
+        metavar="T",
         help="plant time step, s (default: the period, at most 1 ms)",
     )
     p.add_argument(
@@ -131,12 +160,48 @@ def add_loop_args(p) -> None:
 # the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
 FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
 
+# option (argparse dest) -> spec path: the one table between the command line and the machine's fields.
+# A flag given sets its path; an error about the path names the flag.
+FLAG_PATHS = {
+    "controller": ("--controller", "controller.law"),
+    "period": ("--period", "controller.period"),
+    "latency": ("--latency", "controller.latency"),
+    "engine": ("--engine", "controller.engine"),
+    "no_feedforward": ("--no-feedforward", "controller.feedforward"),
+    "sensor_resolution": ("--sensor-resolution", "sensors.resolution"),
+    "word_bits": ("--word-bits", "firmware.word_bits"),
+    "length_lsb": ("--length-lsb", "firmware.length_lsb"),
+    "trig": ("--trig", "firmware.trig"),
+    "plant_step": ("--plant-step", "run.plant_step"),
+    "integrator": ("--integrator", "run.integrator"),
+    "fit": ("--fit", "run.fit"),
+}
+# store_true flags: the value they set
+FLAG_VALUES = {"no_feedforward": False, "fit": True}
+
+
+def machine_from_args(args) -> Machine:
+    """The machine of ``--machine`` (else ``--platform``, else utn-dynamic) with the flags of ``FLAG_PATHS``
+    that were given, then each ``--set``; an error about a flag's path names the flag."""
+    if args.machine is not None and args.platform is not None:
+        raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
+    machine = load_machine(args.machine or args.platform or "utn-dynamic")
+    for dest, (flag, path) in FLAG_PATHS.items():
+        value = getattr(args, dest)
+        if value is None or value is False:
+            continue
+        try:
+            machine = apply_overrides(machine, {path: FLAG_VALUES.get(dest, value)})
+        except (MachineError, QuantityError) as e:
+            raise type(e)(str(e).replace(path, flag, 1)) from None
+    return apply_overrides(machine, args.set)
+
 
 def run(args) -> int:
     reject_unused(
         args,
         "--trajectory FILE.csv",
-        args.trajectory not in ("seed", "rotating"),
+        args.trajectory not in (None, "seed", "rotating"),
         length_unit="m",
         angle_unit="rad",
         smooth=None,
@@ -144,20 +209,11 @@ def run(args) -> int:
     out_folder = output_folder(args, names=FILES)
     reject_unused(args, "--firmware", args.firmware is not None, time_limit=FIRMWARE_IDLE_LIMIT_S)
     plan = plan_run(
-        load_platform(args.platform),
+        machine_from_args(args),
         args.trajectory,
-        args.controller,
-        args.duration,
-        period=args.period,
-        latency=args.latency,
-        sensor_resolution=args.sensor_resolution,
-        plant_step=args.plant_step,
-        feedforward=not args.no_feedforward,
-        engine=args.engine,
-        firmware=args.firmware,
+        duration=args.duration,
+        firmware=None if args.firmware is None else firmware_source(args.firmware, "--firmware"),
         time_limit=args.time_limit,
-        integrator=args.integrator,
-        fit=args.fit,
         allow_out_of_stroke=args.allow_out_of_stroke,
         length_unit=args.length_unit,
         angle_unit=args.angle_unit,

@@ -74,7 +74,12 @@ def load_yaml_typed(path, schema, kind: str, check: Callable[[Any, dict], None] 
     validate values further; ``where`` maps field paths (tuples of keys and 0-based indices) to their
     ``Where``. Raises ``YamlError``."""
     text, shown = read_yaml_text(path, kind)
-    root = compose(text, shown)
+    return load_node_typed(compose(text, shown), schema, kind, shown, check)
+
+
+def load_node_typed(root, schema, kind: str, shown: str, check: Callable[[Any, dict], None] | None = None):
+    """``load_yaml_typed`` on a composed node ``root`` (a mapping of a larger file; ``shown``: the file as
+    messages name it, line numbers are the file's)."""
     if root is None:
         raise YamlError(YamlError.TOP.format(path=shown, kind=kind, got="an empty file"))
     _check_tag(root, shown)

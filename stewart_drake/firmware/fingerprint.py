@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.platform_file import platform_yaml
 from stewart_drake.errors import FirmwareError
 
 # The options of ``firmware generate`` that define the module (their command-line defaults).
@@ -25,15 +27,25 @@ DEFAULTS = {
     "sensor_resolution": 1e-5,
     "trajectory": None,
 }
+# Recorded beside the options (not an option): the content hash of the platform the module was generated for.
+PLATFORM_HASH = "platform_hash"
 TAG = "stewart-drake-options:"
 _LINE = re.compile(r"/\* " + re.escape(TAG) + r" (\{.*?\}) \*/")
 # bytes read from the top of a file when looking for the fingerprint (it is on the first lines)
 HEAD_BYTES = 4096
 
 
+def platform_hash(platform: Platform) -> str:
+    """A content hash of ``platform`` (16 hex digits of the SHA-256 of its platform file in SI): equal for the
+    same geometry, mass properties and legs however the platform was written or named."""
+    text = platform_yaml(platform.replace(name="", description=""), header="")
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
 def fingerprint_line(options: dict) -> str:
-    """The comment line recording ``options`` (``DEFAULTS``' keys) as JSON."""
-    return f"/* {TAG} {json.dumps({k: options[k] for k in DEFAULTS}, sort_keys=True)} */\n"
+    """The comment line recording ``options`` (``DEFAULTS``' keys, and ``PLATFORM_HASH`` when given) as JSON."""
+    keys = [*DEFAULTS, *([PLATFORM_HASH] if options.get(PLATFORM_HASH) else [])]
+    return f"/* {TAG} {json.dumps({k: options[k] for k in keys}, sort_keys=True)} */\n"
 
 
 def stamp(files: dict, options: dict) -> dict:
@@ -44,7 +56,8 @@ def stamp(files: dict, options: dict) -> dict:
 
 def read_fingerprint(path) -> tuple[dict, Path] | None:
     """``(options, file it was read from)`` recorded in ``path`` or in the ``sd_firmware.h`` next to it, or
-    None when neither carries one (a hand-written module)."""
+    None when neither carries one (a hand-written module). ``options`` has ``DEFAULTS``' keys and
+    ``PLATFORM_HASH`` (None in a module generated before it was recorded)."""
     p = Path(path)
     for f in (p, p.with_name("sd_firmware.h")):
         try:
@@ -59,7 +72,7 @@ def read_fingerprint(path) -> tuple[dict, Path] | None:
             except json.JSONDecodeError:
                 continue
             if isinstance(rec, dict):
-                return {k: rec.get(k, v) for k, v in DEFAULTS.items()}, f
+                return {**{k: rec.get(k, v) for k, v in DEFAULTS.items()}, PLATFORM_HASH: rec.get(PLATFORM_HASH)}, f
     return None
 
 

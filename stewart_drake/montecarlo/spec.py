@@ -38,14 +38,12 @@ seed); the other keys are drawn once per run.
 from __future__ import annotations
 
 import difflib
-import math
-import re
 from dataclasses import dataclass, field
-from decimal import Decimal, DecimalException
 from pathlib import Path
 
 from stewart_drake.core.yamlio import compose, read_yaml_text
 from stewart_drake.errors import SpecError, YamlError, short_text
+from stewart_drake.spec.quantity import parse_choice, parse_number, parse_quantity, parse_vector
 
 # key: (dimension, vector length or 0 for a scalar, nominal zero?)
 KEYS = {
@@ -74,16 +72,7 @@ RENAMED = {
 }
 # Keys that configure a per-tick process: a fixed value only.
 PROCESS_KEYS = ("sensor_noise", "latency_jitter")
-# Units as powers of ten of the SI unit (exact decimal scaling: 10um reads as 1e-05, not 9.999999999999999e-06).
-UNITS = {
-    "length": {"": 0, "m": 0, "mm": -3, "um": -6, "µm": -6, "nm": -9},
-    "time": {"": 0, "s": 0, "ms": -3, "us": -6, "µs": -6},
-    "force": {"": 0, "N": 0, "kN": 3},
-    "mass": {"": 0, "kg": 0, "g": -3},
-    "ratio": {"": 0},
-}
 LATENCY_MODES = ("sample", "computation", "none")
-_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
 @dataclass(frozen=True)
@@ -113,62 +102,37 @@ def _where(source: str, line: int | None) -> str:
 
 
 def _number(text: str, key: str, where: str) -> float:
-    dim = KEYS[key][0]
-    m = re.fullmatch(rf"\s*({_NUM})\s*([a-zA-Zµ%]*)\s*", text)
-    units = UNITS.get(dim, {"": 0})
-    if not m or m.group(2) not in units:
-        allowed = ", ".join(u for u in units if u) or "none"
-        raise SpecError(SpecError.NUMBER.format(where=where, key=key, text=text, allowed=allowed))
-    try:
-        v = float(Decimal(m.group(1)).scaleb(units[m.group(2)]))
-    except (DecimalException, OverflowError):  # an exponent beyond Decimal's context (1e999999999999999999)
-        v = math.inf
-    if not math.isfinite(v):
-        raise SpecError(SpecError.NOT_FINITE.format(where=where, key=key, text=text))
-    return v + 0.0  # -0 is 0: numpy's uniform refuses a range from 0.0 to -0.0 ('±-0', '0..-0')
+    return parse_number(text, KEYS[key][0], f"{where}: {key}", error=SpecError)
 
 
 def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
     """The ``Distribution`` of ``key`` written ``text`` (see the module docstring)."""
     text = str(text).strip()
-    dim, _, zero_nominal = KEYS[key]
+    dim, length, zero_nominal = KEYS[key]
+    at = f"{where}: {key}"
     if dim == "mode":
         modes = tuple(m.strip() for m in text.split("|"))
-        bad = [m for m in modes if m not in LATENCY_MODES]
-        if bad:
-            raise SpecError(SpecError.LATENCY.format(where=where, value=bad[0], valid=", ".join(LATENCY_MODES)))
+        for m in modes:
+            parse_choice(m, LATENCY_MODES, f"{where}: latency", error=SpecError)
         return Distribution("choice" if len(modes) > 1 else "fixed", modes if len(modes) > 1 else (modes[0],), text)
     if key in PROCESS_KEYS:
         v = _number(text, key, where)
         if v < 0:
             raise SpecError(SpecError.NEGATIVE_PROCESS.format(where=where, key=key, text=text))
         return Distribution("fixed", (v,), text)
-    if text.startswith(("±", "+-")):
-        body = text[1:] if text.startswith("±") else text[2:]
-        if body.strip().endswith("%"):
-            if zero_nominal:
-                raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=where, key=key, text=text))
-            p = float(_number(body.strip()[:-1], "gain_scale", where)) / 100
-            if not 0 <= p < 1:
-                raise SpecError(SpecError.PERCENT_RANGE.format(where=where, key=key, text=text))
-            return Distribution("relative", (p,), text)
-        w = _number(body, key, where)
-        if w < 0:
-            raise SpecError(SpecError.HALF_WIDTH.format(where=where, key=key, text=text))
-        return Distribution("plusminus", (w,), text)
-    if KEYS[key][1] == 3 and "," in text:  # X,Y,Z: a fixed vector
-        parts = text.split(",")
-        if len(parts) != 3:
+    if zero_nominal and text.startswith(("±", "+-")) and text.endswith("%"):
+        raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=where, key=key, text=text))
+    if length == 3 and "," in text:  # X,Y,Z: a fixed vector
+        if text.count(",") != 2:
             raise SpecError(SpecError.VECTOR_3.format(where=where, key=key, text=text))
-        return Distribution("fixed", tuple(_number(s, key, where) for s in parts), text)
-    if ".." in text:
-        lo, hi = (_number(s, key, where) for s in text.split("..", 1))
-        if not lo <= hi:
-            raise SpecError(SpecError.RANGE_ORDER.format(where=where, key=key, text=text))
-        return Distribution("uniform", (lo, hi), text)
-    if "|" in text:
-        return Distribution("choice", tuple(_number(s, key, where) for s in text.split("|")), text)
-    return Distribution("fixed", (_number(text, key, where),), text)
+        return Distribution("fixed", parse_vector(text, dim, 3, at, error=SpecError), text)
+    q = parse_quantity(text, dim, at, error=SpecError, forms=_FORMS)
+    return Distribution(_KIND[q.kind], q.values, text)
+
+
+# the quantity grammar's forms a --vary value may take, and the Distribution kind of each
+_FORMS = ("value", "plusminus", "relative", "range", "choice")
+_KIND = {"value": "fixed", "plusminus": "plusminus", "relative": "relative", "range": "uniform", "choice": "choice"}
 
 
 def check_key(key, where: str) -> None:

@@ -26,6 +26,7 @@ NUMPY_PACKAGES = (
     "design",
     "firmware",
     "calibration",
+    "spec",
 )
 
 

@@ -79,7 +79,10 @@ def test_init_needs_exactly_one_template(capsys):
     assert main(["init"]) == 2
     assert main(["init", "--envelope-template", "--platform-template", "utn"]) == 2
     err = capsys.readouterr().err
-    assert "one of the arguments --platform-template --envelope-template --requirements-template is required" in err
+    assert (
+        "one of the arguments --platform-template --machine-template --envelope-template --requirements-template "
+        "is required" in err
+    )
     assert "not allowed with argument" in err
 
 

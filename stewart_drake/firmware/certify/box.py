@@ -3,15 +3,15 @@ the conversion to boxes of pose words."""
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import angle_scale, length_scale
-from stewart_drake.errors import CertifyError
+from stewart_drake.errors import CertifyError, QuantityError
 from stewart_drake.fixedpoint.generic import QFormat, pose_words
+from stewart_drake.spec.quantity import parse_quantity
 
 KEYS = ("px", "py", "pz", "a", "b", "g")
 # Workspace boxes stated for a preset (mm, fractions of pi); other platforms get home ± 10 % of the stroke
@@ -19,7 +19,6 @@ KEYS = ("px", "py", "pz", "a", "b", "g")
 WORKSPACE_BOXES = {
     "utn-kinematic": ((-60.0, 60.0), (-60.0, 60.0), (120.0, 250.0), (-0.08, 0.08), (-0.08, 0.08), (-0.08, 0.08)),
 }
-_SPEC = re.compile(r"^(px|py|pz|a|b|g)=([^.][^ ]*?)\.\.(.+)$")
 
 
 @dataclass(frozen=True)
@@ -59,22 +58,21 @@ def parse_box(specs: list[str] | None, platform: Platform, length_unit: str = "m
     lo, hi = base.lo.copy(), base.hi.copy()
     seen = set()
     for spec in specs or []:
-        m = _SPEC.match(spec.strip())
-        if not m:
+        key, sep, text = spec.strip().partition("=")
+        if not sep or key not in KEYS or ".." not in text:
             raise CertifyError(CertifyError.BOX_WORD.format(value=spec))
-        key, a, b = m.group(1), m.group(2), m.group(3)
         if key in seen:
             raise CertifyError(CertifyError.BOX_TWICE.format(key=key, value=spec))
         seen.add(key)
-        try:
-            va, vb = float(a), float(b)
-        except ValueError:
-            raise CertifyError(CertifyError.BOX_WORD.format(value=spec)) from None
-        if not (np.isfinite(va) and np.isfinite(vb) and va <= vb):
-            raise CertifyError(CertifyError.BOX_ORDER.format(value=spec))
         k = KEYS.index(key)
-        scale = length_scale(length_unit) if k < 3 else angle_scale(angle_unit)
-        if k >= 3 and max(abs(va), abs(vb)) * scale > np.pi:
+        dim, scale = ("length", length_scale(length_unit)) if k < 3 else ("angle", angle_scale(angle_unit))
+        try:  # a bare number is in the --length-unit/--angle-unit; a number with its unit is taken as written
+            q = parse_quantity(text, dim, f"--box {spec!r}", forms=("range",), bare=scale)
+        except QuantityError as e:
+            template = CertifyError.BOX_WORD if e.template == QuantityError.NUMBER else CertifyError.BOX_ORDER
+            raise CertifyError(template.format(value=spec)) from None
+        va, vb = q.values
+        if k >= 3 and max(abs(va), abs(vb)) > np.pi:
             raise CertifyError(CertifyError.BOX_ANGLE.format(value=spec))
-        lo[k], hi[k] = va * scale, vb * scale
+        lo[k], hi[k] = va, vb
     return PoseBox(lo, hi)

@@ -11,7 +11,6 @@ in millimetres grows with the LSB), so each candidate costs a few certificates."
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -19,31 +18,30 @@ import numpy as np
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.errors import CertifyError, StewartError
+from stewart_drake.errors import CertifyError, QuantityError, StewartError
 from stewart_drake.firmware.certify.box import PoseBox
 from stewart_drake.firmware.certify.certificate import Certificate, certify
 from stewart_drake.firmware.certify.recipe import Model
 from stewart_drake.firmware.certify.sampling import measure_words
 from stewart_drake.firmware.generate import GeneratedFirmware, generate
 from stewart_drake.fixedpoint.generic import QFormat, pose_words
+from stewart_drake.spec.quantity import parse_number
 
 SIM_SAMPLES = 20_000  # the simulation-only choice sees this many random poses (the issue's 20,000)
 PRUNE_SAMPLES = 4096  # random poses that prune a format before its proof (a real saturation or error)
 SEARCH_CELLS = 30_000  # cells per candidate certificate while searching (sound, a little looser)
 LSB_TRIES = 8  # LSB steps per candidate before it is declared infeasible
-_BUDGET = re.compile(r"^\s*([0-9.eE+-]+)\s*(mm|um|µm|m)?\s*$")
 
 
 def parse_budget(text: str) -> float:
     """``--error-budget``: metres from ``0.5mm``, ``500um``, ``0.0005m`` or ``0.0005``."""
-    m = _BUDGET.match(str(text))
     try:
-        v = float(m.group(1)) if m else float("nan")
-    except ValueError:
-        v = float("nan")
-    if not (math.isfinite(v) and v > 0):
+        v = parse_number(text, "length", "--error-budget")
+    except QuantityError:
+        v = math.nan
+    if not v > 0:
         raise CertifyError(CertifyError.BUDGET.format(value=text))
-    return v * {"mm": 1e-3, "um": 1e-6, "µm": 1e-6, "m": 1.0, None: 1.0}[m.group(2)]
+    return v
 
 
 @dataclass

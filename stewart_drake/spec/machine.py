@@ -1,0 +1,295 @@
+"""A machine as one tree of frozen, typed dataclasses: the platform, its actuators, sensors, controller,
+firmware number format, payload, motions (and optional requirements and calibration).
+
+Every field is in SI (metres, seconds, newtons, kilograms) and checked on construction; an error names the
+field's spec path (``controller.period must be > 0 s, got -1``). ``spec.load.load_machine`` reads one from
+YAML with overrides by path; ``FIELDS`` lists every overridable path with its dimension.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.rotations import CONVENTIONS
+from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.design.payload import with_payload
+from stewart_drake.errors import MachineError
+from stewart_drake.fixedpoint.generic import TRIG_MODES, QFormat
+
+LAWS = ("fixed", "float")
+LATENCIES = ("sample", "computation", "none")
+ENGINES = ("c", "python")
+
+MOTION_WORDS = ("seed", "rotating")
+
+
+def _fmt(v) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def _number(path: str, value, rule: str, ok) -> None:
+    """``MachineError`` unless ``value`` is a finite real number with ``ok(value)``."""
+    good = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    if not (good and math.isfinite(value) and ok(value)):
+        raise MachineError(MachineError.RANGE.format(path=path, rule=rule, value=_fmt(value)))
+
+
+def _word(path: str, value, valid) -> None:
+    if value not in valid:
+        raise MachineError(MachineError.RANGE.format(path=path, rule="one of " + ", ".join(valid), value=value))
+
+
+@dataclass(frozen=True)
+class FirmwareFormat:
+    """The number format of the fixed-point IK in the firmware and the loop: ``word_bits`` (signed words,
+    8..31), ``length_lsb`` (m per LSB of a length word), ``trig`` (``tfr16``: the DSP library, 16-bit
+    words only; ``exact``: correctly rounded) and the angle ``convention`` of the pose words. The defaults
+    are the DSP's: 16-bit words, 1 mm, tfr16, utn."""
+
+    word_bits: int = 16
+    length_lsb: float = 1e-3
+    trig: str = "tfr16"
+    convention: str = "utn"
+
+    def __post_init__(self):
+        wb = self.word_bits
+        if not (isinstance(wb, (int, np.integer)) and not isinstance(wb, bool) and 8 <= wb <= 31):
+            raise MachineError(MachineError.RANGE.format(path="firmware.word_bits", rule="an integer 8..31", value=wb))
+        _number("firmware.length_lsb", self.length_lsb, "> 0 m", lambda v: v > 0)
+        _word("firmware.trig", self.trig, TRIG_MODES)
+        _word("firmware.convention", self.convention, CONVENTIONS)
+        if self.trig == "tfr16" and wb != 16:
+            raise MachineError(
+                MachineError.RANGE.format(
+                    path="firmware.word_bits", rule="16 with trig tfr16 (use trig exact)", value=wb
+                )
+            )
+
+    def qformat(self) -> QFormat:
+        """The IK's ``QFormat``."""
+        return QFormat(int(self.word_bits), float(self.length_lsb), self.trig)
+
+
+@dataclass(frozen=True)
+class Gains:
+    """Explicit leg PID gains (SI): ``kp`` N/m, ``ki`` N/(m·s), ``kd`` and ``kv`` N·s/m."""
+
+    kp: float
+    ki: float
+    kd: float
+    kv: float
+
+    def __post_init__(self):
+        for name in ("kp", "ki", "kd", "kv"):
+            _number(f"controller.gains.{name}", getattr(self, name), ">= 0", lambda v: v >= 0)
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """The controller: ``law`` (``fixed``: the DSP's fixed-point law; ``float``: its float twin), sample
+    ``period`` (s), ``latency`` (``sample``, ``computation`` or ``none``), ``gains`` (``"design"``: designed
+    for the platform over the run's poses, or explicit ``Gains``), ``gain_scale`` (a factor on the designed
+    gains), ``feedforward`` (the model-based force feed-forward) and ``engine`` (``c``, ``python`` or None:
+    ``c`` where a compiler is found)."""
+
+    law: str = "fixed"
+    period: float = 1e-3
+    latency: str = "sample"
+    gains: str | Gains = "design"
+    gain_scale: float = 1.0
+    feedforward: bool = True
+    engine: str | None = None
+
+    def __post_init__(self):
+        _word("controller.law", self.law, LAWS)
+        _number("controller.period", self.period, "> 0 s", lambda v: v > 0)
+        _word("controller.latency", self.latency, LATENCIES)
+        if not (self.gains == "design" or isinstance(self.gains, Gains)):
+            raise MachineError(
+                MachineError.RANGE.format(path="controller.gains", rule="design or {kp, ki, kd, kv}", value=self.gains)
+            )
+        _number("controller.gain_scale", self.gain_scale, "> 0", lambda v: v > 0)
+        if not isinstance(self.feedforward, bool):
+            raise MachineError(
+                MachineError.RANGE.format(path="controller.feedforward", rule="true or false", value=self.feedforward)
+            )
+        if self.engine is not None:
+            _word("controller.engine", self.engine, ENGINES)
+
+
+@dataclass(frozen=True)
+class SensorSpec:
+    """The leg-length sensors: ``resolution`` (m per count; the controller sees whole counts) and ``noise``
+    (σ of white Gaussian noise on each reading, m)."""
+
+    resolution: float = 1e-5
+    noise: float = 0.0
+
+    def __post_init__(self):
+        _number("sensors.resolution", self.resolution, "> 0 m", lambda v: v > 0)
+        _number("sensors.noise", self.noise, ">= 0 m", lambda v: v >= 0)
+
+
+@dataclass(frozen=True)
+class ActuatorSpec:
+    """The leg actuators: a first-order lag ``time_constant`` (s; 0: none) and a force limit ``max_force``
+    (N; None: the platform's ``legs.max_force``)."""
+
+    time_constant: float = 2e-3
+    max_force: float | None = None
+
+    def __post_init__(self):
+        _number("actuators.time_constant", self.time_constant, ">= 0 s", lambda v: v >= 0)
+        if self.max_force is not None:
+            _number("actuators.max_force", self.max_force, "> 0 N", lambda v: v > 0)
+
+
+@dataclass(frozen=True)
+class PayloadSpec:
+    """A point mass ``mass`` (kg) fixed to the plate at ``position`` (3,) m in the plate frame (z >= 0)."""
+
+    mass: float = 0.0
+    position: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        _number("payload.mass", self.mass, ">= 0 kg", lambda v: v >= 0)
+        pos = tuple(float(v) for v in np.asarray(self.position, dtype=float).reshape(-1))
+        if len(pos) != 3 or not all(math.isfinite(v) for v in pos):
+            raise MachineError(
+                MachineError.RANGE.format(path="payload.position", rule="three finite numbers, m", value=self.position)
+            )
+        if pos[2] < 0:
+            raise MachineError(
+                MachineError.RANGE.format(path="payload.position", rule="at z >= 0 (on the plate)", value=list(pos))
+            )
+        object.__setattr__(self, "position", pos)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """How one run is simulated: ``duration`` (s; None: the motion's, else 1 s), ``plant_step`` (s; None:
+    the period, at most 1 ms), ``integrator`` (None: the default) and ``fit`` (move and scale the motion to
+    the platform's home height and stroke) and ``seed`` (of the run's random processes: sensor noise)."""
+
+    duration: float | None = None
+    plant_step: float | None = None
+    integrator: str | None = None
+    fit: bool = False
+    seed: int = 0
+
+    def __post_init__(self):
+        if self.duration is not None:
+            _number("run.duration", self.duration, "> 0 s", lambda v: v > 0)
+        if self.plant_step is not None:
+            _number("run.plant_step", self.plant_step, "> 0 s", lambda v: v > 0)
+        if not isinstance(self.fit, bool):
+            raise MachineError(MachineError.RANGE.format(path="run.fit", rule="true or false", value=self.fit))
+        if not (isinstance(self.seed, (int, np.integer)) and not isinstance(self.seed, bool) and self.seed >= 0):
+            raise MachineError(MachineError.RANGE.format(path="run.seed", rule="an integer >= 0", value=self.seed))
+
+
+def check_motion(path: str, motion) -> None:
+    """``MachineError`` unless ``motion`` is ``seed``, ``rotating``, a ``.csv`` or ``.stw`` path or a
+    ``Trajectory``."""
+    if isinstance(motion, Trajectory):
+        return
+    s = str(motion)
+    if not (s in MOTION_WORDS or s.lower().endswith((".csv", ".stw"))):
+        raise MachineError(MachineError.MOTION.format(path=path, value=s))
+
+
+@dataclass(frozen=True)
+class Machine:
+    """A machine and how it runs. ``platform``: the ``Platform`` as written (``loaded_platform`` adds the
+    payload); ``motions``: the references it runs (``seed``, ``rotating``, CSV or ``.stw`` paths, or
+    ``Trajectory`` objects), the first is the default; ``requirements`` and ``calibration``: paths or None;
+    ``platform_source``: the preset name or file it came from, if any."""
+
+    platform: Platform
+    actuators: ActuatorSpec = field(default_factory=ActuatorSpec)
+    sensors: SensorSpec = field(default_factory=SensorSpec)
+    controller: ControllerSpec = field(default_factory=ControllerSpec)
+    firmware: FirmwareFormat = field(default_factory=FirmwareFormat)
+    motions: tuple = ("seed",)
+    requirements: str | None = None
+    calibration: str | None = None
+    payload: PayloadSpec = field(default_factory=PayloadSpec)
+    run: RunSpec = field(default_factory=RunSpec)
+    platform_source: str | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.platform, Platform):
+            raise MachineError(MachineError.PLATFORM.format(where="", got=type(self.platform).__name__))
+        motions = (self.motions,) if isinstance(self.motions, (str, Trajectory)) else tuple(self.motions)
+        if not motions:
+            raise MachineError(MachineError.RANGE.format(path="motions", rule="at least one motion", value="[]"))
+        for i, m in enumerate(motions):
+            check_motion(f"motions item {i + 1}", m)
+        object.__setattr__(self, "motions", motions)
+
+    @property
+    def loaded_platform(self) -> Platform:
+        """The platform whose plate carries ``payload`` (the plant's and the gain design's)."""
+        p = self.payload
+        return with_payload(self.platform, p.mass, p.position, option="payload") if p.mass else self.platform
+
+    @property
+    def motion(self):
+        """The default motion (the first of ``motions``)."""
+        return self.motions[0]
+
+    def replace(self, **overrides) -> Machine:
+        """A copy with fields replaced by spec path (``{"controller.period": 5e-4}``; values in SI or
+        quantity text as ``spec.load.apply_overrides`` reads them)."""
+        # deferred: load imports this module (the grammar of overrides lives with the loader)
+        from stewart_drake.spec.load import apply_overrides
+
+        return apply_overrides(self, overrides)
+
+    def to_yaml(self) -> str:
+        """The machine as YAML (SI numbers, the platform inline): ``load_machine`` reads it back."""
+        # deferred: load imports this module
+        from stewart_drake.spec.load import machine_yaml
+
+        return machine_yaml(self)
+
+
+SECTIONS = {
+    "actuators": ActuatorSpec,
+    "sensors": SensorSpec,
+    "controller": ControllerSpec,
+    "firmware": FirmwareFormat,
+    "payload": PayloadSpec,
+    "run": RunSpec,
+}
+# spec path -> dimension for the quantity grammar ("bool", "word", "int", "vector", "gains", "optional ..." too)
+FIELDS = {
+    "actuators.time_constant": "time",
+    "actuators.max_force": "force?",
+    "sensors.resolution": "length",
+    "sensors.noise": "length",
+    "controller.law": ("word", LAWS),
+    "controller.period": "time",
+    "controller.latency": ("word", LATENCIES),
+    "controller.gains": "gains",
+    "controller.gain_scale": "ratio",
+    "controller.feedforward": "bool",
+    "controller.engine": ("word?", ENGINES),
+    "firmware.word_bits": "int",
+    "firmware.length_lsb": "length",
+    "firmware.trig": ("word", TRIG_MODES),
+    "firmware.convention": ("word", CONVENTIONS),
+    "payload.mass": "mass",
+    "payload.position": "length3",
+    "run.duration": "time?",
+    "run.plant_step": "time?",
+    "run.integrator": ("word?", ("cenic-fixed", "cenic", "sap")),
+    "run.fit": "bool",
+    "run.seed": "int",
+}
+assert set(FIELDS) == {f"{s}.{f.name}" for s, tp in SECTIONS.items() for f in dataclasses.fields(tp)}

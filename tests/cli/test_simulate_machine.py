@@ -1,0 +1,145 @@
+"""``simulate`` runs a machine: the example 210 kg machine tracks with its own number format and chatters with
+the DSP's default one; a firmware's recorded format reaches the loop (adopted, with a warning naming both
+values); a firmware generated for another platform is refused; flags and ``--set`` name what the user wrote."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stewart_drake as sd
+from stewart_drake.api.simulation import plan_run
+from stewart_drake.cli import main
+from stewart_drake.errors import FIRMWARE_FORMAT_ADOPTED, MachineError
+from stewart_drake.spec import load_machine
+
+EXAMPLE = Path(__file__).parents[2] / "examples" / "newcomer-210kg.yaml"
+RUN = ["--duration", "1", "--no-progress"]  # 1 s of the rotating motion: the chatter shows from the start
+needs_cc = pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
+
+
+def simulate(tmp_path, *args):
+    out = tmp_path / f"run{len(list(tmp_path.iterdir()))}"
+    rc = main(["simulate", "--machine", str(EXAMPLE), *RUN, "--out", str(out), *args])
+    summary = json.loads((out / "summary.json").read_text()) if (out / "summary.json").exists() else None
+    return rc, summary
+
+
+@pytest.fixture(scope="module")
+def firmware_30um(tmp_path_factory):
+    """A firmware generated at a 30 µm length LSB for the example machine's platform (written as a platform
+    file), and one generated for utn-dynamic."""
+    d = tmp_path_factory.mktemp("fw")
+    load_machine(EXAMPLE).platform.to_yaml(d / "platform.yaml")
+    assert main(["firmware", "generate", "--platform", str(d / "platform.yaml"), "--length-lsb", "3e-5", "--out",
+                 str(d / "fw30"), "--no-compile"]) == 0  # fmt: skip
+    assert main(["firmware", "generate", "--platform", "utn-dynamic", "--out", str(d / "utn"), "--no-compile"]) == 0
+    return d
+
+
+def test_the_example_machine_tracks_with_its_format(tmp_path, capsys):
+    rc, summary = simulate(tmp_path)
+    assert rc == 0, capsys.readouterr().err
+    assert summary["firmware_format"] == {"word_bits": 16, "length_lsb_m": 3e-05, "trig": "tfr16", "convention": "utn"}
+    # the plate carries the 150 kg payload: the loop's model is 210 kg
+    assert load_machine(EXAMPLE).loaded_platform.mass == 210.0
+
+
+def test_the_default_format_chatters_on_it(tmp_path, capsys):
+    rc, summary = simulate(tmp_path, "--length-lsb", "1mm")
+    err = capsys.readouterr().err
+    assert rc == 1 and "chatter:" in err and "the IK's length LSB (1 mm)" in err
+    assert summary["firmware_format"]["length_lsb_m"] == 0.001
+
+
+@needs_cc
+def test_the_firmware_format_is_adopted(tmp_path, capsys, firmware_30um):
+    """The machine says 1 mm, the firmware was generated at 30 µm: the loop runs the firmware's 30 µm and
+    tracks (the loop at 1 mm with this firmware lost tracking: the legs dropped ~250 mm)."""
+    rc, summary = simulate(tmp_path, "--length-lsb", "1mm", "--firmware", str(firmware_30um / "fw30"))
+    err = capsys.readouterr().err
+    assert FIRMWARE_FORMAT_ADOPTED.format(what="length LSB 30 µm", machine="1 mm") in err
+    assert rc == 0, err
+    assert summary["firmware_format"]["length_lsb_m"] == 3e-05
+    # within the tracking verdict's bound (5 % of the 300 mm stroke range), which the run at 1 mm exceeded 16-fold
+    assert summary["max_leg_error_mm"] < 15.0
+
+
+def test_the_api_adopts_and_says_so(firmware_30um):
+    machine = sd.load_machine(EXAMPLE, ["firmware.length_lsb=1mm"])
+    plan = plan_run(machine, duration=0.1, firmware=firmware_30um / "fw30")  # a plan: nothing is run
+    assert plan.config.ik_format.length_lsb == 3e-05 and plan.machine.firmware.length_lsb == 3e-05
+    assert plan.warnings[0] == FIRMWARE_FORMAT_ADOPTED.format(what="length LSB 30 µm", machine="1 mm")
+    # the same format: nothing to adopt, nothing said
+    plan = plan_run(sd.load_machine(EXAMPLE), duration=0.1, firmware=firmware_30um / "fw30")
+    assert plan.warnings == ()
+
+
+def test_a_firmware_for_another_platform_is_refused(tmp_path, capsys, firmware_30um):
+    rc, _ = simulate(tmp_path, "--firmware", str(firmware_30um / "utn"))
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert "was generated for platform utn-dynamic (" in err and "not for this run's newcomer-6dof-sim (" in err
+    with pytest.raises(MachineError, match="was generated for platform utn-dynamic"):
+        plan_run(sd.load_machine(EXAMPLE), duration=0.1, firmware=firmware_30um / "utn")
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--period", "-1"], "--period must be > 0 s, got -1"),
+        (["--set", "controller.period=-1"], "controller.period must be > 0 s, got -1"),
+        (["--length-lsb", "30parsecs"], "--length-lsb: cannot read '30parsecs' as a number with a unit"),
+        (["--word-bits", "24"], "--word-bits must be 16 with trig tfr16 (use trig exact), got 24"),
+        (["--set", "controller.perod=1ms"], "unknown key 'controller.perod' (did you mean 'controller.period'?)"),
+        (["--platform", "utn-dynamic"], "give --machine or --platform, not both"),
+    ],
+)
+def test_flags_and_paths_are_named_as_written(tmp_path, capsys, args, message):
+    rc, _ = simulate(tmp_path, *args)
+    err = capsys.readouterr().err
+    assert rc == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_api_errors_name_spec_paths():
+    with pytest.raises(MachineError, match=r"^controller\.period must be > 0 s, got -1$"):
+        sd.simulate(sd.load_platform("utn-dynamic"), period=-1)
+    with pytest.raises(MachineError, match=r"^firmware\.length_lsb must be > 0 m, got 0$"):
+        sd.simulate(sd.load_platform("utn-dynamic"), **{"firmware.length_lsb": 0})
+
+
+def test_a_firmware_generated_for_the_machine_runs_its_format(tmp_path):
+    machine = sd.load_machine(EXAMPLE)
+    r = sd.firmware.generate(machine, tmp_path / "fw", compile=False)
+    assert r.config.ik_format == machine.firmware.qformat() and r.config.convention == "utn"
+    assert r.config.timing.sample_period == machine.controller.period
+    assert r.config.timing.sensor_resolution == machine.sensors.resolution
+    # the gains are designed with the payload on the plate: those of the 210 kg plate, not of the bare 60 kg one
+    bare = sd.firmware.generate(machine.platform, tmp_path / "bare", compile=False, length_lsb=3e-5)
+    assert r.config.gains.kp != bare.config.gains.kp
+    # the firmware and the machine agree: the loop adopts nothing
+    assert plan_run(machine, duration=0.1, firmware=tmp_path / "fw").warnings == ()
+
+
+def test_the_machine_sensor_noise_is_drawn_from_its_seed():
+    machine = sd.load_machine(EXAMPLE, ["sensors.noise=1um", "run.seed=3"])
+    noise = plan_run(machine, duration=0.1).scenario.sensor.noise
+    assert noise.shape == (102, 6)  # ticks 0..100 and one more (the tick at the run's end)
+    # σ of 612 draws: its relative standard error is 1/sqrt(2·612) ≈ 2.9 %; 15 % is five of them
+    assert abs(noise.std() / 1e-6 - 1) < 0.15
+    assert (plan_run(machine, duration=0.1).scenario.sensor.noise == noise).all()
+    other = plan_run(machine.replace(**{"run.seed": 4}), duration=0.1).scenario.sensor.noise
+    assert not (other == noise).all()
+    assert plan_run(sd.load_machine(EXAMPLE), duration=0.1).scenario.sensor is None  # noise 0: an ideal sensor
+
+
+def test_a_motion_program_is_a_machine_motion():
+    platform = sd.load_platform("utn-dynamic")
+    program = Path(__file__).parents[2] / "examples" / "seed_004.stw"
+    traj = plan_run(platform, program, duration=0.1).scenario.trajectory
+    assert traj.name == "seed_004"
+    assert np.allclose(traj.pose(0.0), platform.home_pose(), atol=1e-12)  # a program starts at home
