@@ -1,11 +1,18 @@
 """Identification: robust nonlinear least squares of the calibration model on measured poses.
 
 ``identify`` fits θ (and the poses' own unknowns) with scipy's ``least_squares`` (trust-region reflective):
-a first pass with the plain quadratic loss from the nominal, then a Huber pass (quadratic within
-``HUBER_SIGMAS`` σ, linear beyond) so that an outlying pose pulls the fit no more than a few σ. The
-parameters the data cannot identify (``identifiability``) stay at their nominal values. The covariance
-of θ is (Σ A_kᵀ A_k)⁻¹ over the free parameters (``model.reduced_blocks``: the poses' unknowns
-eliminated; residuals whitened by the stated noise), so σ is what the stated noise gives, not fitted.
+a first pass with the plain quadratic loss from the nominal, then Huber passes (quadratic within f σ, linear
+beyond; f from the plain fit's largest residual down to ``HUBER_SIGMAS``, ``huber_scales``) so that an outlying
+pose pulls the fit no more than a few σ. The parameters the data cannot identify (``identifiability``) stay at
+their nominal values. The covariance of θ is (Σ A_kᵀ A_k)⁻¹ over the free parameters (``model.reduced_blocks``:
+the poses' unknowns eliminated; residuals whitened by the stated noise), so σ is what the stated noise gives,
+not fitted. Rows that repeat an earlier row exactly count once (``Measurements.without_copies``).
+
+A converged fit is then judged: ``failures`` (the model moved beyond what a built machine can,
+``plausible_correction``; forward kinematics that does not converge on the calibrated platform; a validation
+worse than the nominal, ``validation_failures``) make it unusable; ``warnings`` say what to know to read it
+(copies, σ at the floor, residuals below the stated noise, a condition number above ``CONDITION_RULE`` with the
+weakest combination named).
 """
 
 from __future__ import annotations
@@ -319,8 +326,9 @@ def identify(
 ) -> CalibrationResult:
     """Identify the geometry of the machine that produced ``data`` (see the module docstring). Returns a
     ``CalibrationResult`` whose ``converged`` is False (with the reason in ``message``) when the solver
-    stopped short or the fit leaves residuals far above the stated noise. ``gains``: identify each sensor's
-    gain too (48 parameters on a 6-6)."""
+    stopped short or the fit leaves residuals far above the stated noise, and whose ``failures`` (when converged)
+    and ``warnings`` judge it; ``ok`` is converged without failures. ``gains``: identify each sensor's gain too
+    (48 parameters on a 6-6). A σ of ``noise`` below ``NOISE_FLOOR`` is weighed as the floor."""
     stated, noise = noise, noise.floored()
     data, copies = data.without_copies()
     layout = Layout(nominal, data.kind, data.n_targets, gains)

@@ -92,16 +92,18 @@ class Measurements:
         )
 
     def values(self) -> np.ndarray:
-        """``(n, k)`` every number of each row: readings, the measured pose, targets or tilts, weight (SI)."""
-        parts = [self.readings] + [
-            a.reshape(len(self), -1) for a in (self.poses, self.targets, self.tilts) if a is not None
+        """``(n, k)`` the measured numbers of each row: readings, then the measured pose, targets or tilts (SI);
+        not the weight, which says how much a row counts, not what was measured."""
+        parts = [
+            a.reshape(len(self), -1) for a in (self.readings, self.poses, self.targets, self.tilts) if a is not None
         ]
-        return np.concatenate(parts + [self.weights[:, None]], axis=1)
+        return np.concatenate(parts, axis=1)
 
     def without_copies(self) -> tuple[Measurements, list[tuple[int, int]]]:
-        """``(measurements, copies)``: each row that repeats an earlier one bit for bit kept once (its first line),
-        and ``[(line, line it repeats), ...]`` for the rows dropped. A copy is not a second measurement: its noise
-        is the same draw, so counting it would shrink σ by √2 per doubling and pass a single pose for many."""
+        """``(measurements, copies)``: each row whose ``values`` repeat an earlier row's bit for bit kept once (the
+        first, with its weight), and ``[(line, line it repeats), ...]`` for the rows dropped. A copy is not a second
+        measurement: its noise is the same draw, so counting it would shrink σ by √2 per doubling and pass a single
+        pose for many."""
         rows, inverse = distinct_rows(self.values())
         first = np.full(len(rows), len(self))
         np.minimum.at(first, inverse, np.arange(len(self)))

@@ -191,7 +191,7 @@ def plan_measurements(
     gains: bool = False,
 ) -> PlanResult:
     """Plan ``n`` measurement poses (D-optimal, see the module docstring) and draw ``n`` random ones from
-    the same candidates for comparison; both sets' identifiability is analysed. A σ below ``NOISE_FLOOR`` weighs
+    the same candidates for comparison; both sets' identifiability is analysed. A σ below ``model.NOISE_FLOOR`` weighs
     as the floor (``Noise.floored``)."""
     noise = noise.floored()
     box = box or Box.default(platform)
