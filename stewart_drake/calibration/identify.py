@@ -272,7 +272,7 @@ def _warnings(result: CalibrationResult, copies, chi2_inliers: float, dof: int, 
             "of freedom): the noise is overstated or the rows are not independent measurements; σ is not to be trusted"
         )
     ident = result.identifiability
-    if ident.condition > CONDITION_RULE:
+    if ident.condition > CONDITION_RULE and ident.weak and ident.weak[0][1] > 0:
         name, s = ident.weak[0]
         free = ident.free
         worst = int(np.flatnonzero(free)[np.argmax(result.sigma[free])])
