@@ -158,17 +158,20 @@ def test_overstated_noise_warns():
     assert not any("smaller than the stated noise" in w for w in identify(nominal, data, NOISE).warnings)
 
 
-def test_poses_the_nominal_cannot_assemble_do_not_refuse_the_file(tmp_path):
+@pytest.mark.parametrize("kind", ["pose", "inclinometer"])
+def test_poses_the_nominal_cannot_assemble_do_not_refuse_the_file(tmp_path, kind):
     """60 random poses within ±20° on utn-kinematic: at a few of them the nominal geometry admits no assembly
     for the readings of the built machine (Newton's residual stays at ~0.1 mm); they are counted in the nominal's
-    statistics, and the calibration is made and is ok."""
+    statistics, and the calibration is made and is ok. Inclinometer data start their poses there from the
+    least-squares fit of the legs."""
     nominal = load_preset("utn-kinematic")
     rng = np.random.default_rng(0)
     q = nominal.home_pose() + np.concatenate([np.zeros((3000, 3)), rng.uniform(-1, 1, (3000, 3)) * np.radians(20)], 1)
     L = leg_lengths(nominal, q)
     keep = np.all((L > nominal.L_min) & (L < nominal.L_max), 1) & np.all(plate_anchors(nominal, q)[..., 2] > 5e-3, -1)
-    data, _ = simulate_measurements(nominal, ERRORS, q[keep][:60], "pose", NOISE, seed=1)
-    cal = calibrate(nominal, _write(tmp_path, data), holdout=0.2)
+    n = 60 if kind == "pose" else 30  # the inclinometer's fit has 6 more unknowns per pose: fewer, for time
+    data, _ = simulate_measurements(nominal, ERRORS, q[keep][:n], kind, NOISE, seed=1)
+    cal = calibrate(nominal, _write(tmp_path, data), holdout=0.2 if kind == "pose" else None)
     unsolved = cal.identified.fit_before["unsolved"]
     assert cal.ok and unsolved["count"] >= 1 and set(unsolved["lines"]) <= set(cal.identified.lines.tolist())
     assert "unsolved" not in cal.identified.fit_after
