@@ -988,6 +988,11 @@ class CalibrationError(InputError):
         "{path}: {n} poses give {equations} equations for {unknowns} unknowns ({parameters} parameters"
         "{nuisance}); give at least {need} poses"
     )
+    TOO_FEW_DISTINCT = (
+        "{path}: {rows} rows hold only {n} distinct poses ({copies} exact copies counted once; readings all within "
+        "{tol} of another row's are one pose): {n} poses give {equations} equations for {unknowns} unknowns "
+        "({parameters} parameters{nuisance}); give at least {need} distinct poses"
+    )
     STROKE = (
         "{path}:{line}: leg {leg} reads {value} {unit}, so its length {length:.6g} m lies outside the stroke "
         "[{lmin:g}, {lmax:g}] m of platform {name!r}{hint}"
@@ -1013,6 +1018,11 @@ class CalibrationError(InputError):
         "{per} equations per pose)"
     )
     POSE_STROKE = "{path}:{line}: leg {leg} length {length:.6g} m lies outside the stroke [{lmin:g}, {lmax:g}] m"
+    TRUTH_STROKE = (
+        "--errors {errors}: the machine drawn (seed {seed}) cannot reach {path}:{line}: its leg {leg} would be "
+        "{length:.6g} m long, outside the stroke [{lmin:g}, {lmax:g}] m ({count} of {n} poses out of reach); errors "
+        "this large are not a built {name!r}, or the pose lies at the stroke's edge"
+    )
     WORKSPACE = "--workspace {value}: give six numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
     MISSING = "measurement file {path!r} does not exist"
     NOT_A_FILE = "measurement file {path!r} is not a file"
@@ -1027,6 +1037,7 @@ class CalibrationLimitError(PhysicalLimitError):
     """An identification that does not converge, or data that fix too little: the CLI exits 1, result shown."""
 
     NOT_CONVERGED = "the identification did not converge: {reason}; nothing written"
+    NOT_USABLE = "the calibration is not usable: {reason}; calibration.json written, no calibrated.yaml"
 
 
 class CertifyError(UsageError):

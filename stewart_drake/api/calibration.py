@@ -16,7 +16,14 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.calibration.identify import CalibrationResult as Identified
-from stewart_drake.calibration.identify import identify, min_poses
+from stewart_drake.calibration.identify import (
+    copies_warning,
+    distinct_poses,
+    distinct_tolerance,
+    identify,
+    min_poses,
+    validation_failures,
+)
 from stewart_drake.calibration.measurements import Measurements, read_measurements
 from stewart_drake.calibration.model import Layout
 from stewart_drake.calibration.noise import parse_noise
@@ -51,6 +58,13 @@ class CalibrateResult(Result):
     def converged(self) -> bool:
         """Whether the least-squares identification converged (else nothing should be trusted)."""
         return bool(self.identified.converged)
+
+    @property
+    def ok(self) -> bool:
+        """Converged and usable: corrections of a plausible size, forward kinematics that converges on the
+        calibrated platform, a validation no worse than the nominal (the reasons otherwise in
+        ``identified.failures``; what to know besides in ``identified.warnings``)."""
+        return bool(self.identified.ok)
 
     def record(self) -> CalibrationRecord:
         """The ``calibration:`` block of the calibrated platform file (source, residuals, σ, date now)."""
@@ -142,32 +156,42 @@ def calibrate(
         convention: Euler convention of the measured poses.
 
     Returns:
-        The calibrated platform and the identification; check ``converged`` before using it.
+        The calibrated platform and the identification; check ``ok`` before using it. Rows that repeat an
+        earlier row exactly count once (a warning); σ = 0 is weighed as ``NOISE_FLOOR`` (1e-9 m or rad).
 
     Raises:
-        StewartError: an unreadable measurement file, too few poses, a bad noise word or split.
+        StewartError: an unreadable measurement file, too few distinct poses, a bad noise word or split.
     """
     if holdout is not None and validate is not None:
         raise UsageError(UsageError.NOT_BOTH.format(first="holdout (--holdout)", second="validate (--validate)"))
     nominal = load_platform(platform)
     sigma = parse_noise(noise)
-    data = read_measurements(str(measurements), nominal, type, length_unit, angle_unit)
+    rows = read_measurements(str(measurements), nominal, type, length_unit, angle_unit)
+    data, copies = rows.without_copies()
     layout = Layout(nominal, data.kind, data.n_targets, gains)
     fit, val = _split(data, layout, holdout, validate, seed, length_unit, angle_unit)
-    need = min_poses(layout)
-    if len(fit) < need:
+    need, n = min_poses(layout), distinct_poses(fit, sigma)
+    if n < need:
+        words = {
+            "path": measurements,
+            "n": n,
+            "equations": n * layout.rows(),
+            "unknowns": layout.size + n * layout.nuisance,
+            "parameters": layout.size,
+            "nuisance": f" + {layout.nuisance} per pose" if layout.nuisance else "",
+            "need": need,
+        }
+        if n == len(fit) and not copies:
+            raise CalibrationError(CalibrationError.TOO_FEW.format(**words))
+        tol = distinct_tolerance(sigma)
         raise CalibrationError(
-            CalibrationError.TOO_FEW.format(
-                path=measurements,
-                n=len(fit),
-                equations=len(fit) * layout.rows(),
-                unknowns=layout.size + len(fit) * layout.nuisance,
-                parameters=layout.size,
-                nuisance=f" + {layout.nuisance} per pose" if layout.nuisance else "",
-                need=need,
+            CalibrationError.TOO_FEW_DISTINCT.format(
+                rows=len(fit) + len(copies), copies=len(copies), tol=f"{tol * 1e6:.3g} µm", **words
             )
         )
     result = identify(nominal, fit, sigma, convention, gains)
+    if copies:
+        result.warnings.insert(0, copies_warning(copies))
     if val is not None:
         targets0 = layout.split(result.theta0)[3]
         result.validation = {
@@ -177,6 +201,8 @@ def calibrate(
             "nominal": validation_errors(nominal, targets0, val, convention),
             "calibrated": validation_errors(result.calibrated, result.targets, val, convention),
         }
+        if result.converged:
+            result.failures += validation_failures(result.validation)
     return CalibrateResult(result.calibrated, nominal, result)
 
 

@@ -33,6 +33,9 @@ RANK_TOL = 1e-7
 FRAME_TOL = 1e-6  # a frame motion this invisible (relative to s_1) is a freedom of the data
 PIVOT_TOL = 1e-3  # a parameter that moves a null direction less than this (relative) is not fixed for it
 NAME_TOL = 0.05  # a coefficient below this (of the combination's largest) is not named
+CONDITION_RULE = 100.0  # Schroer's rule of thumb: above it, the weakest combinations are poorly fixed
+WEAK_SHOWN = 3  # the weakest combinations named
+WEAK_TERMS = 4  # the parameters named in each
 
 
 @dataclass
@@ -40,7 +43,9 @@ class Identifiability:
     """What the data can identify. ``singular_values`` (r,) of the free part; ``null`` ``(P, d)`` basis of
     the unidentifiable combinations (each column 1 at its fixed parameter, 0 at the other fixed ones);
     ``fixed`` (d,) indices held at their nominal value; ``free`` (P,) mask; ``frame_freedoms`` the rigid
-    motions of the base or plate frame the data cannot see; ``combinations`` each null direction named."""
+    motions of the base or plate frame the data cannot see; ``combinations`` each null direction named;
+    ``weak`` ``(name, s_i)`` for the identifiable directions with s_i < s_1 / ``CONDITION_RULE``, weakest first
+    (at most ``WEAK_SHOWN``): σ along one is the leg sensor's σ / s_i."""
 
     names: tuple[str, ...]
     singular_values: np.ndarray
@@ -49,6 +54,7 @@ class Identifiability:
     free: np.ndarray
     frame_freedoms: list[str] = field(default_factory=list)
     combinations: list[str] = field(default_factory=list)
+    weak: list[tuple[str, float]] = field(default_factory=list)
 
     @property
     def condition(self) -> float:
@@ -75,6 +81,7 @@ class Identifiability:
             "d_index": self.d_index,
             "frame_freedoms": self.frame_freedoms,
             "unidentifiable_combinations": self.combinations,
+            "weakly_identified": [{"combination": c, "singular_value": v} for c, v in self.weak],
             "fixed_by_convention": [self.names[i] for i in self.fixed],
             "convention": "each unidentifiable combination is fixed by holding one parameter at its nominal value, "
             "chosen in the order base joints, plate joints, offsets, gains, targets",
@@ -94,8 +101,15 @@ def analyse(layout: Layout, J: np.ndarray, theta, fixed: list[int] | None = None
     s_full, N, fixed, free = _null_space(J, fixed)
     if fixed:
         N = N @ np.linalg.inv(N[fixed])  # 1 at its own fixed parameter, 0 at the others
-    sf = np.linalg.svd(J[:, free], compute_uv=False) if free.any() else np.zeros(0)
-    ident = Identifiability(names, sf, N, fixed, free)
+    sf, weak = np.zeros(0), []
+    if free.any():
+        _, sf, Vt = np.linalg.svd(J[:, free], full_matrices=False)
+        v = np.zeros((len(sf), len(names)))
+        v[:, free] = Vt
+        weak = [
+            (_name(v[i], names, WEAK_TERMS), float(sf[i])) for i in np.flatnonzero(sf * CONDITION_RULE < sf[0])[::-1]
+        ]
+    ident = Identifiability(names, sf, N, fixed, free, weak=weak[:WEAK_SHOWN])
     ident.frame_freedoms = _frame_freedoms(layout, J, s_full[0], theta)
     ident.combinations = [_name(N[:, j], names) for j in range(N.shape[1])]
     return ident
@@ -151,12 +165,13 @@ def _pivots(N: np.ndarray) -> list[int]:
     return chosen
 
 
-def _name(v: np.ndarray, names) -> str:
-    """A null direction as words: ``base joint 1 x +1, plate joint 1 x -0.99 ...`` (largest first)."""
+def _name(v: np.ndarray, names, terms: int = 8) -> str:
+    """A direction of θ as words: ``base joint 1 x +1, plate joint 1 x -0.99 ...`` (largest first, ``terms``
+    of them)."""
     big = np.abs(v).max()
     order = [i for i in np.argsort(-np.abs(v)) if abs(v[i]) >= NAME_TOL * big]
-    shown = ", ".join(f"{names[i]} {v[i]:+.2f}" for i in order[:8])
-    return shown + (f", … ({len(order) - 8} more)" if len(order) > 8 else "")
+    shown = ", ".join(f"{names[i]} {v[i]:+.2f}" for i in order[:terms])
+    return shown + (f", … ({len(order) - terms} more)" if len(order) > terms else "")
 
 
 def frame_generators(layout: Layout, theta) -> dict[str, np.ndarray]:

@@ -1,11 +1,18 @@
 """Identification: robust nonlinear least squares of the calibration model on measured poses.
 
 ``identify`` fits θ (and the poses' own unknowns) with scipy's ``least_squares`` (trust-region reflective):
-a first pass with the plain quadratic loss from the nominal, then a Huber pass (quadratic within
-``HUBER_SIGMAS`` σ, linear beyond) so that an outlying pose pulls the fit no more than a few σ. The
-parameters the data cannot identify (``identifiability``) stay at their nominal values. The covariance
-of θ is (Σ A_kᵀ A_k)⁻¹ over the free parameters (``model.reduced_blocks``: the poses' unknowns
-eliminated; residuals whitened by the stated noise), so σ is what the stated noise gives, not fitted.
+a first pass with the plain quadratic loss from the nominal, then Huber passes (quadratic within f σ, linear
+beyond; f from the plain fit's largest residual down to ``HUBER_SIGMAS``, ``huber_scales``) so that an outlying
+pose pulls the fit no more than a few σ. The parameters the data cannot identify (``identifiability``) stay at
+their nominal values. The covariance of θ is (Σ A_kᵀ A_k)⁻¹ over the free parameters (``model.reduced_blocks``:
+the poses' unknowns eliminated; residuals whitened by the stated noise), so σ is what the stated noise gives,
+not fitted. Rows that repeat an earlier row exactly count once (``Measurements.without_copies``).
+
+A converged fit is then judged: ``failures`` (the model moved beyond what a built machine can,
+``plausible_correction``; forward kinematics that does not converge on the calibrated platform; a validation
+worse than the nominal, ``validation_failures``) make it unusable; ``warnings`` say what to know to read it
+(copies, σ at the floor, residuals below the stated noise, a condition number above ``CONDITION_RULE`` with the
+weakest combination named).
 """
 
 from __future__ import annotations
@@ -15,9 +22,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from stewart_drake.calibration.identifiability import Identifiability, analyse, free_parameters, stacked
+from stewart_drake.calibration.identifiability import (
+    CONDITION_RULE,
+    Identifiability,
+    analyse,
+    free_parameters,
+    stacked,
+)
 from stewart_drake.calibration.measurements import Measurements
 from stewart_drake.calibration.model import (
+    NOISE_FLOOR,
     Layout,
     Noise,
     Problem,
@@ -27,14 +41,44 @@ from stewart_drake.calibration.model import (
     pose_residuals,
     reduced_blocks,
 )
+from stewart_drake.calibration.plan import Box, candidate_poses
 from stewart_drake.calibration.validate import validation_errors
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import anchor_radius, leg_lengths
 from stewart_drake.errors import ForwardKinematicsError, GeometryError
 
 HUBER_SIGMAS = 3.0
+HUBER_STEP = 10.0  # each Huber pass's f_scale is this factor below the last's (``huber_scales``)
 MAX_NFEV = 60  # evaluations per pass; Gauss–Newton converges in ~10 from ~1 mm errors (inclinometer data: ~30)
 OUTLIER_P = 1e-3  # a pose whose residual a χ² test rejects at this level (Bonferroni over the poses) is named
 MAX_CHI2_RATIO = 100.0  # residuals this many times the stated noise (RMS): the model does not fit the data
+LOW_CHI2_P = 1e-3  # residuals whose χ² falls below its lower quantile at this level are smaller than the noise allows
+DISTINCT_SIGMAS = 10.0  # two readings of one pose differ by N(0, 2σ²) per leg: beyond 7 standard deviations at 10 σ
+PLAUSIBLE_FRACTION = 0.05  # a model change beyond this fraction of the platform's size is no manufacturing error
+WORKSPACE_POSES = 200  # candidate poses drawn to measure how far the calibrated model moved (``model_departure``)
+VALIDATION_SE = 2.0  # the calibrated model is worse than nominal when its RMS exceeds the nominal's by this many
+# standard errors of an RMS of m values (relative 1/√(2m) for Gaussian errors)
+
+
+def huber_scales(r) -> list[float]:
+    """The Huber passes' ``f_scale`` (in σ): from the largest whitened residual ``r`` of the plain fit down to
+    ``HUBER_SIGMAS`` by factors of ``HUBER_STEP``, each pass started where the last stopped. A gross outlier
+    (thousands of σ) then loses its pull in steps, each a short solve; one pass at 3 σ from the plain fit
+    crawls (the outlier's rows are in Huber's linear part, where its Gauss–Newton model is flat)."""
+    top = float(np.max(np.abs(r), initial=0.0))
+    k = int(np.ceil(np.log(max(top, HUBER_SIGMAS) / HUBER_SIGMAS) / np.log(HUBER_STEP)))
+    return [HUBER_SIGMAS * HUBER_STEP ** (k - i) for i in range(k + 1)]
+
+
+def distinct_poses(data: Measurements, noise: Noise) -> int:
+    """The distinct poses in ``data``: rows whose readings all agree within ``DISTINCT_SIGMAS`` σ of the leg
+    sensor (``noise.floored()``) are one pose measured again (``Measurements.distinct_poses``)."""
+    return data.distinct_poses(distinct_tolerance(noise))
+
+
+def distinct_tolerance(noise: Noise) -> float:
+    """The reading difference (m) below which two rows are one pose: ``DISTINCT_SIGMAS`` × the sensor's σ."""
+    return DISTINCT_SIGMAS * noise.floored().length
 
 
 def min_poses(layout: Layout) -> int:
@@ -65,6 +109,8 @@ class CalibrationResult:
     pose_rms_after: np.ndarray
     lines: np.ndarray
     outliers: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+    failures: list = field(default_factory=list)
     fit_before: dict = field(default_factory=dict)
     fit_after: dict = field(default_factory=dict)
     validation: dict | None = None
@@ -80,6 +126,11 @@ class CalibrationResult:
     def corrections(self) -> np.ndarray:
         return self.theta - self.theta0
 
+    @property
+    def ok(self) -> bool:
+        """Converged and none of ``failures``: a calibrated platform to use."""
+        return self.converged and not self.failures
+
     def to_dict(self) -> dict:
         names = self.layout.names
         fixed = set(self.identifiability.fixed)
@@ -93,6 +144,9 @@ class CalibrationResult:
             "noise": self.noise.to_dict(),
             "converged": self.converged,
             "message": self.message,
+            "ok": self.ok,
+            "failures": self.failures,
+            "warnings": self.warnings,
             "evaluations": self.nfev,
             "residual_rms_sigma": {"before": self.rms_sigma_before, "after": self.rms_sigma_after},
             "fit_before": self.fit_before,
@@ -116,6 +170,126 @@ class CalibrationResult:
             "pose_rms_sigma": [{"line": int(ln), "rms": float(r)} for ln, r in zip(self.lines, self.pose_rms_after)],
             "validation": self.validation,
         }
+
+
+def plausible_correction(platform: Platform) -> float:
+    """The largest change (m) calibration can make to what a built ``platform`` reads: ``PLAUSIBLE_FRACTION`` of its
+    size, the smaller of its anchor radius and its stroke range. Manufacturing and assembly put joints and sensor
+    zeros millimetres off the drawing; a model that reads centimetres away from it is another machine, or a fit
+    that wandered along directions the poses do not fix."""
+    return PLAUSIBLE_FRACTION * min(anchor_radius(platform), platform.L_max - platform.L_min)
+
+
+def model_departure(nominal: Platform, calibrated: Platform, convention: str = "utn") -> float:
+    """The largest difference (m) between the readings ``calibrated`` and ``nominal`` predict, over
+    ``WORKSPACE_POSES`` candidate poses drawn (seeded) in the nominal's default planning box: how far the model
+    moved, whichever parameter combination moved it."""
+    q = candidate_poses(nominal, Box.default(nominal), WORKSPACE_POSES, seed=0, convention=convention)
+    d = calibrated.readings(leg_lengths(calibrated, q, convention)) - nominal.readings(
+        leg_lengths(nominal, q, convention)
+    )
+    return float(np.abs(d).max(initial=0.0))
+
+
+def _failures(result: CalibrationResult) -> list[str]:
+    """What makes a converged fit unusable: a calibrated model whose readings depart from the nominal's by more than
+    ``plausible_correction`` over the workspace, a calibrated platform whose forward kinematics does not converge
+    at the fitted readings."""
+    out = []
+    lay, ident = result.layout, result.identifiability
+    limit = plausible_correction(result.nominal)
+    moved = model_departure(result.nominal, result.calibrated, result.convention)
+    if moved > limit:
+        corr = np.abs(result.corrections * ident.free)
+        i = int(np.argmax(corr))
+        out.append(
+            f"the calibrated model reads up to {moved * 1e3:.3g} mm away from the nominal over the workspace, beyond "
+            f"{limit * 1e3:.3g} mm ({PLAUSIBLE_FRACTION:.0%} of the platform's size; largest correction "
+            f"{corr[i] * 1e3:.3g} mm, {lay.names[i]}): this is not a built {result.nominal.name} (wrong --platform, "
+            f"or poses that do not fix the parameters: condition number {ident.condition:.3g})"
+        )
+    unsolved = result.fit_after.get("unsolved")
+    if unsolved:
+        out.append(
+            f"the calibrated platform's forward kinematics does not converge at {unsolved['count']} of "
+            f"{len(result.lines)} fitted poses (lines {_lines(unsolved['lines'])})"
+        )
+    return out
+
+
+def validation_failures(validation: dict) -> list[str]:
+    """What makes a validation fail (``validation``: ``{"nominal": ..., "calibrated": ...}`` of
+    ``validation_errors``): a quantity whose calibrated RMS exceeds the nominal's by more than ``VALIDATION_SE``
+    standard errors, or held-out readings where the calibrated platform's forward kinematics does not converge."""
+    out = []
+    nom, cal = validation["nominal"], validation["calibrated"]
+    for key, c in cal.items():
+        if key == "unsolved" or key not in nom:
+            continue
+        a, b = nom[key]["rms"], c["rms"]
+        if b > a * (1 + VALIDATION_SE / np.sqrt(2 * c["count"])):
+            scale, unit = (1e6, "µm") if c["unit"] == "m" else (1e3, "mrad")
+            out.append(
+                f"validation: the calibrated model is worse than the nominal on the {validation['poses']} held-out "
+                f"poses ({key} RMS {a * scale:.3g} → {b * scale:.3g} {unit})"
+            )
+    if "unsolved" in cal:
+        out.append(
+            f"validation: the calibrated platform's forward kinematics does not converge at {cal['unsolved']['count']} "
+            f"of {validation['poses']} held-out poses"
+        )
+    return out
+
+
+def _lines(lines) -> str:
+    shown = ", ".join(str(v) for v in lines[:8])
+    return shown + (f", … ({len(lines) - 8} more)" if len(lines) > 8 else "")
+
+
+def copies_warning(copies) -> str:
+    """The warning for rows dropped as copies (``[(line, line it repeats), ...]``, ``without_copies``)."""
+    more = ", …" if len(copies) > 1 else ""
+    return (
+        f"{len(copies)} rows repeat an earlier row exactly and were counted once (line {copies[0][0]} repeats "
+        f"line {copies[0][1]}{more}): a copy is not another measurement"
+    )
+
+
+def _warnings(result: CalibrationResult, copies, chi2_inliers: float, dof: int, chi2) -> list[str]:
+    """What a user must know to read a usable fit: copied rows, σ = 0 weighed as the floor, residuals below
+    the stated noise, a condition number above the rule with the weakly identified parameters named."""
+    out = [copies_warning(copies)] if copies else []
+    low = result.noise.below_floor()
+    if low:
+        out.append(
+            f"σ {', '.join(low)} stated below {NOISE_FLOOR:g} (m or rad): weighed as {NOISE_FLOOR:g} (a weight divides "
+            "by σ); the σ of the parameters are what that noise would give"
+        )
+    elif dof > 0 and chi2_inliers < chi2.ppf(LOW_CHI2_P, dof):
+        out.append(
+            f"residuals {np.sqrt(chi2_inliers / dof):.3g} σ RMS after the fit, smaller than the stated noise can give "
+            f"(χ² {chi2_inliers:.3g} < {chi2.ppf(LOW_CHI2_P, dof):.3g}, the {LOW_CHI2_P:g} quantile of {dof} degrees "
+            "of freedom): the noise is overstated or the rows are not independent measurements; σ is not to be trusted"
+        )
+    ident = result.identifiability
+    if ident.condition > CONDITION_RULE and ident.weak and ident.weak[0][1] > 0:
+        name, s = ident.weak[0]
+        free = ident.free
+        worst = int(np.flatnonzero(free)[np.argmax(result.sigma[free])])
+        fit = next((v for v in result.fit_after.values() if "unit" in v), None)
+        model = (
+            f" while the model as a whole fits the poses to {fit['rms'] * 1e6:.3g} µ{'m' if fit['unit'] == 'm' else 'rad'} RMS"
+            if fit
+            else ""
+        )
+        n_weak = int(np.sum(ident.singular_values * CONDITION_RULE < ident.singular_values[0]))
+        out.append(
+            f"condition number {ident.condition:.3g} is above ~{CONDITION_RULE:g}: {n_weak} combinations of the "
+            f"parameters are weakly identified, the weakest [{name}] to σ {result.noise.floored().length / s * 1e6:.3g} µm; "
+            f"single parameters can be off by their σ (up to {result.sigma[worst] * 1e6:.3g} µm, "
+            f"{result.layout.names[worst]}){model}: judge the model by its validation, not the parameter table"
+        )
+    return out
 
 
 def _variables(problem: Problem, free: np.ndarray):
@@ -152,8 +326,11 @@ def identify(
 ) -> CalibrationResult:
     """Identify the geometry of the machine that produced ``data`` (see the module docstring). Returns a
     ``CalibrationResult`` whose ``converged`` is False (with the reason in ``message``) when the solver
-    stopped short or the fit leaves residuals far above the stated noise. ``gains``: identify each sensor's
-    gain too (48 parameters on a 6-6)."""
+    stopped short or the fit leaves residuals far above the stated noise, and whose ``failures`` (when converged)
+    and ``warnings`` judge it; ``ok`` is converged without failures. ``gains``: identify each sensor's gain too
+    (48 parameters on a 6-6). A σ of ``noise`` below ``NOISE_FLOOR`` is weighed as the floor."""
+    stated, noise = noise, noise.floored()
+    data, copies = data.without_copies()
     layout = Layout(nominal, data.kind, data.n_targets, gains)
     problem = make_problem(layout, data, noise, convention)
     targets0 = initial_targets(problem) if data.kind == "points" else None
@@ -173,18 +350,21 @@ def identify(
     z0 = pack(theta0, None)
     r0 = fun(z0)
     first = least_squares(fun, z0, jac=jac, method="trf", x_scale="jac", max_nfev=MAX_NFEV, xtol=1e-12, ftol=1e-12)
-    second = least_squares(
-        fun,
-        first.x,
-        jac=jac,
-        method="trf",
-        loss="huber",
-        f_scale=HUBER_SIGMAS,
-        x_scale="jac",
-        max_nfev=MAX_NFEV,
-        xtol=1e-12,
-        ftol=1e-12,
-    )
+    second, nfev = first, first.nfev
+    for f_scale in huber_scales(first.fun):
+        second = least_squares(
+            fun,
+            second.x,
+            jac=jac,
+            method="trf",
+            loss="huber",
+            f_scale=f_scale,
+            x_scale="jac",
+            max_nfev=MAX_NFEV,
+            xtol=1e-12,
+            ftol=1e-12,
+        )
+        nfev += second.nfev
     theta, xi = unpack(second.x, theta0)
     r = second.fun.reshape(problem.n, -1)
     # covariance of θ at the solution, poses' unknowns eliminated
@@ -219,8 +399,11 @@ def identify(
     ]
     inlier = np.ones(problem.n, bool)
     inlier[bad] = False
-    inlier_ratio = float(np.sqrt(np.sum(per_pose[inlier]) / max(inlier.sum() * k - free.sum(), 1)))
-    if converged and (inlier_ratio > MAX_CHI2_RATIO or len(bad) > problem.n // 4):
+    if not inlier.any():  # every pose outlying: the ratio over all of them, not over none
+        inlier[:] = True
+    dof = inlier.sum() * k - free.sum() - inlier.sum() * layout.nuisance
+    inlier_ratio = float(np.sqrt(np.sum(per_pose[inlier]) / max(dof, 1)))
+    if inlier_ratio > MAX_CHI2_RATIO or len(bad) > problem.n // 4:  # the reason, whether or not the solver stopped
         converged = False
         message = (
             f"residuals {inlier_ratio:.3g} times the stated noise after the fit ({len(bad)} of {problem.n} poses "
@@ -238,7 +421,7 @@ def identify(
         nominal=nominal,
         calibrated=calibrated,
         layout=layout,
-        noise=noise,
+        noise=stated,
         convention=convention,
         theta0=theta0,
         theta=theta,
@@ -246,7 +429,7 @@ def identify(
         identifiability=ident,
         converged=converged,
         message=message,
-        nfev=int(first.nfev + second.nfev),
+        nfev=int(nfev),
         rms_sigma_before=float(np.sqrt(np.mean(r0**2))),
         rms_sigma_after=rms_after,
         pose_rms_before=np.sqrt(np.mean(r0.reshape(problem.n, -1) ** 2, axis=1)),
@@ -258,4 +441,7 @@ def identify(
     )
     result.fit_before = validation_errors(nominal, targets0, data, convention)
     result.fit_after = fit_after
+    result.warnings = _warnings(result, copies, np.sum(per_pose[inlier]), dof, chi2)
+    if converged:
+        result.failures = _failures(result)
     return result

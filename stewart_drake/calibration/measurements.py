@@ -22,7 +22,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
+from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.rotations import angle_scale, length_scale
@@ -86,6 +90,37 @@ class Measurements:
             self.source,
             self.sha256,
         )
+
+    def values(self) -> np.ndarray:
+        """``(n, k)`` the measured numbers of each row: readings, then the measured pose, targets or tilts (SI);
+        not the weight, which says how much a row counts, not what was measured."""
+        parts = [
+            a.reshape(len(self), -1) for a in (self.readings, self.poses, self.targets, self.tilts) if a is not None
+        ]
+        return np.concatenate(parts, axis=1)
+
+    def without_copies(self) -> tuple[Measurements, list[tuple[int, int]]]:
+        """``(measurements, copies)``: each row whose ``values`` repeat an earlier row's bit for bit kept once (the
+        first, with its weight), and ``[(line, line it repeats), ...]`` for the rows dropped. A copy is not a second
+        measurement: its noise is the same draw, so counting it would shrink σ by √2 per doubling and pass a single
+        pose for many."""
+        rows, inverse = distinct_rows(self.values())
+        first = np.full(len(rows), len(self))
+        np.minimum.at(first, inverse, np.arange(len(self)))
+        keep = first[inverse] == np.arange(len(self))
+        if keep.all():
+            return self, []
+        dropped = np.flatnonzero(~keep)
+        copies = [(int(self.lines[i]), int(self.lines[first[inverse[i]]])) for i in dropped]
+        return self.subset(keep), copies
+
+    def distinct_poses(self, tolerance: float) -> int:
+        """The number of distinct poses: rows whose six readings all lie within ``tolerance`` (m) of another's
+        are one pose (transitively), however often it was measured."""
+        pairs = cKDTree(self.readings).query_pairs(tolerance, p=np.inf, output_type="ndarray")
+        n = len(self)
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        return int(connected_components(graph, directed=False)[0])
 
 
 def columns_of(kind: str, n_targets: int = 1) -> tuple[str, ...]:

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from stewart_drake.calibration.measurements import Measurements
 from stewart_drake.core.geometry import Platform, base_joints
@@ -38,6 +39,10 @@ from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 
 AXES = "xyz"
 FD_STEP = 1e-6  # m or rad: central differences; truncation ~h² (1e-12 m), rounding ~1e-16 m / h (1e-10 m)
+# The σ a weight uses when the stated one is below it (σ = 0: noise-free synthetic data). Ten times the
+# central-difference Jacobian's rounding (~1e-10 m, FD_STEP) for lengths; the same number in rad for angles
+# (an angle times the ~0.1–1 m lever arms of the presets is then ~0.1–1 nm).
+NOISE_FLOOR = 1e-9
 
 
 @dataclass(frozen=True)
@@ -51,6 +56,18 @@ class Noise:
 
     def to_dict(self) -> dict:
         return {"length_m": self.length, "position_m": self.position, "angle_rad": self.angle}
+
+    def floored(self) -> Noise:
+        """The σ the weights use: each component at least ``NOISE_FLOOR`` (m or rad); a weight divides by it."""
+        return Noise(*(max(v, NOISE_FLOOR) for v in (self.length, self.position, self.angle)))
+
+    def below_floor(self) -> list[str]:
+        """The components stated below ``NOISE_FLOOR`` (``["length", ...]``), which ``floored`` raises."""
+        return [
+            k
+            for k, v in zip(("length", "position", "angle"), (self.length, self.position, self.angle))
+            if v < NOISE_FLOOR
+        ]
 
 
 def exp_so3(w: np.ndarray) -> np.ndarray:
@@ -212,6 +229,7 @@ def make_problem(layout: Layout, data: Measurements, noise: Noise, convention: s
     """The ``Problem`` of ``data``: reference poses from the measured poses (``pose``) or the forward
     kinematics of ``platform`` (default the nominal) at the readings; the ``pose`` whitening at them."""
     platform = platform or layout.nominal
+    noise = noise.floored()
     if data.kind == "pose":
         q = data.poses
         R0 = rotation_matrix(q[:, 3:], convention)
@@ -225,18 +243,36 @@ def make_problem(layout: Layout, data: Measurements, noise: Noise, convention: s
         )
         whiten = np.linalg.inv(np.linalg.cholesky(W))  # e_w = Lc⁻¹ e has unit covariance
         return Problem(layout, data, noise, convention, p0, R0, whiten)
-    p0, R0 = reference_poses(platform, data.readings, convention)
+    p0, R0, _ = solve_poses(platform, data.readings, None, convention)
     return Problem(layout, data, noise, convention, p0, R0)
 
 
-def reference_poses(platform: Platform, readings, convention: str = "utn") -> tuple[np.ndarray, np.ndarray]:
-    """``(p (n, 3), R (n, 3, 3))``: the forward kinematics of ``platform`` at sensor ``readings`` (m), from
-    home (the assembly mode nearest it)."""
-    r = forward_kinematics(
-        platform, platform.lengths_from_readings(readings), None, convention, check_singularity=False, max_iter=60
-    )
-    r.raise_if_failed()
-    return r.iterate[..., :3], r.rotation
+def solve_poses(platform: Platform, readings, initial=None, convention: str = "utn"):
+    """``(p (n, 3), R (n, 3, 3), solved (n,))``: the forward kinematics of ``platform`` at sensor ``readings``
+    (m) by Newton from ``initial`` ``(n, 6)`` poses (None: home, the assembly mode nearest it). Where Newton does
+    not converge (lengths near the edge of the assembly set, or none there), ``solved`` is False and the pose is
+    the least-squares fit of the legs from the start (``scipy.optimize.least_squares``): the nearest pose the
+    geometry allows, a usable reference for a fit that moves the pose anyway."""
+    L = platform.lengths_from_readings(readings)
+    r = forward_kinematics(platform, L, initial, convention, check_singularity=False, max_iter=60)
+    p, R, solved = r.iterate[..., :3].copy(), r.rotation.copy(), np.asarray(r.converged, bool).copy()
+    q0 = np.broadcast_to(platform.home_pose() if initial is None else np.asarray(initial, float), (len(L), 6))
+    for i in np.flatnonzero(~solved):
+        R0 = rotation_matrix(q0[i, 3:], convention)
+
+        def legs(x, i=i, R0=R0):
+            pk, Rk = q0[i, :3] + x[:3], exp_so3(x[3:]) @ R0
+            return (
+                np.linalg.norm(
+                    pk + (platform.top_anchors_per_leg - platform.rotation_centre) @ Rk.T - platform.base_anchors,
+                    axis=-1,
+                )
+                - L[i]
+            )
+
+        x = least_squares(legs, np.zeros(6), x_scale=np.r_[np.ones(3), np.full(3, 1 / anchor_radius(platform))]).x
+        p[i], R[i] = q0[i, :3] + x[:3], exp_so3(x[3:]) @ R0
+    return p, R, solved
 
 
 def initial_targets(problem: Problem) -> np.ndarray:

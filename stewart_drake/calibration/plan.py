@@ -191,7 +191,9 @@ def plan_measurements(
     gains: bool = False,
 ) -> PlanResult:
     """Plan ``n`` measurement poses (D-optimal, see the module docstring) and draw ``n`` random ones from
-    the same candidates for comparison; both sets' identifiability is analysed."""
+    the same candidates for comparison; both sets' identifiability is analysed. A σ below ``model.NOISE_FLOOR`` weighs
+    as the floor (``Noise.floored``)."""
+    noise = noise.floored()
     box = box or Box.default(platform)
     cand = candidate_poses(platform, box, candidates, seed, convention)
     if len(cand) < max(2 * n, 50):

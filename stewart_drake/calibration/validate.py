@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from stewart_drake.calibration.measurements import Measurements
-from stewart_drake.calibration.model import rotation_angle, tilts
+from stewart_drake.calibration.model import rotation_angle, solve_poses, tilts
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.newton_fk import forward_kinematics
@@ -22,7 +22,7 @@ from stewart_drake.core.rotations import rotation_matrix
 
 def _stats(x: np.ndarray, unit: str) -> dict:
     x = np.abs(np.asarray(x, dtype=float))
-    return {"rms": float(np.sqrt(np.mean(x**2))), "max": float(x.max()), "unit": unit}
+    return {"rms": float(np.sqrt(np.mean(x**2))), "max": float(x.max()), "unit": unit, "count": int(x.size)}
 
 
 def _fk(platform: Platform, readings, initial, convention: str):
@@ -36,21 +36,27 @@ def _fk(platform: Platform, readings, initial, convention: str):
 def validation_errors(platform: Platform, targets, data: Measurements, convention: str = "utn") -> dict:
     """``{"leg_length": {rms, max, unit}, "position": ..., "angle": ...}`` (``pose``), ``{"target": ...}``
     (``points``, with ``(K, 3)`` plate-frame ``targets``) or ``{"tilt": ...}`` (``inclinometer``): the model's
-    errors against the measurements ``data`` (m, rad; RMS over poses of the 3-D distance or angle)."""
+    errors against the measurements ``data`` (m, rad; RMS over poses of the 3-D distance or angle). The forward
+    kinematics starts from the measured pose (``pose``) or from home (``model.solve_poses``); the poses where it
+    does not converge (the model admits no assembly at those readings) are left out of the forward-kinematics
+    statistics and listed as ``"unsolved": {"count", "lines"}``; with none solved those statistics are absent."""
+    p, R, solved = solve_poses(platform, data.readings, data.poses if data.kind == "pose" else None, convention)
+    out = {}
     if data.kind == "pose":
         L = leg_lengths(platform, data.poses, convention)
-        p, R = _fk(platform, data.readings, data.poses, convention)
-        Rm = rotation_matrix(data.poses[:, 3:], convention)
-        return {
-            "leg_length": _stats(platform.readings(L) - data.readings, "m"),
-            "position": _stats(np.linalg.norm(p - data.poses[:, :3], axis=-1), "m"),
-            "angle": _stats(rotation_angle(R, Rm), "rad"),
-        }
-    p, R = _fk(platform, data.readings, None, convention)
-    if data.kind == "points":
-        y = p[:, None, :] + np.einsum("nij,kj->nki", R, np.asarray(targets) - platform.rotation_centre)
-        return {"target": _stats(np.linalg.norm(y - data.targets, axis=-1).ravel(), "m")}
-    return {"tilt": _stats((tilts(R) - data.tilts).ravel(), "rad")}
+        out["leg_length"] = _stats(platform.readings(L) - data.readings, "m")
+        if solved.any():
+            Rm = rotation_matrix(data.poses[solved, 3:], convention)
+            out["position"] = _stats(np.linalg.norm(p[solved] - data.poses[solved, :3], axis=-1), "m")
+            out["angle"] = _stats(rotation_angle(R[solved], Rm), "rad")
+    elif solved.any() and data.kind == "points":
+        y = p[solved, None, :] + np.einsum("nij,kj->nki", R[solved], np.asarray(targets) - platform.rotation_centre)
+        out["target"] = _stats(np.linalg.norm(y - data.targets[solved], axis=-1).ravel(), "m")
+    elif solved.any():
+        out["tilt"] = _stats((tilts(R[solved]) - data.tilts[solved]).ravel(), "rad")
+    if not solved.all():
+        out["unsolved"] = {"count": int((~solved).sum()), "lines": [int(v) for v in data.lines[~solved]]}
+    return out
 
 
 def truth_errors(truth: Platform, model: Platform, poses, convention: str = "utn") -> dict:

@@ -77,14 +77,24 @@ def _summary(d: dict, result: CalibrationResult) -> str:
             f"outlier: line {o['line']} (residual {o['rms_sigma']:.3g} σ RMS; χ² {o['chi2']:.3g} > {o['limit']:.3g})"
         )
     for side in ("fit_before", "fit_after"):
-        words = ", ".join(f"{k} RMS {_fmt(v)} max {_fmt(v, 'max')}" for k, v in d[side].items())
-        out.append(f"{'nominal' if side == 'fit_before' else 'calibrated'} model on the fitted poses: {words}")
+        out.append(
+            f"{'nominal' if side == 'fit_before' else 'calibrated'} model on the fitted poses: {_words(d[side])}"
+        )
     v = d["validation"]
     if v:
         for side in ("nominal", "calibrated"):
-            words = ", ".join(f"{k} RMS {_fmt(x)} max {_fmt(x, 'max')}" for k, x in v[side].items())
-            out.append(f"validation ({v['poses']} poses), {side}: {words}")
+            out.append(f"validation ({v['poses']} poses), {side}: {_words(v[side])}")
+    out += [f"warning: {w}" for w in d["warnings"]]
+    out += [f"failed: {f}" for f in d["failures"]]
     return "\n".join(out)
+
+
+def _words(errors: dict) -> str:
+    words = [f"{k} RMS {_fmt(v)} max {_fmt(v, 'max')}" for k, v in errors.items() if "unit" in v]
+    if "unsolved" in errors:
+        u = errors["unsolved"]
+        words.append(f"forward kinematics unsolved at {u['count']} poses (lines {', '.join(map(str, u['lines'][:8]))})")
+    return ", ".join(words)
 
 
 def _fmt(s: dict, key: str = "rms") -> str:
@@ -111,7 +121,8 @@ def run(args) -> int:
         print_json(d) if args.json else print(_summary(d, result))
         raise CalibrationLimitError(CalibrationLimitError.NOT_CONVERGED.format(reason=result.message))
     with out.writing() as tmp:
-        (tmp / "calibrated.yaml").write_text(cal.platform_yaml(), encoding="utf-8")
+        if cal.ok:
+            (tmp / "calibrated.yaml").write_text(cal.platform_yaml(), encoding="utf-8")
         (tmp / "calibration.json").write_text(dumps_strict(d) + "\n", encoding="utf-8")
         if not args.no_plots:
             import matplotlib  # noqa: PLC0415 -- deferred: plotting only when asked, and Agg chosen first
@@ -125,7 +136,11 @@ def run(args) -> int:
     else:
         print(_summary(d, result))
         print(
-            f"wrote {args.out}/calibrated.yaml, calibration.json"
+            f"wrote {args.out}/"
+            + ("calibrated.yaml, " if cal.ok else "")
+            + "calibration.json"
             + ("" if args.no_plots else ", residuals.png, corrections.png")
         )
+    if not cal.ok:
+        raise CalibrationLimitError(CalibrationLimitError.NOT_USABLE.format(reason="; ".join(result.failures)))
     return 0

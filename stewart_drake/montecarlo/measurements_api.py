@@ -93,7 +93,8 @@ def simulate_measurements(
         The measurements, the true machine and its parameters.
 
     Raises:
-        StewartError: an error key that is not geometric, a pose outside the stroke, a bad file.
+        StewartError: an error key that is not geometric, a pose outside the stroke (of the nominal, or of the
+            machine drawn: errors too large for it to reach the poses), a bad file. A σ of 0 gives noise-free data.
     """
     platform = load_platform(platform)
     spec = parse_spec(errors)
@@ -125,6 +126,25 @@ def simulate_measurements(
             )
         )
     data, truth = measure(platform, spec.laws, q, type, sigma, seed, convention, targets)
+    L = leg_lengths(truth.platform, q, convention)
+    out = (L < platform.L_min) | (L > platform.L_max)
+    if out.any():
+        r, leg = np.argwhere(out)[0]
+        raise CalibrationError(
+            CalibrationError.TRUTH_STROKE.format(
+                errors=" ".join(errors) if not isinstance(errors, str) else errors,
+                seed=seed,
+                path=path,
+                line=lines[r],
+                leg=leg + 1,
+                length=L[r, leg],
+                lmin=platform.L_min,
+                lmax=platform.L_max,
+                count=int(out.any(axis=1).sum()),
+                n=len(q),
+                name=platform.name,
+            )
+        )
     info = {
         "platform": platform.name,
         "errors": spec.to_dict(),

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from stewart_drake.calibration.measurements import measurements_csv, read_measurements
+from stewart_drake.calibration.model import NOISE_FLOOR
 from stewart_drake.calibration.noise import parse_noise
 from stewart_drake.calibration.plan import plan_measurements, stw_program
 from stewart_drake.calibration.simulate import simulate_measurements
@@ -87,12 +88,14 @@ def test_noise_spec():
     n = parse_noise("length=2um position=0.01mm angle=0.05mrad")
     assert (n.length, n.position, n.angle) == (2e-6, 1e-5, 5e-5)
     for bad, msg in (("length=2", None), ("size=1um", "unknown key 'size'"), ("length=-1um", "expected a number >= 0"),
-                     ("angle=1mm", "expected a number >= 0 with a unit (rad mrad urad µrad deg)"), ("position=0", "a σ > 0")):  # fmt: skip
+                     ("angle=1mm", "expected a number >= 0 with a unit (rad mrad urad µrad deg)")):  # fmt: skip
         if msg is None:
             assert parse_noise(bad).length == 2.0
             continue
         with pytest.raises(CalibrationError, match=re.escape(msg)):
             parse_noise(bad)
+    # σ = 0 is noise-free synthetic data: accepted as stated; the fit weighs it at the floor
+    assert parse_noise("position=0").position == 0.0 and parse_noise("position=0").floored().position == NOISE_FLOOR
 
 
 def test_the_plan_program_visits_the_planned_poses():

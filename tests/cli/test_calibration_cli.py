@@ -154,3 +154,46 @@ def test_the_calibration_commands_run_without_pydrake(flow, tmp_path):
         assert status["rc"] == 0 and not status["pydrake"], err
         assert status["commands"] == [f"stewart_drake.commands.{module}"]
         json.loads(out)
+
+
+def test_a_calibration_of_another_platform_exits_1_with_its_result(flow, capsys, tmp_path):
+    """utn-dynamic's measurements calibrated as gonzalez-dutra-2009: exit 1 and one line; the summary and
+    calibration.json (the result) are there, calibrated.yaml is not."""
+    m = flow / "meas" / "measurements.csv"
+    rc, out, err = cli(capsys, "calibrate", "--platform", "gonzalez-dutra-2009", "--measurements", m, "--no-plots", "--out", tmp_path / "o")  # fmt: skip
+    assert rc == 1 and err.count("\n") == 1 and "the calibration is not usable: the calibrated model reads up to" in err
+    assert "failed: the calibrated model reads up to" in out and "calibration.json written, no calibrated.yaml" in err
+    d = json.loads((tmp_path / "o" / "calibration.json").read_text())
+    assert d["converged"] and not d["ok"] and len(d["failures"]) == 1
+    assert not (tmp_path / "o" / "calibrated.yaml").exists()
+
+
+def test_copies_of_one_pose_exit_2(flow, capsys, tmp_path):
+    lines = (flow / "meas" / "measurements.csv").read_text().splitlines()
+    f = tmp_path / "copies.csv"
+    f.write_text("\n".join([lines[0]] + [lines[1]] * 30) + "\n")
+    rc, _, err = cli(capsys, "calibrate", "--platform", "utn-dynamic", "--measurements", f, "--out", tmp_path / "o")
+    assert rc == 2 and err.count("\n") == 1 and "30 rows hold only 1 distinct poses (29 exact copies" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_simulated_readings_stay_within_the_stroke(flow, capsys, tmp_path):
+    """anchor=±1m draws a machine whose legs would be ~2 m long on a 0.55–0.95 m stroke: refused in one line,
+    nothing written; leg lengths of the machine drawn are what the message names."""
+    rc, _, err = cli(capsys, "simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", "--errors", "anchor=±1m", "--out", tmp_path / "o")  # fmt: skip
+    assert rc == 2 and err.count("\n") == 1 and "--errors anchor=±1m: the machine drawn (seed 0) cannot reach" in err
+    assert "outside the stroke [0.55, 0.95] m" in err and not (tmp_path / "o").exists()
+
+
+def test_noise_free_measurements_calibrate(flow, capsys, tmp_path):
+    """--noise length=0 position=0 angle=0: noise-free readings (the true machine's exactly), calibrated with the
+    same statement: exit 0, the calibrated file equal to the truth to well below a micrometre (σ at the 1e-9 floor
+    is ~0.1 µm at most on these poses)."""
+    zero = ["--noise", "length=0", "position=0", "angle=0"]
+    rc, _, _ = cli(capsys, "simulate-measurements", "--platform", "utn-dynamic", "--poses", flow / "plan" / "poses.csv", *zero, "--out", tmp_path / "m")  # fmt: skip
+    assert rc == 0
+    rc, out, _ = cli(capsys, "calibrate", "--platform", "utn-dynamic", "--measurements", tmp_path / "m" / "measurements.csv", *zero, "--no-plots", "--out", tmp_path / "c")  # fmt: skip
+    assert rc == 0 and "warning: σ length, position, angle stated below 1e-09" in out
+    lay = Layout(load_preset("utn-dynamic"), "pose")
+    theta = lay.theta(load_platform(tmp_path / "c" / "calibrated.yaml"))
+    assert np.abs(theta - lay.theta(load_platform(tmp_path / "m" / "truth" / "platform.yaml"))).max() < 1e-6
