@@ -4,6 +4,7 @@ command takes, requirements.json complete; ``workspace --prove`` on a larger box
 from __future__ import annotations
 
 import json
+import re
 from importlib import resources
 
 import numpy as np
@@ -83,18 +84,34 @@ def test_prove_unresolved_exits_1(capsys):
 
 
 def test_optimize_exits_1_when_the_performance_proof_is_unresolved(tmp_path, capsys):
-    """``--max-cells 60``: the box's stroke is proven in 48 cells, force/speed/frequency/condition need more: each
-    says ``unresolved`` in requirements.json (``met`` false, the cells left counted) and the exit status is 1."""
+    """``--max-cells 60``: the box's stroke is proven in 48 cells, force/frequency/condition need more: each says
+    ``unresolved`` in requirements.json (``met`` false, the cells left counted), "not proven yet" on the terminal,
+    and the exit status is 1."""
     out = tmp_path / "o"
     rc = main(["optimize", "--requirements", SEED_001, "--out", str(out), "--budget", "48", "--pop-size", "16",
                "--workers", "0", "--max-cells", "60"])  # fmt: skip
     text = capsys.readouterr().out
-    assert rc == 1 and "proof of the box: proven" in text and "unresolved" in text
+    assert rc == 1 and "proof of the box: proven" in text
     doc = json.loads((out / "requirements.json").read_text())
     perf = {r["requirement"]: r for r in doc["requirements"] if "status" in r}
     assert set(perf) == {"actuator.max_force", "actuator.max_speed", "limits.min_frequency_hz", "limits.max_condition"}
+    # speed is proven on the 48 cells of the first level (each cell carries the requirements still open on it)
+    assert perf.pop("actuator.max_speed")["status"] == "proven"
     assert all(r["status"] == "unresolved" and not r["met"] for r in perf.values())
     assert doc["performance_proof"]["requirements"]["force"]["unresolved_count"] > 0 and not doc["ok"]
+    # an unfinished proof reads as one: not proven yet, the cells used and left, why it stopped; never NOT MET
+    used = doc["performance_proof"]["cells_examined"]
+    assert "NOT MET" not in text and doc["performance_proof"]["stopped"] == "cap"
+    for name, r in perf.items():
+        key = {
+            "actuator.max_force": "force",
+            "limits.min_frequency_hz": "frequency",
+            "limits.max_condition": "condition",
+        }
+        left = doc["performance_proof"]["requirements"][key[name]]["unresolved_count"]
+        assert (r["cells_used"], r["cells_left"]) == (used, left)
+        assert f" ({used} cells used, {left} left; the cell cap (--max-cells) was reached)" in text
+        assert re.search(rf"not proven yet +{name}: required [0-9.]+, sampled [0-9.]+ [NHz]* \({used} cells used", text)
 
 
 def test_a_finished_search_continues_with_a_larger_budget(tmp_path, capsys):
