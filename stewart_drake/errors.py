@@ -357,6 +357,7 @@ class OutputError(StewartError):
     REMEDY_FORCE = "give a new or empty folder, or {force} to write beside them"
     REMEDY_OWN = "give a new or empty folder, or one that `{command}` wrote itself"
     UNWRITABLE = "{option} {typed!r}: cannot write there ({reason})"
+    BUSY = "{option} {typed!r}: another stewart-drake run is writing there; wait for it to end or give another folder"
     BAD_PATH = "{option} {typed!r}: not a usable path"
     CLASH = "{option} {typed!r}: {name!r} exists and was not written by stewart-drake; nothing was written"
     FILE_IS_FOLDER = "{option} {typed!r}: is a folder; give a file name"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 
 from stewart_drake.commands._common import add_force_arg, output_folder, print_json
-from stewart_drake.core.output_folder import claim_in_manifest
+from stewart_drake.core.output_folder import claim_in_manifest, run_lock
 from stewart_drake.synthesis.api import optimize
 from stewart_drake.synthesis.outputs import write_outputs
 from stewart_drake.synthesis.proof import MAX_CELLS, START_CELLS
@@ -70,6 +70,11 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = output_folder(args)
+    with run_lock(out.path, option="--out", typed=out.typed):  # one run at a time in the folder, to its end
+        return _run(args, out)
+
+
+def _run(args, out) -> int:
     r = optimize(
         args.requirements,
         budget=args.budget,

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg_bodies import leg_dimensions
+from stewart_drake.core.output_folder import run_lock
 from stewart_drake.core.rotations import to_radians
 from stewart_drake.core.sanity import check_finite, check_work
 from stewart_drake.errors import OptionError, SynthesisError
@@ -137,18 +139,20 @@ def optimize(
         raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=MAX_PROOF_CELLS, value=max_cells))
     if seed < 0:
         raise OptionError(OptionError.AT_LEAST.format(option="--seed", min=0, value=seed))
-    result = synthesize(
-        req,
-        None if cache is None else Path(cache),
-        budget,
-        seed,
-        workers or 0,
-        scheduler,
-        pick,
-        progress=progress,
-        max_cells=max_cells,
-        pop_size=pop_size,
-    )
+    held = nullcontext() if cache is None else run_lock(cache, option="cache", typed=str(cache))
+    with held:  # one search at a time appends to a folder's journal
+        result = synthesize(
+            req,
+            None if cache is None else Path(cache),
+            budget,
+            seed,
+            workers or 0,
+            scheduler,
+            pick,
+            progress=progress,
+            max_cells=max_cells,
+            pop_size=pop_size,
+        )
     return OptimizeResult(result.platform, result)
 
 

@@ -4,8 +4,13 @@ command takes, requirements.json complete; ``workspace --prove`` on a larger box
 from __future__ import annotations
 
 import json
+import os
 import re
+import subprocess
+import sys
+import time
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -14,8 +19,10 @@ from stewart_drake.cli import main
 from stewart_drake.core.geometry import load_platform_yaml
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.sanity import plate_anchor_heights
+from stewart_drake.errors import OutputError
 from stewart_drake.synthesis.requirements import load_requirements
 
+ROOT = Path(__file__).resolve().parents[2]
 SEED_001 = str(resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml")
 
 
@@ -127,3 +134,31 @@ def test_a_finished_search_continues_with_a_larger_budget(tmp_path, capsys):
     search = json.loads(capsys.readouterr().out)["search"]
     assert (search["evaluated_now"], search["from_cache"], search["designs"]) == (12, 24, 36)
     assert len((out / "evaluations.jsonl").read_text().splitlines()) == 1 + 36
+
+
+def test_a_second_optimize_into_a_running_ones_folder_is_refused(tmp_path, capsys):
+    """Two runs into one --out both ran, appending to one journal (9,097 lines for 4,800 designs): the folder is
+    held for the first run's lifetime and the second is refused before any work (exit 2, one line), the first's
+    journal untouched by it."""
+    out = tmp_path / "o"
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1")
+    first = subprocess.Popen(
+        [sys.executable, "-m", "stewart_drake", "optimize", "--requirements", SEED_001, "--out", str(out),
+         "--budget", "100000", "--workers", "0", "--no-progress"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        t0 = time.monotonic()
+        while not (out / "evaluations.jsonl").exists() and first.poll() is None and time.monotonic() - t0 < 60:
+            time.sleep(0.05)
+        assert first.poll() is None, first.stderr.read()
+        rc = main(["optimize", "--requirements", SEED_001, "--out", str(out), "--budget", "24", "--workers", "0"])
+        err = capsys.readouterr().err.strip()
+        assert rc == 2 and err.splitlines() == [
+            f"stewart-drake optimize: error: {OutputError.BUSY.format(option='--out', typed=str(out))}"
+        ]
+        xs = [tuple(json.loads(line)["row"]["x"]) for line in (out / "evaluations.jsonl").read_text().splitlines()[1:]]
+        assert len(set(xs)) == len(xs)  # one search's designs, none twice
+    finally:
+        first.kill()
+        first.wait()
