@@ -118,15 +118,19 @@ def optimize(
         scheduler: the address of an existing Dask scheduler instead (``tcp://HOST:PORT``).
         pick: the design chosen: ``"knee"``, the best of an objective, or a row of the front.
         pop_size: NSGA-II population.
-        max_cells: cells each proof may examine (the box's, and the force, speed, frequency and condition one's).
-        cache: a folder whose evaluations (of the same requirements and seed) are reused and extended.
+        max_cells: the most cells each proof may examine (the box's, and the force, speed, frequency and condition
+            one's): a proof starts with 200,000 and doubles its budget up to this while the volume left unproven
+            shrinks; a proof that runs out is ``unresolved`` (not proven yet), with the cells used and left.
+        cache: a folder whose evaluations (of the same requirements and seed) are reused and extended; its journal
+            is verified line by line, and the folder is held (locked) while the search runs.
         progress: show a progress bar.
 
     Returns:
         The chosen platform, the Pareto front and the proof; ``ok`` when every requirement is met.
 
     Raises:
-        StewartError: an invalid requirements file or option.
+        StewartError: an invalid requirements file or option, a ``cache`` journal that does not verify
+            (``JournalError``, naming the file and line) or a ``cache`` folder another run holds (``OutputError``).
     """
     req = requirements if isinstance(requirements, Requirements) else read_requirements(requirements)
     if workers is not None and workers < 0:
@@ -209,7 +213,8 @@ def prove_workspace(
         joint_cone: the joints' cone half-angle (``"joints"``; default 45°).
         leg_diameter: the legs' diameter, m (``"collision"``; default the model's cylinder).
         convention: Euler convention of the box's angles.
-        max_cells: cells the proof may examine (1 to 10⁷).
+        max_cells: the most cells the proof may examine (1 to 10⁷): it starts with 200,000 and doubles its budget
+            up to this while the volume left unproven shrinks.
 
     Returns:
         The proof; ``proven`` when every pose of the box is within the limits.
