@@ -65,6 +65,11 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
     sample = SAMPLE_NOTE.format(n=n - 1)
     perf = performance.results
     cells = performance.cells_examined
+    box_left = (  # the box's proof ran out of cells: its rows (workspace, joint cone, leg diameter) say how far
+        {"cells_used": proof.cells_examined, "cells_left": proof.unresolved_count, "stopped": proof.stopped}
+        if proof.status == "unresolved"
+        else {}
+    )
     out = [
         {
             "requirement": "workspace: every pose of the box within the stroke, plate above the base",
@@ -76,11 +81,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
             "established": f"proof over {proof.cells_examined} cells ({proof.method})"
             if proof.status != "unresolved"
             else not_proven(proof.cells_examined, proof.unresolved_count, proof.stopped),
-            **(
-                {"cells_used": proof.cells_examined, "cells_left": proof.unresolved_count, "stopped": proof.stopped}
-                if proof.status == "unresolved"
-                else {}
-            ),
+            **box_left,
         },
         _row(
             "actuator.max_force",
@@ -168,6 +169,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
                 "established": "the proof (l·e_z and l·n bounded on every cell); the search sampled "
                 + f"{float(row['max_joint_angle']):.6f} rad at "
                 + sample,
+                **box_left,
             }
         )
     if req.leg_diameter is not None:
@@ -182,6 +184,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
                 "established": "the proof (a separating direction between each pair's hulls on every cell); the search "
                 + f"sampled {float(row['min_leg_distance']):.6f} m at "
                 + sample,
+                **box_left,
             }
         )
     if req.max_condition is not None:

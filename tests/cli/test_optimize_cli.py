@@ -162,3 +162,15 @@ def test_a_second_optimize_into_a_running_ones_folder_is_refused(tmp_path, capsy
     finally:
         first.kill()
         first.wait()
+
+
+def test_a_box_proof_out_of_cells_reads_not_proven_yet_on_each_of_its_rows(tmp_path, capsys):
+    """``--max-cells 10``: the box's first level is 48 cells, so its proof (stroke, joint cone) stops before any:
+    each row it decides says how far it got, and the exit status is 1."""
+    rc = main(["optimize", "--requirements", SEED_001, "--out", str(tmp_path / "o"), "--budget", "12",
+               "--pop-size", "12", "--workers", "0", "--max-cells", "10"])  # fmt: skip
+    text = capsys.readouterr().out
+    note = "(0 cells used, 48 left; the cell cap (--max-cells) was reached)"
+    assert rc == 1 and f"proof of the box: not proven yet {note}" in text and "NOT MET" not in text
+    for name in ("workspace: every pose of the box", "limits.joint_cone: every pose of the box"):
+        assert re.search(rf"not proven yet +{re.escape(name)}[^\n]*: {re.escape(note)}", text), name
