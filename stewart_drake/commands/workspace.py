@@ -121,7 +121,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    reject_unused(args, "--prove", args.prove, require_box=None, max_cells=200_000)
+    reject_unused(args, "--prove", args.prove, require_box=None, max_cells=MAX_CELLS)
     if args.prove:
         return run_proof(args)
     names = [n.strip() for n in args.limits.split(",")]
