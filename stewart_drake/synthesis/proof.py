@@ -33,9 +33,10 @@ that is not proven is tested at its centre and at the poses where the bounds are
 toolkit's IK (``core.kinematics.leg_lengths``): a pose outside the stroke (by more than the slack below) is
 a witness and the result is ``violated``; otherwise the cell is halved across its widest side (positions
 in metres, angles times the plate radius). The cells examined are budgeted (``CellBudget``): ``START_CELLS``
-first, the budget doubled each time it is reached while the volume of the cells left keeps shrinking, up to the
-cap ``max_cells``; when the cap is reached or the volume stops shrinking the result is ``unresolved``, with the
-cells examined, the cells left and their share of the box's volume.
+first, the budget doubled each time it is reached while the volume of the cells left keeps shrinking (over the
+last six levels: every side halved once), up to the cap ``max_cells``; when the cap is reached or the volume stops
+shrinking the result is ``unresolved``, with the cells examined, the cells left and their share of the box's
+volume.
 
 Floating-point rounding. The bounds are computed in binary64 arithmetic. Each is a sum of at most ~200
 rounded operations on numbers at most 100 m (the project's size limit) and on sines and cosines (numpy's
@@ -65,7 +66,8 @@ FP_SLACK = 1e-9  # m: each bound widened by this (rounding; see the module docst
 COVER_PAD = 1e-12  # each cell's half-widths grown by this × (1 + |centre|): adjacent cells overlap
 MAX_CELLS = 2_000_000  # default cap on the cells a proof examines
 START_CELLS = 200_000  # its first budget, doubled while the unresolved volume shrinks (``CellBudget``)
-SHRINK = 0.99  # the unresolved volume shrinks when it falls below this fraction of its value at the last doubling
+SHRINK = 0.99  # the unresolved volume shrinks when it falls below this fraction of its value ROUND levels before
+ROUND = 6  # levels of cells in which every side of a cell is halved once (one per level, six sides)
 BATCH = 4096  # cells per vectorised step
 PG_STEPS = 40  # projected-gradient steps for the direction of the lower bound
 VERTICES = np.array(list(itertools.product((-1.0, 1.0), repeat=6))).T  # (6, 64)
@@ -113,24 +115,26 @@ def unresolved_volume(cells: Cells, lo, hi) -> float:
 
 
 class CellBudget:
-    """How many cells a proof may examine: ``min(START_CELLS, cap)`` first; when the next level of cells would pass
-    it, it is doubled (up to ``cap``, as many times as that level needs) if the volume of the cells left
-    (``unresolved_volume``) has fallen below ``SHRINK`` times its value at the previous doubling (the whole box at
-    the start). ``stopped`` says why it ran out: ``"cap"`` or ``"stalled"``."""
+    """How many cells a proof may examine, asked once per level of cells (each level halves every cell left across
+    one side): ``min(START_CELLS, cap)`` first; when the next level would pass it, it is doubled (up to ``cap``, as
+    many times as that level needs) while the volume of the cells left (``unresolved_volume``) shrinks: below
+    ``SHRINK`` times its value ``ROUND`` levels before (the whole box before the first level), a full round of
+    halvings of every side. ``stopped`` says why it ran out: ``"cap"`` or ``"stalled"``."""
 
     def __init__(self, cap: int, lo, hi):
         self.cap, self.limit, self.lo, self.hi = int(cap), min(START_CELLS, int(cap)), lo, hi
-        self.volume, self.stopped = 1.0, None
+        self.volumes, self.stopped = [], None
 
     def allows(self, examined: int, pending: Cells) -> bool:
-        """Whether the proof may examine the ``pending`` cells after ``examined`` ones."""
+        """Whether the proof may examine the ``pending`` cells (the next level) after ``examined`` ones."""
+        volume = unresolved_volume(pending, self.lo, self.hi)
+        self.volumes.append(volume)
         if examined + len(pending) <= self.limit:
             return True
-        volume = unresolved_volume(pending, self.lo, self.hi)
-        if self.limit >= self.cap or volume >= SHRINK * self.volume:
+        before = self.volumes[-1 - ROUND] if len(self.volumes) > ROUND else 1.0
+        if self.limit >= self.cap or volume >= SHRINK * before:
             self.stopped = "cap" if self.limit >= self.cap else "stalled"
             return False
-        self.volume = volume
         while examined + len(pending) > self.limit and self.limit < self.cap:
             self.limit = min(2 * self.limit, self.cap)
         if examined + len(pending) <= self.limit:

@@ -19,7 +19,7 @@ from stewart_drake.synthesis.performance import (
     prove_requirements_performance,
     sampled_performance,
 )
-from stewart_drake.synthesis.proof import START_CELLS, CellBudget, Cells
+from stewart_drake.synthesis.proof import ROUND, START_CELLS, CellBudget, Cells
 from stewart_drake.synthesis.requirements import load_requirements
 
 
@@ -150,12 +150,16 @@ def _cells(n, share):
 
 def test_the_cell_budget_doubles_while_the_volume_left_shrinks_and_stops_when_it_stalls():
     """The first budget is ``START_CELLS``; past it, a level whose cells cover less than ``SHRINK`` of the volume left
-    at the last doubling (the whole box at first) doubles it, one that does not stops the proof ("stalled"), and
+    ``ROUND`` levels before (the whole box at first) doubles it, one that does not stops the proof ("stalled"), and
     the cap stops it too ("cap")."""
     lo, hi = -np.ones(6), np.ones(6)
     b = CellBudget(4 * START_CELLS, lo, hi)
-    assert b.allows(0, _cells(1000, 1.0)) and b.limit == START_CELLS
+    for _ in range(ROUND):  # levels within the first budget that prove nothing: allowed
+        assert b.allows(0, _cells(1000, 1.0)) and b.limit == START_CELLS
     assert b.allows(START_CELLS, _cells(START_CELLS, 0.5)) and b.limit == 2 * START_CELLS and b.stopped is None
+    for _ in range(ROUND - 1):
+        assert b.allows(0, _cells(1000, 0.5))
+    # ROUND levels after the volume was 0.5 it is still 0.5: a full round of halvings proved nothing
     assert not b.allows(2 * START_CELLS, _cells(START_CELLS + 1, 0.5)) and b.stopped == "stalled"
     capped = CellBudget(START_CELLS + 10, lo, hi)
     assert not capped.allows(START_CELLS, _cells(11, 1e-3)) and capped.stopped == "cap"
