@@ -92,9 +92,10 @@ def _scan(path: Path, identity: str) -> tuple[list[tuple[int, dict]], str, int]:
             and text.endswith("}")
         )
         row_text = text[_ROW_AT:-1] if ok else ""
-        if not ok or not hmac.compare_digest(text[len(_PREFIX) : len(_PREFIX) + 64], _mac(key, mac, row_text)):
+        stored = raw[len(_PREFIX) : len(_PREFIX) + 64]  # bytes: compare_digest refuses non-ASCII text
+        if not ok or not hmac.compare_digest(stored, _mac(key, mac, row_text).encode()):
             raise JournalError(JournalError.LINE.format(path=str(path), line=n, text=_shown(raw)))
-        mac = text[len(_PREFIX) : len(_PREFIX) + 64]
+        mac = stored.decode()
         rows.append((n, json.loads(row_text)))
     return rows, mac, end
 

@@ -45,6 +45,8 @@ def test_an_interrupted_last_line_is_left_out_and_cut_before_the_next_append(tmp
         (lambda lines: lines.__setitem__(slice(1, 3), [lines[2], lines[1]]), 2),  # two rows swapped
         (lambda lines: lines.insert(3, lines[2]), 4),  # a row repeated
         (lambda lines: lines.__setitem__(3, "{}"), 4),  # not a journal line
+        (lambda lines: lines.__setitem__(1, lines[1][:9] + "é" + lines[1][10:]), 2),  # a non-ASCII mac
+        (lambda lines: lines.__setitem__(1, lines[1][:40]), 2),  # a line cut short, not the last
     ],
 )
 def test_an_edited_line_is_refused_naming_the_file_and_line(tmp_path, edit, line):
