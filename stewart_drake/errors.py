@@ -357,6 +357,7 @@ class OutputError(StewartError):
     REMEDY_FORCE = "give a new or empty folder, or {force} to write beside them"
     REMEDY_OWN = "give a new or empty folder, or one that `{command}` wrote itself"
     UNWRITABLE = "{option} {typed!r}: cannot write there ({reason})"
+    BUSY = "{option} {typed!r}: another stewart-drake run is writing there; wait for it to end or give another folder"
     BAD_PATH = "{option} {typed!r}: not a usable path"
     CLASH = "{option} {typed!r}: {name!r} exists and was not written by stewart-drake; nothing was written"
     CLASH_OTHER = (
@@ -958,6 +959,27 @@ class SynthesisError(StewartError):
     )
     OUT_NOT_OURS = "--out {out}: holds files that are not a search's ({name}); give another folder"
     BUDGET = "--budget must be between {lo} and {hi} design evaluations, got {value}"
+
+
+class JournalError(StewartError):
+    """A resume journal (``evaluations.jsonl``, ``montecarlo.partial.jsonl``; ``core.journal``) whose lines do not
+    verify: edited, cut, or not written for this search or study. Nothing is resumed from it."""
+
+    HEADER = "{path}:1: not a stewart-drake journal header ({text}); remove the file to start again"
+    OTHER = "{path}:1: a journal of another search or study (key {old}, this one {new}); give another folder"
+    LINE = (
+        "{path}:{line}: does not verify ({text}): the journal was edited, cut or not written for this run; "
+        "nothing was resumed from it: remove the file to start again, or give another folder"
+    )
+    ROW = (
+        "{path}:{line}: {problem}; nothing was resumed from it: remove the file to start again, or give another folder"
+    )
+    # the problems of a row checked against what it can be recomputed from
+    ROW_SHAPE = "not a design of {n} variables"
+    ROW_BOUND = "variable {name} = {value!r} is outside its bounds [{lo:g}, {hi:g}]"
+    ROW_METRICS = "its objectives or constraints are not those of its metrics"
+    ROW_NO_METRICS = "a design row without its metrics"
+    ROW_DRAW = "run {run}: {column} = {value!r} is not the study's draw for that run ({drawn!r})"
 
 
 class InfeasibleRequirementsError(PhysicalLimitError):

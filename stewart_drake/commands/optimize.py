@@ -5,12 +5,13 @@ from __future__ import annotations
 import sys
 
 from stewart_drake.commands._common import add_force_arg, output_folder, print_json
-from stewart_drake.core.output_folder import claim_in_manifest
+from stewart_drake.core.output_folder import claim_in_manifest, run_lock
 from stewart_drake.synthesis.api import optimize
 from stewart_drake.synthesis.outputs import write_outputs
-from stewart_drake.synthesis.proof import MAX_CELLS
+from stewart_drake.synthesis.proof import MAX_CELLS, START_CELLS
 from stewart_drake.synthesis.requirements import OBJECTIVES
 from stewart_drake.synthesis.search import CACHE, DEFAULT_POP
+from stewart_drake.synthesis.synthesize import cells_note, not_proven
 
 HELP = "design synthesis: the geometry with the smallest actuators that meets a requirements file, proven"
 
@@ -58,7 +59,8 @@ def register(sub) -> None:
         type=int,
         default=MAX_CELLS,
         metavar="N",
-        help=f"cells each proof may examine: the box's, and force/speed/frequency/condition's (default {MAX_CELLS})",
+        help=f"the most cells each proof may examine: the box's, and force/speed/frequency/condition's (default "
+        f"{MAX_CELLS}; a proof starts with {START_CELLS} and doubles them while the volume left unproven shrinks)",
     )
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -68,6 +70,11 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = output_folder(args)
+    with run_lock(out.path, option="--out", typed=out.typed):  # one run at a time in the folder, to its end
+        return _run(args, out)
+
+
+def _run(args, out) -> int:
     r = optimize(
         args.requirements,
         budget=args.budget,
@@ -100,25 +107,34 @@ def run(args) -> int:
         print(
             f"  stroke [{d['L_min']:.4f}, {d['L_max']:.4f}] m, peak force {d['peak_force']:.1f} N, lowest frequency {d['frequency']:.1f} Hz"
         )
-        pr = result.proof
-        print(f"  proof of the box: {pr.status} ({pr.cells_examined} cells, {pr.seconds:.2f} s)")
+        pr, perf = result.proof, result.performance
+        if pr.status == "unresolved":
+            print(f"  proof of the box: {not_proven(pr.cells_examined, pr.unresolved_count, pr.stopped)}")
+        else:
+            print(f"  proof of the box: {pr.status} ({pr.cells_examined} cells, {pr.seconds:.2f} s)")
+        print(f"  proof of force, speed, frequency, condition: {perf.cells_examined} cells, {perf.seconds:.2f} s")
         if pr.witness:
             print(
                 f"  witness: pose {pr.witness['pose']} leg {pr.witness['leg']} {pr.witness['what']} (L = {pr.witness['length_m']:.6f} m)"
             )
         for r in result.table:
-            mark = "met" if r["met"] else "NOT MET"
+            unresolved = r.get("status", r["achieved"]) == "unresolved"
+            mark = "met" if r["met"] else "not proven yet" if unresolved else "NOT MET"
+            note = cells_note(r["cells_used"], r["cells_left"], r["stopped"]) if "cells_left" in r else ""
             if isinstance(r["achieved"], str):
                 room = f" (least stroke margin {r['margin'] * 1e3:.2f} mm)" if r["margin"] is not None else ""
-                print(f"  {mark:7s} {r['requirement']}: {r['achieved']}{room}")
+                print(f"  {mark:14s} {r['requirement']}: {note if unresolved else r['achieved'] + room}")
             else:
                 proof = ""
-                if "status" in r:  # the performance proof's verdict
+                if unresolved:
+                    proof = f" {note}"
+                elif "status" in r:  # the performance proof's verdict
                     proof = f"; {r['status']}" + (f", bound {r['bound']:.6g}" if r["bound"] is not None else "")
                     if r.get("witness"):
                         proof += f" (witness pose {r['witness']['pose']}: {r['witness']['value']:.6g})"
+                shown = "sampled" if unresolved else "achieved"
                 print(
-                    f"  {mark:7s} {r['requirement']}: required {r['required']:g}, achieved {r['achieved']:.6g} {r['unit']}{proof}"
+                    f"  {mark:14s} {r['requirement']}: required {r['required']:g}, {shown} {r['achieved']:.6g} {r['unit']}{proof}"
                 )
         print(f"  wrote {args.out}/ (design.yaml, pareto.parquet/.csv/.png, requirements.json)")
     return 0 if result.ok else 1

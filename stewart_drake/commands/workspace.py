@@ -21,6 +21,8 @@ from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from stewart_drake.errors import OptionError, SynthesisError
 from stewart_drake.synthesis.api import prove_workspace
+from stewart_drake.synthesis.proof import MAX_CELLS, START_CELLS
+from stewart_drake.synthesis.synthesize import cells_note
 from stewart_drake.workspace import AXES, view_figures
 
 BOX_AXES = ("px", "py", "pz", "a", "b", "g")
@@ -110,15 +112,16 @@ def register(sub) -> None:
     p.add_argument(
         "--max-cells",
         type=int,
-        default=200_000,
+        default=MAX_CELLS,
         metavar="N",
-        help="with --prove: cells the proof may examine (default 200000)",
+        help=f"with --prove: the most cells the proof may examine (default {MAX_CELLS}; it starts with "
+        f"{START_CELLS} and doubles them while the volume left unproven shrinks)",
     )
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    reject_unused(args, "--prove", args.prove, require_box=None, max_cells=200_000)
+    reject_unused(args, "--prove", args.prove, require_box=None, max_cells=MAX_CELLS)
     if args.prove:
         return run_proof(args)
     names = [n.strip() for n in args.limits.split(",")]
@@ -238,5 +241,5 @@ def run_proof(args) -> int:
                 f"(length {w['length_m']:.6f} m, checked by the IK)"
             )
         else:
-            print(f"  {result.unresolved_count} cells left unresolved after --max-cells {args.max_cells}")
+            print(f"  not proven yet {cells_note(result.cells_examined, result.unresolved_count, result.stopped)}")
     return 0 if result.status == "proven" else 1

@@ -153,6 +153,46 @@ def commit_lock(folder: Path) -> Iterator[None]:
         os.close(fd)  # closing the descriptor releases the lock
 
 
+_held: dict[str, list[int]] = {}  # folder -> [descriptor, depth] of the run locks this process holds
+
+
+@contextmanager
+def run_lock(folder, *, option: str = "--out", typed: str | None = None) -> Iterator[None]:
+    """Hold ``folder`` for a run's lifetime: an exclusive, non-blocking ``flock`` on the folder itself (made here if
+    absent, and removed again at the end if still empty). A second run into the folder while this one holds it is
+    refused with ``OutputError.BUSY`` naming ``option`` and ``typed`` (the path as the user wrote it). Re-entrant
+    within a process (a command holding the folder calls an API that holds it too). The folder swapped in at the
+    end (``OutputFolder.writing``) is a new directory: a run started after that commit holds that one."""
+    folder = Path(os.path.abspath(folder))
+    key = str(folder)
+    if key in _held:
+        _held[key][1] += 1
+        try:
+            yield
+        finally:
+            _held[key][1] -= 1
+        return
+    made = not folder.exists()
+    folder.mkdir(parents=True, exist_ok=True)
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise OutputError(OutputError.BUSY.format(option=option, typed=typed or str(folder))) from None
+    _held[key] = [fd, 1]
+    try:
+        yield
+    finally:
+        del _held[key]
+        os.close(fd)  # closing the descriptor releases the lock
+        if made:
+            try:
+                os.rmdir(folder)  # only if nothing was written there
+            except OSError:
+                pass
+
+
 def claim_in_manifest(folder, names, *, prefix: bool = False, command: str | None = None) -> None:
     """Record ``names`` (relative paths the caller has just written in ``folder``) as this command's.
     ``prefix``: the file is an append-only journal, verified by the hash of the bytes written so far

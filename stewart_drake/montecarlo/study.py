@@ -2,8 +2,9 @@
 
 The output folder holds, while a study runs, ``montecarlo.partial.jsonl``: a header line with the
 study's key (``study_key``: a hash of every setting except the number of runs) and one JSON row per
-finished run, flushed as each arrives. A study started again with the same settings and ``--out`` reads
-it and runs only the missing indices (JSON keeps every float bit for bit). At the end the folder is
+finished run, flushed as each arrives (a ``core.journal``: a chain of per-line MACs). A study started again
+with the same settings and ``--out`` verifies every line, checks each row's drawn values against the study's
+draws for its run, and runs only the missing indices (JSON keeps every float bit for bit). At the end the folder is
 replaced atomically by the final files (``summary.write_outputs``).
 
 Dask: ``--workers K`` starts a ``LocalCluster`` of K single-threaded worker processes; ``--scheduler``
@@ -27,11 +28,12 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.geometry import base_joints
+from stewart_drake.core.journal import JournalWriter, header_line, read_rows
 from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
 from stewart_drake.drake.systems import make_law
-from stewart_drake.errors import OutputError, StudyError
+from stewart_drake.errors import JournalError, OutputError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
-from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
+from stewart_drake.montecarlo.scenario import Study, draw, run_scenario, scenario
 from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
 
 PARTIAL = "montecarlo.partial.jsonl"
@@ -212,10 +214,11 @@ def run_row(study: Study, index: int) -> dict:
 # The output folder's state.
 
 
-def load_partial(out: Path, key: str) -> dict[int, dict]:
+def load_partial(out: Path, key: str, study: Study | None = None) -> dict[int, dict]:
     """``{run: row}`` of the runs already finished in ``out`` for the study ``key`` (none if ``out`` does
     not exist). ``StudyError`` if ``out`` holds something else: another study, or files this tool did not
-    write."""
+    write; ``JournalError`` naming the file and line if a line of the journal does not verify (``core.journal``)
+    or, with ``study``, a row's drawn values are not the study's draws for its run."""
     if not out.exists():
         return {}
     if not out.is_dir():
@@ -235,8 +238,8 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
             import pyarrow.parquet as pq
 
             table = _damaged_unless(results, lambda: pq.read_table(results).to_pylist(), list)
-            for r in table:
-                rows[_run_index(results, r)] = r
+            for n, r in enumerate(table, start=1):
+                rows[_checked(study, results, n, r)] = r
     elif not partial.exists() and any(out.iterdir()):
         raise StudyError(StudyError.OUT_NOT_OURS.format(out=str(out), study_file=STUDY_FILE, partial=PARTIAL))
     if partial.exists():
@@ -244,13 +247,22 @@ def load_partial(out: Path, key: str) -> dict[int, dict]:
         head = _damaged_unless(partial, lambda: json.loads(lines[0]) if lines else None, dict)
         if head.get("key") != key:
             raise StudyError(StudyError.OUT_OTHER_PARTIAL.format(out=str(out), old_key=head.get("key"), key=key))
-        for line in lines[1:]:
-            try:
-                r = json.loads(line)
-            except json.JSONDecodeError:  # a line cut short by an interruption: that run is re-run
-                continue
-            rows[_run_index(partial, r)] = r
+        for n, r in read_rows(partial, key):  # every line verified; a last line cut short: that run is re-run
+            rows[_checked(study, partial, n, r)] = r
     return rows
+
+
+def _checked(study: Study | None, path: Path, line: int, row) -> int:
+    """The run index of a stored ``row`` (line ``line`` of ``path``), its drawn values checked against ``study``'s
+    draws for that run (``scenario.draw``: deterministic from the seed and the index)."""
+    run = _run_index(path, row)
+    if study is not None and run < study.runs:
+        seed, d = draw(study, run)
+        for column, drawn in {"seed": seed, **d.columns()}.items():
+            if row.get(column) != drawn:
+                problem = JournalError.ROW_DRAW.format(run=run, column=column, value=row.get(column), drawn=drawn)
+                raise JournalError(JournalError.ROW.format(path=str(path), line=line, problem=problem))
+    return run
 
 
 def _damaged_unless(path: Path, read, kind: type):
@@ -278,7 +290,7 @@ def _run_index(path: Path, row) -> int:
 
 
 class PartialWriter:
-    """Appends finished rows to ``out/montecarlo.partial.jsonl``, one flushed line each. The file is made
+    """Appends finished rows to ``out/montecarlo.partial.jsonl`` (``core.journal``), one flushed line each. The file is made
     at the first row (a study that fails before any run leaves no folder), with its header written whole
     (a temporary and a rename: never a file without its key) and claimed in the folder's manifest as an
     append-only journal of this command (verified by its header's hash)."""
@@ -292,9 +304,8 @@ class PartialWriter:
             if self.fh is None:
                 if not path.exists():
                     self._start(path)
-                self.fh = path.open("a", encoding="utf-8")
-            self.fh.write(json.dumps(obj) + "\n")
-            self.fh.flush()
+                self.fh = JournalWriter(path, self.key)  # a verified chain (core.journal)
+            self.fh.append(obj)
         except OSError as e:  # disk full, ...: one line naming the file and the option
             raise OutputError(
                 OutputError.UNWRITABLE.format(
@@ -308,7 +319,7 @@ class PartialWriter:
         made = not self.out.exists()
         self.out.mkdir(parents=True, exist_ok=True)
         try:
-            write_text_atomic(path, json.dumps({"key": self.key}) + "\n")
+            write_text_atomic(path, header_line(self.key) + "\n")
             claim_in_manifest(self.out, [PARTIAL], prefix=True)  # the final write replaces it
         except OSError:
             path.unlink(missing_ok=True)  # written just now by this process, not yet claimed
@@ -335,7 +346,7 @@ def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None,
     verdict columns (``summary.VERDICT_COLUMNS``: written before runs were judged) is run again."""
     check_study(study)
     key = study_key(study)
-    rows = load_partial(Path(out), key) if out is not None else {}
+    rows = load_partial(Path(out), key, study) if out is not None else {}
     rows = {i: r for i, r in rows.items() if all(c in r for c in VERDICT_COLUMNS)}
     todo = [i for i in range(study.runs) if i not in rows]
     writer = PartialWriter(Path(out), key) if out is not None else None

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg_bodies import leg_dimensions
+from stewart_drake.core.output_folder import run_lock
 from stewart_drake.core.rotations import to_radians
 from stewart_drake.core.sanity import check_finite, check_work
 from stewart_drake.errors import OptionError, SynthesisError
@@ -116,15 +118,19 @@ def optimize(
         scheduler: the address of an existing Dask scheduler instead (``tcp://HOST:PORT``).
         pick: the design chosen: ``"knee"``, the best of an objective, or a row of the front.
         pop_size: NSGA-II population.
-        max_cells: cells each proof may examine (the box's, and the force, speed, frequency and condition one's).
-        cache: a folder whose evaluations (of the same requirements and seed) are reused and extended.
+        max_cells: the most cells each proof may examine (the box's, and the force, speed, frequency and condition
+            one's): a proof starts with 200,000 and doubles its budget up to this while the volume left unproven
+            shrinks; a proof that runs out is ``unresolved`` (not proven yet), with the cells used and left.
+        cache: a folder whose evaluations (of the same requirements and seed) are reused and extended; its journal
+            is verified line by line, and the folder is held (locked) while the search runs.
         progress: show a progress bar.
 
     Returns:
         The chosen platform, the Pareto front and the proof; ``ok`` when every requirement is met.
 
     Raises:
-        StewartError: an invalid requirements file or option.
+        StewartError: an invalid requirements file or option, a ``cache`` journal that does not verify
+            (``JournalError``, naming the file and line) or a ``cache`` folder another run holds (``OutputError``).
     """
     req = requirements if isinstance(requirements, Requirements) else read_requirements(requirements)
     if workers is not None and workers < 0:
@@ -137,18 +143,20 @@ def optimize(
         raise OptionError(OptionError.BETWEEN.format(option="--max-cells", lo=1, hi=MAX_PROOF_CELLS, value=max_cells))
     if seed < 0:
         raise OptionError(OptionError.AT_LEAST.format(option="--seed", min=0, value=seed))
-    result = synthesize(
-        req,
-        None if cache is None else Path(cache),
-        budget,
-        seed,
-        workers or 0,
-        scheduler,
-        pick,
-        progress=progress,
-        max_cells=max_cells,
-        pop_size=pop_size,
-    )
+    held = nullcontext() if cache is None else run_lock(cache, option="cache", typed=str(cache))
+    with held:  # one search at a time appends to a folder's journal
+        result = synthesize(
+            req,
+            None if cache is None else Path(cache),
+            budget,
+            seed,
+            workers or 0,
+            scheduler,
+            pick,
+            progress=progress,
+            max_cells=max_cells,
+            pop_size=pop_size,
+        )
     return OptimizeResult(result.platform, result)
 
 
@@ -205,7 +213,8 @@ def prove_workspace(
         joint_cone: the joints' cone half-angle (``"joints"``; default 45°).
         leg_diameter: the legs' diameter, m (``"collision"``; default the model's cylinder).
         convention: Euler convention of the box's angles.
-        max_cells: cells the proof may examine (1 to 10⁷).
+        max_cells: the most cells the proof may examine (1 to 10⁷): it starts with 200,000 and doubles its budget
+            up to this while the volume left unproven shrinks.
 
     Returns:
         The proof; ``proven`` when every pose of the box is within the limits.

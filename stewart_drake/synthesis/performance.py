@@ -87,7 +87,8 @@ A cell is done when each requirement still open is proven on it; otherwise its c
 values are the toolkit's formulas at that pose): a requirement the centre violates gets a witness, confirmed by
 the toolkit's per-platform functions (``envelope_sizing``, ``stiffness_matrix`` + ``lowest_frequency``,
 ``condition_number``), and is closed as ``violated``; the others' cells are halved as in ``proof.prove_box``.
-Past ``max_cells`` the requirements still open are ``unresolved``.
+The cells are budgeted as ``proof.prove_box``'s (``proof.CellBudget``); when the budget runs out the requirements
+still open on some cell are ``unresolved``.
 """
 
 from __future__ import annotations
@@ -106,14 +107,23 @@ from stewart_drake.design.envelope import Envelope, envelope_peaks, plate_wrench
 from stewart_drake.design.maps import lowest_frequency
 from stewart_drake.design.stiffness import geometric_load_term, stiffness_matrix
 from stewart_drake.errors import StewartError
-from stewart_drake.synthesis.proof import BATCH, COVER_PAD, Cells, initial_cells, rotation_derivatives, split_cells
+from stewart_drake.synthesis.proof import (
+    BATCH,
+    COVER_PAD,
+    MAX_CELLS,
+    CellBudget,
+    Cells,
+    initial_cells,
+    rotation_derivatives,
+    split_cells,
+    unresolved_volume,
+)
 from stewart_drake.synthesis.verified import U, certified_min_eig, down, gamma, quad_box_max, up
 
 EPS_ROT = 64 * U  # ‖R~ − R(c)‖₂ for the computed rotation (module docstring)
 EPS_DROT = 128 * U  # ‖∂R~/∂θ_j − ∂R/∂θ_j(c)‖₂ for the computed derivatives
 FP_W = 2.0**-40  # each computed wrench / inertia entry within FP_W × S_w of its value at R~ (module docstring)
 TWO_PI_UP = float(up(2 * np.pi))  # >= 2π (np.pi < π)
-MAX_CELLS = 200_000
 TIGHTEN_CELLS = 60_000  # cells examined while bounds that meet their limits are still refined (TIGHT)
 TIGHT = 0.1  # bounds within this fraction of the worst centre value seen are tight enough
 NAMES = ("force", "speed", "frequency", "condition")
@@ -386,12 +396,15 @@ class PerformanceProof:
     """Per requirement (``NAMES`` that were asked): ``status`` proven | violated | unresolved, ``required``,
     ``bound`` (the proven worst over the box: max force/speed/condition, min frequency; over the proven cells when
     not proven), ``sampled`` (the worst of the cells' centres, a sample), ``witness`` (a pose and the toolkit's
-    value at it) when violated, ``unresolved`` cells (first 20, lo/hi pairs) when unresolved."""
+    value at it) when violated, and when unresolved the cells left (``unresolved_count``, the first 20 as lo/hi pairs
+    in ``unresolved_cells``) and their share of the box's volume; ``stopped``: why the cell budget ran out
+    (``"cap"``, ``"stalled"``; None when it did not)."""
 
     results: dict
     cells_examined: int
     max_cells: int
     seconds: float = 0.0
+    stopped: str | None = None
     method: str = field(
         default="Weyl and Neumann bounds of J⁻¹ over each cell, the envelope peak at its centre, derived rotation "
         "constants; centre singular values, solve, envelope maximum and pencil eigenvalue verified in floating "
@@ -404,6 +417,7 @@ class PerformanceProof:
             "requirements": self.results,
             "cells_examined": self.cells_examined,
             "max_cells": self.max_cells,
+            "stopped": self.stopped,
             "seconds": self.seconds,
             "method": self.method,
         }
@@ -428,71 +442,106 @@ def prove_performance(
 ) -> PerformanceProof:
     """Prove the ``limits`` (``{"force": N, "speed": m/s, "frequency": Hz, "condition": x}``, any subset; force,
     speed and condition are upper limits, frequency a lower one) over every pose of the box [lo, hi] (absolute,
-    (6,) m and rad) × the motion envelope, find a witness pose against one, or give up after ``max_cells`` cells
-    (see the module docstring). While fewer than ``tighten_cells`` cells have been examined, a cell whose bound
-    meets a limit but exceeds the worst centre value seen by more than ``TIGHT`` (relative) is split too (branch
-    and bound), so that the reported bound is close to the box's worst rather than merely within the limit."""
+    (6,) m and rad) × the motion envelope, find a witness pose against one, or give up (unresolved) when the
+    ``proof.CellBudget`` runs out: at ``max_cells`` cells, or earlier when the volume of the cells left stops
+    shrinking (see the module docstring). Each cell carries the requirements still open on it: a requirement
+    proven on a cell is not split further for it, and a requirement is proven when no cell left needs it. While
+    fewer than ``tighten_cells`` cells have been examined, a cell whose bound meets a limit but exceeds the worst
+    centre value seen by more than ``TIGHT`` (relative) is split too (branch and bound), so that the reported
+    bound is close to the box's worst rather than merely within the limit."""
     check_convention(convention)
     t0 = time.perf_counter()
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    open_ = [k for k in NAMES if limits.get(k) is not None]
+    names = [k for k in NAMES if limits.get(k) is not None]
+    open_ = list(names)
     res = {
         k: {"status": "proven", "required": float(limits[k]), "bound": None, "sampled": None, "unit": UNITS[k]}
-        for k in open_
+        for k in names
     }
-    worst = {k: (np.inf if k == "frequency" else -np.inf) for k in open_}
+    worst = {k: (np.inf if k == "frequency" else -np.inf) for k in names}
     sampled = dict(worst)
     pending = initial_cells(platform, lo, hi, initial)
+    # per cell and requirement: still open on the cell, and the bound its parent proved (nan: not proven there;
+    # a cell split only to tighten a proven bound carries it, so a budget that runs out leaves that bound valid)
+    need = np.ones((len(pending), len(names)), bool)
+    held = np.full((len(pending), len(names)), np.nan)
     examined = 0
+    budget = CellBudget(max_cells, lo, hi)
     while len(pending) and open_:
-        if examined + len(pending) > max_cells:
-            for k in open_:
-                res[k]["status"] = "unresolved"
-                res[k]["unresolved_count"] = len(pending)
-                res[k]["unresolved_cells"] = [
-                    [(cc - hh).tolist(), (cc + hh).tolist()]
-                    for cc, hh in zip(pending.c[:20], pending.h[:20], strict=True)
-                ]
+        if not budget.allows(examined, pending):
+            _give_up(res, names, open_, pending, need, held, worst, lo, hi, budget.stopped)
             break
         tighten = examined + len(pending) <= tighten_cells
-        nxt = []
+        nxt, nxt_need, nxt_held = [], [], []
         for s in range(0, len(pending), BATCH):
             cells = Cells(pending.c[s : s + BATCH], pending.h[s : s + BATCH])
+            nd, hd = need[s : s + BATCH], held[s : s + BATCH]
             b = performance_bounds(platform, cells, v_max, a_max, stiffness, convention)
             examined += len(cells)
-            split = np.zeros(len(cells), bool)
+            split_k = np.zeros((len(cells), len(names)), bool)
+            bound_k = np.full((len(cells), len(names)), np.nan)
             for k in list(open_):
+                j = names.index(k)
                 bound, centre = getattr(b, k), getattr(b, "centre_" + k)
                 low = k == "frequency"
                 sampled[k] = min(sampled[k], centre.min()) if low else max(sampled[k], centre.max())
                 good = bound >= limits[k] if low else bound <= limits[k]
-                bad_c = centre < limits[k] if low else centre > limits[k]
+                bad_c = (centre < limits[k] if low else centre > limits[k]) & nd[:, j]
                 w = _confirm(platform, k, cells.c[bad_c], limits[k], v_max, a_max, stiffness, convention)
                 if w is not None:
                     res[k].update(status="violated", witness=w)
                     open_.remove(k)
                     continue
-                split |= ~good
-                if (
-                    tighten
-                ):  # branch and bound: only cells that could hold a worse value than (1 + TIGHT) × the worst seen
+                split = ~good
+                if tighten:  # branch and bound: only cells that could hold a worse value than (1 + TIGHT) × the worst
                     split |= bound < sampled[k] / (1 + TIGHT) if low else bound > sampled[k] * (1 + TIGHT)
-            for k in open_:  # the leaves' bounds (cells not split further) cover the box
-                bound = getattr(b, k)[~split]
-                if len(bound):
-                    low = k == "frequency"
-                    worst[k] = min(worst[k], bound.min()) if low else max(worst[k], bound.max())
-            if split.any() and open_:
+                split &= nd[:, j]
+                leaf = nd[:, j] & ~split  # the leaves' bounds (cells not split further for k) cover the box
+                if leaf.any():
+                    worst[k] = min(worst[k], bound[leaf].min()) if low else max(worst[k], bound[leaf].max())
+                split_k[:, j] = split
+                bound_k[:, j] = np.where(good, bound, np.nan)
+            cols = [names.index(k) for k in open_]
+            split = split_k[:, cols].any(1)
+            if split.any():
                 nxt.append(split_cells(platform, Cells(cells.c[split], cells.h[split])))
-        pending = (
-            Cells(np.concatenate([p.c for p in nxt]), np.concatenate([p.h for p in nxt]))
-            if nxt
-            else Cells(np.zeros((0, 6)), np.zeros((0, 6)))
-        )
+                carried = np.where(np.isnan(bound_k), hd, bound_k)[split]  # the cell's own bound where proven on it
+                nxt_need.append(np.tile(split_k[split], (2, 1)))
+                nxt_held.append(np.tile(np.where(split_k[split], carried, np.nan), (2, 1)))
+        if nxt:
+            pending = Cells(np.concatenate([p.c for p in nxt]), np.concatenate([p.h for p in nxt]))
+            need, held = np.concatenate(nxt_need), np.concatenate(nxt_held)
+            keep = need[:, [names.index(k) for k in open_]].any(1)  # requirements closed meanwhile drop out
+            pending, need, held = Cells(pending.c[keep], pending.h[keep]), need[keep], held[keep]
+        else:
+            pending = Cells(np.zeros((0, 6)), np.zeros((0, 6)))
     for k, r in res.items():
         r["bound"] = None if r["status"] != "proven" else float(worst[k])
         r["sampled"] = None if not np.isfinite(sampled[k]) else float(sampled[k])
-    return PerformanceProof(res, examined, max_cells, time.perf_counter() - t0)
+    return PerformanceProof(res, examined, max_cells, time.perf_counter() - t0, stopped=budget.stopped)
+
+
+def _give_up(res, names, open_, pending: Cells, need, held, worst, lo, hi, stopped) -> None:
+    """The budget ran out with ``pending`` cells left: a requirement that no cell left needs unproven (every cell
+    left for it carries its parent's proven bound) is proven with those bounds; the others are ``unresolved``,
+    with their cells left, the first 20 of them (lo, hi pairs) and their share of the box's volume."""
+    for k in list(open_):
+        j = names.index(k)
+        mine = need[:, j]
+        open_cells = mine & np.isnan(held[:, j])
+        if not open_cells.any():
+            if mine.any():
+                low = k == "frequency"
+                worst[k] = min(worst[k], held[mine, j].min()) if low else max(worst[k], held[mine, j].max())
+            continue
+        left = Cells(pending.c[open_cells], pending.h[open_cells])
+        res[k]["status"] = "unresolved"
+        res[k]["unresolved_count"] = len(left)
+        res[k]["unresolved_volume"] = unresolved_volume(left, lo, hi)
+        res[k]["stopped"] = stopped
+        res[k]["unresolved_cells"] = [
+            [(cc - hh).tolist(), (cc + hh).tolist()] for cc, hh in zip(left.c[:20], left.h[:20], strict=True)
+        ]
 
 
 def _confirm(platform, name, poses, limit, v_max, a_max, stiffness, convention) -> dict | None:

@@ -32,8 +32,11 @@ cones hold when asked). A cell
 that is not proven is tested at its centre and at the poses where the bounds are attained, with the
 toolkit's IK (``core.kinematics.leg_lengths``): a pose outside the stroke (by more than the slack below) is
 a witness and the result is ``violated``; otherwise the cell is halved across its widest side (positions
-in metres, angles times the plate radius). Past ``max_cells`` cells the result is ``unresolved``, with the
-cells left.
+in metres, angles times the plate radius). The cells examined are budgeted (``CellBudget``): ``START_CELLS``
+first, the budget doubled each time it is reached while the volume of the cells left keeps shrinking (over the
+last six levels: every side halved once), up to the cap ``max_cells``; when the cap is reached or the volume stops
+shrinking the result is ``unresolved``, with the cells examined, the cells left and their share of the box's
+volume.
 
 Floating-point rounding. The bounds are computed in binary64 arithmetic. Each is a sum of at most ~200
 rounded operations on numbers at most 100 m (the project's size limit) and on sines and cosines (numpy's
@@ -61,7 +64,10 @@ from stewart_drake.workspace.limits import Limits, leg_pairs, limit_margins, seg
 
 FP_SLACK = 1e-9  # m: each bound widened by this (rounding; see the module docstring)
 COVER_PAD = 1e-12  # each cell's half-widths grown by this × (1 + |centre|): adjacent cells overlap
-MAX_CELLS = 200_000  # default limit on cells examined
+MAX_CELLS = 2_000_000  # default cap on the cells a proof examines
+START_CELLS = 200_000  # its first budget, doubled while the unresolved volume shrinks (``CellBudget``)
+SHRINK = 0.99  # the unresolved volume shrinks when it falls below this fraction of its value ROUND levels before
+ROUND = 6  # levels of cells in which every side of a cell is halved once (one per level, six sides)
 BATCH = 4096  # cells per vectorised step
 PG_STEPS = 40  # projected-gradient steps for the direction of the lower bound
 VERTICES = np.array(list(itertools.product((-1.0, 1.0), repeat=6))).T  # (6, 64)
@@ -98,6 +104,43 @@ def rotation_derivatives(angles, convention: str = "utn") -> tuple[np.ndarray, n
         R = Rz @ Ry @ Rx
         dR = [R @ Sx, Rz @ Ry @ Sy @ Rx, Sz @ R]
     return R, np.stack(dR, -3)
+
+
+def unresolved_volume(cells: Cells, lo, hi) -> float:
+    """The share of the box [lo, hi] ((6,) m, rad) that ``cells`` cover, over its axes of non-zero width (cells of
+    the box's cover do not overlap but by ``COVER_PAD``)."""
+    half = (np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)) / 2
+    axes = half > 0
+    return float(np.sum(np.prod(cells.h[:, axes] / half[axes], axis=1)))
+
+
+class CellBudget:
+    """How many cells a proof may examine, asked once per level of cells (each level halves every cell left across
+    one side): ``min(START_CELLS, cap)`` first; when the next level would pass it, it is doubled (up to ``cap``, as
+    many times as that level needs) while the volume of the cells left (``unresolved_volume``) shrinks: below
+    ``SHRINK`` times its value ``ROUND`` levels before (the whole box before the first level), a full round of
+    halvings of every side. ``stopped`` says why it ran out: ``"cap"`` or ``"stalled"``."""
+
+    def __init__(self, cap: int, lo, hi):
+        self.cap, self.limit, self.lo, self.hi = int(cap), min(START_CELLS, int(cap)), lo, hi
+        self.volumes, self.stopped = [], None
+
+    def allows(self, examined: int, pending: Cells) -> bool:
+        """Whether the proof may examine the ``pending`` cells (the next level) after ``examined`` ones."""
+        volume = unresolved_volume(pending, self.lo, self.hi)
+        self.volumes.append(volume)
+        if examined + len(pending) <= self.limit:
+            return True
+        before = self.volumes[-1 - ROUND] if len(self.volumes) > ROUND else 1.0
+        if self.limit >= self.cap or volume >= SHRINK * before:
+            self.stopped = "cap" if self.limit >= self.cap else "stalled"
+            return False
+        while examined + len(pending) > self.limit and self.limit < self.cap:
+            self.limit = min(2 * self.limit, self.cap)
+        if examined + len(pending) <= self.limit:
+            return True
+        self.stopped = "cap"
+        return False
 
 
 @dataclass
@@ -259,8 +302,10 @@ def cones_ok(b: CellBounds, cone: float) -> np.ndarray:
 class ProofResult:
     """The outcome for a box: ``status`` "proven" | "violated" | "unresolved"; cells examined and proven; the
     rigorous leg-length range over the box when proven (``length_bounds`` m); the least stroke margin and
-    anchor height proven; a ``witness`` (pose, leg, what) when violated; ``unresolved_cells`` (lo, hi pairs,
-    first 20) when unresolved."""
+    anchor height proven; a ``witness`` (pose, leg, what) when violated; when unresolved, the cells left
+    (``unresolved_count``, the first 20 as lo, hi pairs in ``unresolved_cells``), their share of the box's volume
+    and why the proof ``stopped`` (``"cap"``: ``max_cells`` reached; ``"stalled"``: the volume left stopped
+    shrinking)."""
 
     status: str
     box_lo: np.ndarray
@@ -274,6 +319,8 @@ class ProofResult:
     witness: dict | None = None
     unresolved_cells: list = field(default_factory=list)
     unresolved_count: int = 0
+    unresolved_volume: float = 0.0
+    stopped: str | None = None
     seconds: float = 0.0
     method: str = "zonotope enclosure of the leg vectors with a derived Taylor remainder, rounding widened by 1e-9 m"
 
@@ -291,6 +338,8 @@ class ProofResult:
             "min_anchor_height_m": self.min_anchor_height_m,
             "witness": self.witness,
             "unresolved_count": self.unresolved_count,
+            "unresolved_volume": self.unresolved_volume,
+            "stopped": self.stopped,
             "unresolved_cells": self.unresolved_cells,
             "seconds": self.seconds,
             "method": self.method,
@@ -397,21 +446,23 @@ def prove_box(
 ) -> ProofResult:
     """Prove that every pose in the box [lo, hi] (absolute, (6,) m and rad) is within the stroke with the
     plate above the base (and, with ``joint_cone`` (rad), every leg within that angle of the base normal and
-    of the plate normal at its joints), or find a witness pose that is not, or give up after ``max_cells``
-    cells (unresolved). ``initial``: splits per angle axis to start with (default: cells of about 5°)."""
+    of the plate normal at its joints), or find a witness pose that is not, or give up (unresolved) when the
+    ``CellBudget`` runs out: at ``max_cells`` cells, or earlier when the volume left stops shrinking. ``initial``: splits per angle axis to start with (default: cells of about 5°)."""
     check_convention(convention)
     t0 = time.perf_counter()
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     pending = initial_cells(platform, lo, hi, initial)
     examined = proven = 0
     lmin_b, lmax_b, margin, zmin = np.inf, -np.inf, np.inf, np.inf
+    budget = CellBudget(max_cells, lo, hi)
     while len(pending):
-        if examined + len(pending) > max_cells:
+        if not budget.allows(examined, pending):
             left = pending
             cells = [[(cc - hh).tolist(), (cc + hh).tolist()] for cc, hh in zip(left.c[:20], left.h[:20], strict=True)]
             return ProofResult(
-                "unresolved", lo, hi, examined, proven, max_cells,
-                unresolved_cells=cells, unresolved_count=len(left), seconds=time.perf_counter() - t0,
+                "unresolved", lo, hi, examined, proven, max_cells, unresolved_cells=cells,
+                unresolved_count=len(left), unresolved_volume=unresolved_volume(left, lo, hi),
+                stopped=budget.stopped, seconds=time.perf_counter() - t0,
             )  # fmt: skip
         nxt_c, nxt_h = [], []
         for s in range(0, len(pending), BATCH):

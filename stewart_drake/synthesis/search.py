@@ -13,11 +13,13 @@ gathered in order. So the same seed gives the same generations and the same fron
 workers (a test runs 1 and 2).
 
 Resume: every evaluated design is appended to ``evaluations.jsonl`` in the output folder (a generation's new
-designs flushed together, as soon as they are evaluated), under a
-header with the search's key (a hash of the requirements, the seed and the population size). A search
-started again with the same key replays the algorithm from the seed and takes each design it asks for
-from that file when present (JSON keeps every float bit for bit), evaluating only the rest: an
-interrupted search picks up where it stopped, and a larger ``--budget`` continues a finished one.
+designs flushed together, as soon as they are evaluated), a ``core.journal`` under a header with the search's key
+(a hash of the requirements, the seed and the population size). A search started again with the same key
+verifies every line (an edited or damaged line refuses the resume, naming the file and line), checks each row
+(variables within their bounds, objectives and constraints those of its metrics), replays the algorithm from the
+seed and takes each design it asks for from that file when present (JSON keeps every float bit for bit),
+evaluating only the rest: an interrupted search picks up where it stopped, and a larger ``--budget`` continues a
+finished one.
 """
 
 from __future__ import annotations
@@ -38,10 +40,18 @@ from pymoo.core.termination import NoTermination
 from pymoo.problems.static import StaticProblem
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from stewart_drake.core.output_folder import claim_in_manifest
-from stewart_drake.errors import InfeasibleRequirementsError, SynthesisError
+from stewart_drake.core.journal import JournalWriter, header_line, read_header, read_rows
+from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
+from stewart_drake.errors import InfeasibleRequirementsError, JournalError, SynthesisError
 from stewart_drake.synthesis.batch import evaluate_designs
-from stewart_drake.synthesis.evaluate import CONSTRAINTS
+from stewart_drake.synthesis.evaluate import (
+    CONSTRAINTS,
+    INFEASIBLE_F,
+    INFEASIBLE_G,
+    constraint_values,
+    objective_values,
+)
+from stewart_drake.synthesis.families import home_height
 from stewart_drake.synthesis.requirements import OBJECTIVES, Requirements
 
 CACHE = "evaluations.jsonl"
@@ -87,50 +97,64 @@ def search_key(req: Requirements, seed: int, pop_size: int) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def load_cache(out: Path | None, key: str) -> dict:
-    """``{tuple(x): row}`` of the designs already evaluated in ``out`` for ``key``; ``SynthesisError`` when the
-    folder holds another search."""
-    if out is None or not (out / CACHE).exists():
+def load_cache(out: Path | None, key: str, req: Requirements | None = None) -> dict:
+    """``{tuple(x): row}`` of the designs already evaluated in ``out`` for ``key``, every journal line verified
+    (``core.journal``: ``JournalError`` naming the file and line of an edited or damaged one) and, with ``req``,
+    every row checked against it (``check_row``); ``SynthesisError`` when the folder holds another search."""
+    path = None if out is None else out / CACHE
+    if path is None or not path.exists():
         return {}
-    lines = (out / CACHE).read_text(encoding="utf-8").splitlines()
-    head = json.loads(lines[0]) if lines else {}
+    head = read_header(path)
     if head.get("key") != key:
         raise SynthesisError(SynthesisError.OUT_OTHER.format(out=str(out), old=head.get("key"), new=key))
     rows = {}
-    for line in lines[1:]:
-        try:
-            r = json.loads(line)
-        except json.JSONDecodeError:  # a line cut short by an interruption: evaluated again
-            continue
+    for line, r in read_rows(path, key):
+        problem = check_row(req, r) if req is not None else None
+        if problem is not None:
+            raise JournalError(JournalError.ROW.format(path=str(path), line=line, problem=problem))
         rows[tuple(r["x"])] = r
     return rows
 
 
+def check_row(req: Requirements, row) -> str | None:
+    """What is wrong with a journal ``row`` for ``req``, None if nothing: its variables inside their bounds, and
+    its objectives ``f`` and constraints ``g`` those of its own metrics (recomputed, bit for bit)."""
+    if not isinstance(row, dict) or not isinstance(row.get("x"), list) or len(row["x"]) != len(req.lower):
+        return JournalError.ROW_SHAPE.format(n=len(req.lower))
+    x = row["x"]
+    for name, v, lo, hi in zip(req.variables, x, req.lower, req.upper, strict=True):
+        if not (isinstance(v, float | int) and lo <= v <= hi):
+            return JournalError.ROW_BOUND.format(name=name, value=v, lo=lo, hi=hi)
+    try:
+        if row.get("error") is None:
+            f, g = objective_values(req, row), constraint_values(req, row, home_height(req.family, x))
+        else:
+            f, g = [INFEASIBLE_F] * len(req.objectives), [INFEASIBLE_G] * len(CONSTRAINTS)
+    except (KeyError, TypeError, ZeroDivisionError):
+        return JournalError.ROW_NO_METRICS
+    if row.get("f") != f or row.get("g") != g:
+        return JournalError.ROW_METRICS
+    return None
+
+
 class CacheWriter:
-    """Appends evaluated designs to ``out/evaluations.jsonl`` (header first), one flushed line each."""
+    """Appends evaluated designs to ``out/evaluations.jsonl`` (``core.journal``: a verified chain), the header
+    written first as a whole file."""
 
     def __init__(self, out: Path, key: str):
         out.mkdir(parents=True, exist_ok=True)
         path = out / CACHE
-        new = not path.exists() or path.stat().st_size == 0
-        cut = not new and path.read_bytes()[-1:] != b"\n"  # a line cut short by an interruption: end it
-        self.fh = path.open("a", encoding="utf-8")
-        if cut:
-            self.fh.write("\n")
-        if new:
-            self.write({"key": key})
+        if not path.exists() or path.stat().st_size == 0:
+            write_text_atomic(path, header_line(key) + "\n")
             claim_in_manifest(out, [CACHE], prefix=True)  # append-only: verified by its first bytes
-
-    def write(self, obj: dict) -> None:
-        self.write_lines([json.dumps(obj)])
+        self.journal = JournalWriter(path, key)
 
     def write_lines(self, lines: list[str]) -> None:
         """Appends rows already encoded (``journal_lines``), one flush for them all."""
-        self.fh.write("".join(line + "\n" for line in lines))
-        self.fh.flush()
+        self.journal.append_texts(lines)
 
     def close(self) -> None:
-        self.fh.close()
+        self.journal.close()
 
 
 CHUNK_DESIGNS = 12  # designs per evaluation call, whatever the worker count (see Evaluations)
@@ -317,7 +341,7 @@ def run_search(
     generations = math.ceil(budget / pop_size)
     key = search_key(req, seed, pop_size)
     out = Path(out) if out is not None else None
-    cache = load_cache(out, key)
+    cache = load_cache(out, key, req)
     problem = Problem(
         n_var=len(req.lower), n_obj=len(req.objectives), n_ieq_constr=len(CONSTRAINTS), xl=req.lower, xu=req.upper
     )

@@ -65,6 +65,11 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
     sample = SAMPLE_NOTE.format(n=n - 1)
     perf = performance.results
     cells = performance.cells_examined
+    box_left = (  # the box's proof ran out of cells: its rows (workspace, joint cone, leg diameter) say how far
+        {"cells_used": proof.cells_examined, "cells_left": proof.unresolved_count, "stopped": proof.stopped}
+        if proof.status == "unresolved"
+        else {}
+    )
     out = [
         {
             "requirement": "workspace: every pose of the box within the stroke, plate above the base",
@@ -73,7 +78,10 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
             "margin": proof.stroke_margin_m,
             "unit": "m",
             "met": proof.status == "proven",
-            "established": f"proof over {proof.cells_examined} cells ({proof.method})",
+            "established": f"proof over {proof.cells_examined} cells ({proof.method})"
+            if proof.status != "unresolved"
+            else not_proven(proof.cells_examined, proof.unresolved_count, proof.stopped),
+            **box_left,
         },
         _row(
             "actuator.max_force",
@@ -161,6 +169,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
                 "established": "the proof (l·e_z and l·n bounded on every cell); the search sampled "
                 + f"{float(row['max_joint_angle']):.6f} rad at "
                 + sample,
+                **box_left,
             }
         )
     if req.leg_diameter is not None:
@@ -175,6 +184,7 @@ def requirement_table(req: Requirements, row: dict, proof: ProofResult, performa
                 "established": "the proof (a separating direction between each pair's hulls on every cell); the search "
                 + f"sampled {float(row['min_leg_distance']):.6f} m at "
                 + sample,
+                **box_left,
             }
         )
     if req.max_condition is not None:
@@ -218,8 +228,27 @@ def _row(name, required, achieved, unit, sense, how, proven: dict | None = None,
             out["witness"] = proven["witness"]
             out["established"] = f"violated at a witness pose (the toolkit's value {proven['witness']['value']:.6g})"
         else:
-            out["established"] = f"unresolved: {proven.get('unresolved_count', 0)} cells left at the cell limit; {how}"
+            left = proven.get("unresolved_count", 0)
+            out.update(cells_used=cells, cells_left=left, stopped=proven.get("stopped"))
+            out["established"] = f"{not_proven(cells, left, proven.get('stopped'))}; {how}"
     return out
+
+
+STOPPED = {
+    "cap": "the cell cap (--max-cells) was reached",
+    "stalled": "the volume of the cells left stopped shrinking",
+    None: "the cell budget ran out",
+}
+
+
+def cells_note(used: int, left: int, stopped: str | None) -> str:
+    """``(N cells used, M left; why)`` of a proof that ran out of cells."""
+    return f"({used} cells used, {left} left; {STOPPED[stopped]})"
+
+
+def not_proven(used: int, left: int, stopped: str | None) -> str:
+    """The verdict of a proof that ran out of cells: ``not proven yet (N cells used, M left; why)``."""
+    return f"not proven yet {cells_note(used, left, stopped)}"
 
 
 def chosen_platform(req: Requirements, row: dict, name: str = "synthesised") -> Platform:

@@ -4,7 +4,13 @@ command takes, requirements.json complete; ``workspace --prove`` on a larger box
 from __future__ import annotations
 
 import json
+import os
+import re
+import subprocess
+import sys
+import time
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -13,8 +19,10 @@ from stewart_drake.cli import main
 from stewart_drake.core.geometry import load_platform_yaml
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.sanity import plate_anchor_heights
+from stewart_drake.errors import OutputError
 from stewart_drake.synthesis.requirements import load_requirements
 
+ROOT = Path(__file__).resolve().parents[2]
 SEED_001 = str(resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml")
 
 
@@ -83,18 +91,34 @@ def test_prove_unresolved_exits_1(capsys):
 
 
 def test_optimize_exits_1_when_the_performance_proof_is_unresolved(tmp_path, capsys):
-    """``--max-cells 60``: the box's stroke is proven in 48 cells, force/speed/frequency/condition need more: each
-    says ``unresolved`` in requirements.json (``met`` false, the cells left counted) and the exit status is 1."""
+    """``--max-cells 60``: the box's stroke is proven in 48 cells, force/frequency/condition need more: each says
+    ``unresolved`` in requirements.json (``met`` false, the cells left counted), "not proven yet" on the terminal,
+    and the exit status is 1."""
     out = tmp_path / "o"
     rc = main(["optimize", "--requirements", SEED_001, "--out", str(out), "--budget", "48", "--pop-size", "16",
                "--workers", "0", "--max-cells", "60"])  # fmt: skip
     text = capsys.readouterr().out
-    assert rc == 1 and "proof of the box: proven" in text and "unresolved" in text
+    assert rc == 1 and "proof of the box: proven" in text
     doc = json.loads((out / "requirements.json").read_text())
     perf = {r["requirement"]: r for r in doc["requirements"] if "status" in r}
     assert set(perf) == {"actuator.max_force", "actuator.max_speed", "limits.min_frequency_hz", "limits.max_condition"}
+    # speed is proven on the 48 cells of the first level (each cell carries the requirements still open on it)
+    assert perf.pop("actuator.max_speed")["status"] == "proven"
     assert all(r["status"] == "unresolved" and not r["met"] for r in perf.values())
     assert doc["performance_proof"]["requirements"]["force"]["unresolved_count"] > 0 and not doc["ok"]
+    # an unfinished proof reads as one: not proven yet, the cells used and left, why it stopped; never NOT MET
+    used = doc["performance_proof"]["cells_examined"]
+    assert "NOT MET" not in text and doc["performance_proof"]["stopped"] == "cap"
+    for name, r in perf.items():
+        key = {
+            "actuator.max_force": "force",
+            "limits.min_frequency_hz": "frequency",
+            "limits.max_condition": "condition",
+        }
+        left = doc["performance_proof"]["requirements"][key[name]]["unresolved_count"]
+        assert (r["cells_used"], r["cells_left"]) == (used, left)
+        assert f" ({used} cells used, {left} left; the cell cap (--max-cells) was reached)" in text
+        assert re.search(rf"not proven yet +{name}: required [0-9.]+, sampled [0-9.]+ [NHz]* \({used} cells used", text)
 
 
 def test_a_finished_search_continues_with_a_larger_budget(tmp_path, capsys):
@@ -110,3 +134,43 @@ def test_a_finished_search_continues_with_a_larger_budget(tmp_path, capsys):
     search = json.loads(capsys.readouterr().out)["search"]
     assert (search["evaluated_now"], search["from_cache"], search["designs"]) == (12, 24, 36)
     assert len((out / "evaluations.jsonl").read_text().splitlines()) == 1 + 36
+
+
+def test_a_second_optimize_into_a_running_ones_folder_is_refused(tmp_path, capsys):
+    """Two runs into one --out both ran, appending to one journal (9,097 lines for 4,800 designs): the folder is
+    held for the first run's lifetime and the second is refused before any work (exit 2, one line), the first's
+    journal untouched by it."""
+    out = tmp_path / "o"
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1")
+    first = subprocess.Popen(
+        [sys.executable, "-m", "stewart_drake", "optimize", "--requirements", SEED_001, "--out", str(out),
+         "--budget", "100000", "--workers", "0", "--no-progress"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        t0 = time.monotonic()
+        while not (out / "evaluations.jsonl").exists() and first.poll() is None and time.monotonic() - t0 < 60:
+            time.sleep(0.05)
+        assert first.poll() is None, first.stderr.read()
+        rc = main(["optimize", "--requirements", SEED_001, "--out", str(out), "--budget", "24", "--workers", "0"])
+        err = capsys.readouterr().err.strip()
+        assert rc == 2 and err.splitlines() == [
+            f"stewart-drake optimize: error: {OutputError.BUSY.format(option='--out', typed=str(out))}"
+        ]
+        xs = [tuple(json.loads(line)["row"]["x"]) for line in (out / "evaluations.jsonl").read_text().splitlines()[1:]]
+        assert len(set(xs)) == len(xs)  # one search's designs, none twice
+    finally:
+        first.kill()
+        first.wait()
+
+
+def test_a_box_proof_out_of_cells_reads_not_proven_yet_on_each_of_its_rows(tmp_path, capsys):
+    """``--max-cells 10``: the box's first level is 48 cells, so its proof (stroke, joint cone) stops before any:
+    each row it decides says how far it got, and the exit status is 1."""
+    rc = main(["optimize", "--requirements", SEED_001, "--out", str(tmp_path / "o"), "--budget", "12",
+               "--pop-size", "12", "--workers", "0", "--max-cells", "10"])  # fmt: skip
+    text = capsys.readouterr().out
+    note = "(0 cells used, 48 left; the cell cap (--max-cells) was reached)"
+    assert rc == 1 and f"proof of the box: not proven yet {note}" in text and "NOT MET" not in text
+    for name in ("workspace: every pose of the box", "limits.joint_cone: every pose of the box"):
+        assert re.search(rf"not proven yet +{re.escape(name)}[^\n]*: {re.escape(note)}", text), name

@@ -5,10 +5,13 @@ the toolkit confirms, unresolved)."""
 
 from __future__ import annotations
 
+from importlib import resources
+
 import numpy as np
 import pytest
 
 from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.synthesis.families import design_platform
 from stewart_drake.synthesis.performance import (
     NAMES,
     performance_bounds,
@@ -16,7 +19,8 @@ from stewart_drake.synthesis.performance import (
     prove_requirements_performance,
     sampled_performance,
 )
-from stewart_drake.synthesis.proof import Cells
+from stewart_drake.synthesis.proof import ROUND, START_CELLS, CellBudget, Cells
+from stewart_drake.synthesis.requirements import load_requirements
 
 
 def _args(req):
@@ -118,3 +122,46 @@ def test_derived_constants_hold():
     na, nb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
     lhs = np.linalg.norm(a / na[:, None] - b / nb[:, None], axis=1)
     assert np.all(lhs <= np.linalg.norm(a - b, axis=1) / np.minimum(na, nb) * (1 + 1e-12))
+
+
+TEMPLATE = resources.files("stewart_drake") / "templates" / "requirements.yaml"
+# the design `optimize --budget 48` (seed 0) chooses on the requirements template: radii, half-angles, home height
+TEMPLATE_X = [0.8914985975591974, 0.21701921906811264, 0.32361990590914863, 0.041326076705205037, 1.2579510023564282]
+
+
+def test_the_default_budget_proves_the_templates_design():
+    """The template's (the docs' example) chosen design needs more cells than the first budget: force's bound
+    reaches its 4 kN limit only on fine cells. The default budget grows past ``START_CELLS`` while the volume left
+    shrinks and proves every requirement, each bound on the right side of its limit."""
+    req = load_requirements(TEMPLATE)
+    design = design_platform(req, TEMPLATE_X, [1.2896629093960421, 1.646287872338915])
+    proof = prove_requirements_performance(design, req)
+    assert proof.ok and proof.stopped is None, {k: r["status"] for k, r in proof.results.items()}
+    assert proof.cells_examined > START_CELLS  # what the first budget alone left unresolved
+    r = proof.results
+    assert r["force"]["bound"] <= req.max_force and r["speed"]["bound"] <= req.max_speed
+    assert r["frequency"]["bound"] >= req.min_frequency_hz and r["condition"]["bound"] <= req.max_condition
+
+
+def _cells(n, share):
+    """``n`` cells covering ``share`` of the box [-1, 1]⁶ together (half-widths (share / n)^(1/6))."""
+    return Cells(np.zeros((n, 6)), np.full((n, 6), (share / n) ** (1 / 6)))
+
+
+def test_the_cell_budget_doubles_while_the_volume_left_shrinks_and_stops_when_it_stalls():
+    """The first budget is ``START_CELLS``; past it, a level whose cells cover less than ``SHRINK`` of the volume left
+    ``ROUND`` levels before (the whole box at first) doubles it, one that does not stops the proof ("stalled"), and
+    the cap stops it too ("cap")."""
+    lo, hi = -np.ones(6), np.ones(6)
+    b = CellBudget(4 * START_CELLS, lo, hi)
+    for _ in range(ROUND):  # levels within the first budget that prove nothing: allowed
+        assert b.allows(0, _cells(1000, 1.0)) and b.limit == START_CELLS
+    assert b.allows(START_CELLS, _cells(START_CELLS, 0.5)) and b.limit == 2 * START_CELLS and b.stopped is None
+    for _ in range(ROUND - 1):
+        assert b.allows(0, _cells(1000, 0.5))
+    # ROUND levels after the volume was 0.5 it is still 0.5: a full round of halvings proved nothing
+    assert not b.allows(2 * START_CELLS, _cells(START_CELLS + 1, 0.5)) and b.stopped == "stalled"
+    capped = CellBudget(START_CELLS + 10, lo, hi)
+    assert not capped.allows(START_CELLS, _cells(11, 1e-3)) and capped.stopped == "cap"
+    small = CellBudget(60, lo, hi)  # a cap under the first budget is the budget
+    assert small.allows(0, _cells(60, 1.0)) and not small.allows(60, _cells(1, 1e-3)) and small.stopped == "cap"

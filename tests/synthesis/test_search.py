@@ -4,6 +4,7 @@ the same seed gives the same Pareto set on 1 and 2 Dask workers, and a search re
 from __future__ import annotations
 
 import json
+import re
 from importlib import resources
 
 import numpy as np
@@ -11,9 +12,11 @@ import pytest
 import scipy.linalg
 
 from stewart_drake.core.geometry import load_platform_yaml
+from stewart_drake.core.journal import JournalWriter
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.stiffness import stiffness_matrix
+from stewart_drake.errors import JournalError
 from stewart_drake.synthesis.batch import evaluate_designs
 from stewart_drake.synthesis.evaluate import evaluate_design, leg_range
 from stewart_drake.synthesis.families import design_platform
@@ -99,6 +102,51 @@ def test_resume_after_interruption_and_with_a_larger_budget(req, tmp_path):
     with pytest.raises(Exception, match="holds a search with other requirements or seed"):
         run_search(req, out=out, budget=12, seed=8, pop_size=12)
     assert head["key"] == first.key
+
+
+def _journal(req, tmp_path):
+    """A finished small search's folder and its journal's lines."""
+    out = tmp_path / "search"
+    run_search(req, out=out, **small(req))
+    return out, (out / CACHE).read_text().splitlines()
+
+
+def test_an_edited_journal_row_is_refused_naming_its_line(req, tmp_path):
+    """A hand-edited objective put a fake design alone on the Pareto front after a resume."""
+    out, lines = _journal(req, tmp_path)
+    k = 5  # the 6th line: a design row
+    lines[k] = lines[k].replace('"f": [', '"f": [-1e6, ', 1)
+    (out / CACHE).write_text("\n".join(lines) + "\n")
+    with pytest.raises(JournalError, match=rf"^{re.escape(str(out / CACHE))}:6: does not verify"):
+        run_search(req, out=out, **small(req))
+
+
+def test_a_journal_line_removed_from_the_middle_is_refused(req, tmp_path):
+    out, lines = _journal(req, tmp_path)
+    (out / CACHE).write_text("\n".join(lines[:3] + lines[4:]) + "\n")
+    with pytest.raises(JournalError, match=rf"^{re.escape(str(out / CACHE))}:4: does not verify"):
+        run_search(req, out=out, **small(req))
+
+
+@pytest.mark.parametrize(
+    ("edit", "problem"),
+    [
+        (lambda r: r.update(f=[-1.0e6] * len(r["f"])), "its objectives or constraints are not those of its metrics"),
+        (lambda r: r["x"].__setitem__(0, 5.0), "variable base_radius = 5.0 is outside its bounds"),
+    ],
+)
+def test_a_rewritten_chain_is_still_checked_against_the_requirements(req, tmp_path, edit, problem):
+    """Whoever rewrites the chain (its key is not secret) still meets the row checks: bounds and f, g from the
+    metrics."""
+    out, lines = _journal(req, tmp_path)
+    rows = [json.loads(line)["row"] for line in lines[1:]]
+    edit(rows[2])
+    (out / CACHE).write_text(lines[0] + "\n")
+    w = JournalWriter(out / CACHE, json.loads(lines[0])["key"])
+    w.append_texts([json.dumps(r) for r in rows])
+    w.close()
+    with pytest.raises(JournalError, match=rf"^{re.escape(str(out / CACHE))}:4: {re.escape(problem)}"):
+        run_search(req, out=out, **small(req))
 
 
 def test_batch_evaluation_equals_the_per_platform_functions(req):
