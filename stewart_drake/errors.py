@@ -688,9 +688,9 @@ class TrajectoryError(InputError):
     DESIGN_DURATION = "design duration must be a number of seconds >= 0, got {value!r}"
     UNKNOWN = "unknown trajectory {value!r}: not one of {valid} and not a CSV file"
     QUANTISED = (
-        "{path}: column {column} is rounded too coarsely for its accelerations: its second differences are rounding "
-        "noise (RMS(Δ⁴)/RMS(Δ²) = {ratio:.3g}; a smooth motion gives << 1), {noise:.3g} {unit} of acceleration noise; "
-        "give {option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
+        "{path}: column {column} is rounded too coarsely for its motion: steps of {quantum} {qunit} at {rate} "
+        "samples/s imply {noise:.3g} {unit} RMS of acceleration noise (step/(√2·h²)) against {motion}; give "
+        "{option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
         "rounding step) or write more decimals"
     )
     RATE = (
