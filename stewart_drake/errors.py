@@ -411,6 +411,11 @@ class CsvError(InputError):
     TOO_FEW = "{path}: need at least {need} samples, got {got}"
     TIMES = "{path}: times must increase; sample {k} (t = {t} s) does not follow t = {t_prev} s"
     LINE_TOO_LONG = "{path}:{line}: a line longer than {limit} bytes; not a {kind} file?"
+    HEADER_UNKNOWN = (
+        "{path}:{line}: the first line is a header (not all numbers), but {name!r} names no column of a {kind} file; "
+        "name the columns {columns} (any order) or leave the header out"
+    )
+    HEADER_REPEATED = "{path}:{line}: the header ({header}) names {name} twice; a {kind} file's columns are {columns}"
 
 
 class UsageError(StewartError):

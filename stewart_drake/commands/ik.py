@@ -26,7 +26,10 @@ def register(sub) -> None:
         "--pose", nargs=6, type=float, metavar=("PX", "PY", "PZ", "A", "B", "G"), help="one pose in the chosen units"
     )
     g.add_argument(
-        "--poses", metavar="FILE.csv", help="CSV with columns px,py,pz,a,b,g (header optional), one pose per row"
+        "--poses",
+        metavar="FILE.csv",
+        help="CSV with columns px,py,pz,a,b,g, one pose per row (header optional: its names, in any order, say "
+        "which column is which)",
     )
     add_unit_args(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
