@@ -130,11 +130,19 @@ def read_measurements(
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
         raise CalibrationError(CalibrationError.NOT_TEXT.format(path=shown, offset=e.start)) from None
-    rows = list(csv.reader(text.splitlines()))
-    numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r)]
-    if not numbered:
+    text_lines = text.splitlines()
+    # the header alone is parsed first: a bad one is refused before the body is (seconds for a large file)
+    head_line, head = next(
+        (
+            (i + 1, r)
+            for i, line in enumerate(text_lines)
+            for r in csv.reader([line])
+            if r and any(c.strip() for c in r)
+        ),
+        (0, None),
+    )
+    if head is None:
         raise CalibrationError(CalibrationError.EMPTY.format(path=shown))
-    head_line, head = numbered[0]
     header = [h.strip() for h in head]
     found = _kind_of(header)
     if kind is None:
@@ -171,7 +179,11 @@ def read_measurements(
                 header=",".join(header),
             )
         )
-    body = numbered[1:]
+    body = [
+        (head_line + 1 + i, r)
+        for i, r in enumerate(csv.reader(text_lines[head_line:]))
+        if r and any(c.strip() for c in r)
+    ]
     if len(body) > MAX_ROWS:
         raise CalibrationError(CalibrationError.TOO_MANY.format(path=shown, limit=MAX_ROWS))
     if not body:
