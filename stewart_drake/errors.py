@@ -970,7 +970,13 @@ class CalibrationError(InputError):
         "{per} equations per pose)"
     )
     POSE_STROKE = "{path}:{line}: leg {leg} length {length:.6g} m lies outside the stroke [{lmin:g}, {lmax:g}] m"
-    WORKSPACE = "--workspace {value}: give four numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
+    POSE_UNIT = (
+        "{path}: the measured poses (px,py,pz,a,b,g) put the plate outside the workspace{hint}; the readings "
+        "l1..l6 and the positions px,py,pz share --length-unit: write them in one unit"
+    )
+    WORKSPACE = (
+        "--workspace {value}: give four numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
+    )
     MISSING = "measurement file {path!r} does not exist"
     NOT_A_FILE = "measurement file {path!r} is not a file"
     NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"

@@ -26,6 +26,7 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.core.unit_hint import other_unit_hint
 from stewart_drake.errors import CalibrationError
 
 TYPES = ("pose", "points", "inclinometer")
@@ -221,6 +222,9 @@ def read_measurements(
         poses = np.stack([col[c] for c in POSE], axis=1)
         _check_angles(poses[:, 3:], POSE[3:], lines, shown, angle_unit)
         poses = np.concatenate([poses[:, :3] * k, poses[:, 3:] * a], axis=1)
+        hint = other_unit_hint(platform, poses, length_unit, angle_unit)  # "" unless the other unit fits them all
+        if hint:
+            raise CalibrationError(CalibrationError.POSE_UNIT.format(path=shown, hint=hint))
     elif kind == "points":
         targets = np.stack([col[c] for c in columns_of(kind, n_targets)[6:]], axis=1).reshape(-1, n_targets, 3) * k
     else:
