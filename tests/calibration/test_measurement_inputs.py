@@ -35,7 +35,7 @@ def _pose_file(tmp_path, platform, position_factor=1.0):
 
 def test_positions_in_mm_with_readings_in_m_name_the_unit(tmp_path, platform):
     """The readings in m and the positions in mm: the plate 1000x too far; read in mm every pose fits, which
-    the message says (it was a forward-kinematics failure on 'lengths sample 1' with no unit)."""
+    the message says."""
     assert read_measurements(_pose_file(tmp_path, platform), platform).kind == "pose"  # the same file in m: read
     with pytest.raises(CalibrationError, match=r"m.csv: the measured poses .* read in mm every pose would be inside"):
         read_measurements(_pose_file(tmp_path, platform, 1e3), platform)

@@ -14,7 +14,7 @@ from stewart_drake.core.newton_fk import jacobian_analysis, multiple_root
 
 def test_a_negative_number_with_an_exponent_is_a_value(capsys):
     """``-1e-3`` after an option taking numbers is read as the number (argparse's own matcher knows only
-    ``-1`` and ``-.5`` forms and said "expected 6 arguments"); the pose echoed back carries it."""
+    the ``-1`` and ``-.5`` forms); the pose echoed back carries it."""
     assert main(["ik", "--platform", "utn-dynamic", "--pose", "0", "0", "700", "-1e-3", "-2E-2", "0", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["pose"] == [0, 0, 700, -1e-3, -2e-2, 0]
 

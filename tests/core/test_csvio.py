@@ -68,8 +68,7 @@ def test_a_repeated_column_is_refused(tmp_path):
 
 def test_a_bad_header_is_refused_before_the_rest_of_the_file_arrives(tmp_path):
     """A FIFO whose writer sends the header and one row, then holds the pipe open: the reader refuses at
-    line 1 without waiting for the end of the file (it waited for all of it: a large file took its whole
-    read and parse before the line-1 error)."""
+    line 1 without waiting for the end of the file."""
     fifo = tmp_path / "poses.csv"
     os.mkfifo(fifo)
     done = threading.Event()
