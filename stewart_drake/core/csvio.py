@@ -114,10 +114,13 @@ class _RowBudget:
     a line longer than ``MAX_LINE_BYTES`` (``/dev/zero``) or more rows than memory holds at
     ``bytes_per_row`` each (``sanity.check_work``, naming ``option``)."""
 
-    def __init__(self, path, kind: str, option: str | None, bytes_per_row: float, first_line=None):
+    def __init__(
+        self, path, kind: str, option: str | None, bytes_per_row: float, first_line=None, max_rows=None, too_many=None
+    ):
         self.path, self.kind, self.option, self.bytes_per_row = path, kind, option, bytes_per_row
         self.lines, self.current = 0, 0
-        self.max_rows = memory_budget() / bytes_per_row if bytes_per_row else math.inf
+        self.max_rows, self.too_many, self.blank, self.chunks = max_rows, too_many, 0, 0
+        self.memory_rows = memory_budget() / bytes_per_row if bytes_per_row else math.inf
         self.first_line, self.head = first_line, b""
 
     def __call__(self, chunk: bytes, total: int) -> None:
@@ -128,11 +131,17 @@ class _RowBudget:
         n = chunk.count(b"\n")
         self.current = len(chunk) - 1 - chunk.rfind(b"\n") if n else self.current + len(chunk)
         self.lines += n
+        if self.max_rows is not None:
+            # rows at least: lines less the blank ones, a header, and one per chunk (a blank line split between two)
+            self.blank += chunk.count(b"\n\n") + chunk.count(b"\n\r\n")
+            self.chunks += 1
+            if self.lines - self.blank - 1 - self.chunks > self.max_rows:
+                raise self.too_many
         if self.current > MAX_LINE_BYTES:
             raise CsvError(
                 CsvError.LINE_TOO_LONG.format(path=self.path, line=self.lines + 1, limit=MAX_LINE_BYTES, kind=self.kind)
             )
-        if self.lines + 1 > self.max_rows:
+        if self.lines + 1 > self.memory_rows:
             check_work(
                 self.option or self.kind,
                 repr(str(self.path)),
@@ -150,7 +159,15 @@ class _RowBudget:
 
 
 def read_numeric_csv(
-    path, kind: str, widths: tuple[int, ...], columns: str, *, option: str | None = None, bytes_per_row: float = 0.0
+    path,
+    kind: str,
+    widths: tuple[int, ...],
+    columns: str,
+    *,
+    option: str | None = None,
+    bytes_per_row: float = 0.0,
+    max_rows: int | None = None,
+    too_many: Exception | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(rows (n, w) float array, line numbers (n,))`` from a CSV of numbers, every row of one width
     in ``widths``. A non-numeric first row is a header; blank lines are skipped; a UTF-8 byte-order
@@ -158,7 +175,8 @@ def read_numeric_csv(
     ("poses", "trajectory"), ``columns`` describes the expected columns. A header's names put the columns in
     the order of ``COLUMN_NAMES`` (see the module docstring); it is checked as soon as it is read. The file is read once, as a stream (a FIFO or ``<(...)`` works), and refused
     while it is read when its rows would need more memory than there is (``bytes_per_row`` each, the
-    caller's cost of a row; ``option`` names it). Errors (``CsvError``) name the file and the line,
+    caller's cost of a row; ``option`` names it), or when it has more than ``max_rows`` rows (``too_many`` is
+    raised, while reading). Errors (``CsvError``) name the file and the line,
     counted from 1."""
     found = {"order": None}
 
@@ -177,7 +195,7 @@ def read_numeric_csv(
         if not all(_is_number(c) for c in cells):
             found["order"] = header_order(path, 1, cells, kind, widths)
 
-    budget = _RowBudget(path, kind, option, bytes_per_row, first_line)
+    budget = _RowBudget(path, kind, option, bytes_per_row, first_line, max_rows, too_many)
     raw = read_input(
         path,
         kind=kind,
@@ -188,6 +206,8 @@ def read_numeric_csv(
     )
     budget.finish()
     a, lines = _parse(path, raw, kind, widths, columns)
+    if max_rows is not None and len(a) > max_rows:
+        raise too_many
     return (a, lines) if found["order"] is None else (a[:, found["order"]], lines)
 
 

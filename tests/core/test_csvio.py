@@ -100,3 +100,31 @@ def test_runs_own_trajectory_csv_header_is_read(tmp_path):
     f = _write(tmp_path / "trajectory.csv", ",".join(header), rows)
     a, lines = read_numeric_csv(f, "trajectory", (7, 19), "see --help")
     assert np.array_equal(a, rows) and lines.tolist() == [2, 3]
+
+
+def test_simulate_measurements_refuses_too_many_poses_while_reading(tmp_path, capsys):
+    """More poses than simulate-measurements takes (10 000) are refused as the rows arrive: a FIFO whose
+    writer sends 12 000 rows and holds the pipe open gets the refusal without the end of the file."""
+    fifo = tmp_path / "plan.csv"
+    os.mkfifo(fifo)
+    done = threading.Event()
+
+    def writer():
+        try:
+            with open(fifo, "w") as w:
+                w.write("px,py,pz,a,b,g\n" + "0,0,0.1,0,0,0\n" * 12_000)
+                w.flush()
+                done.wait(20)
+        except BrokenPipeError:  # the reader refused and closed its end
+            pass
+
+    th = threading.Thread(target=writer)
+    th.start()
+    try:
+        start = time.monotonic()
+        assert main(["simulate-measurements", "--poses", str(fifo), "--out", str(tmp_path / "out")]) == 2
+        assert time.monotonic() - start < 10  # the writer holds the pipe 20 s
+    finally:
+        done.set()
+        th.join()
+    assert f"{fifo}: more than 10000 poses" in capsys.readouterr().err
