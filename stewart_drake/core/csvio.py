@@ -39,13 +39,19 @@ _POSE_ALIASES = {
     "b": ("ay", "a_y", "beta"),
     "g": ("az", "a_z", "gamma", "gama", "c"),  # gama: the seed's spelling, in run's trajectory.csv
 }
-# every accepted header name (lower case) -> its column's name
-ALIASES = {"t": "t", "time": "t"}
-for _name, _others in _POSE_ALIASES.items():
-    for _alias in (_name, *_others):
-        ALIASES[_alias] = _name
-        ALIASES[_alias + "_dot"] = ALIASES["d" + _alias] = _name + "_dot"
-        ALIASES[_alias + "_ddot"] = ALIASES["dd" + _alias] = _name + "_ddot"
+
+
+def _aliases() -> dict[str, str]:
+    out = {"t": "t", "time": "t"}
+    for name, others in _POSE_ALIASES.items():
+        for alias in (name, *others):
+            out[alias] = name
+            out[alias + "_dot"] = out["d" + alias] = name + "_dot"
+            out[alias + "_ddot"] = out["dd" + alias] = name + "_ddot"
+    return out
+
+
+ALIASES = _aliases()  # every accepted header name (lower case) -> its column's name
 
 
 def _is_number(text: str) -> bool:
