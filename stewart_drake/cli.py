@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import math
+import re
 import sys
 
 import numpy as np
@@ -110,8 +111,18 @@ def checked_int(text: str) -> int:
     return int(s)
 
 
+# a negative number as a value, exponents and non-finite spellings included (argparse's own matcher takes
+# "-1e-3" for an option and says "expected one argument"; "-inf" then meets the finite-number check)
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 class Parser(argparse.ArgumentParser):
-    """An ``ArgumentParser`` whose errors are one line (``prog: error: message (see --help)``), exit 2."""
+    """An ``ArgumentParser`` whose errors are one line (``prog: error: message (see --help)``), exit 2, and
+    that reads every negative number as a value (``NEGATIVE_NUMBER``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")

@@ -416,6 +416,11 @@ class CsvError(InputError):
     TOO_FEW = "{path}: need at least {need} samples, got {got}"
     TIMES = "{path}: times must increase; sample {k} (t = {t} s) does not follow t = {t_prev} s"
     LINE_TOO_LONG = "{path}:{line}: a line longer than {limit} bytes; not a {kind} file?"
+    HEADER_UNKNOWN = (
+        "{path}:{line}: the first line is a header (not all numbers), but {name!r} names no column of a {kind} file; "
+        "name the columns {columns} (any order) or leave the header out"
+    )
+    HEADER_REPEATED = "{path}:{line}: the header ({header}) names {name} twice; a {kind} file's columns are {columns}"
 
 
 class UsageError(StewartError):
@@ -693,9 +698,9 @@ class TrajectoryError(InputError):
     DESIGN_DURATION = "design duration must be a number of seconds >= 0, got {value!r}"
     UNKNOWN = "unknown trajectory {value!r}: not one of {valid} and not a CSV file"
     QUANTISED = (
-        "{path}: column {column} is rounded too coarsely for its accelerations: its second differences are rounding "
-        "noise (RMS(Δ⁴)/RMS(Δ²) = {ratio:.3g}; a smooth motion gives << 1), {noise:.3g} {unit} of acceleration noise; "
-        "give {option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
+        "{path}: column {column} is rounded too coarsely for its motion: steps of {quantum} {qunit} at {rate} "
+        "samples/s imply {noise:.3g} {unit} RMS of acceleration noise (step/(√2·h²)) against {motion}; give "
+        "{option} TOL (a smoothing spline within TOL RMS of the samples, in the file's units: e.g. its "
         "rounding step) or write more decimals"
     )
     RATE = (
@@ -1045,7 +1050,13 @@ class CalibrationError(InputError):
         "{length:.6g} m long, outside the stroke [{lmin:g}, {lmax:g}] m ({count} of {n} poses out of reach); errors "
         "this large are not a built {name!r}, or the pose lies at the stroke's edge"
     )
-    WORKSPACE = "--workspace {value}: give six numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
+    POSE_UNIT = (
+        "{path}: the measured poses (px,py,pz,a,b,g) put the plate outside the workspace{hint}; the readings "
+        "l1..l6 and the positions px,py,pz share --length-unit: write them in one unit"
+    )
+    WORKSPACE = (
+        "--workspace {value}: give four numbers X Y Z ROT: ±X ±Y ±Z {unit} about home and ±ROT {angle}, each > 0"
+    )
     MISSING = "measurement file {path!r} does not exist"
     NOT_A_FILE = "measurement file {path!r} is not a file"
     NOT_TEXT = "{path}: not UTF-8 text (byte {offset})"

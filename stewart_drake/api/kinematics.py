@@ -12,7 +12,7 @@ from stewart_drake.api.result import Result
 from stewart_drake.core.assembly_modes import modes_from_solutions
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
-from stewart_drake.core.newton_fk import forward_kinematics
+from stewart_drake.core.newton_fk import forward_kinematics, multiple_root
 from stewart_drake.core.realtime_fk import branch_check
 from stewart_drake.core.sanity import (
     below_base_message,
@@ -339,6 +339,11 @@ def solve_fk(
                 iterations=int(r.iterations),
                 branch_certified=on_branch,
                 uniqueness_radius_initial=radius,
+                **(
+                    {"singular": True}
+                    if multiple_root(platform, mode[0].pose, mode[0].sigma_min, tol, convention)
+                    else {}
+                ),
             )
             return FKResult([sol], "newton", None, *common, **allowed)
     if all_modes and method == "homotopy":

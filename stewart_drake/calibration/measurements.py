@@ -30,6 +30,7 @@ from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.core.unit_hint import other_unit_hint
 from stewart_drake.errors import CalibrationError
 
 TYPES = ("pose", "points", "inclinometer")
@@ -165,11 +166,19 @@ def read_measurements(
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
         raise CalibrationError(CalibrationError.NOT_TEXT.format(path=shown, offset=e.start)) from None
-    rows = list(csv.reader(text.splitlines()))
-    numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r)]
-    if not numbered:
+    text_lines = text.splitlines()
+    # the header alone is parsed first: a bad one is refused before the body is (seconds for a large file)
+    head_line, head = next(
+        (
+            (i + 1, r)
+            for i, line in enumerate(text_lines)
+            for r in csv.reader([line])
+            if r and any(c.strip() for c in r)
+        ),
+        (0, None),
+    )
+    if head is None:
         raise CalibrationError(CalibrationError.EMPTY.format(path=shown))
-    head_line, head = numbered[0]
     header = [h.strip() for h in head]
     found = _kind_of(header)
     if kind is None:
@@ -206,7 +215,11 @@ def read_measurements(
                 header=",".join(header),
             )
         )
-    body = numbered[1:]
+    body = [
+        (head_line + 1 + i, r)
+        for i, r in enumerate(csv.reader(text_lines[head_line:]))
+        if r and any(c.strip() for c in r)
+    ]
     if len(body) > MAX_ROWS:
         raise CalibrationError(CalibrationError.TOO_MANY.format(path=shown, limit=MAX_ROWS))
     if not body:
@@ -244,6 +257,9 @@ def read_measurements(
         poses = np.stack([col[c] for c in POSE], axis=1)
         _check_angles(poses[:, 3:], POSE[3:], lines, shown, angle_unit)
         poses = np.concatenate([poses[:, :3] * k, poses[:, 3:] * a], axis=1)
+        hint = other_unit_hint(platform, poses, length_unit, angle_unit)  # "" unless the other unit fits them all
+        if hint:
+            raise CalibrationError(CalibrationError.POSE_UNIT.format(path=shown, hint=hint))
     elif kind == "points":
         targets = np.stack([col[c] for c in columns_of(kind, n_targets)[6:]], axis=1).reshape(-1, n_targets, 3) * k
     else:

@@ -9,8 +9,9 @@ from stewart_drake.api.dynamics import inverse_dynamics
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
 
 CSV_HELP = (
-    "CSV, header optional, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and "
-    "accelerations from a cubic spline through the samples) or 19 columns t, q(6), qd(6), qdd(6)"
+    "CSV, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and accelerations from a cubic "
+    "spline through the samples) or 19 columns t, q(6), qd(6), qdd(6) (px_dot..., px_ddot...); header optional: "
+    "its names, in any order, say which column is which"
 )
 
 

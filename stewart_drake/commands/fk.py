@@ -154,8 +154,13 @@ def run(args) -> int:
         )
     singular = [i for i, s in enumerate(out["solutions"], 1) if s.get("singular")]
     if singular:  # a pose on a singularity is found and shown; it is a physical limit (FKResult.ok is False)
+        why = (
+            "several homotopy paths meet there"
+            if args.all
+            else "a multiple root: the Jacobian's smallest singular value is what Newton's tolerance leaves at one"
+        )
         print(
-            f"fk --all: mode(s) {', '.join(map(str, singular))} lie on a singularity (several homotopy paths meet there; "
+            f"fk{' --all' if args.all else ''}: mode(s) {', '.join(map(str, singular))} lie on a singularity ({why}; "
             "the platform loses stiffness in some direction at that pose)",
             file=sys.stderr,
         )

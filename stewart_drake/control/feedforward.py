@@ -66,8 +66,22 @@ def _forces_of_distinct_rows(platform: Platform, q, qd, qdd) -> np.ndarray:
     costs one row per distinct state, not one per tick."""
     rows, inverse = distinct_rows(np.concatenate([q, qd, qdd], axis=1))
     if len(rows) == len(q):
-        return leg_forces_with_legs(platform, q, qd, qdd)
-    return leg_forces_with_legs(platform, *(np.ascontiguousarray(rows[:, k : k + 6]) for k in (0, 6, 12)))[inverse]
+        return chunked_leg_forces(platform, q, qd, qdd)
+    return chunked_leg_forces(platform, *(np.ascontiguousarray(rows[:, k : k + 6]) for k in (0, 6, 12)))[inverse]
+
+
+CHUNK_ROWS = 4096  # rows of inverse dynamics at a time: its temporaries are ~7 kB a row
+
+
+def chunked_leg_forces(platform: Platform, q, qd, qdd) -> np.ndarray:
+    """``(n, 6)`` ``leg_forces_with_legs`` of ``(n, 6)`` poses, rates and accelerations, ``CHUNK_ROWS`` rows at a
+    time (the same numbers: it is elementwise over rows), so that its working memory is bounded whatever the
+    length of the run: only the ``(n, 6)`` result grows with it."""
+    out = np.empty((len(q), 6))
+    for s in range(0, len(q), CHUNK_ROWS):
+        e = s + CHUNK_ROWS
+        out[s:e] = leg_forces_with_legs(platform, q[s:e], qd[s:e], qdd[s:e])
+    return out
 
 
 TABLE_CACHE = Memo(8)  # the last 8 feed-forward tables of this process

@@ -452,3 +452,22 @@ def forward_kinematics(
             "; the pose is poorly determined and may belong to another assembly mode",
         )
     return result
+
+
+def multiple_root(platform: Platform, pose, sigma_min: float, tol: float, convention: str = "utn") -> bool:
+    """Whether a pose (6,) that Newton reached to ``tol`` (m, the largest leg-length residual) is, at that
+    accuracy, a multiple root: a pose on a singularity.
+
+    Near a fold, along its null direction at distance d from the singular root, the leg lengths miss their
+    targets by r = K·d²/2 and the smallest singular value of the scaled J⁻¹ is σ_min = K·d, K the curvature
+    of the lengths along that direction (1/m), so σ_min² = 2·K·r: a double root stops Newton (which then
+    converges only linearly) with σ_min² ≤ 2·√6·K·tol (r measured along one left singular vector, at most
+    √6 times the largest residual). K is bounded by the slope of σ_min about the pose (one-sided differences
+    over 0.1 mm, and 0.1 mm / anchor radius in the angles). A simple root keeps σ_min of order 1 at any
+    tolerance; a pose is called a multiple root when σ_min² ≤ 8·K·tol."""
+    pose = np.asarray(pose, dtype=float)
+    step = 1e-4 * np.r_[np.ones(3), np.full(3, 1 / anchor_scale(platform))]
+    poses = pose + np.concatenate([np.diag(step), -np.diag(step)])
+    s = jacobian_analysis(platform, poses, convention).sigma_min
+    slope = float(np.linalg.norm((s[:6] + s[6:]) / (2 * 1e-4)))  # |σ_min| each side: ≥ the slope across a fold
+    return bool(sigma_min**2 <= 8 * slope * tol)

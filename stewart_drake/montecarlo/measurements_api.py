@@ -106,7 +106,10 @@ def simulate_measurements(
         raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=targets))
     if isinstance(poses, (str, Path)):
         path = str(poses)
-        raw, lines = read_numeric_csv(path, "poses", (6,), "px,py,pz,a,b,g", option="--poses", bytes_per_row=600)
+        too_many = CalibrationError(CalibrationError.POSE_COUNT.format(path=path, limit=MAX_MEASURED_POSES))
+        raw, lines = read_numeric_csv(
+            path, "poses", (6,), "px,py,pz,a,b,g", option="--poses", max_rows=MAX_MEASURED_POSES, too_many=too_many
+        )
         if len(raw) > MAX_MEASURED_POSES:
             raise CalibrationError(CalibrationError.POSE_COUNT.format(path=path, limit=MAX_MEASURED_POSES))
         q = pose_to_si(raw, length_unit, angle_unit)

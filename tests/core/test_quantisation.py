@@ -3,13 +3,16 @@ refused by dynamics, size and simulate (its accelerations are rounding noise), a
 the true forces back."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import stewart_drake.examples
 from stewart_drake.cli import main
 from stewart_drake.core.geometry import load_platform
-from stewart_drake.core.quantisation import noisy_columns, smooth_columns
+from stewart_drake.core.quantisation import RESOLVED, noisy_columns, quantum, smooth_columns
+from stewart_drake.core.trajectory import TRAJECTORIES, Trajectory
 from stewart_drake.design.sizing import size_trajectory
 
 H = 1e-4  # 10 kHz
@@ -29,22 +32,62 @@ def _write(path, t, q):
     return str(path)
 
 
-def test_noise_ratio_is_the_white_noise_value():
-    """Rounding to 1 µm: RMS(Δ⁴)/RMS(Δ²) = √(70/6) for white noise (within the sampling spread of 12000
-    samples, ~2 %); unrounded, the column is smooth (ratio ~(ωh)²) and not flagged; a few waypoints (a
-    piecewise-linear file) are not noise."""
+def test_quantum_and_noise_of_rounded_columns():
+    """Rounding to 1 µm at 10 kHz: the quantum is found (to float precision) and the acceleration noise is the
+    uniform-rounding model q/(√2·h²) where the motion moves many quanta per sample (0.05·sin(20 t): up to
+    100 µm per sample, so the errors are independent and the file's second differences show the model's RMS,
+    within the ~2 % sampling spread of 12000 samples); the slow motion's correlated errors show no more."""
+    t = np.arange(12000) * H
+    fast = np.round(np.c_[0 * t, 0 * t, 0.7 + 0.05 * np.sin(20 * t), 0 * t, 0 * t, 0 * t], 6)
+    (c,) = noisy_columns(t, fast)
+    model = 1e-6 / (np.sqrt(2) * H**2)
+    assert c.column == 2 and c.quantum == pytest.approx(1e-6, rel=1e-6)
+    assert c.accel_noise == pytest.approx(model, rel=0.02)
+    # 0.05·20²: the peak, read at a stride where the rounding's error bound is at most RESOLVED of it (the stride's
+    # own bias, (ω·m·h)²/12, is ~1e-4 here)
+    assert c.motion_accel == pytest.approx(0.05 * 400, rel=RESOLVED)
     t, q = _gentle()
     (c,) = noisy_columns(t, q)
-    assert c.column == 2 and c.ratio == pytest.approx(np.sqrt(70 / 6), rel=0.03)
-    # the acceleration noise is RMS(Δ²)/h², Δ² of independent errors uniform in ±δ/2 (variance 6 δ²/12, δ = 1 µm;
-    # real rounding is correlated where the motion is slow, so the model is drawn here, seeded); the sampling
-    # spread of 12000 samples is ~1 %
-    noise = np.random.default_rng(5).uniform(-0.5e-6, 0.5e-6, len(t))
-    (c,) = noisy_columns(t, np.c_[q[:, :2], 0.7 + 0.05 * np.sin(t) + noise, q[:, 3:]])
-    assert c.accel_noise == pytest.approx(np.sqrt(6 / 12) * 1e-6 / H**2, rel=0.03)
+    assert c.column == 2 and 0.5 * model < c.accel_noise <= model
+    assert c.motion_accel == pytest.approx(0.05 * np.sin(1.2), rel=RESOLVED)  # 0.05·sin(t) up to t = 1.2 s
+    assert quantum(np.round(np.sin(np.arange(1000) * 0.01), 4) * np.pi / 180) == pytest.approx(1e-4 * np.pi / 180)
     assert noisy_columns(*_gentle(decimals=15)) == []
     tw = np.arange(40) * 0.1
     assert noisy_columns(tw, np.c_[0 * tw, 0 * tw, 0.7 + 0.01 * (tw > 2), 0 * tw, 0 * tw, 0 * tw]) == []
+
+
+def test_a_staircase_coarser_than_the_motion_per_sample_is_refused():
+    """A motion that moves less than one rounding step per sample is a staircase: its second differences
+    are zero at most samples, and spikes of ±q/h² at each step. 0.1 mm at 10 kHz of a 1 cm motion and 4
+    decimals at 1 kHz of a 60 s slow one: the noise is orders of magnitude above the motion's accelerations."""
+    t = np.arange(0, 4, H)
+    (c,) = noisy_columns(t, np.round(np.c_[0 * t, 0.01 * np.sin(2 * t), 0.7 + 0 * t, 0 * t, 0 * t, 0 * t], 4))
+    # the staircase shows fewer spikes than white noise: its noise is at most the model's and > 1000x the motion
+    assert c.column == 1 and c.accel_noise <= 1e-4 / (np.sqrt(2) * H**2) and c.accel_noise > 1000 * c.motion_accel
+    t = np.arange(0, 60, 1e-3)
+    slow = np.c_[0.05 * np.sin(0.2 * t), 0 * t, 0.7 + 0.02 * np.sin(0.1 * t), 0 * t, 0 * t, 0 * t]
+    assert [c.column for c in noisy_columns(t, np.round(slow, 4))] == [0, 2]
+    # an exact ramp on the quantum (every step one q) shows no noise: its second differences are all zero
+    ramp = np.round(0.7 + 0.001 * np.arange(len(t)), 3)
+    assert noisy_columns(t, np.c_[0 * t, 0 * t, ramp, 0 * t, 0 * t, 0 * t]) == []
+
+
+@pytest.mark.parametrize("name", ["seed", "rotating"])
+def test_the_shipped_trajectories_written_with_six_decimals_at_100_hz_pass(name):
+    """The closed-form references written as a CSV would be (6 decimals, 100 samples/s): 1 µm of rounding at
+    h = 10 ms is 7e-3 m/s² of noise against peaks of ~0.4 m/s² (seed) and ~1 rad/s² (rotating): small."""
+    t = np.arange(0, 4, 0.01)
+    q = np.round(TRAJECTORIES[name].pose(t), 6)
+    assert noisy_columns(t, q) == []
+
+
+def test_the_example_programs_samples_pass():
+    """The shipped motion programs, sampled at 100 and 1000 samples/s and written with 9 decimals."""
+    platform = load_platform("utn-kinematic")  # the platform the examples are written for
+    for program in sorted(Path(stewart_drake.examples.__path__[0]).glob("*.stw")):
+        for rate in (100.0, 1000.0):
+            tr = Trajectory.from_program(program, platform, rate=rate)
+            assert noisy_columns(tr.t, np.round(tr.q, 9)) == [], (program.name, rate)
 
 
 def test_smoothing_spline_keeps_the_tolerance_and_the_true_acceleration():
@@ -92,3 +135,36 @@ def test_the_controller_and_trajectories_import_without_scipy_interpolate():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False"]
+
+
+def _write_rows(path, t, q, decimals):
+    rows = np.c_[t, np.round(q, decimals)]
+    np.savetxt(path, rows, delimiter=",", fmt=["%.6f"] + [f"%.{decimals}f"] * 6, header="t,px,py,pz,a,b,g", comments="")
+    return str(path)
+
+
+@pytest.mark.parametrize(
+    "case,command",
+    [("10khz_0.1mm", "dynamics"), ("1khz_4_decimals", "dynamics"), ("1khz_4_decimals", "simulate")],
+)
+def test_commands_refuse_staircases(tmp_path, capsys, case, command):
+    """A 10 kHz CSV in mm rounded to 0.1 mm of a gentle 5 mm motion, and a 60 s slow motion at 1 kHz in metres
+    with 4 decimals: each moves less than a rounding step per sample, so its differentiated accelerations
+    are steps of q/h², thousands of times the motion's. Refused naming the file, the column and the step."""
+    if command == "simulate":
+        pytest.importorskip("pydrake")  # runs a Drake-backed command; the numpy-layer run (no pydrake) skips it
+    if case == "10khz_0.1mm":
+        t = np.arange(0, 1, 1e-4)
+        f = _write_rows(tmp_path / "fine.csv", t, np.c_[0 * t, 5 * np.sin(2 * t), 700 + 0 * t, 0 * t, 0 * t, 0 * t], 1)
+        args, column, step = ["--length-unit", "mm"], "py", "0.0001 m"
+    else:
+        t = np.arange(0, 60, 1e-3)
+        slow = np.c_[0.05 * np.sin(0.2 * t), 0 * t, 0.7 + 0.02 * np.sin(0.1 * t), 0 * t, 0 * t, 0 * t]
+        f = _write_rows(tmp_path / "slow.csv", t, slow, 4)
+        args, column, step = [], "px", "0.0001 m"
+    if command == "simulate":
+        args = ["--out", str(tmp_path / "o"), "--no-progress", "--duration", "0.3"]
+    assert main([command, "--trajectory", f, *args]) == 2
+    err = capsys.readouterr().err
+    assert f"{f}: column {column} is rounded too coarsely for its motion: steps of {step}" in err
+    assert "--smooth TOL" in err and err.count("\n") == 1
