@@ -30,6 +30,7 @@ from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.core.sanity import FAR_FACTOR, platform_size
 from stewart_drake.core.unit_hint import other_unit_hint
 from stewart_drake.errors import CalibrationError
 
@@ -257,7 +258,10 @@ def read_measurements(
         poses = np.stack([col[c] for c in POSE], axis=1)
         _check_angles(poses[:, 3:], POSE[3:], lines, shown, angle_unit)
         poses = np.concatenate([poses[:, :3] * k, poses[:, 3:] * a], axis=1)
-        hint = other_unit_hint(platform, poses, length_unit, angle_unit)  # "" unless the other unit fits them all
+        # a unit mistake puts positions far outside the platform (the sanity rule); poses merely outside this
+        # platform's workspace are measurements of another machine, which the fit's verdict reports
+        far = np.linalg.norm(poses[:, :3], axis=1) > FAR_FACTOR * platform_size(platform)
+        hint = other_unit_hint(platform, poses, length_unit, angle_unit) if far.any() else ""
         if hint:
             raise CalibrationError(CalibrationError.POSE_UNIT.format(path=shown, hint=hint))
     elif kind == "points":
