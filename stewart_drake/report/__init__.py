@@ -34,6 +34,7 @@ from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
 from stewart_drake.report import cache, figures, metadata, parts, render
+from stewart_drake.report import subject as subjects
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 
@@ -362,6 +363,18 @@ def run_analyses(
     user's machine the sections study (``report.subject.Subject``; None: the presets); an analysis that does not
     apply to it gives a section that says why (``report.subject.not_applicable``)."""
     log = log or sys.stderr
+    reasons = [subjects.not_applicable(a, subject) if subject is not None else "" for a in analyses]
+    if any(reasons):
+        applicable = [a for a, r in zip(analyses, reasons) if not r]
+        built = iter(run_analyses(applicable, quick, log, jobs, cache, on_start, subject))
+        out = []
+        for a, r in zip(analyses, reasons):
+            if r:
+                out.append(_not_applicable(a, subject, r, quick))
+                print(f"[not applicable] {a.title}: {r}", file=log, flush=True)
+            else:
+                out.append(next(built))
+        return out
     if cache:
         return _run_cached(analyses, quick, log, jobs, on_start, subject)
     n = len(analyses)
@@ -398,6 +411,14 @@ def run_analyses(
     with worker_pool(jobs) as pool:
         parts.schedule(pool, analyses, quick, jobs, _build_in_worker, on_section, subject)
     return sections
+
+
+def _not_applicable(analysis: Analysis, subject, reason: str, quick: bool) -> Section:
+    """The section of an analysis that does not apply to ``subject``: a visible line saying why, no checks."""
+    s = Section(analysis.title, quick=quick, subject=subject, elapsed=0.0)
+    s.html(subjects.not_applicable_html(subject, reason))
+    s.headline(f"not applicable: {reason}")
+    return s
 
 
 def _start_line(n: int, jobs: int, cached: int = 0) -> str:

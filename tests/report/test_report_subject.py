@@ -1,0 +1,129 @@
+"""The report of a user's platform or machine (``report --platform``/``--machine``, ``sd.report``): the sections
+that apply run on it with real checks, the others say why they do not apply, the title names it, its file is a
+declared input of the cache, and a bad file is one line naming the file and the field."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import stewart_drake as sd
+from stewart_drake.report.subject import from_machine_file
+from tests._own_platform import OWN_RADIAL
+from tests.cli._inprocess import cli
+
+# The 210 kg machine: a 60 kg plate carrying a 150 kg payload, with a 16-bit, 30 µm fixed-point IK format.
+MACHINE = """
+name: newcomer-6dof-sim
+length_unit: mm
+radial:
+  base_radius: 650.0
+  base_angles_deg: [278.0, 22.0, 38.0, 142.0, 158.0, 262.0]
+  top_radius: 450.0
+  top_angles_deg: [318.0, 342.0, 78.0, 102.0, 198.0, 222.0]
+stroke: [550.0, 850.0]
+rotation_centre: [0.0, 0.0, 0.0]
+plate: {mass: 60.0, com: [0.0, 0.0, 50.0], inertia: [3750000.0, 3750000.0, 7500000.0, 0, 0, 0]}
+legs: {cylinder_mass: 4.0, piston_mass: 2.0, max_force: 4000.0, max_speed: 500.0, stiffness: 20000.0}
+payload: {mass: 150.0, position: [0.0, 0.0, 100.0]}
+motions: [seed]
+firmware: {word_bits: 16, length_lsb: 0.03}
+"""
+# the loop on the user's machine and a section that needs nothing but the platform: a subset of the report that
+# keeps the test cheap (a few seconds of simulated loops)
+ONLY = ["--only", "drake_kinematics", "controller_in_the_loop", "seed_table"]
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("STEWART_DRAKE_CACHE", str(tmp_path / "cache"))
+
+
+def _checks(folder) -> list[dict]:
+    return json.loads((folder / "checks.json").read_text())
+
+
+def test_own_platform(tmp_path, capsys):
+    """A platform file without plate or payload: IK against Drake runs on it; the loop needs the plate's mass
+    properties and says so; the seed table is the presets' only."""
+    own = tmp_path / "own.yaml"
+    own.write_text(OWN_RADIAL)
+    rc, out, err = cli(capsys, "report", "--platform", own, "--quick", "--jobs", "1", *ONLY, "--out", tmp_path / "r")
+    assert rc == 0, err
+    checks = _checks(tmp_path / "r")
+    assert len(checks) == 3 and all(c["passed"] and c["what"].startswith("own-radial:") for c in checks)
+    page = (tmp_path / "r" / "index.html").read_text()
+    assert "<title>stewart-drake report: own-radial</title>" in page
+    assert "Not applicable to own-radial: needs the plate&#x27;s mass properties" in page
+    assert "Not applicable to own-radial: this section studies the built-in presets only" in page
+    assert "[not applicable] Seed table" in err
+
+
+def test_the_210_kg_machine_and_its_format(tmp_path, capsys):
+    """The machine's loop runs with its 30 µm format and passes every check, chatter included; the same file with
+    the DSP's 1 mm LSB chatters (the check is real: it fails), and that edit is a cache miss; ``sd.report`` gives
+    the same checks."""
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE)
+    argv = ["report", "--machine", machine, "--quick", "--jobs", "1", *ONLY]
+    rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r0")
+    assert rc == 0, err
+    checks = _checks(tmp_path / "r0")
+    chatter = [c for c in checks if "force ripple" in c["what"]]
+    assert len(checks) == 7 and all(c["passed"] for c in checks) and len(chatter) == 1
+    assert "length LSB 30 µm" in (tmp_path / "r0" / "index.html").read_text()
+    r = sd.report(tmp_path / "r1", machine=machine, only=ONLY[1:], quick=True, jobs=1)
+    assert r.ok and json.loads((tmp_path / "r1" / "checks.json").read_text()) == checks
+    assert "from the cache" in capsys.readouterr().err  # the same file, the same sections: served from the cache
+    machine.write_text(MACHINE.replace("length_lsb: 0.03", "length_lsb: 1.0"))
+    rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r2")
+    assert rc == 1 and "from the cache" not in err.split("Controller in the loop")[1].splitlines()[0]
+    (failed,) = [c for c in _checks(tmp_path / "r2") if not c["passed"]]
+    assert "force ripple" in failed["what"] and "length LSB (1 mm)" in failed["what"]
+
+
+def test_several_platforms(tmp_path, capsys):
+    own = tmp_path / "own.yaml"
+    own.write_text(OWN_RADIAL)
+    argv = ["report", "--platform", own, "--platform", "utn-dynamic", "--quick", "--jobs", "1"]
+    rc, _, err = cli(capsys, *argv, "--only", "drake_kinematics", "--out", tmp_path / "r")
+    assert rc == 0, err
+    sections = {c["section"] for c in _checks(tmp_path / "r")}
+    assert sections == {"Inverse kinematics vs Drake — own-radial", "Inverse kinematics vs Drake — utn-dynamic"}
+
+
+FORMAT = "firmware: {word_bits: 16, length_lsb: 0.03}"
+
+
+@pytest.mark.parametrize(
+    "old,new,message",
+    [
+        (FORMAT, FORMAT, None),
+        (FORMAT, "firmware: {word_bits: 40}", "m.yaml: firmware: word_bits must be"),
+        ("motions: [seed]", "motions: [seed, nowhere.csv]", "m.yaml: motions item 2: 'nowhere.csv' is not seed"),
+        (FORMAT, "requirements: missing.yaml", "m.yaml: requirements: 'missing.yaml' is not a file"),
+        (
+            "payload: {mass: 150.0, position: [0.0, 0.0, 100.0]}",
+            "payload: {mass: 150.0, position: [0, 0, -1]}",
+            "m.yaml: payload.position: z = -1 mm is below the plate",
+        ),
+        (FORMAT, "frimware: {word_bits: 16}", "did you mean 'firmware'?"),
+    ],
+)
+def test_a_bad_machine_file_is_one_line(tmp_path, capsys, old, new, message):
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE.replace(old, new))
+    if message is None:  # the file as given: read
+        assert from_machine_file(machine).ik_format.length_lsb == pytest.approx(3e-5, rel=1e-12)
+        return
+    rc, out, err = cli(capsys, "report", "--machine", machine, "--out", tmp_path / "r")
+    assert rc == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "r").exists()
+
+
+def test_machine_and_platform_are_one_or_the_other(tmp_path, capsys):
+    rc, _, err = cli(capsys, "report", "--machine", "m.yaml", "--platform", "utn-dynamic", "--out", tmp_path / "r")
+    assert rc == 2 and "not allowed with argument" in err
+    with pytest.raises(sd.StewartError, match="give a machine or platforms, not both"):
+        sd.report(tmp_path / "r", machine="m.yaml", platform="utn-dynamic")
