@@ -27,6 +27,7 @@ TITLE = "Forward kinematics: round trips, assembly modes, timing"
 ORDER = 30
 COST = 2.8  # CPU seconds (full report, measured): the report's workers start the costliest first
 ROUND_TRIP_TOL = 1e-9  # m and rad; the pose error is ~ tol_Newton / sigma_min
+NEEDS = ()  # a user's platform: its round trips (the mode counts and timings are the presets')
 
 
 def round_trips(platform, n: int, seed: int = 11) -> dict:
@@ -88,8 +89,9 @@ def build(section) -> None:
 
     # ---- round trips ------------------------------------------------------------------------
     rows, results = [], {}
-    for name in PRESETS:
-        p = load_preset(name)
+    user = section.subject
+    for p in [load_preset(name) for name in PRESETS] if user is None else [user.platform]:
+        name = p.name
         res = round_trips(p, n)
         results[name] = res
         m = res["in_region"]
@@ -124,7 +126,7 @@ def build(section) -> None:
             )
     section.table(
         [
-            "preset",
+            "platform",
             "poses",
             "in home region",
             "max pos err (m)",
@@ -139,13 +141,14 @@ def build(section) -> None:
         caption="IK→FK round trips: poses sampled around home (±0.3 stroke span, angles ±20°), within stroke, "
         "plate above the base; Newton tol 1e-13 m. 'Home region': same sign of det J⁻¹ as home and κ₂ ≤ 1e4.",
     )
-    section.text(
-        "The wide, low utn-kinematic platform (home height 100 mm, plate side 612.5 mm) has sampled poses "
-        "across a singularity from home (det J⁻¹ changes sign within ±20°): for their lengths, Newton from "
-        "home correctly converges to the mode on home's side, which is a different pose with the same leg "
-        "lengths. A controller following a trajectory through such a region must start each solve from the "
-        "previous pose — and must never cross the singularity itself."
-    )
+    if user is None:
+        section.text(
+            "The wide, low utn-kinematic platform (home height 100 mm, plate side 612.5 mm) has sampled poses "
+            "across a singularity from home (det J⁻¹ changes sign within ±20°): for their lengths, Newton from "
+            "home correctly converges to the mode on home's side, which is a different pose with the same leg "
+            "lengths. A controller following a trajectory through such a region must start each solve from the "
+            "previous pose — and must never cross the singularity itself."
+        )
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.4))
     bins = np.linspace(-17, -8, 37)
     for name, res in results.items():
@@ -158,8 +161,10 @@ def build(section) -> None:
         ax.set_ylabel("poses")
         ax.legend(fontsize=7)
     section.figure(
-        fig, "fk_round_trip_hist", "IK→FK round-trip error per preset (poses in home's singularity-free region)"
+        fig, "fk_round_trip_hist", "IK→FK round-trip error per platform (poses in home's singularity-free region)"
     )
+    if user is not None:  # the assembly modes and timings below reproduce the presets' known mode counts
+        return
 
     # ---- assembly modes ---------------------------------------------------------------------
     p = load_preset("utn-dynamic")

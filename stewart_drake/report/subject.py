@@ -18,6 +18,8 @@ import pickle
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from stewart_drake.core.geometry import (
     PLATFORM_RULES,
     PLATFORM_SHAPES,
@@ -255,3 +257,13 @@ def subject_trajectories(subject: Subject) -> list[Trajectory]:
     for m in subject.motions or TRAJECTORY_NAMES:
         out.append(fit_trajectory(TRAJECTORIES[m], subject.platform) if m in TRAJECTORY_NAMES else get_trajectory(m))
     return out
+
+
+def motion_rates(traj: Trajectory, t, h: float = 1e-4) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, q̇, q̈)``, each ``(n, 6)`` SI, of ``traj`` at times ``t`` (n,) s by five-point central differences of
+    its poses (step ``h`` s; truncation O(h⁴), rounding ~1e-16/h² relative): any motion, fitted or read."""
+    t = np.asarray(t, dtype=float)
+    q = [traj.pose(t + k * h) for k in (-2, -1, 0, 1, 2)]
+    qd = (q[0] - 8 * q[1] + 8 * q[3] - q[4]) / (12 * h)
+    qdd = (-q[0] + 16 * q[1] - 30 * q[2] + 16 * q[3] - q[4]) / (12 * h * h)
+    return q[2], qd, qdd
