@@ -24,6 +24,7 @@ ORDER = 96
 COST = 3.8  # CPU seconds (full report, measured): the report's workers start the costliest first
 
 DEFAULT = QFormat(16, 1e-3, "tfr16")
+NEEDS = ()  # a user's machine: its platform's workspace box, in its format (default the DSP's)
 # the formats compared on utn-kinematic: the default, the issue's 20 µm and 100 µm LSBs, and the formats
 # `firmware optimize --error-budget 0.5mm` chose there (proven: 15-bit exact, 50 µm) and simulation alone
 # would choose (14-bit exact, 90 µm: it overflows); each is certified afresh here
@@ -54,6 +55,76 @@ def _slice_map(model, box_words, ax_x: int, ax_y: int, n: int):
     return ex, ey, status.reshape(n, n).T
 
 
+def _certified(section, p, fmt, cells: int, samples: int, tightness: bool = True):
+    """The certificate of ``p``'s generated sd_ik in the format ``fmt`` over its workspace box, its checks against
+    sampled poses through the emulation, and its table row: ``(row, certificate)``. ``tightness``: also check the
+    bound within twice the sampled worst (how tight this cell budget makes it on the presets)."""
+    name = p.name
+    box = workspace_box(p)
+    cert = certify(p, fmt, box, max_cells=cells)
+    model = Model.build(p, fmt)
+    s = sample_box(model, *box.words(fmt), samples, seed=0, adversarial=4)
+    worst = s.worst_err * fmt.length_lsb * 1e3
+    bound = np.array([np.nan if e is None else e for e in cert.error_bound_mm])
+    inside = all(w.min <= s.word_min[k] and s.word_max[k] <= w.max for k, w in enumerate(cert.words))
+    b = box.to_units()
+    row = [
+        name,
+        "; ".join(f"{k} {b[k][0]:g}..{b[k][1]:g}" for k in KEYS),
+        "possible" if cert.saturation_possible else "impossible",
+        float(np.nanmax(bound)),
+        float(worst.max()),
+        float(np.nanmax(bound) / worst.max()),
+        "yes" if inside else "NO",
+    ]
+    section.check(
+        f"{name}: sampled worst error within the proven bound (worst − bound)", float(np.max(worst - bound)), 0.0, "mm"
+    )
+    if tightness:
+        section.check(
+            f"{name}: proven bound at most twice the sampled worst (bound / worst)",
+            float(np.nanmax(bound) / worst.max()),
+            2.0,
+            "",
+        )
+    section.check(f"{name}: sampled words outside their proven ranges", 0 if inside else 1, 0, "")
+    return row, cert
+
+
+def _user_machine(section, subject, cells: int, samples: int) -> None:
+    """The certificate of the firmware generated for the user's machine, in its format, over its workspace box:
+    the checks above, and that no word can saturate over the box."""
+    fmt = subject.ik_format or DEFAULT
+    # the bound's tightness is the cell budget's, not the machine's: shown in the table, not checked
+    row, cert = _certified(section, subject.platform, fmt, cells, samples, tightness=False)
+    section.check(
+        f"{subject.name}: a word can saturate over the workspace box (1: possible)",
+        int(cert.saturation_possible),
+        0,
+        "",
+    )
+    section.table(
+        [
+            "platform",
+            "workspace box (mm, π)",
+            "saturation",
+            "proven bound (mm)",
+            "sampled worst (mm)",
+            "bound / worst",
+            "samples in ranges",
+        ],
+        [row],
+        caption=f"{subject.name}: format {fmt.word_bits}-bit words, {fmt.length_lsb * 1e6:g} µm LSB, {fmt.trig}"
+        + (" (from the machine file)" if subject.ik_format else " (the DSP default: the file gives no firmware format)")
+        + f"; {samples} random poses, corners and 4 adversarial rounds",
+    )
+    section.table(
+        ["word", "proven min", "proven max", "headroom (bits)", "saturation"],
+        [[w.name, w.min, w.max, w.headroom_bits, w.saturation] for w in cert.words if not w.name.startswith("pose")],
+        caption=f"{subject.name}: the proven range of every intermediate word (LSB; Q15 for sin, cos, R)",
+    )
+
+
 def build(section) -> None:
     import matplotlib.pyplot as plt
 
@@ -69,40 +140,14 @@ def build(section) -> None:
         "tighter bounds)."
     )
     rows = []
+    user = section.subject
+    if user is not None:
+        _user_machine(section, user, cells, samples)
+        return
     for name in PRESETS:
         p = load_preset(name)
-        box = workspace_box(p)
-        cert = certify(p, DEFAULT, box, max_cells=cells)
-        model = Model.build(p, DEFAULT)
-        s = sample_box(model, *box.words(DEFAULT), samples, seed=0, adversarial=4)
-        worst = s.worst_err * DEFAULT.length_lsb * 1e3
-        bound = np.array([np.nan if e is None else e for e in cert.error_bound_mm])
-        inside = all(w.min <= s.word_min[k] and s.word_max[k] <= w.max for k, w in enumerate(cert.words))
-        b = box.to_units()
-        rows.append(
-            [
-                name,
-                "; ".join(f"{k} {b[k][0]:g}..{b[k][1]:g}" for k in KEYS),
-                "possible" if cert.saturation_possible else "impossible",
-                float(np.nanmax(bound)),
-                float(worst.max()),
-                float(np.nanmax(bound) / worst.max()),
-                "yes" if inside else "NO",
-            ]
-        )
-        section.check(
-            f"{name}: sampled worst error within the proven bound (worst − bound)",
-            float(np.max(worst - bound)),
-            0.0,
-            "mm",
-        )
-        section.check(
-            f"{name}: proven bound at most twice the sampled worst (bound / worst)",
-            float(np.nanmax(bound) / worst.max()),
-            2.0,
-            "",
-        )
-        section.check(f"{name}: sampled words outside their proven ranges", 0 if inside else 1, 0, "")
+        row, cert = _certified(section, p, DEFAULT, cells, samples)
+        rows.append(row)
         if name == "utn-kinematic":
             table, default_cert = cert.words, cert  # the formats' table below starts with this one
     section.table(
