@@ -56,6 +56,9 @@ def comparison_trajectories(t):
 
 def _user_machine(section, subject) -> None:
     """The complete model (plate, then plate and legs) along each of the user's motions against Drake."""
+    section.title = (
+        "Inverse dynamics along the motions, checked against Drake"  # the preset's title names its paper or seed
+    )
     p = subject.platform
     rows = []
     for traj in subject_trajectories(subject):
