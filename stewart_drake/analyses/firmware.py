@@ -24,7 +24,7 @@ from stewart_drake.fixedpoint import QFormat, scalar
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
 from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
 from stewart_drake.report import run_standalone
-from stewart_drake.report.subject import not_applicable_html, subject_trajectories
+from stewart_drake.report.subject import mark_not_applicable, subject_trajectories
 
 TITLE = "Firmware equivalence: the C compiled, generated and run in the loop"
 ORDER = 95
@@ -265,10 +265,10 @@ def _user_machine(section, subject) -> None:
     loop with the Python law vs the C, bit for bit, along its first motion."""
     fmt = subject.ik_format or ControllerConfig().ik_format
     if fmt.word_bits > C_WORD_BITS:
-        section.html(
-            not_applicable_html(
-                subject, f"the generated C takes words of at most {C_WORD_BITS} bits; the format has {fmt.word_bits}"
-            )
+        mark_not_applicable(
+            section,
+            subject,
+            f"the generated C takes words of at most {C_WORD_BITS} bits; the format has {fmt.word_bits}",
         )
         return
     section.text(

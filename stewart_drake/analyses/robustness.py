@@ -14,7 +14,7 @@ from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import check_study, run_row
 from stewart_drake.montecarlo.summary import METRICS, sensitivity
 from stewart_drake.report import parallel_map, run_standalone
-from stewart_drake.report.subject import TRAJECTORY_NAMES, not_applicable_html
+from stewart_drake.report.subject import TRAJECTORY_NAMES, mark_not_applicable
 
 TITLE = "Robustness: Monte Carlo over tolerances, sensor, timing and payload"
 ORDER = 95
@@ -90,7 +90,7 @@ def build(section) -> None:
 
     quick, subject = section.quick, section.subject
     if subject is not None and subject.ik_format not in (None, DSP_FORMAT):
-        section.html(not_applicable_html(subject, NO_FORMAT))
+        mark_not_applicable(section, subject, NO_FORMAT)
         return
     study = _study(quick, subject)
     runs, duration = study.runs, study.duration

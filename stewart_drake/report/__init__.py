@@ -13,7 +13,9 @@ its top level so that the report's parent reads them without importing the scrip
 calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
 out with ``parallel_map(__file__, "function_name", items)``, and declare them with ``parts(quick)`` so that
 the report runs them in its own pool beside the other sections (``report.parts``). ``section.headline(text)``
-sets the figure shown beside the section's verdict.
+sets the figure shown beside the section's verdict. ``section.subject`` is the user's machine the report studies
+(``report.subject.Subject``; None: the presets); a script declares ``NEEDS`` (what it needs of that machine) or
+``PRESET_ONLY`` (why it studies the presets only), and a section that does not apply says why.
 """
 
 from __future__ import annotations

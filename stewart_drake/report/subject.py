@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.control.gains import ControllerConfig, counts_per_lsb
 from stewart_drake.core.geometry import (
     PLATFORM_RULES,
     PLATFORM_SHAPES,
@@ -38,7 +39,7 @@ from stewart_drake.core.geometry import (
 from stewart_drake.core.trajectory import TRAJECTORIES, Trajectory, fit_trajectory, get_trajectory
 from stewart_drake.core.yamlio import check_rules
 from stewart_drake.design.payload import with_payload
-from stewart_drake.errors import FixedPointError, GeometryError, ReportSubjectError
+from stewart_drake.errors import FixedPointError, GainError, GeometryError, ReportSubjectError
 from stewart_drake.fixedpoint.generic import QFormat
 
 # What an analysis may need of a user's machine (``NEEDS``), and how the report says that the file lacks it.
@@ -110,6 +111,12 @@ def not_applicable(analysis, subject: Subject) -> str:
 def not_applicable_html(subject: Subject, reason: str) -> str:
     """The visible line of a section that does not apply."""
     return f'<p class="na">Not applicable to {html.escape(subject.name)}: {html.escape(reason)}.</p>'
+
+
+def mark_not_applicable(section, subject: Subject, reason: str) -> None:
+    """Say in ``section`` (a whole section found inapplicable while it is built) why it does not apply."""
+    section.html(not_applicable_html(subject, reason))
+    section.headline(f"not applicable: {reason}")
 
 
 def _given_keys(where: dict) -> frozenset:
@@ -226,6 +233,12 @@ def from_machine_file(path) -> Subject:
             fmt = QFormat(f.word_bits, f.length_lsb * k if f.length_lsb else 1e-3, trig)
         except FixedPointError as e:
             raise ReportSubjectError(ReportSubjectError.FIELD.format(path=shown, field="firmware", problem=e)) from None
+        try:  # the loop's sensor counts a whole number of its counts per LSB
+            counts_per_lsb(ControllerConfig(ik_format=fmt))
+        except GainError as e:
+            raise ReportSubjectError(
+                ReportSubjectError.FIELD.format(path=shown, field="firmware.length_lsb", problem=e)
+            ) from None
     folder = Path(path).resolve().parent
     motions, files = [], [str(Path(path).resolve())]
     for i, m in enumerate(cfg.motions, 1):

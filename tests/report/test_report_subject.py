@@ -105,6 +105,7 @@ FORMAT = "firmware: {word_bits: 16, length_lsb: 0.04}"
         (FORMAT, FORMAT, None),
         (FORMAT, "firmware: {word_bits: 40}", "m.yaml: firmware: word_bits must be"),
         ("motions: [seed]", "motions: [seed, nowhere.csv]", "m.yaml: motions item 2: 'nowhere.csv' is not seed"),
+        (FORMAT, "firmware: {word_bits: 16, length_lsb: 0.025}", "m.yaml: firmware.length_lsb: "),
         (FORMAT, "requirements: missing.yaml", "m.yaml: requirements: 'missing.yaml' is not a file"),
         (
             "payload: {mass: 150.0, position: [0.0, 0.0, 100.0]}",
@@ -130,3 +131,18 @@ def test_machine_and_platform_are_one_or_the_other(tmp_path, capsys):
     assert rc == 2 and "not allowed with argument" in err
     with pytest.raises(sd.StewartError, match="give a machine or platforms, not both"):
         sd.report(tmp_path / "r", machine="m.yaml", platform="utn-dynamic")
+
+
+def test_a_platform_object_is_keyed_by_value(tmp_path):
+    """``sd.report(platform=Platform)``: a platform built in Python, keyed by its numbers (no file to hash): the
+    same platform is served from the cache, a changed one is computed again."""
+    p = sd.load_platform("utn-dynamic")
+    logs = []
+    for k, q in enumerate((p, p, p.replace(stroke=p.stroke * [0.99, 1.0]))):
+        r = sd.report(
+            tmp_path / f"r{k}", platform=q, only=["drake_kinematics"], quick=True, jobs=1, on_start=logs.append
+        )
+        assert r.ok
+    assert logs == ["running 1 analysis in this process", "running 0 analyses in this process, 1 from the cache"] + [
+        "running 1 analysis in this process"
+    ]
