@@ -5,6 +5,7 @@ declared input of the cache, and a bad file is one line naming the file and the 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -146,3 +147,28 @@ def test_a_platform_object_is_keyed_by_value(tmp_path):
     assert logs == ["running 1 analysis in this process", "running 0 analyses in this process, 1 from the cache"] + [
         "running 1 analysis in this process"
     ]
+
+
+def test_requirements_are_proven_on_the_machine(tmp_path, capsys):
+    """With a requirements file the machine's required box is proven (and sampled); a box beyond the stroke is
+    refuted (exit 1); without one the section says what it needs."""
+    seed = (Path(sd.__file__).parent / "examples" / "seed_001_requirements.yaml").read_text()
+    box = "\n".join(
+        f"  {k}: [-{v}, {v}]" for k, v in (("px", 0.02), ("py", 0.02), ("pz", 0.02), ("a", 3), ("b", 3), ("g", 3))
+    )
+    start, end = seed.index("workspace:\n") + len("workspace:\n"), seed.index("payload:")
+    (tmp_path / "req.yaml").write_text(seed[:start] + box + "\n" + seed[end:])
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE + "requirements: req.yaml\n")
+    argv = ["report", "--machine", machine, "--quick", "--jobs", "1", "--only", "synthesis"]
+    rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r0")
+    assert rc == 0, err
+    assert [c["passed"] for c in _checks(tmp_path / "r0")] == [True, True]
+    (tmp_path / "req.yaml").write_text(
+        seed[:start] + box.replace("0.02", "0.4") + "\n" + seed[end:]
+    )  # beyond the stroke
+    rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r1")
+    assert rc == 1 and [c["passed"] for c in _checks(tmp_path / "r1")] == [False, False]
+    machine.write_text(MACHINE)
+    rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r2")
+    assert rc == 0 and "needs a requirements file" in (tmp_path / "r2" / "index.html").read_text()
