@@ -163,7 +163,8 @@ def build(section) -> None:
     section.figure(
         fig, "fk_round_trip_hist", "IK→FK round-trip error per platform (poses in home's singularity-free region)"
     )
-    if user is not None:  # the assembly modes and timings below reproduce the presets' known mode counts
+    if user is not None:  # the preset cases, mode counts and timings below are the presets'
+        _user_modes(section, user.platform)
         return
 
     # ---- assembly modes ---------------------------------------------------------------------
@@ -324,6 +325,45 @@ def _mode_gap(hom_modes, ms_modes) -> float:
         return 0.0
     d = np.abs(A[:, None] - B[None]).max(-1)
     return float(max(d.min(0).max(), d.min(1).max()))
+
+
+def _user_modes(section, p) -> None:
+    """The assembly modes of the user's platform at its home lengths by the complete homotopy solver (certified)
+    and by the multi-start search: the home pose among them, every multi-start mode among the homotopy's."""
+    from stewart_drake.homotopy import solve  # deferred: as in homotopy_section (its start systems load on use)
+
+    L = leg_lengths(p, p.home_pose())
+    r = solve(p, L)
+    am = assembly_modes(p, L)
+    c = r.counts()
+    H = np.array([np.r_[m.position, m.rotation.ravel()] for m in r.modes]).reshape(-1, 12)
+    M = np.array([np.r_[m.position, m.rotation.ravel()] for m in am.modes]).reshape(-1, 12)
+    home_vec = np.r_[p.home_pose()[:3], np.eye(3).ravel()]  # position p_BC and R_BT of the home pose
+    home_gap = float(np.abs(H - home_vec).max(-1).min()) if len(H) else float("inf")
+    ms_gap = float(np.abs(M[:, None] - H[None]).max(-1).min(1).max()) if len(H) and len(M) else float("inf")
+    # both solvers' modes are polished to rounding (~1e-15 in position and rotation entries): 1e-9 and 1e-8 are the
+    # presets' tolerances for the same comparisons, far above rounding and far below two distinct modes' distance
+    section.check(f"{p.name}: homotopy failed paths at the home lengths", c["failed"], 0, "paths")
+    section.check(
+        f"{p.name}: homotopy uncertified real modes", len(r.modes) - sum(m.certified for m in r.modes), 0, "modes"
+    )
+    section.check(f"{p.name}: the home pose among the homotopy's modes (nearest mode's gap)", home_gap, 1e-9)
+    section.check(f"{p.name}: every multi-start mode among the homotopy's (largest gap)", ms_gap, 1e-8)
+    section.table(
+        ["#", "px (m)", "py (m)", "pz (m)", "certified", "existence radius", "position bound (m)"],
+        [
+            [
+                k + 1,
+                *[f"{v:.4f}" for v in m.position],
+                "yes" if m.certified else "no",
+                f"{m.radius:.1e}",
+                f"{m.position_bound:.1e}",
+            ]
+            for k, m in enumerate(r.modes)
+        ],
+        caption=f"{p.name} at its home lengths: {c['real']} real assembly modes of {r.max_solutions} paths "
+        f"(complex {c['complex']}, at infinity {c['infinity']}, complete: {r.complete}); the multi-start found {len(am)}",
+    )
 
 
 def homotopy_section(section, known) -> None:
