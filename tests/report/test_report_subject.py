@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import stewart_drake as sd
-from stewart_drake.report.subject import from_machine_file
+from stewart_drake.report.subject import from_machine_file, subject_trajectories
 from tests._own_platform import OWN_RADIAL
 from tests.cli._inprocess import cli
 
@@ -172,3 +172,33 @@ def test_requirements_are_proven_on_the_machine(tmp_path, capsys):
     machine.write_text(MACHINE)
     rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r2")
     assert rc == 0 and "needs a requirements file" in (tmp_path / "r2" / "index.html").read_text()
+
+
+def test_a_motion_file_is_a_declared_input(tmp_path):
+    """A CSV motion beside the machine file is read as written (metres, radians) and keys the cached sections: an
+    edit of it changes the subject's key; the machine file's own edit does too."""
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE.replace("motions: [seed]", "motions: [ride.csv]"))
+    ride = tmp_path / "ride.csv"
+    ride.write_text("t,px,py,pz,a,b,g\n0,0,0,0.56,0,0,0\n1,0.01,0,0.56,0,0,0\n2,0.02,0,0.56,0,0,0\n")
+    s = from_machine_file(machine)
+    (traj,) = subject_trajectories(s)
+    assert s.motions == (str(ride.resolve()),) and str(ride.resolve()) in s.files
+    assert traj.pose(1.0)[0] == pytest.approx(0.01, abs=1e-15)
+    key = s.key()
+    ride.write_text(ride.read_text().replace("0.02,0,0.56", "0.03,0,0.56"))
+    assert s.key() != key
+    ride.write_text(ride.read_text().replace("0.03,0,0.56", "0.02,0,0.56"))
+    assert s.key() == key  # the same bytes: the same key
+    machine.write_text(machine.read_text() + "# a comment\n")
+    assert s.key() != key
+
+
+def test_a_folder_of_the_users_is_refused(tmp_path, capsys):
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE)
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("mine")
+    rc, _, err = cli(capsys, "report", "--machine", machine, "--only", "drake_kinematics", "--out", tmp_path / "mine")
+    assert rc == 2 and "the folder was not written by stewart-drake" in err
+    assert [p.name for p in (tmp_path / "mine").iterdir()] == ["notes.txt"]
