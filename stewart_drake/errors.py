@@ -417,7 +417,7 @@ class ReportSubjectError(InputError):
     """A machine file the report reads has a field it cannot use (``report.subject``)."""
 
     FIELD = "{path}: {field}: {problem}"
-    MOTION = "{path}: motions item {item}: {value!r} is not seed, rotating or a .csv file beside it"
+    MOTION = "{path}: motions item {item}: {value!r} is not seed, rotating, or a .csv or .stw file beside it"
 
 
 class UsageError(StewartError):

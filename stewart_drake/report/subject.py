@@ -64,7 +64,7 @@ class Subject:
         source: the file (or preset name) as the user wrote it.
         given: the file's keys that were given, dotted (``plate.mass``, ``legs.max_force``, ``firmware``, ...).
         ik_format: the loop's fixed-point IK format (``firmware:``), None: not given (the DSP's default).
-        motions: ``seed``, ``rotating`` or paths of ``.csv`` files, as resolved paths.
+        motions: ``seed``, ``rotating`` or paths of ``.csv`` and ``.stw`` files, as resolved paths.
         requirements: the requirements file's resolved path, or None.
         files: every file the subject was read from (the machine or platform file, its requirements and motion
             files): the report's declared inputs, whose content keys its cached sections (``key``).
@@ -175,7 +175,7 @@ class PayloadFields:
 @dataclass
 class MachineFile(PlatformConfig):
     """A machine file as this report reads it: a platform file's keys plus ``firmware``, ``motions`` (``seed``,
-    ``rotating`` or ``.csv`` paths relative to the file), ``payload`` and ``requirements`` (a path)."""
+    ``rotating``, or ``.csv`` and ``.stw`` paths relative to the file), ``payload`` and ``requirements`` (a path)."""
 
     firmware: FirmwareFields | None = None
     motions: list[str] = field(default_factory=list)
@@ -244,9 +244,11 @@ def from_machine_file(path) -> Subject:
     for i, m in enumerate(cfg.motions, 1):
         if m in TRAJECTORY_NAMES:
             motions.append(m)
-        elif m.endswith(".csv") and (folder / m).is_file():
+        elif m.endswith((".csv", ".stw")) and (folder / m).is_file():
             motions.append(str(folder / m))
             files.append(str(folder / m))
+            if m.endswith(".stw"):  # a program's errors are the file's: its file, line and column, now
+                Trajectory.from_program(folder / m, platform)
         else:
             raise ReportSubjectError(ReportSubjectError.MOTION.format(path=shown, item=i, value=m))
     requirements = None
@@ -265,10 +267,16 @@ def from_machine_file(path) -> Subject:
 
 def subject_trajectories(subject: Subject) -> list[Trajectory]:
     """The motions the sections run on ``subject``: its ``motions`` (``seed`` and ``rotating`` fitted to its home
-    height and stroke, CSV files as written, metres and radians), or when it gives none, both fitted ones."""
+    height and stroke, CSV files as written, metres and radians, ``.stw`` programs run on its platform), or when it
+    gives none, both fitted ones."""
     out = []
     for m in subject.motions or TRAJECTORY_NAMES:
-        out.append(fit_trajectory(TRAJECTORIES[m], subject.platform) if m in TRAJECTORY_NAMES else get_trajectory(m))
+        if m in TRAJECTORY_NAMES:
+            out.append(fit_trajectory(TRAJECTORIES[m], subject.platform))
+        elif m.endswith(".stw"):
+            out.append(Trajectory.from_program(m, subject.platform))
+        else:
+            out.append(get_trajectory(m))
     return out
 
 

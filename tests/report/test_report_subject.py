@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import stewart_drake as sd
@@ -202,3 +203,17 @@ def test_a_folder_of_the_users_is_refused(tmp_path, capsys):
     rc, _, err = cli(capsys, "report", "--machine", machine, "--only", "drake_kinematics", "--out", tmp_path / "mine")
     assert rc == 2 and "the folder was not written by stewart-drake" in err
     assert [p.name for p in (tmp_path / "mine").iterdir()] == ["notes.txt"]
+
+
+def test_a_motion_program(tmp_path, capsys):
+    """A ``.stw`` motion program beside the machine file runs on its platform; its error is one line at its
+    file, line and column, before any section runs."""
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE.replace("motions: [seed]", "motions: [lift.stw]"))
+    program = "units mm, deg\nmover(0, 0, 580, 0, 0, 0) en 1.0\nmover(0, 0, 560, 0, 0, 5) en 1.0\n"
+    (tmp_path / "lift.stw").write_text(program)
+    (traj,) = subject_trajectories(from_machine_file(machine))
+    assert traj.name == "lift" and traj.pose(2.0)[5] == pytest.approx(np.radians(5), abs=1e-12)
+    (tmp_path / "lift.stw").write_text(program.replace("560, 0, 0, 5", "0, 0, 0, 5"))  # into the base
+    rc, _, err = cli(capsys, "report", "--machine", machine, "--out", tmp_path / "r")
+    assert rc == 2 and "lift.stw:3:1: error:" in err and len(err.strip().splitlines()) == 1
