@@ -34,7 +34,7 @@ from pathlib import Path
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
-from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
+from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, StewartError, UsageError
 from stewart_drake.report import cache, figures, metadata, parts, render
 from stewart_drake.report import subject as subjects
 
@@ -482,18 +482,31 @@ def command_line(argv=None) -> str:
 
 
 def run_standalone(module_file: str, argv=None) -> int:
-    """``main()`` of an analysis script: build just that section into ``--out`` (default report/<name>)."""
+    """``main()`` of an analysis script: build just that section into ``--out`` (default report/<name>), on the
+    presets or on ``--platform FILE|NAME`` / ``--machine FILE``."""
     import argparse
 
     path = Path(module_file).resolve()
     ap = argparse.ArgumentParser(description=f"analysis {path.stem}")
     ap.add_argument("--out", default=f"report/{path.stem}")
     ap.add_argument("--quick", action="store_true", help="smaller samples, for smoke tests")
+    who = ap.add_mutually_exclusive_group()
+    who.add_argument("--platform", metavar="FILE|NAME", help="run on this platform file or preset")
+    who.add_argument("--machine", metavar="FILE", help="run on this machine file (see report --machine)")
     args = ap.parse_args(argv)
     out = OutputFolder(args.out)
+    subject = None
+    try:
+        if args.machine is not None:
+            subject = subjects.from_machine_file(args.machine)
+        elif args.platform is not None:
+            subject = subjects.from_platform(args.platform)
+    except StewartError as e:
+        print(f"{path.stem}: error: {e}", file=sys.stderr)
+        return getattr(e, "exit_code", 2)
     a = load_analysis(path)
     t0 = time.perf_counter()
-    sections = run_analyses([a], quick=args.quick)
+    sections = run_analyses([a], quick=args.quick, subject=subject)
     meta = render.default_meta(
         sections, command_line([str(path), *(sys.argv[1:] if argv is None else argv)]), time.perf_counter() - t0
     )

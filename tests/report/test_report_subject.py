@@ -217,3 +217,17 @@ def test_a_motion_program(tmp_path, capsys):
     (tmp_path / "lift.stw").write_text(program.replace("560, 0, 0, 5", "0, 0, 0, 5"))  # into the base
     rc, _, err = cli(capsys, "report", "--machine", machine, "--out", tmp_path / "r")
     assert rc == 2 and "lift.stw:3:1: error:" in err and len(err.strip().splitlines()) == 1
+
+
+def test_one_analysis_alone_on_a_machine(tmp_path, capsys):
+    """``python -m stewart_drake.analyses.NAME --machine FILE``: that section alone, on the machine; a bad file is
+    one line and exit 2."""
+    from stewart_drake.analyses import drake_kinematics
+
+    machine = tmp_path / "m.yaml"
+    machine.write_text(MACHINE)
+    assert drake_kinematics.main(["--quick", "--machine", str(machine), "--out", str(tmp_path / "r")]) == 0
+    assert all(c["what"].startswith("newcomer-6dof-sim:") for c in _checks(tmp_path / "r"))
+    machine.write_text(MACHINE.replace("word_bits: 16", "word_bits: 40"))
+    assert drake_kinematics.main(["--quick", "--machine", str(machine), "--out", str(tmp_path / "r2")]) == 2
+    assert "m.yaml: firmware: word_bits must be" in capsys.readouterr().err
