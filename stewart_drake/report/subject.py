@@ -89,11 +89,11 @@ class Subject:
 
     def missing(self, needs) -> list[str]:
         """The descriptions (``NEEDS``) of what ``needs`` asks that the file does not give."""
-        have = set(self.given)
+        have = set(self.given) - {"plate"}  # a ``plate:`` key without a mass gives no plate
         have |= {"motions"} if self.motions else set()
         have |= {"requirements"} if self.requirements else set()
         have |= {"firmware"} if self.ik_format is not None else set()
-        have |= {"plate"} if any(k.startswith("plate.") for k in self.given) else set()
+        have |= {"plate"} if self.platform.mass > 0 else set()  # its plate or its payload gave the plate a mass
         return [NEEDS[n] for n in needs if n not in have]
 
 
@@ -133,7 +133,7 @@ def from_platform(name_or_path) -> Subject:
     gives every field)."""
     if isinstance(name_or_path, Platform):
         p = name_or_path
-        given = {"legs.max_force"} | ({"plate.mass"} if p.mass > 0 else set())
+        given = {"legs.max_force"}
         given |= {"legs.stiffness"} if p.legs.stiffness is not None else set()
         return Subject(p.name, p, p.name, frozenset(given))
     s = str(name_or_path)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import stewart_drake as sd
-from stewart_drake.report.subject import from_machine_file, subject_trajectories
+from stewart_drake.report.subject import NEEDS, from_machine_file, from_platform, subject_trajectories
 from tests._own_platform import OWN_RADIAL
 from tests.cli._inprocess import cli
 
@@ -231,3 +231,16 @@ def test_one_analysis_alone_on_a_machine(tmp_path, capsys):
     machine.write_text(MACHINE.replace("word_bits: 16", "word_bits: 40"))
     assert drake_kinematics.main(["--quick", "--machine", str(machine), "--out", str(tmp_path / "r2")]) == 2
     assert "m.yaml: firmware: word_bits must be" in capsys.readouterr().err
+
+
+def test_what_a_section_needs(tmp_path):
+    """The plate is given when the plate has a mass (from ``plate:`` or a payload), the force limit when the file
+    writes it: a default the file does not state is not the user's."""
+    own = tmp_path / "own.yaml"
+    own.write_text(OWN_RADIAL + "plate: {com: [0, 0, 10]}\n")
+    assert from_platform(own).missing(["plate", "legs.max_force"]) == [NEEDS["plate"], NEEDS["legs.max_force"]]
+    own.write_text(OWN_RADIAL + "plate: {mass: 20}\nlegs: {max_force: 900}\n")
+    assert from_platform(own).missing(["plate", "legs.max_force", "requirements"]) == [NEEDS["requirements"]]
+    machine = tmp_path / "m.yaml"
+    machine.write_text(OWN_RADIAL + "payload: {mass: 20}\n")
+    assert from_machine_file(machine).missing(["plate", "motions", "firmware"]) == [NEEDS["motions"], NEEDS["firmware"]]
