@@ -63,6 +63,7 @@ def test_own_platform(tmp_path, capsys):
     assert "Not applicable to own-radial: needs the plate&#x27;s mass properties" in page
     assert "Not applicable to own-radial: it reproduces the seed&#x27;s published Matlab table" in page
     assert "[not applicable] Seed table" in err
+    assert '<td class="num ">—</td>' in page and ">0/0<" not in page  # no checks: no verdict, not a pass
 
 
 def test_the_210_kg_machine_and_its_format(tmp_path, capsys):
