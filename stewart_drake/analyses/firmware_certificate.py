@@ -13,6 +13,7 @@ from stewart_drake.firmware.certify.box import KEYS, workspace_box
 from stewart_drake.firmware.certify.certificate import certify
 from stewart_drake.firmware.certify.recipe import BENIGN, Model, evaluate, word_names
 from stewart_drake.firmware.certify.sampling import sample_box
+from stewart_drake.firmware.certify.search import MAX_CELLS
 from stewart_drake.firmware.certify.tick import certify_tick
 from stewart_drake.firmware.certify.tp17_recipe import tp17_model
 from stewart_drake.fixedpoint.generic import QFormat
@@ -91,14 +92,16 @@ def _certified(section, p, fmt, cells: int, samples: int, tightness: bool = True
     return row, cert
 
 
-def _user_machine(section, subject, cells: int, samples: int) -> None:
+def _user_machine(section, subject, samples: int) -> None:
     """The certificate of the firmware generated for the user's machine, in its format, over its workspace box:
     the checks above, and that no word can saturate over the box."""
     fmt = subject.ik_format or DEFAULT
-    # the bound's tightness is the cell budget's, not the machine's: shown in the table, not checked
-    row, cert = _certified(section, subject.platform, fmt, cells, samples, tightness=False)
+    # the command's budget (firmware certify): a smaller one can leave a word's range unresolved, which reads as
+    # "saturation possible" where more cells exclude it; the bound's tightness is the budget's, not the machine's:
+    # shown in the table, not checked
+    row, cert = _certified(section, subject.platform, fmt, MAX_CELLS, samples, tightness=False)
     section.check(
-        f"{subject.name}: a word can saturate over the workspace box (1: possible)",
+        f"{subject.name}: a word may saturate over the workspace box, not excluded in {MAX_CELLS} cells (1: may)",
         int(cert.saturation_possible),
         0,
         "",
@@ -130,19 +133,20 @@ def build(section) -> None:
 
     cells = 15_000 if section.quick else 25_000
     samples = 2_000 if section.quick else 10_000
+    if section.subject is not None:
+        cells = MAX_CELLS  # see _user_machine
     section.text(
         "Every intermediate word of the generated sd_ik gets a proven range over the whole pose box by interval "
         "arithmetic on the integer words themselves (the emulation's truncations, shifts and saturations), with the "
         "sine/cosine words bounded exactly over each cell's angle words and branch and bound on the box; each leg gets "
         "a proven bound on |L_firmware − L_float| (rigorous float enclosures). Samples (uniform + corners + an "
         "adversarial local search) through the bit-exact emulation check the bounds: a sample is not a proof, a bound "
-        f"below a sample would be a bug. Budget here: {cells} cells per certificate (the command's default is 200,000: "
-        "tighter bounds)."
+        f"below a sample would be a bug. Budget here: {cells} cells per certificate"
+        + (" (the command's default is 200,000: tighter bounds)." if cells < MAX_CELLS else " (the command's default).")
     )
     rows = []
-    user = section.subject
-    if user is not None:
-        _user_machine(section, user, cells, samples)
+    if section.subject is not None:
+        _user_machine(section, section.subject, samples)
         return
     for name in PRESETS:
         p = load_preset(name)

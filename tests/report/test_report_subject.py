@@ -15,8 +15,8 @@ from stewart_drake.report.subject import NEEDS, from_machine_file, from_platform
 from tests._own_platform import OWN_RADIAL
 from tests.cli._inprocess import cli
 
-# The 210 kg machine: a 60 kg plate carrying a 150 kg payload, with a 16-bit, 40 µm fixed-point IK format (30 µm
-# does not chatter either, but its words can saturate over the workspace box: the certificate fails it).
+# The 210 kg machine (examples/newcomer-210kg.yaml's numbers): a 60 kg plate carrying a 150 kg payload 300 mm above
+# it, with a 16-bit, 30 µm fixed-point IK format (the DSP's 1 mm chatters).
 MACHINE = """
 name: newcomer-6dof-sim
 length_unit: mm
@@ -29,9 +29,9 @@ stroke: [550.0, 850.0]
 rotation_centre: [0.0, 0.0, 0.0]
 plate: {mass: 60.0, com: [0.0, 0.0, 50.0], inertia: [3750000.0, 3750000.0, 7500000.0, 0, 0, 0]}
 legs: {cylinder_mass: 4.0, piston_mass: 2.0, max_force: 4000.0, max_speed: 500.0, stiffness: 20000.0}
-payload: {mass: 150.0, position: [0.0, 0.0, 100.0]}
+payload: {mass: 150.0, position: [0.0, 0.0, 300.0]}
 motions: [seed]
-firmware: {word_bits: 16, length_lsb: 0.04}
+firmware: {word_bits: 16, length_lsb: 0.03}
 """
 # the loop on the user's machine and a section that needs nothing but the platform: a subset of the report that
 # keeps the test cheap (a few seconds of simulated loops)
@@ -67,7 +67,7 @@ def test_own_platform(tmp_path, capsys):
 
 
 def test_the_210_kg_machine_and_its_format(tmp_path, capsys):
-    """The machine's loop runs with its 40 µm format and passes every check, chatter included; the same file with
+    """The machine's loop runs with its 30 µm format and passes every check, chatter included; the same file with
     the DSP's 1 mm LSB chatters (the check is real: it fails), and that edit is a cache miss; ``sd.report`` gives
     the same checks."""
     machine = tmp_path / "m.yaml"
@@ -78,11 +78,11 @@ def test_the_210_kg_machine_and_its_format(tmp_path, capsys):
     checks = _checks(tmp_path / "r0")
     chatter = [c for c in checks if "force ripple" in c["what"]]
     assert len(checks) == 10 and all(c["passed"] for c in checks) and len(chatter) == 1
-    assert "length LSB 40 µm" in (tmp_path / "r0" / "index.html").read_text()
+    assert "length LSB 30 µm" in (tmp_path / "r0" / "index.html").read_text()
     r = sd.report(tmp_path / "r1", machine=machine, only=ONLY[1:], quick=True, jobs=1)
     assert r.ok and json.loads((tmp_path / "r1" / "checks.json").read_text()) == checks
     assert "from the cache" in capsys.readouterr().err  # the same file, the same sections: served from the cache
-    machine.write_text(MACHINE.replace("length_lsb: 0.04", "length_lsb: 1.0"))
+    machine.write_text(MACHINE.replace("length_lsb: 0.03", "length_lsb: 1.0"))
     rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r2")
     assert rc == 1 and "from the cache" not in err.split("Controller in the loop")[1].splitlines()[0]
     (failed,) = [c for c in _checks(tmp_path / "r2") if not c["passed"]]  # the certificate passes at 1 mm
@@ -99,7 +99,7 @@ def test_several_platforms(tmp_path, capsys):
     assert sections == {"Inverse kinematics vs Drake — own-radial", "Inverse kinematics vs Drake — utn-dynamic"}
 
 
-FORMAT = "firmware: {word_bits: 16, length_lsb: 0.04}"
+FORMAT = "firmware: {word_bits: 16, length_lsb: 0.03}"
 
 
 @pytest.mark.parametrize(
@@ -111,7 +111,7 @@ FORMAT = "firmware: {word_bits: 16, length_lsb: 0.04}"
         (FORMAT, "firmware: {word_bits: 16, length_lsb: 0.025}", "m.yaml: firmware.length_lsb: "),
         (FORMAT, "requirements: missing.yaml", "m.yaml: requirements: 'missing.yaml' is not a file"),
         (
-            "payload: {mass: 150.0, position: [0.0, 0.0, 100.0]}",
+            "payload: {mass: 150.0, position: [0.0, 0.0, 300.0]}",
             "payload: {mass: 150.0, position: [0, 0, -1]}",
             "m.yaml: payload.position: z = -1 mm is below the plate",
         ),
@@ -122,7 +122,7 @@ def test_a_bad_machine_file_is_one_line(tmp_path, capsys, old, new, message):
     machine = tmp_path / "m.yaml"
     machine.write_text(MACHINE.replace(old, new))
     if message is None:  # the file as given: read
-        assert from_machine_file(machine).ik_format.length_lsb == pytest.approx(4e-5, rel=1e-12)
+        assert from_machine_file(machine).ik_format.length_lsb == pytest.approx(3e-5, rel=1e-12)
         return
     rc, out, err = cli(capsys, "report", "--machine", machine, "--out", tmp_path / "r")
     assert rc == 2 and message in err and len(err.strip().splitlines()) == 1, err
