@@ -423,6 +423,13 @@ class CsvError(InputError):
     HEADER_REPEATED = "{path}:{line}: the header ({header}) names {name} twice; a {kind} file's columns are {columns}"
 
 
+class ReportSubjectError(InputError):
+    """A machine file the report reads has a field it cannot use (``report.subject``)."""
+
+    FIELD = "{path}: {field}: {problem}"
+    MOTION = "{path}: motions item {item}: {value!r} is not seed, rotating, or a .csv or .stw file beside it"
+
+
 class UsageError(StewartError):
     """Options that contradict each other or are ignored (e.g. ``--json`` without ``--inspect``)."""
 
@@ -937,6 +944,7 @@ OPTION_JOINT_OVERFLOW = "joint angles {value} {unit}: the foot angle gamma = q1 
 OPTION_TARGET = "target must be finite, got {value}"
 OPTION_SERVO_POSE = "--pose has a non-finite number: {value}"
 REPORT_UNKNOWN_ANALYSIS = "unknown analysis {name!r}; available: {available}"
+REPORT_ONE_SUBJECT = "report: give a machine or platforms, not both"
 # The Python API's own argument errors (stewart_drake.api: what a caller passes that no CLI option can)
 API_POSE_SHAPE = "{what}: expected poses of shape (..., 6), got {shape}"
 API_FIT_PLATFORM = "fit=True needs the platform to fit the trajectory to"

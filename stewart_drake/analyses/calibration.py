@@ -32,6 +32,7 @@ NOISE = Noise(length=1e-6, position=10e-6, angle=20e-6)
 POSES = 30
 TARGET_RMS = 15e-6  # m, the target for leg length and plate position on validation poses
 REDUCTION = 0.98
+NEEDS = ()  # a user's machine: the calibration loop on its platform (and its firmware format, when given)
 
 
 def static_hold(truth: Platform, firmware: Platform, poses, fmt: QFormat, resolution: float, convention: str = "utn"):
@@ -61,7 +62,7 @@ def build(section) -> None:
 
     laws = parse_spec(ERRORS).laws
     section.text(
-        f"For each preset: `stewart-drake plan-measurements --poses {POSES}` (D-optimal in the default box), "
+        f"For each {'preset' if section.subject is None else 'platform'}: `stewart-drake plan-measurements --poses {POSES}` (D-optimal in the default box), "
         f"`simulate-measurements --errors {' '.join(ERRORS)} --noise length=1um position=10um angle=20urad --seed 1` "
         "(a laser tracker measuring the plate pose, 1 µm leg sensors), `calibrate`, then the identified platform "
         "against the true machine on 50 other poses of the workspace (noise-free: the model's own error). "
@@ -69,8 +70,9 @@ def build(section) -> None:
     )
     rows, fw_rows = [], []
     bars = {}
-    for name in PRESETS:
-        nominal = load_preset(name)
+    subject = section.subject
+    for nominal in [load_preset(name) for name in PRESETS] if subject is None else [subject.platform]:
+        name = nominal.name
         plan = plan_measurements(nominal, POSES, "pose", noise=NOISE, seed=0, candidates=600 if section.quick else 1000)
         data, truth = simulate_measurements(nominal, laws, plan.poses, "pose", NOISE, seed=1)
         data_r, _ = simulate_measurements(nominal, laws, plan.random, "pose", NOISE, seed=1, truth=truth.platform)
@@ -123,6 +125,11 @@ def build(section) -> None:
             (f"16-bit, {lsb16 * 1e6:.0f} µm LSB (finest 16-bit)", QFormat(16, lsb16, "exact"), res_m),
             ("24-bit, 1 µm LSB, 1 µm sensor (emulation)", QFormat(24, 1e-6, "exact"), 1e-6),
         ]
+        if subject is not None and subject.ik_format is not None:
+            f = subject.ik_format
+            formats.append(
+                (f"{f.word_bits}-bit, {f.length_lsb * 1e6:g} µm LSB, {f.trig} (the machine file's)", f, res_m)
+            )
         for label, fmt, res_s in formats:
             en = static_hold(truth.platform, nominal, hold, fmt, res_s)
             ec = static_hold(truth.platform, res.calibrated, hold, fmt, res_s)

@@ -1,8 +1,12 @@
 """The fixed-point DSP controller in the loop with the closed-loop Drake plant (utn-dynamic): fixed vs
 float tracking, the same controller designed for the other presets, the sample-period/latency sweep,
-saturation, and a Meshcat animation."""
+saturation, and a Meshcat animation. On a user's machine (``report.subject``): its motions (default the seed and
+rotating trajectories fitted to it) with its fixed-point format, against the same bounds and the chatter check."""
 
 from __future__ import annotations
+
+import pickle
+from dataclasses import replace
 
 import numpy as np
 
@@ -19,15 +23,18 @@ from stewart_drake.fixedpoint import fixed_point_leg_lengths
 from stewart_drake.montecarlo.study import check_study, run_row
 from stewart_drake.montecarlo.sweep import sweep_study
 from stewart_drake.report import parallel_map, run_standalone
+from stewart_drake.report.subject import subject_trajectories
 
 TITLE = "Controller in the loop: the fixed-point DSP controller driving the closed-loop plant"
 ORDER = 90
 COST = 22  # CPU seconds (full report, measured): the report's workers start the costliest first
+NEEDS = ("plate", "legs.max_force")  # a user's machine: its plate is the plant, legs.max_force the command range
 
 PLATFORM = "utn-dynamic"
 # the fixed-point controller's tick as compiled C (bit-identical to the Python engine, several times faster)
 ENGINE = resolve_engine("c", "analysis controller_in_the_loop")
 PRESETS = ("utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009")
+C_WORD_BITS = 16  # the widest data word the generated C takes (firmware.generate)
 # The ℓ1 gain's step response (s), quick mode too: the loops ring down over seconds (utn-dynamic's ‖h‖₁ is
 # 10.2 after 1.5 s, 11.27 after 6 s), and a shorter run underestimates the bound's gain. A loop that has not
 # settled in L1_S is continued to twice as long (not re-run from t = 0: the same numbers), up to L1_MAX_S
@@ -36,12 +43,19 @@ L1_S, L1_MAX_S = 6.0, 24.0
 L1_SETTLED = 0.01  # the most of ‖h‖₁ the step response's last quarter may add (the bound's convergence check)
 
 
-def loop_plan(platform, traj, kind: str, duration: float, **options):
+def loop_plan(platform, traj, kind: str, duration: float, ik_format=None, **options):
     """A closed loop of this analysis, built by ``api.simulation.plan_run`` (the one home of a closed-loop run:
     gains designed over the reference's poses, the C engine for the fixed-point law); the report's loops are
-    its own settings, so the per-run sanity checks are skipped."""
+    its own settings, so the per-run sanity checks are skipped. ``ik_format``: the fixed-point IK's format
+    (``fixedpoint.QFormat``; None: the DSP's; words wider than the generated C's 16 bits run the Python engine)."""
     engine = ENGINE if kind == "fixed" else None
-    return plan_run(platform, traj, kind, duration, engine=engine, checks=False, command="report", **options)
+    if kind == "fixed" and ik_format is not None and ik_format.word_bits > C_WORD_BITS:
+        engine = "python"
+    plan = plan_run(platform, traj, kind, duration, engine=engine, checks=False, command="report", **options)
+    if ik_format is None:
+        return plan
+    config = replace(plan.config, ik_format=ik_format)
+    return replace(plan, scenario=replace(plan.scenario, config=config))
 
 
 def simulate_log(platform, traj, kind: str, duration: float, **options):
@@ -69,7 +83,7 @@ def _l1_gain(platform, cfg, quick):
     """The loop's ℓ1 gains from set-point errors to leg lengths (``simulation.setpoint_step_gain``: a 1 mm
     set-point step on leg 1 at home in the float twin, ``L1_S`` continued to twice as long until settled or
     ``L1_MAX_S``), cached per gains."""
-    key = (platform.name, cfg.gains)
+    key = (pickle.dumps(platform), cfg.gains)  # the platform by value: a user's may share a preset's name
     if key not in _GAINS:
         _GAINS[key] = setpoint_step_gain(platform, cfg, duration=L1_S, settle=L1_SETTLED, max_duration=L1_MAX_S)
     return _GAINS[key]
@@ -190,12 +204,22 @@ def _preset_case(case):
     utn-dynamic its float and fixed-point logs and ‖h‖₁ (the tracking section's loops, the same runs)."""
     name, base_name, duration, quick = case
     platform = load_preset(name)
-    m = np.linalg.eigvalsh(leg_space_inertia(platform))
     base = {"seed": SEED, "rotating": ROTATING}[base_name]
     # the trajectories are made for utn-dynamic: their fit to it is the identity (to 3e-17 m of rounding),
     # so its loops are exactly the tracking section's, which reuses them
     traj = base if name == PLATFORM else fit_trajectory(base, platform)
-    plans = {kind: loop_plan(platform, traj, kind, duration) for kind in ("float", "fixed")}
+    checks, row, shared = _loop_case(platform, traj, duration, quick)
+    return checks, row, shared if name == PLATFORM else {}
+
+
+def _loop_case(platform, traj, duration: float, quick: bool, ik_format=None):
+    """The float and fixed-point loops of ``platform`` along ``traj`` (``ik_format``: the fixed-point IK's
+    format, None: the DSP's): the bounds' and the chatter's checks, the presets table's row, and the logs and
+    ‖h‖₁ ``{(trajectory, kind): ...}``."""
+    name = platform.name
+    m = np.linalg.eigvalsh(leg_space_inertia(platform))
+    base = traj
+    plans = {kind: loop_plan(platform, traj, kind, duration, ik_format) for kind in ("float", "fixed")}
     cfg = plans["float"].config
     poses = design_poses(traj, max(duration, traj.duration or 0.0))  # the poses the gains were designed over
     g = cfg.gains
@@ -247,10 +271,10 @@ def _preset_case(case):
         chat["chatter_ratio"],
     ]
     shared = {(base.name, "float"): logs["float"], (base.name, "fixed"): logs["fixed"], (base.name, "gain"): h}
-    return checks, row, shared if name == PLATFORM else {}
+    return checks, row, shared
 
 
-def _presets(section, results, duration):
+def _presets(section, results, duration, what: str = "Default controller on every preset"):
     """The default controller (gains designed per platform, force feed-forward) on every preset, the
     trajectories fitted to each platform's home height and stroke; the same two bounds as above.
     ``results``: the six independent cases' (``_preset_case``, run in worker processes)."""
@@ -284,7 +308,7 @@ def _presets(section, results, duration):
             "ripple / working force",
         ],
         rows,
-        caption=f"Default controller on every preset, {duration:g} s, T = 1 ms, one sample of output delay "
+        caption=f"{what}, {duration:g} s, T = 1 ms, one sample of output delay "
         "(max |leg length − IK(reference)|); force ripple: RMS of the actuator force about the inverse-dynamics "
         "force along the reference (control/chatter.py), a run chatters above both its working force and "
         f"{CHATTER_RANGE_FRACTION:g} × its command range. A ripple above the working force with a small share "
@@ -376,25 +400,52 @@ def _saturation(section, platform, ranges, duration):
     )
 
 
-def _animation(section, platform, log, duration):
-    """The Meshcat animation of a logged run (the seed trajectory's fixed-point run), thinned to 25 fps."""
+def _animation(section, platform, log, duration, traj=SEED):
+    """The Meshcat animation of a logged run (``traj``'s fixed-point run), thinned to 25 fps."""
     page = record_animation(
         platform,
         log.t,
         log.pose,
         log_saturating(log.status),
         fps=25.0,
-        title=f"{platform.name}: fixed-point controller, seed trajectory, {duration:g} s",
+        title=f"{platform.name}: fixed-point controller, {traj.name} trajectory, {duration:g} s",
     )
     section.attach(
         "controller_in_the_loop.html",
         page.encode("utf-8"),
-        f"Meshcat animation of the fixed-point controller driving the plant along the seed trajectory ({duration:g} s, "
+        f"Meshcat animation of the fixed-point controller driving the plant along the {traj.name} trajectory ({duration:g} s, "
         "25 frames/s, self-contained HTML; legs turn red near a stroke end or when saturating)",
     )
 
 
+def _user_machine(section, subject) -> None:
+    """The loop on a user's machine: each of its motions (default: the seed and rotating trajectories fitted to its
+    home height and stroke) with its fixed-point format, float twin and fixed-point controller."""
+    platform, quick = subject.platform, section.quick
+    duration = _duration(quick)
+    fmt = subject.ik_format or ControllerConfig().ik_format
+    trajs = subject_trajectories(subject)
+    section.text(
+        f"{subject.name}: the fixed-point controller and its float twin (DSP timing, T = 1 ms, one sample of output "
+        f"delay, gains designed from this platform, force feed-forward) on the closed-loop Drake plant built from "
+        f"{subject.source}, plate {platform.mass:g} kg, command range legs.max_force = {platform.legs.max_force:g} N. "
+        f"Fixed-point IK format: {fmt.word_bits}-bit words, length LSB {fmt.length_lsb * 1e6:g} µm, {fmt.trig} "
+        f"sine/cosine ({'from the machine file' if subject.ik_format else 'the DSP default: the file gives no firmware format'}). "
+        "Motions: " + ", ".join(t.name for t in trajs) + ". The checks are the preset's bounds, measured on this "
+        "machine: the float twin's error against the distance the legs travel in the loop's delay, the "
+        "fixed-point error against the float error plus the loop's ℓ1 gain times the set-point error, and the "
+        "force ripple against the chatter limit."
+    )
+    results = [_loop_case(platform, traj, duration, quick, fmt) for traj in trajs]
+    _presets(section, results, duration, f"The controller on {subject.name}")
+    seed_log = results[0][2][trajs[0].name, "fixed"]
+    _animation(section, platform, seed_log, duration, trajs[0])
+
+
 def build(section) -> None:
+    if section.subject is not None:
+        _user_machine(section, section.subject)
+        return
     platform = load_preset(PLATFORM)
     quick = section.quick
     duration = _duration(quick)

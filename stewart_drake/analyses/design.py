@@ -10,7 +10,7 @@ import numpy as np
 
 from stewart_drake.core.dynamics import seed_trajectory
 from stewart_drake.core.geometry import PRESETS, load_platform, load_preset
-from stewart_drake.core.kinematics import inverse_jacobian
+from stewart_drake.core.kinematics import inverse_jacobian, leg_lengths
 from stewart_drake.design.envelope import Envelope, cartesian_leg_forces_at, envelope_sizing
 from stewart_drake.design.maps import SAFE_CONDITION, slice_maps
 from stewart_drake.design.modes import analytic_modes, damping_matrix, spatial_inertia, subspace_mac
@@ -20,6 +20,8 @@ from stewart_drake.design.stiffness import principal_stiffness, static_wrench, s
 from stewart_drake.design.verify import newton_euler_fd, sample_box
 from stewart_drake.drake.design_checks import drake_modes
 from stewart_drake.report import run_standalone
+from stewart_drake.report.subject import NEEDS as NEED_TEXT
+from stewart_drake.report.subject import TRAJECTORY_NAMES, motion_rates, not_applicable_html, subject_trajectories
 
 TITLE = "Design: actuator sizing, stiffness, natural frequencies"
 ORDER = 85
@@ -28,6 +30,16 @@ PRESET = "utn-dynamic"
 PROGRAM = Path(__file__).resolve().parents[1] / "examples" / "seed_004.stw"
 PAYLOAD_KG, PAYLOAD_COM = 5.0, np.array([0.02, -0.01, 0.05])  # m, in T
 DEFAULT_K = 1.0e5  # N/m, for presets whose file gives no legs.stiffness (stated in the table)
+Q_TILT = np.r_[0.05, -0.03, 0.72, np.radians([6.0, -4.0, 15.0])]  # the preset's tilted pose (m, rad)
+# a user's machine: its tilted pose, home moved by these (m, rad), halved until every leg is within its stroke
+USER_TILT = np.r_[0.02, -0.01, 0.0, np.radians([3.0, -2.0, 6.0])]
+# sizing along a user's smooth motions (its rates by five-point differences at 0.1 ms: report.subject.motion_rates)
+# vs Newton–Euler by eighth-order differences of the pose at 1 ms (design.verify): both truncations are negligible
+# on smooth motions of a few rad/s, so the difference is the rates' rounding, ~1e-16 |q| / h² ≈ 1e-8 m/s² on
+# accelerations of ~0.1..1 m/s²; relative to the largest force, 1e-6 leaves two orders of margin
+FD_REL_TOL = 1e-6
+EDGE_S = 0.01  # s: the motions are sized from here to this before their end (the stencils stay inside them)
+NEEDS = ("plate", "legs.max_force")  # a user's machine: sizing along its motions (stiffness: legs.stiffness)
 SAMPLE_RATE, LOOP_DELAY = 1000.0, 1.5e-3  # the DSP's 1 kHz loop: one sample of output delay + half a sample of hold
 ENVELOPE = Envelope(
     poses=np.stack(
@@ -174,12 +186,14 @@ def _ellipsoid(ax, vals, dirs, color):
     ax.set_zlim(-m, m)
 
 
-def stiffness(section, p, k) -> None:
+def stiffness(section, p, k, pl=None, q_tilt=None, load: str = f"{PAYLOAD_KG:g} kg payload") -> None:
+    """Stiffness checks and ellipsoids of ``p`` loaded as ``pl`` (default: the report's payload) at home and at
+    ``q_tilt`` (default the preset's tilted pose)."""
     import matplotlib.pyplot as plt
 
-    pl = with_payload(p, PAYLOAD_KG, PAYLOAD_COM)
+    pl = with_payload(p, PAYLOAD_KG, PAYLOAD_COM) if pl is None else pl
     q_home = p.home_pose()
-    q_tilt = np.r_[0.05, -0.03, 0.72, np.radians([6.0, -4.0, 15.0])]
+    q_tilt = Q_TILT if q_tilt is None else q_tilt
     K = stiffness_matrix(pl, q_tilt, k)
     r = inverse_jacobian(pl, q_tilt)
     section.check(
@@ -216,7 +230,7 @@ def stiffness(section, p, k) -> None:
     section.table(
         ["pose", "k_t1 (N/m)", "k_t2", "k_t3", "k_r1 (N·m/rad)", "k_r2", "k_r3"],
         rows,
-        caption=f"Principal stiffnesses (softest first; from the compliance's blocks), legs {k[0]:g} N/m, {PAYLOAD_KG:g} kg payload",
+        caption=f"Principal stiffnesses (softest first; from the compliance's blocks), legs {k[0]:g} N/m, {load}",
         fmt="{:.4g}",
     )
     section.figure(
@@ -226,10 +240,13 @@ def stiffness(section, p, k) -> None:
     )
 
 
-def frequencies(section, p, k) -> None:
-    pl = with_payload(p, PAYLOAD_KG, PAYLOAD_COM)
+def frequencies(section, p, k, pl=None, q_tilt=None, name_shown: str = PRESET) -> None:
+    """Natural frequencies analytic vs Drake of ``p`` loaded as ``pl`` (default: the report's payload) at home and
+    at ``q_tilt`` (default the preset's tilted pose)."""
+    pl = with_payload(p, PAYLOAD_KG, PAYLOAD_COM) if pl is None else pl
+    q_tilt = Q_TILT if q_tilt is None else q_tilt
     rows = []
-    for name, q in (("home", p.home_pose()), ("tilted", np.r_[0.05, -0.03, 0.72, np.radians([6.0, -4.0, 15.0])])):
+    for name, q in (("home", p.home_pose()), ("tilted", q_tilt)):
         for legs in (False, True):
             a = analytic_modes(stiffness_matrix(pl, q, k, legs=legs), spatial_inertia(pl, q, legs=legs))
             d = drake_modes(pl, q, k, legs=legs)["modes"]
@@ -252,7 +269,7 @@ def frequencies(section, p, k) -> None:
         caption="Natural frequencies: plate only via Drake's Linearize of a spring-leg plant; plate + legs via the closed-loop plant reduced to the plate's motion",
         fmt="{:.6g}",
     )
-    q = np.r_[0.05, -0.03, 0.72, np.radians([6.0, -4.0, 15.0])]
+    q = q_tilt
     damped = analytic_modes(stiffness_matrix(pl, q, k), spatial_inertia(pl, q), damping_matrix(pl, q, 300.0))
     dd = drake_modes(pl, q, k, 300.0)["modes"]
     section.check(
@@ -262,7 +279,7 @@ def frequencies(section, p, k) -> None:
     )
     f1 = float(rows[6][3])
     section.text(
-        f"Lowest mode of {PRESET} at home with legs and payload: {f1:.3g} Hz. The DSP's loop at {SAMPLE_RATE:g} Hz samples it "
+        f"Lowest mode of {name_shown} at home with legs and payload: {f1:.3g} Hz. The DSP's loop at {SAMPLE_RATE:g} Hz samples it "
         f"{SAMPLE_RATE / f1:.0f} times per period; its delay (one sample of output delay + half a sample of hold, {LOOP_DELAY * 1e3:g} ms) "
         f"lags that mode by {360 * f1 * LOOP_DELAY:.2g}°. A loop bandwidth well below f1 (a rule of thumb: ≤ f1/3 ≈ {f1 / 3:.2g} Hz) keeps the "
         "controller from exciting the structure; the sample rate is then ample, and a slower loop down to ≈ 20 samples per "
@@ -374,7 +391,80 @@ def presets(section) -> None:
     )
 
 
+def _user_tilt(p):
+    """A tilted pose of the user's platform: home + ``USER_TILT``, halved until every leg is within its stroke."""
+    for k in range(8):
+        q = p.home_pose() + USER_TILT / 2**k
+        L = leg_lengths(p, q)
+        if np.all((L >= p.stroke[0]) & (L <= p.stroke[1])):
+            return q
+    return p.home_pose()
+
+
+def _user_machine(section, subject) -> None:
+    """Sizing along the user's motions (against Newton–Euler and the actuators' limits), then its stiffness and
+    natural frequencies against Drake where the file gives the legs' stiffness."""
+    p = subject.platform
+    lim = p.legs
+    section.text(
+        f"{subject.name}: plate with its payload {p.mass:g} kg; actuator limits from {subject.source}: max_force "
+        f"{lim.max_force:g} N" + (f", max_speed {lim.max_speed:g} m/s" if lim.max_speed else "") + ". Sizing "
+        "along each motion with the legs' own inertia and weight; on the smooth seed and rotating motions the "
+        "plate-only forces are checked against Newton–Euler by central differences of the pose (a second method; "
+        "a program's or a table's moves join with jumps in their higher derivatives, where differences of the "
+        "pose do not converge: their forces are checked against Drake in the inverse dynamics section)."
+    )
+    for spec, traj in zip(subject.motions or TRAJECTORY_NAMES, subject_trajectories(subject), strict=True):
+        t = np.arange(EDGE_S, traj.duration - EDGE_S, 1e-3)
+        q, qd, qdd = motion_rates(traj, t)
+        s_legs = size_trajectory(p, t, q, qd, qdd, legs=True)
+        section.table(
+            LEG_HEADER, _rows(s_legs.legs()), caption=f"{traj.name} ({traj.duration:g} s at 1 kHz), legs included"
+        )
+        if spec in TRAJECTORY_NAMES:  # smooth: both differentiations hold to their truncation (see FD_REL_TOL)
+            s_plate = size_trajectory(p, t, q, qd, qdd)
+            F = newton_euler_fd(p, traj.pose, t)[0]
+            scale = float(np.abs(s_plate.force).max())
+            section.check(
+                f"{traj.name}: sizing forces vs Newton–Euler from finite differences of the pose (relative to "
+                f"{scale:.4g} N)",
+                float(np.abs(s_plate.force - F).max()) / scale,
+                FD_REL_TOL,
+            )
+        section.check(
+            f"{traj.name}: peak leg force <= legs.max_force", float(np.abs(s_legs.force).max()), lim.max_force, "N"
+        )
+        if lim.max_speed:
+            section.check(
+                f"{traj.name}: peak leg speed <= legs.max_speed",
+                float(np.abs(s_legs.speed).max()),
+                lim.max_speed,
+                "m/s",
+            )
+        section.check(
+            f"{traj.name}: leg lengths outside the stroke {p.stroke[0]:g}..{p.stroke[1]:g} m (by how much)",
+            float(max(0.0, p.stroke[0] - s_legs.length.min(), s_legs.length.max() - p.stroke[1])),
+            0.0,
+            "m",
+        )
+    if lim.stiffness is None:
+        section.html(
+            not_applicable_html(
+                subject,
+                f"stiffness and natural frequencies need {NEED_TEXT['legs.stiffness']}, which {subject.source} does not give",
+            )
+        )
+        return
+    k = np.full(6, lim.stiffness)
+    q_tilt = _user_tilt(p)
+    stiffness(section, p, k, pl=p, q_tilt=q_tilt, load="payload as in the file")
+    frequencies(section, p, k, pl=p, q_tilt=q_tilt, name_shown=subject.name)
+
+
 def build(section) -> None:
+    if section.subject is not None:
+        _user_machine(section, section.subject)
+        return
     p = load_platform(PRESET)
     k = np.full(6, p.legs.stiffness)
     section.text(

@@ -10,6 +10,7 @@ from stewart_drake.report import run_standalone
 TITLE = "Inverse kinematics vs Drake"
 ORDER = 5
 COST = 1  # CPU seconds (full report, measured): the report's workers start the costliest first
+NEEDS = ()  # a user's platform: its own plant against its closed form
 # SNOPT closes the ball constraints to its feasibility tolerance (1e-10); lengths agree far below 1 µm.
 IK_TOL_M = 1e-8
 # Anchor frames and forward kinematics are pure float arithmetic on the same numbers.
@@ -19,8 +20,9 @@ FRAME_TOL_M = 1e-12
 def build(section) -> None:
     n = 20 if section.quick else 200
     rows = []
-    for name in PRESETS:
-        p = load_preset(name)
+    platforms = [load_preset(name) for name in PRESETS] if section.subject is None else [section.subject.platform]
+    for p in platforms:
+        name = p.name
         err = compare_ik_with_drake(p, random_poses(p, n, seed=1))
         rows.append([name, n, err["anchors"], err["ik"], err["fk"]])
         section.check(f"{name}: anchor frames read back from the parsed plant", err["anchors"], FRAME_TOL_M, "m")
@@ -37,13 +39,13 @@ def build(section) -> None:
             "m",
         )
     section.text(
-        "For each preset the SDF is generated from the Platform and parsed into a discrete MultibodyPlant with six "
+        "For each platform the SDF is generated from the Platform and parsed into a discrete MultibodyPlant with six "
         "ball constraints. (a) the anchor frames read back from the plant; (b) Drake's InverseKinematics with the "
         "plate's floating joint locked at a random in-stroke pose, legs starting from the home configuration; "
         "(c) Drake's forward kinematics with the joints set to the closed-form solution."
     )
     section.table(
-        ["preset", "poses", "anchor frames (m)", "IK lengths (m)", "FK tip gap (m)"],
+        ["platform", "poses", "anchor frames (m)", "IK lengths (m)", "FK tip gap (m)"],
         rows,
         caption="Worst absolute errors",
         fmt="{:.3g}",

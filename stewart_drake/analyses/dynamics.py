@@ -9,12 +9,16 @@ import stewart_drake.core.dynamics as D
 import stewart_drake.drake.verify_dynamics as V
 from stewart_drake.core.geometry import load_preset, triangular_plate
 from stewart_drake.report import run_standalone
+from stewart_drake.report.subject import motion_rates, subject_trajectories
 
 TITLE = "Inverse dynamics: the seed's Lagrangian model, completed, and checked against Drake"
 ORDER = 40
 COST = 4  # CPU seconds (full report, measured): the report's workers start the costliest first
 OPEN_LOOP_S = 2.5  # the open-loop runs' length (s): see section 5
 TOL_N = 1e-9  # leg-force agreement with Drake (N): rounding is ~1e-14 N on forces of ~5 N
+# a user's machine: the same agreement relative to its largest force (rounding, ~1e-15 relative; heavier plates)
+TOL_REL = 1e-12
+NEEDS = ("plate",)  # a user's machine: its plate along its motions, against Drake
 
 
 def rotating_trajectory(t, omega=3.0, amplitude=np.radians(20)):
@@ -50,7 +54,46 @@ def comparison_trajectories(t):
     return out
 
 
+def _user_machine(section, subject) -> None:
+    """The complete model (plate, then plate and legs) along each of the user's motions against Drake."""
+    section.title = (
+        "Inverse dynamics along the motions, checked against Drake"  # the preset's title names its paper or seed
+    )
+    p = subject.platform
+    rows = []
+    for traj in subject_trajectories(subject):
+        t = np.linspace(0.0, traj.duration, 7 if section.quick else 31)
+        q, qd, qdd = motion_rates(traj, t)
+        Fd = V.drake_leg_forces(p, q, qd, qdd)
+        Fc = D.leg_forces(p, q, qd, qdd)
+        Fl = D.leg_forces_with_legs(p, q[:4], qd[:4], qdd[:4])
+        Fld = V.constrained_leg_forces(p, q[:4], qd[:4], qdd[:4])
+        scale, scale_l = float(np.abs(Fd).max()), float(np.abs(Fld).max())
+        e_c, e_l = float(np.abs(Fc - Fd).max()), float(np.abs(Fl - Fld).max())
+        rows.append([traj.name, len(t), scale, e_c, scale_l, e_l])
+        section.check(f"{traj.name}: plate model vs Drake (free body), relative to {scale:.4g} N", e_c / scale, TOL_REL)
+        section.check(
+            f"{traj.name}: with leg masses, numpy model vs Drake's closed-loop plant ([B Gᵀ][u; λ] = τ_ID), relative "
+            f"to {scale_l:.4g} N",
+            e_l / scale_l,
+            TOL_REL,
+        )
+    section.text(
+        f"{subject.name} ({p.mass:g} kg on the plate, payload included): leg forces of the complete Lagrangian model "
+        "(Coriolis term included) against Drake's inverse dynamics of the plate as a free body, and with the legs' "
+        "masses against Drake's closed-loop plant, along each motion (rates by central differences of its poses)."
+    )
+    section.table(
+        ["motion", "samples", "max |F| plate N", "model − Drake N", "max |F| with legs N", "model − Drake N"],
+        rows,
+        caption="Leg forces vs Drake (the first four samples with legs)",
+    )
+
+
 def build(section) -> None:
+    if section.subject is not None:
+        _user_machine(section, section.subject)
+        return
     import matplotlib.pyplot as plt
 
     quick = section.quick

@@ -24,10 +24,13 @@ from stewart_drake.fixedpoint import QFormat, scalar
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
 from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
 from stewart_drake.report import run_standalone
+from stewart_drake.report.subject import mark_not_applicable, subject_trajectories
 
 TITLE = "Firmware equivalence: the C compiled, generated and run in the loop"
 ORDER = 95
 COST = 4.4  # CPU seconds (full report, measured): the report's workers start the costliest first
+NEEDS = ("plate", "legs.max_force")  # a user's machine: its firmware generated for its plate and force range
+C_WORD_BITS = 16  # the widest data word the generated C takes (firmware.generate)
 
 
 def _seed_table(section) -> None:
@@ -53,12 +56,17 @@ def _seed_table(section) -> None:
     )
 
 
-def _workspace(section, n: int) -> list:
-    """Generated C vs emulation vs float IK for every preset; returns the generated modules."""
+def _workspace(section, n: int, platforms=None, ik_format=None) -> list:
+    """Generated C vs emulation vs float IK for every preset (or ``platforms``, with the fixed-point format
+    ``ik_format``, None: the DSP's); returns the generated modules."""
     rows, gens = [], []
-    for name in PRESETS:
-        p = load_preset(name)
-        cfg = ControllerConfig.for_platform(p)
+    for p in [load_preset(name) for name in PRESETS] if platforms is None else platforms:
+        name = p.name
+        cfg = (
+            ControllerConfig.for_platform(p)
+            if ik_format is None
+            else ControllerConfig.for_platform(p, ik_format=ik_format)
+        )
         g = generate(p, cfg)
         gens.append((p, cfg, g))
         q = workspace_poses(p, n, seed=3)
@@ -79,9 +87,10 @@ def _workspace(section, n: int) -> list:
             ]
         )
         section.check(f"{name}: generated sd_ik vs emulation, {n} workspace poses (worst LSB)", d_ce, 0, "LSB")
+    fmt = gens[0][1].ik_format
     section.table(
         [
-            "preset",
+            "platform",
             "poses",
             "differing",
             "worst C − emulation (LSB)",
@@ -90,7 +99,8 @@ def _workspace(section, n: int) -> list:
             "poses with saturation",
         ],
         rows,
-        caption="The generated firmware's sd_ik (16-bit words, 1 mm LSB, tfr16) over random workspace poses "
+        caption=f"The generated firmware's sd_ik ({fmt.word_bits}-bit words, {fmt.length_lsb * 1e3:g} mm LSB, {fmt.trig}) "
+        "over random workspace poses "
         "(within stroke, ±10 % of the stroke, ±15°): bit-identical with the emulation; its error against the float IK",
     )
     return gens
@@ -189,16 +199,21 @@ def _files(section, gens) -> None:
     )
 
 
-def _sil(section, quick: bool) -> None:
+def _sil(section, quick: bool, p=None, traj=None, ik_format=None) -> None:
+    """The fixed-point loop with the Python law and with the generated C, bit for bit: utn-dynamic on the seed
+    trajectory, or ``p`` along ``traj`` with the format ``ik_format``."""
     import matplotlib.pyplot as plt
 
-    p = load_preset("utn-dynamic")
+    p = load_preset("utn-dynamic") if p is None else p
+    traj = _traj() if traj is None else traj
     duration = 0.3 if quick else 4.0
     logs, wall = {}, {}
     for eng in ("python", "c"):
-        sim = build_simulation(
-            plan_run(p, "seed", "fixed", duration, engine=eng, checks=False, command="report").scenario
-        )
+        plan = plan_run(p, traj, "fixed", duration, engine=eng, checks=False, command="report")
+        if ik_format is not None:
+            config = dataclasses.replace(plan.config, ik_format=ik_format)
+            plan = dataclasses.replace(plan, scenario=dataclasses.replace(plan.scenario, config=config))
+        sim = build_simulation(plan.scenario)
         t0 = time.perf_counter()
         logs[eng] = sim.run(duration)
         wall[eng] = time.perf_counter() - t0
@@ -207,7 +222,9 @@ def _sil(section, quick: bool) -> None:
         float(np.abs(getattr(a, k) - getattr(b, k)).max()) for k in ("lengths", "command", "setpoint", "force", "pose")
     )
     section.check(
-        f"closed loop, seed trajectory {duration:g} s: C engine logs vs Python engine logs (worst |Δ|)", worst, 0.0
+        f"closed loop, {traj.name} trajectory {duration:g} s: C engine logs vs Python engine logs (worst |Δ|)",
+        worst,
+        0.0,
     )
     section.table(
         ["engine", "wall time (s)", "real-time factor", "max leg error (mm)"],
@@ -216,7 +233,7 @@ def _sil(section, quick: bool) -> None:
                 eng,
                 f"{wall[eng]:.2f}",
                 f"{duration / wall[eng]:.2f}",
-                f"{np.abs(lg.length_error(_traj(), p)).max() * 1e3:.3f}",
+                f"{np.abs(lg.length_error(traj, p)).max() * 1e3:.3f}",
             ]
             for eng, lg in logs.items()
         ],
@@ -224,7 +241,7 @@ def _sil(section, quick: bool) -> None:
         "(same LeafSystem ports, timing and logs); times from this run",
     )
     fig, ax = plt.subplots(figsize=(8, 3))
-    ea, eb = a.length_error(_traj(), p), b.length_error(_traj(), p)
+    ea, eb = a.length_error(traj, p), b.length_error(traj, p)
     ax.plot(a.t, ea * 1e3, lw=2.5, alpha=0.4)
     ax.set_prop_cycle(None)
     ax.plot(b.t, eb * 1e3, "--", lw=0.8)
@@ -243,7 +260,32 @@ def _traj():
     return get_trajectory("seed")
 
 
+def _user_machine(section, subject) -> None:
+    """The firmware generated for the user's machine with its format: C vs emulation over its workspace, and the
+    loop with the Python law vs the C, bit for bit, along its first motion."""
+    fmt = subject.ik_format or ControllerConfig().ik_format
+    if fmt.word_bits > C_WORD_BITS:
+        mark_not_applicable(
+            section,
+            subject,
+            f"the generated C takes words of at most {C_WORD_BITS} bits; the format has {fmt.word_bits}",
+        )
+        return
+    section.text(
+        f"{subject.name}: the firmware module generated for this machine (its gains, its command range "
+        f"{subject.platform.legs.max_force:g} N) with the format {fmt.word_bits}-bit words, length LSB "
+        f"{fmt.length_lsb * 1e6:g} µm, {fmt.trig}"
+        + (" (from the machine file)" if subject.ik_format else " (the DSP default: the file gives no firmware format)")
+        + ": its sd_ik against the emulation bit for bit, and its sd_tick in the loop against the Python law."
+    )
+    _workspace(section, 20_000 if section.quick else 200_000, [subject.platform], fmt)
+    _sil(section, section.quick, subject.platform, subject_trajectories(subject)[0], fmt)
+
+
 def build(section) -> None:
+    if section.subject is not None:
+        _user_machine(section, section.subject)
+        return
     quick = section.quick
     section.text(
         "The toolkit verifies the firmware itself, not only a Python model of it. fixedpoint/c/dsp56800e.h and .c implement the "

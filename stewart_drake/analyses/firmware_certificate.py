@@ -13,6 +13,7 @@ from stewart_drake.firmware.certify.box import KEYS, workspace_box
 from stewart_drake.firmware.certify.certificate import certify
 from stewart_drake.firmware.certify.recipe import BENIGN, Model, evaluate, word_names
 from stewart_drake.firmware.certify.sampling import sample_box
+from stewart_drake.firmware.certify.search import MAX_CELLS
 from stewart_drake.firmware.certify.tick import certify_tick
 from stewart_drake.firmware.certify.tp17_recipe import tp17_model
 from stewart_drake.fixedpoint.generic import QFormat
@@ -24,6 +25,7 @@ ORDER = 96
 COST = 3.8  # CPU seconds (full report, measured): the report's workers start the costliest first
 
 DEFAULT = QFormat(16, 1e-3, "tfr16")
+NEEDS = ()  # a user's machine: its platform's workspace box, in its format (default the DSP's)
 # the formats compared on utn-kinematic: the default, the issue's 20 µm and 100 µm LSBs, and the formats
 # `firmware optimize --error-budget 0.5mm` chose there (proven: 15-bit exact, 50 µm) and simulation alone
 # would choose (14-bit exact, 90 µm: it overflows); each is certified afresh here
@@ -54,55 +56,102 @@ def _slice_map(model, box_words, ax_x: int, ax_y: int, n: int):
     return ex, ey, status.reshape(n, n).T
 
 
-def build(section) -> None:
-    import matplotlib.pyplot as plt
-
-    cells = 15_000 if section.quick else 25_000
-    samples = 2_000 if section.quick else 10_000
-    section.text(
-        "Every intermediate word of the generated sd_ik gets a proven range over the whole pose box by interval "
-        "arithmetic on the integer words themselves (the emulation's truncations, shifts and saturations), with the "
-        "sine/cosine words bounded exactly over each cell's angle words and branch and bound on the box; each leg gets "
-        "a proven bound on |L_firmware − L_float| (rigorous float enclosures). Samples (uniform + corners + an "
-        "adversarial local search) through the bit-exact emulation check the bounds: a sample is not a proof, a bound "
-        f"below a sample would be a bug. Budget here: {cells} cells per certificate (the command's default is 200,000: "
-        "tighter bounds)."
+def _certified(section, p, fmt, cells: int, samples: int, tightness: bool = True):
+    """The certificate of ``p``'s generated sd_ik in the format ``fmt`` over its workspace box, its checks against
+    sampled poses through the emulation, and its table row: ``(row, certificate)``. ``tightness``: also check the
+    bound within twice the sampled worst (how tight this cell budget makes it on the presets)."""
+    name = p.name
+    box = workspace_box(p)
+    cert = certify(p, fmt, box, max_cells=cells)
+    model = Model.build(p, fmt)
+    s = sample_box(model, *box.words(fmt), samples, seed=0, adversarial=4)
+    worst = s.worst_err * fmt.length_lsb * 1e3
+    bound = np.array([np.nan if e is None else e for e in cert.error_bound_mm])
+    inside = all(w.min <= s.word_min[k] and s.word_max[k] <= w.max for k, w in enumerate(cert.words))
+    b = box.to_units()
+    row = [
+        name,
+        "; ".join(f"{k} {b[k][0]:g}..{b[k][1]:g}" for k in KEYS),
+        "possible" if cert.saturation_possible else "impossible",
+        float(np.nanmax(bound)),
+        float(worst.max()),
+        float(np.nanmax(bound) / worst.max()),
+        "yes" if inside else "NO",
+    ]
+    section.check(
+        f"{name}: sampled worst error within the proven bound (worst − bound)", float(np.max(worst - bound)), 0.0, "mm"
     )
-    rows = []
-    for name in PRESETS:
-        p = load_preset(name)
-        box = workspace_box(p)
-        cert = certify(p, DEFAULT, box, max_cells=cells)
-        model = Model.build(p, DEFAULT)
-        s = sample_box(model, *box.words(DEFAULT), samples, seed=0, adversarial=4)
-        worst = s.worst_err * DEFAULT.length_lsb * 1e3
-        bound = np.array([np.nan if e is None else e for e in cert.error_bound_mm])
-        inside = all(w.min <= s.word_min[k] and s.word_max[k] <= w.max for k, w in enumerate(cert.words))
-        b = box.to_units()
-        rows.append(
-            [
-                name,
-                "; ".join(f"{k} {b[k][0]:g}..{b[k][1]:g}" for k in KEYS),
-                "possible" if cert.saturation_possible else "impossible",
-                float(np.nanmax(bound)),
-                float(worst.max()),
-                float(np.nanmax(bound) / worst.max()),
-                "yes" if inside else "NO",
-            ]
-        )
-        section.check(
-            f"{name}: sampled worst error within the proven bound (worst − bound)",
-            float(np.max(worst - bound)),
-            0.0,
-            "mm",
-        )
+    if tightness:
         section.check(
             f"{name}: proven bound at most twice the sampled worst (bound / worst)",
             float(np.nanmax(bound) / worst.max()),
             2.0,
             "",
         )
-        section.check(f"{name}: sampled words outside their proven ranges", 0 if inside else 1, 0, "")
+    section.check(f"{name}: sampled words outside their proven ranges", 0 if inside else 1, 0, "")
+    return row, cert
+
+
+def _user_machine(section, subject, samples: int) -> None:
+    """The certificate of the firmware generated for the user's machine, in its format, over its workspace box:
+    the checks above, and that no word can saturate over the box."""
+    fmt = subject.ik_format or DEFAULT
+    # the command's budget (firmware certify): a smaller one can leave a word's range unresolved, which reads as
+    # "saturation possible" where more cells exclude it; the bound's tightness is the budget's, not the machine's:
+    # shown in the table, not checked
+    row, cert = _certified(section, subject.platform, fmt, MAX_CELLS, samples, tightness=False)
+    section.check(
+        f"{subject.name}: a word may saturate over the workspace box, not excluded in {MAX_CELLS} cells (1: may)",
+        int(cert.saturation_possible),
+        0,
+        "",
+    )
+    section.table(
+        [
+            "platform",
+            "workspace box (mm, π)",
+            "saturation",
+            "proven bound (mm)",
+            "sampled worst (mm)",
+            "bound / worst",
+            "samples in ranges",
+        ],
+        [row],
+        caption=f"{subject.name}: format {fmt.word_bits}-bit words, {fmt.length_lsb * 1e6:g} µm LSB, {fmt.trig}"
+        + (" (from the machine file)" if subject.ik_format else " (the DSP default: the file gives no firmware format)")
+        + f"; {samples} random poses, corners and 4 adversarial rounds",
+    )
+    section.table(
+        ["word", "proven min", "proven max", "headroom (bits)", "saturation"],
+        [[w.name, w.min, w.max, w.headroom_bits, w.saturation] for w in cert.words if not w.name.startswith("pose")],
+        caption=f"{subject.name}: the proven range of every intermediate word (LSB; Q15 for sin, cos, R)",
+    )
+
+
+def build(section) -> None:
+    import matplotlib.pyplot as plt
+
+    cells = 15_000 if section.quick else 25_000
+    samples = 2_000 if section.quick else 10_000
+    if section.subject is not None:
+        cells = MAX_CELLS  # see _user_machine
+    section.text(
+        "Every intermediate word of the generated sd_ik gets a proven range over the whole pose box by interval "
+        "arithmetic on the integer words themselves (the emulation's truncations, shifts and saturations), with the "
+        "sine/cosine words bounded exactly over each cell's angle words and branch and bound on the box; each leg gets "
+        "a proven bound on |L_firmware − L_float| (rigorous float enclosures). Samples (uniform + corners + an "
+        "adversarial local search) through the bit-exact emulation check the bounds: a sample is not a proof, a bound "
+        f"below a sample would be a bug. Budget here: {cells} cells per certificate"
+        + (" (the command's default is 200,000: tighter bounds)." if cells < MAX_CELLS else " (the command's default).")
+    )
+    rows = []
+    if section.subject is not None:
+        _user_machine(section, section.subject, samples)
+        return
+    for name in PRESETS:
+        p = load_preset(name)
+        row, cert = _certified(section, p, DEFAULT, cells, samples)
+        rows.append(row)
         if name == "utn-kinematic":
             table, default_cert = cert.words, cert  # the formats' table below starts with this one
     section.table(

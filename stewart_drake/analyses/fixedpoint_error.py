@@ -23,6 +23,7 @@ from stewart_drake.report import run_standalone
 TITLE = "Fixed-point error over the workspace (DSP56800E firmware and word-length study)"
 ORDER = 25
 COST = 2.2  # CPU seconds (full report, measured): the report's workers start the costliest first
+PRESET_ONLY = "it studies the seed DSP firmware's (tp17.C) own errors on utn-kinematic; your machine's format is certified in the firmware certificate section"
 
 SEED = 20
 BUDGET_MM = 6.3  # a 0.4 + anchor words 1.7 + R·anchor 2·sqrt(3) + sqrt 0.5 + trig/matrix 0.3 (see tests)

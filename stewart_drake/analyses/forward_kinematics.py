@@ -27,6 +27,7 @@ TITLE = "Forward kinematics: round trips, assembly modes, timing"
 ORDER = 30
 COST = 2.8  # CPU seconds (full report, measured): the report's workers start the costliest first
 ROUND_TRIP_TOL = 1e-9  # m and rad; the pose error is ~ tol_Newton / sigma_min
+NEEDS = ()  # a user's platform: its round trips (the mode counts and timings are the presets')
 
 
 def round_trips(platform, n: int, seed: int = 11) -> dict:
@@ -88,8 +89,9 @@ def build(section) -> None:
 
     # ---- round trips ------------------------------------------------------------------------
     rows, results = [], {}
-    for name in PRESETS:
-        p = load_preset(name)
+    user = section.subject
+    for p in [load_preset(name) for name in PRESETS] if user is None else [user.platform]:
+        name = p.name
         res = round_trips(p, n)
         results[name] = res
         m = res["in_region"]
@@ -124,7 +126,7 @@ def build(section) -> None:
             )
     section.table(
         [
-            "preset",
+            "platform",
             "poses",
             "in home region",
             "max pos err (m)",
@@ -139,13 +141,14 @@ def build(section) -> None:
         caption="IK→FK round trips: poses sampled around home (±0.3 stroke span, angles ±20°), within stroke, "
         "plate above the base; Newton tol 1e-13 m. 'Home region': same sign of det J⁻¹ as home and κ₂ ≤ 1e4.",
     )
-    section.text(
-        "The wide, low utn-kinematic platform (home height 100 mm, plate side 612.5 mm) has sampled poses "
-        "across a singularity from home (det J⁻¹ changes sign within ±20°): for their lengths, Newton from "
-        "home correctly converges to the mode on home's side, which is a different pose with the same leg "
-        "lengths. A controller following a trajectory through such a region must start each solve from the "
-        "previous pose — and must never cross the singularity itself."
-    )
+    if user is None:
+        section.text(
+            "The wide, low utn-kinematic platform (home height 100 mm, plate side 612.5 mm) has sampled poses "
+            "across a singularity from home (det J⁻¹ changes sign within ±20°): for their lengths, Newton from "
+            "home correctly converges to the mode on home's side, which is a different pose with the same leg "
+            "lengths. A controller following a trajectory through such a region must start each solve from the "
+            "previous pose — and must never cross the singularity itself."
+        )
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.4))
     bins = np.linspace(-17, -8, 37)
     for name, res in results.items():
@@ -158,8 +161,11 @@ def build(section) -> None:
         ax.set_ylabel("poses")
         ax.legend(fontsize=7)
     section.figure(
-        fig, "fk_round_trip_hist", "IK→FK round-trip error per preset (poses in home's singularity-free region)"
+        fig, "fk_round_trip_hist", "IK→FK round-trip error per platform (poses in home's singularity-free region)"
     )
+    if user is not None:  # the preset cases, mode counts and timings below are the presets'
+        _user_modes(section, user.platform)
+        return
 
     # ---- assembly modes ---------------------------------------------------------------------
     p = load_preset("utn-dynamic")
@@ -319,6 +325,45 @@ def _mode_gap(hom_modes, ms_modes) -> float:
         return 0.0
     d = np.abs(A[:, None] - B[None]).max(-1)
     return float(max(d.min(0).max(), d.min(1).max()))
+
+
+def _user_modes(section, p) -> None:
+    """The assembly modes of the user's platform at its home lengths by the complete homotopy solver (certified)
+    and by the multi-start search: the home pose among them, every multi-start mode among the homotopy's."""
+    from stewart_drake.homotopy import solve  # deferred: as in homotopy_section (its start systems load on use)
+
+    L = leg_lengths(p, p.home_pose())
+    r = solve(p, L)
+    am = assembly_modes(p, L)
+    c = r.counts()
+    H = np.array([np.r_[m.position, m.rotation.ravel()] for m in r.modes]).reshape(-1, 12)
+    M = np.array([np.r_[m.position, m.rotation.ravel()] for m in am.modes]).reshape(-1, 12)
+    home_vec = np.r_[p.home_pose()[:3], np.eye(3).ravel()]  # position p_BC and R_BT of the home pose
+    home_gap = float(np.abs(H - home_vec).max(-1).min()) if len(H) else float("inf")
+    ms_gap = float(np.abs(M[:, None] - H[None]).max(-1).min(1).max()) if len(H) and len(M) else float("inf")
+    # both solvers' modes are polished to rounding (~1e-15 in position and rotation entries): 1e-9 and 1e-8 are the
+    # presets' tolerances for the same comparisons, far above rounding and far below two distinct modes' distance
+    section.check(f"{p.name}: homotopy failed paths at the home lengths", c["failed"], 0, "paths")
+    section.check(
+        f"{p.name}: homotopy uncertified real modes", len(r.modes) - sum(m.certified for m in r.modes), 0, "modes"
+    )
+    section.check(f"{p.name}: the home pose among the homotopy's modes (nearest mode's gap)", home_gap, 1e-9)
+    section.check(f"{p.name}: every multi-start mode among the homotopy's (largest gap)", ms_gap, 1e-8)
+    section.table(
+        ["#", "px (m)", "py (m)", "pz (m)", "certified", "existence radius", "position bound (m)"],
+        [
+            [
+                k + 1,
+                *[f"{v:.4f}" for v in m.position],
+                "yes" if m.certified else "no",
+                f"{m.radius:.1e}",
+                f"{m.position_bound:.1e}",
+            ]
+            for k, m in enumerate(r.modes)
+        ],
+        caption=f"{p.name} at its home lengths: {c['real']} real assembly modes of {r.max_solutions} paths "
+        f"(complex {c['complex']}, at infinity {c['infinity']}, complete: {r.complete}); the multi-start found {len(am)}",
+    )
 
 
 def homotopy_section(section, known) -> None:

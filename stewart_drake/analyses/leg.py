@@ -24,6 +24,7 @@ from stewart_drake.report import run_standalone
 TITLE = "3R planar leg (seed 003): DH kinematics"
 ORDER = 70
 COST = 2  # CPU seconds (full report, measured): the report's workers start the costliest first
+PRESET_ONLY = "it studies the 3R planar leg of seed 003, another mechanism"
 
 
 def build(section) -> None:

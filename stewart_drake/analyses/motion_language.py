@@ -17,6 +17,7 @@ from stewart_drake.script.emit import emit_matlab
 TITLE = "Motion language: the seed's program and loops"
 ORDER = 80
 COST = 0.7  # CPU seconds (full report, measured): the report's workers start the costliest first
+PRESET_ONLY = "it runs the motion language's example programs, written for the presets' dimensions"
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SEED_MATLAB = ["L = CinematicaInversa(100,120,300,25,10,0);", "T = DinamicaInversa(L)"]
 

@@ -8,11 +8,13 @@ import numpy as np
 
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.firmware.engine import default_engine
+from stewart_drake.fixedpoint.generic import QFormat
 from stewart_drake.montecarlo.scenario import Study, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import check_study, run_row
 from stewart_drake.montecarlo.summary import METRICS, sensitivity
 from stewart_drake.report import parallel_map, run_standalone
+from stewart_drake.report.subject import TRAJECTORY_NAMES, mark_not_applicable
 
 TITLE = "Robustness: Monte Carlo over tolerances, sensor, timing and payload"
 ORDER = 95
@@ -38,13 +40,31 @@ VARY = [
 # gave every percentile of the position and angle errors within 0.1 %, of the leg errors within 2 %, and
 # the same ranking (plate mass ρ 0.458 vs 0.463), at 80 % of the cost. Quick mode: 8 runs of 0.5 s.
 FULL, QUICK = (40, 3.2), (8, 0.5)
+NEEDS = ("plate", "legs.max_force")  # a user's machine: the study on its plant and command range
+# the Monte Carlo study runs the DSP's fixed-point format only (montecarlo.scenario.Study has no format field)
+DSP_FORMAT = QFormat(16, 1e-3, "tfr16")
+NO_FORMAT = "the Monte Carlo study runs the DSP's fixed-point format only, and the machine file gives another"
 CHUNK = 5  # runs per part of the report's shared pool (8 parts: both cores busy until the end)
 
 
-def _study(quick: bool) -> Study:
+def _study(quick: bool, subject=None) -> Study:
+    """The study on utn-dynamic's seed trajectory, or on ``subject``'s platform along its first motion (seed or
+    rotating, fitted to it: the study's references)."""
     runs, duration = QUICK if quick else FULL
     engine = default_engine(None, "fixed", "analysis robustness")  # the montecarlo command's default
-    return Study(load_preset(PLATFORM), parse_spec(VARY), seed=2026, runs=runs, duration=duration, engine=engine)
+    if subject is None:
+        return Study(load_preset(PLATFORM), parse_spec(VARY), seed=2026, runs=runs, duration=duration, engine=engine)
+    motion = next((m for m in subject.motions if m in TRAJECTORY_NAMES), "seed")
+    return Study(
+        subject.platform,
+        parse_spec(VARY),
+        seed=2026,
+        runs=runs,
+        duration=duration,
+        engine=engine,
+        trajectory=motion,
+        fit=True,
+    )
 
 
 def _chunks(quick: bool) -> list[tuple]:
@@ -68,13 +88,21 @@ def _runs(chunk) -> list[dict]:
 def build(section) -> None:
     import matplotlib.pyplot as plt
 
-    quick = section.quick
-    study = _study(quick)
+    quick, subject = section.quick, section.subject
+    if subject is not None and subject.ik_format not in (None, DSP_FORMAT):
+        mark_not_applicable(section, subject, NO_FORMAT)
+        return
+    study = _study(quick, subject)
     runs, duration = study.runs, study.duration
     check_study(study)  # the bounds and draws run_study checks before it runs
-    rows = [r for chunk in parallel_map(__file__, "_runs", _chunks(quick)) for r in chunk]
+    if subject is None:
+        rows = [r for chunk in parallel_map(__file__, "_runs", _chunks(quick)) for r in chunk]
+    else:  # the study's runs in this worker (the report's parts are the presets' cases)
+        rows = [run_row(study, k) for k in range(runs)]
+    name = PLATFORM if subject is None else subject.name
+    motion = study.trajectory + ("" if subject is None else " (fitted to its home and stroke)")
     section.text(
-        f"{runs} closed-loop runs of the fixed-point controller on {PLATFORM}, seed trajectory, {duration:g} s each "
+        f"{runs} closed-loop runs of the fixed-point controller on {name}, {motion} trajectory, {duration:g} s each "
         f"(stewart-drake montecarlo --runs {runs} --seed 2026 --duration {duration:g} --vary {' '.join(VARY)}). Each run "
         "draws its own parameters from SeedSequence(2026, spawn_key=(run,)): every base and plate anchor moved per axis "
         "within ±0.5 mm (the plant only: the controller keeps the nominal geometry), a 10 µm sensor with 2 µm of white "
@@ -112,6 +140,8 @@ def build(section) -> None:
         f"Runs that lost tracking (a leg more than 5 mm off, or a failed simulation): {len(lost)} of {runs}"
         + (f" ({', '.join(map(str, lost))})." if lost else ".")
     )
+    if subject is not None:
+        section.check(f"{subject.name}: runs that lost tracking over the drawn tolerances", len(lost), 0, "runs")
     ranking = {m: sensitivity(rows, m, p_values=False) for m in ("max_leg_error_m", "max_position_error_m")}
     names = [d["parameter"] for d in ranking["max_leg_error_m"][:10]]
     rho = {m: {d["parameter"]: d["spearman"] for d in r} for m, r in ranking.items()}

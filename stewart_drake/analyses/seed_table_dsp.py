@@ -13,6 +13,7 @@ from stewart_drake.report import run_standalone
 TITLE = "Seed table: the DSP block (fixed-point emulation)"
 ORDER = 20
 COST = 0.3  # CPU seconds (full report, measured): the report's workers start the costliest first
+PRESET_ONLY = "it reproduces the seed firmware's published DSP block bit for bit"
 
 
 def dsp_block() -> dict:

@@ -13,6 +13,7 @@ from stewart_drake.report import run_standalone
 TITLE = "RC-servo hexapod (seed 002): arm angles and PWM"
 ORDER = 60
 COST = 3  # CPU seconds (full report, measured): the report's workers start the costliest first
+PRESET_ONLY = "it studies the RC-servo hexapod of seed 002, another mechanism"
 AXES = ["x (mm)", "y (mm)", "z (mm)", "phi (deg)", "theta (deg)", "psi (deg)"]
 
 

@@ -22,6 +22,7 @@ from stewart_drake.report import run_standalone
 TITLE = "Workspace of the 6-6 platform (González Acuña & Dutra 2009)"
 ORDER = 50
 COST = 5  # CPU seconds (full report, measured): the report's workers start the costliest first
+NEEDS = ()  # a user's platform: its workspace at zero orientation, two volume methods (the paper's part: presets)
 
 PRESET = "gonzalez-dutra-2009"
 # Seed 001, section IV: extents at zero orientation (m), and the mid-stroke height.
@@ -57,7 +58,56 @@ def reproduce(resolution: float) -> dict:
     return {"platform": p, "workspace": w, "time_s": t_ws, "rotation": rot}
 
 
+def _user_machine(section, subject) -> None:
+    """The user's platform's workspace at zero orientation: extents, the volume from the grid and from exact
+    column intervals against the grid's error bound, the bound's halving with the grid step, the views."""
+    section.title = "Workspace at zero orientation"  # the preset's title names its paper or seed
+    quick, p = section.quick, subject.platform
+    h = 0.01 if quick else 0.005
+    levels = [0.04, 0.02] if quick else [0.02, 0.01]
+    w = ws.constant_orientation_workspace(p, resolution=h)
+    conv = [(hh, ws.constant_orientation_workspace(p, resolution=hh, refine=False)) for hh in levels] + [(h, w)]
+    h_col = 0.004 if quick else 0.002
+    v_col = ws.stroke_volume_columns(p, h_col)
+    section.text(
+        f"{subject.name}: the positions the plate reaches at zero orientation within the stroke "
+        f"{p.stroke[0]:g}..{p.stroke[1]:g} m (plate above the base), on an {h * 1e3:g} mm grid with refined extents; "
+        f"the volume checked against exact z-intervals per (x, y) column on a {h_col * 1e3:g} mm grid."
+    )
+    section.table(
+        ["", "X (m)", "Y (m)", "Z (m)"],
+        [["extents", *[f"{lo:.4f} … {hi:.4f}" for lo, hi in w.extents]]],
+        caption=f"Extents (± {w.extent_error * 1e3:.2g} mm)",
+    )
+    section.table(
+        ["grid step (mm)", "volume (L)", "error bound (L)", "V − V_columns (L)"],
+        [[f"{hh * 1e3:g}", x.volume * 1e3, x.volume_error * 1e3, f"{(x.volume - v_col) * 1e3:+.2e}"] for hh, x in conv],
+        caption=f"Volume under refinement (1 L = 1e-3 m³); V_columns = {v_col * 1e3:.4f} L",
+    )
+    section.check(
+        "grid volume vs the column integral, within the grid's error bound", abs(w.volume - v_col), w.volume_error, "m³"
+    )
+    errs = [x.volume_error for _, x in conv]
+    section.check(
+        "volume error bound halves with the grid step (ratio of successive bounds vs 0.5)",
+        max(abs(a / b - 2.0) / 2.0 for a, b in zip(errs[:-1], errs[1:])),
+        0.1,
+        "",
+    )
+    figs = ws.view_figures(w, title=subject.name)
+    for name in ("3d", "top", "front", "side"):
+        section.figure(
+            figs[name], f"workspace_{name}", f"{subject.name}: the workspace at zero orientation, {name} view"
+        )
+    section.points3d(
+        w.boundary, "workspace_3d", "The workspace boundary in 3-D, coloured by height", ("X [m]", "Y [m]", "Z [m]")
+    )
+
+
 def build(section) -> None:
+    if section.subject is not None:
+        _user_machine(section, section.subject)
+        return
     quick = section.quick
     # 5 mm: the extents come from the constrained optimisation (the grid only seeds it: 2.5 mm gave the same
     # extents to 0.1 mm at 8× the nodes), and the volume's error bound (~5 L of 85 L) is what the column

@@ -13,7 +13,9 @@ its top level so that the report's parent reads them without importing the scrip
 calls ``run_standalone`` so it also runs on its own. An analysis with independent heavy cases can fan them
 out with ``parallel_map(__file__, "function_name", items)``, and declare them with ``parts(quick)`` so that
 the report runs them in its own pool beside the other sections (``report.parts``). ``section.headline(text)``
-sets the figure shown beside the section's verdict.
+sets the figure shown beside the section's verdict. ``section.subject`` is the user's machine the report studies
+(``report.subject.Subject``; None: the presets); a script declares ``NEEDS`` (what it needs of that machine) or
+``PRESET_ONLY`` (why it studies the presets only), and a section that does not apply says why.
 """
 
 from __future__ import annotations
@@ -32,8 +34,9 @@ from pathlib import Path
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.processes import worker_pool
-from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, UsageError
-from stewart_drake.report import figures, metadata, parts, reads, render
+from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, StewartError, UsageError
+from stewart_drake.report import cache, figures, metadata, parts, render
+from stewart_drake.report import subject as subjects
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 
@@ -69,7 +72,7 @@ class Section:
     warnings: list[str] = field(default_factory=list)
     crashed: bool = False  # the analysis raised (never cached)
     cached: bool = False  # given back by the result cache (``report.cache``), not computed in this run
-    inputs: dict[str, str] = field(default_factory=dict)  # files it read outside the package (``report.reads``)
+    subject: object = None  # the user's machine it studies (``report.subject.Subject``), None: the presets
 
     def headline(self, text: str) -> None:
         """The one figure that sums the section up, shown in the report's verdict table (default: the
@@ -141,6 +144,9 @@ class Analysis:
     path: Path | None = None
     cost: float = 0.0  # the module's optional COST (relative run time): workers take the costliest first
     parts: object = None  # the module's optional parts(quick): its heavy cases, run in the report's pool
+    inputs: tuple | None = None  # a script's declared INPUTS, relative to it (``report.cache``); None: undeclared
+    needs: tuple | None = None  # NEEDS: what it needs of a user's machine (``report.subject``); None: presets only
+    preset_only: str = ""  # PRESET_ONLY: why it studies the presets only
 
 
 def _module_at(path: Path):
@@ -170,6 +176,9 @@ def load_analysis(path: Path) -> Analysis:
             path,
             float(meta["COST"]),
             FromScript(path, "parts") if meta["parts"] else None,
+            _tuple(meta["INPUTS"]),
+            _tuple(meta["NEEDS"]),
+            meta["PRESET_ONLY"] or "",
         )
     mod = loaded(path)
     for attr in ("TITLE", "ORDER", "build"):
@@ -183,7 +192,15 @@ def load_analysis(path: Path) -> Analysis:
         path,
         float(getattr(mod, "COST", 0.0)),
         getattr(mod, "parts", None),
+        _tuple(getattr(mod, "INPUTS", None)),
+        _tuple(getattr(mod, "NEEDS", None)),
+        getattr(mod, "PRESET_ONLY", "") or "",
     )
+
+
+def _tuple(value) -> tuple | None:
+    """A script's list constant as a tuple of strings (None stays None)."""
+    return None if value is None else tuple(str(v) for v in value)
 
 
 @dataclass(frozen=True)
@@ -283,28 +300,27 @@ def parallel_map(module_file: str, name: str, items: list, jobs: int | None = No
         )
 
 
-def build_section(analysis: Analysis, quick: bool = False) -> Section:
-    """Run one analysis into a new ``Section`` (timed); an analysis that raises becomes a failed check."""
-    with reads.recording() as opened:  # the files it reads, its import's included (``report.reads``)
-        if isinstance(analysis.build, FromScript):  # its import is not the section's time (as when it was discovered)
-            try:
-                loaded(analysis.build.path)
-            except Exception:  # noqa: BLE001, S110 - raised again by the build below, and reported as its failure
-                pass
-        t0, c0 = time.perf_counter(), time.process_time()
-        s = Section(analysis.title, quick=quick)
+def build_section(analysis: Analysis, quick: bool = False, subject=None) -> Section:
+    """Run one analysis into a new ``Section`` (timed) of ``subject`` (``report.subject.Subject``; None: the
+    presets); an analysis that raises becomes a failed check."""
+    if isinstance(analysis.build, FromScript):  # its import is not the section's time (as when it was discovered)
         try:
-            analysis.build(s)
-        except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
-            s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
-            s.check(f"{analysis.name} ran to completion", 1.0, 0.0)
-            s.crashed = True
-        s.elapsed, s.cpu = time.perf_counter() - t0, time.process_time() - c0
-    s.inputs = reads.digests(opened)
+            loaded(analysis.build.path)
+        except Exception:  # noqa: BLE001, S110 - raised again by the build below, and reported as its failure
+            pass
+    t0, c0 = time.perf_counter(), time.process_time()
+    s = Section(analysis.title, quick=quick, subject=subject)
+    try:
+        analysis.build(s)
+    except Exception as e:  # noqa: BLE001 - the report must say which analysis broke, and go on
+        s.html(f'<p class="fail">This analysis failed: {html.escape(type(e).__name__)}: {html.escape(str(e))}</p>')
+        s.check(f"{analysis.name} ran to completion", 1.0, 0.0)
+        s.crashed = True
+    s.elapsed, s.cpu = time.perf_counter() - t0, time.process_time() - c0
     return s
 
 
-def _build_in_worker(path: str, quick: bool, done: dict | None = None) -> Section:
+def _build_in_worker(path: str, quick: bool, done: dict | None = None, subject=None) -> Section:
     """A section in a report worker; ``done``: its parts, computed already (``report.parts``)."""
     import matplotlib
 
@@ -313,7 +329,7 @@ def _build_in_worker(path: str, quick: bool, done: dict | None = None) -> Sectio
     parts._DONE.clear()
     parts._DONE.update(done or {})
     try:
-        return build_section(load_analysis(Path(path)), quick)
+        return build_section(load_analysis(Path(path)), quick, subject)
     finally:
         parts._DONE.clear()
 
@@ -333,29 +349,49 @@ def _progress(k: int, n: int, s: Section, log, done: int | None = None) -> None:
 
 
 def run_analyses(
-    analyses: list[Analysis], quick: bool = False, log=None, jobs: int = 1, cache: bool = False, on_start=None
+    analyses: list[Analysis],
+    quick: bool = False,
+    log=None,
+    jobs: int = 1,
+    cache: bool = False,
+    on_start=None,
+    subject=None,
 ) -> list[Section]:
     """Build each analysis's section, in ``jobs`` worker processes (1: in this process), printing a
     line per analysis as it finishes to ``log`` (default: the current stderr, not the one at import
     time); the sections come back in the analyses' order. ``cache``: take a section whose inputs and
     code are unchanged from the result cache (``report.cache``) and store each one computed.
-    ``on_start``: called with a line saying how many analyses run, and in how many processes."""
+    ``on_start``: called with a line saying how many analyses run, and in how many processes. ``subject``: the
+    user's machine the sections study (``report.subject.Subject``; None: the presets); an analysis that does not
+    apply to it gives a section that says why (``report.subject.not_applicable``)."""
     log = log or sys.stderr
+    reasons = [subjects.not_applicable(a, subject) if subject is not None else "" for a in analyses]
+    if any(reasons):
+        applicable = [a for a, r in zip(analyses, reasons) if not r]
+        built = iter(run_analyses(applicable, quick, log, jobs, cache, on_start, subject))
+        out = []
+        for a, r in zip(analyses, reasons):
+            if r:
+                out.append(_not_applicable(a, subject, r, quick))
+                print(f"[not applicable] {a.title}: {r}", file=log, flush=True)
+            else:
+                out.append(next(built))
+        return out
     if cache:
-        return _run_cached(analyses, quick, log, jobs, on_start)
+        return _run_cached(analyses, quick, log, jobs, on_start, subject)
     n = len(analyses)
     if on_start:
         on_start(_start_line(n, jobs))
     if jobs <= 1 or n <= 1:
         sections = []
         for k, a in enumerate(analyses, 1):
-            sections.append(build_section(a, quick))
+            sections.append(build_section(a, quick, subject))
             _progress(k, n, sections[-1], log)
         return sections
     sections: list[Section | None] = [None] * n
     finished = [0]
 
-    def on_section(i, f, parts_wall, parts_cpu, n_parts, parts_inputs):
+    def on_section(i, f, parts_wall, parts_cpu, n_parts):
         try:
             s = f.result()
         except Exception as e:  # noqa: BLE001 - a worker that died (not an analysis that raised)
@@ -366,7 +402,6 @@ def run_analyses(
             s.check(f"{analyses[i].name} ran to completion", 1.0, 0.0)
             s.elapsed, s.crashed = 0.0, True
         s.parts = n_parts
-        s.inputs.update(parts_inputs)
         s.elapsed = (s.elapsed or 0.0) + parts_wall
         s.cpu = (s.cpu or 0.0) + parts_cpu
         sections[i] = s
@@ -376,8 +411,16 @@ def run_analyses(
     # spawned workers (no fork of Drake's threads), dying with this process; one pool for the sections and
     # their parts, the costliest ready task first (ORDER is no guide; COST is), so the workers finish together
     with worker_pool(jobs) as pool:
-        parts.schedule(pool, analyses, quick, jobs, _build_in_worker, on_section)
+        parts.schedule(pool, analyses, quick, jobs, _build_in_worker, on_section, subject)
     return sections
+
+
+def _not_applicable(analysis: Analysis, subject, reason: str, quick: bool) -> Section:
+    """The section of an analysis that does not apply to ``subject``: a visible line saying why, no checks."""
+    s = Section(analysis.title, quick=quick, subject=subject, elapsed=0.0)
+    s.html(subjects.not_applicable_html(subject, reason))
+    s.headline(f"not applicable: {reason}")
+    return s
 
 
 def _start_line(n: int, jobs: int, cached: int = 0) -> str:
@@ -387,11 +430,10 @@ def _start_line(n: int, jobs: int, cached: int = 0) -> str:
     return f"running {n} analys{'es' if n != 1 else 'is'} {where}" + (f", {cached} from the cache" if cached else "")
 
 
-def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int, on_start=None) -> list[Section]:
-    """``run_analyses`` through the result cache: hits first, then the misses computed and stored."""
-    from stewart_drake.report import cache
-
-    keys = [cache.section_key(a, quick) for a in analyses]
+def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int, on_start=None, subject=None) -> list[Section]:
+    """``run_analyses`` through the result cache: hits first, then the misses computed and stored (a section
+    without a key, ``cache.section_key``, is computed every time)."""
+    keys = [cache.section_key(a, quick, subject) for a in analyses]
     sections: list[Section | None] = [cache.load(k) for k in keys]
     for s in sections:
         if s is not None:
@@ -402,7 +444,7 @@ def _run_cached(analyses: list[Analysis], quick: bool, log, jobs: int, on_start=
         on_start(_start_line(len(todo), jobs, len(hits)))
     for k, i in enumerate(hits, 1):
         _progress(k, len(analyses), sections[i], log)
-    for i, s in zip(todo, run_analyses([analyses[i] for i in todo], quick, log, jobs)):
+    for i, s in zip(todo, run_analyses([analyses[i] for i in todo], quick, log, jobs, subject=subject)):
         sections[i] = s
         if not s.crashed:
             cache.store(keys[i], s)
@@ -440,18 +482,31 @@ def command_line(argv=None) -> str:
 
 
 def run_standalone(module_file: str, argv=None) -> int:
-    """``main()`` of an analysis script: build just that section into ``--out`` (default report/<name>)."""
+    """``main()`` of an analysis script: build just that section into ``--out`` (default report/<name>), on the
+    presets or on ``--platform FILE|NAME`` / ``--machine FILE``."""
     import argparse
 
     path = Path(module_file).resolve()
     ap = argparse.ArgumentParser(description=f"analysis {path.stem}")
     ap.add_argument("--out", default=f"report/{path.stem}")
     ap.add_argument("--quick", action="store_true", help="smaller samples, for smoke tests")
+    who = ap.add_mutually_exclusive_group()
+    who.add_argument("--platform", metavar="FILE|NAME", help="run on this platform file or preset")
+    who.add_argument("--machine", metavar="FILE", help="run on this machine file (see report --machine)")
     args = ap.parse_args(argv)
     out = OutputFolder(args.out)
+    subject = None
+    try:
+        if args.machine is not None:
+            subject = subjects.from_machine_file(args.machine)
+        elif args.platform is not None:
+            subject = subjects.from_platform(args.platform)
+    except StewartError as e:
+        print(f"{path.stem}: error: {e}", file=sys.stderr)
+        return getattr(e, "exit_code", 2)
     a = load_analysis(path)
     t0 = time.perf_counter()
-    sections = run_analyses([a], quick=args.quick)
+    sections = run_analyses([a], quick=args.quick, subject=subject)
     meta = render.default_meta(
         sections, command_line([str(path), *(sys.argv[1:] if argv is None else argv)]), time.perf_counter() - t0
     )

@@ -9,10 +9,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from stewart_drake.api.result import Result
-from stewart_drake.core.geometry import PRESETS
+from stewart_drake.core.geometry import PRESETS, Platform
 from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.processes import check_workers
+from stewart_drake.errors import REPORT_ONE_SUBJECT, UsageError
 from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
+from stewart_drake.report.subject import from_machine_file, from_platform
 
 
 @dataclass(repr=False)
@@ -61,8 +63,11 @@ def report(
     force: bool = False,
     on_start: Callable[[str], None] | None = None,
     cache: bool = True,
+    platform: str | Path | Platform | Sequence[str | Path | Platform] | None = None,
+    machine: str | Path | None = None,
 ) -> ReportResult:
-    """Run the analyses on the built-in presets and write the HTML report (``index.html``, ``checks.json``).
+    """Run the analyses on the built-in presets, or on a user's machine, and write the HTML report (``index.html``,
+    ``checks.json``).
 
     Args:
         out: the output folder.
@@ -75,13 +80,28 @@ def report(
         cache: take a section whose inputs and code version are unchanged from the result cache under
             ``$STEWART_DRAKE_CACHE`` (``report.cache``: checks and figures exactly as computed) and store
             each section computed; False: every section computed, the cache neither read nor written.
+        platform: report on these platforms (a preset name, a platform file or a ``Platform``; several: each
+            section once per platform) instead of the presets: every section that applies to a user's platform
+            runs on it, the others say why they do not apply.
+        machine: report on the machine file at this path (its platform with its payload, the loop's fixed-point
+            format, its motions and requirements: ``report.subject``).
 
     Returns:
         The report's index and its checks.
 
     Raises:
-        StewartError: a refused output folder, an unknown analysis, ``jobs`` out of range.
+        StewartError: a refused output folder, an unknown analysis, ``jobs`` out of range, both ``platform`` and
+            ``machine``, an unreadable platform or machine file.
     """
+    if platform is not None and machine is not None:
+        raise UsageError(REPORT_ONE_SUBJECT)
+    if machine is not None:
+        studied = [from_machine_file(machine)]
+    elif platform is not None:
+        many = isinstance(platform, (list, tuple))
+        studied = [from_platform(p) for p in (platform if many else [platform])]
+    else:
+        studied = [None]
     folder = (
         out
         if isinstance(out, OutputFolder)
@@ -91,8 +111,22 @@ def report(
     check_workers("--jobs", jobs)  # the one rule for worker counts (core.processes)
     t0 = time.perf_counter()
     analyses = discover_analyses(only=only)
-    sections = run_analyses(analyses, quick=quick, jobs=jobs, cache=cache, on_start=on_start)
+    sections = []
+    for subject in studied:
+        done = run_analyses(analyses, quick=quick, jobs=jobs, cache=cache, on_start=on_start, subject=subject)
+        for s in done if len(studied) > 1 else ():  # several platforms: each section names its own
+            s.title = f"{s.title} — {subject.name}"
+            for c in s.checks:
+                c.section = s.title
+        sections += done
     elapsed = time.perf_counter() - t0
-    meta = render.default_meta(sections, command_line(), elapsed, PRESETS)
-    index = write_report(sections, folder, meta=meta)
+    if studied == [None]:
+        meta, title = render.default_meta(sections, command_line(), elapsed, PRESETS), "stewart-drake report"
+    else:
+        names = ", ".join(s.name for s in studied)
+        meta = render.default_meta(sections, command_line(), elapsed)
+        del meta["presets"]
+        meta["machine" if machine is not None else "platforms"] = ", ".join(f"{s.name} ({s.source})" for s in studied)
+        title = f"stewart-drake report: {names}"
+    index = write_report(sections, folder, title=title, meta=meta)
     return ReportResult(Path(index), [c for s in sections for c in s.checks], elapsed)

@@ -1,14 +1,23 @@
-"""The report's result cache: a section is recomputed only when its inputs or its code changed.
+"""The report's result cache: a section is recomputed only when its code or its declared inputs changed.
 
-A section's key is the SHA-256 of: its code version (``code_version``: the package sources its analysis reaches
-by imports, ``code_deps.closure``, and every data file of the installed ``stewart_drake`` package, by relative
-path and content, plus the versions of Python and of the libraries that draw or compute, ``DEPENDENCIES``), the
-analysis' name, the content of its script when it lies outside the package, the ``quick`` flag, and the
-compiler the C builds would use (``$STEWART_DRAKE_CC``, ``$CC``: the compiled firmware is an input of the
-sections that run it). The analyses read only the built-in presets (package files, so part of the code version)
-and their own fixed seeds. So an edit of a module recomputes the sections whose analyses import it, directly or
-not, and no other. A script of the user's may read files of its own: each entry carries the files its section
-read outside the package (``report.reads``), and is given back only while they are unchanged.
+A section's key is the SHA-256 of:
+
+- the package's version (``package_version``): every file of the installed ``stewart_drake`` package, sources
+  and data alike, by relative path and content, and the versions of Python and of the libraries that draw or
+  compute (``DEPENDENCIES``). Any edit of the package recomputes every section: simple and sound, where a
+  scan of the imports would miss code reached by a computed name;
+- the analysis' name, the ``quick`` flag and the compiler the C builds would use (``$STEWART_DRAKE_CC``,
+  ``$CC``: the compiled firmware is an input of the sections that run it);
+- the subject's declared inputs (``report.subject.Subject.key``: the content of the user's platform or
+  machine file, or the preset's name, whose file is package data);
+- for an analysis script outside the package: its own text and the content of the files and folders it declares
+  in ``INPUTS`` (a literal list of paths relative to the script, read from its source: ``report.metadata``). A
+  folder's key is its listing and its files' content. A script that declares no ``INPUTS`` may read anything:
+  its section is never cached (``section_key`` gives None).
+
+The package's own analyses read only package files, their subject and their own fixed seeds. Nothing a section
+reads is recorded while it runs: what is not declared is not an input, and a section that could read something
+undeclared is not cached.
 
 The entry is the pickled ``Section`` (its text, tables, figures' PNG bytes, checks, warnings, original run
 time), so a hit gives back the section exactly as it was computed. Entries live in
@@ -25,38 +34,27 @@ import pickle
 import sys
 import tempfile
 from functools import cache
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from stewart_drake.report import reads
+import numpy as np
+
+from stewart_drake.core.c_build import CacheUnavailable, cache_dir
 
 PACKAGE = Path(__file__).resolve().parents[1]
-FORMAT = 2  # bump when the entry's layout changes (2: a section carries the files it read, ``report.reads``)
-# the libraries whose versions can change a section's numbers or figures (part of the code version)
+FORMAT = 3  # bump when the entry's layout or the key's recipe changes (3: declared inputs only)
+# the libraries whose versions can change a section's numbers or figures (part of the package version)
 DEPENDENCIES = ("drake", "numpy", "scipy", "matplotlib", "pymoo", "python-flint", "cffi")
 
 
-def _digest(p: Path) -> bytes:
-    """SHA-256 of file ``p``'s bytes."""
-    return hashlib.sha256(p.read_bytes()).digest()
-
-
-_package_digest = cache(_digest)  # a package file's: read once per process (the package does not change under it)
-
-
 @cache
-def data_version(root: Path = PACKAGE) -> str:
-    """SHA-256 (hex) of every package file under ``root`` but the Python sources and the bytecode caches
-    (relative path and bytes, in sorted order: C files, presets, grammars, tables), of the Python version and
-    of the ``DEPENDENCIES``' versions: an edit of any data, or an upgrade, changes every section's key."""
-    import numpy as np
-
+def package_version(root: Path = PACKAGE) -> str:
+    """SHA-256 (hex) of every file under ``root`` but the bytecode caches (relative path and bytes, in sorted
+    order), of the Python version and of the ``DEPENDENCIES``' versions. Read once per process: the installed
+    package does not change under a running report."""
     h = hashlib.sha256()
-    for p in sorted(
-        q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix not in (".py", ".pyc")
-    ):
-        h.update(str(p.relative_to(root)).encode() + b"\0" + _package_digest(p))
-    from importlib.metadata import PackageNotFoundError, version
-
+    for p in sorted(q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix != ".pyc"):
+        h.update(str(p.relative_to(root)).encode() + b"\0" + hashlib.sha256(p.read_bytes()).digest())
     for dist in DEPENDENCIES:
         try:
             h.update(f"|{dist}={version(dist)}".encode())
@@ -66,26 +64,43 @@ def data_version(root: Path = PACKAGE) -> str:
     return h.hexdigest()
 
 
-@cache
-def code_version(path: Path | None, root: Path = PACKAGE) -> str:
-    """SHA-256 (hex) of the code a section of the analysis script at ``path`` runs: ``data_version`` and the
-    package sources its imports reach (``code_deps.closure``; every package source when ``path`` is None)."""
-    from stewart_drake.report.code_deps import all_sources, closure
+def path_digest(path: Path) -> bytes:
+    """SHA-256 of what ``path`` holds now, read through symbolic links: a file's bytes; a folder's listing
+    (every file and folder below it, relative names, sorted) and its files' bytes; a marker when absent."""
+    h = hashlib.sha256()
+    if path.is_file():
+        h.update(b"file\0" + path.read_bytes())
+    elif path.is_dir():
+        h.update(b"folder\0")
+        seen = {os.path.realpath(path)}
+        for root, dirs, files in os.walk(path, followlinks=True):
+            dirs[:] = sorted(d for d in dirs if os.path.realpath(Path(root, d)) not in seen)  # no link cycles
+            seen.update(os.path.realpath(Path(root, d)) for d in dirs)
+            for name in sorted(files):
+                p = Path(root, name)
+                h.update(str(p.relative_to(path)).encode() + b"\0" + path_digest(p))
+            for name in dirs:
+                h.update(str(Path(root, name).relative_to(path)).encode() + b"/\0")
+    else:
+        h.update(b"absent")
+    return h.digest()
 
-    sources = closure(path, root) if path is not None else all_sources(root)
-    h = hashlib.sha256(data_version(root).encode())
-    for p in sources:
-        h.update(str(p.relative_to(root)).encode() + b"\0" + _package_digest(p))
-    return h.hexdigest()
 
-
-def section_key(analysis, quick: bool) -> str:
-    """The cache key (hex) of ``analysis``' section (see the module docstring)."""
+def section_key(analysis, quick: bool, subject=None) -> str | None:
+    """The cache key (hex) of ``analysis``' section of ``subject`` (None: the presets), or None when the section
+    must not be cached: a script outside the package that declares no ``INPUTS`` (see the module docstring)."""
     path = Path(analysis.path).resolve() if analysis.path is not None else None
-    h = hashlib.sha256(code_version(path).encode())
+    outside = path is None or PACKAGE not in path.parents
+    declared = getattr(analysis, "inputs", None)
+    if outside and declared is None:
+        return None
+    h = hashlib.sha256(package_version().encode())
     h.update(f"|{analysis.name}|{bool(quick)}".encode())
-    if path is not None and PACKAGE not in path.parents:
-        h.update(b"|script|" + _digest(path))
+    if outside:
+        h.update(b"|script|" + path_digest(path))
+        for name in declared:
+            h.update(f"|input|{name}|".encode() + path_digest(path.parent / name))
+    h.update(b"|subject|" + (b"presets" if subject is None else subject.key().encode()))
     for var in ("STEWART_DRAKE_CC", "CC"):
         h.update(f"|{var}={os.environ.get(var, '')}".encode())
     return h.hexdigest()
@@ -93,8 +108,6 @@ def section_key(analysis, quick: bool) -> str:
 
 def folder() -> Path | None:
     """The cache folder (created), or None where it cannot be used."""
-    from stewart_drake.core.c_build import CacheUnavailable, cache_dir
-
     try:
         d = cache_dir() / "report"
         d.mkdir(parents=True, exist_ok=True)
@@ -103,25 +116,23 @@ def folder() -> Path | None:
         return None
 
 
-def load(key: str):
-    """The cached ``Section`` of ``key``, or None (absent, unreadable, a file it read changed, or the cache
-    unusable)."""
-    d = folder()
+def load(key: str | None):
+    """The cached ``Section`` of ``key``, or None (no key, absent, unreadable, or the cache unusable)."""
+    d = folder() if key is not None else None
     if d is None:
         return None
     try:
         with open(d / f"{key}.pickle", "rb") as f:
-            section = pickle.load(f)
+            return pickle.load(f)
     except FileNotFoundError:
         return None
     except Exception:  # noqa: BLE001 - a truncated or foreign entry is a miss, recomputed and rewritten
         return None
-    return section if reads.unchanged(section.inputs) else None  # a file it read was edited or removed
 
 
-def store(key: str, section) -> None:
-    """Write ``section`` under ``key`` (atomically: a reader never sees half an entry)."""
-    d = folder()
+def store(key: str | None, section) -> None:
+    """Write ``section`` under ``key`` (atomically: a reader never sees half an entry); no key: nothing."""
+    d = folder() if key is not None else None
     if d is None:
         return
     fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")

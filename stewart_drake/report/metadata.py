@@ -1,7 +1,9 @@
 """An analysis script's report metadata read from its source, without importing it.
 
-The report's parent process needs only each analysis's ``TITLE``, ``ORDER``, ``COST`` and whether it defines
-``build`` and ``parts`` to order and schedule the sections; the workers import the scripts (they run them).
+The report's parent process needs only each analysis's ``TITLE``, ``ORDER``, ``COST``, ``INPUTS`` (the files a
+script outside the package declares it reads: ``report.cache``), ``NEEDS`` and ``PRESET_ONLY`` (whether it runs on
+a user's machine and what it needs of it: ``report.subject``) and whether it defines ``build`` and ``parts`` to
+order, schedule and key the sections; the workers import the scripts (they run them).
 Importing all seventeen in the parent as well cost 1.7 s of CPU before the first worker started (each script
 pulls in scipy, Drake, the firmware tools, …; measured with ``time.process_time`` around
 ``discover_analyses()``), while the source's syntax tree gives the same constants in ~0.05 s. A script whose
@@ -14,17 +16,18 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-CONSTANTS = ("TITLE", "ORDER", "COST")
+CONSTANTS = ("TITLE", "ORDER", "COST", "INPUTS", "NEEDS", "PRESET_ONLY")
 
 
 def read(path: Path) -> dict | None:
-    """``{"TITLE": …, "ORDER": …, "COST": …, "build": bool, "parts": bool}`` of the script at ``path``
-    (``COST`` 0.0 when absent; ``build``/``parts``: a top-level ``def`` of that name), or None when a constant
+    """``{"TITLE": …, "ORDER": …, "COST": …, "INPUTS": …, "NEEDS": …, "PRESET_ONLY": …, "build": bool,
+    "parts": bool}`` of the script at ``path`` (``COST`` 0.0 and the others None when absent; ``build``/``parts``:
+    a top-level ``def`` of that name), or None when a constant
     present is not a literal, ``TITLE``/``ORDER``/``build`` is missing, or a name is bound otherwise (an
     assignment or import of ``build``/``parts``, a second binding of a constant): then only importing the
     script says what it holds."""
     tree = ast.parse(Path(path).read_bytes(), str(path))
-    found: dict = {"COST": 0.0}
+    found: dict = {"COST": 0.0, "INPUTS": None, "NEEDS": None, "PRESET_ONLY": None}
     defs: set[str] = set()
     bound: list[str] = []
     for node in tree.body:
@@ -55,6 +58,9 @@ def read(path: Path) -> dict | None:
         "TITLE": found["TITLE"],
         "ORDER": found["ORDER"],
         "COST": found["COST"],
+        "INPUTS": found["INPUTS"],
+        "NEEDS": found["NEEDS"],
+        "PRESET_ONLY": found["PRESET_ONLY"],
         "build": True,
         "parts": "parts" in defs,
     }

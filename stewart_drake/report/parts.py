@@ -42,23 +42,23 @@ def precomputed(module_file, name: str, items: list) -> list | None:
 
 
 def run_part(path: str, name: str, item):
-    """A part in a worker: ``(result, wall s, CPU s, the files it read outside the package)`` (``report.reads``)."""
-    from stewart_drake.report import call_in_analysis, reads
+    """A part in a worker: ``(result, wall s, CPU s)``."""
+    from stewart_drake.report import call_in_analysis
 
     global IN_WORKER
     IN_WORKER = True  # a worker of the report's pool: no pool of its own
-    with reads.recording() as opened:
-        t0, c0 = time.perf_counter(), time.process_time()
-        result = call_in_analysis(path, name, item)
-        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    return result, wall, cpu, reads.digests(opened)
+    t0, c0 = time.perf_counter(), time.process_time()
+    result = call_in_analysis(path, name, item)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    return result, wall, cpu
 
 
-def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_section) -> None:
+def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_section, subject=None) -> None:
     """Run every analysis (and its declared parts) on ``pool``, at most ``jobs`` tasks at a time, the
-    costliest ready task first. ``build_in_worker(path, quick, done)`` builds a section in a worker;
-    ``on_section(i, future, parts_wall, parts_cpu, n_parts, parts_inputs)`` is called as each section's future
-    completes (``parts_inputs``: the files its parts and its declaration read, ``report.reads``).
+    costliest ready task first. ``build_in_worker(path, quick, done, subject)`` builds a section in a worker
+    (``subject``: a user's machine, ``report.subject``, whose sections run their cases themselves: the parts
+    are the presets' cases);
+    ``on_section(i, future, parts_wall, parts_cpu, n_parts)`` is called as each section's future completes.
 
     An analysis whose ``parts`` is still in its unimported script (``report.FromScript``) declares them in a
     worker, first of all tasks (the costliest first): that worker imports the script, which it needs anyway
@@ -69,7 +69,6 @@ def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_s
     ready: list = []  # heap of (-priority, order, kind, analysis index, payload)
     waiting, done, declared = {}, {}, {}
     spent = {i: [0.0, 0.0] for i in range(len(analyses))}  # parts' wall and CPU seconds
-    inputs: dict = {i: {} for i in range(len(analyses))}  # the files the parts and declarations read
 
     def add_parts(i, items):
         declared[i], waiting[i], done[i] = len(items), len(items), {}
@@ -79,7 +78,7 @@ def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_s
             heapq.heappush(ready, (-analyses[i].cost, next(order), "section", i, None))
 
     for i, a in sorted(enumerate(analyses), key=lambda ia: -ia[1].cost):
-        found = getattr(a, "parts", None)
+        found = getattr(a, "parts", None) if subject is None else None
         if isinstance(found, FromScript):
             heapq.heappush(ready, (-float("inf"), next(order), "declare", i, ("parts", quick)))
         else:
@@ -92,21 +91,18 @@ def schedule(pool, analyses: list, quick: bool, jobs: int, build_in_worker, on_s
             if kind in ("part", "declare"):
                 running[pool.submit(run_part, path, *payload)] = (kind, i, payload)
             else:
-                running[pool.submit(build_in_worker, path, quick, done[i])] = (kind, i, None)
+                running[pool.submit(build_in_worker, path, quick, done[i], subject)] = (kind, i, None)
         finished, _ = wait(running, return_when=FIRST_COMPLETED)
         for f in finished:
             kind, i, payload = running.pop(f)
             if kind == "section":
-                on_section(i, f, *spent[i], declared[i], inputs[i])
+                on_section(i, f, *spent[i], declared[i])
                 continue
             if kind == "declare":  # a script that fails to import has no parts: its section says why
                 add_parts(i, list(f.result()[0]) if f.exception() is None else [])
-                if f.exception() is None:
-                    inputs[i].update(f.result()[3])
                 continue
             if f.exception() is None:  # a part that raised is recomputed by its section, which reports it
-                result, wall, cpu, read = f.result()
-                inputs[i].update(read)
+                result, wall, cpu = f.result()
                 done[i][part_key(analyses[i].path, *payload)] = result
                 spent[i][0] += wall
                 spent[i][1] += cpu

@@ -241,7 +241,8 @@ def verdicts_html(sections, anchor: dict) -> str:
         cls = "pass" if ok == n else "fail"
         t = getattr(s, "elapsed", None)
         rows.append(
-            f'<tr><td><a href="#{anchor[id(s)]}">{html.escape(s.title)}</a></td><td class="num {cls}">{ok}/{n}</td>'
+            f'<tr><td><a href="#{anchor[id(s)]}">{html.escape(s.title)}</a></td>'
+            f'<td class="num {cls if n else ""}">{f"{ok}/{n}" if n else "—"}</td>'
             f"<td>{html.escape(headline(s))}</td><td class=num>{'' if t is None else f'{t:.1f}'}"
             f"{' (cached)' if getattr(s, 'cached', False) else ''}</td></tr>"
         )

@@ -69,7 +69,7 @@ class _Inline:
         f = Future()
         if fn is parts.run_part:
             self.order.append(("part", args[0], args[2]))
-            f.set_result((args[2], 0.5, 0.25, {f"/data/{args[0]}": str(args[2])}))
+            f.set_result((args[2], 0.5, 0.25))
         else:
             self.order.append(("section", args[0]))
             f.set_result(args[2])
@@ -88,8 +88,8 @@ def test_schedule_costliest_first_and_a_section_right_after_its_parts():
         analyses,
         False,
         1,
-        lambda path, quick, done: done,
-        lambda i, f, w, c, n, read: got.update({i: (f.result(), w, c, n, read)}),
+        lambda path, quick, done, subject: done,
+        lambda i, f, w, c, n: got.update({i: (f.result(), w, c, n)}),
     )
     assert pool.order == [
         ("part", "heavy", 1),
@@ -101,5 +101,4 @@ def test_schedule_costliest_first_and_a_section_right_after_its_parts():
     ]
     # each section got its own parts' results, keyed by (script, function, item), and their time summed
     assert got[1][0] == {parts.part_key("heavy", "f", 1): 1, parts.part_key("heavy", "f", 2): 2}
-    assert got[1][1:4] == (1.0, 0.5, 2) and got[0] == ({}, 0.0, 0.0, 0, {})
-    assert got[1][4] == {"/data/heavy": "2"} and got[2][4] == {"/data/middle": "3"}  # the files its parts read
+    assert got[1][1:4] == (1.0, 0.5, 2) and got[0] == ({}, 0.0, 0.0, 0)
