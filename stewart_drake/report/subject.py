@@ -1,8 +1,8 @@
 """What a report studies: the built-in presets (the default) or a user's machine, as one small typed ``Subject``.
 
 ``--platform FILE|NAME`` fills a ``Subject`` with the platform alone (``from_platform``); ``--machine FILE`` fills
-it from a machine file (``from_machine_file``: the platform's keys, and optionally the loop's fixed-point
-``firmware:`` format, ``motions:``, a ``payload:`` and a ``requirements:`` file). Each analysis says whether it
+it from a machine file read by ``spec.load_machine`` (``from_machine_file``: the platform with its payload, and
+the loop's fixed-point ``firmware:`` format, ``motions:`` and a ``requirements:`` file where the file gives them). Each analysis says whether it
 applies to a user's machine and what it needs of it with two literals read from its source
 (``report.metadata``): ``NEEDS = ("plate", "legs.max_force", ...)`` (see ``NEEDS``), or ``PRESET_ONLY = "why"``
 for a section that reproduces the presets' published numbers. A section that does not apply is shown with a
@@ -13,34 +13,26 @@ from __future__ import annotations
 
 import hashlib
 import html
-import math
 import pickle
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from stewart_drake.control.gains import ControllerConfig, counts_per_lsb
 from stewart_drake.core.geometry import (
-    PLATFORM_RULES,
-    PLATFORM_SHAPES,
     PRESETS,
     Platform,
     PlatformConfig,
-    check_home,
-    check_length_unit,
-    check_name,
-    check_shared_base,
     load_platform,
     load_yaml_config,
-    platform_from_config,
     preset_path,
 )
 from stewart_drake.core.trajectory import TRAJECTORIES, Trajectory, fit_trajectory, get_trajectory
-from stewart_drake.core.yamlio import check_rules
-from stewart_drake.design.payload import with_payload
-from stewart_drake.errors import FixedPointError, GainError, GeometryError, ReportSubjectError
+from stewart_drake.errors import GainError, ReportSubjectError
 from stewart_drake.fixedpoint.generic import QFormat
+from stewart_drake.spec import Machine, load_machine
 
 # What an analysis may need of a user's machine (``NEEDS``), and how the report says that the file lacks it.
 NEEDS = {
@@ -151,118 +143,81 @@ def _keys_of(path: Path) -> dict:
     return where
 
 
-# ------------------------------------------------------------------------------------------------------------
-# The machine file: a stand-in for the machine spec's loader, in one place.
+def _mapping_keys(node, prefix: str = "") -> set:
+    """The dotted keys of a YAML mapping, each prefix included (list items dropped)."""
+    out = set()
+    if isinstance(node, dict):
+        for k, v in node.items():
+            key = f"{prefix}{k}"
+            out |= {key} | _mapping_keys(v, key + ".")
+    return out
 
 
-@dataclass
-class FirmwareFields:
-    """``firmware:`` of a machine file: the loop's fixed-point IK format (``length_lsb`` in the file's unit)."""
-
-    word_bits: int = 16
-    length_lsb: float = 0.0  # 0: the DSP's 1 mm
-    trig: str = ""  # "": tfr16 for 16-bit words, exact otherwise
-
-
-@dataclass
-class PayloadFields:
-    """``payload:`` of a machine file: a point mass (kg) fixed to the plate at ``position`` (file unit, in T)."""
-
-    mass: float = 0.0
-    position: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-@dataclass
-class MachineFile(PlatformConfig):
-    """A machine file as this report reads it: a platform file's keys plus ``firmware``, ``motions`` (``seed``,
-    ``rotating``, or ``.csv`` and ``.stw`` paths relative to the file), ``payload`` and ``requirements`` (a path)."""
-
-    firmware: FirmwareFields | None = None
-    motions: list[str] = field(default_factory=list)
-    payload: PayloadFields | None = None
-    requirements: str = ""
-
-
-def _check_payload(p: PayloadFields, shown: str, unit: str) -> None:
-    """A physical payload: a finite mass >= 0 kg at three finite coordinates on or above the plate (z >= 0)."""
-
-    def bad(field_, problem):
-        return ReportSubjectError(ReportSubjectError.FIELD.format(path=shown, field=field_, problem=problem))
-
-    if not (math.isfinite(p.mass) and p.mass >= 0):
-        raise bad("payload.mass", f"must be a finite number >= 0 kg, got {p.mass:g}")
-    if len(p.position) != 3 or not all(math.isfinite(v) for v in p.position):
-        raise bad("payload.position", f"must be three finite numbers [x, y, z] in {unit}, got {p.position}")
-    if p.position[2] < 0:
-        raise bad(
-            "payload.position",
-            f"z = {p.position[2]:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)",
-        )
+def _as_written(value, machine_file) -> str:
+    """A path the machine file named, as written there (relative to the file's folder), for messages."""
+    try:
+        return str(Path(value).resolve().relative_to(Path(machine_file).resolve().parent))
+    except (ValueError, TypeError):
+        return str(value)
 
 
 def from_machine_file(path) -> Subject:
-    """The subject of ``--machine FILE``. Errors name the file and the field (``YamlError``,
-    ``ReportSubjectError``).
-
-    This reads the parts of a machine file the report uses; the machine spec's ``load_machine`` replaces it."""
-    shown = str(path)
-    where: dict = {}
-
-    def check(cfg, w):  # a platform file's checks (``core.geometry.load_platform_yaml``'s), on its keys
-        check_name(cfg, w, shown)
-        k = check_length_unit(cfg, w, shown)
-        check_rules(w, PLATFORM_RULES, PLATFORM_SHAPES, cfg, shown, k, cfg.length_unit)
-        check_shared_base(cfg, w, shown, k)
-        where.update(w)
-
-    cfg = load_yaml_config(path, MachineFile, "machine", check)
-    try:
-        platform = platform_from_config(cfg)
-    except GeometryError as e:
-        raise GeometryError(GeometryError.IN_FILE.format(path=shown, problem=e)) from None
-    check_home(platform)
-    k = 1e-3 if cfg.length_unit == "mm" else 1.0
-    if cfg.payload is not None:
-        _check_payload(cfg.payload, shown, cfg.length_unit)
-        platform = with_payload(platform, cfg.payload.mass, [v * k for v in cfg.payload.position])
-    fmt = None
-    if cfg.firmware is not None:
-        f = cfg.firmware
-        trig = f.trig or ("tfr16" if f.word_bits == 16 else "exact")
-        try:
-            fmt = QFormat(f.word_bits, f.length_lsb * k if f.length_lsb else 1e-3, trig)
-        except FixedPointError as e:
-            raise ReportSubjectError(ReportSubjectError.FIELD.format(path=shown, field="firmware", problem=e)) from None
+    """The subject of ``--machine FILE`` (or a ``Machine``): read by ``spec.load_machine`` (errors name the file,
+    line and spec path); the report uses its platform with the payload on the plate, the loop's fixed-point
+    format when the file gives ``firmware:``, its ``motions:`` and ``requirements:``."""
+    if isinstance(path, Machine):
+        machine, shown, raw = path, path.platform.name, None
+    else:
+        shown = str(path)
+        machine = load_machine(path)
+        raw = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+    if raw is None:  # a Machine object gives every field
+        given = {"legs.max_force", "firmware", "motions"}
+        given |= {"legs.stiffness"} if machine.platform.legs.stiffness is not None else set()
+        given |= {"plate.mass"} if machine.platform.mass > 0 else set()
+    else:
+        inline = raw.get("platform", raw)
+        if isinstance(inline, str):  # the platform by name or path: the keys its own file gives
+            src = machine.platform_source or inline
+            inline = None
+            given = set(_given_keys(_keys_of(preset_path(src) if src in PRESETS else Path(src))))
+        else:
+            given = _mapping_keys(inline)
+        given |= {k for k in ("firmware", "motions") if k in raw}
+    platform = machine.loaded_platform
+    fmt = machine.firmware.qformat() if "firmware" in given else None
+    if fmt is not None:
         try:  # the loop's sensor counts a whole number of its counts per LSB
             counts_per_lsb(ControllerConfig(ik_format=fmt))
         except GainError as e:
             raise ReportSubjectError(
                 ReportSubjectError.FIELD.format(path=shown, field="firmware.length_lsb", problem=e)
             ) from None
-    folder = Path(path).resolve().parent
-    motions, files = [], [str(Path(path).resolve())]
-    for i, m in enumerate(cfg.motions, 1):
-        if m in TRAJECTORY_NAMES:
+    motions, files = [], [] if raw is None else [str(Path(path).resolve())]
+    for i, m in enumerate(machine.motions if "motions" in given else (), 1):
+        if isinstance(m, Trajectory) or m in TRAJECTORY_NAMES:
             motions.append(m)
-        elif m.endswith((".csv", ".stw")) and (folder / m).is_file():
-            motions.append(str(folder / m))
-            files.append(str(folder / m))
-            if m.endswith(".stw"):  # a program's errors are the file's: its file, line and column, now
-                Trajectory.from_program(folder / m, platform)
+        elif str(m).endswith((".csv", ".stw")) and Path(m).is_file():
+            motions.append(str(Path(m).resolve()))
+            files.append(str(Path(m).resolve()))
+            if str(m).endswith(".stw"):  # a program's errors are the file's: its file, line and column, now
+                Trajectory.from_program(m, platform)
         else:
-            raise ReportSubjectError(ReportSubjectError.MOTION.format(path=shown, item=i, value=m))
+            raise ReportSubjectError(ReportSubjectError.MOTION.format(path=shown, item=i, value=_as_written(m, path)))
     requirements = None
-    if cfg.requirements:
-        r = folder / cfg.requirements
+    if machine.requirements:
+        r = Path(machine.requirements)
         if not r.is_file():
             raise ReportSubjectError(
                 ReportSubjectError.FIELD.format(
-                    path=shown, field="requirements", problem=f"{cfg.requirements!r} is not a file"
+                    path=shown,
+                    field="requirements",
+                    problem=f"{_as_written(machine.requirements, path)!r} is not a file",
                 )
             )
-        requirements = str(r)
+        requirements = str(r.resolve())
         files.append(requirements)
-    return Subject(platform.name, platform, shown, _given_keys(where), fmt, tuple(motions), requirements, tuple(files))
+    return Subject(platform.name, platform, shown, frozenset(given), fmt, tuple(motions), requirements, tuple(files))
 
 
 def subject_trajectories(subject: Subject) -> list[Trajectory]:

@@ -29,9 +29,9 @@ stroke: [550.0, 850.0]
 rotation_centre: [0.0, 0.0, 0.0]
 plate: {mass: 60.0, com: [0.0, 0.0, 50.0], inertia: [3750000.0, 3750000.0, 7500000.0, 0, 0, 0]}
 legs: {cylinder_mass: 4.0, piston_mass: 2.0, max_force: 4000.0, max_speed: 500.0, stiffness: 20000.0}
-payload: {mass: 150.0, position: [0.0, 0.0, 300.0]}
+payload: {mass: 150.0, position: [0, 0, 300mm]}
 motions: [seed]
-firmware: {word_bits: 16, length_lsb: 0.03}
+firmware: {word_bits: 16, length_lsb: 30um}
 """
 # the loop on the user's machine and a section that needs nothing but the platform: a subset of the report that
 # keeps the test cheap (a few seconds of simulated loops)
@@ -82,7 +82,7 @@ def test_the_210_kg_machine_and_its_format(tmp_path, capsys):
     r = sd.report(tmp_path / "r1", machine=machine, only=ONLY[1:], quick=True, jobs=1)
     assert r.ok and json.loads((tmp_path / "r1" / "checks.json").read_text()) == checks
     assert "from the cache" in capsys.readouterr().err  # the same file, the same sections: served from the cache
-    machine.write_text(MACHINE.replace("length_lsb: 0.03", "length_lsb: 1.0"))
+    machine.write_text(MACHINE.replace("length_lsb: 30um", "length_lsb: 1mm"))
     rc, _, err = cli(capsys, *argv, "--out", tmp_path / "r2")
     assert rc == 1 and "from the cache" not in err.split("Controller in the loop")[1].splitlines()[0]
     (failed,) = [c for c in _checks(tmp_path / "r2") if not c["passed"]]  # the certificate passes at 1 mm
@@ -99,21 +99,21 @@ def test_several_platforms(tmp_path, capsys):
     assert sections == {"Inverse kinematics vs Drake — own-radial", "Inverse kinematics vs Drake — utn-dynamic"}
 
 
-FORMAT = "firmware: {word_bits: 16, length_lsb: 0.03}"
+FORMAT = "firmware: {word_bits: 16, length_lsb: 30um}"
 
 
 @pytest.mark.parametrize(
     "old,new,message",
     [
         (FORMAT, FORMAT, None),
-        (FORMAT, "firmware: {word_bits: 40}", "m.yaml: firmware: word_bits must be"),
-        ("motions: [seed]", "motions: [seed, nowhere.csv]", "m.yaml: motions item 2: 'nowhere.csv' is not seed"),
-        (FORMAT, "firmware: {word_bits: 16, length_lsb: 0.025}", "m.yaml: firmware.length_lsb: "),
+        (FORMAT, "firmware: {word_bits: 40}", "m.yaml:15: firmware.word_bits must be"),
+        ("motions: [seed]", "motions: [seed, nowhere.csv]", "nowhere.csv' is not seed"),
+        (FORMAT, "firmware: {word_bits: 16, length_lsb: 25um}", "m.yaml: firmware.length_lsb: "),
         (FORMAT, "requirements: missing.yaml", "m.yaml: requirements: 'missing.yaml' is not a file"),
         (
-            "payload: {mass: 150.0, position: [0.0, 0.0, 300.0]}",
-            "payload: {mass: 150.0, position: [0, 0, -1]}",
-            "m.yaml: payload.position: z = -1 mm is below the plate",
+            "payload: {mass: 150.0, position: [0, 0, 300mm]}",
+            "payload: {mass: 150.0, position: [0, 0, -1mm]}",
+            "m.yaml:13: payload.position must be at z >= 0 (on the plate)",
         ),
         (FORMAT, "frimware: {word_bits: 16}", "did you mean 'firmware'?"),
     ],
@@ -231,7 +231,7 @@ def test_one_analysis_alone_on_a_machine(tmp_path, capsys):
     assert all(c["what"].startswith("newcomer-6dof-sim:") for c in _checks(tmp_path / "r"))
     machine.write_text(MACHINE.replace("word_bits: 16", "word_bits: 40"))
     assert drake_kinematics.main(["--quick", "--machine", str(machine), "--out", str(tmp_path / "r2")]) == 2
-    assert "m.yaml: firmware: word_bits must be" in capsys.readouterr().err
+    assert "m.yaml:15: firmware.word_bits must be" in capsys.readouterr().err
 
 
 def test_what_a_section_needs(tmp_path):
