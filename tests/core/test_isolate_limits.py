@@ -76,7 +76,7 @@ def test_a_forked_process_ends_with_the_answer(tmp_path):
     def fork_and_answer(beat):
         pid = os.fork()
         if pid == 0:
-            time.sleep(600)
+            time.sleep(60)  # bounded: were it left behind, it holds the test's output pipes this long
             os._exit(0)
         pid_file.write_text(str(pid))
         return 42

@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 
+from stewart_drake.commands._certify import format_tick
 from stewart_drake.control import ControllerConfig
 from stewart_drake.control.gains import DIFF_SHIFT, FixedGains
 from stewart_drake.core.geometry import load_preset
@@ -62,5 +63,9 @@ def test_cli_certify_tick_exit_status(capsys):
     )
     d = json.loads(out)
     assert rc == 1 and d["saturation_possible"] is True and d["tick"]["saturation_possible"] is True, err
-    rc, out, _ = cli(capsys, *argv, "--tick-error", "1e6", "--tick-speed", "1000", "--tick-feedforward", "1e7")
-    assert rc == 1 and "SATURATION POSSIBLE in sd_tick's arithmetic" in out
+    lines = format_tick(certify_tick(_config(), **HUGE)).splitlines()
+    assert lines[-1].startswith("SATURATION POSSIBLE in sd_tick's arithmetic within these bounds: error e (counts)")
+    assert "command" not in lines[-1] and "integrator (Q31)" not in lines[-1]  # the rails are not in the verdict
+    assert any(
+        x.strip().startswith("command (Q15)") and x.endswith("possible (its rail: the law's limit)") for x in lines
+    )
