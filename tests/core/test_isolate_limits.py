@@ -115,3 +115,19 @@ def test_truncated_cache_entry_is_rebuilt(tmp_path, monkeypatch):
     assert again == path and again.read_bytes() == whole and c_build.intact(again)
     ffi, lib = c_build.load(again, "int one(void);")
     assert lib.one() == 1
+
+
+@needs_cc
+def test_truncated_kernel_in_the_cache_is_rebuilt(tmp_path, monkeypatch):
+    """The package's kernels (``RealtimeFK(engine="c")``, the IK kernel, ...) are cached by their source alone
+    (``source_keyed_library``): a truncated copy there is built again before it is loaded."""
+    monkeypatch.setattr(c_build, "cache_dir", lambda: tmp_path)
+    src = tmp_path / "two.c"
+    src.write_text("int two(void) { return 2; }\n")
+    path = c_build.source_keyed_library(src, "int two(void);", "sd-test-two")
+    whole = path.read_bytes()
+    path.write_bytes(whole[:100])
+    again = c_build.source_keyed_library(src, "int two(void);", "sd-test-two")
+    assert again == path and c_build.intact(again) and again.read_bytes() == whole
+    _, lib = c_build.load(again, "int two(void);")
+    assert lib.two() == 2
