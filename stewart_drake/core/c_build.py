@@ -281,8 +281,11 @@ def run_compiler(cmd: list[str], what: str, timeout: float | None = None) -> sub
     compiler echo bytes that are not UTF-8). ``CompileError`` naming ``what`` when it does not finish."""
     timeout = COMPILE_TIMEOUT_S if timeout is None else timeout
     kib = max(1, int(COMPILE_MEMORY_LIMIT_BYTES) // 1024)
-    # the limit set by the shell the compiler replaces (no preexec_fn: unsafe in a process with threads)
-    limited = ["/bin/sh", "-c", f'ulimit -v {kib} && exec "$@"', "sh", *cmd]
+    # the limit set by the shell the compiler replaces (no preexec_fn: unsafe in a process with threads); where
+    # the system refuses it, the compiler runs without it
+    limited = (
+        ["/bin/sh", "-c", f'ulimit -v {kib} 2>/dev/null; exec "$@"', "sh", *cmd] if os.path.exists("/bin/sh") else cmd
+    )
     p = subprocess.Popen(
         limited,
         stdout=subprocess.PIPE,

@@ -186,12 +186,21 @@ def _failure(path: str, ended, start_rss, allowance: int, message: str) -> Isola
     return IsolationError(message)
 
 
+_REAPED: dict[int, tuple] = {}  # children reaped by _has_ended where waitid cannot look without reaping
+
+
 def _has_ended(pid: int) -> bool:
-    """Whether the child has ended (it is not reaped: its process group cannot be taken by another)."""
-    try:
-        return os.waitid(os.P_PID, pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
-    except ChildProcessError:
-        return True
+    """Whether the child has ended (left unreaped where the system allows: its group cannot be taken by another)."""
+    if hasattr(os, "waitid"):
+        try:
+            return os.waitid(os.P_PID, pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
+        except ChildProcessError:
+            return True
+    got, status, usage = os.wait4(pid, os.WNOHANG)
+    if got == 0:
+        return False
+    _REAPED[pid] = (status, usage)
+    return True
 
 
 def _end(pid: int) -> tuple:
@@ -204,5 +213,7 @@ def _end(pid: int) -> tuple:
             os.kill(pid, signal.SIGKILL)
         except OSError:
             pass
+    if pid in _REAPED:
+        return _REAPED.pop(pid)
     _, status, usage = os.wait4(pid, 0)
     return status, usage

@@ -131,3 +131,30 @@ def test_truncated_kernel_in_the_cache_is_rebuilt(tmp_path, monkeypatch):
     assert again == path and c_build.intact(again) and again.read_bytes() == whole
     _, lib = c_build.load(again, "int two(void);")
     assert lib.two() == 2
+
+
+@pytest.mark.parametrize("waitid", [True, False])
+def test_a_crash_after_a_fork_is_seen_and_the_fork_ended(monkeypatch, tmp_path, waitid):
+    """The child forks a sleeper (which holds the answer pipe open) and crashes: the crash is found by the child's
+    status, not the pipe's end, and the sleeper is ended. Where ``os.waitid`` is missing (macOS) the child is
+    reaped as it is found ended and its status kept."""
+    if not waitid:
+        monkeypatch.delattr(os, "waitid", raising=False)
+    pid_file = tmp_path / "sleeper.pid"
+
+    def fork_and_crash(beat):
+        pid = os.fork()
+        if pid == 0:
+            time.sleep(60)  # bounded: were it left behind, it holds the test's output pipes this long
+            os._exit(0)
+        pid_file.write_text(str(pid))
+        ctypes.memset(0, 1, 16)
+
+    with pytest.raises(IsolationError) as e:
+        run_isolated(fork_and_crash, path="segv.c", limit=30, memory=CAP)
+    assert str(e.value).startswith("segv.c: the firmware crashed (SIGSEGV"), e.value
+    sleeper = int(pid_file.read_text())
+    deadline = time.monotonic() + 5
+    while _alive(sleeper) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _alive(sleeper)
