@@ -757,6 +757,7 @@ class IsolationError(StewartError):
         "not call exit() (in sd_ik, sd_tick or a constructor)"
     )
     CRASHED = "{path}: the firmware crashed ({signal}: e.g. a bad pointer or an array index out of range)"
+    MEMORY = "{path}: the firmware ran out of its memory limit ({limit} of address space); stopped"
 
 
 class FirmwareError(StewartError):

@@ -366,13 +366,15 @@ class CertifyResult(Result):
 
     @property
     def saturation_possible(self) -> bool:
-        """Whether some arithmetic word may saturate in the box (a witness, or cells left undecided)."""
-        return bool(self.certificate.saturation_possible)
+        """Whether some arithmetic word may saturate: of ``sd_ik`` in the box (a witness, or cells left undecided)
+        or, when certified, of ``sd_tick`` within its bounds (its rails excluded)."""
+        return bool(self.certificate.saturation_possible) or bool(self.tick and self.tick.saturation_possible)
 
     def _fields(self) -> dict:
         d = self.certificate.to_dict()
         if self.tick is not None:
             d["tick"] = self.tick.to_dict()
+            d["saturation_possible"] = self.saturation_possible
         return d
 
 

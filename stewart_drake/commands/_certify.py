@@ -113,11 +113,18 @@ def format_tick(tick) -> str:
         f"{'word':>28} {'proven min':>12} {'proven max':>12} {'headroom':>9}  saturation",
     ]
     for w in tick.words:
-        lines.append(f"{w.name:>28} {w.min:>12} {w.max:>12} {w.headroom_bits:>8.2f}b  {w.saturation}")
+        rail = " (its rail: the law's limit)" if w.rail and w.saturation != "impossible" else ""
+        lines.append(f"{w.name:>28} {w.min:>12} {w.max:>12} {w.headroom_bits:>8.2f}b  {w.saturation}{rail}")
     lines.append(
         "anti-windup: the integrator is proven to stay inside its Q31 rails"
         if tick.anti_windup
         else "anti-windup: not proven to keep the integrator off its rails (it may reach them; saturating adds: no wrap)"
+    )
+    clamped = [w.name for w in tick.words if w.saturation != "impossible" and not w.rail]
+    lines.append(
+        f"SATURATION POSSIBLE in sd_tick's arithmetic within these bounds: {', '.join(clamped)}"
+        if clamped
+        else "sd_tick: no saturation of the arithmetic within these bounds"
     )
     return "\n".join(lines)
 

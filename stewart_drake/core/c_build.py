@@ -13,7 +13,12 @@ Compiler order: ``$STEWART_DRAKE_CC`` (a command line, e.g. ``clang`` or ``gcc -
 ``gcc``, ``clang`` on PATH, then ``python -m ziglang cc`` when the ``ziglang`` wheel is installed.
 Cache: ``$STEWART_DRAKE_CACHE``, else ``$XDG_CACHE_HOME/stewart-drake``, else ``~/.cache/stewart-drake``
 (never the source tree); an entry's name is the SHA-256 of the compiler's identity, the flags and every
-source's bytes, written atomically (compiled in a temporary folder, then renamed).
+source's bytes, written atomically (compiled in a temporary folder, then renamed) beside the SHA-256 of the
+library's own bytes (``<entry>.sha256``); an entry is used only while its bytes match that record (a truncated
+or altered library would crash the process when loaded), else it is built again.
+
+A compiler runs in its own process group with its address space limited to ``COMPILE_MEMORY_LIMIT_BYTES``
+(``ulimit -v``): a source that makes it allocate without end (``#include "/dev/zero"``) is a ``CompileError``.
 """
 
 from __future__ import annotations
@@ -41,6 +46,8 @@ STRICT_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
 
 
 COMPILE_TIMEOUT_S = 300.0  # one source file; the generated firmware takes ~1 s
+COMPILE_MEMORY_LIMIT_BYTES = 4 << 30  # address space of one compiler process; cc1 needs ~0.1 GB for these sources
+_OUT_OF_MEMORY = re.compile(r"out of memory|memory exhausted|cannot allocate memory|bad_alloc", re.IGNORECASE)
 
 
 class CompilerUnavailable(StewartError):
@@ -57,6 +64,8 @@ UNAVAILABLE = (CompilerUnavailable, CacheUnavailable)
 
 class CompileError(StewartError):
     """The compiler rejected a source; the message is the compiler's own (file:line: error ...)."""
+
+    MEMORY = "{what}: the C compiler ran out of its memory limit ({limit}); stopped"
 
 
 @dataclass(frozen=True)
@@ -210,7 +219,7 @@ def build(
         h.update(s.name.encode() + b"\0" + s.data() + b"\0")
     root = cache_dir()
     out = root / f"sd-{h.hexdigest()[:32]}.so"
-    if out.exists():
+    if intact(out):
         return out
     try:
         workdir = tempfile.TemporaryDirectory(prefix="build-", dir=root)
@@ -234,8 +243,36 @@ def build(
             raise CompilerUnavailable(
                 f"{' '.join(compiler.argv)} exited 0 but wrote no library: not a working C compiler (set ${CC_ENV} to one)"
             )
-        os.replace(target, out)
+        store(target, out)
     return out
+
+
+def _digest_path(path: Path) -> Path:
+    return path.with_name(path.name + ".sha256")
+
+
+def _file_digest(path: Path) -> str:
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
+
+
+def intact(path: Path) -> bool:
+    """Whether the cached library at ``path`` exists and its bytes are those recorded when it was stored."""
+    try:
+        return _digest_path(path).read_text().strip() == _file_digest(path)
+    except OSError:
+        return False
+
+
+def store(built: Path, path: Path) -> None:
+    """Move the library ``built`` to the cache entry ``path`` with the record of its bytes (each file replaced
+    atomically; the record first, so that an interrupted store leaves an entry that does not match it)."""
+    digest = _digest_path(path)
+    fd, tmp = tempfile.mkstemp(suffix=".sha256", dir=path.parent)
+    with os.fdopen(fd, "w") as f:
+        f.write(_file_digest(built) + "\n")
+    os.replace(tmp, digest)
+    os.replace(built, path)
 
 
 def run_compiler(cmd: list[str], what: str, timeout: float | None = None) -> subprocess.CompletedProcess:
@@ -243,8 +280,19 @@ def run_compiler(cmd: list[str], what: str, timeout: float | None = None) -> sub
     its own children (cc1, ld) stop with it; its output decoded leniently (a binary "source" makes the
     compiler echo bytes that are not UTF-8). ``CompileError`` naming ``what`` when it does not finish."""
     timeout = COMPILE_TIMEOUT_S if timeout is None else timeout
+    kib = max(1, int(COMPILE_MEMORY_LIMIT_BYTES) // 1024)
+    # the limit set by the shell the compiler replaces (no preexec_fn: unsafe in a process with threads); where
+    # the system refuses it, the compiler runs without it
+    limited = (
+        ["/bin/sh", "-c", f'ulimit -v {kib} 2>/dev/null; exec "$@"', "sh", *cmd] if os.path.exists("/bin/sh") else cmd
+    )
     p = subprocess.Popen(
-        cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, encoding="utf-8", errors="replace"
+        limited,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+        encoding="utf-8",
+        errors="replace",
     )
     try:
         out, err = p.communicate(timeout=timeout)
@@ -257,6 +305,9 @@ def run_compiler(cmd: list[str], what: str, timeout: float | None = None) -> sub
         if isinstance(e, subprocess.TimeoutExpired):
             raise CompileError(f"{what}: the C compiler did not finish within {timeout:g} s; stopped") from None
         raise
+    if p.returncode != 0 and _OUT_OF_MEMORY.search(err or out or ""):
+        limit = f"{COMPILE_MEMORY_LIMIT_BYTES / (1 << 20):g} MiB of address space"
+        raise CompileError(CompileError.MEMORY.format(what=what, limit=limit))
     return subprocess.CompletedProcess(cmd, p.returncode, out, err)
 
 
@@ -288,12 +339,12 @@ def source_keyed_library(source: Path, cdef: str, prefix: str, opt: str = "-O2",
     (``prefix`` names the cached copy)."""
     key = hashlib.sha256(source.read_bytes() + cdef.encode() + " ".join((opt, *flags)).encode()).hexdigest()[:32]
     fast = cache_dir() / f"{prefix}-{key}.so"
-    if not fast.exists():
+    if not intact(fast):
         built = build([Source(source.name, path=source)], opt=opt, flags=flags)
         fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
         os.close(fd)
         shutil.copyfile(built, tmp)
-        os.replace(tmp, fast)
+        store(Path(tmp), fast)
     return fast
 
 

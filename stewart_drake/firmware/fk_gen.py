@@ -5,8 +5,11 @@
 Newton on the firmware's own IK: ``FK_ITERATIONS`` times, e = measured − sd_ik(pose) · counts_per_LSB (counts),
 the Jacobian of the current estimate from the IK's leg vectors l_i (rows [l_i, (r_i × l_i)ᵀ E(angles)]: the
 rows of J⁻¹ · diag(I, E) times L_i, so the right-hand side is L_i e_i and no length is divided), the 6×6
-system solved by elimination with partial pivoting in 64-bit integers, pose += the rounded step. A fixed
-number of operations (so a fixed cycle count: ``fk_ops``). Why Newton and not a chord with the home
+system solved by elimination with partial pivoting in 64-bit integers, pose += the rounded step. The answer is
+the estimate with the smallest largest |e_i| among the start and the iterates (the last evaluated by one more
+IK): once converged the residuals are the IK's ±1 LSB, which a step multiplies by the Jacobian's conditioning,
+so a later iterate may be worse than an earlier one. A fixed number of operations (so a fixed cycle count:
+``fk_ops``). Why Newton and not a chord with the home
 pose's gain (the first version): on utn-kinematic's workspace (a 0.1 m home height, ±0.35 rad) ∂L/∂q
 changes so much that I − K ∂L/∂q has eigenvalues outside the unit disc (spectral radius 1.8, eigenvalues of
 K ∂L/∂q with negative real parts: no damping converges); Newton's Jacobian is the current estimate's, so
@@ -66,31 +69,38 @@ def step_limits(config: ControllerConfig) -> np.ndarray:
 
 
 def fk_ops(ik_ops: Counter) -> Counter:
-    """Operations of one ``sd_fk``: per Newton iteration the IK, the angle map E (2 products), per leg the
-    row [l_i, (r_i × l_i)ᵀ E] and its right-hand side, the elimination with partial pivoting (15 comparisons,
-    15 multipliers, 70 row updates), the back substitution (15 multiply-subtracts, 6 divisions) and 6
-    updates. A division (a 64-bit quotient, the run-time library's) is costed as two ``div_s`` steps and a
-    normalising shift."""
+    """Operations of one ``sd_fk``: per evaluated estimate (``FK_ITERATIONS`` + 1) the IK, the angle map E
+    (2 products), per leg the row [l_i, (r_i × l_i)ᵀ E] and its right-hand side, and the residual's comparison
+    with the best; per Newton step (``FK_ITERATIONS``) the elimination with partial pivoting (15 comparisons,
+    15 multipliers, 70 row updates), the back substitution (15 multiply-subtracts, 6 divisions) and 6 updates.
+    A division (a 64-bit quotient, the run-time library's) is costed as two ``div_s`` steps and a normalising
+    shift."""
     per = Counter(ik_ops)
     per.update({"L_mult": 2, "L_shl": 2, "negate": 2})  # E
     per.update({"L_sub": 6 * 3, "L_add": 6 * 3})  # r_i = l_i - p + b_i
     per.update({"L_mult": 6 * 6, "L_sub": 6 * 3})  # r_i x l_i
     per.update({"L_mult": 6 * 9, "L_add": 6 * 6, "L_shl": 6 * 3})  # (r_i x l_i)^T E
     per.update({"L_mult": 6 * 2, "L_sub": 6, "L_shl": 6})  # e_i, L_i e_i 2^Y
+    per.update({"L_sub": 6})  # the residual's largest |e_i|, compared with the best estimate's
+    solve = Counter()
     divs = 15 + 6
-    per.update({"L_sub": 15, "L_shl": 15})  # pivot comparisons, multiplier scaling
-    per.update({"L_mult": 70, "L_sub": 70, "L_shl": 70})  # row updates (right-hand side included)
-    per.update({"L_mult": 15, "L_sub": 15})  # back substitution
-    per.update({"div_s": 2 * divs, "L_shl": divs})
-    per.update({"L_mult": 6, "L_add": 6, "L_shl": 6, "add": 6, "sub": 12})  # updates, clamped to the step limits
-    return Counter({k: FK_ITERATIONS * v for k, v in per.items()})
+    solve.update({"L_sub": 15, "L_shl": 15})  # pivot comparisons, multiplier scaling
+    solve.update({"L_mult": 70, "L_sub": 70, "L_shl": 70})  # row updates (right-hand side included)
+    solve.update({"L_mult": 15, "L_sub": 15})  # back substitution
+    solve.update({"div_s": 2 * divs, "L_shl": divs})
+    solve.update({"L_mult": 6, "L_add": 6, "L_shl": 6, "add": 6, "sub": 12})  # updates, clamped to the step limits
+    # FK_ITERATIONS steps, each from an evaluated estimate, and the last estimate evaluated too
+    total = Counter({k: (FK_ITERATIONS + 1) * v for k, v in per.items()})
+    total.update({k: FK_ITERATIONS * v for k, v in solve.items()})
+    return total
 
 
 def fk_prototype() -> str:
     """The header's declaration of ``sd_fk``."""
     return (
         "/* the pose from the leg sensors: pose holds the previous estimate on entry, the new one on return\n"
-        f"   ({FK_ITERATIONS} Newton iterations on sd_ik, the Jacobian from its leg vectors); returns the saturation count */\n"
+        f"   ({FK_ITERATIONS} Newton iterations on sd_ik, the Jacobian from its leg vectors; the iterate that explains\n"
+        "   the sensors best); returns the saturation count */\n"
         "int sd_fk(const sd_count measured[6], sd_word pose[6]);\n"
     )
 
@@ -146,10 +156,12 @@ int sd_fk(const sd_count measured[6], sd_word pose[6])
 {{
     enum {{ F = {f}, ONE = 1 << {f} }};
     int it, i, j, k, nsat = 0;
-    for (it = 0; it < SD_FK_ITERATIONS; it++) {{
+    sd_word best[6];
+    int64_t best_r = -1;
+    for (it = 0; it <= SD_FK_ITERATIONS; it++) {{ /* the last pass evaluates the last step's estimate only */
         int32_t tr[SD_TRACE_WORDS];
         sd_word L[6];
-        int64_t A[6][7], E[3][3], sn[3], cs[3], y[6];
+        int64_t A[6][7], E[3][3], sn[3], cs[3], y[6], r_max = 0;
         int perm[6];
         nsat += ik_core(pose, L, tr);
         for (k = 0; k < 3; k++) {{
@@ -185,11 +197,18 @@ int sd_fk(const sd_count measured[6], sd_word pose[6])
             SD_OP(SD_L_mult);
             SD_OP(SD_L_sub);
             e = (int64_t)measured[i] - (int64_t)L[i] * SD_FK_COUNTS_PER_LSB;
+            SD_OP(SD_L_sub);
+            if ((e < 0 ? -e : e) > r_max) r_max = e < 0 ? -e : e;
             SD_OP(SD_L_mult);
             SD_OP(SD_L_shl);
             A[i][6] = (int64_t)L[i] * e * ((int64_t)1 << {Y_BITS});
             perm[i] = i;
         }}
+        if (best_r < 0 || r_max < best_r) {{ /* the estimate that explains the sensors best so far */
+            best_r = r_max;
+            for (j = 0; j < 6; j++) best[j] = pose[j];
+        }}
+        if (it == SD_FK_ITERATIONS) break;
         for (k = 0; k < 6; k++) {{ /* elimination, rows permuted by index */
             int m = k;
             int64_t big = A[perm[k]][k] < 0 ? -A[perm[k]][k] : A[perm[k]][k];
@@ -233,6 +252,7 @@ int sd_fk(const sd_count measured[6], sd_word pose[6])
             pose[j] = (sd_word)satw((int64_t)pose[j] + d, &nsat);
         }}
     }}
+    for (j = 0; j < 6; j++) pose[j] = best[j]; /* the first pass sets it: best_r starts below any residual */
     return nsat;
 }}
 """
@@ -242,12 +262,15 @@ def fk_readme(cycles, clock_hz: float) -> str:
     """The README's section on ``sd_fk`` with its cycle estimate."""
     return (
         "\n## Pose from the sensors: `sd_fk`\n\n"
-        f"`sd_fk(measured, pose)`: {FK_ITERATIONS} Newton iterations on `sd_ik` from the previous estimate in `pose`; "
+        f"`sd_fk(measured, pose)`: {FK_ITERATIONS} Newton iterations on `sd_ik` from the previous estimate in `pose`, "
+        "returning the estimate that explains the sensors best (the smallest largest-leg residual of the start and "
+        "the iterates); "
         "each solves J⁻¹ Δq = e with the Jacobian of the current estimate, built from the IK's own leg vectors "
         "(rows [l_i, (r_i × l_i)ᵀ E], the equation scaled by L_i: no division by the lengths), by elimination with "
         "partial pivoting in 64-bit integers (see `stewart_drake.firmware.fk_gen`). "
         f"Cycle estimate: {cycles.cycles:.0f} cycles = {cycles.cycles / clock_hz * 1e6:.1f} µs "
-        f"({FK_ITERATIONS} × (the IK + the 6×6 system + 21 divisions, each costed as two `div_s` and a shift)). Its "
+        f"({FK_ITERATIONS + 1} × (the IK + the Jacobian's rows) + {FK_ITERATIONS} × (the 6×6 system + 21 divisions, "
+        "each costed as two `div_s` and a shift)). Its "
         "accuracy is the IK's: the estimate is a pose whose fixed-point IK matches the sensors as well as that IK "
         "can (a few length LSB on the default format), propagated by the Jacobian's conditioning.\n"
     )

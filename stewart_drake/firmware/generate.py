@@ -167,8 +167,8 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
             e.op("tfr16SinPIx")
             e.op("tfr16CosPIx")
         else:
-            e.emit(f"s{ax} = table_sin((int32_t)pose[{3 + k}], &nsat);")
-            e.emit(f"c{ax} = table_cos((int32_t)pose[{3 + k}], &nsat);")
+            e.emit(f"s{ax} = table_sin((int32_t)pose[{3 + k}]);")
+            e.emit(f"c{ax} = table_cos((int32_t)pose[{3 + k}]);")
             e.op("table", 2)
     # -- rotation entries as the emulation forms them (rotation_from_words)
     mono = rotation_monomials(conv)
@@ -420,21 +420,23 @@ static int32_t tfr16_cos(int32_t x)
 }
 """
 
-TABLE_TRIG = """static int32_t table_sin(int32_t w, int *nsat)
+TABLE_TRIG = """/* 1.0 (sin pi/2, cos 0) is stored as the word's top, 2^f - 1: the table's rounding, not a saturation (not counted) */
+static int32_t table_top(int64_t v) { return (int32_t)(v > SD_HI ? SD_HI : v); }
+static int32_t table_sin(int32_t w)
 {
     int32_t a = w < 0 ? -w : w;
     int64_t v;
     SD_OP(SD_table);
     if (a > SD_HALF) a = (SD_HI + 1) - a;
     v = (int64_t)SIN_TABLE[a];
-    return satw(w < 0 ? -v : v, nsat);
+    return table_top(w < 0 ? -v : v);
 }
-static int32_t table_cos(int32_t w, int *nsat)
+static int32_t table_cos(int32_t w)
 {
     int32_t a = w < 0 ? -w : w;
     int64_t v = a <= SD_HALF ? (int64_t)SIN_TABLE[SD_HALF - a] : -(int64_t)SIN_TABLE[a - SD_HALF];
     SD_OP(SD_table);
-    return satw(v, nsat);
+    return table_top(v);
 }
 """
 

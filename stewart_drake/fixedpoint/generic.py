@@ -4,8 +4,9 @@ word length, to study word length against leg-length error.
 It follows the firmware's recipe (``tp17.C``) generalised, not its exact instruction sequence:
 
 1. angles -> fractions of pi in Q(f) words, f = word_bits - 1 (truncation toward zero, like FRAC16);
-2. sin(pi x), cos(pi x) as Q(f) words: ``trig="exact"`` rounds the true value (cos 0 saturates to
-   2^f - 1), ``trig="tfr16"`` uses the DSP library (word_bits = 16 only);
+2. sin(pi x), cos(pi x) as Q(f) words: ``trig="exact"`` rounds the true value (1.0, i.e. cos 0, is stored
+   as 2^f - 1: the table's rounding, not counted as a saturation), ``trig="tfr16"`` uses the DSP library
+   (word_bits = 16 only);
 3. each rotation-matrix entry as the firmware forms it: a sum of signed products of two or three
    sines/cosines, every product truncated back to Q(f) (``(a*b) >> f``, the ``extract_h(L_mult)``
    idiom), sums saturated to the word (the products are derived from the convention's elementary
@@ -130,8 +131,9 @@ def trig_words(w, fmt: QFormat):
     f = fmt.frac_bits
     lo, hi = -(1 << f), (1 << f) - 1
     t = np.pi * w / (1 << f)
-    s = saturate(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo, hi, "generic.sin")
-    c = saturate(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo, hi, "generic.cos")
+    # 1.0 is stored as the word's top: the table's rounding, not a saturation (not recorded)
+    s = np.minimum(np.maximum(np.round(np.sin(t) * (1 << f)).astype(np.int64), lo), hi)
+    c = np.minimum(np.maximum(np.round(np.cos(t) * (1 << f)).astype(np.int64), lo), hi)
     return s, c
 
 

@@ -111,3 +111,65 @@ def test_simulate_user_firmware_that_hangs(folder, capsys, monkeypatch):
 def _fresh(p: Path) -> Path:
     p.mkdir(exist_ok=True)
     return p
+
+
+MEM_CAP = 1 << 30  # far above what a check needs beside the firmware, far below the machine's memory
+MEM = (
+    IK
+    + "#include <string.h>\n"
+    + "int sd_ik(const sd_word p[6], sd_word l[6]) { (void)p; (void)l;\n"
+    + "    for (;;) { volatile char *b = malloc(64u << 20); for (size_t i = 0; i < (64u << 20); i += 4096) b[i] = 1; }\n"
+    + "    return 0; }\n"
+)
+FORK = (
+    "#define _POSIX_C_SOURCE 200809L\n"  # fork, sleep under -std=c99
+    + IK
+    + "#include <unistd.h>\n"
+    + "#define sd_ik sd_ik_real\n"
+    + '#include "gen/sd_firmware.c"\n'
+    + "#undef sd_ik\n"
+    + "int sd_ik(const sd_word p[6], sd_word l[6]) {\n"
+    + "    static int forked = 0;\n"
+    + "    if (!forked) { forked = 1; pid_t c = fork();\n"
+    + '        if (c == 0) { FILE *f = fopen("orphan.pid", "w"); fprintf(f, "%d", (int)getpid()); fclose(f);'
+    + " sleep(60); _exit(0); } }\n"
+    + "    return sd_ik_real(p, l); }\n"
+)
+
+
+def test_firmware_that_allocates_without_end(folder, capsys, monkeypatch):
+    """An endless malloc in sd_ik stops at the child's address-space cap: one line naming the file, exit 2."""
+    from stewart_drake.core import isolate
+
+    monkeypatch.setattr(isolate, "FIRMWARE_MEMORY_LIMIT_BYTES", MEM_CAP)
+    monkeypatch.chdir(folder)
+    (folder / "mem.c").write_text(MEM)
+    rc, out, err = cli(capsys, "firmware", "check", "mem.c", "--poses", "100", "--time-limit", "60")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert err.startswith("stewart-drake firmware: error: mem.c: the firmware ran out of its memory limit (1024 MiB"), (
+        err
+    )
+
+
+def test_a_process_the_firmware_forks_ends_with_the_check(folder, capsys, monkeypatch):
+    monkeypatch.chdir(folder)
+    (folder / "fork.c").write_text(FORK)
+    pid_file = folder / "orphan.pid"
+    pid_file.unlink(missing_ok=True)
+    rc, _, err = cli(capsys, "firmware", "check", "fork.c", "--poses", "100")
+    assert rc == 0, err
+    deadline = time.monotonic() + 10
+    while not pid_file.exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    orphan = int(pid_file.read_text())
+    while _alive(orphan) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _alive(orphan)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"

@@ -76,14 +76,14 @@ def test_sd_fk_error_against_the_float_fk_over_the_workspace(name, start, tmp_pa
 
 
 def test_sd_fk_converges_on_utn_kinematic():
-    """utn-kinematic (0.1 m home height, ±0.35 rad), where the first version's chord with the home gain
-    diverged (spectral radius 1.8): from a tick's offset Newton explains the sensors as well as the IK can at
-    every pose whose Jacobian's condition number (pose words) is below 1000, and at 98 % of all; above it the
-    IK's 1-LSB resolution leaves the step's near-null direction undetermined (1 LSB / σ_min is metres). The
-    error against the float FK is not pinned to the first-order bound here: on legs of ~0.1–0.3 m the
-    second-order term of a few-mm residual is not small (measured: up to 1.3× that bound)."""
+    """utn-kinematic (0.1 m home height, ±0.35 rad), where a chord with the home gain diverges (spectral
+    radius 1.8): from a tick's offset the estimate sd_fk returns (the iterate that explains the sensors best)
+    explains them as well as the IK can at every pose, the ill-conditioned ones too (κ above 1000, where the
+    IK's 1-LSB resolution leaves the step's near-null direction undetermined and the later iterates wander).
+    The error against the float FK is not pinned to the first-order bound here: on legs of ~0.1–0.3 m the
+    second-order term of a few-mm residual is not small (up to 1.3× that bound)."""
     q, q_w, converged, _, kappa, _ = fk_over_workspace(load_preset("utn-kinematic"), STARTS["tick"])
-    assert converged[kappa <= 1000].all() and converged.mean() >= 0.98
+    assert converged.all() and (kappa > 1000).any()
 
 
 def test_sd_fk_operation_count_is_the_cycle_estimates():

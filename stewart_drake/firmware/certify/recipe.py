@@ -81,7 +81,7 @@ def trig_tables(word_bits: int, trig: str) -> TrigTables:
     w = np.arange(-(1 << f), 1 << f, dtype=np.int64)
     s, c = trig_words(w, fmt)
     t = np.pi * w / (1 << f)
-    if trig == "exact":  # the emulation's words before its clamp (generic.trig_words rounds, then saturates)
+    if trig == "exact":  # the emulation's words before its clamp (generic.trig_words rounds, then clamps 1.0)
         s_pre = np.round(np.sin(t) * (1 << f)).astype(np.int64)
         c_pre = np.round(np.cos(t) * (1 << f)).astype(np.int64)
         if np.any(np.clip(s_pre, -(1 << f), (1 << f) - 1) != s) or np.any(np.clip(c_pre, -(1 << f), (1 << f) - 1) != c):

@@ -8,7 +8,14 @@ filters and the integrator are states: their ranges are invariants, found by ite
 map from ``sd_init``'s zeros to a fixed point (filters), and for the integrator the smallest level J such
 that an integrator within one increment of J with a positive error must find the command on its upper rail
 (so conditional integration stops it), and symmetrically below. Without such a level the integrator is
-bounded only by its saturating adds (no wrap: every operation saturates; windup is not excluded)."""
+bounded only by its saturating adds (no wrap: every operation saturates; windup is not excluded).
+
+"Saturation" means what it means for ``sd_ik``: an operation whose exact result does not fit its word and is
+clamped. The integrator and the command (its Q31 sum and the Q15 word) have rails by design: the command's clamp
+is the actuator's limit and conditional integration's trigger, so their reaching a rail is reported
+(``rail: true``, and ``anti_windup_proven``) but is not a saturation of the arithmetic; any other word that may
+clamp makes ``saturation_possible`` true (the error, a difference or a gain product does not fit its word: the
+tick computes something other than the law for inputs within the stated bounds)."""
 
 from __future__ import annotations
 
@@ -32,6 +39,7 @@ class TickWord:
     max: int
     bits: int
     saturation: str
+    rail: bool = False  # a designed limit (integrator, command): reaching it is not a saturation of the arithmetic
 
     @property
     def headroom_bits(self) -> float:
@@ -45,6 +53,7 @@ class TickWord:
             "max": self.max,
             "headroom_bits": self.headroom_bits,
             "saturation": self.saturation,
+            "rail": self.rail,
         }
 
 
@@ -59,8 +68,14 @@ class TickCertificate:
     words: list[TickWord] = field(default_factory=list)
     anti_windup: bool = False
 
+    @property
+    def saturation_possible(self) -> bool:
+        """Whether a word of the arithmetic (not a rail) may saturate for inputs within the bounds."""
+        return any(w.saturation != "impossible" and not w.rail for w in self.words)
+
     def to_dict(self) -> dict:
         return {
+            "saturation_possible": self.saturation_possible,
             "max_error_mm": self.max_error_m * 1e3,
             "max_speed_mps": self.max_speed_mps,
             "max_feedforward_n": self.max_feedforward_n,
@@ -80,8 +95,9 @@ def _shifted(mant: int, shift: int, x: int) -> tuple[int, bool]:
     return _i(q15.sat32(raw)), not (q15.MIN32 <= raw <= q15.MAX32)
 
 
-def _filter_range(alpha: int, d_lo: int, d_hi: int) -> tuple[int, int]:
-    """Invariant range of f <- add(f, mult_r(alpha, sub(d, f))) from f = 0 with d in [d_lo, d_hi]."""
+def _filter_range(alpha: int, d_lo: int, d_hi: int) -> tuple[int, int, bool]:
+    """Invariant range of f <- add(f, mult_r(alpha, sub(d, f))) from f = 0 with d in [d_lo, d_hi], and whether
+    an operation of the step may clamp there (each is monotone: its extremes are at the ranges' ends)."""
 
     def step(f, d):
         return _i(q15.add(f, q15.mult_r(alpha, q15.sub(d, f))))
@@ -90,9 +106,14 @@ def _filter_range(alpha: int, d_lo: int, d_hi: int) -> tuple[int, int]:
     for _ in range(FILTER_ITERATIONS):
         nlo, nhi = min(lo, step(lo, d_lo)), max(hi, step(hi, d_hi))
         if (nlo, nhi) == (lo, hi):
-            return lo, hi
+            break
         lo, hi = nlo, nhi
-    return q15.MIN16, q15.MAX16  # not converged: the word's own range (sound)
+    else:
+        return q15.MIN16, q15.MAX16, True  # not converged: the word's own range (sound)
+    diff = (d_lo - hi, d_hi - lo)  # the exact sub(d, f) over the ranges
+    sums = [f + _i(q15.mult_r(alpha, q15.sat16(d - f))) for f, d in ((lo, d_lo), (hi, d_hi))]  # the exact add
+    clamp = min(*diff, *sums) < q15.MIN16 or max(*diff, *sums) > q15.MAX16
+    return lo, hi, clamp
 
 
 def _u32(P, integ, D, V, ff):
@@ -110,8 +131,8 @@ def certify_tick(
     cpl = counts_per_lsb(config)
     status = {}
 
-    def word(name, lo, hi, bits, clamp):
-        status[name] = TickWord(name, int(lo), int(hi), bits, "possible" if clamp else "impossible")
+    def word(name, lo, hi, bits, clamp, rail=False):
+        status[name] = TickWord(name, int(lo), int(hi), bits, "possible" if clamp else "impossible", rail)
 
     E = math.ceil(max_error_m / t.sensor_resolution)
     e_lo, e_hi = max(-E, q15.MIN16), min(E, q15.MAX16)
@@ -123,10 +144,10 @@ def certify_tick(
     ds = (math.ceil(max_speed_mps * t.sample_period / config.ik_format.length_lsb) + moving) * cpl
     ds_w = _i(q15.sat16(q15.sat16(ds) << DIFF_SHIFT))
     word("set-point difference", -ds_w, ds_w, 16, ds > q15.MAX16 or ds << DIFF_SHIFT > q15.MAX16)
-    df = _filter_range(g.alpha, -dm_w, dm_w)
-    vf = _filter_range(g.alpha_ff, -ds_w, ds_w)
-    word("derivative filter", *df, 16, False)
-    word("set-point velocity filter", *vf, 16, False)
+    *df, df_clamp = _filter_range(g.alpha, -dm_w, dm_w)
+    *vf, vf_clamp = _filter_range(g.alpha_ff, -ds_w, ds_w)
+    word("derivative filter", *df, 16, df_clamp)
+    word("set-point velocity filter", *vf, 16, vf_clamp)
     P = [_shifted(g.kp.mantissa, g.kp.shift, x) for x in (e_lo, e_hi)]
     D = [_shifted(g.kd.mantissa, g.kd.shift, x) for x in df]
     V = [_shifted(g.kv.mantissa, g.kv.shift, x) for x in vf]
@@ -163,11 +184,11 @@ def certify_tick(
     proven = J_hi is not None and J_lo is not None
     I_lo = q15.MIN32 if J_lo is None else J_lo
     I_hi = q15.MAX32 if J_hi is None else J_hi
-    word("integrator (Q31)", I_lo, I_hi, 32, not proven)
+    word("integrator (Q31)", I_lo, I_hi, 32, not proven, rail=True)
     u_lo = _i(_u32(P[0][0], I_lo, D[1][0], V[0][0], -F))
     u_hi = _i(_u32(P[1][0], I_hi, D[0][0], V[1][0], F))
-    word("command sum u32 (Q31)", u_lo, u_hi, 32, u_hi >= q15.MAX32 or u_lo <= q15.MIN32)
-    word("command (Q15)", u_lo >> 16, u_hi >> 16, 16, u_hi >= q15.MAX32 or u_lo <= q15.MIN32)
+    word("command sum u32 (Q31)", u_lo, u_hi, 32, u_hi >= q15.MAX32 or u_lo <= q15.MIN32, rail=True)
+    word("command (Q15)", u_lo >> 16, u_hi >> 16, 16, u_hi >= q15.MAX32 or u_lo <= q15.MIN32, rail=True)
     return TickCertificate(max_error_m, max_speed_mps, max_feedforward_n, list(status.values()), proven)
 
 
