@@ -23,7 +23,7 @@ from stewart_drake.control.chatter import loop_verdict
 from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog, tracking_verdict
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import PRESETS, Platform, load_preset
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S, check_time_limit
 from stewart_drake.core.sanity import (
     check_positive,
@@ -151,13 +151,15 @@ def adopt_firmware(machine: Machine, path) -> tuple[Machine, list]:
     if rec is None:
         return machine, []
     opts, where = rec
-    mine = platform_hash(machine.platform)
-    if opts[PLATFORM_HASH] is not None and opts[PLATFORM_HASH] != mine:
+    mine, recorded_hash = platform_hash(machine.platform), opts[PLATFORM_HASH]
+    if recorded_hash is None and opts["platform"] in PRESETS:  # generated before the hash was recorded
+        recorded_hash = platform_hash(load_preset(opts["platform"]))
+    if recorded_hash is not None and recorded_hash != mine:
         raise MachineError(
             MachineError.FIRMWARE_PLATFORM.format(
                 firmware=where,
                 recorded=opts["platform"],
-                recorded_hash=opts[PLATFORM_HASH],
+                recorded_hash=recorded_hash,
                 platform=machine.platform.name,
                 platform_hash=mine,
             )

@@ -8,13 +8,13 @@ from pathlib import Path
 from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
-    add_platform_arg,
     dumps_strict,
     output_folder,
     print_json,
     reject_unused,
 )
 from stewart_drake.commands.firmware import add_time_limit_arg
+from stewart_drake.core.geometry import PRESETS
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
@@ -25,7 +25,12 @@ from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run the fixed-point (or float) controller in the loop with the Drake plant")
-    add_platform_arg(p, default=None)
+    p.add_argument(
+        "--platform",
+        default=None,
+        metavar="NAME|FILE",
+        help=f"a preset ({', '.join(PRESETS)}) or a platform YAML file (default: utn-dynamic; or give --machine)",
+    )
     p.add_argument(
         "--machine",
         default=None,

@@ -5,6 +5,7 @@ values); a firmware generated for another platform is refused; flags and ``--set
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -15,6 +16,7 @@ import stewart_drake as sd
 from stewart_drake.api.simulation import plan_run
 from stewart_drake.cli import main
 from stewart_drake.errors import FIRMWARE_FORMAT_ADOPTED, MachineError
+from stewart_drake.firmware.fingerprint import read_fingerprint
 from stewart_drake.spec import load_machine
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "newcomer-210kg.yaml"
@@ -143,3 +145,17 @@ def test_a_motion_program_is_a_machine_motion():
     traj = plan_run(platform, program, duration=0.1).scenario.trajectory
     assert traj.name == "seed_004"
     assert np.allclose(traj.pose(0.0), platform.home_pose(), atol=1e-12)  # a program starts at home
+
+
+def test_a_preset_firmware_without_the_hash_is_compared_by_the_preset(tmp_path, firmware_30um):
+    """A module generated before the platform's hash was recorded names its platform only: a preset name is
+    enough to compare (its file's content)."""
+    old = tmp_path / "old"
+    old.mkdir()
+    for f in ("sd_firmware.c", "sd_firmware.h"):
+        text = (firmware_30um / "utn" / f).read_text()
+        (old / f).write_text(re.sub(r', "platform_hash": "[0-9a-f]+"', "", text))
+    assert read_fingerprint(old / "sd_firmware.c")[0]["platform_hash"] is None
+    with pytest.raises(MachineError, match="was generated for platform utn-dynamic"):
+        plan_run(sd.load_machine(EXAMPLE), duration=0.1, firmware=old)
+    assert plan_run(sd.load_platform("utn-dynamic"), duration=0.1, firmware=old).warnings == ()
