@@ -289,7 +289,8 @@ def check(
         raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     rec = read_fingerprint(path)
     if platform is None:
-        platform = load_platform(o["platform"])
+        # a preset, a platform file or a machine file (whose payload the gains were designed with)
+        platform = load_machine(o["platform"]).loaded_platform
     else:
         platform = load_platform(platform)
         if rec and _platform_name(rec[0]["platform"]) != platform.name:
@@ -318,9 +319,10 @@ def _check_in_child(beat, *args) -> dict:
 
 
 def _platform_name(recorded: str) -> str:
-    """The name of the platform a fingerprint records (a preset name, a YAML path, or an API platform's name)."""
+    """The name of the platform a fingerprint records (a preset name, a platform or machine file's path, or an
+    API platform's name)."""
     try:
-        return load_platform(recorded).name
+        return load_machine(recorded).platform.name
     except StewartError:
         return recorded
 

@@ -159,3 +159,20 @@ def test_a_preset_firmware_without_the_hash_is_compared_by_the_preset(tmp_path, 
     with pytest.raises(MachineError, match="was generated for platform utn-dynamic"):
         plan_run(sd.load_machine(EXAMPLE), duration=0.1, firmware=old)
     assert plan_run(sd.load_platform("utn-dynamic"), duration=0.1, firmware=old).warnings == ()
+
+
+@needs_cc
+def test_firmware_generate_for_a_machine_and_check_it(tmp_path, capsys):
+    """``firmware generate --machine``: the machine's format and payload-designed gains, recorded with the
+    machine file, so that ``firmware check`` emulates the same module (the bare platform's gains differed in
+    every tick)."""
+    fw = tmp_path / "fw"
+    assert main(["firmware", "generate", "--machine", str(EXAMPLE), "--out", str(fw), "--no-compile"]) == 0
+    recorded = read_fingerprint(fw / "sd_firmware.c")[0]
+    assert (recorded["platform"], recorded["length_lsb"], recorded["word_bits"]) == (str(EXAMPLE), 3e-05, 16)
+    capsys.readouterr()
+    assert main(["firmware", "check", str(fw / "sd_firmware.c"), "--poses", "500", "--duration", "0.05"]) == 0
+    assert "identical to the emulation" in capsys.readouterr().out
+    argv = ["firmware", "generate", "--machine", str(EXAMPLE), "--platform", "utn-dynamic", "--out", str(tmp_path)]
+    assert main(argv) == 2
+    assert "give --machine or --platform, not both" in capsys.readouterr().err
