@@ -899,7 +899,7 @@ OPTION_SIMULATE_UTN = "--simulate drives the plant with utn-convention poses; us
 OPTION_SIMULATE_EMPTY = "--simulate: the program has no moves or waits (its trajectory lasts 0 s)"
 OPTION_DURATION_POSITIVE = "--duration must be a positive number of seconds, got {value}"
 OPTION_DURATION_PERIOD = (
-    "--duration {value} s is shorter than one controller period ({period} s); give at least one period"
+    "run.duration {value} s is shorter than one controller.period ({period} s); give at least one period"
 )
 OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
 SIMULATION_GAP_WARNING = (

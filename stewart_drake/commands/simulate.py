@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import sys
 from pathlib import Path
 
@@ -18,7 +19,7 @@ from stewart_drake.core.geometry import PRESETS
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
-from stewart_drake.errors import MachineError, QuantityError, UsageError
+from stewart_drake.errors import MachineError, QuantityError, StewartError, UsageError
 from stewart_drake.firmware.engine import ENGINES
 from stewart_drake.spec import Machine, apply_overrides, load_machine
 
@@ -119,10 +120,9 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--duration",
-        type=float,
         default=None,
-        metavar="S",
-        help="simulated seconds (default: the trajectory's, 4 s for seed)",
+        metavar="T",
+        help="simulated time, e.g. 2 or 500ms (default: the trajectory's, 4 s for seed; bare: s)",
     )
     p.add_argument(
         "--out",
@@ -177,6 +177,7 @@ FLAG_PATHS = {
     "plant_step": ("--plant-step", "run.plant_step"),
     "integrator": ("--integrator", "run.integrator"),
     "fit": ("--fit", "run.fit"),
+    "duration": ("--duration", "run.duration"),
 }
 # store_true flags: the value they set
 FLAG_VALUES = {"no_feedforward": False, "fit": True}
@@ -188,15 +189,27 @@ def machine_from_args(args) -> Machine:
     if args.machine is not None and args.platform is not None:
         raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
     machine = load_machine(args.machine or args.platform or "utn-dynamic")
-    for dest, (flag, path) in FLAG_PATHS.items():
+    for dest, (_flag, path) in FLAG_PATHS.items():
         value = getattr(args, dest)
         if value is None or value is False:
             continue
         try:
             machine = apply_overrides(machine, {path: FLAG_VALUES.get(dest, value)})
         except (MachineError, QuantityError) as e:
-            raise type(e)(str(e).replace(path, flag, 1)) from None
+            raise flag_error(e) from None
     return apply_overrides(machine, args.set)
+
+
+def flag_error(e: StewartError) -> StewartError:
+    """``e`` with the spec paths of ``FLAG_PATHS`` in its message named by their flags (the same class)."""
+    message = str(e)
+    for flag, path in FLAG_PATHS.values():
+        message = message.replace(path, flag)
+    if message == str(e):
+        return e
+    e = copy.copy(e)
+    e.args = (message,)
+    return e
 
 
 def run(args) -> int:
@@ -210,18 +223,22 @@ def run(args) -> int:
     )
     out_folder = output_folder(args)
     reject_unused(args, "--firmware", args.firmware is not None, time_limit=FIRMWARE_IDLE_LIMIT_S)
-    plan = plan_run(
-        machine_from_args(args),
-        args.trajectory,
-        duration=args.duration,
-        firmware=None if args.firmware is None else firmware_source(args.firmware, "--firmware"),
-        time_limit=args.time_limit,
-        allow_out_of_stroke=args.allow_out_of_stroke,
-        length_unit=args.length_unit,
-        angle_unit=args.angle_unit,
-        smooth=args.smooth,
-        duration_shown=args.duration,
-    )
+    firmware = None if args.firmware is None else firmware_source(args.firmware, "--firmware")
+    machine = machine_from_args(args)
+    try:  # the API names spec paths; the user gave flags
+        plan = plan_run(
+            machine,
+            args.trajectory,
+            firmware=firmware,
+            time_limit=args.time_limit,
+            allow_out_of_stroke=args.allow_out_of_stroke,
+            length_unit=args.length_unit,
+            angle_unit=args.angle_unit,
+            smooth=args.smooth,
+            duration_shown=args.duration,
+        )
+    except StewartError as e:
+        raise flag_error(e) from None
     warn = lambda w: print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)  # noqa: E731
     result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
     summary = result.to_dict()

@@ -110,6 +110,8 @@ def test_flags_and_paths_are_named_as_written(tmp_path, capsys, args, message):
 def test_api_errors_name_spec_paths():
     with pytest.raises(MachineError, match=r"^controller\.period must be > 0 s, got -1$"):
         sd.simulate(sd.load_platform("utn-dynamic"), period=-1)
+    with pytest.raises(MachineError, match=r"^run\.duration must be > 0 s, got -1$"):
+        sd.simulate(sd.load_platform("utn-dynamic"), duration=-1)
     with pytest.raises(MachineError, match=r"^firmware\.length_lsb must be > 0 m, got 0$"):
         sd.simulate(sd.load_platform("utn-dynamic"), **{"firmware.length_lsb": 0})
 
