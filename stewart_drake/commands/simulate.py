@@ -200,11 +200,16 @@ def machine_from_args(args) -> Machine:
     return apply_overrides(machine, args.set)
 
 
+def flag_text(text: str) -> str:
+    """``text`` with the spec paths of ``FLAG_PATHS`` named by their flags."""
+    for flag, path in FLAG_PATHS.values():
+        text = text.replace(path, flag)
+    return text
+
+
 def flag_error(e: StewartError) -> StewartError:
     """``e`` with the spec paths of ``FLAG_PATHS`` in its message named by their flags (the same class)."""
-    message = str(e)
-    for flag, path in FLAG_PATHS.values():
-        message = message.replace(path, flag)
+    message = flag_text(str(e))
     if message == str(e):
         return e
     e = copy.copy(e)
@@ -239,7 +244,7 @@ def run(args) -> int:
         )
     except StewartError as e:
         raise flag_error(e) from None
-    warn = lambda w: print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)  # noqa: E731
+    warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w)}", file=sys.stderr)  # noqa: E731
     result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
     summary = result.to_dict()
     out = Path(args.out)
