@@ -167,3 +167,17 @@ def test_a_mapping_may_hold_a_platform_object():
     assert load_machine({"platform": p}).platform is p
     with pytest.raises(MachineError, match=r"unknown key 'controler' \(did you mean 'controller'\?\)"):
         load_machine({"platform": p, "controler": {"period": "2ms"}})
+
+
+def test_every_section_field_has_a_path_in_the_grammar():
+    from stewart_drake.spec.machine import SECTIONS
+
+    paths = {f"{name}.{f.name}" for name, tp in SECTIONS.items() for f in dataclasses.fields(tp)}
+    assert paths == set(FIELDS)
+
+
+def test_a_machine_takes_a_platform_object():
+    with pytest.raises(
+        MachineError, match=r"^platform must be a Platform \(load_machine reads names and files\), got str$"
+    ):
+        Machine("utn-dynamic")
