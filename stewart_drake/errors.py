@@ -831,6 +831,7 @@ class MachineError(UsageError):
     UNKNOWN_KEY = "{where}unknown key {path!r}{hint}"
     NOT_MAPPING = "{where}{path} must be a mapping of key: value, got {got}"
     OVERRIDE = "{text!r} is not PATH=VALUE (e.g. controller.period=0.5ms)"
+    KEY = "{where}a key must be a name, got {got}"
     MOTION = "{path}: {value!r} is not seed, rotating, a .csv file or a .stw script"
     PLATFORM = "{where}platform must be a preset name, a platform file or an inline mapping, got {got}"
     FIRMWARE_PLATFORM = (

@@ -181,3 +181,22 @@ def test_a_machine_takes_a_platform_object():
         MachineError, match=r"^platform must be a Platform \(load_machine reads names and files\), got str$"
     ):
         Machine("utn-dynamic")
+
+
+@pytest.mark.parametrize(
+    ("tail", "message"),
+    [
+        ("[a, b]: 1\n", ":12: a key must be a name, got a list"),
+        ("motions: [circle]\n", ":12: motions item 1: 'circle' is not seed, rotating, a .csv file or a .stw script"),
+        ("requirements: {a: 1}\n", ":12: requirements must be a file path or null, got a mapping"),
+        ("controller: {period: null}\n", ":12: controller.period: cannot read 'null' as a number"),
+        ("controller: {gains: {kp: 1}}\n", ":12: controller.gains must be design or {kp, ki, kd, kv}, got"),
+        ("run: {fit: maybe}\n", ":12: run.fit: 'maybe' is not one of true, false"),
+        ("controller: [1, 2]\n", ":12: controller must be a mapping of key: value, got a list"),
+    ],
+)
+def test_a_bad_machine_file_is_one_line_naming_file_line_and_path(tmp_path, tail, message):
+    p = write(tmp_path, PLATFORM + tail)
+    with pytest.raises((MachineError, QuantityError)) as e:
+        load_machine(p)
+    assert str(e.value).startswith(f"{p}{message}"), str(e.value)
