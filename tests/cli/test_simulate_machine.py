@@ -60,14 +60,14 @@ def test_the_default_format_chatters_on_it(tmp_path, capsys):
 
 @needs_cc
 def test_the_firmware_format_is_adopted(tmp_path, capsys, firmware_30um):
-    """The machine says 1 mm, the firmware was generated at 30 µm: the loop runs the firmware's 30 µm and
-    tracks (the loop at 1 mm with this firmware lost tracking: the legs dropped ~250 mm)."""
+    """The machine says 1 mm, the firmware was generated at 30 µm: the loop runs the firmware's 30 µm, says so,
+    and tracks."""
     rc, summary = simulate(tmp_path, "--length-lsb", "1mm", "--firmware", str(firmware_30um / "fw30"))
     err = capsys.readouterr().err
     assert FIRMWARE_FORMAT_ADOPTED.format(what="length LSB 30 µm", machine="1 mm") in err
     assert rc == 0, err
     assert summary["firmware_format"]["length_lsb_m"] == 3e-05
-    # within the tracking verdict's bound (5 % of the 300 mm stroke range), which the run at 1 mm exceeded 16-fold
+    # within the tracking verdict's bound: 5 % of the 300 mm stroke range
     assert summary["max_leg_error_mm"] < 15.0
 
 
@@ -166,8 +166,7 @@ def test_a_preset_firmware_without_the_hash_is_compared_by_the_preset(tmp_path, 
 @needs_cc
 def test_firmware_generate_for_a_machine_and_check_it(tmp_path, capsys):
     """``firmware generate --machine``: the machine's format and payload-designed gains, recorded with the
-    machine file, so that ``firmware check`` emulates the same module (the bare platform's gains differed in
-    every tick)."""
+    machine file, so that ``firmware check`` emulates the same module, gains included."""
     fw = tmp_path / "fw"
     assert main(["firmware", "generate", "--machine", str(EXAMPLE), "--out", str(fw), "--no-compile"]) == 0
     recorded = read_fingerprint(fw / "sd_firmware.c")[0]
