@@ -151,6 +151,8 @@ def load_machine(source: Machine | Platform | Mapping | str | Path, overrides: I
         s = str(source)
         if s in PRESETS:
             machine = Machine(load_platform(s), platform_source=s)
+        elif not Path(s).exists():  # the platform loader's message: an unknown preset or a missing file
+            machine = Machine(load_platform(s))
         else:
             text, shown = read_yaml_text(s, "machine")
             machine = _from_text(text, shown, Path(s).parent, stem=Path(s).stem)
