@@ -177,3 +177,11 @@ def test_firmware_generate_for_a_machine_and_check_it(tmp_path, capsys):
     argv = ["firmware", "generate", "--machine", str(EXAMPLE), "--platform", "utn-dynamic", "--out", str(tmp_path)]
     assert main(argv) == 2
     assert "give --machine or --platform, not both" in capsys.readouterr().err
+
+
+def test_the_certificate_takes_the_machines_format():
+    machine = sd.load_machine(EXAMPLE)
+    cert = sd.firmware.certify(machine, max_cells=20_000).to_dict()
+    assert cert["format"] == {"word_bits": 16, "length_lsb_m": 3e-05, "trig": "tfr16", "convention": "utn"}
+    assert not cert["saturation_possible"]  # the example's 16-bit words hold its legs at 30 µm
+    assert sd.firmware.certify(machine, length_lsb=1e-3, max_cells=2000).to_dict()["format"]["length_lsb_m"] == 1e-3
