@@ -185,31 +185,34 @@ FLAG_VALUES = {"no_feedforward": False, "fit": True}
 
 def machine_from_args(args) -> Machine:
     """The machine of ``--machine`` (else ``--platform``, else utn-dynamic) with the flags of ``FLAG_PATHS``
-    that were given, then each ``--set``; an error about a flag's path names the flag."""
+    that were given and each ``--set`` (applied together: a section is checked as a whole); an error about a
+    flag's path names the flag."""
     if args.machine is not None and args.platform is not None:
         raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
     machine = load_machine(args.machine or args.platform or "utn-dynamic")
-    for dest, (_flag, path) in FLAG_PATHS.items():
-        value = getattr(args, dest)
-        if value is None or value is False:
-            continue
-        try:
-            machine = apply_overrides(machine, {path: FLAG_VALUES.get(dest, value)})
-        except (MachineError, QuantityError) as e:
-            raise flag_error(e) from None
-    return apply_overrides(machine, args.set)
+    given = [d for d in FLAG_PATHS if getattr(args, d) is not None and getattr(args, d) is not False]
+    set_paths = {w.split("=", 1)[0].strip() for w in args.set}
+    named = [d for d in given if FLAG_PATHS[d][1] not in set_paths]  # a path also --set is named as a path
+    flags = {FLAG_PATHS[d][1]: FLAG_VALUES.get(d, getattr(args, d)) for d in given}
+    try:
+        return apply_overrides(machine, [*(f"{p}={v}" for p, v in flags.items()), *args.set])
+    except (MachineError, QuantityError) as e:
+        raise flag_error(e, named) from None
 
 
-def flag_text(text: str) -> str:
-    """``text`` with the spec paths of ``FLAG_PATHS`` named by their flags."""
-    for flag, path in FLAG_PATHS.values():
-        text = text.replace(path, flag)
+def flag_text(text: str, given=None) -> str:
+    """``text`` with the spec paths of ``FLAG_PATHS`` (only those of the ``given`` options, if given) named
+    by their flags."""
+    for dest, (flag, path) in FLAG_PATHS.items():
+        if given is None or dest in given:
+            text = text.replace(path, flag)
     return text
 
 
-def flag_error(e: StewartError) -> StewartError:
-    """``e`` with the spec paths of ``FLAG_PATHS`` in its message named by their flags (the same class)."""
-    message = flag_text(str(e))
+def flag_error(e: StewartError, given=None) -> StewartError:
+    """``e`` with the spec paths of ``FLAG_PATHS`` (of the ``given`` options) in its message named by their
+    flags (the same class)."""
+    message = flag_text(str(e), given)
     if message == str(e):
         return e
     e = copy.copy(e)

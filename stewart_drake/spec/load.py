@@ -94,10 +94,23 @@ def parse_field(path: str, value, where: str | None = None):
 
 def apply_overrides(machine: Machine, overrides) -> Machine:
     """``machine`` with the fields of ``overrides`` replaced: ``PATH=VALUE`` words or a ``{path: value}``
-    mapping (values as ``parse_field`` reads them)."""
-    items = _override_items(overrides)
-    for path, value in items:
-        machine = _replace(machine, path, parse_field(path, value), str(value))
+    mapping (values as ``parse_field`` reads them; a path given twice takes its last value). The fields of a
+    section are replaced together, so that they are checked as a whole (``firmware.word_bits=24`` with
+    ``firmware.trig=exact``)."""
+    values, texts = {}, {}
+    for path, value in _override_items(overrides):
+        values[path], texts[path] = parse_field(path, value), str(value)
+    sections: dict = {}
+    for path, value in values.items():
+        section, name = path.split(".", 1)
+        sections.setdefault(section, {})[name] = value
+    for section, fields in sections.items():
+        try:
+            new = dataclasses.replace(getattr(machine, section), **fields)
+        except MachineError as e:
+            path = str(e).split(" ", 1)[0]
+            raise MachineError(_as_written(e, texts[path]) if path in texts else str(e)) from None
+        machine = dataclasses.replace(machine, **{section: new})
     return machine
 
 
@@ -113,15 +126,6 @@ def _override_items(overrides) -> list:
         path, value = str(w).split("=", 1)
         out.append((path.strip(), value.strip()))
     return out
-
-
-def _replace(machine: Machine, path: str, value, text: str, where: str = "") -> Machine:
-    section, name = path.split(".", 1)
-    try:
-        new = dataclasses.replace(getattr(machine, section), **{name: value})
-    except MachineError as e:
-        raise MachineError(where + _as_written(e, text)) from None
-    return dataclasses.replace(machine, **{section: new})
 
 
 def _as_written(e: MachineError, text: str) -> str:

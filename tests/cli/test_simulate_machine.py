@@ -185,3 +185,15 @@ def test_the_certificate_takes_the_machines_format():
     assert cert["format"] == {"word_bits": 16, "length_lsb_m": 3e-05, "trig": "tfr16", "convention": "utn"}
     assert not cert["saturation_possible"]  # the example's 16-bit words hold its legs at 30 µm
     assert sd.firmware.certify(machine, length_lsb=1e-3, max_cells=2000).to_dict()["format"]["length_lsb_m"] == 1e-3
+
+
+def test_format_flags_are_one_format(tmp_path, capsys):
+    """--word-bits 24 needs --trig exact: given together they are checked together (the C engine's module has
+    16-bit words: the emulation runs wider ones)."""
+    argv = ["--word-bits", "24", "--trig", "exact", "--length-lsb", "10um", "--engine", "python", "--duration", "0.2"]
+    rc, summary = simulate(tmp_path, *argv)
+    assert rc == 0, capsys.readouterr().err
+    assert summary["firmware_format"] == {"word_bits": 24, "length_lsb_m": 1e-05, "trig": "exact", "convention": "utn"}
+    # a path given by a flag and by --set is named as the path the user set last
+    rc, _ = simulate(tmp_path, "--word-bits", "24", "--set", "firmware.trig=exact", "--set", "firmware.word_bits=40")
+    assert rc == 2 and "firmware.word_bits must be an integer 8..31, got 40" in capsys.readouterr().err

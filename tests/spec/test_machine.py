@@ -200,3 +200,13 @@ def test_a_bad_machine_file_is_one_line_naming_file_line_and_path(tmp_path, tail
     with pytest.raises((MachineError, QuantityError)) as e:
         load_machine(p)
     assert str(e.value).startswith(f"{p}{message}"), str(e.value)
+
+
+def test_a_sections_overrides_are_checked_together():
+    # 24-bit words need the exact trig: given together, in either order, they are one valid format
+    for words in (["firmware.word_bits=24", "firmware.trig=exact"], ["firmware.trig=exact", "firmware.word_bits=24"]):
+        assert load_machine("utn-dynamic", words).firmware == FirmwareFormat(24, 1e-3, "exact", "utn")
+    with pytest.raises(
+        MachineError, match=r"^firmware.word_bits must be 16 with trig tfr16 \(use trig exact\), got 24$"
+    ):
+        load_machine("utn-dynamic", ["firmware.word_bits=24"])
