@@ -854,6 +854,7 @@ class MachineError(UsageError):
     UNKNOWN_KEY = "{where}unknown key {path!r}{hint}"
     NOT_MAPPING = "{where}{path} must be a mapping of key: value, got {got}"
     OVERRIDE = "{text!r} is not PATH=VALUE (e.g. controller.period=0.5ms)"
+    KEY = "{where}a key must be a name, got {got}"
     MOTION = "{path}: {value!r} is not seed, rotating, a .csv file or a .stw script"
     PLATFORM = "{where}platform must be a preset name, a platform file or an inline mapping, got {got}"
     FIRMWARE_PLATFORM = (
@@ -925,16 +926,17 @@ OPTION_BRANCH_SAMPLES = "--branch-samples must be between 2 and {limit}, got {va
 OPTION_NON_NEGATIVE = "{name} must be a non-negative number, got {value}"
 OPTION_SIMULATE_UTN = "--simulate drives the plant with utn-convention poses; use --convention utn"
 OPTION_SIMULATE_EMPTY = "--simulate: the program has no moves or waits (its trajectory lasts 0 s)"
-OPTION_DURATION_POSITIVE = "--duration must be a positive number of seconds, got {value}"
 OPTION_DURATION_PERIOD = (
-    "--duration {value} s is shorter than one controller period ({period} s); give at least one period"
+    "run.duration {value} s is shorter than one controller.period ({period} s); give at least one period"
 )
-OPTION_ENGINE_FIXED = "--engine c / --firmware run the fixed-point controller; --controller is {controller!r}"
+OPTION_ENGINE_FIXED = (
+    "controller.engine c and a firmware run the fixed-point controller; controller.law is {controller!r}"
+)
 SIMULATION_GAP_WARNING = (
     "the loop closures opened by up to {gap:.3g} m, more than a tenth of the sensor's {count:g} m count: "
-    "try --integrator cenic or a smaller --plant-step"
+    "try run.integrator cenic or a smaller run.plant_step"
 )
-OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine python; drop one of them"
+OPTION_FIRMWARE_ENGINE = "a firmware runs your C, so it cannot run with controller.engine python; drop one of them"
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"
 OPTION_PORT = "--port must be in 1024..65535 (Meshcat does not listen on a privileged port), got {value}"

@@ -91,6 +91,40 @@ def controller_config(
     return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=convention)
 
 
+def machine_format(
+    platform,
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
+) -> tuple[Machine, dict]:
+    """``(machine, format)``: the machine of ``platform`` (a ``Machine``, a ``Platform``, a preset name or a
+    platform or machine file) and the firmware's ``word_bits``, ``length_lsb``, ``trig``, ``convention``,
+    ``rate`` (Hz) and ``sensor_resolution`` (m): each keyword given, else the machine's (``firmware``,
+    ``1 / controller.period``, ``sensors.resolution``; a platform's machine has the DSP's defaults)."""
+    machine = load_machine(platform)
+    fmt = machine.firmware
+    given = dict(
+        word_bits=word_bits,
+        length_lsb=length_lsb,
+        trig=trig,
+        convention=convention,
+        rate=rate,
+        sensor_resolution=sensor_resolution,
+    )
+    mine = dict(
+        word_bits=fmt.word_bits,
+        length_lsb=fmt.length_lsb,
+        trig=fmt.trig,
+        convention=fmt.convention,
+        rate=1.0 / machine.controller.period,
+        sensor_resolution=machine.sensors.resolution,
+    )
+    return machine, {k: mine[k] if v is None else v for k, v in given.items()}
+
+
 @dataclass(repr=False)
 class GenerateResult(Result):
     """The generated firmware (``firmware.generate``).
@@ -155,15 +189,11 @@ def generate(
     Raises:
         StewartError: bad options, or an output folder that holds other files.
     """
-    machine = load_machine(platform)
-    fmt, platform = machine.firmware, machine.platform
+    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    platform = machine.platform
     platform_source = machine.platform_source if platform_source is None else platform_source
-    word_bits = fmt.word_bits if word_bits is None else word_bits
-    length_lsb = fmt.length_lsb if length_lsb is None else length_lsb
-    trig = fmt.trig if trig is None else trig
-    convention = fmt.convention if convention is None else convention
-    rate = 1.0 / machine.controller.period if rate is None else rate
-    sensor_resolution = machine.sensors.resolution if sensor_resolution is None else sensor_resolution
+    word_bits, length_lsb, trig, convention = f["word_bits"], f["length_lsb"], f["trig"], f["convention"]
+    rate, sensor_resolution = f["rate"], f["sensor_resolution"]
     config = controller_config(
         machine.loaded_platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory
     )
@@ -306,7 +336,8 @@ def check(
         raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     rec = read_fingerprint(path)
     if platform is None:
-        platform = load_platform(o["platform"])
+        # a preset, a platform file or a machine file (whose payload the gains were designed with)
+        platform = load_machine(o["platform"]).loaded_platform
     else:
         platform = load_platform(platform)
         if rec and _platform_name(rec[0]["platform"]) != platform.name:
@@ -343,9 +374,10 @@ def _check_in_child(beat, *args) -> dict:
 
 
 def _platform_name(recorded: str) -> str:
-    """The name of the platform a fingerprint records (a preset name, a YAML path, or an API platform's name)."""
+    """The name of the platform a fingerprint records (a preset name, a platform or machine file's path, or an
+    API platform's name)."""
     try:
-        return load_platform(recorded).name
+        return load_machine(recorded).platform.name
     except StewartError:
         return recorded
 
@@ -420,7 +452,7 @@ def _shown(platform) -> str:
 
 
 def certify(
-    platform: str | Path | Platform,
+    platform: str | Path | Platform | Machine,
     *,
     box: Sequence[str] | None = None,
     length_unit: str = "mm",
@@ -431,12 +463,12 @@ def certify(
     tick_error: float = 5e-3,
     tick_speed: float = 0.1,
     tick_feedforward: float = 0.0,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
 ) -> CertifyResult:
     """Prove, over every pose of a box, each ``sd_ik`` word's range, whether it can saturate, and a bound on
@@ -444,7 +476,8 @@ def certify(
     ``sd_tick`` words too.
 
     Args:
-        platform: a preset name, a platform file or a ``Platform``.
+        platform: a preset name, a platform or machine file, a ``Platform`` or a ``Machine`` (the format,
+            rate and sensor resolution below default to the machine's: a platform's are the DSP's).
         box: pose box words ``KEY=LO..HI`` (KEY one of px py pz a b g, in ``length_unit``/``angle_unit``);
             keys not given keep the workspace box's range (None: the workspace box).
         length_unit: unit of px py pz in ``box``.
@@ -470,8 +503,9 @@ def certify(
     Raises:
         StewartError: a bad box, budget or format; ``tp17`` on another platform.
     """
-    p = load_platform(platform)
-    config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    p = machine.platform
+    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)
     fmt = config.ik_format
     if implementation == "tp17":
@@ -498,24 +532,25 @@ def _certify_tick(config: ControllerConfig, error: float, speed: float, feedforw
 
 
 def certify_tick(
-    platform: str | Path | Platform,
+    platform: str | Path | Platform | Machine,
     *,
     tick_error: float = 5e-3,
     tick_speed: float = 0.1,
     tick_feedforward: float = 0.0,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
 ) -> TickResult:
     """Prove the ranges of ``sd_tick``'s PID words (and whether the anti-windup keeps the integrator inside its
     rails) for stated bounds on the error, the legs' speed and the feed-forward.
 
     Args:
-        platform: a preset name, a platform file or a ``Platform``.
+        platform: a preset name, a platform or machine file, a ``Platform`` or a ``Machine`` (the format,
+            rate and sensor resolution below default to the machine's: a platform's are the DSP's).
         tick_error: bound on ``|set-point - measured|``, m.
         tick_speed: bound on the legs' speed, m/s.
         tick_feedforward: bound on ``|feed-forward|``, N.
@@ -533,13 +568,13 @@ def certify_tick(
     Raises:
         StewartError: a negative or non-finite bound, a bad format.
     """
-    p = load_platform(platform)
-    config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
     return TickResult(_certify_tick(config, tick_error, tick_speed, tick_feedforward))
 
 
 def optimize(
-    platform: str | Path | Platform,
+    platform: str | Path | Platform | Machine,
     *,
     error_budget: str | float,
     objective: str = "bits",
@@ -548,12 +583,12 @@ def optimize(
     length_unit: str = "mm",
     angle_unit: str = "pi",
     max_cells: int | None = None,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
 ) -> OptimizeResult:
     """Choose the length LSB, word bits and trigonometry so that the proven ``sd_ik`` error meets a budget
@@ -561,7 +596,8 @@ def optimize(
     firmware; compared with the default format and with a simulation-only choice.
 
     Args:
-        platform: a preset name, a platform file or a ``Platform``.
+        platform: a preset name, a platform or machine file, a ``Platform`` or a ``Machine`` (the format,
+            rate and sensor resolution below default to the machine's: a platform's are the DSP's).
         error_budget: the bound to meet: metres, or text such as ``"0.5mm"``, ``"500um"``.
         objective: ``"bits"`` or ``"cycles"``.
         out: write the chosen firmware (``sd_firmware.h``/``.c``, README) into this folder.
@@ -585,8 +621,9 @@ def optimize(
     """
     budget = parse_budget(error_budget)
     folder = None if out is None else OutputFolder(out)
-    p = load_platform(platform)
-    config = controller_config(p, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory)
+    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    p = machine.platform
+    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)
     res = choose_formats(p, config, pose_box, budget, objective, MAX_CELLS if max_cells is None else max_cells)
     written = None

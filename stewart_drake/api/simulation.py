@@ -23,10 +23,9 @@ from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.control.verdict import run_verdict
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import PRESETS, Platform, load_preset
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S, check_time_limit
 from stewart_drake.core.sanity import (
-    check_positive,
     check_trajectory,
     check_work,
     fmt_value,
@@ -40,7 +39,6 @@ from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel,
 from stewart_drake.errors import (
     FIRMWARE_FORMAT_ADOPTED,
     OPTION_DURATION_PERIOD,
-    OPTION_DURATION_POSITIVE,
     OPTION_ENGINE_FIXED,
     OPTION_FIRMWARE_ENGINE,
     SIMULATION_GAP_WARNING,
@@ -118,6 +116,7 @@ KEYWORD_PATHS = {
     "plant_step": "run.plant_step",
     "integrator": "run.integrator",
     "fit": "run.fit",
+    "duration": "run.duration",
 }
 
 
@@ -151,13 +150,15 @@ def adopt_firmware(machine: Machine, path) -> tuple[Machine, list]:
     if rec is None:
         return machine, []
     opts, where = rec
-    mine = platform_hash(machine.platform)
-    if opts[PLATFORM_HASH] is not None and opts[PLATFORM_HASH] != mine:
+    mine, recorded_hash = platform_hash(machine.platform), opts[PLATFORM_HASH]
+    if recorded_hash is None and opts["platform"] in PRESETS:  # generated before the hash was recorded
+        recorded_hash = platform_hash(load_preset(opts["platform"]))
+    if recorded_hash is not None and recorded_hash != mine:
         raise MachineError(
             MachineError.FIRMWARE_PLATFORM.format(
                 firmware=where,
                 recorded=opts["platform"],
-                recorded_hash=opts[PLATFORM_HASH],
+                recorded_hash=recorded_hash,
                 platform=machine.platform.name,
                 platform_hash=mine,
             )
@@ -264,6 +265,7 @@ def plan_run(
         engine=engine,
         integrator=integrator,
         fit=fit,
+        duration=duration,
     )
     machine = run_machine(platform, keywords, overrides)
     warnings: list[str] = []
@@ -276,21 +278,17 @@ def plan_run(
     controller, period, latency = ctl.law, ctl.period, ctl.latency
     feedforward, engine, sensor_resolution = ctl.feedforward, ctl.engine, machine.sensors.resolution
     plant_step, integrator, fit = machine.run.plant_step, machine.run.integrator, machine.run.fit
-    duration = duration if duration is not None else machine.run.duration
+    duration = machine.run.duration
     trajectory = machine.motion if trajectory is None else trajectory
     if checks:
         require_plant_plate(platform, command)  # the plate carries the legs: not negligible against them
     plant_step = plant_step if plant_step is not None else min(period, 1e-3)
-    if duration is not None:
-        check_positive(duration, "--duration", "seconds")
     csv = isinstance(trajectory, (str, Path)) and str(trajectory) not in ("seed", "rotating")
     units = {"length_unit": length_unit, "angle_unit": angle_unit}
     traj = _motion(trajectory, platform, 1.0 / period, **units, **({"smooth": smooth} if smooth is not None else {}))
     if fit:
         traj = fit_trajectory(traj, platform)
     duration = duration if duration is not None else (traj.duration or 1.0)
-    if not duration > 0:
-        raise OptionError(OPTION_DURATION_POSITIVE.format(value=duration_shown))
     actuators = actuators or ActuatorModel(machine.actuators.max_force, machine.actuators.time_constant)
     sensor = sensor if sensor is not None else _sensor(machine, duration)
     timing = DspTiming(
@@ -305,7 +303,7 @@ def plan_run(
         if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
             raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
         shown = duration_shown if duration_shown is not None else duration
-        check_simulation_size(duration, plant_step, "--duration", shown)
+        check_simulation_size(duration, plant_step, "run.duration", shown)
         ticks = np.arange(tick_count(duration, period)) * period
         try:
             warnings += check_trajectory(

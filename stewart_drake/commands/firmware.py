@@ -9,9 +9,10 @@ from pathlib import Path
 from stewart_drake.api import firmware
 from stewart_drake.commands._certify import register as register_certify
 from stewart_drake.commands._common import add_platform_arg, print_json
-from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S
+from stewart_drake.errors import UsageError
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
+from stewart_drake.spec import load_machine
 
 
 def _format_args(p, recorded: bool = False) -> None:
@@ -83,7 +84,15 @@ def register(sub) -> None:
         "--no-compile", action="store_true", help="do not compile-check the module with the available compilers"
     )
     g.add_argument("--json", action="store_true", help="print the summary as JSON")
-    g.set_defaults(func=run_generate)
+    g.add_argument(
+        "--machine",
+        default=None,
+        metavar="FILE",
+        help="a machine file (see `simulate --machine`): its platform, payload, firmware format, rate (1/period) "
+        "and sensor resolution; the options above replace them",
+    )
+    # None: the machine's (a platform's machine has the defaults the options' help names)
+    g.set_defaults(func=run_generate, **dict.fromkeys(MACHINE_OPTIONS))
     c = fs.add_parser("check", help="compile FILE.c (implementing the ABI) and compare it with the emulation")
     c.add_argument(
         "file",
@@ -137,11 +146,19 @@ def _format(args) -> dict:
     )
 
 
+# firmware generate's options that default to the machine's
+MACHINE_OPTIONS = ("platform", "word_bits", "length_lsb", "trig", "convention", "rate", "sensor_resolution")
+
+
 def run_generate(args) -> int:
     note = lambda n: print(f"stewart-drake firmware generate: note: {n}", file=sys.stderr)  # noqa: E731
-    platform = load_platform(args.platform)
+    if args.machine is not None and args.platform is not None:
+        raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
+    source = args.machine or args.platform or FP_DEFAULTS["platform"]
+    machine = load_machine(source)
+    platform = machine.platform
     r = firmware.generate(
-        platform, args.out, compile=not args.no_compile, on_note=note, platform_source=args.platform, **_format(args)
+        machine, args.out, compile=not args.no_compile, on_note=note, platform_source=source, **_format(args)
     )
     summary, out, compiled, written = r.to_dict(), Path(args.out), r.summary["compiled_with"], r.files
     clock_hz = r.config.timing.clock_hz

@@ -2,30 +2,36 @@
 
 from __future__ import annotations
 
+import copy
 import sys
 from pathlib import Path
 
 from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
-    add_platform_arg,
     dumps_strict,
     output_folder,
     print_json,
     reject_unused,
 )
 from stewart_drake.commands.firmware import add_time_limit_arg
+from stewart_drake.core.geometry import PRESETS
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
-from stewart_drake.errors import MachineError, QuantityError, UsageError
+from stewart_drake.errors import MachineError, QuantityError, StewartError, UsageError
 from stewart_drake.firmware.engine import ENGINES
 from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run the fixed-point (or float) controller in the loop with the Drake plant")
-    add_platform_arg(p, default=None)
+    p.add_argument(
+        "--platform",
+        default=None,
+        metavar="NAME|FILE",
+        help=f"a preset ({', '.join(PRESETS)}) or a platform YAML file (default: utn-dynamic; or give --machine)",
+    )
     p.add_argument(
         "--machine",
         default=None,
@@ -114,10 +120,9 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--duration",
-        type=float,
         default=None,
-        metavar="S",
-        help="simulated seconds (default: the trajectory's, 4 s for seed)",
+        metavar="T",
+        help="simulated time, e.g. 2 or 500ms (default: the trajectory's, 4 s for seed; bare: s)",
     )
     p.add_argument(
         "--out",
@@ -175,6 +180,7 @@ FLAG_PATHS = {
     "plant_step": ("--plant-step", "run.plant_step"),
     "integrator": ("--integrator", "run.integrator"),
     "fit": ("--fit", "run.fit"),
+    "duration": ("--duration", "run.duration"),
 }
 # store_true flags: the value they set
 FLAG_VALUES = {"no_feedforward": False, "fit": True}
@@ -182,19 +188,39 @@ FLAG_VALUES = {"no_feedforward": False, "fit": True}
 
 def machine_from_args(args) -> Machine:
     """The machine of ``--machine`` (else ``--platform``, else utn-dynamic) with the flags of ``FLAG_PATHS``
-    that were given, then each ``--set``; an error about a flag's path names the flag."""
+    that were given and each ``--set`` (applied together: a section is checked as a whole); an error about a
+    flag's path names the flag."""
     if args.machine is not None and args.platform is not None:
         raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
     machine = load_machine(args.machine or args.platform or "utn-dynamic")
+    given = [d for d in FLAG_PATHS if getattr(args, d) is not None and getattr(args, d) is not False]
+    set_paths = {w.split("=", 1)[0].strip() for w in args.set}
+    named = [d for d in given if FLAG_PATHS[d][1] not in set_paths]  # a path also --set is named as a path
+    flags = {FLAG_PATHS[d][1]: FLAG_VALUES.get(d, getattr(args, d)) for d in given}
+    try:
+        return apply_overrides(machine, [*(f"{p}={v}" for p, v in flags.items()), *args.set])
+    except (MachineError, QuantityError) as e:
+        raise flag_error(e, named) from None
+
+
+def flag_text(text: str, given=None) -> str:
+    """``text`` with the spec paths of ``FLAG_PATHS`` (only those of the ``given`` options, if given) named
+    by their flags."""
     for dest, (flag, path) in FLAG_PATHS.items():
-        value = getattr(args, dest)
-        if value is None or value is False:
-            continue
-        try:
-            machine = apply_overrides(machine, {path: FLAG_VALUES.get(dest, value)})
-        except (MachineError, QuantityError) as e:
-            raise type(e)(str(e).replace(path, flag, 1)) from None
-    return apply_overrides(machine, args.set)
+        if given is None or dest in given:
+            text = text.replace(path, flag)
+    return text
+
+
+def flag_error(e: StewartError, given=None) -> StewartError:
+    """``e`` with the spec paths of ``FLAG_PATHS`` (of the ``given`` options) in its message named by their
+    flags (the same class)."""
+    message = flag_text(str(e), given)
+    if message == str(e):
+        return e
+    e = copy.copy(e)
+    e.args = (message,)
+    return e
 
 
 def run(args) -> int:
@@ -208,19 +234,23 @@ def run(args) -> int:
     )
     out_folder = output_folder(args, names=FILES)
     reject_unused(args, "--firmware", args.firmware is not None, time_limit=FIRMWARE_IDLE_LIMIT_S)
-    plan = plan_run(
-        machine_from_args(args),
-        args.trajectory,
-        duration=args.duration,
-        firmware=None if args.firmware is None else firmware_source(args.firmware, "--firmware"),
-        time_limit=args.time_limit,
-        allow_out_of_stroke=args.allow_out_of_stroke,
-        length_unit=args.length_unit,
-        angle_unit=args.angle_unit,
-        smooth=args.smooth,
-        duration_shown=args.duration,
-    )
-    warn = lambda w: print(f"stewart-drake simulate: warning: {w}", file=sys.stderr)  # noqa: E731
+    firmware = None if args.firmware is None else firmware_source(args.firmware, "--firmware")
+    machine = machine_from_args(args)
+    try:  # the API names spec paths; the user gave flags
+        plan = plan_run(
+            machine,
+            args.trajectory,
+            firmware=firmware,
+            time_limit=args.time_limit,
+            allow_out_of_stroke=args.allow_out_of_stroke,
+            length_unit=args.length_unit,
+            angle_unit=args.angle_unit,
+            smooth=args.smooth,
+            duration_shown=args.duration,
+        )
+    except StewartError as e:
+        raise flag_error(e) from None
+    warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w)}", file=sys.stderr)  # noqa: E731
     result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
     summary = result.to_dict()
     out = Path(args.out)

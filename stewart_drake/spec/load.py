@@ -10,6 +10,7 @@ grammar (``period: 0.5ms``; a bare number is SI); errors name the file, line and
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 from collections.abc import Iterable, Mapping
@@ -34,8 +35,8 @@ from stewart_drake.core.platform_file import platform_document
 from stewart_drake.core.sanity import check_home
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.core.yamlio import compose, load_node_typed, read_yaml_text
-from stewart_drake.errors import GeometryError, MachineError, QuantityError
-from stewart_drake.spec.machine import FIELDS, SECTIONS, Gains, Machine
+from stewart_drake.errors import GeometryError, MachineError, QuantityError, StewartError
+from stewart_drake.spec.machine import FIELDS, SECTIONS, Gains, Machine, check_motion
 from stewart_drake.spec.quantity import parse_choice, parse_number, parse_vector
 
 MACHINE_KEYS = (*SECTIONS, "platform", "motions", "requirements", "calibration")
@@ -51,6 +52,9 @@ def parse_field(path: str, value, where: str | None = None):
         raise MachineError(MachineError.UNKNOWN_KEY.format(where="", path=path, hint=_hint(path, FIELDS)))
     kind = FIELDS[path]
     where = where or path
+    optional = kind[0].endswith("?") if isinstance(kind, tuple) else kind.endswith("?")
+    if value is None and not optional:
+        raise QuantityError(QuantityError.NUMBER.format(where=where, text="null", allowed="a value"))
     if isinstance(kind, tuple):
         word, choices = kind
         if word.endswith("?") and _is_null(value):
@@ -81,7 +85,7 @@ def parse_field(path: str, value, where: str | None = None):
             extra = set(value) - {"kp", "ki", "kd", "kv"}
             if extra or len(value) != 4:
                 raise MachineError(
-                    MachineError.RANGE.format(path=path, rule="design or {kp, ki, kd, kv}", value=dict(value))
+                    MachineError.RANGE.format(path=where, rule="design or {kp, ki, kd, kv}", value=dict(value))
                 )
             return Gains(**{k: parse_number(v, "ratio", f"{where}.{k}") for k, v in value.items()})
         return parse_choice(value, ("design",), where)
@@ -90,10 +94,23 @@ def parse_field(path: str, value, where: str | None = None):
 
 def apply_overrides(machine: Machine, overrides) -> Machine:
     """``machine`` with the fields of ``overrides`` replaced: ``PATH=VALUE`` words or a ``{path: value}``
-    mapping (values as ``parse_field`` reads them)."""
-    items = _override_items(overrides)
-    for path, value in items:
-        machine = _replace(machine, path, parse_field(path, value), str(value))
+    mapping (values as ``parse_field`` reads them; a path given twice takes its last value). The fields of a
+    section are replaced together, so that they are checked as a whole (``firmware.word_bits=24`` with
+    ``firmware.trig=exact``)."""
+    values, texts = {}, {}
+    for path, value in _override_items(overrides):
+        values[path], texts[path] = parse_field(path, value), str(value)
+    sections: dict = {}
+    for path, value in values.items():
+        section, name = path.split(".", 1)
+        sections.setdefault(section, {})[name] = value
+    for section, fields in sections.items():
+        try:
+            new = dataclasses.replace(getattr(machine, section), **fields)
+        except MachineError as e:
+            path = str(e).split(" ", 1)[0]
+            raise MachineError(_as_written(e, texts[path]) if path in texts else str(e)) from None
+        machine = dataclasses.replace(machine, **{section: new})
     return machine
 
 
@@ -109,15 +126,6 @@ def _override_items(overrides) -> list:
         path, value = str(w).split("=", 1)
         out.append((path.strip(), value.strip()))
     return out
-
-
-def _replace(machine: Machine, path: str, value, text: str, where: str = "") -> Machine:
-    section, name = path.split(".", 1)
-    try:
-        new = dataclasses.replace(getattr(machine, section), **{name: value})
-    except MachineError as e:
-        raise MachineError(where + _as_written(e, text)) from None
-    return dataclasses.replace(machine, **{section: new})
 
 
 def _as_written(e: MachineError, text: str) -> str:
@@ -147,6 +155,8 @@ def load_machine(source: Machine | Platform | Mapping | str | Path, overrides: I
         s = str(source)
         if s in PRESETS:
             machine = Machine(load_platform(s), platform_source=s)
+        elif not Path(s).exists():  # the platform loader's message: an unknown preset or a missing file
+            machine = Machine(load_platform(s))
         else:
             text, shown = read_yaml_text(s, "machine")
             machine = _from_text(text, shown, Path(s).parent, stem=Path(s).stem)
@@ -205,8 +215,10 @@ def _from_text(text: str, shown: str, base: Path, stem: str = "", platform: Plat
     fields, platform_pairs, seen = {}, [], {}
     platform_node = None
     for k, v in root.value:
-        key = k.value if isinstance(k, yaml.ScalarNode) else str(k)
         at = f"{shown}:{_line(k)}: "
+        if not isinstance(k, yaml.ScalarNode):
+            raise MachineError(MachineError.KEY.format(where=at, got=_describe(k)))
+        key = k.value
         if key in seen:
             raise MachineError(
                 MachineError.RANGE.format(path=at + key, rule=f"given once (first on line {seen[key]})", value="twice")
@@ -223,18 +235,23 @@ def _from_text(text: str, shown: str, base: Path, stem: str = "", platform: Plat
                     raise MachineError(
                         MachineError.MOTION.format(path=f"{at}motions item {i + 1}", value=_describe(item))
                     )
+                check_motion(f"{shown}:{_line(item)}: motions item {i + 1}", item.value)
             fields["motions"] = tuple(_relative(item.value, base) for item in items)
         elif key == "calibration" and isinstance(v, yaml.MappingNode):  # a calibrated platform file's record
             platform_pairs.append((k, v))
         elif key in ("requirements", "calibration"):
             if not isinstance(v, yaml.ScalarNode):
-                raise MachineError(MachineError.NOT_MAPPING.format(where=at, path=key, got=_describe(v)))
+                raise MachineError(
+                    MachineError.RANGE.format(path=at + key, rule="a file path or null", value=_describe(v))
+                )
             fields[key] = None if _scalar(v) is None else _relative(v.value, base)
         elif key in PLATFORM_KEYS:
             platform_pairs.append((k, v))
         else:
             raise MachineError(
-                MachineError.UNKNOWN_KEY.format(where=at, path=key, hint=_hint(key, (*MACHINE_KEYS, *PLATFORM_KEYS)))
+                MachineError.UNKNOWN_KEY.format(
+                    where=at, path=key, hint=_hint(key, dict.fromkeys(MACHINE_KEYS + PLATFORM_KEYS))
+                )
             )
     if platform is not None:
         if platform_pairs:
@@ -261,7 +278,12 @@ def _from_text(text: str, shown: str, base: Path, stem: str = "", platform: Plat
     if isinstance(platform_node, yaml.ScalarNode):
         src = platform_node.value
         src = src if src in PRESETS else _relative(src, base)
-        platform, source = load_platform(src), src
+        try:
+            platform, source = load_platform(src), src
+        except StewartError as e:  # the same error, located in the machine file
+            located = copy.copy(e)
+            located.args = (f"{shown}:{_line(platform_node)}: platform: {e}",)
+            raise located from None
     elif isinstance(platform_node, yaml.MappingNode):
         platform, source = _inline_platform(platform_node, shown, stem), None
     else:

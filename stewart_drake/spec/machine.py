@@ -8,7 +8,6 @@ YAML with overrides by path; ``FIELDS`` lists every overridable path with its di
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -224,7 +223,13 @@ class Machine:
 
     def __post_init__(self):
         if not isinstance(self.platform, Platform):
-            raise MachineError(MachineError.PLATFORM.format(where="", got=type(self.platform).__name__))
+            raise MachineError(
+                MachineError.RANGE.format(
+                    path="platform",
+                    rule="a Platform (load_machine reads names and files)",
+                    value=type(self.platform).__name__,
+                )
+            )
         motions = (self.motions,) if isinstance(self.motions, (str, Trajectory)) else tuple(self.motions)
         if not motions:
             raise MachineError(MachineError.RANGE.format(path="motions", rule="at least one motion", value="[]"))
@@ -292,4 +297,3 @@ FIELDS = {
     "run.fit": "bool",
     "run.seed": "int",
 }
-assert set(FIELDS) == {f"{s}.{f.name}" for s, tp in SECTIONS.items() for f in dataclasses.fields(tp)}

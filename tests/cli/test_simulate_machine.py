@@ -5,6 +5,7 @@ values); a firmware generated for another platform is refused; flags and ``--set
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -15,6 +16,7 @@ import stewart_drake as sd
 from stewart_drake.api.simulation import plan_run
 from stewart_drake.cli import main
 from stewart_drake.errors import FIRMWARE_FORMAT_ADOPTED, MachineError
+from stewart_drake.firmware.fingerprint import read_fingerprint
 from stewart_drake.spec import load_machine
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "newcomer-210kg.yaml"
@@ -58,14 +60,14 @@ def test_the_default_format_chatters_on_it(tmp_path, capsys):
 
 @needs_cc
 def test_the_firmware_format_is_adopted(tmp_path, capsys, firmware_30um):
-    """The machine says 1 mm, the firmware was generated at 30 µm: the loop runs the firmware's 30 µm and
-    tracks (the loop at 1 mm with this firmware lost tracking: the legs dropped ~250 mm)."""
+    """The machine says 1 mm, the firmware was generated at 30 µm: the loop runs the firmware's 30 µm, says so,
+    and tracks."""
     rc, summary = simulate(tmp_path, "--length-lsb", "1mm", "--firmware", str(firmware_30um / "fw30"))
     err = capsys.readouterr().err
     assert FIRMWARE_FORMAT_ADOPTED.format(what="length LSB 30 µm", machine="1 mm") in err
     assert rc == 0, err
     assert summary["firmware_format"]["length_lsb_m"] == 3e-05
-    # within the tracking verdict's bound (5 % of the 300 mm stroke range), which the run at 1 mm exceeded 16-fold
+    # within the tracking verdict's bound: 5 % of the 300 mm stroke range
     assert summary["max_leg_error_mm"] < 15.0
 
 
@@ -108,6 +110,8 @@ def test_flags_and_paths_are_named_as_written(tmp_path, capsys, args, message):
 def test_api_errors_name_spec_paths():
     with pytest.raises(MachineError, match=r"^controller\.period must be > 0 s, got -1$"):
         sd.simulate(sd.load_platform("utn-dynamic"), period=-1)
+    with pytest.raises(MachineError, match=r"^run\.duration must be > 0 s, got -1$"):
+        sd.simulate(sd.load_platform("utn-dynamic"), duration=-1)
     with pytest.raises(MachineError, match=r"^firmware\.length_lsb must be > 0 m, got 0$"):
         sd.simulate(sd.load_platform("utn-dynamic"), **{"firmware.length_lsb": 0})
 
@@ -143,3 +147,53 @@ def test_a_motion_program_is_a_machine_motion():
     traj = plan_run(platform, program, duration=0.1).scenario.trajectory
     assert traj.name == "seed_004"
     assert np.allclose(traj.pose(0.0), platform.home_pose(), atol=1e-12)  # a program starts at home
+
+
+def test_a_preset_firmware_without_the_hash_is_compared_by_the_preset(tmp_path, firmware_30um):
+    """A module generated before the platform's hash was recorded names its platform only: a preset name is
+    enough to compare (its file's content)."""
+    old = tmp_path / "old"
+    old.mkdir()
+    for f in ("sd_firmware.c", "sd_firmware.h"):
+        text = (firmware_30um / "utn" / f).read_text()
+        (old / f).write_text(re.sub(r', "platform_hash": "[0-9a-f]+"', "", text))
+    assert read_fingerprint(old / "sd_firmware.c")[0]["platform_hash"] is None
+    with pytest.raises(MachineError, match="was generated for platform utn-dynamic"):
+        plan_run(sd.load_machine(EXAMPLE), duration=0.1, firmware=old)
+    assert plan_run(sd.load_platform("utn-dynamic"), duration=0.1, firmware=old).warnings == ()
+
+
+@needs_cc
+def test_firmware_generate_for_a_machine_and_check_it(tmp_path, capsys):
+    """``firmware generate --machine``: the machine's format and payload-designed gains, recorded with the
+    machine file, so that ``firmware check`` emulates the same module, gains included."""
+    fw = tmp_path / "fw"
+    assert main(["firmware", "generate", "--machine", str(EXAMPLE), "--out", str(fw), "--no-compile"]) == 0
+    recorded = read_fingerprint(fw / "sd_firmware.c")[0]
+    assert (recorded["platform"], recorded["length_lsb"], recorded["word_bits"]) == (str(EXAMPLE), 3e-05, 16)
+    capsys.readouterr()
+    assert main(["firmware", "check", str(fw / "sd_firmware.c"), "--poses", "500", "--duration", "0.05"]) == 0
+    assert "identical to the emulation" in capsys.readouterr().out
+    argv = ["firmware", "generate", "--machine", str(EXAMPLE), "--platform", "utn-dynamic", "--out", str(tmp_path)]
+    assert main(argv) == 2
+    assert "give --machine or --platform, not both" in capsys.readouterr().err
+
+
+def test_the_certificate_takes_the_machines_format():
+    machine = sd.load_machine(EXAMPLE)
+    cert = sd.firmware.certify(machine, max_cells=20_000).to_dict()
+    assert cert["format"] == {"word_bits": 16, "length_lsb_m": 3e-05, "trig": "tfr16", "convention": "utn"}
+    assert not cert["saturation_possible"]  # the example's 16-bit words hold its legs at 30 µm
+    assert sd.firmware.certify(machine, length_lsb=1e-3, max_cells=2000).to_dict()["format"]["length_lsb_m"] == 1e-3
+
+
+def test_format_flags_are_one_format(tmp_path, capsys):
+    """--word-bits 24 needs --trig exact: given together they are checked together (the C engine's module has
+    16-bit words: the emulation runs wider ones)."""
+    argv = ["--word-bits", "24", "--trig", "exact", "--length-lsb", "10um", "--engine", "python", "--duration", "0.2"]
+    rc, summary = simulate(tmp_path, *argv)
+    assert rc == 0, capsys.readouterr().err
+    assert summary["firmware_format"] == {"word_bits": 24, "length_lsb_m": 1e-05, "trig": "exact", "convention": "utn"}
+    # a path given by a flag and by --set is named as the path the user set last
+    rc, _ = simulate(tmp_path, "--word-bits", "24", "--set", "firmware.trig=exact", "--set", "firmware.word_bits=40")
+    assert rc == 2 and "firmware.word_bits must be an integer 8..31, got 40" in capsys.readouterr().err

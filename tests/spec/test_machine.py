@@ -167,3 +167,46 @@ def test_a_mapping_may_hold_a_platform_object():
     assert load_machine({"platform": p}).platform is p
     with pytest.raises(MachineError, match=r"unknown key 'controler' \(did you mean 'controller'\?\)"):
         load_machine({"platform": p, "controler": {"period": "2ms"}})
+
+
+def test_every_section_field_has_a_path_in_the_grammar():
+    from stewart_drake.spec.machine import SECTIONS
+
+    paths = {f"{name}.{f.name}" for name, tp in SECTIONS.items() for f in dataclasses.fields(tp)}
+    assert paths == set(FIELDS)
+
+
+def test_a_machine_takes_a_platform_object():
+    with pytest.raises(
+        MachineError, match=r"^platform must be a Platform \(load_machine reads names and files\), got str$"
+    ):
+        Machine("utn-dynamic")
+
+
+@pytest.mark.parametrize(
+    ("tail", "message"),
+    [
+        ("[a, b]: 1\n", ":12: a key must be a name, got a list"),
+        ("motions: [circle]\n", ":12: motions item 1: 'circle' is not seed, rotating, a .csv file or a .stw script"),
+        ("requirements: {a: 1}\n", ":12: requirements must be a file path or null, got a mapping"),
+        ("controller: {period: null}\n", ":12: controller.period: cannot read 'null' as a number"),
+        ("controller: {gains: {kp: 1}}\n", ":12: controller.gains must be design or {kp, ki, kd, kv}, got"),
+        ("run: {fit: maybe}\n", ":12: run.fit: 'maybe' is not one of true, false"),
+        ("controller: [1, 2]\n", ":12: controller must be a mapping of key: value, got a list"),
+    ],
+)
+def test_a_bad_machine_file_is_one_line_naming_file_line_and_path(tmp_path, tail, message):
+    p = write(tmp_path, PLATFORM + tail)
+    with pytest.raises((MachineError, QuantityError)) as e:
+        load_machine(p)
+    assert str(e.value).startswith(f"{p}{message}"), str(e.value)
+
+
+def test_a_sections_overrides_are_checked_together():
+    # 24-bit words need the exact trig: given together, in either order, they are one valid format
+    for words in (["firmware.word_bits=24", "firmware.trig=exact"], ["firmware.trig=exact", "firmware.word_bits=24"]):
+        assert load_machine("utn-dynamic", words).firmware == FirmwareFormat(24, 1e-3, "exact", "utn")
+    with pytest.raises(
+        MachineError, match=r"^firmware.word_bits must be 16 with trig tfr16 \(use trig exact\), got 24$"
+    ):
+        load_machine("utn-dynamic", ["firmware.word_bits=24"])

@@ -109,7 +109,7 @@ def test_vary_vector_reads_the_grammar_vector():
 
 
 def test_vary_message_names_the_key_of_a_bad_percentage():
-    # the percentage is the key's, not gain_scale's
+    # the message names the key the percentage belongs to
     with pytest.raises(SpecError, match=r"^--vary: force_limit: cannot read '1x' as a number"):
         parse_value("force_limit", "±1x%")
 
