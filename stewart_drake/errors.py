@@ -876,11 +876,12 @@ class StudyError(StewartError):
         "use a longer --plant-step or fewer --runs"
     )
     RESOLUTION_RANGE = (
-        "--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
+        "--vary sensor_resolution: the fixed-point controller needs resolutions that divide its length LSB; "
         "give a value or a|b|c list, not a range"
     )
     RESOLUTION_DIVIDE = (
-        "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
+        "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's length LSB "
+        "(firmware.length_lsb {lsb:g} m) into whole counts"
     )
     DRAW = "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; no run was started"
     DRAW_ADVICE = " — narrow the --vary ranges"  # appended to DRAW only when --vary draws something

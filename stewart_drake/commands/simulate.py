@@ -8,8 +8,10 @@ from pathlib import Path
 from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
+    add_machine_args,
     add_platform_arg,
     dumps_strict,
+    machine_from_args,
     output_folder,
     print_json,
     reject_unused,
@@ -18,30 +20,13 @@ from stewart_drake.commands.firmware import add_time_limit_arg
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
-from stewart_drake.errors import MachineError, QuantityError, UsageError
 from stewart_drake.firmware.engine import ENGINES
-from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run the fixed-point (or float) controller in the loop with the Drake plant")
     add_platform_arg(p, default=None)
-    p.add_argument(
-        "--machine",
-        default=None,
-        metavar="FILE",
-        help="a machine file: a platform file with controller, firmware, sensors, actuators, payload, run and "
-        "motions sections (`stewart-drake init --machine-template` writes one); default: --platform "
-        "(utn-dynamic) with the defaults",
-    )
-    p.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="PATH=VALUE",
-        help="set one field of the machine by its spec path, e.g. --set controller.period=0.5ms "
-        "--set payload.mass=150kg (repeatable; after the other options)",
-    )
+    add_machine_args(p)
     p.add_argument(
         "--trajectory",
         default=None,
@@ -159,42 +144,6 @@ def add_loop_args(p) -> None:
 
 # the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
 FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
-
-# option (argparse dest) -> spec path: the one table between the command line and the machine's fields.
-# A flag given sets its path; an error about the path names the flag.
-FLAG_PATHS = {
-    "controller": ("--controller", "controller.law"),
-    "period": ("--period", "controller.period"),
-    "latency": ("--latency", "controller.latency"),
-    "engine": ("--engine", "controller.engine"),
-    "no_feedforward": ("--no-feedforward", "controller.feedforward"),
-    "sensor_resolution": ("--sensor-resolution", "sensors.resolution"),
-    "word_bits": ("--word-bits", "firmware.word_bits"),
-    "length_lsb": ("--length-lsb", "firmware.length_lsb"),
-    "trig": ("--trig", "firmware.trig"),
-    "plant_step": ("--plant-step", "run.plant_step"),
-    "integrator": ("--integrator", "run.integrator"),
-    "fit": ("--fit", "run.fit"),
-}
-# store_true flags: the value they set
-FLAG_VALUES = {"no_feedforward": False, "fit": True}
-
-
-def machine_from_args(args) -> Machine:
-    """The machine of ``--machine`` (else ``--platform``, else utn-dynamic) with the flags of ``FLAG_PATHS``
-    that were given, then each ``--set``; an error about a flag's path names the flag."""
-    if args.machine is not None and args.platform is not None:
-        raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
-    machine = load_machine(args.machine or args.platform or "utn-dynamic")
-    for dest, (flag, path) in FLAG_PATHS.items():
-        value = getattr(args, dest)
-        if value is None or value is False:
-            continue
-        try:
-            machine = apply_overrides(machine, {path: FLAG_VALUES.get(dest, value)})
-        except (MachineError, QuantityError) as e:
-            raise type(e)(str(e).replace(path, flag, 1)) from None
-    return apply_overrides(machine, args.set)
 
 
 def run(args) -> int:

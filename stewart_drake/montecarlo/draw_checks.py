@@ -96,7 +96,7 @@ def nominal_feasibility(study, reference, duration: float):
         key = (force_limit, period)
         if key not in cache:
             ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
-            cache[key] = infeasible_motion(study.platform, reference, ticks, period, force_limit)
+            cache[key] = infeasible_motion(study.machine.loaded_platform, reference, ticks, period, force_limit)
         return cache[key]
 
     return f

@@ -40,27 +40,41 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 from stewart_drake.core.yamlio import compose, read_yaml_text
 from stewart_drake.errors import SpecError, YamlError, short_text
 from stewart_drake.spec.quantity import parse_choice, parse_number, parse_quantity, parse_vector
 
-# key: (dimension, vector length or 0 for a scalar, nominal zero?)
+
+class VaryKey(NamedTuple):
+    """One ``--vary`` key: its quantity ``dimension`` (``mode``: a latency mode), ``length`` (0 for a scalar, 3 or 6
+    components, ``anchors`` for one offset per physical joint), ``zero_nominal`` (±P% refused) and ``path``: the
+    machine's spec path it draws (its nominal is the machine's value there, a drawn value is checked as the
+    machine checks that field), or None for the plant's own geometry and the sensor's per-run processes."""
+
+    dimension: str
+    length: int | str
+    zero_nominal: bool
+    path: str | None = None
+
+
+# The one table of what a study can vary, in draw order (a new key drawn from a machine field is one row here).
 KEYS = {
-    "anchor": ("length", "anchors", True),
-    "leg_offset": ("length", 6, True),
-    "sensor_resolution": ("length", 0, False),
-    "sensor_noise": ("length", 0, True),
-    "latency": ("mode", 0, False),
-    "latency_jitter": ("time", 0, True),
-    "actuator_lag": ("time", 0, False),
-    "force_limit": ("force", 0, False),
-    "plate_mass": ("mass", 0, False),
-    "plate_com": ("length", 3, True),
-    "gain_scale": ("ratio", 0, False),
-    "sample_period": ("time", 0, False),
-    "payload": ("mass", 0, True),
-    "payload_position": ("length", 3, True),
+    "anchor": VaryKey("length", "anchors", True),
+    "leg_offset": VaryKey("length", 6, True),
+    "sensor_resolution": VaryKey("length", 0, False, "sensors.resolution"),
+    "sensor_noise": VaryKey("length", 0, True, "sensors.noise"),
+    "latency": VaryKey("mode", 0, False, "controller.latency"),
+    "latency_jitter": VaryKey("time", 0, True),
+    "actuator_lag": VaryKey("time", 0, False, "actuators.time_constant"),
+    "force_limit": VaryKey("force", 0, False, "actuators.max_force"),
+    "plate_mass": VaryKey("mass", 0, False),
+    "plate_com": VaryKey("length", 3, True),
+    "gain_scale": VaryKey("ratio", 0, False, "controller.gain_scale"),
+    "sample_period": VaryKey("time", 0, False, "controller.period"),
+    "payload": VaryKey("mass", 0, True, "payload.mass"),
+    "payload_position": VaryKey("length", 3, True, "payload.position"),
 }
 # Keys of earlier versions whose names said something else than what they varied: refused, naming the keys
 # that replace them (a study written for the old names must not run with another meaning).
@@ -108,7 +122,7 @@ def _number(text: str, key: str, where: str) -> float:
 def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
     """The ``Distribution`` of ``key`` written ``text`` (see the module docstring)."""
     text = str(text).strip()
-    dim, length, zero_nominal = KEYS[key]
+    dim, length, zero_nominal, _ = KEYS[key]
     at = f"{where}: {key}"
     if dim == "mode":
         modes = tuple(m.strip() for m in text.split("|"))

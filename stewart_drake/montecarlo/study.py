@@ -33,6 +33,8 @@ from stewart_drake.errors import OutputError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
 from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
 from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
+from stewart_drake.spec import Gains, Machine, apply_overrides
+from stewart_drake.spec.machine import FIELDS
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -74,8 +76,29 @@ def study_settings(study: Study) -> dict:
         "grid": list(study.grid) if study.grid is not None else None,
         "motion": motion_settings(study),
         **shared,
+        **machine_settings(study.machine),
         **study.extra,
     }
+
+
+# spec paths study_settings records under names of their own (controller, engine, duration, ...)
+RECORDED_PATHS = ("controller.law", "controller.engine", "run.duration", "run.plant_step", "run.integrator", "run.fit")
+
+
+def machine_settings(machine: Machine) -> dict:
+    """``{"machine": {spec path: value}}`` (SI; lists, the gains as a mapping) of the machine's fields that differ
+    from a machine with defaults (those of ``RECORDED_PATHS`` left to their own settings); ``{}`` when none does,
+    so that a study of a platform keeps its settings and key."""
+    default = Machine(machine.platform)
+    out = {}
+    for path in FIELDS:
+        if path in RECORDED_PATHS:
+            continue
+        section, name = path.split(".")
+        v = getattr(getattr(machine, section), name)
+        if v != getattr(getattr(default, section), name):
+            out[path] = dataclasses.asdict(v) if isinstance(v, Gains) else list(v) if isinstance(v, tuple) else v
+    return {"machine": out} if out else {}
 
 
 def motion_settings(study: Study) -> dict | None:
@@ -116,10 +139,11 @@ def study_from_settings(settings: dict, runs: int) -> Study:
         "grid",
         "base_joints",
         "motion",
+        "machine",
     }
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(
-        platform=Platform(**plat),
+        apply_overrides(Machine(Platform(**plat)), settings.get("machine") or {}),
         spec=spec_from_dict(settings["vary"]),
         seed=settings["seed"],
         runs=runs,
@@ -187,9 +211,10 @@ def check_study(study: Study) -> float:
         law = study.spec.laws.get("sensor_resolution")
         if law is not None and law.kind not in ("fixed", "choice"):
             raise StudyError(StudyError.RESOLUTION_RANGE)
+        lsb = study.machine.firmware.length_lsb
         for r in law.values if law is not None else ():
-            if not (r > 0 and abs(1e-3 / r - round(1e-3 / r)) <= 1e-9 * 1e-3 / r):  # r > 0 first: no 1e-3 / 0
-                raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r))
+            if not (r > 0 and abs(lsb / r - round(lsb / r)) <= 1e-9 * lsb / r):  # r > 0 first: no lsb / 0
+                raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r, lsb=lsb))
     check_draws(study)
     return duration
 
