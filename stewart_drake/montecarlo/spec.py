@@ -9,22 +9,24 @@ Every key takes one value written the same way in both forms (units allowed: ``m
     A..B       uniform in [A, B]
     a|b|c      one of the listed values, equally likely
 
-Keys (nominal in brackets):
+Keys (nominal in brackets: the machine's value at the spec path a key draws, ``KEYS``' ``path``; a drawn value
+is checked as the machine checks that field):
 
     anchor             base and plate joint positions, per axis per physical joint [0 offset]
     leg_offset         the length sensor's zero, per leg [0]
-    sensor_resolution  metres per count [1e-5]
-    sensor_noise       σ of white Gaussian noise on each reading, m [0]
-    latency            sample | computation | none [sample]
+    sensor_resolution  metres per count [sensors.resolution]
+    sensor_noise       σ of white Gaussian noise on each reading, m [sensors.noise]
+    latency            sample | computation | none [controller.latency]
     latency_jitter     the largest lag of a tick's sampling instant, s (per tick uniform in [0, J]) [0]
-    actuator_lag       actuator time constant, s [2e-3]
-    force_limit        actuator force limit, N [the platform's legs.max_force]
+    actuator_lag       actuator time constant, s [actuators.time_constant]
+    force_limit        actuator force limit, N [actuators.max_force, else the platform's legs.max_force]
     plate_mass         the plate's own total mass, kg [the platform's] (its inertia scales alike)
     plate_com          the plate's centre of mass offset, per axis, m [0]
-    gain_scale         factor on every PID gain [1]
-    sample_period      controller sample period, s [1e-3] (the gains stay those designed for the nominal)
-    payload            a point mass added to the plate, kg [0] (as ``size --payload``)
-    payload_position   where that payload sits in the plate frame T, m [0 0 0]; ``X,Y,Z`` fixes it
+    gain_scale         factor on every PID gain [controller.gain_scale]
+    sample_period      controller sample period, s [controller.period] (the gains stay those designed for the
+                       nominal)
+    payload            a point mass on the plate, kg [payload.mass] (as ``size --payload``)
+    payload_position   where that payload sits in the plate frame T, m [payload.position]; ``X,Y,Z`` fixes it
                        (as ``size --payload-com``), ±T draws each component in ±T
 
 The keys ``payload_mass`` and ``payload_com`` of earlier versions set the plate's own mass and centre of
