@@ -118,16 +118,26 @@ def register(sub) -> None:
 
 # the options that set a spec path (simulate's table, and the runs' duration)
 MC_FLAG_PATHS = {**FLAG_PATHS, "duration": ("--duration", "run.duration")}
+# how the study's messages name its settings here (montecarlo.study.NAMES: the API's names)
+FLAG_NAMES = {
+    "runs": "--runs",
+    "seed": "--seed",
+    "duration": "--duration",
+    "plant_step": "--plant-step",
+    "vary": "--vary",
+    "out": "--out",
+    "workers": "--workers",
+    "lost_tracking": "--lost-tracking",
+}
 
 
 def build_study(args):
     """The ``Study`` the options describe: the machine of ``--machine``/``--platform`` with the options of
     ``MC_FLAG_PATHS`` and each ``--set``, checked by the API (``montecarlo.api.make_study``)."""
-    shown = {"workers": "--workers", "lost_tracking": ("--lost-tracking", "mm", args.lost_tracking)}
     return make_study(
         machine_from_args(args, MC_FLAG_PATHS), args.program or args.trajectory, args.vary, args.runs, args.seed, {},
         lost_tracking=args.lost_tracking * 1e-3, units=(args.length_unit, args.angle_unit), workers=args.workers,
-        shown=shown,
+        names=FLAG_NAMES, lost_tracking_shown=("mm", args.lost_tracking),
     )  # fmt: skip
 
 
@@ -137,7 +147,9 @@ def run(args) -> int:
         return replay(args)
     study = build_study(args)
     try:
-        result = run_montecarlo(study, args.out, args.workers, args.scheduler, progress=not args.no_progress)
+        result = run_montecarlo(
+            study, args.out, args.workers, args.scheduler, progress=not args.no_progress, names=FLAG_NAMES
+        )
     except ScriptError as e:  # the reference (program compiled, CSV read) is checked before any run starts
         print(e.render(), file=sys.stderr)
         return 2

@@ -17,7 +17,7 @@ from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import default_engine
 from stewart_drake.montecarlo.scenario import LOST_TRACKING, STUDY_KEYWORDS, Study, reference_data
 from stewart_drake.montecarlo.spec import parse_spec
-from stewart_drake.montecarlo.study import run_study, study_key, study_settings
+from stewart_drake.montecarlo.study import NAMES, run_study, study_key, study_settings
 from stewart_drake.montecarlo.summary import summarise, write_outputs
 from stewart_drake.spec import Machine, load_machine
 
@@ -30,30 +30,30 @@ REPLAY_COMMAND = "montecarlo --replay"  # a replay's files are recorded under "m
 
 def make_study(
     machine, motion, vary, runs: int, seed: int, overrides: dict, *, lost_tracking: float = LOST_TRACKING,
-    units=("m", "rad"), workers: int | None = None, shown: dict | None = None,
+    units=("m", "rad"), workers: int | None = None, names: dict | None = None, lost_tracking_shown=None,
 ) -> Study:  # fmt: skip
     """The ``Study`` of ``montecarlo``'s arguments, checked: ``machine`` with ``overrides`` (spec paths, or the
     keywords of earlier versions: ``STUDY_KEYWORDS``, ``trajectory``, ``program``), its engine resolved (C where a
     compiler is found), ``motion`` (None: the machine's first) read with ``units`` (a CSV's length and angle
-    units). ``shown``: how messages name ``workers`` and ``lost_tracking`` (``{"workers": "--workers",
-    "lost_tracking": ("--lost-tracking", "mm", value as written)}``; default the parameters, in SI)."""
-    shown = shown or {}
+    units). ``names``: how messages name the settings (``study.NAMES``: the parameters and spec paths; the command
+    line's flags); ``lost_tracking_shown``: ``(unit, value)`` as the user wrote ``lost_tracking`` (default m, SI)."""
+    names = NAMES | (names or {})
     overrides = dict(overrides)
     program, trajectory = overrides.pop("program", None), overrides.pop("trajectory", None)
     motion = program or (motion if motion is not None else trajectory)
     given = {STUDY_KEYWORDS.get(k, k): v for k, v in overrides.items() if not (k in STUDY_KEYWORDS and v is None)}
     m = load_machine(machine, given)
-    spec = parse_spec(vary)
+    spec = parse_spec(vary, names["vary"])
     if workers is not None:
-        check_workers(shown.get("workers", "workers"), workers, minimum=0)  # the one rule (core.processes)
+        check_workers(names["workers"], workers, minimum=0)  # the one rule (core.processes)
     ctl = m.controller
     if ctl.engine == "c" and ctl.law != "fixed":
         raise UsageError(UsageError.ENGINE_C.format(controller=ctl.law))
     engine = default_engine(ctl.engine, ctl.law, "stewart-drake montecarlo")
     m = replace(m, controller=replace(ctl, engine=engine))
     if not lost_tracking > 0:
-        option, unit, value = shown.get("lost_tracking", ("lost_tracking", "m", lost_tracking))
-        raise OptionError(OptionError.POSITIVE.format(option=option, unit=unit, value=value))
+        unit, value = lost_tracking_shown or ("m", lost_tracking)
+        raise OptionError(OptionError.POSITIVE.format(option=names["lost_tracking"], unit=unit, value=value))
     ref = reference_data(motion if motion is not None else m.motion, *units)
     return Study(m, spec, seed, runs, lost_tracking=lost_tracking, **ref)
 
@@ -158,12 +158,16 @@ def montecarlo(
     return run_montecarlo(study, out, workers=workers, scheduler=scheduler, progress=progress)
 
 
-def run_montecarlo(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = False):
-    """Run a checked ``Study`` into ``out`` and summarise it (``MonteCarloResult``)."""
-    # --out checked before any run: new, empty, or this study's own (its replays kept beside it)
-    folder = OutputFolder(out, companions=(REPLAY_COMMAND,))
+def run_montecarlo(
+    study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = False, names=None
+) -> MonteCarloResult:
+    """Run a checked ``Study`` into ``out`` and summarise it (``names``: how messages name the settings,
+    ``study.NAMES``)."""
+    # out checked before any run: new, empty, or this study's own (its replays kept beside it)
+    option = (NAMES | (names or {}))["out"]
+    folder = OutputFolder(out, companions=(REPLAY_COMMAND,), option=option)
     study.reference()  # the reference (program compiled, CSV read) checked here, before any run starts
-    rows = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress)
+    rows = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress, names=names)
     summary = summarise(rows, study_settings(study), study_key(study))
     summary["files"] = [str(p) for p in write_outputs(folder, rows, summary)]
     return MonteCarloResult(summary, rows, Path(out))

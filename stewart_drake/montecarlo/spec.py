@@ -169,23 +169,24 @@ def _check_vector(key: str, d: Distribution, where: str) -> None:
         raise SpecError(SpecError.VECTOR_LAW.format(where=where, key=key, text=d.text))
 
 
-def parse_spec(words) -> VarySpec:
+def parse_spec(words, where: str = "--vary") -> VarySpec:
     """A ``VarySpec`` from ``key=value`` words (a list of strings, or one string split at whitespace)
-    or, when the only word names an existing ``.yaml``/``.yml`` file, from that YAML mapping."""
+    or, when the only word names an existing ``.yaml``/``.yml`` file, from that YAML mapping; messages name the
+    words ``where`` (the option or parameter) and a file's line."""
     if isinstance(words, str):
         words = words.split()
     words = list(words)
     if len(words) == 1 and words[0].endswith((".yaml", ".yml")):
-        return _parse_yaml(Path(words[0]))
+        return _parse_yaml(Path(words[0]), where)
     laws = {}
     for w in words:
         if "=" not in w:
-            raise SpecError(SpecError.NOT_KEY_VALUE.format(value=w))
+            raise SpecError(SpecError.NOT_KEY_VALUE.format(where=where, value=w))
         key, value = w.split("=", 1)
         key = key.strip()
-        check_key(key, "--vary")
-        d = parse_value(key, value, "--vary")
-        _check_vector(key, d, "--vary")
+        check_key(key, where)
+        d = parse_value(key, value, where)
+        _check_vector(key, d, where)
         laws[key] = d
     return VarySpec(laws, " ".join(words))
 
@@ -193,13 +194,13 @@ def parse_spec(words) -> VarySpec:
 MAX_SPEC_BYTES = 100_000
 
 
-def _parse_yaml(path: Path) -> VarySpec:
+def _parse_yaml(path: Path, where: str) -> VarySpec:
     import yaml
 
     if not path.exists():
-        raise SpecError(SpecError.MISSING_FILE.format(path=str(path)))
+        raise SpecError(SpecError.MISSING_FILE.format(where=where, path=str(path)))
     # read once, bounded (a spec is a few lines), with the platform files' safe composer (nesting bounded)
-    text, shown = read_yaml_text(path, "--vary spec", limit=MAX_SPEC_BYTES)
+    text, shown = read_yaml_text(path, f"{where} spec", limit=MAX_SPEC_BYTES)
     try:
         node = compose(text, shown)
     except YamlError as e:

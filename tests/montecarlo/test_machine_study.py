@@ -8,7 +8,7 @@ import pytest
 
 import stewart_drake as sd
 from stewart_drake.cli import main
-from stewart_drake.errors import MachineError, StudyError
+from stewart_drake.errors import MachineError, SpecError, StudyError
 from stewart_drake.montecarlo import spec as spec_mod
 from stewart_drake.montecarlo.api import make_study
 from stewart_drake.montecarlo.scenario import Study, draw, scenario
@@ -67,11 +67,22 @@ def test_the_api_names_spec_paths_and_the_command_line_names_flags(tmp_path, cap
     assert "--" not in str(e.value)
     with pytest.raises(MachineError, match=r"^run\.duration must be > 0 s, got -0\.5"):
         sd.montecarlo("utn-dynamic", out=tmp_path / "a", runs=1, duration=-0.5)
+    with pytest.raises(StudyError, match=r"^runs must be 1 … 100000, got 0$"):
+        sd.montecarlo("utn-dynamic", out=tmp_path / "a", runs=0)
+    with pytest.raises(SpecError, match=r"^vary: unknown key 'wobble'"):
+        sd.montecarlo("utn-dynamic", out=tmp_path / "a", vary=["wobble=3"])
+    refused = (
+        r"^run 0 .*: vary sample_period must be a positive number of seconds, got -0\.001; .*narrow the vary ranges$"
+    )
+    with pytest.raises(StudyError, match=refused):
+        sd.montecarlo("utn-dynamic", out=tmp_path / "a", runs=1, vary=["sample_period=-1ms"], duration=0.05)
     common = ["montecarlo", "--machine", str(NEWCOMER), "--runs", "1", "--workers", "0", "--out", str(tmp_path / "b")]
     assert main([*common, "--set", "controller.period=-1ms"]) == 2
     assert "controller.period must be > 0 s, got -1ms" in capsys.readouterr().err
     assert main([*common, "--duration", "-0.5"]) == 2
     assert "--duration must be > 0 s, got -0.5" in capsys.readouterr().err
+    assert main([*common, "--runs", "0"]) == 2
+    assert "--runs must be 1 … 100000, got 0" in capsys.readouterr().err
     assert main([*common, "--platform", "utn-dynamic"]) == 2
     assert "--machine" in capsys.readouterr().err
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
