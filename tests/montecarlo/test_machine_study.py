@@ -2,6 +2,7 @@
 format, payload and run settings reach every run; a ``--vary`` key is one row of ``spec.KEYS`` naming the spec path
 it draws; errors name spec paths in the API and flags on the command line."""
 
+import pickle
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ from stewart_drake.montecarlo import spec as spec_mod
 from stewart_drake.montecarlo.api import make_study
 from stewart_drake.montecarlo.scenario import Study, draw, scenario
 from stewart_drake.montecarlo.spec import VaryKey, parse_spec
-from stewart_drake.montecarlo.study import check_study
+from stewart_drake.montecarlo.study import check_study, study_key
 
 NEWCOMER = Path(__file__).parents[2] / "examples" / "newcomer-210kg.yaml"
 
@@ -31,6 +32,10 @@ def test_a_study_of_the_newcomer_machine_runs_its_own_firmware_format(tmp_path):
     assert r.summary["settings"]["machine"]["firmware.length_lsb"] == 30e-6
     assert r.summary["settings"]["machine"]["payload.mass"] == 150.0 and r.summary["settings"]["fit"] is True
     study = make_study(NEWCOMER, None, ["anchor=±0.1mm"], 2, 0, {"run.duration": 0.5})
+    # what a Dask worker receives: the study pickled, the machine with it (the same settings, the same draws)
+    copy = pickle.loads(pickle.dumps(study))
+    assert study_key(copy) == study_key(study) and copy.machine.firmware == machine.firmware
+    assert draw(copy, 1)[1].columns() == draw(study, 1)[1].columns()
     for i in range(2):
         sc = scenario(study, i)[2]
         fmt = sc.config.ik_format
