@@ -51,7 +51,8 @@ from stewart_drake.spec.quantity import parse_choice, parse_number, parse_quanti
 
 class VaryKey(NamedTuple):
     """One ``--vary`` key: its quantity ``dimension`` (``mode``: a latency mode), ``length`` (0 for a scalar, 3 or 6
-    components, ``anchors`` for one offset per physical joint), ``zero_nominal`` (±P% refused) and ``path``: the
+    components, ``anchors`` for one offset per physical joint), ``zero_nominal`` (±P% refused as read; a key with a ``path``
+    is checked against the machine's value there, ``study.check_study``) and ``path``: the
     machine's spec path it draws (its nominal is the machine's value there, a drawn value is checked as the
     machine checks that field), or None for the plant's own geometry and the sensor's per-run processes."""
 
@@ -136,7 +137,8 @@ def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
         if v < 0:
             raise SpecError(SpecError.NEGATIVE_PROCESS.format(where=where, key=key, text=text))
         return Distribution("fixed", (v,), text)
-    if zero_nominal and text.startswith(("±", "+-")) and text.endswith("%"):
+    # a key drawn about a machine field is checked against the machine's value (study.check_study)
+    if zero_nominal and KEYS[key].path is None and text.startswith(("±", "+-")) and text.endswith("%"):
         raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=where, key=key, text=text))
     if length == 3 and "," in text:  # X,Y,Z: a fixed vector
         if text.count(",") != 2:

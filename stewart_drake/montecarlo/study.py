@@ -29,9 +29,9 @@ import numpy as np
 from stewart_drake.core.geometry import base_joints
 from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
 from stewart_drake.drake.systems import make_law
-from stewart_drake.errors import OutputError, StudyError
+from stewart_drake.errors import OutputError, SpecError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
-from stewart_drake.montecarlo.scenario import Study, run_scenario, scenario
+from stewart_drake.montecarlo.scenario import Study, nominal_value, run_scenario, scenario
 from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
 from stewart_drake.spec import Gains, Machine, apply_overrides
 from stewart_drake.spec.machine import FIELDS
@@ -226,6 +226,9 @@ def check_study(study: Study, names: dict | None = None) -> float:
                 runs=study.runs, steps=steps, total=study.runs * steps, limit=MAX_TOTAL_STEPS, **opt
             )
         )
+    for key, law in study.spec.laws.items():  # ±P% of a machine field whose value is zero (a payload of 0 kg)
+        if law.kind == "relative" and not np.any(nominal_value(study.machine, key)):
+            raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=opt["vary_opt"], key=key, text=law.text))
     if study.controller == "fixed":
         law = study.spec.laws.get("sensor_resolution")
         if law is not None and law.kind not in ("fixed", "choice"):

@@ -91,3 +91,15 @@ def test_the_api_names_spec_paths_and_the_command_line_names_flags(tmp_path, cap
     assert main([*common, "--platform", "utn-dynamic"]) == 2
     assert "--machine" in capsys.readouterr().err
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_a_percentage_is_of_the_machines_own_value():
+    """``payload=±10%`` draws about the machine's payload (the newcomer's 150 kg: within 135 … 165 kg, the
+    controller's model keeping 150 kg); on a machine without a payload it is a percentage of zero: refused."""
+    newcomer = Study(sd.load_machine(NEWCOMER), parse_spec(["payload=±10%"], "vary"), seed=0, runs=8)
+    masses = [draw(newcomer, i)[1].payload for i in range(newcomer.runs)]
+    assert all(135.0 <= m <= 165.0 for m in masses) and len(set(masses)) == len(masses)
+    assert draw(newcomer, 0)[1].machine().payload.mass == masses[0] and newcomer.machine.payload.mass == 150.0
+    bare = Study(sd.load_platform("utn-dynamic"), parse_spec(["payload=±10%"], "vary"), seed=0, runs=1)
+    with pytest.raises(SpecError, match=r"^vary: payload: '±10%': a percentage of a zero nominal"):
+        check_study(bare)
