@@ -1,13 +1,16 @@
 """One Monte Carlo run as plain, picklable data, and the function that runs it.
 
-Drake objects do not pickle, so a worker receives a ``Study`` (the study's fixed settings: platform,
-reference, controller, integrator, duration, SPEC, seed) and a run index, draws that run's ``Draw`` from
-its own seed, turns it into a ``drake.simulation.Scenario`` (``scenario``) and builds its Diagram from that
-itself (``run_scenario``). The run's seed is
+Drake objects do not pickle, so a worker receives a ``Study`` (the nominal ``Machine``, the reference, the
+SPEC, the seed) and a run index, draws that run's ``Draw`` from its own seed (``sample(machine, spec, seed,
+index)``; ``Draw.machine()`` is the drawn machine), turns it into a ``drake.simulation.Scenario`` through
+``api.simulation.plan_run`` (``scenario``) and builds its Diagram from that itself (``run_scenario``). The
+run's seed is
 ``run_seed(study.seed, index)``: the first 64-bit word (its low 63 bits) of ``numpy.random.SeedSequence(S,
 spawn_key=(index,))``, so any run can be re-drawn alone from (S, index) or from its seed.
 
-What a draw changes (the controller keeps the nominal model: it is what the firmware was built for):
+What a draw changes (the controller keeps the nominal model, the machine's platform and payload with the gains
+designed for its timing: it is what the firmware was built for; every other field of the machine, its firmware
+format included, is the drawn machine's):
 
 - the plant is built from the platform with every physical joint moved (``anchor``: one offset per
   distinct base joint and per distinct plate anchor, so that legs sharing a joint keep sharing it) and the
