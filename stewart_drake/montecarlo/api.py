@@ -142,7 +142,7 @@ def montecarlo(
         angle_unit: a CSV reference's angle unit.
         **overrides: any spec path, ``**{"firmware.length_lsb": "30um", "run.duration": 0.5}`` (values in SI or
             in the quantity grammar); the keywords of earlier versions (``duration``, ``controller``, ``engine``,
-            ``integrator``, ``plant_step``, ``fit``, ``program``) set their spec paths.
+            ``integrator``, ``plant_step``, ``fit``; ``trajectory`` and ``program``: the motion) set their spec paths.
 
     Returns:
         The study's summary and rows.
