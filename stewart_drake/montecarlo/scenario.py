@@ -141,9 +141,10 @@ class Study:
         if trajectory is None and program is None and table is None and motion is None:
             ref = reference_data(machine.motion)
             trajectory, program, table, motion = (ref.get(k) for k in ("trajectory", "program", "table", "motion"))
-        values = dict(locals())
+        given = dict(machine=machine, spec=spec, seed=seed, runs=runs, trajectory=trajectory, program=program)
+        given |= dict(table=table, lost_tracking=lost_tracking, grid=grid, extra=dict(extra or {}), motion=motion)
         for f in fields(Study):
-            object.__setattr__(self, f.name, values[f.name] if f.name != "extra" else dict(extra or {}))
+            object.__setattr__(self, f.name, given[f.name])
 
     @property
     def platform(self) -> Platform:
