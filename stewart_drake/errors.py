@@ -820,8 +820,8 @@ class SpecError(StewartError):
     RANGE_ORDER = "{where}: {key}: {text!r}: the range's low end is above its high end"
     UNKNOWN_KEY = "{where}: unknown key {key!r}{hint}"
     VECTOR_LAW = "{where}: {key}: give ±tolerance (per component) or a fixed offset, not {text!r}"
-    NOT_KEY_VALUE = "--vary: {value!r} is not key=value"
-    MISSING_FILE = "--vary: file {path!r} does not exist"
+    NOT_KEY_VALUE = "{where}: {value!r} is not key=value"
+    MISSING_FILE = "{where}: file {path!r} does not exist"
     NOT_YAML = "{path}:{line}: not YAML ({problem})"
     NOT_MAPPING = "{path}: the SPEC must be a mapping of key: value"
     DUPLICATE = "{where}: {key!r} is given twice (first on line {first}); give each key once"
@@ -872,44 +872,45 @@ class StudyError(StewartError):
     """A study that cannot start: too large, inconsistent settings, or an output folder that is not its own
     (``montecarlo.study``)."""
 
-    RUNS = "--runs must be 1 … {limit}, got {value}"
-    SEED = "--seed must be an integer >= 0, got {value}"
+    RUNS = "{runs_opt} must be 1 … {limit}, got {value}"
+    SEED = "{seed_opt} must be an integer >= 0, got {value}"
     GRID = "a sweep's runs ({runs}) must equal its grid's points ({points})"
     PLANT_STEP = "plant step must be in (0, 0.01] s, got {value}"
-    DURATION = "--duration must be in (0, {limit:g}] s per run, got {value}"
+    DURATION = "{duration_opt} must be in (0, {limit:g}] s per run, got {value}"
     MOTION_NOT_STORED = (
         "the study was run from a Python Trajectory ({name!r}), which study.json records only by its hash: "
         "--replay cannot rebuild it; run the study again from Python with the same Trajectory"
     )
-    TOTAL = "--runs {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
+    TOTAL = "{runs_opt} {runs} × {duration:g} s = {total:g} simulated s is more than the bound {limit:g} s"
     STEPS = (
-        "--plant-step {step:g} s: {duration:g} s per run is {steps:.3g} plant steps, more than the bound {limit:.3g}; "
-        "use a longer --plant-step or a shorter --duration"
+        "{plant_step_opt} {step:g} s: {duration:g} s per run is {steps:.3g} plant steps, more than the bound "
+        "{limit:.3g}; use a longer {plant_step_opt} or a shorter {duration_opt}"
     )
     TOTAL_STEPS = (
-        "--runs {runs} × {steps:.3g} plant steps = {total:.4g} is more than the bound {limit:.4g}; "
-        "use a longer --plant-step or fewer --runs"
+        "{runs_opt} {runs} × {steps:.3g} plant steps = {total:.4g} is more than the bound {limit:.4g}; "
+        "use a longer {plant_step_opt} or fewer {runs_opt}"
     )
     RESOLUTION_RANGE = (
-        "--vary sensor_resolution: the fixed-point controller needs resolutions that divide 1 mm; "
+        "{vary_opt} sensor_resolution: the fixed-point controller needs resolutions that divide its length LSB; "
         "give a value or a|b|c list, not a range"
     )
     RESOLUTION_DIVIDE = (
-        "--vary sensor_resolution: {value:g} m does not divide the fixed-point IK's 1 mm LSB into whole counts"
+        "{vary_opt} sensor_resolution: {value:g} m does not divide the fixed-point IK's length LSB "
+        "(firmware.length_lsb {lsb:g} m) into whole counts"
     )
     DRAW = "run {run} (seed {seed}) draws a scenario simulate would refuse ({drawn}): {reason}; no run was started"
-    DRAW_ADVICE = " — narrow the --vary ranges"  # appended to DRAW only when --vary draws something
+    DRAW_ADVICE = " — narrow the {vary_opt} ranges"  # appended to DRAW only when the study draws something
     DRAW_NOMINAL = (
         "the study's nominal scenario (nothing drawn) is one simulate would refuse: {reason}; no run was started"
     )
-    OUT_NOT_FOLDER = "--out {out!r} exists and is not a folder"
-    OUT_OTHER_STUDY = "--out {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
+    OUT_NOT_FOLDER = "{out_opt} {out!r} exists and is not a folder"
+    OUT_OTHER_STUDY = "{out_opt} {out!r} holds another study (key {old_key}, this one {key}); choose another folder"
     OUT_NOT_OURS = (
-        "--out {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to overwrite it"
+        "{out_opt} {out!r} is a folder this tool did not write (no {study_file} or {partial}); refusing to overwrite it"
     )
-    OUT_DAMAGED = "{path}: damaged ({reason}); not a study stewart-drake wrote: remove it or choose another --out"
+    OUT_DAMAGED = "{path}: damaged ({reason}); not a study stewart-drake wrote: remove it or choose another {out_opt}"
     OUT_OTHER_PARTIAL = (
-        "--out {out!r} holds a partial study with another key ({old_key}, this one {key}); choose another folder"
+        "{out_opt} {out!r} holds a partial study with another key ({old_key}, this one {key}); choose another folder"
     )
 
 

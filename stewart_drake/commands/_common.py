@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import math
 import sys
 
@@ -11,7 +12,8 @@ from stewart_drake.core.geometry import PRESETS, Platform, load_platform
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
-from stewart_drake.errors import UsageError
+from stewart_drake.errors import MachineError, QuantityError, UsageError
+from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
@@ -94,3 +96,81 @@ def finite_option(value, option: str) -> float:
     if value is not None and not math.isfinite(value):
         raise UsageError(UsageError.NOT_FINITE.format(option=option, value=value))
     return value
+
+
+def add_machine_args(parser) -> None:
+    """``--machine FILE`` and ``--set PATH=VALUE`` (read by ``machine_from_args``)."""
+    parser.add_argument(
+        "--machine",
+        default=None,
+        metavar="FILE",
+        help="a machine file: a platform file with controller, firmware, sensors, actuators, payload, run and "
+        "motions sections (`stewart-drake init --machine-template` writes one); default: --platform "
+        "(utn-dynamic) with the defaults",
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="PATH=VALUE",
+        help="set one field of the machine by its spec path, e.g. --set controller.period=0.5ms "
+        "--set payload.mass=150kg (repeatable; after the other options)",
+    )
+
+
+# option (argparse dest) -> spec path: the one table between the command line and the machine's fields.
+# A flag given sets its path; an error about the path names the flag.
+FLAG_PATHS = {
+    "controller": ("--controller", "controller.law"),
+    "period": ("--period", "controller.period"),
+    "latency": ("--latency", "controller.latency"),
+    "engine": ("--engine", "controller.engine"),
+    "no_feedforward": ("--no-feedforward", "controller.feedforward"),
+    "sensor_resolution": ("--sensor-resolution", "sensors.resolution"),
+    "word_bits": ("--word-bits", "firmware.word_bits"),
+    "length_lsb": ("--length-lsb", "firmware.length_lsb"),
+    "trig": ("--trig", "firmware.trig"),
+    "plant_step": ("--plant-step", "run.plant_step"),
+    "integrator": ("--integrator", "run.integrator"),
+    "fit": ("--fit", "run.fit"),
+    "duration": ("--duration", "run.duration"),
+}
+# store_true flags: the value they set
+FLAG_VALUES = {"no_feedforward": False, "fit": True}
+
+
+def machine_from_args(args, flag_paths: dict = FLAG_PATHS) -> Machine:
+    """The machine of ``--machine`` (else ``--platform``, else utn-dynamic) with the flags of ``flag_paths``
+    (``{dest: (flag, spec path)}``; a command without a flag skips it) that were given and each ``--set``
+    (applied together: a section is checked as a whole); an error about a flag's path names the flag."""
+    if args.machine is not None and args.platform is not None:
+        raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
+    machine = load_machine(args.machine or args.platform or "utn-dynamic")
+    given = [d for d in flag_paths if getattr(args, d, None) is not None and getattr(args, d, None) is not False]
+    set_paths = {w.split("=", 1)[0].strip() for w in args.set}
+    named = [d for d in given if flag_paths[d][1] not in set_paths]  # a path also --set is named as a path
+    flags = {flag_paths[d][1]: FLAG_VALUES.get(d, getattr(args, d)) for d in given}
+    try:
+        return apply_overrides(machine, [*(f"{p}={v}" for p, v in flags.items()), *args.set])
+    except (MachineError, QuantityError) as e:
+        raise flag_error(e, named, flag_paths) from None
+
+
+def flag_text(text: str, given=None, flag_paths: dict = FLAG_PATHS) -> str:
+    """``text`` with the spec paths of ``flag_paths`` (only those of the ``given`` options, if given) named by
+    their flags."""
+    for dest, (flag, path) in flag_paths.items():
+        if given is None or dest in given:
+            text = text.replace(path, flag)
+    return text
+
+
+def flag_error(e: StewartError, given=None, flag_paths: dict = FLAG_PATHS) -> StewartError:
+    """``e`` with the spec paths of ``flag_paths`` (of the ``given`` options) in its message named by their flags
+    (the same class)."""
+    message = flag_text(str(e), given, flag_paths)
+    if message == str(e):
+        return e
+    e = copy.copy(e)
+    e.args = (message,)
+    return e

@@ -7,9 +7,16 @@ import json
 import sys
 from pathlib import Path
 
-from stewart_drake.commands._common import add_platform_arg, dumps_strict, print_json, reject_unused
+from stewart_drake.commands._common import (
+    FLAG_PATHS,
+    add_machine_args,
+    add_platform_arg,
+    dumps_strict,
+    machine_from_args,
+    print_json,
+    reject_unused,
+)
 from stewart_drake.commands.simulate import add_loop_args, write_plots
-from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, StewartError
@@ -31,10 +38,14 @@ def register(sub) -> None:
         "montecarlo",
         help="robustness study: many closed-loop runs with drawn tolerances (Dask), or --replay one of them",
     )
-    add_platform_arg(p, default="utn-dynamic")
+    add_platform_arg(p, default=None)
+    add_machine_args(p)
     src = p.add_mutually_exclusive_group()
     src.add_argument(
-        "--trajectory", default="seed", metavar="seed|rotating|FILE.csv", help="the pose reference (default seed)"
+        "--trajectory",
+        default=None,
+        metavar="seed|rotating|FILE.csv",
+        help="the pose reference (default: the machine's first motion, seed)",
     )
     src.add_argument("--program", metavar="P.stw", help="a motion program as the reference instead")
     p.add_argument("--length-unit", choices=["m", "mm"], default="m", help="CSV length unit (default m)")
@@ -58,11 +69,15 @@ def register(sub) -> None:
         "units m mm um s ms us N kg g)",
     )
     add_loop_args(p)
+    p.set_defaults(controller=None)  # None: the machine's controller.law (fixed)
     p.add_argument(
-        "--duration", type=float, default=None, metavar="S", help="simulated seconds per run (default the trajectory's)"
+        "--duration", default=None, metavar="S", help="simulated seconds per run, e.g. 0.5s (default the trajectory's)"
     )
     p.add_argument(
-        "--plant-step", type=float, default=1e-3, metavar="S", help="plant step / log period, s (default 0.001)"
+        "--plant-step",
+        default=None,
+        metavar="S",
+        help="plant step / log period, e.g. 1ms (default: the machine's period, at most 1 ms)",
     )
     p.add_argument(
         "--lost-tracking",
@@ -101,27 +116,29 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+# the options that set a spec path (simulate's table, and the runs' duration)
+MC_FLAG_PATHS = {**FLAG_PATHS, "duration": ("--duration", "run.duration")}
+# how the study's messages name its settings here (montecarlo.study.NAMES: the API's names)
+FLAG_NAMES = {
+    "runs": "--runs",
+    "seed": "--seed",
+    "duration": "--duration",
+    "plant_step": "--plant-step",
+    "vary": "--vary",
+    "out": "--out",
+    "workers": "--workers",
+    "lost_tracking": "--lost-tracking",
+}
+
+
 def build_study(args):
-    """The ``Study`` the options describe, checked by the API (``montecarlo.api.make_study``)."""
+    """The ``Study`` the options describe: the machine of ``--machine``/``--platform`` with the options of
+    ``MC_FLAG_PATHS`` and each ``--set``, checked by the API (``montecarlo.api.make_study``)."""
     return make_study(
-        load_platform(args.platform),
-        args.trajectory,
-        runs=args.runs,
-        seed=args.seed,
-        vary=args.vary,
-        program=args.program,
-        controller=args.controller,
-        engine=args.engine,
-        integrator=args.integrator,
-        duration=args.duration,
-        plant_step=args.plant_step,
-        lost_tracking=args.lost_tracking * 1e-3,
-        fit=args.fit,
-        length_unit=args.length_unit,
-        angle_unit=args.angle_unit,
-        workers=args.workers,
-        lost_tracking_shown=args.lost_tracking,
-    )
+        machine_from_args(args, MC_FLAG_PATHS), args.program or args.trajectory, args.vary, args.runs, args.seed, {},
+        lost_tracking=args.lost_tracking * 1e-3, units=(args.length_unit, args.angle_unit), workers=args.workers,
+        names=FLAG_NAMES, lost_tracking_shown=("mm", args.lost_tracking),
+    )  # fmt: skip
 
 
 def run(args) -> int:
@@ -130,7 +147,9 @@ def run(args) -> int:
         return replay(args)
     study = build_study(args)
     try:
-        result = run_montecarlo(study, args.out, args.workers, args.scheduler, progress=not args.no_progress)
+        result = run_montecarlo(
+            study, args.out, args.workers, args.scheduler, progress=not args.no_progress, names=FLAG_NAMES
+        )
     except ScriptError as e:  # the reference (program compiled, CSV read) is checked before any run starts
         print(e.render(), file=sys.stderr)
         return 2
@@ -242,6 +261,8 @@ def _finished_study(out: Path):
 
 # the options that define a study (its settings and its number of runs)
 STUDY_OPTIONS = (
+    "machine",
+    "set",
     "platform",
     "trajectory",
     "program",

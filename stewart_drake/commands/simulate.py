@@ -2,52 +2,33 @@
 
 from __future__ import annotations
 
-import copy
 import sys
 from pathlib import Path
 
 from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
+    add_machine_args,
+    add_platform_arg,
     dumps_strict,
+    flag_error,
+    flag_text,
+    machine_from_args,
     output_folder,
     print_json,
     reject_unused,
 )
 from stewart_drake.commands.firmware import add_time_limit_arg
-from stewart_drake.core.geometry import PRESETS
 from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
 from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
-from stewart_drake.errors import MachineError, QuantityError, StewartError, UsageError
 from stewart_drake.firmware.engine import ENGINES
-from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="run the fixed-point (or float) controller in the loop with the Drake plant")
-    p.add_argument(
-        "--platform",
-        default=None,
-        metavar="NAME|FILE",
-        help=f"a preset ({', '.join(PRESETS)}) or a platform YAML file (default: utn-dynamic; or give --machine)",
-    )
-    p.add_argument(
-        "--machine",
-        default=None,
-        metavar="FILE",
-        help="a machine file: a platform file with controller, firmware, sensors, actuators, payload, run and "
-        "motions sections (`stewart-drake init --machine-template` writes one); default: --platform "
-        "(utn-dynamic) with the defaults",
-    )
-    p.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="PATH=VALUE",
-        help="set one field of the machine by its spec path, e.g. --set controller.period=0.5ms "
-        "--set payload.mass=150kg (repeatable; after the other options)",
-    )
+    add_platform_arg(p, default=None)
+    add_machine_args(p)
     p.add_argument(
         "--trajectory",
         default=None,
@@ -164,63 +145,6 @@ def add_loop_args(p) -> None:
 
 # the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
 FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
-
-# option (argparse dest) -> spec path: the one table between the command line and the machine's fields.
-# A flag given sets its path; an error about the path names the flag.
-FLAG_PATHS = {
-    "controller": ("--controller", "controller.law"),
-    "period": ("--period", "controller.period"),
-    "latency": ("--latency", "controller.latency"),
-    "engine": ("--engine", "controller.engine"),
-    "no_feedforward": ("--no-feedforward", "controller.feedforward"),
-    "sensor_resolution": ("--sensor-resolution", "sensors.resolution"),
-    "word_bits": ("--word-bits", "firmware.word_bits"),
-    "length_lsb": ("--length-lsb", "firmware.length_lsb"),
-    "trig": ("--trig", "firmware.trig"),
-    "plant_step": ("--plant-step", "run.plant_step"),
-    "integrator": ("--integrator", "run.integrator"),
-    "fit": ("--fit", "run.fit"),
-    "duration": ("--duration", "run.duration"),
-}
-# store_true flags: the value they set
-FLAG_VALUES = {"no_feedforward": False, "fit": True}
-
-
-def machine_from_args(args) -> Machine:
-    """The machine of ``--machine`` (else ``--platform``, else utn-dynamic) with the flags of ``FLAG_PATHS``
-    that were given and each ``--set`` (applied together: a section is checked as a whole); an error about a
-    flag's path names the flag."""
-    if args.machine is not None and args.platform is not None:
-        raise UsageError(UsageError.NOT_BOTH.format(first="--machine", second="--platform"))
-    machine = load_machine(args.machine or args.platform or "utn-dynamic")
-    given = [d for d in FLAG_PATHS if getattr(args, d) is not None and getattr(args, d) is not False]
-    set_paths = {w.split("=", 1)[0].strip() for w in args.set}
-    named = [d for d in given if FLAG_PATHS[d][1] not in set_paths]  # a path also --set is named as a path
-    flags = {FLAG_PATHS[d][1]: FLAG_VALUES.get(d, getattr(args, d)) for d in given}
-    try:
-        return apply_overrides(machine, [*(f"{p}={v}" for p, v in flags.items()), *args.set])
-    except (MachineError, QuantityError) as e:
-        raise flag_error(e, named) from None
-
-
-def flag_text(text: str, given=None) -> str:
-    """``text`` with the spec paths of ``FLAG_PATHS`` (only those of the ``given`` options, if given) named
-    by their flags."""
-    for dest, (flag, path) in FLAG_PATHS.items():
-        if given is None or dest in given:
-            text = text.replace(path, flag)
-    return text
-
-
-def flag_error(e: StewartError, given=None) -> StewartError:
-    """``e`` with the spec paths of ``FLAG_PATHS`` (of the ``given`` options) in its message named by their
-    flags (the same class)."""
-    message = flag_text(str(e), given)
-    if message == str(e):
-        return e
-    e = copy.copy(e)
-    e.args = (message,)
-    return e
 
 
 def run(args) -> int:

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -12,16 +12,14 @@ from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.processes import check_workers
-from stewart_drake.core.quantisation import check_finite_rates, check_quantisation
-from stewart_drake.core.trajectory import TRAJECTORIES, Trajectory, read_trajectory_table
-from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
+from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import default_engine
-from stewart_drake.montecarlo.scenario import LOST_TRACKING, Study
+from stewart_drake.montecarlo.scenario import LOST_TRACKING, STUDY_KEYWORDS, Study, reference_data
 from stewart_drake.montecarlo.spec import parse_spec
-from stewart_drake.montecarlo.study import run_study, study_key, study_settings
+from stewart_drake.montecarlo.study import NAMES, run_study, study_key, study_settings
 from stewart_drake.montecarlo.summary import summarise, write_outputs
-from stewart_drake.script.source import read_program
+from stewart_drake.spec import Machine, load_machine
 
 if TYPE_CHECKING:  # annotations only: pandas is optional
     import pandas
@@ -31,71 +29,33 @@ REPLAY_COMMAND = "montecarlo --replay"  # a replay's files are recorded under "m
 
 
 def make_study(
-    platform: Platform,
-    trajectory: str | Trajectory = "seed",
-    *,
-    runs: int = 100,
-    seed: int = 0,
-    vary=(),
-    program: str | None = None,
-    controller: str = "fixed",
-    engine: str | None = None,
-    integrator: str | None = None,
-    duration: float | None = None,
-    plant_step: float = 1e-3,
-    lost_tracking: float = LOST_TRACKING,
-    fit: bool = False,
-    length_unit: str = "m",
-    angle_unit: str = "rad",
-    workers: int | None = None,
-    lost_tracking_shown=None,
-) -> Study:
-    """The ``Study`` the arguments describe, checked (see ``montecarlo``; ``lost_tracking_shown``: the value
-    as the user wrote it, in mm)."""
-    spec = parse_spec(vary)
-    program_text = (program, read_program(program)) if program else None
+    machine, motion, vary, runs: int, seed: int, overrides: dict, *, lost_tracking: float = LOST_TRACKING,
+    units=("m", "rad"), workers: int | None = None, names: dict | None = None, lost_tracking_shown=None,
+) -> Study:  # fmt: skip
+    """The ``Study`` of ``montecarlo``'s arguments, checked: ``machine`` with ``overrides`` (spec paths, or the
+    keywords of earlier versions: ``STUDY_KEYWORDS``, ``trajectory``, ``program``), its engine resolved (C where a
+    compiler is found), ``motion`` (None: the machine's first) read with ``units`` (a CSV's length and angle
+    units). ``names``: how messages name the settings (``study.NAMES``: the parameters and spec paths; the command
+    line's flags); ``lost_tracking_shown``: ``(unit, value)`` as the user wrote ``lost_tracking`` (default m, SI)."""
+    names = NAMES | (names or {})
+    overrides = dict(overrides)
+    program, trajectory = overrides.pop("program", None), overrides.pop("trajectory", None)
+    motion = program or (motion if motion is not None else trajectory)
+    given = {STUDY_KEYWORDS.get(k, k): v for k, v in overrides.items() if not (k in STUDY_KEYWORDS and v is None)}
+    m = load_machine(machine, given)
+    spec = parse_spec(vary, names["vary"])
     if workers is not None:
-        check_workers("--workers", workers, minimum=0)  # the one rule for worker counts (core.processes)
-    if engine == "c" and controller != "fixed":
-        raise UsageError(UsageError.ENGINE_C.format(controller=controller))
-    engine = default_engine(engine, controller, "stewart-drake montecarlo")
+        check_workers(names["workers"], workers, minimum=0)  # the one rule (core.processes)
+    ctl = m.controller
+    if ctl.engine == "c" and ctl.law != "fixed":
+        raise UsageError(UsageError.ENGINE_C.format(controller=ctl.law))
+    engine = default_engine(ctl.engine, ctl.law, "stewart-drake montecarlo")
+    m = replace(m, controller=replace(ctl, engine=engine))
     if not lost_tracking > 0:
-        shown = lost_tracking * 1e3 if lost_tracking_shown is None else lost_tracking_shown
-        raise OptionError(OptionError.POSITIVE.format(option="--lost-tracking", unit="mm", value=shown))
-    trajectory = None if program_text else trajectory
-    table, motion = None, None
-    if isinstance(trajectory, Trajectory):
-        motion, trajectory = trajectory, None
-    elif trajectory is not None and trajectory not in TRAJECTORIES:
-        table = csv_table(str(trajectory), length_unit, angle_unit)
-        trajectory = None
-    return Study(
-        platform=platform,
-        spec=spec,
-        seed=seed,
-        runs=runs,
-        trajectory=trajectory,
-        program=program_text,
-        table=table,
-        fit=fit,
-        controller=controller,
-        integrator=integrator or DEFAULT_INTEGRATOR,
-        engine=engine,
-        duration=duration,
-        plant_step=plant_step,
-        lost_tracking=lost_tracking,
-        motion=motion,
-    )
-
-
-def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
-    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once as a
-    stream (``read_trajectory_table`` names a bad line; a FIFO works) and checked as ``load_trajectory_csv``
-    checks it (finite rates; rounding noise refused)."""
-    name, ts, poses = read_trajectory_table(path, length_unit, angle_unit)
-    check_finite_rates(path, ts, poses)
-    check_quantisation(path, ts, poses)
-    return (name, ts.tolist(), poses.tolist())
+        unit, value = lost_tracking_shown or ("m", lost_tracking)
+        raise OptionError(OptionError.POSITIVE.format(option=names["lost_tracking"], unit=unit, value=value))
+    ref = reference_data(motion if motion is not None else m.motion, *units)
+    return Study(m, spec, seed, runs, lost_tracking=lost_tracking, **ref)
 
 
 @dataclass(repr=False)
@@ -141,88 +101,73 @@ class MonteCarloResult(Result):
 
 
 def montecarlo(
-    platform: Platform,
-    trajectory: str | Trajectory = "seed",
+    machine: Machine | Platform | str | Path,
+    motion: str | Path | Trajectory | None = None,
     *,
     out: str | Path,
+    vary: Sequence[str] | str = (),
     runs: int = 100,
     seed: int = 0,
-    vary: Sequence[str] | str = (),
-    program: str | None = None,
-    controller: str = "fixed",
-    engine: str | None = None,
-    integrator: str | None = None,
-    duration: float | None = None,
-    plant_step: float = 1e-3,
-    lost_tracking: float = LOST_TRACKING,
-    fit: bool = False,
-    length_unit: str = "m",
-    angle_unit: str = "rad",
     workers: int = 1,
     scheduler: str | None = None,
     progress: bool = False,
+    lost_tracking: float = LOST_TRACKING,
+    length_unit: str = "m",
+    angle_unit: str = "rad",
+    **overrides,
 ) -> MonteCarloResult:
-    """Many closed-loop runs with drawn tolerances (on Dask), summarised with their sensitivities.
+    """Many closed-loop runs of a machine with drawn tolerances (on Dask), summarised with their sensitivities.
 
     Args:
-        platform: the nominal platform (the controller's model).
-        trajectory: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, or a `Trajectory` (pickled to the
-            workers with the study, by value where its functions are not importable; a study run from one
-            cannot be replayed from the command line: its study.json records the motion by its hash).
+        machine: the nominal machine: a ``Machine`` (``load_machine``'s), a machine file, a preset name or a
+            ``Platform`` (every other section at its defaults). Its controller, firmware format, sensors,
+            actuators, payload and run settings reach every run; the controller keeps its nominal model.
+        motion: the pose reference: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, a ``.stw`` motion
+            program, or a `Trajectory` (pickled to the workers with the study, by value where its functions are
+            not importable; a study run from one cannot be replayed from the command line: its study.json
+            records the motion by its hash); default the machine's first motion.
         out: the study's folder (a finished or partial study there is resumed).
+        vary: what each run draws, as ``"key=law"`` words (``"anchor=±0.5mm"``, ``"sensor_noise=10um"``, ...)
+            or a YAML file's path; a key with a spec path (``sample_period``: ``controller.period``, ...) draws
+            about the machine's value there (``montecarlo.spec.KEYS``).
         runs: number of runs.
         seed: the study's seed (run k's seed derives from it: any run can be replayed alone).
-        vary: what each run draws, as ``"key=law"`` words (``"anchor=±0.5mm"``, ``"sensor_noise=10um"``, ...)
-            or a YAML file's path.
-        program: a motion program (``.stw``) as the reference instead of ``trajectory``.
-        controller: ``"fixed"`` or ``"float"``.
-        engine: the fixed-point tick: ``"c"`` or ``"python"`` (default ``"c"`` where a compiler is found).
-        integrator: ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"``.
-        duration: simulated seconds per run (default the reference's).
-        plant_step: plant time step, s.
-        lost_tracking: a run with a leg error beyond this (m) lost tracking.
-        fit: move the reference to the platform's home.
-        length_unit: a CSV reference's length unit.
-        angle_unit: a CSV reference's angle unit.
         workers: Dask worker processes (0: in this process). They do not import the caller's ``__main__``: a
             script calling ``montecarlo`` needs no ``if __name__ == "__main__":`` guard, and the functions it
             defines (a `Trajectory`'s) reach the workers by value.
         scheduler: a Dask scheduler's address instead of a local cluster.
         progress: show a progress bar.
+        lost_tracking: a run with a leg error beyond this (m) lost tracking.
+        length_unit: a CSV reference's length unit.
+        angle_unit: a CSV reference's angle unit.
+        **overrides: any spec path, ``**{"firmware.length_lsb": "30um", "run.duration": 0.5}`` (values in SI or
+            in the quantity grammar); the keywords of earlier versions (``duration``, ``controller``, ``engine``,
+            ``integrator``, ``plant_step``, ``fit``; ``trajectory`` and ``program``: the motion) set their spec paths.
 
     Returns:
         The study's summary and rows.
 
     Raises:
-        StewartError: a bad ``vary`` word, a study too large, bad options.
+        StewartError: a bad ``vary`` word, a study too large, bad settings (``MachineError`` naming the spec
+            path), a draw that ``simulate`` would refuse.
     """
     study = make_study(
-        platform,
-        trajectory,
-        runs=runs,
-        seed=seed,
-        vary=vary,
-        program=program,
-        controller=controller,
-        engine=engine,
-        integrator=integrator,
-        duration=duration,
-        plant_step=plant_step,
-        lost_tracking=lost_tracking,
-        fit=fit,
-        length_unit=length_unit,
-        angle_unit=angle_unit,
+        machine, motion, vary, runs, seed, overrides, lost_tracking=lost_tracking, units=(length_unit, angle_unit),
         workers=workers,
-    )
+    )  # fmt: skip
     return run_montecarlo(study, out, workers=workers, scheduler=scheduler, progress=progress)
 
 
-def run_montecarlo(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = False):
-    """Run a checked ``Study`` into ``out`` and summarise it (``MonteCarloResult``)."""
-    # --out checked before any run: new, empty, or this study's own (its replays kept beside it)
-    folder = OutputFolder(out, companions=(REPLAY_COMMAND,))
+def run_montecarlo(
+    study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = False, names=None
+) -> MonteCarloResult:
+    """Run a checked ``Study`` into ``out`` and summarise it (``names``: how messages name the settings,
+    ``study.NAMES``)."""
+    # out checked before any run: new, empty, or this study's own (its replays kept beside it)
+    option = (NAMES | (names or {}))["out"]
+    folder = OutputFolder(out, companions=(REPLAY_COMMAND,), option=option)
     study.reference()  # the reference (program compiled, CSV read) checked here, before any run starts
-    rows = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress)
+    rows = run_study(study, out, workers=workers, scheduler=scheduler, progress=progress, names=names)
     summary = summarise(rows, study_settings(study), study_key(study))
     summary["files"] = [str(p) for p in write_outputs(folder, rows, summary)]
     return MonteCarloResult(summary, rows, Path(out))

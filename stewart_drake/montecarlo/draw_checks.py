@@ -37,25 +37,26 @@ def _of_key(column: str, keys) -> bool:
     return any(column == k or column.startswith(k + "_") or column.startswith(k) and k == "anchor" for k in keys)
 
 
-def check_draw(study, index: int, reference, duration: float, gains=None, infeasible=None) -> None:
+def check_draw(study, index: int, reference, duration: float, gains=None, infeasible=None, vary="vary") -> None:
     """``StudyError`` (exit 2) naming run ``index`` when its scenario fails a check ``simulate`` makes;
-    ``infeasible(force_limit, period)``: the motion's feasibility (``nominal_feasibility``), or None."""
-    found = draw_refusal(study, index, reference, duration, gains, infeasible)
+    ``infeasible(force_limit, period)``: the motion's feasibility (``nominal_feasibility``), or None; ``vary``:
+    how messages name what the study varies."""
+    found = draw_refusal(study, index, reference, duration, gains, infeasible, vary)
     if found:
         seed, d, reason = found
-        advice = StudyError.DRAW_ADVICE if study.spec.laws else ""
+        advice = StudyError.DRAW_ADVICE.format(vary_opt=vary) if study.spec.laws else ""
         raise StudyError(StudyError.DRAW.format(run=index, seed=seed, drawn=_drawn(study, d), reason=reason) + advice)
 
 
-def draw_refusal(study, index: int, reference, duration: float, gains=None, infeasible=None):
+def draw_refusal(study, index: int, reference, duration: float, gains=None, infeasible=None, vary="vary"):
     """``(run seed, Draw, reason)`` when run ``index``'s scenario fails a check ``simulate`` makes, else None."""
     seed, d = draw(study, index)
     try:
         # the period, then the run's size, before any of it is allocated (a period of 1e-123 s: 1e121 ticks)
-        check_positive(d.sample_period, "--vary sample_period", "seconds")
+        check_positive(d.sample_period, f"{vary} sample_period", "seconds")
         step = min(d.sample_period, study.plant_step)
         check_work(
-            "--vary sample_period",
+            f"{vary} sample_period",
             f"{d.sample_period:.6g} s",
             duration / step,
             f"steps of {step:.6g} s in its {duration:.6g} s",
@@ -96,25 +97,26 @@ def nominal_feasibility(study, reference, duration: float):
         key = (force_limit, period)
         if key not in cache:
             ticks = np.arange(int(math.floor(duration / period + 1e-9)) + 1) * period
-            cache[key] = infeasible_motion(study.platform, reference, ticks, period, force_limit)
+            cache[key] = infeasible_motion(study.machine.loaded_platform, reference, ticks, period, force_limit)
         return cache[key]
 
     return f
 
 
-def check_draws(study) -> None:
+def check_draws(study, names: dict | None = None) -> None:
     """``check_draw`` for every run of ``study`` (the reference, the nominal gains and the motion's
-    feasibility computed once)."""
+    feasibility computed once; ``names``: how messages name the settings, ``study.NAMES``)."""
+    vary = (names or {}).get("vary", "vary")
     reference = study.reference()
     duration = study.run_duration(reference)
     gains = nominal_gains(study, reference)
     infeasible = nominal_feasibility(study, reference, duration)
     for i in range(study.runs):
-        if draw_refusal(study, i, reference, duration, gains, infeasible) is None:
+        if draw_refusal(study, i, reference, duration, gains, infeasible, vary) is None:
             continue
         # refused: when the nominal scenario is too, the study's settings are at fault (no narrower --vary mends it)
         nominal = replace(study, spec=VarySpec(), grid=None, runs=1)
-        found = draw_refusal(nominal, 0, reference, duration, gains, infeasible)
+        found = draw_refusal(nominal, 0, reference, duration, gains, infeasible, vary)
         if found:
             raise StudyError(StudyError.DRAW_NOMINAL.format(reason=found[2]))
-        check_draw(study, i, reference, duration, gains, infeasible)
+        check_draw(study, i, reference, duration, gains, infeasible, vary)

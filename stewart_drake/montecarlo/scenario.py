@@ -1,13 +1,16 @@
 """One Monte Carlo run as plain, picklable data, and the function that runs it.
 
-Drake objects do not pickle, so a worker receives a ``Study`` (the study's fixed settings: platform,
-reference, controller, integrator, duration, SPEC, seed) and a run index, draws that run's ``Draw`` from
-its own seed, turns it into a ``drake.simulation.Scenario`` (``scenario``) and builds its Diagram from that
-itself (``run_scenario``). The run's seed is
+Drake objects do not pickle, so a worker receives a ``Study`` (the nominal ``Machine``, the reference, the
+SPEC, the seed) and a run index, draws that run's ``Draw`` from its own seed (``sample(machine, spec, seed,
+index)``; ``Draw.machine()`` is the drawn machine), turns it into a ``drake.simulation.Scenario`` through
+``api.simulation.plan_run`` (``scenario``) and builds its Diagram from that itself (``run_scenario``). The
+run's seed is
 ``run_seed(study.seed, index)``: the first 64-bit word (its low 63 bits) of ``numpy.random.SeedSequence(S,
 spawn_key=(index,))``, so any run can be re-drawn alone from (S, index) or from its seed.
 
-What a draw changes (the controller keeps the nominal model: it is what the firmware was built for):
+What a draw changes (the controller keeps the nominal model, the machine's platform and payload with the gains
+designed for its timing: it is what the firmware was built for; every other field of the machine, its firmware
+format included, is the drawn machine's):
 
 - the plant is built from the platform with every physical joint moved (``anchor``: one offset per
   distinct base joint and per distinct plate anchor, so that legs sharing a joint keep sharing it) and the
@@ -25,63 +28,160 @@ What a draw changes (the controller keeps the nominal model: it is what the firm
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from stewart_drake.api.simulation import plan_run, tick_count
-from stewart_drake.control import ControllerConfig
+from stewart_drake.api.simulation import KEYWORD_PATHS, plan_run, tick_count
+from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import Platform, base_joints
-from stewart_drake.core.trajectory import Trajectory, design_poses, fit_trajectory, get_trajectory, table_trajectory
+from stewart_drake.core.quantisation import check_finite_rates, check_quantisation
+from stewart_drake.core.trajectory import (
+    TRAJECTORIES,
+    Trajectory,
+    design_poses,
+    fit_trajectory,
+    get_trajectory,
+    read_trajectory_table,
+    table_trajectory,
+)
 from stewart_drake.design.payload import with_payload
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.drake.simulation import ActuatorModel, Scenario, SensorModel, build_simulation
 from stewart_drake.montecarlo.spec import KEYS, VarySpec
 from stewart_drake.montecarlo.summary import FAILURE_SEPARATOR
 from stewart_drake.script import run_program
+from stewart_drake.script.source import read_program
+from stewart_drake.spec import Machine, apply_overrides
 
-# Nominal values of the keys whose nominal is not the platform's.
-NOMINAL = {
-    "sensor_resolution": 1e-5,
-    "latency": "sample",
-    "actuator_lag": 2e-3,
-    "gain_scale": 1.0,
-    "sensor_noise": 0.0,
-    "latency_jitter": 0.0,
-    "sample_period": 1e-3,
-}
 # A run loses tracking when a leg is this far (m) from the reference's IK, or the state is not finite.
 LOST_TRACKING = 5e-3
 AXES = ("x", "y", "z")
+# the SI unit in a drawn column's name, by the key's dimension
+UNIT = {"length": "m", "time": "s", "force": "N", "mass": "kg", "ratio": "", "mode": ""}
+# Study's keywords of earlier versions -> the spec path they set (plan_run's, and the run's duration)
+STUDY_KEYWORDS = {**KEYWORD_PATHS, "duration": "run.duration"}
 
 
-@dataclass(frozen=True)
+def reference_data(motion, length_unit: str = "m", angle_unit: str = "rad") -> dict:
+    """A motion as ``Study``'s picklable reference fields: ``seed``/``rotating`` (``trajectory``), a ``.stw``
+    program (``program``: its name and text), a CSV of t, pose rows (``table``, read here in the units given) or
+    a ``Trajectory`` (``motion``)."""
+    if isinstance(motion, Trajectory):
+        return {"trajectory": None, "motion": motion}
+    m = str(motion)
+    if m in TRAJECTORIES:
+        return {"trajectory": m}
+    if m.endswith(".stw"):
+        return {"trajectory": None, "program": (m, read_program(m))}
+    return {"trajectory": None, "table": csv_table(m, length_unit, angle_unit)}
+
+
+def csv_table(path: str, length_unit: str, angle_unit: str) -> tuple:
+    """A (t, pose) CSV reference as ``(name, times, poses SI)`` lists (``Study.table``), read here once as a
+    stream (``read_trajectory_table`` names a bad line; a FIFO works) and checked as ``load_trajectory_csv``
+    checks it (finite rates; rounding noise refused)."""
+    name, ts, poses = read_trajectory_table(path, length_unit, angle_unit)
+    check_finite_rates(path, ts, poses)
+    check_quantisation(path, ts, poses)
+    return (name, ts.tolist(), poses.tolist())
+
+
+@dataclass(frozen=True, init=False)
 class Study:
-    """A study's fixed settings (picklable). ``trajectory``: ``seed`` or ``rotating``; ``table``: a CSV
-    reference read on the client, (name, times (n,), poses (n, 6) SI) as lists, so that workers need no
-    file; ``program``: (file name, text) of a ``.stw`` motion program instead; ``fit``: move the trajectory to
-    the platform's home; ``lost_tracking``: metres of leg error that count as lost tracking; ``grid``: one
-    ``{key: SI value}`` per run that replaces that run's draws of those keys (a sweep; ``runs`` = its length);
-    ``motion``: a Python ``Trajectory`` as the reference instead (pickled to the workers with the study)."""
+    """A study's fixed settings (picklable): the nominal ``machine`` (its platform, controller, firmware format,
+    sensors, actuators, payload and run settings reach every run), what varies (``spec``), the study's ``seed``
+    and its number of ``runs``. The reference as data: ``trajectory`` (``seed`` or ``rotating``), ``table`` (a
+    CSV read on the client: name, times (n,), poses (n, 6) SI as lists, so that workers need no file),
+    ``program`` ((file name, text) of a ``.stw`` motion program) or ``motion`` (a Python ``Trajectory``, pickled
+    to the workers with the study); none given: the machine's first motion. ``lost_tracking``: metres of leg
+    error that count as lost tracking; ``grid``: one ``{key: SI value}`` per run that replaces that run's draws
+    of those keys (a sweep; ``runs`` = its length).
 
-    platform: Platform
+    ``machine`` may be a ``Platform`` (a machine with defaults) and the keywords ``controller``, ``engine``,
+    ``integrator``, ``duration``, ``plant_step``, ``fit``, ... set their spec paths (``STUDY_KEYWORDS``). A
+    machine whose ``controller.engine`` is None runs the Python tick (``sd.montecarlo`` picks C where a compiler
+    is found)."""
+
+    machine: Machine
     spec: VarySpec
     seed: int
     runs: int
     trajectory: str | None = "seed"
     program: tuple | None = None
     table: tuple | None = None
-    fit: bool = False
-    controller: str = "fixed"
-    integrator: str = DEFAULT_INTEGRATOR
-    engine: str = "python"
-    duration: float | None = None
-    plant_step: float = 1e-3
     lost_tracking: float = LOST_TRACKING
     grid: tuple | None = None
     extra: dict = field(default_factory=dict)
     motion: Trajectory | None = None
+
+    def __init__(
+        self,
+        machine: Machine | Platform,
+        spec: VarySpec,
+        seed: int,
+        runs: int,
+        trajectory: str | None = None,
+        program: tuple | None = None,
+        table: tuple | None = None,
+        lost_tracking: float = LOST_TRACKING,
+        grid: tuple | None = None,
+        extra: dict | None = None,
+        motion: Trajectory | None = None,
+        **keywords,
+    ):
+        unknown = set(keywords) - set(STUDY_KEYWORDS)
+        if unknown:  # internal: a caller's typo
+            raise TypeError(f"Study() got unexpected keywords {sorted(unknown)}")
+        machine = machine if isinstance(machine, Machine) else Machine(machine)
+        machine = apply_overrides(machine, {STUDY_KEYWORDS[k]: v for k, v in keywords.items() if v is not None})
+        if machine.controller.engine is None:
+            machine = replace(machine, controller=replace(machine.controller, engine="python"))
+        if trajectory is None and program is None and table is None and motion is None:
+            ref = reference_data(machine.motion)
+            trajectory, program, table, motion = (ref.get(k) for k in ("trajectory", "program", "table", "motion"))
+        given = dict(machine=machine, spec=spec, seed=seed, runs=runs, trajectory=trajectory, program=program)
+        given |= dict(table=table, lost_tracking=lost_tracking, grid=grid, extra=dict(extra or {}), motion=motion)
+        for f in fields(Study):
+            object.__setattr__(self, f.name, given[f.name])
+
+    @property
+    def platform(self) -> Platform:
+        """The nominal platform as written (the machine's, without its payload)."""
+        return self.machine.platform
+
+    @property
+    def controller(self) -> str:
+        """The law: ``fixed`` or ``float`` (``controller.law``)."""
+        return self.machine.controller.law
+
+    @property
+    def engine(self) -> str:
+        """The fixed-point tick: ``c`` or ``python`` (``controller.engine``)."""
+        return self.machine.controller.engine
+
+    @property
+    def integrator(self) -> str:
+        """The plant integrator (``run.integrator``, else the default)."""
+        return self.machine.run.integrator or DEFAULT_INTEGRATOR
+
+    @property
+    def duration(self) -> float | None:
+        """Simulated seconds per run as given (``run.duration``; None: the reference's)."""
+        return self.machine.run.duration
+
+    @property
+    def plant_step(self) -> float:
+        """The plant step, s: ``run.plant_step``, else the nominal period, at most 1 ms (a drawn period leaves
+        it as it is)."""
+        run = self.machine.run
+        return run.plant_step if run.plant_step is not None else min(self.machine.controller.period, 1e-3)
+
+    @property
+    def fit(self) -> bool:
+        """Move and scale the reference to the platform's home height and stroke (``run.fit``)."""
+        return self.machine.run.fit
 
     def reference(self) -> Trajectory:
         """The pose reference (built on the worker)."""
@@ -111,52 +211,60 @@ def run_seed(seed: int, index: int) -> int:
     return int(np.random.SeedSequence(seed, spawn_key=(index,)).generate_state(1, np.uint64)[0]) & (2**63 - 1)
 
 
+# Draw's attribute names of the keys whose name differs
+_ALIASES = {"plate_com_offset": "plate_com"}
+
+
 @dataclass(frozen=True)
 class Draw:
-    """One run's parameters (SI). Anchor offsets per physical joint: ``(m, 3)`` base joints in B (leg i
-    on joint ``base_leg_joint[i]``) and ``(k, 3)`` plate anchors in T (leg i on ``platform.leg_top[i]``)."""
+    """One run's draw: ``values`` ``{key: value}`` for every key of ``spec.KEYS`` (SI; vectors as arrays;
+    ``anchor``: offsets per physical joint, ``(m, 3)`` base joints in B, leg i on ``base_leg_joint[i]``, and
+    ``(k, 3)`` plate anchors in T, leg i on ``platform.leg_top[i]``) and the ``nominal`` machine it was drawn
+    from. ``machine()`` is the drawn ``Machine``; each key's value is also an attribute (``d.sample_period``;
+    ``base_anchor_offset``, ``top_anchor_offset``, ``plate_com_offset``)."""
 
-    base_anchor_offset: np.ndarray
-    top_anchor_offset: np.ndarray
+    values: dict
     base_leg_joint: np.ndarray
-    leg_offset: np.ndarray
-    sensor_resolution: float
-    sensor_noise: float
-    latency: str
-    latency_jitter: float
-    actuator_lag: float
-    force_limit: float
-    plate_mass: float
-    plate_com_offset: np.ndarray
-    gain_scale: float
-    sample_period: float
-    payload: float = 0.0
-    payload_position: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    nominal: Machine
+
+    def __getattr__(self, name: str):
+        if name.startswith("__") or "values" not in self.__dict__:
+            raise AttributeError(name)
+        if name in ("base_anchor_offset", "top_anchor_offset"):
+            return self.values["anchor"][name.startswith("top")]
+        key = _ALIASES.get(name, name)
+        if key not in self.values:
+            raise AttributeError(name)
+        return self.values[key]
+
+    def machine(self) -> Machine:
+        """The drawn ``Machine``: its platform is the plant's (``plant_geometry``) and each key with a spec path
+        sets that path (checked as the machine checks it: ``MachineError`` naming the path)."""
+        m = self.nominal
+        sections: dict = {}
+        for key, k in KEYS.items():
+            if k.path is not None:
+                section, name = k.path.split(".")
+                v = self.values[key]
+                sections.setdefault(section, {})[name] = tuple(v) if isinstance(v, np.ndarray) else v
+        drawn = {s: replace(getattr(m, s), **f) for s, f in sections.items()}
+        return replace(m, platform=plant_geometry(m.platform, self), **drawn)
 
     def columns(self) -> dict:
         """The drawn parameters as flat ``{column: value}`` (SI, names with their unit)."""
         out = {}
-        for j, v in enumerate(self.base_anchor_offset):
-            out.update({f"anchor_base{j + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
-        for j, v in enumerate(self.top_anchor_offset):
-            out.update({f"anchor_top{j + 1}_{a}_m": float(x) for a, x in zip(AXES, v)})
-        out.update({f"leg_offset{i + 1}_m": float(x) for i, x in enumerate(self.leg_offset)})
-        out.update(
-            {
-                "sensor_resolution_m": self.sensor_resolution,
-                "sensor_noise_m": self.sensor_noise,
-                "latency": self.latency,
-                "latency_jitter_s": self.latency_jitter,
-                "actuator_lag_s": self.actuator_lag,
-                "force_limit_N": self.force_limit,
-                "plate_mass_kg": self.plate_mass,
-            }
-        )
-        out.update({f"plate_com_{a}_m": float(x) for a, x in zip(AXES, self.plate_com_offset)})
-        out["gain_scale"] = self.gain_scale
-        out["sample_period_s"] = self.sample_period
-        out["payload_kg"] = self.payload
-        out.update({f"payload_position_{a}_m": float(x) for a, x in zip(AXES, self.payload_position)})
+        for key, k in KEYS.items():
+            v, unit = self.values[key], UNIT[k.dimension]
+            if key == "anchor":
+                for side, offsets in (("base", v[0]), ("top", v[1])):
+                    for j, row in enumerate(offsets):
+                        out.update({f"anchor_{side}{j + 1}_{a}_m": float(x) for a, x in zip(AXES, row)})
+            elif k.length == 3:
+                out.update({f"{key}_{a}_{unit}": float(x) for a, x in zip(AXES, v)})
+            elif k.length:
+                out.update({f"{key}{i + 1}_{unit}": float(x) for i, x in enumerate(v)})
+            else:
+                out[f"{key}_{unit}" if unit else key] = v
         return out
 
 
@@ -182,71 +290,68 @@ def _draw_one(rng, law, nominal, shape=()):
     raise ValueError(f"unknown law {law.kind!r}")  # internal: the study loader accepts only the kinds above
 
 
-def draw(study: Study, index: int) -> tuple[int, Draw]:
-    """``(run seed, Draw)`` of run ``index``: every key drawn in ``KEYS`` order from the run's own
-    generator (a key left nominal draws nothing). ``anchor`` draws ``(6, 3)`` base offsets, one row per
-    leg, then ``(k, 3)`` plate offsets; a base joint takes the row of its first leg and the rows of the
-    other legs on it are skipped, so the stream (and so every key drawn after) is the same on every
-    architecture, and a platform with six distinct base anchors draws what it always drew."""
-    seed = run_seed(study.seed, index)
-    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
-    p, laws = study.platform, study.spec.laws
-    k = len(p.top_anchors)
+def nominal_value(machine: Machine, key: str):
+    """The nominal of ``key``: the machine's value at its spec path (``actuators.max_force`` unset: the
+    platform's ``legs.max_force``), the plate's own mass (``plate_mass``), else zero offsets."""
+    k = KEYS[key]
+    if key == "plate_mass":
+        return float(machine.platform.mass)
+    if k.path is None:
+        return 0.0
+    section, name = k.path.split(".")
+    v = getattr(getattr(machine, section), name)
+    if v is None and k.path == "actuators.max_force":
+        v = machine.platform.legs.max_force
+    return v if isinstance(v, str) else np.asarray(v, float) if isinstance(v, tuple) else float(v)
+
+
+def sample(machine: Machine, spec: VarySpec, seed: int, index: int, grid: dict | None = None) -> tuple[int, Draw]:
+    """``(run seed, Draw)`` of run ``index`` of a study of ``machine`` seeded ``seed``: every key drawn in
+    ``KEYS`` order from the run's own generator (a key left nominal draws nothing); ``grid``: values that replace
+    the draws of their keys. ``anchor`` draws ``(6, 3)`` base offsets, one row per leg, then ``(k, 3)`` plate
+    offsets; a base joint takes the row of its first leg and the rows of the other legs on it are skipped, so the
+    stream (and so every key drawn after) is the same on every architecture."""
+    run = run_seed(seed, index)
+    rng = np.random.default_rng(np.random.SeedSequence(run, spawn_key=(0,)))
+    p, laws = machine.platform, spec.laws
     first, leg_joint = base_joints(p)
     vals = {}
-    for key in KEYS:
+    for key, k in KEYS.items():
         law = laws.get(key)
         if key == "anchor":
-            vals[key] = (_draw_one(rng, law, 0.0, (6, 3))[first], _draw_one(rng, law, 0.0, (k, 3)))
-        elif key == "leg_offset":
-            vals[key] = _draw_one(rng, law, 0.0, (6,))
-        elif key in ("plate_com", "payload_position"):
-            vals[key] = _draw_one(rng, law, 0.0, (3,))
-        elif key == "force_limit":
-            vals[key] = float(_draw_one(rng, law, float(p.legs.max_force)))
-        elif key == "plate_mass":
-            vals[key] = float(_draw_one(rng, law, float(p.mass)))
-        elif key == "payload":
-            vals[key] = float(_draw_one(rng, law, 0.0))
-        elif key == "latency":
-            vals[key] = str(_draw_one(rng, law, NOMINAL[key]))
-        else:
-            vals[key] = float(_draw_one(rng, law, NOMINAL[key]))
-    if study.grid is not None:
-        vals.update(study.grid[index])
-    return seed, Draw(
-        base_anchor_offset=np.asarray(vals["anchor"][0], float),
-        top_anchor_offset=np.asarray(vals["anchor"][1], float),
-        base_leg_joint=leg_joint,
-        leg_offset=np.asarray(vals["leg_offset"], float),
-        sensor_resolution=vals["sensor_resolution"],
-        sensor_noise=vals["sensor_noise"],
-        latency=vals["latency"],
-        latency_jitter=vals["latency_jitter"],
-        actuator_lag=vals["actuator_lag"],
-        force_limit=vals["force_limit"],
-        plate_mass=vals["plate_mass"],
-        plate_com_offset=np.asarray(vals["plate_com"], float),
-        gain_scale=vals["gain_scale"],
-        sample_period=vals["sample_period"],
-        payload=vals["payload"],
-        payload_position=np.asarray(vals["payload_position"], float),
-    )
+            base = np.asarray(_draw_one(rng, law, 0.0, (6, 3))[first], float)
+            vals[key] = (base, np.asarray(_draw_one(rng, law, 0.0, (len(p.top_anchors), 3)), float))
+            continue
+        v = _draw_one(rng, law, nominal_value(machine, key), (k.length,) if k.length else ())
+        vals[key] = str(v) if k.dimension == "mode" else np.asarray(v, float) if k.length else float(v)
+    vals.update(grid or {})
+    return run, Draw(vals, leg_joint, machine)
 
 
-def plant_platform(platform: Platform, d: Draw) -> Platform:
-    """The platform the plant is built from: each base joint and plate anchor moved by its offset (legs
-    on one joint move together), the plate's own mass (inertia scaled alike) and centre of mass changed,
-    then the payload added (``with_payload``: a point mass at ``payload_position`` in the plate frame)."""
+def draw(study: Study, index: int) -> tuple[int, Draw]:
+    """``(run seed, Draw)`` of run ``index`` of ``study`` (``sample`` of its machine; a sweep's grid point
+    replaces the draws of its keys)."""
+    grid = study.grid[index] if study.grid is not None else None
+    return sample(study.machine, study.spec, study.seed, index, grid)
+
+
+def plant_geometry(platform: Platform, d: Draw) -> Platform:
+    """``platform`` with each base joint and plate anchor moved by its offset (legs on one joint move together)
+    and the plate's own mass (inertia scaled alike) and centre of mass changed."""
     scale = d.plate_mass / platform.mass if platform.mass > 0 else 1.0
-    plant = platform.replace(
+    return platform.replace(
         base_anchors=platform.base_anchors + d.base_anchor_offset[d.base_leg_joint],
         top_anchors=platform.top_anchors + d.top_anchor_offset,
         mass=d.plate_mass,
         inertia=platform.inertia * scale,
         com=platform.com + d.plate_com_offset,
     )
-    return with_payload(plant, d.payload, d.payload_position, option="--vary payload")
+
+
+def plant_platform(platform: Platform, d: Draw) -> Platform:
+    """The platform the plant is built from: ``plant_geometry``, then the drawn payload added (``with_payload``:
+    a point mass at ``payload_position`` in the plate frame); the drawn machine's ``loaded_platform``."""
+    return with_payload(plant_geometry(platform, d), d.payload, d.payload_position, option="payload")
 
 
 def sensor_model(d: Draw, seed: int, period: float, n_ticks: int) -> SensorModel:
@@ -259,39 +364,44 @@ def sensor_model(d: Draw, seed: int, period: float, n_ticks: int) -> SensorModel
 
 
 def nominal_gains(study: Study, reference: Trajectory):
-    """The gains designed for the nominal platform, timing and actuator lag over the reference's poses (as
-    ``simulate`` and ``api.simulation.plan_run`` design them): the same for every run of a study."""
+    """The gains designed for the nominal machine (its loaded platform, timing and actuator lag) over the
+    reference's poses, as ``api.simulation.plan_run`` designs them: the same for every run of a study."""
+    m = study.machine
+    platform, ctl = m.loaded_platform, m.controller
     duration = study.run_duration(reference)
     poses = design_poses(reference, max(duration, reference.duration or 0.0))
-    return ControllerConfig.for_platform(study.platform, poses=poses).gains
+    timing = DspTiming(
+        sample_period=ctl.period,
+        latency=ctl.latency,
+        sensor_resolution=m.sensors.resolution,
+        command_range=float(platform.legs.max_force),
+    )
+    return ControllerConfig.for_platform(platform, timing, m.actuators.time_constant, poses=poses).gains
 
 
 def scenario(study: Study, index: int, reference: Trajectory | None = None, gains=None) -> tuple[int, Draw, Scenario]:
     """``(run seed, Draw, Scenario)`` of run ``index``, built by ``api.simulation.plan_run`` (the one home of a
-    closed-loop run): the controller keeps the nominal model with the ``nominal_gains`` (computed unless
-    given), scaled by the draw's ``gain_scale``; the plant, actuators and sensor are the draw's. Every draw was
-    checked before the study runs (``draw_checks``), so the per-run checks are skipped."""
+    closed-loop run) from the drawn machine (``Draw.machine``): the controller keeps the nominal model (the
+    machine's platform and payload) with the ``nominal_gains`` (computed unless given), scaled by the drawn
+    ``controller.gain_scale``; the plant, actuators, sensor, timing and number format are the drawn machine's.
+    Every draw was checked before the study runs (``draw_checks``), so the per-run checks are skipped."""
     seed, d = draw(study, index)
+    drawn = d.machine()
     ref = reference or study.reference()
     duration = study.run_duration(ref)
-    n_ticks = tick_count(duration, d.sample_period) + 1
+    period = drawn.controller.period
+    model = replace(drawn, platform=study.machine.platform, payload=study.machine.payload)
     plan = plan_run(
-        study.platform,
+        model,
         ref,
-        study.controller,
-        duration,
-        period=d.sample_period,
-        latency=d.latency,
-        sensor_resolution=d.sensor_resolution,
+        duration=duration,
         plant_step=study.plant_step,
-        engine=study.engine,
-        integrator=study.integrator,
+        fit=False,  # the reference is fitted already (Study.reference)
         actuators=ActuatorModel(d.force_limit, d.actuator_lag),
-        sensor=sensor_model(d, seed, d.sample_period, n_ticks),
-        plant_platform=plant_platform(study.platform, d),
-        gain_scale=d.gain_scale,
+        sensor=sensor_model(d, seed, period, tick_count(duration, period) + 1),
+        plant_platform=drawn.loaded_platform,
         nominal_gains=True,
-        gains=gains,
+        gains=gains if gains is not None else nominal_gains(study, ref),
         checks=False,
         command="montecarlo",
     )

@@ -9,22 +9,24 @@ Every key takes one value written the same way in both forms (units allowed: ``m
     A..B       uniform in [A, B]
     a|b|c      one of the listed values, equally likely
 
-Keys (nominal in brackets):
+Keys (nominal in brackets: the machine's value at the spec path a key draws, ``KEYS``' ``path``; a drawn value
+is checked as the machine checks that field):
 
     anchor             base and plate joint positions, per axis per physical joint [0 offset]
     leg_offset         the length sensor's zero, per leg [0]
-    sensor_resolution  metres per count [1e-5]
-    sensor_noise       σ of white Gaussian noise on each reading, m [0]
-    latency            sample | computation | none [sample]
+    sensor_resolution  metres per count [sensors.resolution]
+    sensor_noise       σ of white Gaussian noise on each reading, m [sensors.noise]
+    latency            sample | computation | none [controller.latency]
     latency_jitter     the largest lag of a tick's sampling instant, s (per tick uniform in [0, J]) [0]
-    actuator_lag       actuator time constant, s [2e-3]
-    force_limit        actuator force limit, N [the platform's legs.max_force]
+    actuator_lag       actuator time constant, s [actuators.time_constant]
+    force_limit        actuator force limit, N [actuators.max_force, else the platform's legs.max_force]
     plate_mass         the plate's own total mass, kg [the platform's] (its inertia scales alike)
     plate_com          the plate's centre of mass offset, per axis, m [0]
-    gain_scale         factor on every PID gain [1]
-    sample_period      controller sample period, s [1e-3] (the gains stay those designed for the nominal)
-    payload            a point mass added to the plate, kg [0] (as ``size --payload``)
-    payload_position   where that payload sits in the plate frame T, m [0 0 0]; ``X,Y,Z`` fixes it
+    gain_scale         factor on every PID gain [controller.gain_scale]
+    sample_period      controller sample period, s [controller.period] (the gains stay those designed for the
+                       nominal)
+    payload            a point mass on the plate, kg [payload.mass] (as ``size --payload``)
+    payload_position   where that payload sits in the plate frame T, m [payload.position]; ``X,Y,Z`` fixes it
                        (as ``size --payload-com``), ±T draws each component in ±T
 
 The keys ``payload_mass`` and ``payload_com`` of earlier versions set the plate's own mass and centre of
@@ -40,27 +42,42 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 from stewart_drake.core.yamlio import compose, read_yaml_text
 from stewart_drake.errors import SpecError, YamlError, short_text
 from stewart_drake.spec.quantity import parse_choice, parse_number, parse_quantity, parse_vector
 
-# key: (dimension, vector length or 0 for a scalar, nominal zero?)
+
+class VaryKey(NamedTuple):
+    """One ``--vary`` key: its quantity ``dimension`` (``mode``: a latency mode), ``length`` (0 for a scalar, 3 or 6
+    components, ``anchors`` for one offset per physical joint), ``zero_nominal`` (±P% refused as read; a key with a ``path``
+    is checked against the machine's value there, ``study.check_study``) and ``path``: the
+    machine's spec path it draws (its nominal is the machine's value there, a drawn value is checked as the
+    machine checks that field), or None for the plant's own geometry and the sensor's per-run processes."""
+
+    dimension: str
+    length: int | str
+    zero_nominal: bool
+    path: str | None = None
+
+
+# The one table of what a study can vary, in draw order (a new key drawn from a machine field is one row here).
 KEYS = {
-    "anchor": ("length", "anchors", True),
-    "leg_offset": ("length", 6, True),
-    "sensor_resolution": ("length", 0, False),
-    "sensor_noise": ("length", 0, True),
-    "latency": ("mode", 0, False),
-    "latency_jitter": ("time", 0, True),
-    "actuator_lag": ("time", 0, False),
-    "force_limit": ("force", 0, False),
-    "plate_mass": ("mass", 0, False),
-    "plate_com": ("length", 3, True),
-    "gain_scale": ("ratio", 0, False),
-    "sample_period": ("time", 0, False),
-    "payload": ("mass", 0, True),
-    "payload_position": ("length", 3, True),
+    "anchor": VaryKey("length", "anchors", True),
+    "leg_offset": VaryKey("length", 6, True),
+    "sensor_resolution": VaryKey("length", 0, False, "sensors.resolution"),
+    "sensor_noise": VaryKey("length", 0, True, "sensors.noise"),
+    "latency": VaryKey("mode", 0, False, "controller.latency"),
+    "latency_jitter": VaryKey("time", 0, True),
+    "actuator_lag": VaryKey("time", 0, False, "actuators.time_constant"),
+    "force_limit": VaryKey("force", 0, False, "actuators.max_force"),
+    "plate_mass": VaryKey("mass", 0, False),
+    "plate_com": VaryKey("length", 3, True),
+    "gain_scale": VaryKey("ratio", 0, False, "controller.gain_scale"),
+    "sample_period": VaryKey("time", 0, False, "controller.period"),
+    "payload": VaryKey("mass", 0, True, "payload.mass"),
+    "payload_position": VaryKey("length", 3, True, "payload.position"),
 }
 # Keys of earlier versions whose names said something else than what they varied: refused, naming the keys
 # that replace them (a study written for the old names must not run with another meaning).
@@ -108,7 +125,7 @@ def _number(text: str, key: str, where: str) -> float:
 def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
     """The ``Distribution`` of ``key`` written ``text`` (see the module docstring)."""
     text = str(text).strip()
-    dim, length, zero_nominal = KEYS[key]
+    dim, length, zero_nominal, _ = KEYS[key]
     at = f"{where}: {key}"
     if dim == "mode":
         modes = tuple(m.strip() for m in text.split("|"))
@@ -120,7 +137,8 @@ def parse_value(key: str, text: str, where: str = "--vary") -> Distribution:
         if v < 0:
             raise SpecError(SpecError.NEGATIVE_PROCESS.format(where=where, key=key, text=text))
         return Distribution("fixed", (v,), text)
-    if zero_nominal and text.startswith(("±", "+-")) and text.endswith("%"):
+    # a key drawn about a machine field is checked against the machine's value (study.check_study)
+    if zero_nominal and KEYS[key].path is None and text.startswith(("±", "+-")) and text.endswith("%"):
         raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=where, key=key, text=text))
     if length == 3 and "," in text:  # X,Y,Z: a fixed vector
         if text.count(",") != 2:
@@ -153,23 +171,24 @@ def _check_vector(key: str, d: Distribution, where: str) -> None:
         raise SpecError(SpecError.VECTOR_LAW.format(where=where, key=key, text=d.text))
 
 
-def parse_spec(words) -> VarySpec:
+def parse_spec(words, where: str = "--vary") -> VarySpec:
     """A ``VarySpec`` from ``key=value`` words (a list of strings, or one string split at whitespace)
-    or, when the only word names an existing ``.yaml``/``.yml`` file, from that YAML mapping."""
+    or, when the only word names an existing ``.yaml``/``.yml`` file, from that YAML mapping; messages name the
+    words ``where`` (the option or parameter) and a file's line."""
     if isinstance(words, str):
         words = words.split()
     words = list(words)
     if len(words) == 1 and words[0].endswith((".yaml", ".yml")):
-        return _parse_yaml(Path(words[0]))
+        return _parse_yaml(Path(words[0]), where)
     laws = {}
     for w in words:
         if "=" not in w:
-            raise SpecError(SpecError.NOT_KEY_VALUE.format(value=w))
+            raise SpecError(SpecError.NOT_KEY_VALUE.format(where=where, value=w))
         key, value = w.split("=", 1)
         key = key.strip()
-        check_key(key, "--vary")
-        d = parse_value(key, value, "--vary")
-        _check_vector(key, d, "--vary")
+        check_key(key, where)
+        d = parse_value(key, value, where)
+        _check_vector(key, d, where)
         laws[key] = d
     return VarySpec(laws, " ".join(words))
 
@@ -177,13 +196,13 @@ def parse_spec(words) -> VarySpec:
 MAX_SPEC_BYTES = 100_000
 
 
-def _parse_yaml(path: Path) -> VarySpec:
+def _parse_yaml(path: Path, where: str) -> VarySpec:
     import yaml
 
     if not path.exists():
-        raise SpecError(SpecError.MISSING_FILE.format(path=str(path)))
+        raise SpecError(SpecError.MISSING_FILE.format(where=where, path=str(path)))
     # read once, bounded (a spec is a few lines), with the platform files' safe composer (nesting bounded)
-    text, shown = read_yaml_text(path, "--vary spec", limit=MAX_SPEC_BYTES)
+    text, shown = read_yaml_text(path, f"{where} spec", limit=MAX_SPEC_BYTES)
     try:
         node = compose(text, shown)
     except YamlError as e:

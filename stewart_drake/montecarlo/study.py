@@ -31,10 +31,12 @@ from stewart_drake.core.geometry import base_joints
 from stewart_drake.core.journal import JournalWriter, header_line, read_rows
 from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
 from stewart_drake.drake.systems import make_law
-from stewart_drake.errors import JournalError, OutputError, StudyError
+from stewart_drake.errors import JournalError, OutputError, SpecError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
-from stewart_drake.montecarlo.scenario import Study, draw, run_scenario, scenario
+from stewart_drake.montecarlo.scenario import Study, draw, nominal_value, run_scenario, scenario
 from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
+from stewart_drake.spec import Gains, Machine, apply_overrides
+from stewart_drake.spec.machine import FIELDS
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -47,6 +49,22 @@ MAX_TOTAL_SECONDS = 500_000.0
 MAX_RUN_STEPS = MAX_RUN_SECONDS / 1e-3
 MAX_TOTAL_STEPS = MAX_TOTAL_SECONDS / 1e-3
 RETRIES = 3
+# How a study's messages name its settings: the API's parameters and spec paths; the command line passes its flags.
+NAMES = {
+    "runs": "runs",
+    "seed": "seed",
+    "duration": "run.duration",
+    "plant_step": "run.plant_step",
+    "vary": "vary",
+    "out": "out",
+    "workers": "workers",
+    "lost_tracking": "lost_tracking",
+}
+
+
+def option_names(names: dict | None = None) -> dict:
+    """The message templates' fields (``{"runs_opt": "runs", ...}``) of ``NAMES`` updated by ``names``."""
+    return {f"{k}_opt": v for k, v in (NAMES | (names or {})).items()}
 
 
 def study_settings(study: Study) -> dict:
@@ -76,8 +94,29 @@ def study_settings(study: Study) -> dict:
         "grid": list(study.grid) if study.grid is not None else None,
         "motion": motion_settings(study),
         **shared,
+        **machine_settings(study.machine),
         **study.extra,
     }
+
+
+# spec paths study_settings records under names of their own (controller, engine, duration, ...)
+RECORDED_PATHS = ("controller.law", "controller.engine", "run.duration", "run.plant_step", "run.integrator", "run.fit")
+
+
+def machine_settings(machine: Machine) -> dict:
+    """``{"machine": {spec path: value}}`` (SI; lists, the gains as a mapping) of the machine's fields that differ
+    from a machine with defaults (those of ``RECORDED_PATHS`` left to their own settings); ``{}`` when none does,
+    so that a study of a platform keeps its settings and key."""
+    default = Machine(machine.platform)
+    out = {}
+    for path in FIELDS:
+        if path in RECORDED_PATHS:
+            continue
+        section, name = path.split(".")
+        v = getattr(getattr(machine, section), name)
+        if v != getattr(getattr(default, section), name):
+            out[path] = dataclasses.asdict(v) if isinstance(v, Gains) else list(v) if isinstance(v, tuple) else v
+    return {"machine": out} if out else {}
 
 
 def motion_settings(study: Study) -> dict | None:
@@ -118,10 +157,11 @@ def study_from_settings(settings: dict, runs: int) -> Study:
         "grid",
         "base_joints",
         "motion",
+        "machine",
     }
     extra = {k: v for k, v in settings.items() if k not in known}
     return Study(
-        platform=Platform(**plat),
+        apply_overrides(Machine(Platform(**plat)), settings.get("machine") or {}),
         spec=spec_from_dict(settings["vary"]),
         seed=settings["seed"],
         runs=runs,
@@ -153,46 +193,53 @@ def settings_key(settings: dict) -> str:
     return hashlib.sha256(json.dumps(settings, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
 
-def check_study(study: Study) -> float:
+def check_study(study: Study, names: dict | None = None) -> float:
     """Raise ``StudyError`` if the study is too large or inconsistent, or a run's draw fails ``simulate``'s
-    checks (``draw_checks``); return the seconds per run."""
+    checks (``draw_checks``); return the seconds per run. ``names``: how messages name the settings (``NAMES``)."""
+    opt = option_names(names)
     from stewart_drake.drake.integrators import check_integrator
 
     check_integrator(study.integrator)
     if not (isinstance(study.runs, int) and 1 <= study.runs <= MAX_RUNS):
-        raise StudyError(StudyError.RUNS.format(limit=MAX_RUNS, value=study.runs))
+        raise StudyError(StudyError.RUNS.format(limit=MAX_RUNS, value=study.runs, **opt))
     if not (isinstance(study.seed, int) and study.seed >= 0):
-        raise StudyError(StudyError.SEED.format(value=study.seed))
+        raise StudyError(StudyError.SEED.format(value=study.seed, **opt))
     if study.grid is not None and len(study.grid) != study.runs:
         raise StudyError(StudyError.GRID.format(runs=study.runs, points=len(study.grid)))
     if not (math.isfinite(study.plant_step) and 0 < study.plant_step <= 1e-2):
         raise StudyError(StudyError.PLANT_STEP.format(value=study.plant_step))
     duration = study.run_duration()
     if not (math.isfinite(duration) and 0 < duration <= MAX_RUN_SECONDS):
-        raise StudyError(StudyError.DURATION.format(limit=MAX_RUN_SECONDS, value=duration))
+        raise StudyError(StudyError.DURATION.format(limit=MAX_RUN_SECONDS, value=duration, **opt))
     if study.runs * duration > MAX_TOTAL_SECONDS:
         raise StudyError(
             StudyError.TOTAL.format(
-                runs=study.runs, duration=duration, total=study.runs * duration, limit=MAX_TOTAL_SECONDS
+                runs=study.runs, duration=duration, total=study.runs * duration, limit=MAX_TOTAL_SECONDS, **opt
             )
         )
     steps = duration / study.plant_step
     if steps > MAX_RUN_STEPS:
         raise StudyError(
-            StudyError.STEPS.format(step=study.plant_step, duration=duration, steps=steps, limit=MAX_RUN_STEPS)
+            StudyError.STEPS.format(step=study.plant_step, duration=duration, steps=steps, limit=MAX_RUN_STEPS, **opt)
         )
     if study.runs * steps > MAX_TOTAL_STEPS:
         raise StudyError(
-            StudyError.TOTAL_STEPS.format(runs=study.runs, steps=steps, total=study.runs * steps, limit=MAX_TOTAL_STEPS)
+            StudyError.TOTAL_STEPS.format(
+                runs=study.runs, steps=steps, total=study.runs * steps, limit=MAX_TOTAL_STEPS, **opt
+            )
         )
+    for key, law in study.spec.laws.items():  # ±P% of a machine field whose value is zero (a payload of 0 kg)
+        if law.kind == "relative" and not np.any(nominal_value(study.machine, key)):
+            raise SpecError(SpecError.PERCENT_OF_ZERO.format(where=opt["vary_opt"], key=key, text=law.text))
     if study.controller == "fixed":
         law = study.spec.laws.get("sensor_resolution")
         if law is not None and law.kind not in ("fixed", "choice"):
-            raise StudyError(StudyError.RESOLUTION_RANGE)
+            raise StudyError(StudyError.RESOLUTION_RANGE.format(**opt))
+        lsb = study.machine.firmware.length_lsb
         for r in law.values if law is not None else ():
-            if not (r > 0 and abs(1e-3 / r - round(1e-3 / r)) <= 1e-9 * 1e-3 / r):  # r > 0 first: no 1e-3 / 0
-                raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r))
-    check_draws(study)
+            if not (r > 0 and abs(lsb / r - round(lsb / r)) <= 1e-9 * lsb / r):  # r > 0 first: no lsb / 0
+                raise StudyError(StudyError.RESOLUTION_DIVIDE.format(value=r, lsb=lsb, **opt))
+    check_draws(study, names)
     return duration
 
 
@@ -214,48 +261,50 @@ def run_row(study: Study, index: int) -> dict:
 # The output folder's state.
 
 
-def load_partial(out: Path, key: str, study: Study | None = None) -> dict[int, dict]:
+def load_partial(out: Path, key: str, study: Study | None = None, names: dict | None = None) -> dict[int, dict]:
     """``{run: row}`` of the runs already finished in ``out`` for the study ``key`` (none if ``out`` does
     not exist). ``StudyError`` if ``out`` holds something else: another study, or files this tool did not
     write; ``JournalError`` naming the file and line if a line of the journal does not verify (``core.journal``)
-    or, with ``study``, a row's drawn values are not the study's draws for its run."""
+    or, with ``study``, a row's drawn values are not the study's draws for its run (``names``: how messages name
+    ``out``, ``NAMES``)."""
+    opt = option_names(names)
     if not out.exists():
         return {}
     if not out.is_dir():
-        raise StudyError(StudyError.OUT_NOT_FOLDER.format(out=str(out)))
+        raise StudyError(StudyError.OUT_NOT_FOLDER.format(out=str(out), **opt))
     rows: dict[int, dict] = {}
     partial = out / PARTIAL
     previous = out / STUDY_FILE
     if previous.exists():
-        old = _damaged_unless(previous, lambda: json.loads(previous.read_text()), dict)
+        old = _damaged_unless(previous, lambda: json.loads(previous.read_text()), dict, opt)
         old_key = _damaged_unless(
-            previous, lambda: settings_key(old["settings"]) if "settings" in old else old.get("key"), str
+            previous, lambda: settings_key(old["settings"]) if "settings" in old else old.get("key"), str, opt
         )
         if old_key != key:
-            raise StudyError(StudyError.OUT_OTHER_STUDY.format(out=str(out), old_key=old_key, key=key))
+            raise StudyError(StudyError.OUT_OTHER_STUDY.format(out=str(out), old_key=old_key, key=key, **opt))
         results = out / "results.parquet"
         if results.exists():
             import pyarrow.parquet as pq
 
-            table = _damaged_unless(results, lambda: pq.read_table(results).to_pylist(), list)
+            table = _damaged_unless(results, lambda: pq.read_table(results).to_pylist(), list, opt)
             for n, r in enumerate(table, start=1):
-                rows[_checked(study, results, n, r)] = r
+                rows[_checked(study, results, n, r, opt)] = r
     elif not partial.exists() and any(out.iterdir()):
-        raise StudyError(StudyError.OUT_NOT_OURS.format(out=str(out), study_file=STUDY_FILE, partial=PARTIAL))
+        raise StudyError(StudyError.OUT_NOT_OURS.format(out=str(out), study_file=STUDY_FILE, partial=PARTIAL, **opt))
     if partial.exists():
         lines = partial.read_text(encoding="utf-8", errors="replace").splitlines()
-        head = _damaged_unless(partial, lambda: json.loads(lines[0]) if lines else None, dict)
+        head = _damaged_unless(partial, lambda: json.loads(lines[0]) if lines else None, dict, opt)
         if head.get("key") != key:
-            raise StudyError(StudyError.OUT_OTHER_PARTIAL.format(out=str(out), old_key=head.get("key"), key=key))
+            raise StudyError(StudyError.OUT_OTHER_PARTIAL.format(out=str(out), old_key=head.get("key"), key=key, **opt))
         for n, r in read_rows(partial, key):  # every line verified; a last line cut short: that run is re-run
-            rows[_checked(study, partial, n, r)] = r
+            rows[_checked(study, partial, n, r, opt)] = r
     return rows
 
 
-def _checked(study: Study | None, path: Path, line: int, row) -> int:
+def _checked(study: Study | None, path: Path, line: int, row, opt: dict) -> int:
     """The run index of a stored ``row`` (line ``line`` of ``path``), its drawn values checked against ``study``'s
     draws for that run (``scenario.draw``: deterministic from the seed and the index)."""
-    run = _run_index(path, row)
+    run = _run_index(path, row, opt)
     if study is not None and run < study.runs:
         seed, d = draw(study, run)
         for column, drawn in {"seed": seed, **d.columns()}.items():
@@ -265,7 +314,7 @@ def _checked(study: Study | None, path: Path, line: int, row) -> int:
     return run
 
 
-def _damaged_unless(path: Path, read, kind: type):
+def _damaged_unless(path: Path, read, kind: type, opt: dict):
     """``read()`` if it gives a ``kind``; else ``StudyError`` naming ``path`` as damaged (a resume folder
     edited or cut short: one line, never a traceback)."""
     try:
@@ -276,15 +325,15 @@ def _damaged_unless(path: Path, read, kind: type):
         if isinstance(value, kind):
             return value
         reason = f"{type(value).__name__} where a {kind.__name__} belongs"
-    raise StudyError(StudyError.OUT_DAMAGED.format(path=str(path), reason=reason))
+    raise StudyError(StudyError.OUT_DAMAGED.format(path=str(path), reason=reason, **opt))
 
 
-def _run_index(path: Path, row) -> int:
+def _run_index(path: Path, row, opt: dict) -> int:
     """The run index of a stored row (a JSON object with an integer "run"), else ``StudyError`` naming ``path``."""
     run = row.get("run") if isinstance(row, dict) else None
     if type(run) is not int or run < 0:
         raise StudyError(
-            StudyError.OUT_DAMAGED.format(path=str(path), reason=f"a row without a run index: {str(row)[:60]}")
+            StudyError.OUT_DAMAGED.format(path=str(path), reason=f"a row without a run index: {str(row)[:60]}", **opt)
         )
     return run
 
@@ -339,17 +388,20 @@ class PartialWriter:
 # Running.
 
 
-def run_study(study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = True) -> list[dict]:
+def run_study(
+    study: Study, out, workers: int = 1, scheduler: str | None = None, progress: bool = True, names: dict | None = None
+) -> list[dict]:
     """Run every run of ``study`` not yet in ``out`` and return all rows in run order. ``workers`` 0
     runs them in this process (no Dask); otherwise a ``LocalCluster`` of ``workers`` processes, or the
     cluster at ``scheduler``. ``out`` None: nothing kept on disk (no resume). A finished row without the
-    verdict columns (``summary.VERDICT_COLUMNS``: written before runs were judged) is run again."""
-    check_study(study)
+    verdict columns (``summary.VERDICT_COLUMNS``: written before runs were judged) is run again. ``names``: how
+    messages name the settings (``NAMES``)."""
+    check_study(study, names)
     key = study_key(study)
-    rows = load_partial(Path(out), key, study) if out is not None else {}
+    rows = load_partial(Path(out), key, study, names) if out is not None else {}
     rows = {i: r for i, r in rows.items() if all(c in r for c in VERDICT_COLUMNS)}
     todo = [i for i in range(study.runs) if i not in rows]
-    writer = PartialWriter(Path(out), key) if out is not None else None
+    writer = PartialWriter(Path(out), key, option_names(names)["out_opt"]) if out is not None else None
     bar = None
     if progress:
         from tqdm import tqdm

@@ -7,45 +7,25 @@ from __future__ import annotations
 import itertools
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR
 from stewart_drake.montecarlo.scenario import Study
 from stewart_drake.montecarlo.spec import KEYS, SpecError, VarySpec, check_key
 from stewart_drake.montecarlo.study import run_study
+from stewart_drake.spec import Machine
 
 
-def sweep_study(
-    platform: Platform,
-    axes: dict,
-    trajectory: str = "seed",
-    controller: str = "fixed",
-    duration: float | None = None,
-    plant_step: float = 1e-3,
-    integrator: str = DEFAULT_INTEGRATOR,
-    engine: str = "python",
-) -> Study:
-    """The ``Study`` of the cartesian product of ``axes`` (``{key: [SI values]}``, keys of ``spec.KEYS``;
-    the first key varies slowest): point i is run i."""
+def sweep_study(machine: Machine | Platform, axes: dict, trajectory: str | None = None, **keywords) -> Study:
+    """The ``Study`` of ``machine`` (a ``Platform``: a machine with defaults) over the cartesian product of
+    ``axes`` (``{key: [SI values]}``, keys of ``spec.KEYS``; the first key varies slowest): point i is run i.
+    ``keywords``: ``Study``'s (``duration``, ``plant_step``, ``engine``, ...: they set their spec paths)."""
     for k, values in axes.items():
         check_key(k, "sweep")
-        if KEYS[k][1]:
+        if KEYS[k].length:
             raise SpecError(SpecError.SWEEP_VECTOR.format(key=k))
         if not len(values):
             raise SpecError(SpecError.SWEEP_EMPTY.format(key=k))
     keys = list(axes)
     grid = tuple(dict(zip(keys, point)) for point in itertools.product(*(axes[k] for k in keys)))
-    return Study(
-        platform,
-        VarySpec({}, "sweep"),
-        seed=0,
-        runs=len(grid),
-        trajectory=trajectory,
-        controller=controller,
-        duration=duration,
-        plant_step=plant_step,
-        integrator=integrator,
-        engine=engine,
-        grid=grid,
-    )
+    return Study(machine, VarySpec({}, "sweep"), 0, len(grid), trajectory, grid=grid, **keywords)
 
 
 def run_sweep(study: Study, workers: int = 0, out=None, progress: bool = False) -> list[dict]:

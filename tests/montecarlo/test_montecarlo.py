@@ -261,7 +261,7 @@ def test_a_pickled_run_scenario_builds_the_same_diagram(platform):
     from stewart_drake.montecarlo.scenario import scenario
 
     study = Study(
-        platform=platform,
+        machine=platform,
         spec=parse_spec(VARY + ["sensor_noise=5um", "gain_scale=±10%"]),
         seed=11,
         runs=2,
@@ -337,7 +337,7 @@ def test_the_parent_compiles_the_firmware_the_workers_load(platform, tmp_path, m
     if not c_build.compilers():
         pytest.skip("no C compiler")
     monkeypatch.setenv("STEWART_DRAKE_CACHE", str(tmp_path / "cache"))
-    study = Study(platform=platform, spec=parse_spec(VARY), seed=3, runs=2, duration=0.02, engine="c")
+    study = Study(machine=platform, spec=parse_spec(VARY), seed=3, runs=2, duration=0.02, engine="c")
     study_mod.compile_firmware(study, 0)
     assert len(list((tmp_path / "cache").glob("sd-*.so"))) >= 1
 

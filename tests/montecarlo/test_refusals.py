@@ -60,7 +60,11 @@ def test_a_drawn_scenario_refused_still_advises_narrower_ranges(capsys, tmp_path
     argv = ["montecarlo", "--vary", "anchor=±100mm", "--runs", "2", "--workers", "0", "--duration", "0.05"]
     assert main([*argv, "--no-progress", "--out", str(tmp_path / "mc")]) == 2
     err = capsys.readouterr().err
-    assert "run 0 (seed" in err and "leaves the stroke" in err and err.rstrip().endswith(StudyError.DRAW_ADVICE.strip())
+    assert (
+        "run 0 (seed" in err
+        and "leaves the stroke" in err
+        and err.rstrip().endswith(StudyError.DRAW_ADVICE.format(vary_opt="--vary").strip())
+    )
     assert "--allow-out-of-stroke" not in err
 
 
