@@ -216,7 +216,7 @@ def loop_response(
     if pm < MIN_PHASE_MARGIN_DEG:
         failures.append(ResponseError.PHASE_MARGIN.format(value=pm, minimum=MIN_PHASE_MARGIN_DEG))
     measured = []
-    if measure is not None:
+    if measure is not None and rho < 1:  # an unstable loop has no steady response to measure
         lsb = sc.config.ik_format.length_lsb if sc.controller == "fixed" else 0.0
         for fm in _frequencies(measure, T, "measure"):
             p = measure_point(sc, model, float(fm), leg - 1, amplitude, setpoint_lsb=lsb)
@@ -251,5 +251,5 @@ def _frequencies(values, T: float, name: str) -> np.ndarray:
     bad = ~(np.isfinite(f) & (f > 0) & (f < nyq))
     if bad.any():
         i = int(np.argmax(bad))
-        raise ResponseError(ResponseError.FREQUENCY.format(name=name, index=i + 1, value=f[i], nyquist=nyq))
+        raise ResponseError(ResponseError.FREQUENCY.format(name=name, index=i + 1, value=float(f[i]), nyquist=nyq))
     return f

@@ -1,0 +1,32 @@
+"""``stewart-drake response``: the verdict on the margins, and refusals of bad input."""
+
+import json
+
+from stewart_drake.cli import main
+
+
+def test_designed_loop_passes_and_reports_margins(capsys):
+    assert main(["response", "--platform", "utn-dynamic", "--controller", "float"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert min(m["gain_margin_db"] for m in out["margins"]) >= out["min_gain_margin_db"]
+    assert min(m["phase_margin_deg"] for m in out["margins"]) >= out["min_phase_margin_deg"]
+    assert out["spectral_radius"] < 1 and out["failures"] == []
+
+
+def test_doubled_gains_exit_1_naming_the_unstable_loop(capsys):
+    # utn-dynamic's loop-at-a-time gain margin is ~6.4 dB (a factor ~2.1 on one leg); doubling every leg's gains
+    # at once leaves the linearised loop unstable: the verdict must say so and exit 1
+    assert (
+        main(["response", "--platform", "utn-dynamic", "--controller", "float", "--set", "controller.gain_scale=2"])
+        == 1
+    )
+    err = capsys.readouterr().err
+    assert "unstable" in err
+
+
+def test_measure_above_nyquist_is_refused(capsys):
+    assert main(["response", "--controller", "float", "--measure", "600"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "stewart-drake response: error: measure: frequency 1 must be in (0, 500) Hz (below the Nyquist frequency), got 600.0"
+    ]
