@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from stewart_drake.control.frequency import controller_matrices
+from stewart_drake.control.frequency import LoopModel, controller_matrices
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.laws import FloatLaw
 from stewart_drake.control.timing import DspTiming
@@ -35,3 +35,27 @@ def test_controller_state_space_is_the_float_law():
         u_ss = Cc @ c + Dc @ w
         c = Ac @ c + Bc @ w
         np.testing.assert_allclose(u_ss, u, rtol=1e-9, atol=atol)
+
+
+def _model(name="utn-dynamic", feedforward=True):
+    p = load_preset(name)
+    cfg = ControllerConfig.for_platform(p)
+    lead = 4e-3 if feedforward else None
+    return p, LoopModel.build(p, p.home_pose(), cfg.gains, 1e-3, 1e-3, 2e-3, 1e-3, lead)
+
+
+def test_plant_static_gain_is_the_leg_space_compliance():
+    # at z = 1 the actuators pass a constant command whole and the plate settles where K·δL = δF: the tick map's
+    # static gain is K⁻¹ (the model's own K, so this pins the discretisation, lag and delay, not K)
+    p, m = _model()
+    G0 = m.plant_response([1e-7])[0]
+    np.testing.assert_allclose(G0.real, np.linalg.inv(m.K), rtol=1e-6, atol=1e-6 * np.abs(np.linalg.inv(m.K)).max())
+
+
+def test_integral_action_gives_unit_static_response():
+    # the PID integrates the error: at low frequency every leg follows its own set-point (T → I, error ∝ f)
+    for ff in (True, False):
+        _, m = _model(feedforward=ff)
+        assert m.spectral_radius < 1
+        T0 = m.setpoint_response([1e-5])[0]
+        np.testing.assert_allclose(T0, np.eye(6), atol=1e-3)
