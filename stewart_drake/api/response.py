@@ -217,9 +217,8 @@ def loop_response(
         failures.append(ResponseError.PHASE_MARGIN.format(value=pm, minimum=MIN_PHASE_MARGIN_DEG))
     measured = []
     if measure is not None and rho < 1:  # an unstable loop has no steady response to measure
-        lsb = sc.config.ik_format.length_lsb if sc.controller == "fixed" else 0.0
         for fm in _frequencies(measure, T, "measure"):
-            p = measure_point(sc, model, float(fm), leg - 1, amplitude, setpoint_lsb=lsb)
+            p = measure_point(sc, model, float(fm), leg - 1, amplitude)
             measured.append(p)
             if not p.agrees:
                 failures.append(

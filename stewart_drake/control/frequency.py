@@ -231,17 +231,25 @@ class LoopModel:
         ph = np.exp(1j * 2 * np.pi * f * self.lead)
         return (self.K[None] - w2[:, None, None] * self.M[None]) * ph[:, None, None]
 
-    def setpoint_response(self, freqs) -> np.ndarray:
-        """``(n, 6, 6)`` complex: the leg lengths per unit leg set-point (m/m) at ``freqs`` (n,) Hz, the
-        feed-forward included (entry [i, j]: length i per set-point j)."""
+    def setpoint_parts(self, freqs) -> tuple[np.ndarray, np.ndarray]:
+        """``(through_pid, through_feedforward)``, each ``(n, 6, 6)`` complex m/m at ``freqs`` (n,) Hz: the leg
+        lengths per unit leg set-point through the PID, and through the feed-forward rows the reference's own
+        motion adds (``setpoint_response`` is their sum)."""
         freqs = np.asarray(freqs, dtype=float)
         eye = np.eye(len(self.A))
         ff = self.feedforward_gain(freqs)
-        out = []
+        pid, fwd = [], []
         for z, F in zip(self._z(freqs), ff):
             H = self.C @ np.linalg.solve(z * eye - self.A, self.B) + self.D
-            out.append(H[:, :6] + H[:, 6:] @ F)
-        return np.array(out)
+            pid.append(H[:, :6])
+            fwd.append(H[:, 6:] @ F)
+        return np.array(pid), np.array(fwd)
+
+    def setpoint_response(self, freqs) -> np.ndarray:
+        """``(n, 6, 6)`` complex: the leg lengths per unit leg set-point (m/m) at ``freqs`` (n,) Hz, the
+        feed-forward included (entry [i, j]: length i per set-point j)."""
+        pid, fwd = self.setpoint_parts(freqs)
+        return pid + fwd
 
     def cartesian_response(self, freqs) -> np.ndarray:
         """``(n, 6, 6)`` complex: the pose per unit pose reference, J⁻¹·T·J (pose in m and rad)."""

@@ -3,12 +3,12 @@ held pose, run through the real controller (the float law, or the compiled fixed
 closed-chain plant, its leg-length response fitted by least squares.
 
 The tolerance of a measured point against the linear model (``control.frequency.LoopModel``) is the sum of
-(``tolerance``):
+(``MeasuredPoint.tolerance``):
 
 - the fit's standard error, three times (the residual's RMS · √(2/n) per coefficient, over the amplitude);
-- the quantisers: the sensor count ``r`` and the set-point LSB (0 for the float law) each move the fitted
-  sine by at most 4/π · LSB/2 (a bounded error's projection on a sine), so by 0.64·(r + LSB)/A per unit
-  response;
+- the sensor's count ``r``: a bounded error of r/2 moves the fitted sine by at most 4/π · r/2 (its projection on
+  a sine), 0.64·r/A per unit response (the set-points' own rounding is in the model's input: the fitted sine of
+  the set-points the law computes, ``setpoints``);
 - the linearisation: the neglected terms are second order in the amplitude A over the platform's lengths,
   so relative to |H| they are of order A/ℓ, ℓ the shortest leg at the pose;
 - the start's transient: the loop starts on the reference, (1 + |H|)·A from its sinusoidal steady state at
@@ -26,6 +26,7 @@ from functools import partial
 import numpy as np
 
 from stewart_drake.control.frequency import LoopModel
+from stewart_drake.control.laws import FixedPointLaw, FloatLaw
 from stewart_drake.core.kinematics import leg_lengths, length_jacobian
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.drake.simulation import Scenario, build_simulation
@@ -34,13 +35,14 @@ from stewart_drake.drake.simulation import Scenario, build_simulation
 # share of the command range: the loop stays far from saturation, where it is linear.
 COMMAND_SHARE = 0.1
 # The fit starts once the slowest closed-loop pole of the linear model has decayed to this fraction.
-TRANSIENT_LEFT = 1e-2
+TRANSIENT_LEFT = 2e-3
 
 
 @dataclass(frozen=True)
 class MeasuredPoint:
     """One frequency of the measured response: ``freq`` Hz, ``leg`` (0-based) driven with ``amplitude`` m;
-    ``response`` (6,) complex: each leg's length per unit set-point; ``linear`` (6,) complex: the model's;
+    ``response`` (6,) complex: each leg's length per unit amplitude; ``linear`` (6,) complex: the model's for the
+    set-points the law computed (``setpoints``) and the reference's feed-forward;
     ``tolerance`` (6,) the allowed |response − linear|; ``residual`` the fit's RMS residual over the amplitude."""
 
     freq: float
@@ -54,6 +56,15 @@ class MeasuredPoint:
     @property
     def agrees(self) -> bool:
         return bool(np.all(np.abs(self.response - self.linear) <= self.tolerance))
+
+
+def setpoints(scenario: Scenario, poses) -> np.ndarray:
+    """``(n, 6)`` leg set-points (m) the scenario's law computes from ``poses`` (n, 6): the fixed-point IK's
+    words times their LSB (``laws.FixedPointLaw``, the C firmware's twin), or the float law's IK."""
+    cfg = scenario.config
+    if scenario.controller == "fixed":
+        return FixedPointLaw(scenario.platform, cfg).ik_words(poses) * cfg.ik_format.length_lsb
+    return FloatLaw(scenario.platform, cfg).setpoints(poses)
 
 
 def _sine_pose(pose, dq, w, t):
@@ -75,13 +86,11 @@ def measure_point(
     leg: int = 0,
     amplitude: float = 1e-3,
     window: float = 0.5,
-    setpoint_lsb: float = 0.0,
 ) -> MeasuredPoint:
     """Drive leg ``leg``'s set-point with a sine of ``freq`` Hz about ``model.pose`` (the pose moves by
     J⁻¹·e_leg·A·sin ωt, so the other legs' set-points move only to second order) through ``scenario``'s loop,
     and fit the ticks' leg lengths over whole periods spanning at least ``window`` s after the start's
-    transient. ``amplitude`` (m): at most, see ``sine_amplitude``; ``setpoint_lsb``: the set-point's LSB (m)
-    for the tolerance (0: the float law)."""
+    transient. ``amplitude`` (m): at most, see ``sine_amplitude``."""
     T = model.T
     pose = model.pose
     A = sine_amplitude(model, freq, leg, scenario.config.timing.command_range, amplitude)
@@ -101,10 +110,15 @@ def measure_point(
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     res = y - X @ coef
     response = (coef[1] + 1j * coef[2]) / A
-    linear = model.setpoint_response([freq])[0][:, leg]
+    # the set-points the law computes from the reference's poses at the fitted ticks (the fixed-point IK's words
+    # are not exactly J·δq): their sine drives the PID; the feed-forward rows follow the reference itself
+    S = np.linalg.lstsq(X, setpoints(scenario, traj.pose(t)), rcond=None)[0]
+    S = (S[1] + 1j * S[2]) / A
+    pid, fwd = model.setpoint_parts([freq])
+    linear = pid[0] @ S + fwd[0][:, leg]
     sigma = np.sqrt(np.mean(res**2, axis=0)) * math.sqrt(2.0 / len(t)) / A
     ell = float(leg_lengths(scenario.platform, pose).min())
     r = scenario.config.timing.sensor_resolution
-    tol = 3 * sigma + 0.64 * (r + setpoint_lsb) / A + np.abs(linear) * (A / ell + w * scenario.plant_time_step)
+    tol = 3 * sigma + 0.64 * r / A + np.abs(linear) * (A / ell + w * scenario.plant_time_step)
     tol = tol + TRANSIENT_LEFT * (1 + np.abs(linear))
     return MeasuredPoint(float(freq), leg, A, response, linear, tol, float(np.sqrt(np.mean(res[:, leg] ** 2)) / A))
