@@ -5,9 +5,17 @@ import json
 from stewart_drake.cli import main
 
 
-def test_designed_loop_passes_and_reports_margins(capsys):
-    assert main(["response", "--platform", "utn-dynamic", "--controller", "float"]) == 0
+def test_designed_loop_passes_and_reports_margins(here, capsys):
+    assert main(["response", "--platform", "utn-dynamic", "--controller", "float", "--out", "r"]) == 0
     out = json.loads(capsys.readouterr().out)
+    # (the folder also holds its ownership mark, a dotfile)
+    assert sorted(p.name for p in (here / "r").iterdir() if not p.name.startswith(".")) == [
+        "response.json",
+        "response.png",
+    ]
+    full = json.loads((here / "r" / "response.json").read_text())
+    n = len(full["frequencies_hz"])
+    assert n == 300 and len(full["setpoint"]["magnitude"]) == n and len(full["cartesian"]["phase_deg"][0]) == 6
     assert min(m["gain_margin_db"] for m in out["margins"]) >= out["min_gain_margin_db"]
     assert min(m["phase_margin_deg"] for m in out["margins"]) >= out["min_phase_margin_deg"]
     assert out["spectral_radius"] < 1 and out["failures"] == []
