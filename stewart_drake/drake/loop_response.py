@@ -9,12 +9,14 @@ The tolerance of a measured point against the linear model (``control.frequency.
 - the sensor's count ``r``: a bounded error of r/2 moves the fitted sine by at most 4/π · r/2 (its projection on
   a sine), 0.64·r/A per unit response (the set-points' own rounding is in the model's input: the fitted sine of
   the set-points the law computes, ``setpoints``);
-- the linearisation: the neglected terms are second order in the amplitude A over the platform's lengths,
-  so relative to |H| they are of order A/ℓ, ℓ the shortest leg at the pose;
+- the linearisation: the neglected terms are second order in the amplitude A over the platform's lengths, a
+  relative plant error of order A/ℓ (ℓ the shortest leg at the pose);
 - the start's transient: the loop starts on the reference, (1 + |H|)·A from its sinusoidal steady state at
   most, decayed by ``TRANSIENT_LEFT`` at the fit (the slowest pole's decay);
-- the plant's integrator: CENIC's convex step is first order, a phase error of order ω·h/2 at plant step h;
-  |H|·ω·h is allowed.
+- the plant's integrator: CENIC's convex step is first order, a phase error of ω·h/2 at plant step h (a
+  relative plant error of that size);
+- a relative plant error ε moves the set-point response T by ε·S·T to first order (S = (I + c_y·G)⁻¹): the two
+  plant terms count σ̄(S(ω))·‖T e_leg‖·ε — near a lightly damped mode the loop itself magnifies them.
 """
 
 from __future__ import annotations
@@ -119,6 +121,10 @@ def measure_point(
     sigma = np.sqrt(np.mean(res**2, axis=0)) * math.sqrt(2.0 / len(t)) / A
     ell = float(leg_lengths(scenario.platform, pose).min())
     r = scenario.config.timing.sensor_resolution
-    tol = 3 * sigma + 0.64 * r / A + np.abs(linear) * (A / ell + w * scenario.plant_time_step)
+    # a relative plant error ε moves the set-point response T by ε·S·T (first order): the model terms are scaled
+    # by the sensitivity's largest singular value at this frequency and the response's size
+    s_max = float(np.linalg.svd(model.loops([freq])[1][0], compute_uv=False)[0])
+    model_error = s_max * np.linalg.norm(linear) * (A / ell + w * scenario.plant_time_step / 2)
+    tol = 3 * sigma + 0.64 * r / A + model_error
     tol = tol + TRANSIENT_LEFT * (1 + np.abs(linear))
     return MeasuredPoint(float(freq), leg, A, response, linear, tol, float(np.sqrt(np.mean(res[:, leg] ** 2)) / A))

@@ -25,7 +25,7 @@ def test_float_law_measured_response_agrees(freq):
 def test_fixed_law_fine_format_measured_response_agrees():
     # the finest 16-bit set-point word that still holds the longest leg (32767 LSB ≥ the stroke's end)
     r = loop_response(
-        "utn-dynamic", measure=[3.0], **FINE, **{"controller.law": "fixed", "firmware.length_lsb": "30um"}
+        "utn-dynamic", measure=[20.0], **FINE, **{"controller.law": "fixed", "firmware.length_lsb": "30um"}
     )
     (p,) = r.measured
     assert abs(p.response[0] - p.linear[0]) <= p.tolerance[0]
