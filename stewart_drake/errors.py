@@ -712,6 +712,10 @@ class ResponseError(StewartError):
     AMPLITUDE = "amplitude must be a positive number of metres, got {value!r}"
     COUNT = "{name} must be 1 … {limit} frequencies, got {count}"
     FREQUENCY = "{name}: frequency {index} must be in (0, {nyquist:g}) Hz (below the Nyquist frequency), got {value!r}"
+    MEASURE_WORK = (
+        "measure: {count} frequencies need {seconds:.0f} s of closed-loop simulation (the loop settles slowly), "
+        "more than {limit:g} s; measure fewer"
+    )
     UNSTABLE = "the linearised closed loop is unstable: largest pole |z| = {rho:.6f} >= 1"
     GAIN_MARGIN = "gain margin {value:.2f} dB is below the minimum {minimum:g} dB"
     PHASE_MARGIN = "phase margin {value:.1f} deg is below the minimum {minimum:g} deg"

@@ -29,7 +29,7 @@ from stewart_drake.control.frequency import (
 from stewart_drake.core.argcheck import check_finite_samples, check_shape
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.trajectory import constant_trajectory
-from stewart_drake.drake.loop_response import measure_point
+from stewart_drake.drake.loop_response import measure_duration, measure_point
 from stewart_drake.errors import ResponseError
 from stewart_drake.spec import Machine
 
@@ -38,6 +38,9 @@ if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is ask
 
 # at most this many frequencies in one response (the 6×6 responses are ~1 kB per frequency)
 MAX_FREQUENCIES = 100_000
+# at most this many measured frequencies, and this many simulated seconds in all (each is a closed-loop run)
+MAX_MEASURED = 50
+MAX_MEASURE_SECONDS = 600.0
 
 
 @dataclass(repr=False)
@@ -216,8 +219,14 @@ def loop_response(
     if pm < MIN_PHASE_MARGIN_DEG:
         failures.append(ResponseError.PHASE_MARGIN.format(value=pm, minimum=MIN_PHASE_MARGIN_DEG))
     measured = []
-    if measure is not None and rho < 1:  # an unstable loop has no steady response to measure
-        for fm in _frequencies(measure, T, "measure"):
+    fms = None if measure is None else _frequencies(measure, T, "measure", MAX_MEASURED)
+    if fms is not None and rho < 1:  # an unstable loop has no steady response to measure
+        total = sum(measure_duration(model, float(fm)) for fm in fms)
+        if total > MAX_MEASURE_SECONDS:
+            raise ResponseError(
+                ResponseError.MEASURE_WORK.format(count=len(fms), seconds=total, limit=MAX_MEASURE_SECONDS)
+            )
+        for fm in fms:
             p = measure_point(sc, model, float(fm), leg - 1, amplitude)
             measured.append(p)
             if not p.agrees:
@@ -242,10 +251,10 @@ def loop_response(
     )
 
 
-def _frequencies(values, T: float, name: str) -> np.ndarray:
+def _frequencies(values, T: float, name: str, limit: int = MAX_FREQUENCIES) -> np.ndarray:
     f = np.atleast_1d(np.asarray(values, dtype=float))
-    if f.ndim != 1 or not 1 <= len(f) <= MAX_FREQUENCIES:
-        raise ResponseError(ResponseError.COUNT.format(name=name, count=f.size, limit=MAX_FREQUENCIES))
+    if f.ndim != 1 or not 1 <= len(f) <= limit:
+        raise ResponseError(ResponseError.COUNT.format(name=name, count=f.size, limit=limit))
     nyq = 0.5 / T
     bad = ~(np.isfinite(f) & (f > 0) & (f < nyq))
     if bad.any():

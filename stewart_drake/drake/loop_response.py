@@ -69,6 +69,16 @@ def setpoints(scenario: Scenario, poses) -> np.ndarray:
     return FloatLaw(scenario.platform, cfg).setpoints(poses)
 
 
+def settle_time(model: LoopModel) -> float:
+    """Seconds until the slowest closed-loop pole of a stable ``model`` has decayed to ``TRANSIENT_LEFT``."""
+    return math.log(1 / TRANSIENT_LEFT) / (-math.log(model.spectral_radius) / model.T)
+
+
+def measure_duration(model: LoopModel, freq: float, window: float = 0.5) -> float:
+    """Simulated seconds ``measure_point`` runs at ``freq`` Hz: the settling and whole periods spanning ``window`` s."""
+    return settle_time(model) + max(2, math.ceil(window * freq)) / freq
+
+
 def _sine_pose(pose, dq, w, t):
     return pose + np.sin(w * np.asarray(t, dtype=float))[..., None] * dq
 
@@ -99,10 +109,8 @@ def measure_point(
     w = 2 * math.pi * freq
     dq = np.linalg.solve(length_jacobian(scenario.platform, pose), np.eye(6)[leg]) * A
     traj = Trajectory(f"sine {freq:g} Hz", partial(_sine_pose, pose, dq, w))
-    slowest = -math.log(model.spectral_radius) / T  # the slowest pole's decay rate, 1/s
-    settle = math.log(1 / TRANSIENT_LEFT) / slowest
-    periods = max(2, math.ceil(window * freq))
-    duration = settle + periods / freq
+    settle = settle_time(model)
+    duration = measure_duration(model, freq, window)
     log = build_simulation(replace(scenario, trajectory=traj, duration=duration)).run(duration)
     k = np.round(log.t / T)
     at = np.isclose(log.t, k * T, atol=1e-9 * T) & (log.t >= settle - 1e-9 * T)

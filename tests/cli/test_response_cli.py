@@ -38,3 +38,13 @@ def test_measure_above_nyquist_is_refused(capsys):
     assert err == [
         "stewart-drake response: error: measure: frequency 1 must be in (0, 500) Hz (below the Nyquist frequency), got 600.0"
     ]
+
+
+def test_measuring_is_bounded_before_any_run(capsys):
+    # 30 frequencies of 0.1 Hz: each run is two whole periods (20 s) after the settling, 600+ s in all
+    argv = ["response", "--controller", "float"] + ["--measure", "0.1"] * 30
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "30 frequencies need" in err[0] and "more than 600 s" in err[0]
+    assert main(["response", "--controller", "float"] + ["--measure", "10"] * 51) == 2
+    assert "measure must be 1 … 50 frequencies, got 51" in capsys.readouterr().err
