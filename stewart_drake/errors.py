@@ -712,6 +712,9 @@ class ResponseError(StewartError):
     AMPLITUDE = "amplitude must be a positive number of metres, got {value!r}"
     COUNT = "{name} must be 1 … {limit} frequencies, got {count}"
     FREQUENCY = "{name}: frequency {index} must be in (0, {nyquist:g}) Hz (below the Nyquist frequency), got {value!r}"
+    PLANT_STEPS = (
+        "run.plant_step {step:g} s must divide controller.period {period:g} s into whole steps for the loop's model"
+    )
     MEASURE_WORK = (
         "measure: {count} frequencies need {seconds:.0f} s of closed-loop simulation (the loop settles slowly), "
         "more than {limit:g} s; measure fewer"

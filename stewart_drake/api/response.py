@@ -198,6 +198,9 @@ def loop_response(
     T = plan.timing.sample_period
     f = default_frequencies(T) if frequencies is None else _frequencies(frequencies, T, "frequencies")
     lag = sc.actuators.time_constant
+    steps = T / sc.plant_time_step
+    if lag > 0 and abs(steps - round(steps)) > 1e-9 * steps:  # the lag steps at the plant steps between ticks
+        raise ResponseError(ResponseError.PLANT_STEPS.format(step=sc.plant_time_step, period=T))
     lead = feedforward_lead(sc.config, lag) if sc.feedforward else None
     model = LoopModel.build(
         sc.platform, pose, effective_gains(sc.controller, sc.config), T, plan.timing.output_delay, lag,

@@ -48,3 +48,22 @@ def test_measuring_is_bounded_before_any_run(capsys):
     assert len(err) == 1 and "30 frequencies need" in err[0] and "more than 600 s" in err[0]
     assert main(["response", "--controller", "float"] + ["--measure", "10"] * 51) == 2
     assert "measure must be 1 … 50 frequencies, got 51" in capsys.readouterr().err
+
+
+def test_pose_in_mm_and_degrees(capsys):
+    # utn-dynamic's home is (0, 0, 0.7 m, 0, 0, 0): given explicitly in the CLI's units it is the default's loop
+    assert main(["response", "--controller", "float", "--pose", "0", "0", "700", "0", "0", "0"]) == 0
+    given = json.loads(capsys.readouterr().out)
+    assert main(["response", "--controller", "float"]) == 0
+    default = json.loads(capsys.readouterr().out)
+    assert given["pose"] == default["pose"] and given["margins"] == default["margins"]
+    # a tilted pose (2° about x) is a different loop
+    assert main(["response", "--controller", "float", "--pose", "0", "0", "700", "2", "0", "0"]) in (0, 1)
+    tilted = json.loads(capsys.readouterr().out)
+    assert abs(tilted["pose"][3] - 0.0349066) < 1e-6 and tilted["margins"] != default["margins"]
+
+
+def test_plant_step_must_divide_the_period(capsys):
+    assert main(["response", "--controller", "float", "--set", "run.plant_step=0.3ms"]) == 2
+    err = capsys.readouterr().err
+    assert "run.plant_step 0.0003 s must divide controller.period 0.001 s" in err
