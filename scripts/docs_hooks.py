@@ -55,6 +55,7 @@ PYTHON = {
     "size": "size",
     "workspace": "workspace",
     "simulate": "simulate",
+    "response": "loop_response",
     "montecarlo": "montecarlo",
     "firmware": "firmware",
     "report": "report",

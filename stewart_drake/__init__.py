@@ -37,6 +37,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.model import ModelInspection, inspect_model
     from stewart_drake.api.platform import load_platform, presets
     from stewart_drake.api.reach import WorkspaceResult, workspace
+    from stewart_drake.api.response import LoopResponse, loop_response
     from stewart_drake.api.servo import ServoResult, servo
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
@@ -84,6 +85,8 @@ _PUBLIC = {
     "workspace": ("stewart_drake.api.reach", "workspace"),
     "WorkspaceResult": ("stewart_drake.api.reach", "WorkspaceResult"),
     "simulate": ("stewart_drake.api.simulation", "simulate"),
+    "loop_response": ("stewart_drake.api.response", "loop_response"),
+    "LoopResponse": ("stewart_drake.api.response", "LoopResponse"),
     "SimulationResult": ("stewart_drake.api.simulation", "SimulationResult"),
     "montecarlo": ("stewart_drake.montecarlo.api", "montecarlo"),
     "MonteCarloResult": ("stewart_drake.montecarlo.api", "MonteCarloResult"),
@@ -146,6 +149,8 @@ __all__ = [
     "WorkspaceResult",
     "simulate",
     "SimulationResult",
+    "loop_response",
+    "LoopResponse",
     "montecarlo",
     "MonteCarloResult",
     "firmware",

@@ -61,6 +61,10 @@ COMMANDS = {
         "report",
         "run the analyses on the built-in presets (or on your platform or machine) and write an HTML report",
     ),
+    "response": (
+        "response",
+        "the closed leg loop in the frequency domain at a pose: margins, bandwidth, sensitivity peak, Bode/Nyquist",
+    ),
     "run": ("run", "run a motion program (.stw): leg lengths and forces along its trajectory"),
     "servo": ("servo", "servo arm angles and pulse widths for a pose (RC-servo hexapod, seed 002)"),
     "simulate": ("simulate", "run the fixed-point (or float) controller in the loop with the Drake plant"),

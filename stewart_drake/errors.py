@@ -717,6 +717,27 @@ class TrajectoryError(InputError):
     SMOOTH_TOL = "{option}: the tolerance must be a finite number > 0 (in the file's units), got {value!r}"
 
 
+class ResponseError(StewartError):
+    """A loop-response request with values outside what it accepts (``api.response``); its ``UNSTABLE``,
+    ``GAIN_MARGIN``, ``PHASE_MARGIN`` and ``DISAGREES`` are the verdict's failures (exit 1), not raised."""
+
+    LEG = "leg must be 1 … 6, got {value!r}"
+    AMPLITUDE = "amplitude must be a positive number of metres, got {value!r}"
+    COUNT = "{name} must be 1 … {limit} frequencies, got {count}"
+    FREQUENCY = "{name}: frequency {index} must be in (0, {nyquist:g}) Hz (below the Nyquist frequency), got {value!r}"
+    PLANT_STEPS = (
+        "run.plant_step {step:g} s must divide controller.period {period:g} s into whole steps for the loop's model"
+    )
+    MEASURE_WORK = (
+        "measure: {count} frequencies need {seconds:.0f} s of closed-loop simulation (the loop settles slowly), "
+        "more than {limit:g} s; measure fewer"
+    )
+    UNSTABLE = "the linearised closed loop is unstable: largest pole |z| = {rho:.6f} >= 1"
+    GAIN_MARGIN = "gain margin {value:.2f} dB is below the minimum {minimum:g} dB"
+    PHASE_MARGIN = "phase margin {value:.1f} deg is below the minimum {minimum:g} deg"
+    DISAGREES = "measured response at {f:g} Hz differs from the linear model by {d:.4f} (per unit), above its tolerance {tol:.4f}"
+
+
 class SimulationError(StewartError):
     """A simulation or Drake model request with values outside what it accepts (``drake.simulation``,
     ``drake.systems``, ``drake.*_model``)."""
