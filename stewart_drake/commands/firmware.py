@@ -189,6 +189,9 @@ def run_build(args) -> int:
         print("stack depth: unbounded (" + " -> ".join(s["stack_path"]) + ")")
     else:
         print(f"stack depth: {s['stack_bytes']} B worst case (" + " -> ".join(s["stack_path"]) + ")")
+    fs = s["functions"]
+    stack = lambda v: "unbounded" if v is None else f"{v} B"  # noqa: E731
+    print("; ".join(f"{f}: code {v['code_bytes']} B, stack {stack(v['stack_bytes'])}" for f, v in fs.items()))
     return 0
 
 

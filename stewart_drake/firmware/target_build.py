@@ -105,8 +105,8 @@ def _run(argv: list[str], cwd: Path, target: str, step: str) -> str:
 class TargetBuild:
     """A target build: the ELF and its map, the bytes of code (``.text``, vectors and constants: flash) and of
     data (``.data`` initialised, ``.bss`` zeroed: RAM), and the worst-case stack depth in bytes with its call
-    path from the entry (``stack_bytes`` None: unbounded, ``stack_path`` naming why); ``functions``: the code
-    bytes and the stack depth of each ABI function (``ABI``) on its own."""
+    path from the entry (``stack_bytes`` None: unbounded, ``stack_path`` naming why); ``functions``: for each ABI
+    function (``ABI``), the code bytes of it and of every function it calls, and its own stack depth."""
 
     target: str
     elf: Path
@@ -170,7 +170,13 @@ def build_target(files: dict, work: Path, target: str = "cortex-m4", name: str =
         frames.setdefault(fn, asm_frames.get(fn))
         calls[fn] = sorted(set(calls.get(fn, ())) | set(asm_calls.get(fn, ())))
     depth, path = stack_depth(frames, calls, t["entry"])
-    functions = {f: {"code_bytes": linked.get(f), "stack_bytes": stack_depth(frames, calls, f)[0]} for f in ABI}
+    functions = {
+        f: {
+            "code_bytes": sum(linked.get(g, 0) for g in reach(calls, f)),
+            "stack_bytes": stack_depth(frames, calls, f)[0],
+        }
+        for f in ABI
+    }
     return TargetBuild(
         target,
         elf,
@@ -287,6 +293,17 @@ def call_graph(work: Path) -> tuple[dict, dict]:
         for a, b in _EDGE.findall(text):
             calls.setdefault(bare(a), []).append(bare(b))
     return frames, calls
+
+
+def reach(calls: dict, entry: str) -> set:
+    """``entry`` and every function its calls reach."""
+    seen, todo = set(), [entry]
+    while todo:
+        f = todo.pop()
+        if f not in seen:
+            seen.add(f)
+            todo += calls.get(f, ())
+    return seen
 
 
 def stack_depth(frames: dict, calls: dict, entry: str) -> tuple[int | None, tuple[str, ...]]:

@@ -155,6 +155,18 @@ def test_bad_frames_are_counted_and_never_acted_on(target, pipe):
 
 
 @needs_cc
+def test_an_overlong_frame_is_malformed_and_the_next_one_is_read(target, pipe):
+    exe, files, g = target
+    host = link.LinkHost(pipe.write, pipe.read, fingerprint(files))
+    host.handshake(REPLY_S)
+    pipe.write(b"\x01" * (3 * link.MAX_PAYLOAD) + b"\x00")  # longer than any frame: no delimiter lost in it
+    pose, measured, ff = ticks(1, seed=4)
+    r = host.tick(pose[0], measured[0], ff[0], timeout=REPLY_S)
+    assert r is not None and list(r.command) == list(reference(g, pose, measured, ff)[0])
+    assert (r.target["malformed"], r.target["frames"]) == (1, 2)
+
+
+@needs_cc
 def test_a_reply_after_its_deadline_is_late_on_the_host(target, pipe):
     exe, files, g = target
     host = link.LinkHost(pipe.write, pipe.read, fingerprint(files))

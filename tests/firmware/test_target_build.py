@@ -31,7 +31,7 @@ from tests.firmware.test_link import fingerprint, reference, ticks
 CROSS = shutil.which("arm-none-eabi-gcc")
 QEMU = shutil.which("qemu-system-arm")
 needs_cross = pytest.mark.skipif(CROSS is None, reason="no arm-none-eabi-gcc (Debian: gcc-arm-none-eabi)")
-needs_qemu = pytest.mark.skipif(CROSS is None or QEMU is None, reason="no qemu-system-arm (Debian: qemu-system-arm)")
+needs_qemu = pytest.mark.skipif(QEMU is None, reason="no qemu-system-arm (Debian: qemu-system-arm)")
 
 
 def tool(name, *args, cwd=None) -> str:
@@ -83,7 +83,8 @@ def test_sizes_agree_with_the_linker_map(built):
             sizes.setdefault(p[0], int(p[2], 16))
     assert s["code_bytes"] >= sizes[".text"] > 0
     assert (s["data_bytes"], s["bss_bytes"]) == (sizes.get(".data", 0), sizes[".bss"])
-    assert s["code_bytes"] > sum(f["code_bytes"] for f in s["functions"].values())
+    f = s["functions"]  # each with what it calls: sd_tick runs sd_ik, and all of it is in the code
+    assert s["code_bytes"] > f["sd_tick"]["code_bytes"] > f["sd_ik"]["code_bytes"] > 0
     assert json.loads((out / "build.json").read_text())["code_bytes"] == s["code_bytes"]
 
 
@@ -174,6 +175,7 @@ def test_cli_names_the_missing_cross_compiler(tmp_path, capsys, monkeypatch):
     assert not (tmp_path / "b").exists()
 
 
+@needs_cross
 @needs_qemu
 def test_the_elf_in_qemu_answers_a_handshake_and_ticks_like_sd_tick(built, tmp_path):
     out, s = built
