@@ -9,7 +9,10 @@ A frame is ``COBS(payload) 0x00``; the payload is ``type u8 | seq u16 LE | body 
 - ``SENSOR`` (host → target, once a tick): reference pose words i16[6], measured leg counts i32[6],
   feed-forward words i16[6], flags u8 (bit 0: feed-forward present);
 - ``COMMAND`` (target → host, the SENSOR's seq): command words i16[6] (Q15 of the command range), saturated
-  legs u8, the target's counters u32[7] (``COUNTERS``).
+  legs u8, the target's counters u32[7] (``COUNTERS``);
+- ``STATUS`` (host → target, any time): no body;
+- ``STATUS_REPLY`` (target → host, the same seq): the counters u32[7] and the most stack used since reset,
+  u32 bytes (``NOT_MEASURED`` where the runtime does not paint its stack).
 
 The format fingerprint is the first 8 bytes of the SHA-256 of the module's recorded options
 (``firmware.fingerprint.fingerprint_line``): a target whose number format, gains or platform differ refuses
@@ -32,7 +35,8 @@ from dataclasses import dataclass, field
 from stewart_drake.errors import FirmwareError
 
 VERSION = 1
-HELLO, HELLO_ACK, SENSOR, COMMAND = 1, 2, 3, 4
+HELLO, HELLO_ACK, SENSOR, COMMAND, STATUS, STATUS_REPLY = 1, 2, 3, 4, 5, 6
+NOT_MEASURED = 0xFFFFFFFF  # a stack high-water mark the target's runtime does not measure
 MAX_PAYLOAD = 96  # bytes, type to CRC (sd_link.h's SD_LINK_MAX_PAYLOAD)
 FINGERPRINT_BYTES = 8
 COUNTERS = ("frames", "corrupt", "malformed", "lost", "duplicate", "late", "unexpected")
@@ -40,7 +44,15 @@ _SENSOR = struct.Struct("<6h6i6hB")
 _COMMAND = struct.Struct(f"<6hB{len(COUNTERS)}I")
 _HELLO = struct.Struct(f"<B{FINGERPRINT_BYTES}s")
 _HELLO_ACK = struct.Struct(f"<B{FINGERPRINT_BYTES}sB")
-BODY_SIZES = {HELLO: _HELLO.size, HELLO_ACK: _HELLO_ACK.size, SENSOR: _SENSOR.size, COMMAND: _COMMAND.size}
+_STATUS_REPLY = struct.Struct(f"<{len(COUNTERS)}II")
+BODY_SIZES = {
+    HELLO: _HELLO.size,
+    HELLO_ACK: _HELLO_ACK.size,
+    SENSOR: _SENSOR.size,
+    COMMAND: _COMMAND.size,
+    STATUS: 0,
+    STATUS_REPLY: _STATUS_REPLY.size,
+}
 
 
 def crc16(data: bytes) -> int:
@@ -259,6 +271,19 @@ class LinkHost:
             return None
         v = _COMMAND.unpack(body)
         return Reply(seq, v[:6], v[6], dict(zip(COUNTERS, v[7:], strict=True)))
+
+    def status(self, timeout: float = 2.0) -> dict:
+        """The target's counters and ``stack_bytes``, the most stack it has used since reset (None: not measured).
+
+        Raises:
+            FirmwareError: no answer in ``timeout`` s.
+        """
+        self.write(encode_frame(STATUS, self.seq, b""))  # the last tick's number: the ticks' sequence goes on
+        body = self._await(STATUS_REPLY, self.seq, timeout)
+        if body is None:
+            raise FirmwareError(FirmwareError.LINK_SILENT.format(what="a status request", timeout=timeout))
+        v = _STATUS_REPLY.unpack(body)
+        return {**dict(zip(COUNTERS, v[:-1], strict=True)), "stack_bytes": None if v[-1] == NOT_MEASURED else v[-1]}
 
     def tick(self, pose_words, measured, feedforward=None, timeout: float = 1.0) -> Reply | None:
         """One controller period: the sensor frame out, the command frame back (None when it did not come)."""

@@ -167,6 +167,20 @@ def test_an_overlong_frame_is_malformed_and_the_next_one_is_read(target, pipe):
 
 
 @needs_cc
+def test_status_reports_the_counters_without_breaking_the_tick_sequence(target, pipe):
+    exe, files, g = target
+    host = link.LinkHost(pipe.write, pipe.read, fingerprint(files))
+    host.handshake(REPLY_S)
+    pose, measured, ff = ticks(2, seed=5)
+    first = host.tick(pose[0], measured[0], ff[0], timeout=REPLY_S)
+    st = host.status(REPLY_S)
+    assert st == {**first.target, "frames": 3, "stack_bytes": None}  # the host build does not paint its stack
+    second = host.tick(pose[1], measured[1], ff[1], timeout=REPLY_S)
+    assert second.target == {**first.target, "frames": 4}  # nothing lost between the ticks
+    assert list(second.command) == list(reference(g, pose, measured, ff)[1])
+
+
+@needs_cc
 def test_a_reply_after_its_deadline_is_late_on_the_host(target, pipe):
     exe, files, g = target
     host = link.LinkHost(pipe.write, pipe.read, fingerprint(files))
@@ -223,7 +237,8 @@ def test_pipe_reader_reports_the_end():
 def test_the_docs_tables_are_the_protocol():
     text = (Path(__file__).parents[2] / "docs" / "pil-link.md").read_text()
     types = dict((int(n), name) for n, name in re.findall(r"^\| (\d) `(\w+)` \|", text, re.M))
-    assert types == {link.HELLO: "HELLO", link.HELLO_ACK: "HELLO_ACK", link.SENSOR: "SENSOR", link.COMMAND: "COMMAND"}
+    names = ("HELLO", "HELLO_ACK", "SENSOR", "COMMAND", "STATUS", "STATUS_REPLY")
+    assert types == {getattr(link, n): n for n in names}
     sizes = {"u8": 1, "i16": 2, "i32": 4, "u32": 4}
     for n, name in types.items():  # the body a row lists, field by field, has the size the code sends
         row = re.search(rf"^\| {n} `{name}` \|[^|]*\|([^|]*)\|", text, re.M).group(1)

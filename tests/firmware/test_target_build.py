@@ -177,7 +177,7 @@ def test_cli_names_the_missing_cross_compiler(tmp_path, capsys, monkeypatch):
 
 @needs_cross
 @needs_qemu
-def test_the_elf_in_qemu_answers_a_handshake_and_ticks_like_sd_tick(built, tmp_path):
+def test_the_elf_in_qemu_answers_a_handshake_and_ticks_like_sd_tick_within_its_stack_bound(built, tmp_path):
     out, s = built
     p = sd.load_platform("utn-dynamic")
     files = generated(tmp_path / "gen")
@@ -205,6 +205,13 @@ def test_the_elf_in_qemu_answers_a_handshake_and_ticks_like_sd_tick(built, tmp_p
                 r = host.tick(pose[k], measured[k], ff[k], timeout=10.0)
                 assert r is not None and list(r.command) == list(want[k])
             assert r.target["frames"] == 6
+            used = host.status(10.0)["stack_bytes"]
     finally:
         q.kill()
         q.wait(timeout=10)
+    # the static bound holds on the board, and is reached: the measured mark lies in the frame of the worst path's
+    # last function, which every tick runs (GCC's -fstack-usage record of it, from the build's sd_pil.su)
+    leaf = s["stack_path"][-1]
+    su = (out / "sd_pil.su").read_text().splitlines()
+    leaf_frame = next(int(ln.split("\t")[1]) for ln in su if ln.split("\t")[0].endswith(":" + leaf))
+    assert s["stack_bytes"] - leaf_frame <= used <= s["stack_bytes"]

@@ -15,7 +15,7 @@
 #define SD_LINK_MAX_ENCODED (SD_LINK_MAX_PAYLOAD + SD_LINK_MAX_PAYLOAD / 254 + 1)
 #define SD_LINK_FINGERPRINT_BYTES 8
 
-enum { SD_MSG_HELLO = 1, SD_MSG_HELLO_ACK = 2, SD_MSG_SENSOR = 3, SD_MSG_COMMAND = 4 };
+enum { SD_MSG_HELLO = 1, SD_MSG_HELLO_ACK = 2, SD_MSG_SENSOR = 3, SD_MSG_COMMAND = 4, SD_MSG_STATUS = 5, SD_MSG_STATUS_REPLY = 6 };
 
 /* The receiver's counts; a frame counted in any of the last six is never acted on. */
 typedef struct {

@@ -24,6 +24,17 @@ static void put32(uint8_t *b, uint32_t v)
     b[3] = (uint8_t)(v >> 24);
 }
 
+static void put_counters(uint8_t *b, const sd_link_counters *c)
+{
+    put32(b, c->frames);
+    put32(b + 4, c->corrupt);
+    put32(b + 8, c->malformed);
+    put32(b + 12, c->lost);
+    put32(b + 16, c->duplicate);
+    put32(b + 20, c->late);
+    put32(b + 24, c->unexpected);
+}
+
 static void send(uint8_t type, uint16_t seq, const uint8_t *body, size_t n)
 {
     uint8_t frame[SD_LINK_MAX_ENCODED + 1];
@@ -64,7 +75,6 @@ static void sensor(sd_pil *p, uint16_t seq, const uint8_t *body)
     sd_count measured[6];
     int16_t feedforward[6], command[6];
     uint8_t out[SD_COMMAND_BODY];
-    uint32_t counts[SD_LINK_COUNTERS];
     int i, saturated;
     if (!p->ready) {
         p->counters.unexpected++;
@@ -81,16 +91,16 @@ static void sensor(sd_pil *p, uint16_t seq, const uint8_t *body)
     for (i = 0; i < 6; ++i)
         put16(out + 2 * i, command[i]);
     out[12] = (uint8_t)saturated;
-    counts[0] = p->counters.frames;
-    counts[1] = p->counters.corrupt;
-    counts[2] = p->counters.malformed;
-    counts[3] = p->counters.lost;
-    counts[4] = p->counters.duplicate;
-    counts[5] = p->counters.late;
-    counts[6] = p->counters.unexpected;
-    for (i = 0; i < SD_LINK_COUNTERS; ++i)
-        put32(out + 13 + 4 * i, counts[i]);
+    put_counters(out + 13, &p->counters);
     send(SD_MSG_COMMAND, seq, out, sizeof out);
+}
+
+static void status(sd_pil *p, uint16_t seq)
+{
+    uint8_t out[SD_STATUS_REPLY_BODY];
+    put_counters(out, &p->counters);
+    put32(out + 4 * SD_LINK_COUNTERS, sd_pil_stack_used());
+    send(SD_MSG_STATUS_REPLY, seq, out, sizeof out);
 }
 
 void sd_pil_byte(sd_pil *p, uint8_t byte)
@@ -104,6 +114,8 @@ void sd_pil_byte(sd_pil *p, uint8_t byte)
         hello(p, seq, p->payload + 3);
     else if (p->payload[0] == SD_MSG_SENSOR && n == 3 + SD_SENSOR_BODY)
         sensor(p, seq, p->payload + 3);
+    else if (p->payload[0] == SD_MSG_STATUS && n == 3 + SD_STATUS_BODY)
+        status(p, seq);
     else {
         p->counters.frames--; /* a good CRC but not a message this end takes */
         p->counters.malformed++;

@@ -11,6 +11,8 @@
 #define SD_COMMAND_BODY 41 /* command i16[6], saturated legs u8, counters u32[7] */
 #define SD_HELLO_BODY 9    /* version u8, format fingerprint u8[8] */
 #define SD_HELLO_ACK_BODY 10 /* version u8, format fingerprint u8[8], accepted u8 */
+#define SD_STATUS_BODY 0
+#define SD_STATUS_REPLY_BODY 32 /* counters u32[7], stack high-water mark u32 (bytes; 0xFFFFFFFF: not measured) */
 
 typedef struct {
     sd_link_rx rx;
@@ -25,5 +27,7 @@ void sd_pil_init(sd_pil *p);
 void sd_pil_byte(sd_pil *p, uint8_t byte);
 /* defined by the runtime: send n bytes */
 void sd_pil_write(const uint8_t *data, size_t n);
+/* defined by the runtime: the most stack used since reset, bytes (0xFFFFFFFF where it is not measured) */
+uint32_t sd_pil_stack_used(void);
 
 #endif

@@ -4,6 +4,9 @@
 #include <stdint.h>
 
 extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
+
+#define STACK_PAINT 0xA5A5A5A5u
+#define STACK_WATCHED 65536u /* bytes below the top of RAM painted at reset, to measure the stack's use */
 int main(void);
 void Reset_Handler(void);
 void Default_Handler(void);
@@ -32,9 +35,20 @@ void Reset_Handler(void)
         *d++ = *s++;
     for (d = &_sbss; d < &_ebss;)
         *d++ = 0;
+    /* paint the watched stack below this frame (a margin of 16 words) */
+    for (d = (uint32_t *)((uintptr_t)&_estack - STACK_WATCHED); d < (uint32_t *)((uintptr_t)&s - 64u);)
+        *d++ = STACK_PAINT;
     main();
     for (;;)
         ;
+}
+
+uint32_t sd_pil_stack_used(void)
+{
+    const uint32_t *d = (const uint32_t *)((uintptr_t)&_estack - STACK_WATCHED);
+    while (*d == STACK_PAINT)
+        ++d;
+    return (uint32_t)((uintptr_t)&_estack - (uintptr_t)d);
 }
 
 void Default_Handler(void)
