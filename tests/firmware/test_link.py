@@ -246,3 +246,11 @@ def test_the_docs_tables_are_the_protocol():
         assert sum(sizes[t] * int(k or 1) for t, k in fields) == link.BODY_SIZES[n], name
     counters = re.findall(r"^\| `(\w+)` \| (?:decoded|has|is|\(|repeats|carries)", text, re.M)
     assert tuple(counters) == link.COUNTERS
+
+
+def test_a_silent_target_is_one_line_naming_the_wait():
+    host = link.LinkHost(lambda data: None, lambda timeout: b"", bytes(link.FINGERPRINT_BYTES))
+    with pytest.raises(FirmwareError, match=r"^PIL link: no answer to the handshake within 0\.05 s$"):
+        host.handshake(0.05)
+    with pytest.raises(FirmwareError, match=r"^PIL link: no answer to a status request within 0\.05 s$"):
+        host.status(0.05)
