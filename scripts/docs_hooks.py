@@ -40,7 +40,7 @@ SEE_ALSO = {
     "size": ["../envelope-file.md", "../motion-language.md"],
     "init": ["../platform-file.md", "../envelope-file.md"],
     "montecarlo": ["../montecarlo-vary.md"],
-    "firmware": ["../firmware-abi.md"],
+    "firmware": ["../firmware-abi.md", "../pil-link.md"],
     "simulate": ["../firmware-abi.md"],
 }
 

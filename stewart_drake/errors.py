@@ -808,6 +808,14 @@ class FirmwareError(StewartError):
     ENGINE = "--engine must be one of {valid}, got {value!r}"
     WORD_BITS = "generated C takes word_bits 8..16 (16-bit data words, 32-bit accumulators), got {value}"
     SINE_TABLE = "the quarter-wave sine table does not reproduce the exact trig at angle word {index}"
+    TARGET = "--target must be one of {valid}, got {value!r}"
+    NO_CROSS = "firmware build --target {target}: {tool} not found on PATH (install {package})"
+    CROSS_FAILED = "firmware build --target {target}: {step} failed: {detail}"
+    LINK_SILENT = "PIL link: no answer to {what} within {timeout:g} s"
+    LINK_REFUSED = (
+        "PIL link: the target (link version {version}, format fingerprint {fingerprint}) refused the handshake of "
+        "this host (version {our_version}, fingerprint {ours}): rebuild it from the same module and options"
+    )
 
 
 class IntegratorError(StewartError):

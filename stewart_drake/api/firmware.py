@@ -3,7 +3,10 @@ C firmware with the bit-exact emulation. ``sd.firmware.generate(...)``, ``sd.fir
 
 from __future__ import annotations
 
+import json
 import math
+import shutil
+import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,16 +50,19 @@ from stewart_drake.firmware.fingerprint import (
 )
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
+from stewart_drake.firmware.target_build import build_target, check_target
 from stewart_drake.fixedpoint.generic import QFormat
 from stewart_drake.spec import Machine, load_machine
 
 __all__ = [
     "generate",
+    "build",
     "check",
     "certify",
     "certify_tick",
     "optimize",
     "GenerateResult",
+    "BuildResult",
     "CheckResult",
     "CertifyResult",
     "TickResult",
@@ -125,6 +131,35 @@ def machine_format(
     return machine, {k: mine[k] if v is None else v for k, v in given.items()}
 
 
+def _options(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory, platform_source):
+    """The module's options, checked, and its gains designed: (platform, config, options to record)."""
+    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    platform = machine.platform
+    platform_source = machine.platform_source if platform_source is None else platform_source
+    config = controller_config(
+        machine.loaded_platform, f["word_bits"], f["length_lsb"], f["trig"], f["convention"], f["rate"],
+        f["sensor_resolution"], trajectory,
+    )  # fmt: skip
+    options = dict(
+        platform=platform.name if platform_source is None else str(platform_source),
+        **f,
+        trajectory=trajectory,
+        platform_hash=platform_hash(platform),
+    )
+    return platform, config, options
+
+
+def _module(platform, config, options: dict):
+    """The generated module (``GeneratedFirmware``) with ``options`` recorded in its files."""
+    g = generate_sources(platform, config)
+    trajectory = options["trajectory"]
+    if isinstance(trajectory, Trajectory):  # no name `check` can look up: the design poses beside the C
+        options = dict(options)
+        options["trajectory"], g.files[DESIGN_POSES] = motion_record(trajectory.name, design_poses(trajectory))
+    g.files = stamp(g.files, options)  # the options, for `firmware check`
+    return g
+
+
 @dataclass(repr=False)
 class GenerateResult(Result):
     """The generated firmware (``firmware.generate``).
@@ -189,31 +224,13 @@ def generate(
     Raises:
         StewartError: bad options, or an output folder that holds other files.
     """
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
-    platform = machine.platform
-    platform_source = machine.platform_source if platform_source is None else platform_source
-    word_bits, length_lsb, trig, convention = f["word_bits"], f["length_lsb"], f["trig"], f["convention"]
-    rate, sensor_resolution = f["rate"], f["sensor_resolution"]
-    config = controller_config(
-        machine.loaded_platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory
+    platform, config, options = _options(
+        platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory, platform_source
     )
+    rate = options["rate"]
     folder = OutputFolder(out)  # the policy, before any work: new, empty, or this command's own verified files
     out = Path(out)
-    g = generate_sources(platform, config)
-    options = dict(
-        platform=platform.name if platform_source is None else str(platform_source),
-        word_bits=word_bits,
-        length_lsb=length_lsb,
-        trig=trig,
-        convention=convention,
-        rate=rate,
-        sensor_resolution=sensor_resolution,
-        trajectory=trajectory,
-        platform_hash=platform_hash(platform),
-    )
-    if isinstance(trajectory, Trajectory):  # no name `check` can look up: the design poses beside the C
-        options["trajectory"], g.files[DESIGN_POSES] = motion_record(trajectory.name, design_poses(trajectory))
-    g.files = stamp(g.files, options)  # the options, for `firmware check`
+    g = _module(platform, config, options)
     compiled = []
     if compile:
         for cc in compilers():
@@ -243,6 +260,79 @@ def generate(
         "compiled_with": compiled,
     }
     return GenerateResult(summary, [out / p.name for p in written], config)
+
+
+@dataclass(repr=False)
+class BuildResult(Result):
+    """The generated firmware built for a target (``firmware.build``).
+
+    Attributes:
+        summary: platform, target and board, output folder, the files written, the bytes of code (flash) and of
+            data (``data_bytes`` initialised, ``bss_bytes`` zeroed: RAM), and the worst-case stack depth in
+            bytes (``stack_bytes``; None: unbounded) with its call path from the reset handler.
+        files: the paths written.
+    """
+
+    summary: dict
+    files: list
+
+    def _fields(self) -> dict:
+        return self.summary
+
+
+BUILD_FILES = ("sd_pil.elf", "sd_pil.map", "sd_pil.su", "build.json")
+
+
+def build(
+    platform: Platform | Machine,
+    out: str | Path,
+    *,
+    target: str = "cortex-m4",
+    word_bits: int | None = None,
+    length_lsb: float | None = None,
+    trig: str | None = None,
+    convention: str | None = None,
+    rate: float | None = None,
+    sensor_resolution: float | None = None,
+    trajectory: str | Trajectory | None = None,
+    platform_source: str | None = None,
+) -> BuildResult:
+    """Build the generated firmware (``sd_ik``, ``sd_tick``, ``sd_fk``) with the PIL runtime for a
+    microcontroller: an ELF that boots on the target's board and runs ``sd_tick`` for each sensor frame of the
+    link (``firmware.link``), its linker map, the per-function stack usage (``sd_pil.su``) and ``build.json``.
+
+    The options are those of ``generate``; the module is compiled with the strict flags (``-Werror``).
+
+    Args:
+        platform: the platform, or a ``Machine``.
+        out: the output folder: new, empty, or holding only files this command wrote.
+        target: ``"cortex-m4"`` (the Arm MPS2+ AN386 board, as QEMU's ``mps2-an386`` models it).
+
+    Returns:
+        The summary (sizes, stack depth) and the files written.
+
+    Raises:
+        StewartError: bad options, an unknown target, no cross compiler, a failing build, or an output folder
+            that holds other files.
+    """
+    check_target(target)
+    platform, config, options = _options(
+        platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory, platform_source
+    )
+    folder = OutputFolder(out)  # the policy, before any work
+    out = Path(out)
+    g = _module(platform, config, options)
+    with tempfile.TemporaryDirectory(prefix="sd-build-") as work:
+        b = build_target(g.files, Path(work), target)
+        summary = {"platform": platform.name, "out": str(out), **b.to_dict()}
+        stack_usage = "".join(p.read_text() for p in sorted(Path(work).glob("*.su")))
+        with atomic_folder(folder) as tmp:
+            shutil.copyfile(b.elf, tmp / BUILD_FILES[0])
+            shutil.copyfile(b.map, tmp / BUILD_FILES[1])
+            (tmp / BUILD_FILES[2]).write_text(stack_usage)
+            (tmp / BUILD_FILES[3]).write_text(json.dumps(summary, indent=2) + "\n")
+    summary["files"] = list(BUILD_FILES)
+    return BuildResult(summary, [out / n for n in BUILD_FILES])
 
 
 @dataclass(repr=False)

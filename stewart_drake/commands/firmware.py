@@ -74,7 +74,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "firmware", help="generate the C firmware (IK + controller tick) or check a C firmware against the emulation"
     )
-    fs = p.add_subparsers(dest="firmware_command", required=True, metavar="generate|check|certify|optimize")
+    fs = p.add_subparsers(dest="firmware_command", required=True, metavar="generate|build|check|certify|optimize")
     g = fs.add_parser("generate", help="emit a self-contained C99 module: sd_ik, sd_init, sd_tick (+ README)")
     _format_args(g)
     g.add_argument(
@@ -93,6 +93,21 @@ def register(sub) -> None:
     )
     # None: the machine's (a platform's machine has the defaults the options' help names)
     g.set_defaults(func=run_generate, **dict.fromkeys(MACHINE_OPTIONS))
+    b = fs.add_parser(
+        "build", help="cross-compile the generated firmware with the PIL runtime: ELF, map, code/data size, stack depth"
+    )
+    _format_args(b)
+    b.add_argument(
+        "--target",
+        default="cortex-m4",
+        metavar="NAME",
+        help="the processor: cortex-m4 (the MPS2+ AN386 board; arm-none-eabi-gcc) (default cortex-m4)",
+    )
+    b.add_argument(
+        "--out", required=True, metavar="DIR", help="output folder (created; only its own files are replaced)"
+    )
+    b.add_argument("--json", action="store_true", help="print the summary as JSON")
+    b.set_defaults(func=run_build, **dict.fromkeys(MACHINE_OPTIONS))
     c = fs.add_parser("check", help="compile FILE.c (implementing the ABI) and compare it with the emulation")
     c.add_argument(
         "file",
@@ -175,6 +190,25 @@ def run_generate(args) -> int:
         )
         if not args.no_compile:
             print("compile-checked (-std=c99 -Wall -Wextra -Werror -pedantic) with: " + (", ".join(compiled) or "none"))
+    return 0
+
+
+def run_build(args) -> int:
+    source = args.platform or FP_DEFAULTS["platform"]
+    r = firmware.build(source, args.out, target=args.target, platform_source=source, **_format(args))
+    s = r.to_dict()
+    if args.json:
+        print_json(s)
+        return 0
+    print(f"wrote {', '.join(s['files'])} to {Path(args.out)}/ for {s['platform']} on {s['target']} ({s['board']})")
+    print(f"code {s['code_bytes']} B (flash), data {s['data_bytes']} B + bss {s['bss_bytes']} B (RAM)")
+    if s["stack_bytes"] is None:
+        print("stack depth: unbounded (" + " -> ".join(s["stack_path"]) + ")")
+    else:
+        print(f"stack depth: {s['stack_bytes']} B worst case (" + " -> ".join(s["stack_path"]) + ")")
+    fs = s["functions"]
+    stack = lambda v: "unbounded" if v is None else f"{v} B"  # noqa: E731
+    print("; ".join(f"{f}: code {v['code_bytes']} B, stack {stack(v['stack_bytes'])}" for f, v in fs.items()))
     return 0
 
 
