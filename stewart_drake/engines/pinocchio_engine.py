@@ -1,0 +1,144 @@
+"""The platform in Pinocchio: the URDF's open tree (``models.urdf_text``) closed by the six ball closures of
+``models.closures`` as ``RigidConstraintModel`` (3-D contact), its kinematics and its constrained inverse dynamics.
+
+Pinocchio has no constraint-aware inverse dynamics either: for one sample the plate's twist and acceleration are
+set, the legs' joint rates and accelerations are solved from the closures (tip velocity and classical acceleration
+equal to the anchor's), ``rnea`` (gravity included) gives τ (24,), and [B Gᵀ] [u; λ] = τ gives the six actuator
+forces u (B selects the prismatic joints, G the closures' 18 × 24 Jacobian).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from stewart_drake.core.dynamics import G_EARTH
+from stewart_drake.core.geometry import Platform
+from stewart_drake.engines.models import closures, urdf_text
+from stewart_drake.engines.plate import plate_state
+
+NAME = "pinocchio"
+VERSION = pin.__version__
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+class PinocchioPlatform:
+    """The closed-loop platform in Pinocchio, built from URDF text and closure dicts (default: the platform's).
+
+    Attributes:
+        model, data: Pinocchio's model of the open tree and its data.
+        constraints: the six ``RigidConstraintModel`` (CONTACT_3D) of the closures.
+    """
+
+    def __init__(self, platform: Platform, urdf: str | None = None, closure_list: list | None = None):
+        self.platform = platform
+        self.model = pin.buildModelFromXML(urdf if urdf is not None else urdf_text(platform))
+        self.model.gravity.linear = np.array([0.0, 0.0, -G_EARTH])
+        model = self.model
+        self.top = model.getJointId("top")
+        self.universal = [[model.getJointId(f"universal_{i + 1}_{k}") for k in (1, 2)] for i in range(6)]
+        self.prismatic = [model.getJointId(f"prismatic_{i + 1}") for i in range(6)]
+        self.base_anchor = [model.getFrameId(f"base_anchor_{i + 1}", pin.FrameType.BODY) for i in range(6)]
+        self.top_anchor = [model.getFrameId(f"top_anchor_{i + 1}", pin.FrameType.BODY) for i in range(6)]
+        self.constraints, self.points = [], []
+        for c in closures(platform) if closure_list is None else closure_list:
+            fa, fb = (model.frames[model.getFrameId(c[k], pin.FrameType.BODY)] for k in ("frame_a", "frame_b"))
+            pa = fa.placement * pin.SE3(np.eye(3), np.asarray(c["p_a"], dtype=float))
+            pb = fb.placement * pin.SE3(np.eye(3), np.asarray(c["p_b"], dtype=float))
+            self.constraints.append(
+                pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, fa.parentJoint, pa, fb.parentJoint, pb, LWA)
+            )
+            ids = []
+            for name, joint, placement in (
+                (f"{c['name']}_a", fa.parentJoint, pa),
+                (f"{c['name']}_b", fb.parentJoint, pb),
+            ):
+                ids.append(model.addFrame(pin.Frame(name, joint, placement, pin.FrameType.OP_FRAME)))
+            self.points.append(ids)
+        self.data = model.createData()
+        self.i_top = np.arange(model.idx_vs[self.top], model.idx_vs[self.top] + 6)
+        self.i_legs = np.setdiff1d(np.arange(model.nv), self.i_top)
+        self.B = np.zeros((model.nv, 6))
+        for i, j in enumerate(self.prismatic):
+            self.B[model.idx_vs[j], i] = 1.0
+
+    def configuration(self, state, k: int) -> np.ndarray:
+        """Pinocchio's q (nq,) for sample ``k`` of a ``plate.PlateState``."""
+        model = self.model
+        q = pin.neutral(model)
+        X = model.jointPlacements[self.top].inverse() * pin.SE3(state.R[k], state.p[k])
+        q[model.idx_qs[self.top] : model.idx_qs[self.top] + 7] = pin.SE3ToXYZQUAT(X)
+        for i in range(6):
+            for m, j in enumerate(self.universal[i]):
+                q[model.idx_qs[j]] = state.angles[k, i, m]
+            q[model.idx_qs[self.prismatic[i]]] = state.lengths[k, i]
+        return q
+
+    def closure_residuals(self, poses, convention: str = "utn") -> np.ndarray:
+        """``(n, 6)`` |point a − point b| (m) of each closure at ``(n, 6)`` poses, the legs at our closed-form
+        joint positions."""
+        st = plate_state(self.platform, poses, convention=convention)
+        out = np.empty(st.lengths.shape)
+        for k in range(len(out)):
+            pin.framesForwardKinematics(self.model, self.data, self.configuration(st, k))
+            for i, (a, b) in enumerate(self.points):
+                out[k, i] = np.linalg.norm(self.data.oMf[a].translation - self.data.oMf[b].translation)
+        return out
+
+    def leg_lengths(self, poses, convention: str = "utn") -> np.ndarray:
+        """``(n, 6)`` the distances (m) between the model's ``base_anchor_i`` and ``top_anchor_i`` frames."""
+        st = plate_state(self.platform, poses, convention=convention)
+        out = np.empty(st.lengths.shape)
+        for k in range(len(out)):
+            pin.framesForwardKinematics(self.model, self.data, self.configuration(st, k))
+            for i, (a, b) in enumerate(zip(self.base_anchor, self.top_anchor)):
+                out[k, i] = np.linalg.norm(self.data.oMf[a].translation - self.data.oMf[b].translation)
+        return out
+
+    def _closure_terms(self, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """``(18, nv)`` G and ``(18,)`` Ġv of the closures (point a − point b, in W) at (q, v)."""
+        model, data = self.model, self.data
+        pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        G, bias = [], []
+        for a, b in self.points:
+            G.append(pin.getFrameJacobian(model, data, a, LWA)[:3] - pin.getFrameJacobian(model, data, b, LWA)[:3])
+            bias.append(
+                pin.getFrameClassicalAcceleration(model, data, a, LWA).linear
+                - pin.getFrameClassicalAcceleration(model, data, b, LWA).linear
+            )
+        return np.vstack(G), np.concatenate(bias)
+
+    def leg_forces(self, q, qd, qdd, convention: str = "utn") -> np.ndarray:
+        """``(n, 6)`` actuator forces (N, > 0 pushes the plate away) along ``(n, 6)`` q, q̇, q̈, legs' inertia included."""
+        st = plate_state(self.platform, q, qd, qdd, convention)
+        out = np.empty(st.lengths.shape)
+        for k in range(len(out)):
+            out[k] = self.actuator_forces(st, k)
+        return out
+
+    def actuator_forces(self, st, k: int) -> np.ndarray:
+        """Sample ``k``'s ``(6,)`` actuator forces (N) of a ``plate.PlateState``."""
+        A, tau = self.system(st, k)
+        return np.linalg.solve(A, tau)[:6]
+
+    def condition(self, st, k: int) -> float:
+        """The condition number of sample ``k``'s [B Gᵀ]."""
+        return float(np.linalg.cond(self.system(st, k)[0]))
+
+    def system(self, st, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Sample ``k``'s ``(nv, nv)`` [B Gᵀ] and ``(nv,)`` τ of ``rnea`` (legs on the closures)."""
+        model = self.model
+        q = self.configuration(st, k)
+        R = st.R[k]
+        v, a = np.zeros(model.nv), np.zeros(model.nv)
+        v_l, w_l = R.T @ st.v[k], R.T @ st.w[k]
+        v[self.i_top] = np.concatenate([v_l, w_l])
+        G, _ = self._closure_terms(q, v)
+        v[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ v[self.i_top])
+        G, bias = self._closure_terms(q, v)
+        a[self.i_top] = np.concatenate([R.T @ st.a[k] - np.cross(w_l, v_l), R.T @ st.wd[k]])
+        a[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ a[self.i_top] - bias)
+        tau = pin.rnea(model, self.data, q, v, a)
+        return np.hstack([self.B, G.T]), tau
