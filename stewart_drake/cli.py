@@ -28,6 +28,10 @@ COMMANDS = {
         "compile",
         "translate a motion program (.stw) to Python (calling this library) or Matlab (the seed's output)",
     ),
+    "cross-check": (
+        "cross_check",
+        "the platform's kinematics and leg forces in Pinocchio and MuJoCo against the closed forms",
+    ),
     "dsp-ik": ("dsp_ik", "leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK"),
     "dynamics": ("dynamics", "leg forces along a trajectory (inverse dynamics, with or without Coriolis)"),
     "firmware": (

@@ -22,6 +22,9 @@ at most 5e-15 × 10 m from the platform's.
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 import yaml
 
@@ -29,8 +32,10 @@ from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
+from stewart_drake.core.output_folder import check_output_file, safe_file_stem, write_output_file
 from stewart_drake.core.sdf import cylinder_inertia, rpy, xml_attr, xml_comment, xml_vec
-from stewart_drake.core.sdf_models import platform_model_name
+from stewart_drake.core.sdf_models import platform_model_name, platform_sdf
+from stewart_drake.errors import OutputError
 
 FORMATS = ("sdf", "urdf", "mjcf")
 # MuJoCo's connect constraints are soft: solref = (time constant s, damping ratio). Its default (0.02, 1) is
@@ -236,3 +241,28 @@ def mjcf_text(platform: Platform, solref=MJCF_SOLREF) -> str:
         )
         + "\n"
     )
+
+
+def model_files(platform: Platform, fmt: str) -> dict:
+    """file name -> text of the platform's model in format ``fmt`` (``FORMATS``): ``<name>.sdf``; ``<name>.urdf``
+    with ``<name>.closures.yaml``; ``<name>.xml`` (MJCF). ``<name>`` is the file-safe platform name."""
+    stem = safe_file_stem(platform.name)
+    if fmt == "sdf":
+        return {f"{stem}.sdf": platform_sdf(platform)}
+    if fmt == "urdf":
+        return {f"{stem}.urdf": urdf_text(platform), f"{stem}.closures.yaml": closures_yaml(platform, f"{stem}.urdf")}
+    if fmt == "mjcf":
+        return {f"{stem}.xml": mjcf_text(platform)}
+    raise ValueError(f"unknown model format {fmt!r}")  # internal: the CLI's choices are FORMATS
+
+
+def write_models(platform: Platform, folder, fmt: str, *, option: str = "--write") -> list[Path]:
+    """Write ``model_files(platform, fmt)`` into ``folder`` under the output-file policy of
+    ``output_folder.write_output_file`` (a file the tool did not write is never replaced); every file is checked
+    before the first is written. Returns the paths."""
+    if os.path.exists(folder) and not os.path.isdir(folder):
+        raise OutputError(OutputError.NOT_A_FOLDER.format(option=option, typed=folder, part=folder))
+    files = model_files(platform, fmt)
+    for name in files:
+        check_output_file(os.path.join(folder, name), option=option)
+    return [write_output_file(os.path.join(folder, name), text, option=option) for name, text in files.items()]
