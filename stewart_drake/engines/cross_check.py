@@ -13,6 +13,14 @@
   solve the 24 × 24 system [B Gᵀ], which amplifies rounding by its condition number κ. The tolerance is
   ``DYNAMIC_ROUNDING`` × κ × ε of the largest force (κ measured per run, ε the double precision epsilon).
 
+- **Forward simulation** (``open_loop_check``, ``passive_release``): the closed-form forces along the seed sway
+  applied open loop from the trajectory's first state, and the passive platform released at rest from home. Pinocchio
+  (rigid closures, ``constraintDynamics``, RK4 with the forces linear over each step) should follow the plan to the
+  forces' interpolation error: |F̈| dt²/8 per leg, six legs on the plate's mass, grown as ½ δa T²
+  (``pinocchio_open_loop_bound``). MuJoCo's ``connect`` is a spring–damper (stiffness 1/(d_max² τ² ζ²) per unit
+  effective mass for ``solref`` = (τ, ζ)): under load it stretches by ∝ τ², less where its impedance d rises with
+  the stretch; the check runs it with RK4 at several τ and reports the stretch and the plate's error per τ.
+
 The engines are optional (``pip install .[engines]``): ``engine_status`` says which are importable and why not.
 """
 
@@ -22,10 +30,11 @@ import importlib
 
 import numpy as np
 
-from stewart_drake.core.dynamics import harmonic_trajectory, leg_forces_with_legs
+from stewart_drake.core.dynamics import G_EARTH, harmonic_trajectory, leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, stroke_within
 from stewart_drake.core.sampling import random_poses
+from stewart_drake.engines.models import MJCF_SOLREF, mjcf_text
 from stewart_drake.engines.plate import plate_state
 
 ENGINES = ("pinocchio", "mujoco")
@@ -37,6 +46,11 @@ KINEMATIC_TOL_REL = 1e-12  # of the longest leg, m/m (see the module docstring)
 DYNAMIC_ROUNDING = 1000.0
 EPS = float(np.finfo(float).eps)
 TRAJECTORIES = ("seed", "rotating")
+SIM_STEP = 1e-3  # s, both engines' step in the simulation checks
+SIM_DURATION = 0.5  # s of open-loop tracking
+RELEASE_DURATION = 0.2  # s of passive fall from home (the plate drops ~20 cm, legs beyond their stroke: no limits)
+SOLREF_TIMES = (0.02, 0.01, 0.005, 0.002)  # s, MuJoCo's connect time constants swept (≥ 2 steps: its stability floor)
+RECORD = 0.05  # s between recorded samples
 
 
 def engine_status() -> dict:
@@ -114,12 +128,20 @@ def dynamics_check(engine, platform: Platform, q, qd, qdd, convention: str = "ut
 
 
 def cross_check(
-    platform: Platform, engines=None, poses: int = 1000, samples: int = 13, seed: int = 0, convention: str = "utn"
+    platform: Platform,
+    engines=None,
+    poses: int = 1000,
+    samples: int = 13,
+    seed: int = 0,
+    convention: str = "utn",
+    simulate: bool = True,
 ) -> dict:
-    """Every check of every engine in ``engines`` (default: all) on ``platform``.
+    """Every check of every engine in ``engines`` (default: all) on ``platform``; ``simulate``: with the forward
+    simulations (``open_loop_check``, ``passive_release``).
 
     Returns engine name -> ``{"available": bool, "reason": str | None, "version": str, "kinematics": dict,
-    "dynamics": {trajectory name: dict}, "ok": bool}`` (a missing engine: available False and its reason)."""
+    "dynamics": {trajectory name: dict}, "open_loop": dict, "passive_release": dict, "ok": bool}`` (a missing
+    engine: available False and its reason)."""
     status = engine_status()
     P = random_poses(platform, poses, seed, convention=convention)
     trajs = trajectories(platform, samples)
@@ -146,6 +168,11 @@ def cross_check(
             "dynamics": dyn,
             "ok": bool(kin["ok"] and all(d["ok"] for d in dyn.values())),
         }
+        if simulate:
+            ol = open_loop_check(name, platform)
+            rel = passive_release(name, platform)
+            out[name].update(open_loop=ol, passive_release={k: v for k, v in rel.items() if k not in ("t", "z")})
+            out[name]["ok"] = bool(out[name]["ok"] and ol["ok"])
     return out
 
 
@@ -153,3 +180,85 @@ def engine_condition(engine, platform: Platform, q, qd, qdd, convention: str = "
     """The worst condition number of the engine's [B Gᵀ] along the samples."""
     st = plate_state(platform, q, qd, qdd, convention)
     return max(engine.condition(st, k) for k in range(len(st.lengths)))
+
+
+def _plate_errors(st, rec, idx) -> tuple[float, float]:
+    """Worst plate-origin distance (m) and rotation angle (rad) between a recorded run and the plan at ``idx``."""
+    dp = float(np.linalg.norm(rec["p"] - st.p[idx], axis=-1).max())
+    c = (np.einsum("kij,kij->k", rec["R"], st.R[idx]) - 1) / 2
+    return dp, float(np.arccos(np.clip(c, -1.0, 1.0)).max())
+
+
+def pinocchio_open_loop_bound(platform: Platform, F, dt: float, duration: float) -> float:
+    """The plate's drift (m) from the forces' linear interpolation over steps of ``dt``: δF = |F̈| dt²/8 per leg
+    (|F̈| from second differences of ``(n, 6)`` F), six legs on the plate's mass, grown as ½ δa T²."""
+    Fdd = np.abs(np.diff(F, 2, axis=0)).max() / dt**2
+    return 0.5 * (6 * Fdd * dt**2 / 8 / max(platform.mass, 1e-6)) * duration**2
+
+
+def open_loop_check(name: str, platform: Platform, duration: float = SIM_DURATION, dt: float = SIM_STEP) -> dict:
+    """The closed-form forces of the seed sway (``trajectories``) applied open loop in engine ``name``.
+
+    Returns for Pinocchio ``{"position_error_m", "angle_error_rad", "constraint_m", "bound_m", "ok"}``; for MuJoCo
+    ``{"solref_s": [τ...], "position_error_m": [...], "angle_error_rad": [...], "constraint_m": [...], "ok"}`` (ok:
+    both shrink as τ shrinks)."""
+    t = np.arange(0.0, duration + dt / 2, dt)
+    home, s = platform.home_pose(), platform.L_max - platform.L_min
+    q, qd, qdd = harmonic_trajectory(t, home, [0, s / 4, 0, 0, 0, 0], 2.0)
+    F = leg_forces_with_legs(platform, q, qd, qdd)
+    st = plate_state(platform, q, qd, qdd)
+    every = int(round(RECORD / dt))
+    idx = np.arange(0, len(t), every)
+    if name == "pinocchio":
+        eng = engine_model(name, platform)
+        q0, v0 = eng.set_state(st, 0)
+        rec = eng.simulate(q0, v0, F, dt, every)
+        dp, da = _plate_errors(st, rec, idx)
+        bound = pinocchio_open_loop_bound(platform, F, dt, duration)
+        return {
+            "position_error_m": dp,
+            "angle_error_rad": da,
+            "constraint_m": float(rec["constraint"].max()),
+            "bound_m": bound,
+            "ok": bool(dp <= bound),
+        }
+    out = {"solref_s": list(SOLREF_TIMES), "position_error_m": [], "angle_error_rad": [], "constraint_m": []}
+    for tau in SOLREF_TIMES:
+        eng = engine_model(name, platform, mjcf=mjcf_text(platform, (tau, MJCF_SOLREF[1]), dt, "RK4"))
+        eng.set_state(st, 0)
+        rec = eng.simulate(F, every)
+        dp, da = _plate_errors(st, rec, idx)
+        out["position_error_m"].append(dp)
+        out["angle_error_rad"].append(da)
+        out["constraint_m"].append(float(rec["constraint"].max()))
+    shrinks = all(np.diff(out["constraint_m"]) < 0) and all(np.diff(out["position_error_m"]) < 0)
+    out["ok"] = bool(shrinks)
+    return out
+
+
+def passive_release(name: str, platform: Platform, duration: float = RELEASE_DURATION, dt: float = SIM_STEP) -> dict:
+    """The passive platform (no actuator force) released at rest from home in engine ``name``.
+
+    Returns ``t`` (m,) s, ``z`` (m,) the plate origin's height (m), ``energy_drift_j`` the largest |E − E(0)| (J),
+    ``energy_exchanged_j`` the largest |potential energy − its start| (J), ``constraint_m`` the worst closure gap."""
+    st = plate_state(platform, platform.home_pose())
+    n = int(round(duration / dt)) + 1
+    zero = np.zeros((n, 6))
+    every = int(round(RECORD / dt))
+    if name == "pinocchio":
+        eng = engine_model(name, platform)
+        q0, v0 = eng.set_state(st, 0)
+        rec = eng.simulate(q0, v0, zero, dt, every)
+    else:
+        eng = engine_model(name, platform, mjcf=mjcf_text(platform, MJCF_SOLREF, dt, "RK4"))
+        eng.set_state(st, 0)
+        rec = eng.simulate(zero, every)
+    drop = rec["p"][0, 2] - rec["p"][:, 2]
+    mass = platform.mass + 6 * (platform.legs.cylinder_mass + platform.legs.piston_mass)
+    return {
+        "t": np.arange(len(rec["p"])) * every * dt,
+        "z": rec["p"][:, 2],
+        "energy_drift_j": float(np.abs(rec["energy"] - rec["energy"][0]).max()),
+        "energy_exchanged_j": float(mass * G_EARTH * drop.max()),
+        "constraint_m": float(rec["constraint"].max()),
+    }

@@ -51,6 +51,7 @@ class MujocoPlatform:
         self.prismatic = [jid(f"prismatic_{i + 1}") for i in range(6)]
         self.base_anchor = [sid(f"base_anchor_{i + 1}") for i in range(6)]
         self.top_anchor = [sid(f"top_anchor_{i + 1}") for i in range(6)]
+        self.actuators = [mujoco.mj_name2id(m, obj.mjOBJ_ACTUATOR, f"leg_{i + 1}") for i in range(6)]
         # The closures as written: each connect equality's two sites.
         self.points = [(int(m.eq_obj1id[e]), int(m.eq_obj2id[e])) for e in range(m.neq)]
         d0 = int(m.jnt_dofadr[self.top])
@@ -144,3 +145,42 @@ class MujocoPlatform:
         d.qacc[:] = qacc
         mujoco.mj_rne(m, d, 1, tau)
         return np.hstack([self.B, G.T]), tau
+
+    def set_state(self, st, k: int) -> None:
+        """Write sample ``k`` of a ``plate.PlateState`` into (qpos, qvel) on the closures (legs' rates solved)."""
+        d = self.data
+        self.set_configuration(st, k)
+        d.qvel[:] = 0.0
+        d.qvel[self.i_top] = np.concatenate([st.v[k], st.R[k].T @ st.w[k]])
+        G, _ = self._closure_terms()
+        d.qvel[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ d.qvel[self.i_top])
+        mujoco.mj_forward(self.model, d)
+
+    def simulate(self, forces, record_every: int = 1) -> dict:
+        """Step MuJoCo ``n − 1`` times from the data's state under ``(n, 6)`` actuator forces (N, at the step
+        boundaries of ``opt.timestep``; each step holds the mean of its two ends), with its own soft ``connect``
+        closures and its semi-implicit Euler integrator.
+
+        Returns ``R`` (m, 3, 3), ``p`` (m, 3) the plate frame every ``record_every`` steps (step 0 first),
+        ``constraint`` (m,) worst |site 1 − site 2| (m) and ``energy`` (m,) kinetic + potential energy (J)."""
+        m, d = self.model, self.data
+        m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "top")
+        out = {k: [] for k in ("R", "p", "constraint", "energy")}
+
+        def record():
+            mujoco.mj_forward(m, d)
+            out["R"].append(d.xmat[body].reshape(3, 3).copy())
+            out["p"].append(d.xpos[body].copy())
+            out["constraint"].append(max(np.linalg.norm(d.site_xpos[a] - d.site_xpos[b]) for a, b in self.points))
+            out["energy"].append(float(d.energy.sum()))
+
+        forces = np.asarray(forces, dtype=float)
+        for k in range(len(forces) - 1):
+            if k % record_every == 0:
+                record()
+            d.ctrl[self.actuators] = (forces[k] + forces[k + 1]) / 2
+            mujoco.mj_step(m, d)
+        if (len(forces) - 1) % record_every == 0:
+            record()
+        return {k: np.array(x) for k, x in out.items()}

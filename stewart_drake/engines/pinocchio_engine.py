@@ -142,3 +142,68 @@ class PinocchioPlatform:
         a[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ a[self.i_top] - bias)
         tau = pin.rnea(model, self.data, q, v, a)
         return np.hstack([self.B, G.T]), tau
+
+    def set_state(self, st, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Pinocchio's (q, v) on the closures for sample ``k`` of a ``plate.PlateState`` (legs' rates solved)."""
+        q = self.configuration(st, k)
+        v = np.zeros(self.model.nv)
+        v[self.i_top] = np.concatenate([st.R[k].T @ st.v[k], st.R[k].T @ st.w[k]])
+        G, _ = self._closure_terms(q, v)
+        v[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ v[self.i_top])
+        return q, v
+
+    def simulate(self, q0, v0, forces, dt: float, record_every: int = 1, baumgarte: float = 0.0) -> dict:
+        """Integrate the closed loop from (q0, v0) for ``n − 1`` steps of ``dt`` s under ``(n, 6)`` actuator forces
+        (N, at the step boundaries, linear in between) with ``constraintDynamics`` (rigid closures; ``baumgarte`` ω
+        rad/s of the drift correction, Kp = ω², Kd = 2ω) and classic fourth-order Runge–Kutta on the configuration
+        manifold.
+
+        Returns ``R`` (m, 3, 3), ``p`` (m, 3) the plate frame every ``record_every`` steps (step 0 first),
+        ``constraint`` (m,) worst |point a − point b| (m) and ``energy`` (m,) kinetic + potential energy (J)."""
+        model, data = self.model, self.data
+        cms = pin.StdVec_RigidConstraintModel()
+        for c in self.constraints:
+            c.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(baumgarte**2, 2 * baumgarte))
+            cms.append(c)
+        cds = pin.StdVec_RigidConstraintData()
+        for c in cms:
+            cds.append(c.createData())
+        pin.initConstraintDynamics(model, data, cms, cds)
+
+        def acc(q, v, tau):
+            return pin.constraintDynamics(model, data, q, v, tau, cms, cds)
+
+        q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
+        out = {k: [] for k in ("R", "p", "constraint", "energy")}
+        forces = np.asarray(forces, dtype=float)
+        for k in range(len(forces) - 1):
+            if k % record_every == 0:
+                self._record(q, v, out)
+            tau0, tau1 = self.B @ forces[k], self.B @ forces[k + 1]
+            tau_mid = (tau0 + tau1) / 2
+            k1v, k1a = v, acc(q, v, tau0)
+            q2 = pin.integrate(model, q, k1v * dt / 2)
+            k2v = v + k1a * dt / 2
+            k2a = acc(q2, k2v, tau_mid)
+            q3 = pin.integrate(model, q, k2v * dt / 2)
+            k3v = v + k2a * dt / 2
+            k3a = acc(q3, k3v, tau_mid)
+            q4 = pin.integrate(model, q, k3v * dt)
+            k4v = v + k3a * dt
+            k4a = acc(q4, k4v, tau1)
+            q = pin.integrate(model, q, (k1v + 2 * k2v + 2 * k3v + k4v) * dt / 6)
+            v = v + (k1a + 2 * k2a + 2 * k3a + k4a) * dt / 6
+        if (len(forces) - 1) % record_every == 0:
+            self._record(q, v, out)
+        return {k: np.array(x) for k, x in out.items()}
+
+    def _record(self, q, v, out) -> None:
+        model, data = self.model, self.data
+        pin.framesForwardKinematics(model, data, q)
+        X = data.oMi[self.top]
+        out["R"].append(X.rotation.copy())
+        out["p"].append(X.translation.copy())
+        out["constraint"].append(
+            max(np.linalg.norm(data.oMf[a].translation - data.oMf[b].translation) for a, b in self.points)
+        )
+        out["energy"].append(pin.computeKineticEnergy(model, data, q, v) + pin.computePotentialEnergy(model, data, q))
