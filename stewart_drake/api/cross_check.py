@@ -28,7 +28,7 @@ class CrossCheck(Result):
         engines: engine name -> ``{"available", "reason", "version", "kinematics": {"poses",
             "closure_residual_m", "leg_length_error_m", "tolerance_m", "ok"}, "dynamics": {trajectory:
             {"samples", "max_force_n", "max_error_n", "relative_error", "tolerance_relative", "condition", "ok"}},
-            "ok"}`` (``engines.cross_check``).
+            "open_loop", "passive_release", "ok"}`` (``engines.cross_check``).
     """
 
     platform: str
@@ -51,6 +51,7 @@ def cross_check(
     poses: int = 1000,
     samples: int = 13,
     seed: int = 0,
+    simulate: bool = True,
 ) -> CrossCheck:
     """Check the platform's closed forms against Pinocchio and MuJoCo.
 
@@ -60,6 +61,8 @@ def cross_check(
         poses: seeded poses (``sampling.random_poses``, box region) for the kinematics.
         samples: samples of each trajectory (the seed's sway and a rotation about every axis, 3 s) for the dynamics.
         seed: the poses' seed.
+        simulate: also run the forward simulations (the closed-form forces open loop for 0.5 s; the passive
+            platform released from home for 0.2 s; MuJoCo at four ``solref`` time constants).
 
     Returns:
         Per engine: the worst closure residual and leg-length error (m) and the worst leg-force error (N, relative)
@@ -88,4 +91,6 @@ def cross_check(
                 raise EngineError(EngineError.UNKNOWN.format(value=n, valid=", ".join(ENGINES)))
             if status[n] is not None:
                 raise EngineError(EngineError.MISSING.format(name=n, reason=status[n]))
-    return CrossCheck(platform.name, run_cross_check(platform, names, int(poses), int(samples), int(seed)))
+    return CrossCheck(
+        platform.name, run_cross_check(platform, names, int(poses), int(samples), int(seed), simulate=bool(simulate))
+    )
