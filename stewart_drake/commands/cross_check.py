@@ -59,6 +59,14 @@ def run(args) -> int:
                     f" = {d['relative_error']:.1e} relative (tolerance {d['tolerance_relative']:.1e}, κ = {d['condition']:.3g})"
                     f" {'ok' if d['ok'] else 'DISAGREES'}"
                 )
+            m = e["modes"]
+            print(
+                f"    mass matrix in task space at {m['poses']} poses: {m['mass_matrix_relative_error']:.1e} relative,"
+                f" natural frequencies {m['frequency_relative_error']:.1e} relative (tolerance"
+                f" {m['tolerance_relative']:.1e}) {'ok' if m['ok'] else 'DISAGREES'}; at home "
+                + ", ".join(f"{f:.4g}" for f in m["frequencies_hz"])
+                + " Hz"
+            )
             _print_simulation(e)
         print("verdict: " + ("every engine agrees" if r.ok else "an engine disagrees with the closed forms"))
     return 0 if r.ok else 1

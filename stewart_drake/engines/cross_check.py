@@ -21,6 +21,11 @@
   effective mass for ``solref`` = (τ, ζ)): under load it stretches by ∝ τ², less where its impedance d rises with
   the stretch; the check runs it with RK4 at several τ and reports the stretch and the plate's error per τ.
 
+- **Mass matrix and modes** (``modes_check``): the engine's inertia reduced to the plate's Cartesian coordinates
+  (Sᵀ M S, the legs' rates from the closures) against ``design.modes.spatial_inertia(legs=True)``, and the natural
+  frequencies of K φ = ω² M φ (K: ``design.stiffness``) with either; rounding bound as for the forces, with κ the
+  condition number of the legs' closure block.
+
 The engines are optional (``pip install .[engines]``): ``engine_status`` says which are importable and why not.
 """
 
@@ -29,11 +34,14 @@ from __future__ import annotations
 import importlib
 
 import numpy as np
+import scipy.linalg
 
 from stewart_drake.core.dynamics import G_EARTH, harmonic_trajectory, leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, stroke_within
 from stewart_drake.core.sampling import random_poses
+from stewart_drake.design.modes import spatial_inertia
+from stewart_drake.design.stiffness import stiffness_matrix
 from stewart_drake.engines.models import MJCF_SOLREF, mjcf_text
 from stewart_drake.engines.plate import plate_state
 
@@ -51,6 +59,7 @@ SIM_DURATION = 0.5  # s of open-loop tracking
 RELEASE_DURATION = 0.2  # s of passive fall from home (the plate drops ~20 cm, legs beyond their stroke: no limits)
 SOLREF_TIMES = (0.02, 0.01, 0.005, 0.002)  # s, MuJoCo's connect time constants swept (≥ 2 steps: its stability floor)
 RECORD = 0.05  # s between recorded samples
+MODE_POSES = 10  # home and the first nine kinematic poses
 
 
 def engine_status() -> dict:
@@ -140,7 +149,7 @@ def cross_check(
     simulations (``open_loop_check``, ``passive_release``).
 
     Returns engine name -> ``{"available": bool, "reason": str | None, "version": str, "kinematics": dict,
-    "dynamics": {trajectory name: dict}, "open_loop": dict, "passive_release": dict, "ok": bool}`` (a missing
+    "dynamics": {trajectory name: dict}, "modes": dict, "open_loop": dict, "passive_release": dict, "ok": bool}`` (a missing
     engine: available False and its reason)."""
     status = engine_status()
     P = random_poses(platform, poses, seed, convention=convention)
@@ -160,13 +169,15 @@ def cross_check(
         for tname, (q, qd, qdd) in trajs.items():
             kappa = engine_condition(eng, platform, q, qd, qdd, convention)
             dyn[tname] = dynamics_check(eng, platform, q, qd, qdd, convention, kappa)
+        mod = modes_check(eng, platform, np.vstack([platform.home_pose(), P[: MODE_POSES - 1]]), convention)
         out[name] = {
             "available": True,
             "reason": None,
             "version": importlib.import_module(_MODULES[name]).VERSION,
             "kinematics": kin,
             "dynamics": dyn,
-            "ok": bool(kin["ok"] and all(d["ok"] for d in dyn.values())),
+            "modes": mod,
+            "ok": bool(kin["ok"] and all(d["ok"] for d in dyn.values()) and mod["ok"]),
         }
         if simulate:
             ol = open_loop_check(name, platform)
@@ -261,4 +272,39 @@ def passive_release(name: str, platform: Platform, duration: float = RELEASE_DUR
         "energy_drift_j": float(np.abs(rec["energy"] - rec["energy"][0]).max()),
         "energy_exchanged_j": float(mass * G_EARTH * drop.max()),
         "constraint_m": float(rec["constraint"].max()),
+    }
+
+
+NOMINAL_LEG_STIFFNESS = 1e6  # N/m, where the platform gives none: only the inertia differs between the sides
+
+
+def modes_check(engine, platform: Platform, poses, convention: str = "utn") -> dict:
+    """The engine's Cartesian inertia and the natural frequencies with it against ``spatial_inertia`` (legs) and
+    ``design.stiffness`` at ``(n, 6)`` poses.
+
+    Returns ``poses``, ``mass_matrix_relative_error`` (worst ‖ΔM‖/‖M‖), ``frequency_relative_error`` (worst),
+    ``frequencies_hz`` (the first pose's, from the engine: home in ``cross_check``), ``tolerance_relative``, ``ok``."""
+    poses = np.atleast_2d(poses)
+    st = plate_state(platform, poses, convention=convention)
+    k = platform.legs.stiffness or NOMINAL_LEG_STIFFNESS
+    err_m, err_f, freqs, kappa = 0.0, 0.0, None, 1.0
+    for i, q in enumerate(poses):
+        M_eng = engine.task_mass_matrix(st, i)
+        M_ref = spatial_inertia(platform, q, convention, legs=True)
+        err_m = max(err_m, float(np.linalg.norm(M_eng - M_ref) / np.linalg.norm(M_ref)))
+        K = stiffness_matrix(platform, q, k, convention, legs=True)
+        K = 0.5 * (K + K.T)
+        f_eng = np.sqrt(np.abs(scipy.linalg.eigh(K, 0.5 * (M_eng + M_eng.T), eigvals_only=True))) / (2 * np.pi)
+        f_ref = np.sqrt(np.abs(scipy.linalg.eigh(K, M_ref, eigvals_only=True))) / (2 * np.pi)
+        err_f = max(err_f, float(np.abs(f_eng - f_ref).max() / f_ref.max()))
+        kappa = max(kappa, float(np.linalg.cond(M_ref)))
+        freqs = f_eng if freqs is None else freqs
+    tol = DYNAMIC_ROUNDING * kappa * EPS
+    return {
+        "poses": len(poses),
+        "mass_matrix_relative_error": err_m,
+        "frequency_relative_error": err_f,
+        "frequencies_hz": freqs,
+        "tolerance_relative": tol,
+        "ok": bool(err_m <= tol and err_f <= tol),
     }

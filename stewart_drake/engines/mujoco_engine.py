@@ -184,3 +184,22 @@ class MujocoPlatform:
         if (len(forces) - 1) % record_every == 0:
             record()
         return {k: np.array(x) for k, x in out.items()}
+
+    def task_mass_matrix(self, st, k: int) -> np.ndarray:
+        """``(6, 6)`` the closed loop's inertia in the plate's Cartesian coordinates [v_C; ω] (base frame, C the
+        rotation centre) at sample ``k`` of a ``plate.PlateState``: Sᵀ M S, S mapping [v_C; ω] to MuJoCo's velocities
+        with the legs' rates solved from the closures (kg, kg·m, kg·m²)."""
+        m, d = self.model, self.data
+        self.set_configuration(st, k)
+        d.qvel[:] = 0.0
+        G, _ = self._closure_terms()
+        M = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, M)
+        R = st.R[k]
+        r = R @ self.platform.rotation_centre  # C − T in W
+        S = np.zeros((m.nv, 6))
+        for j in range(6):
+            V = np.eye(6)[j]
+            S[self.i_top, j] = np.concatenate([V[:3] - np.cross(V[3:], r), R.T @ V[3:]])
+        S[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ S[self.i_top])
+        return S.T @ M @ S

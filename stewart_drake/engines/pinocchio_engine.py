@@ -207,3 +207,22 @@ class PinocchioPlatform:
             max(np.linalg.norm(data.oMf[a].translation - data.oMf[b].translation) for a, b in self.points)
         )
         out["energy"].append(pin.computeKineticEnergy(model, data, q, v) + pin.computePotentialEnergy(model, data, q))
+
+    def task_mass_matrix(self, st, k: int) -> np.ndarray:
+        """``(6, 6)`` the closed loop's inertia in the plate's Cartesian coordinates [v_C; ω] (base frame, C the
+        rotation centre) at sample ``k`` of a ``plate.PlateState``: Sᵀ M S, S mapping [v_C; ω] to the tree's
+        velocities with the legs' rates solved from the closures (kg, kg·m, kg·m²)."""
+        model = self.model
+        q = self.configuration(st, k)
+        M = pin.crba(model, self.data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        G, _ = self._closure_terms(q, np.zeros(model.nv))
+        R = st.R[k]
+        r = R @ self.platform.rotation_centre  # C − T in W
+        S = np.zeros((model.nv, 6))
+        for j in range(6):
+            V = np.eye(6)[j]
+            v_T = V[:3] - np.cross(V[3:], r)
+            S[self.i_top, j] = np.concatenate([R.T @ v_T, R.T @ V[3:]])
+        S[self.i_legs] = np.linalg.solve(G[:, self.i_legs], -G[:, self.i_top] @ S[self.i_top])
+        return S.T @ M @ S

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+import stewart_drake as sd
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.core.sdf import xml_vec
@@ -102,3 +103,22 @@ def test_a_missing_engine_is_reported_not_raised(monkeypatch):
     r = X.cross_check(load_preset("utn-dynamic"), poses=10, samples=3)
     assert r["pinocchio"] == {"available": False, "reason": "pinocchio is not installed (x)", "ok": None}
     assert r["mujoco"]["ok"]
+
+
+@pytest.mark.parametrize("engine", X.ENGINES)
+def test_task_space_inertia_and_natural_frequencies_match_modes(platform, engine):
+    """The engine's inertia reduced to the plate's Cartesian coordinates is ``modes``' M_C with the legs, and the
+    natural frequencies with ``design.stiffness``' K agree; the legs' share is real (dropping it moves M)."""
+    available(engine)
+    eng = X.engine_model(engine, platform)
+    r = X.modes_check(eng, platform, np.vstack([platform.home_pose(), random_poses(platform, 4, seed=5)]))
+    assert r["mass_matrix_relative_error"] <= r["tolerance_relative"]
+    assert r["frequency_relative_error"] <= r["tolerance_relative"]
+    k = platform.legs.stiffness or X.NOMINAL_LEG_STIFFNESS
+    f = sd.modes(platform, platform.home_pose(), leg_stiffness=k, legs=True).to_dict()["frequencies_hz"]
+    np.testing.assert_allclose(r["frequencies_hz"], f, rtol=r["tolerance_relative"])
+    plate_only = X.spatial_inertia(platform, platform.home_pose(), legs=False)
+    st = X.plate_state(platform, platform.home_pose())
+    assert np.linalg.norm(eng.task_mass_matrix(st, 0) - plate_only) > 1e3 * r["tolerance_relative"] * np.linalg.norm(
+        plate_only
+    )
