@@ -31,8 +31,6 @@ The engines are optional (``pip install .[engines]``): ``engine_status`` says wh
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 import scipy.linalg
 
@@ -45,8 +43,19 @@ from stewart_drake.design.stiffness import stiffness_matrix
 from stewart_drake.engines.models import MJCF_SOLREF, mjcf_text
 from stewart_drake.engines.plate import plate_state
 
+# Each engine is an optional extra: a missing one is reported by ``engine_status``, not raised at import.
+MISSING: dict = {}
+try:
+    from stewart_drake.engines import pinocchio_engine
+except ImportError as e:
+    pinocchio_engine, MISSING["pinocchio"] = None, str(e)
+try:
+    from stewart_drake.engines import mujoco_engine
+except ImportError as e:
+    mujoco_engine, MISSING["mujoco"] = None, str(e)
+
 ENGINES = ("pinocchio", "mujoco")
-_MODULES = {"pinocchio": "stewart_drake.engines.pinocchio_engine", "mujoco": "stewart_drake.engines.mujoco_engine"}
+_MODULES = {"pinocchio": pinocchio_engine, "mujoco": mujoco_engine}
 _CLASSES = {"pinocchio": "PinocchioPlatform", "mujoco": "MujocoPlatform"}
 KINEMATIC_TOL_REL = 1e-12  # of the longest leg, m/m (see the module docstring)
 # Rounding of a 24-unknown elimination and of the closed form's ~100 operations per force: a bound of
@@ -64,22 +73,20 @@ MODE_POSES = 10  # home and the first nine kinematic poses
 
 def engine_status() -> dict:
     """engine name -> None when importable, else the one-line reason it is not."""
-    out = {}
-    for name in ENGINES:
-        try:
-            # deferred: each engine is an optional extra; a missing one is reported, not raised at import
-            importlib.import_module(_MODULES[name])
-            out[name] = None
-        except ImportError as e:
-            out[name] = f"{name} is not installed ({e}); pip install 'stewart-drake[engines]'"
-    return out
+    return {
+        name: None
+        if name not in MISSING
+        else f"{name} is not installed ({MISSING[name]}); pip install 'stewart-drake[engines]'"
+        for name in ENGINES
+    }
 
 
 def engine_model(name: str, platform: Platform, **texts):
     """The platform in engine ``name`` ("pinocchio" | "mujoco"); ``texts`` replace the generated model text
     (``urdf=``, ``closure_list=`` for Pinocchio, ``mjcf=`` for MuJoCo). Raises ImportError when it is missing."""
-    module = importlib.import_module(_MODULES[name])  # deferred: the engine is an optional extra
-    return getattr(module, _CLASSES[name])(platform, **texts)
+    if _MODULES[name] is None:
+        raise ImportError(engine_status()[name])
+    return getattr(_MODULES[name], _CLASSES[name])(platform, **texts)
 
 
 def trajectories(platform: Platform, n: int = 13, duration: float = 3.0) -> dict:
@@ -173,7 +180,7 @@ def cross_check(
         out[name] = {
             "available": True,
             "reason": None,
-            "version": importlib.import_module(_MODULES[name]).VERSION,
+            "version": _MODULES[name].VERSION,
             "kinematics": kin,
             "dynamics": dyn,
             "modes": mod,
