@@ -162,11 +162,13 @@ class MujocoPlatform:
         closures and its semi-implicit Euler integrator.
 
         Returns ``R`` (m, 3, 3), ``p`` (m, 3) the plate frame every ``record_every`` steps (step 0 first),
-        ``constraint`` (m,) worst |site 1 − site 2| (m) and ``energy`` (m,) kinetic + potential energy (J)."""
+        ``constraint`` (m,) worst |site 1 − site 2| (m), ``energy`` (m,) kinetic + potential energy (J) and
+        ``lengths`` (m, 6) the slide positions (m)."""
         m, d = self.model, self.data
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "top")
-        out = {k: [] for k in ("R", "p", "constraint", "energy")}
+        out = {k: [] for k in ("R", "p", "constraint", "energy", "lengths")}
+        slides = [m.jnt_qposadr[j] for j in self.prismatic]
 
         def record():
             mujoco.mj_forward(m, d)
@@ -174,6 +176,7 @@ class MujocoPlatform:
             out["p"].append(d.xpos[body].copy())
             out["constraint"].append(max(np.linalg.norm(d.site_xpos[a] - d.site_xpos[b]) for a, b in self.points))
             out["energy"].append(float(d.energy.sum()))
+            out["lengths"].append(d.qpos[slides].copy())
 
         forces = np.asarray(forces, dtype=float)
         for k in range(len(forces) - 1):

@@ -159,7 +159,8 @@ class PinocchioPlatform:
         manifold.
 
         Returns ``R`` (m, 3, 3), ``p`` (m, 3) the plate frame every ``record_every`` steps (step 0 first),
-        ``constraint`` (m,) worst |point a − point b| (m) and ``energy`` (m,) kinetic + potential energy (J)."""
+        ``constraint`` (m,) worst |point a − point b| (m), ``energy`` (m,) kinetic + potential energy (J) and
+        ``lengths`` (m, 6) the prismatic positions (m)."""
         model, data = self.model, self.data
         cms = pin.StdVec_RigidConstraintModel()
         for c in self.constraints:
@@ -174,7 +175,7 @@ class PinocchioPlatform:
             return pin.constraintDynamics(model, data, q, v, tau, cms, cds)
 
         q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
-        out = {k: [] for k in ("R", "p", "constraint", "energy")}
+        out = {k: [] for k in ("R", "p", "constraint", "energy", "lengths")}
         forces = np.asarray(forces, dtype=float)
         for k in range(len(forces) - 1):
             if k % record_every == 0:
@@ -207,6 +208,7 @@ class PinocchioPlatform:
             max(np.linalg.norm(data.oMf[a].translation - data.oMf[b].translation) for a, b in self.points)
         )
         out["energy"].append(pin.computeKineticEnergy(model, data, q, v) + pin.computePotentialEnergy(model, data, q))
+        out["lengths"].append([q[model.idx_qs[j]] for j in self.prismatic])
 
     def task_mass_matrix(self, st, k: int) -> np.ndarray:
         """``(6, 6)`` the closed loop's inertia in the plate's Cartesian coordinates [v_C; ω] (base frame, C the
