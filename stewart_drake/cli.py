@@ -46,7 +46,7 @@ COMMANDS = {
         "(stewart-drake init --platform-template radial > my.yaml)",
     ),
     "leg": ("leg", "3R planar leg (seed 003): DH forward kinematics, geometric inverse kinematics"),
-    "model": ("model", "generate (write) or inspect the SDF model of a platform"),
+    "model": ("model", "generate (write) or inspect the model of a platform: SDF (Drake), URDF + closures, MJCF"),
     "modes": ("modes", "natural frequencies (Hz) and mode shapes at a pose; --drake checks them against Drake"),
     "montecarlo": (
         "montecarlo",

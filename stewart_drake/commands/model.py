@@ -1,4 +1,5 @@
-"""``stewart-drake model``: write or inspect the generated Drake model (SDF) of a platform."""
+"""``stewart-drake model``: write or inspect the generated model of a platform (SDF for Drake; URDF + loop-closure YAML
+for Pinocchio and ROS 2; MJCF for MuJoCo)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,9 @@ from stewart_drake.errors import UsageError
 
 
 def register(sub) -> None:
-    p = sub.add_parser("model", help="generate (write) or inspect the SDF model of a platform")
+    p = sub.add_parser(
+        "model", help="generate (write) or inspect the model of a platform: SDF (Drake), URDF + closures, MJCF"
+    )
     add_platform_arg(p)
     p.add_argument(
         "--write",

@@ -9,7 +9,9 @@ import yaml
 
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.kinematics import leg_lengths
-from stewart_drake.engines.models import closures_yaml, mjcf_text, urdf_text
+from stewart_drake.core.sampling import random_poses
+from stewart_drake.engines.cross_check import engine_model, kinematics_check
+from stewart_drake.engines.models import closures_yaml, mjcf_text, urdf_text, write_models
 
 from .own_platform import own_platform
 
@@ -84,3 +86,16 @@ def test_mujoco_loads_back_anchors_masses_and_a_closed_home(platform):
     assert np.abs(tips - anchors).max() <= POS_TOL
     slides = [m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"prismatic_{i}")] for i in range(1, 7)]
     np.testing.assert_allclose(d.qpos[slides], leg_lengths(platform, platform.home_pose()), rtol=0, atol=POS_TOL)
+
+
+def test_the_written_urdf_and_closures_load_back_closed(tmp_path):
+    """What ``model --format urdf`` writes (a ROS 2 user's two files) rebuilds the closed loop: Pinocchio loads the
+    URDF and the YAML's closures from disk, and they close at our joint positions to rounding."""
+    pytest.importorskip("pinocchio", reason="pinocchio not installed (pip install 'stewart-drake[engines]')")
+    platform = own_platform(tmp_path)
+    urdf, closures_file = write_models(platform, tmp_path / "out", "urdf")
+    doc = yaml.safe_load(closures_file.read_text())
+    assert doc["urdf"] == urdf.name
+    eng = engine_model("pinocchio", platform, urdf=urdf.read_text(), closure_list=doc["closures"])
+    r = kinematics_check(eng, platform, random_poses(platform, 50, seed=7))
+    assert r["ok"], r
