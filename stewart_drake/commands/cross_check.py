@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import stewart_drake as sd
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
-from stewart_drake.engines.cross_check import ENGINES
+from stewart_drake.engines.cross_check import ENGINES, RELEASE_DURATION
 
 
 def register(sub) -> None:
@@ -92,6 +92,6 @@ def _print_simulation(e: dict) -> None:
             f" {'shrinks' if ol['ok'] else 'DOES NOT SHRINK'}"
         )
     print(
-        f"    passive release from home (0.2 s): energy drift {rel['energy_drift_j']:.2e} J of"
+        f"    passive release from home ({RELEASE_DURATION:g} s): energy drift {rel['energy_drift_j']:.2e} J of"
         f" {rel['energy_exchanged_j']:.3g} J exchanged, closure gap {rel['constraint_m'] * 1e3:.2g} mm"
     )

@@ -45,12 +45,24 @@ MJCF_TIMESTEP = 1e-3  # s
 MASSLESS = 1e-9  # kg (and kg·m²): the plate of a massless platform, as in the SDF
 
 
+MASSLESS_PLATE = 1e-6  # kg: a massless platform's plate in the models (the SDF's placeholder)
+
+
 def plate_inertial(platform: Platform) -> tuple[float, np.ndarray]:
     """The plate's mass (kg) and ``(3, 3)`` inertia about its centre of mass (kg·m²) as the models carry them
-    (a massless platform gets the SDF's placeholder)."""
+    (a massless platform gets the SDF's placeholder: 1e-6 kg, 1e-9 kg·m²)."""
     if platform.mass > 0:
         return float(platform.mass), np.asarray(platform.inertia, dtype=float)
-    return 1e-6, np.eye(3) * MASSLESS
+    return MASSLESS_PLATE, np.eye(3) * MASSLESS
+
+
+def modelled_platform(platform: Platform) -> Platform:
+    """``platform`` with the plate the models carry (``plate_inertial``): what the engines' numbers are compared
+    with."""
+    if platform.mass > 0:
+        return platform
+    mass, inertia = plate_inertial(platform)
+    return platform.replace(mass=mass, inertia=inertia)
 
 
 def home_plate_origin(platform: Platform) -> np.ndarray:

@@ -8,13 +8,14 @@ import numpy as np
 import pytest
 
 import stewart_drake as sd
+from stewart_drake.cli import main
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.core.sdf import xml_vec
 from stewart_drake.engines import cross_check as X
 from stewart_drake.engines.models import closures, mjcf_text
 
-from .own_platform import own_platform
+from .own_platform import OWN, own_platform
 
 STATUS = X.engine_status()
 pytestmark = pytest.mark.skipif(
@@ -122,3 +123,48 @@ def test_task_space_inertia_and_natural_frequencies_match_modes(platform, engine
     assert np.linalg.norm(eng.task_mass_matrix(st, 0) - plate_only) > 1e3 * r["tolerance_relative"] * np.linalg.norm(
         plate_only
     )
+
+
+def test_trajectories_shrink_to_stay_in_stroke(tmp_path):
+    """A home pose near the short end of the stroke: the sway of a quarter stroke would pull legs below L_min, so it
+    is halved until every leg stays in; the check still runs (no internal error on a user's platform)."""
+    path = tmp_path / "low.yaml"
+    path.write_text(OWN + "home_height: 430.0\n")
+    p = sd.load_platform(str(path))
+    q = X.trajectories(p, 13)["seed"][0]
+    quarter = (p.L_max - p.L_min) / 4
+    amp = np.abs(q[:, 1] - p.home_pose()[1]).max()
+    assert amp < quarter and amp > quarter / 4  # halved once or twice, not to nothing
+    L = X.leg_lengths(p, q)
+    assert L.min() >= p.L_min and L.max() <= p.L_max
+
+
+def test_a_disagreeing_engine_exits_1_with_its_table(monkeypatch, capsys):
+    available("mujoco")
+    real = X.cross_check
+
+    def bad(*args, **kwargs):
+        out = real(*args, **kwargs)
+        out["mujoco"]["kinematics"].update(closure_residual_m=1e-3, ok=False)
+        out["mujoco"]["ok"] = False
+        return out
+
+    monkeypatch.setattr("stewart_drake.api.cross_check.run_cross_check", bad)
+    rc = main(["cross-check", "--platform", "utn-dynamic", "--engine", "mujoco", "--poses", "5", "--no-simulation"])
+    out = capsys.readouterr().out
+    assert rc == 1
+    assert "closure residual 1.00e-03 m" in out and "DISAGREES" in out
+    assert out.rstrip().endswith("verdict: an engine disagrees with the closed forms")
+
+
+def test_a_platform_without_plate_mass_is_compared_with_the_plate_the_models_carry(tmp_path):
+    """The models give a massless plate the SDF's placeholder (1e-6 kg): the closed form is evaluated with that plate,
+    so the leg forces (then from the legs alone) agree to rounding instead of by the placeholder's weight."""
+    available("pinocchio")
+    path = tmp_path / "bare.yaml"
+    path.write_text("\n".join(line for line in OWN.splitlines() if not line.startswith("plate:")))
+    p = sd.load_platform(str(path))
+    assert p.mass == 0
+    r = X.cross_check(p, engines=["pinocchio"], poses=20, samples=3, simulate=False)["pinocchio"]
+    assert r["ok"], r
+    assert all(d["max_force_n"] > 0.1 for d in r["dynamics"].values())  # the legs' own weight and inertia
