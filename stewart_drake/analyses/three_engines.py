@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import PRESETS, load_preset
-from stewart_drake.drake.verify_dynamics import simulate_open_loop
+from stewart_drake.drake.verify_dynamics import constrained_leg_forces, simulate_open_loop
 from stewart_drake.engines import cross_check as X
 from stewart_drake.report import run_standalone
 
@@ -36,6 +37,20 @@ def build(section) -> None:
         p = load_preset(name)
         res = X.cross_check(p, poses=n, samples=7 if section.quick else 13)
         releases = {}
+        # Drake's closed-loop plant on the same trajectories: the third engine's leg forces (its own [B Gᵀ] solve)
+        for traj, (q, qd, qdd) in X.trajectories(p, 7 if section.quick else 13).items():
+            F_ref = leg_forces_with_legs(p, q, qd, qdd)
+            scale = float(np.abs(F_ref).max())
+            rel = float(np.abs(constrained_leg_forces(p, q, qd, qdd) - F_ref).max()) / scale
+            kappa = (
+                res["pinocchio"]["dynamics"][traj]["condition"] if res.get("pinocchio", {}).get("available") else 1e3
+            )
+            dyn_rows.append([name, "drake", traj, scale, rel, kappa])
+            section.check(
+                f"{name}: drake leg forces along the {traj} trajectory, relative",
+                rel,
+                X.DYNAMIC_ROUNDING * kappa * X.EPS,
+            )
         for engine, r in res.items():
             if not r["available"]:
                 continue
