@@ -34,9 +34,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
+from stewart_drake.control.laws import FloatLaw
 from stewart_drake.core.dynamics import G_EARTH, harmonic_trajectory, leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import leg_lengths, stroke_within
+from stewart_drake.core.kinematics import leg_lengths, length_jacobian, stroke_within
 from stewart_drake.core.sampling import random_poses
 from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.stiffness import stiffness_matrix
@@ -341,3 +342,56 @@ def modes_check(engine, platform: Platform, poses, convention: str = "utn") -> d
         "tolerance_relative": tol,
         "ok": bool(err_m <= tol and err_f <= tol),
     }
+
+
+LOOP_DURATION = 1.0  # s of the float-law loop along the seed sway
+
+
+def float_loop(name: str, platform: Platform, duration: float = LOOP_DURATION, solref=MJCF_SOLREF) -> dict:
+    """The float PID law (``control.laws.FloatLaw``, its gains and period T designed for the platform) closing the
+    loop on engine ``name`` along the seed sway (``sway``) with the closed-form feed-forward: at each tick the legs'
+    true lengths are read, the law's command is held over the next period (no output delay: the engines' loop,
+    not the DSP's), the engine advances one period (RK4, step T; MuJoCo with ``solref``).
+
+    Returns ``t`` (m,) s, ``p`` (m, 3) the plate origin and ``R`` (m, 3, 3) every ``RECORD`` s, ``tracking_m``
+    the worst plate-origin distance from the plan, ``period_s``."""
+    law = FloatLaw(platform)
+    T = law.timing.sample_period
+    t = np.arange(0.0, duration + T / 2, T)
+    q, qd, qdd = sway(platform, t)
+    F_ff = leg_forces_with_legs(platform, q, qd, qdd)
+    st = plate_state(platform, q, qd, qdd)
+    rates = np.einsum("ij,j->i", length_jacobian(platform, q[0]), qd[0])
+    state = law.initial_pid_state(st.lengths[0], F_ff[0], rates)
+    every = max(1, int(round(RECORD / T)))
+    out = {"p": [], "R": []}
+    if name == "pinocchio":
+        eng = engine_model(name, platform)
+        x, v = eng.set_state(st, 0)
+        step = eng.stepper()
+
+        def lengths():
+            return eng.lengths(x)
+
+        def plate():
+            return eng.plate(x)
+    else:
+        eng = engine_model(name, platform, mjcf=mjcf_text(platform, solref, T, "RK4"))
+        eng.set_state(st, 0)
+        lengths, plate = eng.lengths, eng.plate
+    for k in range(len(t)):
+        if k % every == 0:
+            R, p = plate()
+            out["R"].append(R)
+            out["p"].append(p)
+        if k == len(t) - 1:
+            break
+        u, _, state, _ = law.step(state, q[k], lengths(), F_ff[k])
+        if name == "pinocchio":
+            x, v = step(x, v, u, u, T)
+        else:
+            eng.advance(u)
+    rec = {k: np.array(v) for k, v in out.items()}
+    idx = np.arange(0, len(t), every)
+    dp, _ = _plate_errors(st, rec, idx)
+    return {"t": t[idx], **rec, "tracking_m": dp, "period_s": T}

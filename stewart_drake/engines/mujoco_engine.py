@@ -188,6 +188,22 @@ class MujocoPlatform:
             record()
         return {k: np.array(x) for k, x in out.items()}
 
+    def advance(self, force, steps: int = 1) -> None:
+        """Step MuJoCo ``steps`` times from the data's state with actuator forces ``force`` (6,) N held."""
+        self.data.ctrl[self.actuators] = force
+        mujoco.mj_step(self.model, self.data, steps)
+
+    def lengths(self) -> np.ndarray:
+        """``(6,)`` the slide positions (m) of the data's state."""
+        return np.array([self.data.qpos[self.model.jnt_qposadr[j]] for j in self.prismatic])
+
+    def plate(self) -> tuple[np.ndarray, np.ndarray]:
+        """The plate's R_WT (3, 3) and p_WT (3,) of the data's state."""
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "top")
+        return d.xmat[body].reshape(3, 3).copy(), d.xpos[body].copy()
+
     def task_mass_matrix(self, st, k: int) -> np.ndarray:
         """``(6, 6)`` the closed loop's inertia in the plate's Cartesian coordinates [v_C; ω] (base frame, C the
         rotation centre) at sample ``k`` of a ``plate.PlateState``: Sᵀ M S, S mapping [v_C; ω] to MuJoCo's velocities

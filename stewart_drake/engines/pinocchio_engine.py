@@ -161,6 +161,22 @@ class PinocchioPlatform:
         Returns ``R`` (m, 3, 3), ``p`` (m, 3) the plate frame every ``record_every`` steps (step 0 first),
         ``constraint`` (m,) worst |point a − point b| (m), ``energy`` (m,) kinetic + potential energy (J) and
         ``lengths`` (m, 6) the prismatic positions (m)."""
+        step = self.stepper(baumgarte)
+        q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
+        out = {k: [] for k in ("R", "p", "constraint", "energy", "lengths")}
+        forces = np.asarray(forces, dtype=float)
+        for k in range(len(forces) - 1):
+            if k % record_every == 0:
+                self._record(q, v, out)
+            q, v = step(q, v, forces[k], forces[k + 1], dt)
+        if (len(forces) - 1) % record_every == 0:
+            self._record(q, v, out)
+        return {k: np.array(x) for k, x in out.items()}
+
+    def stepper(self, baumgarte: float = 0.0):
+        """``step(q, v, f0, f1, dt) -> (q, v)``: one classic RK4 step of ``dt`` s of the closed loop under actuator
+        forces (6,) N going linearly from ``f0`` to ``f1`` (``constraintDynamics``, rigid closures, ``baumgarte`` ω
+        rad/s of drift correction: Kp = ω², Kd = 2ω)."""
         model, data = self.model, self.data
         cms = pin.StdVec_RigidConstraintModel()
         for c in self.constraints:
@@ -174,13 +190,8 @@ class PinocchioPlatform:
         def acc(q, v, tau):
             return pin.constraintDynamics(model, data, q, v, tau, cms, cds)
 
-        q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
-        out = {k: [] for k in ("R", "p", "constraint", "energy", "lengths")}
-        forces = np.asarray(forces, dtype=float)
-        for k in range(len(forces) - 1):
-            if k % record_every == 0:
-                self._record(q, v, out)
-            tau0, tau1 = self.B @ forces[k], self.B @ forces[k + 1]
+        def step(q, v, f0, f1, dt):
+            tau0, tau1 = self.B @ f0, self.B @ f1
             tau_mid = (tau0 + tau1) / 2
             k1v, k1a = v, acc(q, v, tau0)
             q2 = pin.integrate(model, q, k1v * dt / 2)
@@ -192,11 +203,20 @@ class PinocchioPlatform:
             q4 = pin.integrate(model, q, k3v * dt)
             k4v = v + k3a * dt
             k4a = acc(q4, k4v, tau1)
-            q = pin.integrate(model, q, (k1v + 2 * k2v + 2 * k3v + k4v) * dt / 6)
-            v = v + (k1a + 2 * k2a + 2 * k3a + k4a) * dt / 6
-        if (len(forces) - 1) % record_every == 0:
-            self._record(q, v, out)
-        return {k: np.array(x) for k, x in out.items()}
+            q_next = pin.integrate(model, q, (k1v + 2 * k2v + 2 * k3v + k4v) * dt / 6)
+            return q_next, v + (k1a + 2 * k2a + 2 * k3a + k4a) * dt / 6
+
+        return step
+
+    def lengths(self, q) -> np.ndarray:
+        """``(6,)`` the prismatic positions (m) in configuration ``q``."""
+        return np.array([q[self.model.idx_qs[j]] for j in self.prismatic])
+
+    def plate(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """The plate's R_WT (3, 3) and p_WT (3,) in configuration ``q``."""
+        pin.forwardKinematics(self.model, self.data, q)
+        X = self.data.oMi[self.top]
+        return X.rotation.copy(), X.translation.copy()
 
     def _record(self, q, v, out) -> None:
         model, data = self.model, self.data

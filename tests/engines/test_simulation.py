@@ -60,3 +60,17 @@ def test_passive_release_falls_alike_and_pinocchio_keeps_its_energy(platform):
     assert rp["energy_drift_j"] <= bound
     # MuJoCo's closures are damped (solref damping ratio 1): energy leaves, and more than rounding
     assert rm["energy_drift_j"] > 1e3 * rp["energy_drift_j"]
+
+
+def test_float_law_loop_in_both_engines_side_by_side(platform):
+    """The float PID law closing the loop along the seed sway for 1 s: MuJoCo's plate follows Pinocchio's (rigid
+    closures) more closely as its connect stiffens: its soft closures enter the loop as compliance in series with
+    the legs, and at solref 2 ms they are stiff enough for the two plates to agree to a tenth of the tracking error."""
+    needs("pinocchio", "mujoco")
+    rp = X.float_loop("pinocchio", platform)
+    soft = X.float_loop("mujoco", platform, solref=(0.02, 1.0))
+    stiff = X.float_loop("mujoco", platform, solref=(0.002, 1.0))
+    d_soft = np.linalg.norm(soft["p"] - rp["p"], axis=-1).max()
+    d_stiff = np.linalg.norm(stiff["p"] - rp["p"], axis=-1).max()
+    assert d_stiff < d_soft / 10
+    assert d_stiff <= rp["tracking_m"] / 10
