@@ -354,7 +354,8 @@ def float_loop(name: str, platform: Platform, duration: float = LOOP_DURATION, s
     not the DSP's), the engine advances one period (RK4, step T; MuJoCo with ``solref``).
 
     Returns ``t`` (m,) s, ``p`` (m, 3) the plate origin and ``R`` (m, 3, 3) every ``RECORD`` s, ``tracking_m``
-    the worst plate-origin distance from the plan, ``period_s``."""
+    the worst plate-origin distance from the plan, ``constraint_m`` the worst closure gap (MuJoCo: over every
+    step; Pinocchio: at the end), ``period_s``."""
     law = FloatLaw(platform)
     T = law.timing.sample_period
     t = np.arange(0.0, duration + T / 2, T)
@@ -362,7 +363,8 @@ def float_loop(name: str, platform: Platform, duration: float = LOOP_DURATION, s
     F_ff = leg_forces_with_legs(platform, q, qd, qdd)
     st = plate_state(platform, q, qd, qdd)
     rates = np.einsum("ij,j->i", length_jacobian(platform, q[0]), qd[0])
-    state = law.initial_pid_state(st.lengths[0], F_ff[0], rates)
+    # holding F_ff[0] with the feed-forward F_ff[0]: the integrator holds their difference, nothing
+    state = law.initial_pid_state(st.lengths[0], np.zeros(6), rates)
     every = max(1, int(round(RECORD / T)))
     out = {"p": [], "R": []}
     if name == "pinocchio":
@@ -379,6 +381,7 @@ def float_loop(name: str, platform: Platform, duration: float = LOOP_DURATION, s
         eng = engine_model(name, platform, mjcf=mjcf_text(platform, solref, T, "RK4"))
         eng.set_state(st, 0)
         lengths, plate = eng.lengths, eng.plate
+    gap = 0.0
     for k in range(len(t)):
         if k % every == 0:
             R, p = plate()
@@ -391,7 +394,10 @@ def float_loop(name: str, platform: Platform, duration: float = LOOP_DURATION, s
             x, v = step(x, v, u, u, T)
         else:
             eng.advance(u)
+            gap = max(gap, eng.closure_gap())
     rec = {k: np.array(v) for k, v in out.items()}
     idx = np.arange(0, len(t), every)
     dp, _ = _plate_errors(st, rec, idx)
-    return {"t": t[idx], **rec, "tracking_m": dp, "period_s": T}
+    if name == "pinocchio":
+        gap = float(eng.closure_residuals_at(x).max())
+    return {"t": t[idx], **rec, "tracking_m": dp, "constraint_m": gap, "period_s": T}

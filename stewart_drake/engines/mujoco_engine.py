@@ -193,6 +193,11 @@ class MujocoPlatform:
         self.data.ctrl[self.actuators] = force
         mujoco.mj_step(self.model, self.data, steps)
 
+    def closure_gap(self) -> float:
+        """The worst |site 1 − site 2| (m) of the connect equalities at the data's state (after ``mj_step``)."""
+        x = self.data.site_xpos
+        return float(max(np.linalg.norm(x[a] - x[b]) for a, b in self.points))
+
     def lengths(self) -> np.ndarray:
         """``(6,)`` the slide positions (m) of the data's state."""
         return np.array([self.data.qpos[self.model.jnt_qposadr[j]] for j in self.prismatic])

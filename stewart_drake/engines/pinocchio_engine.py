@@ -208,6 +208,13 @@ class PinocchioPlatform:
 
         return step
 
+    def closure_residuals_at(self, q) -> np.ndarray:
+        """``(6,)`` |point a − point b| (m) of each closure in configuration ``q``."""
+        pin.framesForwardKinematics(self.model, self.data, q)
+        return np.array(
+            [np.linalg.norm(self.data.oMf[a].translation - self.data.oMf[b].translation) for a, b in self.points]
+        )
+
     def lengths(self, q) -> np.ndarray:
         """``(6,)`` the prismatic positions (m) in configuration ``q``."""
         return np.array([q[self.model.idx_qs[j]] for j in self.prismatic])
