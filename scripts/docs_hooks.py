@@ -47,6 +47,7 @@ SEE_ALSO = {
 
 # The public function each command calls (``import stewart_drake as sd``), linked from its page.
 PYTHON = {
+    "cross-check": "cross_check",
     "ik": "ik",
     "fk": "fk",
     "dynamics": "inverse_dynamics",

@@ -28,6 +28,7 @@ import typing  # noqa: E402
 if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
     from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
+    from stewart_drake.api.cross_check import CrossCheck, cross_check
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
     from stewart_drake.api.drawing import plot_platform
     from stewart_drake.api.dsp import DspIKResult, dsp_ik
@@ -113,6 +114,8 @@ _PUBLIC = {
     "leg_ik": ("stewart_drake.api.leg", "leg_ik"),
     "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
     "inspect_model": ("stewart_drake.api.model", "inspect_model"),
+    "cross_check": ("stewart_drake.api.cross_check", "cross_check"),
+    "CrossCheck": ("stewart_drake.api.cross_check", "CrossCheck"),
     "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
     "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
     "ViewerReadout": ("stewart_drake.api.viewer", "ViewerReadout"),
@@ -177,6 +180,8 @@ __all__ = [
     "LegIKResult",
     "inspect_model",
     "ModelInspection",
+    "cross_check",
+    "CrossCheck",
     "viewer_readout",
     "ViewerReadout",
     "plot_platform",

@@ -29,6 +29,10 @@ COMMANDS = {
         "compile",
         "translate a motion program (.stw) to Python (calling this library) or Matlab (the seed's output)",
     ),
+    "cross-check": (
+        "cross_check",
+        "the platform's kinematics and leg forces in Pinocchio and MuJoCo against the closed forms",
+    ),
     "dsp-ik": ("dsp_ik", "leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK"),
     "dynamics": ("dynamics", "leg forces along a trajectory (inverse dynamics, with or without Coriolis)"),
     "firmware": (
@@ -43,7 +47,7 @@ COMMANDS = {
         "(stewart-drake init --platform-template radial > my.yaml)",
     ),
     "leg": ("leg", "3R planar leg (seed 003): DH forward kinematics, geometric inverse kinematics"),
-    "model": ("model", "generate (write) or inspect the SDF model of a platform"),
+    "model": ("model", "generate (write) or inspect the model of a platform: SDF (Drake), URDF + closures, MJCF"),
     "modes": ("modes", "natural frequencies (Hz) and mode shapes at a pose; --drake checks them against Drake"),
     "montecarlo": (
         "montecarlo",

@@ -470,6 +470,15 @@ class OptionError(UsageError):
     )
 
 
+class EngineError(UsageError):
+    """A cross-check asked of a physics engine that is not installed, or of none (``stewart_drake.engines``)."""
+
+    MISSING = "--engine {name}: {reason}"
+    NONE = "no physics engine to cross-check with: {reasons}"
+    TOO_MANY = "{option} {value} is more than {limit} (each is one engine evaluation per engine)"
+    UNKNOWN = "--engine: unknown engine {value!r}; choose from {valid}"
+
+
 # ----------------------------------------------------------------------------------------------
 # The motion language (``script``): templates of ``script.errors.ScriptError`` messages, which the
 # diagnostics print as ``file:line:column: error: message``.

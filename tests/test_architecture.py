@@ -18,8 +18,10 @@ ALLOWED = {
     **{layer: CORE for layer in CORE},
     **{layer: CORE | CONTROL for layer in CONTROL},
     "drake": CORE | CONTROL | {"drake"},
-    "api": CORE | CONTROL | {"drake", "api"},  # the public API (stewart_drake.__all__); the app sits above it
+    "engines": CORE | CONTROL | {"engines"},  # Pinocchio and MuJoCo, optional extras (their own imports only here)
+    "api": CORE | CONTROL | {"drake", "engines", "api"},  # the public API (stewart_drake.__all__); the app above it
 }
+ENGINE_LIBRARIES = ("pinocchio", "mujoco")
 APP = {"commands", "report", "analyses", "montecarlo", "synthesis", "cli", "__init__", "__main__"}
 
 
@@ -85,6 +87,8 @@ def test_module_respects_its_layer(path):
             elif id(node) not in top:
                 problems.append(f"line {node.lineno}: imports {name} inside a function")
             continue
+        if name.split(".")[0] in ENGINE_LIBRARIES and layer != "engines":
+            problems.append(f"line {node.lineno}: imports {name} outside the engines package")
         if not name.startswith("stewart_drake"):
             continue
         parts = name.split(".")

@@ -1,4 +1,5 @@
-"""``stewart-drake model``: write or inspect the generated Drake model (SDF) of a platform."""
+"""``stewart-drake model``: write or inspect the generated model of a platform (SDF for Drake; URDF + loop-closure YAML
+for Pinocchio and ROS 2; MJCF for MuJoCo)."""
 
 from __future__ import annotations
 
@@ -7,16 +8,26 @@ import io
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
 from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.core.sdf_models import sdf_text, write_sdf
+from stewart_drake.engines.models import FORMATS, model_files, write_models
 from stewart_drake.errors import UsageError
 
 
 def register(sub) -> None:
-    p = sub.add_parser("model", help="generate (write) or inspect the SDF model of a platform")
+    p = sub.add_parser(
+        "model", help="generate (write) or inspect the model of a platform: SDF (Drake), URDF + closures, MJCF"
+    )
     add_platform_arg(p)
     p.add_argument(
         "--write",
         metavar="DIR",
         help="write <DIR>/<name>.sdf (name made file-safe; an existing file is replaced only if stewart-drake wrote it)",
+    )
+    p.add_argument(
+        "--format",
+        choices=FORMATS,
+        default="sdf",
+        help="sdf (Drake), urdf (the open tree for Pinocchio/ROS 2; --write adds <name>.closures.yaml, the six loop"
+        " closures) or mjcf (MuJoCo, <name>.xml); default sdf",
     )
     p.add_argument(
         "--inspect", action="store_true", help="parse into a MultibodyPlant and list bodies, joints, constraints"
@@ -33,6 +44,8 @@ def register(sub) -> None:
 def run(args) -> int:
     if args.json and not args.inspect:
         raise UsageError(UsageError.NEEDS.format(option="--json", needs="--inspect"))
+    if args.inspect and args.format != "sdf":
+        raise UsageError(UsageError.NEEDS.format(option="--inspect", needs="--format sdf"))
     platform = platform_from_args(args)
     if args.figure:
         print(write_output_file(args.figure, _figure_png(platform), option="--figure"))
@@ -47,10 +60,16 @@ def run(args) -> int:
         else:
             for k, v in info.items():
                 print(f"{k}: {v}")
-    elif args.write:
+    elif args.write and args.format == "sdf":
         print(write_sdf(platform, args.write, option="--write"))
+    elif args.write:
+        for path in write_models(platform, args.write, args.format, option="--write"):
+            print(path)
     elif not args.figure:
-        print(sdf_text(platform), end="")
+        print(
+            sdf_text(platform) if args.format == "sdf" else next(iter(model_files(platform, args.format).values())),
+            end="",
+        )
     return 0
 
 
