@@ -900,6 +900,10 @@ class MachineError(UsageError):
         "({platform_hash}); regenerate it for this platform"
     )
     SOURCE = "load_machine: expected a path, a mapping or a Platform, got {got}"
+    WORD_RANGE = (
+        "firmware.length_lsb {lsb} m in {bits}-bit words holds lengths up to {range} m, less than the stroke's end "
+        "{longest} m: the loop's set-points would clamp; use a coarser firmware.length_lsb or more firmware.word_bits"
+    )
 
 
 # a warning of a run with a firmware (api.simulation.adopt_firmware)

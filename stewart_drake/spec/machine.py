@@ -236,6 +236,17 @@ class Machine:
         for i, m in enumerate(motions):
             check_motion(f"motions item {i + 1}", m)
         object.__setattr__(self, "motions", motions)
+        longest = float(self.platform.stroke[1])
+        fmt = self.firmware
+        if fmt.qformat().range_m < longest:  # the set-point word would clamp below the stroke's end, silently
+            raise MachineError(
+                MachineError.WORD_RANGE.format(
+                    bits=fmt.word_bits,
+                    lsb=_fmt(fmt.length_lsb),
+                    range=_fmt(fmt.qformat().range_m),
+                    longest=_fmt(longest),
+                )
+            )
 
     @property
     def loaded_platform(self) -> Platform:

@@ -52,10 +52,10 @@ def test_a_new_vary_key_is_one_table_row_drawn_checked_and_run(monkeypatch):
     (a negative LSB) stops the study naming the run and the spec path's rule."""
     monkeypatch.setitem(spec_mod.KEYS, "length_lsb", VaryKey("length", 0, False, "firmware.length_lsb"))
     p = sd.load_platform("utn-dynamic")
-    study = Study(p, parse_spec(["length_lsb=10um|20um"]), seed=4, runs=6, duration=0.05)
+    study = Study(p, parse_spec(["length_lsb=30um|40um"]), seed=4, runs=6, duration=0.05)
     drawn = [draw(study, i)[1] for i in range(study.runs)]
     lsbs = [d.columns()["length_lsb_m"] for d in drawn]
-    assert set(lsbs) == {10e-6, 20e-6}  # both choices drawn over 6 runs at this seed
+    assert set(lsbs) == {30e-6, 40e-6}  # both choices drawn over 6 runs at this seed (16-bit words hold the stroke)
     for i, d in enumerate(drawn):
         assert scenario(study, i)[2].config.ik_format.length_lsb == d.length_lsb
     check_study(study)  # 10 µm sensor counts divide both LSBs: every draw passes

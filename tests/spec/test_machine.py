@@ -210,3 +210,14 @@ def test_a_sections_overrides_are_checked_together():
         MachineError, match=r"^firmware.word_bits must be 16 with trig tfr16 \(use trig exact\), got 24$"
     ):
         load_machine("utn-dynamic", ["firmware.word_bits=24"])
+
+
+def test_a_format_that_cannot_hold_the_stroke_is_refused():
+    """16-bit words at 20 µm hold 32767 × 20 µm = 0.655 m, less than utn-dynamic's 0.95 m stroke end: the loop's
+    set-point word would clamp (the loop ran 75 mm below its reference without a word); 30 µm holds 0.983 m."""
+    from stewart_drake.errors import MachineError
+    from stewart_drake.spec import load_machine
+
+    with pytest.raises(MachineError, match=r"holds lengths up to 0\.65534 m, less than the stroke's end 0\.95 m"):
+        load_machine("utn-dynamic", ["firmware.length_lsb=20um"])
+    assert load_machine("utn-dynamic", ["firmware.length_lsb=30um"]).firmware.length_lsb == 3e-5
