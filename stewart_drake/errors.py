@@ -453,6 +453,19 @@ class OptionError(UsageError):
     )
 
 
+class ArgumentError(UsageError):
+    """An argument of the public API of the wrong kind: text or ``None`` for numbers, complex values, a
+    fraction for a count, a name that is not one of the choices, a non-platform for a platform."""
+
+    NOT_NUMBERS = "Expected {name} to be real numbers, got {value}"
+    NOT_NUMBER = "Expected {name} to be one real number, got {value}"
+    COMPLEX = "Expected {name} to be real numbers, got complex values {value} (the imaginary part is not dropped)"
+    NOT_INT = "Expected {name} to be a whole number{bounds}, got {value}"
+    CHOICE = "Expected {name} to be one of {choices}, got {value}"
+    NOT_BOOL = "Expected {name} to be True or False, got {value}"
+    NOT_PLATFORM = "Expected {name} to be a Platform (see load_platform), got {value}"
+
+
 # ----------------------------------------------------------------------------------------------
 # The motion language (``script``): templates of ``script.errors.ScriptError`` messages, which the
 # diagnostics print as ``file:line:column: error: message``.
@@ -876,8 +889,8 @@ OPTION_FIRMWARE_ENGINE = "--firmware runs your C, so it cannot run with --engine
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"
 OPTION_PORT = "--port must be in 1024..65535 (Meshcat does not listen on a privileged port), got {value}"
-OPTION_LEG_DAMPING = "--leg-damping must be a finite number >= 0 N·s/m, got {value}"
-OPTION_SAMPLE_RATE = "--sample-rate must be a positive number of Hz, got {value}"
+OPTION_LEG_DAMPING = "{name} must be a finite number >= 0 N·s/m, got {value}"
+OPTION_SAMPLE_RATE = "{name} must be a positive number of Hz, got {value}"
 OPTION_JOINT_ANGLES = "joint angles must be finite, got {value}"
 OPTION_JOINT_OVERFLOW = "joint angles {value} {unit}: the foot angle gamma = q1 + q2 + alpha overflows a float"
 OPTION_TARGET = "target must be finite, got {value}"
@@ -1016,6 +1029,6 @@ def short_text(value, limit: int = MAX_ECHO) -> str:
 
 
 OPTION_LEG_DAMPING_RESOLVE = (
-    "--leg-damping {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
+    "{name} {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
     "this overdamped are not resolved in double precision (one root per mode runs to ~0, the other to ~infinity)"
 )

@@ -9,6 +9,7 @@ metres and masses kilograms inside the library; YAML files may use millimetres (
 # The YAML schema dataclasses' field types are read by yamlio (typing.get_type_hints).
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -20,7 +21,7 @@ from stewart_drake.core.joints import coincident_groups, first_close_pair
 from stewart_drake.core.rotations import length_scale
 from stewart_drake.core.sanity import check_home
 from stewart_drake.core.yamlio import Rule, check_rules, load_yaml_typed
-from stewart_drake.errors import GeometryError, YamlError
+from stewart_drake.errors import ArgumentError, GeometryError, YamlError
 
 SQRT3 = np.sqrt(3.0)
 PRESETS = ("utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009")
@@ -666,11 +667,26 @@ def load_preset(name: str) -> Platform:
     return load_platform_yaml(preset_path(name))
 
 
+def check_platform(value, name: str = "platform") -> Platform:
+    """``value`` when it is a ``Platform``; ``ArgumentError`` naming ``name`` otherwise (a preset name or a file
+    is loaded by ``load_platform``, not here)."""
+    if not isinstance(value, Platform):
+        shown = repr(value)
+        raise ArgumentError(
+            ArgumentError.NOT_PLATFORM.format(name=name, value=shown if len(shown) <= 80 else shown[:77] + "...")
+        )
+    return value
+
+
 def load_platform(name_or_path) -> Platform:
     """A preset name or a path to a YAML file."""
     if isinstance(name_or_path, Platform):
         return name_or_path
-    s = str(name_or_path)
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        check_platform(name_or_path, "name_or_path")
+    s = os.fspath(name_or_path)
+    if not isinstance(s, str) or "\0" in s:
+        raise GeometryError(GeometryError.UNKNOWN_PLATFORM.format(name=repr(s), presets=", ".join(PRESETS)))
     if s in PRESETS:
         return load_preset(s)
     if s.endswith((".yaml", ".yml")) or Path(s).exists():
