@@ -47,6 +47,8 @@ class GeometryError(StewartError):
     NOT_NUMBERS = "{name} must be numbers, got {value!r}"
     SHAPE = "{name} must have shape {shape}, got {got}"
     NOT_FINITE = "{name} must be finite, got {value}"
+    FIELD_KIND = "Platform.{name} must be {kind}, got {value!r}"
+    LEG_FIELD = "legs.{name} must be {rule}, got {value:g}"
     COINCIDE = "{what} {i} and {j} coincide at {at} m (closer than {limit} m)"
     TOO_WIDE = (
         "platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is "
@@ -273,8 +275,9 @@ class PayloadError(StewartError):
     COM_NOT_FINITE = "{option}-com: payload centre of mass must be finite, got {value} m"
     COM_BELOW = "{option}-com: z = {z:g} m is below the plate (the plate frame's z >= 0 holds the plate and its load)"
 
+    TOO_HEAVY = "{option}: payload mass {value:g} kg is beyond {limit:g} kg (1000 t); is it in kg?"
     BELOW_PLATE = (
-        "--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)"
+        "{option}: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)"
     )
 
 
@@ -298,7 +301,7 @@ class WorkspaceError(StewartError):
     EXECUTOR = "executor must be a concurrent.futures.Executor (or have submit), got {kind}"
     GRID_TOO_LARGE = (
         "resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can "
-        "hold is ~{h_min_mm:.2g} mm; use a coarser --resolution"
+        "hold is ~{h_min_mm:.2g} mm; use a coarser {option}"
     )
     GRID_NODES = "more than the {limit:.0e} nodes one sweep may take"
     EMPTY_STROKE = "the stroke workspace at orientation {orientation} rad is empty (no common point of the legs' reach)"
@@ -442,8 +445,8 @@ class OptionError(UsageError):
     BETWEEN = "{option} must be between {lo} and {hi}, got {value}"
     GRAVITY = "{option} must be a finite number >= 0 m/s², got {value}"
     UNKNOWN_LIMIT = "{option}: unknown limit {value!r}; choose from {valid}"
-    DT = "--dt must be > 0 and --t-end >= 0, got dt = {dt}, t-end = {t_end}"
-    TOO_MANY_SAMPLES = "--t-end / --dt = {n} samples, more than {limit}"
+    DT = "{dt_name} must be > 0 and {t_end_name} >= 0, got dt = {dt}, t-end = {t_end}"
+    TOO_MANY_SAMPLES = "{t_end_name} / {dt_name} = {n} samples, more than {limit}"
     NO_STUDY = "--replay: {out!r} holds no finished study ({file} missing); run the study first"
     NO_RUN = "--replay {run}: the study in {out!r} has runs 0 … {last}"
     BAD_STUDY = "--replay: {path} is not a study written by stewart-drake montecarlo ({reason})"
@@ -463,6 +466,7 @@ class ArgumentError(UsageError):
     NOT_INT = "Expected {name} to be a whole number{bounds}, got {value}"
     CHOICE = "Expected {name} to be one of {choices}, got {value}"
     NOT_BOOL = "Expected {name} to be True or False, got {value}"
+    NOT_TEXT = "Expected {name} to be {what} (text), got {value}"
     NOT_PLATFORM = "Expected {name} to be a Platform (see load_platform), got {value}"
 
 
@@ -562,7 +566,7 @@ BELOW_BASE = (
 )
 FAR_POSITION = (
     "{what}: position {pos_m} m is {ratio:.3g} × the platform's size ({size_m:.3f} m); positions beyond "
-    "{limit:g} × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
+    "{limit:g} × are surely a unit mistake (a file in mm read as metres? use {hint})"
 )
 NOT_FINITE = "{what} must be finite, got {value}"
 NOT_POSITIVE = "{what} must be a positive number{unit}, got {value}"

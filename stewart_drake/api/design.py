@@ -12,7 +12,7 @@ from stewart_drake.core.argcheck import as_flag, as_real, check_shape, param
 from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.kinematics import inverse_kinematics, leg_lengths, require_nonsingular
 from stewart_drake.core.rotations import check_convention, rotation_matrix
-from stewart_drake.core.sanity import check_poses
+from stewart_drake.core.sanity import check_finite, check_gravity, check_poses
 from stewart_drake.design.load_limits import (
     MAX_DAMPING_RATIO,
     beyond_linear_range,
@@ -34,6 +34,9 @@ from stewart_drake.errors import (
     PhysicalLimitError,
     StewartError,
 )
+
+# The heaviest payload taken (kg): 1000 t, beyond the heaviest motion platforms built; more is a unit mistake.
+MAX_PAYLOAD = 1e6
 
 
 @dataclass
@@ -74,8 +77,6 @@ def load_at_pose(
     q = check_shape(pose, param("pose"), (6,))
     check_convention(convention)
     legs = as_flag(legs, param("legs"))
-    payload = as_real(payload, param("payload"))
-    gravity = as_real(gravity, param("gravity"))
     loaded, p_TP = carrying(platform, payload, payload_com, gravity, shown_com=shown_com, unit=unit)
     if leg_stiffness is not None:
         k = leg_stiffness_vector(leg_stiffness, param("leg_stiffness"))
@@ -102,12 +103,17 @@ def require_analysable(load: Load) -> None:
 def carrying(platform: Platform, payload: float, payload_com, gravity: float, *, shown_com=None, unit: str = "m"):
     """``(platform carrying the payload, p_TP (3,) m)`` after checking ``gravity`` (finite, >= 0) and that the
     payload sits on the plate (``shown_com``: its position as the user wrote it, in ``unit``)."""
+    payload = as_real(payload, param("payload"))
+    gravity = as_real(gravity, param("gravity"))
     if not (np.isfinite(gravity) and gravity >= 0):
         raise OptionError(OptionError.GRAVITY.format(option=param("gravity"), value=gravity))
-    p_TP = check_shape(payload_com, param("payload_com"), (3,))
+    check_gravity(gravity, param("gravity"))
+    if np.isfinite(payload) and payload > MAX_PAYLOAD:
+        raise PayloadError(PayloadError.TOO_HEAVY.format(option=param("payload"), value=payload, limit=MAX_PAYLOAD))
+    p_TP = check_finite(check_shape(payload_com, param("payload_com"), (3,)), param("payload_com"))
     shown = p_TP if shown_com is None else shown_com
     if shown[2] < 0:
-        raise PayloadError(PayloadError.BELOW_PLATE.format(z=shown[2], unit=unit))
+        raise PayloadError(PayloadError.BELOW_PLATE.format(option=param("payload_com"), z=shown[2], unit=unit))
     return with_payload(platform, payload, p_TP, param("payload")), p_TP
 
 
@@ -351,6 +357,7 @@ def modes(
         platform, pose, leg_stiffness, convention, legs, payload, payload_com, gravity, check_pose=False
     )
     check_modes_options(leg_damping, sample_rate)
+    drake = as_flag(drake, param("drake"))
     require_analysable(load)
     return modes_at(load, leg_damping, sample_rate, drake)
 

@@ -327,7 +327,7 @@ def solve_fk(
         check_finite(initial, param("initial"))
     check_convention(convention)
     method = as_choice(method, param("method"), FK_METHODS)
-    check_positive(as_real(tol, param("tol")), param("tol"), "metres")
+    tol = check_positive(as_real(tol, param("tol")), param("tol"), "metres")
     max_iter = as_int(max_iter, param("max_iter"), 1)
     seed = as_int(seed, param("seed"), 0, MAX_SEED)
     check_work(

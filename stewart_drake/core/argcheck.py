@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import math
+import os
 
 import numpy as np
 
@@ -131,10 +132,15 @@ def as_real(value, name: str) -> float:
     """One real number (a Python or numpy scalar, or a 0-d array): ``ArgumentError`` naming ``name`` otherwise
     (text, ``None``, complex, an array of several values). Not checked for being finite. A Python or numpy
     real number is returned as it is (a value that prints as the user typed it keeps doing so)."""
-    if isinstance(value, (bool, np.bool_)):
+    if isinstance(value, (bool, np.bool_, str, bytes)) or value is None:
         raise ArgumentError(ArgumentError.NOT_NUMBER.format(name=name, value=_shown(value)))
-    if isinstance(value, (int, float, np.integer, np.floating)):
+    if isinstance(value, (float, np.floating)) or (isinstance(value, (int, np.integer)) and abs(value) < 2**63):
         return value
+    if isinstance(value, int):  # beyond int64: numpy's isfinite cannot take it
+        try:
+            return float(value)
+        except OverflowError:
+            return math.copysign(math.inf, value)
     a = as_real_array(value, name)
     if a.shape != ():
         raise ArgumentError(ArgumentError.NOT_NUMBER.format(name=name, value=_shown(value)))
@@ -167,6 +173,16 @@ def as_choice(value, name: str, choices) -> str:
         raise ArgumentError(
             ArgumentError.CHOICE.format(name=name, value=_shown(value), choices=", ".join(map(repr, choices)))
         )
+    return value
+
+
+def check_path(value, name: str) -> str:
+    """``value`` as a path string: text or an ``os.PathLike`` (not a number, ``None`` or text with a NUL
+    character); ``ArgumentError`` naming ``name`` otherwise."""
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if not isinstance(value, str) or not value or "\0" in value:
+        raise ArgumentError(ArgumentError.NOT_TEXT.format(name=name, what="a file name", value=_shown(value)))
     return value
 
 

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.argcheck import as_flag
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
 from stewart_drake.core.geometry import Platform
@@ -168,7 +169,7 @@ TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
 
 
 def _fitted(trajectory: Trajectory, platform: Platform | None, fit: bool) -> Trajectory:
-    if not fit:
+    if not as_flag(fit, "fit"):
         return trajectory
     if platform is None:
         raise TrajectoryError(API_FIT_PLATFORM)
