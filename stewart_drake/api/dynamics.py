@@ -182,7 +182,12 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     units) RMS of the samples; a file whose second differences are rounding noise is refused without it. The
     file is read once as a stream (a FIFO works) within the memory budget."""
     a, _ = read_numeric_csv(
-        path, "trajectory", (7, 19), "see --help", option="--trajectory", bytes_per_row=BYTES_PER_SAMPLE + 600
+        path,
+        "trajectory",
+        (7, 19),
+        "t, px, py, pz, a, b, g [, their 6 rates, their 6 accelerations]",
+        option=param("trajectory"),
+        bytes_per_row=BYTES_PER_SAMPLE + 600,
     )
     width = a.shape[1]
     if len(a) < (2 if width == 19 else 4):

@@ -102,6 +102,13 @@ def setting(name: str, value: str) -> str:
     return f"{shown} {value}" if shown.startswith("--") else f"{shown}={value!r}"
 
 
+def switch(name: str) -> str:
+    """How a message tells the user to turn the option ``name`` on: ``name=True`` in Python, ``--name`` on the
+    command line."""
+    shown = param(name)
+    return shown if shown.startswith("--") else f"{shown}=True"
+
+
 def _shown(value) -> str:
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."

@@ -27,7 +27,7 @@ import os
 
 import numpy as np
 
-from stewart_drake.core.argcheck import as_real, as_real_array, check_shape, param, setting
+from stewart_drake.core.argcheck import as_real, as_real_array, check_shape, param, setting, switch
 from stewart_drake.core.kinematics import condition_number, leg_lengths, plate_anchors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import (
@@ -271,7 +271,9 @@ def check_trajectory(
     if v is None:
         return []
     if not allow_out_of_stroke:
-        raise PhysicalLimitError(stroke_message(v, what, "; --allow-out-of-stroke runs it anyway, with a warning"))
+        raise PhysicalLimitError(
+            stroke_message(v, what, f"; {switch('allow_out_of_stroke')} runs it anyway, with a warning")
+        )
     return [stroke_message(v, what)]
 
 
@@ -408,7 +410,7 @@ def check_work(
     """Refuse (``WorkTooLargeError``) a request of ``count`` items (``what``: "grid nodes", "samples")
     whose memory (``bytes_per`` each) exceeds ``memory_budget``, whose count exceeds ``max_count``, or
     whose time (``seconds_per`` each) exceeds ``max_seconds``. ``option``/``value`` name the user's
-    option as typed; ``hint`` ends the message (e.g. "; use a coarser --resolution")."""
+    option as typed; ``hint`` ends the message (e.g. "; use a coarser resolution")."""
     count = float(count)
     if not math.isfinite(count):
         raise WorkTooLargeError(WORK_UNBOUNDED.format(option=option, value=value, what=what, hint=hint))
@@ -467,7 +469,7 @@ def check_centre(platform, centre, option: str | None = None) -> np.ndarray:
 SERVO_PULSE_RANGE_US = (500.0, 2500.0)
 
 
-def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
+def check_servo_neutrals(hexapod, what: str = "trim") -> None:
     """``StewartError`` unless every neutral pulse W0_i (µs) is finite and leaves room for the full travel:
     W0_i ± travel·rate within ``SERVO_PULSE_RANGE_US``."""
     w0 = np.asarray(hexapod.neutral_us, dtype=float)
