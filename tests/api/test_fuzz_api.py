@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import warnings
 
 import numpy as np
@@ -20,7 +21,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import stewart_drake as sd
-from tests.cli._fuzz import ci, fuzz
+from tests.cli._fuzz import ROOT, ci, fuzz
 
 P = sd.load_platform("utn-dynamic")
 HOME = P.home_pose()
@@ -155,6 +156,13 @@ CALLS = {
         {"base_anchors": P.base_anchors, "top_anchors_per_leg": P.top_anchors_per_leg, "stroke": P.stroke},
     ),
     "Trajectory.seed": (sd.Trajectory.seed, {"platform": P, "fit": False}),
+    "Trajectory.rotating": (sd.Trajectory.rotating, {"platform": P, "fit": True}),
+    "Trajectory.from_program": (
+        sd.Trajectory.from_program,
+        {"path": str(ROOT / "examples" / "circle.stw"), "platform": P, "rate": 50.0, "convention": "utn"},
+    ),
+    "inspect_model": (sd.inspect_model, {"platform": P}),  # write= would write into the working folder
+    "viewer_readout": (sd.viewer_readout, {"platform": P, "pose": POSE, "convention": "utn", "modes": False}),
     "presets": (sd.presets, {}),
 }
 
@@ -164,11 +172,19 @@ FAST_INVALID = {
     "montecarlo": (sd.montecarlo, {"platform": P, "runs": 2, "seed": 0}),
     "optimize": (sd.optimize, {"budget": 24, "seed": 0, "pop_size": 24}),
     "prove_workspace": (sd.prove_workspace, {"platform": P, "box_lo": [0, 0, 0.6], "box_hi": [0.01, 0.01, 0.61]}),
+    "load_requirements": (sd.load_requirements, {"path": "no-such-requirements.yaml"}),
+    "calibrate": (sd.calibrate, {"platform": P, "noise": (), "seed": 0}),
+    "plan_measurements": (sd.plan_measurements, {"platform": P, "poses": 6, "candidates": 50, "targets": 3}),
+    "simulate_measurements": (
+        sd.simulate_measurements,
+        {"platform": P, "poses": [[0, 0, 0.7, 0, 0, 0]] * 3, "seed": 0, "targets": 3, "noise": ()},
+    ),
 }
 INVALID = st.sampled_from([None, "abc", math.nan, math.inf, -1, 1j, np.zeros((2, 3)), [math.nan] * 3, {"a": 1}])
 FAST_FIXED = {  # the arguments each slow name needs besides the replaced one
     "montecarlo": {"out": "never-written"},
     "optimize": {"requirements": "no-such-requirements.yaml"},
+    "calibrate": {"measurements": "no-such-measurements.csv"},
 }
 
 # Values a caller passes by mistake.
@@ -188,15 +204,26 @@ BAD = st.one_of(
 )
 
 
-def check_call(fn, kwargs: dict) -> None:
-    """``fn(**kwargs)`` raises a ``StewartError`` on one line with no ``--flag`` in it, or returns a result whose
-    ``to_dict()`` (where it has one) is strict JSON."""
+@pytest.fixture(autouse=True, scope="module")
+def scratch_folder(tmp_path_factory):
+    """Every call runs in an empty scratch folder: a path argument drawn as text names nothing of the user's."""
+    old = os.getcwd()
+    os.chdir(tmp_path_factory.mktemp("fuzz-api"))
+    yield
+    os.chdir(old)
+
+
+def check_call(fn, kwargs: dict, value=None) -> None:
+    """``fn(**kwargs)`` raises a ``StewartError`` with no ``--flag`` in it (beyond the ``value`` passed, which a
+    message may echo), or returns a result whose ``to_dict()`` (where it has one) is strict JSON."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", np.exceptions.ComplexWarning)  # a complex value cast silently
             result = fn(**kwargs)
     except sd.StewartError as e:
         text = str(e)
+        if isinstance(value, str) and "--" in value:  # the user's own text, echoed
+            text = text.replace(repr(value), "").replace(value, "")
         assert "--" not in text, f"the API names a command-line flag: {text}"
         return
     if hasattr(result, "to_dict"):
@@ -206,11 +233,11 @@ def check_call(fn, kwargs: dict) -> None:
 def replaced(data, table):
     name = data.draw(st.sampled_from(sorted(table)), label="call")
     fn, good = table[name]
-    kwargs = dict(good)
+    kwargs, value = dict(good), None
     if kwargs:
         arg = data.draw(st.sampled_from(sorted(kwargs)), label="argument")
-        kwargs[arg] = data.draw(BAD, label="value")
-    return fn, kwargs
+        kwargs[arg] = value = data.draw(BAD, label="value")
+    return fn, kwargs, value
 
 
 @pytest.mark.parametrize("name", sorted(CALLS))
@@ -232,6 +259,10 @@ OWNED_ELSEWHERE = {
     "simulate": "api/simulation.py: sd.simulate(None) and duration=None raise AttributeError / TypeError",
     "montecarlo": "montecarlo/api.py: platform=None raises AttributeError; runs' message names --runs",
     "prove_workspace": "synthesis/api.py: box_lo=1j raises TypeError, box_hi=None ValueError",
+    "load_requirements": "synthesis/requirements.py: path=None raises TypeError",
+    "calibrate": "api/calibration.py, calibration/noise.py: noise=[1, 2] raises TypeError; messages name --noise",
+    "plan_measurements": "api/calibration.py: poses=None raises TypeError; messages name --poses",
+    "simulate_measurements": "montecarlo/measurements_api.py: poses=None ValueError, seed=-1 ValueError",
 }
 
 
