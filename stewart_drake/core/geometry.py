@@ -419,13 +419,14 @@ def _finite_array(value, name, shape) -> np.ndarray:
 
 
 # legs.<field>: (sign, largest magnitude in SI): the platform file's rules (PLATFORM_RULES) for a Platform built
-# in code. Length-valued fields are bounded by their file rule's metres only through the file.
+# in code. Length-valued fields are bounded by their file rule's metres only through the file; a leg mass may be
+# 0 in code (massless legs: the seed's rigid-body model), never negative.
 _LEG_RULES = {
     "cylinder_length": ("nonneg", math.inf),
     "cylinder_radius": ("nonneg", math.inf),
     "piston_radius": ("nonneg", math.inf),
-    "cylinder_mass": ("pos", 1e4),
-    "piston_mass": ("pos", 1e4),
+    "cylinder_mass": ("nonneg", 1e4),
+    "piston_mass": ("nonneg", 1e4),
     "max_force": ("pos", 1e8),
     "max_speed": ("pos", math.inf),
     "max_power": ("pos", 1e9),

@@ -44,16 +44,16 @@ def test_a_loaded_platform_cannot_be_changed_in_place():
 @pytest.mark.parametrize(
     "field, value, rule",
     [
-        ("cylinder_mass", -5.0, "a positive number up to 10000"),
-        ("piston_mass", 0.0, "a positive number up to 10000"),
+        ("cylinder_mass", -5.0, "a number >= 0 up to 10000"),
+        ("piston_mass", 2e4, "a number >= 0 up to 10000"),
         ("max_force", float("nan"), "a positive number up to 1e+08"),
         ("cylinder_radius", -0.01, "a number >= 0"),
         ("stiffness", -1e6, "a positive number"),
     ],
 )
 def test_a_platform_built_in_code_is_checked_as_a_file_is(field, value, rule):
-    """``replace`` and direct construction run the platform file's leg rules (PLATFORM_RULES: masses in
-    (0, 1e4] kg, forces in (0, 1e8] N, radii >= 0)."""
+    """``replace`` and direct construction run the platform file's leg rules (PLATFORM_RULES: masses up to 1e4 kg,
+    never negative (0: massless legs), forces in (0, 1e8] N, radii >= 0)."""
     legs = dataclasses.replace(P.legs, **{field: value})
     message = GeometryError.LEG_FIELD.format(name=field, rule=rule, value=value)
     with pytest.raises(GeometryError, match=re.escape(message)):
