@@ -17,8 +17,8 @@ from stewart_drake.core.argcheck import cli_names
 from stewart_drake.errors import StewartError, UsageError
 
 # The API's parameter -> its flag, where the flag is not the parameter with ``--`` and ``-`` for ``_``
-# (``core.argcheck.param``): what the API's messages call ``trim_us`` the command line calls ``--trim``.
-CLI_NAMES = {"trim_us": "--trim", "pose": "--pose", "leg_stiffness": "--leg-stiffness"}
+# (``core.argcheck.param``): what the API's messages call ``all_modes`` the command line calls ``--all``.
+CLI_NAMES = {"all_modes": "--all"}
 
 # Every subcommand: its name -> (its module in ``stewart_drake.commands``, the one-line help that
 # ``stewart-drake --help`` lists; the module's own parser carries the same text, a test keeps them equal).

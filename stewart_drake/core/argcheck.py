@@ -147,7 +147,7 @@ def as_real(value, name: str) -> float:
         try:
             return float(value)
         except OverflowError:
-            return math.copysign(math.inf, value)
+            return math.inf if value > 0 else -math.inf
     a = as_real_array(value, name)
     if a.shape != ():
         raise ArgumentError(ArgumentError.NOT_NUMBER.format(name=name, value=_shown(value)))
