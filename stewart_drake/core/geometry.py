@@ -137,7 +137,9 @@ class PlatformConfig:
 
 @dataclass(frozen=True, eq=False)
 class Platform:
-    """A Stewart platform. Arrays are read-only numpy arrays in SI units.
+    """A Stewart platform, frozen: its arrays are read-only numpy arrays in SI units (views no one can make
+    writeable), its ``legs`` a frozen ``LegConfig``. Every construction (a file, ``replace``, the constructors)
+    checks the fields as a platform file's are checked (``GeometryError`` naming the field).
 
     Attributes:
         name: the platform's name, shown in outputs.
