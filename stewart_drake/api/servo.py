@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
-from stewart_drake.core.argcheck import as_flag, as_real_array, check_shape, param
+from stewart_drake.core.argcheck import as_flag, as_real_array, check_path, check_shape, param
 from stewart_drake.core.sanity import check_finite, check_servo_neutrals, check_servo_pose
 from stewart_drake.core.sdf_models import write_sdf as write_sdf_file
 from stewart_drake.core.servo import ServoHexapod, load_servo_hexapod, solve
@@ -117,7 +117,11 @@ def solve_servo(platform, pose, *, from_home=False, trim_us=None, write_sdf=None
         trim_us = check_finite(check_shape(trim_us, param("trim"), (6,)), f"{param('trim')} (µs)")
         check_servo_neutrals(hexapod.replace(neutral_us=trim_us), param("trim"))
         hexapod = hexapod.replace(neutral_us=trim_us)
-    sdf_file = None if write_sdf is None else write_sdf_file(hexapod, write_sdf, option=param("write_sdf"))
+    sdf_file = (
+        None
+        if write_sdf is None
+        else write_sdf_file(hexapod, check_path(write_sdf, param("write_sdf")), option=param("write_sdf"))
+    )
     if pose is None:
         q = np.zeros(6) if from_home else hexapod.home_pose()
     else:

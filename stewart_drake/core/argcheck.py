@@ -189,7 +189,7 @@ def check_path(value, name: str) -> str:
     if isinstance(value, os.PathLike):
         value = os.fspath(value)
     if not isinstance(value, str) or not value or "\0" in value:
-        raise ArgumentError(ArgumentError.NOT_TEXT.format(name=name, what="a file name", value=_shown(value)))
+        raise ArgumentError(ArgumentError.NOT_TEXT.format(name=name, what="a path", value=_shown(value)))
     return value
 
 
