@@ -14,7 +14,12 @@ import numpy as np
 
 from stewart_drake import __version__, commands
 from stewart_drake.core import interrupts, output_folder, processes
+from stewart_drake.core.argcheck import cli_names
 from stewart_drake.errors import StewartError, UsageError
+
+# The API's parameter -> its flag, where the flag is not the parameter with ``--`` and ``-`` for ``_``
+# (``core.argcheck.param``): what the API's messages call ``all_modes`` the command line calls ``--all``.
+CLI_NAMES = {"all_modes": "--all"}
 
 # Every subcommand: its name -> (its module in ``stewart_drake.commands``, the one-line help that
 # ``stewart-drake --help`` lists; the module's own parser carries the same text, a test keeps them equal).
@@ -204,7 +209,8 @@ def main(argv=None) -> int:
             interrupts.unwind()
         # Intermediate overflow/NaN in numpy is not reported as a multi-line RuntimeWarning: every result
         # is checked (finite inputs and outputs, strict JSON, the sanity checks) before it is printed.
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        # The API's messages name its parameters (max_iter); here they name the flags (--max-iter).
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"), cli_names(CLI_NAMES):
             return int(args.func(args) or 0)
     except (StewartError, ValueError) as e:
         print(f"stewart-drake {name}: error: {_one_line(e)}", file=sys.stderr)

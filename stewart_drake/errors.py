@@ -47,6 +47,8 @@ class GeometryError(StewartError):
     NOT_NUMBERS = "{name} must be numbers, got {value!r}"
     SHAPE = "{name} must have shape {shape}, got {got}"
     NOT_FINITE = "{name} must be finite, got {value}"
+    FIELD_KIND = "Platform.{name} must be {kind}, got {value!r}"
+    LEG_FIELD = "legs.{name} must be {rule}, got {value:g}"
     COINCIDE = "{what} {i} and {j} coincide at {at} m (closer than {limit} m)"
     TOO_WIDE = (
         "platform too wide for its stroke: a leg spans {span:.4f} m horizontally but mid-stroke is "
@@ -273,8 +275,9 @@ class PayloadError(StewartError):
     COM_NOT_FINITE = "{option}-com: payload centre of mass must be finite, got {value} m"
     COM_BELOW = "{option}-com: z = {z:g} m is below the plate (the plate frame's z >= 0 holds the plate and its load)"
 
+    TOO_HEAVY = "{option}: payload mass {value:g} kg is beyond {limit:g} kg (1000 t); is it in kg?"
     BELOW_PLATE = (
-        "--payload-com: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)"
+        "{option}: Z = {z:g} {unit} is below the plate (the plate frame's z >= 0 holds the plate and its load)"
     )
 
 
@@ -298,7 +301,7 @@ class WorkspaceError(StewartError):
     EXECUTOR = "executor must be a concurrent.futures.Executor (or have submit), got {kind}"
     GRID_TOO_LARGE = (
         "resolution {h:g} m would need {nodes:.1e} grid nodes ({why}); the finest this machine can "
-        "hold is ~{h_min_mm:.2g} mm; use a coarser --resolution"
+        "hold is ~{h_min_mm:.2g} mm; use a coarser {option}"
     )
     GRID_NODES = "more than the {limit:.0e} nodes one sweep may take"
     EMPTY_STROKE = "the stroke workspace at orientation {orientation} rad is empty (no common point of the legs' reach)"
@@ -459,8 +462,8 @@ class OptionError(UsageError):
     BETWEEN = "{option} must be between {lo} and {hi}, got {value}"
     GRAVITY = "{option} must be a finite number >= 0 m/s², got {value}"
     UNKNOWN_LIMIT = "{option}: unknown limit {value!r}; choose from {valid}"
-    DT = "--dt must be > 0 and --t-end >= 0, got dt = {dt}, t-end = {t_end}"
-    TOO_MANY_SAMPLES = "--t-end / --dt = {n} samples, more than {limit}"
+    DT = "{dt_name} must be > 0 and {t_end_name} >= 0, got dt = {dt}, t-end = {t_end}"
+    TOO_MANY_SAMPLES = "{t_end_name} / {dt_name} = {n} samples, more than {limit}"
     NO_STUDY = "--replay: {out!r} holds no finished study ({file} missing); run the study first"
     NO_RUN = "--replay {run}: the study in {out!r} has runs 0 … {last}"
     BAD_STUDY = "--replay: {path} is not a study written by stewart-drake montecarlo ({reason})"
@@ -477,6 +480,20 @@ class EngineError(UsageError):
     NONE = "no physics engine to cross-check with: {reasons}"
     TOO_MANY = "{option} {value} is more than {limit} (each is one engine evaluation per engine)"
     UNKNOWN = "--engine: unknown engine {value!r}; choose from {valid}"
+
+
+class ArgumentError(UsageError):
+    """An argument of the public API of the wrong kind: text or ``None`` for numbers, complex values, a
+    fraction for a count, a name that is not one of the choices, a non-platform for a platform."""
+
+    NOT_NUMBERS = "Expected {name} to be real numbers, got {value}"
+    NOT_NUMBER = "Expected {name} to be one real number, got {value}"
+    COMPLEX = "Expected {name} to be real numbers, got complex values {value} (the imaginary part is not dropped)"
+    NOT_INT = "Expected {name} to be a whole number{bounds}, got {value}"
+    CHOICE = "Expected {name} to be one of {choices}, got {value}"
+    NOT_BOOL = "Expected {name} to be True or False, got {value}"
+    NOT_TEXT = "Expected {name} to be {what} (text), got {value}"
+    NOT_PLATFORM = "Expected {name} to be a Platform (see load_platform), got {value}"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -575,7 +592,7 @@ BELOW_BASE = (
 )
 FAR_POSITION = (
     "{what}: position {pos_m} m is {ratio:.3g} × the platform's size ({size_m:.3f} m); positions beyond "
-    "{limit:g} × are surely a unit mistake (a file in mm read as metres? use --length-unit mm)"
+    "{limit:g} × are surely a unit mistake (a file in mm read as metres? use {hint})"
 )
 NOT_FINITE = "{what} must be finite, got {value}"
 NOT_POSITIVE = "{what} must be a positive number{unit}, got {value}"
@@ -983,8 +1000,8 @@ OPTION_FIRMWARE_ENGINE = "a firmware runs your C, so it cannot run with controll
 OPTION_VIEW_DURATION = "--duration must be between 0 and 86400 s, got {value!r}"
 OPTION_SPEED = "--speed must be a positive number, got {value!r}"
 OPTION_PORT = "--port must be in 1024..65535 (Meshcat does not listen on a privileged port), got {value}"
-OPTION_LEG_DAMPING = "--leg-damping must be a finite number >= 0 N·s/m, got {value}"
-OPTION_SAMPLE_RATE = "--sample-rate must be a positive number of Hz, got {value}"
+OPTION_LEG_DAMPING = "{name} must be a finite number >= 0 N·s/m, got {value}"
+OPTION_SAMPLE_RATE = "{name} must be a positive number of Hz, got {value}"
 OPTION_JOINT_ANGLES = "joint angles must be finite, got {value}"
 OPTION_JOINT_OVERFLOW = "joint angles {value} {unit}: the foot angle gamma = q1 + q2 + alpha overflows a float"
 OPTION_TARGET = "target must be finite, got {value}"
@@ -1162,6 +1179,6 @@ def short_text(value, limit: int = MAX_ECHO) -> str:
 
 
 OPTION_LEG_DAMPING_RESOLVE = (
-    "--leg-damping {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
+    "{name} {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
     "this overdamped are not resolved in double precision (one root per mode runs to ~0, the other to ~infinity)"
 )

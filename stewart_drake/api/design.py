@@ -8,10 +8,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.argcheck import as_flag, as_real, check_shape, param
+from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.kinematics import inverse_kinematics, leg_lengths, require_nonsingular
-from stewart_drake.core.rotations import rotation_matrix
-from stewart_drake.core.sanity import check_poses
+from stewart_drake.core.rotations import check_convention, rotation_matrix
+from stewart_drake.core.sanity import check_finite, check_gravity, check_poses
 from stewart_drake.design.load_limits import (
     MAX_DAMPING_RATIO,
     beyond_linear_range,
@@ -33,6 +34,9 @@ from stewart_drake.errors import (
     PhysicalLimitError,
     StewartError,
 )
+
+# The heaviest payload taken (kg): 1000 t, beyond the heaviest motion platforms built; more is a unit mistake.
+MAX_PAYLOAD = 1e6
 
 
 @dataclass
@@ -69,12 +73,16 @@ def load_at_pose(
     (``shown_com``: its position as the user wrote it, in ``unit``), the leg stiffness (argument, else the
     platform's ``legs.stiffness``), and the pose analysable (finite, near, above the base; then within the
     stroke and away from a singularity: ``PhysicalLimitError``)."""
+    check_platform(platform)
+    q = check_shape(pose, param("pose"), (6,))
+    check_convention(convention)
+    legs = as_flag(legs, param("legs"))
     loaded, p_TP = carrying(platform, payload, payload_com, gravity, shown_com=shown_com, unit=unit)
     if leg_stiffness is not None:
-        k = leg_stiffness_vector(leg_stiffness, "--leg-stiffness")
+        k = leg_stiffness_vector(leg_stiffness, param("leg_stiffness"))
     else:
         k = leg_stiffness_vector(platform.legs.stiffness, "legs.stiffness")
-    load = Load(loaded, np.asarray(pose, dtype=float).reshape(6), k, p_TP, gravity, bool(legs), payload, convention)
+    load = Load(loaded, q, k, p_TP, gravity, legs, payload, convention)
     if check_pose:
         require_analysable(load)
     return load
@@ -84,7 +92,7 @@ def require_analysable(load: Load) -> None:
     """Refuse a pose that cannot be analysed: the sanity checks every command applies (finite, near the
     platform, plate above the base), then within the stroke and away from a singularity
     (``PhysicalLimitError``)."""
-    check_poses(load.platform, load.q, load.convention, what="--pose")
+    check_poses(load.platform, load.q, load.convention, what=param("pose"))
     try:
         inverse_kinematics(load.platform, load.q, load.convention)
         require_nonsingular(load.platform, load.q, load.convention)
@@ -95,13 +103,18 @@ def require_analysable(load: Load) -> None:
 def carrying(platform: Platform, payload: float, payload_com, gravity: float, *, shown_com=None, unit: str = "m"):
     """``(platform carrying the payload, p_TP (3,) m)`` after checking ``gravity`` (finite, >= 0) and that the
     payload sits on the plate (``shown_com``: its position as the user wrote it, in ``unit``)."""
+    payload = as_real(payload, param("payload"))
+    gravity = as_real(gravity, param("gravity"))
     if not (np.isfinite(gravity) and gravity >= 0):
-        raise OptionError(OptionError.GRAVITY.format(option="--gravity", value=gravity))
-    shown = payload_com if shown_com is None else shown_com
+        raise OptionError(OptionError.GRAVITY.format(option=param("gravity"), value=gravity))
+    check_gravity(gravity, param("gravity"))
+    if np.isfinite(payload) and payload > MAX_PAYLOAD:
+        raise PayloadError(PayloadError.TOO_HEAVY.format(option=param("payload"), value=payload, limit=MAX_PAYLOAD))
+    p_TP = check_finite(check_shape(payload_com, param("payload_com"), (3,)), param("payload_com"))
+    shown = p_TP if shown_com is None else shown_com
     if shown[2] < 0:
-        raise PayloadError(PayloadError.BELOW_PLATE.format(z=shown[2], unit=unit))
-    p_TP = np.asarray(payload_com, dtype=float).reshape(3)
-    return with_payload(platform, payload, p_TP), p_TP
+        raise PayloadError(PayloadError.BELOW_PLATE.format(option=param("payload_com"), z=shown[2], unit=unit))
+    return with_payload(platform, payload, p_TP, param("payload")), p_TP
 
 
 @dataclass(repr=False)
@@ -344,16 +357,19 @@ def modes(
         platform, pose, leg_stiffness, convention, legs, payload, payload_com, gravity, check_pose=False
     )
     check_modes_options(leg_damping, sample_rate)
+    drake = as_flag(drake, param("drake"))
     require_analysable(load)
     return modes_at(load, leg_damping, sample_rate, drake)
 
 
 def check_modes_options(leg_damping: float, sample_rate: float) -> None:
     """``OptionError`` for a damping that is not finite and >= 0 or a sample rate that is not positive."""
+    leg_damping = as_real(leg_damping, param("leg_damping"))
+    sample_rate = as_real(sample_rate, param("sample_rate"))
     if not (np.isfinite(leg_damping) and leg_damping >= 0):
-        raise OptionError(OPTION_LEG_DAMPING.format(value=leg_damping))
+        raise OptionError(OPTION_LEG_DAMPING.format(name=param("leg_damping"), value=leg_damping))
     if not (np.isfinite(sample_rate) and sample_rate > 0):
-        raise OptionError(OPTION_SAMPLE_RATE.format(value=sample_rate))
+        raise OptionError(OPTION_SAMPLE_RATE.format(name=param("sample_rate"), value=sample_rate))
 
 
 def modes_at(load: Load, leg_damping: float, sample_rate: float, drake: bool) -> ModesResult:
@@ -366,7 +382,11 @@ def modes_at(load: Load, leg_damping: float, sample_rate: float, drake: bool) ->
         raise GeometryError(GeometryError.INERTIA_SINGULAR.format(name=p.name, mass=p.mass))
     zeta = damping_ratio_scale(K, M, C)
     if zeta > MAX_DAMPING_RATIO:
-        raise OptionError(OPTION_LEG_DAMPING_RESOLVE.format(value=leg_damping, zeta=zeta, limit=MAX_DAMPING_RATIO))
+        raise OptionError(
+            OPTION_LEG_DAMPING_RESOLVE.format(
+                name=param("leg_damping"), value=leg_damping, zeta=zeta, limit=MAX_DAMPING_RATIO
+            )
+        )
     m = analytic_modes(K, M, C)
     f1 = float(m.frequencies_hz[0])
     delay = 1.5 / sample_rate  # one sample of output delay + half a sample of zero-order hold

@@ -9,11 +9,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_choice, as_flag, as_real_array, param
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.rotations import angle_scale
 from stewart_drake.core.sanity import above_base, below_base_message, plate_anchor_heights
 from stewart_drake.errors import API_POSE_SHAPE, DspPoseError, UsageError
-from stewart_drake.firmware.engine import resolve_engine
+from stewart_drake.firmware.engine import ENGINES, resolve_engine
 from stewart_drake.firmware.host import tp17_leg_lengths_c
 from stewart_drake.fixedpoint.q15 import SaturationCounter
 from stewart_drake.fixedpoint.tp17 import TP17_GEOMETRY_MM, check_dsp_poses, tp17_error_stages, tp17_trace
@@ -105,7 +106,7 @@ class DspIKResult(Result):
 def firmware_pose(pose: ArrayLike, angle_unit: str = "rad", what: str = "pose") -> np.ndarray:
     """``(6,)`` a pose [px, py, pz mm, a, b, g in ``angle_unit``] as the firmware's [mm, fractions of pi];
     an angle beyond ±180° is refused naming ``A``/``B``/``G`` and the value as given."""
-    raw = np.asarray(pose, dtype=float)
+    raw = as_real_array(pose, what)
     if raw.shape != (6,):
         raise UsageError(API_POSE_SHAPE.format(what=what, shape=raw.shape))
     q = raw.copy()
@@ -137,9 +138,11 @@ def dsp_ik(pose: ArrayLike, *, engine: str = "python", trace: bool = False) -> D
     Raises:
         StewartError: a pose of the wrong shape, not finite, beyond ±pi or beyond the 16-bit mm words.
     """
-    q = np.asarray(pose, dtype=float)
+    q = as_real_array(pose, "pose")
     if q.shape != (6,):
         raise UsageError(API_POSE_SHAPE.format(what="pose", shape=q.shape))
+    engine = as_choice(engine, "engine", ENGINES)
+    trace = as_flag(trace, "trace")
     with np.errstate(over="ignore", invalid="ignore"):
         mm = np.round(q[:3] * 1e3, 9)
     return dsp_ik_firmware(firmware_pose(np.r_[mm, q[3:]], "rad"), engine=engine, trace=trace)
@@ -154,7 +157,7 @@ def dsp_ik_firmware(q: np.ndarray, *, engine: str = "python", trace: bool = Fals
     # outside the stroke. Any pose of the DSP's range (16-bit mm, one turn: ``check_dsp_poses``) is computed.
     kin = load_preset("utn-kinematic")
     pose_si = np.r_[np.trunc(q[:3]) * 1e-3, q[3:] * np.pi]
-    flags = [] if above_base(kin, pose_si) else [below_base_message("--pose", plate_anchor_heights(kin, pose_si))]
+    flags = [] if above_base(kin, pose_si) else [below_base_message(param("pose"), plate_anchor_heights(kin, pose_si))]
     with SaturationCounter() as sat:
         tr = tp17_trace(q)
     if sat.total:

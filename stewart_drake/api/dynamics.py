@@ -11,11 +11,12 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_flag, as_real, check_path, param
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import leg_forces, leg_forces_with_legs, seed_trajectory
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_tolerance, smoothing_spline
-from stewart_drake.core.rotations import angle_scale, length_scale
+from stewart_drake.core.rotations import angle_scale, check_convention, length_scale
 from stewart_drake.core.sanity import (
     check_finite,
     check_gravity,
@@ -125,8 +126,15 @@ def inverse_dynamics(
         StewartError: a platform without plate mass, bad samples or options; ``PhysicalLimitError`` when the
             trajectory leaves the stroke (unless allowed).
     """
+    check_platform(platform)
     require_plate(platform, "dynamics")
     gravity = check_gravity(gravity)
+    legs, coriolis = as_flag(legs, param("legs")), as_flag(coriolis, param("coriolis"))
+    allow_out_of_stroke = as_flag(allow_out_of_stroke, param("allow_out_of_stroke"))
+    check_convention(convention)
+    smooth = None if smooth is None else as_real(smooth, param("smooth"))
+    if not isinstance(trajectory, Trajectory):
+        trajectory = check_path(trajectory, param("trajectory"))
     read_units = None
     if isinstance(trajectory, Trajectory) and trajectory.t is not None and t_end is None:  # a program's samples
         t, q, qd, qdd = trajectory.t, trajectory.q, trajectory.qd, trajectory.qdd
@@ -174,7 +182,12 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
     units) RMS of the samples; a file whose second differences are rounding noise is refused without it. The
     file is read once as a stream (a FIFO works) within the memory budget."""
     a, _ = read_numeric_csv(
-        path, "trajectory", (7, 19), "see --help", option="--trajectory", bytes_per_row=BYTES_PER_SAMPLE + 600
+        path,
+        "trajectory",
+        (7, 19),
+        "t, px, py, pz, a, b, g [, their 6 rates, their 6 accelerations]",
+        option=param("trajectory"),
+        bytes_per_row=BYTES_PER_SAMPLE + 600,
     )
     width = a.shape[1]
     if len(a) < (2 if width == 19 else 4):
@@ -198,18 +211,20 @@ def read_trajectory_csv(path: str, length_unit: str = "m", angle_unit: str = "ra
 def sample_times(t_end: float, dt: float) -> np.ndarray:
     """``(n,)`` sample times 0, dt, ... t_end (s), after checking that both are finite and the sample count
     fits the memory and sample budget (before allocating)."""
-    check_finite(t_end, "--t-end (s)")
-    check_finite(dt, "--dt (s)")
+    names = {"dt_name": param("dt"), "t_end_name": param("t_end")}
+    t_end, dt = as_real(t_end, names["t_end_name"]), as_real(dt, names["dt_name"])
+    check_finite(t_end, f"{names['t_end_name']} (s)")
+    check_finite(dt, f"{names['dt_name']} (s)")
     if not (dt > 0 and t_end >= 0):
-        raise OptionError(OptionError.DT.format(dt=fmt_value(dt), t_end=fmt_value(t_end)))
+        raise OptionError(OptionError.DT.format(dt=fmt_value(dt), t_end=fmt_value(t_end), **names))
     n = math.floor(t_end / dt + 0.5) + 1
     check_work(
-        "--t-end/--dt",
+        f"{names['t_end_name']}/{names['dt_name']}",
         f"{fmt_value(t_end)}/{fmt_value(dt)} s",
         n,
         "samples",
         BYTES_PER_SAMPLE,
         MAX_SAMPLES,
-        hint="; use a larger --dt or a shorter --t-end",
+        hint=f"; use a larger {names['dt_name']} or a shorter {names['t_end_name']}",
     )
     return np.arange(0.0, t_end + dt / 2, dt)

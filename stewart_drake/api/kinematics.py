@@ -9,11 +9,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_choice, as_flag, as_int, as_real, as_real_array, check_shape, param
 from stewart_drake.core.assembly_modes import modes_from_solutions
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
 from stewart_drake.core.newton_fk import forward_kinematics, multiple_root
 from stewart_drake.core.realtime_fk import branch_check
+from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import (
     below_base_message,
     check_finite,
@@ -22,11 +24,15 @@ from stewart_drake.core.sanity import (
     check_work,
     plate_anchor_heights,
 )
-from stewart_drake.errors import API_POSE_SHAPE, OPTION_MAX_ITER, OptionError, UsageError
+from stewart_drake.errors import API_POSE_SHAPE, UsageError
 
 # Newton converges quadratically from a good start (< 20 iterations); beyond this many it is not
 # converging, and each iteration costs a Jacobian solve.
 MAX_ITER = 1000
+# The all-mode searches ``fk`` offers.
+FK_METHODS = ("homotopy", "multi-start")
+# numpy's seed sequences take any non-negative integer; the searches' seeds are stored as 64-bit words.
+MAX_SEED = 2**63 - 1
 
 
 @dataclass(repr=False)
@@ -105,7 +111,9 @@ def ik(platform: Platform, poses: ArrayLike, convention: str = "utn") -> IKResul
 
 def solve_ik(platform: Platform, poses, convention: str = "utn", what: str = "pose", lines=None) -> IKResult:
     """``ik`` with the name its errors give the poses (``what``, and the file ``lines`` they came from)."""
-    q = np.asarray(poses, dtype=float)
+    check_platform(platform)
+    check_convention(convention)
+    q = as_real_array(poses, param("poses"))
     if q.shape[-1:] != (6,):
         raise UsageError(API_POSE_SHAPE.format(what=what, shape=q.shape))
     flat = q.reshape(-1, 6)
@@ -306,23 +314,30 @@ def solve_fk(
 ) -> FKResult:
     """``fk`` with the names its errors give the lengths: ``what``, and ``given`` (the values as the user wrote
     them, in ``unit``; default ``lengths`` in metres)."""
-    given = lengths if given is None else given
+    check_platform(platform)
+    L = check_shape(lengths, what, (6,))
+    given = L if given is None else given
     for i, v in enumerate(given, 1):
         if not v > 0:
             raise UsageError(f"{what}: leg {i} length {v} {unit} must be a positive number")
     check_finite(given, what)
-    check_positive(tol, "--tol", "metres")
-    if max_iter < 1:
-        raise OptionError(OPTION_MAX_ITER.format(value=max_iter))
+    all_modes = as_flag(all_modes, param("all_modes"))
+    if initial is not None:
+        initial = check_shape(initial, param("initial"), (6,))
+        check_finite(initial, param("initial"))
+    check_convention(convention)
+    method = as_choice(method, param("method"), FK_METHODS)
+    tol = check_positive(as_real(tol, param("tol")), param("tol"), "metres")
+    max_iter = as_int(max_iter, param("max_iter"), 1)
+    seed = as_int(seed, param("seed"), 0, MAX_SEED)
     check_work(
-        "--max-iter",
+        param("max_iter"),
         str(max_iter),
         max_iter,
         "Newton iterations",
         max_count=MAX_ITER,
-        hint="; Newton converges in a few tens of iterations or not at all (without --max-iter, the multi-start search runs)",
+        hint="; Newton converges in a few tens of iterations or not at all",
     )
-    L = np.asarray(lengths, dtype=float)
     common = (L, platform.name, convention)
     allowed = {"below_base_allowed": platform.plate_below_base_allowed}
     if not all_modes:

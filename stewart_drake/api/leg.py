@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_choice, as_real
 from stewart_drake.core.leg3r import (
     Leg3R,
     foot,
@@ -24,7 +25,7 @@ __all__ = ["leg_fk", "leg_ik", "LegFKResult", "LegIKResult"]
 
 def make_leg(l1: float | None = None, l2: float | None = None, l3: float | None = None) -> Leg3R:
     """The seed-003 leg with the lengths given (m); the others at their defaults (80, 80, 30 mm)."""
-    dims = {n: v for n, v in (("l1", l1), ("l2", l2), ("l3", l3)) if v is not None}
+    dims = {n: as_real(v, n) for n, v in (("l1", l1), ("l2", l2), ("l3", l3)) if v is not None}
     return Leg3R(**dims)
 
 
@@ -106,7 +107,7 @@ def leg_fk(
     Raises:
         StewartError: a length that is not positive, angles that are not finite or whose sum overflows.
     """
-    return solve_leg_fk(np.array([q1, q2], dtype=float), make_leg(l1, l2, l3))
+    return solve_leg_fk(np.array([as_real(q1, "q1"), as_real(q2, "q2")], dtype=float), make_leg(l1, l2, l3))
 
 
 def solve_leg_fk(q: np.ndarray, leg: Leg3R, shown=None, unit: str = "rad", scale: float = 1.0) -> LegFKResult:
@@ -157,7 +158,9 @@ def leg_ik(
             branch.
     """
     leg = make_leg(l1, l2, l3)
-    t = np.array([px, py], dtype=float)
+    t = np.array([as_real(px, "px"), as_real(py, "py")], dtype=float)
+    gamma = None if gamma is None else as_real(gamma, "gamma")
+    branch = as_choice(branch, "branch", ("a", "b", "both"))
     if not np.all(np.isfinite(t)):
         raise LegError(OPTION_TARGET.format(value=t.tolist()))
     sols = {}

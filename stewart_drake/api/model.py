@@ -11,6 +11,7 @@ from pathlib import Path
 
 from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import check_path, param
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.sdf_models import platform_model_name
 from stewart_drake.core.sdf_models import write_sdf as write_sdf_file
@@ -84,7 +85,9 @@ def inspect_model(platform: Platform | str | Path, *, write: str | Path | None =
         StewartError: an unknown platform, a folder that cannot be written.
     """
     platform = load_platform(platform)
-    sdf_file = None if write is None else write_sdf_file(platform, write, option="--write")
+    sdf_file = (
+        None if write is None else write_sdf_file(platform, check_path(write, param("write")), option=param("write"))
+    )
     h = make_plant(platform)
     plant = h.plant
     instance = plant.GetModelInstanceByName(platform_model_name(platform))

@@ -11,11 +11,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.argcheck import as_flag, as_int, as_real, check_shape, param
+from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.processes import check_workers
+from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import check_centre, check_finite
-from stewart_drake.errors import OptionError
+from stewart_drake.errors import ArgumentError, OptionError
 from stewart_drake.workspace import (
     AXES,
     Limits,
@@ -55,12 +57,22 @@ class WorkspaceResult(Result):
 
 def parse_limits(limits, platform: Platform, joint_cone: float, leg_diameter: float | None, max_condition: float):
     """A ``workspace.Limits`` from a comma-separated list or a sequence of limit names (``LIMIT_CHOICES``)."""
-    names = [n.strip() for n in limits.split(",") if n.strip()] if isinstance(limits, str) else list(limits)
-    unknown = [n for n in names if n not in LIMIT_CHOICES]
+    if isinstance(limits, str):
+        names = [n.strip() for n in limits.split(",") if n.strip()]
+    elif isinstance(limits, (list, tuple)):
+        names = list(limits)
+    else:
+        raise ArgumentError(
+            ArgumentError.NOT_TEXT.format(name=param("limits"), what="limit names", value=repr(limits)[:80])
+        )
+    unknown = [n for n in names if not isinstance(n, str) or n not in LIMIT_CHOICES]
     if unknown:
         raise OptionError(
-            OptionError.UNKNOWN_LIMIT.format(option="--limits", value=unknown[0], valid=", ".join(LIMIT_CHOICES))
+            OptionError.UNKNOWN_LIMIT.format(option=param("limits"), value=unknown[0], valid=", ".join(LIMIT_CHOICES))
         )
+    joint_cone = as_real(joint_cone, param("joint_cone"))
+    max_condition = as_real(max_condition, param("max_condition"))
+    leg_diameter = None if leg_diameter is None else as_real(leg_diameter, param("leg_diameter"))
     kw = {}
     if "joints" in names:
         kw["base_cone"] = kw["top_cone"] = joint_cone
@@ -121,13 +133,18 @@ def solve_workspace(
     progress, orientation_shown,
 ) -> WorkspaceResult:  # fmt: skip
     """``workspace`` with the orientation as the user wrote it (``orientation_shown``) for its finiteness check."""
+    check_platform(platform)
+    check_convention(convention)
+    resolution = as_real(resolution, param("resolution"))
     if not (resolution > 0 and math.isfinite(resolution)):
-        raise OptionError(OptionError.POSITIVE.format(option="--resolution", unit="metres", value=resolution))
+        raise OptionError(OptionError.POSITIVE.format(option=param("resolution"), unit="metres", value=resolution))
     if centre is not None:
-        check_centre(platform, centre)
-    check_finite(orientation if orientation_shown is None else orientation_shown, "--orientation")
-    check_workers("--workers", workers)  # the one rule for worker counts (core.processes)
-    orientation = np.asarray(orientation, dtype=float)
+        centre = check_centre(platform, centre)
+    orientation = check_shape(orientation, param("orientation"), (3,))
+    check_finite(orientation if orientation_shown is None else orientation_shown, param("orientation"))
+    workers = as_int(workers, param("workers"))
+    check_workers(param("workers"), workers)  # the one rule for worker counts (core.processes)
+    progress = as_flag(progress, param("progress"))
     lim = parse_limits(limits, platform, joint_cone, leg_diameter, max_condition)
     w = constant_orientation_workspace(
         platform, orientation, resolution, lim, convention, workers=workers, progress=progress

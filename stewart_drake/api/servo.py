@@ -3,6 +3,7 @@ a pose, with the reach and travel checks."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,10 +11,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_flag, as_real_array, check_path, check_shape, param
 from stewart_drake.core.sanity import check_finite, check_servo_neutrals, check_servo_pose
 from stewart_drake.core.sdf_models import write_sdf as write_sdf_file
-from stewart_drake.core.servo import load_servo_hexapod, solve
-from stewart_drake.errors import API_POSE_SHAPE, OPTION_SERVO_POSE, ServoPoseError, UsageError
+from stewart_drake.core.servo import ServoHexapod, load_servo_hexapod, solve
+from stewart_drake.errors import API_POSE_SHAPE, OPTION_SERVO_POSE, ArgumentError, ServoPoseError, UsageError
 
 __all__ = ["servo", "ServoResult"]
 
@@ -96,23 +98,34 @@ def servo(
         StewartError: an unknown platform, a pose or trim that is not finite, a trim that leaves no room for
             the travel, an SDF folder that cannot be written.
     """
-    trim_us = None if trim is None else np.asarray(trim, dtype=float) / US
+    if trim is not None:
+        trim = check_finite(check_shape(trim, "trim", (6,)), "trim (s)")
+    trim_us = None if trim is None else trim / US
     return solve_servo(platform, pose, from_home=from_home, trim_us=trim_us, write_sdf=write_sdf)
 
 
 def solve_servo(platform, pose, *, from_home=False, trim_us=None, write_sdf=None, what="pose") -> ServoResult:
     """``servo`` with the trim in µs (as ``stewart-drake servo --trim`` takes it, so that its errors show the
     value typed) and ``what``, the name errors give the pose."""
+    named = isinstance(platform, (str, os.PathLike)) and "\0" not in os.fspath(platform)
+    if not named and not isinstance(platform, ServoHexapod):
+        raise ArgumentError(ArgumentError.NOT_PLATFORM.format(name="platform", value=repr(platform)[:80]))
     hexapod = load_servo_hexapod(platform)
+    from_home = as_flag(from_home, param("from_home"))
     check_servo_neutrals(hexapod, f"{platform}: servo.neutral_us")
     if trim_us is not None:
-        check_servo_neutrals(hexapod.replace(neutral_us=check_finite(trim_us, "--trim (µs)")), "--trim")
-        hexapod = hexapod.replace(neutral_us=np.asarray(trim_us, dtype=float))
-    sdf_file = None if write_sdf is None else write_sdf_file(hexapod, write_sdf, option="--write-sdf")
+        trim_us = check_finite(check_shape(trim_us, param("trim"), (6,)), f"{param('trim')} (µs)")
+        check_servo_neutrals(hexapod.replace(neutral_us=trim_us), param("trim"))
+        hexapod = hexapod.replace(neutral_us=trim_us)
+    sdf_file = (
+        None
+        if write_sdf is None
+        else write_sdf_file(hexapod, check_path(write_sdf, param("write_sdf")), option=param("write_sdf"))
+    )
     if pose is None:
         q = np.zeros(6) if from_home else hexapod.home_pose()
     else:
-        q = np.array(pose, dtype=float)
+        q = np.array(as_real_array(pose, what), dtype=float)
         if q.shape != (6,):
             raise UsageError(API_POSE_SHAPE.format(what=what, shape=q.shape))
         if not np.all(np.isfinite(q)):

@@ -12,8 +12,10 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.design import carrying
 from stewart_drake.api.dynamics import read_trajectory_csv, trajectory_rates
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_flag, as_real, check_path, param
 from stewart_drake.core.dynamics import seed_trajectory
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, check_platform
+from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
@@ -121,6 +123,15 @@ def size(
     Raises:
         StewartError: not exactly one source, bad options or samples.
     """
+    check_platform(platform)
+    check_convention(convention)
+    legs = as_flag(legs, "legs")
+    smooth = None if smooth is None else as_real(smooth, "smooth")
+    for name, value in (("program", program), ("envelope", envelope)):
+        if value is not None:
+            check_path(value, name)
+    if trajectory is not None and not isinstance(trajectory, Trajectory):
+        check_path(trajectory, "trajectory")
     sources = [s for s in (trajectory, program, envelope) if s is not None]
     if len(sources) != 1:
         raise OptionError(API_SIZE_SOURCE.format(given=len(sources)))
@@ -197,8 +208,9 @@ def size_loaded(
 def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit, smooth=None):
     """``(source name, t, q, q̇, q̈, convention)`` of the motion to size."""
     if program is not None:
+        rate = as_real(rate, param("rate"))
         if not (np.isfinite(rate) and rate > 0):
-            raise OptionError(OptionError.POSITIVE.format(option="--rate", unit="samples per second", value=rate))
+            raise OptionError(OptionError.POSITIVE.format(option=param("rate"), unit="samples per second", value=rate))
         tr = run_program(read_program(program), program, platform, rate=rate, convention=convention).trajectory
         return program, tr.t, tr.q, tr.qd, tr.qdd, convention
     if isinstance(trajectory, Trajectory):
@@ -215,11 +227,14 @@ def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_
 
 
 def _times(t_end: float, dt: float) -> np.ndarray:
+    names = {"dt_name": param("dt"), "t_end_name": param("t_end")}
+    t_end, dt = as_real(t_end, names["t_end_name"]), as_real(dt, names["dt_name"])
     if not (np.isfinite(dt) and dt > 0 and np.isfinite(t_end) and t_end >= 0):
-        raise OptionError(OptionError.DT.format(dt=dt, t_end=t_end))
-    n = int(np.floor(t_end / dt + 0.5)) + 1
+        raise OptionError(OptionError.DT.format(dt=dt, t_end=t_end, **names))
+    n = np.floor(t_end / dt + 0.5) + 1
     if n > MAX_SAMPLES:
-        raise OptionError(OptionError.TOO_MANY_SAMPLES.format(n=n, limit=MAX_SAMPLES))
+        raise OptionError(OptionError.TOO_MANY_SAMPLES.format(n=f"{n:.3g}", limit=MAX_SAMPLES, **names))
+    n = int(n)
     return np.arange(n) * dt
 
 

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.kinematics import solve_ik
 from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import as_flag, check_shape
 from stewart_drake.core.geometry import Platform
 from stewart_drake.drake.viewer import Readout, readout
 
@@ -112,6 +113,7 @@ def viewer_readout(
         StewartError: an unknown platform, a pose of the wrong shape, not finite or far outside the platform.
     """
     platform = load_platform(platform)
-    q = platform.home_pose() if pose is None else np.asarray(pose, dtype=float)
+    q = platform.home_pose() if pose is None else check_shape(pose, "pose", (6,))
+    modes = as_flag(modes, "modes")
     solve_ik(platform, q, convention)  # the pose checks of ik: shape, finite, within reach of the platform
     return ViewerReadout.from_readout(readout(platform, q, convention, modes))

@@ -9,6 +9,8 @@ metres and masses kilograms inside the library; YAML files may use millimetres (
 # The YAML schema dataclasses' field types are read by yamlio (typing.get_type_hints).
 
 import dataclasses
+import math
+import os
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -16,11 +18,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from stewart_drake.core.argcheck import as_real_array
 from stewart_drake.core.joints import coincident_groups, first_close_pair
 from stewart_drake.core.rotations import length_scale
 from stewart_drake.core.sanity import check_home
 from stewart_drake.core.yamlio import Rule, check_rules, load_yaml_typed
-from stewart_drake.errors import GeometryError, YamlError
+from stewart_drake.errors import ArgumentError, GeometryError, YamlError
 
 SQRT3 = np.sqrt(3.0)
 PRESETS = ("utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009")
@@ -64,10 +67,11 @@ class PlateConfig:
     density: float | None = None
 
 
-@dataclass
+@dataclass(frozen=True)
 class LegConfig:
     """Physical legs for the Drake model: a cylinder on a universal joint at the base and a piston
-    on a prismatic joint (lengths in the file's unit, masses kg)."""
+    on a prismatic joint (lengths in the file's unit, masses kg). Frozen; a ``Platform`` holds a checked copy
+    whose ``length_offset`` and ``length_gain`` are tuples, in metres."""
 
     cylinder_length: float = 0.0  # 0: half of the minimum stroke length
     cylinder_radius: float = 0.0  # 0: 1/40 of the minimum stroke length
@@ -133,7 +137,9 @@ class PlatformConfig:
 
 @dataclass(frozen=True, eq=False)
 class Platform:
-    """A Stewart platform. Arrays are read-only numpy arrays in SI units.
+    """A Stewart platform, frozen: its arrays are read-only numpy arrays in SI units (views no one can make
+    writeable), its ``legs`` a frozen ``LegConfig``. Every construction (a file, ``replace``, the constructors)
+    checks the fields as a platform file's are checked (``GeometryError`` naming the field).
 
     Attributes:
         name: the platform's name, shown in outputs.
@@ -167,6 +173,7 @@ class Platform:
     plate_below_base_allowed: bool = False  # poses may put plate anchors at or below z = 0 (sanity.above_base)
 
     def __post_init__(self):
+        _check_kinds(self)
         conv = {
             "base_anchors": (6, 3),
             "top_anchors": None,
@@ -194,14 +201,13 @@ class Platform:
         unused = sorted(set(range(top.shape[0])) - set(leg_top.tolist()))
         if unused:
             raise GeometryError(GeometryError.LEG_TOP_UNUSED.format(anchor=unused[0]))
-        leg_top = leg_top.astype(np.intp)
-        leg_top.flags.writeable = False
-        object.__setattr__(self, "leg_top", leg_top)
+        object.__setattr__(self, "leg_top", _read_only(leg_top.astype(np.intp)))
         check_base_anchors(self.base_anchors)
         _check_distinct(top, "top anchors")
         lmin, lmax = self.stroke
         if not 0 < lmin < lmax:
             raise GeometryError(GeometryError.STROKE.format(lmin=lmin, lmax=lmax))
+        object.__setattr__(self, "legs", _checked_legs(self.legs))
         self.length_offset  # noqa: B018 -- validates legs.length_offset: six finite numbers (or none)
         self.length_gain  # noqa: B018 -- validates legs.length_gain: six positive numbers (or none)
         if not np.isfinite(self.mass) or self.mass < 0:
@@ -339,8 +345,10 @@ class Platform:
 def utn_anchors(b: float, d: float, a: float) -> tuple[np.ndarray, np.ndarray]:
     """The UTN 3-6 anchors: ``(6, 3)`` base anchors and ``(3, 3)`` top anchors, same unit as b, d, a."""
     for name, value in (("b", b), ("d", d), ("a", a)):
+        value = _number(value, name)
         if not np.isfinite(value) or value <= 0:
             raise GeometryError(GeometryError.UTN_DIMENSION.format(name=name, value=value))
+    b, d, a = (_number(v, n) for v, n in ((b, "b"), (d, "d"), (a, "a")))
     s = SQRT3 / 6
     base = np.array(
         [
@@ -370,25 +378,101 @@ def triangular_plate(side: float, thickness: float, density: float) -> tuple[flo
 
 
 def _circle_points(radius, angles, what) -> np.ndarray:
-    angles = np.asarray(angles, dtype=float)
+    angles = _real_array(angles, f"{what}_angles")
     if angles.shape != (6,):
         raise GeometryError(GeometryError.CIRCLE_ANGLES.format(what=what, shape=angles.shape))
+    radius = _number(radius, f"{what}_radius")
     if not np.isfinite(radius) or radius <= 0:
         raise GeometryError(GeometryError.CIRCLE_RADIUS.format(what=what, value=radius))
     return np.stack([radius * np.cos(angles), radius * np.sin(angles), np.zeros(6)], -1)
 
 
-def _finite_array(value, name, shape) -> np.ndarray:
+def _real_array(value, name) -> np.ndarray:
+    """``value`` as a new float array; ``GeometryError`` for what is not real numbers (text, None, complex)."""
     try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
+        return np.array(as_real_array(value, name), dtype=float)
+    except ArgumentError:
         raise GeometryError(GeometryError.NOT_NUMBERS.format(name=name, value=value)) from None
+
+
+def _number(value, name) -> float:
+    """One real number (not checked for being finite); ``GeometryError`` naming ``name`` otherwise."""
+    arr = _real_array(value, name)
+    if arr.shape != () or isinstance(value, (bool, np.bool_)):
+        raise GeometryError(GeometryError.NOT_NUMBERS.format(name=name, value=value))
+    return float(arr)
+
+
+def _read_only(arr: np.ndarray) -> np.ndarray:
+    """A view of ``arr`` that no one can make writeable again (its base is read-only)."""
+    arr.flags.writeable = False
+    view = arr.view()
+    view.flags.writeable = False
+    return view
+
+
+def _finite_array(value, name, shape) -> np.ndarray:
+    arr = _real_array(value, name)
     if shape is not None and arr.shape != shape:
         raise GeometryError(GeometryError.SHAPE.format(name=name, shape=shape, got=arr.shape))
     if not np.all(np.isfinite(arr)):
         raise GeometryError(GeometryError.NOT_FINITE.format(name=name, value=arr.tolist()))
-    arr.flags.writeable = False
-    return arr
+    return _read_only(arr)
+
+
+# legs.<field>: (sign, largest magnitude in SI): the platform file's rules (PLATFORM_RULES) for a Platform built
+# in code. Length-valued fields are bounded by their file rule's metres only through the file; a leg mass may be
+# 0 in code (massless legs: the seed's rigid-body model), never negative.
+_LEG_RULES = {
+    "cylinder_length": ("nonneg", math.inf),
+    "cylinder_radius": ("nonneg", math.inf),
+    "piston_radius": ("nonneg", math.inf),
+    "cylinder_mass": ("nonneg", 1e4),
+    "piston_mass": ("nonneg", 1e4),
+    "max_force": ("pos", 1e8),
+    "max_speed": ("pos", math.inf),
+    "max_power": ("pos", 1e9),
+    "stiffness": ("pos", math.inf),
+}
+
+
+def _check_kinds(p: "Platform") -> None:
+    """The non-array fields of a ``Platform`` are of their types (``GeometryError`` naming the field)."""
+    kinds = (
+        ("name", str, "text"),
+        ("description", str, "text"),
+        ("plate_below_base_allowed", (bool, np.bool_), "a bool"),
+    )
+    for name, kind, shown in kinds:
+        if not isinstance(getattr(p, name), kind):
+            raise GeometryError(GeometryError.FIELD_KIND.format(name=name, kind=shown, value=getattr(p, name)))
+    object.__setattr__(p, "plate_below_base_allowed", bool(p.plate_below_base_allowed))
+    if not isinstance(p.legs, LegConfig):
+        raise GeometryError(GeometryError.FIELD_KIND.format(name="legs", kind="a LegConfig", value=p.legs))
+    object.__setattr__(p, "mass", _number(p.mass, "mass"))
+    if p.home_height is not None:
+        object.__setattr__(p, "home_height", _number(p.home_height, "home_height"))
+
+
+def _checked_legs(legs: LegConfig) -> LegConfig:
+    """``legs`` checked as a platform file's ``legs:`` block is (finite numbers, signs, magnitudes), with its
+    per-leg lists as tuples."""
+    values = {}
+    for name, (sign, largest) in _LEG_RULES.items():
+        v = getattr(legs, name)
+        if v is None and name in ("max_speed", "max_power", "stiffness"):
+            continue
+        v = _number(v, f"legs.{name}")
+        ok = math.isfinite(v) and (v > 0 if sign == "pos" else v >= 0) and abs(v) <= largest
+        if not ok:
+            rule = ("a positive number" if sign == "pos" else "a number >= 0") + (
+                f" up to {largest:g}" if math.isfinite(largest) else ""
+            )
+            raise GeometryError(GeometryError.LEG_FIELD.format(name=name, rule=rule, value=v))
+        values[name] = v
+    for name in ("length_offset", "length_gain"):
+        values[name] = tuple(float(x) for x in _real_array(getattr(legs, name), f"legs.{name}").reshape(-1))
+    return dataclasses.replace(legs, **values)
 
 
 def _check_distinct(points: np.ndarray, what: str) -> None:
@@ -666,11 +750,26 @@ def load_preset(name: str) -> Platform:
     return load_platform_yaml(preset_path(name))
 
 
+def check_platform(value, name: str = "platform") -> Platform:
+    """``value`` when it is a ``Platform``; ``ArgumentError`` naming ``name`` otherwise (a preset name or a file
+    is loaded by ``load_platform``, not here)."""
+    if not isinstance(value, Platform):
+        shown = repr(value)
+        raise ArgumentError(
+            ArgumentError.NOT_PLATFORM.format(name=name, value=shown if len(shown) <= 80 else shown[:77] + "...")
+        )
+    return value
+
+
 def load_platform(name_or_path) -> Platform:
     """A preset name or a path to a YAML file."""
     if isinstance(name_or_path, Platform):
         return name_or_path
-    s = str(name_or_path)
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        check_platform(name_or_path, "name_or_path")
+    s = os.fspath(name_or_path)
+    if not isinstance(s, str) or "\0" in s:
+        raise GeometryError(GeometryError.UNKNOWN_PLATFORM.format(name=repr(s), presets=", ".join(PRESETS)))
     if s in PRESETS:
         return load_preset(s)
     if s.endswith((".yaml", ".yml")) or Path(s).exists():

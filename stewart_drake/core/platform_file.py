@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from stewart_drake.core.argcheck import as_real_array, check_shape
 from stewart_drake.core.geometry import CalibrationRecord, Platform
 from stewart_drake.errors import API_FILE_EXISTS, OutputError
 
@@ -43,7 +44,7 @@ def platform_document(platform: Platform, calibration: CalibrationRecord | None 
     base, leg_base = unique_rows(platform.base_anchors)
     I = platform.inertia
     legs = {k: v for k, v in dataclasses.asdict(platform.legs).items() if v is not None}
-    legs = {k: [float(x) for x in v] if isinstance(v, list) else float(v) for k, v in legs.items()}
+    legs = {k: [float(x) for x in v] if isinstance(v, (list, tuple)) else float(v) for k, v in legs.items()}
     if not np.any(platform.length_offset):
         legs.pop("length_offset", None)
     if not platform.has_sensor_gains:
@@ -93,15 +94,15 @@ def platform_from_anchors(base_anchors, top_anchors_per_leg, stroke, name: str =
     """A ``Platform`` from each leg's base anchor ``(6, 3)`` (in B) and plate anchor ``(6, 3)`` (in T), metres;
     legs that share a plate point share its anchor. ``kwargs``: the other ``Platform`` fields (mass, com,
     inertia default to a massless plate)."""
-    top, leg_top = unique_rows(top_anchors_per_leg)
+    top, leg_top = unique_rows(check_shape(top_anchors_per_leg, "top_anchors_per_leg", (6, 3)))
     kwargs.setdefault("mass", 0.0)
     kwargs.setdefault("com", np.zeros(3))
     kwargs.setdefault("inertia", np.zeros((3, 3)))
     return Platform(
         name=name,
-        base_anchors=np.asarray(base_anchors, dtype=float),
+        base_anchors=as_real_array(base_anchors, "base_anchors"),
         top_anchors=top,
         leg_top=leg_top,
-        stroke=np.asarray(stroke, dtype=float),
+        stroke=as_real_array(stroke, "stroke"),
         **kwargs,
     )

@@ -44,8 +44,9 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.argcheck import as_int, as_real, as_real_array
 from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.kinematics import anchor_radius
 from stewart_drake.core.newton_fk import CONVERGED, leg_geometry, newton_core, validate_lengths
 from stewart_drake.core.rotations import CONVENTIONS, angles_from_matrix, check_convention, rotation_matrix
@@ -61,6 +62,8 @@ OPT = "-O2"
 # instruction (no errno branch; the same results), 3 % fewer (callgrind)
 FLAGS = ("-funroll-loops", "-fno-math-errno")
 INFO = ("residual", "iterations", "status", "certified", "radius", "eta", "step", "substeps")
+# Newton converges in tens of iterations or not at all; the C kernel counts iterations and substeps in ints.
+MAX_ITERATIONS = 10_000
 MARGIN = 1e-9  # relative margin on the bounds (the C kernel's MARGIN)
 NO_COMPILER_NOTE = "note: no C compiler: real-time FK runs the numpy Newton (~100x slower per call)"
 _LIB: list = []
@@ -122,13 +125,14 @@ class RealtimeFK:
         max_substeps: int = 0,
         engine: str = "auto",
     ):
+        check_platform(platform)
         check_convention(convention)
-        for name, v in (("tol", tol),):
-            if not (np.isfinite(v) and v > 0):
-                raise FkInputError(FkInputError.POSITIVE.format(name=name, value=v))
-        if int(max_iter) != max_iter or max_iter < 1:
-            raise FkInputError(FkInputError.MAX_ITER.format(value=max_iter))
-        if engine not in ("auto", "c", "numpy"):
+        tol = as_real(tol, "tol")
+        if not (np.isfinite(tol) and tol > 0):
+            raise FkInputError(FkInputError.POSITIVE.format(name="tol", value=tol))
+        max_iter = as_int(max_iter, "max_iter", 1, MAX_ITERATIONS)
+        max_substeps = as_int(max_substeps, "max_substeps", 0, MAX_ITERATIONS)
+        if not isinstance(engine, str) or engine not in ("auto", "c", "numpy"):
             raise FkInputError(FkInputError.ENGINE.format(value=engine))
         self.platform, self.convention = platform, convention
         self.tol, self.max_iter, self.max_substeps = float(tol), int(max_iter), int(max_substeps)
@@ -174,8 +178,8 @@ class RealtimeFK:
 
     # ------------------------------------------------------------------------------------------
     def _run(self, lengths, previous, track: bool) -> RealtimeResult:
-        L = np.ascontiguousarray(validate_lengths(lengths).reshape(-1, 6))
-        q0 = np.ascontiguousarray(np.asarray(previous, dtype=float))
+        L = np.ascontiguousarray(validate_lengths(as_real_array(lengths, "lengths")).reshape(-1, 6))
+        q0 = np.ascontiguousarray(as_real_array(previous, "previous"))
         if q0.shape != (6,) and q0.shape != L.shape:
             raise FkInputError(FkInputError.INITIAL_BROADCAST.format(shape=q0.shape, lengths_shape=L.shape))
         if not np.all(np.isfinite(q0)):

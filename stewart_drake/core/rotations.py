@@ -25,7 +25,7 @@ LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 
 def check_convention(convention: str) -> str:
     """Return ``convention`` if it is known, else raise RotationError naming it."""
-    if convention not in CONVENTIONS:
+    if not isinstance(convention, str) or convention not in CONVENTIONS:
         raise RotationError(RotationError.CONVENTION.format(value=convention, valid=", ".join(CONVENTIONS)))
     return convention
 

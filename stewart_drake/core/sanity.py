@@ -27,6 +27,7 @@ import os
 
 import numpy as np
 
+from stewart_drake.core.argcheck import as_real, as_real_array, check_shape, param, setting, switch
 from stewart_drake.core.kinematics import condition_number, leg_lengths, plate_anchors
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.errors import (
@@ -73,8 +74,9 @@ def fmt_value(v) -> str:
 
 
 def check_finite(value, what: str) -> np.ndarray:
-    """``value`` as a float array; ``StewartError`` naming ``what`` if any element is NaN or infinite."""
-    a = np.asarray(value, dtype=float)
+    """``value`` as a float array; ``StewartError`` naming ``what`` if it is not real numbers or any element is NaN
+    or infinite."""
+    a = as_real_array(value, what)
     if not np.all(np.isfinite(a)):
         shown = fmt_value(a) if a.ndim == 0 else "[" + ", ".join(fmt_value(x) for x in a.ravel()[:12]) + "]"
         raise StewartError(NOT_FINITE.format(what=what, value=shown))
@@ -83,15 +85,17 @@ def check_finite(value, what: str) -> np.ndarray:
 
 def check_positive(value, what: str, unit: str = "") -> float:
     """A finite, strictly positive float, or ``StewartError`` naming ``what``."""
-    v = float(value)
+    v = float(as_real(value, what))
     if not (math.isfinite(v) and v > 0):
         raise StewartError(NOT_POSITIVE.format(what=what, unit=" of " + unit if unit else "", value=fmt_value(v)))
     return v
 
 
-def check_gravity(g: float, option: str = "--gravity") -> float:
-    """Gravity in m/s²: finite and within ±100 m/s² (10 g; larger is a unit mistake)."""
-    v = float(g)
+def check_gravity(g: float, option: str | None = None) -> float:
+    """Gravity in m/s²: finite and within ±100 m/s² (10 g; larger is a unit mistake). ``option``: its name in
+    messages (default ``param("gravity")``)."""
+    option = param("gravity") if option is None else option
+    v = float(as_real(g, option))
     if not math.isfinite(v):
         raise StewartError(NOT_FINITE.format(what=f"{option} (m/s²)", value=fmt_value(v)))
     if abs(v) > 100.0:
@@ -118,7 +122,7 @@ def servo_hexapod_size(hexapod) -> float:
     return max(r_base, r_top, hexapod.arm_length + hexapod.rod_length, hexapod.home_height)
 
 
-def check_servo_pose(hexapod, pose, what: str = "--pose") -> None:
+def check_servo_pose(hexapod, pose, what: str = "pose") -> None:
     """``StewartError`` when the position of ``pose`` (6,) (m, rad; finite) lies farther than ``FAR_FACTOR`` ×
     ``servo_hexapod_size`` from the base centre: a unit mistake, as for a platform (``check_poses``), not a
     pose to call unreachable with a 150-digit ratio."""
@@ -128,7 +132,12 @@ def check_servo_pose(hexapod, pose, what: str = "--pose") -> None:
     if r > FAR_FACTOR * size:
         raise StewartError(
             FAR_POSITION.format(
-                what=what, pos_m=[float(f"{x:.6g}") for x in p], ratio=r / size, size_m=size, limit=FAR_FACTOR
+                what=what,
+                pos_m=[float(f"{x:.6g}") for x in p],
+                ratio=r / size,
+                size_m=size,
+                limit=FAR_FACTOR,
+                hint=setting("length_unit", "mm"),
             )
         )
 
@@ -187,6 +196,7 @@ def check_poses(
                 ratio=r[i] / size,
                 size_m=size,
                 limit=FAR_FACTOR,
+                hint=setting("length_unit", "mm"),
             )
         )
     if base and not getattr(platform, "plate_below_base_allowed", False):
@@ -261,7 +271,9 @@ def check_trajectory(
     if v is None:
         return []
     if not allow_out_of_stroke:
-        raise PhysicalLimitError(stroke_message(v, what, "; --allow-out-of-stroke runs it anyway, with a warning"))
+        raise PhysicalLimitError(
+            stroke_message(v, what, f"; {switch('allow_out_of_stroke')} runs it anyway, with a warning")
+        )
     return [stroke_message(v, what)]
 
 
@@ -358,8 +370,10 @@ def memory_budget() -> int:
 
 
 def human_bytes(n: float) -> str:
-    """``512 MB``, ``3.4 GB``, ``~10^19 GB`` for absurd sizes."""
+    """``512 MB``, ``3.4 GB``, ``~10^19 GB`` for absurd sizes, ``unboundedly many GB`` beyond the floats."""
     n = float(n)
+    if not math.isfinite(n):
+        return "unboundedly many GB"
     if n >= 1e15:
         return f"~10^{int(math.floor(math.log10(n / 1e9)))} GB"
     for unit, k in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
@@ -371,6 +385,8 @@ def human_bytes(n: float) -> str:
 def human_seconds(s: float) -> str:
     """A duration in seconds as people read it (s, min, h, days or years), for work estimates."""
     s = float(s)
+    if not math.isfinite(s):
+        return "forever"
     if s >= 86400 * 365:
         return f"~{s / (86400 * 365):.2g} years"
     if s >= 3600:
@@ -394,7 +410,7 @@ def check_work(
     """Refuse (``WorkTooLargeError``) a request of ``count`` items (``what``: "grid nodes", "samples")
     whose memory (``bytes_per`` each) exceeds ``memory_budget``, whose count exceeds ``max_count``, or
     whose time (``seconds_per`` each) exceeds ``max_seconds``. ``option``/``value`` name the user's
-    option as typed; ``hint`` ends the message (e.g. "; use a coarser --resolution")."""
+    option as typed; ``hint`` ends the message (e.g. "; use a coarser resolution")."""
     count = float(count)
     if not math.isfinite(count):
         raise WorkTooLargeError(WORK_UNBOUNDED.format(option=option, value=value, what=what, hint=hint))
@@ -428,10 +444,12 @@ def check_work(
         )
 
 
-def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
+def check_centre(platform, centre, option: str | None = None) -> np.ndarray:
     """A rotation centre ``(3,)`` (m, plate frame): finite and within ``FAR_FACTOR`` × ``platform_size``
-    of the plate's origin (farther is a unit mistake), else ``StewartError``."""
-    c = check_finite(centre, f"{option} (m)")
+    of the plate's origin (farther is a unit mistake), else ``StewartError``. ``option``: its name in messages
+    (default ``param("centre")``)."""
+    option = param("centre") if option is None else option
+    c = check_finite(check_shape(centre, option, (3,)), f"{option} (m)")
     size = platform_size(platform)
     r = float(np.linalg.norm(c))
     if r > FAR_FACTOR * size:
@@ -451,7 +469,7 @@ def check_centre(platform, centre, option: str = "--centre") -> np.ndarray:
 SERVO_PULSE_RANGE_US = (500.0, 2500.0)
 
 
-def check_servo_neutrals(hexapod, what: str = "--trim") -> None:
+def check_servo_neutrals(hexapod, what: str = "trim") -> None:
     """``StewartError`` unless every neutral pulse W0_i (µs) is finite and leaves room for the full travel:
     W0_i ± travel·rate within ``SERVO_PULSE_RANGE_US``."""
     w0 = np.asarray(hexapod.neutral_us, dtype=float)

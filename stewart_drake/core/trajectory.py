@@ -18,9 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
+from stewart_drake.core.argcheck import as_flag, as_real, check_path
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.dynamics import harmonic_trajectory, seed_trajectory
-from stewart_drake.core.geometry import Platform
+from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.quantisation import check_finite_rates, check_quantisation, smooth_columns, smooth_tolerance
 from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.errors import API_FIT_PLATFORM, TrajectoryError
@@ -113,7 +114,7 @@ class Trajectory:
         Raises:
             StewartError: the file's first bad line, named; a noise-dominated file without ``smooth``.
         """
-        return load_trajectory_csv(path, length_unit, angle_unit, smooth)
+        return load_trajectory_csv(check_path(path, "path"), length_unit, angle_unit, smooth)
 
     @classmethod
     def from_program(
@@ -137,7 +138,8 @@ class Trajectory:
         from stewart_drake.script import run_program
         from stewart_drake.script.source import read_program
 
-        result = run_program(read_program(str(path)), str(path), platform, rate=rate, convention=convention)
+        path, platform, rate = check_path(path, "path"), check_platform(platform), as_real(rate, "rate")
+        result = run_program(read_program(path), path, platform, rate=rate, convention=convention)
         return dataclasses.replace(result.trajectory, name=Path(path).stem)
 
 
@@ -168,8 +170,10 @@ TRAJECTORIES = {"seed": SEED, "rotating": ROTATING}
 
 
 def _fitted(trajectory: Trajectory, platform: Platform | None, fit: bool) -> Trajectory:
-    if not fit:
+    if not as_flag(fit, "fit"):
         return trajectory
+    if platform is not None:
+        check_platform(platform)
     if platform is None:
         raise TrajectoryError(API_FIT_PLATFORM)
     return fit_trajectory(trajectory, platform)

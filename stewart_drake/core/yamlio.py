@@ -279,7 +279,7 @@ def _dataclass(node, tp, path, shown, where):
         raise _wrong(node, path, shown, "a mapping of keys to values")
     hints = typing.get_type_hints(tp)
     fields = [f.name for f in dataclasses.fields(tp)]
-    obj = tp()
+    values = {}
     seen = set()
     for knode, vnode in node.value:
         _check_tag(knode, shown)
@@ -307,9 +307,9 @@ def _dataclass(node, tp, path, shown, where):
                 YamlError.DUPLICATE_KEY.format(path=shown, line=_line(knode), field=field_name(path + (key,)))
             )
         seen.add(key)
-        setattr(obj, key, _convert(vnode, hints[key], path + (key,), shown, where))
+        values[key] = _convert(vnode, hints[key], path + (key,), shown, where)
         where.setdefault(path + (key,), Where(_line(vnode), _describe(vnode)))
-    return obj
+    return tp(**values)  # built once from every key: a frozen schema dataclass (LegConfig) is read as any other
 
 
 # ----------------------------------------------------------------------------------------------

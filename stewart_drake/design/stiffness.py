@@ -25,12 +25,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from stewart_drake.core.argcheck import as_poses
+from stewart_drake.core.argcheck import as_poses, as_real_array, shape_text
 from stewart_drake.core.dynamics import G_EARTH, leg_forces, leg_forces_with_legs, skew
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import inverse_jacobian
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
-from stewart_drake.errors import StiffnessError
+from stewart_drake.errors import SHAPE, ShapeError, StiffnessError
 
 FD_STEP = 1e-6  # m and rad: central-difference step for the legs' weight term (error ~ step²)
 
@@ -40,7 +40,10 @@ def leg_stiffness_vector(value, option: str = "--leg-stiffness") -> np.ndarray:
     naming ``option`` otherwise."""
     if value is None:
         raise StiffnessError(StiffnessError.MISSING.format(option=option))
-    k = np.broadcast_to(np.asarray(value, dtype=float), (6,)).copy()
+    k = as_real_array(value, option)
+    if k.shape not in ((), (6,)):
+        raise ShapeError(SHAPE.format(name=option, shape="() or (6,)", got=shape_text(k.shape)))
+    k = np.broadcast_to(k, (6,)).copy()
     if not np.all(np.isfinite(k)) or np.any(k <= 0):
         raise StiffnessError(StiffnessError.NOT_POSITIVE.format(option=option, value=np.asarray(value).tolist()))
     return k

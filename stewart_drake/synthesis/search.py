@@ -359,8 +359,11 @@ def run_search(
     owned = engine is None
     engine = Evaluations(req, workers, scheduler) if owned else engine
     try:
-        for _ in range(generations):
+        for generation in range(generations):
             pop = algorithm.ask()
+            if pop is None:  # pymoo has no new design to offer: every variable is fixed (low == high)
+                generations = generation
+                break
             X = pop.get("X")
             keys = [tuple(x.tolist()) for x in X]
             todo = [k for k in dict.fromkeys(keys) if k not in cache]

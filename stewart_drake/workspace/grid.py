@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from stewart_drake.core.argcheck import param
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_vectors
 from stewart_drake.core.rotations import check_convention
@@ -51,7 +52,11 @@ def check_grid_size(bounds, h) -> None:
     # memory scales as 1/h² (faces), time as 1/h³ (nodes): the finest step that fits both
     h_min = max(h * math.sqrt(need / budget), h * (nodes / MAX_GRID_NODES) ** (1 / 3))
     why = human_bytes(need) if need > budget else WorkspaceError.GRID_NODES.format(limit=MAX_GRID_NODES)
-    raise WorkspaceError(WorkspaceError.GRID_TOO_LARGE.format(h=h, nodes=nodes, why=why, h_min_mm=h_min * 1e3))
+    raise WorkspaceError(
+        WorkspaceError.GRID_TOO_LARGE.format(
+            h=h, nodes=nodes, why=why, h_min_mm=h_min * 1e3, option=param("resolution")
+        )
+    )
 
 
 @dataclass

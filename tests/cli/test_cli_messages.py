@@ -46,7 +46,10 @@ STIFFNESS = [
 ]
 CASES = [
     (["dynamics", "--platform", "utn-dynamic", "--legs", "on", "--coriolis", "off"], UsageError.LEGS_CORIOLIS),
-    (["dynamics", "--platform", "utn-dynamic", "--dt", "0", "--t-end", "1"], OptionError.DT.format(dt="0", t_end="1")),
+    (
+        ["dynamics", "--platform", "utn-dynamic", "--dt", "0", "--t-end", "1"],
+        OptionError.DT.format(dt_name="--dt", t_end_name="--t-end", dt="0", t_end="1"),
+    ),
     (
         ["workspace", "--resolution", "-1"],
         OptionError.POSITIVE.format(option="--resolution", unit="metres", value="-1"),
@@ -63,7 +66,7 @@ CASES = [
     ),
     (
         ["size", "--platform", "utn-dynamic", "--trajectory", "seed", "--dt", "0"],
-        OptionError.DT.format(dt="0", t_end="4.0"),
+        OptionError.DT.format(dt_name="--dt", t_end_name="--t-end", dt="0", t_end="4.0"),
     ),
     (STIFFNESS + ["--gravity", "-1"], OptionError.GRAVITY.format(option="--gravity", value="-1")),
     (

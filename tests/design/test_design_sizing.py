@@ -275,7 +275,10 @@ def test_cli_envelope_errors(tmp_path, capsys, text, needle):
     "args, needle",
     [
         (["--payload", "-1"], PayloadError.MASS.format(option="--payload", value="-1")),
-        (["--payload", "2", "--payload-com", "0", "0", "-0.01"], PayloadError.BELOW_PLATE.format(z=-0.01, unit="m")),
+        (
+            ["--payload", "2", "--payload-com", "0", "0", "-0.01"],
+            PayloadError.BELOW_PLATE.format(option="--payload-com", z=-0.01, unit="m"),
+        ),
         (["--gravity", "-1"], OptionError.GRAVITY.format(option="--gravity", value="-1")),
     ],
 )

@@ -171,7 +171,11 @@ def test_cli_stiffness_json(capsys):
     [
         (["--leg-stiffness", "-5"], StiffnessError.NOT_POSITIVE.format(option="--leg-stiffness", value=-5.0), 2),
         (["--leg-stiffness", "nan"], "--leg-stiffness", 2),
-        (["--payload", "2", "--payload-com", "0", "0", "-5"], PayloadError.BELOW_PLATE.format(z=-5.0, unit="mm"), 2),
+        (
+            ["--payload", "2", "--payload-com", "0", "0", "-5"],
+            PayloadError.BELOW_PLATE.format(option="--payload-com", z=-5.0, unit="mm"),
+            2,
+        ),
         (["--platform", "utn-kinematic"], StiffnessError.MISSING.format(option="legs.stiffness"), 2),
     ],
 )

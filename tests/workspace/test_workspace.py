@@ -316,7 +316,7 @@ def test_errors(gd):
         ws.constant_orientation_workspace(gd, resolution=-0.01)
     with pytest.raises(
         ws.WorkspaceError,
-        match=r"resolution 1e-06 m would need .* grid nodes .*; the finest this machine can hold is ~.* mm; use a coarser --resolution",
+        match=r"resolution 1e-06 m would need .* grid nodes .*; the finest this machine can hold is ~.* mm; use a coarser resolution",
     ):
         ws.constant_orientation_workspace(gd, resolution=1e-6)
     with pytest.raises(W, match=re.escape(W.ORIENTATION.format(value=[0.0, 0.0]))):
