@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from stewart_drake.core.servo import load_servo_hexapod, solve
+from stewart_drake.mechanisms.servo import load_servo_hexapod, solve
 
 
 def main(argv=None):

@@ -21,7 +21,6 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 import numpy as np  # noqa: E402
 
 from stewart_drake.control import ControllerConfig  # noqa: E402
-from stewart_drake.core.c_build import compiler_by_name  # noqa: E402
 from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
 from stewart_drake.core.trajectory import fit_trajectory, get_trajectory  # noqa: E402
 from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
@@ -31,6 +30,7 @@ from stewart_drake.firmware.host import tp17_leg_lengths_c  # noqa: E402
 from stewart_drake.firmware.module import compile_generated  # noqa: E402
 from stewart_drake.fixedpoint import tp17_leg_lengths  # noqa: E402
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words  # noqa: E402
+from stewart_drake.system.c_build import compiler_by_name  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -13,9 +13,9 @@ only ``simulate``, ``montecarlo``, ``firmware.check``, ``report``, ``inspect_mod
 Drake.
 """
 
-# First, before any other import: Ctrl-C from the first moment (``core.interrupts``): the command line, while
+# First, before any other import: Ctrl-C from the first moment (``system.interrupts``): the command line, while
 # it starts, ends at once with one line and status 130; a worker process it started ignores it.
-from stewart_drake.core import interrupts  # isort: skip
+from stewart_drake.system import interrupts  # isort: skip
 
 interrupts.at_import()
 

@@ -13,9 +13,9 @@ import sys
 import numpy as np
 
 from stewart_drake import __version__, commands
-from stewart_drake.core import interrupts, output_folder, processes
 from stewart_drake.core.argcheck import cli_names
 from stewart_drake.errors import StewartError, UsageError
+from stewart_drake.system import interrupts, output_folder, processes
 
 # The API's parameter -> its flag, where the flag is not the parameter with ``--`` and ``-`` for ``_``
 # (``core.argcheck.param``): what the API's messages call ``all_modes`` the command line calls ``--all``.

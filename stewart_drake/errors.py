@@ -79,7 +79,7 @@ class GeometryError(StewartError):
         "leg_base (the base joint of each leg)"
     )
 
-    # a servo hexapod description (``core.servo``)
+    # a servo hexapod description (``mechanisms.servo``)
     SERVO_SHAPE = "servo hexapod {name} must have shape {shape}, got {got}"
     SERVO_NOT_FINITE = "servo hexapod {name} has non-finite values: {value}"
     SERVO_NOT_POSITIVE = "servo hexapod {name} must be a positive number, got {value}"
@@ -165,8 +165,8 @@ SINGULAR_POSE = "pose {index} is singular or nearly so: Jacobian condition numbe
 
 
 # ----------------------------------------------------------------------------------------------
-# Mechanisms other than the 6-UPS platform: the 3R leg (``core.leg3r``) and the RC-servo hexapod
-# (``core.servo``).
+# Mechanisms other than the 6-UPS platform: the 3R leg (``mechanisms.leg3r``) and the RC-servo hexapod
+# (``mechanisms.servo``).
 
 
 class LegError(StewartError):
@@ -793,7 +793,7 @@ class SimulationError(StewartError):
 
 
 class IsolationError(StewartError):
-    """User code run in a child process (``core.isolate``) failed: it hung, ended the process, or crashed."""
+    """User code run in a child process (``system.isolate``) failed: it hung, ended the process, or crashed."""
 
     HUNG = (
         "{path}: the firmware did not return within {limit:g} s (an endless loop in sd_ik, sd_tick or a "
@@ -1038,7 +1038,7 @@ class SynthesisError(StewartError):
 
 
 class JournalError(StewartError):
-    """A resume journal (``evaluations.jsonl``, ``montecarlo.partial.jsonl``; ``core.journal``) whose lines do not
+    """A resume journal (``evaluations.jsonl``, ``montecarlo.partial.jsonl``; ``system.journal``) whose lines do not
     verify: edited, cut, or not written for this search or study. Nothing is resumed from it."""
 
     HEADER = "{path}:1: not a stewart-drake journal header ({text}); remove the file to start again"

@@ -13,7 +13,7 @@ import pytest  # noqa: E402
 
 from stewart_drake import workspace as ws  # noqa: E402
 from stewart_drake.core.geometry import PRESETS, load_preset  # noqa: E402
-from stewart_drake.core.servo import hobby_servo_hexapod  # noqa: E402
+from stewart_drake.mechanisms.servo import hobby_servo_hexapod  # noqa: E402
 
 
 @pytest.fixture(params=PRESETS)

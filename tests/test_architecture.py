@@ -12,7 +12,18 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "stewart_drake"
 
 # layer -> the layers its modules may import (besides stewart_drake.errors and the standard library)
-CORE = {"core", "fixedpoint", "workspace", "script", "homotopy", "design", "calibration", "spec"}
+CORE = {
+    "core",
+    "system",
+    "mechanisms",
+    "fixedpoint",
+    "workspace",
+    "script",
+    "homotopy",
+    "design",
+    "calibration",
+    "spec",
+}
 CONTROL = {"control", "firmware"}  # the laws, and the same law as generated, compiled C
 ALLOWED = {
     **{layer: CORE for layer in CORE},

@@ -12,6 +12,8 @@ ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = "tests.cli._no_drake"
 DRAKE_FREE = (
     "tests/core",
+    "tests/system",
+    "tests/mechanisms",
     "tests/control",
     "tests/fixedpoint",
     "tests/workspace",

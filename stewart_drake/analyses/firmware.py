@@ -12,7 +12,6 @@ import numpy as np
 
 from stewart_drake.api.simulation import plan_run
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
-from stewart_drake.core.c_build import compilers
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.drake.simulation import build_simulation
@@ -25,6 +24,7 @@ from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
 from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
 from stewart_drake.report import run_standalone
 from stewart_drake.report.subject import mark_not_applicable, subject_trajectories
+from stewart_drake.system.c_build import compilers
 
 TITLE = "Firmware equivalence: the C compiled, generated and run in the loop"
 ORDER = 95

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.leg3r import (
+from stewart_drake.core.rotations import wrap_angle
+from stewart_drake.drake.leg_model import drake_fk_errors, drake_ik
+from stewart_drake.mechanisms.leg3r import (
     SEED_FIX_TEXT,
     SEED_FIXES,
     Leg3R,
@@ -17,8 +19,6 @@ from stewart_drake.core.leg3r import (
     random_configurations,
     seed_inverse_kinematics,
 )
-from stewart_drake.core.rotations import wrap_angle
-from stewart_drake.drake.leg_model import drake_fk_errors, drake_ik
 from stewart_drake.report import run_standalone
 
 TITLE = "3R planar leg (seed 003): DH kinematics"

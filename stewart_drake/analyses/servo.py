@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.servo import load_servo_hexapod, solve
-from stewart_drake.core.servo_loop import servo_gains, tracking_bounds
 from stewart_drake.drake.servo_model import IK_GAP_TOL_M, compare_with_drake, run_closed_loop, run_controller
+from stewart_drake.mechanisms.servo import load_servo_hexapod, solve
+from stewart_drake.mechanisms.servo_loop import servo_gains, tracking_bounds
 from stewart_drake.report import run_standalone
 
 TITLE = "RC-servo hexapod (seed 002): arm angles and PWM"

@@ -14,10 +14,7 @@ from pathlib import Path
 from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.control import ControllerConfig, DspTiming
-from stewart_drake.core.c_build import compiler_by_name, compilers
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S, check_time_limit, run_isolated
-from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.trajectory import Trajectory, design_poses, get_trajectory
 from stewart_drake.errors import (
     OPTION_FIRMWARE_RATE,
@@ -53,6 +50,9 @@ from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.firmware.target_build import build_target, check_target
 from stewart_drake.fixedpoint.generic import QFormat
 from stewart_drake.spec import Machine, load_machine
+from stewart_drake.system.c_build import compiler_by_name, compilers
+from stewart_drake.system.isolate import FIRMWARE_TIME_LIMIT_S, check_time_limit, run_isolated
+from stewart_drake.system.output_folder import OutputFolder, atomic_folder
 
 __all__ = [
     "generate",
@@ -456,7 +456,7 @@ def check(
 
 
 def _check_in_child(beat, *args) -> dict:
-    """``drake.firmware_check.check_firmware(*args)``, run by ``core.isolate`` in a child process (deferred
+    """``drake.firmware_check.check_firmware(*args)``, run by ``system.isolate`` in a child process (deferred
     import: only check needs Drake, it records a closed loop; generate runs without pydrake)."""
     from stewart_drake.drake.firmware_check import check_firmware
 

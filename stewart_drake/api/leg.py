@@ -9,7 +9,8 @@ import numpy as np
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.argcheck import as_choice, as_real
-from stewart_drake.core.leg3r import (
+from stewart_drake.errors import OPTION_JOINT_ANGLES, OPTION_JOINT_OVERFLOW, OPTION_TARGET, LegError
+from stewart_drake.mechanisms.leg3r import (
     Leg3R,
     foot,
     forward_kinematics,
@@ -18,7 +19,6 @@ from stewart_drake.core.leg3r import (
     limit_violations,
     within_limits,
 )
-from stewart_drake.errors import OPTION_JOINT_ANGLES, OPTION_JOINT_OVERFLOW, OPTION_TARGET, LegError
 
 __all__ = ["leg_fk", "leg_ik", "LegFKResult", "LegIKResult"]
 

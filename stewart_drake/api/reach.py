@@ -14,10 +14,10 @@ from stewart_drake.api.result import Result
 from stewart_drake.core.argcheck import as_flag, as_int, as_real, check_shape, param
 from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.leg_bodies import leg_dimensions
-from stewart_drake.core.processes import check_workers
 from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import check_centre, check_finite
 from stewart_drake.errors import ArgumentError, OptionError
+from stewart_drake.system.processes import check_workers
 from stewart_drake.workspace import (
     AXES,
     Limits,
@@ -143,7 +143,7 @@ def solve_workspace(
     orientation = check_shape(orientation, param("orientation"), (3,))
     check_finite(orientation if orientation_shown is None else orientation_shown, param("orientation"))
     workers = as_int(workers, param("workers"))
-    check_workers(param("workers"), workers)  # the one rule for worker counts (core.processes)
+    check_workers(param("workers"), workers)  # the one rule for worker counts (system.processes)
     progress = as_flag(progress, param("progress"))
     lim = parse_limits(limits, platform, joint_cone, leg_diameter, max_condition)
     w = constant_orientation_workspace(

@@ -14,8 +14,8 @@ from stewart_drake.api.result import Result
 from stewart_drake.core.argcheck import as_flag, as_real_array, check_path, check_shape, param
 from stewart_drake.core.sanity import check_finite, check_servo_neutrals, check_servo_pose
 from stewart_drake.core.sdf_models import write_sdf as write_sdf_file
-from stewart_drake.core.servo import ServoHexapod, load_servo_hexapod, solve
 from stewart_drake.errors import API_POSE_SHAPE, OPTION_SERVO_POSE, ArgumentError, ServoPoseError, UsageError
+from stewart_drake.mechanisms.servo import ServoHexapod, load_servo_hexapod, solve
 
 __all__ = ["servo", "ServoResult"]
 

@@ -24,7 +24,6 @@ from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import PRESETS, Platform, load_preset
-from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S, check_time_limit
 from stewart_drake.core.sanity import (
     check_trajectory,
     check_work,
@@ -53,6 +52,7 @@ from stewart_drake.firmware.module import check_source
 from stewart_drake.script import compile_program
 from stewart_drake.script.source import read_program
 from stewart_drake.spec import Gains, Machine, load_machine
+from stewart_drake.system.isolate import FIRMWARE_IDLE_LIMIT_S, check_time_limit
 
 if TYPE_CHECKING:  # annotations only: matplotlib and pandas are loaded when a figure or a table is asked for
     import pandas

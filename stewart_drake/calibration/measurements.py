@@ -28,11 +28,11 @@ from scipy.spatial import cKDTree
 
 from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.core.sanity import FAR_FACTOR, platform_size
 from stewart_drake.core.unit_hint import other_unit_hint
 from stewart_drake.errors import CalibrationError
+from stewart_drake.system.input_stream import read_input
 
 TYPES = ("pose", "points", "inclinometer")
 READINGS = tuple(f"l{i}" for i in range(1, 7))

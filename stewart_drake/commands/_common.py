@@ -9,11 +9,11 @@ import sys
 import numpy as np
 
 from stewart_drake.core.geometry import PRESETS, Platform, load_platform
-from stewart_drake.core.jsonout import dumps_strict
-from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 from stewart_drake.errors import MachineError, QuantityError, StewartError, UsageError
 from stewart_drake.spec import Machine, apply_overrides, load_machine
+from stewart_drake.system.jsonout import dumps_strict
+from stewart_drake.system.output_folder import OutputFolder
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:

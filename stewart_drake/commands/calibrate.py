@@ -11,9 +11,9 @@ from stewart_drake.commands._common import (
     output_folder,
     print_json,
 )
-from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 from stewart_drake.errors import CalibrationLimitError
+from stewart_drake.system.jsonout import dumps_strict
 
 HELP = "identify a built platform's geometry from measured poses; write a calibrated platform file"
 

@@ -9,12 +9,12 @@ from __future__ import annotations
 import sys
 
 from stewart_drake.commands._common import add_platform_arg, platform_from_args
-from stewart_drake.core.output_folder import check_output_file, write_output_file
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.script import ScriptError, compile_program
 from stewart_drake.script.emit import emit_matlab, emit_python
 from stewart_drake.script.runtime import check_reachable
 from stewart_drake.script.source import read_program
+from stewart_drake.system.output_folder import check_output_file, write_output_file
 
 
 def register(sub) -> None:

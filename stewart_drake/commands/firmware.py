@@ -9,10 +9,10 @@ from pathlib import Path
 from stewart_drake.api import firmware
 from stewart_drake.commands._certify import register as register_certify
 from stewart_drake.commands._common import add_platform_arg, print_json
-from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S
 from stewart_drake.errors import UsageError
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.spec import load_machine
+from stewart_drake.system.isolate import FIRMWARE_TIME_LIMIT_S
 
 
 def _format_args(p, recorded: bool = False) -> None:

@@ -6,10 +6,10 @@ from __future__ import annotations
 import io
 
 from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
-from stewart_drake.core.output_folder import write_output_file
 from stewart_drake.core.sdf_models import sdf_text, write_sdf
 from stewart_drake.engines.models import FORMATS, model_files, write_models
 from stewart_drake.errors import UsageError
+from stewart_drake.system.output_folder import write_output_file
 
 
 def register(sub) -> None:

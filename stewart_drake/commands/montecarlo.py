@@ -17,7 +17,6 @@ from stewart_drake.commands._common import (
     reject_unused,
 )
 from stewart_drake.commands.simulate import add_loop_args, write_plots
-from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.drake.montecarlo_animation import write_animation
 from stewart_drake.errors import OptionError, StewartError
 from stewart_drake.firmware.engine import resolve_engine
@@ -31,6 +30,7 @@ from stewart_drake.montecarlo.study import (
 )
 from stewart_drake.montecarlo.summary import read_table
 from stewart_drake.script import ScriptError
+from stewart_drake.system.output_folder import OutputFolder, atomic_folder
 
 
 def register(sub) -> None:

@@ -5,13 +5,13 @@ from __future__ import annotations
 import sys
 
 from stewart_drake.commands._common import add_force_arg, output_folder, print_json
-from stewart_drake.core.output_folder import claim_in_manifest, run_lock
 from stewart_drake.synthesis.api import optimize
 from stewart_drake.synthesis.outputs import write_outputs
 from stewart_drake.synthesis.proof import MAX_CELLS, START_CELLS
 from stewart_drake.synthesis.requirements import OBJECTIVES
 from stewart_drake.synthesis.search import CACHE, DEFAULT_POP
 from stewart_drake.synthesis.synthesize import cells_note, not_proven
+from stewart_drake.system.output_folder import claim_in_manifest, run_lock
 
 HELP = "design synthesis: the geometry with the smallest actuators that meets a requirements file, proven"
 

@@ -11,8 +11,8 @@ from stewart_drake.commands._common import (
     output_folder,
     print_json,
 )
-from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
+from stewart_drake.system.jsonout import dumps_strict
 
 HELP = "plan calibration poses (D-optimal) inside a workspace box; CSV and a .stw program that visits them"
 

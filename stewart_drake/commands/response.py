@@ -10,9 +10,9 @@ import numpy as np
 
 from stewart_drake.api.response import loop_response
 from stewart_drake.commands._common import add_force_arg, add_platform_arg, dumps_strict, output_folder, print_json
-from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.errors import UsageError
 from stewart_drake.spec import apply_overrides, load_machine
+from stewart_drake.system.output_folder import atomic_folder
 
 HELP = "the closed leg loop in the frequency domain at a pose: margins, bandwidth, sensitivity peak, Bode/Nyquist"
 # the files response writes into --out

@@ -22,7 +22,6 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
-from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.errors import (
     OPTION_NEEDS_BRANCHES,
@@ -34,6 +33,7 @@ from stewart_drake.errors import (
     UsageError,
 )
 from stewart_drake.script.source import read_program
+from stewart_drake.system.output_folder import atomic_folder
 
 SIMULATE_CONTROLLERS = ("fixed", "float")
 SETTLE = 0.5  # s simulated after the program's end (the reference holds the final pose)

@@ -9,8 +9,8 @@ import numpy as np
 from stewart_drake.api.servo import US, solve_servo
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS, angle_scale, length_scale
-from stewart_drake.core.servo import SERVO_PRESETS
 from stewart_drake.errors import OPTION_SERVO_POSE, ServoPoseError
+from stewart_drake.mechanisms.servo import SERVO_PRESETS
 
 
 def register(sub) -> None:

@@ -19,11 +19,11 @@ from stewart_drake.commands._common import (
     reject_unused,
 )
 from stewart_drake.commands.firmware import add_time_limit_arg
-from stewart_drake.core.isolate import FIRMWARE_IDLE_LIMIT_S
-from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.drake.integrators import INTEGRATORS
 from stewart_drake.errors import StewartError
 from stewart_drake.firmware.engine import ENGINES
+from stewart_drake.system.isolate import FIRMWARE_IDLE_LIMIT_S
+from stewart_drake.system.output_folder import atomic_folder
 
 
 def register(sub) -> None:

@@ -11,10 +11,10 @@ from stewart_drake.commands._common import (
     output_folder,
     print_json,
 )
-from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.platform_file import platform_yaml
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 from stewart_drake.montecarlo.measurements_api import simulate_measurements
+from stewart_drake.system.jsonout import dumps_strict
 
 HELP = "synthetic calibration measurements of a machine drawn around the nominal (truth written apart)"
 

@@ -10,11 +10,11 @@ import numpy as np
 from stewart_drake.api.design import Load, load_at_pose, stiffness_at
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
 from stewart_drake.commands._design import add_payload_args
-from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si
 from stewart_drake.design.maps import MAX_POINTS, slice_maps
 from stewart_drake.design.plots import plot_slice_maps
 from stewart_drake.errors import OptionError
+from stewart_drake.system.output_folder import OutputFolder, atomic_folder
 
 NAMES = ("x", "y", "z", "rx", "ry", "rz")
 

@@ -17,12 +17,12 @@ from stewart_drake.commands._common import (
     print_json,
     reject_unused,
 )
-from stewart_drake.core.output_folder import atomic_folder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from stewart_drake.errors import OptionError, SynthesisError
 from stewart_drake.synthesis.api import prove_workspace
 from stewart_drake.synthesis.proof import MAX_CELLS, START_CELLS
 from stewart_drake.synthesis.synthesize import cells_note
+from stewart_drake.system.output_folder import atomic_folder
 from stewart_drake.workspace import AXES, view_figures
 
 BOX_AXES = ("px", "py", "pz", "a", "b", "g")

@@ -19,8 +19,8 @@ from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.memo import Memo, digest
 from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.system.memo import Memo, digest
 
 
 def feedforward_lead(config: ControllerConfig, actuator_lag: float) -> float:

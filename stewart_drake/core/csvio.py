@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 
-from stewart_drake.core.input_stream import read_input
 from stewart_drake.core.sanity import check_work, memory_budget
 from stewart_drake.errors import CsvError
+from stewart_drake.system.input_stream import read_input
 
 MAX_FIELD_CHARS = 131_072  # the csv module's own limit: a longer field is not a number
 

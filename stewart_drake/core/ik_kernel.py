@@ -1,5 +1,5 @@
 """The compiled IK kernel: ``(..., 6)`` poses -> ``(..., 6)`` leg lengths (metres), ``core/ik_kernel.c``
-through ``core.c_build`` (cffi), with ``kinematics.leg_lengths`` as the reference and the fallback.
+through ``system.c_build`` (cffi), with ``kinematics.leg_lengths`` as the reference and the fallback.
 
 Why: a design search or a dense map evaluates IK billions of times; the numpy path streams a dozen
 ``(n, 6)`` temporaries per block, the C loop keeps a pose in registers and uses its own sine and cosine
@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.argcheck import as_poses
-from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths as numpy_leg_lengths
 from stewart_drake.core.rotations import CONVENTIONS, check_convention
 from stewart_drake.errors import FkInputError
+from stewart_drake.system.c_build import UNAVAILABLE, load, source_keyed_library
 
 SOURCE = Path(__file__).with_name("ik_kernel.c")
 CDEF = "void sd_ik(int64_t n, const double *g, int conv, const double *q, double *L);"

@@ -1,5 +1,5 @@
 """Real-time forward kinematics: one Newton solve per length set from the previous pose, compiled
-(``core/fk_kernel.c`` through ``core.c_build``, called with cffi), with a branch certificate.
+(``core/fk_kernel.c`` through ``system.c_build``, called with cffi), with a branch certificate.
 
 Why: a viewer, an estimator or a trajectory check calls FK once per sample with the previous pose as the
 guess; the numpy Newton (``newton_fk.forward_kinematics``) pays ~0.5 ms of numpy overhead per call, the C
@@ -45,12 +45,12 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.argcheck import as_int, as_real, as_real_array
-from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.kinematics import anchor_radius
 from stewart_drake.core.newton_fk import CONVERGED, leg_geometry, newton_core, validate_lengths
 from stewart_drake.core.rotations import CONVENTIONS, angles_from_matrix, check_convention, rotation_matrix
 from stewart_drake.errors import FkInputError
+from stewart_drake.system.c_build import UNAVAILABLE, load, source_keyed_library
 
 SOURCE = Path(__file__).with_name("fk_kernel.c")
 CDEF = """

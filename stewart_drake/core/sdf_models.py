@@ -33,9 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.geometry import Platform, base_joints
-from stewart_drake.core.leg3r import Leg3R, dh_rows
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions, leg_visual_dimensions
-from stewart_drake.core.output_folder import safe_file_stem, write_output_file
 from stewart_drake.core.sdf import (
     ball_constraint_xml,
     box_inertia,
@@ -46,9 +44,11 @@ from stewart_drake.core.sdf import (
     visual_xml,
     xml_vec,
 )
-from stewart_drake.core.servo import ServoHexapod
-from stewart_drake.core.servo_mounting import pivot_frames, rod_frames, servo_joint_home
 from stewart_drake.errors import OutputError
+from stewart_drake.mechanisms.leg3r import Leg3R, dh_rows
+from stewart_drake.mechanisms.servo import ServoHexapod
+from stewart_drake.mechanisms.servo_mounting import pivot_frames, rod_frames, servo_joint_home
+from stewart_drake.system.output_folder import safe_file_stem, write_output_file
 
 # ----------------------------------------------------------------------------------------------
 # Stewart platform

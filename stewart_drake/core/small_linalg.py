@@ -1,6 +1,6 @@
 """Batched 2 × 2 Gram matrices and 2 × 2 / 3 × 3 solves with numpy's own bits, and approximate inverses, one C loop
 per batch (``core/small_linalg.c``
-through ``core.c_build``), numpy as the reference and the fallback.
+through ``system.c_build``), numpy as the reference and the fallback.
 
 Why: the legs' inverse dynamics (``dynamics.leg_forces_with_legs``) forms, per leg and per row of a feed-forward
 table, the 2 × 2 Gram matrix of its universal joint's rate map and solves it twice. numpy does each with a
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
+from stewart_drake.system.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
 
 SOURCE = Path(__file__).with_name("small_linalg.c")
 CDEF = """

@@ -21,8 +21,8 @@ from typing import Any
 
 import yaml
 
-from stewart_drake.core.input_stream import read_input
 from stewart_drake.errors import InputError, YamlError
+from stewart_drake.system.input_stream import read_input
 
 MAX_BYTES = 1_000_000  # a platform file is a few hundred bytes
 MAX_DEPTH = 32  # nesting levels of mappings/sequences

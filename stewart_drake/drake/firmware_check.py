@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
-from stewart_drake.core.c_build import Compiler
 from stewart_drake.core.geometry import Platform
 from stewart_drake.drake.simulation import Scenario, build_simulation
 from stewart_drake.errors import FirmwareError
@@ -18,6 +17,7 @@ from stewart_drake.firmware.check import MAX_POSES, check_ik, check_tick
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.module import compile_user
 from stewart_drake.fixedpoint.generic import pose_words
+from stewart_drake.system.c_build import Compiler
 
 
 def record_closed_loop(platform: Platform, config: ControllerConfig, trajectory="seed", duration: float = 0.5) -> list:

@@ -1,5 +1,5 @@
 """Running a closed loop whose tick is the user's own C firmware (``simulate --firmware``) in a child
-process (``core.isolate``): a hang, an ``exit()`` or a crash in their code is one line naming the file, and
+process (``system.isolate``): a hang, an ``exit()`` or a crash in their code is one line naming the file, and
 their ``printf`` cannot reach our output. Only user-supplied firmware runs this way: the generated
 firmware (the default C engine) runs in this process, at full speed.
 
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import threading
 
-from stewart_drake.core.isolate import run_isolated
 from stewart_drake.drake.simulation import Scenario, build_simulation
+from stewart_drake.system.isolate import run_isolated
 
 WATCH_PERIOD_S = 1.0
 

@@ -15,8 +15,8 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.solvers import SnoptSolver, SolverOptions
 
-from stewart_drake.core.leg3r import Leg3R, check_branch, frame_transforms
 from stewart_drake.core.sdf_models import leg_sdf
+from stewart_drake.mechanisms.leg3r import Leg3R, check_branch, frame_transforms
 
 # drake_ik accepts a solution whose foot (by Drake's FK) is this close to the target. With tight
 # tolerances SNOPT lands at ~1e-16 m typically but sometimes stops ("cannot be improved") at up to a few

@@ -33,9 +33,9 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, ZeroOrderHold
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.memo import Memo, digest
 from stewart_drake.drake.integrators import CONTINUOUS
 from stewart_drake.drake.platform_model import build_plant
+from stewart_drake.system.memo import Memo, digest
 
 VISUALIZER_PERIOD = 1 / 32  # s: the Meshcat animation's frame period
 

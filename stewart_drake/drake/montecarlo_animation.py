@@ -9,9 +9,9 @@ from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.systems.framework import DiagramBuilder
 
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.output_folder import write_text_atomic
 from stewart_drake.drake.animation import recording_meshcat
 from stewart_drake.drake.platform_model import build_plant, set_pose
+from stewart_drake.system.output_folder import write_text_atomic
 
 FRAME_RATE = 32.0  # frames per second of the animation
 

@@ -4,7 +4,7 @@ loop as discrete systems.
 
 Model names: ``base``, ``platform`` (link frame P), frames ``pivot_i``, ``platform_anchor_i`` and
 ``arm_tip_i``; ``arm_i`` on the actuated revolute ``servo_i`` whose angle is the servo's mechanical
-angle (``core/servo_mounting``); ``rod_i`` on the ball joint ``rod_joint_i``, a ball constraint closing
+angle (``mechanisms/servo_mounting``); ``rod_i`` on the ball joint ``rod_joint_i``, a ball constraint closing
 its end onto ``platform_anchor_i`` (a discrete SAP plant, as ball constraints need).
 """
 
@@ -27,16 +27,21 @@ from pydrake.trajectories import PiecewisePolynomial
 from stewart_drake.core.rotations import angles_from_matrix, rotation_matrix
 from stewart_drake.core.sdf import rpy
 from stewart_drake.core.sdf_models import SERVO_HEXAPOD_MODEL, servo_hexapod_sdf
-from stewart_drake.core.servo import (
+from stewart_drake.errors import SimulationError
+from stewart_drake.mechanisms.servo import (
     FRAME_RATE_HZ,
     ServoHexapod,
     angles_from_pulses,
     quantise_pulses,
     solve,
 )
-from stewart_drake.core.servo_loop import servo_gains
-from stewart_drake.core.servo_mounting import frame_from_zx, joint_arm_angles, pulse_joint_angles, servo_joint_home
-from stewart_drake.errors import SimulationError
+from stewart_drake.mechanisms.servo_loop import servo_gains
+from stewart_drake.mechanisms.servo_mounting import (
+    frame_from_zx,
+    joint_arm_angles,
+    pulse_joint_angles,
+    servo_joint_home,
+)
 
 # Drake IK results are accepted when every rod length is this close to s (Drake FK), success flag or not:
 # SNOPT reaches ~1e-9 m on this loop-closure problem before reporting "cannot be improved".

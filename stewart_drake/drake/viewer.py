@@ -24,7 +24,6 @@ from pydrake.math import RigidTransform, RotationMatrix
 
 from stewart_drake.core.assembly_modes import assembly_modes
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.input_stream import decode_text, read_input
 from stewart_drake.core.kinematics import leg_lengths, plate_anchors
 from stewart_drake.core.leg_bodies import leg_visual_dimensions
 from stewart_drake.core.newton_fk import anchor_scale, jacobian_analysis
@@ -33,6 +32,7 @@ from stewart_drake.core.rotations import angle_scale, angles_from_matrix, length
 from stewart_drake.core.sanity import memory_budget
 from stewart_drake.drake.animation import GHOST_RGBA, MeshcatScene, leg_warnings, log_saturating, stroke_margin
 from stewart_drake.errors import ReplayError, SimulationError, StewartError
+from stewart_drake.system.input_stream import decode_text, read_input
 
 AXES = ("px", "py", "pz", "alpha", "beta", "gamma")
 MAX_LABEL = 28  # characters of a readout line (a Meshcat button label) that the control panel shows
@@ -312,7 +312,7 @@ def load_replay(path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str]:
         raise ReplayError(ReplayError.EMPTY_FOLDER.format(path=path))
     if not p.exists():
         raise ReplayError(ReplayError.MISSING.format(path=path))
-    # read once, bounded (core.input_stream): a FIFO works, /dev/zero stops at the budget
+    # read once, bounded (system.input_stream): a FIFO works, /dev/zero stops at the budget
     data = read_input(p, kind="replay log", limit=memory_budget(), missing=ReplayError.MISSING.format(path=path))
     if p.suffix == ".npz":
         try:

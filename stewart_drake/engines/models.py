@@ -32,10 +32,10 @@ from stewart_drake.core.dynamics import G_EARTH
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.leg_bodies import home_leg_frames, leg_dimensions
-from stewart_drake.core.output_folder import check_output_file, safe_file_stem, write_output_file
 from stewart_drake.core.sdf import cylinder_inertia, rpy, xml_attr, xml_comment, xml_vec
 from stewart_drake.core.sdf_models import platform_model_name, platform_sdf
 from stewart_drake.errors import OutputError
+from stewart_drake.system.output_folder import check_output_file, safe_file_stem, write_output_file
 
 FORMATS = ("sdf", "urdf", "mjcf")
 # MuJoCo's connect constraints are soft: solref = (time constant s, damping ratio). Its default (0.02, 1) is

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import sys
 
-from stewart_drake.core.c_build import UNAVAILABLE, cache_dir, default_compiler
 from stewart_drake.errors import FirmwareError
+from stewart_drake.system.c_build import UNAVAILABLE, cache_dir, default_compiler
 
 ENGINES = ("python", "c")
 

@@ -14,8 +14,8 @@ from collections import Counter
 
 import numpy as np
 
-from stewart_drake.core.c_build import C_DIR, Compiler, build, library_sources, load
 from stewart_drake.fixedpoint.tp17 import check_dsp_poses
+from stewart_drake.system.c_build import C_DIR, Compiler, build, library_sources, load
 
 
 def c_enum(file: str, prefix: str) -> tuple[str, ...]:

@@ -21,8 +21,8 @@ import numpy as np
 
 from stewart_drake.control.laws import STATUS, FloatLaw
 from stewart_drake.control.loop_sensor import IdealSensor, SensorReading
-from stewart_drake.core.c_build import C_DIR, UNAVAILABLE, load, source_keyed_library
 from stewart_drake.errors import FirmwareError
+from stewart_drake.system.c_build import C_DIR, UNAVAILABLE, load, source_keyed_library
 
 SOURCE = C_DIR / "sd_loop.c"
 HEADER = C_DIR / "sd_loop.h"

@@ -10,11 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import Compiler, Source, build, library_sources, load
-from stewart_drake.core.input_stream import decode_text, read_input
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
 from stewart_drake.firmware.loop_kernel import CDEF as LOOP_CDEF
+from stewart_drake.system.c_build import Compiler, Source, build, library_sources, load
+from stewart_drake.system.input_stream import decode_text, read_input
 
 # the closed loop's kernel (``loop_kernel``), linked with the host glue of the tick: its fixed-point law calls
 # sd_host_tick; -ffp-contract=off keeps its float arithmetic numpy's (the firmware's own code is integer)

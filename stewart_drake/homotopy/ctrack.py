@@ -1,4 +1,4 @@
-"""The compiled path tracker (``track.c``): built once with the project's C build (``core.c_build``:
+"""The compiled path tracker (``track.c``): built once with the project's C build (``system.c_build``:
 content-hash cache in ``$STEWART_DRAKE_CACHE``) and called through cffi.
 
 Why compiled: the numpy tracker advances all paths in lockstep, so a length set costs (steps of its
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
+from stewart_drake.system.c_build import UNAVAILABLE, load, source_keyed_library
 
 SOURCE = Path(__file__).with_name("track.c")
 CDEF = """

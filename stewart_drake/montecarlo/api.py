@@ -10,8 +10,6 @@ from typing import TYPE_CHECKING
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.output_folder import OutputFolder
-from stewart_drake.core.processes import check_workers
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.errors import OptionError, UsageError
 from stewart_drake.firmware.engine import default_engine
@@ -20,6 +18,8 @@ from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import NAMES, run_study, study_key, study_settings
 from stewart_drake.montecarlo.summary import summarise, write_outputs
 from stewart_drake.spec import Machine, load_machine
+from stewart_drake.system.output_folder import OutputFolder
+from stewart_drake.system.processes import check_workers
 
 if TYPE_CHECKING:  # annotations only: pandas is optional
     import pandas
@@ -45,7 +45,7 @@ def make_study(
     m = load_machine(machine, given)
     spec = parse_spec(vary, names["vary"])
     if workers is not None:
-        check_workers(names["workers"], workers, minimum=0)  # the one rule (core.processes)
+        check_workers(names["workers"], workers, minimum=0)  # the one rule (system.processes)
     ctl = m.controller
     if ctl.engine == "c" and ctl.law != "fixed":
         raise UsageError(UsageError.ENGINE_C.format(controller=ctl.law))

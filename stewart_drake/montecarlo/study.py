@@ -2,7 +2,7 @@
 
 The output folder holds, while a study runs, ``montecarlo.partial.jsonl``: a header line with the
 study's key (``study_key``: a hash of every setting except the number of runs) and one JSON row per
-finished run, flushed as each arrives (a ``core.journal``: a chain of per-line MACs). A study started again
+finished run, flushed as each arrives (a ``system.journal``: a chain of per-line MACs). A study started again
 with the same settings and ``--out`` verifies every line, checks each row's drawn values against the study's
 draws for its run, and runs only the missing indices (JSON keeps every float bit for bit). At the end the folder is
 replaced atomically by the final files (``summary.write_outputs``).
@@ -28,8 +28,6 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.core.geometry import base_joints
-from stewart_drake.core.journal import JournalWriter, header_line, read_rows
-from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
 from stewart_drake.drake.systems import make_law
 from stewart_drake.errors import JournalError, OutputError, SpecError, StudyError
 from stewart_drake.montecarlo.draw_checks import check_draws
@@ -37,6 +35,8 @@ from stewart_drake.montecarlo.scenario import Study, draw, nominal_value, run_sc
 from stewart_drake.montecarlo.summary import VERDICT_COLUMNS
 from stewart_drake.spec import Gains, Machine, apply_overrides
 from stewart_drake.spec.machine import FIELDS
+from stewart_drake.system.journal import JournalWriter, header_line, read_rows
+from stewart_drake.system.output_folder import claim_in_manifest, write_text_atomic
 
 PARTIAL = "montecarlo.partial.jsonl"
 STUDY_FILE = "study.json"
@@ -264,7 +264,7 @@ def run_row(study: Study, index: int) -> dict:
 def load_partial(out: Path, key: str, study: Study | None = None, names: dict | None = None) -> dict[int, dict]:
     """``{run: row}`` of the runs already finished in ``out`` for the study ``key`` (none if ``out`` does
     not exist). ``StudyError`` if ``out`` holds something else: another study, or files this tool did not
-    write; ``JournalError`` naming the file and line if a line of the journal does not verify (``core.journal``)
+    write; ``JournalError`` naming the file and line if a line of the journal does not verify (``system.journal``)
     or, with ``study``, a row's drawn values are not the study's draws for its run (``names``: how messages name
     ``out``, ``NAMES``)."""
     opt = option_names(names)
@@ -339,7 +339,7 @@ def _run_index(path: Path, row, opt: dict) -> int:
 
 
 class PartialWriter:
-    """Appends finished rows to ``out/montecarlo.partial.jsonl`` (``core.journal``), one flushed line each. The file is made
+    """Appends finished rows to ``out/montecarlo.partial.jsonl`` (``system.journal``), one flushed line each. The file is made
     at the first row (a study that fails before any run leaves no folder), with its header written whole
     (a temporary and a rename: never a file without its key) and claimed in the folder's manifest as an
     append-only journal of this command (verified by its header's hash)."""
@@ -353,7 +353,7 @@ class PartialWriter:
             if self.fh is None:
                 if not path.exists():
                     self._start(path)
-                self.fh = JournalWriter(path, self.key)  # a verified chain (core.journal)
+                self.fh = JournalWriter(path, self.key)  # a verified chain (system.journal)
             self.fh.append(obj)
         except OSError as e:  # disk full, ...: one line naming the file and the option
             raise OutputError(

@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.control.chatter import CHATTER_RANGE_FRACTION
-from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.montecarlo.spec import LATENCY_MODES
+from stewart_drake.system.jsonout import dumps_strict
 
 METRICS = (
     "max_leg_error_m",
@@ -223,7 +223,7 @@ def write_plots(rows: list[dict], summary: dict, folder: Path) -> list[Path]:
 def write_outputs(out, rows: list[dict], summary: dict) -> list[Path]:
     """Replace ``out`` atomically with the table, ``summary.json``, ``study.json`` and the plots. ``out``: a
     path, or an ``output_folder.OutputFolder`` checked before the runs."""
-    from stewart_drake.core.output_folder import OutputFolder, atomic_folder
+    from stewart_drake.system.output_folder import OutputFolder, atomic_folder
 
     folder, out = out, Path(out.typed if isinstance(out, OutputFolder) else out)
     with atomic_folder(folder) as tmp:

@@ -31,12 +31,12 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from stewart_drake.core.jsonout import dumps_strict
-from stewart_drake.core.output_folder import OutputFolder, atomic_folder
-from stewart_drake.core.processes import worker_pool
 from stewart_drake.errors import REPORT_UNKNOWN_ANALYSIS, StewartError, UsageError
 from stewart_drake.report import cache, figures, metadata, parts, render
 from stewart_drake.report import subject as subjects
+from stewart_drake.system.jsonout import dumps_strict
+from stewart_drake.system.output_folder import OutputFolder, atomic_folder
+from stewart_drake.system.processes import worker_pool
 
 ANALYSES_DIR = Path(__file__).resolve().parents[1] / "analyses"
 

@@ -10,11 +10,11 @@ from pathlib import Path
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import PRESETS, Platform
-from stewart_drake.core.output_folder import OutputFolder
-from stewart_drake.core.processes import check_workers
 from stewart_drake.errors import REPORT_ONE_SUBJECT, UsageError
 from stewart_drake.report import command_line, discover_analyses, render, run_analyses, write_report
 from stewart_drake.report.subject import from_machine_file, from_platform
+from stewart_drake.system.output_folder import OutputFolder
+from stewart_drake.system.processes import check_workers
 
 
 @dataclass(repr=False)
@@ -108,7 +108,7 @@ def report(
         else OutputFolder(str(out), force=force, option="--out", force_option="force=True")
     )
     jobs = jobs if jobs is not None else min(4, os.cpu_count() or 1)
-    check_workers("--jobs", jobs)  # the one rule for worker counts (core.processes)
+    check_workers("--jobs", jobs)  # the one rule for worker counts (system.processes)
     t0 = time.perf_counter()
     analyses = discover_analyses(only=only)
     sections = []

@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import CacheUnavailable, cache_dir
+from stewart_drake.system.c_build import CacheUnavailable, cache_dir
 
 PACKAGE = Path(__file__).resolve().parents[1]
 FORMAT = 3  # bump when the entry's layout or the key's recipe changes (3: declared inputs only)

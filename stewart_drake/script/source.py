@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from stewart_drake.core.input_stream import read_input
 from stewart_drake.errors import InputError
+from stewart_drake.system.input_stream import read_input
 
 MAX_PROGRAM_BYTES = 1_000_000
 

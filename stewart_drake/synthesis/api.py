@@ -18,7 +18,6 @@ from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg_bodies import leg_dimensions
-from stewart_drake.core.output_folder import run_lock
 from stewart_drake.core.rotations import to_radians
 from stewart_drake.core.sanity import check_finite, check_work
 from stewart_drake.errors import OptionError, SynthesisError
@@ -28,6 +27,7 @@ from stewart_drake.synthesis.requirements import Requirements
 from stewart_drake.synthesis.requirements import load_requirements as read_requirements
 from stewart_drake.synthesis.search import DEFAULT_POP
 from stewart_drake.synthesis.synthesize import SynthesisResult, synthesize
+from stewart_drake.system.output_folder import run_lock
 
 BOX_AXES = ("px", "py", "pz", "a", "b", "g")
 PROOF_LIMITS = ("stroke", "joints", "collision")

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.synthesis.families import design_yaml_fields
 from stewart_drake.synthesis.requirements import OBJECTIVES
 from stewart_drake.synthesis.search import CACHE
+from stewart_drake.system.jsonout import dumps_strict
 
 METRIC_COLUMNS = {
     "peak_force": "peak_force_N",

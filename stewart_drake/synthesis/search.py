@@ -13,7 +13,7 @@ gathered in order. So the same seed gives the same generations and the same fron
 workers (a test runs 1 and 2).
 
 Resume: every evaluated design is appended to ``evaluations.jsonl`` in the output folder (a generation's new
-designs flushed together, as soon as they are evaluated), a ``core.journal`` under a header with the search's key
+designs flushed together, as soon as they are evaluated), a ``system.journal`` under a header with the search's key
 (a hash of the requirements, the seed and the population size). A search started again with the same key
 verifies every line (an edited or damaged line refuses the resume, naming the file and line), checks each row
 (variables within their bounds, objectives and constraints those of its metrics), replays the algorithm from the
@@ -40,8 +40,6 @@ from pymoo.core.termination import NoTermination
 from pymoo.problems.static import StaticProblem
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from stewart_drake.core.journal import JournalWriter, header_line, read_header, read_rows
-from stewart_drake.core.output_folder import claim_in_manifest, write_text_atomic
 from stewart_drake.errors import InfeasibleRequirementsError, JournalError, SynthesisError
 from stewart_drake.synthesis.batch import evaluate_designs
 from stewart_drake.synthesis.evaluate import (
@@ -53,6 +51,8 @@ from stewart_drake.synthesis.evaluate import (
 )
 from stewart_drake.synthesis.families import home_height
 from stewart_drake.synthesis.requirements import OBJECTIVES, Requirements
+from stewart_drake.system.journal import JournalWriter, header_line, read_header, read_rows
+from stewart_drake.system.output_folder import claim_in_manifest, write_text_atomic
 
 CACHE = "evaluations.jsonl"
 DEFAULT_POP = 24
@@ -99,7 +99,7 @@ def search_key(req: Requirements, seed: int, pop_size: int) -> str:
 
 def load_cache(out: Path | None, key: str, req: Requirements | None = None) -> dict:
     """``{tuple(x): row}`` of the designs already evaluated in ``out`` for ``key``, every journal line verified
-    (``core.journal``: ``JournalError`` naming the file and line of an edited or damaged one) and, with ``req``,
+    (``system.journal``: ``JournalError`` naming the file and line of an edited or damaged one) and, with ``req``,
     every row checked against it (``check_row``); ``SynthesisError`` when the folder holds another search."""
     path = None if out is None else out / CACHE
     if path is None or not path.exists():
@@ -138,7 +138,7 @@ def check_row(req: Requirements, row) -> str | None:
 
 
 class CacheWriter:
-    """Appends evaluated designs to ``out/evaluations.jsonl`` (``core.journal``: a verified chain), the header
+    """Appends evaluated designs to ``out/evaluations.jsonl`` (``system.journal``: a verified chain), the header
     written first as a whole file."""
 
     def __init__(self, out: Path, key: str):

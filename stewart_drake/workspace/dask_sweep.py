@@ -45,7 +45,7 @@ import dask
 import distributed
 import numpy as np
 
-from stewart_drake.core.processes import ONE_BLAS_THREAD, quiet_resource_tracker
+from stewart_drake.system.processes import ONE_BLAS_THREAD, quiet_resource_tracker
 from stewart_drake.workspace.executors import default_workers
 from stewart_drake.workspace.grid import constant_orientation_workspace, default_bounds, grid_axes
 from stewart_drake.workspace.maps import count_reachable
@@ -55,8 +55,8 @@ from stewart_drake.workspace.maps import count_reachable
 WORKER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.nanny.pre-spawn-environ": ONE_BLAS_THREAD,
-    # each worker dies with this process (even by SIGKILL) and leaves Ctrl-C to it (core.processes)
-    "distributed.worker.preload": ["stewart_drake.core.processes"],
+    # each worker dies with this process (even by SIGKILL) and leaves Ctrl-C to it (system.processes)
+    "distributed.worker.preload": ["stewart_drake.system.processes"],
 }
 # At least this many tasks per worker thread (load balance: the last wave of tasks is a small share).
 TASKS_PER_WORKER = 8

@@ -11,7 +11,7 @@ from concurrent.futures import Executor
 
 from tqdm import tqdm
 
-from stewart_drake.core.processes import worker_pool
+from stewart_drake.system.processes import worker_pool
 from stewart_drake.workspace.limits import WorkspaceError
 
 

@@ -13,9 +13,9 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import condition_above, inverse_jacobian, leg_vectors
-from stewart_drake.core.memo import Memo, digest
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sanity import plate_floor
+from stewart_drake.system.memo import Memo, digest
 from stewart_drake.workspace.limits import Limits, check_orientation, leg_axis_distances, leg_pairs, margins_from_legs
 
 

@@ -160,7 +160,7 @@ def test_size_and_dynamics_take_a_trajectory_object():
 def test_summary_says_where_the_ticks_ran():
     """``tick_loop`` names the loop that ran the ticks: the compiled kernel for the float law too (where a C
     compiler is found), the Python loop for engine python (``engine`` alone names the firmware's engine)."""
-    from stewart_drake.core.c_build import compilers
+    from stewart_drake.system.c_build import compilers
 
     p = sd.load_platform("utn-dynamic")
     float_run = sd.simulate(p, "seed", duration=0.02, controller="float").to_dict()

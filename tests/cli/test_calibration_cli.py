@@ -96,7 +96,7 @@ def test_ik_readings_and_fk_readings_round_trip(flow, capsys):
 
 
 def test_firmware_bakes_the_offsets_in_and_checks(flow, capsys, tmp_path, monkeypatch):
-    from stewart_drake.core.c_build import CACHE_ENV
+    from stewart_drake.system.c_build import CACHE_ENV
 
     monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
     f = flow / "cal" / "calibrated.yaml"

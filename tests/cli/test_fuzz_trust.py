@@ -26,9 +26,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, load_manifest
 from stewart_drake.errors import OutputError, StewartError
 from stewart_drake.montecarlo.spec import parse_spec
+from stewart_drake.system.output_folder import MANIFEST, OutputFolder, atomic_folder, load_manifest
 from tests.cli._fuzz import ROOT, ci, fuzz, run_cli, tree
 from tests.cli.test_orphans import group_members
 
@@ -212,7 +212,7 @@ def test_concurrent_writers_fuzz(plan):
 def interpreter_startup(err: str) -> bool:
     """True for the traceback of a Ctrl-C inside the interpreter's own startup (``site``, ``runpy``), before
     the first line of this package runs: Python's default handler is in place then and no code of ours can
-    answer (core.interrupts; ~30 ms on an idle machine, the signals fuzz found it at 62 ms under load).
+    answer (system.interrupts; ~30 ms on an idle machine, the signals fuzz found it at 62 ms under load).
     Any frame of ``stewart_drake`` makes it ours (from the package's first statement on, Ctrl-C is quiet)."""
     files = re.findall(r'File "([^"]+)"', err)
     last = err.strip().splitlines()[-1:] if err.strip() else []

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.core.processes import max_workers
 from stewart_drake.core.trajectory import read_trajectory_table
+from stewart_drake.system.processes import max_workers
 from tests.cli._inprocess import cli
 
 POSES = "px,py,pz,a,b,g\n0,0,0.7,0,0,0\n0.01,0,0.71,0,0,0\n"

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake.core.jsonout import dumps_strict
-from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from stewart_drake.errors import OPTION_JOINT_OVERFLOW, OutputError
+from stewart_drake.system.jsonout import dumps_strict
+from stewart_drake.system.output_folder import MANIFEST, OutputFolder, atomic_folder, read_manifest, safe_file_stem
 from tests.cli._inprocess import cli
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -66,7 +66,7 @@ def test_disk_full_names_the_file_and_the_rerun_resumes(here, capsys):
 def _partial(folder: Path, rows: list[str]) -> None:
     w = PartialWriter(folder, "k" * 16)
     w.write({"run": 0, "x": 1.0})
-    w.fh.append_texts(rows)  # lines that verify (core.journal), rows that are damaged
+    w.fh.append_texts(rows)  # lines that verify (system.journal), rows that are damaged
     w.close()
 
 

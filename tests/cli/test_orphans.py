@@ -37,7 +37,7 @@ def start(argv, cwd) -> subprocess.Popen:
     # $STEWART_DRAKE_CLI_PID names this process, as it did inside the full suite once a test had run
     # cli.main in-process: the command, a child of the process the variable names, ignored Ctrl-C as if
     # it were one of that process's workers and ran all 200 runs (the "outlived 30 s" of the full suite).
-    # A command line is never a worker (core.interrupts).
+    # A command line is never a worker (system.interrupts).
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg", STEWART_DRAKE_CLI_PID=str(os.getpid()))
     return subprocess.Popen(
         [sys.executable, "-m", "stewart_drake.cli", *argv],

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from stewart_drake.core.output_folder import MANIFEST, OutputFolder, atomic_folder, load_manifest
 from stewart_drake.errors import OutputError
+from stewart_drake.system.output_folder import MANIFEST, OutputFolder, atomic_folder, load_manifest
 from tests.cli._inprocess import cli
 
 

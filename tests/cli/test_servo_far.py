@@ -12,8 +12,8 @@ import pytest
 import stewart_drake as sd
 from stewart_drake.cli import main
 from stewart_drake.core.sanity import FAR_FACTOR, servo_hexapod_size
-from stewart_drake.core.servo import hobby_servo_hexapod
 from stewart_drake.errors import StewartError
+from stewart_drake.mechanisms.servo import hobby_servo_hexapod
 
 
 @pytest.mark.parametrize("z", ["1.3407807929942597e+157", "1e308", "5000"])

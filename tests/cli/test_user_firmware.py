@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from stewart_drake.cli import main
-from stewart_drake.core import c_build
+from stewart_drake.system import c_build
 from tests.cli._inprocess import cli
 
 pytestmark = pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
@@ -139,7 +139,7 @@ FORK = (
 
 def test_firmware_that_allocates_without_end(folder, capsys, monkeypatch):
     """An endless malloc in sd_ik stops at the child's address-space cap: one line naming the file, exit 2."""
-    from stewart_drake.core import isolate
+    from stewart_drake.system import isolate
 
     monkeypatch.setattr(isolate, "FIRMWARE_MEMORY_LIMIT_BYTES", MEM_CAP)
     monkeypatch.chdir(folder)

@@ -18,6 +18,8 @@ ROOT = Path(__file__).resolve().parents[2]
 RUNNER = str(Path(__file__).with_name("_no_drake.py"))
 NUMPY_PACKAGES = (
     "core",
+    "system",
+    "mechanisms",
     "control",
     "fixedpoint",
     "workspace",

@@ -85,7 +85,7 @@ def test_numpy_fallback_without_a_compiler(tmp_path):
 def test_portable_loop_equals_the_sse2_loop():
     """Where SSE2 is missing (other architectures) the plain C loop runs: built here with ``__SSE2__``
     undefined, it gives the same lengths bit for bit (the same operations in the same order)."""
-    from stewart_drake.core.c_build import Source, build, load
+    from stewart_drake.system.c_build import Source, build, load
 
     lib_path = build([Source(ik_kernel.SOURCE.name, path=ik_kernel.SOURCE)], opt=ik_kernel.OPT, flags=("-U__SSE2__",))
     ffi, lib = load(lib_path, ik_kernel.CDEF)

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from stewart_drake.core.geometry import PRESETS, load_preset
-from stewart_drake.core.leg3r import Leg3R
 from stewart_drake.core.rotations import rotation_matrix
 from stewart_drake.core.sdf import (
     box_inertia,
@@ -21,7 +20,8 @@ from stewart_drake.core.sdf import (
     xml_vec,
 )
 from stewart_drake.core.sdf_models import sdf_file_name, sdf_text, write_sdf
-from stewart_drake.core.servo import hobby_servo_hexapod
+from stewart_drake.mechanisms.leg3r import Leg3R
+from stewart_drake.mechanisms.servo import hobby_servo_hexapod
 
 
 def _committed_sdf_folder() -> Path:
@@ -117,7 +117,7 @@ def test_models_and_their_commands_need_no_pydrake(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(root), MPLBACKEND="Agg")
     code = (
         "import stewart_drake.core.sdf, stewart_drake.core.sdf_models, stewart_drake.core.leg_bodies, "
-        "stewart_drake.core.servo_mounting, stewart_drake.core.servo_loop, stewart_drake.core.assembly_modes, "
+        "stewart_drake.mechanisms.servo_mounting, stewart_drake.mechanisms.servo_loop, stewart_drake.core.assembly_modes, "
         "stewart_drake.core.reference_platforms, stewart_drake.core.sampling, stewart_drake.core.dynamics\n"
         "from stewart_drake.cli import main\n"
         "for argv in (['leg', 'sdf', '--write', 'a'], ['servo', '--write-sdf', 'b', '--json'], ['model', '--platform', 'utn-dynamic']):\n"

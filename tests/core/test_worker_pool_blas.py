@@ -1,8 +1,8 @@
-"""``core.processes.worker_pool``: its workers run with one BLAS thread, and the parent's environment is put back."""
+"""``system.processes.worker_pool``: its workers run with one BLAS thread, and the parent's environment is put back."""
 
 import os
 
-from stewart_drake.core.processes import ONE_BLAS_THREAD, worker_pool
+from stewart_drake.system.processes import ONE_BLAS_THREAD, worker_pool
 
 
 def _blas_environment(_) -> dict:

@@ -1,11 +1,11 @@
-"""3R planar leg (``core/leg3r``) cross-checked against Drake: every DH frame and both IK
+"""3R planar leg (``mechanisms/leg3r``) cross-checked against Drake: every DH frame and both IK
 branches (``drake/leg_model``)."""
 
 import numpy as np
 import pytest
 
-from stewart_drake.core.leg3r import Leg3R, foot, foot_jacobian, inverse_kinematics, random_configurations
 from stewart_drake.drake.leg_model import drake_fk_errors, drake_ik
+from stewart_drake.mechanisms.leg3r import Leg3R, foot, foot_jacobian, inverse_kinematics, random_configurations
 
 LEG = Leg3R()
 

@@ -7,8 +7,8 @@ import pytest
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import SnoptSolver, SolverOptions
 
-from stewart_drake.core.leg3r import Leg3R, check_branch, foot, random_configurations
 from stewart_drake.drake.leg_model import LegPlant, drake_fk_errors, drake_ik, leg_plant
+from stewart_drake.mechanisms.leg3r import Leg3R, check_branch, foot, random_configurations
 
 LEG = Leg3R()
 

@@ -1,13 +1,13 @@
-"""RC-servo hexapod (``core/servo``, ``core/servo_loop``) cross-checked against Drake
+"""RC-servo hexapod (``mechanisms/servo``, ``mechanisms/servo_loop``) cross-checked against Drake
 (``drake/servo_model``): the plant's frames, FK and IK, the controller system, and the 50 Hz loop closed in
 simulation."""
 
 import numpy as np
 import pytest
 
-from stewart_drake.core.servo import quantise_pulses, solve
-from stewart_drake.core.servo_loop import tracking_bounds
 from stewart_drake.drake.servo_model import compare_with_drake, run_closed_loop, run_controller
+from stewart_drake.mechanisms.servo import quantise_pulses, solve
+from stewart_drake.mechanisms.servo_loop import tracking_bounds
 from tests.core.test_servo import random_poses
 
 

@@ -7,9 +7,9 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from stewart_drake.core.sdf_models import SERVO_HEXAPOD_MODEL
-from stewart_drake.core.servo_loop import servo_gains
-from stewart_drake.core.servo_mounting import servo_joint_home
 from stewart_drake.drake.servo_model import build_plant
+from stewart_drake.mechanisms.servo_loop import servo_gains
+from stewart_drake.mechanisms.servo_mounting import servo_joint_home
 
 
 def _states(hexapod, visuals: bool) -> tuple[np.ndarray, int]:

@@ -5,8 +5,8 @@ was set (the positions a rod's frame is built from do not depend on the other ro
 import numpy as np
 
 from stewart_drake.core.sdf import rpy
-from stewart_drake.core.servo_mounting import frame_from_zx, servo_joint_home
 from stewart_drake.drake.servo_model import ServoPlant
+from stewart_drake.mechanisms.servo_mounting import frame_from_zx, servo_joint_home
 
 
 def _rod_by_rod(h: ServoPlant, angles) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 import pytest
 
-from stewart_drake.core.c_build import CACHE_ENV
+from stewart_drake.system.c_build import CACHE_ENV
 
 
 @pytest.fixture(scope="module", autouse=True)

@@ -12,13 +12,13 @@ import pytest
 
 from stewart_drake.cli import main
 from stewart_drake.control import FEEDFORWARD_OPS_PER_LEG, PID_OPS_PER_LEG, ControllerConfig
-from stewart_drake.core import c_build as build
 from stewart_drake.core.geometry import PRESETS, load_preset
 from stewart_drake.firmware.check import emulation_trace, trace_names, workspace_poses
 from stewart_drake.firmware.generate import TRACE_WORDS, generate
 from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.fixedpoint import QFormat, SaturationCounter
 from stewart_drake.fixedpoint.generic import leg_length_words, pose_words
+from stewart_drake.system import c_build as build
 from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 

@@ -8,10 +8,10 @@ from itertools import product
 import numpy as np
 import pytest
 
-from stewart_drake.core import c_build as build
 from stewart_drake.firmware.host import BATCH_OPS, frac, intrinsic, op_counts_tp17, tp17_leg_lengths_c
 from stewart_drake.fixedpoint import q15, scalar, tp17_leg_lengths
 from stewart_drake.fixedpoint.tp17 import SEED_DSP_MM, SEED_DSP_POSES
+from stewart_drake.system import c_build as build
 from tests.firmware.firmware_cache import firmware_cache  # noqa: F401
 
 E16 = [-32768, -32767, -16385, -16384, -2, -1, 0, 1, 2, 16383, 16384, 16385, 32766, 32767]

@@ -392,7 +392,7 @@ def test_tracker_falls_back_to_numpy_without_a_compiler(monkeypatch, tmp_path):
     """Without a C compiler ($STEWART_DRAKE_CC naming a program that does not exist) and no compiled
     tracker in the (empty) build cache, "auto" tracks with numpy and gives the compiled tracker's
     result, and "c" says there is no compiler; an unknown engine name is refused."""
-    from stewart_drake.core.c_build import CompilerUnavailable
+    from stewart_drake.system.c_build import CompilerUnavailable
 
     p = load_preset("utn-dynamic")
     L = leg_lengths(p, p.home_pose() + [0.01, 0.02, -0.01, 0.1, 0.05, -0.1])

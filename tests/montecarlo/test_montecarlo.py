@@ -293,8 +293,8 @@ def test_replay_runs_the_stored_study_and_refuses_other_options(tmp_path, capsys
     difference. A study run with the C engine replays without a compiler (the Python engine, with the
     note: bit-identical). A study.json or results.parquet a study did not write is one line naming it
     (it was a KeyError traceback)."""
-    from stewart_drake.core.c_build import CC_ENV
     from stewart_drake.errors import OptionError
+    from stewart_drake.system.c_build import CC_ENV
 
     out = tmp_path / "s"
     options = ["--runs", "1", "--duration", "0.05", "--integrator", "sap", "--engine", "c"]
@@ -332,7 +332,7 @@ def test_replay_runs_the_stored_study_and_refuses_other_options(tmp_path, capsys
 def test_the_parent_compiles_the_firmware_the_workers_load(platform, tmp_path, monkeypatch):
     """``study.compile_firmware`` (called before the workers start) leaves run 0's compiled firmware in the
     C build cache: a run then builds its C engine without calling the compiler at all."""
-    from stewart_drake.core import c_build
+    from stewart_drake.system import c_build
 
     if not c_build.compilers():
         pytest.skip("no C compiler")

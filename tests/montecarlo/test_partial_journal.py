@@ -1,4 +1,4 @@
-"""``montecarlo``'s resume journal (``montecarlo.partial.jsonl``, a ``core.journal``): a hand-edited row is refused
+"""``montecarlo``'s resume journal (``montecarlo.partial.jsonl``, a ``system.journal``): a hand-edited row is refused
 naming the file and line, and a row whose chain was rewritten is still checked against the study's draws."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import json
 import re
 
 from stewart_drake.cli import main
-from stewart_drake.core.journal import JournalWriter, header_line
 from stewart_drake.montecarlo import study as study_mod
+from stewart_drake.system.journal import JournalWriter, header_line
 
 VARY = ["gain_scale=0.9..1.1", "plate_mass=±20%"]
 

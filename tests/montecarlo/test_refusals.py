@@ -6,8 +6,8 @@ import pytest
 
 from stewart_drake.cli import main
 from stewart_drake.commands import simulate as simulate_cmd
-from stewart_drake.core.output_folder import MANIFEST, OutputFolder
 from stewart_drake.errors import StudyError
+from stewart_drake.system.output_folder import MANIFEST, OutputFolder
 
 
 def test_simulate_force_into_a_study_folder_is_refused_before_it_runs(tmp_path, capsys, monkeypatch):

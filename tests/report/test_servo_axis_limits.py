@@ -5,7 +5,7 @@ must separate a reachable step from an unreachable one."""
 import numpy as np
 
 from stewart_drake.analyses.servo import axis_limits
-from stewart_drake.core.servo import solve
+from stewart_drake.mechanisms.servo import solve
 
 
 def _one_direction(h, direction, hi):

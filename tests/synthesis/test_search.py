@@ -12,7 +12,6 @@ import pytest
 import scipy.linalg
 
 from stewart_drake.core.geometry import load_platform_yaml
-from stewart_drake.core.journal import JournalWriter
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.design.modes import spatial_inertia
 from stewart_drake.design.stiffness import stiffness_matrix
@@ -25,6 +24,7 @@ from stewart_drake.synthesis.proof import prove_requirements_box
 from stewart_drake.synthesis.requirements import load_requirements
 from stewart_drake.synthesis.search import CACHE, run_search
 from stewart_drake.synthesis.synthesize import synthesize
+from stewart_drake.system.journal import JournalWriter
 
 SEED_001 = resources.files("stewart_drake") / "examples" / "seed_001_requirements.yaml"
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.servo import FRAME_RATE_HZ, ServoHexapod, arm_angles, pose_jacobian
 from stewart_drake.errors import SimulationError
+from stewart_drake.mechanisms.servo import FRAME_RATE_HZ, ServoHexapod, arm_angles, pose_jacobian
 
 
 def servo_gains(hexapod: ServoHexapod) -> tuple[float, float]:

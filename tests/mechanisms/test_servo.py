@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from stewart_drake.core.servo import (
+from stewart_drake.errors import GeometryError
+from stewart_drake.mechanisms.servo import (
     RATE_US_PER_RAD,
     ServoPoseError,
     anchor_positions,
@@ -15,7 +16,6 @@ from stewart_drake.core.servo import (
     quantise_pulses,
     solve,
 )
-from stewart_drake.errors import GeometryError
 
 
 def random_poses(h, n, seed, dx=0.008, da=np.radians(6)):
@@ -119,7 +119,7 @@ def test_quantisation_rounds_half_away_from_zero():
 
 def test_yaml_preset_is_the_documented_layout(hexapod):
     """The shipped presets/servo-hobby.yaml (mm, paired layout) builds exactly hobby_servo_hexapod()."""
-    from stewart_drake.core.servo import load_servo_hexapod
+    from stewart_drake.mechanisms.servo import load_servo_hexapod
 
     y = load_servo_hexapod("hobby-servo")
     for name in ("base_pivots", "arm_directions", "platform_anchors", "shaft_directions", "neutral_us"):
@@ -153,7 +153,7 @@ def _explicit_yaml(h, trims):
 
 
 def test_yaml_explicit_layout_round_trip(hexapod, tmp_path):
-    from stewart_drake.core.servo import load_servo_hexapod
+    from stewart_drake.mechanisms.servo import load_servo_hexapod
 
     trims = [1500, 1512, 1490, 1503, 1497, 1521]
     path = tmp_path / "mine.yaml"
@@ -188,7 +188,7 @@ def test_yaml_explicit_layout_round_trip(hexapod, tmp_path):
     ],
 )
 def test_yaml_errors_name_the_field_and_value(tmp_path, edit, message):
-    from stewart_drake.core.servo import load_servo_hexapod, servo_preset_path
+    from stewart_drake.mechanisms.servo import load_servo_hexapod, servo_preset_path
 
     text = servo_preset_path("hobby-servo").read_text()
     assert edit[0] in text
@@ -199,7 +199,7 @@ def test_yaml_errors_name_the_field_and_value(tmp_path, edit, message):
 
 
 def test_explicit_yaml_missing_fields_and_unknown_names(hexapod, tmp_path):
-    from stewart_drake.core.servo import load_servo_hexapod
+    from stewart_drake.mechanisms.servo import load_servo_hexapod
 
     path = tmp_path / "partial.yaml"
     path.write_text(

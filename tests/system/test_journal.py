@@ -1,4 +1,4 @@
-"""``core.journal``: every line of a resume journal verified, an interrupted last line dropped and cut off before
+"""``system.journal``: every line of a resume journal verified, an interrupted last line dropped and cut off before
 the next append, a journal of another identity or with a damaged header refused naming the file and line."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import re
 
 import pytest
 
-from stewart_drake.core.journal import JournalWriter, header_line, read_header, read_rows
 from stewart_drake.errors import JournalError
+from stewart_drake.system.journal import JournalWriter, header_line, read_header, read_rows
 
 
 def _journal(path, identity="k" * 16, rows=3):

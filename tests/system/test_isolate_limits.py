@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.core import c_build
-from stewart_drake.core.isolate import run_isolated
 from stewart_drake.errors import IsolationError
+from stewart_drake.system import c_build
+from stewart_drake.system.isolate import run_isolated
 
 needs_cc = pytest.mark.skipif(shutil.which("cc") is None and shutil.which("gcc") is None, reason="no C compiler")
 CAP = 256 << 20  # a cap far above what the child needs to start and far below the machine's memory

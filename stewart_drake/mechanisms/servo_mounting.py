@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stewart_drake.core.servo import ServoHexapod, arm_tips
+from stewart_drake.mechanisms.servo import ServoHexapod, arm_tips
 
 
 def frame_from_zx(z, x_hint) -> np.ndarray:

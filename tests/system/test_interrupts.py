@@ -1,4 +1,4 @@
-"""Who answers Ctrl-C (core.interrupts): the command line is recognised from the interpreter's own command
+"""Who answers Ctrl-C (system.interrupts): the command line is recognised from the interpreter's own command
 line (never a spawned worker, never another program), a worker only by its parent, and a command run
 in-process leaves no mark in its caller's environment (the mark made a later command, started by the test
 runner, ignore Ctrl-C as if it were the runner's worker: the Dask orphan test's full-suite timeouts)."""
@@ -10,7 +10,7 @@ import os
 import pytest
 
 from stewart_drake import cli
-from stewart_drake.core import interrupts, processes
+from stewart_drake.system import interrupts, processes
 
 PY = "/usr/bin/python3"
 
@@ -29,7 +29,7 @@ PY = "/usr/bin/python3"
             False,
         ),
         ([PY, "-m", "pytest", "tests"], False),
-        ([PY, "-m", "stewart_drake.core.isolate"], False),
+        ([PY, "-m", "stewart_drake.system.isolate"], False),
         ([PY, "my_study.py", "stewart-drake"], False),
         ([PY], False),  # the interactive interpreter
         ([PY, "-m"], False),

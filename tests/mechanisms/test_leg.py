@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from stewart_drake.core.leg3r import (
+from stewart_drake.mechanisms.leg3r import (
     SEED_FIXES,
     Leg3R,
     UnreachableTargetError,

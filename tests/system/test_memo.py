@@ -1,6 +1,6 @@
-"""``core.memo``: the per-process memo behind the remembered feed-forward tables and loop Diagrams."""
+"""``system.memo``: the per-process memo behind the remembered feed-forward tables and loop Diagrams."""
 
-from stewart_drake.core.memo import Memo, digest
+from stewart_drake.system.memo import Memo, digest
 
 
 def test_memo_computes_once_per_key_and_drops_the_least_recently_used():

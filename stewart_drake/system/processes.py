@@ -9,7 +9,7 @@
   (``mark_cli``; ``dask_sweep.WORKER_CONFIG`` preloads this module) and end within a second of their
   parent's SIGKILL by themselves (their nanny's pipe closes; measured on a 2-worker study).
 - ``mark_cli``: the command line's PID in the environment (``STEWART_DRAKE_CLI_PID``): a worker process it
-  starts (its child) ignores SIGINT from the moment it imports this package (``core.interrupts``), so that
+  starts (its child) ignores SIGINT from the moment it imports this package (``system.interrupts``), so that
   a Ctrl-C while the worker starts is not a traceback either; ``mark_cli`` returns what restores the
   environment (a command run in-process must not mark the caller's later children).
 - ``worker_pool``: a spawn ``ProcessPoolExecutor`` whose workers run ``child_setup`` and are terminated,
@@ -29,9 +29,9 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 
-from stewart_drake.core.interrupts import CLI_PID_ENV
 from stewart_drake.core.sanity import check_work
 from stewart_drake.errors import OptionError
+from stewart_drake.system.interrupts import CLI_PID_ENV
 
 BYTES_PER_WORKER = 150e6
 WORKERS_PER_CPU = 4

@@ -23,8 +23,8 @@ import signal
 import time
 from collections.abc import Callable
 
-from stewart_drake.core.processes import child_setup
 from stewart_drake.errors import IsolationError, OptionError
+from stewart_drake.system.processes import child_setup
 
 FIRMWARE_TIME_LIMIT_S = 120.0  # firmware check: compile, 100000 poses, 0.5 s closed loop (~10 s here)
 FIRMWARE_IDLE_LIMIT_S = 60.0  # simulate --firmware: seconds the simulated time may stand still (a tick takes µs)

@@ -1,0 +1,1 @@
+"""Operating-system plumbing: output folders and their manifests, processes and interrupts, the isolated child for user code, C builds with their content-hash cache, input streams, strict JSON, verified journals, memoisation (numpy-free where it can be; below every layer that writes files or starts processes)."""
