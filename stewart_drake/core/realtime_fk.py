@@ -44,7 +44,6 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import anchor_radius
 from stewart_drake.core.newton_fk import CONVERGED, leg_geometry, newton_core, validate_lengths
@@ -69,6 +68,10 @@ _LIB: list = []
 def library():
     """``(ffi, lib)`` of the compiled kernel, or None without a compiler or cache (noted once on stderr)."""
     if not _LIB:
+        # deferred: the compiler glue (subprocess, tempfile, hashing, cffi) is needed only when the kernel first
+        # runs, and the command line's fk and ik import this module at start
+        from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
+
         try:
             _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-realtime-fk", OPT, flags=FLAGS), CDEF))
         except UNAVAILABLE:

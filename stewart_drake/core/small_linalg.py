@@ -21,8 +21,6 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.core.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
-
 SOURCE = Path(__file__).with_name("small_linalg.c")
 CDEF = """
 void sd_gram2(int64_t n, int64_t k, const double *B, double *G);
@@ -52,6 +50,10 @@ _LIB: list = []
 def library():
     """``(ffi, lib)`` of the compiled loops when they give numpy's bits here (probed once), else None."""
     if not _LIB:
+        # deferred: the compiler glue (subprocess, tempfile, hashing, cffi) is needed only when the loops are first
+        # run, and every command imports this module at start (through the kinematics)
+        from stewart_drake.core.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
+
         try:
             lib = load(source_keyed_library(SOURCE, CDEF, "sd-small-linalg", "-O2", FLAGS), CDEF)
         except (*UNAVAILABLE, CompileError, OSError, ImportError):  # numpy gives the same numbers: run it
