@@ -105,7 +105,8 @@ NOT_NEEDED = (
     "multiprocessing",
     "concurrent.futures",
 )
-# the compiler glue: only where a compiled kernel runs (fk's real-time branch check, dsp-ik's firmware engine)
+# the compiler glue: only where a compiled kernel runs (fk's real-time branch check and homotopy tracker, dsp-ik's
+# firmware engine)
 COMPILER = ("stewart_drake.core.c_build", "cffi")
 
 
@@ -114,13 +115,14 @@ COMPILER = ("stewart_drake.core.c_build", "cffi")
     [
         (["ik", "--platform", "utn-dynamic", "--pose", "0", "0", "700", "0", "0", "0"], NOT_NEEDED + COMPILER),
         (["fk", "--platform", "utn-dynamic", "--lengths", *["730"] * 6], NOT_NEEDED),
+        (["fk", "--all", "--platform", "utn-dynamic", "--lengths", *["730"] * 6], NOT_NEEDED),
         (["dsp-ik", "--pose", "0", "0", "100", "0.1", "0", "0"], NOT_NEEDED),
         (["servo", "--pose", "0", "0", "0", "0", "0", "0", "--from-home"], NOT_NEEDED + COMPILER),
         (["leg", "fk", "0.1", "0.2"], NOT_NEEDED + COMPILER),
         (["workspace", "--help"], NOT_NEEDED + COMPILER),
         (["--help"], NOT_NEEDED + COMPILER),
     ],
-    ids=lambda v: " ".join(v[:2]) if isinstance(v, list) else None,
+    ids=lambda v: " ".join(a for a in v[:2] if a != "--platform") if isinstance(v, list) else None,
 )
 def test_numpy_command_imports_only_what_it_runs(argv, not_needed):
     p = subprocess.run([sys.executable, "-c", LOADED, *argv], capture_output=True, text=True, timeout=300)
