@@ -91,7 +91,8 @@ with contextlib.redirect_stdout(io.StringIO()):
 print(json.dumps({"rc": rc, "modules": sorted(sys.modules)}))
 """
 # The libraries of the other commands (Drake, the optimisers, Dask, tables, plots, the motion language, progress
-# bars) and the process-pool machinery: no numpy command's work uses them, and each adds to its start-up.
+# bars), numpy's masked arrays and the process-pool machinery: no numpy command's work uses them, and each adds
+# to its start-up.
 NOT_NEEDED = (
     "pydrake",
     "scipy",
@@ -104,6 +105,7 @@ NOT_NEEDED = (
     "tqdm",
     "multiprocessing",
     "concurrent.futures",
+    "numpy.ma",
 )
 # the compiler glue: only where a compiled kernel runs (fk's real-time branch check and homotopy tracker, dsp-ik's
 # firmware engine)
