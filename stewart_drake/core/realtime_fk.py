@@ -73,7 +73,8 @@ def library():
         from stewart_drake.core.c_build import UNAVAILABLE, load, source_keyed_library
 
         try:
-            _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-realtime-fk", OPT, flags=FLAGS), CDEF))
+            path = source_keyed_library(SOURCE, CDEF, "sd-realtime-fk", OPT, flags=FLAGS)
+            _LIB.append(load(path, CDEF, cache_declarations=True))
         except UNAVAILABLE:
             print(NO_COMPILER_NOTE, file=sys.stderr)
             _LIB.append(None)

@@ -55,7 +55,9 @@ def library():
         from stewart_drake.core.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
 
         try:
-            lib = load(source_keyed_library(SOURCE, CDEF, "sd-small-linalg", "-O2", FLAGS), CDEF)
+            lib = load(
+                source_keyed_library(SOURCE, CDEF, "sd-small-linalg", "-O2", FLAGS), CDEF, cache_declarations=True
+            )
         except (*UNAVAILABLE, CompileError, OSError, ImportError):  # numpy gives the same numbers: run it
             lib = None
         _LIB.append(lib if lib is not None and _probe(lib) else None)
