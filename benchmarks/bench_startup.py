@@ -9,7 +9,7 @@ waiting process costs wall time but no CPU time. Bytecode is cached under a temp
 ``PYTHONPYCACHEPREFIX`` (filled by a first, untimed round), as an installed package has its ``.pyc``: no run
 pays for compiling the sources, and nothing is written into the checkouts. The rounds are interleaved (every case and checkout once per
 round) so that all see the same machine state. The reference is ``python -c "import numpy"`` from the same
-round; the target (issue 42) is a numpy-only command's start-up within 2x the reference. With ``--compare``,
+round; the target is a numpy-only command's start-up within 2x the reference. With ``--compare``,
 the other checkout's figures print beside (e.g. main before a change). Pins nothing; exit 0.
 """
 
@@ -24,7 +24,7 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-TARGET = 2.0  # issue 42: a numpy-only command's start-up <= 2x `python -c "import numpy"` in the same run
+TARGET = 2.0  # a numpy-only command's start-up <= 2x `python -c "import numpy"` in the same run
 
 REFERENCE = ["-c", "import numpy"]
 # the numpy-only commands a user scripts, each with a small input (the figure is start-up, not the work)
