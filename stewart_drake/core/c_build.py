@@ -15,7 +15,8 @@ Cache: ``$STEWART_DRAKE_CACHE``, else ``$XDG_CACHE_HOME/stewart-drake``, else ``
 (never the source tree); an entry's name is the SHA-256 of the compiler's identity, the flags and every
 source's bytes, written atomically (compiled in a temporary folder, then renamed) beside the SHA-256 of the
 library's own bytes (``<entry>.sha256``); an entry is used only while its bytes match that record (a truncated
-or altered library would crash the process when loaded), else it is built again.
+or altered library would crash the process when loaded), else it is built again. The package's own kernels'
+cffi declarations are cached the same way (``ffi-<SHA-256 of the declarations>.py``, see ``_ffi``).
 
 A compiler runs in its own process group with its address space limited to ``COMPILE_MEMORY_LIMIT_BYTES``
 (``ulimit -v``): a source that makes it allocate without end (``#include "/dev/zero"``) is a ``CompileError``.
