@@ -348,9 +348,13 @@ def _ffi(cdef: str, cached: bool = False):
 
 
 def _ffi_entry(cdef: str) -> Path | None:
-    """The cache entry of the declarations ``cdef`` (None without a usable cache)."""
+    """The cache entry of the declarations ``cdef`` for this cffi (its generated modules are read by the
+    ``_cffi_backend`` of the version that wrote them); None without a usable cache."""
+    import _cffi_backend  # deferred: cffi's C part, loaded only by a process that loads a kernel
+
+    key = hashlib.sha256(f"{_cffi_backend.__version__}\n{cdef}".encode()).hexdigest()[:32]
     try:
-        return cache_dir() / f"ffi-{hashlib.sha256(cdef.encode()).hexdigest()[:32]}.py"
+        return cache_dir() / f"ffi-{key}.py"
     except CacheUnavailable:
         return None
 
