@@ -10,11 +10,8 @@ from numpy.typing import ArrayLike
 
 from stewart_drake.api.result import Result
 from stewart_drake.core.argcheck import as_choice, as_flag, as_int, as_real, as_real_array, check_shape, param
-from stewart_drake.core.assembly_modes import modes_from_solutions
 from stewart_drake.core.geometry import Platform, check_platform
 from stewart_drake.core.kinematics import check_stroke, leg_lengths
-from stewart_drake.core.newton_fk import forward_kinematics, multiple_root
-from stewart_drake.core.realtime_fk import branch_check
 from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import (
     below_base_message,
@@ -314,6 +311,11 @@ def solve_fk(
 ) -> FKResult:
     """``fk`` with the names its errors give the lengths: ``what``, and ``given`` (the values as the user wrote
     them, in ``unit``; default ``lengths`` in metres)."""
+    # deferred: the FK solvers are for this function alone, and `ik` (this module's other command) starts without
+    from stewart_drake.core.assembly_modes import modes_from_solutions
+    from stewart_drake.core.newton_fk import forward_kinematics, multiple_root
+    from stewart_drake.core.realtime_fk import branch_check
+
     check_platform(platform)
     L = check_shape(lengths, what, (6,))
     given = L if given is None else given
@@ -397,7 +399,8 @@ def _solution(mode, method: str, **extra) -> FKSolution:
 
 def _homotopy_all(platform, L, convention: str, seed: int, common, allowed) -> FKResult:
     """Every mode by the complete homotopy solver: nearest home first, each with its certificate."""
-    # Deferred: the homotopy solver pulls in scipy (~0.1 s); only all-mode FK needs it.
+    # deferred: the homotopy solver and its compiled tracker (cffi) are for all-mode FK alone
+    from stewart_drake.core.assembly_modes import modes_from_solutions
     from stewart_drake.homotopy import solve
 
     r = solve(platform, L, seed=seed)

@@ -9,9 +9,7 @@ import numpy as np
 
 from stewart_drake.api.kinematics import solve_ik
 from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
-from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.rotations import length_scale, pose_to_si
-from stewart_drake.core.unit_hint import other_unit_hint
 
 # Bytes a CSV row costs until the output is written: its text and parsed values, its pose in SI and its
 # output line (table ~80 characters, JSON ~400); the results themselves are computed CHUNK_ROWS at a time.
@@ -40,6 +38,8 @@ def register(sub) -> None:
 
 def read_poses_csv(path: str) -> np.ndarray:
     """``(n, 6)`` poses from a CSV file; a non-numeric first row is a header. Errors name the line."""
+    from stewart_drake.core.csvio import read_numeric_csv  # deferred: see ``run``
+
     return read_numeric_csv(path, "poses", (6,), "px,py,pz,a,b,g")[0]
 
 
@@ -48,6 +48,9 @@ def run(args) -> int:
     if args.pose is not None:
         raw, lines = np.array(args.pose), None
     else:
+        # deferred: the CSV reader (and the csv module) is needed only with --poses; one pose starts without it
+        from stewart_drake.core.csvio import read_numeric_csv
+
         cost = BYTES_PER_ROW + (BYTES_PER_JSON_ROW if args.json else 0)
         raw, lines = read_numeric_csv(args.poses, "poses", (6,), "px,py,pz,a,b,g", option="--poses", bytes_per_row=cost)
     what = "--pose" if lines is None else f"{args.poses}: pose"
@@ -85,7 +88,12 @@ def run(args) -> int:
             sys.stdout.write(_table_header(platform.name, args) + "\n")
             for part in parts:
                 sys.stdout.write(part)
-    hint = "" if ok else other_unit_hint(platform, q, args.length_unit, args.angle_unit, args.convention)
+    if ok:
+        hint = ""
+    else:
+        from stewart_drake.core.unit_hint import other_unit_hint  # deferred: only a failed pose needs it
+
+        hint = other_unit_hint(platform, q, args.length_unit, args.angle_unit, args.convention)
     if hint:
         print(f"stewart-drake ik: outside the workspace{hint}", file=sys.stderr)
     return 0 if ok else 1

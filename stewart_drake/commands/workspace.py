@@ -19,9 +19,7 @@ from stewart_drake.commands._common import (
 )
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, to_radians
 from stewart_drake.errors import OptionError, SynthesisError
-from stewart_drake.synthesis.api import prove_workspace
 from stewart_drake.synthesis.proof import MAX_CELLS, START_CELLS
-from stewart_drake.synthesis.synthesize import cells_note
 from stewart_drake.system.output_folder import atomic_folder
 from stewart_drake.workspace import AXES, view_figures
 
@@ -198,6 +196,11 @@ def write_outputs(w, result: dict, out) -> None:
 
 def run_proof(args) -> int:
     """``--prove``: the proof of ``--require-box`` alone (``synthesis.proof``); exit 1 unless proven."""
+    # deferred: the synthesis API imports its search (pymoo, scipy), which only --prove's module needs, and
+    # not for the proof itself; the sweep and --help start without it
+    from stewart_drake.synthesis.api import prove_workspace
+    from stewart_drake.synthesis.synthesize import cells_note
+
     reject_unused(args, "the workspace sweep (without --prove)", False, out=None, centre=None, workers=1)
     if args.require_box is None:
         raise OptionError(SynthesisError.BOX_OPTION_COUNT.format(n=0))

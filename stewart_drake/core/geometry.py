@@ -12,7 +12,6 @@ import dataclasses
 import math
 import os
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +26,9 @@ from stewart_drake.errors import ArgumentError, GeometryError, YamlError
 
 SQRT3 = np.sqrt(3.0)
 PRESETS = ("utn-kinematic", "utn-dynamic", "gonzalez-dutra-2009")
+# the built-in presets' files: a folder of the installed package (a path, not importlib.resources, whose readers
+# import zipfile and tempfile at every command's start)
+PRESET_FOLDER = Path(__file__).resolve().parent.parent / "presets"
 # Two base anchors closer than this are the same point: a modelling error, not a design.
 MIN_ANCHOR_SEPARATION = 1e-6
 
@@ -742,7 +744,7 @@ def preset_path(name: str) -> Path:
     """The YAML file of a built-in preset."""
     if name not in PRESETS:
         raise GeometryError(GeometryError.UNKNOWN_PRESET.format(name=name, presets=", ".join(PRESETS)))
-    return Path(str(resources.files("stewart_drake") / "presets" / f"{name}.yaml"))
+    return PRESET_FOLDER / f"{name}.yaml"
 
 
 def load_preset(name: str) -> Platform:

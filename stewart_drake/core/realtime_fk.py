@@ -50,7 +50,6 @@ from stewart_drake.core.kinematics import anchor_radius
 from stewart_drake.core.newton_fk import CONVERGED, leg_geometry, newton_core, validate_lengths
 from stewart_drake.core.rotations import CONVENTIONS, angles_from_matrix, check_convention, rotation_matrix
 from stewart_drake.errors import FkInputError
-from stewart_drake.system.c_build import UNAVAILABLE, load, source_keyed_library
 
 SOURCE = Path(__file__).with_name("fk_kernel.c")
 CDEF = """
@@ -72,8 +71,13 @@ _LIB: list = []
 def library():
     """``(ffi, lib)`` of the compiled kernel, or None without a compiler or cache (noted once on stderr)."""
     if not _LIB:
+        # deferred: the compiler glue (subprocess, tempfile, hashing, cffi) is needed only when the kernel first
+        # runs, and the command line's fk and ik import this module at start
+        from stewart_drake.system.c_build import UNAVAILABLE, load, source_keyed_library
+
         try:
-            _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-realtime-fk", OPT, flags=FLAGS), CDEF))
+            path = source_keyed_library(SOURCE, CDEF, "sd-realtime-fk", OPT, flags=FLAGS)
+            _LIB.append(load(path, CDEF, cache_declarations=True))
         except UNAVAILABLE:
             print(NO_COMPILER_NOTE, file=sys.stderr)
             _LIB.append(None)

@@ -21,8 +21,6 @@ from pathlib import Path
 
 import numpy as np
 
-from stewart_drake.system.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
-
 SOURCE = Path(__file__).with_name("small_linalg.c")
 CDEF = """
 void sd_gram2(int64_t n, int64_t k, const double *B, double *G);
@@ -52,8 +50,14 @@ _LIB: list = []
 def library():
     """``(ffi, lib)`` of the compiled loops when they give numpy's bits here (probed once), else None."""
     if not _LIB:
+        # deferred: the compiler glue (subprocess, tempfile, hashing, cffi) is needed only when the loops are first
+        # run, and every command imports this module at start (through the kinematics)
+        from stewart_drake.system.c_build import UNAVAILABLE, CompileError, load, source_keyed_library
+
         try:
-            lib = load(source_keyed_library(SOURCE, CDEF, "sd-small-linalg", "-O2", FLAGS), CDEF)
+            lib = load(
+                source_keyed_library(SOURCE, CDEF, "sd-small-linalg", "-O2", FLAGS), CDEF, cache_declarations=True
+            )
         except (*UNAVAILABLE, CompileError, OSError, ImportError):  # numpy gives the same numbers: run it
             lib = None
         _LIB.append(lib if lib is not None and _probe(lib) else None)

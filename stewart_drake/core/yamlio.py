@@ -11,7 +11,6 @@ written in the file; an unknown key suggests the nearest valid one.
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 import types
 import typing
@@ -291,6 +290,8 @@ def _dataclass(node, tp, path, shown, where):
             )
         key = knode.value
         if key not in hints:
+            import difflib  # deferred: only a misspelt key needs it, and every command reads a file at start
+
             close = difflib.get_close_matches(key, fields, n=1, cutoff=0.6)
             hint = f" {key!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
             raise YamlError(

@@ -34,7 +34,9 @@ def library():
     bug, never hidden by a fallback)."""
     if not _LIB:
         try:
-            _LIB.append(load(source_keyed_library(SOURCE, CDEF, "sd-homotopy-track", OPT), CDEF))
+            _LIB.append(
+                load(source_keyed_library(SOURCE, CDEF, "sd-homotopy-track", OPT), CDEF, cache_declarations=True)
+            )
         except UNAVAILABLE as err:
             _LIB.append(err)
     if isinstance(_LIB[0], UNAVAILABLE):

@@ -317,7 +317,9 @@ def solve_batch(
     # A set with a path that still failed is tracked again, all its paths, with a new random γ (a new
     # arc of the same homotopy: the path correspondence changes, so all paths are redone together).
     for _ in range(gamma_retries if retrack else 0):
-        sets = np.unique(np.flatnonzero(paths.state == FAILED) // N)
+        # the sets with a failed path, ascending (row r is path r % N of set r // N); not np.unique, whose
+        # first call imports numpy.ma, a large share of `fk --all`'s start-up
+        sets = np.flatnonzero((paths.state == FAILED).reshape(-1, N).any(axis=1))
         if len(sets) == 0:
             break
         rows = (sets[:, None] * N + np.arange(N)).ravel()

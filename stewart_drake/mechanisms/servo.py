@@ -38,13 +38,12 @@ the anchor) and the commanded pulse is clamped to the servo's travel.
 
 import dataclasses
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
 from stewart_drake.core.argcheck import first_index
-from stewart_drake.core.geometry import check_name, load_yaml_config
+from stewart_drake.core.geometry import PRESET_FOLDER, check_name, load_yaml_config
 from stewart_drake.core.rotations import length_scale, rotation_matrix, wrap_angle
 from stewart_drake.errors import SERVO_RESOLUTION, GeometryError, ServoPoseError, StewartError, counted
 
@@ -394,7 +393,7 @@ def servo_preset_path(name: str) -> Path:
     """The YAML file of a built-in servo hexapod preset."""
     if name not in _PRESET_FILES:
         raise GeometryError(GeometryError.SERVO_UNKNOWN_PRESET.format(name=name, presets=", ".join(SERVO_PRESETS)))
-    return Path(str(resources.files("stewart_drake") / "presets" / _PRESET_FILES[name]))
+    return PRESET_FOLDER / _PRESET_FILES[name]
 
 
 def load_servo_preset(name: str) -> ServoHexapod:

@@ -15,7 +15,8 @@ Cache: ``$STEWART_DRAKE_CACHE``, else ``$XDG_CACHE_HOME/stewart-drake``, else ``
 (never the source tree); an entry's name is the SHA-256 of the compiler's identity, the flags and every
 source's bytes, written atomically (compiled in a temporary folder, then renamed) beside the SHA-256 of the
 library's own bytes (``<entry>.sha256``); an entry is used only while its bytes match that record (a truncated
-or altered library would crash the process when loaded), else it is built again.
+or altered library would crash the process when loaded), else it is built again. The package's own kernels'
+cffi declarations are cached the same way (``ffi-<SHA-256 of the declarations>.py``, see ``_ffi``).
 
 A compiler runs in its own process group with its address space limited to ``COMPILE_MEMORY_LIMIT_BYTES``
 (``ulimit -v``): a source that makes it allocate without end (``#include "/dev/zero"``) is a ``CompileError``.
@@ -321,12 +322,60 @@ def _first_error(msg: str, compiler: Compiler) -> str:
 
 
 @cache
-def _ffi(cdef: str):
-    import cffi
+def _ffi(cdef: str, cached: bool = False):
+    """cffi's ``FFI`` for the declarations ``cdef``. Parsing them takes cffi's C parser (pycparser), whose
+    import and parse cost a large share of a short command's start-up; ``cached``: the parsed declarations are
+    also kept in the cache as the module cffi generates for them (its out-of-line ABI mode: a few type tables,
+    run with ``_cffi_backend`` alone, checked against its recorded SHA-256 like a library) and read from there
+    by later processes."""
+    entry = _ffi_entry(cdef) if cached else None
+    if entry is not None:
+        try:
+            code = entry.read_bytes()
+            if _digest_path(entry).read_text().strip() == hashlib.sha256(code).hexdigest():
+                namespace: dict = {}
+                exec(compile(code, str(entry), "exec"), namespace)  # the module cffi generated for ``cdef``
+                return namespace["ffi"]
+        except OSError:  # not stored yet (or unreadable): parse, and store
+            pass
+    import cffi  # deferred: only a process that parses declarations (not read from the cache) needs the parser
 
     ffi = cffi.FFI()
     ffi.cdef(cdef)
+    if entry is not None:
+        _store_ffi(ffi, entry)
     return ffi
+
+
+def _ffi_entry(cdef: str) -> Path | None:
+    """The cache entry of the declarations ``cdef`` for this cffi (its generated modules are read by the
+    ``_cffi_backend`` of the version that wrote them); None without a usable cache."""
+    import _cffi_backend  # deferred: cffi's C part, loaded only by a process that loads a kernel
+
+    key = hashlib.sha256(f"{_cffi_backend.__version__}\n{cdef}".encode()).hexdigest()[:32]
+    try:
+        return cache_dir() / f"ffi-{key}.py"
+    except CacheUnavailable:
+        return None
+
+
+def _store_ffi(ffi, entry: Path) -> None:
+    """Keep ``ffi``'s declarations as the module cffi generates for them at ``entry`` (nothing if the cache
+    cannot hold it, nor declarations cffi does not write out of line: the next process parses them again)."""
+    import cffi
+    from cffi.recompiler import make_py_source
+
+    try:
+        fd, tmp = tempfile.mkstemp(suffix=".py", dir=entry.parent)
+        os.close(fd)
+        try:
+            make_py_source(ffi, entry.stem.replace("-", "_"), tmp)
+            store(Path(tmp), entry)
+        finally:
+            if os.path.lexists(tmp):
+                os.unlink(tmp)
+    except (OSError, cffi.FFIError, cffi.CDefError, cffi.VerificationError):
+        pass
 
 
 _LOADED: dict[tuple[str, str], object] = {}
@@ -348,9 +397,12 @@ def source_keyed_library(source: Path, cdef: str, prefix: str, opt: str = "-O2",
     return fast
 
 
-def load(path: Path, cdef: str):
-    """``(ffi, lib)`` for the shared library at ``path`` with the declarations ``cdef`` (loaded once)."""
-    ffi = _ffi(cdef)
+def load(path: Path, cdef: str, cache_declarations: bool = False):
+    """``(ffi, lib)`` for the shared library at ``path`` with the declarations ``cdef`` (loaded once).
+    ``cache_declarations``: for the package's own kernels, whose libraries define every declared function
+    (``_ffi``'s cache: a missing function raises ``ffi.error`` from cached declarations, ``AttributeError``
+    from parsed ones, which is how a user's firmware is probed for optional functions)."""
+    ffi = _ffi(cdef, cache_declarations)
     key = (str(path), cdef)
     if key not in _LOADED:
         _LOADED[key] = ffi.dlopen(str(path))

@@ -34,12 +34,9 @@ from __future__ import annotations
 import ctypes
 import errno
 import fcntl
-import hashlib
 import json
 import os
 import re
-import secrets
-import shutil
 import stat
 import sys
 from collections.abc import Iterator
@@ -226,6 +223,14 @@ def _read_nofollow(path: Path) -> bytes:
         os.close(fd)
 
 
+def _remove_tree(path: Path, ignore_errors: bool = False) -> None:
+    """``shutil.rmtree``: fd-based, removes the links inside a folder and never follows them."""
+    # deferred: every command imports this module at start, and only a command that writes files removes any
+    import shutil
+
+    shutil.rmtree(path, ignore_errors=ignore_errors)
+
+
 def _hash_file(path: Path, limit: int | None = None) -> tuple[str, int]:
     """``(sha256 hex, bytes hashed)`` of a regular file (never through a symbolic link); ``limit``: only
     its first ``limit`` bytes (``OSError`` if it is shorter)."""
@@ -233,6 +238,10 @@ def _hash_file(path: Path, limit: int | None = None) -> tuple[str, int]:
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):
             raise OSError(errno.EINVAL, "not a regular file", str(path))
+        # deferred: every command imports this module at start (the command line records its name here), and
+        # only a command that writes files hashes them
+        import hashlib
+
         h, n = hashlib.sha256(), 0
         while limit is None or n < limit:
             chunk = os.read(fd, _CHUNK if limit is None else min(_CHUNK, limit - n))
@@ -350,7 +359,7 @@ def _probe_writable(path: Path, typed: str, option: str) -> None:
     if not parent.is_dir():
         part = str(shown) if str(shown) not in ("", ".") else str(parent)
         raise OutputError(OutputError.NOT_A_FOLDER.format(option=option, typed=typed, part=part))
-    probe = parent / f".{path.name or 'out'}.sd-tmp-{os.getpid()}-{secrets.token_hex(4)}"
+    probe = parent / f".{path.name or 'out'}.sd-tmp-{os.getpid()}-{os.urandom(4).hex()}"
     try:
         os.mkdir(probe)
         os.rmdir(probe)
@@ -381,7 +390,7 @@ def clean_stale_temps(path: Path) -> list[Path]:
             continue
         if not isinstance(mark, dict) or mark.get("pid") != int(m["pid"]) or mark.get("token") != m["token"]:
             continue
-        shutil.rmtree(e, ignore_errors=True)  # fd-based: removes links inside, never follows them
+        _remove_tree(e, ignore_errors=True)  # fd-based: removes links inside, never follows them
         removed.append(e)
     return removed
 
@@ -534,7 +543,7 @@ class OutputFolder:
             raise self._write_error(e, tmp) from None
         finally:
             if tmp is not None and not committed and os.path.lexists(tmp):
-                shutil.rmtree(tmp, ignore_errors=True)
+                _remove_tree(tmp, ignore_errors=True)
 
     def _write_error(self, e: OSError, tmp: Path | None) -> OutputError:
         name = e.filename
@@ -591,7 +600,7 @@ class OutputFolder:
             os.replace(tmp / rel, dst)
         kept = {r: e for r, e in manifest.items() if e["command"] != self.command}
         _write_manifest(out, kept | new)
-        shutil.rmtree(tmp, ignore_errors=True)  # only the empty folders of the moved files are left
+        _remove_tree(tmp, ignore_errors=True)  # only the empty folders of the moved files are left
 
 
 def _remove_verified(root: Path, manifest: dict[str, dict], rels: list[str], keep_root: bool = False) -> None:
@@ -625,7 +634,7 @@ def make_temp_dir(path: Path) -> Path:
     """A new empty folder ``.NAME.sd-tmp-PID-XXXXXXXX`` beside ``path`` (normal permissions, umask) with
     the marker that lets a later run recognise it as a stale temporary (``clean_stale_temps``)."""
     while True:
-        token = secrets.token_hex(4)
+        token = os.urandom(4).hex()
         tmp = path.with_name(f".{path.name}.sd-tmp-{os.getpid()}-{token}")
         try:
             os.mkdir(tmp, 0o777)
@@ -689,7 +698,7 @@ def _write_file_atomic(path: Path, data: bytes) -> None:
             fh.write(data)
         os.replace(tmp / path.name, path)
     finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        _remove_tree(tmp, ignore_errors=True)
 
 
 def write_text_atomic(path, text: str) -> Path:

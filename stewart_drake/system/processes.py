@@ -20,18 +20,19 @@
 
 from __future__ import annotations
 
-import ctypes
-import multiprocessing
 import os
 import signal
 import sys
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from stewart_drake.core.sanity import check_work
 from stewart_drake.errors import OptionError
 from stewart_drake.system.interrupts import CLI_PID_ENV
+
+if TYPE_CHECKING:
+    from concurrent.futures import ProcessPoolExecutor
 
 BYTES_PER_WORKER = 150e6
 WORKERS_PER_CPU = 4
@@ -61,6 +62,9 @@ def check_workers(option: str, value: int, minimum: int = 1) -> int:
 
 def die_with_parent(sig: int = signal.SIGKILL) -> None:
     """Ask the kernel to send ``sig`` to this process when its parent dies (Linux; elsewhere nothing)."""
+    # deferred: the command line imports this module at start, and only a worker process asks this
+    import ctypes
+
     try:
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(_PR_SET_PDEATHSIG, int(sig), 0, 0, 0)
@@ -85,6 +89,11 @@ def worker_pool(n: int) -> Iterator[ProcessPoolExecutor]:
     threads) running ``child_setup`` with ``ONE_BLAS_THREAD`` in their environment (the workers start at the
     first task, so the parent's environment carries it for the pool's life, then is put back); on an error or
     interrupt the workers are terminated at once."""
+    # deferred: multiprocessing and concurrent.futures are a large share of a numpy command's start-up, and only
+    # the commands that start workers need them (the command line imports this module at start)
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
     quiet_resource_tracker()
     ctx = multiprocessing.get_context("spawn")
     before = set(multiprocessing.active_children())
@@ -134,7 +143,10 @@ def mark_cli() -> Callable[[], None]:
 def exit_now(code: int) -> None:
     """End this process now with ``code`` after flushing its output, without the exit hooks (an interrupted
     Dask cluster's atexit close prints tracebacks); its workers die with it (``die_with_parent``)."""
-    for p in multiprocessing.active_children():  # first, so that none logs the lost connection
+    # a process that never imported multiprocessing has started no children through it
+    multiprocessing = sys.modules.get("multiprocessing")
+    children = multiprocessing.active_children() if multiprocessing is not None else []
+    for p in children:  # first, so that none logs the lost connection
         try:
             os.kill(p.pid, signal.SIGKILL)
         except OSError:

@@ -7,9 +7,6 @@ from __future__ import annotations
 import os
 import sys
 from collections import deque
-from concurrent.futures import Executor
-
-from tqdm import tqdm
 
 from stewart_drake.system.processes import worker_pool
 from stewart_drake.workspace.limits import WorkspaceError
@@ -19,13 +16,16 @@ def run_tasks(fn, tasks, executor, workers, progress, desc):
     """Yield ``fn(*task)`` for every task, in order: in-process, on a process pool of ``workers``, or on a
     given ``concurrent.futures.Executor``. A generator, so that callers merge results as they come
     and memory stays bounded by the slab, not by the number of slabs. Progress with tqdm on stderr."""
+    # deferred: tqdm is needed only when a sweep runs, and `stewart-drake workspace --help` imports this module
+    from tqdm import tqdm
+
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, file=sys.stderr, leave=False)
     try:
         if executor is None and workers > 1 and len(tasks) > 1:
             with worker_pool(workers) as ex:  # spawned, dying with this process, terminated on Ctrl-C/SIGTERM
                 yield from _drain(ex, fn, tasks, bar, window=4 * workers)
         elif executor is not None:
-            if not isinstance(executor, Executor) and not hasattr(executor, "submit"):
+            if not hasattr(executor, "submit"):  # a concurrent.futures.Executor, or any object like one
                 raise WorkspaceError(WorkspaceError.EXECUTOR.format(kind=type(executor).__name__))
             yield from _drain(executor, fn, tasks, bar, window=None)
         else:

@@ -6,8 +6,8 @@ extents, boundary points and the three views (``Workspace``).
 from __future__ import annotations
 
 import math
-from concurrent.futures import Executor
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +19,9 @@ from stewart_drake.core.sanity import human_bytes, memory_budget, plate_floor
 from stewart_drake.workspace.executors import run_tasks
 from stewart_drake.workspace.extents import extents_from_views, refine_extents
 from stewart_drake.workspace.limits import Limits, WorkspaceError, check_orientation
+
+if TYPE_CHECKING:  # an annotation only: concurrent.futures is imported by the sweep that uses an executor
+    from concurrent.futures import Executor
 from stewart_drake.workspace.slabs import grid_spec, slab_task
 
 # Largest grid the sweep accepts (nodes): ~10 min of the stroke kernel at ~5e7 nodes/s on one core.

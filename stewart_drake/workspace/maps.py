@@ -5,7 +5,7 @@
 from __future__ import annotations
 
 import math
-from concurrent.futures import Executor
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -14,6 +14,9 @@ from stewart_drake.core.kinematics import condition_number
 from stewart_drake.workspace.executors import run_tasks
 from stewart_drake.workspace.grid import default_bounds
 from stewart_drake.workspace.limits import Limits, WorkspaceError, check_orientation, classify
+
+if TYPE_CHECKING:  # an annotation only: concurrent.futures is imported by the sweep that uses an executor
+    from concurrent.futures import Executor
 
 
 def dexterity_map(

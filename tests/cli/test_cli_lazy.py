@@ -80,3 +80,55 @@ def test_help_and_bad_command_without_pydrake():
     assert status["rc"] == 0 and status["commands"] == [] and all(name in out for name in COMMANDS)
     status, _, err = run_blocked("nosuch")
     assert status["rc"] == 2 and "invalid choice: 'nosuch'" in err
+
+
+# Run the CLI in a fresh interpreter and print which modules it has loaded at the end.
+LOADED = """
+import contextlib, io, json, sys
+from stewart_drake.cli import main
+with contextlib.redirect_stdout(io.StringIO()):
+    rc = main(sys.argv[1:])
+print(json.dumps({"rc": rc, "modules": sorted(sys.modules)}))
+"""
+# The libraries of the other commands (Drake, the optimisers, Dask, tables, plots, the motion language, progress
+# bars), numpy's masked arrays and the process-pool machinery: no numpy command's work uses them, and each adds
+# to its start-up.
+NOT_NEEDED = (
+    "pydrake",
+    "scipy",
+    "pymoo",
+    "dask",
+    "distributed",
+    "pandas",
+    "matplotlib",
+    "lark",
+    "tqdm",
+    "multiprocessing",
+    "concurrent.futures",
+    "numpy.ma",
+)
+# the compiler glue: only where a compiled kernel runs (fk's real-time branch check and homotopy tracker, dsp-ik's
+# firmware engine)
+COMPILER = ("stewart_drake.system.c_build", "cffi")
+
+
+@pytest.mark.parametrize(
+    "argv, not_needed",
+    [
+        (["ik", "--platform", "utn-dynamic", "--pose", "0", "0", "700", "0", "0", "0"], NOT_NEEDED + COMPILER),
+        (["fk", "--platform", "utn-dynamic", "--lengths", *["730"] * 6], NOT_NEEDED),
+        (["fk", "--all", "--platform", "utn-dynamic", "--lengths", *["730"] * 6], NOT_NEEDED),
+        (["dsp-ik", "--pose", "0", "0", "100", "0.1", "0", "0"], NOT_NEEDED),
+        (["servo", "--pose", "0", "0", "0", "0", "0", "0", "--from-home"], NOT_NEEDED + COMPILER),
+        (["leg", "fk", "0.1", "0.2"], NOT_NEEDED + COMPILER),
+        (["workspace", "--help"], NOT_NEEDED + COMPILER),
+        (["--help"], NOT_NEEDED + COMPILER),
+    ],
+    ids=lambda v: " ".join(a for a in v[:2] if a != "--platform") if isinstance(v, list) else None,
+)
+def test_numpy_command_imports_only_what_it_runs(argv, not_needed):
+    p = subprocess.run([sys.executable, "-c", LOADED, *argv], capture_output=True, text=True, timeout=300)
+    status = json.loads(p.stdout.strip().splitlines()[-1])
+    assert status["rc"] == 0, p.stderr
+    loaded = [m for m in status["modules"] if any(m == n or m.startswith(n + ".") for n in not_needed)]
+    assert loaded == [], f"{' '.join(argv)} imported {loaded[:8]}"
