@@ -16,15 +16,7 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S, check_time_limit, run_isolated
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
 from stewart_drake.core.trajectory import Trajectory, design_poses, get_trajectory
-from stewart_drake.errors import (
-    OPTION_FIRMWARE_RATE,
-    OPTION_FIRMWARE_TFR16,
-    OPTION_FIRMWARE_WORD_BITS,
-    CertifyError,
-    OptionError,
-    StewartError,
-    UsageError,
-)
+from stewart_drake.errors import CertifyError, MachineError, OptionError, StewartError, UsageError
 from stewart_drake.firmware.certify.box import parse_box
 from stewart_drake.firmware.certify.certificate import Certificate
 from stewart_drake.firmware.certify.certificate import certify as certify_ik
@@ -34,7 +26,6 @@ from stewart_drake.firmware.certify.optimize import parse_budget
 from stewart_drake.firmware.certify.search import MAX_CELLS
 from stewart_drake.firmware.certify.tick import TickCertificate
 from stewart_drake.firmware.certify.tick import certify_tick as certify_tick_words
-from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.firmware.fingerprint import (
     DESIGN_POSES,
     motion_record,
@@ -48,7 +39,7 @@ from stewart_drake.firmware.fingerprint import (
 from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.fixedpoint.generic import QFormat
-from stewart_drake.spec import Machine, load_machine
+from stewart_drake.spec import Machine, apply_overrides, load_machine
 
 __all__ = [
     "generate",
@@ -64,65 +55,79 @@ __all__ = [
 ]
 
 
-def controller_config(
-    platform: Platform,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
-    trajectory: str | Trajectory | None = None,
-    poses=None,
-) -> ControllerConfig:
-    """The firmware's number format, timing and gains (designed over ``trajectory``'s poses, else over
-    ``poses`` ``(n, 6)`` SI, else home)."""
-    if not 8 <= word_bits <= 16:
-        raise OptionError(OPTION_FIRMWARE_WORD_BITS.format(value=word_bits))
-    if not (rate > 0 and rate <= 1e6):
-        raise OptionError(OPTION_FIRMWARE_RATE.format(value=rate))
-    if trig == "tfr16" and word_bits != 16:
-        raise UsageError(OPTION_FIRMWARE_TFR16.format(value=word_bits))
-    fmt = QFormat(word_bits, length_lsb, trig)
+# The firmware format's keywords (``**format`` of every function below) -> the spec path each sets. ``rate``
+# (Hz) sets ``controller.period`` to ``1 / rate``.
+FORMAT_PATHS = {
+    "word_bits": "firmware.word_bits",
+    "length_lsb": "firmware.length_lsb",
+    "trig": "firmware.trig",
+    "convention": "firmware.convention",
+    "rate": "controller.period",
+    "sensor_resolution": "sensors.resolution",
+}
+MAX_RATE_HZ = 1e6  # a faster loop is a unit mistake (a period typed as a rate); MachineError.FORMAT_RATE says it
+MAX_C_WORD_BITS = 16  # the generated C holds words in 16-bit data words
+
+
+def controller_config(platform: Platform, fmt: dict, trajectory=None, poses=None) -> ControllerConfig:
+    """The firmware's number format, timing and gains for ``fmt`` (``machine_format``'s, checked), designed over
+    ``trajectory``'s poses, else over ``poses`` ``(n, 6)`` SI, else home."""
+    qformat = QFormat(fmt["word_bits"], fmt["length_lsb"], fmt["trig"])
     timing = DspTiming(
-        sample_period=1.0 / rate, sensor_resolution=sensor_resolution, command_range=float(platform.legs.max_force)
+        sample_period=1.0 / fmt["rate"],
+        sensor_resolution=fmt["sensor_resolution"],
+        command_range=float(platform.legs.max_force),
     ).check()
     poses = poses if trajectory is None else design_poses(get_trajectory(trajectory))
-    return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=convention)
+    return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=qformat, convention=fmt["convention"])
 
 
-def machine_format(
-    platform,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
-) -> tuple[Machine, dict]:
+def format_keywords(format: dict) -> dict:
+    """The keywords of ``format`` that are given (not None); a ``MachineError`` naming one that is not a
+    firmware format keyword (``FORMAT_PATHS``) and the valid ones."""
+    for name in format:
+        if name not in FORMAT_PATHS:
+            raise MachineError(MachineError.FORMAT_KEYWORD.format(name=name, valid=", ".join(FORMAT_PATHS)))
+    return {k: v for k, v in format.items() if v is not None}
+
+
+def machine_format(platform, format: dict) -> tuple[Machine, dict]:
     """``(machine, format)``: the machine of ``platform`` (a ``Machine``, a ``Platform``, a preset name or a
-    platform or machine file) and the firmware's ``word_bits``, ``length_lsb``, ``trig``, ``convention``,
-    ``rate`` (Hz) and ``sensor_resolution`` (m): each keyword given, else the machine's (``firmware``,
-    ``1 / controller.period``, ``sensors.resolution``; a platform's machine has the DSP's defaults)."""
-    machine = load_machine(platform)
-    fmt = machine.firmware
-    given = dict(
-        word_bits=word_bits,
-        length_lsb=length_lsb,
-        trig=trig,
-        convention=convention,
-        rate=rate,
-        sensor_resolution=sensor_resolution,
+    platform or machine file) with the firmware format keywords of ``format`` applied to their spec paths
+    (``FORMAT_PATHS``; checked as the machine's fields are, errors naming the path), and the resolved
+    ``word_bits``, ``length_lsb`` (m), ``trig``, ``convention``, ``rate`` (Hz) and ``sensor_resolution`` (m):
+    each given, else the machine's (a platform's machine has the DSP's defaults).
+
+    Raises:
+        MachineError, QuantityError: an unknown keyword, a value out of its field's range, a rate that is not
+            in (0, 1e6] Hz, words wider than the generated C holds (16 bits).
+    """
+    given = format_keywords(format)
+    rate = given.get("rate")
+    if rate is not None:
+        number = isinstance(rate, (int, float)) and not isinstance(rate, bool)
+        if not (number and math.isfinite(rate) and 0 < rate <= MAX_RATE_HZ):
+            shown = f"{rate:g}" if number else repr(rate)
+            raise MachineError(MachineError.FORMAT_RATE.format(value=shown))
+    overrides = {FORMAT_PATHS[k]: 1.0 / rate if k == "rate" else v for k, v in given.items()}
+    machine = apply_overrides(load_machine(platform), overrides)
+    fw = machine.firmware
+    if fw.word_bits > MAX_C_WORD_BITS:
+        raise MachineError(
+            MachineError.RANGE.format(
+                path="firmware.word_bits", rule="in 8..16 for generated C (16-bit data words and narrower)",
+                value=given.get("word_bits", fw.word_bits),
+            )
+        )  # fmt: skip
+    resolved = dict(
+        word_bits=int(fw.word_bits),
+        length_lsb=float(fw.length_lsb),
+        trig=fw.trig,
+        convention=fw.convention,
+        rate=rate if rate is not None else 1.0 / machine.controller.period,
+        sensor_resolution=float(machine.sensors.resolution),
     )
-    mine = dict(
-        word_bits=fmt.word_bits,
-        length_lsb=fmt.length_lsb,
-        trig=fmt.trig,
-        convention=fmt.convention,
-        rate=1.0 / machine.controller.period,
-        sensor_resolution=machine.sensors.resolution,
-    )
-    return machine, {k: mine[k] if v is None else v for k, v in given.items()}
+    return machine, resolved
 
 
 @dataclass(repr=False)
@@ -148,16 +153,11 @@ def generate(
     platform: Platform | Machine,
     out: str | Path,
     *,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
     compile: bool = True,
     on_note: Callable[[str], None] | None = None,
     platform_source: str | None = None,
+    **format,
 ) -> GenerateResult:
     """Generate the C firmware (``sd_firmware.h``, ``sd_firmware.c``, README) for a platform into a folder.
 
@@ -169,12 +169,6 @@ def generate(
         platform: the platform, or a ``Machine`` (its gains are designed with its payload on the plate).
         out: the output folder: new, empty, or holding only files this command wrote (the manifest records each
             with its sha256; another command's file or a changed one is refused, never replaced).
-        word_bits: data word width, 8..16 (``firmware.word_bits``).
-        length_lsb: metres per length LSB (``firmware.length_lsb``).
-        trig: the trigonometry (``"tfr16"``: the DSP's; needs 16-bit words) (``firmware.trig``).
-        convention: Euler convention of the pose angles (``firmware.convention``).
-        rate: controller rate, Hz (``1 / controller.period``).
-        sensor_resolution: leg sensor, m per count (``sensors.resolution``).
         trajectory: design the gains over this reference's poses (default: home only). A `Trajectory` (no
             name ``check`` can look up) also writes its design poses to ``sd_design_poses.json`` beside the C,
             which ``check`` reads (their hash is recorded in the fingerprint).
@@ -182,6 +176,11 @@ def generate(
         on_note: called with a note (no compiler found).
         platform_source: how the platform is named (a preset name or a YAML path), recorded with the other
             options in the files (a fingerprint ``check`` reads back); default the platform's name.
+        **format: the firmware format keywords, each replacing the machine's value: ``word_bits`` (data word
+            width, 8..16: ``firmware.word_bits``), ``length_lsb`` (metres per length LSB: ``firmware.length_lsb``),
+            ``trig`` (``"tfr16"``: the DSP's, 16-bit words only; ``"exact"``: ``firmware.trig``), ``convention``
+            (Euler convention of the pose angles: ``firmware.convention``), ``rate`` (controller rate, Hz:
+            ``1 / controller.period``), ``sensor_resolution`` (leg sensor, m per count: ``sensors.resolution``).
 
     Returns:
         The summary and the files written.
@@ -189,25 +188,16 @@ def generate(
     Raises:
         StewartError: bad options, or an output folder that holds other files.
     """
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    machine, f = machine_format(platform, format)
     platform = machine.platform
     platform_source = machine.platform_source if platform_source is None else platform_source
-    word_bits, length_lsb, trig, convention = f["word_bits"], f["length_lsb"], f["trig"], f["convention"]
-    rate, sensor_resolution = f["rate"], f["sensor_resolution"]
-    config = controller_config(
-        machine.loaded_platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory
-    )
+    config = controller_config(machine.loaded_platform, f, trajectory)
     folder = OutputFolder(out)  # the policy, before any work: new, empty, or this command's own verified files
     out = Path(out)
     g = generate_sources(platform, config)
     options = dict(
         platform=platform.name if platform_source is None else str(platform_source),
-        word_bits=word_bits,
-        length_lsb=length_lsb,
-        trig=trig,
-        convention=convention,
-        rate=rate,
-        sensor_resolution=sensor_resolution,
+        **f,
         trajectory=trajectory,
         platform_hash=platform_hash(platform),
     )
@@ -233,7 +223,7 @@ def generate(
             "trig": config.ik_format.trig,
             "convention": config.convention,
         },
-        "rate_hz": rate,
+        "rate_hz": f["rate"],
         "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
         "files": [{"name": p.name, "bytes": (out / p.name).stat().st_size} for p in written],
         "ik_cycles": round(ik.cycles),
@@ -275,13 +265,8 @@ def check(
     duration: float = 0.5,
     compiler: str | None = None,
     time_limit: float = FIRMWARE_TIME_LIMIT_S,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> CheckResult:
     """Compile a C firmware against the header generated for the platform and compare it with the bit-exact
     emulation: ``sd_ik`` over random workspace poses and ``sd_tick`` over a recorded closed-loop stream.
@@ -301,15 +286,11 @@ def check(
         compiler: a compiler name (default the first found).
         time_limit: seconds the check may run the firmware (compiled and run in a child process: a hang,
             ``exit()`` or crash in it is one ``StewartError`` naming the file).
-        word_bits: data word width (as generated).
-        length_lsb: metres per length LSB (as generated).
-        trig: the trigonometry (as generated).
-        convention: Euler convention (as generated).
-        rate: controller rate, Hz (as generated).
-        sensor_resolution: m per count (as generated).
         trajectory: the reference the gains were designed over (as generated; a module generated from a
             `Trajectory` reads its design poses from the ``sd_design_poses.json`` beside it, or takes that
             same `Trajectory` here).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), as generated: each defaults to the recorded one.
 
     Returns:
         The comparison; ``identical`` when bit-exact.
@@ -321,17 +302,11 @@ def check(
     check_source(path)
     limit = check_time_limit(time_limit)
     given = dict(
+        format_keywords(format),
         platform=None,  # compared below by the platform's name (a preset, a path or an API platform's name)
-        word_bits=word_bits,
-        length_lsb=length_lsb,
-        trig=trig,
-        convention=convention,
-        rate=rate,
-        sensor_resolution=sensor_resolution,
         trajectory=trajectory if trajectory is None or isinstance(trajectory, str) else None,
     )
-    names = {k: "--" + k.replace("_", "-") for k in FP_DEFAULTS}
-    o, mismatch = resolve_options(given, path, names)
+    o, mismatch = resolve_options(given, path)
     if mismatch:  # the check would compare the C with another module's emulation
         raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     rec = read_fingerprint(path)
@@ -341,7 +316,7 @@ def check(
     else:
         platform = load_platform(platform)
         if rec and _platform_name(rec[0]["platform"]) != platform.name:
-            mismatch = f"--platform {platform.name} here, {rec[0]['platform']} in {rec[1]}"
+            mismatch = f"platform={platform.name} here, {rec[0]['platform']} in {rec[1]}"
             raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     design, motion = None, o["trajectory"] if isinstance(o["trajectory"], dict) else None
     if isinstance(trajectory, Trajectory):
@@ -353,10 +328,8 @@ def check(
             raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     elif motion:  # generated from a Python Trajectory: its design poses, recorded beside the C
         o["trajectory"], design = None, recorded_design_poses(motion, rec[1])
-    config = controller_config(
-        platform, o["word_bits"], o["length_lsb"], o["trig"], o["convention"], o["rate"], o["sensor_resolution"],
-        o["trajectory"], design,
-    )  # fmt: skip
+    _, f = machine_format(platform, {k: o[k] for k in FORMAT_PATHS})
+    config = controller_config(platform, f, o["trajectory"], design)
     cc = compiler_by_name(compiler) if compiler else None
     # the user's code runs in a child process: a hang, an exit() or a crash is one line naming the file
     r = run_isolated(
@@ -463,13 +436,8 @@ def certify(
     tick_error: float = 5e-3,
     tick_speed: float = 0.1,
     tick_feedforward: float = 0.0,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> CertifyResult:
     """Prove, over every pose of a box, each ``sd_ik`` word's range, whether it can saturate, and a bound on
     ``|L_firmware - L_float|`` per leg (interval branch and bound, memory bounded); optionally the
@@ -489,13 +457,9 @@ def certify(
         tick_error: bound on ``|set-point - measured|``, m.
         tick_speed: bound on the legs' speed, m/s.
         tick_feedforward: bound on ``|feed-forward|``, N.
-        word_bits: data word width, 8..16.
-        length_lsb: metres per length LSB.
-        trig: the trigonometry (``"tfr16"`` needs 16-bit words).
-        convention: Euler convention of the pose angles.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
         trajectory: design the gains over this reference's poses (default: home only).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), each replacing the machine's value.
 
     Returns:
         The certificate; ``saturation_possible`` says whether a word may saturate.
@@ -503,9 +467,9 @@ def certify(
     Raises:
         StewartError: a bad box, budget or format; ``tp17`` on another platform.
     """
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    machine, f = machine_format(platform, format)
     p = machine.platform
-    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
+    config = controller_config(machine.loaded_platform, f, trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)
     fmt = config.ik_format
     if implementation == "tp17":
@@ -519,15 +483,10 @@ def certify(
 
 
 def _certify_tick(config: ControllerConfig, error: float, speed: float, feedforward: float) -> TickCertificate:
-    """The tick certificate after the bounds' checks (the message shows ``--tick-error`` in mm, the option's
-    unit)."""
-    for opt, v, shown in (
-        ("--tick-error", error, error * 1e3),
-        ("--tick-speed", speed, speed),
-        ("--tick-feedforward", feedforward, feedforward),
-    ):
+    """The tick certificate after the bounds' checks (``OptionError`` naming the keyword and its SI value)."""
+    for name, v in (("tick_error", error), ("tick_speed", speed), ("tick_feedforward", feedforward)):
         if not (math.isfinite(v) and v >= 0):
-            raise OptionError(OptionError.AT_LEAST.format(option=opt, min=0, value=f"{shown:g}"))
+            raise OptionError(OptionError.AT_LEAST.format(option=name, min=0, value=f"{v:g}"))
     return certify_tick_words(config, error, speed, feedforward)
 
 
@@ -537,13 +496,8 @@ def certify_tick(
     tick_error: float = 5e-3,
     tick_speed: float = 0.1,
     tick_feedforward: float = 0.0,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> TickResult:
     """Prove the ranges of ``sd_tick``'s PID words (and whether the anti-windup keeps the integrator inside its
     rails) for stated bounds on the error, the legs' speed and the feed-forward.
@@ -554,13 +508,9 @@ def certify_tick(
         tick_error: bound on ``|set-point - measured|``, m.
         tick_speed: bound on the legs' speed, m/s.
         tick_feedforward: bound on ``|feed-forward|``, N.
-        word_bits: data word width, 8..16.
-        length_lsb: metres per length LSB.
-        trig: the trigonometry.
-        convention: Euler convention.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
         trajectory: design the gains over this reference's poses (default: home only).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), each replacing the machine's value.
 
     Returns:
         The tick's certificate.
@@ -568,8 +518,8 @@ def certify_tick(
     Raises:
         StewartError: a negative or non-finite bound, a bad format.
     """
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
-    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
+    machine, f = machine_format(platform, format)
+    config = controller_config(machine.loaded_platform, f, trajectory)
     return TickResult(_certify_tick(config, tick_error, tick_speed, tick_feedforward))
 
 
@@ -583,13 +533,8 @@ def optimize(
     length_unit: str = "mm",
     angle_unit: str = "pi",
     max_cells: int | None = None,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> OptimizeResult:
     """Choose the length LSB, word bits and trigonometry so that the proven ``sd_ik`` error meets a budget
     without saturation over a pose box (``objective``: fewest bits or fewest cycles), and generate that
@@ -605,13 +550,10 @@ def optimize(
         length_unit: unit of px py pz in ``box``.
         angle_unit: unit of a b g in ``box``.
         max_cells: the final certificate's budget, cells evaluated (default 200000).
-        word_bits: the default format's word width (the comparison's baseline), and the gains' design.
-        length_lsb: the default format's metres per LSB.
-        trig: the default format's trigonometry.
-        convention: Euler convention.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
         trajectory: design the gains over this reference's poses (default: home only).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), each replacing the machine's value: the default
+            format (the comparison's baseline) and the gains' design.
 
     Returns:
         The chosen formats (``chosen`` None when none meets the budget) and the comparison.
@@ -621,9 +563,9 @@ def optimize(
     """
     budget = parse_budget(error_budget)
     folder = None if out is None else OutputFolder(out)
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    machine, f = machine_format(platform, format)
     p = machine.platform
-    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
+    config = controller_config(machine.loaded_platform, f, trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)
     res = choose_formats(p, config, pose_box, budget, objective, MAX_CELLS if max_cells is None else max_cells)
     written = None

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import copy
 import math
+import re
 import sys
 
 import numpy as np
@@ -11,7 +13,7 @@ from stewart_drake.core.geometry import PRESETS, Platform, load_platform
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
-from stewart_drake.errors import UsageError
+from stewart_drake.errors import StewartError, UsageError
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
@@ -94,3 +96,29 @@ def finite_option(value, option: str) -> float:
     if value is not None and not math.isfinite(value):
         raise UsageError(UsageError.NOT_FINITE.format(option=option, value=value))
     return value
+
+
+def flag_text(text: str, table: dict, given=None) -> str:
+    """``text`` (an API message) with the names of ``table`` (option dest -> ``(flag, spec path or None)``; only
+    those of the ``given`` dests, if given) turned into the command line's: a spec path, an API keyword
+    written ``name=value`` and one that starts the message become the flag (``controller.period`` ->
+    ``--period``, ``length_lsb=0.5`` -> ``--length-lsb 0.5``, ``rate must be`` -> ``--rate must be``)."""
+    for dest, (flag, path) in table.items():
+        if given is None or dest in given:
+            if path:
+                text = text.replace(path, flag)
+            text = re.sub(rf"(?<![\w.-]){re.escape(dest)}=", flag + " ", text)
+            if text.startswith(dest + " "):
+                text = flag + text[len(dest) :]
+    return text
+
+
+def flag_error(e: StewartError, table: dict, given=None) -> StewartError:
+    """``e`` with its message's spec paths and API keywords named by their flags (``flag_text``; the same
+    class)."""
+    message = flag_text(str(e), table, given)
+    if message == str(e):
+        return e
+    e = copy.copy(e)
+    e.args = (message,)
+    return e

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 import sys
 from pathlib import Path
 
@@ -10,6 +9,8 @@ from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
     add_force_arg,
     dumps_strict,
+    flag_error,
+    flag_text,
     output_folder,
     print_json,
     reject_unused,
@@ -200,27 +201,7 @@ def machine_from_args(args) -> Machine:
     try:
         return apply_overrides(machine, [*(f"{p}={v}" for p, v in flags.items()), *args.set])
     except (MachineError, QuantityError) as e:
-        raise flag_error(e, named) from None
-
-
-def flag_text(text: str, given=None) -> str:
-    """``text`` with the spec paths of ``FLAG_PATHS`` (only those of the ``given`` options, if given) named
-    by their flags."""
-    for dest, (flag, path) in FLAG_PATHS.items():
-        if given is None or dest in given:
-            text = text.replace(path, flag)
-    return text
-
-
-def flag_error(e: StewartError, given=None) -> StewartError:
-    """``e`` with the spec paths of ``FLAG_PATHS`` (of the ``given`` options) in its message named by their
-    flags (the same class)."""
-    message = flag_text(str(e), given)
-    if message == str(e):
-        return e
-    e = copy.copy(e)
-    e.args = (message,)
-    return e
+        raise flag_error(e, FLAG_PATHS, named) from None
 
 
 def run(args) -> int:
@@ -249,8 +230,8 @@ def run(args) -> int:
             duration_shown=args.duration,
         )
     except StewartError as e:
-        raise flag_error(e) from None
-    warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w)}", file=sys.stderr)  # noqa: E731
+        raise flag_error(e, FLAG_PATHS) from None
+    warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w, FLAG_PATHS)}", file=sys.stderr)  # noqa: E731
     result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
     summary = result.to_dict()
     out = Path(args.out)

@@ -1,0 +1,124 @@
+"""A run's and a firmware's options are declared once: the firmware format keywords (``**format``) are checked
+in one place as the machine's fields are, and the API's messages name spec paths and keywords, never a
+command-line flag (the commands turn them into flags at their edge)."""
+
+from __future__ import annotations
+
+import inspect
+import re
+
+import pytest
+
+import stewart_drake as sd
+from stewart_drake.api.firmware import FORMAT_PATHS
+from stewart_drake.api.simulation import plan_run
+from stewart_drake.cli import main
+from stewart_drake.errors import MachineError, StewartError, UsageError
+
+FIRMWARE_FUNCTIONS = ("generate", "check", "certify", "certify_tick", "optimize")
+
+
+@pytest.mark.parametrize("name", FIRMWARE_FUNCTIONS)
+def test_firmware_functions_take_the_format_as_one_keyword_set(name):
+    """Each function's own keywords hold none of the format's: the format is ``**format``, checked once."""
+    params = inspect.signature(getattr(sd.firmware, name)).parameters
+    assert not set(FORMAT_PATHS) & set(params)
+    assert params["format"].kind is inspect.Parameter.VAR_KEYWORD
+
+
+def test_an_unknown_format_keyword_is_named_with_the_valid_ones(tmp_path):
+    with pytest.raises(
+        MachineError, match=r"^unknown firmware format keyword 'word_bit'; the keywords are word_bits, "
+    ):
+        sd.firmware.generate(sd.load_platform("utn-dynamic"), tmp_path / "fw", compile=False, word_bit=12)
+    assert not (tmp_path / "fw").exists()  # refused before any output
+
+
+@pytest.mark.parametrize(
+    ("keywords", "message"),
+    [
+        (dict(length_lsb=-1), r"^firmware\.length_lsb must be > 0 m, got -1$"),
+        (dict(word_bits=24, trig="exact"), r"^firmware\.word_bits must be in 8\.\.16 for generated C .*, got 24$"),
+        (dict(word_bits=12), r"^firmware\.word_bits must be 16 with trig tfr16 \(use trig exact\), got 12$"),
+        (dict(rate=-5), r"^rate must be a positive number of Hz up to 1e6, got -5$"),
+        (dict(sensor_resolution=0), r"^sensors\.resolution must be > 0 m, got 0$"),
+        (dict(convention="xyz"), r"^firmware\.convention: 'xyz' is not one of utn, zyx$"),
+    ],
+)
+@pytest.mark.parametrize("name", ["certify", "certify_tick"])
+def test_format_errors_name_spec_paths_not_flags(name, keywords, message):
+    with pytest.raises(StewartError, match=message) as e:
+        getattr(sd.firmware, name)("utn-dynamic", **keywords)
+    assert "--" not in str(e.value)
+
+
+def test_a_format_keyword_reaches_the_certificate():
+    """``length_lsb`` given replaces the machine's 1 mm: the certificate's format is the one given."""
+    r = sd.firmware.certify("utn-dynamic", box=["pz=150..160"], max_cells=50, length_lsb=5e-4)
+    assert r.certificate.fmt.length_lsb == 5e-4 and r.certificate.fmt.word_bits == 16
+
+
+def test_check_names_a_differing_option_by_its_keyword(tmp_path):
+    out = tmp_path / "fw"
+    sd.firmware.generate(sd.load_platform("utn-dynamic"), out, compile=False, length_lsb=5e-4, rate=500)
+    with pytest.raises(UsageError, match=r"generated with other options \(length_lsb=0\.001 here, 0\.0005 in ") as e:
+        sd.firmware.check(out / "sd_firmware.c", length_lsb=1e-3, poses=10)
+    assert "--" not in str(e.value)
+    with pytest.raises(UsageError, match=r"\(platform=utn-kinematic here, utn-dynamic in ") as e:
+        sd.firmware.check(out / "sd_firmware.c", "utn-kinematic", poses=10)
+    assert "--" not in str(e.value)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["generate", "--word-bits", "24", "--trig", "exact"], "--word-bits must be in 8..16 for generated C"),
+        (["generate", "--length-lsb", "-1"], "--length-lsb must be > 0 m, got -1"),
+        (["certify", "--rate", "-5"], "--rate must be a positive number of Hz up to 1e6, got -5"),
+        (["certify", "--tick", "--tick-speed", "-1"], "--tick-speed must be >= 0, got -1"),
+    ],
+)
+def test_the_cli_names_its_flags(tmp_path, capsys, args, message):
+    rc = main(["firmware", *args, *(["--out", str(tmp_path / "fw"), "--no-compile"] if args[0] == "generate" else [])])
+    err = capsys.readouterr().err
+    assert rc == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_check_cli_names_a_differing_platform_by_its_flag(tmp_path, capsys):
+    out = tmp_path / "fw"
+    assert main(["firmware", "generate", "--platform", "utn-dynamic", "--out", str(out), "--no-compile"]) == 0
+    rc = main(["firmware", "check", str(out / "sd_firmware.c"), "--platform", "utn-kinematic", "--poses", "10"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "(--platform utn-kinematic here, utn-dynamic in " in err, err
+
+
+# -- the run -----------------------------------------------------------------------------------------------------
+def _documented_options(function) -> set[str]:
+    """The names of the ``Keyword Args:`` section of ``function``'s docstring."""
+    doc = inspect.getdoc(function)
+    section = doc.split("Keyword Args:\n", 1)[1].split("\n\n", 1)[0]
+    return set(re.findall(r"^    (\w+) \(", section, re.M))
+
+
+def test_simulate_documents_every_option_of_plan_run_once():
+    """``simulate`` forwards its options to ``plan_run``: its docstring documents each of ``plan_run``'s user
+    keywords (``trajectory`` .. ``smooth``), and nothing else."""
+    names = list(inspect.signature(plan_run).parameters)
+    user = set(names[names.index("trajectory") + 1 : names.index("smooth") + 1])
+    assert _documented_options(sd.simulate) == user
+    assert set(inspect.signature(sd.simulate).parameters) == {"machine", "trajectory", "progress", "options"}
+
+
+@pytest.mark.parametrize(
+    ("keywords", "message"),
+    [
+        (dict(period=10.0), r"^controller\.period 10 s is too slow for platform utn-dynamic"),
+        (dict(plant_step=2e-3), r"^run\.plant_step 0\.002 s is longer than the controller period 0\.001 s"),
+        (dict(perod=1e-3), r"unknown key 'perod'"),
+    ],
+)
+def test_simulate_errors_name_spec_paths_not_flags(keywords, message):
+    """Refused while the run is checked, before any plant is built."""
+    with pytest.raises(StewartError, match=message) as e:
+        sd.simulate(sd.load_platform("utn-dynamic"), "seed", **keywords)
+    assert "--" not in str(e.value)
