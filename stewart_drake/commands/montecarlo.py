@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from stewart_drake.commands._common import add_platform_arg, dumps_strict, print_json, reject_unused
+from stewart_drake.commands._common import add_platform_arg, dumps_strict, flag_error, print_json, reject_unused
 from stewart_drake.commands.simulate import add_loop_args, write_plots
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.output_folder import OutputFolder, atomic_folder
@@ -101,6 +101,10 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+# option (argparse dest) -> (flag, spec path) of the draws' checks' messages (``commands._common.flag_text``)
+STUDY_FLAGS = {"plant_step": ("--plant-step", "run.plant_step")}
+
+
 def build_study(args):
     """The ``Study`` the options describe, checked by the API (``montecarlo.api.make_study``)."""
     return make_study(
@@ -134,6 +138,8 @@ def run(args) -> int:
     except ScriptError as e:  # the reference (program compiled, CSV read) is checked before any run starts
         print(e.render(), file=sys.stderr)
         return 2
+    except StewartError as e:  # the draws' checks name spec paths; the user gave flags
+        raise flag_error(e, STUDY_FLAGS) from None
     rows, summary = result.rows, result.to_dict()
     if args.json:
         print_json(summary)

@@ -122,3 +122,13 @@ def test_simulate_errors_name_spec_paths_not_flags(keywords, message):
     with pytest.raises(StewartError, match=message) as e:
         sd.simulate(sd.load_platform("utn-dynamic"), "seed", **keywords)
     assert "--" not in str(e.value)
+
+
+def test_montecarlo_names_the_plant_step_by_its_flag(tmp_path, capsys):
+    """The draws' timing check names ``run.plant_step``; the command, where the user typed ``--plant-step``,
+    names the flag."""
+    argv = ["montecarlo", "--runs", "1", "--duration", "0.05", "--plant-step", "0.01", "--no-progress"]
+    rc = main([*argv, "--out", str(tmp_path / "mc")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--plant-step 0.01 s is longer than the controller period 0.001 s" in err, err
+    assert "run.plant_step" not in err and not (tmp_path / "mc").exists()
