@@ -8,7 +8,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.c_build import compiler_by_name, compilers
@@ -257,7 +256,7 @@ class CheckResult(Result):
 
 def check(
     path: str | Path,
-    platform: Platform | str | None = None,
+    platform: Machine | Platform | str | Path | None = None,
     *,
     poses: int = 100_000,
     seed: int = 0,
@@ -277,8 +276,8 @@ def check(
 
     Args:
         path: the C file (implementing ``sd_firmware.h``).
-        platform: the platform it was generated for (a Platform, a preset name or a YAML path; default as
-            recorded).
+        platform: the machine or platform it was generated for (a ``Machine``, a ``Platform``, a preset name, a
+            platform or machine file; default as recorded).
         poses: workspace poses compared.
         seed: random seed of the poses.
         trace: trace the first differing pose word by word.
@@ -314,9 +313,10 @@ def check(
         # a preset, a platform file or a machine file (whose payload the gains were designed with)
         platform = load_machine(o["platform"]).loaded_platform
     else:
-        platform = load_platform(platform)
-        if rec and _platform_name(rec[0]["platform"]) != platform.name:
-            mismatch = f"platform={platform.name} here, {rec[0]['platform']} in {rec[1]}"
+        machine = load_machine(platform)  # a machine's payload is on the plate its gains are designed for
+        platform = machine.loaded_platform
+        if rec and _platform_name(rec[0]["platform"]) != machine.platform.name:
+            mismatch = f"platform={machine.platform.name} here, {rec[0]['platform']} in {rec[1]}"
             raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     design, motion = None, o["trajectory"] if isinstance(o["trajectory"], dict) else None
     if isinstance(trajectory, Trajectory):

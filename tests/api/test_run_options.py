@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import inspect
 import re
+from pathlib import Path
 
 import pytest
 
@@ -67,6 +68,9 @@ def test_check_names_a_differing_option_by_its_keyword(tmp_path):
     with pytest.raises(UsageError, match=r"\(platform=utn-kinematic here, utn-dynamic in ") as e:
         sd.firmware.check(out / "sd_firmware.c", "utn-kinematic", poses=10)
     assert "--" not in str(e.value)
+    machine = sd.load_machine(Path(__file__).parents[2] / "examples" / "newcomer-210kg.yaml")
+    with pytest.raises(UsageError, match=r"\(platform=newcomer-6dof-sim here, utn-dynamic in "):
+        sd.firmware.check(out / "sd_firmware.c", machine, poses=10)  # a Machine, like generate takes
 
 
 @pytest.mark.parametrize(
