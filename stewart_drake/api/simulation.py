@@ -311,7 +311,11 @@ def plan_run(
                 platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", allow_out_of_stroke
             )
         except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
-            hint = other_unit_hint(platform, traj.pose(ticks), length_unit, angle_unit) if csv and not fit else ""
+            hint = (
+                other_unit_hint(platform, traj.pose(ticks), length_unit, angle_unit, api=True)
+                if csv and not fit
+                else ""
+            )
             raise PhysicalLimitError(str(e) + hint) from None
         why = infeasible_motion(platform, traj, ticks, period)
         if why:  # before the run: no controller follows it (it ended in raw solver messages)

@@ -102,11 +102,13 @@ def flag_text(text: str, table: dict, given=None) -> str:
     """``text`` (an API message) with the names of ``table`` (option dest -> ``(flag, spec path or None)``; only
     those of the ``given`` dests, if given) turned into the command line's: a spec path, an API keyword
     written ``name=value`` and one that starts the message become the flag (``controller.period`` ->
-    ``--period``, ``length_lsb=0.5`` -> ``--length-lsb 0.5``, ``rate must be`` -> ``--rate must be``)."""
+    ``--period``, ``length_lsb=0.5`` -> ``--length-lsb 0.5``, ``fit=True`` -> ``--fit``, ``rate must be`` ->
+    ``--rate must be``)."""
     for dest, (flag, path) in table.items():
         if given is None or dest in given:
             if path:
                 text = text.replace(path, flag)
+            text = re.sub(rf"(?<![\w.-]){re.escape(dest)}=True\b", flag, text)  # a store_true flag
             text = re.sub(rf"(?<![\w.-]){re.escape(dest)}=", flag + " ", text)
             if text.startswith(dest + " "):
                 text = flag + text[len(dest) :]

@@ -183,6 +183,12 @@ FLAG_PATHS = {
     "fit": ("--fit", "run.fit"),
     "duration": ("--duration", "run.duration"),
 }
+# the options the API's messages name by keyword (``length_unit=m``, ``allow_out_of_stroke=True``)
+KEYWORD_FLAGS = {
+    "length_unit": ("--length-unit", None),
+    "angle_unit": ("--angle-unit", None),
+    "allow_out_of_stroke": ("--allow-out-of-stroke", None),
+}
 # store_true flags: the value they set
 FLAG_VALUES = {"no_feedforward": False, "fit": True}
 
@@ -230,7 +236,7 @@ def run(args) -> int:
             duration_shown=args.duration,
         )
     except StewartError as e:
-        raise flag_error(e, FLAG_PATHS) from None
+        raise flag_error(e, {**FLAG_PATHS, **KEYWORD_FLAGS}) from None
     warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w, FLAG_PATHS)}", file=sys.stderr)  # noqa: E731
     result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
     summary = result.to_dict()

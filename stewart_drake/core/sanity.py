@@ -261,7 +261,7 @@ def check_trajectory(
     if v is None:
         return []
     if not allow_out_of_stroke:
-        raise PhysicalLimitError(stroke_message(v, what, "; --allow-out-of-stroke runs it anyway, with a warning"))
+        raise PhysicalLimitError(stroke_message(v, what, "; allow_out_of_stroke=True runs it anyway, with a warning"))
     return [stroke_message(v, what)]
 
 

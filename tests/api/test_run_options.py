@@ -136,3 +136,20 @@ def test_montecarlo_names_the_plant_step_by_its_flag(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "--plant-step 0.01 s is longer than the controller period 0.001 s" in err, err
     assert "run.plant_step" not in err and not (tmp_path / "mc").exists()
+
+
+def test_a_reference_in_the_other_unit_is_named_by_keyword_in_the_api_and_by_flag_in_the_cli(tmp_path, capsys):
+    """A CSV in metres read in mm leaves the stroke: the API's hints name ``length_unit=m`` and
+    ``allow_out_of_stroke=True``, the command's its flags; both refuse before any plant is built."""
+    p = sd.load_platform("utn-dynamic")
+    z = float(p.home_pose()[2])
+    f = tmp_path / "m.csv"
+    f.write_text("t,px,py,pz,a,b,g\n" + "".join(f"{i * 0.1:.1f},0,0,{z!r},0,0,0\n" for i in range(10)))
+    with pytest.raises(sd.PhysicalLimitError, match=r"give length_unit=m if that is what you meant") as e:
+        sd.simulate(p, str(f), length_unit="mm")
+    assert "--" not in str(e.value) and "; allow_out_of_stroke=True runs it anyway" in str(e.value)
+    rc = main(["simulate", "--platform", "utn-dynamic", "--trajectory", str(f), "--length-unit", "mm", "--out",
+               str(tmp_path / "o"), "--no-progress"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert rc == 1 and "give --length-unit m if that is what you meant" in err, err
+    assert "; --allow-out-of-stroke runs it anyway" in err and "allow_out_of_stroke" not in err
