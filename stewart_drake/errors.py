@@ -1084,16 +1084,16 @@ class CalibrationLimitError(PhysicalLimitError):
 class CertifyError(UsageError):
     """A pose box or budget the firmware certificate cannot take (``firmware certify`` / ``optimize``)."""
 
-    BOX_WORD = "--box {value!r}: expected KEY=LO..HI with KEY one of px py pz a b g, e.g. pz=120..250"
-    BOX_TWICE = "--box {value!r}: {key} is given twice"
-    BOX_ORDER = "--box {value!r}: LO and HI must be finite numbers with LO <= HI"
-    BOX_ANGLE = "--box {value!r}: an angle beyond ±180°"
-    BOX_WORDS = (
-        "--box: {key} = {value} does not fit the {bits}-bit pose word at this --length-lsb (range ±{range_mm:g} mm)"
+    BOX_WORD = "box {value!r}: expected KEY=LO..HI with KEY one of px py pz a b g, e.g. pz=120..250"
+    BOX_TWICE = "box {value!r}: {key} is given twice"
+    BOX_ORDER = "box {value!r}: LO and HI must be finite numbers with LO <= HI"
+    BOX_ANGLE = "box {value!r}: an angle beyond ±180°"
+    BOX_WORDS = "box {key} = {value} does not fit the {bits}-bit pose word at this length LSB (range ±{range_mm:g} mm)"
+    CELLS = "max_cells must be in {lo}..{hi}, got {value}"
+    BUDGET = "error_budget must be a positive length such as 0.5mm, got {value!r}"
+    IMPLEMENTATION = (
+        "implementation=tp17 certifies the seed's DSP firmware, whose platform is utn-kinematic; got platform={value}"
     )
-    CELLS = "--max-cells must be in {lo}..{hi}, got {value}"
-    BUDGET = "--error-budget must be a positive length such as 0.5mm, got {value!r}"
-    IMPLEMENTATION = "--implementation tp17 certifies the seed's DSP firmware, whose platform is utn-kinematic; got --platform {value!r}"
 
 
 # ----------------------------------------------------------------------------------------------

@@ -159,6 +159,10 @@ FORMAT_FLAGS = {
     "trajectory": ("--trajectory", None),
     "tick_speed": ("--tick-speed", None),
     "tick_feedforward": ("--tick-feedforward", None),
+    "box": ("--box", None),
+    "max_cells": ("--max-cells", None),
+    "error_budget": ("--error-budget", None),
+    "implementation": ("--implementation", None),
 }
 
 

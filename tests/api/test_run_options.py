@@ -74,8 +74,30 @@ def test_check_names_a_differing_option_by_its_keyword(tmp_path):
 
 
 @pytest.mark.parametrize(
+    ("keywords", "message"),
+    [
+        (dict(box=["pz=1..0"]), r"^box 'pz=1\.\.0': LO and HI must be finite numbers with LO <= HI$"),
+        (
+            dict(box=["pz=0..5000"], length_lsb=1e-4),
+            r"^box pz = 5000 mm does not fit the 16-bit pose word at this length LSB ",
+        ),
+        (dict(max_cells=0), r"^max_cells must be in 1\.\."),
+        (dict(implementation="tp17"), r"^implementation=tp17 certifies .*; got platform=utn-dynamic$"),
+    ],
+)
+def test_certificate_errors_name_keywords_not_flags(keywords, message):
+    with pytest.raises(StewartError, match=message) as e:
+        sd.firmware.certify("utn-dynamic", **keywords)
+    assert "--" not in str(e.value)
+
+
+@pytest.mark.parametrize(
     ("args", "message"),
     [
+        (["certify", "--box", "pz=1..0"], "--box 'pz=1..0': LO and HI must be finite numbers with LO <= HI"),
+        (["certify", "--max-cells", "0"], "--max-cells must be in 1.."),
+        (["certify", "--implementation", "tp17"], "--implementation tp17 certifies the seed's DSP firmware"),
+        (["optimize", "--error-budget=-1mm"], "--error-budget must be a positive length such as 0.5mm, got '-1mm'"),
         (["generate", "--word-bits", "24", "--trig", "exact"], "--word-bits must be in 8..16 for generated C"),
         (["generate", "--length-lsb", "-1"], "--length-lsb must be > 0 m, got -1"),
         (["certify", "--rate", "-5"], "--rate must be a positive number of Hz up to 1e6, got -5"),
