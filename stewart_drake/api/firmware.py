@@ -112,12 +112,9 @@ def machine_format(platform, format: dict) -> tuple[Machine, dict]:
     machine = apply_overrides(load_machine(platform), overrides)
     fw = machine.firmware
     if fw.word_bits > MAX_C_WORD_BITS:
-        raise MachineError(
-            MachineError.RANGE.format(
-                path="firmware.word_bits", rule="in 8..16 for generated C (16-bit data words and narrower)",
-                value=given.get("word_bits", fw.word_bits),
-            )
-        )  # fmt: skip
+        rule = "in 8..16 for generated C (16-bit data words and narrower)"
+        value = given.get("word_bits", fw.word_bits)
+        raise MachineError(MachineError.RANGE.format(path="firmware.word_bits", rule=rule, value=value))
     resolved = dict(
         word_bits=int(fw.word_bits),
         length_lsb=float(fw.length_lsb),
