@@ -79,30 +79,24 @@ def register(fs, format_args, format_kwargs, call_api) -> None:
     o.set_defaults(func=run_optimize, format_kwargs=format_kwargs, call_api=call_api)
 
 
-def _common(args) -> dict:
-    """The keywords ``certify`` and ``optimize`` share: the format options, the box and its units, the budget."""
-    return dict(
-        args.format_kwargs(args),
-        box=args.box,
-        length_unit=args.length_unit,
-        angle_unit=args.angle_unit,
-        max_cells=args.max_cells,
-    )
+def _call(function, args, **keywords):
+    """``function`` (``firmware.certify`` or ``optimize``) of ``--platform`` with ``keywords`` and the options
+    both share (the format, the box and its units, the budget), through ``call_api``."""
+    shared = dict(box=args.box, length_unit=args.length_unit, angle_unit=args.angle_unit, max_cells=args.max_cells)
+    return args.call_api(function, args, args.platform, **keywords, **shared, **args.format_kwargs(args))
 
 
 def run_certify(args) -> int:
     if not (math.isfinite(args.tick_error) and args.tick_error >= 0):  # in mm here, in m in the API's message
         raise OptionError(OptionError.AT_LEAST.format(option="--tick-error", min=0, value=f"{args.tick_error:g}"))
-    r = args.call_api(
+    r = _call(
         firmware.certify,
         args,
-        args.platform,
         implementation=args.implementation,
         tick=args.tick,
         tick_error=args.tick_error * 1e-3,
         tick_speed=args.tick_speed,
         tick_feedforward=args.tick_feedforward,
-        **_common(args),
     )
     if args.json:
         print_json(r.to_dict())
@@ -177,15 +171,7 @@ def format_certificate(cert) -> str:
 
 
 def run_optimize(args) -> int:
-    r = args.call_api(
-        firmware.optimize,
-        args,
-        args.platform,
-        error_budget=args.error_budget,
-        objective=args.objective,
-        out=args.out,
-        **_common(args),
-    )
+    r = _call(firmware.optimize, args, error_budget=args.error_budget, objective=args.objective, out=args.out)
     if args.json:
         print_json(r.to_dict())
     else:
