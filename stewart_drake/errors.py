@@ -635,15 +635,15 @@ INFEASIBLE_TIMING = (
     "longer than the sample period {period_us:.3f} µs"
 )
 PLANT_STEP_TOO_LONG = (
-    "--plant-step {step} s is longer than the controller period {period} s; "
+    "run.plant_step {step} s is longer than the controller period {period} s; "
     "the plant step must resolve the period (at most one period)"
 )
 PLANT_STEP_ABOVE_LAG = (
-    "--plant-step {step} s is longer than the actuators' time constant {lag} s, "
+    "run.plant_step {step} s is longer than the actuators' time constant {lag} s, "
     "the platform's fastest modelled dynamics; use a step of at most that"
 )
 PERIOD_TOO_SLOW = (
-    "--period {period} s is too slow for platform {name}: its fastest open-loop mode grows at "
+    "controller.period {period} s is too slow for platform {name}: its fastest open-loop mode grows at "
     "{lam:.3g}/s, and the leg loops' crossover at this period is at most {w_c:.3g} rad/s (< {margin:g} × "
     "{lam:.3g}); use a period of at most ~{t_max:.3g} s"
 )
@@ -921,6 +921,8 @@ class MachineError(UsageError):
         "firmware.length_lsb {lsb} m in {bits}-bit words holds lengths up to {range} m, less than the stroke's end "
         "{longest} m: the loop's set-points would clamp; use a coarser firmware.length_lsb or more firmware.word_bits"
     )
+    FORMAT_KEYWORD = "unknown firmware format keyword {name!r}; the keywords are {valid}"
+    FORMAT_RATE = "rate must be a positive number of Hz up to 1e6, got {value}"
 
 
 # a warning of a run with a firmware (api.simulation.adopt_firmware)
@@ -974,11 +976,6 @@ class StudyError(StewartError):
 
 
 # Command-line options checked by the commands (raised as ``OptionError`` or ``UsageError``).
-OPTION_FIRMWARE_WORD_BITS = "--word-bits must be in 8..16 for generated C (16-bit data words and narrower), got {value}"
-OPTION_FIRMWARE_RATE = "--rate must be a positive number of Hz up to 1e6, got {value:g}"
-OPTION_FIRMWARE_TFR16 = (
-    "--trig tfr16 is the DSP's 16-bit library: it needs --word-bits 16, got {value} (or use --trig exact)"
-)
 OPTION_RUN_RATE = "--rate must be a positive number of samples per second, got {value}"
 OPTION_NEEDS_BRANCHES = "--{option} needs --check-branches"
 OPTION_MAX_ITER = "--max-iter must be >= 1, got {value}"
@@ -1147,16 +1144,16 @@ class CalibrationLimitError(PhysicalLimitError):
 class CertifyError(UsageError):
     """A pose box or budget the firmware certificate cannot take (``firmware certify`` / ``optimize``)."""
 
-    BOX_WORD = "--box {value!r}: expected KEY=LO..HI with KEY one of px py pz a b g, e.g. pz=120..250"
-    BOX_TWICE = "--box {value!r}: {key} is given twice"
-    BOX_ORDER = "--box {value!r}: LO and HI must be finite numbers with LO <= HI"
-    BOX_ANGLE = "--box {value!r}: an angle beyond ±180°"
-    BOX_WORDS = (
-        "--box: {key} = {value} does not fit the {bits}-bit pose word at this --length-lsb (range ±{range_mm:g} mm)"
+    BOX_WORD = "box {value!r}: expected KEY=LO..HI with KEY one of px py pz a b g, e.g. pz=120..250"
+    BOX_TWICE = "box {value!r}: {key} is given twice"
+    BOX_ORDER = "box {value!r}: LO and HI must be finite numbers with LO <= HI"
+    BOX_ANGLE = "box {value!r}: an angle beyond ±180°"
+    BOX_WORDS = "box {key} = {value} does not fit the {bits}-bit pose word at this length LSB (range ±{range_mm:g} mm)"
+    CELLS = "max_cells must be in {lo}..{hi}, got {value}"
+    BUDGET = "error_budget must be a positive length such as 0.5mm, got {value!r}"
+    IMPLEMENTATION = (
+        "implementation=tp17 certifies the seed's DSP firmware, whose platform is utn-kinematic; got platform={value}"
     )
-    CELLS = "--max-cells must be in {lo}..{hi}, got {value}"
-    BUDGET = "--error-budget must be a positive length such as 0.5mm, got {value!r}"
-    IMPLEMENTATION = "--implementation tp17 certifies the seed's DSP firmware, whose platform is utn-kinematic; got --platform {value!r}"
 
 
 # ----------------------------------------------------------------------------------------------

@@ -11,20 +11,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.trajectory import Trajectory, design_poses, get_trajectory
-from stewart_drake.errors import (
-    OPTION_FIRMWARE_RATE,
-    OPTION_FIRMWARE_TFR16,
-    OPTION_FIRMWARE_WORD_BITS,
-    CertifyError,
-    OptionError,
-    StewartError,
-    UsageError,
-)
+from stewart_drake.errors import CertifyError, MachineError, OptionError, StewartError, UsageError
 from stewart_drake.firmware.certify.box import parse_box
 from stewart_drake.firmware.certify.certificate import Certificate
 from stewart_drake.firmware.certify.certificate import certify as certify_ik
@@ -34,7 +25,6 @@ from stewart_drake.firmware.certify.optimize import parse_budget
 from stewart_drake.firmware.certify.search import MAX_CELLS
 from stewart_drake.firmware.certify.tick import TickCertificate
 from stewart_drake.firmware.certify.tick import certify_tick as certify_tick_words
-from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.firmware.fingerprint import (
     DESIGN_POSES,
     motion_record,
@@ -49,7 +39,7 @@ from stewart_drake.firmware.generate import generate as generate_sources
 from stewart_drake.firmware.module import check_source, compile_generated
 from stewart_drake.firmware.target_build import build_target, check_target
 from stewart_drake.fixedpoint.generic import QFormat
-from stewart_drake.spec import Machine, load_machine
+from stewart_drake.spec import Machine, apply_overrides, load_machine
 from stewart_drake.system.c_build import compiler_by_name, compilers
 from stewart_drake.system.isolate import FIRMWARE_TIME_LIMIT_S, check_time_limit, run_isolated
 from stewart_drake.system.output_folder import OutputFolder, atomic_folder
@@ -70,76 +60,85 @@ __all__ = [
 ]
 
 
-def controller_config(
-    platform: Platform,
-    word_bits: int = 16,
-    length_lsb: float = 1e-3,
-    trig: str = "tfr16",
-    convention: str = "utn",
-    rate: float = 1000.0,
-    sensor_resolution: float = 1e-5,
-    trajectory: str | Trajectory | None = None,
-    poses=None,
-) -> ControllerConfig:
-    """The firmware's number format, timing and gains (designed over ``trajectory``'s poses, else over
-    ``poses`` ``(n, 6)`` SI, else home)."""
-    if not 8 <= word_bits <= 16:
-        raise OptionError(OPTION_FIRMWARE_WORD_BITS.format(value=word_bits))
-    if not (rate > 0 and rate <= 1e6):
-        raise OptionError(OPTION_FIRMWARE_RATE.format(value=rate))
-    if trig == "tfr16" and word_bits != 16:
-        raise UsageError(OPTION_FIRMWARE_TFR16.format(value=word_bits))
-    fmt = QFormat(word_bits, length_lsb, trig)
+# The firmware format's keywords (``**format`` of every function below) -> the spec path each sets. ``rate``
+# (Hz) sets ``controller.period`` to ``1 / rate``.
+FORMAT_PATHS = {
+    "word_bits": "firmware.word_bits",
+    "length_lsb": "firmware.length_lsb",
+    "trig": "firmware.trig",
+    "convention": "firmware.convention",
+    "rate": "controller.period",
+    "sensor_resolution": "sensors.resolution",
+}
+MAX_RATE_HZ = 1e6  # a faster loop is a unit mistake (a period typed as a rate); MachineError.FORMAT_RATE says it
+MAX_C_WORD_BITS = 16  # the generated C holds words in 16-bit data words
+
+
+def controller_config(platform: Platform, fmt: dict, trajectory=None, poses=None) -> ControllerConfig:
+    """The firmware's number format, timing and gains for ``fmt`` (``machine_format``'s, checked), designed over
+    ``trajectory``'s poses, else over ``poses`` ``(n, 6)`` SI, else home."""
+    qformat = QFormat(fmt["word_bits"], fmt["length_lsb"], fmt["trig"])
     timing = DspTiming(
-        sample_period=1.0 / rate, sensor_resolution=sensor_resolution, command_range=float(platform.legs.max_force)
+        sample_period=1.0 / fmt["rate"],
+        sensor_resolution=fmt["sensor_resolution"],
+        command_range=float(platform.legs.max_force),
     ).check()
     poses = poses if trajectory is None else design_poses(get_trajectory(trajectory))
-    return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=fmt, convention=convention)
+    return ControllerConfig.for_platform(platform, timing, poses=poses, ik_format=qformat, convention=fmt["convention"])
 
 
-def machine_format(
-    platform,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
-) -> tuple[Machine, dict]:
+def format_keywords(format: dict) -> dict:
+    """The keywords of ``format`` that are given (not None); a ``MachineError`` naming one that is not a
+    firmware format keyword (``FORMAT_PATHS``) and the valid ones."""
+    for name in format:
+        if name not in FORMAT_PATHS:
+            raise MachineError(MachineError.FORMAT_KEYWORD.format(name=name, valid=", ".join(FORMAT_PATHS)))
+    return {k: v for k, v in format.items() if v is not None}
+
+
+def machine_format(platform, format: dict) -> tuple[Machine, dict]:
     """``(machine, format)``: the machine of ``platform`` (a ``Machine``, a ``Platform``, a preset name or a
-    platform or machine file) and the firmware's ``word_bits``, ``length_lsb``, ``trig``, ``convention``,
-    ``rate`` (Hz) and ``sensor_resolution`` (m): each keyword given, else the machine's (``firmware``,
-    ``1 / controller.period``, ``sensors.resolution``; a platform's machine has the DSP's defaults)."""
-    machine = load_machine(platform)
-    fmt = machine.firmware
-    given = dict(
-        word_bits=word_bits,
-        length_lsb=length_lsb,
-        trig=trig,
-        convention=convention,
-        rate=rate,
-        sensor_resolution=sensor_resolution,
+    platform or machine file) with the firmware format keywords of ``format`` applied to their spec paths
+    (``FORMAT_PATHS``; checked as the machine's fields are, errors naming the path), and the resolved
+    ``word_bits``, ``length_lsb`` (m), ``trig``, ``convention``, ``rate`` (Hz) and ``sensor_resolution`` (m):
+    each given, else the machine's (a platform's machine has the DSP's defaults).
+
+    Raises:
+        MachineError, QuantityError: an unknown keyword, a value out of its field's range, a rate that is not
+            in (0, 1e6] Hz, words wider than the generated C holds (16 bits).
+    """
+    given = format_keywords(format)
+    rate = given.get("rate")
+    if rate is not None:
+        number = isinstance(rate, (int, float)) and not isinstance(rate, bool)
+        if not (number and math.isfinite(rate) and 0 < rate <= MAX_RATE_HZ):
+            shown = f"{rate:g}" if number else repr(rate)
+            raise MachineError(MachineError.FORMAT_RATE.format(value=shown))
+    overrides = {FORMAT_PATHS[k]: 1.0 / rate if k == "rate" else v for k, v in given.items()}
+    machine = apply_overrides(load_machine(platform), overrides)
+    fw = machine.firmware
+    if fw.word_bits > MAX_C_WORD_BITS:
+        rule = "in 8..16 for generated C (16-bit data words and narrower)"
+        value = given.get("word_bits", fw.word_bits)
+        raise MachineError(MachineError.RANGE.format(path="firmware.word_bits", rule=rule, value=value))
+    resolved = dict(
+        word_bits=int(fw.word_bits),
+        length_lsb=float(fw.length_lsb),
+        trig=fw.trig,
+        convention=fw.convention,
+        rate=rate if rate is not None else 1.0 / machine.controller.period,
+        sensor_resolution=float(machine.sensors.resolution),
     )
-    mine = dict(
-        word_bits=fmt.word_bits,
-        length_lsb=fmt.length_lsb,
-        trig=fmt.trig,
-        convention=fmt.convention,
-        rate=1.0 / machine.controller.period,
-        sensor_resolution=machine.sensors.resolution,
-    )
-    return machine, {k: mine[k] if v is None else v for k, v in given.items()}
+    return machine, resolved
 
 
-def _options(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory, platform_source):
-    """The module's options, checked, and its gains designed: (platform, config, options to record)."""
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+def _options(platform, format: dict, trajectory, platform_source):
+    """The module's options (``format``: the firmware format keywords, ``machine_format``), checked, and its gains
+    designed: (platform, config, options to record)."""
+    machine, f = machine_format(platform, format)
     platform = machine.platform
     platform_source = machine.platform_source if platform_source is None else platform_source
-    config = controller_config(
-        machine.loaded_platform, f["word_bits"], f["length_lsb"], f["trig"], f["convention"], f["rate"],
-        f["sensor_resolution"], trajectory,
-    )  # fmt: skip
+    config = controller_config(machine.loaded_platform, f, trajectory)
     options = dict(
         platform=platform.name if platform_source is None else str(platform_source),
         **f,
@@ -183,16 +182,11 @@ def generate(
     platform: Platform | Machine,
     out: str | Path,
     *,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
     compile: bool = True,
     on_note: Callable[[str], None] | None = None,
     platform_source: str | None = None,
+    **format,
 ) -> GenerateResult:
     """Generate the C firmware (``sd_firmware.h``, ``sd_firmware.c``, README) for a platform into a folder.
 
@@ -204,12 +198,6 @@ def generate(
         platform: the platform, or a ``Machine`` (its gains are designed with its payload on the plate).
         out: the output folder: new, empty, or holding only files this command wrote (the manifest records each
             with its sha256; another command's file or a changed one is refused, never replaced).
-        word_bits: data word width, 8..16 (``firmware.word_bits``).
-        length_lsb: metres per length LSB (``firmware.length_lsb``).
-        trig: the trigonometry (``"tfr16"``: the DSP's; needs 16-bit words) (``firmware.trig``).
-        convention: Euler convention of the pose angles (``firmware.convention``).
-        rate: controller rate, Hz (``1 / controller.period``).
-        sensor_resolution: leg sensor, m per count (``sensors.resolution``).
         trajectory: design the gains over this reference's poses (default: home only). A `Trajectory` (no
             name ``check`` can look up) also writes its design poses to ``sd_design_poses.json`` beside the C,
             which ``check`` reads (their hash is recorded in the fingerprint).
@@ -217,6 +205,11 @@ def generate(
         on_note: called with a note (no compiler found).
         platform_source: how the platform is named (a preset name or a YAML path), recorded with the other
             options in the files (a fingerprint ``check`` reads back); default the platform's name.
+        **format: the firmware format keywords, each replacing the machine's value: ``word_bits`` (data word
+            width, 8..16: ``firmware.word_bits``), ``length_lsb`` (metres per length LSB: ``firmware.length_lsb``),
+            ``trig`` (``"tfr16"``: the DSP's, 16-bit words only; ``"exact"``: ``firmware.trig``), ``convention``
+            (Euler convention of the pose angles: ``firmware.convention``), ``rate`` (controller rate, Hz:
+            ``1 / controller.period``), ``sensor_resolution`` (leg sensor, m per count: ``sensors.resolution``).
 
     Returns:
         The summary and the files written.
@@ -224,9 +217,7 @@ def generate(
     Raises:
         StewartError: bad options, or an output folder that holds other files.
     """
-    platform, config, options = _options(
-        platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory, platform_source
-    )
+    platform, config, options = _options(platform, format, trajectory, platform_source)
     rate = options["rate"]
     folder = OutputFolder(out)  # the policy, before any work: new, empty, or this command's own verified files
     out = Path(out)
@@ -288,14 +279,9 @@ def build(
     out: str | Path,
     *,
     target: str = "cortex-m4",
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
     platform_source: str | None = None,
+    **format,
 ) -> BuildResult:
     """Build the generated firmware (``sd_ik``, ``sd_tick``, ``sd_fk``) with the PIL runtime for a
     microcontroller: an ELF that boots on the target's board and runs ``sd_tick`` for each sensor frame of the
@@ -307,6 +293,9 @@ def build(
         platform: the platform, or a ``Machine``.
         out: the output folder: new, empty, or holding only files this command wrote.
         target: ``"cortex-m4"`` (the Arm MPS2+ AN386 board, as QEMU's ``mps2-an386`` models it).
+        trajectory: design the gains over this reference's poses (as ``generate``).
+        platform_source: how the platform is named in the recorded options (as ``generate``).
+        **format: the firmware format keywords of ``generate``.
 
     Returns:
         The summary (sizes, stack depth) and the files written.
@@ -316,9 +305,7 @@ def build(
             that holds other files.
     """
     check_target(target)
-    platform, config, options = _options(
-        platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution, trajectory, platform_source
-    )
+    platform, config, options = _options(platform, format, trajectory, platform_source)
     folder = OutputFolder(out)  # the policy, before any work
     out = Path(out)
     g = _module(platform, config, options)
@@ -357,7 +344,7 @@ class CheckResult(Result):
 
 def check(
     path: str | Path,
-    platform: Platform | str | None = None,
+    platform: Machine | Platform | str | Path | None = None,
     *,
     poses: int = 100_000,
     seed: int = 0,
@@ -365,13 +352,8 @@ def check(
     duration: float = 0.5,
     compiler: str | None = None,
     time_limit: float = FIRMWARE_TIME_LIMIT_S,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> CheckResult:
     """Compile a C firmware against the header generated for the platform and compare it with the bit-exact
     emulation: ``sd_ik`` over random workspace poses and ``sd_tick`` over a recorded closed-loop stream.
@@ -382,8 +364,8 @@ def check(
 
     Args:
         path: the C file (implementing ``sd_firmware.h``).
-        platform: the platform it was generated for (a Platform, a preset name or a YAML path; default as
-            recorded).
+        platform: the machine or platform it was generated for (a ``Machine``, a ``Platform``, a preset name, a
+            platform or machine file; default as recorded).
         poses: workspace poses compared.
         seed: random seed of the poses.
         trace: trace the first differing pose word by word.
@@ -391,15 +373,11 @@ def check(
         compiler: a compiler name (default the first found).
         time_limit: seconds the check may run the firmware (compiled and run in a child process: a hang,
             ``exit()`` or crash in it is one ``StewartError`` naming the file).
-        word_bits: data word width (as generated).
-        length_lsb: metres per length LSB (as generated).
-        trig: the trigonometry (as generated).
-        convention: Euler convention (as generated).
-        rate: controller rate, Hz (as generated).
-        sensor_resolution: m per count (as generated).
         trajectory: the reference the gains were designed over (as generated; a module generated from a
             `Trajectory` reads its design poses from the ``sd_design_poses.json`` beside it, or takes that
             same `Trajectory` here).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), as generated: each defaults to the recorded one.
 
     Returns:
         The comparison; ``identical`` when bit-exact.
@@ -411,17 +389,11 @@ def check(
     check_source(path)
     limit = check_time_limit(time_limit)
     given = dict(
+        format_keywords(format),
         platform=None,  # compared below by the platform's name (a preset, a path or an API platform's name)
-        word_bits=word_bits,
-        length_lsb=length_lsb,
-        trig=trig,
-        convention=convention,
-        rate=rate,
-        sensor_resolution=sensor_resolution,
         trajectory=trajectory if trajectory is None or isinstance(trajectory, str) else None,
     )
-    names = {k: "--" + k.replace("_", "-") for k in FP_DEFAULTS}
-    o, mismatch = resolve_options(given, path, names)
+    o, mismatch = resolve_options(given, path)
     if mismatch:  # the check would compare the C with another module's emulation
         raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     rec = read_fingerprint(path)
@@ -429,9 +401,10 @@ def check(
         # a preset, a platform file or a machine file (whose payload the gains were designed with)
         platform = load_machine(o["platform"]).loaded_platform
     else:
-        platform = load_platform(platform)
-        if rec and _platform_name(rec[0]["platform"]) != platform.name:
-            mismatch = f"--platform {platform.name} here, {rec[0]['platform']} in {rec[1]}"
+        machine = load_machine(platform)  # a machine's payload is on the plate its gains are designed for
+        platform = machine.loaded_platform
+        if rec and _platform_name(rec[0]["platform"]) != machine.platform.name:
+            mismatch = f"platform={machine.platform.name} here, {rec[0]['platform']} in {rec[1]}"
             raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     design, motion = None, o["trajectory"] if isinstance(o["trajectory"], dict) else None
     if isinstance(trajectory, Trajectory):
@@ -443,10 +416,8 @@ def check(
             raise UsageError(UsageError.FIRMWARE_OPTIONS.format(file=path, mismatch=mismatch))
     elif motion:  # generated from a Python Trajectory: its design poses, recorded beside the C
         o["trajectory"], design = None, recorded_design_poses(motion, rec[1])
-    config = controller_config(
-        platform, o["word_bits"], o["length_lsb"], o["trig"], o["convention"], o["rate"], o["sensor_resolution"],
-        o["trajectory"], design,
-    )  # fmt: skip
+    _, f = machine_format(platform, {k: o[k] for k in FORMAT_PATHS})
+    config = controller_config(platform, f, o["trajectory"], design)
     cc = compiler_by_name(compiler) if compiler else None
     # the user's code runs in a child process: a hang, an exit() or a crash is one line naming the file
     r = run_isolated(
@@ -553,13 +524,8 @@ def certify(
     tick_error: float = 5e-3,
     tick_speed: float = 0.1,
     tick_feedforward: float = 0.0,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> CertifyResult:
     """Prove, over every pose of a box, each ``sd_ik`` word's range, whether it can saturate, and a bound on
     ``|L_firmware - L_float|`` per leg (interval branch and bound, memory bounded); optionally the
@@ -579,13 +545,9 @@ def certify(
         tick_error: bound on ``|set-point - measured|``, m.
         tick_speed: bound on the legs' speed, m/s.
         tick_feedforward: bound on ``|feed-forward|``, N.
-        word_bits: data word width, 8..16.
-        length_lsb: metres per length LSB.
-        trig: the trigonometry (``"tfr16"`` needs 16-bit words).
-        convention: Euler convention of the pose angles.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
         trajectory: design the gains over this reference's poses (default: home only).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), each replacing the machine's value.
 
     Returns:
         The certificate; ``saturation_possible`` says whether a word may saturate.
@@ -593,9 +555,9 @@ def certify(
     Raises:
         StewartError: a bad box, budget or format; ``tp17`` on another platform.
     """
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    machine, f = machine_format(platform, format)
     p = machine.platform
-    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
+    config = controller_config(machine.loaded_platform, f, trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)
     fmt = config.ik_format
     if implementation == "tp17":
@@ -609,15 +571,10 @@ def certify(
 
 
 def _certify_tick(config: ControllerConfig, error: float, speed: float, feedforward: float) -> TickCertificate:
-    """The tick certificate after the bounds' checks (the message shows ``--tick-error`` in mm, the option's
-    unit)."""
-    for opt, v, shown in (
-        ("--tick-error", error, error * 1e3),
-        ("--tick-speed", speed, speed),
-        ("--tick-feedforward", feedforward, feedforward),
-    ):
+    """The tick certificate after the bounds' checks (``OptionError`` naming the keyword and its SI value)."""
+    for name, v in (("tick_error", error), ("tick_speed", speed), ("tick_feedforward", feedforward)):
         if not (math.isfinite(v) and v >= 0):
-            raise OptionError(OptionError.AT_LEAST.format(option=opt, min=0, value=f"{shown:g}"))
+            raise OptionError(OptionError.AT_LEAST.format(option=name, min=0, value=f"{v:g}"))
     return certify_tick_words(config, error, speed, feedforward)
 
 
@@ -627,13 +584,8 @@ def certify_tick(
     tick_error: float = 5e-3,
     tick_speed: float = 0.1,
     tick_feedforward: float = 0.0,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> TickResult:
     """Prove the ranges of ``sd_tick``'s PID words (and whether the anti-windup keeps the integrator inside its
     rails) for stated bounds on the error, the legs' speed and the feed-forward.
@@ -644,13 +596,9 @@ def certify_tick(
         tick_error: bound on ``|set-point - measured|``, m.
         tick_speed: bound on the legs' speed, m/s.
         tick_feedforward: bound on ``|feed-forward|``, N.
-        word_bits: data word width, 8..16.
-        length_lsb: metres per length LSB.
-        trig: the trigonometry.
-        convention: Euler convention.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
         trajectory: design the gains over this reference's poses (default: home only).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), each replacing the machine's value.
 
     Returns:
         The tick's certificate.
@@ -658,8 +606,8 @@ def certify_tick(
     Raises:
         StewartError: a negative or non-finite bound, a bad format.
     """
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
-    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
+    machine, f = machine_format(platform, format)
+    config = controller_config(machine.loaded_platform, f, trajectory)
     return TickResult(_certify_tick(config, tick_error, tick_speed, tick_feedforward))
 
 
@@ -673,13 +621,8 @@ def optimize(
     length_unit: str = "mm",
     angle_unit: str = "pi",
     max_cells: int | None = None,
-    word_bits: int | None = None,
-    length_lsb: float | None = None,
-    trig: str | None = None,
-    convention: str | None = None,
-    rate: float | None = None,
-    sensor_resolution: float | None = None,
     trajectory: str | Trajectory | None = None,
+    **format,
 ) -> OptimizeResult:
     """Choose the length LSB, word bits and trigonometry so that the proven ``sd_ik`` error meets a budget
     without saturation over a pose box (``objective``: fewest bits or fewest cycles), and generate that
@@ -695,13 +638,10 @@ def optimize(
         length_unit: unit of px py pz in ``box``.
         angle_unit: unit of a b g in ``box``.
         max_cells: the final certificate's budget, cells evaluated (default 200000).
-        word_bits: the default format's word width (the comparison's baseline), and the gains' design.
-        length_lsb: the default format's metres per LSB.
-        trig: the default format's trigonometry.
-        convention: Euler convention.
-        rate: controller rate, Hz.
-        sensor_resolution: leg sensor, m per count.
         trajectory: design the gains over this reference's poses (default: home only).
+        **format: the firmware format keywords (``generate``'s: ``word_bits``, ``length_lsb``, ``trig``,
+            ``convention``, ``rate``, ``sensor_resolution``), each replacing the machine's value: the default
+            format (the comparison's baseline) and the gains' design.
 
     Returns:
         The chosen formats (``chosen`` None when none meets the budget) and the comparison.
@@ -711,9 +651,9 @@ def optimize(
     """
     budget = parse_budget(error_budget)
     folder = None if out is None else OutputFolder(out)
-    machine, f = machine_format(platform, word_bits, length_lsb, trig, convention, rate, sensor_resolution)
+    machine, f = machine_format(platform, format)
     p = machine.platform
-    config = controller_config(machine.loaded_platform, **f, trajectory=trajectory)
+    config = controller_config(machine.loaded_platform, f, trajectory)
     pose_box = parse_box(box, p, length_unit, angle_unit)
     res = choose_formats(p, config, pose_box, budget, objective, MAX_CELLS if max_cells is None else max_cells)
     written = None

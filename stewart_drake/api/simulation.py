@@ -240,7 +240,8 @@ def plan_run(
     duration_shown=None,
     **overrides,
 ) -> RunPlan:
-    """Check a closed-loop run's settings and build its ``Scenario`` (see ``simulate`` for the arguments).
+    """Check a closed-loop run's settings and build its ``Scenario``. Its keywords from ``trajectory`` to
+    ``smooth`` are ``simulate``'s options, documented there once.
 
     ``platform``: a ``Machine`` (or a ``Platform`` or machine file: a machine with defaults); the keywords
     ``controller``, ``period``, ``latency``, ``sensor_resolution``, ``plant_step``, ``feedforward``, ``engine``,
@@ -310,7 +311,11 @@ def plan_run(
                 platform, ticks, traj.pose(ticks), "utn", f"the {traj.name} reference", allow_out_of_stroke
             )
         except PhysicalLimitError as e:  # a CSV in the other unit than it was read in says so
-            hint = other_unit_hint(platform, traj.pose(ticks), length_unit, angle_unit) if csv and not fit else ""
+            hint = (
+                other_unit_hint(platform, traj.pose(ticks), length_unit, angle_unit, api=True)
+                if csv and not fit
+                else ""
+            )
             raise PhysicalLimitError(str(e) + hint) from None
         why = infeasible_motion(platform, traj, ticks, period)
         if why:  # before the run: no controller follows it (it ended in raw solver messages)
@@ -506,25 +511,9 @@ class SimulationResult(Result):
 def simulate(
     machine: Machine | Platform | str | Path,
     trajectory: str | Path | Trajectory | None = None,
-    controller: str | None = None,
-    duration: float | None = None,
     *,
-    period: float | None = None,
-    latency: str | None = None,
-    sensor_resolution: float | None = None,
-    plant_step: float | None = None,
-    feedforward: bool | None = None,
-    engine: str | None = None,
-    firmware: str | Path | None = None,
-    time_limit: float = FIRMWARE_IDLE_LIMIT_S,
-    integrator: str | None = None,
-    fit: bool | None = None,
-    allow_out_of_stroke: bool = False,
-    length_unit: str = "m",
-    angle_unit: str = "rad",
-    smooth: float | None = None,
     progress: bool = False,
-    **overrides,
+    **options,
 ) -> SimulationResult:
     """Run the fixed-point (or float) controller in the loop with the Drake plant.
 
@@ -533,66 +522,48 @@ def simulate(
             section at its defaults) or a machine file.
         trajectory: the pose reference: ``"seed"``, ``"rotating"``, a CSV file of t, pose rows, a ``.stw``
             motion program, or a `Trajectory` (default the machine's first motion).
-        controller: ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin) (spec path
-            ``controller.law``; None here and below: the machine's).
-        duration: simulated seconds (default ``run.duration``, else the trajectory's, else 1 s).
-        period: controller sample period, s (``controller.period``).
-        latency: when a tick's output is released: ``"sample"`` (one sample later), ``"computation"`` (after
-            the cycle model's computation time) or ``"none"`` (``controller.latency``).
-        sensor_resolution: leg-length sensor resolution, m per count (``sensors.resolution``).
-        plant_step: plant time step, s (default the period, at most 1 ms) (``run.plant_step``).
-        feedforward: connect the model-based force feed-forward (``controller.feedforward``).
-        engine: the fixed-point tick: ``"c"`` (the generated firmware, compiled) or ``"python"`` (the
-            emulation); default ``"c"`` where a C compiler is found (``controller.engine``).
-        firmware: a C file implementing the firmware ABI, or the folder ``firmware generate`` wrote, run as the
-            controller tick (in a child process: a hang, ``exit()`` or crash in it is one ``StewartError``
-            naming the file). The loop runs the number format, sensor resolution and rate the firmware
-            records (a warning names each that differs from the machine's); a firmware recorded for another
-            platform is refused.
-        time_limit: seconds the simulated time may stand still while ``firmware`` runs.
-        integrator: ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"`` (``run.integrator``).
-        fit: move and scale the reference to the platform's home height and stroke (``run.fit``).
-        allow_out_of_stroke: simulate a reference that leaves the stroke (a warning) instead of raising.
-        length_unit: unit of a CSV reference's positions.
-        angle_unit: unit of a CSV reference's angles.
-        smooth: replace a CSV reference's samples by a smoothing spline's within this RMS tolerance (the
-            file's units); without it, a file rounded so coarsely that its second differences are noise is
-            refused.
         progress: show a progress bar.
-        **overrides: any spec path, ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values
-            in SI or in the quantity grammar).
+        **options: the run's options (below, ``plan_run``'s keywords) and any spec path,
+            ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values in SI or in the quantity
+            grammar). An option left out (or None) keeps the machine's value.
+
+    Keyword Args:
+        controller (str | None): ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin) (spec
+            path ``controller.law``).
+        duration (float | None): simulated seconds (default ``run.duration``, else the trajectory's, else 1 s).
+        period (float | None): controller sample period, s (``controller.period``).
+        latency (str | None): when a tick's output is released: ``"sample"`` (one sample later),
+            ``"computation"`` (after the cycle model's computation time) or ``"none"`` (``controller.latency``).
+        sensor_resolution (float | None): leg-length sensor resolution, m per count (``sensors.resolution``).
+        plant_step (float | None): plant time step, s (default the period, at most 1 ms) (``run.plant_step``).
+        feedforward (bool | None): connect the model-based force feed-forward (``controller.feedforward``).
+        engine (str | None): the fixed-point tick: ``"c"`` (the generated firmware, compiled) or ``"python"``
+            (the emulation); default ``"c"`` where a C compiler is found (``controller.engine``).
+        firmware (str | Path | None): a C file implementing the firmware ABI, or the folder ``firmware
+            generate`` wrote, run as the controller tick (in a child process: a hang, ``exit()`` or crash in it
+            is one ``StewartError`` naming the file). The loop runs the number format, sensor resolution and
+            rate the firmware records (a warning names each that differs from the machine's); a firmware
+            recorded for another platform is refused.
+        time_limit (float): seconds the simulated time may stand still while ``firmware`` runs (default 60).
+        integrator (str | None): ``"cenic-fixed"`` (default), ``"cenic"`` or ``"sap"`` (``run.integrator``).
+        fit (bool | None): move and scale the reference to the platform's home height and stroke (``run.fit``).
+        allow_out_of_stroke (bool): simulate a reference that leaves the stroke (a warning) instead of raising.
+        length_unit (str): unit of a CSV reference's positions (default ``"m"``).
+        angle_unit (str): unit of a CSV reference's angles (default ``"rad"``).
+        smooth (float | None): replace a CSV reference's samples by a smoothing spline's within this RMS
+            tolerance (the file's units); without it, a file rounded so coarsely that its second differences
+            are noise is refused.
 
     Returns:
         The summary, logs and verdict of the run.
 
     Raises:
-        StewartError: bad settings (``MachineError`` naming the spec path, a period too slow for the
-            dynamics, a run too large, an engine that does not fit the controller, ...);
+        StewartError: bad settings (``MachineError`` naming the spec path or the keyword, a period too slow for
+            the dynamics, a run too large, an engine that does not fit the controller, ...);
             ``PhysicalLimitError`` when the reference leaves the stroke or is beyond the actuators (force or
             speed), before the run.
     """
-    plan = plan_run(
-        machine,
-        trajectory,
-        controller,
-        duration,
-        period=period,
-        latency=latency,
-        sensor_resolution=sensor_resolution,
-        plant_step=plant_step,
-        feedforward=feedforward,
-        engine=engine,
-        firmware=firmware,
-        time_limit=time_limit,
-        integrator=integrator,
-        fit=fit,
-        allow_out_of_stroke=allow_out_of_stroke,
-        length_unit=length_unit,
-        angle_unit=angle_unit,
-        smooth=smooth,
-        **overrides,
-    )
-    return run_plan(plan, progress=progress)
+    return run_plan(plan_run(machine, trajectory, **options), progress=progress)
 
 
 def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=None) -> SimulationResult:

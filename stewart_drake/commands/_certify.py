@@ -4,9 +4,12 @@ by that proof."""
 
 from __future__ import annotations
 
+import math
+
 from stewart_drake.api import firmware
 from stewart_drake.commands._common import print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
+from stewart_drake.errors import OptionError
 
 
 def add_box_args(p) -> None:
@@ -36,9 +39,10 @@ def add_box_args(p) -> None:
     )
 
 
-def register(fs, format_args, format_kwargs) -> None:
+def register(fs, format_args, format_kwargs, call_api) -> None:
     """Add ``certify`` and ``optimize`` to the ``firmware`` subparsers ``fs``; ``format_args`` adds
-    generate's format options, ``format_kwargs(args)`` turns them into the API's keywords."""
+    generate's format options, ``format_kwargs(args)`` turns them into the API's keywords,
+    ``call_api(function, args, ...)`` calls the API naming the options by their flags."""
     c = fs.add_parser(
         "certify",
         help="prove every sd_ik word's range, saturation and a bound on |L_firmware - L_float| over a pose box",
@@ -61,7 +65,7 @@ def register(fs, format_args, format_kwargs) -> None:
     c.add_argument("--tick-speed", type=float, default=0.1, metavar="M/S", help="leg speed bound, m/s (0.1)")
     c.add_argument("--tick-feedforward", type=float, default=0.0, metavar="N", help="|feed-forward| bound, N (0: none)")
     c.add_argument("--json", action="store_true", help="print JSON")
-    c.set_defaults(func=run_certify, format_kwargs=format_kwargs)
+    c.set_defaults(func=run_certify, format_kwargs=format_kwargs, call_api=call_api)
     o = fs.add_parser(
         "optimize",
         help="choose the length LSB, word bits and trig so the proven error meets a budget without saturation",
@@ -72,29 +76,27 @@ def register(fs, format_args, format_kwargs) -> None:
     o.add_argument("--objective", choices=["bits", "cycles"], default="bits", help="minimise word bits or sd_ik cycles")
     o.add_argument("--out", default=None, metavar="DIR", help="write the chosen firmware (sd_firmware.h/.c, README)")
     o.add_argument("--json", action="store_true", help="print JSON")
-    o.set_defaults(func=run_optimize, format_kwargs=format_kwargs)
+    o.set_defaults(func=run_optimize, format_kwargs=format_kwargs, call_api=call_api)
 
 
-def _common(args) -> dict:
-    """The keywords ``certify`` and ``optimize`` share: the format options, the box and its units, the budget."""
-    return dict(
-        args.format_kwargs(args),
-        box=args.box,
-        length_unit=args.length_unit,
-        angle_unit=args.angle_unit,
-        max_cells=args.max_cells,
-    )
+def _call(function, args, **keywords):
+    """``function`` (``firmware.certify`` or ``optimize``) of ``--platform`` with ``keywords`` and the options
+    both share (the format, the box and its units, the budget), through ``call_api``."""
+    shared = dict(box=args.box, length_unit=args.length_unit, angle_unit=args.angle_unit, max_cells=args.max_cells)
+    return args.call_api(function, args, args.platform, **keywords, **shared, **args.format_kwargs(args))
 
 
 def run_certify(args) -> int:
-    r = firmware.certify(
-        args.platform,
+    if not (math.isfinite(args.tick_error) and args.tick_error >= 0):  # in mm here, in m in the API's message
+        raise OptionError(OptionError.AT_LEAST.format(option="--tick-error", min=0, value=f"{args.tick_error:g}"))
+    r = _call(
+        firmware.certify,
+        args,
         implementation=args.implementation,
         tick=args.tick,
         tick_error=args.tick_error * 1e-3,
         tick_speed=args.tick_speed,
         tick_feedforward=args.tick_feedforward,
-        **_common(args),
     )
     if args.json:
         print_json(r.to_dict())
@@ -169,9 +171,7 @@ def format_certificate(cert) -> str:
 
 
 def run_optimize(args) -> int:
-    r = firmware.optimize(
-        args.platform, error_budget=args.error_budget, objective=args.objective, out=args.out, **_common(args)
-    )
+    r = _call(firmware.optimize, args, error_budget=args.error_budget, objective=args.objective, out=args.out)
     if args.json:
         print_json(r.to_dict())
     else:

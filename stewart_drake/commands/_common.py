@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import sys
 
 import numpy as np
@@ -153,22 +154,30 @@ def machine_from_args(args, flag_paths: dict = FLAG_PATHS) -> Machine:
     try:
         return apply_overrides(machine, [*(f"{p}={v}" for p, v in flags.items()), *args.set])
     except (MachineError, QuantityError) as e:
-        raise flag_error(e, named, flag_paths) from None
+        raise flag_error(e, flag_paths, named) from None
 
 
-def flag_text(text: str, given=None, flag_paths: dict = FLAG_PATHS) -> str:
-    """``text`` with the spec paths of ``flag_paths`` (only those of the ``given`` options, if given) named by
-    their flags."""
-    for dest, (flag, path) in flag_paths.items():
+def flag_text(text: str, table: dict, given=None) -> str:
+    """``text`` (an API message) with the names of ``table`` (option dest -> ``(flag, spec path or None)``; only
+    those of the ``given`` dests, if given) turned into the command line's: a spec path, an API keyword
+    written ``name=value`` and one that starts the message become the flag (``controller.period`` ->
+    ``--period``, ``length_lsb=0.5`` -> ``--length-lsb 0.5``, ``fit=True`` -> ``--fit``, ``rate must be`` ->
+    ``--rate must be``)."""
+    for dest, (flag, path) in table.items():
         if given is None or dest in given:
-            text = text.replace(path, flag)
+            if path:
+                text = text.replace(path, flag)
+            text = re.sub(rf"(?<![\w.-]){re.escape(dest)}=True\b", flag, text)  # a store_true flag
+            text = re.sub(rf"(?<![\w.-]){re.escape(dest)}=", flag + " ", text)
+            if text.startswith(dest + " "):
+                text = flag + text[len(dest) :]
     return text
 
 
-def flag_error(e: StewartError, given=None, flag_paths: dict = FLAG_PATHS) -> StewartError:
-    """``e`` with the spec paths of ``flag_paths`` (of the ``given`` options) in its message named by their flags
-    (the same class)."""
-    message = flag_text(str(e), given, flag_paths)
+def flag_error(e: StewartError, table: dict, given=None) -> StewartError:
+    """``e`` with its message's spec paths and API keywords named by their flags (``flag_text``; the same
+    class)."""
+    message = flag_text(str(e), table, given)
     if message == str(e):
         return e
     e = copy.copy(e)

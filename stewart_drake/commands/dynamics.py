@@ -6,7 +6,14 @@ import csv
 import sys
 
 from stewart_drake.api.dynamics import inverse_dynamics
-from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json, reject_unused
+from stewart_drake.commands._common import (
+    add_platform_arg,
+    flag_error,
+    platform_from_args,
+    print_json,
+    reject_unused,
+)
+from stewart_drake.errors import StewartError
 
 CSV_HELP = (
     "CSV, one sample per row: either 7 columns t,px,py,pz,a,b,g (velocities and accelerations from a cubic "
@@ -60,27 +67,34 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+# the options the API's messages name by keyword (``allow_out_of_stroke=True``)
+DYNAMICS_FLAGS = {"allow_out_of_stroke": ("--allow-out-of-stroke", None)}
+
+
 def run(args) -> int:
     seed = args.trajectory == "seed"
     reject_unused(args, "--trajectory seed", seed, t_end=4.0, dt=0.1)
     reject_unused(
         args, "--trajectory FILE.csv", not seed, length_unit="m", angle_unit="rad", convention="utn", smooth=None
     )
-    r = inverse_dynamics(
-        platform_from_args(args),
-        args.trajectory,
-        legs=args.legs == "on",
-        coriolis=args.coriolis == "on",
-        gravity=args.gravity,
-        t_end=args.t_end,
-        dt=args.dt,
-        convention=args.convention,
-        length_unit=args.length_unit,
-        angle_unit=args.angle_unit,
-        allow_out_of_stroke=args.allow_out_of_stroke,
-        smooth=args.smooth,
-        on_warning=lambda w: print(f"stewart-drake dynamics: warning: {w}", file=sys.stderr),
-    )
+    try:  # the API names its keywords (allow_out_of_stroke=True); the user gave flags
+        r = inverse_dynamics(
+            platform_from_args(args),
+            args.trajectory,
+            legs=args.legs == "on",
+            coriolis=args.coriolis == "on",
+            gravity=args.gravity,
+            t_end=args.t_end,
+            dt=args.dt,
+            convention=args.convention,
+            length_unit=args.length_unit,
+            angle_unit=args.angle_unit,
+            allow_out_of_stroke=args.allow_out_of_stroke,
+            smooth=args.smooth,
+            on_warning=lambda w: print(f"stewart-drake dynamics: warning: {w}", file=sys.stderr),
+        )
+    except StewartError as e:
+        raise flag_error(e, DYNAMICS_FLAGS) from None
     if args.json:
         print_json(r.to_dict())
     elif args.csv:

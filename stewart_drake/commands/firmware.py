@@ -8,8 +8,8 @@ from pathlib import Path
 
 from stewart_drake.api import firmware
 from stewart_drake.commands._certify import register as register_certify
-from stewart_drake.commands._common import add_platform_arg, print_json
-from stewart_drake.errors import UsageError
+from stewart_drake.commands._common import add_platform_arg, flag_error, print_json
+from stewart_drake.errors import StewartError, UsageError
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 from stewart_drake.spec import load_machine
 from stewart_drake.system.isolate import FIRMWARE_TIME_LIMIT_S
@@ -133,7 +133,7 @@ def register(sub) -> None:
     add_time_limit_arg(c)
     c.add_argument("--json", action="store_true", help="print JSON")
     c.set_defaults(func=run_check)
-    register_certify(fs, _format_args, _format)
+    register_certify(fs, _format_args, _format, call_api)
 
 
 def add_time_limit_arg(p, default: float = FIRMWARE_TIME_LIMIT_S, what: str = "the check") -> None:
@@ -161,6 +161,35 @@ def _format(args) -> dict:
     )
 
 
+# option (argparse dest) -> (flag, spec path): the API's messages name the spec path or the keyword
+# (``length_lsb=0.001 here``); the command line names the flag the user gave.
+FORMAT_FLAGS = {
+    "platform": ("--platform", None),
+    "word_bits": ("--word-bits", "firmware.word_bits"),
+    "length_lsb": ("--length-lsb", "firmware.length_lsb"),
+    "trig": ("--trig", "firmware.trig"),
+    "convention": ("--convention", "firmware.convention"),
+    "rate": ("--rate", None),
+    "sensor_resolution": ("--sensor-resolution", "sensors.resolution"),
+    "trajectory": ("--trajectory", None),
+    "tick_speed": ("--tick-speed", None),
+    "tick_feedforward": ("--tick-feedforward", None),
+    "box": ("--box", None),
+    "max_cells": ("--max-cells", None),
+    "error_budget": ("--error-budget", None),
+    "implementation": ("--implementation", None),
+}
+
+
+def call_api(function, args, *positional, **keywords):
+    """``function(*positional, **keywords)`` (an ``api.firmware`` function), its errors about the format options
+    the user gave named by their flags."""
+    try:
+        return function(*positional, **keywords)
+    except StewartError as e:
+        raise flag_error(e, FORMAT_FLAGS, [d for d in FORMAT_FLAGS if getattr(args, d, None) is not None]) from None
+
+
 # firmware generate's options that default to the machine's
 MACHINE_OPTIONS = ("platform", "word_bits", "length_lsb", "trig", "convention", "rate", "sensor_resolution")
 
@@ -172,8 +201,15 @@ def run_generate(args) -> int:
     source = args.machine or args.platform or FP_DEFAULTS["platform"]
     machine = load_machine(source)
     platform = machine.platform
-    r = firmware.generate(
-        machine, args.out, compile=not args.no_compile, on_note=note, platform_source=source, **_format(args)
+    r = call_api(
+        firmware.generate,
+        args,
+        machine,
+        args.out,
+        compile=not args.no_compile,
+        on_note=note,
+        platform_source=source,
+        **_format(args),
     )
     summary, out, compiled, written = r.to_dict(), Path(args.out), r.summary["compiled_with"], r.files
     clock_hz = r.config.timing.clock_hz
@@ -195,7 +231,7 @@ def run_generate(args) -> int:
 
 def run_build(args) -> int:
     source = args.platform or FP_DEFAULTS["platform"]
-    r = firmware.build(source, args.out, target=args.target, platform_source=source, **_format(args))
+    r = call_api(firmware.build, args, source, args.out, target=args.target, platform_source=source, **_format(args))
     s = r.to_dict()
     if args.json:
         print_json(s)
@@ -213,7 +249,9 @@ def run_build(args) -> int:
 
 
 def run_check(args) -> int:
-    result = firmware.check(
+    result = call_api(
+        firmware.check,
+        args,
         args.file,
         args.platform,  # None: as recorded in the file
         poses=args.poses,

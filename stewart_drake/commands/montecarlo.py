@@ -12,6 +12,7 @@ from stewart_drake.commands._common import (
     add_machine_args,
     add_platform_arg,
     dumps_strict,
+    flag_error,
     machine_from_args,
     print_json,
     reject_unused,
@@ -129,6 +130,8 @@ FLAG_NAMES = {
     "workers": "--workers",
     "lost_tracking": "--lost-tracking",
 }
+# option (argparse dest) -> (flag, spec path) of the draws' checks' messages (``commands._common.flag_text``)
+STUDY_FLAGS = {"plant_step": ("--plant-step", "run.plant_step")}
 
 
 def build_study(args):
@@ -153,6 +156,8 @@ def run(args) -> int:
     except ScriptError as e:  # the reference (program compiled, CSV read) is checked before any run starts
         print(e.render(), file=sys.stderr)
         return 2
+    except StewartError as e:  # the draws' checks name spec paths; the user gave flags
+        raise flag_error(e, STUDY_FLAGS) from None
     rows, summary = result.rows, result.to_dict()
     if args.json:
         print_json(summary)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from stewart_drake.api.simulation import firmware_source, plan_run, run_plan
 from stewart_drake.commands._common import (
+    FLAG_PATHS,
     add_force_arg,
     add_machine_args,
     add_platform_arg,
@@ -147,6 +148,13 @@ def add_loop_args(p) -> None:
 # the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
 FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
 
+# the options the API's messages name by keyword (``length_unit=m``, ``allow_out_of_stroke=True``)
+KEYWORD_FLAGS = {
+    "length_unit": ("--length-unit", None),
+    "angle_unit": ("--angle-unit", None),
+    "allow_out_of_stroke": ("--allow-out-of-stroke", None),
+}
+
 
 def run(args) -> int:
     reject_unused(
@@ -174,8 +182,8 @@ def run(args) -> int:
             duration_shown=args.duration,
         )
     except StewartError as e:
-        raise flag_error(e) from None
-    warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w)}", file=sys.stderr)  # noqa: E731
+        raise flag_error(e, {**FLAG_PATHS, **KEYWORD_FLAGS}) from None
+    warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w, FLAG_PATHS)}", file=sys.stderr)  # noqa: E731
     result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
     summary = result.to_dict()
     out = Path(args.out)

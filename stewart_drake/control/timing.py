@@ -65,12 +65,13 @@ PHASE_BUDGET = 1.2
 CROSSOVER_MARGIN = 2.0
 
 
-# The fields a user sets, named as the options and keys that set them (not the class's attribute names).
+# The fields a user sets, named as the spec paths and study keys that set them (not the class's attribute names;
+# a command turns a spec path into its flag).
 TIMING_FIELDS = {
     "clock_hz": "clock (Hz)",
-    "sample_period": "sample period (--period, --vary sample_period; s)",
-    "sensor_resolution": "sensor resolution (--sensor-resolution, --vary sensor_resolution; m per count)",
-    "command_range": "command range (legs.max_force, --vary force_limit; N)",
+    "sample_period": "sample period (controller.period, vary sample_period; s)",
+    "sensor_resolution": "sensor resolution (sensors.resolution, vary sensor_resolution; m per count)",
+    "command_range": "command range (legs.max_force, vary force_limit; N)",
 }
 
 
@@ -161,8 +162,8 @@ def check_timing(platform, period: float, plant_step: float, actuator_lag: float
       (``loop_delay``) is at least ``CROSSOVER_MARGIN`` × the platform's fastest open-loop growth
       rate λ at home (``dynamics.open_loop_growth_rates``): a slower loop cannot hold the plate up.
     """
-    T = check_positive(period, "--period", "seconds")
-    h = check_positive(plant_step, "--plant-step", "seconds")
+    T = check_positive(period, "controller.period", "seconds")
+    h = check_positive(plant_step, "run.plant_step", "seconds")
     if h > T * (1 + 1e-12):
         raise StewartError(PLANT_STEP_TOO_LONG.format(step=fmt_value(h), period=fmt_value(T)))
     if actuator_lag > 0 and h > actuator_lag * (1 + 1e-12):

@@ -26,12 +26,13 @@ def _inside(platform, q, convention: str) -> bool:
 
 
 def other_unit_hint(
-    platform, poses_si, length_unit: str, angle_unit: str, convention: str = "utn", option: str = ""
+    platform, poses_si, length_unit: str, angle_unit: str, convention: str = "utn", option: str = "", api=False
 ) -> str:
     """A hint ("; read in m instead, every pose would be within the stroke: give --length-unit m") when the
     ``(n, 6)`` SI poses, read in ``length_unit``/``angle_unit``, are not all inside the workspace and the
     same numbers in the other unit would be; "" otherwise. ``option`` prefixes the option names (e.g. for a
-    command whose unit options are named differently, unused here)."""
+    command whose unit options are named differently, unused here); ``api`` names the API's keyword instead
+    (``length_unit=m``)."""
     q = np.asarray(poses_si, dtype=float).reshape(-1, 6)
     if _inside(platform, q, convention):
         return ""
@@ -47,6 +48,6 @@ def other_unit_hint(
         if _inside(platform, alt, convention):
             return (
                 f" (the values were read in {unit}; read in {other} every pose would be inside the workspace: "
-                f"give {option}--{name}-unit {other} if that is what you meant)"
+                f"give {f'{name}_unit={other}' if api else f'{option}--{name}-unit {other}'} if that is what you meant)"
             )
     return ""

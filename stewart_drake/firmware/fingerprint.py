@@ -76,10 +76,10 @@ def read_fingerprint(path) -> tuple[dict, Path] | None:
     return None
 
 
-def resolve_options(given: dict, path, option_names: dict) -> tuple[dict, str | None]:
+def resolve_options(given: dict, path) -> tuple[dict, str | None]:
     """The options ``check`` uses: each given one (not None) as given, the others from the fingerprint of
     ``path`` (else ``DEFAULTS``); ``(options, mismatch)`` where ``mismatch`` names the first given option
-    that differs from the recorded one (``option_names``: key -> ``--option``), else None."""
+    that differs from the recorded one (``name=given here, recorded in FILE``), else None."""
     rec = read_fingerprint(path)
     recorded, where = rec if rec else ({}, None)
     out = {}
@@ -87,7 +87,7 @@ def resolve_options(given: dict, path, option_names: dict) -> tuple[dict, str | 
         g = given.get(k)
         out[k] = g if g is not None else recorded.get(k, default)
         if g is not None and k in recorded and not _same(g, recorded[k]):
-            return out, f"{option_names[k]} {g} here, {recorded[k]} in {where}"
+            return out, f"{k}={g} here, {recorded[k]} in {where}"
     return out, None
 
 

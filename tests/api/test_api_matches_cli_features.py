@@ -125,7 +125,7 @@ def test_firmware_certify_with_tick(capsys):
     assert_same(without_times(r.to_dict()), without_times(cli))
     tick = sd.firmware.certify_tick("utn-dynamic", tick_error=3e-3)
     assert_same(tick.to_dict(), r.to_dict()["tick"])
-    with pytest.raises(sd.UsageError, match="--tick-error must be >= 0"):
+    with pytest.raises(sd.UsageError, match="^tick_error must be >= 0, got -0.001$"):
         sd.firmware.certify_tick("utn-dynamic", tick_error=-1e-3)
 
 

@@ -88,5 +88,5 @@ def test_firmware_check_takes_the_recorded_options_and_refuses_others(tmp_path):
     g = sd.firmware.generate(p, tmp_path / "fw", length_lsb=5e-4, compile=False)
     source = next(f for f in g.files if f.name == "sd_firmware.c")
     assert sd.firmware.check(source, p, poses=200, duration=0.05).identical
-    with pytest.raises(sd.StewartError, match="--length-lsb 0.001 here, 0.0005 in"):
+    with pytest.raises(sd.StewartError, match="length_lsb=0.001 here, 0.0005 in"):
         sd.firmware.check(source, p, poses=200, duration=0.05, length_lsb=1e-3)

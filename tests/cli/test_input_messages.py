@@ -22,7 +22,7 @@ def test_a_negative_number_with_an_exponent_is_a_value(capsys):
 def test_a_negative_exponent_value_meets_the_options_own_check(tmp_path, capsys):
     assert main(["firmware", "generate", "--length-lsb", "-1e-3", "--out", str(tmp_path / "fw")]) == 2
     err = capsys.readouterr().err
-    assert "length_lsb must be a positive number of metres, got -1e-3" in err and "expected one argument" not in err
+    assert "error: --length-lsb must be > 0 m, got -1e-3" in err and "expected one argument" not in err
     assert not (tmp_path / "fw").exists()
 
 

@@ -57,13 +57,13 @@ def test_infeasible_timing_is_refused_with_both_numbers():
     [
         (
             dict(sample_period=0.0),
-            r"sample period \(--period, --vary sample_period; s\) must be a positive number, got 0.0",
+            r"sample period \(controller.period, vary sample_period; s\) must be a positive number, got 0.0",
         ),
         (dict(latency="late"), "latency must be one of sample, computation, none, got 'late'"),
         (dict(computation_cycles=-3), "computation_cycles must be a positive integer, got -3"),
         (
             dict(sensor_resolution=float("nan")),
-            r"sensor resolution \(--sensor-resolution, --vary sensor_resolution; m per count\) must be a positive number",
+            r"sensor resolution \(sensors.resolution, vary sensor_resolution; m per count\) must be a positive number",
         ),
     ],
 )

@@ -36,7 +36,7 @@ def test_a_chattering_study_fails_with_each_run_and_its_reason(tmp_path, capsys)
 
     # the same run as simulate gives the same ripple and the same failure (nothing varied: every run is the
     # nominal platform, so its loop is simulate's, bit for bit)
-    sim = sd.simulate(sd.load_platform(NEWCOMER), "seed", "fixed", 0.3, fit=True, engine="python")
+    sim = sd.simulate(sd.load_platform(NEWCOMER), "seed", controller="fixed", duration=0.3, fit=True, engine="python")
     assert not sim.ok
     assert rows[0]["force_ripple_rms_N"] == max(sim.summary["force_ripple_N"])
     assert rows[0]["failures"].split(FAILURE_SEPARATOR) == sim.verdict["failures"]

@@ -126,7 +126,7 @@ def test_noise_reads_what_the_grammar_reads():
 def test_budget_reads_what_the_grammar_reads():
     for text in ("0.5mm", "500um", "0.0005m", "0.0005", "30µm"):
         assert parse_budget(text) == parse_number(text, "length", "x")
-    with pytest.raises(CertifyError, match="--error-budget"):
+    with pytest.raises(CertifyError, match="^error_budget must be a positive length such as 0.5mm, got '-1mm'$"):
         parse_budget("-1mm")
 
 

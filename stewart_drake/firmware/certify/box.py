@@ -66,8 +66,8 @@ def parse_box(specs: list[str] | None, platform: Platform, length_unit: str = "m
         seen.add(key)
         k = KEYS.index(key)
         dim, scale = ("length", length_scale(length_unit)) if k < 3 else ("angle", angle_scale(angle_unit))
-        try:  # a bare number is in the --length-unit/--angle-unit; a number with its unit is taken as written
-            q = parse_quantity(text, dim, f"--box {spec!r}", forms=("range",), bare=scale)
+        try:  # a bare number is in length_unit/angle_unit; a number with its unit is taken as written
+            q = parse_quantity(text, dim, f"box {spec!r}", forms=("range",), bare=scale)
         except QuantityError as e:
             template = CertifyError.BOX_WORD if e.template == QuantityError.NUMBER else CertifyError.BOX_ORDER
             raise CertifyError(template.format(value=spec)) from None

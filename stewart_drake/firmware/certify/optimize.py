@@ -34,9 +34,9 @@ LSB_TRIES = 8  # LSB steps per candidate before it is declared infeasible
 
 
 def parse_budget(text: str) -> float:
-    """``--error-budget``: metres from ``0.5mm``, ``500um``, ``0.0005m`` or ``0.0005``."""
+    """``error_budget``: metres from ``0.5mm``, ``500um``, ``0.0005m`` or ``0.0005``."""
     try:
-        v = parse_number(text, "length", "--error-budget")
+        v = parse_number(text, "length", "error_budget")
     except QuantityError:
         v = math.nan
     if not v > 0:
