@@ -30,6 +30,7 @@ from stewart_drake.calibration.noise import parse_noise
 from stewart_drake.calibration.plan import MAX_POSES, Box, PlanResult, stw_program
 from stewart_drake.calibration.plan import plan_measurements as plan_poses
 from stewart_drake.calibration.validate import validation_errors
+from stewart_drake.core.argcheck import as_int, param
 from stewart_drake.core.geometry import CalibrationRecord, Platform
 from stewart_drake.core.platform_file import platform_yaml
 from stewart_drake.core.rotations import angle_scale, length_scale
@@ -269,14 +270,23 @@ def plan_measurements(
         StewartError: counts out of range, too few poses for the unknowns, a box that is not positive.
     """
     platform = load_platform(platform)
+    poses, candidates, targets = (
+        as_int(v, param(n)) for v, n in ((poses, "poses"), (candidates, "candidates"), (targets, "targets"))
+    )
     if not 1 <= poses <= MAX_POSES:
-        raise CalibrationError(CalibrationError.POSES.format(value=poses, lo=1, hi=MAX_POSES))
+        raise CalibrationError(CalibrationError.POSES.format(name=param("poses"), value=poses, lo=1, hi=MAX_POSES))
     if not 1 <= candidates <= MAX_CANDIDATES or candidates < 2 * poses:
         raise CalibrationError(
-            CalibrationError.CANDIDATE_COUNT.format(value=candidates, lo=max(2 * poses, 1), hi=MAX_CANDIDATES)
+            CalibrationError.CANDIDATE_COUNT.format(
+                name=param("candidates"),
+                poses=param("poses"),
+                value=candidates,
+                lo=max(2 * poses, 1),
+                hi=MAX_CANDIDATES,
+            )
         )
     if not 1 <= targets <= 8:
-        raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=targets))
+        raise CalibrationError(CalibrationError.TARGET_COUNT.format(name=param("targets"), value=targets))
     layout = Layout(platform, type, targets if type == "points" else 0, gains)
     if poses < min_poses(layout):
         raise CalibrationError(

@@ -16,6 +16,7 @@ from stewart_drake.api.result import Result
 from stewart_drake.calibration.measurements import Measurements, measurements_csv
 from stewart_drake.calibration.noise import parse_noise
 from stewart_drake.calibration.simulate import simulate_measurements as measure
+from stewart_drake.core.argcheck import as_int, as_poses, param
 from stewart_drake.core.csvio import read_numeric_csv
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
@@ -100,10 +101,11 @@ def simulate_measurements(
     spec = parse_spec(errors)
     bad = [k for k in spec.laws if k not in GEOMETRIC_KEYS]
     if bad:
-        raise CalibrationError(CalibrationError.ERRORS_KEY.format(key=bad[0]))
+        raise CalibrationError(CalibrationError.ERRORS_KEY.format(name=param("errors"), key=bad[0]))
     sigma = parse_noise(noise)
+    targets, seed = as_int(targets, param("targets")), as_int(seed, param("seed"), 0, 2**63 - 1)
     if not 1 <= targets <= 8:
-        raise CalibrationError(CalibrationError.TARGET_COUNT.format(value=targets))
+        raise CalibrationError(CalibrationError.TARGET_COUNT.format(name=param("targets"), value=targets))
     if isinstance(poses, (str, Path)):
         path = str(poses)
         too_many = CalibrationError(CalibrationError.POSE_COUNT.format(path=path, limit=MAX_MEASURED_POSES))
@@ -114,7 +116,7 @@ def simulate_measurements(
             raise CalibrationError(CalibrationError.POSE_COUNT.format(path=path, limit=MAX_MEASURED_POSES))
         q = pose_to_si(raw, length_unit, angle_unit)
     else:
-        path, q = "poses", np.asarray(poses, dtype=float).reshape(-1, 6)
+        path, q = "poses", as_poses(poses, param("poses"))
         lines = list(range(1, len(q) + 1))
         if len(q) > MAX_MEASURED_POSES:
             raise CalibrationError(CalibrationError.POSE_COUNT.format(path=path, limit=MAX_MEASURED_POSES))

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from stewart_drake.api.platform import load_platform
 from stewart_drake.api.result import Result
+from stewart_drake.core.argcheck import check_path, check_shape, param
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.leg_bodies import leg_dimensions
 from stewart_drake.core.rotations import to_radians
@@ -47,6 +48,7 @@ def load_requirements(path: str | Path) -> Requirements:
     Raises:
         StewartError: a missing or invalid file (file, line and field named).
     """
+    path = check_path(path, "path")
     return read_requirements(path)
 
 
@@ -231,8 +233,8 @@ def prove_workspace(
             )
         )
     p = load_platform(platform)
-    box = np.stack([np.asarray(box_lo, dtype=float).reshape(6), np.asarray(box_hi, dtype=float).reshape(6)], axis=1)
-    check_finite(box, "--require-box")
+    box = np.stack([check_shape(box_lo, param("box_lo"), (6,)), check_shape(box_hi, param("box_hi"), (6,))], axis=1)
+    check_finite(box, param("box"))
     for j, (lo, hi) in enumerate(box):
         if lo > hi:
             raise OptionError(
