@@ -98,7 +98,7 @@ def simulate_measurements(
             machine drawn: errors too large for it to reach the poses), a bad file. A σ of 0 gives noise-free data.
     """
     platform = load_platform(platform)
-    spec = parse_spec(errors)
+    spec = parse_spec(errors, where=param("errors"))
     bad = [k for k in spec.laws if k not in GEOMETRIC_KEYS]
     if bad:
         raise CalibrationError(CalibrationError.ERRORS_KEY.format(name=param("errors"), key=bad[0]))

@@ -224,3 +224,19 @@ def test_optimize_with_every_variable_fixed_evaluates_that_design(tmp_path):
     r = sd.optimize(path, budget=24, pop_size=4).to_dict()
     assert r["search"]["designs"] == 1 and r["search"]["evaluated_now"] == 1
     assert r["variables"] == pytest.approx({**fixed, "base_half_angle": np.radians(10), "top_half_angle": np.radians(10)})  # fmt: skip
+
+
+def test_simulate_measurements_names_its_own_option(tmp_path, capsys):
+    """simulate-measurements' errors are drawn with the --vary grammar, but a bad one names --errors (it named
+    --vary, an option the command does not have)."""
+    from stewart_drake.cli import main
+
+    poses = tmp_path / "p.csv"
+    poses.write_text("px,py,pz,a,b,g\n0,0,700,0,0,0\n0,0,710,0,0,0\n")
+    argv = ["simulate-measurements", "--platform", "utn-dynamic", "--poses", str(poses), "--out", str(tmp_path / "o")]
+    assert main([*argv, "--errors", "anchor=abc"]) == 2
+    err = capsys.readouterr().err
+    assert "--errors: anchor" in err and "--vary" not in err
+    with pytest.raises(sd.StewartError, match=r"^errors: anchor") as e:
+        sd.simulate_measurements("utn-dynamic", [[0, 0, 0.7, 0, 0, 0]] * 3, errors=["anchor=abc"])
+    assert "--" not in str(e.value)
