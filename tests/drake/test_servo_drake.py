@@ -8,7 +8,7 @@ import pytest
 from stewart_drake.drake.servo_model import compare_with_drake, run_closed_loop, run_controller
 from stewart_drake.mechanisms.servo import quantise_pulses, solve
 from stewart_drake.mechanisms.servo_loop import tracking_bounds
-from tests.core.test_servo import random_poses
+from tests.mechanisms.test_servo import random_poses
 
 
 def test_drake_cross_checks(hexapod):
