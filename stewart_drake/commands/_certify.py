@@ -5,7 +5,7 @@ by that proof."""
 from __future__ import annotations
 
 from stewart_drake.api import firmware
-from stewart_drake.commands._common import print_json
+from stewart_drake.commands._common import platform_arg, print_json
 from stewart_drake.core.rotations import ANGLE_UNITS, LENGTH_UNITS
 
 
@@ -88,7 +88,7 @@ def _common(args) -> dict:
 
 def run_certify(args) -> int:
     r = firmware.certify(
-        args.platform,
+        platform_arg(args),
         implementation=args.implementation,
         tick=args.tick,
         tick_error=args.tick_error * 1e-3,
@@ -170,7 +170,7 @@ def format_certificate(cert) -> str:
 
 def run_optimize(args) -> int:
     r = firmware.optimize(
-        args.platform, error_budget=args.error_budget, objective=args.objective, out=args.out, **_common(args)
+        platform_arg(args), error_budget=args.error_budget, objective=args.objective, out=args.out, **_common(args)
     )
     if args.json:
         print_json(r.to_dict())

@@ -4,14 +4,21 @@ from __future__ import annotations
 
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
+import yaml
 
 from stewart_drake.core.geometry import PRESETS, Platform, load_platform
 from stewart_drake.core.jsonout import dumps_strict
 from stewart_drake.core.output_folder import OutputFolder
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 from stewart_drake.errors import UsageError
+from stewart_drake.spec import Machine, load_machine
+from stewart_drake.spec.machine import SECTIONS
+
+# the top-level keys that make a YAML file a machine file rather than a platform file
+_MACHINE_ONLY = (*SECTIONS, "platform", "motions", "requirements")
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
@@ -20,7 +27,8 @@ def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
         "--platform",
         default=default,
         metavar="NAME|FILE",
-        help=f"a preset ({', '.join(PRESETS)}) or a platform YAML file (default: {default})",
+        help=f"a preset ({', '.join(PRESETS)}), a platform YAML file or a machine file (its platform, the payload on "
+        f"the plate) (default: {default})",
     )
 
 
@@ -40,9 +48,33 @@ def add_unit_args(parser, length_default: str = "mm", angle_default: str = "deg"
     )
 
 
+def machine_from_args(args) -> Machine | None:
+    """The machine when ``--platform`` names a machine file (a platform file with machine sections such as
+    ``payload``, ``controller``, ``firmware``; ``stewart-drake init --machine-template``), else None."""
+    source = args.platform
+    if source is None or source in PRESETS or not Path(source).is_file():
+        return None
+    try:  # a peek at the top-level keys; a file that does not parse is left to the loader's message
+        keys = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return None
+    if not isinstance(keys, dict) or not any(k in _MACHINE_ONLY for k in keys):
+        return None
+    return load_machine(source)
+
+
+def platform_arg(args) -> str | Platform | None:
+    """``--platform`` for an API call that loads it: the text as given (a preset or a platform file, named
+    as the user wrote it), or for a machine file its platform with the payload on the plate."""
+    machine = machine_from_args(args)
+    return args.platform if machine is None else machine.loaded_platform
+
+
 def platform_from_args(args) -> Platform:
-    """The platform named by ``--platform`` (a preset or a YAML file), validated."""
-    return load_platform(args.platform)
+    """The platform named by ``--platform`` (a preset or a YAML file), validated. A machine file gives its
+    platform with the payload on the plate (``Machine.loaded_platform``)."""
+    machine = machine_from_args(args)
+    return load_platform(args.platform) if machine is None else machine.loaded_platform
 
 
 def add_force_arg(parser) -> None:

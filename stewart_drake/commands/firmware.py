@@ -8,7 +8,7 @@ from pathlib import Path
 
 from stewart_drake.api import firmware
 from stewart_drake.commands._certify import register as register_certify
-from stewart_drake.commands._common import add_platform_arg, print_json
+from stewart_drake.commands._common import add_platform_arg, machine_from_args, platform_arg, print_json
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.isolate import FIRMWARE_TIME_LIMIT_S
 from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
@@ -16,50 +16,54 @@ from stewart_drake.firmware.fingerprint import DEFAULTS as FP_DEFAULTS
 
 def _format_args(p, recorded: bool = False) -> None:
     """The module's options; with ``recorded`` (``check``) their defaults are those recorded in the file
-    (``firmware.fingerprint``), the generator's defaults for a file without a record."""
-    d = (lambda k: None) if recorded else FP_DEFAULTS.get
-    note = " (default: as recorded in FILE.c's header" if recorded else ""
-    add_platform_arg(p, default=d("platform"))
+    (``firmware.fingerprint``), the generator's defaults for a file without a record; else those of the machine
+    file ``--platform`` names (its ``firmware`` format, ``1 / controller.period``, ``sensors.resolution``), the
+    generator's defaults for a platform."""
+    d = lambda k: None  # noqa: E731  (filled by _format: the record, a machine file's value or FP_DEFAULTS)
+    note = " (default: as recorded in FILE.c's header, else" if recorded else " (default: a machine file's, else"
+    add_platform_arg(p, default=None if recorded else FP_DEFAULTS["platform"])
+    p.set_defaults(recorded_format=recorded)
     p.add_argument(
         "--word-bits",
         type=int,
         default=d("word_bits"),
         metavar="N",
-        help="data word width, 8..16" + (note + ", else 16)" if recorded else " (default 16, the DSP)"),
+        help="data word width, 8..16" + note + " 16, the DSP)",
     )
     p.add_argument(
         "--length-lsb",
         type=float,
         default=d("length_lsb"),
         metavar="M",
-        help="metres per length LSB" + (note + ", else 1e-3)" if recorded else " (default 1e-3: integer mm)"),
+        help="metres per length LSB" + note + " 1e-3: integer mm)",
     )
     p.add_argument(
         "--trig",
         choices=["tfr16", "exact"],
         default=d("trig"),
         help="sin/cos: tfr16 (the DSP library polynomial, 16-bit words) or exact (a correctly rounded table)"
-        + (note + ", else tfr16)" if recorded else "; default tfr16"),
+        + note
+        + " tfr16)",
     )
     p.add_argument(
         "--convention",
         choices=["utn", "zyx"],
         default=d("convention"),
-        help="Euler convention of the pose angles" + (note + ", else utn)" if recorded else " (default utn)"),
+        help="Euler convention of the pose angles" + note + " utn)",
     )
     p.add_argument(
         "--rate",
         type=float,
         default=d("rate"),
         metavar="HZ",
-        help="controller rate, Hz" + (note + ", else 1000)" if recorded else " (default 1000)"),
+        help="controller rate, Hz" + note + " 1000)",
     )
     p.add_argument(
         "--sensor-resolution",
         type=float,
         default=d("sensor_resolution"),
         metavar="M",
-        help="leg sensor, m per count" + (note + ", else 1e-5)" if recorded else " (default 1e-5)"),
+        help="leg sensor, m per count" + note + " 1e-5)",
     )
     p.add_argument(
         "--trajectory",
@@ -125,23 +129,40 @@ def add_time_limit_arg(p, default: float = FIRMWARE_TIME_LIMIT_S, what: str = "t
 
 
 def _format(args) -> dict:
-    """The number format, rate, sensor and design reference the options give (``api.firmware``'s keywords)."""
-    return dict(
-        word_bits=args.word_bits,
-        length_lsb=args.length_lsb,
-        trig=args.trig,
-        convention=args.convention,
-        rate=args.rate,
-        sensor_resolution=args.sensor_resolution,
-        trajectory=args.trajectory,
-    )
+    """The number format, rate, sensor and design reference the options give (``api.firmware``'s keywords);
+    an option left out is, for ``check``, None (the record's), else the machine file's value or the default."""
+    given = {
+        k: getattr(args, k) for k in ("word_bits", "length_lsb", "trig", "convention", "rate", "sensor_resolution")
+    }
+    if not args.recorded_format:
+        m = machine_from_args(args)
+        own = (
+            {}
+            if m is None
+            else dict(
+                word_bits=m.firmware.word_bits,
+                length_lsb=m.firmware.length_lsb,
+                trig=m.firmware.trig,
+                convention=m.firmware.convention,
+                rate=1.0 / m.controller.period,
+                sensor_resolution=m.sensors.resolution,
+            )
+        )
+        given = {k: own.get(k, FP_DEFAULTS[k]) if v is None else v for k, v in given.items()}
+    return dict(given, trajectory=args.trajectory)
 
 
 def run_generate(args) -> int:
     note = lambda n: print(f"stewart-drake firmware generate: note: {n}", file=sys.stderr)  # noqa: E731
-    platform = load_platform(args.platform)
+    machine = machine_from_args(args)
+    platform = load_platform(args.platform) if machine is None else machine.platform
     r = firmware.generate(
-        platform, args.out, compile=not args.no_compile, on_note=note, platform_source=args.platform, **_format(args)
+        platform if machine is None else machine,
+        args.out,
+        compile=not args.no_compile,
+        on_note=note,
+        platform_source=args.platform if machine is None else None,
+        **_format(args),
     )
     summary, out, compiled, written = r.to_dict(), Path(args.out), r.summary["compiled_with"], r.files
     clock_hz = r.config.timing.clock_hz
@@ -164,7 +185,7 @@ def run_generate(args) -> int:
 def run_check(args) -> int:
     result = firmware.check(
         args.file,
-        args.platform,  # None: as recorded in the file
+        platform_arg(args),  # None: as recorded in the file
         poses=args.poses,
         seed=args.seed,
         trace=args.trace,
