@@ -96,12 +96,15 @@ def test_page_commands_exit_as_the_page_says(tmp_path):
 
 @pytest.mark.parametrize("kind", ["ik", "size"])
 def test_machine_file_as_platform(tmp_path, kind):
-    """A machine file given as ``--platform`` is its platform with the payload on the plate: ``ik`` gives the
-    same lengths as for the platform alone, and ``size`` needs more force than the unloaded plate (the 150 kg
-    payload weighs 1.47 kN on six legs)."""
+    """A machine file given as ``--platform`` is its platform, its payload the design commands' ``--payload``:
+    ``ik`` gives the platform's lengths; ``size`` carries the machine's payload (more force than the bare
+    plate), and ``--payload 0`` given replaces it (the platform's forces,
+    bit for bit: the same arithmetic on the same platform)."""
     import json
 
     import yaml
+
+    from stewart_drake.spec import load_machine
 
     machine = ROOT / "examples" / "newcomer-210kg.yaml"
     doc = yaml.safe_load(machine.read_text(encoding="utf-8"))
@@ -110,10 +113,10 @@ def test_machine_file_as_platform(tmp_path, kind):
     platform = tmp_path / "platform.yaml"
     platform.write_text(yaml.safe_dump(doc))
 
-    def run(path):
+    def run(path, *more):
         args = ["ik", "--pose", "0", "0", "700", "0", "0", "0"] if kind == "ik" else ["size", "--trajectory", "seed"]
         r = subprocess.run(
-            [sys.executable, "-m", "stewart_drake", *args, "--platform", str(path), "--json"],
+            [sys.executable, "-m", "stewart_drake", *args, *more, "--platform", str(path), "--json"],
             cwd=tmp_path,
             env={**os.environ, "PYTHONPATH": str(ROOT)},
             capture_output=True,
@@ -126,6 +129,9 @@ def test_machine_file_as_platform(tmp_path, kind):
     plain, loaded = run(platform), run(machine)
     if kind == "ik":
         assert loaded["lengths"] == plain["lengths"]
-    else:
-        force = lambda out: max(leg["peak_force_n"] for leg in out["legs"])  # noqa: E731
-        assert force(loaded) > force(plain) + 1.47e3 / 6 * 0.5  # at least half of its static share per leg
+        return
+    force = lambda out: [leg["peak_force_n"] for leg in out["legs"]]  # noqa: E731
+    assert loaded["payload_kg"] == load_machine(machine).payload.mass
+    # the 150 kg ride on the legs: their peak forces together grow by more than half its weight (1.47 kN)
+    assert sum(force(loaded)) > sum(force(plain)) + 0.5 * 150 * 9.81
+    assert force(run(machine, "--payload", "0")) == force(plain)
