@@ -1,5 +1,6 @@
 """The "Your machine" guide (``docs/your-machine.md``) runs as written: every command of its bash blocks, in
-order, in one empty folder, exits with the status the page gives it (a trailing ``# exit N``, else 0)."""
+order, in one empty folder, exits with the status the page gives it (a trailing ``# exit N``, else 0), and its
+Python blocks run there after them and print what their comments say."""
 
 from __future__ import annotations
 
@@ -92,6 +93,16 @@ def test_page_commands_exit_as_the_page_says(tmp_path):
             assert "chatter" in r.stderr and "length LSB (1 mm)" in r.stderr, r.stderr[-1000:]
     assert (work / "joints.png").stat().st_size > 0
     assert (work / "fw" / "sd_firmware.c").is_file()
+    text = PAGE.read_text(encoding="utf-8")
+    outputs = []
+    for block in re.findall(r"^```python\n(.*?)^```$", text, flags=re.S | re.M):
+        r = subprocess.run(
+            [sys.executable, "-c", block], cwd=work, env=env, capture_output=True, text=True, timeout=300
+        )
+        assert r.returncode == 0, f"{block}\n{r.stderr[-2000:]}"
+        outputs.append(r.stdout)
+    # the loop block's comment: the machine's 30 um tracks, the DSP's 1 mm chatters
+    assert "3e-05 True []" in outputs[-1] and '0.001 False ["chatter:' in outputs[-1], outputs[-1]
 
 
 @pytest.mark.parametrize("kind", ["ik", "size"])
