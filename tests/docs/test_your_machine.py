@@ -146,3 +146,33 @@ def test_machine_file_as_platform(tmp_path, kind):
     # the 150 kg ride on the legs: their peak forces together grow by more than half its weight (1.47 kN)
     assert sum(force(loaded)) > sum(force(plain)) + 0.5 * 150 * 9.81
     assert force(run(machine, "--payload", "0")) == force(plain)
+
+
+def test_firmware_generate_takes_the_machine_format(tmp_path):
+    """``firmware generate --platform MACHINE`` records the machine's number format, rate and sensor resolution
+    and the platform as written (the hash ``simulate --machine --firmware`` compares); an option given replaces
+    its value; a platform alone keeps the DSP's defaults (1 mm)."""
+    from stewart_drake.firmware.fingerprint import platform_hash, read_fingerprint
+    from stewart_drake.spec import load_machine
+
+    machine = ROOT / "examples" / "newcomer-210kg.yaml"
+    m = load_machine(machine)
+
+    def generate(out, *more):
+        r = subprocess.run(
+            [sys.executable, "-m", "stewart_drake", "firmware", "generate", "--no-compile", "--out", out, *more],
+            cwd=tmp_path,
+            env={**os.environ, "PYTHONPATH": str(ROOT)},
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert r.returncode == 0, r.stderr
+        return read_fingerprint(tmp_path / out / "sd_firmware.c")[0]
+
+    own = generate("fw", "--platform", str(machine))
+    assert own["length_lsb"] == m.firmware.length_lsb and own["word_bits"] == m.firmware.word_bits
+    assert own["rate"] == 1.0 / m.controller.period and own["sensor_resolution"] == m.sensors.resolution
+    assert own["platform_hash"] == platform_hash(m.platform)
+    assert generate("fw-1mm", "--platform", str(machine), "--length-lsb", "1e-3")["length_lsb"] == 1e-3
+    assert generate("fw-preset", "--platform", "utn-dynamic")["length_lsb"] == 1e-3
