@@ -51,16 +51,26 @@ def add_unit_args(parser, length_default: str = "mm", angle_default: str = "deg"
 def machine_from_args(args) -> Machine | None:
     """The machine when ``--platform`` names a machine file (a platform file with machine sections such as
     ``payload``, ``controller``, ``firmware``; ``stewart-drake init --machine-template``), else None."""
-    source = args.platform
-    if source is None or source in PRESETS or not Path(source).is_file():
-        return None
+    return load_machine(args.platform) if is_machine_file(args.platform) else None
+
+
+def is_machine_file(source) -> bool:
+    """Whether ``source`` (a ``--platform`` value) names a file with machine sections beside the platform's."""
+    if not isinstance(source, str) or source in PRESETS or not Path(source).is_file():
+        return False
     try:  # a peek at the top-level keys; a file that does not parse is left to the loader's message
         keys = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
-        return None
-    if not isinstance(keys, dict) or not any(k in _MACHINE_ONLY for k in keys):
-        return None
-    return load_machine(source)
+        return False
+    return isinstance(keys, dict) and any(k in _MACHINE_ONLY for k in keys)
+
+
+def refuse_machine_file(sources, use: str) -> None:
+    """Refuse a machine file among the ``--platform`` values ``sources`` of a command that reads the whole machine
+    with another option (``use``, e.g. ``"--machine"``), in one line naming the file as written."""
+    for source in [sources] if isinstance(sources, str) else sources or ():
+        if is_machine_file(source):
+            raise UsageError(UsageError.MACHINE_AS_PLATFORM.format(path=source, use=use))
 
 
 def platform_arg(args) -> str | Platform | None:

@@ -176,3 +176,17 @@ def test_firmware_generate_takes_the_machine_format(tmp_path):
     assert own["platform_hash"] == platform_hash(m.platform)
     assert generate("fw-1mm", "--platform", str(machine), "--length-lsb", "1e-3")["length_lsb"] == 1e-3
     assert generate("fw-preset", "--platform", "utn-dynamic")["length_lsb"] == 1e-3
+
+
+def test_report_refuses_a_machine_file_as_platform(tmp_path, capsys):
+    """``report --platform MACHINE`` (the report reads a machine with ``--machine``) is one line naming the file
+    as written and the option to use, exit 2, before any work: no output folder."""
+    from stewart_drake.cli import main
+    from stewart_drake.errors import UsageError
+
+    machine = tmp_path / "m.yaml"
+    machine.write_text((ROOT / "examples" / "newcomer-210kg.yaml").read_text(encoding="utf-8"))
+    rc = main(["report", "--platform", str(machine), "--quick", "--only", "workspace", "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and not (tmp_path / "r").exists()
+    assert err.endswith(UsageError.MACHINE_AS_PLATFORM.format(path=machine, use="--machine")) and "\n" not in err
