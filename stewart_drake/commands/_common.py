@@ -62,7 +62,10 @@ def is_machine_file(source) -> bool:
         keys = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
         return False
-    return isinstance(keys, dict) and any(k in _MACHINE_ONLY for k in keys)
+    if not isinstance(keys, dict):
+        return False
+    # a platform file's calibration is its record (a mapping); a machine's names a measurements file
+    return any(k in _MACHINE_ONLY or (k == "calibration" and not isinstance(v, dict)) for k, v in keys.items())
 
 
 def refuse_machine_file(sources, use: str) -> None:
