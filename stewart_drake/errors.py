@@ -450,6 +450,9 @@ class UsageError(StewartError):
     INTERNAL = "internal error ({kind}: {detail}); please report it with the command line"
     LEGS_CORIOLIS = "--legs on computes the complete model; it cannot be combined with --coriolis off"
     ENGINE_C = "--engine c runs the fixed-point controller; --controller is {controller!r}"
+    MACHINE_AS_PLATFORM = (
+        "--platform {path}: a machine file (payload, controller, firmware, ...); give it as {use} {path}"
+    )
 
 
 class OptionError(UsageError):

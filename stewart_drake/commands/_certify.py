@@ -39,6 +39,10 @@ def add_box_args(p) -> None:
     )
 
 
+# the format options left out take the machine's values (a platform's machine has the DSP's defaults)
+MACHINE_DEFAULTS = dict.fromkeys(("word_bits", "length_lsb", "trig", "convention", "rate", "sensor_resolution"))
+
+
 def register(fs, format_args, format_kwargs, call_api) -> None:
     """Add ``certify`` and ``optimize`` to the ``firmware`` subparsers ``fs``; ``format_args`` adds
     generate's format options, ``format_kwargs(args)`` turns them into the API's keywords,
@@ -65,7 +69,7 @@ def register(fs, format_args, format_kwargs, call_api) -> None:
     c.add_argument("--tick-speed", type=float, default=0.1, metavar="M/S", help="leg speed bound, m/s (0.1)")
     c.add_argument("--tick-feedforward", type=float, default=0.0, metavar="N", help="|feed-forward| bound, N (0: none)")
     c.add_argument("--json", action="store_true", help="print JSON")
-    c.set_defaults(func=run_certify, format_kwargs=format_kwargs, call_api=call_api)
+    c.set_defaults(func=run_certify, format_kwargs=format_kwargs, call_api=call_api, **MACHINE_DEFAULTS)
     o = fs.add_parser(
         "optimize",
         help="choose the length LSB, word bits and trig so the proven error meets a budget without saturation",
@@ -76,7 +80,7 @@ def register(fs, format_args, format_kwargs, call_api) -> None:
     o.add_argument("--objective", choices=["bits", "cycles"], default="bits", help="minimise word bits or sd_ik cycles")
     o.add_argument("--out", default=None, metavar="DIR", help="write the chosen firmware (sd_firmware.h/.c, README)")
     o.add_argument("--json", action="store_true", help="print JSON")
-    o.set_defaults(func=run_optimize, format_kwargs=format_kwargs, call_api=call_api)
+    o.set_defaults(func=run_optimize, format_kwargs=format_kwargs, call_api=call_api, **MACHINE_DEFAULTS)
 
 
 def _call(function, args, **keywords):

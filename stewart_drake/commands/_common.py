@@ -6,15 +6,21 @@ import copy
 import math
 import re
 import sys
+from pathlib import Path
 
 import numpy as np
+import yaml
 
 from stewart_drake.core.geometry import PRESETS, Platform, load_platform
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 from stewart_drake.errors import MachineError, QuantityError, StewartError, UsageError
 from stewart_drake.spec import Machine, apply_overrides, load_machine
+from stewart_drake.spec.machine import SECTIONS
 from stewart_drake.system.jsonout import dumps_strict
 from stewart_drake.system.output_folder import OutputFolder
+
+# the top-level keys that make a YAML file a machine file rather than a platform file
+_MACHINE_ONLY = (*SECTIONS, "platform", "motions", "requirements")
 
 
 def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
@@ -23,7 +29,8 @@ def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
         "--platform",
         default=default,
         metavar="NAME|FILE",
-        help=f"a preset ({', '.join(PRESETS)}) or a platform YAML file (default: {default})",
+        help=f"a preset ({', '.join(PRESETS)}), a platform YAML file or a machine file (its platform, the payload on "
+        f"the plate) (default: {default})",
     )
 
 
@@ -43,9 +50,46 @@ def add_unit_args(parser, length_default: str = "mm", angle_default: str = "deg"
     )
 
 
+def platform_machine(args) -> Machine | None:
+    """The machine when ``--platform`` names a machine file (a platform file with machine sections such as
+    ``payload``, ``controller``, ``firmware``; ``stewart-drake init --machine-template``), else None."""
+    return load_machine(args.platform) if is_machine_file(args.platform) else None
+
+
+def is_machine_file(source) -> bool:
+    """Whether ``source`` (a ``--platform`` value) names a file with machine sections beside the platform's."""
+    if not isinstance(source, str) or source in PRESETS or not Path(source).is_file():
+        return False
+    try:  # a peek at the top-level keys; a file that does not parse is left to the loader's message
+        keys = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return False
+    if not isinstance(keys, dict):
+        return False
+    # a platform file's calibration is its record (a mapping); a machine's names a measurements file
+    return any(k in _MACHINE_ONLY or (k == "calibration" and not isinstance(v, dict)) for k, v in keys.items())
+
+
+def refuse_machine_file(sources, use: str) -> None:
+    """Refuse a machine file among the ``--platform`` values ``sources`` of a command that reads the whole machine
+    with another option (``use``, e.g. ``"--machine"``), in one line naming the file as written."""
+    for source in [sources] if isinstance(sources, str) else sources or ():
+        if is_machine_file(source):
+            raise UsageError(UsageError.MACHINE_AS_PLATFORM.format(path=source, use=use))
+
+
+def platform_arg(args) -> str | Platform | None:
+    """``--platform`` for an API call that loads it: the text as given (a preset or a platform file, named
+    as the user wrote it), or for a machine file its platform with the payload on the plate."""
+    machine = platform_machine(args)
+    return args.platform if machine is None else machine.loaded_platform
+
+
 def platform_from_args(args) -> Platform:
-    """The platform named by ``--platform`` (a preset or a YAML file), validated."""
-    return load_platform(args.platform)
+    """The platform named by ``--platform`` (a preset or a YAML file), validated. A machine file gives its
+    platform with the payload on the plate (``Machine.loaded_platform``)."""
+    machine = platform_machine(args)
+    return load_platform(args.platform) if machine is None else machine.loaded_platform
 
 
 def add_force_arg(parser) -> None:

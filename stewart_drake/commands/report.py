@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from stewart_drake.commands._common import add_force_arg, output_folder
+from stewart_drake.commands._common import add_force_arg, output_folder, refuse_machine_file
 from stewart_drake.report.api import report
 
 
@@ -47,6 +47,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    refuse_machine_file(args.platform, "--machine")
     out = output_folder(args)
     say = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
     r = report(

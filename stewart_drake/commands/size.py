@@ -8,8 +8,8 @@ import numpy as np
 
 from stewart_drake.api.design import carrying
 from stewart_drake.api.sizing import AXES, size_loaded
-from stewart_drake.commands._common import add_platform_arg, platform_from_args, print_json
-from stewart_drake.commands._design import add_payload_args
+from stewart_drake.commands._common import add_platform_arg, print_json
+from stewart_drake.commands._design import add_payload_args, design_platform
 from stewart_drake.core.rotations import CONVENTIONS, length_scale
 from stewart_drake.script import ScriptError
 
@@ -55,7 +55,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    base = platform_from_args(args)
+    base = design_platform(args)
     k = length_scale(args.length_unit)
     platform, p_TP = carrying(
         base,

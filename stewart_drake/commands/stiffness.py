@@ -8,8 +8,8 @@ import sys
 import numpy as np
 
 from stewart_drake.api.design import Load, load_at_pose, stiffness_at
-from stewart_drake.commands._common import add_platform_arg, add_unit_args, platform_from_args, print_json
-from stewart_drake.commands._design import add_payload_args
+from stewart_drake.commands._common import add_platform_arg, add_unit_args, print_json
+from stewart_drake.commands._design import add_payload_args, design_platform
 from stewart_drake.core.rotations import angle_scale, length_scale, pose_to_si
 from stewart_drake.design.maps import MAX_POINTS, slice_maps
 from stewart_drake.design.plots import plot_slice_maps
@@ -64,9 +64,10 @@ def register(sub) -> None:
 
 def load(args, check_pose: bool = True) -> Load:
     """The platform with its payload at ``--pose`` (SI), checked once (``api.design.load_at_pose``)."""
+    platform = design_platform(args)
     k = length_scale(args.length_unit)
     return load_at_pose(
-        platform_from_args(args),
+        platform,
         pose_to_si(np.array(args.pose), args.length_unit, args.angle_unit),
         args.leg_stiffness,
         args.convention,
