@@ -8,13 +8,13 @@ import numpy as np
 
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.firmware.engine import default_engine
-from stewart_drake.fixedpoint.generic import QFormat
 from stewart_drake.montecarlo.scenario import Study, run_scenario
 from stewart_drake.montecarlo.spec import parse_spec
 from stewart_drake.montecarlo.study import check_study, run_row
 from stewart_drake.montecarlo.summary import METRICS, sensitivity
 from stewart_drake.report import parallel_map, run_standalone
-from stewart_drake.report.subject import TRAJECTORY_NAMES, mark_not_applicable
+from stewart_drake.report.subject import TRAJECTORY_NAMES
+from stewart_drake.spec import FirmwareFormat, Machine
 
 TITLE = "Robustness: Monte Carlo over tolerances, sensor, timing and payload"
 ORDER = 95
@@ -41,9 +41,6 @@ VARY = [
 # the same ranking (plate mass ρ 0.458 vs 0.463), at 80 % of the cost. Quick mode: 8 runs of 0.5 s.
 FULL, QUICK = (40, 3.2), (8, 0.5)
 NEEDS = ("plate", "legs.max_force")  # a user's machine: the study on its plant and command range
-# the Monte Carlo study runs the DSP's fixed-point format only (montecarlo.scenario.Study has no format field)
-DSP_FORMAT = QFormat(16, 1e-3, "tfr16")
-NO_FORMAT = "the Monte Carlo study runs the DSP's fixed-point format only, and the machine file gives another"
 CHUNK = 5  # runs per part of the report's shared pool (8 parts: both cores busy until the end)
 
 
@@ -55,8 +52,14 @@ def _study(quick: bool, subject=None) -> Study:
     if subject is None:
         return Study(load_preset(PLATFORM), parse_spec(VARY), seed=2026, runs=runs, duration=duration, engine=engine)
     motion = next((m for m in subject.motions if m in TRAJECTORY_NAMES), "seed")
+    fmt = subject.ik_format  # the loop's number format: the machine file's, else the DSP's
+    machine = (
+        Machine(subject.platform)
+        if fmt is None
+        else Machine(subject.platform, firmware=FirmwareFormat(fmt.word_bits, fmt.length_lsb, fmt.trig))
+    )
     return Study(
-        subject.platform,
+        machine,
         parse_spec(VARY),
         seed=2026,
         runs=runs,
@@ -89,9 +92,6 @@ def build(section) -> None:
     import matplotlib.pyplot as plt
 
     quick, subject = section.quick, section.subject
-    if subject is not None and subject.ik_format not in (None, DSP_FORMAT):
-        mark_not_applicable(section, subject, NO_FORMAT)
-        return
     study = _study(quick, subject)
     runs, duration = study.runs, study.duration
     check_study(study)  # the bounds and draws run_study checks before it runs

@@ -266,7 +266,8 @@ def test_the_whole_report_of_the_210_kg_machine(tmp_path):
         "Firmware equivalence: the C compiled, generated and run in the loop",
         "Firmware certificate (proven word ranges, saturation and error bound over the workspace)",
         "Calibration: measured poses → calibrated platform file → regenerated firmware",
+        "Robustness: Monte Carlo over tolerances, sensor, timing and payload",
     }
     page = r.index.read_text()
-    # 6 presets-only sections, the requirements' proof (the file gives none) and the robustness study
+    # 7 presets-only sections and the requirements' proof (the file gives none)
     assert page.count('<p class="na">Not applicable to newcomer-6dof-sim: ') == 8
