@@ -172,7 +172,7 @@ SINGULAR_POSE = "pose {index} is singular or nearly so: Jacobian condition numbe
 class LegError(StewartError):
     """A 3R leg's parameters, joint angles or targets are malformed."""
 
-    LENGTH = "leg length {name} must be a positive number of metres, got {value}"
+    LENGTH = "leg length {name} must be a positive number of metres up to {limit:g}, got {value}"
     ALPHA = "ankle angle alpha must be finite, got {value}"
     LIMITS = "{name} must be two finite angles (rad) with lower < upper, got {value}"
     ANGLES_2 = "leg joint angles need 2 numbers (q1, q2), got shape {shape}"

@@ -274,6 +274,7 @@ def plan_run(
         firmware = str(firmware_source(firmware))
         machine, warnings = adopt_firmware(machine, firmware)
     time_limit = check_time_limit(time_limit)
+    machine.check_loop_format()
     platform = machine.loaded_platform
     ctl, fmt = machine.controller, machine.firmware
     controller, period, latency = ctl.law, ctl.period, ctl.latency

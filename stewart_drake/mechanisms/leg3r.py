@@ -42,6 +42,11 @@ BRANCHES = ("a", "b")
 BOUNDARY_RTOL = 1e-12
 
 
+# The longest link taken (m): a legged robot's links are centimetres to a metre; squares of lengths far beyond
+# (1e308) overflow the IK's arithmetic.
+MAX_LINK_M = 100.0
+
+
 @dataclass(frozen=True)
 class Leg3R:
     """The seed-003 leg. Lengths in metres, angles in radians.
@@ -62,8 +67,8 @@ class Leg3R:
     def __post_init__(self):
         for n in ("l1", "l2", "l3"):
             v = getattr(self, n)
-            if not (np.isfinite(v) and v > 0):
-                raise LegError(LegError.LENGTH.format(name=n, value=v))
+            if not (np.isfinite(v) and 0 < v <= MAX_LINK_M):
+                raise LegError(LegError.LENGTH.format(name=n, value=v, limit=MAX_LINK_M))
         if not np.isfinite(self.alpha):
             raise LegError(LegError.ALPHA.format(value=self.alpha))
         for n in ("q1_limits", "q2_limits"):

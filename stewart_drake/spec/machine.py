@@ -236,9 +236,13 @@ class Machine:
         for i, m in enumerate(motions):
             check_motion(f"motions item {i + 1}", m)
         object.__setattr__(self, "motions", motions)
-        longest = float(self.platform.stroke[1])
-        fmt = self.firmware
-        if fmt.qformat().range_m < longest:  # the set-point word would clamp below the stroke's end, silently
+
+    def check_loop_format(self) -> None:
+        """Refuse a number format whose length words cannot hold the stroke's end: a closed loop with it would
+        clamp its set-points there without a word (``MachineError`` naming ``firmware.length_lsb``). A
+        certificate of such a format is another matter: it finds the clamp and says so."""
+        longest, fmt = float(self.platform.stroke[1]), self.firmware
+        if fmt.qformat().range_m < longest:
             raise MachineError(
                 MachineError.WORD_RANGE.format(
                     bits=fmt.word_bits,

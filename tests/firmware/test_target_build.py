@@ -12,7 +12,7 @@ import time
 import pytest
 
 import stewart_drake as sd
-from stewart_drake.api.firmware import controller_config
+from stewart_drake.api.firmware import controller_config, machine_format
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware import link
 from stewart_drake.firmware.generate import generate
@@ -200,7 +200,7 @@ def test_the_elf_in_qemu_answers_a_handshake_and_ticks_like_sd_tick_within_its_s
             host = link.LinkHost(conn.sendall, link.pipe_reader(conn.fileno()), fingerprint(files))
             host.handshake(10.0)
             pose, measured, ff = ticks(5, seed=3)
-            want = reference(generate(p, controller_config(p)), pose, measured, ff)
+            want = reference(generate(p, controller_config(p, machine_format(p, {})[1])), pose, measured, ff)
             for k in range(5):
                 r = host.tick(pose[k], measured[k], ff[k], timeout=10.0)
                 assert r is not None and list(r.command) == list(want[k])

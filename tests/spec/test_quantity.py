@@ -119,7 +119,7 @@ def test_noise_reads_what_the_grammar_reads():
     assert n.length == parse_number("10um", "length", "x") == 1e-05
     assert n.position == parse_number("0.01mm", "length", "x")
     assert n.angle == parse_number("0.05deg", "angle", "x")
-    with pytest.raises(CalibrationError, match=r"^--noise: length=2parsecs: expected a number >= 0"):
+    with pytest.raises(CalibrationError, match=r"^noise: length=2parsecs: expected a number >= 0"):
         parse_noise("length=2parsecs")
 
 
