@@ -197,3 +197,18 @@ def test_format_flags_are_one_format(tmp_path, capsys):
     # a path given by a flag and by --set is named as the path the user set last
     rc, _ = simulate(tmp_path, "--word-bits", "24", "--set", "firmware.trig=exact", "--set", "firmware.word_bits=40")
     assert rc == 2 and "firmware.word_bits must be an integer 8..31, got 40" in capsys.readouterr().err
+
+
+def test_a_loop_refuses_a_format_that_cannot_hold_the_stroke(capsys):
+    """16-bit words at 20 µm clamp every set-point above 0.655 m on utn-dynamic (stroke end 0.95 m): the run is
+    refused before it starts, naming the spec path in Python and the flag on the command line."""
+    import stewart_drake as sd
+    from stewart_drake.cli import main
+    from stewart_drake.errors import MachineError
+
+    with pytest.raises(
+        MachineError, match=r"^firmware\.length_lsb 2e-05 m in 16-bit words holds lengths up to 0\.65534"
+    ):
+        sd.simulate("utn-dynamic", duration=0.01, **{"firmware.length_lsb": 2e-5})
+    assert main(["simulate", "--platform", "utn-dynamic", "--length-lsb", "20um", "--duration", "0.01"]) == 2
+    assert "--length-lsb 2e-05 m in 16-bit words" in capsys.readouterr().err

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stewart_drake.api.firmware import controller_config
+from stewart_drake.api.firmware import controller_config, machine_format
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware import link
@@ -54,7 +54,7 @@ def target(tmp_path_factory):
     if CC is None:
         pytest.skip("no host C compiler (cc or gcc)")
     p = load_platform("utn-dynamic")
-    g = generate(p, controller_config(p))
+    g = generate(p, controller_config(p, machine_format(p, {})[1]))
     files = stamp(g.files, dict(DEFAULTS))
     exe = build_host(files, tmp_path_factory.mktemp("pil"), compiler=CC)
     return exe, files, g
