@@ -14,7 +14,7 @@ import numpy as np
 
 from stewart_drake.core.geometry import Platform
 from stewart_drake.engines.models import mjcf_text
-from stewart_drake.engines.plate import plate_state
+from stewart_drake.engines.plate import ConstrainedSolve, plate_state
 
 NAME = "mujoco"
 VERSION = mujoco.__version__
@@ -26,7 +26,7 @@ def _quat_wxyz(R) -> np.ndarray:
     return q
 
 
-class MujocoPlatform:
+class MujocoPlatform(ConstrainedSolve):
     """The closed-loop platform in MuJoCo, built from MJCF text (default: the platform's).
 
     Attributes:
@@ -109,23 +109,6 @@ class MujocoPlatform:
             G.append(rows[0] - rows[1])
             bias.append(drows[0] - drows[1])
         return np.vstack(G), np.concatenate(bias)
-
-    def leg_forces(self, q, qd, qdd, convention: str = "utn") -> np.ndarray:
-        """``(n, 6)`` actuator forces (N, > 0 pushes the plate away) along ``(n, 6)`` q, q̇, q̈, legs' inertia included."""
-        st = plate_state(self.platform, q, qd, qdd, convention)
-        out = np.empty(st.lengths.shape)
-        for k in range(len(out)):
-            out[k] = self.actuator_forces(st, k)
-        return out
-
-    def actuator_forces(self, st, k: int) -> np.ndarray:
-        """Sample ``k``'s ``(6,)`` actuator forces (N) of a ``plate.PlateState``."""
-        A, tau = self.system(st, k)
-        return np.linalg.solve(A, tau)[:6]
-
-    def condition(self, st, k: int) -> float:
-        """The condition number of sample ``k``'s [B Gᵀ]."""
-        return float(np.linalg.cond(self.system(st, k)[0]))
 
     def system(self, st, k: int) -> tuple[np.ndarray, np.ndarray]:
         """Sample ``k``'s ``(nv, nv)`` [B Gᵀ] and ``(nv,)`` τ of ``mj_rne`` (legs on the closures)."""

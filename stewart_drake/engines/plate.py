@@ -48,3 +48,25 @@ def plate_state(platform, q, qd=None, qdd=None, convention: str = "utn") -> Plat
     a = qdd[:, :3] - cross(wd, r) - cross(w, cross(w, r))
     angles, lengths = leg_joint_positions(platform, q, convention)
     return PlateState(R, p, v, a, w, wd, angles, lengths)
+
+
+class ConstrainedSolve:
+    """The leg forces of an engine's model from its constrained inverse dynamics ``system(st, k) -> ([B Gᵀ], τ)``
+    (the unknowns: the six actuator forces first, then the closures' forces), shared by both engines."""
+
+    def leg_forces(self, q, qd, qdd, convention: str = "utn") -> np.ndarray:
+        """``(n, 6)`` actuator forces (N, > 0 pushes the plate away) along ``(n, 6)`` q, q̇, q̈, legs' inertia included."""
+        st = plate_state(self.platform, q, qd, qdd, convention)
+        out = np.empty(st.lengths.shape)
+        for k in range(len(out)):
+            out[k] = self.actuator_forces(st, k)
+        return out
+
+    def actuator_forces(self, st, k: int) -> np.ndarray:
+        """Sample ``k``'s ``(6,)`` actuator forces (N) of a ``plate.PlateState``."""
+        A, tau = self.system(st, k)
+        return np.linalg.solve(A, tau)[:6]
+
+    def condition(self, st, k: int) -> float:
+        """The condition number of sample ``k``'s [B Gᵀ]."""
+        return float(np.linalg.cond(self.system(st, k)[0]))
