@@ -30,7 +30,7 @@ PRESETS = ("utn-dynamic", "gonzalez-dutra-2009")
 ERRORS = ["anchor=±1mm", "leg_offset=±0.5mm"]
 NOISE = Noise(length=1e-6, position=10e-6, angle=20e-6)
 POSES = 30
-TARGET_RMS = 15e-6  # m, the target for leg length and plate position on validation poses
+TARGET_RMS = 15e-6  # m, the target for leg length and plate position on validation poses
 REDUCTION = 0.98
 NEEDS = ()  # a user's machine: the calibration loop on its platform (and its firmware format, when given)
 

@@ -26,7 +26,7 @@ COST = 3.8  # CPU seconds (full report, measured): the report's workers start th
 
 DEFAULT = QFormat(16, 1e-3, "tfr16")
 NEEDS = ()  # a user's machine: its platform's workspace box, in its format (default the DSP's)
-# the formats compared on utn-kinematic: the default, the 20 µm and 100 µm LSBs, and the formats
+# the formats compared on utn-kinematic: the default, 20 µm and 100 µm LSBs, and the formats
 # `firmware optimize --error-budget 0.5mm` chose there (proven: 15-bit exact, 50 µm) and simulation alone
 # would choose (14-bit exact, 90 µm: it overflows); each is certified afresh here
 COMPARED = (

@@ -44,7 +44,7 @@ PAPER_LENGTHS_M = {
     ("y", 1): [0.618, 0.604, 0.706, 0.814, 0.949, 0.869],
     ("z", 1): [0.949, 0.692, 0.949, 0.692, 0.949, 0.692],
 }
-# Tolerances of the issue: extents ±1 cm, angles ±0.5°, table lengths ±2 mm.
+# Tolerances against the paper's figures: extents ±1 cm, angles ±0.5°, table lengths ±2 mm.
 TOL_EXTENT_M, TOL_ANGLE_DEG, TOL_LENGTH_M = 0.01, 0.5, 0.002
 
 

@@ -3,12 +3,11 @@
 ``savefig(bbox_inches="tight")`` of a figure under the constrained layout draws it twice and measures it in
 between: a draw that runs the layout (itself two passes over every axes' extent), the figure's tight box (a
 third pass over every tick and label), then the draw that renders. The Python work over the artists in those
-passes is what a report figure costs (~0.3 s, of which the pixels and the PNG encoding are a few per cent).
-``png_bytes`` draws the figure once (the layout runs in that draw), then cuts the rendered pixels to the ink
-plus the same 0.1-inch margin of background that ``savefig`` puts around a tight box: the same picture, about
-a third cheaper (measured on the 33 figures of ``stewart-drake report --quick``: 6.8 s of CPU against 10.0 s,
-each the least of three). The box is the ink's rather than the artists' extents, so an image may be a few
-pixels smaller (a 3-D axes' invisible margin is not kept).
+passes is what a report figure costs. ``png_bytes`` draws the figure once (the layout runs in that draw), then
+cuts the rendered pixels to the ink plus the same 0.1-inch margin of background that ``savefig`` puts around a
+tight box: the same picture, drawn once (``benchmarks/bench_report_figures.py`` measures the difference). The box
+is the ink's rather than the artists' extents, so an image may be a few pixels smaller (a 3-D axes' invisible
+margin is not kept).
 
 A figure with a layout engine of its own (or laid out by ``tight_layout``) is drawn once the same way (the
 engine runs in the draw). Where cutting could lose something, the figure is saved as before: one the
@@ -25,8 +24,8 @@ import numpy as np
 
 DPI = 110
 PAD_INCHES = 0.1  # savefig's margin around a tight box (its pad_inches default)
-# zlib level 1 for the figures' PNGs: measured on a report figure (four panels of 4,000-point lines), the
-# encoding took 0.17 s of its 0.88 s at matplotlib's default level 6 and ~0 s at level 1, for a file 5 % larger
+# zlib level 1 for the figures' PNGs: a few per cent larger files than matplotlib's default level 6, for an
+# encoding that costs next to nothing
 COMPRESS_LEVEL = 1
 SAVEFIG = {"format": "png", "dpi": DPI, "bbox_inches": "tight", "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
 

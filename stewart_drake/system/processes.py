@@ -39,9 +39,8 @@ WORKERS_PER_CPU = 4
 _PR_SET_PDEATHSIG = 1
 # The environment of every worker process this package starts (``worker_pool``, Dask's nannies): one BLAS thread.
 # The workers already fill the CPUs, and OpenBLAS's own threads on top of them spin for the small (6 × 6 … 6000 × 42)
-# matrices of these analyses: measured in the report's calibration section, 4.9–6.0 s of CPU with 2 threads per
-# process against 2.1–2.8 s with 1 (2-core machine), the same numbers. One thread also makes the results
-# independent of the machine's core count (a threaded product may sum in another order).
+# matrices of these analyses. One thread also makes the results independent of the machine's core count (a
+# threaded product may sum in another order).
 ONE_BLAS_THREAD = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 
 

@@ -11,28 +11,20 @@ chunk functions run on a laptop's processes or on a cluster. Use:
 For a geometry optimisation over many candidate platforms, ``map_platforms`` sends one evaluation
 per platform to the cluster (each evaluation runs single-threaded on its worker).
 
-Where the time went, and what is done about it (``benchmarks/bench_workspace_dask.py`` measures it):
+How the cluster is set up for these sweeps (``benchmarks/bench_workspace_dask.py`` measures each choice):
 
-- Dask starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand freed memory back to the OS),
-  which turns off glibc's adaptive mmap threshold: every large numpy temporary of a slab is then a fresh
-  mmap, page-faulted and zeroed. The 2.5 mm workspace sweep took 1.9× the CPU time in a process with
-  that setting, with or without Dask: ``local_cluster`` starts workers without it (``WORKER_CONFIG``;
-  and Dask writes the variable into the spawning process's own environment, where later clusters
-  would inherit it: it is held out of the environment while the workers start);
-- each worker's statistical profiler interrupts the computing thread every 10 ms to walk its stack,
-  taking the GIL from numpy code made of many mid-sized operations: ``local_client`` turns it off
-  (``WORKER_CONFIG``);
-- the first task on each worker paid the imports (numpy, scipy, the package): ``local_client`` imports
-  them on every worker before any task (``warm_up``);
-- the number of tasks did not follow the number of workers (a 2.5 mm workspace was 46 slabs: 2.9
-  waves on 16 workers, the last one a fifth full): the Dask entry points size the tasks to at least
-  ``TASKS_PER_WORKER`` per worker thread;
-- the extents' refinement after the sweep, serial, checked each candidate node in a Python loop
-  (~7000 margin evaluations at 2.5 mm, ~15 % of the serial time): now one vectorised batch per plane
+- workers start without Dask's ``MALLOC_TRIM_THRESHOLD_`` (it turns off glibc's adaptive mmap threshold, so every
+  large numpy temporary of a slab would be a fresh, zeroed mapping), and the variable is held out of the
+  spawning process's own environment while they start (``WORKER_CONFIG``);
+- the workers' statistical profiler is off: it takes the GIL from numpy code every 10 ms (``WORKER_CONFIG``);
+- every worker imports numpy, scipy and the package before its first task (``warm_up``);
+- the Dask entry points size the tasks to at least ``TASKS_PER_WORKER`` per worker thread, so the last wave is
+  not a fraction of the others;
+- the extents' refinement after the sweep checks each plane's candidate nodes in one vectorised batch
   (``workspace.extents``).
 
-What is shipped per task is small (a slab's ``GridSpec`` ~7 kB, a 6-D chunk's arguments ~2 kB, a
-slab's result ~80 kB), so scattering it once would not change the time.
+What is shipped per task is small (a slab's ``GridSpec``, a 6-D chunk's arguments, a slab's result), so
+nothing is scattered.
 """
 
 from __future__ import annotations

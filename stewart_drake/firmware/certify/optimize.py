@@ -27,7 +27,7 @@ from stewart_drake.firmware.generate import GeneratedFirmware, generate
 from stewart_drake.fixedpoint.generic import QFormat, pose_words
 from stewart_drake.spec.quantity import parse_number
 
-SIM_SAMPLES = 20_000  # the simulation-only choice sees this many random poses (the 20,000)
+SIM_SAMPLES = 20_000  # the simulation-only choice sees this many random poses
 PRUNE_SAMPLES = 4096  # random poses that prune a format before its proof (a real saturation or error)
 SEARCH_CELLS = 30_000  # cells per candidate certificate while searching (sound, a little looser)
 LSB_TRIES = 8  # LSB steps per candidate before it is declared infeasible
