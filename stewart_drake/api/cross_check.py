@@ -1,5 +1,6 @@
 """``sd.cross_check``: the platform's kinematics and inverse dynamics in Pinocchio and MuJoCo against the closed
-forms (``stewart_drake.engines``; the engines are optional extras, ``pip install 'stewart-drake[engines]'``)."""
+forms (``stewart_drake.engines``; the engines are optional extras, ``pip install 'stewart-drake[engines]'``), and
+the float-law loop on Pinocchio against ``sd.simulate``'s (``drake_loop_check``)."""
 
 from __future__ import annotations
 
@@ -73,7 +74,8 @@ def cross_check(
         samples: samples of each trajectory (the seed's sway and a rotation about every axis, 3 s) for the dynamics.
         seed: the poses' seed.
         simulate: also run the forward simulations (the closed-form forces open loop for 0.5 s; the passive
-            platform released from home for 0.2 s; MuJoCo at four ``solref`` time constants).
+            platform released from home for 0.2 s; MuJoCo at four ``solref`` time constants; Pinocchio's float-law
+            loop against ``sd.simulate``'s, ``drake_loop_check``).
 
     Returns:
         Per engine: the worst closure residual and leg-length error (m) and the worst leg-force error (N, relative)
