@@ -23,7 +23,9 @@ def register(sub) -> None:
     p.add_argument("--samples", type=int, default=13, help="samples of each trajectory for the dynamics (default 13)")
     p.add_argument("--seed", type=int, default=0, help="the poses' seed (default 0)")
     p.add_argument(
-        "--no-simulation", action="store_true", help="skip the forward simulations (open loop, passive release)"
+        "--no-simulation",
+        action="store_true",
+        help="skip the forward simulations (open loop, passive release, the float-law loop against Drake's)",
     )
     p.add_argument("--json", action="store_true", help="JSON output (SI units)")
     p.set_defaults(func=run)
@@ -94,4 +96,17 @@ def _print_simulation(e: dict) -> None:
     print(
         f"    passive release from home ({RELEASE_DURATION:g} s): energy drift {rel['energy_drift_j']:.2e} J of"
         f" {rel['energy_exchanged_j']:.3g} J exchanged, closure gap {rel['constraint_m'] * 1e3:.2g} mm"
+    )
+    loop = e.get("drake_loop")
+    if loop is None:
+        return
+    if loop["ok"] is None:
+        print(f"    float-law loop against Drake's: not run ({loop['reason']})")
+        return
+    f = loop["fine"]
+    print(
+        f"    float-law loop against Drake's ({loop['duration_s']:g} s of the seed): plate {loop['position_m'] * 1e3:.3g} mm,"
+        f" legs {loop['length_m'] * 1e3:.3g} mm apart with the {loop['sensor_resolution_m'] * 1e6:g} µm sensor; with a"
+        f" fine one {f['position_m'][0] * 1e3:.3g} mm at {f['plant_step_s'][0] * 1e3:g} ms, × {loop['step_ratio']:.3f}"
+        f" at half the step (bound {loop['bound_m'] * 1e3:.2g} mm) {'ok' if loop['ok'] else 'DISAGREES'}"
     )

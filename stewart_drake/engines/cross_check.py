@@ -351,7 +351,8 @@ def float_loop(name: str, platform: Platform, duration: float = LOOP_DURATION, s
     """The float PID law (``control.laws.FloatLaw``, its gains and period T designed for the platform) closing the
     loop on engine ``name`` along the seed sway (``sway``) with the closed-form feed-forward: at each tick the legs'
     true lengths are read, the law's command is held over the next period (no output delay: the engines' loop,
-    not the DSP's), the engine advances one period (RK4, step T; MuJoCo with ``solref``).
+    not the DSP's; ``engines.dsp_loop`` runs the DSP's, as ``sd.simulate`` does), the engine advances one period
+    (RK4, step T; MuJoCo with ``solref``).
 
     Returns ``t`` (m,) s, ``p`` (m, 3) the plate origin and ``R`` (m, 3, 3) every ``RECORD`` s, ``tracking_m``
     the worst plate-origin distance from the plan, ``constraint_m`` the worst closure gap (MuJoCo: over every
