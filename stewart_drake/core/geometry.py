@@ -708,7 +708,10 @@ def check_shared_base(cfg: PlatformConfig, where: dict, shown: str, k: float) ->
         )
 
 
-def _check_platform_fields(shown: str):
+def check_platform_fields(shown: str):
+    """The checks of a platform's fields in a file ``shown`` (name, length unit, each field's rule, shared base
+    joints), as a ``check(cfg, where)`` for the typed YAML loaders."""
+
     def check(cfg, where):
         check_name(cfg, where, shown)
         k = check_length_unit(cfg, where, shown)
@@ -731,12 +734,18 @@ def load_yaml_config(path, schema, kind: str, check=None):
 def load_platform_yaml(path) -> Platform:
     """Load one platform from a YAML file (schema: ``PlatformConfig``); every field is checked
     (type, finite, sign, magnitude, list sizes) with the file's line numbers before it is used."""
-    cfg = load_yaml_config(path, PlatformConfig, "platform", _check_platform_fields(str(path)))
+    cfg = load_yaml_config(path, PlatformConfig, "platform", check_platform_fields(str(path)))
+    return platform_from_file_config(cfg, path)
+
+
+def platform_from_file_config(cfg: PlatformConfig, shown) -> Platform:
+    """The ``Platform`` of a checked ``cfg`` read from ``shown`` (a file): a geometry error names the file, and a
+    platform singular at its home pose is refused (``check_home``)."""
     try:
         platform = platform_from_config(cfg)
     except GeometryError as e:
-        raise GeometryError(GeometryError.IN_FILE.format(path=path, problem=e)) from None
-    check_home(platform)  # sanity: a platform singular at its home pose is refused when loaded
+        raise GeometryError(GeometryError.IN_FILE.format(path=shown, problem=e)) from None
+    check_home(platform)
     return platform
 
 

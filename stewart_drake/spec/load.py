@@ -19,23 +19,17 @@ from pathlib import Path
 import yaml
 
 from stewart_drake.core.geometry import (
-    PLATFORM_RULES,
-    PLATFORM_SHAPES,
     PRESETS,
     Platform,
     PlatformConfig,
-    check_length_unit,
-    check_name,
-    check_rules,
-    check_shared_base,
+    check_platform_fields,
     load_platform,
-    platform_from_config,
+    platform_from_file_config,
 )
 from stewart_drake.core.platform_file import platform_document
-from stewart_drake.core.sanity import check_home
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.core.yamlio import compose, load_node_typed, read_yaml_text
-from stewart_drake.errors import GeometryError, MachineError, QuantityError, StewartError
+from stewart_drake.errors import MachineError, QuantityError, StewartError
 from stewart_drake.spec.machine import FIELDS, SECTIONS, Gains, Machine, check_motion
 from stewart_drake.spec.quantity import parse_choice, parse_number, parse_vector
 
@@ -297,26 +291,11 @@ def _relative(path: str, base: Path) -> str:
     return str(base / path)
 
 
-def _check_platform(shown: str):
-    def check(cfg, where):
-        check_name(cfg, where, shown)
-        k = check_length_unit(cfg, where, shown)
-        check_rules(where, PLATFORM_RULES, PLATFORM_SHAPES, cfg, shown, k, cfg.length_unit)
-        check_shared_base(cfg, where, shown, k)
-
-    return check
-
-
 def _inline_platform(node, shown: str, stem: str) -> Platform:
-    cfg = load_node_typed(node, PlatformConfig, "platform", shown, _check_platform(shown))
+    cfg = load_node_typed(node, PlatformConfig, "platform", shown, check_platform_fields(shown))
     if not cfg.name:
         cfg.name = stem or "machine"
-    try:
-        platform = platform_from_config(cfg)
-    except GeometryError as e:
-        raise GeometryError(GeometryError.IN_FILE.format(path=shown, problem=e)) from None
-    check_home(platform)
-    return platform
+    return platform_from_file_config(cfg, shown)
 
 
 def _section(name: str, node, shown: str):
