@@ -26,6 +26,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from stewart_drake.core.csvio import is_number
 from stewart_drake.core.distinct import distinct_rows
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import angle_scale, length_scale
@@ -185,7 +186,7 @@ def read_measurements(
     if kind is None:
         kind = found or "pose"
     need = ",".join(columns_of(kind, 1)).replace("t1_x,t1_y,t1_z", "tK_x,tK_y,tK_z")
-    if all(_is_number(h) for h in header):
+    if all(is_number(h) for h in header):
         raise CalibrationError(CalibrationError.NO_HEADER.format(path=shown, need=need, row=",".join(head)[:80]))
     if found is not None and found != kind:
         raise CalibrationError(
@@ -271,14 +272,6 @@ def read_measurements(
         _check_angles(tilts, TILTS, lines, shown, angle_unit)
         tilts = tilts * a
     return Measurements(kind, readings, poses, targets, tilts, np.asarray(weights, float), lines, shown, digest)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _check_readings(readings, platform: Platform, lines, shown: str, unit: str) -> None:

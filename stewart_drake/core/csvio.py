@@ -54,7 +54,8 @@ def _aliases() -> dict[str, str]:
 ALIASES = _aliases()  # every accepted header name (lower case) -> its column's name
 
 
-def _is_number(text: str) -> bool:
+def is_number(text: str) -> bool:
+    """Whether the text of a CSV cell reads as a number (a header cell does not)."""
     try:
         float(text)
     except ValueError:
@@ -198,7 +199,7 @@ def read_numeric_csv(
         if len(cells) not in widths:
             expected = " or ".join(map(str, widths))
             raise CsvError(CsvError.WIDTH.format(path=path, line=1, expected=expected, columns=columns, got=len(cells)))
-        if not all(_is_number(c) for c in cells):
+        if not all(is_number(c) for c in cells):
             found["order"] = header_order(path, 1, cells, kind, widths)
 
     budget = _RowBudget(path, kind, option, bytes_per_row, first_line, max_rows, too_many)
