@@ -23,3 +23,20 @@ def own_radial(folder: Path) -> Platform:
     path = folder / "own.yaml"
     path.write_text(OWN_RADIAL)
     return load_platform(str(path))
+
+
+# The platform part of the issue's 210 kg machine as its user wrote it (examples/newcomer-210kg.yaml adds the
+# payload, the controller and the number format).
+NEWCOMER_PLATFORM = """\
+name: newcomer-6dof-sim
+length_unit: mm
+radial:
+  base_radius: 650.0
+  base_angles_deg: [278.0, 22.0, 38.0, 142.0, 158.0, 262.0]
+  top_radius: 450.0
+  top_angles_deg: [318.0, 342.0, 78.0, 102.0, 198.0, 222.0]
+stroke: [550.0, 850.0]
+rotation_centre: [0.0, 0.0, 0.0]
+plate: {mass: 60.0, com: [0.0, 0.0, 50.0], inertia: [3750000.0, 3750000.0, 7500000.0, 0, 0, 0]}
+legs: {cylinder_mass: 4.0, piston_mass: 2.0, max_force: 4000.0, max_speed: 500.0, stiffness: 20000.0}
+"""

@@ -12,27 +12,19 @@ import pytest
 
 import stewart_drake as sd
 from stewart_drake.report.subject import NEEDS, from_machine_file, from_platform, subject_trajectories
-from tests._own_platform import OWN_RADIAL
+from tests._own_platform import NEWCOMER_PLATFORM, OWN_RADIAL
 from tests.cli._inprocess import cli
 
 # The 210 kg machine (examples/newcomer-210kg.yaml's numbers): a 60 kg plate carrying a 150 kg payload 300 mm above
 # it, with a 16-bit, 30 µm fixed-point IK format (the DSP's 1 mm chatters).
-MACHINE = """
-name: newcomer-6dof-sim
-length_unit: mm
-radial:
-  base_radius: 650.0
-  base_angles_deg: [278.0, 22.0, 38.0, 142.0, 158.0, 262.0]
-  top_radius: 450.0
-  top_angles_deg: [318.0, 342.0, 78.0, 102.0, 198.0, 222.0]
-stroke: [550.0, 850.0]
-rotation_centre: [0.0, 0.0, 0.0]
-plate: {mass: 60.0, com: [0.0, 0.0, 50.0], inertia: [3750000.0, 3750000.0, 7500000.0, 0, 0, 0]}
-legs: {cylinder_mass: 4.0, piston_mass: 2.0, max_force: 4000.0, max_speed: 500.0, stiffness: 20000.0}
-payload: {mass: 150.0, position: [0, 0, 300mm]}
+MACHINE = (
+    "\n"
+    + NEWCOMER_PLATFORM
+    + """payload: {mass: 150.0, position: [0, 0, 300mm]}
 motions: [seed]
 firmware: {word_bits: 16, length_lsb: 30um}
 """
+)
 # the loop on the user's machine and a section that needs nothing but the platform: a subset of the report that
 # keeps the test cheap (a few seconds of simulated loops)
 ONLY = ["--only", "drake_kinematics", "controller_in_the_loop", "firmware_certificate", "seed_table"]

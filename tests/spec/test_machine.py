@@ -13,20 +13,9 @@ from stewart_drake.core.geometry import load_preset, preset_path
 from stewart_drake.errors import MachineError, QuantityError
 from stewart_drake.spec import ControllerSpec, FirmwareFormat, Machine, PayloadSpec, load_machine
 from stewart_drake.spec.machine import FIELDS
+from tests._own_platform import NEWCOMER_PLATFORM
 
-PLATFORM = """\
-name: newcomer-6dof-sim
-length_unit: mm
-radial:
-  base_radius: 650.0
-  base_angles_deg: [278.0, 22.0, 38.0, 142.0, 158.0, 262.0]
-  top_radius: 450.0
-  top_angles_deg: [318.0, 342.0, 78.0, 102.0, 198.0, 222.0]
-stroke: [550.0, 850.0]
-rotation_centre: [0.0, 0.0, 0.0]
-plate: {mass: 60.0, com: [0.0, 0.0, 50.0], inertia: [3750000.0, 3750000.0, 7500000.0, 0, 0, 0]}
-legs: {cylinder_mass: 4.0, piston_mass: 2.0, max_force: 4000.0, max_speed: 500.0, stiffness: 20000.0}
-"""
+PLATFORM = NEWCOMER_PLATFORM
 SECTIONS = """\
 payload: {mass: 150kg, position: [0, 0, 50mm]}
 controller:
