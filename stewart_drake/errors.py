@@ -767,6 +767,32 @@ class ResponseError(StewartError):
     DISAGREES = "measured response at {f:g} Hz differs from the linear model by {d:.4f} (per unit), above its tolerance {tol:.4f}"
 
 
+class TuneError(StewartError):
+    """A ``tune`` request with values outside what it accepts (``api.tune``); its ``NO_GAINS``, ``NO_FORMAT``,
+    ``RIPPLE`` and ``VERIFY`` are the verdict's failures (exit 1), not raised."""
+
+    MARGIN = "{name} must be a number >= 0 {unit}, got {value!r}"
+    BANDWIDTH = "bandwidth must be a positive frequency below the Nyquist frequency {nyquist:g} Hz, got {value!r}"
+    OUT_IS_MACHINE = "out {path} is the machine file itself: the original is never modified; name another file"
+    OUT_EXISTS = "out {path} exists; name a new file, or pass --force to replace it"
+    PLANT_STEPS = (
+        "run.plant_step {step:g} s must divide controller.period {period:g} s into whole steps for the loop's model"
+    )
+    NO_POSES = "no pose of the workspace box's grid keeps the legs within the stroke of {name}"
+    NO_GAINS = (
+        "no gains of the {count} tried meet GM >= {gm:g} dB, PM >= {pm:g} deg{bw} at every grid pose; the best: "
+        "GM {best_gm:.2f} dB, PM {best_pm:.1f} deg, bandwidth {best_bw}"
+    )
+    NO_FORMAT = (
+        "no length LSB of {bits}-bit words (a whole number of {r:g} m sensor counts) is proven free of saturation"
+    )
+    RIPPLE = (
+        "predicted ripple {rms:.4g} N RMS is above the chatter limit {limit:.4g} N ({fraction:g} % of the command "
+        "range) for every feasible gain set; the largest source: {cause}"
+    )
+    VERIFY = "the tuned machine's run failed: {failure}"
+
+
 class SimulationError(StewartError):
     """A simulation or Drake model request with values outside what it accepts (``drake.simulation``,
     ``drake.systems``, ``drake.*_model``)."""
