@@ -42,6 +42,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.servo import ServoResult, servo
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
+    from stewart_drake.api.tune import TuneResult, tune
     from stewart_drake.api.viewer import ViewerReadout, viewer_readout
     from stewart_drake.core.geometry import Platform
     from stewart_drake.core.realtime_fk import RealtimeFK, RealtimeResult
@@ -88,6 +89,8 @@ _PUBLIC = {
     "simulate": ("stewart_drake.api.simulation", "simulate"),
     "loop_response": ("stewart_drake.api.response", "loop_response"),
     "LoopResponse": ("stewart_drake.api.response", "LoopResponse"),
+    "tune": ("stewart_drake.api.tune", "tune"),
+    "TuneResult": ("stewart_drake.api.tune", "TuneResult"),
     "SimulationResult": ("stewart_drake.api.simulation", "SimulationResult"),
     "montecarlo": ("stewart_drake.montecarlo.api", "montecarlo"),
     "MonteCarloResult": ("stewart_drake.montecarlo.api", "MonteCarloResult"),
@@ -154,6 +157,8 @@ __all__ = [
     "SimulationResult",
     "loop_response",
     "LoopResponse",
+    "tune",
+    "TuneResult",
     "montecarlo",
     "MonteCarloResult",
     "firmware",

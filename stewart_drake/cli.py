@@ -83,6 +83,7 @@ COMMANDS = {
     ),
     "size": ("size", "actuator sizing: peak/RMS force, speed, acceleration, power and stroke per leg"),
     "stiffness": ("stiffness", "6×6 Cartesian stiffness, compliance and payload deflection at a pose"),
+    "tune": ("tune", "tune the leg PID gains and length LSB of a machine to stated margins; write the tuned machine"),
     "view": (
         "view",
         "interactive 3-D viewer (Meshcat on localhost): pose sliders, leg lengths, stroke margins, "

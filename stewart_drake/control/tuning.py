@@ -3,7 +3,7 @@ grid over the workspace box, with the largest worst-pose bandwidth.
 
 The grid (``grid_poses``): the box's centre, its 12 face centres and its 64 corners, less the poses whose legs
 leave the stroke. The candidates: today's design (``gains.design_gains``) scaled — kd (= kv) by ``KD_SCALES``,
-kp by ``KP_SCALES``, ki by ``KI_SCALES`` — a deterministic grid of 16 × 9 × 5 gain sets around the design,
+kp by ``KP_SCALES``, ki by ``KI_SCALES`` — a deterministic grid of 12 × 7 × 4 gain sets around the design,
 whose loops all keep the design's structure (the PD zero, the integral corner, the velocity feed-forward equal
 to kd). A candidate is feasible when, at every grid pose, the closed loop is stable (every pole |z| < 1) and
 each leg's loop, broken at its command with the other five closed, has at least the gain and phase margins
@@ -26,9 +26,9 @@ from stewart_drake.control.gains import PidGains
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 
-KD_SCALES = tuple(float(x) for x in np.logspace(-1.2, 0.3, 16))
-KP_SCALES = tuple(float(x) for x in np.logspace(-1.0, 0.6, 9))
-KI_SCALES = (0.05, 0.15, 0.4, 1.0, 2.0)
+KD_SCALES = tuple(float(x) for x in np.logspace(-1.2, 0.3, 12))
+KP_SCALES = tuple(float(x) for x in np.logspace(-1.0, 0.6, 7))
+KI_SCALES = (0.05, 0.2, 0.6, 1.5)
 # frequencies per pose for the margins and bandwidth (log-spaced to just below Nyquist)
 FREQUENCIES = 200
 
