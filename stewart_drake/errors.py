@@ -771,7 +771,7 @@ class TuneError(StewartError):
     """A ``tune`` request with values outside what it accepts (``api.tune``); its ``NO_GAINS``, ``NO_FORMAT``,
     ``RIPPLE`` and ``VERIFY`` are the verdict's failures (exit 1), not raised."""
 
-    MARGIN = "{name} must be a number >= 0 {unit}, got {value!r}"
+    MARGIN = "{name} must be a number {rule}, got {value!r}"
     BANDWIDTH = "bandwidth must be a positive frequency below the Nyquist frequency {nyquist:g} Hz, got {value!r}"
     OUT_IS_MACHINE = "out {path} is the machine file itself: the original is never modified; name another file"
     OUT_EXISTS = "out {path} exists; name a new file, or pass --force to replace it"

@@ -22,6 +22,7 @@ from stewart_drake.control import ControllerConfig, DspTiming, check_timing
 from stewart_drake.control.feasibility import infeasible_motion
 from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog
+from stewart_drake.control.tuning import LoopSpec, tuned_gains
 from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import PRESETS, Platform, load_preset
 from stewart_drake.core.sanity import (
@@ -46,6 +47,7 @@ from stewart_drake.errors import (
     PhysicalLimitError,
     UsageError,
 )
+from stewart_drake.firmware.certify.box import workspace_box
 from stewart_drake.firmware.engine import default_engine
 from stewart_drake.firmware.fingerprint import PLATFORM_HASH, platform_hash, read_fingerprint
 from stewart_drake.firmware.module import check_source
@@ -331,6 +333,11 @@ def plan_run(
         gains = ControllerConfig.for_platform(platform, poses=poses).gains
     elif not nominal_gains:
         gains = ControllerConfig.for_platform(platform, timing, machine.actuators.time_constant, poses=poses).gains
+    if ctl.gains == "tune":  # the tuner, around the design, at plan time
+        designed = ControllerConfig.for_platform(platform, timing, gains=gains, **form)
+        spec = LoopSpec.of(designed, actuators.time_constant, plant_step, feedforward)
+        box = workspace_box(platform)
+        gains = tuned_gains(platform, designed, controller, spec, box.lo, box.hi)
     if scale != 1.0:
         gains = replace(gains, kp=gains.kp * scale, ki=gains.ki * scale, kd=gains.kd * scale, kv=gains.kv * scale)
     config = ControllerConfig.for_platform(platform, timing, gains=gains, **form)

@@ -19,13 +19,12 @@ import numpy as np
 from stewart_drake.api.result import Result
 from stewart_drake.api.simulation import plan_run, run_machine, run_plan
 from stewart_drake.control.chatter import CHATTER_RANGE_FRACTION
-from stewart_drake.control.feedforward import feedforward_lead
 from stewart_drake.control.frequency import MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, effective_gains
 from stewart_drake.control.ripple import quantisation_ripple
-from stewart_drake.control.tuning import GridLoops, LoopSpec, candidates, grid_poses, tune_gains
+from stewart_drake.control.tuning import GridLoops, LoopSpec, grid_poses, no_gains_message, tune_gains
 from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import StewartError, TuneError
-from stewart_drake.firmware.certify.box import workspace_box
+from stewart_drake.firmware.certify.box import PoseBox, parse_box
 from stewart_drake.firmware.certify.certificate import certify
 from stewart_drake.spec import Gains, Machine
 
@@ -111,30 +110,28 @@ class TuneResult(Result):
         return fig
 
 
-def _number(value, name: str, unit: str, ok) -> float:
+def _number(value, name: str, rule: str, ok) -> float:
     good = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
     if not (good and math.isfinite(value) and ok(value)):
-        raise TuneError(TuneError.MARGIN.format(name=name, unit=unit, value=value))
+        raise TuneError(TuneError.MARGIN.format(name=name, rule=rule, value=value))
     return float(value)
 
 
 def loop_spec(plan) -> LoopSpec:
     """The linear loop's timing, lag and feed-forward lead of a planned run."""
-    sc, t = plan.scenario, plan.timing
-    lag = sc.actuators.time_constant
-    steps = t.sample_period / sc.plant_time_step
+    sc = plan.scenario
+    lag, step = sc.actuators.time_constant, sc.plant_time_step
+    steps = plan.timing.sample_period / step
     if lag > 0 and abs(steps - round(steps)) > 1e-9 * steps:  # the model steps the lag at the plant steps
-        raise TuneError(TuneError.PLANT_STEPS.format(step=sc.plant_time_step, period=t.sample_period))
-    lead = feedforward_lead(sc.config, lag) if sc.feedforward else None
-    return LoopSpec(t.sample_period, t.output_delay, lag, sc.plant_time_step, lead)
+        raise TuneError(TuneError.PLANT_STEPS.format(step=step, period=plan.timing.sample_period))
+    return LoopSpec.of(sc.config, lag, step, sc.feedforward)
 
 
-def choose_length_lsb(platform: Platform, machine: Machine, budget_m: float) -> tuple[float | None, float | None]:
+def choose_length_lsb(platform: Platform, machine: Machine, box: PoseBox) -> tuple[float | None, float | None]:
     """``(length_lsb, error_m)``: the finest LSB, a whole number of sensor counts, whose words hold the stroke
-    and whose certificate over the workspace box proves no saturation, with its certified error (largest leg);
+    and whose certificate over ``box`` proves no saturation, with its certified error (largest leg);
     ``(None, None)`` when none is proven within ``MAX_COUNTS_PER_LSB`` counts."""
     r, fmt = machine.sensors.resolution, machine.firmware
-    box = workspace_box(platform)
     for k in range(1, MAX_COUNTS_PER_LSB + 1):
         f = replace(fmt, length_lsb=float(f"{k * r:.12g}"))
         if f.qformat().range_m < float(platform.stroke[1]):
@@ -176,6 +173,7 @@ def tune(
     gain_margin_db: float = MIN_GAIN_MARGIN_DB,
     phase_margin_deg: float = MIN_PHASE_MARGIN_DEG,
     error_budget: float = ERROR_BUDGET_M,
+    box: list[str] | None = None,
     verify: bool = True,
     **overrides,
 ) -> TuneResult:
@@ -187,6 +185,9 @@ def tune(
         gain_margin_db: the gain margin each leg's loop must keep at every grid pose (dB).
         phase_margin_deg: the phase margin each leg's loop must keep at every grid pose (degrees).
         error_budget: the certified IK error (m) the chosen format must keep within.
+        box: ``KEY=LO..HI`` words (``KEY`` in px py pz a b g; mm and degrees, or with a unit) narrowing the
+            workspace box (``firmware.certify.workspace_box``) whose grid the gains must hold on and over which
+            the format is certified (keys not given keep its range).
         verify: run the nonlinear loop (``simulate``) of the machine as given and as tuned.
         **overrides: any spec path (``**{"controller.period": 5e-4}``).
 
@@ -197,9 +198,9 @@ def tune(
         StewartError: bad input (``TuneError`` naming the argument), and ``plan_run``'s checks of the machine.
     """
     t0 = time.perf_counter()
-    gm = _number(gain_margin_db, "gain_margin_db", "dB", lambda v: v >= 0)
-    pm = _number(phase_margin_deg, "phase_margin_deg", "deg", lambda v: 0 <= v < 180)
-    budget = _number(error_budget, "error_budget", "m", lambda v: v > 0)
+    gm = _number(gain_margin_db, "gain_margin_db", ">= 0 dB", lambda v: v >= 0)
+    pm = _number(phase_margin_deg, "phase_margin_deg", "0 … 180 deg", lambda v: 0 <= v < 180)
+    budget = _number(error_budget, "error_budget", "> 0 m", lambda v: v > 0)
     m = run_machine(machine, {}, overrides)
     plan = plan_run(m, command="tune")
     sc, timing = plan.scenario, plan.timing
@@ -209,7 +210,7 @@ def tune(
         if not (good and math.isfinite(bandwidth) and 0 < bandwidth < nyquist):
             raise TuneError(TuneError.BANDWIDTH.format(nyquist=nyquist, value=bandwidth))
     platform = sc.platform
-    box = workspace_box(platform)
+    box = parse_box(box, platform, "mm", "deg")
     poses = grid_poses(platform, box.lo, box.hi)
     if not len(poses):
         raise TuneError(TuneError.NO_POSES.format(name=platform.name))
@@ -231,20 +232,14 @@ def tune(
         "ripple_limit_N": CHATTER_RANGE_FRACTION * timing.command_range,
         "error_budget_m": budget,
         "grid": "centre, 12 face centres and 64 corners of the workspace box, in stroke",
+        "box": box.to_units("mm", "deg"),
     }
     failures: list[str] = []
     chosen, best, feasible = tune_gains(loops, sc.config.gains, gm, pm, bandwidth, realise=realised)
     if chosen is None:
-        bw = f", bandwidth >= {bandwidth:g} Hz" if bandwidth is not None else ""
-        best_bw = "none" if best.bandwidth_hz is None else f"{best.bandwidth_hz:.2f} Hz"
-        failures.append(
-            TuneError.NO_GAINS.format(
-                count=len(list(candidates(sc.config.gains))), gm=gm, pm=pm, bw=bw,
-                best_gm=best.gain_margin_db, best_pm=best.phase_margin_deg, best_bw=best_bw,
-            )
-        )  # fmt: skip
+        failures.append(no_gains_message(best, sc.config.gains, gm, pm, bandwidth))
         return TuneResult(None, before, None, poses, targets, None, failures, time.perf_counter() - t0)
-    lsb, err = choose_length_lsb(platform, m, budget)
+    lsb, err = choose_length_lsb(platform, m, box)
     fmt = None
     if lsb is None:
         failures.append(TuneError.NO_FORMAT.format(bits=m.firmware.word_bits, r=m.sensors.resolution))

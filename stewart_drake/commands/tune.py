@@ -36,6 +36,14 @@ def register(sub) -> None:
     p.add_argument("--gain-margin", default=f"{MIN_GAIN_MARGIN_DB:g}dB", metavar="DB", help="default 6dB")
     p.add_argument("--phase-margin", default=f"{MIN_PHASE_MARGIN_DEG:g}deg", metavar="DEG", help="default 30deg")
     p.add_argument("--error-budget", default="0.5mm", metavar="LEN", help="certified IK error allowed (0.5mm)")
+    p.add_argument(
+        "--box",
+        action="append",
+        default=None,
+        metavar="KEY=LO..HI",
+        help="narrow the workspace box (px py pz in mm, a b g in degrees; repeatable) whose grid the gains must "
+        "hold on and over which the format is certified",
+    )
     p.add_argument("--out", required=True, metavar="FILE", help="the tuned machine file to write (a new file)")
     p.add_argument("--force", action="store_true", help="replace an existing --out file")
     p.set_defaults(func=run)
@@ -59,6 +67,7 @@ def run(args) -> int:
             f"{math.degrees(parse_number(args.phase_margin, 'angle', '--phase-margin', bare=math.pi / 180)):.12g}"
         ),
         "error_budget": parse_number(args.error_budget, "length", "--error-budget"),
+        "box": args.box,
     }
     machine = apply_overrides(load_machine(args.machine), args.set)
     try:

@@ -21,10 +21,20 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from stewart_drake.control.frequency import LoopModel, bandwidth, controller_matrices, margins
-from stewart_drake.control.gains import PidGains
+from stewart_drake.control.feedforward import feedforward_lead
+from stewart_drake.control.frequency import (
+    MIN_GAIN_MARGIN_DB,
+    MIN_PHASE_MARGIN_DEG,
+    LoopModel,
+    bandwidth,
+    controller_matrices,
+    effective_gains,
+    margins,
+)
+from stewart_drake.control.gains import ControllerConfig, PidGains
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.errors import PhysicalLimitError, TuneError
 
 KD_SCALES = tuple(float(x) for x in np.logspace(-1.2, 0.3, 12))
 KP_SCALES = tuple(float(x) for x in np.logspace(-1.0, 0.6, 7))
@@ -35,12 +45,14 @@ FREQUENCIES = 200
 
 def grid_poses(platform: Platform, lo, hi) -> np.ndarray:
     """``(n, 6)`` poses (m, rad): the centre, the 12 face centres and the 64 corners of the box ``lo``..``hi``
-    (6,), without those whose legs leave ``platform``'s stroke."""
+    (6,), each once (a box flat in some key repeats them), without those whose legs leave ``platform``'s stroke."""
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     c = (lo + hi) / 2
     faces = [c + s * np.eye(6)[k] * (hi - lo) / 2 for k in range(6) for s in (-1, 1)]
     corners = [np.where(np.array(b), hi, lo) for b in itertools.product((0, 1), repeat=6)]
     poses = np.array([c, *faces, *corners])
+    _, first = np.unique(poses, axis=0, return_index=True)  # a flat box repeats poses: each once, in order
+    poses = poses[np.sort(first)]
     L = leg_lengths(platform, poses)
     inside = np.all((L >= platform.L_min) & (L <= platform.L_max), axis=1)
     return poses[inside]
@@ -56,6 +68,13 @@ class LoopSpec:
     lag: float
     step: float
     lead: float | None
+
+    @classmethod
+    def of(cls, config: ControllerConfig, lag: float, step: float, feedforward: bool) -> LoopSpec:
+        """The loop of a controller ``config`` with actuator ``lag`` (s), plant ``step`` (s) and, if
+        ``feedforward``, the feed-forward table's lead."""
+        t = config.timing
+        return cls(t.sample_period, t.output_delay, lag, step, feedforward_lead(config, lag) if feedforward else None)
 
     def model(self, platform: Platform, pose, gains: PidGains) -> LoopModel:
         return LoopModel.build(platform, pose, gains, self.T, self.delay, self.lag, self.step, self.lead)
@@ -171,3 +190,32 @@ def tune_gains(
             feasible.append(ev)
     feasible.sort(key=lambda e: -(e.bandwidth_hz or 0.0))
     return (feasible[0] if feasible else None), best, feasible
+
+
+def tuned_gains(platform: Platform, config: ControllerConfig, law: str, spec: LoopSpec, lo, hi) -> PidGains:
+    """The gains ``controller.gains: tune`` runs with: the widest-bandwidth candidate around ``config``'s
+    designed gains that meets ``MIN_GAIN_MARGIN_DB`` and ``MIN_PHASE_MARGIN_DEG`` at every pose of the grid of
+    the box ``lo``..``hi`` (6,), as ``law`` applies them (the fixed law's Q15 words). Raises
+    ``PhysicalLimitError`` (naming the best found) when none does."""
+    poses = grid_poses(platform, lo, hi)
+    if not len(poses):
+        raise PhysicalLimitError(TuneError.NO_POSES.format(name=platform.name))
+
+    def realise(g):
+        return effective_gains(law, replace(config, gains=g))
+
+    loops = GridLoops(platform, poses, spec, realise(config.gains))
+    chosen, best, _ = tune_gains(loops, config.gains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, realise=realise)
+    if chosen is None:
+        raise PhysicalLimitError(no_gains_message(best, config.gains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG))
+    return chosen.gains
+
+
+def no_gains_message(best: Evaluation, design: PidGains, gm: float, pm: float, bandwidth_hz=None) -> str:
+    """``TuneError.NO_GAINS`` for the candidates around ``design``, naming the ``best`` found."""
+    bw = f", bandwidth >= {bandwidth_hz:g} Hz" if bandwidth_hz is not None else ""
+    best_bw = "none" if best.bandwidth_hz is None else f"{best.bandwidth_hz:.2f} Hz"
+    return TuneError.NO_GAINS.format(
+        count=len(list(candidates(design))), gm=gm, pm=pm, bw=bw,
+        best_gm=best.gain_margin_db, best_pm=best.phase_margin_deg, best_bw=best_bw,
+    )  # fmt: skip

@@ -30,7 +30,7 @@ from stewart_drake.core.platform_file import platform_document
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.core.yamlio import compose, load_node_typed, read_yaml_text
 from stewart_drake.errors import MachineError, QuantityError, StewartError
-from stewart_drake.spec.machine import FIELDS, SECTIONS, Gains, Machine, check_motion
+from stewart_drake.spec.machine import FIELDS, GAIN_WORDS, SECTIONS, Gains, Machine, check_motion
 from stewart_drake.spec.quantity import parse_choice, parse_number, parse_vector
 
 MACHINE_KEYS = (*SECTIONS, "platform", "motions", "requirements", "calibration")
@@ -79,10 +79,10 @@ def parse_field(path: str, value, where: str | None = None):
             extra = set(value) - {"kp", "ki", "kd", "kv"}
             if extra or len(value) != 4:
                 raise MachineError(
-                    MachineError.RANGE.format(path=where, rule="design or {kp, ki, kd, kv}", value=dict(value))
+                    MachineError.RANGE.format(path=where, rule="design, tune or {kp, ki, kd, kv}", value=dict(value))
                 )
             return Gains(**{k: parse_number(v, "ratio", f"{where}.{k}") for k, v in value.items()})
-        return parse_choice(value, ("design",), where)
+        return parse_choice(value, GAIN_WORDS, where)
     return parse_number(value, kind, where)
 
 

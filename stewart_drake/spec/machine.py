@@ -21,6 +21,8 @@ from stewart_drake.errors import MachineError
 from stewart_drake.fixedpoint.generic import TRIG_MODES, QFormat
 
 LAWS = ("fixed", "float")
+# controller.gains as a word: today's design for the platform, or the tuner's gains (``control.tuning``)
+GAIN_WORDS = ("design", "tune")
 LATENCIES = ("sample", "computation", "none")
 ENGINES = ("c", "python")
 
@@ -92,7 +94,8 @@ class Gains:
 class ControllerSpec:
     """The controller: ``law`` (``fixed``: the DSP's fixed-point law; ``float``: its float twin), sample
     ``period`` (s), ``latency`` (``sample``, ``computation`` or ``none``), ``gains`` (``"design"``: designed
-    for the platform over the run's poses, or explicit ``Gains``), ``gain_scale`` (a factor on the designed
+    for the platform over the run's poses; ``"tune"``: chosen by ``control.tuning`` at plan time to meet the
+    minimum margins over the workspace box's grid; or explicit ``Gains``), ``gain_scale`` (a factor on the designed
     gains), ``feedforward`` (the model-based force feed-forward) and ``engine`` (``c``, ``python`` or None:
     ``c`` where a compiler is found)."""
 
@@ -108,9 +111,11 @@ class ControllerSpec:
         _word("controller.law", self.law, LAWS)
         _number("controller.period", self.period, "> 0 s", lambda v: v > 0)
         _word("controller.latency", self.latency, LATENCIES)
-        if not (self.gains == "design" or isinstance(self.gains, Gains)):
+        if not (self.gains in GAIN_WORDS or isinstance(self.gains, Gains)):
             raise MachineError(
-                MachineError.RANGE.format(path="controller.gains", rule="design or {kp, ki, kd, kv}", value=self.gains)
+                MachineError.RANGE.format(
+                    path="controller.gains", rule="design, tune or {kp, ki, kd, kv}", value=self.gains
+                )
             )
         _number("controller.gain_scale", self.gain_scale, "> 0", lambda v: v > 0)
         if not isinstance(self.feedforward, bool):

@@ -84,3 +84,14 @@ def test_ripple_bound_and_estimate_against_the_nonlinear_loop(machine, lsbs):
         # the white-noise estimate assumes an error uncorrelated from tick to tick; a slow reference (fewer steps
         # than ticks) or a limit cycle (a correlated error) moves the truth either way: within a factor 2
         assert 0.5 <= rip.rms_N / rms <= 2.0, (lsb, rip.rms_N, rms)
+
+
+def test_gains_tune_in_the_machine_file_runs_the_tuner_at_plan_time(tuned):
+    # controller.gains: tune plans the run with the gains sd.tune chose (the same grid, margins and candidates;
+    # the newcomer's widest-bandwidth feasible set also fits the ripple limit, so sd.tune keeps it)
+    plan = plan_run(NEWCOMER, **{"controller.gains": "tune"})
+    sc = plan.scenario
+    g = effective_gains(sc.controller, sc.config)
+    assert {k: getattr(g, k) for k in ("kp", "ki", "kd", "kv")} == pytest.approx(tuned.after["linear"]["gains"])
+    # and "design" (the default) is today's design, untouched
+    assert plan_run(NEWCOMER).scenario.config.gains.kp == pytest.approx(tuned.before["linear"]["gains"]["kp"], 1e-4)
