@@ -42,6 +42,7 @@ SEE_ALSO = {
     "montecarlo": ["../montecarlo-vary.md"],
     "firmware": ["../firmware-abi.md", "../pil-link.md"],
     "simulate": ["../firmware-abi.md"],
+    "tune": ["../designing-the-loop.md"],
 }
 
 
@@ -57,6 +58,7 @@ PYTHON = {
     "workspace": "workspace",
     "simulate": "simulate",
     "response": "loop_response",
+    "tune": "tune",
     "montecarlo": "montecarlo",
     "firmware": "firmware",
     "report": "report",
