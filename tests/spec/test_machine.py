@@ -179,7 +179,7 @@ def test_a_machine_takes_a_platform_object():
         ("motions: [circle]\n", ":12: motions item 1: 'circle' is not seed, rotating, a .csv file or a .stw script"),
         ("requirements: {a: 1}\n", ":12: requirements must be a file path or null, got a mapping"),
         ("controller: {period: null}\n", ":12: controller.period: cannot read 'null' as a number"),
-        ("controller: {gains: {kp: 1}}\n", ":12: controller.gains must be design or {kp, ki, kd, kv}, got"),
+        ("controller: {gains: {kp: 1}}\n", ":12: controller.gains must be design, tune or {kp, ki, kd, kv}, got"),
         ("run: {fit: maybe}\n", ":12: run.fit: 'maybe' is not one of true, false"),
         ("controller: [1, 2]\n", ":12: controller must be a mapping of key: value, got a list"),
     ],
