@@ -790,6 +790,7 @@ class TuneError(StewartError):
         "predicted ripple {rms:.4g} N RMS is above the chatter limit {limit:.4g} N ({fraction:g} % of the command "
         "range) for every feasible gain set; the largest source: {cause}"
     )
+    BUDGET = "the certified IK error {error:.3g} mm of the finest proven LSB is above the budget {budget:g} mm"
     VERIFY = "the tuned machine's run failed: {failure}"
 
 

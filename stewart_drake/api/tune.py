@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is ask
 # The certified IK error (mm, largest leg) the chosen format must keep within.
 ERROR_BUDGET_M = 0.5e-3
 # At most this many sensor counts per length LSB are tried (the finest proven one is taken).
-MAX_COUNTS_PER_LSB = 200
+LSB_COUNTS_TRIED = 200
 # Cells per certificate while choosing the LSB (``firmware optimize``'s search budget).
 CERTIFY_CELLS = 30_000
 # Feasible gain sets tried against the ripple budget, widest bandwidth first.
@@ -97,8 +97,8 @@ class TuneResult(Result):
             ("phase margin [deg]", lambda d: d["linear"]["phase_margin_deg"]),
             ("bandwidth [Hz]", lambda d: d["linear"]["bandwidth_hz"] or 0.0),
             ("ripple, estimate [N]", lambda d: d["ripple"]["rms_N"]),
-            ("ripple, simulated [N]", lambda d: d["run"]["force_ripple_N"]),
-            ("max leg error [mm]", lambda d: d["run"]["max_leg_error_mm"]),
+            ("ripple, simulated [N]", lambda d: d.get("run", {}).get("force_ripple_N", math.nan)),
+            ("max leg error [mm]", lambda d: d.get("run", {}).get("max_leg_error_mm", math.nan)),
         ]
         fig, axes = plt.subplots(1, len(rows), figsize=(14, 3))
         for ax, (name, get) in zip(axes, rows):
@@ -130,9 +130,9 @@ def loop_spec(plan) -> LoopSpec:
 def choose_length_lsb(platform: Platform, machine: Machine, box: PoseBox) -> tuple[float | None, float | None]:
     """``(length_lsb, error_m)``: the finest LSB, a whole number of sensor counts, whose words hold the stroke
     and whose certificate over ``box`` proves no saturation, with its certified error (largest leg);
-    ``(None, None)`` when none is proven within ``MAX_COUNTS_PER_LSB`` counts."""
+    ``(None, None)`` when none is proven within ``LSB_COUNTS_TRIED`` counts."""
     r, fmt = machine.sensors.resolution, machine.firmware
-    for k in range(1, MAX_COUNTS_PER_LSB + 1):
+    for k in range(1, LSB_COUNTS_TRIED + 1):
         f = replace(fmt, length_lsb=float(f"{k * r:.12g}"))
         if f.qformat().range_m < float(platform.stroke[1]):
             continue
@@ -215,7 +215,7 @@ def tune(
     if not len(poses):
         raise TuneError(TuneError.NO_POSES.format(name=platform.name))
     spec = loop_spec(plan)
-    centre = poses[0]
+    centre = poses[0]  # the box's centre where it is in stroke: the ripple is predicted there
 
     def realised(g):  # the gains the law applies (the fixed law's Q15 words)
         return effective_gains(sc.controller, replace(sc.config, gains=g))
@@ -247,10 +247,7 @@ def tune(
     else:
         fmt = {"word_bits": m.firmware.word_bits, "length_lsb_m": lsb, "trig": m.firmware.trig, "error_m": err}
         if err > budget:
-            failures.append(
-                f"the certified IK error {err * 1e3:.3g} mm of the finest proven LSB is above the budget "
-                f"{budget * 1e3:g} mm"
-            )
+            failures.append(TuneError.BUDGET.format(error=err * 1e3, budget=budget * 1e3))
     limit = targets["ripple_limit_N"]
     tuned_plan, ripple, pick = None, None, chosen
     for ev in feasible[:RIPPLE_TRIES]:  # the widest bandwidth whose predicted ripple fits the chatter limit
