@@ -3,9 +3,9 @@ grid over the workspace box, with the largest worst-pose bandwidth.
 
 The grid (``grid_poses``): the box's centre, its 12 face centres and its 64 corners, less the poses whose legs
 leave the stroke. The candidates: today's design (``gains.design_gains``) scaled — kd (= kv) by ``KD_SCALES``,
-kp by ``KP_SCALES``, ki by ``KI_SCALES`` — a deterministic grid of 12 × 7 × 4 gain sets around the design,
-whose loops all keep the design's structure (the PD zero, the integral corner, the velocity feed-forward equal
-to kd). A candidate is feasible when, at every grid pose, the closed loop is stable (every pole |z| < 1) and
+kp by ``KP_SCALES``, ki by ``KI_SCALES`` times kp's factor (the integral corner ki/kp moves by ``KI_SCALES``
+alone) — a deterministic grid of 12 × 7 × 4 gain sets around the design, each the law's PID with its velocity
+feed-forward equal to kd. A candidate is feasible when, at every grid pose, the closed loop is stable (every pole |z| < 1) and
 each leg's loop, broken at its command with the other five closed, has at least the gain and phase margins
 asked for (``frequency.margins``). Among the feasible ones the tuner takes the largest worst-pose bandwidth:
 the lowest −3 dB frequency of the legs' set-point responses through the PID, without the feed-forward (the
@@ -95,7 +95,12 @@ class Evaluation:
     def meets(self, gain_margin_db: float, phase_margin_deg: float, bandwidth_hz: float | None = None) -> bool:
         ok = self.spectral_radius < 1 and self.gain_margin_db >= gain_margin_db
         ok = ok and self.phase_margin_deg >= phase_margin_deg
-        return ok and (bandwidth_hz is None or (self.bandwidth_hz or 0.0) >= bandwidth_hz)
+        return ok and (bandwidth_hz is None or self.bandwidth >= bandwidth_hz)
+
+    @property
+    def bandwidth(self) -> float:
+        """``bandwidth_hz``, inf where it is above the frequencies."""
+        return np.inf if self.bandwidth_hz is None else self.bandwidth_hz
 
     def to_dict(self) -> dict:
         return {
@@ -174,10 +179,11 @@ def tune_gains(
     bandwidth_hz: float | None = None,
     realise=None,
 ) -> tuple[Evaluation | None, Evaluation, list[Evaluation]]:
-    """``(chosen, best_margin, feasible)`` (each candidate evaluated as ``realise(gains)``, the gains the law
-    applies, e.g. the fixed law's Q15 words; None: as is): the feasible candidate with the largest worst-pose bandwidth (None:
-    none meets the margins and ``bandwidth_hz``), the candidate whose smaller margin excess is largest (to show
-    when none is feasible), and every feasible candidate, by bandwidth, largest first."""
+    """``(chosen, best_margin, feasible)``: the feasible candidate with the largest worst-pose bandwidth (None:
+    none meets the margins and ``bandwidth_hz``), the stable candidate whose smaller margin excess is largest (a
+    degree of phase counted as a fifth of a dB; shown when none is feasible), and every feasible candidate, by
+    bandwidth, largest first. Each candidate is evaluated as ``realise(gains)``: the gains the law applies,
+    e.g. the fixed law's Q15 words (None: as is)."""
     feasible, best, best_excess = [], None, -np.inf
     for g in candidates(design):
         ev = loops.evaluate(g if realise is None else realise(g))
@@ -188,7 +194,7 @@ def tune_gains(
             best, best_excess = ev, excess
         if ev.meets(gain_margin_db, phase_margin_deg, bandwidth_hz):
             feasible.append(ev)
-    feasible.sort(key=lambda e: -(e.bandwidth_hz or 0.0))
+    feasible.sort(key=lambda e: -e.bandwidth)
     return (feasible[0] if feasible else None), best, feasible
 
 
