@@ -333,7 +333,8 @@ def plan_run(
         gains = ControllerConfig.for_platform(platform, poses=poses).gains
     elif not nominal_gains:
         gains = ControllerConfig.for_platform(platform, timing, machine.actuators.time_constant, poses=poses).gains
-    if ctl.gains == "tune":  # the tuner, around the design, at plan time
+    # the tuner, around the design, at plan time (a Monte Carlo study's runs share the nominal design instead)
+    if ctl.gains == "tune" and not nominal_gains:
         designed = ControllerConfig.for_platform(platform, timing, gains=gains, **form)
         spec = LoopSpec.of(designed, actuators.time_constant, plant_step, feedforward)
         box = workspace_box(platform)
