@@ -775,6 +775,7 @@ class TuneError(StewartError):
     BANDWIDTH = "bandwidth must be a positive frequency below the Nyquist frequency {nyquist:g} Hz, got {value!r}"
     OUT_IS_MACHINE = "out {path} is the machine file itself: the original is never modified; name another file"
     OUT_EXISTS = "out {path} exists; name a new file, or pass --force to replace it"
+    OUT_FOLDER = "out {path} is a folder; name the machine file to write"
     PLANT_STEPS = (
         "run.plant_step {step:g} s must divide controller.period {period:g} s into whole steps for the loop's model"
     )

@@ -58,6 +58,8 @@ def run(args) -> int:
     out = Path(args.out)
     if out.exists() and out.resolve() == Path(args.machine).resolve():
         raise flag_error(TuneError(TuneError.OUT_IS_MACHINE.format(path=args.out)), FLAGS)
+    if out.is_dir():
+        raise flag_error(TuneError(TuneError.OUT_FOLDER.format(path=args.out)), FLAGS)
     if out.exists() and not args.force:
         raise flag_error(TuneError(TuneError.OUT_EXISTS.format(path=args.out)), FLAGS)
     options = {

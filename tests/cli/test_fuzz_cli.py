@@ -87,7 +87,7 @@ SAFE = {
 }
 # multi-start/homotopy FK, full simulations, Drake linearisation, branch checks and maps: seconds each
 SKIP = {"--all", "--help", "--version", "--simulate", "--drake", "--check-branches", "--map"}
-HEAVY = {"workspace", "simulate", "run", "report", "montecarlo", "response"}
+HEAVY = {"workspace", "simulate", "run", "report", "montecarlo", "response", "tune"}
 # The Meshcat viewer is interactive: without --duration it follows its sliders until Ctrl-C (the main
 # thread in time.sleep, Meshcat's server thread idle in a futex wait: what looked like a deadlock when it
 # ran in-process thousands of times). Every generated `view` vector is bounded by a --duration here.

@@ -30,12 +30,14 @@ def test_writes_the_tuned_machine_and_never_replaces_a_file_unasked(capsys, tmp_
     assert rc == 2 and "--out" in err and "--force" in err and out.read_text() == before
 
 
-def test_the_machine_file_itself_is_refused(capsys, tmp_path):
+def test_the_machine_file_itself_and_a_folder_are_refused(capsys, tmp_path):
     own = tmp_path / "m.yaml"
     own.write_text(Path(NEWCOMER).read_text())
     rc, _, err = cli(capsys, "tune", "--machine", own, "--out", own, "--force")
     assert rc == 2 and "is the machine file itself" in err
     assert own.read_text() == Path(NEWCOMER).read_text()
+    rc, _, err = cli(capsys, "tune", "--machine", own, "--out", tmp_path, "--force")
+    assert rc == 2 and err.startswith(f"stewart-drake tune: error: --out {tmp_path} is a folder")
 
 
 @pytest.mark.parametrize(
