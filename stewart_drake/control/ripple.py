@@ -131,13 +131,13 @@ def quantisation_ripple(model: LoopModel, length_lsb: float, sensor_resolution: 
     _, Ga, Cp = model.plant
     I6 = np.eye(6)
     _, Bc, _, Dc = (np.kron(X, I6) for X in controller_matrices(model.gains, model.T))
-    Dsp, Dm = Dc[:, :6], Dc[:, 6:]
     Z = np.zeros
-    # the closed loop's inputs per source (its B and the command's feed-through)
+    # the closed loop's input matrix per source: the set-point's, the measurement's (through the controller's
+    # direct term into the plant and into the controller's state), the command's (as the feed-forward's)
     inputs = {
-        "length_lsb": (model.B[:, :6], Dsp),
-        "sensor": (np.vstack([Ga @ Dm, Bc[:, 6:]]), Dm),
-        "command_word": (model.B[:, 6:], I6),
+        "length_lsb": model.B[:, :6],
+        "sensor": np.vstack([Ga @ Dc[:, 6:], Bc[:, 6:]]),
+        "command_word": model.B[:, 6:],
     }
     steps = {"length_lsb": length_lsb, "sensor": sensor_resolution, "command_word": command_range / 32768.0}
     # peak error per step: rounding (half a step) or the command word's truncation (a whole step)
@@ -155,7 +155,7 @@ def quantisation_ripple(model: LoopModel, length_lsb: float, sensor_resolution: 
     feeds["sensor"].append(Z((6, 6)))
     feeds["command_word"].append(I6)
     C_all = np.vstack(outs)  # (30, n): P, I, D, V, word
-    B_all = np.hstack([inputs[s][0] for s in SOURCES])  # (n, 18)
+    B_all = np.hstack([inputs[s] for s in SOURCES])  # (n, 18)
     D_all = np.hstack([np.vstack(feeds[s]) for s in SOURCES])  # (30, 18)
     abs_sum = np.abs(D_all)  # Σ|h_k| per output row and input, the feed-through h_0 first
     total = D_all.reshape(5, 6, 18).sum(axis=0)  # the command: the terms and the word added
