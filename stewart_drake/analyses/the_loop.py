@@ -81,10 +81,12 @@ def motion(machine: Machine, subject=None):
 
 def chosen_machine(machine: Machine, traj) -> Machine:
     """``machine`` with explicit gains: those designed for it over ``traj``'s poses (what a run of that motion
-    uses), so that every pose of the grid is studied with the same controller.
+    uses), so that every pose of the grid is studied with the same controller; ``run.fit`` off (``traj`` is fitted
+    already, and a held pose of the grid is not to be moved).
 
     HOOK (issue 38 items 3+4, ``sd.tune``): return the tuned machine here (its gains and word format) and the
     section shows and confirms them."""
+    machine = replace(machine, run=replace(machine.run, fit=False))
     g = plan_run(machine, traj, checks=False, command="report").config.gains
     return replace(machine, controller=replace(machine.controller, gains=Gains(g.kp, g.ki, g.kd, g.kv)))
 
@@ -123,9 +125,11 @@ def workspace_margins(machine: Machine, full: bool = True) -> list[dict]:
     return rows
 
 
-def worst(rows: list[dict]) -> dict:
-    """The grid's worst pose: the largest sensitivity peak (the loop's least distance from instability)."""
-    return max(rows, key=lambda r: r["peak"])
+def worst(rows: list[dict]) -> dict | None:
+    """The grid's worst pose where the loop is stable (an unstable loop has no steady response to measure): the
+    largest sensitivity peak (the loop's least distance from instability); None when it is stable nowhere."""
+    stable = [r for r in rows if r["rho"] < 1]
+    return max(stable, key=lambda r: r["peak"]) if stable else None
 
 
 def measured_response(machine: Machine, pose, law: str, count: int):
@@ -262,14 +266,14 @@ def margins_figure(results: dict):
     import matplotlib.pyplot as plt
 
     fig, (ax_g, ax_p) = plt.subplots(1, 2, figsize=(11, 3.6))
+    names = list(dict.fromkeys(r["pose"] for rows in results.values() for r in rows))  # a machine may lack a pose
     for name, rows in results.items():
-        x = np.arange(len(rows))
+        x = [names.index(r["pose"]) for r in rows]
         ax_g.plot(x, [min(r["gm"], 40.0) for r in rows], "o-", label=name)
         ax_p.plot(x, [min(r["pm"], 120.0) for r in rows], "o-", label=name)
-    names = max(results.values(), key=len)
     for ax, level, unit in ((ax_g, MIN_GAIN_MARGIN_DB, "dB"), (ax_p, MIN_PHASE_MARGIN_DEG, "deg")):
         ax.axhline(level, color="r", ls="--", lw=1, label=f"minimum {level:g} {unit}")
-        ax.set_xticks(range(len(names)), [r["pose"] for r in names], fontsize=8)
+        ax.set_xticks(range(len(names)), names, fontsize=8)
         ax.set_xlabel("pose of the workspace box (centre, face centres)")
         ax.grid(True, alpha=0.3)
     ax_g.set_ylabel("gain margin [dB]")
@@ -357,14 +361,15 @@ def _margins(section, results: dict, studied: str, full: bool) -> None:
         ],
         caption=f"{studied}: the loop at each pose of the grid (smallest margin over the six legs, each broken at "
         "its command with the others closed; bandwidth: the legs' own −3 dB; sensitivity peak: the largest singular "
-        "value of S)",
+        "value of S; |z| max: the largest closed-loop pole, ≥ 1 unstable, where the margins say nothing)",
         nan_reason="above the Nyquist frequency",
     )
     summary = []
     for name, rs in results.items():
-        g, p, s = min(rs, key=lambda r: r["gm"]), min(rs, key=lambda r: r["pm"]), worst(rs)
+        g, p = min(rs, key=lambda r: r["gm"]), min(rs, key=lambda r: r["pm"])
         bws = [r["bandwidth"] for r in rs if r["bandwidth"] is not None]
-        summary.append([name, len(rs), g["gm"], g["pose"], p["pm"], p["pose"], min(bws) if bws else np.nan, s["peak"]])
+        peak = max(r["peak"] for r in rs)
+        summary.append([name, len(rs), g["gm"], g["pose"], p["pm"], p["pose"], min(bws) if bws else np.nan, peak])
         margin_checks(section, name, rs)
     section.table(
         ["machine", "poses", "least GM dB", "at", "least PM deg", "at", "least bandwidth Hz", "worst peak"],
@@ -380,12 +385,16 @@ def _margins(section, results: dict, studied: str, full: bool) -> None:
     )
 
 
-def _bode(section, machine: Machine, row: dict, count: int) -> dict:
-    """The measured Bode plots at the worst pose, float and fine fixed-point laws, and their agreement check."""
-    responses = {}
-    for law in ("float", "fixed"):
-        r = measured_response(machine, row["q"], law, count)
-        responses[law] = r
+def bode_responses(machine: Machine, row: dict, count: int) -> dict:
+    """``{law: measured_response}`` at the grid row ``row``'s pose, the float law and the fine fixed-point law."""
+    return {law: measured_response(machine, row["q"], law, count) for law in ("float", "fixed")}
+
+
+def _bode(section, machine: Machine, row: dict, count: int) -> None:
+    """The measured Bode plots at the worst stable pose, float and fine fixed-point laws, and their agreement
+    checks."""
+    responses = bode_responses(machine, row, count)
+    for law, r in responses.items():
         if not r.measured:
             section.text(f"{law} law at {row['pose']}: the loop is unstable there, no steady response to measure.")
             continue
@@ -400,11 +409,10 @@ def _bode(section, machine: Machine, row: dict, count: int) -> dict:
     section.figure(
         bode_figure(responses, row["pose"]),
         "loop_bode",
-        f"Bode plots at the worst pose ({row['pose']}, sensitivity peak {row['peak']:.2f}): lines the linear model, "
+        f"Bode plots at the worst stable pose ({row['pose']}, sensitivity peak {row['peak']:.2f}): lines the linear model, "
         "circles the response measured on the nonlinear Drake loop with a set-point sine on leg 1 (float law; "
         f"fixed-point firmware at {fine_lsb(machine) * 1e6:g} µm).",
     )
-    return responses
 
 
 def _ripple(section, machine: Machine, runs: list[dict]) -> None:
@@ -466,7 +474,10 @@ def _study(section, machine: Machine, traj, margins: dict, runs: list[dict], qui
     )
     _margins(section, margins, name, s["full_grid"])
     w = worst(margins[name])
-    _bode(section, machine, w, s["measured"])
+    if w is None:
+        section.text(f"{name}: the loop is unstable at every pose of the grid: no steady response to measure.")
+    else:
+        _bode(section, machine, w, s["measured"])
     section.text(
         "Quantisation: the same gains with the fixed-point IK at coarser length LSBs. Each set-point step of one "
         "LSB reaches the actuator as kp·LSB, and on its first tick as kv·LSB/T through the set-point-rate "
@@ -480,16 +491,35 @@ def _study(section, machine: Machine, traj, margins: dict, runs: list[dict], qui
     )
 
 
-def _user_machine(section, subject) -> None:
-    s = _sizes(section.quick)
+def machine_study(subject, quick: bool) -> tuple:
+    """``(machine with its chosen gains, motion, {name: margins rows}, runs)`` of a user's machine (``_study``'s
+    inputs: the ripple sweep's runs then the confirmation run)."""
+    s = _sizes(quick)
     base = machine_of(subject)
     traj = motion(base, subject)
     machine = chosen_machine(base, traj)
     margins = {machine.loaded_platform.name: workspace_margins(machine, s["full_grid"])}
-    lsbs = ripple_lsbs(machine)
-    runs = [fixed_run(machine, traj, s["ripple_s"], lsb) for lsb in lsbs]
+    runs = [fixed_run(machine, traj, s["ripple_s"], lsb) for lsb in ripple_lsbs(machine)]
     runs.append(fixed_run(machine, traj, s["confirm_s"], machine.firmware.length_lsb))
-    _study(section, machine, traj, margins, runs, section.quick)
+    return machine, traj, margins, runs
+
+
+def docs_figures(subject) -> dict:
+    """The section's figures for a user's machine (``report.subject.Subject``), ``{"margins" | "bode" | "ripple":
+    Figure}``: the documentation's ``loop-*.png`` (``scripts/docs_hooks.py``)."""
+    machine, _, margins, runs = machine_study(subject, quick=False)
+    rows = margins[machine.loaded_platform.name]
+    w = worst(rows)
+    limit = CHATTER_RANGE_FRACTION * machine.loaded_platform.legs.max_force
+    predicted = predicted_ripple(machine, [r["lsb"] for r in runs[:-1]])
+    out = {"margins": margins_figure(margins), "ripple": ripple_figure(runs[:-1], limit, predicted)}
+    if w is not None:
+        out["bode"] = bode_figure(bode_responses(machine, w, _sizes(False)["measured"]), w["pose"])
+    return out
+
+
+def _user_machine(section, subject) -> None:
+    _study(section, *machine_study(subject, section.quick), section.quick)
 
 
 def build(section) -> None:
