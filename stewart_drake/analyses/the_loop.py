@@ -265,12 +265,19 @@ def margins_figure(results: dict):
     """Gain and phase margin at each grid pose, per machine (``{name: workspace_margins rows}``), with the minimums."""
     import matplotlib.pyplot as plt
 
-    fig, (ax_g, ax_p) = plt.subplots(1, 2, figsize=(11, 3.6))
+    fig, (ax_g, ax_p) = plt.subplots(1, 2, figsize=(11, 3.6), layout="constrained")
     names = list(dict.fromkeys(r["pose"] for rows in results.values() for r in rows))  # a machine may lack a pose
+    label = "unstable there (its margins say nothing)"
     for name, rows in results.items():
         x = [names.index(r["pose"]) for r in rows]
-        ax_g.plot(x, [min(r["gm"], 40.0) for r in rows], "o-", label=name)
-        ax_p.plot(x, [min(r["pm"], 120.0) for r in rows], "o-", label=name)
+        gm, pm = [min(r["gm"], 40.0) for r in rows], [min(r["pm"], 120.0) for r in rows]
+        ax_g.plot(x, gm, "o-", label=name)
+        ax_p.plot(x, pm, "o-", label=name)
+        bad = [k for k, r in enumerate(rows) if not r["rho"] < 1]
+        if bad:
+            ax_g.plot([x[k] for k in bad], [gm[k] for k in bad], "rx", ms=10, mew=2, label=label)
+            ax_p.plot([x[k] for k in bad], [pm[k] for k in bad], "rx", ms=10, mew=2)
+            label = None  # once in the legend
     for ax, level, unit in ((ax_g, MIN_GAIN_MARGIN_DB, "dB"), (ax_p, MIN_PHASE_MARGIN_DEG, "deg")):
         ax.axhline(level, color="r", ls="--", lw=1, label=f"minimum {level:g} {unit}")
         ax.set_xticks(range(len(names)), names, fontsize=8)
@@ -287,16 +294,19 @@ def bode_figure(responses: dict, pose_name: str):
     response's diagonal (right), the linear model as lines and the nonlinear loop's measured points as dots."""
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True, layout="constrained")
     for k, (law, r) in enumerate(responses.items()):
         f, style = r.frequencies, ("-", "--")[k % 2]
         h = r.setpoint[:, 0, 0]
+        phase = np.degrees(np.unwrap(np.angle(h)))
         axes[0, 0].semilogx(f, 20 * np.log10(np.abs(h)), style, color=f"C{k}", label=f"{law} law, linear model")
-        axes[1, 0].semilogx(f, np.degrees(np.unwrap(np.angle(h))), style, color=f"C{k}")
+        axes[1, 0].semilogx(f, phase, style, color=f"C{k}")
         for p in r.measured:
             m = p.response[p.leg]
+            ph = np.degrees(np.angle(m))
+            ph += 360.0 * np.round((np.interp(np.log(p.freq), np.log(f), phase) - ph) / 360.0)  # the line's branch
             axes[0, 0].semilogx([p.freq], [20 * np.log10(abs(m))], "o", color=f"C{k}", mfc="none", ms=6)
-            axes[1, 0].semilogx([p.freq], [np.degrees(np.angle(m))], "o", color=f"C{k}", mfc="none", ms=6)
+            axes[1, 0].semilogx([p.freq], [ph], "o", color=f"C{k}", mfc="none", ms=6)
         if k == 0:
             for i in range(6):
                 c = r.cartesian[:, i, i]
@@ -321,7 +331,7 @@ def ripple_figure(runs: list[dict], limit: float, predicted=None):
     """Simulated force ripple against the length LSB, the chatter limit, and the predicted ripple where given."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    fig, ax = plt.subplots(figsize=(6.5, 3.8), layout="constrained")
     lsb = np.array([r["lsb"] for r in runs]) * 1e6
     ax.loglog(lsb, [r["ripple"] for r in runs], "o-", label="simulated (fixed-point firmware, Drake plant)")
     if predicted is not None:
