@@ -146,14 +146,17 @@ def ripple_lsbs(machine: Machine) -> list[float]:
     """The ripple sweep's length LSBs (m): the fine one, ``RIPPLE_LSBS`` and the machine's own, ascending, each one
     whose ``WORD_BITS`` words hold the stroke."""
     fine = fine_lsb(machine)
-    return sorted({fine, machine.firmware.length_lsb, *(x for x in RIPPLE_LSBS if x > fine)})
+    return sorted({fine, *(x for x in (*RIPPLE_LSBS, machine.firmware.length_lsb) if x >= fine)})
 
 
-def fixed_run(machine: Machine, traj, duration: float, lsb: float) -> dict:
-    """The fixed-point loop (the C firmware) of ``machine`` along ``traj`` for ``duration`` s at length LSB ``lsb``
-    (m): ``{"lsb", "ripple" N (largest leg's RMS force about the quasi-static force), "ratio" (ripple / working
-    force), "error" m (max |leg length − IK(reference)|), "failures"}`` (``control.verdict.run_verdict``)."""
-    m = replace(machine, firmware=replace(machine.firmware, word_bits=WORD_BITS, length_lsb=lsb))
+def fixed_run(machine: Machine, traj, duration: float, lsb: float | None = None) -> dict:
+    """The fixed-point loop (the C firmware) of ``machine`` along ``traj`` for ``duration`` s, its IK in
+    ``WORD_BITS`` words of length LSB ``lsb`` (m; None: the machine's own format): ``{"lsb", "ripple" N (largest
+    leg's RMS force about the quasi-static force), "ratio" (ripple / working force), "error" m (max |leg length −
+    IK(reference)|), "failures"}`` (``control.verdict.run_verdict``)."""
+    m = machine
+    if lsb is not None:
+        m = replace(m, firmware=replace(m.firmware, word_bits=WORD_BITS, length_lsb=lsb))
     m = replace(m, controller=replace(m.controller, law="fixed"))
     plan = plan_run(m, traj, duration=duration, checks=False, command="report")
     sc = plan.scenario
@@ -162,7 +165,7 @@ def fixed_run(machine: Machine, traj, duration: float, lsb: float) -> dict:
     verdict, _ = run_verdict(sc.platform, sc.platform, sc.trajectory, log, sc.config, e, log.pose_error(sc.trajectory))
     chat = chatter_measure(sc.platform, sc.trajectory, log, sc.config)
     return {
-        "lsb": lsb,
+        "lsb": m.firmware.length_lsb,
         "ripple": max(chat["force_ripple_N"]),
         "ratio": chat["chatter_ratio"],
         "error": float(np.abs(e).max()),
@@ -217,9 +220,8 @@ def _run_part(item):
 
 def _run_items(name: str, quick: bool) -> list[tuple]:
     s = _sizes(quick)
-    m = _study_machine(name)[0]
-    items = [(name, s["ripple_s"], lsb) for lsb in ripple_lsbs(m)]
-    return items + [(name, s["confirm_s"], m.firmware.length_lsb)]
+    items = [(name, s["ripple_s"], lsb) for lsb in ripple_lsbs(load_machine(name))]
+    return items + [(name, s["confirm_s"], None)]
 
 
 def parts(quick: bool) -> list[tuple[str, tuple]]:
@@ -510,7 +512,7 @@ def machine_study(subject, quick: bool) -> tuple:
     machine = chosen_machine(base, traj)
     margins = {machine.loaded_platform.name: workspace_margins(machine, s["full_grid"])}
     runs = [fixed_run(machine, traj, s["ripple_s"], lsb) for lsb in ripple_lsbs(machine)]
-    runs.append(fixed_run(machine, traj, s["confirm_s"], machine.firmware.length_lsb))
+    runs.append(fixed_run(machine, traj, s["confirm_s"]))
     return machine, traj, margins, runs
 
 
