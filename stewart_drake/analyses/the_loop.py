@@ -32,12 +32,13 @@ from stewart_drake.spec import Gains, Machine, load_machine
 
 TITLE = "The loop: actuators, margins across the workspace, frequency response and quantisation"
 ORDER = 91
-COST = 20  # CPU seconds (full report, measured): the report's workers start the costliest first
+COST = 22  # CPU seconds (full report, measured): the report's workers start the costliest first
 NEEDS = ("plate", "legs.max_force")  # a user's machine: its plate is the plant, legs.max_force the command range
 
 PLATFORM = "utn-dynamic"  # the preset studied in full
 PRESETS = ("utn-dynamic", "utn-kinematic", "gonzalez-dutra-2009")  # the margins across the workspace of each
 AXES = ("x", "y", "z", "α", "β", "γ")
+LAWS = ("float", "fixed")  # the measured responses: the float law and the fixed-point firmware at the fine format
 # the measured points: log-spaced from MEASURE_LOW Hz to MEASURE_HIGH of the Nyquist frequency (where the
 # response has fallen far enough that the sine's command limit leaves a measurable amplitude)
 MEASURE_LOW, MEASURE_HIGH = 1.0, 0.4
@@ -207,9 +208,25 @@ def _study_machine(name: str) -> tuple[Machine, object]:
     return chosen_machine(m, traj), traj
 
 
+_MARGINS: dict = {}  # a preset's grid per process: the measured parts need its worst pose (computed once)
+
+
 def _margins_part(item):
-    name, full = item
-    return workspace_margins(_study_machine(name)[0], full)
+    if item not in _MARGINS:
+        name, full = item
+        _MARGINS[item] = workspace_margins(_study_machine(name)[0], full)
+    return _MARGINS[item]
+
+
+def _measure_part(item):
+    name, full, law, count = item
+    w = worst(_margins_part((name, full)))
+    return None if w is None else measured_response(_study_machine(name)[0], w["q"], law, count)
+
+
+def _measure_items(quick: bool) -> list[tuple]:
+    s = _sizes(quick)
+    return [(PLATFORM, s["full_grid"], law, s["measured"]) for law in LAWS]
 
 
 def _run_part(item):
@@ -225,9 +242,12 @@ def _run_items(name: str, quick: bool) -> list[tuple]:
 
 
 def parts(quick: bool) -> list[tuple[str, tuple]]:
-    """The independent heavy cases: each preset's margins over the grid, utn-dynamic's fixed-point runs."""
+    """The independent heavy cases: each preset's margins over the grid, utn-dynamic's measured responses and its
+    fixed-point runs."""
     full = _sizes(quick)["full_grid"]
-    return [("_margins_part", (n, full)) for n in PRESETS] + [("_run_part", it) for it in _run_items(PLATFORM, quick)]
+    out = [("_margins_part", (n, full)) for n in PRESETS]
+    out += [("_measure_part", it) for it in _measure_items(quick)]
+    return out + [("_run_part", it) for it in _run_items(PLATFORM, quick)]
 
 
 # --- the section ---------------------------------------------------------------------------------------------
@@ -399,13 +419,11 @@ def _margins(section, results: dict, studied: str, full: bool) -> None:
 
 def bode_responses(machine: Machine, row: dict, count: int) -> dict:
     """``{law: measured_response}`` at the grid row ``row``'s pose, the float law and the fine fixed-point law."""
-    return {law: measured_response(machine, row["q"], law, count) for law in ("float", "fixed")}
+    return {law: measured_response(machine, row["q"], law, count) for law in LAWS}
 
 
-def _bode(section, machine: Machine, row: dict, count: int) -> None:
-    """The measured Bode plots at the worst stable pose, float and fine fixed-point laws, and their agreement
-    checks."""
-    responses = bode_responses(machine, row, count)
+def _bode(section, machine: Machine, row: dict, responses: dict) -> None:
+    """The measured Bode plots at the worst stable pose (``bode_responses``) and their agreement checks."""
     for law, r in responses.items():
         if not r.measured:
             section.text(f"{law} law at {row['pose']}: the loop is unstable there, no steady response to measure.")
@@ -471,9 +489,9 @@ def _confirm(section, machine: Machine, run: dict, duration: float) -> None:
     )
 
 
-def _study(section, machine: Machine, traj, margins: dict, runs: list[dict], quick: bool) -> None:
+def _study(section, machine: Machine, traj, margins: dict, runs: list[dict], quick: bool, responses=None) -> None:
     """The full study of one machine (its margins in ``margins``, its fixed-point runs ``runs``: the ripple sweep
-    then the confirmation run)."""
+    then the confirmation run; ``responses``: its ``bode_responses`` if computed already)."""
     s = _sizes(quick)
     name = machine.loaded_platform.name
     _actuators(section, machine)
@@ -489,7 +507,7 @@ def _study(section, machine: Machine, traj, margins: dict, runs: list[dict], qui
     if w is None:
         section.text(f"{name}: the loop is unstable at every pose of the grid: no steady response to measure.")
     else:
-        _bode(section, machine, w, s["measured"])
+        _bode(section, machine, w, responses or bode_responses(machine, w, s["measured"]))
     section.text(
         "Quantisation: the same gains with the fixed-point IK at coarser length LSBs. Each set-point step of one "
         "LSB reaches the actuator as kp·LSB, and on its first tick as kv·LSB/T through the set-point-rate "
@@ -547,9 +565,11 @@ def build(section) -> None:
         "the time domain with the firmware in the loop."
     )
     margins = dict(zip(PRESETS, parallel_map(__file__, "_margins_part", [(n, full) for n in PRESETS])))
+    measured = parallel_map(__file__, "_measure_part", _measure_items(quick))
     runs = parallel_map(__file__, "_run_part", _run_items(PLATFORM, quick))
     machine, traj = _study_machine(PLATFORM)
-    _study(section, machine, traj, margins, runs, quick)
+    responses = dict(zip(LAWS, measured)) if all(r is not None for r in measured) else None
+    _study(section, machine, traj, margins, runs, quick, responses)
 
 
 def main(argv=None):
