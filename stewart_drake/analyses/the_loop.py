@@ -98,10 +98,9 @@ def fine_lsb(machine: Machine) -> float:
     return r * math.ceil(machine.loaded_platform.L_max / (2 ** (WORD_BITS - 1) - 1) / r * (1 - 1e-12))
 
 
-def fine_format(machine: Machine) -> Machine:
-    """``machine`` with the fine format: ``WORD_BITS`` words at ``fine_lsb``."""
-    fw = replace(machine.firmware, word_bits=WORD_BITS, length_lsb=fine_lsb(machine))
-    return replace(machine, firmware=fw)
+def with_lsb(machine: Machine, lsb: float) -> Machine:
+    """``machine``'s fixed-point IK in ``WORD_BITS`` words of length LSB ``lsb`` (m)."""
+    return replace(machine, firmware=replace(machine.firmware, word_bits=WORD_BITS, length_lsb=lsb))
 
 
 def workspace_margins(machine: Machine, full: bool = True) -> list[dict]:
@@ -136,7 +135,7 @@ def worst(rows: list[dict]) -> dict | None:
 def measured_response(machine: Machine, pose, law: str, count: int):
     """``sd.loop_response`` at ``pose`` with ``count`` points measured on the nonlinear Drake loop (leg 1) under
     ``law`` (``float``, or ``fixed`` at the fine format)."""
-    m = fine_format(machine) if law == "fixed" else machine
+    m = with_lsb(machine, fine_lsb(machine)) if law == "fixed" else machine
     m = replace(m, controller=replace(m.controller, law=law))
     nyquist = 0.5 / m.controller.period
     freqs = np.logspace(math.log10(MEASURE_LOW), math.log10(MEASURE_HIGH * nyquist), count)
@@ -151,13 +150,11 @@ def ripple_lsbs(machine: Machine) -> list[float]:
 
 
 def fixed_run(machine: Machine, traj, duration: float, lsb: float | None = None) -> dict:
-    """The fixed-point loop (the C firmware) of ``machine`` along ``traj`` for ``duration`` s, its IK in
+    """The fixed-point loop (the firmware) of ``machine`` along ``traj`` for ``duration`` s, its IK in
     ``WORD_BITS`` words of length LSB ``lsb`` (m; None: the machine's own format): ``{"lsb", "ripple" N (largest
     leg's RMS force about the quasi-static force), "ratio" (ripple / working force), "error" m (max |leg length −
     IK(reference)|), "failures"}`` (``control.verdict.run_verdict``)."""
-    m = machine
-    if lsb is not None:
-        m = replace(m, firmware=replace(m.firmware, word_bits=WORD_BITS, length_lsb=lsb))
+    m = machine if lsb is None else with_lsb(machine, lsb)
     m = replace(m, controller=replace(m.controller, law="fixed"))
     plan = plan_run(m, traj, duration=duration, checks=False, command="report")
     sc = plan.scenario
@@ -285,7 +282,7 @@ def margin_checks(section, label: str, rows: list[dict]) -> None:
 
 def margins_figure(results: dict):
     """Gain and phase margin at each grid pose, per machine (``{name: workspace_margins rows}``), with the minimums."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: pyplot is loaded when a figure is drawn
 
     fig, (ax_g, ax_p) = plt.subplots(1, 2, figsize=(11, 3.6), layout="constrained")
     names = list(dict.fromkeys(r["pose"] for rows in results.values() for r in rows))  # a machine may lack a pose
@@ -314,7 +311,7 @@ def margins_figure(results: dict):
 def bode_figure(responses: dict, pose_name: str):
     """Bode plots at the worst pose (``{law: LoopResponse}``): leg 1's set-point response (left) and the Cartesian
     response's diagonal (right), the linear model as lines and the nonlinear loop's measured points as dots."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: pyplot is loaded when a figure is drawn
 
     fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True, layout="constrained")
     for k, (law, r) in enumerate(responses.items()):
@@ -351,7 +348,7 @@ def bode_figure(responses: dict, pose_name: str):
 
 def ripple_figure(runs: list[dict], limit: float, predicted=None):
     """Simulated force ripple against the length LSB, the chatter limit, and the predicted ripple where given."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: pyplot is loaded when a figure is drawn
 
     fig, ax = plt.subplots(figsize=(6.5, 3.8), layout="constrained")
     lsb = np.array([r["lsb"] for r in runs]) * 1e6
