@@ -9,7 +9,7 @@ drift from them.
   with their outputs and figures by mkdocs-jupyter (``mkdocs.yml``: no cache, so a page never shows an earlier
   run's output; a notebook that raises fails the build);
 - ``img/*.png``: the figures of the prose pages, drawn by the package at build time (each preset's joints and legs,
-  the pose angles' sense, a workspace).
+  the pose angles' sense, a workspace, the report section "The loop" on the 210 kg example machine).
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from stewart_drake.cli import COMMANDS, build_parser
 log = logging.getLogger("mkdocs.hooks.stewart_drake")
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
+LOOP_MACHINE = ROOT / "examples" / "newcomer-210kg.yaml"  # the machine of the figures of "The loop" (loop-*.png)
 
 # Prose pages a command's reference links to (relative to the commands/ folder).
 SEE_ALSO = {
@@ -254,8 +255,10 @@ def figures() -> dict[str, bytes]:
     import matplotlib.pyplot as plt
 
     from stewart_drake import workspace as ws
+    from stewart_drake.analyses.the_loop import docs_figures
     from stewart_drake.core.geometry import PRESETS, load_preset
     from stewart_drake.design.drawings import convention_figure, platform_figure
+    from stewart_drake.report.subject import from_machine_file
     from stewart_drake.workspace.views import view_figures
 
     def png(fig) -> bytes:
@@ -270,6 +273,8 @@ def figures() -> dict[str, bytes]:
     views = view_figures(ws.constant_orientation_workspace(gd, resolution=0.02), title="gonzalez-dutra-2009")
     for name, fig in views.items():
         out[f"img/workspace-{name}.png"] = png(fig)
+    for name, fig in docs_figures(from_machine_file(LOOP_MACHINE)).items():
+        out[f"img/loop-{name}.png"] = png(fig)
     return out
 
 

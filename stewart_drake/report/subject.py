@@ -60,6 +60,8 @@ class Subject:
         requirements: the requirements file's resolved path, or None.
         files: every file the subject was read from (the machine or platform file, its requirements and motion
             files): the report's declared inputs, whose content keys its cached sections (``key``).
+        machine: the ``Machine`` as read (its controller, sensors and actuators), None for ``--platform`` (a
+            machine with the defaults: ``machine_of``).
     """
 
     name: str
@@ -70,11 +72,13 @@ class Subject:
     motions: tuple = ()
     requirements: str | None = None
     files: tuple = field(default=())
+    machine: Machine | None = None
 
     def key(self) -> str:
         """SHA-256 (hex) of the declared inputs: the subject as read (its pickled fields, every number exact) and
         each file's path and content."""
-        h = hashlib.sha256(pickle.dumps((self.name, self.platform, self.ik_format, self.motions), protocol=4))
+        fields = (self.name, self.platform, self.ik_format, self.motions, self.machine)
+        h = hashlib.sha256(pickle.dumps(fields, protocol=4))
         for f in self.files:
             h.update(f"{f}\0".encode() + hashlib.sha256(Path(f).read_bytes()).digest())
         return h.hexdigest()
@@ -217,7 +221,17 @@ def from_machine_file(path) -> Subject:
             )
         requirements = str(r.resolve())
         files.append(requirements)
-    return Subject(platform.name, platform, shown, frozenset(given), fmt, tuple(motions), requirements, tuple(files))
+    return Subject(
+        platform.name, platform, shown, frozenset(given), fmt, tuple(motions), requirements, tuple(files), machine
+    )
+
+
+def machine_of(subject: Subject) -> Machine:
+    """The machine the report runs for ``subject``: the machine file's, or its platform with every other section at
+    the defaults (``--platform``)."""
+    if subject.machine is not None:
+        return subject.machine
+    return load_machine(subject.platform)
 
 
 def subject_trajectories(subject: Subject) -> list[Trajectory]:

@@ -241,12 +241,14 @@ def test_what_a_section_needs(tmp_path):
 
 @pytest.mark.slow
 def test_the_whole_report_of_the_210_kg_machine(tmp_path):
-    """``sd.report(machine=...)``, quick: every section that applies to the machine passes; the ones that do not
+    """``sd.report(machine=...)``, quick: every section that applies to the machine passes but for the finding of
+    "The loop" (its designed gains miss the 6 dB / 30° margins: a failed check, issue 38); the ones that do not apply
     say why."""
     machine = tmp_path / "m.yaml"
     machine.write_text(MACHINE)
     r = sd.report(tmp_path / "r", machine=machine, quick=True, jobs=2)
-    assert r.ok, r.failed
+    findings = ("newcomer-6dof-sim: gain margin ≥ 6 dB", "newcomer-6dof-sim: phase margin ≥ 30°")
+    assert sorted(c.what.split(" at the grid")[0] for c in r.failed) == sorted(findings), r.failed
     ran = {c.section for c in r.checks}
     assert ran == {
         "Inverse kinematics vs Drake",
@@ -259,6 +261,7 @@ def test_the_whole_report_of_the_210_kg_machine(tmp_path):
         "Firmware certificate (proven word ranges, saturation and error bound over the workspace)",
         "Calibration: measured poses → calibrated platform file → regenerated firmware",
         "Robustness: Monte Carlo over tolerances, sensor, timing and payload",
+        "The loop: actuators, margins across the workspace, frequency response and quantisation",
     }
     page = r.index.read_text()
     # 7 presets-only sections and the requirements' proof (the file gives none)
