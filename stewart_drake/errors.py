@@ -1220,5 +1220,7 @@ class CueingError(StewartError):
     PARAMS_FILE = "{path}:{line}: {field}: {value} must be {rule}"
     POSES_TIMES = "poses ({n} rows) and t ({m} samples) must have one row per sample"
     SAME_TIMES = "the vehicle drive ({n} samples, step {dt} s) and the platform drive ({m}, step {dt2} s) must share t"
-    HOME_OUTSIDE = "the home pose {home} is outside the guard's stroke (with its margin {margin} m)"
+    HOME_OUTSIDE = (
+        "the home pose {home} is outside the guard's limits (the stroke less {margin} m at each end, joint cones)"
+    )
     NO_DRIVES = "tune_classical needs at least one drive"
