@@ -183,7 +183,7 @@ class WorkspaceGuard:
 
     def admissible_scale(self, e: np.ndarray) -> np.ndarray:
         """``(N,)``: for each excursion ``e`` ``(N, 6)`` from home, a scale in [0, 1] whose pose ``home + s e`` is
-        within the guard's stroke (1 when the whole excursion is), by bisection on the exact IK."""
+        within the guard's stroke and limits (1 when the whole excursion is), by bisection on the exact IK."""
         lo, hi = np.zeros(len(e)), np.ones(len(e))
         inside = self._inside(e)
         lo[inside] = 1.0
