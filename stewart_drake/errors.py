@@ -1192,7 +1192,6 @@ OPTION_LEG_DAMPING_RESOLVE = (
 class DriveError(InputError):
     """A vehicle-motion ("drive") file or value is malformed: messages name the file, line and column."""
 
-    COLUMNS = "{path}: a drive file's columns are {columns} (optionally {optional}); got {got}"
     PARQUET = "{path}: cannot read it as Parquet ({reason})"
     PARQUET_COLUMN = "{path}: column {column!r} is missing; a drive's columns are {columns}"
     PARQUET_VALUE = "{path}: row {row}, column {column!r}: values must be finite numbers, got {value}"
