@@ -20,6 +20,7 @@ import numpy as np
 from stewart_drake.api.result import Result, plain
 from stewart_drake.control import ControllerConfig, DspTiming, check_timing
 from stewart_drake.control.feasibility import infeasible_motion
+from stewart_drake.control.feedforward import feedforward_engine
 from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.control.verdict import run_verdict
@@ -604,6 +605,8 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "sample_period_s": timing.sample_period,
         "latency": timing.latency,
         "feedforward": sc.feedforward,
+        # the tables' inverse dynamics, "c" (compiled, within leg_forces_kernel.RELATIVE_TOLERANCE) or "numpy"
+        "feedforward_engine": feedforward_engine() if sc.feedforward else None,
         "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
         "firmware_format": {
             "word_bits": config.ik_format.word_bits,
