@@ -168,7 +168,7 @@ def loop(
     """CPU µs per tick of one closed-loop run (build excluded; the tick tables that ``run`` fills first
     included, their share noted in ``TABLES``). ``cold``: the feed-forward table computed, not remembered
     from an earlier run of the process; ``python``: the Python ticks instead of the compiled kernel; ``ff``:
-    the feed-forward's inverse dynamics (``"numpy"``; else the default, ``feedforward_engine()``)."""
+    the feed-forward's inverse dynamics (``"numpy"``; else the law's default, ``feedforward_engine``)."""
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
     if python:
         sim.controller.kernel = None
@@ -245,13 +245,13 @@ def dsp_side(p, kind: str, engine: str, duration: float) -> float:
 
 def table_memory(p, duration: float) -> tuple[int, int]:
     """``(peak bytes, table bytes)``: tracemalloc's peak while a cold feed-forward table of ``duration`` s is
-    computed (``FeedforwardTable.prime``, the default engine), and the table's own size."""
+    computed (``FeedforwardTable.prime``, the fixed-point loop's engine), and the table's own size."""
     from stewart_drake.control.feedforward import FeedforwardTable
     from stewart_drake.core.trajectory import get_trajectory
 
     TABLE_CACHE.clear()
     ticks = np.arange(int(round(duration / PERIOD)) + 1) * PERIOD
-    table = FeedforwardTable(p, get_trajectory("seed"), 3.5e-3, PERIOD)
+    table = FeedforwardTable(p, get_trajectory("seed"), 3.5e-3, PERIOD, feedforward_engine("fixed"))
     tracemalloc.start()
     try:
         rows = table.prime(ticks)
@@ -339,7 +339,7 @@ def main(argv=None) -> int:
     for k, f in alone.items():
         print(f"  {k:48s} {min(f() for _ in range(args.repeat)):6.2f} µs")
     print(
-        f"the feed-forward table's peak memory (tracemalloc; engine {feedforward_engine()}, {CHUNK_ROWS} ticks a chunk):"
+        f"the feed-forward table's peak memory (tracemalloc; engine {feedforward_engine('fixed')}, {CHUNK_ROWS} ticks a chunk):"
     )
     beyond = {}
     for seconds in MEMORY_RUNS_S:

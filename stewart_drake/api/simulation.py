@@ -606,7 +606,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "latency": timing.latency,
         "feedforward": sc.feedforward,
         # the tables' inverse dynamics, "c" (compiled, within leg_forces_kernel.RELATIVE_TOLERANCE) or "numpy"
-        "feedforward_engine": feedforward_engine() if sc.feedforward else None,
+        "feedforward_engine": feedforward_engine(sc.controller) if sc.feedforward else None,
         "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
         "firmware_format": {
             "word_bits": config.ik_format.word_bits,

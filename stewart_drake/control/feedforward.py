@@ -58,12 +58,14 @@ def feedforward_forces(
     return TABLE_CACHE.get(key, compute)
 
 
-def feedforward_engine() -> str:
-    """Which inverse dynamics computes a closed loop's tables (``FeedforwardTable``) here: ``"c"``
-    (``core.leg_forces_kernel``, compiled once per source into the shared build cache; a batch it cannot prove
-    well-conditioned runs numpy) or ``"numpy"`` (``dynamics.leg_forces_with_legs``, the reference and the
-    fallback: without a C compiler). The run's summary records it."""
-    return leg_forces_kernel.engine()
+def feedforward_engine(controller: str) -> str:
+    """Which inverse dynamics computes the tables (``FeedforwardTable``) of a loop with the ``controller`` law
+    (``"fixed"`` or ``"float"``) here: ``"c"`` (``core.leg_forces_kernel``, compiled once per source into the
+    shared build cache; a batch it cannot prove well-conditioned runs numpy) for the fixed-point law, which reads
+    the table as Q15 words, so that the tolerance reaches its log only where it moves a word across a rounding
+    boundary; ``"numpy"`` (``dynamics.leg_forces_with_legs``, the reference) for the float law, whose log would
+    carry every last bit, and everywhere without a C compiler. The run's summary records it."""
+    return leg_forces_kernel.engine() if controller == "fixed" else "numpy"
 
 
 CHUNK_ROWS = 4096  # ticks at a time: the numpy inverse dynamics' temporaries are ~7 kB a row
@@ -100,12 +102,11 @@ TABLE_CACHE = Memo(8)  # the last 8 feed-forward tables of this process
 
 
 class FeedforwardTable:
-    """``feedforward_forces`` of ``trajectory`` at tick times by ``feedforward_engine()``, filled in one batch by
-    ``prime(times)``; a time not in the table is computed on its own (same numbers)."""
+    """``feedforward_forces`` of ``trajectory`` at tick times by ``engine`` (``feedforward_engine``'s), filled in one
+    batch by ``prime(times)``; a time not in the table is computed on its own (same numbers)."""
 
-    def __init__(self, platform: Platform, trajectory: Trajectory, lead: float, h: float):
-        self.platform, self.trajectory, self.lead, self.h = platform, trajectory, lead, h
-        self.engine = feedforward_engine()
+    def __init__(self, platform: Platform, trajectory: Trajectory, lead: float, h: float, engine: str = "numpy"):
+        self.platform, self.trajectory, self.lead, self.h, self.engine = platform, trajectory, lead, h, engine
         self._primed: tuple = (np.zeros(0), np.zeros((0, 6)))
         self._table: dict[float, np.ndarray] | None = None
 
