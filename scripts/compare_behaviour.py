@@ -12,8 +12,8 @@ tolerance, not a difference, and a recording without them is not compared. Every
 Equality is exact: the same JSON types (an int is not a float, a bool is not an int), numbers bit for bit
 (JSON numbers parse to the shortest round-tripping float, so equal text means equal bits), strings and
 list lengths identical. Only the run-dependent fields listed in ``VOLATILE_KEYS``, ``VOLATILE_COLUMNS``,
-``REPORT_IGNORED`` and ``TEXT_SUBSTITUTIONS`` are removed before comparing, each with its reason; nothing
-else. Standard library only.
+``VOLATILE_HASHES``, ``REPORT_IGNORED`` and ``TEXT_SUBSTITUTIONS`` are removed before comparing, each with its
+reason; nothing else. Standard library only.
 """
 
 from __future__ import annotations
@@ -33,6 +33,11 @@ VOLATILE_KEYS = {
 # Columns removed from recorded CSV files (``csv_header``/``csv_rows``) and Parquet tables (``parquet``).
 VOLATILE_COLUMNS = {
     "wall_s": "montecarlo results.csv / results.parquet: each run's wall-clock time",
+}
+# Files whose SHA-256 in an output folder's ownership manifest (``.stewart-drake-manifest.json``) is not compared: the
+# file's own text is, less its volatile keys.
+VOLATILE_HASHES = {
+    "summary.json": "simulate: its text carries wall_s and real_time_factor, so its hash differs from run to run",
 }
 # Dict keys a later tree adds: absent from A and present in B, they are listed, not counted as a difference.
 ADDED_KEYS = {
@@ -98,8 +103,18 @@ def clean(obj):
     return obj
 
 
+def _drop_volatile_hashes(rec: dict) -> None:
+    """Remove the ``VOLATILE_HASHES`` from the ownership manifests among a call's files."""
+    for name, content in rec.get("files", {}).items() if isinstance(rec.get("files"), dict) else ():
+        if name.endswith(".stewart-drake-manifest.json") and isinstance(content, dict):
+            for entry, meta in content.get("files", {}).items():
+                if entry in VOLATILE_HASHES and isinstance(meta, dict):
+                    meta.pop("sha256", None)
+
+
 def load(path: Path) -> dict:
     rec = json.loads(path.read_text(encoding="utf-8"))
+    _drop_volatile_hashes(rec)
     if path.stem.startswith("report-"):
         rec = {k: v for k, v in rec.items() if k not in REPORT_IGNORED}
     return clean(rec)

@@ -3,7 +3,8 @@
  *
  * The same formulas in the same order as the numpy path (dynamics.plate_motion, _generalized_force, the legs'
  * universal-joint rates, J_tip^T f = tau_leg, J^T F = Q), not its bits: libm's sine and cosine, sums in written
- * order, 2 x 2, 3 x 3 and 6 x 6 solves by LU with partial pivoting (numpy: LAPACK/BLAS with fused multiply-adds).
+ * order, the 2 x 2 and 3 x 3 solves by LU with partial pivoting and J^T F = Q through the Gauss-Jordan inverse of
+ * the scaled J that also proves its condition (numpy: LAPACK/BLAS with fused multiply-adds).
  * The condition test of dynamics.leg_forces_from_jacobians is kinematics.condition_at_most's a-posteriori bound:
  * with X a Gauss-Jordan inverse of the scaled J (A), r = |I - X A|_F <= 1/2 and |A|_F |X|_F / (1 - r) <= limit/4
  * proves cond_2(A) <= limit. A row that fails it, has a zero or non-finite pivot, a non-finite input or result is
