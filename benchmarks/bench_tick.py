@@ -8,12 +8,16 @@ its reference, all measured in one run, interleaved, best of ``--repeat``:
 - the loops with their compiled DSP side (``firmware.loop_kernel``: one C call per stop): the fixed-point
   law with the generated firmware (C engine) and the float law, each with its tick tables computed cold
   (``TABLE_CACHE`` cleared: a report's or a study's first run) and remembered (every later run of the same
-  reference and model in the process); target ≥ 0.8 × the bare plant's real-time factor;
+  reference and model in the process); target ≥ 0.8 × the bare plant's real-time factor; the cold fixed/C
+  loop's feed-forward by the compiled inverse dynamics (``core.leg_forces_kernel``, the default) and by numpy
+  (the reference and the fallback);
 - the same loops with the Python ticks (``TickLoop._run_python``, the reference and the fallback) for
   comparison;
 - where a loop's tick goes: the tables, the thread CPU inside Drake's ``AdvanceTo`` (beside the bare plant's,
   the stopped plant's and the replay's: the plant's work along the loop's own motion) and outside it;
-- the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it).
+- the DSP side alone per tick, with ``AdvanceTo`` replaced by a no-op (load-robust: no Drake work in it);
+- the feed-forward table's peak memory (tracemalloc) for runs of 2, 20 and 200 s beside the table itself: the
+  target is a working memory independent of the run's length beyond the table (the log's own rows).
 
 Inside ``AdvanceTo``, one change at a time from the bare plant to the loop: ``bench_loop_drake.py``.
 
@@ -28,18 +32,20 @@ from __future__ import annotations
 import argparse
 import os
 import time
+import tracemalloc
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import numpy as np  # noqa: E402
 from bench_integrators import CONTINUOUS, apply_integrator  # noqa: E402  (benchmarks/ is the script's folder)
 
-from stewart_drake.control.feedforward import TABLE_CACHE  # noqa: E402
+from stewart_drake.control.feedforward import CHUNK_ROWS, TABLE_CACHE, feedforward_engine  # noqa: E402
 from stewart_drake.core.geometry import load_preset  # noqa: E402
 from stewart_drake.drake.integrators import DEFAULT_INTEGRATOR  # noqa: E402
 from stewart_drake.drake.simulation import Scenario, build_simulation  # noqa: E402
 
 TARGET = 0.8  # the loop's real-time factor over the bare plant's
+MEMORY_RUNS_S = (2.0, 20.0, 200.0)  # run lengths of the table's memory measure: below one chunk, 5 and 49 chunks
 NEWTON: dict[str, float] = {}  # CENIC's Newton iterations (Hessian factorisations) per step, per reference
 
 
@@ -156,13 +162,18 @@ def replayed_plant(p, kind: str, engine: str, duration: float) -> float:
 TABLES: dict[str, float] = {}  # CPU µs per tick of Simulation.prepare (the tick tables), per loop label
 
 
-def loop(p, label: str, kind: str, engine: str, duration: float, cold: bool, python: bool = False) -> float:
+def loop(
+    p, label: str, kind: str, engine: str, duration: float, cold: bool, python: bool = False, ff: str = ""
+) -> float:
     """CPU µs per tick of one closed-loop run (build excluded; the tick tables that ``run`` fills first
     included, their share noted in ``TABLES``). ``cold``: the feed-forward table computed, not remembered
-    from an earlier run of the process; ``python``: the Python ticks instead of the compiled kernel."""
+    from an earlier run of the process; ``python``: the Python ticks instead of the compiled kernel; ``ff``:
+    the feed-forward's inverse dynamics (``"numpy"``; else the law's default, ``feedforward_engine``)."""
     sim = build_simulation(Scenario(p, "seed", kind, engine=engine))
     if python:
         sim.controller.kernel = None
+    if ff:
+        sim.feedforward.engine = ff
     if cold:
         TABLE_CACHE.clear()
     else:
@@ -232,8 +243,28 @@ def dsp_side(p, kind: str, engine: str, duration: float) -> float:
     return 1e6 * (time.perf_counter() - t0) / (duration / PERIOD)
 
 
-LOOPS = {  # label: (kind, engine, cold tables, Python ticks)
+def table_memory(p, duration: float) -> tuple[int, int]:
+    """``(peak bytes, table bytes)``: tracemalloc's peak while a cold feed-forward table of ``duration`` s is
+    computed (``FeedforwardTable.prime``, the fixed-point loop's engine), and the table's own size."""
+    from stewart_drake.control.feedforward import FeedforwardTable
+    from stewart_drake.core.trajectory import get_trajectory
+
+    TABLE_CACHE.clear()
+    ticks = np.arange(int(round(duration / PERIOD)) + 1) * PERIOD
+    table = FeedforwardTable(p, get_trajectory("seed"), 3.5e-3, PERIOD, feedforward_engine("fixed"))
+    tracemalloc.start()
+    try:
+        rows = table.prime(ticks)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    TABLE_CACHE.clear()
+    return peak, rows.nbytes + ticks.nbytes  # the table and the tick times the caller holds
+
+
+LOOPS = {  # label: (kind, engine, cold tables, Python ticks, feed-forward engine)
     "fixed/C, cold tables": ("fixed", "c", True, False),
+    "fixed/C, cold tables, numpy feed-forward": ("fixed", "c", True, False, "numpy"),
     "fixed/C, remembered tables": ("fixed", "c", False, False),
     "float, cold tables": ("float", "python", True, False),
     "float, remembered tables": ("float", "python", False, False),
@@ -259,7 +290,7 @@ def main(argv=None) -> int:
     loop(p, "warm-up", "float", "python", 0.01, True)
     runs = {PLANT: lambda: plant(p, D), STOPPED: lambda: stopped_plant(p, D)}
     runs |= {label: (lambda a=a: replayed_plant(p, a[0], a[1], D)) for label, a in REPLAYS.items()}
-    runs |= {label: (lambda a=a, label=label: loop(p, label, a[0], a[1], D, a[2], a[3])) for label, a in LOOPS.items()}
+    runs |= {label: (lambda a=a, label=label: loop(p, label, *a[:2], D, *a[2:])) for label, a in LOOPS.items()}
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
         for k, f in runs.items():
@@ -307,6 +338,22 @@ def main(argv=None) -> int:
     }
     for k, f in alone.items():
         print(f"  {k:48s} {min(f() for _ in range(args.repeat)):6.2f} µs")
+    print(
+        f"the feed-forward table's peak memory (tracemalloc; engine {feedforward_engine('fixed')}, {CHUNK_ROWS} ticks a chunk):"
+    )
+    beyond = {}
+    for seconds in MEMORY_RUNS_S:
+        peak, own = table_memory(p, seconds)
+        beyond[seconds] = peak - own
+        print(
+            f"  {seconds:5.0f} s run: peak {peak / 1e6:7.2f} MB = the table and its times {own / 1e6:7.2f} MB + {beyond[seconds] / 1e6:5.2f} MB working"
+        )
+    ok = beyond[MEMORY_RUNS_S[-1]] <= 1.1 * beyond[MEMORY_RUNS_S[1]]
+    print(
+        f"  target: working memory independent of the run's length beyond the table (from one chunk on): "
+        f"{MEMORY_RUNS_S[-1]:.0f} s vs {MEMORY_RUNS_S[1]:.0f} s {beyond[MEMORY_RUNS_S[-1]] / beyond[MEMORY_RUNS_S[1]]:.2f}x; "
+        f"{'met' if ok else 'NOT met'}"
+    )
     print(f"# {load()}")
     return 0
 

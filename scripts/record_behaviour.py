@@ -11,7 +11,9 @@ repository this script sits in, and writes one ``OUTDIR/NN-name.json`` per call:
 ``files`` holds what the call wrote into its output folder or file: JSON (and JSON-lines) files parsed, CSV files
 as header + rows of strings (the text as written, so numbers compare bit for bit), other text files as their
 lines, NumPy ``.npz`` archives as the SHA-256 of each member (a zip's own timestamps are not data), Parquet
-files as their columns (read by pyarrow in a child process), any other binary (PNG) as its SHA-256 and size. Then it runs ``report --quick`` and
+files as their columns (read by pyarrow in a child process), any other binary (PNG) as its SHA-256 and size. Then it
+records the fixed-point loop's feed-forward words (``FEEDFORWARD_CASES``, ``OUTDIR/feedforward-words.json``: a child
+process of the recorded tree, the one place this script runs the package's Python API) and runs ``report --quick`` and
 (unless ``--quick-report``) the full ``report`` and copies each one's ``checks.json`` (parsed) with its exit
 code into ``OUTDIR/report-quick.json`` / ``OUTDIR/report-full.json``; ``OUTDIR/manifest.json`` lists the
 calls, the interpreter, the repository's git commit and the wall times.
@@ -175,6 +177,19 @@ CALLS: list[tuple[str, list[str], str | None]] = [
 REPORTS = [("report-quick", ["report", "--quick", "--out", "report-quick"], "report-quick"),
            ("report-full", ["report", "--out", "report-full"], "report-full")]
 
+# The fixed-point loop's feed-forward table as the Q15 words the law reads (issue 42 item 2: the table may be computed
+# within a stated tolerance, and ``compare_behaviour`` lists the ticks where that moved a word). (name, machine (a
+# preset or a file under the repository), trajectory, duration s, ``plan_run`` options): the simulate calls'
+# fixed-point runs above, and 2 s of both references on the three presets (fitted to the two they were not made for)
+# and the 210 kg machine (its payload, its own fit).
+FEEDFORWARD_CASES = [
+    ("simulate-fixed-cenic", "utn-dynamic", "seed", 0.15, {}),
+    ("simulate-fixed-c-rotating", "utn-dynamic", "rotating", 0.1, {"latency": "none"}),
+    *((f"utn-dynamic-{t}", "utn-dynamic", t, 2.0, {}) for t in ("seed", "rotating")),
+    *((f"{m}-{t}", m, t, 2.0, {"fit": True}) for m in ("utn-kinematic", "gonzalez-dutra-2009") for t in ("seed", "rotating")),
+    *((f"newcomer-210kg-{t}", "examples/newcomer-210kg.yaml", t, 2.0, {}) for t in ("seed", "rotating")),
+]
+
 # fmt: on
 
 TEXT_LIMIT = 2_000_000  # bytes: larger text files are recorded by hash
@@ -290,6 +305,42 @@ def run_call(name: str, argv: list[str], out: str | None, tmp: Path, env: dict, 
     return normalise(rec, str(tmp), str(REPO)), wall
 
 
+_FEEDFORWARD_WORDS = """
+import json, sys
+from pathlib import Path
+from stewart_drake.api.simulation import plan_run
+from stewart_drake.drake.simulation import build_simulation
+from stewart_drake.spec import load_machine
+out = {}
+for name, machine, trajectory, duration, options in json.loads(sys.argv[1]):
+    if machine.endswith(".yaml"):
+        machine = load_machine(Path(sys.argv[2]) / machine)
+    plan = plan_run(machine, trajectory, "fixed", duration, engine="c", **options)
+    sim = build_simulation(plan.scenario)
+    sim.prepare(duration)
+    words = sim.controller.law.feedforward_words(sim.controller.feedforward)
+    out[name] = {"engine": getattr(sim.feedforward, "engine", "numpy"), "words": words.tolist()}
+print(json.dumps(out))
+"""
+
+
+def record_feedforward_words(env: dict, tmp: Path) -> dict:
+    """The ``FEEDFORWARD_CASES``' Q15 feed-forward words, per case ``{"engine", "words": (ticks, 6) ints}``, computed
+    in a child process of the recorded tree (``plan_run`` and ``build_simulation`` as ``simulate`` calls them)."""
+    cases = json.dumps(FEEDFORWARD_CASES)
+    p = subprocess.run(
+        [PYTHON, "-c", _FEEDFORWARD_WORDS, cases, str(REPO)],
+        cwd=tmp,
+        env=env,
+        check=False,
+        capture_output=True,
+        text=True,
+    )
+    if p.returncode != 0:
+        return {"error": p.stderr.strip().splitlines()[-1:]}
+    return json.loads(p.stdout)
+
+
 def git_commit() -> str:
     try:
         return subprocess.run(
@@ -334,6 +385,12 @@ def main(argv=None) -> int:
             (outdir / f"{name}.json").write_text(json.dumps(rec, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
             print(f"{name}: exit {rec['exit_code']}, {wall:.1f} s", flush=True)
         t_calls = time.perf_counter() - t_all
+        if not args.only:
+            t0 = time.perf_counter()
+            rec = {"name": "feedforward-words", "cases": record_feedforward_words(env, tmp)}
+            walls["feedforward-words"] = round(time.perf_counter() - t0, 2)
+            (outdir / "feedforward-words.json").write_text(json.dumps(rec) + "\n", encoding="utf-8")
+            print(f"feedforward-words: {len(rec['cases'])} cases, {walls['feedforward-words']:.1f} s", flush=True)
         for name, argv_, out in reports:
             rec, wall = run_call(name, argv_, None, tmp, env, max(args.timeout, 1800.0))
             checks = tmp / out / "checks.json"

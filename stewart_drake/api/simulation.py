@@ -20,6 +20,7 @@ import numpy as np
 from stewart_drake.api.result import Result, plain
 from stewart_drake.control import ControllerConfig, DspTiming, check_timing
 from stewart_drake.control.feasibility import infeasible_motion
+from stewart_drake.control.feedforward import feedforward_engine
 from stewart_drake.control.gains import PidGains
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.control.tuning import LoopSpec, tuned_gains
@@ -612,6 +613,8 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "sample_period_s": timing.sample_period,
         "latency": timing.latency,
         "feedforward": sc.feedforward,
+        # the tables' inverse dynamics, "c" (compiled, within leg_forces_kernel.RELATIVE_TOLERANCE) or "numpy"
+        "feedforward_engine": feedforward_engine(sc.controller) if sc.feedforward else None,
         "gains": {k: getattr(config.gains, k) for k in ("kp", "ki", "kd", "kv")},
         "firmware_format": {
             "word_bits": config.ik_format.word_bits,

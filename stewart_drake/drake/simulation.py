@@ -37,7 +37,12 @@ from pydrake.systems.analysis import Simulator
 from tqdm import tqdm
 
 from stewart_drake.control.actuation import Actuation
-from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
+from stewart_drake.control.feedforward import (
+    FeedforwardTable,
+    feedforward_engine,
+    feedforward_lead,
+    initial_leg_forces,
+)
 from stewart_drake.control.gains import ControllerConfig
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.core.geometry import Platform
@@ -323,7 +328,8 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
         )
     ff = None
     if s.feedforward:
-        ff = FeedforwardTable(platform, trajectory, feedforward_lead(config, actuators.time_constant), T)
+        lead = feedforward_lead(config, actuators.time_constant)
+        ff = FeedforwardTable(platform, trajectory, lead, T, feedforward_engine(s.controller))
     simulator = Simulator(diagram)
     apply_integrator(simulator, integrator, plant_time_step)
     root = simulator.get_mutable_context()

@@ -16,7 +16,13 @@ import numpy as np
 
 from stewart_drake.control import dsp_state
 from stewart_drake.control.actuation import Actuation
-from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
+from stewart_drake.control.feedforward import (
+    FeedforwardTable,
+    feedforward_engine,
+    feedforward_lead,
+    initial_leg_forces,
+)
+from stewart_drake.control.laws import FloatLaw
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.engines.plate import plate_state
@@ -61,7 +67,9 @@ def dsp_loop(
         law.prime(ref)
     ff = None
     if feedforward:
-        ff = FeedforwardTable(platform, trajectory, feedforward_lead(law.config, time_constant), T).prime(ticks)
+        controller = "float" if isinstance(law, FloatLaw) else "fixed"  # the Drake loop's table (``drake.simulation``)
+        lead = feedforward_lead(law.config, time_constant)
+        ff = FeedforwardTable(platform, trajectory, lead, T, feedforward_engine(controller)).prime(ticks)
     h = RATE_STEP
     qm, q0, qp = trajectory.pose(np.array([-h, 0.0, h]))
     L0 = leg_lengths(platform, q0)

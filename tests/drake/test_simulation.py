@@ -107,7 +107,9 @@ def test_tick_tables_hold_the_values_of_one_time_at_a_time(kind):
     rows, table = primed_sim.controller.feedforward, primed_sim.feedforward
     assert len(rows) == len(primed.t_ref)
     for row, t in zip(rows, primed.t_ref):
-        np.testing.assert_array_equal(row, feedforward_forces(PLATFORM, traj, [t], table.lead, table.h)[0])
+        np.testing.assert_array_equal(
+            row, feedforward_forces(PLATFORM, traj, [t], table.lead, table.h, table.engine)[0]
+        )
     sim = build_simulation(Scenario(PLATFORM, traj, kind))
     sim.controller.law.prime = lambda poses: None
     bare = sim.run(0.1)

@@ -14,7 +14,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput, MatrixGain
 
 from stewart_drake.control import ControllerConfig, DspTiming
-from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
+from stewart_drake.control.feedforward import FeedforwardTable, feedforward_engine, feedforward_lead, initial_leg_forces
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import SEED
@@ -50,7 +50,8 @@ def all_drake_run(sc: Scenario, duration: float) -> dict:
         D[i, plant.GetJointByName(f"prismatic_{i + 1}").position_start()] = 1.0
     sensor = b.AddSystem(MatrixGain(D))
     T = cfg.timing.sample_period
-    ff = FeedforwardTable(PLATFORM, SEED, feedforward_lead(cfg, sc.actuators.time_constant), T)
+    lead = feedforward_lead(cfg, sc.actuators.time_constant)
+    ff = FeedforwardTable(PLATFORM, SEED, lead, T, feedforward_engine(sc.controller))  # the loop's own table
     ff.prime(np.arange(int(duration / T + 1e-9) + 1) * T)
     ffs = b.AddSystem(_FeedforwardSource(ff))
     b.Connect(src.get_output_port(), ctrl.GetInputPort("reference"))
