@@ -6,8 +6,7 @@ format confirmed on the motion with the real firmware in the loop. On the preset
 utn-dynamic; on a user's machine (``report.subject``) all of it on that machine.
 
 Hooks for the pieces of issue 38 built beside this one (each a few lines, marked ``HOOK``): the actuator model's
-parameters (``actuator_rows``), the predicted ripple (``predicted_ripple``) and tuned gains and format
-(``chosen_machine``).
+parameters (``actuator_rows``), and the predicted ripple (``predicted_ripple``, ``control.ripple``).
 """
 
 from __future__ import annotations
@@ -87,8 +86,8 @@ def chosen_machine(machine: Machine, traj) -> Machine:
     uses), so that every pose of the grid is studied with the same controller; ``run.fit`` off (``traj`` is fitted
     already, and a held pose of the grid is not to be moved).
 
-    HOOK (issue 38 items 3+4, ``sd.tune``): return the tuned machine here (its gains and word format) and the
-    section shows and confirms them."""
+    The section judges these, the gains the machine runs with; ``stewart-drake tune`` designs gains for the whole
+    box (``api.tune``), and a machine file that holds them is studied with them."""
     machine = replace(machine, run=replace(machine.run, fit=False))
     g = plan_run(machine, traj, checks=False, command="report").config.gains
     return replace(machine, controller=replace(machine.controller, gains=Gains(g.kp, g.ki, g.kd, g.kv)))
