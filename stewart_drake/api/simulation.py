@@ -40,7 +40,9 @@ from stewart_drake.errors import (
     OPTION_DURATION_PERIOD,
     OPTION_ENGINE_FIXED,
     OPTION_FIRMWARE_ENGINE,
+    PIL_STOPPED,
     SIMULATION_GAP_WARNING,
+    FirmwareError,
     MachineError,
     OptionError,
     PhysicalLimitError,
@@ -339,6 +341,10 @@ def plan_run(
     if firmware and engine == "python":
         raise UsageError(OPTION_FIRMWARE_ENGINE)
     engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command.split()[0]}")
+    pil = machine.pil if machine.pil.target else None
+    if pil is not None and (controller != "fixed" or firmware):
+        law = "user firmware's" if firmware else controller
+        raise FirmwareError(FirmwareError.PIL_LAW.format(target=pil.target, law=law))
     scenario = Scenario(
         platform,
         traj,
@@ -353,6 +359,8 @@ def plan_run(
         plant_platform=plant_platform,
         sensor=sensor,
         duration=duration,
+        pil=pil,
+        seed=machine.run.seed,
     )
     read_units = {"length": length_unit, "angle": angle_unit} if csv else None
     return RunPlan(scenario, timing, duration, tuple(warnings), read_units, time_limit, machine)
@@ -580,9 +588,13 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         log, gap, tick_loop = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
     else:
         sim = build_simulation(sc, meshcat=meshcat)
-        log = sim.run(plan.duration, progress=progress)
+        try:
+            log = sim.run(plan.duration, progress=progress)
+            pil = sim.controller.law.report() if sc.pil is not None else None
+        finally:
+            sim.close()
         gap = sim.max_constraint_gap()
-        tick_loop = sim.tick_loop
+        tick_loop = "pil" if sc.pil is not None else sim.tick_loop
     t_wall = time.perf_counter() - t_wall
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -635,6 +647,10 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         if on_warning:
             on_warning(w)
     summary.update(loop)
+    if sc.pil is not None:
+        summary["pil"] = pil
+        if pil["stopped_at_tick"] is not None:
+            verdict["failures"].append(PIL_STOPPED.format(**pil))
     summary.update(verdict)
     summary["warnings"] = warnings
     return SimulationResult(plain(summary), Log(log, e, pe), verdict, warnings, plan)

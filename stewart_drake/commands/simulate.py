@@ -113,6 +113,26 @@ def register(sub) -> None:
         metavar="DIR",
         help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)",
     )
+    p.add_argument(
+        "--pil",
+        default=None,
+        metavar="TARGET",
+        help="processor in the loop: each tick computed by the firmware on qemu (the Cortex-M4 build in QEMU's "
+        "mps2-an386) or serial:/dev/ttyX (a flashed board) over the PIL link (pil.target)",
+    )
+    p.add_argument(
+        "--pil-fault",
+        default=None,
+        metavar="KIND:RATE|KIND:@K,...",
+        help="inject link faults: drop, corrupt, delay or duplicate at a seeded rate a tick (drop:0.01) or at "
+        "given ticks (corrupt:@10,200) (pil.fault)",
+    )
+    p.add_argument(
+        "--pil-on-fault",
+        default=None,
+        choices=["hold", "stop"],
+        help="a tick without a command: hold the last command (default) or stop (zero force, exit 1) (pil.on_fault)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument(
         "--allow-out-of-stroke",
@@ -184,7 +204,10 @@ def run(args) -> int:
     except StewartError as e:
         raise flag_error(e, {**FLAG_PATHS, **KEYWORD_FLAGS}) from None
     warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w, FLAG_PATHS)}", file=sys.stderr)  # noqa: E731
-    result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
+    try:  # a PIL target is started by the run: its errors name spec paths too
+        result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
+    except StewartError as e:
+        raise flag_error(e, FLAG_PATHS) from None
     summary = result.to_dict()
     out = Path(args.out)
     with atomic_folder(out_folder) as tmp:
