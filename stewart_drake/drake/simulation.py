@@ -55,10 +55,10 @@ from stewart_drake.drake.integrators import (
 from stewart_drake.drake.loop_diagram import VISUALIZER_PERIOD, loop_diagram
 from stewart_drake.drake.platform_model import set_pose
 from stewart_drake.drake.systems import make_law
-from stewart_drake.firmware.pil import PilLaw
-from stewart_drake.spec.machine import PilSpec
 from stewart_drake.drake.tick_loop import IdealSensor, SensorReading, TickLoop, periodic_times
 from stewart_drake.errors import SimulationError
+from stewart_drake.firmware.pil import PilLaw
+from stewart_drake.spec.machine import PilSpec
 
 # ----------------------------------------------------------------------------------------------
 # The scenario: what a run is, as plain data.

@@ -17,6 +17,8 @@ frames the host sends (``PilFaults``).
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from stewart_drake.control.gains import ControllerConfig
@@ -37,6 +39,22 @@ CORRUPT_BYTE = 8  # the byte of a SENSOR frame a corrupt fault flips (inside the
 # no memory wait states (the AN386's SSRAM; an STM32F405's flash at 168 MHz hides its 5 through the ART cache)
 M4_CYCLES_PER_INSTRUCTION = 1.0
 M4_CLOCKS_HZ = {"stm32f405_168mhz": 168e6, "an386_25mhz": 25e6}
+
+
+def program_module(platform: Platform, config: ControllerConfig, generated=None) -> dict:
+    """The generated module (name -> text) the target runs for ``platform`` and ``config``, with its options
+    recorded (``fingerprint.stamp``: the link's handshake compares their fingerprint); ``generated``: the
+    ``generate(platform, config)`` result if the caller has it."""
+    g = generated if generated is not None else generate(platform, config)
+    ik, t = config.ik_format, config.timing
+    options = {**DEFAULTS, "platform": platform.name, "platform_hash": platform_hash(platform)}
+    options |= {"word_bits": ik.word_bits, "length_lsb": ik.length_lsb, "trig": ik.trig}
+    options |= {
+        "convention": config.convention,
+        "rate": 1.0 / t.sample_period,
+        "sensor_resolution": t.sensor_resolution,
+    }
+    return stamp(g.files, options)
 
 
 class PilFaults:
@@ -64,13 +82,8 @@ class PilLaw(FixedPointLaw):
         if not spec.target:
             raise ValueError("PilLaw without pil.target")  # a caller's bug: the spec chooses this law
         self.spec, self.faults = spec, PilFaults(spec, seed)
-        options = {**DEFAULTS, "platform": platform.name, "platform_hash": platform_hash(platform)}
-        ik, t = self.config.ik_format, self.timing
-        options |= {"word_bits": ik.word_bits, "length_lsb": ik.length_lsb, "trig": ik.trig}
-        options |= {"convention": self.config.convention, "rate": 1.0 / t.sample_period}
-        options |= {"sensor_resolution": t.sensor_resolution}
         self.generated = generate(self.platform, self.config)
-        self.files = stamp(self.generated.files, options)
+        self.files = program_module(self.platform, self.config, self.generated)
         self.target = open_target(spec.target, self.files)
         try:
             fp = format_fingerprint(self.files["sd_firmware.h"].splitlines()[0])
@@ -85,6 +98,7 @@ class PilLaw(FixedPointLaw):
         self._delayed: bytes | None = None
         self.tick_count = 0
         self.clock_counts: list[int] = []
+        self.latencies: list[float] = []  # s, each tick's round trip (SENSOR written to COMMAND read)
         self.events: list[dict] = []  # each injected fault and each tick without a command
         self.stopped_at: int | None = None
 
@@ -128,9 +142,11 @@ class PilLaw(FixedPointLaw):
         ff = None
         if feedforward is not None:
             ff = np.clip(np.rint(np.asarray(feedforward, dtype=float) / t.command_range * 32768.0), -32768, 32767)
+        sent = time.perf_counter()
         reply = self._guard(self._exchange, words, counts, ff)
         if reply is None:
             return self._react(state)
+        self.latencies.append(time.perf_counter() - sent)
         self.clock_counts.append(reply.clock)
         command = np.asarray(reply.command, dtype=float) / 32768.0 * float(t.command_range)
         setpoint = np.asarray(reply.setpoint, dtype=float) * float(self.config.ik_format.length_lsb)
@@ -206,6 +222,13 @@ class PilLaw(FixedPointLaw):
             "host_counters": self.host.counters.to_dict(),
             "target_counters": target,
             "timing": timing,
+            "round_trip_s": None
+            if not self.latencies
+            else {
+                "median": float(np.median(self.latencies)),
+                "p99": float(np.percentile(self.latencies, 99)),
+                "max": float(np.max(self.latencies)),
+            },
         }
 
     def close(self) -> None:

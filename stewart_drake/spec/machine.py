@@ -211,7 +211,7 @@ class PilSpec:
     target: str | None = None
     fault: str | None = None
     on_fault: str = "hold"
-    timeout: float = 1.0
+    timeout: float = 5.0
 
     def __post_init__(self):
         t = self.target
