@@ -22,8 +22,8 @@ import numpy as np
 
 import stewart_drake as sd
 from stewart_drake.api.simulation import plan_run
-from stewart_drake.firmware.link import LinkHost, format_fingerprint
 from stewart_drake.firmware.generate import generate
+from stewart_drake.firmware.link import LinkHost, format_fingerprint
 from stewart_drake.firmware.module import TickRunner, compile_generated
 from stewart_drake.firmware.pil import program_module
 from stewart_drake.firmware.pil_target import QemuTarget, target_elf
