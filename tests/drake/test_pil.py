@@ -9,6 +9,7 @@ this 2-core machine under load), so the three 10⁴-tick runs (marked slow) take
 run 150-300 ticks.
 """
 
+import json
 import os
 import shutil
 import signal
@@ -120,19 +121,19 @@ def test_a_duplicated_frame_is_counted_and_ignored():
 
 @needs_qemu
 def test_stop_commands_zero_force_and_fails_the_run(tmp_path, capsys):
-    machine = "utn-dynamic"
     args = ["--pil", "qemu", "--pil-fault", f"drop:@{FAULT_TICK}", "--pil-on-fault", "stop", "--duration", "0.1"]
-    rc, out, err = cli(capsys, "simulate", "--machine", machine, *args, "--set", "pil.timeout=2s",
-                       "--out", str(tmp_path / "s"), "--no-progress")  # fmt: skip
+    out = tmp_path / "s"
+    rc, _, err = cli(capsys, "simulate", *args, "--set", f"pil.timeout={TIMEOUT}", "--out", str(out), "--no-progress")
     assert rc == 1, err
-    r = sd.simulate(machine, duration=0.1, **{"pil.target": "qemu", "pil.fault": f"drop:@{FAULT_TICK}",
-                                              "pil.on_fault": "stop", "pil.timeout": "2s"})  # fmt: skip
-    p = r.summary["pil"]
-    assert p["stopped_at_tick"] == FAULT_TICK
-    assert PIL_STOPPED.format(**p) in r.verdict["failures"] and not r.ok
-    assert PIL_STOPPED.format(**p).replace("pil.timeout", "--set pil.timeout") in err or "PIL link: tick 40" in err
-    t = r.log["t"]
-    assert np.all(r.log["command"][t > (FAULT_TICK + 1) * 1e-3] == 0.0)  # released a tick later (latency sample)
+    summary = json.loads((out / "summary.json").read_text())
+    p = summary["pil"]
+    assert p["stopped_at_tick"] == FAULT_TICK and p["events"][-1] == {"tick": FAULT_TICK, "no_command": "stop"}
+    assert summary["failures"][-1] == PIL_STOPPED.format(**p)  # after the fall it causes (tracking lost)
+    assert f"stewart-drake simulate: {PIL_STOPPED.format(**p)}" in err
+    log = np.load(out / "log.npz")
+    t, command = log["t"], log["command"]
+    # tick k's command is released at (k + 1)·T (latency sample): zero from the faulty tick's release on
+    assert np.all(command[t > FAULT_TICK * 1e-3] == 0.0) and np.any(command[t < FAULT_TICK * 1e-3] != 0.0)
 
 
 def test_fault_draws_follow_the_seed():
