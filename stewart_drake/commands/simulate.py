@@ -222,9 +222,26 @@ def run(args) -> int:
         + (f" ({rtf:.3g} × real time)" if rtf else ""),
         file=sys.stderr,
     )
+    if "pil" in summary:
+        print(f"stewart-drake simulate: {pil_line(summary['pil'])}", file=sys.stderr)
     for f in result.verdict["failures"]:
         print(f"stewart-drake simulate: {f}", file=sys.stderr)
     return 0 if result.ok else 1
+
+
+def pil_line(pil: dict) -> str:
+    """The PIL run in one line: ticks, those without a command, and the measured tick beside the DSP's estimate."""
+    text = f"PIL {pil['target']}: {pil['ticks']} ticks, {pil['ticks_without_command']} without a command"
+    t = pil["timing"]
+    if t:
+        what = f"{t['instructions_worst']} instructions" if t["instructions_worst"] else "measured"
+        share = t["period_share"]["stm32f405_168mhz"]
+        text += (
+            f"; sd_tick worst {what}, {t['cortex_m4_cycles_worst']:.0f} Cortex-M4 cycles ({share:.1%} of the period "
+            f"at 168 MHz), DSP56800E estimate {t['dsp56800e_cycles']:.0f} cycles ({t['dsp56800e_period_share']:.1%} at "
+            f"{t['dsp56800e_clock_hz'] / 1e6:g} MHz)"
+        )
+    return text
 
 
 def write_plots(log, length_error, out: Path) -> list[Path]:

@@ -217,6 +217,7 @@ class PilLaw(FixedPointLaw):
                 "cortex_m4_cycles_per_instruction": cpi,
                 "period_share": {k: cycles / hz / T for k, hz in M4_CLOCKS_HZ.items()},
                 "dsp56800e_cycles": dsp,
+                "dsp56800e_clock_hz": self.timing.clock_hz,
                 "dsp56800e_period_share": dsp / self.timing.clock_hz / T,
             }
         return {

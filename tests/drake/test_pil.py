@@ -130,6 +130,7 @@ def test_stop_commands_zero_force_and_fails_the_run(tmp_path, capsys):
     assert p["stopped_at_tick"] == FAULT_TICK and p["events"][-1] == {"tick": FAULT_TICK, "no_command": "stop"}
     assert summary["failures"][-1] == PIL_STOPPED.format(**p)  # after the fall it causes (tracking lost)
     assert f"stewart-drake simulate: {PIL_STOPPED.format(**p)}" in err
+    assert " ticks, 1 without a command; sd_tick worst " in err and "DSP56800E estimate " in err
     log = np.load(out / "log.npz")
     t, command = log["t"], log["command"]
     # tick k's command is released at (k + 1)·T (latency sample): zero from the faulty tick's release on
