@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 
 from stewart_drake.errors import FirmwareError
 
-VERSION = 1
+VERSION = 2  # sd_link.h's SD_LINK_VERSION
 HELLO, HELLO_ACK, SENSOR, COMMAND, STATUS, STATUS_REPLY, SET_STATE = 1, 2, 3, 4, 5, 6, 7
 NOT_MEASURED = 0xFFFFFFFF  # a stack high-water mark or clock count the target's runtime does not measure
 MAX_PAYLOAD = 128  # bytes, type to CRC (sd_link.h's SD_LINK_MAX_PAYLOAD)

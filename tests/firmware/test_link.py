@@ -198,7 +198,7 @@ def test_a_handshake_of_another_format_is_refused_and_ticks_are_not_acted_on(tar
     exe, files, g = target
     other = bytes(b ^ 0xFF for b in fingerprint(files))
     host = link.LinkHost(pipe.write, pipe.read, other)
-    with pytest.raises(FirmwareError, match=r"refused the handshake of this host \(version 1, fingerprint "):
+    with pytest.raises(FirmwareError, match=r"refused the handshake of this host \(version 2, fingerprint "):
         host.handshake(REPLY_S)
     pose, measured, ff = ticks(1)
     assert host.tick(pose[0], measured[0], ff[0], timeout=SILENT_S) is None

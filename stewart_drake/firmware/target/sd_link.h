@@ -10,7 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SD_LINK_VERSION 1
+#define SD_LINK_VERSION 2
 #define SD_LINK_MAX_PAYLOAD 128 /* bytes: type + seq + body + crc */
 #define SD_LINK_MAX_ENCODED (SD_LINK_MAX_PAYLOAD + SD_LINK_MAX_PAYLOAD / 254 + 1)
 #define SD_LINK_FINGERPRINT_BYTES 8
