@@ -166,7 +166,7 @@ def add_loop_args(p) -> None:
 
 
 # the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
-FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
+FILES = ("log.npz", "log.csv", "tracking.png", "summary.json", "pil.csv")  # pil.csv: a --pil run's ticks
 
 # the options the API's messages name by keyword (``length_unit=m``, ``allow_out_of_stroke=True``)
 KEYWORD_FLAGS = {
@@ -213,6 +213,8 @@ def run(args) -> int:
     with atomic_folder(out_folder) as tmp:
         log = result.log
         written = log.raw.save(tmp) + write_plots(log.raw, log.length_error, tmp) + [tmp / "summary.json"]
+        if "pil" in summary:  # the per-tick round trips and clock counts in a CSV, not the summary
+            written.append(write_pil_ticks(summary["pil"].pop("per_tick"), tmp / "pil.csv"))
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
         (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
@@ -227,6 +229,14 @@ def run(args) -> int:
     for f in result.verdict["failures"]:
         print(f"stewart-drake simulate: {f}", file=sys.stderr)
     return 0 if result.ok else 1
+
+
+def write_pil_ticks(per_tick: dict, path: Path) -> Path:
+    """``pil.csv``: each tick the target answered (from 1), its round trip (s) and ``sd_tick``'s clock counts."""
+    rows = zip(per_tick["tick"], per_tick["round_trip_s"], per_tick["clock_counts"], strict=True)
+    lines = ["tick,round_trip_s,clock_counts"] + [f"{k},{t!r},{'' if c is None else c}" for k, t, c in rows]
+    path.write_text("\n".join(lines) + "\n")
+    return path
 
 
 def pil_line(pil: dict) -> str:

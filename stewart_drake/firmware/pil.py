@@ -97,8 +97,11 @@ class PilLaw(FixedPointLaw):
         self._last = None  # the last (command, setpoint, saturated) applied
         self._delayed: bytes | None = None
         self.tick_count = 0
-        self.clock_counts: list[int] = []
-        self.latencies: list[float] = []  # s, each tick's round trip (SENSOR written to COMMAND read)
+        # each tick with a command: its number (from 1), round trip (s, SENSOR written to COMMAND read) and the
+        # clock counts of the target's sd_tick (None: no clock)
+        self.answered: list[int] = []
+        self.latencies: list[float] = []
+        self.clock_counts: list[int | None] = []
         self.events: list[dict] = []  # each injected fault and each tick without a command
         self.stopped_at: int | None = None
 
@@ -147,6 +150,7 @@ class PilLaw(FixedPointLaw):
         if reply is None:
             return self._react(state)
         self.latencies.append(time.perf_counter() - sent)
+        self.answered.append(self.tick_count)
         self.clock_counts.append(reply.clock)
         command = np.asarray(reply.command, dtype=float) / 32768.0 * float(t.command_range)
         setpoint = np.asarray(reply.setpoint, dtype=float) * float(self.config.ik_format.length_lsb)
@@ -185,7 +189,8 @@ class PilLaw(FixedPointLaw):
         return command, setpoint, state, saturated
 
     def report(self) -> dict:
-        """The link's counters (host and target), the faults and reactions, each tick's round trip, and
+        """The link's counters (host and target), the faults and reactions, the round trips (and ``per_tick``:
+        each answered tick's number, round trip and clock counts), and
         ``sd_tick``'s measured time: in QEMU instructions (from the clock counts, ``INSTRUCTIONS_PER_COUNT``)
         worst and mean over the run and the Cortex-M4 cycles of the stated model, on a board the cycles its
         SysTick counted; their share of the period at each of ``M4_CLOCKS_HZ``, beside the DSP56800E's estimate
@@ -238,6 +243,7 @@ class PilLaw(FixedPointLaw):
                 "p99": float(np.percentile(self.latencies, 99)),
                 "max": float(np.max(self.latencies)),
             },
+            "per_tick": {"tick": self.answered, "round_trip_s": self.latencies, "clock_counts": self.clock_counts},
         }
 
     def close(self) -> None:

@@ -131,6 +131,12 @@ def test_stop_commands_zero_force_and_fails_the_run(tmp_path, capsys):
     assert summary["failures"][-1] == PIL_STOPPED.format(**p)  # after the fall it causes (tracking lost)
     assert f"stewart-drake simulate: {PIL_STOPPED.format(**p)}" in err
     assert " ticks, 1 without a command; sd_tick worst " in err and "DSP56800E estimate " in err
+    rows = (out / "pil.csv").read_text().splitlines()  # the ticks the target answered, each timed
+    assert rows[0] == "tick,round_trip_s,clock_counts" and [int(r.split(",")[0]) for r in rows[1:]] == list(
+        range(1, FAULT_TICK)
+    )
+    assert all(float(r.split(",")[1]) > 0 and int(r.split(",")[2]) > 0 for r in rows[1:])
+    assert "per_tick" not in p
     log = np.load(out / "log.npz")
     t, command = log["t"], log["command"]
     # tick k's command is released at (k + 1)·T (latency sample): zero from the faulty tick's release on
@@ -213,4 +219,6 @@ def test_serial_link_to_a_host_process_on_a_pseudo_terminal_equals_the_host_c_lo
         os.close(slave)
     assert_same_logs(host, r)
     assert r.summary["pil"]["timing"] is None  # the host build has no cycle clock
-    assert r.summary["pil"]["round_trip_s"]["median"] > 0
+    per_tick = r.summary["pil"]["per_tick"]  # the serial line's round trip, logged at every tick
+    assert per_tick["tick"] == list(range(1, r.summary["ticks"] + 1))
+    assert min(per_tick["round_trip_s"]) > 0 and set(per_tick["clock_counts"]) == {None}
