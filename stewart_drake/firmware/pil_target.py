@@ -27,7 +27,7 @@ from pathlib import Path
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.link import pipe_reader
 from stewart_drake.firmware.target_build import C_FLAGS, TARGETS, build_target, cross_tools, program_files
-from stewart_drake.system.c_build import cache_dir, store
+from stewart_drake.system.c_build import cache_dir, intact, store
 from stewart_drake.system.processes import die_with_parent
 
 QEMU = "qemu-system-arm"
@@ -50,7 +50,7 @@ def target_elf(files: dict, target: str = "cortex-m4") -> Path:
         h.update(name.encode() + b"\0" + text.encode() + b"\0")
     root = cache_dir()
     out = root / f"sd-pil-{h.hexdigest()[:32]}.elf"
-    if not out.is_file():
+    if not intact(out):
         with tempfile.TemporaryDirectory(prefix="pil-", dir=root) as work:
             built = build_target(files, Path(work), target)
             store(built.elf, out)

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import stewart_drake as sd
+import stewart_drake.firmware.pil as pil_module
 from stewart_drake.api.simulation import plan_run
 from stewart_drake.errors import PIL_STOPPED
 from stewart_drake.firmware.generate import generate
@@ -200,6 +201,18 @@ def test_qemu_ends_with_the_run_even_when_it_is_interrupted_or_killed(sig):
         p.kill()
         p.wait()
         p.stderr.close()
+
+
+@needs_qemu
+def test_qemu_ends_when_the_run_fails(monkeypatch):
+    monkeypatch.setattr(pil_module, "format_fingerprint", lambda line: bytes(8))  # a host of another format
+    started = []
+    real = pil_module.open_target
+    monkeypatch.setattr(pil_module, "open_target", lambda *a: started.append(real(*a)) or started[-1])
+    with pytest.raises(sd.StewartError, match=r"^PIL link: the target .* refused the handshake"):
+        sd.simulate("utn-dynamic", duration=0.05, **{"pil.target": "qemu"})
+    assert len(started) == 1 and started[0].process.poll() is not None  # stopped, and waited for
+    assert qemu_children(os.getpid()) == []
 
 
 @pytest.mark.skipif(shutil.which("cc") is None, reason="no host C compiler")
