@@ -17,6 +17,7 @@ frames the host sends (``PilFaults``).
 
 from __future__ import annotations
 
+import struct
 import time
 
 import numpy as np
@@ -27,13 +28,20 @@ from stewart_drake.core.geometry import Platform
 from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.fingerprint import DEFAULTS, platform_hash, stamp
 from stewart_drake.firmware.generate import generate
-from stewart_drake.firmware.link import SENSOR, LinkHost, encode_frame, format_fingerprint, sensor_body
+from stewart_drake.firmware.link import (
+    SENSOR,
+    LinkHost,
+    cobs_encode,
+    crc16,
+    encode_frame,
+    format_fingerprint,
+    sensor_body,
+)
 from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT, open_target
 from stewart_drake.fixedpoint.generic import pose_words
 from stewart_drake.spec.machine import PilSpec
 
 HANDSHAKE_S = 30.0  # QEMU boots in about a second; a loaded machine, or a board being reset, may take longer
-CORRUPT_BYTE = 8  # the byte of a SENSOR frame a corrupt fault flips (inside the body: the CRC no longer matches)
 # the stated cycle model of the Cortex-M4 estimate: one cycle an instruction (most Thumb-2 ALU, multiply and
 # multiply-accumulate instructions; loads, taken branches and divisions take 2-12, so it is a lower bound),
 # no memory wait states (the AN386's SSRAM; an STM32F405's flash at 168 MHz hides its 5 through the ART cache)
@@ -163,11 +171,13 @@ class PilLaw(FixedPointLaw):
         host, k = self.host, self.tick_count
         fault = self.faults.at(k)
         host.seq = seq = (host.seq + 1) & 0xFFFF
-        frame = encode_frame(SENSOR, seq, sensor_body(words, counts, ff))
+        body = sensor_body(words, counts, ff)
+        frame = encode_frame(SENSOR, seq, body)
         if fault is not None:
             self.events.append({"tick": k, "fault": fault})
-        if fault == "corrupt":
-            frame = frame[:CORRUPT_BYTE] + bytes([frame[CORRUPT_BYTE] ^ 0x10]) + frame[CORRUPT_BYTE + 1 :]
+        if fault == "corrupt":  # one bit of the body flipped after its CRC was computed: a CRC-16 always sees it
+            p = struct.pack("<BH", SENSOR, seq) + body
+            frame = cobs_encode(p[:3] + bytes([p[3] ^ 1]) + p[4:] + struct.pack(">H", crc16(p))) + b"\x00"
         if fault not in ("drop", "delay"):
             host.write(frame)
         if fault == "duplicate":
