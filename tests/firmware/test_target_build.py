@@ -226,3 +226,29 @@ def test_the_stm32f405_build_boots_from_flash_with_its_stack_at_the_top_of_sram(
     assert sp == 0x20000000 + 128 * 1024
     assert 0x08000000 < reset < 0x08000000 + b.text and reset & 1  # a Thumb address in the flash
     assert b.stack_bytes is not None and b.data + b.bss + b.stack_bytes < 128 * 1024
+
+
+@needs_cross
+@needs_qemu
+def test_the_stm32f405_build_in_qemus_netduinoplus2_ticks_like_sd_tick(tmp_path):
+    """QEMU's netduinoplus2 is an STM32F405: its flash, SRAM and USART2 (the machine's second serial port; RCC
+    and GPIO are not modelled, their writes ignored) run the board build unchanged."""
+    p = sd.load_platform("utn-dynamic")
+    files = generated(tmp_path / "gen")
+    b = build_target(files, tmp_path / "w", target="stm32f405")
+    argv = [QEMU, "-M", "netduinoplus2", "-nographic", "-monitor", "none", "-serial", "null", "-serial", "stdio"]
+    q = subprocess.Popen([*argv, "-kernel", str(b.elf)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, bufsize=0)
+    try:
+        host = link.LinkHost(q.stdin.write, link.pipe_reader(q.stdout.fileno()), fingerprint(files))
+        host.handshake(10.0)
+        pose, measured, ff = ticks(5, seed=6)
+        want = reference(generate(p, controller_config(p, machine_format(p, {})[1])), pose, measured, ff)
+        for k in range(5):
+            r = host.tick(pose[k], measured[k], ff[k], timeout=10.0)
+            assert r is not None and list(r.command) == list(want[k])
+        assert r.clock is not None and r.clock > 0  # SysTick counted sd_tick
+    finally:
+        q.kill()
+        q.wait(timeout=10)
+        q.stdin.close()
+        q.stdout.close()
