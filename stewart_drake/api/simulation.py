@@ -534,7 +534,10 @@ def simulate(
         progress: show a progress bar.
         **options: the run's options (below, ``plan_run``'s keywords) and any spec path,
             ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values in SI or in the quantity
-            grammar). An option left out (or None) keeps the machine's value.
+            grammar). An option left out (or None) keeps the machine's value. ``**{"pil.target": "qemu"}`` runs
+            each tick on the firmware built for a Cortex-M4 in QEMU (``"serial:/dev/ttyX"``: on a board) over the
+            PIL link, in lock step (``summary["pil"]``: the link's counters, faults, round trips and the measured
+            tick; docs/simulation-to-board.md).
 
     Keyword Args:
         controller (str | None): ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin) (spec
