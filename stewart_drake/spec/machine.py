@@ -216,7 +216,8 @@ class PilSpec:
     def __post_init__(self):
         t = self.target
         if t is not None and not (t == "qemu" or (t.startswith("serial:") and len(t) > len("serial:"))):
-            raise MachineError(MachineError.RANGE.format(path="pil.target", rule="one of qemu, serial:PATH", value=t))
+            rule = "one of " + ", ".join(PIL_TARGETS)
+            raise MachineError(MachineError.RANGE.format(path="pil.target", rule=rule, value=t))
         if self.fault is not None:
             self.fault_plan()
         _word("pil.on_fault", self.on_fault, PIL_REACTIONS)
