@@ -67,9 +67,10 @@ def test_ten_thousand_ticks_in_qemu_equal_the_host_c_loop_bit_for_bit(machine):
 
 
 @needs_qemu
-def test_qemu_run_equals_the_host_c_loop_and_measures_the_tick():
+def test_qemu_run_equals_the_host_c_loop_and_the_emulation_and_measures_the_tick():
     host, pil = runs(NEWCOMER, 0.3, target="qemu")
     assert_same_logs(host, pil)
+    assert_same_logs(sd.simulate(NEWCOMER, duration=0.3, engine="python"), pil)  # the Python emulation's loop
     r = pil.summary["pil"]
     assert pil.summary["tick_loop"] == "pil"
     t = r["timing"]
