@@ -107,6 +107,8 @@ class RunPlan:
         return self.scenario.config
 
 
+PIL_COMMANDS = ("simulate", "run --simulate")  # the callers of plan_run whose run goes to a PIL target (pil.target)
+
 # plan_run's and simulate's keywords of earlier versions -> the spec path they set (None: the machine's)
 KEYWORD_PATHS = {
     "controller": "controller.law",
@@ -341,7 +343,9 @@ def plan_run(
     if firmware and engine == "python":
         raise UsageError(OPTION_FIRMWARE_ENGINE)
     engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command.split()[0]}")
-    pil = machine.pil if machine.pil.target else None
+    # one run on a target: simulate and run --simulate; the studies of many runs (Monte Carlo, the report, the
+    # response) keep the host loop, whose numbers the target's equal
+    pil = machine.pil if machine.pil.target and command in PIL_COMMANDS else None
     if pil is not None and (controller != "fixed" or firmware):
         law = "user firmware's" if firmware else controller
         raise FirmwareError(FirmwareError.PIL_LAW.format(target=pil.target, law=law))

@@ -236,3 +236,10 @@ def test_serial_link_to_a_host_process_on_a_pseudo_terminal_equals_the_host_c_lo
     per_tick = r.summary["pil"]["per_tick"]  # the serial line's round trip, logged at every tick
     assert per_tick["tick"] == list(range(1, r.summary["ticks"] + 1))
     assert min(per_tick["round_trip_s"]) > 0 and set(per_tick["clock_counts"]) == {None}
+
+
+def test_only_single_runs_go_to_the_target():
+    m = sd.load_machine("utn-dynamic", ["pil.target=qemu", "run.duration=0.1"])
+    assert plan_run(m).scenario.pil == m.pil and plan_run(m, command="run --simulate").scenario.pil == m.pil
+    for study in ("montecarlo", "report", "response"):  # many runs of the host loop: the target's numbers
+        assert plan_run(m, command=study).scenario.pil is None
