@@ -15,6 +15,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
@@ -214,6 +215,20 @@ def test_qemu_ends_when_the_run_fails(monkeypatch):
         sd.simulate("utn-dynamic", duration=0.05, **{"pil.target": "qemu"})
     assert len(started) == 1 and started[0].process.poll() is not None  # stopped, and waited for
     assert qemu_children(os.getpid()) == []
+
+
+@needs_qemu
+def test_a_target_that_dies_mid_run_is_one_error_naming_the_tick(monkeypatch):
+    real = pil_module.open_target
+
+    def dying(*args):  # QEMU killed from outside a second into the ticks
+        target = real(*args)
+        threading.Timer(1.0, target.process.kill).start()
+        return target
+
+    monkeypatch.setattr(pil_module, "open_target", dying)
+    with pytest.raises(sd.StewartError, match=r"^PIL link: the target closed the link at tick \d+$"):
+        sd.simulate("utn-dynamic", duration=30.0, **{"pil.target": "qemu"})
 
 
 @pytest.mark.skipif(shutil.which("cc") is None, reason="no host C compiler")
