@@ -873,6 +873,10 @@ class FirmwareError(StewartError):
         "PIL link: the target (link version {version}, format fingerprint {fingerprint}) refused the handshake of "
         "this host (version {our_version}, fingerprint {ours}): rebuild it from the same module and options"
     )
+    NO_QEMU = "pil.target qemu: {tool} not found on PATH (install {package})"
+    PIL_START = "pil.target {target}: {what} cannot be started or opened: {detail}"
+    PIL_LAW = "pil.target {target} runs the fixed-point firmware (controller.law fixed), not the {law} law"
+    PIL_GONE = "PIL link: the target closed the link at tick {tick}"
 
 
 class IntegratorError(StewartError):
@@ -956,6 +960,11 @@ class MachineError(UsageError):
     FORMAT_RATE = "rate must be a positive number of Hz up to 1e6, got {value}"
 
 
+# the verdict's failure of a PIL run whose controller stopped on a link fault (api.simulation.run_plan)
+PIL_STOPPED = (
+    "PIL link: tick {stopped_at_tick} got no command from the target ({target}) within pil.timeout; "
+    "pil.on_fault stop: zero force from then on"
+)
 # a warning of a run with a firmware (api.simulation.adopt_firmware)
 FIRMWARE_FORMAT_ADOPTED = "loop format adopted from the firmware: {what} (the machine said {machine})"
 

@@ -42,7 +42,9 @@ from stewart_drake.errors import (
     OPTION_DURATION_PERIOD,
     OPTION_ENGINE_FIXED,
     OPTION_FIRMWARE_ENGINE,
+    PIL_STOPPED,
     SIMULATION_GAP_WARNING,
+    FirmwareError,
     MachineError,
     OptionError,
     PhysicalLimitError,
@@ -107,6 +109,8 @@ class RunPlan:
         """The controller's timing and gains."""
         return self.scenario.config
 
+
+PIL_COMMANDS = ("simulate", "run --simulate")  # the callers of plan_run whose run goes to a PIL target (pil.target)
 
 # plan_run's and simulate's keywords of earlier versions -> the spec path they set (None: the machine's)
 KEYWORD_PATHS = {
@@ -348,6 +352,12 @@ def plan_run(
     if firmware and engine == "python":
         raise UsageError(OPTION_FIRMWARE_ENGINE)
     engine = "c" if firmware else default_engine(engine, controller, f"stewart-drake {command.split()[0]}")
+    # one run on a target: simulate and run --simulate; the studies of many runs (Monte Carlo, the report, the
+    # response) keep the host loop, whose numbers the target's equal
+    pil = machine.pil if machine.pil.target and command in PIL_COMMANDS else None
+    if pil is not None and (controller != "fixed" or firmware):
+        law = "user firmware's" if firmware else controller
+        raise FirmwareError(FirmwareError.PIL_LAW.format(target=pil.target, law=law))
     scenario = Scenario(
         platform,
         traj,
@@ -362,6 +372,8 @@ def plan_run(
         plant_platform=plant_platform,
         sensor=sensor,
         duration=duration,
+        pil=pil,
+        seed=machine.run.seed,
     )
     read_units = {"length": length_unit, "angle": angle_unit} if csv else None
     return RunPlan(scenario, timing, duration, tuple(warnings), read_units, time_limit, machine)
@@ -535,7 +547,10 @@ def simulate(
         progress: show a progress bar.
         **options: the run's options (below, ``plan_run``'s keywords) and any spec path,
             ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values in SI or in the quantity
-            grammar). An option left out (or None) keeps the machine's value.
+            grammar). An option left out (or None) keeps the machine's value. ``**{"pil.target": "qemu"}`` runs
+            each tick on the firmware built for a Cortex-M4 in QEMU (``"serial:/dev/ttyX"``: on a board) over the
+            PIL link, in lock step (``summary["pil"]``: the link's counters, faults, round trips and the measured
+            tick; docs/simulation-to-board.md).
 
     Keyword Args:
         controller (str | None): ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin) (spec
@@ -589,9 +604,13 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         log, gap, tick_loop = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
     else:
         sim = build_simulation(sc, meshcat=meshcat)
-        log = sim.run(plan.duration, progress=progress)
+        try:
+            log = sim.run(plan.duration, progress=progress)
+            pil = sim.controller.law.report() if sc.pil is not None else None
+        finally:
+            sim.close()
         gap = sim.max_constraint_gap()
-        tick_loop = sim.tick_loop
+        tick_loop = "pil" if sc.pil is not None else sim.tick_loop
     t_wall = time.perf_counter() - t_wall
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -646,6 +665,10 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         if on_warning:
             on_warning(w)
     summary.update(loop)
+    if sc.pil is not None:
+        summary["pil"] = pil
+        if pil["stopped_at_tick"] is not None:
+            verdict["failures"].append(PIL_STOPPED.format(**pil))
     summary.update(verdict)
     summary["warnings"] = warnings
     return SimulationResult(plain(summary), Log(log, e, pe), verdict, warnings, plan)

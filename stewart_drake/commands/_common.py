@@ -179,6 +179,9 @@ FLAG_PATHS = {
     "integrator": ("--integrator", "run.integrator"),
     "fit": ("--fit", "run.fit"),
     "duration": ("--duration", "run.duration"),
+    "pil": ("--pil", "pil.target"),
+    "pil_fault": ("--pil-fault", "pil.fault"),
+    "pil_on_fault": ("--pil-on-fault", "pil.on_fault"),
 }
 # store_true flags: the value they set
 FLAG_VALUES = {"no_feedforward": False, "fit": True}

@@ -113,6 +113,26 @@ def register(sub) -> None:
         metavar="DIR",
         help="output folder for log.npz, log.csv, summary.json, plots (default simulation/)",
     )
+    p.add_argument(
+        "--pil",
+        default=None,
+        metavar="TARGET",
+        help="processor in the loop: each tick computed by the firmware on qemu (the Cortex-M4 build in QEMU's "
+        "mps2-an386) or serial:/dev/ttyX (a flashed board) over the PIL link (pil.target)",
+    )
+    p.add_argument(
+        "--pil-fault",
+        default=None,
+        metavar="KIND:RATE|KIND:@K,...",
+        help="inject link faults: drop, corrupt, delay or duplicate at a seeded rate a tick (drop:0.01) or at "
+        "given ticks (corrupt:@10,200) (pil.fault)",
+    )
+    p.add_argument(
+        "--pil-on-fault",
+        default=None,
+        choices=["hold", "stop"],
+        help="a tick without a command: hold the last command (default) or stop (zero force, exit 1) (pil.on_fault)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument(
         "--allow-out-of-stroke",
@@ -146,7 +166,7 @@ def add_loop_args(p) -> None:
 
 
 # the files simulate writes into --out (SimulationLog.save, write_plots, the summary)
-FILES = ("log.npz", "log.csv", "tracking.png", "summary.json")
+FILES = ("log.npz", "log.csv", "tracking.png", "summary.json", "pil.csv")  # pil.csv: a --pil run's ticks
 
 # the options the API's messages name by keyword (``length_unit=m``, ``allow_out_of_stroke=True``)
 KEYWORD_FLAGS = {
@@ -184,12 +204,17 @@ def run(args) -> int:
     except StewartError as e:
         raise flag_error(e, {**FLAG_PATHS, **KEYWORD_FLAGS}) from None
     warn = lambda w: print(f"stewart-drake simulate: warning: {flag_text(w, FLAG_PATHS)}", file=sys.stderr)  # noqa: E731
-    result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
+    try:  # a PIL target is started by the run: its errors name spec paths too
+        result = run_plan(plan, progress=not args.no_progress, on_warning=warn)
+    except StewartError as e:
+        raise flag_error(e, FLAG_PATHS) from None
     summary = result.to_dict()
     out = Path(args.out)
     with atomic_folder(out_folder) as tmp:
         log = result.log
         written = log.raw.save(tmp) + write_plots(log.raw, log.length_error, tmp) + [tmp / "summary.json"]
+        if "pil" in summary:  # the per-tick round trips and clock counts in a CSV, not the summary
+            written.append(write_pil_ticks(summary["pil"].pop("per_tick"), tmp / "pil.csv"))
         summary["files"] = [str(out / p.relative_to(tmp)) for p in written]
         (tmp / "summary.json").write_text(dumps_strict(summary))
     print_json(summary)
@@ -199,9 +224,34 @@ def run(args) -> int:
         + (f" ({rtf:.3g} × real time)" if rtf else ""),
         file=sys.stderr,
     )
+    if "pil" in summary:
+        print(f"stewart-drake simulate: {pil_line(summary['pil'])}", file=sys.stderr)
     for f in result.verdict["failures"]:
         print(f"stewart-drake simulate: {f}", file=sys.stderr)
     return 0 if result.ok else 1
+
+
+def write_pil_ticks(per_tick: dict, path: Path) -> Path:
+    """``pil.csv``: each tick the target answered (from 1), its round trip (s) and ``sd_tick``'s clock counts."""
+    rows = zip(per_tick["tick"], per_tick["round_trip_s"], per_tick["clock_counts"], strict=True)
+    lines = ["tick,round_trip_s,clock_counts"] + [f"{k},{t!r},{'' if c is None else c}" for k, t, c in rows]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def pil_line(pil: dict) -> str:
+    """The PIL run in one line: ticks, those without a command, and the measured tick beside the DSP's estimate."""
+    text = f"PIL {pil['target']}: {pil['ticks']} ticks, {pil['ticks_without_command']} without a command"
+    t = pil["timing"]
+    if t:
+        what = f"{t['instructions_worst']} instructions" if t["instructions_worst"] else "measured"
+        share = t["period_share"]["stm32f405_168mhz"]
+        text += (
+            f"; sd_tick worst {what}, {t['cortex_m4_cycles_worst']:.0f} Cortex-M4 cycles ({share:.1%} of the period "
+            f"at 168 MHz), DSP56800E estimate {t['dsp56800e_cycles']:.0f} cycles ({t['dsp56800e_period_share']:.1%} at "
+            f"{t['dsp56800e_clock_hz'] / 1e6:g} MHz)"
+        )
+    return text
 
 
 def write_plots(log, length_error, out: Path) -> list[Path]:

@@ -62,6 +62,8 @@ from stewart_drake.drake.platform_model import set_pose
 from stewart_drake.drake.systems import make_law
 from stewart_drake.drake.tick_loop import IdealSensor, SensorReading, TickLoop, periodic_times
 from stewart_drake.errors import SimulationError
+from stewart_drake.firmware.pil import PilLaw
+from stewart_drake.spec.machine import PilSpec
 
 # ----------------------------------------------------------------------------------------------
 # The scenario: what a run is, as plain data.
@@ -108,7 +110,8 @@ class Scenario:
     (s): the discrete plant's step, or the continuous plant's logging period and fixed step; ``integrator``:
     one of ``integrators.INTEGRATORS`` (None: ``integrators.DEFAULT_INTEGRATOR``); ``feedforward``: connect
     the model-based force feed-forward table; ``sensor``: None (ideal) or a ``SensorModel``; ``duration`` (s): what ``simulate``
-    runs (None: the trajectory's own duration, else 1 s).
+    runs (None: the trajectory's own duration, else 1 s); ``pil``: the tick computed on a target over the link
+    (``firmware.pil``; None or no ``target``: on the host); ``seed``: the run's seed (the link faults' draws).
     """
 
     platform: Platform
@@ -125,6 +128,8 @@ class Scenario:
     plant_platform: Platform | None = None
     sensor: SensorModel | None = None
     duration: float | None = None
+    pil: PilSpec | None = None
+    seed: int = 0
 
 
 def set_velocity(plant, context, platform: Platform, trajectory: Trajectory, t: float, h: float = 1e-6) -> None:
@@ -176,6 +181,11 @@ class Simulation:
         """Where the ticks run: ``"compiled"`` (one C call per tick, ``firmware.loop_kernel``: the float law or
         the compiled firmware) or ``"python"`` (the reference loop: engine python, a replaced law, no compiler)."""
         return "python" if self.controller.kernel is None else "compiled"
+
+    def close(self) -> None:
+        """End what the run holds outside this process (a PIL target: QEMU stopped, the port closed)."""
+        if isinstance(self.controller.law, PilLaw):
+            self.controller.law.close()
 
     def run(self, duration: float, progress: bool = False) -> SimulationLog:
         """Simulate ``duration`` seconds from t = 0 (once per Simulation) and return the logs."""
@@ -302,7 +312,21 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     if config is None:
         poses = design_poses(trajectory, s.design_duration)
         config = ControllerConfig.for_platform(platform, actuator_lag=actuators.time_constant, poses=poses)
-    law = make_law(s.controller, platform, config, s.engine, s.firmware)
+    if s.pil is not None and s.pil.target:
+        law = PilLaw(platform, config, s.pil, s.seed)  # the target is started here: ``Simulation.close`` ends it
+    else:
+        law = make_law(s.controller, platform, config, s.engine, s.firmware)
+    try:
+        return _build(s, platform, integrator, plant_platform, trajectory, actuators, config, law, meshcat)
+    except BaseException:
+        if isinstance(law, PilLaw):
+            law.close()
+        raise
+
+
+def _build(s, platform, integrator, plant_platform, trajectory, actuators, config, law, meshcat) -> Simulation:
+    """``build_simulation`` once the law is made."""
+    plant_time_step = s.plant_time_step
     T = config.timing.sample_period
     max_force = actuators.max_force or float(platform.legs.max_force)
     # the plant: reused from an earlier run of this process with the same one (``loop_diagram``)

@@ -9,10 +9,14 @@ A frame is ``COBS(payload) 0x00``; the payload is ``type u8 | seq u16 LE | body 
 - ``SENSOR`` (host → target, once a tick): reference pose words i16[6], measured leg counts i32[6],
   feed-forward words i16[6], flags u8 (bit 0: feed-forward present);
 - ``COMMAND`` (target → host, the SENSOR's seq): command words i16[6] (Q15 of the command range), saturated
-  legs u8, the target's counters u32[7] (``COUNTERS``);
+  legs u8 (bit i: leg i + 1), the target's counters u32[7] (``COUNTERS``), the set-point words i32[6] and the
+  clock counts ``sd_tick`` took u32 (``NOT_MEASURED`` where the runtime has no clock);
 - ``STATUS`` (host → target, any time): no body;
 - ``STATUS_REPLY`` (target → host, the same seq): the counters u32[7] and the most stack used since reset,
-  u32 bytes (``NOT_MEASURED`` where the runtime does not paint its stack).
+  u32 bytes (``NOT_MEASURED`` where the runtime does not paint its stack);
+- ``SET_STATE`` (host → target, after the handshake): the controller's state (``sd_state``: integrator
+  i32[6], previous measurement i32[6], measurement filter i16[6], set-point i32[6], set-point filter i16[6]),
+  answered by a ``STATUS_REPLY`` of the same seq; the tick sequence is unchanged.
 
 The format fingerprint is the first 8 bytes of the SHA-256 of the module's recorded options
 (``firmware.fingerprint.fingerprint_line``): a target whose number format, gains or platform differ refuses
@@ -34,17 +38,18 @@ from dataclasses import dataclass, field
 
 from stewart_drake.errors import FirmwareError
 
-VERSION = 1
-HELLO, HELLO_ACK, SENSOR, COMMAND, STATUS, STATUS_REPLY = 1, 2, 3, 4, 5, 6
-NOT_MEASURED = 0xFFFFFFFF  # a stack high-water mark the target's runtime does not measure
-MAX_PAYLOAD = 96  # bytes, type to CRC (sd_link.h's SD_LINK_MAX_PAYLOAD)
+VERSION = 2  # sd_link.h's SD_LINK_VERSION
+HELLO, HELLO_ACK, SENSOR, COMMAND, STATUS, STATUS_REPLY, SET_STATE = 1, 2, 3, 4, 5, 6, 7
+NOT_MEASURED = 0xFFFFFFFF  # a stack high-water mark or clock count the target's runtime does not measure
+MAX_PAYLOAD = 128  # bytes, type to CRC (sd_link.h's SD_LINK_MAX_PAYLOAD)
 FINGERPRINT_BYTES = 8
 COUNTERS = ("frames", "corrupt", "malformed", "lost", "duplicate", "late", "unexpected")
 _SENSOR = struct.Struct("<6h6i6hB")
-_COMMAND = struct.Struct(f"<6hB{len(COUNTERS)}I")
+_COMMAND = struct.Struct(f"<6hB{len(COUNTERS)}I6iI")
 _HELLO = struct.Struct(f"<B{FINGERPRINT_BYTES}s")
 _HELLO_ACK = struct.Struct(f"<B{FINGERPRINT_BYTES}sB")
 _STATUS_REPLY = struct.Struct(f"<{len(COUNTERS)}II")
+_SET_STATE = struct.Struct("<6i6i6h6i6h")
 BODY_SIZES = {
     HELLO: _HELLO.size,
     HELLO_ACK: _HELLO_ACK.size,
@@ -52,6 +57,7 @@ BODY_SIZES = {
     COMMAND: _COMMAND.size,
     STATUS: 0,
     STATUS_REPLY: _STATUS_REPLY.size,
+    SET_STATE: _SET_STATE.size,
 }
 
 
@@ -195,12 +201,15 @@ def sensor_body(pose_words, measured, feedforward=None) -> bytes:
 
 @dataclass
 class Reply:
-    """A COMMAND: the six command words, the saturated legs and the target's counters."""
+    """A COMMAND: the six command words, the saturated legs (bit i: leg i + 1), the target's counters, the
+    six set-point words and the clock counts of its ``sd_tick`` (None: not measured)."""
 
     seq: int
     command: tuple
     saturated: int
     target: dict
+    setpoint: tuple = ()
+    clock: int | None = None
 
 
 class LinkHost:
@@ -270,7 +279,9 @@ class LinkHost:
             self.counters.lost += 1
             return None
         v = _COMMAND.unpack(body)
-        return Reply(seq, v[:6], v[6], dict(zip(COUNTERS, v[7:], strict=True)))
+        n = 7 + len(COUNTERS)
+        counts = None if v[-1] == NOT_MEASURED else v[-1]
+        return Reply(seq, v[:6], v[6], dict(zip(COUNTERS, v[7:n], strict=True)), v[n : n + 6], counts)
 
     def status(self, timeout: float = 2.0) -> dict:
         """The target's counters and ``stack_bytes``, the most stack it has used since reset (None: not measured).
@@ -278,10 +289,22 @@ class LinkHost:
         Raises:
             FirmwareError: no answer in ``timeout`` s.
         """
-        self.write(encode_frame(STATUS, self.seq, b""))  # the last tick's number: the ticks' sequence goes on
+        return self._status(STATUS, b"", "a status request", timeout)
+
+    def set_state(self, integ, prev, dfilt, setpoint, vfilt, timeout: float = 2.0) -> dict:
+        """Set the target's controller state (six words each, ``sd_state``'s fields); returns its status.
+
+        Raises:
+            FirmwareError: no answer in ``timeout`` s.
+        """
+        words = [int(v) for part in (integ, prev, dfilt, setpoint, vfilt) for v in part]
+        return self._status(SET_STATE, _SET_STATE.pack(*words), "the controller state", timeout)
+
+    def _status(self, kind: int, body: bytes, what: str, timeout: float) -> dict:
+        self.write(encode_frame(kind, self.seq, body))  # the last tick's number: the ticks' sequence goes on
         body = self._await(STATUS_REPLY, self.seq, timeout)
         if body is None:
-            raise FirmwareError(FirmwareError.LINK_SILENT.format(what="a status request", timeout=timeout))
+            raise FirmwareError(FirmwareError.LINK_SILENT.format(what=what, timeout=timeout))
         v = _STATUS_REPLY.unpack(body)
         return {**dict(zip(COUNTERS, v[:-1], strict=True)), "stack_bytes": None if v[-1] == NOT_MEASURED else v[-1]}
 

@@ -34,6 +34,18 @@ TARGETS = {
         "runtime": ("sd_startup.c", "sd_uart_cmsdk.c"),
         "entry": "Reset_Handler",
     },
+    "stm32f405": {  # the STM32F4 Discovery and other STM32F405/F407 boards: flash at 0x08000000, USART2
+        "board": "stm32f4",
+        "cc": "arm-none-eabi-gcc",
+        "size": "arm-none-eabi-size",
+        "readelf": "arm-none-eabi-readelf",
+        "objdump": "arm-none-eabi-objdump",
+        "package": "gcc-arm-none-eabi",
+        "flags": ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=soft"),
+        "linker_script": "stm32f405.ld",
+        "runtime": ("sd_startup.c", "sd_usart_stm32f4.c"),
+        "entry": "Reset_Handler",
+    },
 }
 LINK_SOURCES = ("sd_link.c", "sd_pil.c")
 HEADERS = ("sd_link.h", "sd_pil.h")

@@ -58,6 +58,8 @@ def parse_field(path: str, value, where: str | None = None):
         if _is_null(value):
             return None
         kind = kind[:-1]
+    if kind == "text":
+        return str(value).strip()
     if kind == "bool":
         if isinstance(value, bool):
             return value

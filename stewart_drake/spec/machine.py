@@ -27,6 +27,12 @@ LATENCIES = ("sample", "computation", "none")
 ENGINES = ("c", "python")
 
 MOTION_WORDS = ("seed", "rotating")
+PIL_TARGETS = ("qemu", "serial:PATH")
+PIL_FAULTS = ("drop", "corrupt", "delay", "duplicate")
+PIL_REACTIONS = ("hold", "stop")
+PIL_FAULT_RULE = "KIND:RATE (0 < RATE < 1 a tick) or KIND:@K[,K...] (ticks, from 1), KIND one of " + ", ".join(
+    PIL_FAULTS
+)
 
 
 def _fmt(v) -> str:
@@ -197,6 +203,52 @@ class RunSpec:
             raise MachineError(MachineError.RANGE.format(path="run.seed", rule="an integer >= 0", value=self.seed))
 
 
+@dataclass(frozen=True)
+class PilSpec:
+    """Processor in the loop: ``target`` (None: the tick runs on the host; ``qemu``: the firmware built for the
+    Cortex-M4 in QEMU's MPS2 AN386; ``serial:PATH``: a board on the serial port PATH) computes each tick over the
+    link (``firmware.link``); ``fault`` injects link faults (``drop``, ``corrupt``, ``delay``, ``duplicate``) at a
+    seeded rate a tick (``drop:0.01``, seeded by ``run.seed``) or at given ticks (``corrupt:@10,200``, counted
+    from 1); ``on_fault``: the controller's reaction to a tick without a command, ``hold`` (keep the last
+    command) or ``stop`` (zero force from then on: the run fails); ``timeout`` (s): how long the host waits for
+    a tick's command (a lost frame costs that)."""
+
+    target: str | None = None
+    fault: str | None = None
+    on_fault: str = "hold"
+    timeout: float = 5.0
+
+    def __post_init__(self):
+        t = self.target
+        if t is not None and not (t == "qemu" or (t.startswith("serial:") and len(t) > len("serial:"))):
+            rule = "one of " + ", ".join(PIL_TARGETS)
+            raise MachineError(MachineError.RANGE.format(path="pil.target", rule=rule, value=t))
+        if self.fault is not None:
+            self.fault_plan()
+        _word("pil.on_fault", self.on_fault, PIL_REACTIONS)
+        _number("pil.timeout", self.timeout, "> 0 s", lambda v: v > 0)
+
+    def fault_plan(self) -> tuple[str, float | None, tuple]:
+        """``(kind, rate a tick or None, ticks counted from 1)`` of ``fault`` (``MachineError`` naming ``pil.fault``)."""
+        kind, _, arg = str(self.fault).partition(":")
+        try:
+            if kind not in PIL_FAULTS or not arg:
+                raise ValueError(kind)  # the one message below
+            if arg.startswith("@"):
+                ticks = tuple(sorted({int(w) for w in arg[1:].split(",")}))
+                if ticks[0] < 1:
+                    raise ValueError(arg)  # the one message below
+                return kind, None, ticks
+            rate = float(arg)
+            if not 0 < rate < 1:
+                raise ValueError(arg)  # the one message below
+            return kind, rate, ()
+        except ValueError:
+            raise MachineError(
+                MachineError.RANGE.format(path="pil.fault", rule=PIL_FAULT_RULE, value=self.fault)
+            ) from None
+
+
 def check_motion(path: str, motion) -> None:
     """``MachineError`` unless ``motion`` is ``seed``, ``rotating``, a ``.csv`` or ``.stw`` path or a
     ``Trajectory``."""
@@ -224,6 +276,7 @@ class Machine:
     calibration: str | None = None
     payload: PayloadSpec = field(default_factory=PayloadSpec)
     run: RunSpec = field(default_factory=RunSpec)
+    pil: PilSpec = field(default_factory=PilSpec)
     platform_source: str | None = None
 
     def __post_init__(self):
@@ -291,6 +344,7 @@ SECTIONS = {
     "firmware": FirmwareFormat,
     "payload": PayloadSpec,
     "run": RunSpec,
+    "pil": PilSpec,
 }
 # spec path -> dimension for the quantity grammar ("bool", "word", "int", "vector", "gains", "optional ..." too)
 FIELDS = {
@@ -316,4 +370,8 @@ FIELDS = {
     "run.integrator": ("word?", ("cenic-fixed", "cenic", "sap")),
     "run.fit": "bool",
     "run.seed": "int",
+    "pil.target": "text?",
+    "pil.fault": "text?",
+    "pil.on_fault": ("word", PIL_REACTIONS),
+    "pil.timeout": "time",
 }

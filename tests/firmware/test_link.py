@@ -198,7 +198,7 @@ def test_a_handshake_of_another_format_is_refused_and_ticks_are_not_acted_on(tar
     exe, files, g = target
     other = bytes(b ^ 0xFF for b in fingerprint(files))
     host = link.LinkHost(pipe.write, pipe.read, other)
-    with pytest.raises(FirmwareError, match=r"refused the handshake of this host \(version 1, fingerprint "):
+    with pytest.raises(FirmwareError, match=r"refused the handshake of this host \(version 2, fingerprint "):
         host.handshake(REPLY_S)
     pose, measured, ff = ticks(1)
     assert host.tick(pose[0], measured[0], ff[0], timeout=SILENT_S) is None
@@ -237,7 +237,7 @@ def test_pipe_reader_reports_the_end():
 def test_the_docs_tables_are_the_protocol():
     text = (Path(__file__).parents[2] / "docs" / "pil-link.md").read_text()
     types = dict((int(n), name) for n, name in re.findall(r"^\| (\d) `(\w+)` \|", text, re.M))
-    names = ("HELLO", "HELLO_ACK", "SENSOR", "COMMAND", "STATUS", "STATUS_REPLY")
+    names = ("HELLO", "HELLO_ACK", "SENSOR", "COMMAND", "STATUS", "STATUS_REPLY", "SET_STATE")
     assert types == {getattr(link, n): n for n in names}
     sizes = {"u8": 1, "i16": 2, "i32": 4, "u32": 4}
     for n, name in types.items():  # the body a row lists, field by field, has the size the code sends

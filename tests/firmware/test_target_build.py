@@ -162,7 +162,7 @@ def test_cli_reports_code_data_and_stack(tmp_path, capsys):
 def test_cli_refuses_an_unknown_target(tmp_path, capsys):
     rc, out, err = cli(capsys, "firmware", "build", "--target", "cortex-m0", "--out", str(tmp_path / "b"))
     assert rc == 2
-    assert err.strip().endswith("--target must be one of cortex-m4, got 'cortex-m0'")
+    assert err.strip().endswith("--target must be one of cortex-m4, stm32f405, got 'cortex-m0'")
     assert not (tmp_path / "b").exists()
 
 
@@ -215,3 +215,40 @@ def test_the_elf_in_qemu_answers_a_handshake_and_ticks_like_sd_tick_within_its_s
     su = (out / "sd_pil.su").read_text().splitlines()
     leaf_frame = next(int(ln.split("\t")[1]) for ln in su if ln.split("\t")[0].endswith(":" + leaf))
     assert s["stack_bytes"] - leaf_frame <= used <= s["stack_bytes"]
+
+
+@needs_cross
+def test_the_stm32f405_build_boots_from_flash_with_its_stack_at_the_top_of_sram(tmp_path):
+    b = build_target(generated(tmp_path / "gen"), tmp_path / "w", target="stm32f405")
+    words = tool("arm-none-eabi-objdump", "-s", "-j", ".text", "--stop-address=0x08000008", str(b.elf))
+    sp, reset = (int.from_bytes(bytes.fromhex(w), "little") for w in words.splitlines()[-1].split()[1:3])
+    # the reference manual's memory map (RM0090): 128 KiB of SRAM1 + SRAM2 at 0x20000000, flash at 0x08000000
+    assert sp == 0x20000000 + 128 * 1024
+    assert 0x08000000 < reset < 0x08000000 + b.text and reset & 1  # a Thumb address in the flash
+    assert b.stack_bytes is not None and b.data + b.bss + b.stack_bytes < 128 * 1024
+
+
+@needs_cross
+@needs_qemu
+def test_the_stm32f405_build_in_qemus_netduinoplus2_ticks_like_sd_tick(tmp_path):
+    """QEMU's netduinoplus2 is an STM32F405: its flash, SRAM and USART2 (the machine's second serial port; RCC
+    and GPIO are not modelled, their writes ignored) run the board build unchanged."""
+    p = sd.load_platform("utn-dynamic")
+    files = generated(tmp_path / "gen")
+    b = build_target(files, tmp_path / "w", target="stm32f405")
+    argv = [QEMU, "-M", "netduinoplus2", "-nographic", "-monitor", "none", "-serial", "null", "-serial", "stdio"]
+    q = subprocess.Popen([*argv, "-kernel", str(b.elf)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, bufsize=0)
+    try:
+        host = link.LinkHost(q.stdin.write, link.pipe_reader(q.stdout.fileno()), fingerprint(files))
+        host.handshake(10.0)
+        pose, measured, ff = ticks(5, seed=6)
+        want = reference(generate(p, controller_config(p, machine_format(p, {})[1])), pose, measured, ff)
+        for k in range(5):
+            r = host.tick(pose[k], measured[k], ff[k], timeout=10.0)
+            assert r is not None and list(r.command) == list(want[k])
+        assert r.clock is not None and r.clock > 0  # SysTick counted sd_tick
+    finally:
+        q.kill()
+        q.wait(timeout=10)
+        q.stdin.close()
+        q.stdout.close()

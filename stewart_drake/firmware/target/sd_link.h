@@ -10,12 +10,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SD_LINK_VERSION 1
-#define SD_LINK_MAX_PAYLOAD 96 /* bytes: type + seq + body + crc */
+#define SD_LINK_VERSION 2
+#define SD_LINK_MAX_PAYLOAD 128 /* bytes: type + seq + body + crc */
 #define SD_LINK_MAX_ENCODED (SD_LINK_MAX_PAYLOAD + SD_LINK_MAX_PAYLOAD / 254 + 1)
 #define SD_LINK_FINGERPRINT_BYTES 8
 
-enum { SD_MSG_HELLO = 1, SD_MSG_HELLO_ACK = 2, SD_MSG_SENSOR = 3, SD_MSG_COMMAND = 4, SD_MSG_STATUS = 5, SD_MSG_STATUS_REPLY = 6 };
+enum { SD_MSG_HELLO = 1, SD_MSG_HELLO_ACK = 2, SD_MSG_SENSOR = 3, SD_MSG_COMMAND = 4, SD_MSG_STATUS = 5, SD_MSG_STATUS_REPLY = 6,
+       SD_MSG_SET_STATE = 7 };
 
 /* The receiver's counts; a frame counted in any of the last six is never acted on. */
 typedef struct {

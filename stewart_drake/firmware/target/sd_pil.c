@@ -75,7 +75,8 @@ static void sensor(sd_pil *p, uint16_t seq, const uint8_t *body)
     sd_count measured[6];
     int16_t feedforward[6], command[6];
     uint8_t out[SD_COMMAND_BODY];
-    int i, saturated;
+    uint32_t start, counts;
+    int i;
     if (!p->ready) {
         p->counters.unexpected++;
         return;
@@ -87,11 +88,17 @@ static void sensor(sd_pil *p, uint16_t seq, const uint8_t *body)
         measured[i] = get32(body + 12 + 4 * i);
         feedforward[i] = get16(body + 36 + 2 * i);
     }
-    saturated = sd_tick(&p->state, pose, measured, (body[48] & 1u) ? feedforward : 0, command);
-    for (i = 0; i < 6; ++i)
+    start = sd_pil_clock();
+    (void)sd_tick(&p->state, pose, measured, (body[48] & 1u) ? feedforward : 0, command);
+    counts = sd_pil_clock_since(start);
+    out[12] = 0;
+    for (i = 0; i < 6; ++i) {
         put16(out + 2 * i, command[i]);
-    out[12] = (uint8_t)saturated;
+        out[12] = (uint8_t)(out[12] | (p->state.saturated[i] ? 1u << i : 0u));
+        put32(out + 41 + 4 * i, (uint32_t)(int32_t)p->state.setpoint[i]);
+    }
     put_counters(out + 13, &p->counters);
+    put32(out + 65, counts);
     send(SD_MSG_COMMAND, seq, out, sizeof out);
 }
 
@@ -101,6 +108,25 @@ static void status(sd_pil *p, uint16_t seq)
     put_counters(out, &p->counters);
     put32(out + 4 * SD_LINK_COUNTERS, sd_pil_stack_used());
     send(SD_MSG_STATUS_REPLY, seq, out, sizeof out);
+}
+
+/* the controller's state as the host holds it (a closed loop starts from a held pose, not from sd_init's
+ * zeros); not a tick: the sequence is unchanged. Answered with the status. */
+static void set_state(sd_pil *p, uint16_t seq, const uint8_t *body)
+{
+    int i;
+    if (!p->ready) {
+        p->counters.unexpected++;
+        return;
+    }
+    for (i = 0; i < 6; ++i) {
+        p->state.integ[i] = get32(body + 4 * i);
+        p->state.prev[i] = (sd_count)get32(body + 24 + 4 * i);
+        p->state.dfilt[i] = get16(body + 48 + 2 * i);
+        p->state.setpoint[i] = (sd_word)get32(body + 60 + 4 * i);
+        p->state.vfilt[i] = get16(body + 84 + 2 * i);
+    }
+    status(p, seq);
 }
 
 void sd_pil_byte(sd_pil *p, uint8_t byte)
@@ -116,6 +142,8 @@ void sd_pil_byte(sd_pil *p, uint8_t byte)
         sensor(p, seq, p->payload + 3);
     else if (p->payload[0] == SD_MSG_STATUS && n == 3 + SD_STATUS_BODY)
         status(p, seq);
+    else if (p->payload[0] == SD_MSG_SET_STATE && n == 3 + SD_SET_STATE_BODY)
+        set_state(p, seq, p->payload + 3);
     else {
         p->counters.frames--; /* a good CRC but not a message this end takes */
         p->counters.malformed++;

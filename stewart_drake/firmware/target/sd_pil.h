@@ -8,11 +8,13 @@
 #include "sd_link.h"
 
 #define SD_SENSOR_BODY 49  /* pose i16[6], measured i32[6], feedforward i16[6], flags u8 (bit 0: feed-forward) */
-#define SD_COMMAND_BODY 41 /* command i16[6], saturated legs u8, counters u32[7] */
+#define SD_COMMAND_BODY 69 /* command i16[6], saturated legs u8 (bit i: leg i + 1), counters u32[7],
+                            set-point words i32[6], sd_tick's clock counts u32 (0xFFFFFFFF: not measured) */
 #define SD_HELLO_BODY 9    /* version u8, format fingerprint u8[8] */
 #define SD_HELLO_ACK_BODY 10 /* version u8, format fingerprint u8[8], accepted u8 */
 #define SD_STATUS_BODY 0
 #define SD_STATUS_REPLY_BODY 32 /* counters u32[7], stack high-water mark u32 (bytes; 0xFFFFFFFF: not measured) */
+#define SD_SET_STATE_BODY 96 /* integ i32[6], prev i32[6], dfilt i16[6], setpoint i32[6], vfilt i16[6] */
 
 typedef struct {
     sd_link_rx rx;
@@ -29,5 +31,9 @@ void sd_pil_byte(sd_pil *p, uint8_t byte);
 void sd_pil_write(const uint8_t *data, size_t n);
 /* defined by the runtime: the most stack used since reset, bytes (0xFFFFFFFF where it is not measured) */
 uint32_t sd_pil_stack_used(void);
+/* defined by the runtime: a free-running clock, and the counts since a reading of it (0xFFFFFFFF where the
+ * runtime has no clock) */
+uint32_t sd_pil_clock(void);
+uint32_t sd_pil_clock_since(uint32_t start);
 
 #endif

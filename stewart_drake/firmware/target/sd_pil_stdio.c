@@ -11,6 +11,14 @@ void sd_pil_write(const uint8_t *data, size_t n)
 
 uint32_t sd_pil_stack_used(void) { return 0xFFFFFFFFu; }
 
+uint32_t sd_pil_clock(void) { return 0u; }
+
+uint32_t sd_pil_clock_since(uint32_t start)
+{
+    (void)start;
+    return 0xFFFFFFFFu; /* no cycle clock on the host */
+}
+
 int main(void)
 {
     static sd_pil pil;

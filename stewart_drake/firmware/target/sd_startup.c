@@ -51,6 +51,24 @@ uint32_t sd_pil_stack_used(void)
     return (uint32_t)((uintptr_t)&_estack - (uintptr_t)d);
 }
 
+/* SysTick (Armv7-M system control space) as a free-running 24-bit down-counter of processor clocks */
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYST_MASK 0x00FFFFFFu
+
+uint32_t sd_pil_clock(void)
+{
+    if (!(SYST_CSR & 1u)) {
+        SYST_RVR = SYST_MASK;
+        SYST_CVR = 0u;
+        SYST_CSR = 5u; /* enabled, the processor clock, no interrupt */
+    }
+    return SYST_CVR;
+}
+
+uint32_t sd_pil_clock_since(uint32_t start) { return (start - SYST_CVR) & SYST_MASK; }
+
 void Default_Handler(void)
 {
     for (;;)
