@@ -208,6 +208,16 @@ def _motion(motion, platform: Platform, rate: float, **units) -> Trajectory:
     return get_trajectory(motion, **units)
 
 
+def actuator_model(machine: Machine) -> ActuatorModel:
+    """The loop's ``ActuatorModel`` of ``machine.actuators``: the lag, or the screw with its current loop's
+    time constant as the lag the gains and the feed-forward are designed for."""
+    a = machine.actuators
+    if a.model == "screw":
+        screw = a.screw(machine.platform.legs.max_force)
+        return ActuatorModel(screw.max_force, screw.current_time_constant, screw)
+    return ActuatorModel(a.max_force, a.time_constant)
+
+
 def plan_run(
     platform: Machine | Platform | str | Path,
     trajectory: str | Path | Trajectory | None = None,
@@ -291,7 +301,11 @@ def plan_run(
     if fit:
         traj = fit_trajectory(traj, platform)
     duration = duration if duration is not None else (traj.duration or 1.0)
-    actuators = actuators or ActuatorModel(machine.actuators.max_force, machine.actuators.time_constant)
+    actuators = actuators or actuator_model(machine)
+    if actuators.screw is not None and actuators.screw.encoder_resolution is not None:
+        sensor_resolution = actuators.screw.encoder_resolution  # the legs' sensor is the motor's encoder
+    # the lag the gains are designed for: the lag's (the machine's nominal one), or the screw's current loop
+    design_lag = machine.actuators.time_constant if actuators.screw is None else actuators.time_constant
     sensor = sensor if sensor is not None else _sensor(machine, duration)
     timing = DspTiming(
         sample_period=period,
@@ -301,7 +315,9 @@ def plan_run(
     )
     if checks:
         timing.check()
-        check_timing(platform, period, plant_step, actuators.time_constant, timing.output_delay)
+        # the screw's current loop is stepped exactly (zero-order hold), so a plant step may be longer than it
+        lag = actuators.time_constant if actuators.screw is None else 0.0
+        check_timing(platform, period, plant_step, lag, timing.output_delay)
         if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
             raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
         shown = duration_shown if duration_shown is not None else duration
@@ -330,7 +346,7 @@ def plan_run(
     elif nominal_gains and gains is None:
         gains = ControllerConfig.for_platform(platform, poses=poses).gains
     elif not nominal_gains:
-        gains = ControllerConfig.for_platform(platform, timing, machine.actuators.time_constant, poses=poses).gains
+        gains = ControllerConfig.for_platform(platform, timing, design_lag, poses=poses).gains
     if scale != 1.0:
         gains = replace(gains, kp=gains.kp * scale, ki=gains.ki * scale, kd=gains.kd * scale, kv=gains.kv * scale)
     config = ControllerConfig.for_platform(platform, timing, gains=gains, **form)
@@ -578,11 +594,13 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
     t_wall = time.perf_counter()
     if sc.firmware and meshcat is None:  # the user's C runs in a child process with a time limit
         log, gap, tick_loop = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
+        energy = None
     else:
         sim = build_simulation(sc, meshcat=meshcat)
         log = sim.run(plan.duration, progress=progress)
         gap = sim.max_constraint_gap()
         tick_loop = sim.tick_loop
+        energy = sim.controller.energy
     t_wall = time.perf_counter() - t_wall
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -600,6 +618,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "controller": sc.controller,
         "engine": sc.engine,
         "tick_loop": tick_loop,  # "compiled" for either law where the loop kernel runs; "engine" is the firmware's
+        "actuator_model": sc.actuators.model,  # "screw": the Python loop (the compiled kernel steps the lag only)
         "firmware": sc.firmware,
         "sample_period_s": timing.sample_period,
         "latency": timing.latency,
@@ -627,6 +646,8 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
+    if energy is not None:  # the screws' energy flows over the run, J per leg (control.screw.powers)
+        summary["actuator_energy_J"] = {k: v.tolist() for k, v in energy.items()}
     # tracking, and the loop's own verdict: chatter (force ripple about the inverse-dynamics force) and
     # saturation at the reference's ends (control/verdict.py; each Monte Carlo run is judged there too)
     verdict, loop = run_verdict(sc.platform, truth, traj, log, config, e, pe)
