@@ -2,7 +2,7 @@
 
 A servo motor turns a ball or roller screw of ``lead`` m per revolution: motor angle θ = ρ·L with
 ρ = 2π/lead (rad/m). The drive turns the controller's force command u (N) into a current command
-i* = clip(u / k_F, ±``max_current``) with k_F = ρ·Kt·η (the force per ampere while the motor drives); the
+i* = clip(u / k_F, ±``max_current``) with k_F = ρ·Kt (the force per ampere of a screw at rest); the
 current follows i* through the current loop, a first-order lag of ``current_time_constant`` τ_i (0: none),
 di/dt = (i* − i)/τ_i. The motor torque Kt·i reaches the leg through the screw:
 
@@ -46,22 +46,18 @@ class ScrewActuation:
         tau = params.current_time_constant
         self.a = math.exp(-self.h / tau) if tau > 0 else 0.0
 
-    def current_command(self, u) -> np.ndarray:
-        """``(..., 6)`` i* (A) of force commands ``u`` (N): u/k_F clipped at ±max_current."""
-        p = self.params
-        return np.clip(np.asarray(u, dtype=float) / p.force_per_amp, -p.max_current, p.max_current)
-
     def initial_current(self, hold_forces) -> np.ndarray:
         """``(6,)`` the currents (A) of a drive holding ``hold_forces`` (6, N) at rest."""
-        return self.current_command(hold_forces)
+        return current_command(self.params, hold_forces)
 
     def step(self, current, u) -> np.ndarray:
         """``(6,)`` the currents after a plant step from ``current`` under the held command ``u`` (6, N)."""
-        return self.a * current + (1 - self.a) * self.current_command(u)
+        return self.a * current + (1 - self.a) * current_command(self.params, u)
 
-    def saturate(self, u) -> np.ndarray:
-        """``(6,)`` the force of command ``u`` held at rest (N): the drive's current limit."""
-        return self.current_command(u) * self.params.force_per_amp
+
+def current_command(p: ScrewParameters, u) -> np.ndarray:
+    """``(..., 6)`` the drive's current command i* (A) of force commands ``u`` (N): u/k_F within ±max_current."""
+    return np.clip(np.asarray(u, dtype=float) / p.force_per_amp, -p.max_current, p.max_current)
 
 
 def efficiency_factor(p: ScrewParameters, current, velocity) -> np.ndarray:
@@ -84,8 +80,7 @@ def leg_force(p: ScrewParameters, current, velocity) -> np.ndarray:
 
 def current_derivative(p: ScrewParameters, current, u) -> np.ndarray:
     """``(..., 6)`` di/dt (A/s) of the current loop at ``current`` A under force command ``u`` N."""
-    i_cmd = np.clip(np.asarray(u, dtype=float) / p.force_per_amp, -p.max_current, p.max_current)
-    return (i_cmd - np.asarray(current, dtype=float)) / p.current_time_constant
+    return (current_command(p, u) - np.asarray(current, dtype=float)) / p.current_time_constant
 
 
 def powers(p: ScrewParameters, current, velocity) -> dict:

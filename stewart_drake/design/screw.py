@@ -33,16 +33,16 @@ class ScrewParameters:
     @classmethod
     def defaults(cls, max_force: float, **given) -> ScrewParameters:
         """Parameters of a screw actuator sized for ``max_force`` N, ``given`` (non-None) replacing them: a
-        10 mm lead, η 0.9, Kt 0.5 N·m/A, the current limit that gives ``max_force`` (i_max = F_max/(ρ·Kt·η)),
-        a rated current of a third of it, a low-inertia servo's rotor (J = 1e-5 kg·m² per N·m of the peak
-        torque F_max·lead/(2π·η)), 3000 rpm, a 0.2 ms current loop, 1 Ω, Coulomb friction 1 % of F_max and
+        10 mm lead, η 0.9, Kt 0.5 N·m/A, the current limit that gives ``max_force`` at rest (i_max =
+        F_max/(ρ·Kt)), a rated current of a third of it, a low-inertia servo's rotor (J = 1e-5 kg·m² per N·m
+        of the peak torque F_max·lead/2π), 3000 rpm, a 0.2 ms current loop, 1 Ω, Coulomb friction 1 % of F_max and
         viscous friction 1 % of F_max at 0.1 m/s. The current limit, rotor and friction scale with the force
         (a larger machine has a larger motor); the rest are a typical catalogue servo's."""
         g = {k: v for k, v in given.items() if v is not None}
         lead = float(g.get("lead", 0.01))
         eta = float(g.get("efficiency", 0.9))
         kt = float(g.get("torque_constant", 0.5))
-        peak_torque = max_force * lead / (2 * math.pi * eta)
+        peak_torque = max_force * lead / (2 * math.pi)
         i_max = float(g.get("max_current", peak_torque / kt))
         base = cls(
             lead=lead,
@@ -72,12 +72,13 @@ class ScrewParameters:
 
     @property
     def force_per_amp(self) -> float:
-        """k_F = ρ·Kt·η (N/A): the leg force per ampere while the motor drives."""
-        return self.ratio * self.torque_constant * self.efficiency
+        """k_F = ρ·Kt (N/A): the leg force per ampere at rest (η× that while the motor drives the leg, 1/η×
+        while the leg drives the motor)."""
+        return self.ratio * self.torque_constant
 
     @property
     def max_force(self) -> float:
-        """The driving force at the current limit (N): k_F·i_max."""
+        """The force at the current limit at rest (N): k_F·i_max."""
         return self.force_per_amp * self.max_current
 
     @property
