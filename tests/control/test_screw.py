@@ -99,8 +99,9 @@ def test_a_small_step_follows_the_linear_model():
     linear = c * (b / -a) * du * (1 - np.exp(a * t)) + d * dv
     # the current is linear in the command (ZOH exact): what is left is F's curvature in L̇ and i·L̇, second
     # order: |½·F_vv·dv²| + |F_iv·δi·dv| with F_vv ≤ d's scale over v_s, F_iv ≤ c·|ln η|/v_s
-    second = 0.5 * abs(d) / screw.FRICTION_SPEED * dv**2 + c * abs(math.log(P.efficiency)) / screw.FRICTION_SPEED * (
-        du / P.force_per_amp
-    ) * dv
+    second = (
+        0.5 * abs(d) / screw.FRICTION_SPEED * dv**2
+        + c * abs(math.log(P.efficiency)) / screw.FRICTION_SPEED * (du / P.force_per_amp) * dv
+    )
     np.testing.assert_allclose(np.array(F) - F0, linear, atol=4 * second + 1e-9 * F0)
     assert abs(linear[-1]) > 100 * (4 * second)  # the response is far above the tolerance
