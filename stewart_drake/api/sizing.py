@@ -1,5 +1,7 @@
 """``size``: actuator sizing (peak and RMS force, speed, acceleration, power, stroke per leg) for a motion
-program, a trajectory or a duty envelope, against the platform's actuator limits."""
+program, a trajectory or a duty envelope, against the platform's actuator limits; for a machine with screw
+actuators along a trajectory, the motors' peak torque, speed and current and RMS current against the motor's
+limits too (``control.screw.motor_demand``)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.design import carrying
 from stewart_drake.api.dynamics import read_trajectory_csv, trajectory_rates
 from stewart_drake.api.result import Result
+from stewart_drake.control.screw import motor_demand
 from stewart_drake.core.argcheck import as_flag, as_real, check_path, param
 from stewart_drake.core.dynamics import seed_trajectory
 from stewart_drake.core.geometry import Platform, check_platform
@@ -19,8 +22,10 @@ from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
+from stewart_drake.design.screw import ScrewParameters
 from stewart_drake.design.sizing import (
     UNITS,
+    TrajectorySizing,
     first_violation,
     limits_of,
     rotating_trajectory,
@@ -30,6 +35,7 @@ from stewart_drake.design.sizing import (
 from stewart_drake.errors import API_SIZE_SOURCE, OptionError
 from stewart_drake.script import run_program
 from stewart_drake.script.source import read_program
+from stewart_drake.spec.machine import Machine
 
 MAX_LISTED = 10_000  # envelope poses whose allowed accelerations are listed in the JSON
 MAX_SAMPLES = 10_000_000  # samples of a seed/rotating trajectory (t_end / dt)
@@ -54,18 +60,26 @@ class SizingResult(Result):
     violation: dict | None
     where: str
     peak_where: str = ""
+    motor_violation: dict | None = None
 
     @property
     def ok(self) -> bool:
-        """Every leg within its limits."""
-        return self.violation is None
+        """Every leg (and screw actuator's motor) within its limits."""
+        return self.violation is None and self.motor_violation is None
 
     def violation_message(self) -> str | None:
         """The violation as one line: the worst excess (the peak the table shows) and where the limit is first
         exceeded; or None."""
         v = self.violation
         if v is None:
-            return None
+            m = self.motor_violation
+            if m is None:
+                return None
+            return (
+                f"leg {m['leg']} motor {m['quantity']} peaks at {m['value']:.6g} {m['unit']}, beyond "
+                f"actuators.{m['limit_name']} {m['limit']:.6g} {m['unit']}"
+                + ("" if m["t_s"] is None else f" at t = {m['t_s']:.4f} s")
+            )
         qty = v["quantity"]
         name = "stroke" if qty == "length" else f"legs.max_{qty}"
         u = UNITS[qty]
@@ -79,7 +93,7 @@ class SizingResult(Result):
 
 
 def size(
-    platform: Platform,
+    platform: Platform | Machine,
     trajectory: str | Path | Trajectory | None = None,
     *,
     program: str | None = None,
@@ -99,7 +113,8 @@ def size(
     """Actuator sizing for one source of motion: a trajectory, a motion program or a duty envelope.
 
     Args:
-        platform: the platform (its ``legs`` limits are checked).
+        platform: the platform (its ``legs`` limits are checked), or a machine: its platform, and with
+            ``actuators.model: screw`` its motors sized along a trajectory or program too.
         trajectory: ``"seed"``, ``"rotating"``, a CSV file (as for `inverse_dynamics`) or a `Trajectory` with
             samples or exact rates.
         program: a motion program (``.stw``), sampled at ``rate``.
@@ -123,6 +138,11 @@ def size(
     Raises:
         StewartError: not exactly one source, bad options or samples.
     """
+    screw = None
+    if isinstance(platform, Machine):
+        machine, platform = platform, platform.platform
+        if machine.actuators.model == "screw":
+            screw = machine.actuators.screw(platform.legs.max_force)
     check_platform(platform)
     check_convention(convention)
     legs = as_flag(legs, "legs")
@@ -138,15 +158,16 @@ def size(
     loaded, p_TP = carrying(platform, payload, payload_com, gravity)
     return size_loaded(
         platform, loaded, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-        length_unit, angle_unit, smooth=smooth,
+        length_unit, angle_unit, smooth=smooth, screw=screw,
     )  # fmt: skip
 
 
 def size_loaded(
     base, platform, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-    length_unit, angle_unit, envelope_shown=None, smooth=None,
+    length_unit, angle_unit, envelope_shown=None, smooth=None, screw=None,
 ) -> SizingResult:  # fmt: skip
-    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name)."""
+    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name); ``screw``: the
+    machine's ``ScrewParameters`` (None: no motors to size)."""
     header = {
         "platform": base.name,
         "legs_model": bool(legs),
@@ -200,9 +221,68 @@ def size_loaded(
         limits=limits,
         violation=viol,
     )
+    motor_viol = None
+    if screw is not None:
+        out["motor"], motor_viol = motor_sizing(screw, s)
     if viol is None:
-        return SizingResult(out, None, "")
-    return SizingResult(out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s")
+        return SizingResult(out, None, "", motor_violation=motor_viol)
+    return SizingResult(
+        out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s", motor_violation=motor_viol
+    )
+
+
+# motor quantity -> (the demand's array, the limit's field, unit)
+MOTOR_LIMITS = {
+    "current": ("max_current", "A"),
+    "speed": ("max_motor_speed", "rad/s"),
+    "rms_current": ("rated_current", "A"),
+}
+
+
+def motor_sizing(screw: ScrewParameters, s: TrajectorySizing) -> tuple[dict, dict | None]:
+    """The screw actuators' motors along the sized trajectory ``s``: per leg the peak |current| (A), |torque|
+    (N·m) and |speed| (rad/s) with their times, the RMS current over the run (trapezoid over ``s.t``), the
+    limits (``max_current``, ``max_motor_speed``, ``rated_current``) and the screw's derived numbers; and the
+    worst excess of a limit (``quantity``, ``leg``, ``value``, ``limit``, ``limit_name``, ``unit``, ``t_s``),
+    or None."""
+    d = motor_demand(screw, s.force, s.speed, s.accel)
+    t, i = s.t, np.abs(d["current"])
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    rms = np.sqrt(np.trapezoid(i**2, t, axis=0) / span) if span > 0 else i.max(axis=0)
+    peaks = {"current": i, "speed": np.abs(d["speed"])}
+    legs = []
+    for leg in range(6):
+        row = {"leg": leg + 1, "rms_current_a": float(rms[leg])}
+        for name, arr, unit in (
+            ("current", i, "a"),
+            ("torque", np.abs(d["torque"]), "nm"),
+            ("speed", peaks["speed"], "rad_s"),
+        ):
+            k = int(np.argmax(arr[:, leg]))
+            row[f"peak_{name}_{unit}"], row[f"peak_{name}_t_s"] = float(arr[k, leg]), float(t[k])
+        legs.append(row)
+    worst = None
+    for qty, (field, unit) in MOTOR_LIMITS.items():
+        limit = getattr(screw, field)
+        values = rms if qty == "rms_current" else peaks[qty].max(axis=0)
+        leg = int(np.argmax(values / limit))
+        ratio = float(values[leg] / limit)
+        if ratio > 1 and (worst is None or ratio > worst[0]):
+            t_s = None if qty == "rms_current" else float(t[int(np.argmax(peaks[qty][:, leg]))])
+            worst = (ratio, {"quantity": qty, "leg": leg + 1, "value": float(values[leg]), "limit": limit,
+                             "limit_name": field, "unit": unit, "t_s": t_s})  # fmt: skip
+    summary = {
+        "legs": legs,
+        "limits": {field: getattr(screw, field) for field, _ in MOTOR_LIMITS.values()},
+        "screw": {
+            "lead_m": screw.lead,
+            "reflected_mass_kg": screw.reflected_mass,
+            "force_per_amp_n_a": screw.force_per_amp,
+            "torque_constant_nm_a": screw.torque_constant,
+        },
+        "violation": None if worst is None else worst[1],
+    }
+    return summary, None if worst is None else worst[1]
 
 
 def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit, smooth=None):

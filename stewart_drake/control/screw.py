@@ -117,3 +117,15 @@ def linearisation(p: ScrewParameters, current: float, velocity: float) -> tuple[
     if tau > 0:
         return -1 / tau, 1 / (tau * p.force_per_amp), c, d
     return -math.inf, math.inf, c, d
+
+
+def motor_demand(p: ScrewParameters, force, velocity, acceleration) -> dict:
+    """What the motors must give for the legs to apply ``force`` (..., 6) N (the inverse dynamics') while
+    moving at ``velocity`` m/s and accelerating at ``acceleration`` m/s² (each (..., 6)): the screw force
+    F_s = F + m_eff·L̈ + F_f(L̇) (the rotor accelerated and the friction overcome) from the current
+    i = F_s/(ρ·Kt·η^tanh(sign(F_s)·L̇/v_s)) (``leg_force`` inverted). Returns ``current`` A, ``torque`` Kt·i N·m
+    and ``speed`` ρ·L̇ rad/s."""
+    v, a = np.asarray(velocity, dtype=float), np.asarray(acceleration, dtype=float)
+    screw_force = np.asarray(force, dtype=float) + p.reflected_mass * a + friction_force(p, v)
+    current = screw_force / (p.ratio * p.torque_constant * efficiency_factor(p, screw_force, v))
+    return {"current": current, "torque": p.torque_constant * current, "speed": p.ratio * v}

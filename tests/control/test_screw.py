@@ -105,3 +105,12 @@ def test_a_small_step_follows_the_linear_model():
     )
     np.testing.assert_allclose(np.array(F) - F0, linear, atol=4 * second + 1e-9 * F0)
     assert abs(linear[-1]) > 100 * (4 * second)  # the response is far above the tolerance
+
+
+def test_motor_demand_inverts_the_law():
+    # the current motor_demand asks for gives, through leg_force, the force asked for plus the rotor's m_eff·L̈
+    rng = np.random.default_rng(3)
+    F, v, acc = rng.normal(0, 2000, (40, 6)), rng.normal(0, 0.05, (40, 6)), rng.normal(0, 2, (40, 6))
+    d = screw.motor_demand(P, F, v, acc)
+    np.testing.assert_allclose(screw.leg_force(P, d["current"], v), F + P.reflected_mass * acc, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(d["speed"], v * 2 * math.pi / P.lead, rtol=1e-15)
