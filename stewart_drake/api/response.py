@@ -16,7 +16,7 @@ import numpy as np
 
 from stewart_drake.api.result import Result
 from stewart_drake.api.simulation import plan_run, run_machine
-from stewart_drake.control.feedforward import feedforward_lead
+from stewart_drake.control.feedforward import feedforward_lead, initial_leg_forces
 from stewart_drake.control.frequency import (
     MIN_GAIN_MARGIN_DB,
     MIN_PHASE_MARGIN_DEG,
@@ -26,6 +26,7 @@ from stewart_drake.control.frequency import (
     effective_gains,
     margins,
 )
+from stewart_drake.control.screw import small_signal
 from stewart_drake.core.argcheck import check_finite_samples, check_shape
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.trajectory import constant_trajectory
@@ -202,9 +203,12 @@ def loop_response(
     if lag > 0 and abs(steps - round(steps)) > 1e-9 * steps:  # the lag steps at the plant steps between ticks
         raise ResponseError(ResponseError.PLANT_STEPS.format(step=sc.plant_time_step, period=T))
     lead = feedforward_lead(sc.config, lag) if sc.feedforward else None
+    screw = None
+    if sc.actuators.screw is not None:  # about the currents that hold the plate at the pose, as the run starts
+        screw = small_signal(sc.actuators.screw, initial_leg_forces(sc.platform, sc.trajectory), sc.plant_time_step)
     model = LoopModel.build(
         sc.platform, pose, effective_gains(sc.controller, sc.config), T, plan.timing.output_delay, lag,
-        sc.plant_time_step, lead,
+        sc.plant_time_step, lead, screw,
     )  # fmt: skip
     Tsp = model.setpoint_response(f)
     L, S = model.loops(f)

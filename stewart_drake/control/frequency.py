@@ -10,7 +10,8 @@ continuous system does not take. About a pose at rest the legs obey
 (the leg forces that hold the plate, differentiated along the legs: ``leg_space_stiffness``; the rate terms are
 quadratic at rest). The actuators are the loop's own discrete lag F ← a·F + b·u at each plant step h
 (``control.actuation``), reading the command held just before that step; without a lag the force follows the
-command from its release. The mechanics between plant steps are integrated exactly (zero-order hold), so the
+command from its release. Screw actuators (``control.screw``) are their small signal at rest (``SmallSignal``:
+the current loop, the force of the current and the velocity's damping, the rotor's mass on the legs). The mechanics between plant steps are integrated exactly (zero-order hold), so the
 tick-to-tick map of (lengths, rates, forces) is exact for the linear plant. The controller is the PID of
 ``control.laws`` as a discrete state space (integrator, measurement and set-point difference filters), its
 command released ``DspTiming.output_delay`` after the tick. The feed-forward table's rows enter, linearised, as
@@ -32,6 +33,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from stewart_drake.control.gains import ControllerConfig, FixedGains, PidGains, leg_space_inertia
+from stewart_drake.control.screw import SmallSignal
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import length_jacobian
@@ -138,6 +140,37 @@ def plant_matrices(M: np.ndarray, K: np.ndarray, lag: float, step: float, T: flo
     return Phi, G_old, G_new
 
 
+def screw_plant_matrices(M: np.ndarray, K: np.ndarray, screw: SmallSignal, step: float, T: float, delay: float):
+    """``plant_matrices`` with screw actuators (``control.screw.SmallSignal``) in place of the lag: the legs
+    carry the rotors' reflected mass, and at each plant step the currents take the command held just before it,
+    i ← a·i + β·u, and the force c·i + d·L̇ is held over the next step. State s = (lengths m, rates m/s, currents
+    A, held forces N)."""
+    Minv = np.linalg.inv(M + screw.reflected_mass * np.eye(6))
+    Am = np.block([[np.zeros((6, 6)), np.eye(6)], [-Minv @ K, np.zeros((6, 6))]])
+    Bm = np.vstack([np.zeros((6, 6)), Minv])
+    Ad, Bd = _zoh(Am, Bm, step)
+    I6, Z6, D = np.eye(6), np.zeros((6, 6)), np.diag(screw.d)
+    rate = np.hstack([Z6, I6])  # picks L̇ from (L, L̇)
+    # mechanics with F held, then i ← a·i (+ β·u) and F ← c·i + d·L̇ at the step's end
+    sub = np.block(
+        [
+            [Ad, np.zeros((12, 6)), Bd],
+            [np.zeros((6, 12)), screw.a * I6, Z6],
+            [D @ rate @ Ad, screw.c * screw.a * I6, D @ rate @ Bd],
+        ]
+    )
+    inj = np.vstack([np.zeros((12, 6)), screw.beta * I6, screw.c * screw.beta * I6])
+    n = int(round(T / step))
+    Phi, G_old, G_new = np.eye(24), np.zeros((24, 6)), np.zeros((24, 6))
+    for j in range(1, n + 1):
+        Phi, G_old, G_new = sub @ Phi, sub @ G_old, sub @ G_new
+        if j * step > delay + 1e-9 * T:  # the currents read the command held just before this plant step
+            G_new = G_new + inj
+        else:
+            G_old = G_old + inj
+    return Phi, G_old, G_new
+
+
 @dataclass(frozen=True)
 class LoopModel:
     """The discrete closed leg loop about ``pose`` (6,): inputs the six leg set-points (m) and the six
@@ -173,13 +206,17 @@ class LoopModel:
         lag: float,
         step: float,
         lead: float | None,
+        screw: SmallSignal | None = None,
     ) -> LoopModel:
         """The loop of ``platform`` at ``pose`` (6,) with the law's SI ``gains``, sample period ``T`` (s), output
         ``delay`` (s, ≤ T), actuator ``lag`` (s) stepped at the plant ``step`` (s) and the feed-forward ``lead``
-        (s; None: no feed-forward)."""
+        (s; None: no feed-forward); ``screw``: screw actuators' small signal in place of the lag."""
         pose = np.asarray(pose, dtype=float).reshape(6)
         M, K = leg_space_mass(platform, pose), leg_space_stiffness(platform, pose)
-        Phi, G_old, G_new = plant_matrices(M, K, lag, step, T, delay)
+        if screw is None:
+            Phi, G_old, G_new = plant_matrices(M, K, lag, step, T, delay)
+        else:
+            Phi, G_old, G_new = screw_plant_matrices(M, K, screw, step, T, delay)
         ns = len(Phi)
         I6, Z = np.eye(6), np.zeros
         # plant with the released command as state: p = (s, u_{k−1}); p' = Pa·p + Ga·u_k; y = Cp·p

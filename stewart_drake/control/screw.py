@@ -28,6 +28,7 @@ error of O(h·|dF/dL̇|·|L̈|) in the force.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -129,3 +130,26 @@ def motor_demand(p: ScrewParameters, force, velocity, acceleration) -> dict:
     screw_force = np.asarray(force, dtype=float) + p.reflected_mass * a + friction_force(p, v)
     current = screw_force / (p.ratio * p.torque_constant * efficiency_factor(p, screw_force, v))
     return {"current": current, "torque": p.torque_constant * current, "speed": p.ratio * v}
+
+
+@dataclass(frozen=True)
+class SmallSignal:
+    """The six screw actuators linearised at rest holding forces, as the loop steps them every ``step`` s:
+    at each plant step i ← ``a``·i + ``beta``·u, then F = ``c``·i + ``d``·L̇ held over the step; ``reflected_mass``
+    (kg) rides on each leg. ``d`` (6,) N·s/m: at rest the blended Coulomb friction and efficiency damp
+    (−F_c/v_s, and ρ·Kt·|i|·ln η/v_s with the holding current)."""
+
+    a: float
+    beta: float
+    c: float
+    d: np.ndarray
+    reflected_mass: float
+
+
+def small_signal(p: ScrewParameters, hold_forces, step: float) -> SmallSignal:
+    """``SmallSignal`` of the screws holding ``hold_forces`` (6,) N at rest, stepped every ``step`` s
+    (``linearisation`` at L̇ = 0 of each leg's holding current, its current loop discretised exactly)."""
+    act = ScrewActuation(p, step)
+    currents = act.initial_current(np.asarray(hold_forces, dtype=float).reshape(6))
+    lin = [linearisation(p, float(i) if i != 0 else 1e-300, 0.0) for i in currents]
+    return SmallSignal(act.a, (1 - act.a) / p.force_per_amp, lin[0][2], np.array([x[3] for x in lin]), p.reflected_mass)
