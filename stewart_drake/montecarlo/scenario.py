@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from stewart_drake.api.simulation import KEYWORD_PATHS, plan_run, tick_count
+from stewart_drake.api.simulation import KEYWORD_PATHS, actuator_model, plan_run, tick_count
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import Platform, base_joints
@@ -397,7 +397,10 @@ def scenario(study: Study, index: int, reference: Trajectory | None = None, gain
         duration=duration,
         plant_step=study.plant_step,
         fit=False,  # the reference is fitted already (Study.reference)
-        actuators=ActuatorModel(d.force_limit, d.actuator_lag),
+        # screws: the drawn machine's (the lag's draws, actuator_lag and force_limit, are the lag model's)
+        actuators=actuator_model(drawn)
+        if drawn.actuators.model == "screw"
+        else ActuatorModel(d.force_limit, d.actuator_lag),
         sensor=sensor_model(d, seed, period, tick_count(duration, period) + 1),
         plant_platform=drawn.loaded_platform,
         nominal_gains=True,
