@@ -51,6 +51,18 @@ class ScrewActuation:
         """``(6,)`` the currents (A) of a drive holding ``hold_forces`` (6, N) at rest."""
         return current_command(self.params, hold_forces)
 
+    def start(self, hold_forces, lengths, rates) -> tuple[np.ndarray, np.ndarray]:
+        """``(currents, force)``: the drive holding ``hold_forces`` (6, N), the legs at ``rates`` (6, m/s)
+        (``lengths`` unused: the screw's force does not depend on them)."""
+        i = self.initial_current(hold_forces)
+        return i, leg_force(self.params, i, rates)
+
+    def advance(self, current, u, lengths, rates) -> tuple[np.ndarray, np.ndarray, dict]:
+        """One plant step under the held command ``u`` (6, N) from the legs' ``rates`` (6, m/s) at its start:
+        ``(currents, force to hold (6, N), powers (W) over the step)``."""
+        i = self.step(current, u)
+        return i, leg_force(self.params, i, rates), powers(self.params, i, rates)
+
     def step(self, current, u) -> np.ndarray:
         """``(6,)`` the currents after a plant step from ``current`` under the held command ``u`` (6, N)."""
         return self.a * current + (1 - self.a) * current_command(self.params, u)

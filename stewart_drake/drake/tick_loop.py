@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stewart_drake.control import dsp_state, screw
+from stewart_drake.control import dsp_state
 from stewart_drake.control.loop_sensor import IdealSensor, SensorReading
 from stewart_drake.firmware.loop_kernel import make_kernel
 
@@ -92,10 +92,11 @@ class TickLoop:
     ``sensor``: ``(t, x) -> (6,)`` readings of the plant state ``x``; ``step`` (s): the plant step;
     ``actuators``: their saturation and lag (``control.actuation.Actuation``), stepped here at every plant
     step; ``discrete``: the plant is discrete (it logs at every stop); ``legs``: ``(positions, velocities)``,
-    the legs' indices in the plant state, for actuators that read the legs' motion (``control.screw``'s
-    ``ScrewActuation``, stepped by the Python loop: the compiled kernel steps the lag only), None for the lag.
-    Such actuators' energy flows (``control.screw.powers`` at each plant step's start, held over the step) add
-    up in ``energy`` ({flow: (6,) J})."""
+    the legs' indices in the plant state, for actuators with a state that read the legs' motion (``control.screw``'s
+    ``ScrewActuation``: ``start(hold_forces, L, L̇) -> state`` and ``advance(state, command, L, L̇) -> (state,
+    force, powers)``, stepped by the Python loop: the compiled kernel steps the lag only), None for the lag.
+    Such actuators' energy flows (the powers of each plant step, W, held over it) add up in ``energy``
+    ({flow: (6,) J})."""
 
     def __init__(
         self, simulator, plant, plant_context, actuation_input, law, sensor, step, actuators, discrete, legs=None
@@ -111,7 +112,7 @@ class TickLoop:
         self._fixed = actuation_input.FixValue(simulator.get_mutable_context(), np.zeros(6))
         # the compiled DSP side (one C call per stop), None: the Python loop below (``firmware.loop_kernel``)
         self.kernel = make_kernel(law, sensor) if legs is None else None
-        self.legs, self.current, self.energy = legs, None, None
+        self.legs, self.actuator_state, self.energy = legs, None, None
         self._end, self._boundaries, self._raw = 0.0, (), None  # the last run's end, extra stops and raw logs
 
     def prime(self, poses) -> None:
@@ -129,10 +130,10 @@ class TickLoop:
             self.law, lengths, hold_forces, feedforward, rates
         )
         if self.legs is not None:
-            self.current = self.actuators.initial_current(np.zeros(6) if hold_forces is None else hold_forces)
             x = self.plant.GetPositionsAndVelocities(self.plant_context)
-            self.lag_force = screw.leg_force(self.actuators.params, self.current, x[self.legs[1]])
-            self.energy = {k: np.zeros(6) for k in screw.powers(self.actuators.params, self.current, 0.0)}
+            hold = np.zeros(6) if hold_forces is None else hold_forces
+            self.actuator_state, self.lag_force = self.actuators.start(hold, x[self.legs[0]], x[self.legs[1]])
+            self.energy = None  # the flows' names come with the first step
         elif self.actuators.has_lag:
             self.lag_force = self.actuators.saturate(np.zeros(6) if hold_forces is None else hold_forces)
         self._set_force(self._force_of(self.held))
@@ -260,21 +261,24 @@ class TickLoop:
                     if self.legs is None:
                         self.lag_force = act.step(self.lag_force, before[:6])
                     else:
-                        self.lag_force = self._screw_step(before[:6], get_x(pc))
+                        self.lag_force = self._actuator_step(before[:6], get_x(pc))
                     self._set_force(self.lag_force)
             elif held is not before:
                 self._set_force(act.saturate(held[:6]))
         self.held, self.memory, self.status = held, memory, status
         return logs
 
-    def _screw_step(self, command, x) -> np.ndarray:
-        """The screw actuators' plant step at plant state ``x`` under the held ``command`` (6, N): the currents
+    def _actuator_step(self, command, x) -> np.ndarray:
+        """The stateful actuators' plant step at plant state ``x`` under the held ``command`` (6, N): their state
         advanced, their energy flows over the step added; the force (6, N) to hold over the step."""
-        p, v = self.actuators.params, x[self.legs[1]]
-        self.current = self.actuators.step(self.current, command)
-        for name, power in screw.powers(p, self.current, v).items():
+        self.actuator_state, force, powers = self.actuators.advance(
+            self.actuator_state, command, x[self.legs[0]], x[self.legs[1]]
+        )
+        if self.energy is None:
+            self.energy = {name: np.zeros(6) for name in powers}
+        for name, power in powers.items():
             self.energy[name] += power * self.step
-        return screw.leg_force(p, self.current, v)
+        return force
 
     _force = None
 
