@@ -210,11 +210,14 @@ def _motion(motion, platform: Platform, rate: float, **units) -> Trajectory:
 
 def actuator_model(machine: Machine) -> ActuatorModel:
     """The loop's ``ActuatorModel`` of ``machine.actuators``: the lag, or the screw with its current loop's
-    time constant as the lag the gains and the feed-forward are designed for."""
+    (the cylinder with its valve's) time constant as the lag the gains and the feed-forward are designed for."""
     a = machine.actuators
     if a.model == "screw":
         screw = a.screw(machine.platform.legs.max_force)
         return ActuatorModel(screw.max_force, screw.current_time_constant, screw)
+    if a.model == "hydraulic":  # the force loop's lag as the lag
+        hyd = a.hydraulic(machine.platform)
+        return ActuatorModel(hyd.max_force, hyd.valve_time_constant, hydraulic=hyd)
     return ActuatorModel(a.max_force, a.time_constant)
 
 
@@ -305,7 +308,7 @@ def plan_run(
     if actuators.screw is not None and actuators.screw.encoder_resolution is not None:
         sensor_resolution = actuators.screw.encoder_resolution  # the legs' sensor is the motor's encoder
     # the lag the gains are designed for: the lag's (the machine's nominal one), or the screw's current loop
-    design_lag = machine.actuators.time_constant if actuators.screw is None else actuators.time_constant
+    design_lag = machine.actuators.time_constant if actuators.model == "lag" else actuators.time_constant
     sensor = sensor if sensor is not None else _sensor(machine, duration)
     timing = DspTiming(
         sample_period=period,
@@ -315,8 +318,9 @@ def plan_run(
     )
     if checks:
         timing.check()
-        # the screw's current loop is stepped exactly (zero-order hold), so a plant step may be longer than it
-        lag = actuators.time_constant if actuators.screw is None else 0.0
+        # the screw's current loop is stepped exactly (zero-order hold), the cylinder's by sub-steps: a plant step
+        # may be longer than either
+        lag = actuators.time_constant if actuators.model == "lag" else 0.0
         check_timing(platform, period, plant_step, lag, timing.output_delay)
         if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
             raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))

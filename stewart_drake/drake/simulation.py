@@ -39,6 +39,7 @@ from tqdm import tqdm
 from stewart_drake.control.actuation import Actuation
 from stewart_drake.control.feedforward import FeedforwardTable, feedforward_lead, initial_leg_forces
 from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.control.hydraulic import HydraulicActuation
 from stewart_drake.control.screw import ScrewActuation
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.core.geometry import Platform
@@ -46,6 +47,7 @@ from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
+from stewart_drake.design.hydraulic import HydraulicParameters
 from stewart_drake.design.screw import ScrewParameters
 from stewart_drake.drake.actuator_systems import set_reflected_inertia
 from stewart_drake.drake.integrators import (
@@ -70,17 +72,19 @@ class ActuatorModel:
     """Leg actuators: a force limit (N, None: the platform's ``legs.max_force``) and a first-order lag
     with time constant ``time_constant`` (s; 0: none), or with ``screw`` an electric screw actuator
     (``control.screw``: its current limit and current loop in place of both; the rotor's reflected mass on
-    the plant's prismatic joints; the loop's ticks in Python). The stroke end stops are the prismatic
+    the plant's prismatic joints; the loop's ticks in Python), or with ``hydraulic`` a valve-driven cylinder
+    (``control.hydraulic``: its supply pressure and force loop in place of both; the loop's ticks in Python). The stroke end stops are the prismatic
     joints' limits in the plant (SAP enforces them as constraints)."""
 
     max_force: float | None = None
     time_constant: float = 2e-3
     screw: ScrewParameters | None = None
+    hydraulic: HydraulicParameters | None = None
 
     @property
     def model(self) -> str:
-        """``lag`` or ``screw``."""
-        return "lag" if self.screw is None else "screw"
+        """``lag``, ``screw`` or ``hydraulic``."""
+        return "screw" if self.screw is not None else "hydraulic" if self.hydraulic is not None else "lag"
 
     def __post_init__(self):
         if self.max_force is not None and not (math.isfinite(self.max_force) and self.max_force > 0):
@@ -349,11 +353,13 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
     # the actuators (saturation, lag; or the screws) are stepped by the loop at the plant steps, starting at F0
     legs = None
-    if actuators.screw is None:
-        act = Actuation.from_time_constant(max_force, actuators.time_constant, plant_time_step)
-    else:
+    if actuators.screw is not None:
         act, legs = ScrewActuation(actuators.screw, plant_time_step), (pos, vel)
         set_reflected_inertia(plant, pc, actuators.screw)
+    elif actuators.hydraulic is not None:
+        act, legs = HydraulicActuation(actuators.hydraulic, plant_time_step, plant_platform.L_min), (pos, vel)
+    else:
+        act = Actuation.from_time_constant(max_force, actuators.time_constant, plant_time_step)
     discrete = integrator not in CONTINUOUS
     loop = TickLoop(
         simulator, plant, pc, diagram.GetInputPort("actuation"), law, sensor, plant_time_step, act, discrete, legs

@@ -16,6 +16,7 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.design.hydraulic import HydraulicParameters
 from stewart_drake.design.payload import with_payload
 from stewart_drake.design.screw import ScrewParameters
 from stewart_drake.errors import MachineError
@@ -150,7 +151,21 @@ SCREW_FIELDS = {
     "winding_resistance": (">= 0 Ω", lambda v: v >= 0),
     "encoder_counts": ("an integer >= 1 per revolution", lambda v: v >= 1 and float(v).is_integer()),
 }
-ACTUATOR_MODELS = ("lag", "screw")
+# the hydraulic cylinder's fields (``control.hydraulic.HydraulicParameters``; None: its default) -> (rule, check)
+HYDRAULIC_FIELDS = {
+    "piston_area": ("> 0 m²", lambda v: v > 0),
+    "rod_area": ("> 0 m²", lambda v: v > 0),
+    "dead_volume": ("> 0 m³", lambda v: v > 0),
+    "bulk_modulus": ("> 0 Pa", lambda v: v > 0),
+    "supply_pressure": ("> 0 Pa", lambda v: v > 0),
+    "return_pressure": (">= 0 Pa", lambda v: v >= 0),
+    "valve_flow_gain": ("> 0 m³/(s·√Pa)", lambda v: v > 0),
+    "valve_time_constant": ("> 0 s", lambda v: v > 0),
+    "leakage": (">= 0 m³/(s·Pa)", lambda v: v >= 0),
+    "force_gain": ("> 0 per N", lambda v: v > 0),
+}
+MODEL_FIELDS = {"lag": {}, "screw": SCREW_FIELDS, "hydraulic": HYDRAULIC_FIELDS}
+ACTUATOR_MODELS = tuple(MODEL_FIELDS)
 
 
 @dataclass(frozen=True)
@@ -175,23 +190,31 @@ class ActuatorSpec:
     current_time_constant: float | None = None
     winding_resistance: float | None = None
     encoder_counts: int | None = None
+    piston_area: float | None = None
+    rod_area: float | None = None
+    dead_volume: float | None = None
+    bulk_modulus: float | None = None
+    supply_pressure: float | None = None
+    return_pressure: float | None = None
+    valve_flow_gain: float | None = None
+    valve_time_constant: float | None = None
+    leakage: float | None = None
+    force_gain: float | None = None
 
     def __post_init__(self):
         _number("actuators.time_constant", self.time_constant, ">= 0 s", lambda v: v >= 0)
         if self.max_force is not None:
             _number("actuators.max_force", self.max_force, "> 0 N", lambda v: v > 0)
         _word("actuators.model", self.model, ACTUATOR_MODELS)
-        for name, (rule, ok) in SCREW_FIELDS.items():
-            value = getattr(self, name)
-            if value is None:
-                continue
-            if self.model != "screw":
-                raise MachineError(
-                    MachineError.RANGE.format(
-                        path=f"actuators.{name}", rule="left out unless actuators.model is screw", value=value
-                    )
-                )
-            _number(f"actuators.{name}", value, rule, ok)
+        for model, checks in MODEL_FIELDS.items():
+            for name, (rule, ok) in checks.items():
+                value = getattr(self, name)
+                if value is None:
+                    continue
+                if self.model != model:
+                    rule = f"left out unless actuators.model is {model}"
+                    raise MachineError(MachineError.RANGE.format(path=f"actuators.{name}", rule=rule, value=value))
+                _number(f"actuators.{name}", value, rule, ok)
 
     def screw(self, platform_max_force: float) -> ScrewParameters:
         """The screw's parameters, the defaults sized for ``max_force`` (else ``platform_max_force``) N."""
@@ -199,6 +222,14 @@ class ActuatorSpec:
         if given["encoder_counts"] is not None:
             given["encoder_counts"] = int(given["encoder_counts"])
         return ScrewParameters.defaults(self.max_force or float(platform_max_force), **given)
+
+    def hydraulic(self, platform: Platform) -> HydraulicParameters:
+        """The cylinder's parameters, the defaults sized for ``max_force`` (else the legs') N, the platform's
+        stroke and its legs' ``max_speed`` (m/s)."""
+        given = {name: getattr(self, name) for name in HYDRAULIC_FIELDS}
+        force = self.max_force or float(platform.legs.max_force)
+        speed = platform.legs.max_speed
+        return HydraulicParameters.defaults(force, platform.L_max - platform.L_min, speed, **given)
 
 
 @dataclass(frozen=True)
@@ -357,6 +388,16 @@ FIELDS = {
     "actuators.current_time_constant": "time?",
     "actuators.winding_resistance": "ratio?",
     "actuators.encoder_counts": "int?",
+    "actuators.piston_area": "ratio?",
+    "actuators.rod_area": "ratio?",
+    "actuators.dead_volume": "ratio?",
+    "actuators.bulk_modulus": "pressure?",
+    "actuators.supply_pressure": "pressure?",
+    "actuators.return_pressure": "pressure?",
+    "actuators.valve_flow_gain": "ratio?",
+    "actuators.valve_time_constant": "time?",
+    "actuators.leakage": "ratio?",
+    "actuators.force_gain": "ratio?",
     "sensors.resolution": "length",
     "sensors.noise": "length",
     "controller.law": ("word", LAWS),
