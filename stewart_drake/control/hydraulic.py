@@ -174,7 +174,7 @@ def linearisation(p: HydraulicParameters, state, extension: float, rate: float) 
         [
             [0.0, -beta / va * p.piston_area, -beta * p.piston_area / va**2 * net_a],
             [0.0, beta / vb * p.rod_area, beta * p.rod_area / vb**2 * net_b],
-            [k / tau, 0.0, 0.0],
+            [k / tau, float(feed(p, 1.0 if rate > 0 else -1.0)) * (1 if rate > 0 else -1) / tau, 0.0],
         ]
     )
     return A, B
