@@ -1,11 +1,12 @@
-"""The electric screw actuators in Drake: ``ScrewActuators``, a thin ``LeafSystem`` around ``control.screw``,
-and ``set_reflected_inertia``, the rotor's inertia carried by the plant's prismatic joints.
+"""The stateful leg actuators in Drake: ``ScrewActuators`` and ``HydraulicActuators``, thin ``LeafSystem``s
+around ``control.screw`` and ``control.hydraulic``, and ``set_reflected_inertia``, the screw's rotor inertia
+carried by the plant's prismatic joints.
 
 The rotor turns with the leg (θ = ρ·L), so its inertia is part of the plant's mass matrix: Drake adds a joint
 actuator's reflected inertia ρ²·J (gear ratio ρ, rotor inertia J, both context parameters) to the joint's
 diagonal, integrated with the plant (implicitly by SAP). The closed loop (``drake.tick_loop``) steps the law
-itself at the plant steps, as it does the lag; ``ScrewActuators`` is the same step as a Diagram system, for
-a Diagram built by hand and for the test that the loop's numbers are the system's.
+itself at the plant steps, as it does the lag; the systems are the same steps as Diagram systems, for a
+Diagram built by hand and for the test that the loop's numbers are the systems'.
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ import numpy as np
 from pydrake.multibody.tree import JointActuatorIndex
 from pydrake.systems.framework import BasicVector, LeafSystem
 
+from stewart_drake.control.hydraulic import HydraulicActuation
 from stewart_drake.control.screw import ScrewActuation, leg_force
+from stewart_drake.design.hydraulic import HydraulicParameters
 from stewart_drake.design.screw import ScrewParameters
 
 
@@ -51,3 +54,32 @@ class ScrewActuators(LeafSystem):
         current = self.law.step(context.get_discrete_state(self._current).value(), self._command.Eval(context))
         discrete_state.set_value(self._current, current)
         discrete_state.set_value(self._force, leg_force(self.law.params, current, self._velocity.Eval(context)))
+
+
+class HydraulicActuators(LeafSystem):
+    """Six hydraulic cylinders stepped every ``step`` s (``control.hydraulic.HydraulicActuation``), the legs'
+    shortest length ``L_min`` m, starting as ``HydraulicActuation.start`` holding ``hold_forces`` (6, N) at rest.
+
+    Inputs ``command`` (6: force commands, N), ``leg_length`` (6: m) and ``leg_velocity`` (6: m/s); output
+    ``force`` (6: N, held between steps). Discrete state: the pressures and spools (18: p_A, p_B, s per leg) and
+    the force (6, N); at each step the state is integrated over the step that ends there (the loop's step)."""
+
+    def __init__(self, params: HydraulicParameters, step: float, L_min: float, hold_forces, lengths):
+        super().__init__()
+        self.law = HydraulicActuation(params, step, L_min)
+        state, force = self.law.start(hold_forces, lengths, np.zeros(6))
+        self._command = self.DeclareVectorInputPort("command", 6)
+        self._length = self.DeclareVectorInputPort("leg_length", 6)
+        self._velocity = self.DeclareVectorInputPort("leg_velocity", 6)
+        self._state = self.DeclareDiscreteState(BasicVector(state.reshape(-1)))
+        self._force = self.DeclareDiscreteState(BasicVector(force))
+        self.DeclareStateOutputPort("force", self._force)
+        self.DeclarePeriodicDiscreteUpdateEvent(step, step, self._Step)  # the first step ends at t = step
+
+    def _Step(self, context, discrete_state):
+        state = context.get_discrete_state(self._state).value().reshape(3, 6)
+        state, force, _ = self.law.advance(
+            state, self._command.Eval(context), self._length.Eval(context), self._velocity.Eval(context)
+        )
+        discrete_state.set_value(self._state, state.reshape(-1))
+        discrete_state.set_value(self._force, force)
