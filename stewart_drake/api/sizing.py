@@ -1,7 +1,8 @@
 """``size``: actuator sizing (peak and RMS force, speed, acceleration, power, stroke per leg) for a motion
 program, a trajectory or a duty envelope, against the platform's actuator limits; for a machine with screw
 actuators along a trajectory, the motors' peak torque, speed and current and RMS current against the motor's
-limits too (``control.screw.motor_demand``)."""
+limits too (``control.screw.motor_demand``), and for hydraulic cylinders the valve's opening, the pressures
+and the supply flow against the valve and the supply (``control.hydraulic.steady_demand``)."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.design import carrying
 from stewart_drake.api.dynamics import read_trajectory_csv, trajectory_rates
 from stewart_drake.api.result import Result
+from stewart_drake.control.hydraulic import steady_demand
 from stewart_drake.control.screw import motor_demand
 from stewart_drake.core.argcheck import as_flag, as_real, check_path, param
 from stewart_drake.core.dynamics import seed_trajectory
@@ -22,6 +24,7 @@ from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
+from stewart_drake.design.hydraulic import HydraulicParameters
 from stewart_drake.design.screw import ScrewParameters
 from stewart_drake.design.sizing import (
     UNITS,
@@ -60,26 +63,27 @@ class SizingResult(Result):
     violation: dict | None
     where: str
     peak_where: str = ""
-    motor_violation: dict | None = None
+    actuator_violation: dict | None = None
 
     @property
     def ok(self) -> bool:
-        """Every leg (and screw actuator's motor) within its limits."""
-        return self.violation is None and self.motor_violation is None
+        """Every leg (and a screw's motor, a cylinder's valve and supply) within its limits."""
+        return self.violation is None and self.actuator_violation is None
 
     def violation_message(self) -> str | None:
         """The violation as one line: the worst excess (the peak the table shows) and where the limit is first
         exceeded; or None."""
         v = self.violation
         if v is None:
-            m = self.motor_violation
+            m = self.actuator_violation
             if m is None:
                 return None
             return (
-                f"leg {m['leg']} motor {m['quantity']} peaks at {m['value']:.6g} {m['unit']}, beyond "
-                f"actuators.{m['limit_name']} {m['limit']:.6g} {m['unit']}"
+                f"leg {m['leg']} {m['what']} {m['quantity']} peaks at {m['value']:.6g} {m['unit']}, beyond "
+                + (f"actuators.{m['limit_name']} {m['limit']:.6g} {m['unit']}" if m["unit"] != "× full" else
+                   f"a fully open valve (actuators.{m['limit_name']})")
                 + ("" if m["t_s"] is None else f" at t = {m['t_s']:.4f} s")
-            )
+            )  # fmt: skip
         qty = v["quantity"]
         name = "stroke" if qty == "length" else f"legs.max_{qty}"
         u = UNITS[qty]
@@ -114,7 +118,8 @@ def size(
 
     Args:
         platform: the platform (its ``legs`` limits are checked), or a machine: its platform, and with
-            ``actuators.model: screw`` its motors sized along a trajectory or program too.
+            ``actuators.model: screw`` its motors (``hydraulic``: its valves and supply) sized along a trajectory
+            or program too.
         trajectory: ``"seed"``, ``"rotating"``, a CSV file (as for `inverse_dynamics`) or a `Trajectory` with
             samples or exact rates.
         program: a motion program (``.stw``), sampled at ``rate``.
@@ -138,11 +143,9 @@ def size(
     Raises:
         StewartError: not exactly one source, bad options or samples.
     """
-    screw = None
+    actuators = None
     if isinstance(platform, Machine):
-        machine, platform = platform, platform.platform
-        if machine.actuators.model == "screw":
-            screw = machine.actuators.screw(platform.legs.max_force)
+        actuators, platform = sized_actuators(platform), platform.platform
     check_platform(platform)
     check_convention(convention)
     legs = as_flag(legs, "legs")
@@ -158,16 +161,17 @@ def size(
     loaded, p_TP = carrying(platform, payload, payload_com, gravity)
     return size_loaded(
         platform, loaded, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-        length_unit, angle_unit, smooth=smooth, screw=screw,
+        length_unit, angle_unit, smooth=smooth, actuators=actuators,
     )  # fmt: skip
 
 
 def size_loaded(
     base, platform, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-    length_unit, angle_unit, envelope_shown=None, smooth=None, screw=None,
+    length_unit, angle_unit, envelope_shown=None, smooth=None, actuators=None,
 ) -> SizingResult:  # fmt: skip
-    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name); ``screw``: the
-    machine's ``ScrewParameters`` (None: no motors to size)."""
+    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name); ``actuators``:
+    the machine's ``ScrewParameters`` or ``HydraulicParameters`` (``sized_actuators``; None: the legs' limits
+    only)."""
     header = {
         "platform": base.name,
         "legs_model": bool(legs),
@@ -221,14 +225,79 @@ def size_loaded(
         limits=limits,
         violation=viol,
     )
-    motor_viol = None
-    if screw is not None:
-        out["motor"], motor_viol = motor_sizing(screw, s)
+    act_viol = None
+    if isinstance(actuators, ScrewParameters):
+        out["motor"], act_viol = motor_sizing(actuators, s)
+    elif isinstance(actuators, HydraulicParameters):
+        out["hydraulic"], act_viol = hydraulic_sizing(actuators, s)
     if viol is None:
-        return SizingResult(out, None, "", motor_violation=motor_viol)
+        return SizingResult(out, None, "", actuator_violation=act_viol)
     return SizingResult(
-        out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s", motor_violation=motor_viol
+        out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s", actuator_violation=act_viol
     )
+
+
+def sized_actuators(machine: Machine) -> ScrewParameters | HydraulicParameters | None:
+    """The parameters of ``machine``'s actuators that ``size`` checks beyond the legs' limits (None: a lag)."""
+    a = machine.actuators
+    if a.model == "screw":
+        return a.screw(machine.platform.legs.max_force)
+    if a.model == "hydraulic":
+        return a.hydraulic(machine.platform)
+    return None
+
+
+def _worst(checks, t) -> dict | None:
+    """The largest excess of ``checks`` — (quantity, (n, 6) or (6,) values, limit, limit's field, unit, what) —
+    as a violation (``quantity``, ``leg``, ``value``, ``limit``, ``limit_name``, ``unit``, ``what``, ``t_s``:
+    None for a value over the whole run), or None."""
+    worst = None
+    for qty, values, limit, field, unit, what in checks:
+        peak = values if values.ndim == 1 else values.max(axis=0)
+        leg = int(np.argmax(peak / limit))
+        ratio = float(peak[leg] / limit)
+        if ratio > 1 and (worst is None or ratio > worst[0]):
+            t_s = None if values.ndim == 1 else float(t[int(np.argmax(values[:, leg]))])
+            worst = (ratio, {"quantity": qty, "leg": leg + 1, "value": float(peak[leg]), "limit": float(limit),
+                             "limit_name": field, "unit": unit, "what": what, "t_s": t_s})  # fmt: skip
+    return None if worst is None else worst[1]
+
+
+def hydraulic_sizing(hyd: HydraulicParameters, s: TrajectorySizing) -> tuple[dict, dict | None]:
+    """The cylinders along the sized trajectory ``s``, the oil taken as incompressible: per leg the peak valve
+    opening (1: fully open), the peak chamber pressures and supply flow with their times; the six legs' peak
+    total supply flow; the force limits at the supply; and the worst excess (the opening beyond 1:
+    ``valve_flow_gain``; a force beyond what the supply holds: ``supply_pressure``), or None."""
+    d = steady_demand(hyd, s.force, s.speed)
+    t = s.t
+    legs = []
+    for leg in range(6):
+        row = {"leg": leg + 1}
+        for name, arr in (("spool", d["spool"]), ("p_A_pa", d["p_A"]), ("p_B_pa", d["p_B"]),
+                          ("supply_flow_m3_s", d["supply_flow"])):  # fmt: skip
+            k = int(np.argmax(arr[:, leg]))
+            row[f"peak_{name}"], row[f"peak_{name}_t_s"] = float(arr[k, leg]), float(t[k])
+        legs.append(row)
+    # the supply pressure that would hold the force (the other chamber at the return's)
+    aa, ab, pt = hyd.piston_area, hyd.rod_area, hyd.return_pressure
+    need = np.where(s.force >= 0, (s.force + ab * pt) / aa, (aa * pt - s.force) / ab)
+    spool = np.where(np.isinf(d["spool"]), 0.0, d["spool"])  # beyond the supply: the pressure's violation
+    checks = [
+        ("pressure needed", need, hyd.supply_pressure, "supply_pressure", "Pa", "cylinder"),
+        ("opening", spool, 1.0, "valve_flow_gain", "× full", "valve"),
+    ]
+    worst = _worst(checks, t)
+    summary = {
+        "legs": legs,
+        "total_supply_flow_m3_s": float(np.maximum(d["supply_flow"], 0).sum(axis=1).max()),
+        "limits": {
+            "supply_pressure": hyd.supply_pressure,
+            "max_extending_force_n": float(d["max_extending"]),
+            "max_retracting_force_n": float(d["max_retracting"]),
+        },
+        "violation": worst,
+    }
+    return summary, worst
 
 
 # motor quantity -> (the demand's array, the limit's field, unit)
@@ -261,16 +330,11 @@ def motor_sizing(screw: ScrewParameters, s: TrajectorySizing) -> tuple[dict, dic
             k = int(np.argmax(arr[:, leg]))
             row[f"peak_{name}_{unit}"], row[f"peak_{name}_t_s"] = float(arr[k, leg]), float(t[k])
         legs.append(row)
-    worst = None
-    for qty, (field, unit) in MOTOR_LIMITS.items():
-        limit = getattr(screw, field)
-        values = rms if qty == "rms_current" else peaks[qty].max(axis=0)
-        leg = int(np.argmax(values / limit))
-        ratio = float(values[leg] / limit)
-        if ratio > 1 and (worst is None or ratio > worst[0]):
-            t_s = None if qty == "rms_current" else float(t[int(np.argmax(peaks[qty][:, leg]))])
-            worst = (ratio, {"quantity": qty, "leg": leg + 1, "value": float(values[leg]), "limit": limit,
-                             "limit_name": field, "unit": unit, "t_s": t_s})  # fmt: skip
+    checks = [
+        (qty, rms if qty == "rms_current" else peaks[qty], getattr(screw, field), field, unit, "motor")
+        for qty, (field, unit) in MOTOR_LIMITS.items()
+    ]
+    worst = _worst(checks, t)
     summary = {
         "legs": legs,
         "limits": {field: getattr(screw, field) for field, _ in MOTOR_LIMITS.values()},
@@ -280,9 +344,9 @@ def motor_sizing(screw: ScrewParameters, s: TrajectorySizing) -> tuple[dict, dic
             "force_per_amp_n_a": screw.force_per_amp,
             "torque_constant_nm_a": screw.torque_constant,
         },
-        "violation": None if worst is None else worst[1],
+        "violation": worst,
     }
-    return summary, None if worst is None else worst[1]
+    return summary, worst
 
 
 def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit, smooth=None):

@@ -178,3 +178,29 @@ def linearisation(p: HydraulicParameters, state, extension: float, rate: float) 
         ]
     )
     return A, B
+
+
+def steady_demand(p: HydraulicParameters, force, velocity) -> dict:
+    """What the cylinders need, the oil incompressible, to apply ``force`` (..., 6) N while moving at ``velocity``
+    (..., 6) m/s: the meter-in land feeds A_A·ẋ (extending; A_B·|ẋ| retracting) at p_s − A²·z and the meter-out
+    land passes the other side's flow at p_t + A²·z, z = (ẋ/(s·K_v))² from the force balance. Returns ``spool``
+    (the opening, > 1: beyond the valve; inf: beyond the supply), ``p_A``, ``p_B`` (Pa), ``supply_flow`` (m³/s)
+    and the force limits at the supply, ``max_extending`` and ``max_retracting`` (N, the latter < 0)."""
+    F, v = np.asarray(force, dtype=float), np.asarray(velocity, dtype=float)
+    aa, ab, ps, pt = p.piston_area, p.rod_area, p.supply_pressure, p.return_pressure
+    ext, ret = aa * ps - ab * pt, aa * pt - ab * ps  # the forces at full pressure either way
+    extending = v >= 0
+    z = np.where(extending, ext - F, F - ret) / (aa**3 + ab**3)
+    p_a = np.where(extending, ps - aa**2 * z, pt + aa**2 * z)
+    p_b = np.where(extending, pt + ab**2 * z, ps - ab**2 * z)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spool = np.where(z > 0, np.abs(v) / (p.valve_flow_gain * np.sqrt(np.maximum(z, 0.0))), np.inf)
+    spool = np.where((v == 0) & (z > 0), 0.0, spool)
+    return {
+        "spool": spool,
+        "p_A": p_a,
+        "p_B": p_b,
+        "supply_flow": np.where(extending, aa * v, -ab * v),
+        "max_extending": ext,
+        "max_retracting": ret,
+    }

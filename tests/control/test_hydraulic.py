@@ -107,3 +107,17 @@ def test_a_small_step_follows_the_linear_model():
         errs.append(err)
         assert err < 0.02 * peak
     assert errs[1] > 2.5 * errs[0]  # second order in the step (4× for twice the step)
+
+
+def test_the_steady_demand_holds_the_force_with_the_valves_flows():
+    # the pressures balance the force, and the lands at that opening pass exactly the piston's flows
+    rng = np.random.default_rng(5)
+    F, v = rng.uniform(-2000, 5000, (30, 6)), rng.normal(0, 0.2, (30, 6))
+    d = hy.steady_demand(P, F, v)
+    np.testing.assert_allclose(P.piston_area * d["p_A"] - P.rod_area * d["p_B"], F, rtol=1e-9, atol=1e-6)
+    state = np.stack([d["p_A"], d["p_B"], np.sign(v) * d["spool"]])
+    f = hy.flows(P, state)
+    np.testing.assert_allclose(f["A"], P.piston_area * v, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(f["B"], -P.rod_area * v, rtol=1e-9, atol=1e-15)
+    beyond = hy.steady_demand(P, np.full(6, 1.01 * P.max_force), np.full(6, 0.1))
+    assert np.isinf(beyond["spool"]).all()

@@ -1,6 +1,7 @@
-"""``size`` of a machine with screw actuators: the motors' current, torque and speed along the motion against
-the force and speed the leg table shows (an ideal screw is a fixed ratio of them), and a motor limit exceeded
-is a violation (exit 1, the tables shown)."""
+"""``size`` of a machine with screw actuators or hydraulic cylinders: the motors' current, torque and speed (the
+valves' opening, pressures and flows) along the motion against the force and speed the leg table shows (an
+ideal screw is a fixed ratio of them, a cylinder's flow its areas times the speed), and a limit exceeded is a
+violation (exit 1, the tables shown)."""
 
 import math
 
@@ -40,7 +41,7 @@ def test_a_motor_limit_exceeded_exits_1_with_the_tables(tmp_path, capsys):
     m = load_machine("utn-dynamic", [*SCREW, "actuators.max_motor_speed=10"])  # rad/s: 95 rpm
     r = sd.size(m, "seed")
     assert not r.ok and r.violation is None
-    v = r.motor_violation
+    v = r.actuator_violation
     assert v["quantity"] == "speed" and v["limit_name"] == "max_motor_speed" and v["value"] > 10
     path = tmp_path / "screw.yaml"
     path.write_text(m.to_yaml())
@@ -52,3 +53,39 @@ def test_a_motor_limit_exceeded_exits_1_with_the_tables(tmp_path, capsys):
 
 def test_a_lag_machine_has_no_motor_section():
     assert "motor" not in sd.size(load_machine("utn-dynamic"), "seed").to_dict()
+
+
+HYDRAULIC = ["actuators.model=hydraulic"]
+
+
+def test_a_cylinders_supply_flow_is_the_pistons():
+    m = load_machine("utn-dynamic", HYDRAULIC)
+    hyd = m.actuators.hydraulic(m.platform)
+    d = sd.size(m, "seed").to_dict()
+    assert d["hydraulic"]["violation"] is None
+    for leg, cyl in zip(d["legs"], d["hydraulic"]["legs"]):
+        # the oil incompressible: A_A·L̇ extending, A_B·|L̇| retracting, so between A_B and A_A times the peak |L̇|
+        q = cyl["peak_supply_flow_m3_s"]
+        assert (
+            hyd.rod_area * leg["peak_speed_m_s"] * (1 - 1e-12)
+            <= q
+            <= hyd.piston_area * leg["peak_speed_m_s"] * (1 + 1e-12)
+        )
+        assert 0 < cyl["peak_spool"] < 1
+
+
+@pytest.mark.parametrize(
+    "override, message",
+    [
+        ("actuators.valve_flow_gain=1e-9", "valve opening peaks at"),
+        ("actuators.supply_pressure=1bar", "cylinder pressure needed peaks at"),
+    ],
+)
+def test_a_cylinder_limit_exceeded_exits_1(tmp_path, capsys, override, message):
+    m = load_machine("utn-dynamic", [*HYDRAULIC, override])
+    assert not sd.size(m, "seed").ok
+    path = tmp_path / "hydraulic.yaml"
+    path.write_text(m.to_yaml())
+    assert main(["size", "--platform", str(path), "--trajectory", "seed"]) == 1
+    out, err = capsys.readouterr()
+    assert "hydraulic cylinders: supply" in out and message in err
