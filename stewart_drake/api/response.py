@@ -198,6 +198,8 @@ def loop_response(
     sc = plan.scenario
     T = plan.timing.sample_period
     f = default_frequencies(T) if frequencies is None else _frequencies(frequencies, T, "frequencies")
+    if sc.actuators.hydraulic is not None:
+        raise ResponseError(ResponseError.ACTUATOR_MODEL.format(model=sc.actuators.model))
     lag = sc.actuators.time_constant
     steps = T / sc.plant_time_step
     if lag > 0 and abs(steps - round(steps)) > 1e-9 * steps:  # the lag steps at the plant steps between ticks

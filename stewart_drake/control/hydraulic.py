@@ -120,11 +120,12 @@ class HydraulicActuation:
         self.params, self.h, self.L_min = params, float(step), float(L_min)
 
     def start(self, hold_forces, lengths, rates) -> tuple[np.ndarray, np.ndarray]:
-        """``(state, force)``: holding ``hold_forces`` (6, N) with the spool centred and the annulus at the
-        mean of supply and return (the cap side's pressure then holds the force)."""
+        """``(state, force)``: holding ``hold_forces`` (6, N) at rest with the spool centred, at the pressures a
+        leaking piston settles to (equal drops across the two open lands: p_A + p_B = p_s + p_t) that hold it."""
         p = self.params
-        pb = np.full(6, 0.5 * (p.supply_pressure + p.return_pressure))
-        pa = (np.asarray(hold_forces, dtype=float) + p.rod_area * pb) / p.piston_area
+        total = p.supply_pressure + p.return_pressure
+        pa = (np.asarray(hold_forces, dtype=float) + p.rod_area * total) / (p.piston_area + p.rod_area)
+        pb = total - pa
         state = np.stack([pa, pb, np.zeros(6)])
         return state, cylinder_force(p, state)
 

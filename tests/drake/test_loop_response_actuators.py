@@ -9,6 +9,7 @@ import pytest
 
 from stewart_drake.api.response import loop_response
 from stewart_drake.control.screw import FRICTION_SPEED
+from stewart_drake.errors import ResponseError
 
 # a 0.1 µm sensor: the amplitudes are a few µm
 FINE = {"sensors.resolution": "0.1um", "run.plant_step": "0.25ms", "controller.law": "float"}
@@ -30,3 +31,8 @@ def test_the_screw_changes_the_loop():
     screw = loop_response("utn-dynamic", **{"controller.law": "float", "actuators.model": "screw"})
     assert screw.spectral_radius < 1 and screw.ok
     assert screw.bandwidth_hz < 0.5 * lag.bandwidth_hz
+
+
+def test_a_hydraulic_machine_is_refused_naming_the_model():
+    with pytest.raises(ResponseError, match=r"^actuators.model hydraulic: the loop's linear model holds the lag"):
+        loop_response("utn-dynamic", **{"actuators.model": "hydraulic"})
