@@ -307,7 +307,8 @@ def plan_run(
     actuators = actuators or actuator_model(machine)
     if actuators.screw is not None and actuators.screw.encoder_resolution is not None:
         sensor_resolution = actuators.screw.encoder_resolution  # the legs' sensor is the motor's encoder
-    # the lag the gains are designed for: the lag's (the machine's nominal one), or the screw's current loop
+    # the lag the gains are designed for: the lag's (the machine's nominal one), or the screw's current loop's
+    # (the cylinder's valve's)
     design_lag = machine.actuators.time_constant if actuators.model == "lag" else actuators.time_constant
     sensor = sensor if sensor is not None else _sensor(machine, duration)
     timing = DspTiming(
@@ -622,7 +623,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "controller": sc.controller,
         "engine": sc.engine,
         "tick_loop": tick_loop,  # "compiled" for either law where the loop kernel runs; "engine" is the firmware's
-        "actuator_model": sc.actuators.model,  # "screw": the Python loop (the compiled kernel steps the lag only)
+        "actuator_model": sc.actuators.model,  # not "lag": the Python loop (the compiled kernel steps the lag only)
         "firmware": sc.firmware,
         "sample_period_s": timing.sample_period,
         "latency": timing.latency,
@@ -650,7 +651,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
-    if energy is not None:  # the screws' energy flows over the run, J per leg (control.screw.powers)
+    if energy is not None:  # a screw's or cylinder's energy flows over the run, J per leg (their ``powers``)
         summary["actuator_energy_J"] = {k: v.tolist() for k, v in energy.items()}
     # tracking, and the loop's own verdict: chatter (force ripple about the inverse-dynamics force) and
     # saturation at the reference's ends (control/verdict.py; each Monte Carlo run is judged there too)

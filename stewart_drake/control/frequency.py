@@ -11,8 +11,8 @@ continuous system does not take. About a pose at rest the legs obey
 quadratic at rest). The actuators are the loop's own discrete lag F ← a·F + b·u at each plant step h
 (``control.actuation``), reading the command held just before that step; without a lag the force follows the
 command from its release. Screw actuators (``control.screw``) are their small signal at rest (``SmallSignal``:
-the current loop, the force of the current and the velocity's damping, the rotor's mass on the legs). The mechanics between plant steps are integrated exactly (zero-order hold), so the
-tick-to-tick map of (lengths, rates, forces) is exact for the linear plant. The controller is the PID of
+the current loop, the force of the current and the velocity's damping, the rotor's mass on the legs). The
+mechanics between plant steps are integrated exactly (zero-order hold), so the tick-to-tick map of (lengths, rates, forces) is exact for the linear plant. The controller is the PID of
 ``control.laws`` as a discrete state space (integrator, measurement and set-point difference filters), its
 command released ``DspTiming.output_delay`` after the tick. The feed-forward table's rows enter, linearised, as
 (K − ω̃²·M_L)·e^{jω·lead} per unit set-point (ω̃² = (2 − 2 cos ωT)/T², the table's central second difference).
@@ -125,15 +125,21 @@ def plant_matrices(M: np.ndarray, K: np.ndarray, lag: float, step: float, T: flo
         E1, G1 = _zoh(Am, Bm, delay)
         E2, G2 = _zoh(Am, Bm, T - delay)
         return Phi, E2 @ G1, G2
-    n = int(round(T / step))
     Ad, Bd = _zoh(Am, Bm, step)
     a = math.exp(-step / lag)
     sub = np.block([[Ad, Bd], [np.zeros((6, 12)), a * np.eye(6)]])  # mechanics with F held, then F ← a·F
     inj = np.vstack([np.zeros((12, 6)), (1 - a) * np.eye(6)])  # ... + b·u
-    Phi, G_old, G_new = np.eye(18), np.zeros((18, 6)), np.zeros((18, 6))
+    return _tick_map(sub, inj, step, T, delay)
+
+
+def _tick_map(sub: np.ndarray, inj: np.ndarray, step: float, T: float, delay: float):
+    """``(Phi, G_old, G_new)`` of a tick from the plant-step map s ← ``sub``·s (+ ``inj``·u at each step's end):
+    a step reads the command held just before it, u_{k−1} until the release ``delay`` s after the tick."""
+    n = int(round(T / step))
+    Phi, G_old, G_new = np.eye(len(sub)), np.zeros((len(sub), 6)), np.zeros((len(sub), 6))
     for j in range(1, n + 1):
         Phi, G_old, G_new = sub @ Phi, sub @ G_old, sub @ G_new
-        if j * step > delay + 1e-9 * T:  # the lag reads the command held just before this plant step
+        if j * step > delay + 1e-9 * T:  # the actuators read the command held just before this plant step
             G_new = G_new + inj
         else:
             G_old = G_old + inj
@@ -160,15 +166,7 @@ def screw_plant_matrices(M: np.ndarray, K: np.ndarray, screw: SmallSignal, step:
         ]
     )
     inj = np.vstack([np.zeros((12, 6)), screw.beta * I6, screw.c * screw.beta * I6])
-    n = int(round(T / step))
-    Phi, G_old, G_new = np.eye(24), np.zeros((24, 6)), np.zeros((24, 6))
-    for j in range(1, n + 1):
-        Phi, G_old, G_new = sub @ Phi, sub @ G_old, sub @ G_new
-        if j * step > delay + 1e-9 * T:  # the currents read the command held just before this plant step
-            G_new = G_new + inj
-        else:
-            G_old = G_old + inj
-    return Phi, G_old, G_new
+    return _tick_map(sub, inj, step, T, delay)
 
 
 @dataclass(frozen=True)

@@ -115,7 +115,7 @@ def powers(p: ScrewParameters, current, velocity) -> dict:
 
 
 def linearisation(p: ScrewParameters, current: float, velocity: float) -> tuple[float, float, float, float]:
-    """One leg's actuator linearised at ``current`` A (≠ 0) and leg velocity ``velocity`` m/s, the current
+    """One leg's actuator linearised at ``current`` A and leg velocity ``velocity`` m/s, the current
     loop unsaturated: di/dt = a·δi + b·δu, δF = c·δi + d·δL̇. Returns ``(a, b, c, d)``: a = −1/τ_i (1/s),
     b = 1/(τ_i·k_F) (A/(N·s)), c = ∂F/∂i (N/A), d = ∂F/∂L̇ (N·s/m, < 0: the friction's and the screw's
     damping). τ_i = 0 has no current state: then a = −inf, b = inf (i = u/k_F)."""
@@ -163,5 +163,5 @@ def small_signal(p: ScrewParameters, hold_forces, step: float) -> SmallSignal:
     (``linearisation`` at L̇ = 0 of each leg's holding current, its current loop discretised exactly)."""
     act = ScrewActuation(p, step)
     currents = act.initial_current(np.asarray(hold_forces, dtype=float).reshape(6))
-    lin = [linearisation(p, float(i) if i != 0 else 1e-300, 0.0) for i in currents]
+    lin = [linearisation(p, float(i), 0.0) for i in currents]
     return SmallSignal(act.a, (1 - act.a) / p.force_per_amp, lin[0][2], np.array([x[3] for x in lin]), p.reflected_mass)

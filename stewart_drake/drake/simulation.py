@@ -70,11 +70,11 @@ from stewart_drake.errors import SimulationError
 @dataclass(frozen=True)
 class ActuatorModel:
     """Leg actuators: a force limit (N, None: the platform's ``legs.max_force``) and a first-order lag
-    with time constant ``time_constant`` (s; 0: none), or with ``screw`` an electric screw actuator
+    with time constant ``time_constant`` (s; 0: none); or with ``screw`` an electric screw actuator
     (``control.screw``: its current limit and current loop in place of both; the rotor's reflected mass on
-    the plant's prismatic joints; the loop's ticks in Python), or with ``hydraulic`` a valve-driven cylinder
-    (``control.hydraulic``: its supply pressure and force loop in place of both; the loop's ticks in Python). The stroke end stops are the prismatic
-    joints' limits in the plant (SAP enforces them as constraints)."""
+    the plant's prismatic joints), or with ``hydraulic`` a valve-driven cylinder (``control.hydraulic``: its
+    supply pressure and force loop in place of both), either stepped by the loop's Python ticks. The stroke end
+    stops are the prismatic joints' limits in the plant (SAP enforces them as constraints)."""
 
     max_force: float | None = None
     time_constant: float = 2e-3
@@ -351,7 +351,8 @@ def build_simulation(scenario: Scenario, meshcat=None) -> Simulation:
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
-    # the actuators (saturation, lag; or the screws) are stepped by the loop at the plant steps, starting at F0
+    # the actuators (saturation, lag; or the screws, the cylinders) are stepped by the loop at the plant steps,
+    # starting at F0
     legs = None
     if actuators.screw is not None:
         act, legs = ScrewActuation(actuators.screw, plant_time_step), (pos, vel)

@@ -92,11 +92,11 @@ class TickLoop:
     ``sensor``: ``(t, x) -> (6,)`` readings of the plant state ``x``; ``step`` (s): the plant step;
     ``actuators``: their saturation and lag (``control.actuation.Actuation``), stepped here at every plant
     step; ``discrete``: the plant is discrete (it logs at every stop); ``legs``: ``(positions, velocities)``,
-    the legs' indices in the plant state, for actuators with a state that read the legs' motion (``control.screw``'s
-    ``ScrewActuation``: ``start(hold_forces, L, L̇) -> state`` and ``advance(state, command, L, L̇) -> (state,
-    force, powers)``, stepped by the Python loop: the compiled kernel steps the lag only), None for the lag.
-    Such actuators' energy flows (the powers of each plant step, W, held over it) add up in ``energy``
-    ({flow: (6,) J})."""
+    the legs' indices in the plant state, for actuators with a state that read the legs' motion
+    (``control.screw.ScrewActuation``, ``control.hydraulic.HydraulicActuation``: ``start(hold_forces, L, L̇)
+    -> (state, force)`` and ``advance(state, command, L, L̇) -> (state, force, powers)``, stepped by the Python
+    loop: the compiled kernel steps the lag only), None for the lag. Such actuators' energy flows (the powers
+    of each plant step, W, held over it) add up in ``energy`` ({flow: (6,) J})."""
 
     def __init__(
         self, simulator, plant, plant_context, actuation_input, law, sensor, step, actuators, discrete, legs=None

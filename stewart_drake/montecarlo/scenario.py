@@ -397,9 +397,9 @@ def scenario(study: Study, index: int, reference: Trajectory | None = None, gain
         duration=duration,
         plant_step=study.plant_step,
         fit=False,  # the reference is fitted already (Study.reference)
-        # screws: the drawn machine's (the lag's draws, actuator_lag and force_limit, are the lag model's)
+        # a screw or a cylinder: the drawn machine's (the draws actuator_lag and force_limit are the lag's)
         actuators=actuator_model(drawn)
-        if drawn.actuators.model == "screw"
+        if drawn.actuators.model != "lag"
         else ActuatorModel(d.force_limit, d.actuator_lag),
         sensor=sensor_model(d, seed, period, tick_count(duration, period) + 1),
         plant_platform=drawn.loaded_platform,

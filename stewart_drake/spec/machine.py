@@ -171,9 +171,10 @@ ACTUATOR_MODELS = tuple(MODEL_FIELDS)
 @dataclass(frozen=True)
 class ActuatorSpec:
     """The leg actuators: ``model`` (``lag``: a first-order lag ``time_constant`` s (0: none) and a force
-    limit; ``screw``: an electric motor on a screw, ``control.screw``, with the fields of ``SCREW_FIELDS``, each
-    None for its default sized from the force limit) and the force limit ``max_force`` (N; None: the platform's
-    ``legs.max_force``)."""
+    limit; ``screw``: an electric motor on a screw, ``control.screw``, with the fields of ``SCREW_FIELDS``;
+    ``hydraulic``: a servo valve and cylinder, ``control.hydraulic``, with the fields of ``HYDRAULIC_FIELDS``;
+    each of those None for its default, sized from the force limit) and the force limit ``max_force`` (N; None:
+    the platform's ``legs.max_force``). A model's fields are refused with another model."""
 
     time_constant: float = 2e-3
     max_force: float | None = None
