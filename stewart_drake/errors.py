@@ -757,10 +757,6 @@ class ResponseError(StewartError):
     PLANT_STEPS = (
         "run.plant_step {step:g} s must divide controller.period {period:g} s into whole steps for the loop's model"
     )
-    ACTUATOR_MODEL = (
-        "actuators.model {model}: the loop's linear model holds the lag and screw actuators (a cylinder's "
-        "critical-centre valve has no linearisation at rest); simulate the loop instead"
-    )
     MEASURE_WORK = (
         "measure: {count} frequencies need {seconds:.0f} s of closed-loop simulation (the loop settles slowly), "
         "more than {limit:g} s; measure fewer"

@@ -26,9 +26,11 @@ from stewart_drake.control.frequency import (
     effective_gains,
     margins,
 )
+from stewart_drake.control.hydraulic import small_signal as hydraulic_signal
 from stewart_drake.control.screw import small_signal
 from stewart_drake.core.argcheck import check_finite_samples, check_shape
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import constant_trajectory
 from stewart_drake.drake.loop_response import measure_duration, measure_point
 from stewart_drake.errors import ResponseError
@@ -198,19 +200,22 @@ def loop_response(
     sc = plan.scenario
     T = plan.timing.sample_period
     f = default_frequencies(T) if frequencies is None else _frequencies(frequencies, T, "frequencies")
-    if sc.actuators.hydraulic is not None:
-        raise ResponseError(ResponseError.ACTUATOR_MODEL.format(model=sc.actuators.model))
     lag = sc.actuators.time_constant
     steps = T / sc.plant_time_step
     if lag > 0 and abs(steps - round(steps)) > 1e-9 * steps:  # the lag steps at the plant steps between ticks
         raise ResponseError(ResponseError.PLANT_STEPS.format(step=sc.plant_time_step, period=T))
     lead = feedforward_lead(sc.config, lag) if sc.feedforward else None
-    screw = None
-    if sc.actuators.screw is not None:  # about the currents that hold the plate at the pose, as the run starts
-        screw = small_signal(sc.actuators.screw, initial_leg_forces(sc.platform, sc.trajectory), sc.plant_time_step)
+    # the screws and cylinders about the forces that hold the plate at the pose, as the run starts
+    screw = cylinders = None
+    hold = initial_leg_forces(sc.platform, sc.trajectory)
+    if sc.actuators.screw is not None:
+        screw = small_signal(sc.actuators.screw, hold, sc.plant_time_step)
+    if sc.actuators.hydraulic is not None:
+        L = leg_lengths(sc.platform, pose)
+        cylinders = hydraulic_signal(sc.actuators.hydraulic, hold, L, sc.platform.L_min, sc.plant_time_step)
     model = LoopModel.build(
         sc.platform, pose, effective_gains(sc.controller, sc.config), T, plan.timing.output_delay, lag,
-        sc.plant_time_step, lead, screw,
+        sc.plant_time_step, lead, screw, cylinders,
     )  # fmt: skip
     Tsp = model.setpoint_response(f)
     L, S = model.loops(f)

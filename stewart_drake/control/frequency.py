@@ -11,7 +11,8 @@ continuous system does not take. About a pose at rest the legs obey
 quadratic at rest). The actuators are the loop's own discrete lag F ← a·F + b·u at each plant step h
 (``control.actuation``), reading the command held just before that step; without a lag the force follows the
 command from its release. Screw actuators (``control.screw``) are their small signal at rest (``SmallSignal``:
-the current loop, the force of the current and the velocity's damping, the rotor's mass on the legs). The
+the current loop, the force of the current and the velocity's damping, the rotor's mass on the legs), hydraulic
+cylinders theirs (``control.hydraulic.SmallSignal``: pressures and spool, the valve's describing gain). The
 mechanics between plant steps are integrated exactly (zero-order hold), so the tick-to-tick map of (lengths, rates, forces) is exact for the linear plant. The controller is the PID of
 ``control.laws`` as a discrete state space (integrator, measurement and set-point difference filters), its
 command released ``DspTiming.output_delay`` after the tick. The feed-forward table's rows enter, linearised, as
@@ -33,6 +34,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from stewart_drake.control.gains import ControllerConfig, FixedGains, PidGains, leg_space_inertia
+from stewart_drake.control.hydraulic import SmallSignal as HydraulicSignal
 from stewart_drake.control.screw import SmallSignal
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
@@ -169,6 +171,36 @@ def screw_plant_matrices(M: np.ndarray, K: np.ndarray, screw: SmallSignal, step:
     return _tick_map(sub, inj, step, T, delay)
 
 
+def hydraulic_plant_matrices(M: np.ndarray, K: np.ndarray, cyl: HydraulicSignal, step: float, T: float, delay: float):
+    """``plant_matrices`` with hydraulic cylinders (``control.hydraulic.SmallSignal``) in place of the lag: at
+    each plant step the cylinders' state a = (p_A, p_B, s) takes the command held just before it and the legs'
+    velocity at the step's end, a ← E·a + G_u·u + G_v·L̇, and the force c·a is held over the next step. State
+    s = (lengths m, rates m/s, p_A Pa, p_B Pa, spools, held forces N)."""
+    Minv = np.linalg.inv(M)
+    Am = np.block([[np.zeros((6, 6)), np.eye(6)], [-Minv @ K, np.zeros((6, 6))]])
+    Bm = np.vstack([np.zeros((6, 6)), Minv])
+    Ad, Bd = _zoh(Am, Bm, step)
+    # the cylinders' 18 states ordered (p_A legs 1..6, p_B legs 1..6, spools legs 1..6)
+    E, Gu, Gv = np.zeros((18, 18)), np.zeros((18, 6)), np.zeros((18, 6))
+    for leg in range(6):
+        idx = [leg, 6 + leg, 12 + leg]
+        E[np.ix_(idx, idx)] = cyl.E[leg]
+        Gu[idx, leg], Gv[idx, leg] = cyl.G_u[leg], cyl.G_v[leg]
+    C = np.kron(cyl.c[None, :], np.eye(6))  # (6, 18): F = c·a per leg
+    rate = np.hstack([np.zeros((6, 6)), np.eye(6)])  # picks L̇ from (L, L̇)
+    new_rate_m, new_rate_f = rate @ Ad, rate @ Bd  # L̇ at the step's end, of (L, L̇) and F at its start
+    # mechanics with F held; then a ← E·a + G_v·L̇(end) (+ G_u·u), F ← C·a
+    sub = np.block(
+        [
+            [Ad, np.zeros((12, 18)), Bd],
+            [Gv @ new_rate_m, E, Gv @ new_rate_f],
+            [C @ Gv @ new_rate_m, C @ E, C @ Gv @ new_rate_f],
+        ]
+    )
+    inj = np.vstack([np.zeros((12, 6)), Gu, C @ Gu])
+    return _tick_map(sub, inj, step, T, delay)
+
+
 @dataclass(frozen=True)
 class LoopModel:
     """The discrete closed leg loop about ``pose`` (6,): inputs the six leg set-points (m) and the six
@@ -205,16 +237,20 @@ class LoopModel:
         step: float,
         lead: float | None,
         screw: SmallSignal | None = None,
+        hydraulic: HydraulicSignal | None = None,
     ) -> LoopModel:
         """The loop of ``platform`` at ``pose`` (6,) with the law's SI ``gains``, sample period ``T`` (s), output
         ``delay`` (s, ≤ T), actuator ``lag`` (s) stepped at the plant ``step`` (s) and the feed-forward ``lead``
-        (s; None: no feed-forward); ``screw``: screw actuators' small signal in place of the lag."""
+        (s; None: no feed-forward); ``screw``, ``hydraulic``: the screws' or cylinders' small signal in place of
+        the lag."""
         pose = np.asarray(pose, dtype=float).reshape(6)
         M, K = leg_space_mass(platform, pose), leg_space_stiffness(platform, pose)
-        if screw is None:
-            Phi, G_old, G_new = plant_matrices(M, K, lag, step, T, delay)
-        else:
+        if screw is not None:
             Phi, G_old, G_new = screw_plant_matrices(M, K, screw, step, T, delay)
+        elif hydraulic is not None:
+            Phi, G_old, G_new = hydraulic_plant_matrices(M, K, hydraulic, step, T, delay)
+        else:
+            Phi, G_old, G_new = plant_matrices(M, K, lag, step, T, delay)
         ns = len(Phi)
         I6, Z = np.eye(6), np.zeros
         # plant with the released command as state: p = (s, u_{k−1}); p' = Pa·p + Ga·u_k; y = Cp·p

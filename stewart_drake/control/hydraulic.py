@@ -27,8 +27,10 @@ the next step (the pressures see the plant's velocity one step late at most: an 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import expm
 
 from stewart_drake.design.hydraulic import HydraulicParameters
 
@@ -205,3 +207,43 @@ def steady_demand(p: HydraulicParameters, force, velocity) -> dict:
         "max_extending": ext,
         "max_retracting": ret,
     }
+
+
+@dataclass(frozen=True)
+class SmallSignal:
+    """The six cylinders linearised at rest holding forces, as the loop steps them every plant step: per leg
+    a' = ``E``·a + ``G_u``·u + ``G_v``·L̇ over the step (a = (p_A, p_B, s), L̇ the leg's velocity at the step's
+    end, held) and the force ``c``·a' held over the next: ``E`` (6, 3, 3), ``G_u`` and ``G_v`` (6, 3), ``c`` (3,)."""
+
+    E: np.ndarray
+    G_u: np.ndarray
+    G_v: np.ndarray
+    c: np.ndarray
+
+
+def small_signal(p: HydraulicParameters, hold_forces, lengths, L_min: float, step: float) -> SmallSignal:
+    """``SmallSignal`` of the cylinders holding ``hold_forces`` (6,) N at rest at ``lengths`` (6,) m
+    (``HydraulicActuation.start``'s pressures, with the spool s_eq open just enough to feed the leakage). The
+    valve's gain about a centred spool differs on its two sides (q(p_s − p_A) opening to the supply, q(p_A − p_t)
+    to the return), and so does the velocity compensation's (A_A, A_B); their means are the fundamental of a
+    sinusoidal spool's flow (the describing function), the gains used here; at ±|s_eq| the lands' pressure
+    terms hold the chambers' pressure level (without them it is a neutral mode). The step's map over ``step`` s
+    is exact for the linear model (zero-order hold, ``scipy.linalg.expm``)."""
+    act = HydraulicActuation(p, step, L_min)
+    state, _ = act.start(np.asarray(hold_forces, dtype=float).reshape(6), lengths, np.zeros(6))
+    x = np.asarray(lengths, dtype=float).reshape(6) - L_min
+    E, G_u, G_v = np.empty((6, 3, 3)), np.empty((6, 3)), np.empty((6, 3))
+    pa, pb = state[0], state[1]
+    leak = p.leakage * (pa - pb)
+    s_eq = leak / np.where(leak > 0, orifice(p, p.supply_pressure - pa), orifice(p, pa - p.return_pressure))
+    for leg in range(6):
+        st = np.r_[state[:2, leg], s_eq[leg]]
+        lin = [linearisation(p, st, x[leg], side) for side in (1e-300, -1e-300)]
+        A = lin[0][0]  # the valve on the side that feeds the leakage
+        B = 0.5 * (lin[0][1] + lin[1][1])[:, :2]  # (u, ẋ): the compensation's mean; the volumes' term is 0 at rest
+        n = 5
+        Z = np.zeros((n, n))
+        Z[:3, :3], Z[:3, 3:] = A * step, B * step
+        X = expm(Z)
+        E[leg], G_u[leg], G_v[leg] = X[:3, :3], X[:3, 3], X[:3, 4]
+    return SmallSignal(E, G_u, G_v, np.array([p.piston_area, -p.rod_area, 0.0]))
