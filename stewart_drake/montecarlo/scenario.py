@@ -376,7 +376,8 @@ def nominal_gains(study: Study, reference: Trajectory):
         sensor_resolution=m.sensors.resolution,
         command_range=float(platform.legs.max_force),
     )
-    return ControllerConfig.for_platform(platform, timing, m.actuators.time_constant, poses=poses).gains
+    # the lag the gains are designed for: the lag's, a screw's current loop's, a cylinder's valve's
+    return ControllerConfig.for_platform(platform, timing, actuator_model(m).time_constant, poses=poses).gains
 
 
 def scenario(study: Study, index: int, reference: Trajectory | None = None, gains=None) -> tuple[int, Draw, Scenario]:
