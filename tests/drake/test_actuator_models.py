@@ -9,6 +9,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 import stewart_drake as sd
+from stewart_drake.api.simulation import plan_run
 from stewart_drake.control import hydraulic, screw
 from stewart_drake.core.geometry import load_preset
 from stewart_drake.design.hydraulic import HydraulicParameters
@@ -115,3 +116,14 @@ def test_a_hydraulic_machine_tracks_the_seed_trajectory():
         e["hydraulic"], e["throttle"] + e["leakage"] + e["compression"] + e["mechanical"], rtol=1e-9, atol=1e-9
     )
     assert (e["throttle"] > 0).all() and (e["leakage"] > 0).all()
+
+
+def test_a_motor_encoder_is_the_legs_sensor():
+    # lead/counts per count in place of sensors.resolution: 10 mm / 4096 = 2.44 µm
+    m = sd.load_machine("utn-dynamic", ["actuators.model=screw", "actuators.encoder_counts=4096"])
+    plan = plan_run(m, duration=0.1)
+    assert plan.timing.sensor_resolution == 0.01 / 4096
+    assert (
+        plan_run(sd.load_machine("utn-dynamic", ["actuators.model=screw"]), duration=0.1).timing.sensor_resolution
+        == 1e-5
+    )
