@@ -58,8 +58,8 @@ class ScrewActuation:
         return i, leg_force(self.params, i, rates)
 
     def advance(self, current, u, lengths, rates) -> tuple[np.ndarray, np.ndarray, dict]:
-        """One plant step under the held command ``u`` (6, N) from the legs' ``rates`` (6, m/s) at its start:
-        ``(currents, force to hold (6, N), powers (W) over the step)``."""
+        """The plant step at a stop under the held command ``u`` (6, N), the legs moving at ``rates`` (6, m/s)
+        there: ``(currents, force to hold over the next step (6, N), powers (W) over it)``."""
         i = self.step(current, u)
         return i, leg_force(self.params, i, rates), powers(self.params, i, rates)
 
