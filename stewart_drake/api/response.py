@@ -16,7 +16,7 @@ import numpy as np
 
 from stewart_drake.api.result import Result
 from stewart_drake.api.simulation import plan_run, run_machine
-from stewart_drake.control.feedforward import feedforward_lead
+from stewart_drake.control.feedforward import feedforward_lead, initial_leg_forces
 from stewart_drake.control.frequency import (
     MIN_GAIN_MARGIN_DB,
     MIN_PHASE_MARGIN_DEG,
@@ -26,8 +26,11 @@ from stewart_drake.control.frequency import (
     effective_gains,
     margins,
 )
+from stewart_drake.control.hydraulic import small_signal as hydraulic_signal
+from stewart_drake.control.screw import small_signal
 from stewart_drake.core.argcheck import check_finite_samples, check_shape
 from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import constant_trajectory
 from stewart_drake.drake.loop_response import measure_duration, measure_point
 from stewart_drake.errors import ResponseError
@@ -202,9 +205,17 @@ def loop_response(
     if lag > 0 and abs(steps - round(steps)) > 1e-9 * steps:  # the lag steps at the plant steps between ticks
         raise ResponseError(ResponseError.PLANT_STEPS.format(step=sc.plant_time_step, period=T))
     lead = feedforward_lead(sc.config, lag) if sc.feedforward else None
+    # the screws and cylinders about the forces that hold the plate at the pose, as the run starts
+    screw = cylinders = None
+    hold = initial_leg_forces(sc.platform, sc.trajectory)
+    if sc.actuators.screw is not None:
+        screw = small_signal(sc.actuators.screw, hold, sc.plant_time_step)
+    if sc.actuators.hydraulic is not None:
+        L = leg_lengths(sc.platform, pose)
+        cylinders = hydraulic_signal(sc.actuators.hydraulic, hold, L, sc.platform.L_min, sc.plant_time_step)
     model = LoopModel.build(
         sc.platform, pose, effective_gains(sc.controller, sc.config), T, plan.timing.output_delay, lag,
-        sc.plant_time_step, lead,
+        sc.plant_time_step, lead, screw, cylinders,
     )  # fmt: skip
     Tsp = model.setpoint_response(f)
     L, S = model.loops(f)

@@ -215,6 +215,19 @@ def _motion(motion, platform: Platform, rate: float, **units) -> Trajectory:
     return get_trajectory(motion, **units)
 
 
+def actuator_model(machine: Machine) -> ActuatorModel:
+    """The loop's ``ActuatorModel`` of ``machine.actuators``: the lag, or the screw with its current loop's
+    (the cylinder with its valve's) time constant as the lag the gains and the feed-forward are designed for."""
+    a = machine.actuators
+    if a.model == "screw":
+        screw = a.screw(machine.platform.legs.max_force)
+        return ActuatorModel(screw.max_force, screw.current_time_constant, screw)
+    if a.model == "hydraulic":  # the force loop's lag as the lag
+        hyd = a.hydraulic(machine.platform)
+        return ActuatorModel(hyd.max_force, hyd.valve_time_constant, hydraulic=hyd)
+    return ActuatorModel(a.max_force, a.time_constant)
+
+
 def plan_run(
     platform: Machine | Platform | str | Path,
     trajectory: str | Path | Trajectory | None = None,
@@ -298,7 +311,12 @@ def plan_run(
     if fit:
         traj = fit_trajectory(traj, platform)
     duration = duration if duration is not None else (traj.duration or 1.0)
-    actuators = actuators or ActuatorModel(machine.actuators.max_force, machine.actuators.time_constant)
+    actuators = actuators or actuator_model(machine)
+    if actuators.screw is not None and actuators.screw.encoder_resolution is not None:
+        sensor_resolution = actuators.screw.encoder_resolution  # the legs' sensor is the motor's encoder
+    # the lag the gains are designed for: the lag's (the machine's nominal one), or the screw's current loop's
+    # (the cylinder's valve's)
+    design_lag = machine.actuators.time_constant if actuators.model == "lag" else actuators.time_constant
     sensor = sensor if sensor is not None else _sensor(machine, duration)
     timing = DspTiming(
         sample_period=period,
@@ -308,7 +326,10 @@ def plan_run(
     )
     if checks:
         timing.check()
-        check_timing(platform, period, plant_step, actuators.time_constant, timing.output_delay)
+        # the screw's current loop is stepped exactly (zero-order hold), the cylinder's by sub-steps: a plant step
+        # may be longer than either
+        lag = actuators.time_constant if actuators.model == "lag" else 0.0
+        check_timing(platform, period, plant_step, lag, timing.output_delay)
         if duration < period:  # the log would hold the initial state only, its errors 0: no result at all
             raise OptionError(OPTION_DURATION_PERIOD.format(value=fmt_value(duration), period=fmt_value(period)))
         shown = duration_shown if duration_shown is not None else duration
@@ -337,11 +358,11 @@ def plan_run(
     elif nominal_gains and gains is None:
         gains = ControllerConfig.for_platform(platform, poses=poses).gains
     elif not nominal_gains:
-        gains = ControllerConfig.for_platform(platform, timing, machine.actuators.time_constant, poses=poses).gains
+        gains = ControllerConfig.for_platform(platform, timing, design_lag, poses=poses).gains
     # the tuner, around the design, at plan time (a Monte Carlo study's runs share the nominal design instead)
     if ctl.gains == "tune" and not nominal_gains:
         designed = ControllerConfig.for_platform(platform, timing, gains=gains, **form)
-        spec = LoopSpec.of(designed, actuators.time_constant, plant_step, feedforward)
+        spec = LoopSpec.of(designed, design_lag, plant_step, feedforward)
         box = workspace_box(platform)
         gains = tuned_gains(platform, designed, controller, spec, box.lo, box.hi)
     if scale != 1.0:
@@ -602,6 +623,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
     t_wall = time.perf_counter()
     if sc.firmware and meshcat is None:  # the user's C runs in a child process with a time limit
         log, gap, tick_loop = run_user_firmware(sc, plan.duration, progress, sc.firmware, plan.time_limit)
+        energy = None
     else:
         sim = build_simulation(sc, meshcat=meshcat)
         try:
@@ -611,6 +633,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
             sim.close()
         gap = sim.max_constraint_gap()
         tick_loop = "pil" if sc.pil is not None else sim.tick_loop
+        energy = sim.controller.energy
     t_wall = time.perf_counter() - t_wall
     if gap > timing.sensor_resolution / 10:
         warnings.append(SIMULATION_GAP_WARNING.format(gap=gap, count=timing.sensor_resolution))
@@ -628,6 +651,7 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "controller": sc.controller,
         "engine": sc.engine,
         "tick_loop": tick_loop,  # "compiled" for either law where the loop kernel runs; "engine" is the firmware's
+        "actuator_model": sc.actuators.model,  # not "lag": the Python loop (the compiled kernel steps the lag only)
         "firmware": sc.firmware,
         "sample_period_s": timing.sample_period,
         "latency": timing.latency,
@@ -657,6 +681,8 @@ def run_plan(plan: RunPlan, progress: bool = False, on_warning=None, meshcat=Non
         "max_angle_error_deg": float(np.degrees(np.abs(pe[:, 3:]).max())),
         "saturated_ticks_per_leg": log.saturations().astype(int).tolist(),
     }
+    if energy is not None:  # a screw's or cylinder's energy flows over the run, J per leg (their ``powers``)
+        summary["actuator_energy_J"] = {k: v.tolist() for k, v in energy.items()}
     # tracking, and the loop's own verdict: chatter (force ripple about the inverse-dynamics force) and
     # saturation at the reference's ends (control/verdict.py; each Monte Carlo run is judged there too)
     verdict, loop = run_verdict(sc.platform, truth, traj, log, config, e, pe)

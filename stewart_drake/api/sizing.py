@@ -1,5 +1,8 @@
 """``size``: actuator sizing (peak and RMS force, speed, acceleration, power, stroke per leg) for a motion
-program, a trajectory or a duty envelope, against the platform's actuator limits."""
+program, a trajectory or a duty envelope, against the platform's actuator limits; for a machine with screw
+actuators along a trajectory, the motors' peak torque, speed and current and RMS current against the motor's
+limits too (``control.screw.motor_demand``), and for hydraulic cylinders the valve's opening, the pressures
+and the supply flow against the valve and the supply (``control.hydraulic.steady_demand``)."""
 
 from __future__ import annotations
 
@@ -12,6 +15,8 @@ from numpy.typing import ArrayLike
 from stewart_drake.api.design import carrying
 from stewart_drake.api.dynamics import read_trajectory_csv, trajectory_rates
 from stewart_drake.api.result import Result
+from stewart_drake.control.hydraulic import steady_demand
+from stewart_drake.control.screw import motor_demand
 from stewart_drake.core.argcheck import as_flag, as_real, check_path, param
 from stewart_drake.core.dynamics import seed_trajectory
 from stewart_drake.core.geometry import Platform, check_platform
@@ -19,8 +24,11 @@ from stewart_drake.core.rotations import check_convention
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.design.envelope import envelope_sizing, load_envelope
+from stewart_drake.design.hydraulic import HydraulicParameters
+from stewart_drake.design.screw import ScrewParameters
 from stewart_drake.design.sizing import (
     UNITS,
+    TrajectorySizing,
     first_violation,
     limits_of,
     rotating_trajectory,
@@ -30,6 +38,7 @@ from stewart_drake.design.sizing import (
 from stewart_drake.errors import API_SIZE_SOURCE, OptionError
 from stewart_drake.script import run_program
 from stewart_drake.script.source import read_program
+from stewart_drake.spec.machine import Machine
 
 MAX_LISTED = 10_000  # envelope poses whose allowed accelerations are listed in the JSON
 MAX_SAMPLES = 10_000_000  # samples of a seed/rotating trajectory (t_end / dt)
@@ -54,18 +63,27 @@ class SizingResult(Result):
     violation: dict | None
     where: str
     peak_where: str = ""
+    actuator_violation: dict | None = None
 
     @property
     def ok(self) -> bool:
-        """Every leg within its limits."""
-        return self.violation is None
+        """Every leg (and a screw's motor, a cylinder's valve and supply) within its limits."""
+        return self.violation is None and self.actuator_violation is None
 
     def violation_message(self) -> str | None:
         """The violation as one line: the worst excess (the peak the table shows) and where the limit is first
         exceeded; or None."""
         v = self.violation
         if v is None:
-            return None
+            m = self.actuator_violation
+            if m is None:
+                return None
+            return (
+                f"leg {m['leg']} {m['what']} {m['quantity']} peaks at {m['value']:.6g} {m['unit']}, beyond "
+                + (f"actuators.{m['limit_name']} {m['limit']:.6g} {m['unit']}" if m["unit"] != "× full" else
+                   f"a fully open valve (actuators.{m['limit_name']})")
+                + ("" if m["t_s"] is None else f" at t = {m['t_s']:.4f} s")
+            )  # fmt: skip
         qty = v["quantity"]
         name = "stroke" if qty == "length" else f"legs.max_{qty}"
         u = UNITS[qty]
@@ -79,7 +97,7 @@ class SizingResult(Result):
 
 
 def size(
-    platform: Platform,
+    platform: Platform | Machine,
     trajectory: str | Path | Trajectory | None = None,
     *,
     program: str | None = None,
@@ -99,7 +117,9 @@ def size(
     """Actuator sizing for one source of motion: a trajectory, a motion program or a duty envelope.
 
     Args:
-        platform: the platform (its ``legs`` limits are checked).
+        platform: the platform (its ``legs`` limits are checked), or a machine: its platform, and with
+            ``actuators.model: screw`` its motors (``hydraulic``: its valves and supply) sized along a trajectory
+            or program too.
         trajectory: ``"seed"``, ``"rotating"``, a CSV file (as for `inverse_dynamics`) or a `Trajectory` with
             samples or exact rates.
         program: a motion program (``.stw``), sampled at ``rate``.
@@ -123,6 +143,9 @@ def size(
     Raises:
         StewartError: not exactly one source, bad options or samples.
     """
+    actuators = None
+    if isinstance(platform, Machine):
+        actuators, platform = sized_actuators(platform), platform.platform
     check_platform(platform)
     check_convention(convention)
     legs = as_flag(legs, "legs")
@@ -138,15 +161,17 @@ def size(
     loaded, p_TP = carrying(platform, payload, payload_com, gravity)
     return size_loaded(
         platform, loaded, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-        length_unit, angle_unit, smooth=smooth,
+        length_unit, angle_unit, smooth=smooth, actuators=actuators,
     )  # fmt: skip
 
 
 def size_loaded(
     base, platform, p_TP, trajectory, program, envelope, legs, payload, gravity, rate, t_end, dt, convention,
-    length_unit, angle_unit, envelope_shown=None, smooth=None,
+    length_unit, angle_unit, envelope_shown=None, smooth=None, actuators=None,
 ) -> SizingResult:  # fmt: skip
-    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name)."""
+    """``size`` of a platform already carrying its payload (``base``: as loaded, for its name); ``actuators``:
+    the machine's ``ScrewParameters`` or ``HydraulicParameters`` (``sized_actuators``; None: the legs' limits
+    only)."""
     header = {
         "platform": base.name,
         "legs_model": bool(legs),
@@ -200,9 +225,126 @@ def size_loaded(
         limits=limits,
         violation=viol,
     )
+    act_viol = None
+    if isinstance(actuators, ScrewParameters):
+        out["motor"], act_viol = motor_sizing(actuators, s)
+    elif isinstance(actuators, HydraulicParameters):
+        out["hydraulic"], act_viol = hydraulic_sizing(actuators, s)
     if viol is None:
-        return SizingResult(out, None, "")
-    return SizingResult(out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s")
+        return SizingResult(out, None, "", actuator_violation=act_viol)
+    return SizingResult(
+        out, viol, f"at t = {viol['t_s']:.4f} s", f"at t = {viol['peak_t_s']:.4f} s", actuator_violation=act_viol
+    )
+
+
+def sized_actuators(machine: Machine) -> ScrewParameters | HydraulicParameters | None:
+    """The parameters of ``machine``'s actuators that ``size`` checks beyond the legs' limits (None: a lag)."""
+    a = machine.actuators
+    if a.model == "screw":
+        return a.screw(machine.platform.legs.max_force)
+    if a.model == "hydraulic":
+        return a.hydraulic(machine.platform)
+    return None
+
+
+def _worst(checks, t) -> dict | None:
+    """The largest excess of ``checks`` — (quantity, (n, 6) or (6,) values, limit, limit's field, unit, what) —
+    as a violation (``quantity``, ``leg``, ``value``, ``limit``, ``limit_name``, ``unit``, ``what``, ``t_s``:
+    None for a value over the whole run), or None."""
+    worst = None
+    for qty, values, limit, field, unit, what in checks:
+        peak = values if values.ndim == 1 else values.max(axis=0)
+        leg = int(np.argmax(peak / limit))
+        ratio = float(peak[leg] / limit)
+        if ratio > 1 and (worst is None or ratio > worst[0]):
+            t_s = None if values.ndim == 1 else float(t[int(np.argmax(values[:, leg]))])
+            worst = (ratio, {"quantity": qty, "leg": leg + 1, "value": float(peak[leg]), "limit": float(limit),
+                             "limit_name": field, "unit": unit, "what": what, "t_s": t_s})  # fmt: skip
+    return None if worst is None else worst[1]
+
+
+def hydraulic_sizing(hyd: HydraulicParameters, s: TrajectorySizing) -> tuple[dict, dict | None]:
+    """The cylinders along the sized trajectory ``s``, the oil taken as incompressible: per leg the peak valve
+    opening (1: fully open), the peak chamber pressures and supply flow with their times; the six legs' peak
+    total supply flow; the force limits at the supply; and the worst excess (the opening beyond 1:
+    ``valve_flow_gain``; a force beyond what the supply holds: ``supply_pressure``), or None."""
+    d = steady_demand(hyd, s.force, s.speed)
+    t = s.t
+    legs = []
+    for leg in range(6):
+        row = {"leg": leg + 1}
+        for name, arr in (("spool", d["spool"]), ("p_A_pa", d["p_A"]), ("p_B_pa", d["p_B"]),
+                          ("supply_flow_m3_s", d["supply_flow"])):  # fmt: skip
+            k = int(np.argmax(arr[:, leg]))
+            row[f"peak_{name}"], row[f"peak_{name}_t_s"] = float(arr[k, leg]), float(t[k])
+        legs.append(row)
+    # the supply pressure that would hold the force (the other chamber at the return's)
+    aa, ab, pt = hyd.piston_area, hyd.rod_area, hyd.return_pressure
+    need = np.where(s.force >= 0, (s.force + ab * pt) / aa, (aa * pt - s.force) / ab)
+    spool = np.where(np.isinf(d["spool"]), 0.0, d["spool"])  # beyond the supply: the pressure's violation
+    # a force beyond the supply first: the valve's opening grows without bound on the way there
+    worst = _worst([("pressure needed", need, hyd.supply_pressure, "supply_pressure", "Pa", "cylinder")], t)
+    worst = worst or _worst([("opening", spool, 1.0, "valve_flow_gain", "× full", "valve")], t)
+    summary = {
+        "legs": legs,
+        "total_supply_flow_m3_s": float(np.maximum(d["supply_flow"], 0).sum(axis=1).max()),
+        "limits": {
+            "supply_pressure": hyd.supply_pressure,
+            "max_extending_force_n": float(d["max_extending"]),
+            "max_retracting_force_n": float(d["max_retracting"]),
+        },
+        "violation": worst,
+    }
+    return summary, worst
+
+
+# motor quantity -> (the demand's array, the limit's field, unit)
+MOTOR_LIMITS = {
+    "current": ("max_current", "A"),
+    "speed": ("max_motor_speed", "rad/s"),
+    "rms_current": ("rated_current", "A"),
+}
+
+
+def motor_sizing(screw: ScrewParameters, s: TrajectorySizing) -> tuple[dict, dict | None]:
+    """The screw actuators' motors along the sized trajectory ``s``: per leg the peak |current| (A), |torque|
+    (N·m) and |speed| (rad/s) with their times, the RMS current over the run (trapezoid over ``s.t``), the
+    limits (``max_current``, ``max_motor_speed``, ``rated_current``) and the screw's derived numbers; and the
+    worst excess of a limit (``quantity``, ``leg``, ``value``, ``limit``, ``limit_name``, ``unit``, ``t_s``),
+    or None."""
+    d = motor_demand(screw, s.force, s.speed, s.accel)
+    t, i = s.t, np.abs(d["current"])
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    rms = np.sqrt(np.trapezoid(i**2, t, axis=0) / span) if span > 0 else i.max(axis=0)
+    peaks = {"current": i, "speed": np.abs(d["speed"])}
+    legs = []
+    for leg in range(6):
+        row = {"leg": leg + 1, "rms_current_a": float(rms[leg])}
+        for name, arr, unit in (
+            ("current", i, "a"),
+            ("torque", np.abs(d["torque"]), "nm"),
+            ("speed", peaks["speed"], "rad_s"),
+        ):
+            k = int(np.argmax(arr[:, leg]))
+            row[f"peak_{name}_{unit}"], row[f"peak_{name}_t_s"] = float(arr[k, leg]), float(t[k])
+        legs.append(row)
+    checks = [
+        (qty, rms if qty == "rms_current" else peaks[qty], getattr(screw, field), field, unit, "motor")
+        for qty, (field, unit) in MOTOR_LIMITS.items()
+    ]
+    worst = _worst(checks, t)
+    summary = {
+        "legs": legs,
+        "limits": {field: getattr(screw, field) for field, _ in MOTOR_LIMITS.values()},
+        "screw": {
+            "lead_m": screw.lead,
+            "reflected_mass_kg": screw.reflected_mass,
+            "force_per_amp_n_a": screw.force_per_amp,
+            "torque_constant_nm_a": screw.torque_constant,
+        },
+        "violation": worst,
+    }
+    return summary, worst
 
 
 def _samples(platform, trajectory, program, rate, t_end, dt, convention, length_unit, angle_unit, smooth=None):

@@ -7,8 +7,8 @@ import sys
 import numpy as np
 
 from stewart_drake.api.design import carrying
-from stewart_drake.api.sizing import AXES, size_loaded
-from stewart_drake.commands._common import add_platform_arg, print_json
+from stewart_drake.api.sizing import AXES, size_loaded, sized_actuators
+from stewart_drake.commands._common import add_platform_arg, platform_machine, print_json
 from stewart_drake.commands._design import add_payload_args, design_platform
 from stewart_drake.core.rotations import CONVENTIONS, length_scale
 from stewart_drake.script import ScriptError
@@ -56,6 +56,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     base = design_platform(args)
+    machine = platform_machine(args)
+    actuators = None if machine is None else sized_actuators(machine)
     k = length_scale(args.length_unit)
     platform, p_TP = carrying(
         base,
@@ -69,7 +71,7 @@ def run(args) -> int:
         r = size_loaded(
             base, platform, p_TP, args.trajectory, args.program, args.envelope, args.legs == "on", args.payload,
             args.gravity, args.rate, args.t_end, args.dt, args.convention, args.length_unit, args.angle_unit,
-            smooth=args.smooth,
+            smooth=args.smooth, actuators=actuators,
         )  # fmt: skip
     except ScriptError as e:
         print(e.render(), file=sys.stderr)
@@ -94,10 +96,31 @@ def run(args) -> int:
             + f": {out['samples']} samples over {out['duration_s']:.3f} s, legs model {args.legs}, payload {args.payload} kg"
         )
         _print_table(out["legs"], with_times=True)
-    if r.violation is not None:
+    if not args.json and "motor" in out:
+        _print_motor_table(out["motor"])
+    elif not args.json and "hydraulic" in out:
+        _print_hydraulic_table(out["hydraulic"])
+    elif not args.json and actuators is not None:
+        print(f"{machine.actuators.model} actuators: sized along a trajectory or program (not over an envelope)")
+    if not r.ok:
         print(f"stewart-drake size: {r.violation_message()}", file=sys.stderr)
         return 1
     return 0
+
+
+def _print_motor_table(motor: dict) -> None:
+    lim, sc = motor["limits"], motor["screw"]
+    print(
+        f"screw actuators: lead {sc['lead_m'] * 1e3:g} mm, rotor {sc['reflected_mass_kg']:.4g} kg on each leg; motor "
+        f"limits {lim['max_current']:.4g} A peak, {lim['rated_current']:.4g} A RMS, "
+        f"{lim['max_motor_speed'] * 60 / (2 * np.pi):.5g} rpm"
+    )
+    print(f"{'leg':>3} {'peak|i| A':>10} {'RMS i A':>9} {'peak|τ| N·m':>12} {'peak rpm':>9}")
+    for r in motor["legs"]:
+        rpm = r["peak_speed_rad_s"] * 60 / (2 * np.pi)
+        print(
+            f"{r['leg']:3d} {r['peak_current_a']:10.4g} {r['rms_current_a']:9.4g} {r['peak_torque_nm']:12.4g} {rpm:9.5g}"
+        )
 
 
 def _print_table(legs_json, with_times: bool) -> None:
@@ -111,4 +134,19 @@ def _print_table(legs_json, with_times: bool) -> None:
             f"{r['leg']:3d} {r['peak_force_n']:10.3f} {rms:>9} {r['peak_speed_m_s']:9.4f} {r['peak_accel_m_s2']:10.4f} {r['peak_power_w']:9.3f} "
             f"{r['min_length_m'] * 1e3:9.2f} {r['max_length_m'] * 1e3:9.2f}"
             + (f"   {r['peak_force_t_s']:.4f}" if with_times else "")
+        )
+
+
+def _print_hydraulic_table(hyd: dict) -> None:
+    lim = hyd["limits"]
+    print(
+        f"hydraulic cylinders: supply {lim['supply_pressure'] / 1e5:.4g} bar, forces {lim['max_extending_force_n']:.5g} N "
+        f"extending, {-lim['max_retracting_force_n']:.5g} N retracting; peak total supply flow "
+        f"{hyd['total_supply_flow_m3_s'] * 6e4:.4g} L/min"
+    )
+    print(f"{'leg':>3} {'spool':>7} {'p_A bar':>8} {'p_B bar':>8} {'Q L/min':>8}")
+    for r in hyd["legs"]:
+        print(
+            f"{r['leg']:3d} {r['peak_spool']:7.3g} {r['peak_p_A_pa'] / 1e5:8.4g} {r['peak_p_B_pa'] / 1e5:8.4g} "
+            f"{r['peak_supply_flow_m3_s'] * 6e4:8.4g}"
         )

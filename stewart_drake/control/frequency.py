@@ -10,8 +10,10 @@ continuous system does not take. About a pose at rest the legs obey
 (the leg forces that hold the plate, differentiated along the legs: ``leg_space_stiffness``; the rate terms are
 quadratic at rest). The actuators are the loop's own discrete lag F ← a·F + b·u at each plant step h
 (``control.actuation``), reading the command held just before that step; without a lag the force follows the
-command from its release. The mechanics between plant steps are integrated exactly (zero-order hold), so the
-tick-to-tick map of (lengths, rates, forces) is exact for the linear plant. The controller is the PID of
+command from its release. Screw actuators (``control.screw``) are their small signal at rest (``SmallSignal``:
+the current loop, the force of the current and the velocity's damping, the rotor's mass on the legs), hydraulic
+cylinders theirs (``control.hydraulic.SmallSignal``: pressures and spool, the valve's describing gain). The
+mechanics between plant steps are integrated exactly (zero-order hold), so the tick-to-tick map of (lengths, rates, forces) is exact for the linear plant. The controller is the PID of
 ``control.laws`` as a discrete state space (integrator, measurement and set-point difference filters), its
 command released ``DspTiming.output_delay`` after the tick. The feed-forward table's rows enter, linearised, as
 (K − ω̃²·M_L)·e^{jω·lead} per unit set-point (ω̃² = (2 − 2 cos ωT)/T², the table's central second difference).
@@ -32,6 +34,8 @@ import numpy as np
 from scipy.linalg import expm
 
 from stewart_drake.control.gains import ControllerConfig, FixedGains, PidGains, leg_space_inertia
+from stewart_drake.control.hydraulic import SmallSignal as HydraulicSignal
+from stewart_drake.control.screw import SmallSignal
 from stewart_drake.core.dynamics import leg_forces_with_legs
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import length_jacobian
@@ -123,19 +127,78 @@ def plant_matrices(M: np.ndarray, K: np.ndarray, lag: float, step: float, T: flo
         E1, G1 = _zoh(Am, Bm, delay)
         E2, G2 = _zoh(Am, Bm, T - delay)
         return Phi, E2 @ G1, G2
-    n = int(round(T / step))
     Ad, Bd = _zoh(Am, Bm, step)
     a = math.exp(-step / lag)
     sub = np.block([[Ad, Bd], [np.zeros((6, 12)), a * np.eye(6)]])  # mechanics with F held, then F ← a·F
     inj = np.vstack([np.zeros((12, 6)), (1 - a) * np.eye(6)])  # ... + b·u
-    Phi, G_old, G_new = np.eye(18), np.zeros((18, 6)), np.zeros((18, 6))
+    return _tick_map(sub, inj, step, T, delay)
+
+
+def _tick_map(sub: np.ndarray, inj: np.ndarray, step: float, T: float, delay: float):
+    """``(Phi, G_old, G_new)`` of a tick from the plant-step map s ← ``sub``·s (+ ``inj``·u at each step's end):
+    a step reads the command held just before it, u_{k−1} until the release ``delay`` s after the tick."""
+    n = int(round(T / step))
+    Phi, G_old, G_new = np.eye(len(sub)), np.zeros((len(sub), 6)), np.zeros((len(sub), 6))
     for j in range(1, n + 1):
         Phi, G_old, G_new = sub @ Phi, sub @ G_old, sub @ G_new
-        if j * step > delay + 1e-9 * T:  # the lag reads the command held just before this plant step
+        if j * step > delay + 1e-9 * T:  # the actuators read the command held just before this plant step
             G_new = G_new + inj
         else:
             G_old = G_old + inj
     return Phi, G_old, G_new
+
+
+def screw_plant_matrices(M: np.ndarray, K: np.ndarray, screw: SmallSignal, step: float, T: float, delay: float):
+    """``plant_matrices`` with screw actuators (``control.screw.SmallSignal``) in place of the lag: the legs
+    carry the rotors' reflected mass, and at each plant step the currents take the command held just before it,
+    i ← a·i + β·u, and the force c·i + d·L̇ is held over the next step. State s = (lengths m, rates m/s, currents
+    A, held forces N)."""
+    Minv = np.linalg.inv(M + screw.reflected_mass * np.eye(6))
+    Am = np.block([[np.zeros((6, 6)), np.eye(6)], [-Minv @ K, np.zeros((6, 6))]])
+    Bm = np.vstack([np.zeros((6, 6)), Minv])
+    Ad, Bd = _zoh(Am, Bm, step)
+    I6, Z6, D = np.eye(6), np.zeros((6, 6)), np.diag(screw.d)
+    rate = np.hstack([Z6, I6])  # picks L̇ from (L, L̇)
+    # mechanics with F held, then i ← a·i (+ β·u) and F ← c·i + d·L̇ at the step's end
+    sub = np.block(
+        [
+            [Ad, np.zeros((12, 6)), Bd],
+            [np.zeros((6, 12)), screw.a * I6, Z6],
+            [D @ rate @ Ad, screw.c * screw.a * I6, D @ rate @ Bd],
+        ]
+    )
+    inj = np.vstack([np.zeros((12, 6)), screw.beta * I6, screw.c * screw.beta * I6])
+    return _tick_map(sub, inj, step, T, delay)
+
+
+def hydraulic_plant_matrices(M: np.ndarray, K: np.ndarray, cyl: HydraulicSignal, step: float, T: float, delay: float):
+    """``plant_matrices`` with hydraulic cylinders (``control.hydraulic.SmallSignal``) in place of the lag: at
+    each plant step the cylinders' state a = (p_A, p_B, s) takes the command held just before it and the legs'
+    velocity at the step's end, a ← E·a + G_u·u + G_v·L̇, and the force c·a is held over the next step. State
+    s = (lengths m, rates m/s, p_A Pa, p_B Pa, spools, held forces N)."""
+    Minv = np.linalg.inv(M)
+    Am = np.block([[np.zeros((6, 6)), np.eye(6)], [-Minv @ K, np.zeros((6, 6))]])
+    Bm = np.vstack([np.zeros((6, 6)), Minv])
+    Ad, Bd = _zoh(Am, Bm, step)
+    # the cylinders' 18 states ordered (p_A legs 1..6, p_B legs 1..6, spools legs 1..6)
+    E, Gu, Gv = np.zeros((18, 18)), np.zeros((18, 6)), np.zeros((18, 6))
+    for leg in range(6):
+        idx = [leg, 6 + leg, 12 + leg]
+        E[np.ix_(idx, idx)] = cyl.E[leg]
+        Gu[idx, leg], Gv[idx, leg] = cyl.G_u[leg], cyl.G_v[leg]
+    C = np.kron(cyl.c[None, :], np.eye(6))  # (6, 18): F = c·a per leg
+    rate = np.hstack([np.zeros((6, 6)), np.eye(6)])  # picks L̇ from (L, L̇)
+    new_rate_m, new_rate_f = rate @ Ad, rate @ Bd  # L̇ at the step's end, of (L, L̇) and F at its start
+    # mechanics with F held; then a ← E·a + G_v·L̇(end) (+ G_u·u), F ← C·a
+    sub = np.block(
+        [
+            [Ad, np.zeros((12, 18)), Bd],
+            [Gv @ new_rate_m, E, Gv @ new_rate_f],
+            [C @ Gv @ new_rate_m, C @ E, C @ Gv @ new_rate_f],
+        ]
+    )
+    inj = np.vstack([np.zeros((12, 6)), Gu, C @ Gu])
+    return _tick_map(sub, inj, step, T, delay)
 
 
 @dataclass(frozen=True)
@@ -173,13 +236,21 @@ class LoopModel:
         lag: float,
         step: float,
         lead: float | None,
+        screw: SmallSignal | None = None,
+        hydraulic: HydraulicSignal | None = None,
     ) -> LoopModel:
         """The loop of ``platform`` at ``pose`` (6,) with the law's SI ``gains``, sample period ``T`` (s), output
         ``delay`` (s, ≤ T), actuator ``lag`` (s) stepped at the plant ``step`` (s) and the feed-forward ``lead``
-        (s; None: no feed-forward)."""
+        (s; None: no feed-forward); ``screw``, ``hydraulic``: the screws' or cylinders' small signal in place of
+        the lag."""
         pose = np.asarray(pose, dtype=float).reshape(6)
         M, K = leg_space_mass(platform, pose), leg_space_stiffness(platform, pose)
-        Phi, G_old, G_new = plant_matrices(M, K, lag, step, T, delay)
+        if screw is not None:
+            Phi, G_old, G_new = screw_plant_matrices(M, K, screw, step, T, delay)
+        elif hydraulic is not None:
+            Phi, G_old, G_new = hydraulic_plant_matrices(M, K, hydraulic, step, T, delay)
+        else:
+            Phi, G_old, G_new = plant_matrices(M, K, lag, step, T, delay)
         ns = len(Phi)
         I6, Z = np.eye(6), np.zeros
         # plant with the released command as state: p = (s, u_{k−1}); p' = Pa·p + Ga·u_k; y = Cp·p

@@ -29,6 +29,7 @@ import numpy as np
 
 from stewart_drake.control.frequency import LoopModel
 from stewart_drake.control.laws import FixedPointLaw, FloatLaw
+from stewart_drake.control.screw import FRICTION_SPEED
 from stewart_drake.core.kinematics import leg_lengths, length_jacobian
 from stewart_drake.core.trajectory import Trajectory
 from stewart_drake.drake.simulation import Scenario, build_simulation
@@ -102,9 +103,12 @@ def measure_point(
     """Drive leg ``leg``'s set-point with a sine of ``freq`` Hz about ``model.pose`` (the pose moves by
     J⁻¹·e_leg·A·sin ωt, so the other legs' set-points move only to second order) through ``scenario``'s loop,
     and fit the ticks' leg lengths over whole periods spanning at least ``window`` s after the start's
-    transient. ``amplitude`` (m): at most, see ``sine_amplitude``."""
+    transient. ``amplitude`` (m): at most, see ``sine_amplitude`` (with screw actuators, also at most
+    v_s/(20π·freq): the leg's velocity a tenth of the friction's blend, ``control.screw.FRICTION_SPEED``)."""
     T = model.T
     pose = model.pose
+    if scenario.actuators.screw is not None:  # the screws' small signal: |L̇| ≤ v_s/10, where tanh is linear
+        amplitude = min(amplitude, FRICTION_SPEED / (20 * math.pi * freq))
     A = sine_amplitude(model, freq, leg, scenario.config.timing.command_range, amplitude)
     w = 2 * math.pi * freq
     dq = np.linalg.solve(length_jacobian(scenario.platform, pose), np.eye(6)[leg]) * A

@@ -44,12 +44,17 @@ from stewart_drake.control.feedforward import (
     initial_leg_forces,
 )
 from stewart_drake.control.gains import ControllerConfig
+from stewart_drake.control.hydraulic import HydraulicActuation
+from stewart_drake.control.screw import ScrewActuation
 from stewart_drake.control.simulation_log import SimulationLog
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.leg_bodies import leg_joint_positions
 from stewart_drake.core.rotations import angles_from_matrix, quaternion_to_matrix, rotation_matrix
 from stewart_drake.core.trajectory import Trajectory, constant_trajectory, design_poses, get_trajectory
+from stewart_drake.design.hydraulic import HydraulicParameters
+from stewart_drake.design.screw import ScrewParameters
+from stewart_drake.drake.actuator_systems import set_reflected_inertia
 from stewart_drake.drake.integrators import (
     CONTINUOUS,
     DEFAULT_INTEGRATOR,
@@ -72,11 +77,21 @@ from stewart_drake.spec.machine import PilSpec
 @dataclass(frozen=True)
 class ActuatorModel:
     """Leg actuators: a force limit (N, None: the platform's ``legs.max_force``) and a first-order lag
-    with time constant ``time_constant`` (s; 0: none). The stroke end stops are the prismatic joints'
-    limits in the plant (SAP enforces them as constraints)."""
+    with time constant ``time_constant`` (s; 0: none); or with ``screw`` an electric screw actuator
+    (``control.screw``: its current limit and current loop in place of both; the rotor's reflected mass on
+    the plant's prismatic joints), or with ``hydraulic`` a valve-driven cylinder (``control.hydraulic``: its
+    supply pressure and force loop in place of both), either stepped by the loop's Python ticks. The stroke end
+    stops are the prismatic joints' limits in the plant (SAP enforces them as constraints)."""
 
     max_force: float | None = None
     time_constant: float = 2e-3
+    screw: ScrewParameters | None = None
+    hydraulic: HydraulicParameters | None = None
+
+    @property
+    def model(self) -> str:
+        """``lag``, ``screw`` or ``hydraulic``."""
+        return "screw" if self.screw is not None else "hydraulic" if self.hydraulic is not None else "lag"
 
     def __post_init__(self):
         if self.max_force is not None and not (math.isfinite(self.max_force) and self.max_force > 0):
@@ -342,10 +357,10 @@ def _build(s, platform, integrator, plant_platform, trajectory, actuators, confi
             else replace(s.sensor, offset=np.asarray(s.sensor.offset) + o)
         )
     pos = np.array([j.position_start() for j in joints])
+    vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
     if sensor_model is None:
         sensor = IdealSensor(pos)  # the prismatic positions
     else:
-        vel = plant.num_positions() + np.array([j.velocity_start() for j in joints])
         m = sensor_model
         sensor = SensorReading(
             pos, vel, np.asarray(m.offset, float), np.asarray(m.noise, float), np.asarray(m.jitter, float), m.period
@@ -366,11 +381,19 @@ def _build(s, platform, integrator, plant_platform, trajectory, actuators, confi
     F0 = initial_leg_forces(platform, trajectory)
     h = 1e-6
     rates0 = (leg_lengths(platform, trajectory.pose(h)) - leg_lengths(platform, trajectory.pose(-h))) / (2 * h)
-    # the actuators (saturation, lag) are stepped by the loop at the plant steps, their lag starting at F0
-    act = Actuation.from_time_constant(max_force, actuators.time_constant, plant_time_step)
+    # the actuators (saturation, lag; or the screws, the cylinders) are stepped by the loop at the plant steps,
+    # starting at F0
+    legs = None
+    if actuators.screw is not None:
+        act, legs = ScrewActuation(actuators.screw, plant_time_step), (pos, vel)
+        set_reflected_inertia(plant, pc, actuators.screw)
+    elif actuators.hydraulic is not None:
+        act, legs = HydraulicActuation(actuators.hydraulic, plant_time_step, plant_platform.L_min), (pos, vel)
+    else:
+        act = Actuation.from_time_constant(max_force, actuators.time_constant, plant_time_step)
     discrete = integrator not in CONTINUOUS
     loop = TickLoop(
-        simulator, plant, pc, diagram.GetInputPort("actuation"), law, sensor, plant_time_step, act, discrete
+        simulator, plant, pc, diagram.GetInputPort("actuation"), law, sensor, plant_time_step, act, discrete, legs
     )
     loop.reference = trajectory.pose(np.zeros(1))  # until ``run`` fills the tables: the pose at t = 0
     loop.initialize(L0, F0, None if ff is None else ff.force(0.0), rates0)

@@ -91,9 +91,16 @@ class TickLoop:
     actuation input port of the Diagram (fixed here: the actuators' force); ``law``: the control law;
     ``sensor``: ``(t, x) -> (6,)`` readings of the plant state ``x``; ``step`` (s): the plant step;
     ``actuators``: their saturation and lag (``control.actuation.Actuation``), stepped here at every plant
-    step; ``discrete``: the plant is discrete (it logs at every stop)."""
+    step; ``discrete``: the plant is discrete (it logs at every stop); ``legs``: ``(positions, velocities)``,
+    the legs' indices in the plant state, for actuators with a state that read the legs' motion
+    (``control.screw.ScrewActuation``, ``control.hydraulic.HydraulicActuation``: ``start(hold_forces, L, L̇)
+    -> (state, force)`` and ``advance(state, command, L, L̇) -> (state, force, powers)``, stepped by the Python
+    loop: the compiled kernel steps the lag only), None for the lag. Such actuators' energy flows (the powers
+    of each plant step, W, held over it) add up in ``energy`` ({flow: (6,) J})."""
 
-    def __init__(self, simulator, plant, plant_context, actuation_input, law, sensor, step, actuators, discrete):
+    def __init__(
+        self, simulator, plant, plant_context, actuation_input, law, sensor, step, actuators, discrete, legs=None
+    ):
         self.simulator, self.plant, self.plant_context = simulator, plant, plant_context
         self.law, self.sensor, self.step = law, sensor, step
         self.timing = law.timing
@@ -104,7 +111,8 @@ class TickLoop:
         self.reference = self.feedforward = None
         self._fixed = actuation_input.FixValue(simulator.get_mutable_context(), np.zeros(6))
         # the compiled DSP side (one C call per stop), None: the Python loop below (``firmware.loop_kernel``)
-        self.kernel = make_kernel(law, sensor)
+        self.kernel = make_kernel(law, sensor) if legs is None else None
+        self.legs, self.actuator_state, self.energy = legs, None, None
         self._end, self._boundaries, self._raw = 0.0, (), None  # the last run's end, extra stops and raw logs
 
     def prime(self, poses) -> None:
@@ -121,7 +129,12 @@ class TickLoop:
         self.held, self.memory, self.status = dsp_state.initial_state(
             self.law, lengths, hold_forces, feedforward, rates
         )
-        if self.actuators.has_lag:
+        if self.legs is not None:
+            x = self.plant.GetPositionsAndVelocities(self.plant_context)
+            hold = np.zeros(6) if hold_forces is None else hold_forces
+            self.actuator_state, self.lag_force = self.actuators.start(hold, x[self.legs[0]], x[self.legs[1]])
+            self.energy = None  # the flows' names come with the first step
+        elif self.actuators.has_lag:
             self.lag_force = self.actuators.saturate(np.zeros(6) if hold_forces is None else hold_forces)
         self._set_force(self._force_of(self.held))
 
@@ -245,12 +258,27 @@ class TickLoop:
             # command just held
             if act.has_lag:
                 if step:
-                    self.lag_force = act.step(self.lag_force, before[:6])
+                    if self.legs is None:
+                        self.lag_force = act.step(self.lag_force, before[:6])
+                    else:
+                        self.lag_force = self._actuator_step(before[:6], get_x(pc))
                     self._set_force(self.lag_force)
             elif held is not before:
                 self._set_force(act.saturate(held[:6]))
         self.held, self.memory, self.status = held, memory, status
         return logs
+
+    def _actuator_step(self, command, x) -> np.ndarray:
+        """The stateful actuators' plant step at plant state ``x`` under the held ``command`` (6, N): their state
+        advanced, their energy flows over the step added; the force (6, N) to hold over the step."""
+        self.actuator_state, force, powers = self.actuators.advance(
+            self.actuator_state, command, x[self.legs[0]], x[self.legs[1]]
+        )
+        if self.energy is None:
+            self.energy = {name: np.zeros(6) for name in powers}
+        for name, power in powers.items():
+            self.energy[name] += power * self.step
+        return force
 
     _force = None
 

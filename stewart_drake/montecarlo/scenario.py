@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from stewart_drake.api.simulation import KEYWORD_PATHS, plan_run, tick_count
+from stewart_drake.api.simulation import KEYWORD_PATHS, actuator_model, plan_run, tick_count
 from stewart_drake.control import ControllerConfig, DspTiming
 from stewart_drake.control.verdict import run_verdict
 from stewart_drake.core.geometry import Platform, base_joints
@@ -376,7 +376,8 @@ def nominal_gains(study: Study, reference: Trajectory):
         sensor_resolution=m.sensors.resolution,
         command_range=float(platform.legs.max_force),
     )
-    return ControllerConfig.for_platform(platform, timing, m.actuators.time_constant, poses=poses).gains
+    # the lag the gains are designed for: the lag's, a screw's current loop's, a cylinder's valve's
+    return ControllerConfig.for_platform(platform, timing, actuator_model(m).time_constant, poses=poses).gains
 
 
 def scenario(study: Study, index: int, reference: Trajectory | None = None, gains=None) -> tuple[int, Draw, Scenario]:
@@ -397,7 +398,10 @@ def scenario(study: Study, index: int, reference: Trajectory | None = None, gain
         duration=duration,
         plant_step=study.plant_step,
         fit=False,  # the reference is fitted already (Study.reference)
-        actuators=ActuatorModel(d.force_limit, d.actuator_lag),
+        # a screw or a cylinder: the drawn machine's (the draws actuator_lag and force_limit are the lag's)
+        actuators=actuator_model(drawn)
+        if drawn.actuators.model != "lag"
+        else ActuatorModel(d.force_limit, d.actuator_lag),
         sensor=sensor_model(d, seed, period, tick_count(duration, period) + 1),
         plant_platform=drawn.loaded_platform,
         nominal_gains=True,

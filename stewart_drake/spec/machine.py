@@ -16,7 +16,9 @@ import numpy as np
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.rotations import CONVENTIONS
 from stewart_drake.core.trajectory import Trajectory
+from stewart_drake.design.hydraulic import HydraulicParameters
 from stewart_drake.design.payload import with_payload
+from stewart_drake.design.screw import ScrewParameters
 from stewart_drake.errors import MachineError
 from stewart_drake.fixedpoint.generic import TRIG_MODES, QFormat
 
@@ -145,18 +147,101 @@ class SensorSpec:
         _number("sensors.noise", self.noise, ">= 0 m", lambda v: v >= 0)
 
 
+# the screw actuator's fields (``control.screw.ScrewParameters``; None: its default) -> (rule, check)
+SCREW_FIELDS = {
+    "lead": ("> 0 m", lambda v: v > 0),
+    "torque_constant": ("> 0 N·m/A", lambda v: v > 0),
+    "rotor_inertia": (">= 0 kg·m²", lambda v: v >= 0),
+    "efficiency": ("in (0, 1]", lambda v: 0 < v <= 1),
+    "coulomb_friction": (">= 0 N", lambda v: v >= 0),
+    "viscous_friction": (">= 0 N·s/m", lambda v: v >= 0),
+    "max_current": ("> 0 A", lambda v: v > 0),
+    "rated_current": ("> 0 A", lambda v: v > 0),
+    "max_motor_speed": ("> 0 rad/s", lambda v: v > 0),
+    "current_time_constant": (">= 0 s", lambda v: v >= 0),
+    "winding_resistance": (">= 0 Ω", lambda v: v >= 0),
+    "encoder_counts": ("an integer >= 1 per revolution", lambda v: v >= 1 and float(v).is_integer()),
+}
+# the hydraulic cylinder's fields (``control.hydraulic.HydraulicParameters``; None: its default) -> (rule, check)
+HYDRAULIC_FIELDS = {
+    "piston_area": ("> 0 m²", lambda v: v > 0),
+    "rod_area": ("> 0 m²", lambda v: v > 0),
+    "dead_volume": ("> 0 m³", lambda v: v > 0),
+    "bulk_modulus": ("> 0 Pa", lambda v: v > 0),
+    "supply_pressure": ("> 0 Pa", lambda v: v > 0),
+    "return_pressure": (">= 0 Pa", lambda v: v >= 0),
+    "valve_flow_gain": ("> 0 m³/(s·√Pa)", lambda v: v > 0),
+    "valve_time_constant": ("> 0 s", lambda v: v > 0),
+    "leakage": (">= 0 m³/(s·Pa)", lambda v: v >= 0),
+    "force_gain": ("> 0 per N", lambda v: v > 0),
+}
+MODEL_FIELDS = {"lag": {}, "screw": SCREW_FIELDS, "hydraulic": HYDRAULIC_FIELDS}
+ACTUATOR_MODELS = tuple(MODEL_FIELDS)
+
+
 @dataclass(frozen=True)
 class ActuatorSpec:
-    """The leg actuators: a first-order lag ``time_constant`` (s; 0: none) and a force limit ``max_force``
-    (N; None: the platform's ``legs.max_force``)."""
+    """The leg actuators: ``model`` (``lag``: a first-order lag ``time_constant`` s (0: none) and a force
+    limit; ``screw``: an electric motor on a screw, ``control.screw``, with the fields of ``SCREW_FIELDS``;
+    ``hydraulic``: a servo valve and cylinder, ``control.hydraulic``, with the fields of ``HYDRAULIC_FIELDS``;
+    each of those None for its default, sized from the force limit) and the force limit ``max_force`` (N; None:
+    the platform's ``legs.max_force``). A model's fields are refused with another model."""
 
     time_constant: float = 2e-3
     max_force: float | None = None
+    model: str = "lag"
+    lead: float | None = None
+    torque_constant: float | None = None
+    rotor_inertia: float | None = None
+    efficiency: float | None = None
+    coulomb_friction: float | None = None
+    viscous_friction: float | None = None
+    max_current: float | None = None
+    rated_current: float | None = None
+    max_motor_speed: float | None = None
+    current_time_constant: float | None = None
+    winding_resistance: float | None = None
+    encoder_counts: int | None = None
+    piston_area: float | None = None
+    rod_area: float | None = None
+    dead_volume: float | None = None
+    bulk_modulus: float | None = None
+    supply_pressure: float | None = None
+    return_pressure: float | None = None
+    valve_flow_gain: float | None = None
+    valve_time_constant: float | None = None
+    leakage: float | None = None
+    force_gain: float | None = None
 
     def __post_init__(self):
         _number("actuators.time_constant", self.time_constant, ">= 0 s", lambda v: v >= 0)
         if self.max_force is not None:
             _number("actuators.max_force", self.max_force, "> 0 N", lambda v: v > 0)
+        _word("actuators.model", self.model, ACTUATOR_MODELS)
+        for model, checks in MODEL_FIELDS.items():
+            for name, (rule, ok) in checks.items():
+                value = getattr(self, name)
+                if value is None:
+                    continue
+                if self.model != model:
+                    rule = f"left out unless actuators.model is {model}"
+                    raise MachineError(MachineError.RANGE.format(path=f"actuators.{name}", rule=rule, value=value))
+                _number(f"actuators.{name}", value, rule, ok)
+
+    def screw(self, platform_max_force: float) -> ScrewParameters:
+        """The screw's parameters, the defaults sized for ``max_force`` (else ``platform_max_force``) N."""
+        given = {name: getattr(self, name) for name in SCREW_FIELDS}
+        if given["encoder_counts"] is not None:
+            given["encoder_counts"] = int(given["encoder_counts"])
+        return ScrewParameters.defaults(self.max_force or float(platform_max_force), **given)
+
+    def hydraulic(self, platform: Platform) -> HydraulicParameters:
+        """The cylinder's parameters, the defaults sized for ``max_force`` (else the legs') N, the platform's
+        stroke and its legs' ``max_speed`` (m/s)."""
+        given = {name: getattr(self, name) for name in HYDRAULIC_FIELDS}
+        force = self.max_force or float(platform.legs.max_force)
+        speed = platform.legs.max_speed
+        return HydraulicParameters.defaults(force, platform.L_max - platform.L_min, speed, **given)
 
 
 @dataclass(frozen=True)
@@ -350,6 +435,29 @@ SECTIONS = {
 FIELDS = {
     "actuators.time_constant": "time",
     "actuators.max_force": "force?",
+    "actuators.model": ("word", ACTUATOR_MODELS),
+    "actuators.lead": "length?",
+    "actuators.torque_constant": "ratio?",
+    "actuators.rotor_inertia": "ratio?",
+    "actuators.efficiency": "ratio?",
+    "actuators.coulomb_friction": "force?",
+    "actuators.viscous_friction": "ratio?",
+    "actuators.max_current": "ratio?",
+    "actuators.rated_current": "ratio?",
+    "actuators.max_motor_speed": "ratio?",
+    "actuators.current_time_constant": "time?",
+    "actuators.winding_resistance": "ratio?",
+    "actuators.encoder_counts": "int?",
+    "actuators.piston_area": "ratio?",
+    "actuators.rod_area": "ratio?",
+    "actuators.dead_volume": "ratio?",
+    "actuators.bulk_modulus": "pressure?",
+    "actuators.supply_pressure": "pressure?",
+    "actuators.return_pressure": "pressure?",
+    "actuators.valve_flow_gain": "ratio?",
+    "actuators.valve_time_constant": "time?",
+    "actuators.leakage": "ratio?",
+    "actuators.force_gain": "ratio?",
     "sensors.resolution": "length",
     "sensors.noise": "length",
     "controller.law": ("word", LAWS),

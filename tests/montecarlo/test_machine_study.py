@@ -103,3 +103,10 @@ def test_a_percentage_is_of_the_machines_own_value():
     bare = Study(sd.load_platform("utn-dynamic"), parse_spec(["payload=±10%"], "vary"), seed=0, runs=1)
     with pytest.raises(SpecError, match=r"^vary: payload: '±10%': a percentage of a zero nominal"):
         check_study(bare)
+
+
+def test_a_study_of_a_screw_machine_runs_its_screws():
+    # the drawn machine's screws reach each run (the lag's draws, actuator_lag and force_limit, are the lag's)
+    study = make_study(NEWCOMER, None, ["anchor=±0.1mm"], 1, 0, {"run.duration": 0.2, "actuators.model": "screw"})
+    sc = scenario(study, 0)[2]
+    assert sc.actuators.model == "screw" and sc.actuators.screw == study.machine.actuators.screw(4000.0)
