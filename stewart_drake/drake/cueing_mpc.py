@@ -40,6 +40,7 @@ from pydrake.solvers import ClarabelSolver, MathematicalProgram, OsqpSolver, Sol
 from scipy.linalg import expm
 
 from stewart_drake.control.cueing.drive import GRAVITY, Drive
+from stewart_drake.control.cueing.guard import DEFAULT_MAX_ACCEL, DEFAULT_MAX_SPEED
 from stewart_drake.control.cueing.vestibular import RATE_THRESHOLD, canal_ss, otolith_ss
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import (
@@ -76,8 +77,9 @@ class MpcParams:
         w_velocity: weight on the pose rates, per m/s (rad/s).
         w_acceleration: weight on the pose accelerations (inputs), per m/s² (rad/s²).
         stroke_margin: leg-length margin kept from each stroke end in the program, m.
-        max_leg_speed: leg speed limit, m/s; ``None``: the platform's ``legs.max_speed``, else 0.5 m/s.
-        max_leg_acceleration: leg acceleration limit, m/s².
+        max_leg_speed: leg speed limit, m/s; ``None``: the platform's ``legs.max_speed``, else the guard's
+            ``DEFAULT_MAX_SPEED``.
+        max_leg_acceleration: leg acceleration limit, m/s² (default the guard's ``DEFAULT_MAX_ACCEL``, 1 g).
         max_tilt_rate: limit on the roll and pitch rates, rad/s (default 3 °/s, the roll-rate perception
             threshold of ``vestibular.RATE_THRESHOLD``: tilt coordination below what the canals notice); ``None``:
             none (the canal model in the cost alone shapes the tilt).
@@ -97,7 +99,7 @@ class MpcParams:
     w_acceleration: float = 0.05
     stroke_margin: float = 0.005
     max_leg_speed: float | None = None
-    max_leg_acceleration: float = 10.0
+    max_leg_acceleration: float = DEFAULT_MAX_ACCEL
     max_tilt_rate: float | None = TILT_RATE
     preview: bool = False
     decay: float | None = None
@@ -134,6 +136,8 @@ class MpcRun:
         t: ``(N,)`` s, the drive's times.
         poses: ``(N, 6)`` commanded poses (m, rad, ``utn``), poses[0] the home pose.
         solve_times: ``(K,)`` s, wall time of each sample's whole step (linearise, update, solve, re-check).
+        cpu_times: ``(K,)`` s, the same steps' CPU time on the calling thread (what one free core would take,
+            on a machine whose other work stretches the wall time).
         stroke_violation: ``(K,)`` m, per solve the exact IK's largest leg excess past a stroke end of the pose
             it commands (max(L_min − L, L − L_max) over the legs): ≤ 0 on every sample.
         leg_speed: ``(K,)`` m/s, per solve the largest exact leg speed of the pose it commands.
@@ -143,16 +147,18 @@ class MpcRun:
     t: np.ndarray
     poses: np.ndarray
     solve_times: np.ndarray
+    cpu_times: np.ndarray
     stroke_violation: np.ndarray
     leg_speed: np.ndarray
     fallbacks: dict
 
 
 def leg_speed_limit(platform: Platform, params: MpcParams) -> float:
-    """The leg speed limit the MPC keeps, m/s: ``params.max_leg_speed``, else the platform's, else 0.5 m/s."""
+    """The leg speed limit the MPC keeps, m/s: ``params.max_leg_speed``, else the platform's, else the guard's
+    ``DEFAULT_MAX_SPEED``."""
     if params.max_leg_speed is not None:
         return float(params.max_leg_speed)
-    return float(platform.legs.max_speed) if platform.legs.max_speed is not None else 0.5
+    return float(platform.legs.max_speed) if platform.legs.max_speed is not None else DEFAULT_MAX_SPEED
 
 
 def vestibular_system() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -423,11 +429,11 @@ def mpc_cue(
     U = np.zeros(6 * N)
     poses = np.empty((n_s, 6))
     poses[0] = home
-    times, excess, speed = np.empty(n_s - 1), np.empty(n_s - 1), np.empty(n_s - 1)
+    times, cpu, excess, speed = (np.empty(n_s - 1) for _ in range(4))
     fallbacks = {"tightened": 0, "scaled": 0}
     L0 = leg_lengths(platform, home)
     for i in range(n_s - 1):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.thread_time()
         if params.preview:
             Rs = np.stack([np.interp(t[i] + plan_t[:-1], t, r[:, j]) for j in range(6)], axis=1).ravel()
         else:
@@ -459,5 +465,13 @@ def mpc_cue(
         x[:6], x[6:12] = p1, v1
         poses[i + 1] = home + p1
         U = sol
-        times[i] = time.perf_counter() - start
-    return MpcRun(t=t, poses=poses, solve_times=times, stroke_violation=excess, leg_speed=speed, fallbacks=fallbacks)
+        times[i], cpu[i] = time.perf_counter() - start, time.thread_time() - start_cpu
+    return MpcRun(
+        t=t,
+        poses=poses,
+        solve_times=times,
+        cpu_times=cpu,
+        stroke_violation=excess,
+        leg_speed=speed,
+        fallbacks=fallbacks,
+    )
