@@ -31,10 +31,10 @@ NAMES = "car-lane-change,car-braking,car-slalom,ship-ss4"
 BUDGET = 0.010  # s per sample at 100 Hz
 VARIANTS = {
     "mpc": MpcParams(),
+    "mpc held": MpcParams(decay=None),
     "mpc 6°/s": MpcParams(max_tilt_rate=math.radians(6.0)),
-    "mpc decay 0.5 s": MpcParams(decay=0.5),
     "mpc preview": MpcParams(preview=True),
-}
+}  # the defaults; the vehicle's motion held over the horizon; the hand set's tilt rate; the recorded future seen
 
 
 def scores(drive, q, guard, platform) -> dict:

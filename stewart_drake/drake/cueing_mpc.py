@@ -57,7 +57,7 @@ from stewart_drake.workspace.limits import Limits, raw_margins
 
 SOLVERS = {"osqp": OsqpSolver, "clarabel": ClarabelSolver}
 FALLBACK_TIGHTENING = 4.0  # the re-solve's stroke (and cone) margin is this many times the program's, rates ÷ 1.25
-TILT_RATE = float(RATE_THRESHOLD[0])  # rad/s
+TILT_RATE = 0.9 * float(RATE_THRESHOLD[0])  # rad/s: 2.7 °/s, below the threshold by more than OSQP's 1e-3 tolerance
 MAX_HORIZON = 200  # prediction steps: the condensed program is dense in 6 × horizon inputs
 CONE_MARGIN = 0.01  # rad kept from a joint cone in the program
 HALVINGS = 6  # scaled steps tried (1/2 .. 1/64) before the pose is held
@@ -80,12 +80,12 @@ class MpcParams:
         max_leg_speed: leg speed limit, m/s; ``None``: the platform's ``legs.max_speed``, else the guard's
             ``DEFAULT_MAX_SPEED``.
         max_leg_acceleration: leg acceleration limit, m/s² (default the guard's ``DEFAULT_MAX_ACCEL``, 1 g).
-        max_tilt_rate: limit on the roll and pitch rates, rad/s (default 3 °/s, the roll-rate perception
-            threshold of ``vestibular.RATE_THRESHOLD``: tilt coordination below what the canals notice); ``None``:
-            none (the canal model in the cost alone shapes the tilt).
+        max_tilt_rate: limit on the roll and pitch rates, rad/s (default ``TILT_RATE``, 0.9 × the 3 °/s roll-rate
+            perception threshold of ``vestibular.RATE_THRESHOLD``: tilt coordination below what the canals notice);
+            ``None``: none (the canal model in the cost alone shapes the tilt).
         preview: the program sees the drive's future (recorded drives) instead of predicting it.
         decay: without ``preview``, the vehicle's present motion is predicted to decay to rest with this time
-            constant, s (``None``: held over the horizon).
+            constant, s (default 0.5 s; ``None``: held over the horizon, which plans for a cue that lasts).
         solver: ``"osqp"`` or ``"clarabel"`` (both ship with Drake).
     """
 
@@ -102,7 +102,7 @@ class MpcParams:
     max_leg_acceleration: float = DEFAULT_MAX_ACCEL
     max_tilt_rate: float | None = TILT_RATE
     preview: bool = False
-    decay: float | None = None
+    decay: float | None = 0.5
     solver: str = "osqp"
     solver_options: dict = field(
         default_factory=lambda: {"eps_abs": 1e-3, "eps_rel": 1e-3, "polishing": 0, "max_iter": 500}
