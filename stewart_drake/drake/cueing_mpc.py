@@ -17,7 +17,7 @@ the state and the vehicle's motion; the hard constraints are the leg lengths (st
 and leg accelerations, each linearised along the horizon about the previous solution's poses with the exact
 Jacobian ∂L/∂q of ``core.kinematics`` (leg acceleration without its J̇ q̇ term). One ``MathematicalProgram`` serves
 the whole run: each sample updates the cost's and the constraint's coefficients and solves again (OSQP, warm
-started from the previous solution shifted by one sample).
+started from the previous sample's solution).
 
 The first input is applied for one drive sample; the new pose is then re-checked with the exact inverse kinematics
 (stroke, leg speed; joint cones where ``limits`` give them). If the check fails (linearisation error) or the
@@ -26,8 +26,8 @@ with the margins tightened (``FALLBACK_TIGHTENING``) and only the first step's l
 step is scaled toward the previous pose (halving, down to holding it still), which is inside by induction from the
 home pose. The poses are therefore never outside the workspace.
 
-Without ``preview`` the vehicle's motion is held at its present value over the horizon (a real-time simulator
-does not know the future); with it the recorded drive is previewed.
+A real-time simulator does not know the vehicle's future: without ``preview`` the program predicts the present
+motion decaying to rest (``decay``; or held); with it a recorded drive's future is seen.
 """
 
 from __future__ import annotations
@@ -114,16 +114,22 @@ class MpcParams:
 
         if not (isinstance(self.horizon, int) and 1 <= self.horizon <= MAX_HORIZON):
             bad("horizon", f"a whole number of steps in 1..{MAX_HORIZON}")
+
+        def number(v) -> bool:
+            return isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+
         for name in ("step", "w_force", "w_rate", "max_leg_acceleration"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+            if not (number(getattr(self, name)) and getattr(self, name) > 0):
                 bad(name, "a positive number")
         for name in ("w_position", "w_angle", "w_velocity", "w_acceleration", "stroke_margin"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+            if not (number(getattr(self, name)) and getattr(self, name) >= 0):
                 bad(name, "a number >= 0")
         for name in ("max_leg_speed", "max_tilt_rate", "decay"):
             v = getattr(self, name)
-            if v is not None and not (np.isfinite(v) and v > 0):
+            if v is not None and not (number(v) and v > 0):
                 bad(name, "a positive number or None")
+        if not isinstance(self.preview, bool):
+            bad("preview", "true or false")
         if self.solver not in SOLVERS:
             bad("solver", "one of " + ", ".join(SOLVERS))
 
@@ -221,8 +227,9 @@ def discretise(model: dict, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
 @dataclass(frozen=True)
 class Condensed:
-    """The horizon condensed onto the inputs U = [a_0 .. a_{N−1}] (6N,): every predicted quantity is
-    ``F x0 + G U + Q Rs`` with Rs = [r_0 .. r_{N−1}] (6N,). ``P``/``V`` give p_k, v_k for k = 1..N (rows 6N)."""
+    """The horizon condensed onto the inputs U = [a_0 .. a_{N−1}] (6N,): the offsets p_k = Px x0 + Pu U and rates
+    v_k = Vx x0 + Vu U stacked for k = 1..N (6N rows; the vehicle's motion moves only the vestibular states), and
+    the cost ½ Uᵀ H U + (Gx x0 + Gr Rs)ᵀ U with Rs = [r_0 .. r_{N−1}] (6N,)."""
 
     Px: np.ndarray
     Pu: np.ndarray
