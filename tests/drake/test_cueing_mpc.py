@@ -1,6 +1,7 @@
 """MPC cueing on the user's 210 kg machine: every commanded pose re-checked here with the exact IK (stroke, leg
 speed, joint cones), the rider at rest kept at home, a drive far beyond the workspace kept inside, the fallback
-that scales a bad step, and the vestibular model in the cost checked against ``vestibular.perceive``."""
+that scales a bad step, a sustained acceleration cued by tilt, only a preview anticipating the drive, and the
+vestibular model in the cost checked against ``vestibular.perceive``."""
 
 import math
 import re
