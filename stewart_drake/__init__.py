@@ -29,6 +29,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
     from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
     from stewart_drake.api.cross_check import CrossCheck, cross_check
+    from stewart_drake.api.cueing import CueResult, cue
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
     from stewart_drake.api.drawing import plot_platform
     from stewart_drake.api.dsp import DspIKResult, dsp_ik
@@ -115,6 +116,8 @@ _PUBLIC = {
     "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
     "inspect_model": ("stewart_drake.api.model", "inspect_model"),
     "cross_check": ("stewart_drake.api.cross_check", "cross_check"),
+    "cue": ("stewart_drake.api.cueing", "cue"),
+    "CueResult": ("stewart_drake.api.cueing", "CueResult"),
     "CrossCheck": ("stewart_drake.api.cross_check", "CrossCheck"),
     "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
     "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
@@ -182,6 +185,8 @@ __all__ = [
     "ModelInspection",
     "cross_check",
     "CrossCheck",
+    "cue",
+    "CueResult",
     "viewer_readout",
     "ViewerReadout",
     "plot_platform",

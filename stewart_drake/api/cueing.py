@@ -1,0 +1,317 @@
+"""``sd.cue``: a vehicle's motion (a ``Drive``) turned into platform poses by a motion-cueing law (classical
+washout, hand-set or tuned, or MPC), kept inside the workspace by the limit guard, scored by what a rider
+perceives and, with ``simulate=True``, run through the machine's own controller and the Drake plant so that the
+scores are those of the *plant's* motion (the controller's lag and the actuators included).
+
+The laws, the guard, the vestibular models and the scores live in ``control.cueing``; this module loads and
+checks the inputs once, chains them and judges the run: 0 samples outside the stroke or over the leg speed
+limit, in the commanded poses and in the simulated plant, and the loop tracking.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, is_dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from stewart_drake.api.result import Result
+from stewart_drake.control.cueing.classical import HAND_SET, ClassicalParams, classical
+from stewart_drake.control.cueing.drive import Drive, load_drive
+from stewart_drake.control.cueing.generators import DRIVES
+from stewart_drake.control.cueing.guard import WorkspaceGuard
+from stewart_drake.control.cueing.platform_motion import platform_drive
+from stewart_drake.control.cueing.scores import score
+from stewart_drake.control.cueing.tuning import load_params, tune_classical
+from stewart_drake.control.cueing.vestibular import perceive
+from stewart_drake.core.geometry import Platform
+from stewart_drake.core.kinematics import leg_lengths, stroke_within
+from stewart_drake.core.trajectory import table_trajectory
+from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, ArgumentError, UsageError
+from stewart_drake.spec import Machine, load_machine
+
+if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is drawn
+    from matplotlib.figure import Figure
+
+    from stewart_drake.api.simulation import SimulationResult
+
+ALGORITHMS = ("classical", "tuned", "mpc")
+CHANNELS = ("fx", "fy", "fz", "wx", "wy", "wz")  # specific force (m/s²) and angular velocity (rad/s), head frame
+
+
+def resolve_drive(drive: Drive | str | Path, name: str = "drive") -> Drive:
+    """``drive`` as a ``Drive``: itself, a shipped drive by name (``DRIVES``) or a CSV/Parquet drive file
+    (``load_drive``: its errors name the file, line and column); anything else is an ``ArgumentError`` naming
+    ``name`` (the keyword, or the option) and the value as given."""
+    if isinstance(drive, Drive):
+        return drive
+    if isinstance(drive, (str, Path)):
+        if str(drive) in DRIVES:
+            return DRIVES[str(drive)]()
+        if Path(drive).suffix or Path(drive).exists():
+            return load_drive(drive)
+    raise ArgumentError(CUE_DRIVE.format(name=name, value=repr(drive), names=", ".join(DRIVES)))
+
+
+def limit_samples(platform: Platform, t, lengths) -> dict:
+    """The samples of leg ``lengths`` (N, 6) m at times ``t`` (N,) s outside the platform's limits:
+    ``outside_stroke`` (any leg beyond [L_min, L_max]), ``over_speed`` (any leg faster than ``legs.max_speed``
+    between two samples; 0 where the platform states no limit), with the ``peak_leg_speed_m_s`` and the
+    ``stroke_use`` (the largest leg excursion from mid-stroke over half the stroke: 1 reaches an end)."""
+    L = np.asarray(lengths, dtype=float)
+    speed = np.abs(np.diff(L, axis=0)) / np.diff(np.asarray(t, dtype=float))[:, None]
+    vmax = platform.legs.max_speed
+    mid, half = platform.stroke.mean(), (platform.L_max - platform.L_min) / 2
+    return {
+        "samples": int(len(L)),
+        "outside_stroke": int(np.count_nonzero(~stroke_within(platform, L))),
+        "over_speed": int(np.count_nonzero((speed > vmax).any(axis=1))) if vmax is not None else 0,
+        "max_leg_speed_m_s": None if vmax is None else float(vmax),
+        "peak_leg_speed_m_s": float(speed.max(initial=0.0)),
+        "stroke_use": float(np.abs(L - mid).max() / half),
+    }
+
+
+def resample(t_from, values, t_to) -> np.ndarray:
+    """``values`` (n, k) sampled at ``t_from`` (n,) s, linearly interpolated at ``t_to`` (m,) s: (m, k)."""
+    return np.stack([np.interp(t_to, t_from, values[:, j]) for j in range(values.shape[1])], axis=-1)
+
+
+def channels(drive: Drive) -> np.ndarray:
+    """``(N, 6)``: a drive's specific force (m/s²) and angular velocity (rad/s) side by side (``CHANNELS``)."""
+    return np.hstack([drive.specific_force, drive.angular_velocity])
+
+
+@dataclass(repr=False)
+class CueResult(Result):
+    """A motion-cueing run (``cue``).
+
+    Attributes:
+        drive: the vehicle's motion (``Drive``) cued.
+        algorithm: ``"classical"``, ``"tuned"`` or ``"mpc"``; ``params`` the law's parameters used.
+        poses: ``(N, 6)`` the guarded commanded poses at ``drive.t`` (m, rad; utn convention, absolute).
+        motion: the ``Drive`` a rider on the commanded platform feels.
+        perceived: ``{"vehicle", "platform"}`` (and ``"plant"`` when simulated): the perceived ``Drive``s.
+        scores: ``control.cueing.scores.score`` of the vehicle against the commanded platform.
+        limits: ``limit_samples`` of the commanded poses.
+        simulation: the closed-loop run (``SimulationResult``) when ``simulate=True``, else None; then
+            ``plant_poses`` (N, 6) the plant's poses at ``drive.t``, ``plant_scores`` and ``plant_limits``.
+        failures: why the run is not good (a limit violated, tracking lost); empty when it is.
+    """
+
+    machine: Machine
+    drive: Drive
+    algorithm: str
+    params: object
+    poses: np.ndarray
+    motion: Drive
+    perceived: dict
+    scores: dict
+    limits: dict
+    simulation: SimulationResult | None = field(default=None, repr=False)
+    plant_poses: np.ndarray | None = None
+    plant_scores: dict | None = None
+    plant_limits: dict | None = None
+    failures: list = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """No limit violated in the commanded poses (nor the simulated plant), and the loop tracked."""
+        return not self.failures
+
+    def _fields(self) -> dict:
+        d = {
+            "platform": self.machine.platform.name,
+            "drive": self.drive.name,
+            "samples": int(len(self.drive.t)),
+            "duration_s": float(self.drive.t[-1] - self.drive.t[0]),
+            "algorithm": self.algorithm,
+            "params": asdict(self.params) if is_dataclass(self.params) else self.params,
+            "scores": self.scores,
+            "limits": self.limits,
+            "simulated": self.simulation is not None,
+        }
+        if self.simulation is not None:
+            d["plant_scores"] = self.plant_scores
+            d["plant_limits"] = self.plant_limits
+            d["simulation"] = {k: v for k, v in self.simulation.summary.items() if k != "warnings"}
+        return {**d, "failures": self.failures, "ok": self.ok}
+
+    def plot(self) -> Figure:
+        """The perceived specific force and angular velocity per channel: the vehicle's, the commanded
+        platform's and (when simulated) the plant's.
+
+        Returns:
+            A matplotlib ``Figure`` (six panels).
+        """
+        # deferred: pyplot is loaded only when a figure is drawn
+        import matplotlib.pyplot as plt
+
+        t = self.drive.t
+        fig, axes = plt.subplots(3, 2, figsize=(10, 7), sharex=True)
+        units = ("m/s²",) * 3 + ("rad/s",) * 3
+        for j, (name, unit) in enumerate(zip(CHANNELS, units, strict=True)):
+            ax = axes[j % 3, j // 3]
+            for key, style in (("vehicle", "k-"), ("platform", "C0-"), ("plant", "C1--")):
+                if key in self.perceived:
+                    ax.plot(t, channels(self.perceived[key])[:, j], style, lw=1, label=key)
+            ax.set_ylabel(f"perceived {name} [{unit}]")
+        axes[0, 0].legend(fontsize=7)
+        for ax in axes[-1]:
+            ax.set_xlabel("t [s]")
+        fig.suptitle(f"{self.algorithm} cueing of {self.drive.name} on {self.machine.platform.name}")
+        fig.tight_layout()
+        return fig
+
+    def plot_legs(self) -> Figure:
+        """The legs' lengths along the run against the stroke (commanded, and the plant's when simulated).
+
+        Returns:
+            A matplotlib ``Figure``.
+        """
+        # deferred: pyplot is loaded only when a figure is drawn
+        import matplotlib.pyplot as plt
+
+        p, t = self.machine.platform, self.drive.t
+        fig, ax = plt.subplots(figsize=(9, 4))
+        ax.plot(t, leg_lengths(p, self.poses) * 1e3, lw=1)
+        if self.plant_poses is not None:
+            ax.plot(t, leg_lengths(p, self.plant_poses) * 1e3, "k:", lw=0.8)
+        for end in p.stroke:
+            ax.axhline(end * 1e3, color="r", lw=1)
+        ax.set(xlabel="t [s]", ylabel="leg length [mm]", title="leg usage against the stroke (red)")
+        ax.legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
+        fig.tight_layout()
+        return fig
+
+
+def cueing_params(algorithm: str, params, drive: Drive, platform: Platform):
+    """The law's parameters: ``params`` (a parameter object, or for the classical laws a YAML file of
+    ``tuning.save_params``), else the defaults (classical: ``HAND_SET``; tuned: ``tune_classical`` on this
+    drive; mpc: ``MpcParams()``)."""
+    if isinstance(params, (str, Path)):
+        if algorithm == "mpc":
+            raise UsageError(CUE_PARAMS.format(name="params", value=repr(str(params))))
+        return load_params(params)
+    if params is not None:
+        return params
+    if algorithm == "classical":
+        return HAND_SET
+    if algorithm == "tuned":
+        return tune_classical([drive], platform)
+    # deferred: MpcParams is defined beside the MPC law, which imports pydrake (classical cueing needs no Drake)
+    from stewart_drake.drake.cueing_mpc import MpcParams
+
+    return MpcParams()
+
+
+def commanded_poses(algorithm: str, params, drive: Drive, platform: Platform) -> np.ndarray:
+    """``(N, 6)`` the law's poses for ``drive`` through the workspace guard (absolute, m and rad)."""
+    home = platform.home_pose()
+    if algorithm == "mpc":
+        # deferred: the MPC law imports pydrake (classical cueing needs no Drake)
+        from stewart_drake.drake.cueing_mpc import mpc_cue
+
+        raw = mpc_cue(drive, platform, params, home).poses
+    else:
+        raw = classical(drive, params if isinstance(params, ClassicalParams) else ClassicalParams(**params), home)
+    return WorkspaceGuard.for_platform(platform).guard(raw, drive.t)
+
+
+def cue(
+    machine: Machine | Platform | str | Path,
+    drive: Drive | str | Path,
+    *,
+    algorithm: str = "classical",
+    params=None,
+    simulate: bool = False,
+    progress: bool | None = None,
+) -> CueResult:
+    """Cue a vehicle's motion on the machine: poses by the law, kept inside the workspace by the guard,
+    scored by the perceived motion (otolith and semicircular-canal models) against the vehicle's.
+
+    Args:
+        machine: the machine (``load_machine``'s: a ``Machine``, a ``Platform``, a preset name or a machine file).
+        drive: the vehicle's motion: a ``Drive``, a shipped drive's name (``"ship-ss4"``, ``"car-lane-change"``,
+            ...) or a drive file (CSV or Parquet, ``t,fx,fy,fz,wx,wy,wz[,roll,pitch,yaw]``, SI).
+        algorithm: ``"classical"`` (classical washout, hand-set: ``HAND_SET``), ``"tuned"`` (classical washout
+            tuned for this drive, or with ``params`` as given) or ``"mpc"`` (model-predictive cueing).
+        params: the law's parameters (``ClassicalParams``, ``MpcParams``, or a YAML file written by
+            ``tune_classical``'s ``save_params`` for the classical laws); None: the defaults above.
+        simulate: also run the poses through the machine's controller (fixed point) and the Drake plant
+            (``sd.simulate``) and score the plant's motion.
+        progress: show the simulation's progress bar.
+
+    Returns:
+        A ``CueResult``: its ``failures`` name each limit violated (in the commanded poses, and in the plant)
+        and a lost tracking; ``ok`` is True when there are none.
+
+    Raises:
+        StewartError: a bad machine, drive or parameter file (naming it and the value as written), an
+            unknown algorithm.
+    """
+    if algorithm not in ALGORITHMS:
+        raise ArgumentError(ArgumentError.CHOICE.format(name="algorithm", choices=ALGORITHMS, value=repr(algorithm)))
+    if not isinstance(simulate, bool):
+        raise ArgumentError(ArgumentError.NOT_BOOL.format(name="simulate", value=repr(simulate)))
+    machine = load_machine(machine)
+    platform = machine.platform
+    drive = resolve_drive(drive)
+    params = cueing_params(algorithm, params, drive, platform)
+    poses = commanded_poses(algorithm, params, drive, platform)
+    home = platform.home_pose()
+    motion = platform_drive(poses, drive.t, home)
+    perceived = {"vehicle": perceive(drive), "platform": perceive(motion)}
+    limits = limit_samples(platform, drive.t, leg_lengths(platform, poses))  # the exact IK
+    failures = limit_failures(limits, "the commanded poses")
+    result = CueResult(
+        machine,
+        drive,
+        algorithm,
+        params,
+        poses,
+        motion,
+        perceived,
+        score(drive, motion, poses, platform),
+        limits,
+        failures=failures,
+    )
+    if simulate:
+        in_the_loop(result, bool(progress))
+    return result
+
+
+def limit_failures(limits: dict, what: str) -> list[str]:
+    """One line per kind of limit ``limits`` (``limit_samples``') shows violated in ``what``."""
+    out = []
+    if limits["outside_stroke"]:
+        out.append(f"{limits['outside_stroke']} of {limits['samples']} samples of {what} have a leg outside the stroke")
+    if limits["over_speed"]:
+        out.append(
+            f"{limits['over_speed']} of {limits['samples']} samples of {what} move a leg faster than "
+            f"{limits['max_leg_speed_m_s']:g} m/s (legs.max_speed; peak {limits['peak_leg_speed_m_s']:.4g} m/s)"
+        )
+    return out
+
+
+def in_the_loop(result: CueResult, progress: bool) -> None:
+    """Run ``result``'s poses as a table reference through the machine's controller and the Drake plant and
+    fill in the plant's poses, scores and limits (at the drive's samples) and its failures."""
+    # deferred: the closed loop imports pydrake (classical cueing needs no Drake)
+    from stewart_drake.api.simulation import simulate
+
+    drive, platform = result.drive, result.machine.platform
+    t = drive.t - drive.t[0]
+    reference = table_trajectory(f"cue-{drive.name}", t, result.poses)
+    run = simulate(result.machine, reference, duration=float(t[-1]), progress=progress)
+    log = run.log.raw
+    plant = resample(log.t, log.pose, t)
+    motion = platform_drive(plant, drive.t, platform.home_pose())
+    result.simulation = run
+    result.plant_poses = plant
+    result.perceived["plant"] = perceive(motion)
+    result.plant_scores = score(drive, motion, plant, platform)
+    result.plant_limits = limit_samples(platform, log.t, log.lengths)  # the plant's own leg lengths
+    result.failures += limit_failures(result.plant_limits, "the simulated plant")
+    result.failures += [f"the loop: {f}" for f in run.verdict["failures"]]
