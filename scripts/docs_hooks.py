@@ -42,6 +42,7 @@ SEE_ALSO = {
     "montecarlo": ["../montecarlo-vary.md"],
     "firmware": ["../firmware-abi.md", "../pil-link.md"],
     "simulate": ["../firmware-abi.md"],
+    "cue": ["../motion-cueing.md"],
 }
 
 
@@ -56,6 +57,7 @@ PYTHON = {
     "size": "size",
     "workspace": "workspace",
     "simulate": "simulate",
+    "cue": "cue",
     "response": "loop_response",
     "montecarlo": "montecarlo",
     "firmware": "firmware",
