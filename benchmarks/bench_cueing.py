@@ -1,0 +1,66 @@
+"""The classical washout's and the limit guard's cost per drive sample (issue 39, item 6, first part), against the
+budget of one sample at the drive's rate (10 ms at 100 Hz), on seed 001's ship simulator (``gonzalez-dutra-2009``)
+and the 210 kg machine (``examples/newcomer-210kg.yaml``).
+
+The laws are numpy over a whole drive (``control.cueing.classical``, ``guard``): this measures their cost per sample
+amortised over the drive, not a streaming step in a compiled kernel (the firmware has none yet); the exact-IK
+re-check of the guarded poses (``api.cueing.limit_samples``) is timed beside them. Process CPU time, best of
+``--repeat``; the ratios to the sample budget are what travel between machines.
+
+Run by hand: ``python benchmarks/bench_cueing.py [--repeat 3] [--drive ship-ss4]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+from stewart_drake.api.cueing import limit_samples, resolve_drive
+from stewart_drake.control.cueing.classical import HAND_SET, classical
+from stewart_drake.control.cueing.guard import WorkspaceGuard
+from stewart_drake.core.kinematics import leg_lengths
+from stewart_drake.spec import load_machine
+
+MACHINES = ("gonzalez-dutra-2009", "examples/newcomer-210kg.yaml")
+
+
+def best_cpu(fn, repeat: int) -> float:
+    """Best process CPU seconds of ``repeat`` calls of ``fn()``."""
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        best = min(best, time.process_time() - t0)
+    return best
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--drive", default="ship-ss4")
+    args = ap.parse_args()
+    drive = resolve_drive(args.drive)
+    n, dt = len(drive.t), float(drive.t[1] - drive.t[0])
+    print(f"load average {os.getloadavg()[0]:.2f}; drive {drive.name}: {n} samples at {1 / dt:g} Hz")
+    print(f"{'machine':30s} {'part':22s} {'µs/sample':>10s} {'share of budget':>16s}")
+    for source in MACHINES:
+        platform = load_machine(source).platform
+        home = platform.home_pose()
+        guard = WorkspaceGuard.for_platform(platform)
+        raw = classical(drive, HAND_SET, home)
+        guarded = guard.guard(raw, drive.t)
+        parts = {
+            "classical washout": lambda: classical(drive, HAND_SET, home),
+            "guard": lambda: guard.guard(raw, drive.t),
+            "exact-IK re-check": lambda: limit_samples(platform, drive.t, leg_lengths(platform, guarded)),
+        }
+        for part, fn in parts.items():
+            us = best_cpu(fn, args.repeat) / n * 1e6
+            print(f"{platform.name:30s} {part:22s} {us:10.2f} {us * 1e-6 / dt:16.2e}")
+
+
+if __name__ == "__main__":
+    main()
