@@ -1189,3 +1189,42 @@ OPTION_LEG_DAMPING_RESOLVE = (
     "{name} {value:g} N·s/m gives damping ratios of ~{zeta:.3g}, beyond {limit:g}: the modes of a platform "
     "this overdamped are not resolved in double precision (one root per mode runs to ~0, the other to ~infinity)"
 )
+
+
+# ----------------------------------------------------------------------------------------------
+# Motion cueing (``control/cueing``): vehicle-motion files, generators, washout and tuning parameters.
+
+
+class DriveError(InputError):
+    """A vehicle-motion ("drive") file or value is malformed: messages name the file, line and column."""
+
+    COLUMNS = "{path}: a drive file's columns are {columns} (optionally {optional}); got {got}"
+    PARQUET = "{path}: cannot read it as Parquet ({reason})"
+    PARQUET_COLUMN = "{path}: column {column!r} is missing; a drive's columns are {columns}"
+    PARQUET_VALUE = "{path}: row {row}, column {column!r}: values must be finite numbers, got {value}"
+    TOO_FEW = "{path}: a drive needs at least {need} samples, got {got}"
+    TOO_MANY = "{path}: {got} rows; a drive holds at most {limit} samples (split it or lower its rate)"
+    STEP = (
+        "{path}:{line}: column t: samples must be evenly spaced; t = {t} s follows t = {t_prev} s, a step of "
+        "{step} s where its first step is {expected} s"
+    )
+    SHAPE = "drive {name!r}: {field} must have shape {shape}, got {got}"
+    NOT_FINITE = "drive {name!r}: {field} must be finite; sample {index} is {value}"
+    TIMES = "drive {name!r}: t must increase in equal steps; sample {index} steps {step} s, the first {expected} s"
+    UNKNOWN = "unknown drive {name!r}; the shipped drives are {names}"
+    MANOEUVRE = "unknown {vehicle} manoeuvre {name!r}; expected one of {valid}"
+    SEA_STATE = "sea_state must be one of {valid}, got {value!r}"
+    DURATION = "{name} must be a positive number of seconds of at most {limit} s, got {value!r}"
+    RATE = "rate must be between {low} and {high} Hz, got {value!r}"
+    FORMAT = "{path}: a drive file ends in .csv or .parquet"
+
+
+class CueingError(StewartError):
+    """A washout, guard or tuning request that cannot be met (a bad parameter, a mismatched drive)."""
+
+    PARAM = "{name} must be {rule}, got {value!r}"
+    PARAMS_FILE = "{path}:{line}: {field}: {value} must be {rule}"
+    POSES_TIMES = "poses ({n} rows) and t ({m} samples) must have one row per sample"
+    SAME_TIMES = "the vehicle drive ({n} samples, step {dt} s) and the platform drive ({m}, step {dt2} s) must share t"
+    HOME_OUTSIDE = "the home pose {home} is outside the guard's stroke (with its margin {margin} m)"
+    NO_DRIVES = "tune_classical needs at least one drive"

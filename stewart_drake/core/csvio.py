@@ -63,16 +63,19 @@ def is_number(text: str) -> bool:
     return True
 
 
-def header_order(path, line: int, header: list[str], kind: str, widths) -> np.ndarray | None:
-    """The column order that puts a file's columns as ``COLUMN_NAMES`` lists them, from its ``header`` (the
-    cells of its line ``line``); None when the header is in that order already or its width has no names.
-    ``CsvError`` naming the file, the line and the name for an unknown, repeated or missing column."""
-    names = COLUMN_NAMES.get(len(header)) if len(header) in widths else None
+def header_order(path, line: int, header: list[str], kind: str, widths, column_names=None) -> np.ndarray | None:
+    """The column order that puts a file's columns as ``column_names`` (width -> names; default
+    ``COLUMN_NAMES``, whose names also have the ``ALIASES``) lists them, from its ``header`` (the cells of its
+    line ``line``); None when the header is in that order already or its width has no names. ``CsvError``
+    naming the file, the line and the name for an unknown, repeated or missing column."""
+    table = COLUMN_NAMES if column_names is None else column_names
+    names = table.get(len(header)) if len(header) in widths else None
     if names is None:
         return None
+    aliases = ALIASES if column_names is None else {"time": "t"} | {n: n for n in names}
     got = []
     for cell in header:
-        name = ALIASES.get(cell.strip().lower())
+        name = aliases.get(cell.strip().lower())
         if name is None or name not in names:
             raise CsvError(
                 CsvError.HEADER_UNKNOWN.format(
@@ -175,6 +178,7 @@ def read_numeric_csv(
     bytes_per_row: float = 0.0,
     max_rows: int | None = None,
     too_many: Exception | None = None,
+    column_names: dict[int, tuple[str, ...]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(rows (n, w) float array, line numbers (n,))`` from a CSV of numbers, every row of one width
     in ``widths``. A non-numeric first row is a header; blank lines are skipped; a UTF-8 byte-order
@@ -183,8 +187,8 @@ def read_numeric_csv(
     the order of ``COLUMN_NAMES`` (see the module docstring); it is checked as soon as it is read. The file is read once, as a stream (a FIFO or ``<(...)`` works), and refused
     while it is read when its rows would need more memory than there is (``bytes_per_row`` each, the
     caller's cost of a row; ``option`` names it), or when it has more than ``max_rows`` rows (``too_many`` is
-    raised, while reading). Errors (``CsvError``) name the file and the line,
-    counted from 1."""
+    raised, while reading). ``column_names`` (width -> names, lower case) replaces ``COLUMN_NAMES`` for a file of
+    other columns. Errors (``CsvError``) name the file and the line, counted from 1."""
     found = {"order": None}
 
     def first_line(head: bytes) -> None:
@@ -200,7 +204,7 @@ def read_numeric_csv(
             expected = " or ".join(map(str, widths))
             raise CsvError(CsvError.WIDTH.format(path=path, line=1, expected=expected, columns=columns, got=len(cells)))
         if not all(is_number(c) for c in cells):
-            found["order"] = header_order(path, 1, cells, kind, widths)
+            found["order"] = header_order(path, 1, cells, kind, widths, column_names)
 
     budget = _RowBudget(path, kind, option, bytes_per_row, first_line, max_rows, too_many)
     raw = read_input(
