@@ -44,6 +44,8 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.simulation import SimulationResult, simulate
     from stewart_drake.api.sizing import SizingResult, size
     from stewart_drake.api.viewer import ViewerReadout, viewer_readout
+    from stewart_drake.control.cueing.drive import Drive, load_drive
+    from stewart_drake.control.cueing.generators import ship_drive
     from stewart_drake.core.geometry import Platform
     from stewart_drake.core.realtime_fk import RealtimeFK, RealtimeResult
     from stewart_drake.core.trajectory import Trajectory
@@ -118,6 +120,9 @@ _PUBLIC = {
     "cross_check": ("stewart_drake.api.cross_check", "cross_check"),
     "cue": ("stewart_drake.api.cueing", "cue"),
     "CueResult": ("stewart_drake.api.cueing", "CueResult"),
+    "Drive": ("stewart_drake.control.cueing.drive", "Drive"),
+    "load_drive": ("stewart_drake.control.cueing.drive", "load_drive"),
+    "ship_drive": ("stewart_drake.control.cueing.generators", "ship_drive"),
     "CrossCheck": ("stewart_drake.api.cross_check", "CrossCheck"),
     "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
     "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
@@ -187,6 +192,9 @@ __all__ = [
     "CrossCheck",
     "cue",
     "CueResult",
+    "Drive",
+    "load_drive",
+    "ship_drive",
     "viewer_readout",
     "ViewerReadout",
     "plot_platform",

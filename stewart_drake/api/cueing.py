@@ -34,7 +34,7 @@ from stewart_drake.spec import Machine, load_machine
 if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is drawn
     from matplotlib.figure import Figure
 
-    from stewart_drake.api.simulation import SimulationResult
+    from stewart_drake.api.simulation import Animation, SimulationResult
 
 ALGORITHMS = ("classical", "tuned", "mpc")
 CHANNELS = ("fx", "fy", "fz", "wx", "wy", "wz")  # specific force (m/s²) and angular velocity (rad/s), head frame
@@ -184,6 +184,25 @@ class CueResult(Result):
         ax.legend([f"leg {i}" for i in range(1, 7)], ncol=6, fontsize=7)
         fig.tight_layout()
         return fig
+
+    def animate(self, fps: float = 25.0) -> Animation:
+        """The run as a Meshcat animation: the simulated plant's motion when simulated (legs red while
+        saturated), else the commanded poses (legs red near a stroke end).
+
+        Args:
+            fps: frames per second of the animation.
+
+        Returns:
+            An ``Animation``: displayed inline in Jupyter, ``save(path)`` writes the HTML.
+        """
+        if self.simulation is not None:
+            return self.simulation.animate(fps)
+        # deferred: the Meshcat scene (and the Animation beside the closed loop) import pydrake; cueing needs no Drake
+        from stewart_drake.api.simulation import Animation
+        from stewart_drake.drake.animation import record_animation
+
+        title = f"{self.algorithm} cueing of {self.drive.name} on {self.machine.platform.name}"
+        return Animation(record_animation(self.machine.platform, self.drive.t, self.poses, fps=fps, title=title))
 
 
 def cueing_params(algorithm: str, params, drive: Drive, platform: Platform):
