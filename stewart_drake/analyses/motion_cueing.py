@@ -31,11 +31,30 @@ def scalar_scores(scores: dict) -> dict:
     return {k: float(v) for k, v in scores.items() if isinstance(v, (int, float))}
 
 
+def cue_runs(machine, drives, simulate: bool) -> dict:
+    """``{(drive name, law): CueResult}``: each drive cued by hand-set classical washout and by classical washout
+    tuned over all the drives together (one tuning), in the loop when ``simulate``."""
+    tuned = tune_classical(drives, machine.platform)
+    laws = (("hand-set", "classical", HAND_SET), ("tuned", "tuned", tuned))
+    return {
+        (drive.name, label): cue(machine, drive, algorithm=algorithm, params=params, simulate=simulate)
+        for drive in drives
+        for label, algorithm, params in laws
+    }
+
+
+def score_table(runs: dict, plant: bool) -> tuple[list, list]:
+    """``(header, rows)``: one row per run of ``cue_runs``, its scalar scores (the plant's when ``plant``)."""
+    scores = {key: scalar_scores(r.plant_scores if plant else r.scores) for key, r in runs.items()}
+    names = sorted({k for s in scores.values() for k in s})
+    rows = [[drive, label, *(s.get(k, float("nan")) for k in names)] for (drive, label), s in scores.items()]
+    return ["drive", "classical", *names], rows
+
+
 def build(section) -> None:
     machine = load_machine(PLATFORM)
     seconds = SECONDS[section.quick]
     drives = [ship_drive(s, duration=seconds, rate=RATE, seed=s) for s in SEA_STATES]
-    tuned = tune_classical(drives, machine.platform)
     section.text(
         f"Ship drives (JONSWAP sea through the ship response model of control.cueing.generators) in sea states "
         f"{SEA_STATES[0]}–{SEA_STATES[-1]}, {seconds:g} s each at {RATE:g} Hz, cued on {PLATFORM} by classical "
@@ -44,18 +63,9 @@ def build(section) -> None:
         "controller and the Drake plant (sd.cue(..., simulate=True)). Scores compare what a rider perceives "
         "(otolith and semicircular-canal models) on the plant with what the ship's rider perceives."
     )
-    runs = {}
-    for drive in drives:
-        for label, algorithm, params in (("hand-set", "classical", HAND_SET), ("tuned", "tuned", tuned)):
-            runs[drive.name, label] = cue(machine, drive, algorithm=algorithm, params=params, simulate=True)
-    names = sorted({k for r in runs.values() for k in scalar_scores(r.plant_scores)})
-    rows = [
-        [drive, label, *(scalar_scores(r.plant_scores).get(k, float("nan")) for k in names)]
-        for (drive, label), r in runs.items()
-    ]
+    runs = cue_runs(machine, drives, simulate=True)
     section.table(
-        ["drive", "classical", *names],
-        rows,
+        *score_table(runs, plant=True),
         caption="Perceived-motion scores of the simulated plant against the vehicle (SI; per-channel values in "
         "stewart-drake cue's scores.json)",
         fmt="{:.3g}",
