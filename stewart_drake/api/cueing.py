@@ -28,7 +28,7 @@ from stewart_drake.control.cueing.vestibular import perceive
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths, stroke_within
 from stewart_drake.core.trajectory import table_trajectory
-from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, ArgumentError, UsageError
+from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, ArgumentError, PhysicalLimitError, UsageError
 from stewart_drake.spec import Machine, load_machine
 
 if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is drawn
@@ -37,6 +37,7 @@ if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is dra
     from stewart_drake.api.simulation import Animation, SimulationResult
 
 ALGORITHMS = ("classical", "tuned", "mpc")
+TAIL_SAMPLES = 10  # drive samples of the in-the-loop reference past the drive's end (never reached by the run)
 CHANNELS = ("fx", "fy", "fz", "wx", "wy", "wz")  # specific force (m/s²) and angular velocity (rad/s), head frame
 
 
@@ -316,14 +317,24 @@ def limit_failures(limits: dict, what: str) -> list[str]:
 
 def in_the_loop(result: CueResult, progress: bool) -> None:
     """Run ``result``'s poses as a table reference through the machine's controller and the Drake plant and
-    fill in the plant's poses, scores and limits (at the drive's samples) and its failures."""
+    fill in the plant's poses, scores and limits (at the drive's samples) and its failures (a reference that
+    ``simulate`` refuses as beyond the actuators is one, and leaves the plant's fields None)."""
     # deferred: the closed loop imports pydrake (classical cueing needs no Drake)
     from stewart_drake.api.simulation import simulate
 
     drive, platform = result.drive, result.machine.platform
     t = drive.t - drive.t[0]
-    reference = table_trajectory(f"cue-{drive.name}", t, result.poses)
-    run = simulate(result.machine, reference, duration=float(t[-1]), progress=progress)
+    # the last sample's velocity carried on past the run's end (TAIL_SAMPLES): a table held at its last pose
+    # would stop the reference dead there, and the loop's last ticks (their feed-forward differences) would see a
+    # deceleration that exists only because the drive ends
+    k = np.arange(1, TAIL_SAMPLES + 1)
+    tail = result.poses[-1] + k[:, None] * (result.poses[-1] - result.poses[-2])
+    reference = table_trajectory(f"cue-{drive.name}", np.r_[t, t[-1] + k * drive.dt], np.vstack([result.poses, tail]))
+    try:  # the poses as they are (fit=False: a machine's run.fit would move and scale them)
+        run = simulate(result.machine, reference, duration=float(t[-1]), fit=False, progress=progress)
+    except PhysicalLimitError as e:  # beyond the actuators before the run: a failure of this result, shown with it
+        result.failures.append(f"the loop: {e}")
+        return
     log = run.log.raw
     plant = resample(log.t, log.pose, t)
     motion = platform_drive(plant, drive.t, platform.home_pose())

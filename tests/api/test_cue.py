@@ -61,12 +61,14 @@ def test_classical_cue_keeps_every_pose_in_stroke_on_the_newcomer_machine():
 
 
 def test_in_the_loop_plant_follows_the_commanded_poses():
-    """Three seconds of the sea-state-4 ship drive on gonzalez-dutra-2009 through its fixed-point loop: the plant's
-    leg lengths at the drive's samples stay within the run's own tracking bound (``control.verdict``) of the
-    commanded poses' IK, no plant sample leaves the stroke, and the plant's perceived motion is scored."""
+    """Three seconds of the sea-state-4 ship drive on the 210 kg machine (30 µm words) through its fixed-point loop:
+    the plant's leg lengths at the drive's samples stay within the run's own tracking bound (``control.verdict``)
+    of the commanded poses' IK, although the machine file says ``run: {fit: true}`` (a fitted reference would be
+    moved and scaled to the stroke), no plant sample leaves the stroke, and the plant's perceived motion is
+    scored."""
     drive = first_seconds(resolve_drive("ship-ss4"), 3.0)
-    r = sd.cue("gonzalez-dutra-2009", drive, simulate=True)
-    assert r.simulation is not None and r.plant_poses.shape == r.poses.shape
+    r = sd.cue(NEWCOMER, drive, simulate=True)
+    assert r.machine.run.fit and r.simulation is not None and r.plant_poses.shape == r.poses.shape
     bound = r.simulation.verdict["tracking_bound_mm"] * 1e-3
     p = r.machine.platform
     assert np.abs(sd.ik(p, r.plant_poses).lengths - sd.ik(p, r.poses).lengths).max() < bound
