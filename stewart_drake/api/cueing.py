@@ -10,6 +10,7 @@ limit, in the commanded poses and in the simulated plant, and the loop tracking.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field, is_dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -17,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from stewart_drake.api.result import Result
-from stewart_drake.control.cueing.classical import HAND_SET, ClassicalParams, classical
+from stewart_drake.control.cueing.classical import HAND_SET, classical
 from stewart_drake.control.cueing.drive import Drive, load_drive
 from stewart_drake.control.cueing.generators import DRIVES
 from stewart_drake.control.cueing.guard import WorkspaceGuard
@@ -26,7 +27,7 @@ from stewart_drake.control.cueing.scores import score
 from stewart_drake.control.cueing.tuning import load_params, tune_classical
 from stewart_drake.control.cueing.vestibular import perceive
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import leg_lengths, stroke_within
+from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import table_trajectory
 from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, ArgumentError, PhysicalLimitError, UsageError
 from stewart_drake.spec import Machine, load_machine
@@ -55,22 +56,23 @@ def resolve_drive(drive: Drive | str | Path, name: str = "drive") -> Drive:
     raise ArgumentError(CUE_DRIVE.format(name=name, value=repr(drive), names=", ".join(DRIVES)))
 
 
-def limit_samples(platform: Platform, t, lengths) -> dict:
-    """The samples of leg ``lengths`` (N, 6) m at times ``t`` (N,) s outside the platform's limits:
-    ``outside_stroke`` (any leg beyond [L_min, L_max]), ``over_speed`` (any leg faster than ``legs.max_speed``
-    between two samples; 0 where the platform states no limit), with the ``peak_leg_speed_m_s`` and the
-    ``stroke_use`` (the largest leg excursion from mid-stroke over half the stroke: 1 reaches an end)."""
-    L = np.asarray(lengths, dtype=float)
-    speed = np.abs(np.diff(L, axis=0)) / np.diff(np.asarray(t, dtype=float))[:, None]
-    vmax = platform.legs.max_speed
-    mid, half = platform.stroke.mean(), (platform.L_max - platform.L_min) / 2
+def limit_samples(guard: WorkspaceGuard, t, poses) -> dict:
+    """The samples of ``poses`` (N, 6) at the uniform times ``t`` (N,) s outside the platform's own limits, by the
+    exact IK (``guard.check`` against the whole stroke, not the guard's margins): ``outside_stroke`` (any leg beyond
+    [L_min, L_max]), ``over_speed`` (any leg faster than ``legs.max_speed``; 0 where the platform states none), with
+    the ``peak_leg_speed_m_s`` and the ``stroke_use`` (the largest leg excursion from mid-stroke over half the
+    stroke: 1 reaches an end)."""
+    p = guard.platform
+    vmax = p.legs.max_speed
+    c = guard.check(poses, t, stroke=p.stroke, max_speed=math.inf if vmax is None else vmax, max_accel=math.inf)
+    mid, half = p.stroke.mean(), (p.L_max - p.L_min) / 2
     return {
-        "samples": int(len(L)),
-        "outside_stroke": int(np.count_nonzero(~stroke_within(platform, L))),
-        "over_speed": int(np.count_nonzero((speed > vmax).any(axis=1))) if vmax is not None else 0,
-        "max_leg_speed_m_s": None if vmax is None else float(vmax),
-        "peak_leg_speed_m_s": float(speed.max(initial=0.0)),
-        "stroke_use": float(np.abs(L - mid).max() / half),
+        "samples": int(len(poses)),
+        "outside_stroke": c.outside_stroke,
+        "over_speed": c.over_speed,
+        "max_leg_speed_m_s": vmax,
+        "peak_leg_speed_m_s": c.max_speed,
+        "stroke_use": max(c.max_length - mid, mid - c.min_length) / half,
     }
 
 
@@ -226,17 +228,17 @@ def cueing_params(algorithm: str, params, drive: Drive, platform: Platform):
     return MpcParams()
 
 
-def commanded_poses(algorithm: str, params, drive: Drive, platform: Platform) -> np.ndarray:
-    """``(N, 6)`` the law's poses for ``drive`` through the workspace guard (absolute, m and rad)."""
-    home = platform.home_pose()
+def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard) -> np.ndarray:
+    """``(N, 6)`` the law's poses for ``drive`` through the workspace ``guard`` (absolute, m and rad)."""
+    platform, home = guard.platform, guard.home
     if algorithm == "mpc":
         # deferred: the MPC law imports pydrake (classical cueing needs no Drake)
         from stewart_drake.drake.cueing_mpc import mpc_cue
 
         raw = mpc_cue(drive, platform, params, home).poses
     else:
-        raw = classical(drive, params if isinstance(params, ClassicalParams) else ClassicalParams(**params), home)
-    return WorkspaceGuard.for_platform(platform).guard(raw, drive.t)
+        raw = classical(drive, params, home)
+    return guard.guard(raw, drive.t)
 
 
 def cue(
@@ -279,11 +281,11 @@ def cue(
     platform = machine.platform
     drive = resolve_drive(drive)
     params = cueing_params(algorithm, params, drive, platform)
-    poses = commanded_poses(algorithm, params, drive, platform)
-    home = platform.home_pose()
-    motion = platform_drive(poses, drive.t, home)
+    guard = WorkspaceGuard.for_platform(platform)
+    poses = commanded_poses(algorithm, params, drive, guard)
+    motion = platform_drive(poses, drive.t, guard.home)
     perceived = {"vehicle": perceive(drive), "platform": perceive(motion)}
-    limits = limit_samples(platform, drive.t, leg_lengths(platform, poses))  # the exact IK
+    limits = limit_samples(guard, drive.t, poses)
     failures = limit_failures(limits, "the commanded poses")
     result = CueResult(
         machine,
@@ -298,7 +300,7 @@ def cue(
         failures=failures,
     )
     if simulate:
-        in_the_loop(result, bool(progress))
+        in_the_loop(result, guard, bool(progress))
     return result
 
 
@@ -315,7 +317,7 @@ def limit_failures(limits: dict, what: str) -> list[str]:
     return out
 
 
-def in_the_loop(result: CueResult, progress: bool) -> None:
+def in_the_loop(result: CueResult, guard: WorkspaceGuard, progress: bool) -> None:
     """Run ``result``'s poses as a table reference through the machine's controller and the Drake plant and
     fill in the plant's poses, scores and limits (at the drive's samples) and its failures (a reference that
     ``simulate`` refuses as beyond the actuators is one, and leaves the plant's fields None)."""
@@ -337,11 +339,11 @@ def in_the_loop(result: CueResult, progress: bool) -> None:
         return
     log = run.log.raw
     plant = resample(log.t, log.pose, t)
-    motion = platform_drive(plant, drive.t, platform.home_pose())
+    motion = platform_drive(plant, drive.t, guard.home)
     result.simulation = run
     result.plant_poses = plant
     result.perceived["plant"] = perceive(motion)
     result.plant_scores = score(drive, motion, plant, platform)
-    result.plant_limits = limit_samples(platform, log.t, log.lengths)  # the plant's own leg lengths
+    result.plant_limits = limit_samples(guard, log.t, log.pose)  # every plant step
     result.failures += limit_failures(result.plant_limits, "the simulated plant")
     result.failures += [f"the loop: {f}" for f in run.verdict["failures"]]

@@ -10,6 +10,7 @@ import stewart_drake as sd
 from stewart_drake.api.cueing import limit_samples, resolve_drive
 from stewart_drake.control.cueing.drive import Drive
 from stewart_drake.control.cueing.generators import DRIVES
+from stewart_drake.control.cueing.guard import WorkspaceGuard
 from stewart_drake.errors import ArgumentError, UsageError
 
 NEWCOMER = "examples/newcomer-210kg.yaml"
@@ -32,18 +33,20 @@ def first_seconds(drive: Drive, seconds: float) -> Drive:
 
 def test_limit_samples_counts_what_the_anchors_say():
     """A vertical sweep through the top of the stroke: the samples counted outside are those whose hand-computed
-    longest leg exceeds L_max; a 10 mm jump in one 10 ms sample moves the legs at ~1 m/s, over utn-dynamic's
-    0.5 m/s, and is the one sample counted over speed."""
+    longest leg exceeds L_max; a 30 mm jump in one 10 ms sample moves the legs at ~1 m/s by central differences on
+    either side of it, over utn-dynamic's 0.5 m/s: those two samples are counted over speed."""
     p = sd.load_platform("utn-dynamic")
     t = np.arange(200) * 0.01
     poses = np.tile(p.home_pose(), (200, 1))
     poses[:, 2] += np.linspace(0.0, 0.3, 200)  # home is mid-stroke: the legs pass L_max on the way up
-    poses[100:, 2] += 0.01
+    poses[100:, 2] += 0.03
     L = hand_lengths(p, poses)
-    lim = limit_samples(p, t, L)
+    lim = limit_samples(WorkspaceGuard.for_platform(p), t, poses)
     expected = int(np.count_nonzero(L.max(axis=1) > p.L_max))
     assert 0 < expected < 200 and lim["outside_stroke"] == expected
-    assert lim["over_speed"] == 1 and lim["peak_leg_speed_m_s"] > 0.5
+    speed = np.abs(np.gradient(L, t, axis=0)).max(axis=1)
+    assert np.flatnonzero(speed > 0.5).tolist() == [99, 100] and lim["over_speed"] == 2
+    assert lim["peak_leg_speed_m_s"] == pytest.approx(speed.max())
     assert lim["stroke_use"] == pytest.approx((L.max() - p.stroke.mean()) / ((p.L_max - p.L_min) / 2))
 
 
