@@ -56,10 +56,14 @@ class ClassicalParams:
             value = getattr(self, f.name)
             zero_ok = f.name == "hp_break"
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise CueingError(CueingError.PARAM.format(name=f.name, rule="a finite number", value=value))
-            if value < 0 or (value == 0 and not zero_ok):
+                rule = "a finite number"
+            elif value < 0 or (value == 0 and not zero_ok):
                 rule = "a number >= 0" if zero_ok else "a positive number"
-                raise CueingError(CueingError.PARAM.format(name=f.name, rule=rule, value=value))
+            else:
+                continue
+            error = CueingError(CueingError.PARAM.format(name=f.name, rule=rule, value=value))
+            error.field, error.value, error.rule = f.name, value, rule  # a parameters file names the line
+            raise error
 
 
 # A hobby tool's hand set (FlyPT Mover-like: its users set per-axis gains and first-order-like washout by feel;

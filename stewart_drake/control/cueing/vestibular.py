@@ -19,6 +19,8 @@ each filter starting at rest at the drive's first value).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy import signal
 
@@ -67,12 +69,41 @@ def _axis(axis: int) -> int:
     return axis
 
 
+def bilinear(num, den, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(b, a)``: the continuous ``num/den`` (descending powers of s) with s = (2/dt)(z − 1)/(z + 1), as
+    ``scipy.signal.bilinear`` (whose polynomial classes cost milliseconds a call: the tuning makes thousands)."""
+    n = max(len(num), len(den)) - 1
+    k = 2.0 / dt
+    terms = []
+    for power in range(n, -1, -1):  # (k (z − 1))^power (z + 1)^(n − power)
+        term = np.array([1.0])
+        for _ in range(power):
+            term = np.convolve(term, [k, -k])
+        for _ in range(n - power):
+            term = np.convolve(term, [1.0, 1.0])
+        terms.append(term)
+
+    def poly(c):
+        c = np.concatenate([np.zeros(n + 1 - len(c)), np.asarray(c, dtype=float)])
+        return np.sum([ci * term for ci, term in zip(c, terms)], axis=0)
+
+    b, a = poly(num), poly(den)
+    return b / a[0], a / a[0]
+
+
 def filter_series(tf: tuple[np.ndarray, np.ndarray], u: np.ndarray, dt: float) -> np.ndarray:
     """``u`` ``(N,)`` through the continuous ``tf`` discretised by the bilinear transform at ``dt`` s, starting
     at rest at ``u[0]`` (the filter's steady state for a constant ``u[0]``)."""
-    b, a = signal.bilinear(*tf, fs=1.0 / dt)
-    y, _ = signal.lfilter(b, a, u, zi=signal.lfilter_zi(b, a) * u[0])
+    b, a, zi = _discrete(tuple(tf[0]), tuple(tf[1]), dt)
+    y, _ = signal.lfilter(b, a, u, zi=zi * u[0])
     return y
+
+
+@functools.lru_cache(maxsize=256)
+def _discrete(num: tuple, den: tuple, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(b, a, zi)`` of ``bilinear`` and ``lfilter_zi``, once per filter and step (the models are fixed)."""
+    b, a = bilinear(num, den, dt)
+    return b, a, signal.lfilter_zi(b, a)
 
 
 def perceive(drive: Drive) -> Drive:

@@ -6,7 +6,7 @@ import pytest
 from scipy import signal
 
 from stewart_drake.control.cueing.drive import GRAVITY, Drive
-from stewart_drake.control.cueing.vestibular import canal_ss, canal_tf, otolith_ss, otolith_tf, perceive
+from stewart_drake.control.cueing.vestibular import bilinear, canal_ss, canal_tf, otolith_ss, otolith_tf, perceive
 
 
 @pytest.mark.parametrize("axis", [0, 1, 2])
@@ -41,3 +41,10 @@ def test_rest_is_perceived_as_rest_and_a_constant_rotation_fades():
     np.testing.assert_allclose(d.specific_force, np.tile([0, 0, GRAVITY], (n, 1)), atol=1e-9)
     # started at rest at ω = 0.5 rad/s: the canal's steady state for a constant rate is 0 (adaptation)
     assert np.max(np.abs(d.angular_velocity)) < 1e-9
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_bilinear_is_scipys(axis):
+    for tf in (otolith_tf(axis), canal_tf(axis), ([1.0], [1.0, 3.0, 2.25])):
+        for b, b_ref in zip(bilinear(*tf, 0.01), signal.bilinear(*tf, fs=100.0)):
+            np.testing.assert_allclose(b, b_ref, rtol=1e-12, atol=1e-15)
