@@ -61,7 +61,7 @@ runs = {s: sd.cue(machine, drive, algorithm="classical") for s, drive in drives.
 def row(scores: dict, limits: dict) -> dict:
     """One line of a side-by-side table: the scalar scores and the limit counts."""
     shown = {k: v for k, v in scores.items() if isinstance(v, (int, float))}
-    return {**shown, "outside stroke": limits["outside_stroke"], "stroke use": limits["stroke_use"]}
+    return {**shown, "outside stroke": limits["outside_stroke"]}
 
 
 pd.DataFrame({f"sea state {s}": row(r.scores, r.limits) for s, r in runs.items()}).transpose()

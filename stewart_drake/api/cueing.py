@@ -60,19 +60,16 @@ def limit_samples(guard: WorkspaceGuard, t, poses) -> dict:
     """The samples of ``poses`` (N, 6) at the uniform times ``t`` (N,) s outside the platform's own limits, by the
     exact IK (``guard.check`` against the whole stroke, not the guard's margins): ``outside_stroke`` (any leg beyond
     [L_min, L_max]), ``over_speed`` (any leg faster than ``legs.max_speed``; 0 where the platform states none), with
-    the ``peak_leg_speed_m_s`` and the ``stroke_use`` (the largest leg excursion from mid-stroke over half the
-    stroke: 1 reaches an end)."""
+    the ``peak_leg_speed_m_s`` (the scores give the stroke use)."""
     p = guard.platform
     vmax = p.legs.max_speed
     c = guard.check(poses, t, stroke=p.stroke, max_speed=math.inf if vmax is None else vmax, max_accel=math.inf)
-    mid, half = p.stroke.mean(), (p.L_max - p.L_min) / 2
     return {
         "samples": int(len(poses)),
         "outside_stroke": c.outside_stroke,
         "over_speed": c.over_speed,
         "max_leg_speed_m_s": vmax,
         "peak_leg_speed_m_s": c.max_speed,
-        "stroke_use": max(c.max_length - mid, mid - c.min_length) / half,
     }
 
 
@@ -98,6 +95,7 @@ class CueResult(Result):
         perceived: ``{"vehicle", "platform"}`` (and ``"plant"`` when simulated): the perceived ``Drive``s.
         scores: ``control.cueing.scores.score`` of the vehicle against the commanded platform.
         limits: ``limit_samples`` of the commanded poses.
+        mpc: the MPC's solve times and exact-IK re-checks (``commanded_poses``), None for the classical laws.
         simulation: the closed-loop run (``SimulationResult``) when ``simulate=True``, else None; then
             ``plant_poses`` (N, 6) the plant's poses at ``drive.t``, ``plant_scores`` and ``plant_limits``.
         failures: why the run is not good (a limit violated, tracking lost); empty when it is.
@@ -112,6 +110,7 @@ class CueResult(Result):
     perceived: dict
     scores: dict
     limits: dict
+    mpc: dict | None = None
     simulation: SimulationResult | None = field(default=None, repr=False)
     plant_poses: np.ndarray | None = None
     plant_scores: dict | None = None
@@ -133,6 +132,7 @@ class CueResult(Result):
             "params": asdict(self.params) if is_dataclass(self.params) else self.params,
             "scores": self.scores,
             "limits": self.limits,
+            **({"mpc": self.mpc} if self.mpc is not None else {}),
             "simulated": self.simulation is not None,
         }
         if self.simulation is not None:
@@ -228,17 +228,23 @@ def cueing_params(algorithm: str, params, drive: Drive, platform: Platform):
     return MpcParams()
 
 
-def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard) -> np.ndarray:
-    """``(N, 6)`` the law's poses for ``drive`` through the workspace ``guard`` (absolute, m and rad)."""
-    platform, home = guard.platform, guard.home
-    if algorithm == "mpc":
-        # deferred: the MPC law imports pydrake (classical cueing needs no Drake)
-        from stewart_drake.drake.cueing_mpc import mpc_cue
+def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard) -> tuple[np.ndarray, dict | None]:
+    """``(poses, mpc)``: ``(N, 6)`` the law's poses for ``drive`` through the workspace ``guard`` (absolute, m and
+    rad) and, for the MPC law, its solves: ``worst_solve_s``, ``mean_solve_s`` (wall time of each sample's step),
+    ``max_stroke_violation_m`` (the exact IK's re-check after each solve: ≤ 0) and ``fallbacks``; else None."""
+    if algorithm != "mpc":
+        return guard.guard(classical(drive, params, guard.home), drive.t), None
+    # deferred: the MPC law imports pydrake (classical cueing and the cue command run without Drake)
+    from stewart_drake.drake.cueing_mpc import mpc_cue
 
-        raw = mpc_cue(drive, platform, params, home).poses
-    else:
-        raw = classical(drive, params, home)
-    return guard.guard(raw, drive.t)
+    run = mpc_cue(drive, guard.platform, params, guard.home)
+    solves = {
+        "worst_solve_s": float(run.solve_times.max()),
+        "mean_solve_s": float(run.solve_times.mean()),
+        "max_stroke_violation_m": float(run.stroke_violation.max()),
+        "fallbacks": dict(run.fallbacks),
+    }
+    return guard.guard(run.poses, drive.t), solves
 
 
 def cue(
@@ -282,7 +288,7 @@ def cue(
     drive = resolve_drive(drive)
     params = cueing_params(algorithm, params, drive, platform)
     guard = WorkspaceGuard.for_platform(platform)
-    poses = commanded_poses(algorithm, params, drive, guard)
+    poses, mpc = commanded_poses(algorithm, params, drive, guard)
     motion = platform_drive(poses, drive.t, guard.home)
     perceived = {"vehicle": perceive(drive), "platform": perceive(motion)}
     limits = limit_samples(guard, drive.t, poses)
@@ -297,6 +303,7 @@ def cue(
         perceived,
         score(drive, motion, poses, platform),
         limits,
+        mpc=mpc,
         failures=failures,
     )
     if simulate:
