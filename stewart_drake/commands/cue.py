@@ -86,7 +86,7 @@ def run(args) -> int:
         write_poses(tmp / "poses.csv", result.drive.t, result.poses)
         (tmp / "scores.json").write_text(dumps_strict(d))
         for name, fig in (("perception.png", result.plot()), ("legs.png", result.plot_legs())):
-            fig.savefig(tmp / name, dpi=100)
+            fig.savefig(tmp / name, dpi=100, bbox_inches="tight")
             plt.close(fig)
     print_json(d if args.json else summary(d))
     for f in result.failures:
@@ -95,8 +95,13 @@ def run(args) -> int:
 
 
 def summary(d: dict) -> dict:
-    """The result without the parameters and the loop's settings: what a person reads first."""
-    return {k: v for k, v in d.items() if k not in ("params", "simulation")}
+    """The result without the parameters, the loop's settings and the per-channel scores (all in scores.json):
+    what a person reads first."""
+    out = {k: v for k, v in d.items() if k not in ("params", "simulation")}
+    for key in ("scores", "plant_scores"):
+        if out.get(key) is not None:
+            out[key] = {k: v for k, v in out[key].items() if k != "channels"}
+    return out
 
 
 def write_poses(path: Path, t, poses) -> None:
