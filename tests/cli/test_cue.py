@@ -22,7 +22,20 @@ def test_writes_poses_scores_and_plots(here, capsys):
         "scores.json",
     ]
     full = json.loads((here / "c" / "scores.json").read_text())
-    assert full["scores"] == summary["scores"] and "params" in full and "params" not in summary
+    assert full["scores"] == {**summary["scores"], "channels": full["scores"]["channels"]}
+    assert (
+        "params" in full
+        and "params" not in summary
+        and set(full["scores"]["channels"])
+        == {
+            "fx",
+            "fy",
+            "fz",
+            "wx",
+            "wy",
+            "wz",
+        }
+    )
     # the poses as simulate --trajectory reads them: one row per drive sample, SI
     traj = load_trajectory_csv(str(here / "c" / "poses.csv"))
     t = np.loadtxt(here / "c" / "poses.csv", delimiter=",", skiprows=1)[:, 0]
