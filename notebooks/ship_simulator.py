@@ -58,10 +58,12 @@ plt.show()
 runs = {s: sd.cue(machine, drive, algorithm="classical") for s, drive in drives.items()}
 
 
+SHOWN = ("specific_force_rmse", "angular_velocity_rmse", "specific_force_pearson", "false_cue_share", "stroke_use_pct")
+
+
 def row(scores: dict, limits: dict) -> dict:
-    """One line of a side-by-side table: the scalar scores and the limit counts."""
-    shown = {k: v for k, v in scores.items() if isinstance(v, (int, float))}
-    return {**shown, "outside stroke": limits["outside_stroke"]}
+    """One line of a side-by-side table: the main scores (all of them: `scores.keys()`) and the limit count."""
+    return {**{k: scores[k] for k in SHOWN}, "outside stroke": limits["outside_stroke"]}
 
 
 pd.DataFrame({f"sea state {s}": row(r.scores, r.limits) for s, r in runs.items()}).transpose()
@@ -84,6 +86,11 @@ pd.DataFrame(
         **{f"{a}, plant": row(r.plant_scores, r.plant_limits) for a, r in compared.items()},
     }
 ).transpose()
+
+# %% [markdown]
+# The rows "commanded" score the poses sent to the controller, the rows "plant" the motion the simulated plate made
+# of them: the difference is what the controller (its fixed-point words, its lag) and the actuators add to what
+# the rider feels.
 
 # %%
 compared["tuned"].plot()
