@@ -503,6 +503,7 @@ class ArgumentError(UsageError):
 # file given to the MPC law (its parameters are an ``MpcParams``)
 CUE_DRIVE = "{name} {value}: neither a shipped drive ({names}) nor a drive file (.csv, .parquet)"
 CUE_PARAMS = "{name} {value}: a parameter file holds classical washout parameters; mpc takes an MpcParams"
+CUE_PARAMS_TYPE = "Expected params to be {what} for algorithm {algorithm!r}, got {value}"
 
 
 # ----------------------------------------------------------------------------------------------

@@ -18,18 +18,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from stewart_drake.api.result import Result
-from stewart_drake.control.cueing.classical import HAND_SET, classical
+from stewart_drake.control.cueing.classical import HAND_SET, ClassicalParams, classical
 from stewart_drake.control.cueing.drive import Drive, load_drive
 from stewart_drake.control.cueing.generators import DRIVES
 from stewart_drake.control.cueing.guard import WorkspaceGuard
 from stewart_drake.control.cueing.platform_motion import platform_drive
-from stewart_drake.control.cueing.scores import score
+from stewart_drake.control.cueing.scores import CHANNELS, score
 from stewart_drake.control.cueing.tuning import load_params, tune_classical
 from stewart_drake.control.cueing.vestibular import perceive
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import table_trajectory
-from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, ArgumentError, PhysicalLimitError, UsageError
+from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, CUE_PARAMS_TYPE, ArgumentError, PhysicalLimitError, UsageError
 from stewart_drake.spec import Machine, load_machine
 
 if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is drawn
@@ -39,7 +39,6 @@ if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is dra
 
 ALGORITHMS = ("classical", "tuned", "mpc")
 TAIL_SAMPLES = 10  # drive samples of the in-the-loop reference past the drive's end (never reached by the run)
-CHANNELS = ("fx", "fy", "fz", "wx", "wy", "wz")  # specific force (m/s²) and angular velocity (rad/s), head frame
 
 
 def resolve_drive(drive: Drive | str | Path, name: str = "drive") -> Drive:
@@ -208,24 +207,30 @@ class CueResult(Result):
         return Animation(record_animation(self.machine.platform, self.drive.t, self.poses, fps=fps, title=title))
 
 
-def cueing_params(algorithm: str, params, drive: Drive, platform: Platform):
-    """The law's parameters: ``params`` (a parameter object, or for the classical laws a YAML file of
-    ``tuning.save_params``), else the defaults (classical: ``HAND_SET``; tuned: ``tune_classical`` on this
-    drive; mpc: ``MpcParams()``)."""
-    if isinstance(params, (str, Path)):
-        if algorithm == "mpc":
-            raise UsageError(CUE_PARAMS.format(name="params", value=repr(str(params))))
-        return load_params(params)
-    if params is not None:
-        return params
-    if algorithm == "classical":
-        return HAND_SET
-    if algorithm == "tuned":
-        return tune_classical([drive], platform)
-    # deferred: MpcParams is defined beside the MPC law, which imports pydrake (classical cueing needs no Drake)
-    from stewart_drake.drake.cueing_mpc import MpcParams
+def cueing_params(algorithm: str, params, drive: Drive, guard: WorkspaceGuard):
+    """The law's parameters: ``params`` (a ``ClassicalParams`` or, for the classical laws, a YAML file of
+    ``tuning.save_params``; an ``MpcParams`` for mpc), else the defaults (classical: ``HAND_SET``; tuned:
+    ``tune_classical`` on this drive through ``guard``; mpc: ``MpcParams()``)."""
+    if algorithm == "mpc":
+        # deferred: MpcParams is defined beside the MPC law, which imports pydrake (classical cueing needs no Drake)
+        from stewart_drake.drake.cueing_mpc import MpcParams
 
-    return MpcParams()
+        if isinstance(params, (str, Path)):
+            raise UsageError(CUE_PARAMS.format(name="params", value=repr(str(params))))
+        kind = MpcParams
+        if params is None:
+            return MpcParams()
+    else:
+        if isinstance(params, (str, Path)):
+            return load_params(params)
+        kind = ClassicalParams
+        if params is None:
+            return HAND_SET if algorithm == "classical" else tune_classical([drive], guard.platform, guard=guard)
+    if not isinstance(params, kind):
+        raise ArgumentError(
+            CUE_PARAMS_TYPE.format(what=kind.__name__, algorithm=algorithm, value=type(params).__name__)
+        )
+    return params
 
 
 def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard) -> tuple[np.ndarray, dict | None]:
@@ -286,8 +291,8 @@ def cue(
     machine = load_machine(machine)
     platform = machine.platform
     drive = resolve_drive(drive)
-    params = cueing_params(algorithm, params, drive, platform)
     guard = WorkspaceGuard.for_platform(platform)
+    params = cueing_params(algorithm, params, drive, guard)
     poses, mpc = commanded_poses(algorithm, params, drive, guard)
     motion = platform_drive(poses, drive.t, guard.home)
     perceived = {"vehicle": perceive(drive), "platform": perceive(motion)}

@@ -118,3 +118,7 @@ def test_bad_input_is_named():
         sd.cue("utn-dynamic", "car-lane-change", algorithm="washout")
     with pytest.raises(UsageError, match=r"^params 'p.yaml': a parameter file holds classical"):
         sd.cue("utn-dynamic", "car-lane-change", algorithm="mpc", params="p.yaml")
+    with pytest.raises(
+        ArgumentError, match=r"^Expected params to be MpcParams for algorithm 'mpc', got ClassicalParams"
+    ):
+        sd.cue("utn-dynamic", "car-lane-change", algorithm="mpc", params=HAND_SET)
