@@ -27,6 +27,7 @@ from stewart_drake.system.output_folder import atomic_folder
 HELP = "motion cueing: a vehicle's motion (drive file or shipped drive) to platform poses, scored by perceived motion"
 # the files cue writes into --out (perception.png: vehicle vs perceived per channel; legs.png: leg usage)
 FILES = ("poses.csv", "scores.json", "perception.png", "legs.png")
+ANIMATION = "animation.html"  # with --animate
 
 
 def register(sub) -> None:
@@ -56,6 +57,11 @@ def register(sub) -> None:
         help="run the poses through the machine's controller and the Drake plant and score the plant's motion",
     )
     p.add_argument("--out", required=True, metavar="DIR", help="write poses.csv, scores.json, perception.png, legs.png")
+    p.add_argument(
+        "--animate",
+        action="store_true",
+        help="also write animation.html: the plant's motion (with --simulate) or the commanded poses, in Meshcat",
+    )
     p.add_argument("--json", action="store_true", help="print the whole result as JSON (default: a summary)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (with --simulate)")
     add_force_arg(p)
@@ -64,7 +70,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     reject_unused(args, "--algorithm classical or tuned", args.algorithm != "mpc", params=None)
-    out_folder = output_folder(args, names=FILES)
+    out_folder = output_folder(args, names=FILES + (ANIMATION,) * args.animate)
     machine = machine_from_args(args)
     drive = resolve_drive(args.drive, "--drive")
     result = cue(
@@ -88,6 +94,8 @@ def run(args) -> int:
         for name, fig in (("perception.png", result.plot()), ("legs.png", result.plot_legs())):
             fig.savefig(tmp / name, dpi=100, bbox_inches="tight")
             plt.close(fig)
+        if args.animate:
+            (tmp / ANIMATION).write_text(result.animate().html, encoding="utf-8")
     print_json(d if args.json else summary(d))
     for f in result.failures:
         print(f"stewart-drake cue: {f}", file=sys.stderr)

@@ -45,9 +45,12 @@ def test_writes_poses_scores_and_plots(here, capsys):
 
 def test_a_drive_file_is_read(here, capsys):
     save_drive(DRIVES["car-lane-change"](), here / "d.csv")
-    rc, out, err = cli(capsys, "cue", "--platform", "gonzalez-dutra-2009", "--drive", "d.csv", "--out", "c", "--json")
+    rc, out, err = cli(
+        capsys, "cue", "--platform", "gonzalez-dutra-2009", "--drive", "d.csv", "--out", "c", "--json", "--animate"
+    )
     assert rc == 0, err
     assert "params" in json.loads(out)
+    assert (here / "c" / "animation.html").read_text().startswith("<!DOCTYPE html>")
 
 
 def test_refusals_name_the_flag(here, capsys):
