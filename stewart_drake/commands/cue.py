@@ -70,6 +70,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     reject_unused(args, "--algorithm classical or tuned", args.algorithm != "mpc", params=None)
+    reject_unused(args, "--simulate", args.simulate, no_progress=False)
     out_folder = output_folder(args, names=FILES + (ANIMATION,) * args.animate)
     machine = machine_from_args(args)
     drive = resolve_drive(args.drive, "--drive")
@@ -79,7 +80,7 @@ def run(args) -> int:
         algorithm=args.algorithm,
         params=load_params(args.params) if args.params is not None else None,
         simulate=args.simulate,
-        progress=args.simulate and not args.no_progress,
+        progress=not args.no_progress,
     )
     d = result.to_dict()
     # deferred: matplotlib is loaded only when the figures are written

@@ -62,6 +62,8 @@ def test_refusals_name_the_flag(here, capsys):
         capsys, "cue", "--drive", "car-lane-change", "--algorithm", "mpc", "--params", "p.yaml", "--out", "c"
     )
     assert rc == 2 and "--params only applies with --algorithm classical or tuned" in err
+    rc, _, err = cli(capsys, "cue", "--drive", "car-lane-change", "--no-progress", "--out", "c")
+    assert rc == 2 and "--no-progress only applies with --simulate" in err
     rc, _, err = cli(capsys, "cue", "--drive", "car-lane-change", "--algorithm", "washout", "--out", "c")
     assert rc == 2 and "invalid choice: 'washout'" in err
     assert not (here / "c").exists()  # nothing written on a refusal
