@@ -1199,7 +1199,6 @@ OPTION_LEG_DAMPING_RESOLVE = (
 class DriveError(InputError):
     """A vehicle-motion ("drive") file or value is malformed: messages name the file, line and column."""
 
-    COLUMNS = "{path}: a drive file's columns are {columns} (optionally {optional}); got {got}"
     PARQUET = "{path}: cannot read it as Parquet ({reason})"
     PARQUET_COLUMN = "{path}: column {column!r} is missing; a drive's columns are {columns}"
     PARQUET_VALUE = "{path}: row {row}, column {column!r}: values must be finite numbers, got {value}"
@@ -1227,5 +1226,7 @@ class CueingError(StewartError):
     PARAMS_FILE = "{path}:{line}: {field}: {value} must be {rule}"
     POSES_TIMES = "poses ({n} rows) and t ({m} samples) must have one row per sample"
     SAME_TIMES = "the vehicle drive ({n} samples, step {dt} s) and the platform drive ({m}, step {dt2} s) must share t"
-    HOME_OUTSIDE = "the home pose {home} is outside the guard's stroke (with its margin {margin} m)"
+    HOME_OUTSIDE = (
+        "the home pose {home} is outside the guard's limits (the stroke less {margin} m at each end, joint cones)"
+    )
     NO_DRIVES = "tune_classical needs at least one drive"

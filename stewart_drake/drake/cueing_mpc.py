@@ -21,9 +21,10 @@ started from the previous solution shifted by one sample).
 
 The first input is applied for one drive sample; the new pose is then re-checked with the exact inverse kinematics
 (stroke, leg speed; joint cones where ``limits`` give them). If the check fails (linearisation error) or the
-program has no solution, the program is solved again with the margins tightened (``FALLBACK_TIGHTENING``); if that
-fails too, the step is scaled toward the previous pose (halving, down to holding it still), which is inside by
-induction from the home pose. The poses are therefore never outside the workspace.
+program has no solution (a horizon linearised about a far-off plan can be infeasible), the program is solved again
+with the margins tightened (``FALLBACK_TIGHTENING``) and only the first step's limits kept; if that fails too, the
+step is scaled toward the previous pose (halving, down to holding it still), which is inside by induction from the
+home pose. The poses are therefore never outside the workspace.
 
 Without ``preview`` the vehicle's motion is held at its present value over the horizon (a real-time simulator
 does not know the future); with it the recorded drive is previewed.
@@ -41,15 +42,23 @@ from scipy.linalg import expm
 from stewart_drake.control.cueing.drive import GRAVITY, Drive
 from stewart_drake.control.cueing.vestibular import RATE_THRESHOLD, canal_ss, otolith_ss
 from stewart_drake.core.geometry import Platform
-from stewart_drake.core.kinematics import check_stroke, leg_lengths, leg_vectors, length_jacobian
-from stewart_drake.core.rotations import rotation_matrix
+from stewart_drake.core.kinematics import (
+    check_stroke,
+    inverse_jacobian_of_legs,
+    leg_lengths,
+    leg_vectors,
+    length_jacobian_of,
+    plate_offsets,
+)
+from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
 from stewart_drake.errors import CueingError
 from stewart_drake.workspace.limits import Limits, raw_margins
 
 SOLVERS = {"osqp": OsqpSolver, "clarabel": ClarabelSolver}
-FALLBACK_TIGHTENING = 4.0  # the re-solve's stroke margin is this many times params.stroke_margin, limits ÷ 1.25
+FALLBACK_TIGHTENING = 4.0  # the re-solve's stroke (and cone) margin is this many times the program's, rates ÷ 1.25
 TILT_RATE = float(RATE_THRESHOLD[0])  # rad/s
 MAX_HORIZON = 200  # prediction steps: the condensed program is dense in 6 × horizon inputs
+CONE_MARGIN = 0.01  # rad kept from a joint cone in the program
 HALVINGS = 6  # scaled steps tried (1/2 .. 1/64) before the pose is held
 
 
@@ -93,7 +102,9 @@ class MpcParams:
     preview: bool = False
     decay: float | None = None
     solver: str = "osqp"
-    solver_options: dict = field(default_factory=lambda: {"eps_abs": 1e-3, "eps_rel": 1e-3, "polishing": 0})
+    solver_options: dict = field(
+        default_factory=lambda: {"eps_abs": 1e-3, "eps_rel": 1e-3, "polishing": 0, "max_iter": 500}
+    )
 
     def __post_init__(self):
         def bad(name, rule):
@@ -259,6 +270,16 @@ def condense(model: dict, params: MpcParams) -> Condensed:
     )
 
 
+def legs_and_jacobian(platform: Platform, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(L (..., 6) m, J (..., 6, 6))``: the exact leg lengths of ``(..., 6)`` poses and their Jacobian ∂L/∂q
+    (``kinematics.length_jacobian``) from one rotation per pose: the hot path of each sample."""
+    R = rotation_matrix(q[..., 3:])
+    r = plate_offsets(platform, R)
+    legs = q[..., None, :3] + r - platform.base_anchors
+    J = length_jacobian_of(inverse_jacobian_of_legs(legs, r), angular_velocity_map(q[..., 3:]))
+    return np.sqrt(np.einsum("...k,...k->...", legs, legs)), J
+
+
 def joint_margins(platform: Platform, poses, limits: Limits | None) -> np.ndarray:
     """``(..., k)`` rad: the joint-cone margins (≥ 0 inside) of ``(..., 6)`` poses that ``limits`` bounds (k = 6
     per cone given, 0 without ``limits`` or cones)."""
@@ -287,65 +308,69 @@ class CueingProgram:
         self.U = self.prog.NewContinuousVariables(6 * N, "a")
         self.cost = self.prog.AddQuadraticCost(cond.H, np.zeros(6 * N), self.U, is_convex=True).evaluator()
         rows = (18 + 2 * (params.max_tilt_rate is not None) + joint_margins(platform, home, limits).size) * N
-        self.constraint = self.prog.AddLinearConstraint(
-            np.zeros((rows, 6 * N)), np.full(rows, -np.inf), np.full(rows, np.inf), self.U
-        ).evaluator()
+        z = np.zeros(rows)
+        self.constraint = self.prog.AddLinearConstraint(np.zeros((rows, 6 * N)), z, z, self.U).evaluator()
         self.solver = SOLVERS[params.solver]()
         self.options = SolverOptions()
         for k, v in params.solver_options.items():
             self.options.SetOption(self.solver.solver_id(), k, v)
         self.v_max = leg_speed_limit(platform, params)
-        I = np.zeros((N, 6, 6 * N))
-        for k in range(N):
-            I[k, :, 6 * k : 6 * k + 6] = np.eye(6)
-        self.blocks = I  # a_k picked from U, k = 0..N−1
+        self.blocks = np.eye(6 * N).reshape(N, 6, 6 * N)  # a_k picked from U, k = 0..N−1
 
-    def solve(self, x0: np.ndarray, Rs: np.ndarray, qbar: np.ndarray, guess: np.ndarray, tight: bool):
-        """The inputs U (6N,) for state ``x0``, vehicle motion ``Rs`` (6N,) and linearisation offsets ``qbar``
-        (N, 6) (the predicted p_1..p_N about which the legs are linearised), or None if the solver fails.
-        ``tight`` multiplies the stroke margin by ``FALLBACK_TIGHTENING`` and divides the rate limits by 1.25."""
+    def constraints(self, x0: np.ndarray, qbar: np.ndarray, tight: bool) -> tuple[list, tuple]:
+        """The rows lo ≤ A U ≤ hi for state ``x0``, linearised about the offsets ``qbar`` (N, 6) (the predicted
+        p_1..p_N): ``([(A (N, m, 6N), lo (N, m), hi (N, m)) per step-wise group], leg acceleration (A, lo, hi))``,
+        the groups being stroke, leg speed, tilt rate and joint cones. ``tight`` multiplies the stroke margin (and
+        the cones' ``CONE_MARGIN``) by ``FALLBACK_TIGHTENING`` and divides the rate limits by 1.25."""
         c, p, N = self.cond, self.params, self.params.horizon
-        margin = p.stroke_margin * (FALLBACK_TIGHTENING if tight else 1.0)
+        margin = FALLBACK_TIGHTENING if tight else 1.0
         shrink = 1.25 if tight else 1.0
         q = self.home + qbar
-        J = length_jacobian(self.platform, q)  # (N, 6, 6)
-        L = leg_lengths(self.platform, q)
+        L, J = legs_and_jacobian(self.platform, q)  # (N, 6), (N, 6, 6)
         Pu = c.Pu.reshape(N, 6, 6 * N)
         Vu = c.Vu.reshape(N, 6, 6 * N)
         p_free = (c.Px @ x0).reshape(N, 6)
         v_free = (c.Vx @ x0).reshape(N, 6)
         off_L = L + np.einsum("kij,kj->ki", J, p_free - qbar)
         off_V = np.einsum("kij,kj->ki", J, v_free)
-        A = [
-            np.einsum("kij,kjl->kil", J, Pu),
-            np.einsum("kij,kjl->kil", J, Vu),
-            np.einsum("kij,kjl->kil", J, self.blocks),
-        ]
-        lo = [
-            self.platform.L_min + margin - off_L,
-            -self.v_max / shrink - off_V,
-            np.full((N, 6), -p.max_leg_acceleration / shrink),
-        ]
-        hi = [
-            self.platform.L_max - margin - off_L,
-            self.v_max / shrink - off_V,
-            np.full((N, 6), p.max_leg_acceleration / shrink),
+        v_max = self.v_max / shrink
+        groups = [
+            (
+                np.einsum("kij,kjl->kil", J, Pu),
+                self.platform.L_min + p.stroke_margin * margin - off_L,
+                self.platform.L_max - p.stroke_margin * margin - off_L,
+            ),
+            (np.einsum("kij,kjl->kil", J, Vu), -v_max - off_V, v_max - off_V),
         ]
         if p.max_tilt_rate is not None:
-            A.append(Vu[:, 3:5])
-            lo.append(-p.max_tilt_rate - v_free[:, 3:5])
-            hi.append(p.max_tilt_rate - v_free[:, 3:5])
+            rate = p.max_tilt_rate / shrink
+            groups.append((Vu[:, 3:5], -rate - v_free[:, 3:5], rate - v_free[:, 3:5]))
         m0 = joint_margins(self.platform, q, self.limits)  # (N, k)
         if m0.shape[-1]:
-            d = 1e-6
+            d = 1e-6  # rad or m: a forward difference of the margins, error ~ d × their curvature (~1)
             G = (joint_margins(self.platform, q[:, None, :] + d * np.eye(6), self.limits) - m0[:, None, :]) / d
             G = np.swapaxes(G, 1, 2)  # (N, k, 6): ∂margin/∂q
-            A.append(np.einsum("kij,kjl->kil", G, Pu))
-            lo.append(0.01 * (FALLBACK_TIGHTENING if tight else 1.0) - m0 - np.einsum("kij,kj->ki", G, p_free - qbar))
-            hi.append(np.full_like(m0, np.inf))
-        A = np.concatenate([a.reshape(-1, 6 * N) for a in A])
+            low = CONE_MARGIN * margin - m0 - np.einsum("kij,kj->ki", G, p_free - qbar)
+            groups.append((np.einsum("kij,kjl->kil", G, Pu), low, np.full_like(m0, np.inf)))
+        a_max = np.full(6 * N, p.max_leg_acceleration / shrink)
+        return groups, (np.einsum("kij,kjl->kil", J, self.blocks).reshape(6 * N, 6 * N), -a_max, a_max)
+
+    def solve(self, x0: np.ndarray, Rs: np.ndarray, qbar: np.ndarray, guess: np.ndarray, tight: bool):
+        """The inputs U (6N,) for state ``x0`` and vehicle motion ``Rs`` (6N,) under ``constraints(x0, qbar,
+        tight)`` (warm started from ``guess``), or None if the solver finds none. ``tight`` also drops the rows of
+        steps 2..N but the leg accelerations': the fallback for a horizon made infeasible by a linearisation about
+        a far-off plan, whose first step (the one applied) keeps every limit."""
+        c, N = self.cond, self.params.horizon
+        groups, accel = self.constraints(x0, qbar, tight)
+        A = np.concatenate([g[0] for g in groups], axis=1)  # (N, m, 6N): step-major rows
+        lo = np.concatenate([g[1] for g in groups], axis=1)
+        hi = np.concatenate([g[2] for g in groups], axis=1)
+        if tight:
+            lo[1:], hi[1:] = -np.inf, np.inf
         self.constraint.UpdateCoefficients(
-            A, np.concatenate([x.ravel() for x in lo]), np.concatenate([x.ravel() for x in hi])
+            np.concatenate([accel[0], A.reshape(-1, 6 * N)]),
+            np.concatenate([accel[1], lo.ravel()]),
+            np.concatenate([accel[2], hi.ravel()]),
         )
         self.cost.UpdateCoefficients(c.H, c.Gx @ x0 + c.Gr @ Rs, 0.0, True)
         result = self.solver.Solve(self.prog, guess, self.options)
@@ -364,9 +389,9 @@ def exact_check(
     earlier, with the exact IK: ``(inside, stroke excess m, leg speed m/s, leg lengths (6,))``. The excess is the
     largest max(L_min − L, L − L_max) (≤ 0 inside); the leg speed the larger of the exact |J(q1) v1| and the leg
     lengths' difference over the step; joint cones where ``limits`` give them."""
-    L1 = leg_lengths(platform, q1)
+    L1, J = legs_and_jacobian(platform, q1)
     excess = float(np.max(np.maximum(platform.L_min - L1, L1 - platform.L_max)))
-    speed = float(max(np.max(np.abs(length_jacobian(platform, q1) @ v1)), np.max(np.abs(L1 - L0)) / dt))
+    speed = float(max(np.max(np.abs(J @ v1)), np.max(np.abs(L1 - L0)) / dt))
     joints = joint_margins(platform, q1, limits)
     inside = excess <= 0.0 and speed <= v_max and bool(np.all(joints >= 0.0))
     return inside, excess, speed, L1

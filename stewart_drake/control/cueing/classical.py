@@ -87,7 +87,8 @@ HAND_SET = ClassicalParams(
 
 
 def classical(drive: Drive, params: ClassicalParams = ClassicalParams(), home=None) -> np.ndarray:
-    """``(N, 6)`` platform poses (m, rad, ``utn``) cueing ``drive`` with ``params`` about ``home`` ``(6,)``."""
+    """``(N, 6)`` platform poses (m, rad, ``utn``) cueing ``drive`` with ``params`` about ``home`` ``(6,)`` (None:
+    zeros, the excursions alone)."""
     home = np.zeros(6) if home is None else np.asarray(home, dtype=float)
     p, dt = params, drive.dt
     f, w = drive.specific_force, drive.angular_velocity

@@ -2,8 +2,9 @@
 
 A drive is sampled at a uniform step: the specific force ``f = a − g`` (m/s²) and the angular velocity (rad/s) at
 the rider's head, both in the head frame (x forward, y left, z up; at rest ``f = (0, 0, +g)``), and optionally the
-vehicle's attitude (roll, pitch, yaw, rad). The file's columns are ``t,fx,fy,fz,wx,wy,wz`` and optionally
-``roll,pitch,yaw``, in SI; a CSV's header may give them in any order (or be left out, in that order).
+vehicle's attitude (roll, pitch, yaw, rad; ``zyx``: R = Rz(yaw) Ry(pitch) Rx(roll), Drake's ``RollPitchYaw``).
+The file's columns are ``t,fx,fy,fz,wx,wy,wz`` and optionally ``roll,pitch,yaw``, in SI; a CSV's header may give
+them in any order (or be left out, in that order).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ class Drive:
         t: ``(N,)`` s, increasing in one step.
         specific_force: ``(N, 3)`` m/s², head frame (x forward, y left, z up); ``(0, 0, g)`` at rest.
         angular_velocity: ``(N, 3)`` rad/s, head frame.
-        attitude: ``(N, 3)`` rad (roll, pitch, yaw of the vehicle), or None.
+        attitude: ``(N, 3)`` rad (roll, pitch, yaw of the vehicle, ``zyx``), or None.
     """
 
     name: str
@@ -49,12 +50,12 @@ class Drive:
 
     def __post_init__(self):
         t = np.array(self.t, dtype=float)
-        n = t.shape[0] if t.ndim == 1 else -1
-        _check(self.name, "t", t, (n,))
-        if n < MIN_SAMPLES:
+        if t.ndim != 1 or len(t) < MIN_SAMPLES:
             raise DriveError(
                 DriveError.SHAPE.format(name=self.name, field="t", shape=f"(N >= {MIN_SAMPLES},)", got=t.shape)
             )
+        n = len(t)
+        _check(self.name, "t", t, (n,))
         step = np.diff(t)
         bad = np.flatnonzero(np.abs(step - step[0]) > STEP_TOLERANCE * abs(step[0]))
         if step[0] <= 0 or bad.size:

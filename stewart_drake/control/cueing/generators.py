@@ -150,7 +150,7 @@ def _series(lines: np.ndarray, n: int) -> np.ndarray:
 def wave_elevation(sea_state: int, duration: float, rate: float = 100.0, seed: int = 0) -> np.ndarray:
     """``(N,)`` m: the wave elevation at the ship, sampled at ``rate`` Hz over ``duration`` s."""
     t = _times(duration, rate)
-    omega, lines = wave_spectrum_lines(sea_state, len(t), 1.0 / rate, seed)
+    _, lines = wave_spectrum_lines(sea_state, len(t), 1.0 / rate, seed)
     return _series(lines, len(t))
 
 

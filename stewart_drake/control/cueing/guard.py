@@ -15,11 +15,13 @@ creates false cues). ``c`` is the largest smooth scale below each sample's admis
 4. last, the whole sequence is re-checked with the exact IK; should a limit still be exceeded, ``c`` is scaled
    down as a whole by bisection on that check (``c = 0``, home throughout, passes it).
 
-The platform files give no joint-angle limits, so none are checked here.
+Joint-angle cones, leg collision and dexterity are checked where a ``workspace.limits.Limits`` gives them (the
+platform files give none): the admissible scale and the last check require their margins too.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -30,6 +32,7 @@ from stewart_drake.core.argcheck import as_poses
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.errors import CueingError
+from stewart_drake.workspace.limits import Limits, limit_margins
 
 STROKE_MARGIN = 0.02  # of the stroke, at each end
 SPEED_MARGIN = 0.9  # the guard keeps legs below this share of their speed limit
@@ -42,7 +45,8 @@ SPEED_PASSES = 20
 @dataclass(frozen=True, eq=False)
 class LimitCheck:
     """The exact-IK check of poses sampled at a step: samples past the stroke ends, the leg speed and the leg
-    acceleration limits (counts), and the extremes (m, m/s, m/s²)."""
+    acceleration limits (counts), the extremes (m, m/s, m/s²), and samples past the ``Limits``' joint cones,
+    collision or dexterity bounds."""
 
     outside_stroke: int
     over_speed: int
@@ -51,11 +55,12 @@ class LimitCheck:
     max_length: float
     max_speed: float
     max_accel: float
+    outside_joints: int = 0
 
     @property
     def ok(self) -> bool:
         """No sample past any limit."""
-        return self.outside_stroke == 0 and self.over_speed == 0 and self.over_accel == 0
+        return self.outside_stroke == 0 and self.over_speed == 0 and self.over_accel == 0 and self.outside_joints == 0
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,6 +75,8 @@ class WorkspaceGuard:
         max_accel: m/s², the leg acceleration the guard keeps below.
         scale_rate: 1/s, the largest rate of the scale.
         smoothing: s, the half-width W of the scale's erosion and averages.
+        limits: joint cones, leg collision, dexterity (``Limits``, its stroke switched off: the guard's own); None:
+            none.
     """
 
     platform: Platform
@@ -79,6 +86,7 @@ class WorkspaceGuard:
     max_accel: float
     scale_rate: float = 0.5
     smoothing: float = 0.25
+    limits: Limits | None = None
 
     @classmethod
     def for_platform(
@@ -90,10 +98,12 @@ class WorkspaceGuard:
         home=None,
         scale_rate: float = 0.5,
         smoothing: float = 0.25,
+        limits: Limits | None = None,
     ) -> WorkspaceGuard:
         """The guard of ``platform``: its stroke less ``margin`` (a share of the stroke) at each end, ``SPEED_MARGIN``
         of ``max_speed`` (default the platform's ``legs.max_speed``, else ``DEFAULT_MAX_SPEED``) and of
-        ``max_accel``, about ``home`` (default the platform's home pose)."""
+        ``max_accel``, the joint cones, collision and dexterity bounds of ``limits``, about ``home`` (default the
+        platform's home pose)."""
         for name, value, low in (
             ("margin", margin, 0.0),
             ("scale_rate", scale_rate, 0.0),
@@ -115,15 +125,19 @@ class WorkspaceGuard:
         m = margin * (hi - lo)
         home = platform.home_pose() if home is None else np.asarray(home, dtype=float)
         stroke = np.array([lo + m, hi - m])
-        L = leg_lengths(platform, home)
-        if np.any(L < stroke[0]) or np.any(L > stroke[1]):
+        others = None if limits is None else dataclasses.replace(limits, stroke=False)
+        guard = cls(
+            platform, home, stroke, SPEED_MARGIN * speed, SPEED_MARGIN * max_accel, scale_rate, smoothing, others
+        )
+        if not guard._inside(np.zeros((1, 6)))[0]:
             raise CueingError(CueingError.HOME_OUTSIDE.format(home=home.tolist(), margin=m))
-        return cls(platform, home, stroke, SPEED_MARGIN * speed, SPEED_MARGIN * max_accel, scale_rate, smoothing)
+        return guard
 
     def check(self, poses, t, stroke=None, max_speed=None, max_accel=None) -> LimitCheck:
         """The exact-IK check of ``poses`` ``(N, 6)`` at times ``t`` ``(N,)`` against the guard's limits (or those
         given: the platform's own stroke and limits, for a report)."""
-        L = leg_lengths(self.platform, as_poses(poses))
+        q = as_poses(poses)
+        L = leg_lengths(self.platform, q)
         dt = float(t[1] - t[0])
         lo, hi = self.stroke if stroke is None else stroke
         v, a = _rates(L, dt)
@@ -137,6 +151,7 @@ class WorkspaceGuard:
             float(L.max()),
             float(vmax.max()),
             float(amax.max()),
+            int(np.sum(~self._within_limits(q))),
         )
 
     def guard(self, poses, t) -> np.ndarray:
@@ -168,7 +183,7 @@ class WorkspaceGuard:
 
     def admissible_scale(self, e: np.ndarray) -> np.ndarray:
         """``(N,)``: for each excursion ``e`` ``(N, 6)`` from home, a scale in [0, 1] whose pose ``home + s e`` is
-        within the guard's stroke (1 when the whole excursion is), by bisection on the exact IK."""
+        within the guard's stroke and limits (1 when the whole excursion is), by bisection on the exact IK."""
         lo, hi = np.zeros(len(e)), np.ones(len(e))
         inside = self._inside(e)
         lo[inside] = 1.0
@@ -183,8 +198,16 @@ class WorkspaceGuard:
         return lo
 
     def _inside(self, e: np.ndarray) -> np.ndarray:
+        """``(N,)``: the poses ``home + e`` within the guard's stroke and its ``limits``."""
         L = leg_lengths(self.platform, self.home + e)
-        return np.all((L >= self.stroke[0]) & (L <= self.stroke[1]), axis=1)
+        return np.all((L >= self.stroke[0]) & (L <= self.stroke[1]), axis=1) & self._within_limits(self.home + e)
+
+    def _within_limits(self, q: np.ndarray) -> np.ndarray:
+        """``(N,)``: the poses ``q`` within ``limits`` (all True without)."""
+        if self.limits is None or not self.limits.active:
+            return np.ones(len(q), dtype=bool)
+        margins = limit_margins(self.platform, q, self.limits)
+        return np.all([m >= 0 for m, _ in margins.values()], axis=0)  # each margin: the worst leg's
 
     def _smooth_below(self, allowed: np.ndarray, dt: float, width: int) -> np.ndarray:
         """The largest rate-limited, twice-averaged scale at most ``allowed`` (see the module, step 2)."""

@@ -14,7 +14,7 @@ import numpy as np
 
 from stewart_drake.control.cueing.drive import GRAVITY, Drive
 from stewart_drake.core.argcheck import as_poses
-from stewart_drake.core.rotations import angular_velocity_map, rotation_matrix
+from stewart_drake.core.rotations import angles_from_matrix, angular_velocity_map, rotation_matrix
 from stewart_drake.errors import CueingError
 
 
@@ -29,8 +29,8 @@ def platform_drive(poses, t, home, head=(0.0, 0.0, 0.0), name: str = "platform")
         name: the drive's name.
 
     Returns:
-        A ``Drive`` with ``specific_force`` and ``angular_velocity`` ``(N, 3)`` in the head frame and the plate's
-        angles from home as ``attitude`` (the pose's angles less home's; exact when home is level).
+        A ``Drive`` with ``specific_force`` and ``angular_velocity`` ``(N, 3)`` in the head frame and the head
+        frame's roll, pitch, yaw from home as ``attitude`` (``zyx``, as a vehicle drive's).
     """
     q = as_poses(poses)
     t = np.asarray(t, dtype=float)
@@ -48,4 +48,4 @@ def platform_drive(poses, t, home, head=(0.0, 0.0, 0.0), name: str = "platform")
     rates = np.gradient(q[:, 3:], dt, axis=0)
     w_base = np.einsum("nij,nj->ni", angular_velocity_map(q[:, 3:]), rates)
     w = np.einsum("nji,nj->ni", R_head, w_base)
-    return Drive(name, t, f, w, q[:, 3:] - np.asarray(home, dtype=float)[3:])
+    return Drive(name, t, f, w, angles_from_matrix(R_head, "zyx"))

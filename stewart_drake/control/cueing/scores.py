@@ -28,6 +28,7 @@ from stewart_drake.errors import CueingError
 
 CHANNELS = ("fx", "fy", "fz", "wx", "wy", "wz")
 MAX_LAG = 2.0  # s
+CONSTANT = 1e-9  # m/s², rad/s: a series whose range is below this is constant (a still channel)
 
 
 def score(vehicle: Drive, platform: Drive, poses, platform_geometry: Platform, max_lag: float = MAX_LAG) -> dict:
@@ -75,18 +76,24 @@ def score(vehicle: Drive, platform: Drive, poses, platform_geometry: Platform, m
 
 
 def pearson(a: np.ndarray, b: np.ndarray) -> float:
-    """The correlation coefficient of two ``(N,)`` series; 0 where either is constant."""
+    """The correlation coefficient of two ``(N,)`` series; 0 where either is constant (``CONSTANT``)."""
+    if _constant(a) or _constant(b):
+        return 0.0
     a, b = a - a.mean(), b - b.mean()
-    norm = np.sqrt(np.sum(a * a) * np.sum(b * b))
-    return float(np.sum(a * b) / norm) if norm > 0 else 0.0
+    return float(np.sum(a * b) / np.sqrt(np.sum(a * a) * np.sum(b * b)))
+
+
+def _constant(x: np.ndarray) -> bool:
+    """Whether ``x`` varies by less than ``CONSTANT``: a filter's rounding, not a motion."""
+    return bool(np.ptp(x) < CONSTANT)
 
 
 def delay(reference: np.ndarray, delayed: np.ndarray, max_lag: int) -> int:
     """The lag (samples) within ±``max_lag`` at which ``delayed`` best matches ``reference`` (the peak of their
     cross-correlation, means removed); positive when ``delayed`` comes later; 0 for a constant series."""
-    a, b = reference - reference.mean(), delayed - delayed.mean()
-    if not np.any(a) or not np.any(b):
+    if _constant(reference) or _constant(delayed):
         return 0
+    a, b = reference - reference.mean(), delayed - delayed.mean()
     xc = signal.correlate(b, a, mode="full", method="fft")
     lags = signal.correlation_lags(len(b), len(a), mode="full")
     keep = np.abs(lags) <= max_lag

@@ -19,6 +19,7 @@ from stewart_drake.control.cueing.generators import (
     car_drive,
     jonswap,
     ship_drive,
+    shipped_drive,
     single_track,
     wave_elevation,
 )
@@ -130,3 +131,5 @@ def test_bad_requests_are_named():
         car_drive("drift")
     with pytest.raises(DriveError, match="duration must be a positive number of seconds"):
         car_drive("slalom", duration=-1.0)
+    with pytest.raises(DriveError, match="unknown drive 'ship-ss9'; the shipped drives are ship-ss3, ship-ss4"):
+        shipped_drive("ship-ss9")

@@ -12,6 +12,7 @@ from stewart_drake.control.cueing.guard import WorkspaceGuard
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.errors import CueingError
+from stewart_drake.workspace.limits import Limits, limit_margins
 from tests._own_platform import NEWCOMER_PLATFORM
 
 
@@ -61,6 +62,22 @@ def test_guard_scales_the_whole_excursion_smoothly(platforms, drives):
     moving = np.sum(e * e, axis=1) > 1e-10  # where the excursion is ~0 the scale is not observable
     steps = np.abs(np.diff(c))[moving[1:] & moving[:-1]]
     assert steps.max() <= guard.scale_rate * d.dt * (1 + 1e-9)
+
+
+def test_joint_cones_are_kept_where_limits_give_them(platforms, drives):
+    # 38° cones about the base and plate normals (the legs lean 30.7° at home): the hand set's ship-ss6 poses cross
+    # them; guarded, no sample does
+    # (limit_margins, the workspace module's own check, reads the joint angles independently of the guard)
+    platform = platforms["gonzalez-dutra-2009"]
+    limits = Limits(stroke=False, base_cone=np.radians(38), top_cone=np.radians(38))
+    guard = WorkspaceGuard.for_platform(platform, limits=limits)
+    d = drives["ship-ss6"]
+    q = classical(d, HAND_SET, guard.home)
+    worst = lambda poses: min(m.min() for m, _ in limit_margins(platform, poses, limits).values())  # noqa: E731
+    assert worst(q) < 0
+    g = guard.guard(q, d.t)
+    assert worst(g) >= 0
+    assert _hard_check(guard, g, d.t).ok
 
 
 def test_small_motion_is_left_as_it_is(platforms):

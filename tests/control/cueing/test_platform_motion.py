@@ -25,6 +25,7 @@ def test_surge_and_pitch_match_the_closed_form():
     # second central difference: error A W⁴ dt²/12 = 3e-6 m/s²; central rate: B V³ dt²/6 = 1.4e-6 rad/s
     np.testing.assert_allclose(d.specific_force[inner], f[inner], atol=1e-5)
     np.testing.assert_allclose(d.angular_velocity[inner], w[inner], atol=1e-5)
+    np.testing.assert_allclose(d.attitude[:, 1], q[:, 4], atol=1e-12)  # a pure pitch: the same angle in zyx
 
 
 def test_head_off_the_yaw_axis_feels_the_centripetal_acceleration():

@@ -48,6 +48,16 @@ def test_a_delayed_cue_shows_its_delay_and_a_reversed_one_its_false_cues(setting
     assert s["channels"]["fy"]["false_cue_share"] == pytest.approx(np.mean(np.abs(pv) > FORCE_THRESHOLD[1]))
 
 
+def test_a_still_channel_correlates_with_nothing(setting):
+    # the slalom has no pitch rate and a still platform no motion: their perceived series are constant up to the
+    # filters' rounding, which must not read as a correlation or a delay
+    platform, home, d, q = setting
+    still = np.tile(home, (len(d), 1))
+    s = score(d, platform_drive(still, d.t, home), still, platform)
+    for c in CHANNELS:
+        assert s["channels"][c]["pearson"] == 0.0 and s["channels"][c]["delay_s"] == 0.0
+
+
 def test_workspace_figures_come_from_the_exact_leg_lengths(setting):
     platform, home, d, q = setting
     s = score(d, platform_drive(q, d.t, home), q, platform)
