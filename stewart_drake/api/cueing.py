@@ -26,11 +26,21 @@ from stewart_drake.control.cueing.platform_motion import platform_drive
 from stewart_drake.control.cueing.scores import CHANNELS, score
 from stewart_drake.control.cueing.tuning import load_params, tune_classical
 from stewart_drake.control.cueing.vestibular import perceive
+from stewart_drake.core.argcheck import as_real
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.core.trajectory import table_trajectory
-from stewart_drake.errors import CUE_DRIVE, CUE_PARAMS, CUE_PARAMS_TYPE, ArgumentError, PhysicalLimitError, UsageError
+from stewart_drake.errors import (
+    CUE_DRIVE,
+    CUE_PARAMS,
+    CUE_PARAMS_TYPE,
+    ArgumentError,
+    OptionError,
+    PhysicalLimitError,
+    UsageError,
+)
 from stewart_drake.spec import Machine, load_machine
+from stewart_drake.workspace.limits import Limits
 
 if TYPE_CHECKING:  # annotations only: matplotlib is loaded when a figure is drawn
     from matplotlib.figure import Figure
@@ -58,8 +68,9 @@ def resolve_drive(drive: Drive | str | Path, name: str = "drive") -> Drive:
 def limit_samples(guard: WorkspaceGuard, t, poses) -> dict:
     """The samples of ``poses`` (N, 6) at the uniform times ``t`` (N,) s outside the platform's own limits, by the
     exact IK (``guard.check`` against the whole stroke, not the guard's margins): ``outside_stroke`` (any leg beyond
-    [L_min, L_max]), ``over_speed`` (any leg faster than ``legs.max_speed``; 0 where the platform states none), with
-    the ``peak_leg_speed_m_s`` (the scores give the stroke use)."""
+    [L_min, L_max]), ``over_speed`` (any leg faster than ``legs.max_speed``; 0 where the platform states none),
+    ``outside_joints`` (past the guard's joint cones, if any), with the ``peak_leg_speed_m_s`` (the scores give the
+    stroke use)."""
     p = guard.platform
     vmax = p.legs.max_speed
     c = guard.check(poses, t, stroke=p.stroke, max_speed=math.inf if vmax is None else vmax, max_accel=math.inf)
@@ -67,6 +78,7 @@ def limit_samples(guard: WorkspaceGuard, t, poses) -> dict:
         "samples": int(len(poses)),
         "outside_stroke": c.outside_stroke,
         "over_speed": c.over_speed,
+        "outside_joints": c.outside_joints,
         "max_leg_speed_m_s": vmax,
         "peak_leg_speed_m_s": c.max_speed,
     }
@@ -242,7 +254,7 @@ def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard)
     # deferred: the MPC law imports pydrake (classical cueing and the cue command run without Drake)
     from stewart_drake.drake.cueing_mpc import mpc_cue
 
-    run = mpc_cue(drive, guard.platform, params, guard.home)
+    run = mpc_cue(drive, guard.platform, params, guard.home, limits=guard.limits)
     solves = {
         "worst_solve_s": float(run.solve_times.max()),
         "mean_solve_s": float(run.solve_times.mean()),
@@ -259,6 +271,7 @@ def cue(
     algorithm: str = "classical",
     params=None,
     simulate: bool = False,
+    joint_cone: float | None = None,
     progress: bool | None = None,
 ) -> CueResult:
     """Cue a vehicle's motion on the machine: poses by the law, kept inside the workspace by the guard,
@@ -274,6 +287,9 @@ def cue(
             ``tune_classical``'s ``save_params`` for the classical laws); None: the defaults above.
         simulate: also run the poses through the machine's controller (fixed point) and the Drake plant
             (``sd.simulate``) and score the plant's motion.
+        joint_cone: the joints' cone half-angle, rad, about the base and plate normals: the guard (and MPC) keep
+            every leg within it and ``limits`` counts the samples outside (None: no joint limit; platform files
+            give none).
         progress: show the simulation's progress bar.
 
     Returns:
@@ -291,7 +307,12 @@ def cue(
     machine = load_machine(machine)
     platform = machine.platform
     drive = resolve_drive(drive)
-    guard = WorkspaceGuard.for_platform(platform)
+    cone = None if joint_cone is None else as_real(joint_cone, "joint_cone")
+    if cone is not None and not 0 < cone <= math.pi:
+        raise OptionError(OptionError.BETWEEN.format(option="joint_cone", lo="0 (excluded)", hi="pi rad", value=cone))
+    guard = WorkspaceGuard.for_platform(
+        platform, limits=None if cone is None else Limits(base_cone=cone, top_cone=cone)
+    )
     params = cueing_params(algorithm, params, drive, guard)
     poses, mpc = commanded_poses(algorithm, params, drive, guard)
     motion = platform_drive(poses, drive.t, guard.home)
@@ -321,6 +342,8 @@ def limit_failures(limits: dict, what: str) -> list[str]:
     out = []
     if limits["outside_stroke"]:
         out.append(f"{limits['outside_stroke']} of {limits['samples']} samples of {what} have a leg outside the stroke")
+    if limits["outside_joints"]:
+        out.append(f"{limits['outside_joints']} of {limits['samples']} samples of {what} have a joint outside its cone")
     if limits["over_speed"]:
         out.append(
             f"{limits['over_speed']} of {limits['samples']} samples of {what} move a leg faster than "

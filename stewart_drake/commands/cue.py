@@ -4,6 +4,7 @@ machine's controller and the Drake plant; writes the poses, the scores and plots
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from stewart_drake.commands._common import (
 )
 from stewart_drake.control.cueing.generators import DRIVES
 from stewart_drake.control.cueing.tuning import load_params
+from stewart_drake.errors import OptionError
 from stewart_drake.system.output_folder import atomic_folder
 
 HELP = "motion cueing: a vehicle's motion (drive file or shipped drive) to platform poses, scored by perceived motion"
@@ -58,6 +60,14 @@ def register(sub) -> None:
     )
     p.add_argument("--out", required=True, metavar="DIR", help="write poses.csv, scores.json, perception.png, legs.png")
     p.add_argument(
+        "--joint-cone",
+        type=float,
+        default=None,
+        metavar="DEG",
+        help="keep every leg within this angle of its joint's axis (base and plate normals), degrees (default: no "
+        "joint limit; platform files give none)",
+    )
+    p.add_argument(
         "--animate",
         action="store_true",
         help="also write animation.html: the plant's motion (with --simulate) or the commanded poses, in Meshcat",
@@ -74,12 +84,19 @@ def run(args) -> int:
     out_folder = output_folder(args, names=FILES + (ANIMATION,) * args.animate)
     machine = machine_from_args(args)
     drive = resolve_drive(args.drive, "--drive")
+    if args.joint_cone is not None and not 0 < args.joint_cone <= 180:
+        raise OptionError(
+            OptionError.BETWEEN.format(
+                option="--joint-cone", lo="0 (excluded)", hi="180 degrees", value=args.joint_cone
+            )
+        )
     result = cue(
         machine,
         drive,
         algorithm=args.algorithm,
         params=load_params(args.params) if args.params is not None else None,
         simulate=args.simulate,
+        joint_cone=None if args.joint_cone is None else math.radians(args.joint_cone),
         progress=not args.no_progress,
     )
     d = result.to_dict()

@@ -62,6 +62,8 @@ def test_refusals_name_the_flag(here, capsys):
         capsys, "cue", "--drive", "car-lane-change", "--algorithm", "mpc", "--params", "p.yaml", "--out", "c"
     )
     assert rc == 2 and "--params only applies with --algorithm classical or tuned" in err
+    rc, _, err = cli(capsys, "cue", "--drive", "car-lane-change", "--joint-cone", "200", "--out", "c")
+    assert rc == 2 and err.strip().endswith("--joint-cone must be between 0 (excluded) and 180 degrees, got 200")
     rc, _, err = cli(capsys, "cue", "--drive", "car-lane-change", "--no-progress", "--out", "c")
     assert rc == 2 and "--no-progress only applies with --simulate" in err
     rc, _, err = cli(capsys, "cue", "--drive", "car-lane-change", "--algorithm", "washout", "--out", "c")
