@@ -2,10 +2,12 @@
 budget of one sample at the drive's rate (10 ms at 100 Hz), on seed 001's ship simulator (``gonzalez-dutra-2009``)
 and the 210 kg machine (``examples/newcomer-210kg.yaml``).
 
-The laws are numpy over a whole drive (``control.cueing.classical``, ``guard``): this measures their cost per sample
-amortised over the drive, not a streaming step in a compiled kernel (the firmware has none yet; the guard as built
-is not causal either: its erosion and averages look ``smoothing`` s ahead and its last pass scales the whole
-sequence). The exact-IK re-check of the guarded poses (``api.cueing.limit_samples``) is timed beside them. Process CPU time, best of
+The numpy law and the guard run over a whole drive (``control.cueing.classical``, ``guard``): their cost per
+sample is amortised over the drive. The compiled washout (``control.cueing.classical_kernel``) is the streaming
+step a real-time loop runs, sample after sample from its state: timed over the drive in one call (the step's own
+cost) and one sample per call (with cffi's call overhead). The guard as built is not causal (its erosion and
+averages look ``smoothing`` s ahead and its last pass scales the whole sequence), so it has no streaming step yet.
+The exact-IK re-check of the guarded poses (``api.cueing.limit_samples``) is timed beside them. Process CPU time, best of
 ``--repeat``; the ratios to the sample budget are what travel between machines.
 
 Run by hand: ``python benchmarks/bench_cueing.py [--repeat 3] [--drive ship-ss4]``.
@@ -21,6 +23,7 @@ import numpy as np
 
 from stewart_drake.api.cueing import limit_samples, resolve_drive
 from stewart_drake.control.cueing.classical import HAND_SET, classical
+from stewart_drake.control.cueing.classical_kernel import WashoutKernel
 from stewart_drake.control.cueing.guard import WorkspaceGuard
 from stewart_drake.spec import load_machine
 
@@ -52,8 +55,13 @@ def main() -> None:
         guard = WorkspaceGuard.for_platform(platform)
         raw = classical(drive, HAND_SET, home)
         guarded = guard.guard(raw, drive.t)
+        u = np.hstack([drive.specific_force, drive.angular_velocity])
         parts = {
             "classical washout": lambda: classical(drive, HAND_SET, home),
+            "compiled washout step": lambda: WashoutKernel(HAND_SET, drive.dt, home).run(u),
+            "  one sample per call": lambda: [
+                kernel.run(row) for kernel in [WashoutKernel(HAND_SET, drive.dt, home)] for row in u
+            ],
             "guard": lambda: guard.guard(raw, drive.t),
             "exact-IK re-check": lambda: limit_samples(guard, drive.t, guarded),
         }
