@@ -17,7 +17,7 @@ the state and the vehicle's motion; the hard constraints are the leg lengths (st
 and leg accelerations, each linearised along the horizon about the previous solution's poses with the exact
 Jacobian ∂L/∂q of ``core.kinematics`` (leg acceleration without its J̇ q̇ term). One ``MathematicalProgram`` serves
 the whole run: each sample updates the cost's and the constraint's coefficients and solves again (OSQP, warm
-started from the previous solution shifted by one sample).
+started from the previous sample's solution).
 
 The first input is applied for one drive sample; the new pose is then re-checked with the exact inverse kinematics
 (stroke, leg speed; joint cones where ``limits`` give them). If the check fails (linearisation error) or the
@@ -26,8 +26,8 @@ with the margins tightened (``FALLBACK_TIGHTENING``) and only the first step's l
 step is scaled toward the previous pose (halving, down to holding it still), which is inside by induction from the
 home pose. The poses are therefore never outside the workspace.
 
-Without ``preview`` the vehicle's motion is held at its present value over the horizon (a real-time simulator
-does not know the future); with it the recorded drive is previewed.
+A real-time simulator does not know the vehicle's future: without ``preview`` the program predicts the present
+motion decaying to rest (``decay``; or held); with it a recorded drive's future is seen.
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ from pydrake.solvers import ClarabelSolver, MathematicalProgram, OsqpSolver, Sol
 from scipy.linalg import expm
 
 from stewart_drake.control.cueing.drive import GRAVITY, Drive
+from stewart_drake.control.cueing.guard import DEFAULT_MAX_ACCEL, DEFAULT_MAX_SPEED
 from stewart_drake.control.cueing.vestibular import RATE_THRESHOLD, canal_ss, otolith_ss
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import (
@@ -56,7 +57,7 @@ from stewart_drake.workspace.limits import Limits, raw_margins
 
 SOLVERS = {"osqp": OsqpSolver, "clarabel": ClarabelSolver}
 FALLBACK_TIGHTENING = 4.0  # the re-solve's stroke (and cone) margin is this many times the program's, rates ÷ 1.25
-TILT_RATE = float(RATE_THRESHOLD[0])  # rad/s
+TILT_RATE = 0.9 * float(RATE_THRESHOLD[0])  # rad/s: 2.7 °/s, below the threshold by more than OSQP's 1e-3 tolerance
 MAX_HORIZON = 200  # prediction steps: the condensed program is dense in 6 × horizon inputs
 CONE_MARGIN = 0.01  # rad kept from a joint cone in the program
 HALVINGS = 6  # scaled steps tried (1/2 .. 1/64) before the pose is held
@@ -76,14 +77,15 @@ class MpcParams:
         w_velocity: weight on the pose rates, per m/s (rad/s).
         w_acceleration: weight on the pose accelerations (inputs), per m/s² (rad/s²).
         stroke_margin: leg-length margin kept from each stroke end in the program, m.
-        max_leg_speed: leg speed limit, m/s; ``None``: the platform's ``legs.max_speed``, else 0.5 m/s.
-        max_leg_acceleration: leg acceleration limit, m/s².
-        max_tilt_rate: limit on the roll and pitch rates, rad/s (default 3 °/s, the roll-rate perception
-            threshold of ``vestibular.RATE_THRESHOLD``: tilt coordination below what the canals notice); ``None``:
-            none (the canal model in the cost alone shapes the tilt).
+        max_leg_speed: leg speed limit, m/s; ``None``: the platform's ``legs.max_speed``, else the guard's
+            ``DEFAULT_MAX_SPEED``.
+        max_leg_acceleration: leg acceleration limit, m/s² (default the guard's ``DEFAULT_MAX_ACCEL``, 1 g).
+        max_tilt_rate: limit on the roll and pitch rates, rad/s (default ``TILT_RATE``, 0.9 × the 3 °/s roll-rate
+            perception threshold of ``vestibular.RATE_THRESHOLD``: tilt coordination below what the canals notice);
+            ``None``: none (the canal model in the cost alone shapes the tilt).
         preview: the program sees the drive's future (recorded drives) instead of predicting it.
         decay: without ``preview``, the vehicle's present motion is predicted to decay to rest with this time
-            constant, s (``None``: held over the horizon).
+            constant, s (default 0.5 s; ``None``: held over the horizon, which plans for a cue that lasts).
         solver: ``"osqp"`` or ``"clarabel"`` (both ship with Drake).
     """
 
@@ -97,10 +99,10 @@ class MpcParams:
     w_acceleration: float = 0.05
     stroke_margin: float = 0.005
     max_leg_speed: float | None = None
-    max_leg_acceleration: float = 10.0
+    max_leg_acceleration: float = DEFAULT_MAX_ACCEL
     max_tilt_rate: float | None = TILT_RATE
     preview: bool = False
-    decay: float | None = None
+    decay: float | None = 0.5
     solver: str = "osqp"
     solver_options: dict = field(
         default_factory=lambda: {"eps_abs": 1e-3, "eps_rel": 1e-3, "polishing": 0, "max_iter": 500}
@@ -112,16 +114,22 @@ class MpcParams:
 
         if not (isinstance(self.horizon, int) and 1 <= self.horizon <= MAX_HORIZON):
             bad("horizon", f"a whole number of steps in 1..{MAX_HORIZON}")
+
+        def number(v) -> bool:
+            return isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+
         for name in ("step", "w_force", "w_rate", "max_leg_acceleration"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+            if not (number(getattr(self, name)) and getattr(self, name) > 0):
                 bad(name, "a positive number")
         for name in ("w_position", "w_angle", "w_velocity", "w_acceleration", "stroke_margin"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+            if not (number(getattr(self, name)) and getattr(self, name) >= 0):
                 bad(name, "a number >= 0")
         for name in ("max_leg_speed", "max_tilt_rate", "decay"):
             v = getattr(self, name)
-            if v is not None and not (np.isfinite(v) and v > 0):
+            if v is not None and not (number(v) and v > 0):
                 bad(name, "a positive number or None")
+        if not isinstance(self.preview, bool):
+            bad("preview", "true or false")
         if self.solver not in SOLVERS:
             bad("solver", "one of " + ", ".join(SOLVERS))
 
@@ -134,6 +142,8 @@ class MpcRun:
         t: ``(N,)`` s, the drive's times.
         poses: ``(N, 6)`` commanded poses (m, rad, ``utn``), poses[0] the home pose.
         solve_times: ``(K,)`` s, wall time of each sample's whole step (linearise, update, solve, re-check).
+        cpu_times: ``(K,)`` s, the same steps' CPU time on the calling thread (what one free core would take,
+            on a machine whose other work stretches the wall time).
         stroke_violation: ``(K,)`` m, per solve the exact IK's largest leg excess past a stroke end of the pose
             it commands (max(L_min − L, L − L_max) over the legs): ≤ 0 on every sample.
         leg_speed: ``(K,)`` m/s, per solve the largest exact leg speed of the pose it commands.
@@ -143,16 +153,18 @@ class MpcRun:
     t: np.ndarray
     poses: np.ndarray
     solve_times: np.ndarray
+    cpu_times: np.ndarray
     stroke_violation: np.ndarray
     leg_speed: np.ndarray
     fallbacks: dict
 
 
 def leg_speed_limit(platform: Platform, params: MpcParams) -> float:
-    """The leg speed limit the MPC keeps, m/s: ``params.max_leg_speed``, else the platform's, else 0.5 m/s."""
+    """The leg speed limit the MPC keeps, m/s: ``params.max_leg_speed``, else the platform's, else the guard's
+    ``DEFAULT_MAX_SPEED``."""
     if params.max_leg_speed is not None:
         return float(params.max_leg_speed)
-    return float(platform.legs.max_speed) if platform.legs.max_speed is not None else 0.5
+    return float(platform.legs.max_speed) if platform.legs.max_speed is not None else DEFAULT_MAX_SPEED
 
 
 def vestibular_system() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -215,8 +227,9 @@ def discretise(model: dict, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
 @dataclass(frozen=True)
 class Condensed:
-    """The horizon condensed onto the inputs U = [a_0 .. a_{N−1}] (6N,): every predicted quantity is
-    ``F x0 + G U + Q Rs`` with Rs = [r_0 .. r_{N−1}] (6N,). ``P``/``V`` give p_k, v_k for k = 1..N (rows 6N)."""
+    """The horizon condensed onto the inputs U = [a_0 .. a_{N−1}] (6N,): the offsets p_k = Px x0 + Pu U and rates
+    v_k = Vx x0 + Vu U stacked for k = 1..N (6N rows; the vehicle's motion moves only the vestibular states), and
+    the cost ½ Uᵀ H U + (Gx x0 + Gr Rs)ᵀ U with Rs = [r_0 .. r_{N−1}] (6N,)."""
 
     Px: np.ndarray
     Pu: np.ndarray
@@ -423,11 +436,11 @@ def mpc_cue(
     U = np.zeros(6 * N)
     poses = np.empty((n_s, 6))
     poses[0] = home
-    times, excess, speed = np.empty(n_s - 1), np.empty(n_s - 1), np.empty(n_s - 1)
+    times, cpu, excess, speed = (np.empty(n_s - 1) for _ in range(4))
     fallbacks = {"tightened": 0, "scaled": 0}
     L0 = leg_lengths(platform, home)
     for i in range(n_s - 1):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.thread_time()
         if params.preview:
             Rs = np.stack([np.interp(t[i] + plan_t[:-1], t, r[:, j]) for j in range(6)], axis=1).ravel()
         else:
@@ -459,5 +472,13 @@ def mpc_cue(
         x[:6], x[6:12] = p1, v1
         poses[i + 1] = home + p1
         U = sol
-        times[i] = time.perf_counter() - start
-    return MpcRun(t=t, poses=poses, solve_times=times, stroke_violation=excess, leg_speed=speed, fallbacks=fallbacks)
+        times[i], cpu[i] = time.perf_counter() - start, time.thread_time() - start_cpu
+    return MpcRun(
+        t=t,
+        poses=poses,
+        solve_times=times,
+        cpu_times=cpu,
+        stroke_violation=excess,
+        leg_speed=speed,
+        fallbacks=fallbacks,
+    )

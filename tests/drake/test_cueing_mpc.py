@@ -1,6 +1,7 @@
 """MPC cueing on the user's 210 kg machine: every commanded pose re-checked here with the exact IK (stroke, leg
 speed, joint cones), the rider at rest kept at home, a drive far beyond the workspace kept inside, the fallback
-that scales a bad step, and the vestibular model in the cost checked against ``vestibular.perceive``."""
+that scales a bad step, a sustained acceleration cued by tilt, only a preview anticipating the drive, and the
+vestibular model in the cost checked against ``vestibular.perceive``."""
 
 import math
 import re
@@ -99,14 +100,24 @@ def test_joint_cones_are_kept(platform):
 
 def test_a_sustained_acceleration_is_cued_by_tilt(platform):
     # 1 m/s² forward for 6 s: translation washes out, tilt (nose up, f_x = −g sin(pitch)) carries the cue, and
-    # the tilt turns no faster than the canals' threshold
+    # the tilt turns no faster than the canals' threshold; the program predicts the acceleration held (decay=None)
     d = drive("accelerate", 6.0, lambda t: np.column_stack([np.where(t > 0.5, 1.0, 0.0), 0 * t, 0 * t]))
-    params = MpcParams()
+    params = MpcParams(decay=None)
     run = mpc_cue(d, platform, params)
     pitch = run.poses[:, 4]
     assert -GRAVITY * np.sin(pitch[-1]) > 0.5  # more than half of the 1 m/s² is tilt at the end
     assert np.abs(np.diff(pitch)).max() * RATE <= params.max_tilt_rate * (1 + 1e-3)  # QP tolerance 1e-3
     assert abs(run.poses[-1, 0] - run.poses[0, 0]) < 0.1  # washed out: not a surge held at a stroke end
+
+
+def test_preview_moves_before_the_vehicle_and_the_present_does_not(platform):
+    # a 1 m/s² surge from t = 1 s: only the program that sees the recorded future moves before it
+    d = drive("surge", 1.5, lambda t: np.column_stack([np.where(t >= 1.0, 1.0, 0.0), 0 * t, 0 * t]))
+    before = d.t < 1.0
+    ahead = mpc_cue(d, platform, MpcParams(preview=True)).poses[before]
+    present = mpc_cue(d, platform, MpcParams()).poses[before]
+    assert np.abs(ahead - platform.home_pose()).max() > 1e-3
+    np.testing.assert_allclose(present, np.tile(platform.home_pose(), (before.sum(), 1)), atol=1e-12)
 
 
 def test_the_cost_model_is_the_vestibular_models(platform):
