@@ -248,6 +248,7 @@ def cueing_params(algorithm: str, params, drive: Drive, guard: WorkspaceGuard):
 def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard) -> tuple[np.ndarray, dict | None]:
     """``(poses, mpc)``: ``(N, 6)`` the law's poses for ``drive`` through the workspace ``guard`` (absolute, m and
     rad) and, for the MPC law, its solves: ``worst_solve_s``, ``mean_solve_s`` (wall time of each sample's step),
+    ``worst_solve_cpu_s`` (its CPU time on the calling thread),
     ``max_stroke_violation_m`` (the exact IK's re-check after each solve: ≤ 0) and ``fallbacks``; else None."""
     if algorithm != "mpc":
         return guard.guard(classical(drive, params, guard.home), drive.t), None
@@ -258,6 +259,7 @@ def commanded_poses(algorithm: str, params, drive: Drive, guard: WorkspaceGuard)
     solves = {
         "worst_solve_s": float(run.solve_times.max()),
         "mean_solve_s": float(run.solve_times.mean()),
+        "worst_solve_cpu_s": float(run.cpu_times.max()),
         "max_stroke_violation_m": float(run.stroke_violation.max()),
         "fallbacks": dict(run.fallbacks),
     }
