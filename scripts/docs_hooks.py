@@ -9,7 +9,9 @@ drift from them.
   with their outputs and figures by mkdocs-jupyter (``mkdocs.yml``: no cache, so a page never shows an earlier
   run's output; a notebook that raises fails the build);
 - ``img/*.png``: the figures of the prose pages, drawn by the package at build time (each preset's joints and legs,
-  the pose angles' sense, a workspace, the report section "The loop" on the 210 kg example machine).
+  the pose angles' sense, a workspace, the report section "The loop" on the 210 kg example machine, a ship drive
+  cued in the loop);
+- the motion-cueing page's side-by-side table (``CUEING_TABLE`` in ``motion-cueing.md``), computed at build time.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import importlib
 import inspect
 import io
 import logging
+from functools import partial
 from pathlib import Path
 
 import jupytext
@@ -27,6 +30,7 @@ from mkdocs.plugins import event_priority
 from mkdocs.structure.files import File
 
 import stewart_drake
+from stewart_drake.analyses import motion_cueing
 from stewart_drake.cli import COMMANDS, build_parser
 
 log = logging.getLogger("mkdocs.hooks.stewart_drake")
@@ -44,6 +48,7 @@ SEE_ALSO = {
     "firmware": ["../firmware-abi.md", "../pil-link.md"],
     "simulate": ["../firmware-abi.md"],
     "tune": ["../designing-the-loop.md"],
+    "cue": ["../motion-cueing.md"],
 }
 
 
@@ -58,6 +63,7 @@ PYTHON = {
     "size": "size",
     "workspace": "workspace",
     "simulate": "simulate",
+    "cue": "cue",
     "response": "loop_response",
     "tune": "tune",
     "montecarlo": "montecarlo",
@@ -268,6 +274,9 @@ def figures() -> dict[str, bytes]:
         return buf.getvalue()
 
     out = {f"img/platform-{name}.png": png(platform_figure(load_preset(name))) for name in PRESETS}
+    ship = stewart_drake.cue("gonzalez-dutra-2009", CUEING_DRIVE(), algorithm="tuned", simulate=True)
+    out["img/cueing-perception.png"] = png(ship.plot())
+    out["img/cueing-legs.png"] = png(ship.plot_legs())
     gd = load_preset("gonzalez-dutra-2009")
     out["img/convention.png"] = png(convention_figure(gd))
     views = view_figures(ws.constant_orientation_workspace(gd, resolution=0.02), title="gonzalez-dutra-2009")
@@ -276,6 +285,33 @@ def figures() -> dict[str, bytes]:
     for name, fig in docs_figures(from_machine_file(LOOP_MACHINE)).items():
         out[f"img/loop-{name}.png"] = png(fig)
     return out
+
+
+# The marker in motion-cueing.md that the side-by-side table replaces, its drives (20 s of each sea state, as in the
+# ship notebook: the build stays quick) and the drive of the page's figures.
+CUEING_TABLE = "<!-- cueing-table -->"
+CUEING_DRIVES = [partial(stewart_drake.ship_drive, s, 20.0, seed=s) for s in (3, 4, 5, 6)]
+CUEING_DRIVE = CUEING_DRIVES[2]
+CUEING_BUDGET = 128  # the tuning's evaluations: one generation (the report's full section runs tune_classical's 400)
+
+
+def cueing_table() -> str:
+    """The motion-cueing page's table: hand-set and tuned classical washout and MPC on gonzalez-dutra-2009, per ship
+    drive, the commanded motion's scores (``analyses.motion_cueing.score_table``)."""
+    machine = stewart_drake.load_machine("gonzalez-dutra-2009")
+    runs = motion_cueing.cue_runs(machine, [d() for d in CUEING_DRIVES], simulate=False, budget=CUEING_BUDGET)
+    header, rows = motion_cueing.score_table(runs, plant=False)
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for r in rows:
+        lines.append("| " + " | ".join(v if isinstance(v, str) else f"{v:.3g}" for v in r) + " |")
+    return "\n".join(lines)
+
+
+def on_page_markdown(markdown, page, config, files):
+    """Fill in the computed parts of a prose page (the motion-cueing table)."""
+    if CUEING_TABLE in markdown:
+        return markdown.replace(CUEING_TABLE, cueing_table())
+    return markdown
 
 
 @event_priority(100)  # before mkdocs-jupyter's on_files, which turns the notebooks added here into pages

@@ -29,6 +29,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api import firmware
     from stewart_drake.api.calibration import CalibrateResult, PlanMeasurementsResult, calibrate, plan_measurements
     from stewart_drake.api.cross_check import CrossCheck, cross_check
+    from stewart_drake.api.cueing import CueResult, cue
     from stewart_drake.api.design import ModesResult, StiffnessResult, modes, stiffness
     from stewart_drake.api.drawing import plot_platform
     from stewart_drake.api.dsp import DspIKResult, dsp_ik
@@ -44,6 +45,8 @@ if typing.TYPE_CHECKING:
     from stewart_drake.api.sizing import SizingResult, size
     from stewart_drake.api.tune import TuneResult, tune
     from stewart_drake.api.viewer import ViewerReadout, viewer_readout
+    from stewart_drake.control.cueing.drive import Drive, load_drive
+    from stewart_drake.control.cueing.generators import ship_drive
     from stewart_drake.core.geometry import Platform
     from stewart_drake.core.realtime_fk import RealtimeFK, RealtimeResult
     from stewart_drake.core.trajectory import Trajectory
@@ -118,6 +121,11 @@ _PUBLIC = {
     "LegIKResult": ("stewart_drake.api.leg", "LegIKResult"),
     "inspect_model": ("stewart_drake.api.model", "inspect_model"),
     "cross_check": ("stewart_drake.api.cross_check", "cross_check"),
+    "cue": ("stewart_drake.api.cueing", "cue"),
+    "CueResult": ("stewart_drake.api.cueing", "CueResult"),
+    "Drive": ("stewart_drake.control.cueing.drive", "Drive"),
+    "load_drive": ("stewart_drake.control.cueing.drive", "load_drive"),
+    "ship_drive": ("stewart_drake.control.cueing.generators", "ship_drive"),
     "CrossCheck": ("stewart_drake.api.cross_check", "CrossCheck"),
     "ModelInspection": ("stewart_drake.api.model", "ModelInspection"),
     "viewer_readout": ("stewart_drake.api.viewer", "viewer_readout"),
@@ -187,6 +195,11 @@ __all__ = [
     "ModelInspection",
     "cross_check",
     "CrossCheck",
+    "cue",
+    "CueResult",
+    "Drive",
+    "load_drive",
+    "ship_drive",
     "viewer_readout",
     "ViewerReadout",
     "plot_platform",

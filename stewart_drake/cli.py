@@ -38,6 +38,10 @@ COMMANDS = {
         "cross_check",
         "the platform's kinematics and leg forces in Pinocchio and MuJoCo against the closed forms",
     ),
+    "cue": (
+        "cue",
+        "motion cueing: a vehicle's motion (drive file or shipped drive) to platform poses, scored by perceived motion",
+    ),
     "dsp-ik": ("dsp_ik", "leg lengths as the DSP56800E firmware computes them (integer mm), with the float IK"),
     "dynamics": ("dynamics", "leg forces along a trajectory (inverse dynamics, with or without Coriolis)"),
     "firmware": (

@@ -499,6 +499,13 @@ class ArgumentError(UsageError):
     NOT_PLATFORM = "Expected {name} to be a Platform (see load_platform), got {value}"
 
 
+# motion cueing (``api.cueing``): a drive that is neither a Drive, a shipped drive's name nor a file; a parameter
+# file given to the MPC law (its parameters are an ``MpcParams``)
+CUE_DRIVE = "{name} {value}: neither a shipped drive ({names}) nor a drive file (.csv, .parquet)"
+CUE_PARAMS = "{name} {value}: a parameter file holds classical washout parameters; mpc takes an MpcParams"
+CUE_PARAMS_TYPE = "Expected params to be {what} for algorithm {algorithm!r}, got {value}"
+
+
 # ----------------------------------------------------------------------------------------------
 # The motion language (``script``): templates of ``script.errors.ScriptError`` messages, which the
 # diagnostics print as ``file:line:column: error: message``.

@@ -86,6 +86,7 @@ COMMANDS = {
     "workspace": ["workspace", "--platform", "utn-kinematic", "--resolution", "0.05", "--json", "--out", "ws"],
     "servo": ["servo", "--pose", "1", "0", "2", "1", "0", "0", "--from-home", "--json"],
     "leg": ["leg", "ik", "100", "40", "--json"],
+    "cue": ["cue", "--platform", "gonzalez-dutra-2009", "--drive", "car-braking", "--out", "cue"],
 }
 
 

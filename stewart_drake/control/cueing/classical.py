@@ -95,7 +95,7 @@ def classical(drive: Drive, params: ClassicalParams = ClassicalParams(), home=No
     accel = f * [p.scale_xy, p.scale_xy, p.scale_z] - [0.0, 0.0, p.scale_z * GRAVITY]
     pose = np.tile(home, (len(drive), 1))
     for i, omega in enumerate((p.hp_xy, p.hp_xy, p.hp_z)):
-        pose[:, i] += filter_series(_translational(omega, p.hp_zeta, p.hp_break), accel[:, i], dt)
+        pose[:, i] += filter_series(translational_tf(omega, p.hp_zeta, p.hp_break), accel[:, i], dt)
     lp = (np.array([p.tilt_lp**2]), np.array([1.0, 2 * p.tilt_zeta * p.tilt_lp, p.tilt_lp**2]))
     fx, fy = (filter_series(lp, p.scale_xy * f[:, i], dt) for i in (0, 1))
     pitch = np.arcsin(np.clip(-fx / GRAVITY, -1.0, 1.0))
@@ -109,7 +109,7 @@ def classical(drive: Drive, params: ClassicalParams = ClassicalParams(), home=No
     return pose
 
 
-def _translational(omega: float, zeta: float, brk: float) -> tuple[np.ndarray, np.ndarray]:
+def translational_tf(omega: float, zeta: float, brk: float) -> tuple[np.ndarray, np.ndarray]:
     """``(num, den)`` of position over acceleration: high-pass then double integration."""
     second = np.array([1.0, 2 * zeta * omega, omega**2])
     if brk == 0:
