@@ -69,6 +69,7 @@ class TuneResult(Result):
 
     @property
     def ok(self) -> bool:
+        """True when every step passed: margins met, a format proven, the ripple under the limit, the run good."""
         return not self.failures
 
     def _fields(self) -> dict:
