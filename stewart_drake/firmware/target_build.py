@@ -21,30 +21,28 @@ from stewart_drake.errors import FirmwareError
 from stewart_drake.firmware.link import fingerprint_header, format_fingerprint
 
 C_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
+# Cortex-M4 cores (GNU Arm toolchain, soft float): what every target shares
+CORTEX_M4 = {
+    "cc": "arm-none-eabi-gcc",
+    "size": "arm-none-eabi-size",
+    "readelf": "arm-none-eabi-readelf",
+    "objdump": "arm-none-eabi-objdump",
+    "package": "gcc-arm-none-eabi",
+    "flags": ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=soft"),
+    "entry": "Reset_Handler",
+}
 TARGETS = {
     "cortex-m4": {
+        **CORTEX_M4,
         "board": "mps2-an386",
-        "cc": "arm-none-eabi-gcc",
-        "size": "arm-none-eabi-size",
-        "readelf": "arm-none-eabi-readelf",
-        "objdump": "arm-none-eabi-objdump",
-        "package": "gcc-arm-none-eabi",
-        "flags": ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=soft"),
         "linker_script": "mps2_an386.ld",
         "runtime": ("sd_startup.c", "sd_uart_cmsdk.c"),
-        "entry": "Reset_Handler",
     },
     "stm32f405": {  # the STM32F4 Discovery and other STM32F405/F407 boards: flash at 0x08000000, USART2
+        **CORTEX_M4,
         "board": "stm32f4",
-        "cc": "arm-none-eabi-gcc",
-        "size": "arm-none-eabi-size",
-        "readelf": "arm-none-eabi-readelf",
-        "objdump": "arm-none-eabi-objdump",
-        "package": "gcc-arm-none-eabi",
-        "flags": ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=soft"),
         "linker_script": "stm32f405.ld",
         "runtime": ("sd_startup.c", "sd_usart_stm32f4.c"),
-        "entry": "Reset_Handler",
     },
 }
 LINK_SOURCES = ("sd_link.c", "sd_pil.c")
