@@ -5,14 +5,14 @@ fine format), the simulated force ripple against the length LSB with the chatter
 format confirmed on the motion with the real firmware in the loop. On the presets: margins on each, the rest on
 utn-dynamic; on a user's machine (``report.subject``) all of it on that machine.
 
-Hooks for the pieces of issue 38 built beside this one (each a few lines, marked ``HOOK``): the actuator model's
-parameters (``actuator_rows``), and the predicted ripple (``predicted_ripple``, ``control.ripple``).
+The actuators' rows (``actuator_rows``) list a screw's or a cylinder's parameters; the ripple figure shows the
+linear loop's prediction (``predicted_ripple``, ``control.ripple``) beside the simulated ripple.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 
@@ -186,19 +186,56 @@ def predicted_ripple(machine: Machine, traj, lsbs) -> np.ndarray:
     return np.array(out)
 
 
-def actuator_rows(machine: Machine) -> list[list]:
-    """The actuators as the machine states them: ``[[quantity, value, unit, where it is set]]``.
+# the units of the screw's and the cylinder's parameters (``design.screw``, ``design.hydraulic``: SI)
+PARAMETER_UNITS = {
+    "lead": "m/rev",
+    "torque_constant": "N·m/A",
+    "rotor_inertia": "kg·m²",
+    "coulomb_friction": "N",
+    "viscous_friction": "N·s/m",
+    "max_current": "A",
+    "rated_current": "A",
+    "max_motor_speed": "rad/s",
+    "current_time_constant": "s",
+    "winding_resistance": "Ω",
+    "encoder_counts": "/rev",
+    "piston_area": "m²",
+    "rod_area": "m²",
+    "dead_volume": "m³",
+    "stroke": "m",
+    "bulk_modulus": "Pa",
+    "supply_pressure": "Pa",
+    "return_pressure": "Pa",
+    "valve_flow_gain": "m³/(s·√Pa)",
+    "valve_time_constant": "s",
+    "leakage": "m³/(s·Pa)",
+    "force_gain": "1/N",
+}
 
-    HOOK (issue 38 item 1, ``actuators.model``): a row for the model and one per parameter of a screw or hydraulic
-    model."""
+
+def actuator_rows(machine: Machine) -> list[list]:
+    """The actuators as the machine states them: ``[[quantity, value, unit, where it is set]]``; for a screw or
+    hydraulic model one row per parameter (SI), set in the file or its stated default (``design.screw``,
+    ``design.hydraulic``)."""
     a = machine.actuators
     full_scale = machine.loaded_platform.legs.max_force
+    command = ["the command's full scale (Q15)", full_scale, "N", "legs.max_force"]
+    if a.model in ("screw", "hydraulic"):
+        params = a.screw(full_scale) if a.model == "screw" else a.hydraulic(machine.platform)
+        title = "servo motor on a screw" if a.model == "screw" else "servo valve and differential cylinder"
+        rows = [["model", title, "", "actuators.model"]]
+        for f in fields(params):
+            given = getattr(a, f.name, None) is not None
+            rows.append(
+                [f.name.replace("_", " "), getattr(params, f.name), "SI", f"actuators.{f.name}" if given else "default"]
+            )
+        return [*rows, command]
     limit, where = (a.max_force, "actuators.max_force") if a.max_force is not None else (full_scale, "legs.max_force")
     return [
         ["model", "first-order lag with a force limit", "", "the default"],
         ["time constant τ", a.time_constant * 1e3, "ms", "actuators.time_constant"],
         ["force limit", limit, "N", where],
-        ["the command's full scale (Q15)", full_scale, "N", "legs.max_force"],
+        command,
     ]
 
 

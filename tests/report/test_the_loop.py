@@ -4,6 +4,7 @@ finding, not an error), and its fine format and ripple sweep's LSBs."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -77,3 +78,26 @@ def test_actuators_as_the_machine_states_them(tmp_path):
     assert rows["time constant τ"][1] == pytest.approx(5.0)
     assert rows["force limit"][1:] == [150.0, "N", "actuators.max_force"]
     assert rows["the command's full scale (Q15)"][1] == m.loaded_platform.legs.max_force
+
+
+@pytest.mark.parametrize("model", ["screw", "hydraulic"])
+def test_the_actuator_rows_list_every_parameter_of_a_screw_or_cylinder_with_its_unit(model):
+    """A screw's or cylinder's rows: the model, then each resolved parameter (as ``actuators.screw``/``hydraulic``
+    give them) with a unit and where it is set (the file's field, or its default), then the command's scale."""
+    machine = load_machine(
+        "utn-dynamic",
+        {
+            "actuators.model": model,
+            "actuators.efficiency" if model == "screw" else "actuators.leakage": 0.8 if model == "screw" else 1e-12,
+        },
+    )
+    rows = the_loop.actuator_rows(machine)
+    a = machine.actuators
+    params = a.screw(machine.platform.legs.max_force) if model == "screw" else a.hydraulic(machine.platform)
+    names = [f.name for f in dataclasses.fields(params)]
+    assert rows[0][2:] == ["", "actuators.model"] and rows[-1][0].startswith("the command's full scale")
+    assert [r[0] for r in rows[1:-1]] == [n.replace("_", " ") for n in names]
+    assert [r[1] for r in rows[1:-1]] == [getattr(params, n) for n in names]
+    assert all(the_loop.PARAMETER_UNITS.get(n, "") or n == "efficiency" for n in names)
+    given = "efficiency" if model == "screw" else "leakage"
+    assert {r[0]: r[3] for r in rows[1:-1]}[given] == f"actuators.{given}"
