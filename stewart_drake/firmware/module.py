@@ -27,6 +27,12 @@ LOOP_SOURCES, LOOP_HEADERS, LOOP_DEFINES, LOOP_FLAGS = (
 )
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
 MAX_SOURCE_BYTES = 16_000_000  # a firmware source file; the generated one is ~15 kB
+# The host's optimisation of generated firmware. Its C is integer arithmetic, and the loop's float code keeps
+# numpy's roundings at every level (-ffp-contract=off), so every level gives the same words
+# (tests/firmware/test_host_gains.py compares this build with -O3's); -O1 compiles in about half the CPU of
+# -O3, which a first run on a fresh machine pays per library, at a small cost per tick beside the plant's step.
+# A caller timing the batch IK's throughput asks for -O3.
+HOST_OPT = "-O1"
 
 
 def _cdef(word: str, counting: bool, gains_table: bool = False) -> str:
@@ -131,7 +137,7 @@ def compile_generated(
     g: GeneratedFirmware,
     compiler: Compiler | None = None,
     counting: bool = False,
-    opt: str = "-O3",
+    opt: str = HOST_OPT,
     constants: bool = False,
 ) -> FirmwareModule:
     """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue.
@@ -140,7 +146,8 @@ def compile_generated(
     loading: firmware that differs only in its gains compiles once, and each set of gains is loaded from a
     copy of that library of its own (``c_build.instance``: a process maps a file's globals once), so that
     modules with different gains live side by side. ``constants``: compile ``g.files``, the C a target
-    compiles (its gains compile-time constants), as it is. Both give the same words bit for bit."""
+    compiles (its gains compile-time constants), as it is. Both give the same words bit for bit, at any
+    optimisation ``opt``."""
     files = g.files if constants else g.host_files
     sources = [
         Source("sd_firmware.c", files["sd_firmware.c"]),

@@ -1,7 +1,7 @@
 """The host's build of the generated firmware reads its gains from a table (``generate``'s ``host_files``,
-``module.compile_generated``): firmware that differs only in its gains compiles once, the target's files are
-unchanged, and the table build gives the words of the constants build bit for bit, with several gain sets
-loaded side by side."""
+``module.compile_generated``) and is optimised less (``module.HOST_OPT``): firmware that differs only in its
+gains compiles once, the target's files are unchanged, and the host's build gives the words of the target's C
+compiled at -O3 bit for bit, with several gain sets loaded side by side."""
 
 import difflib
 from dataclasses import replace
@@ -80,14 +80,12 @@ def test_gain_variants_compile_once(monkeypatch, tmp_path):
     assert len(compiles) == 2
 
 
-def _closed_loop_inputs(platform, cfg, n: int, seed: int):
-    """``n`` ticks' inputs near a closed loop's: a pose, readings within a few mm of its legs (the gains
-    decide the commands, unsaturated mostly) and a feed-forward word."""
+def _closed_loop_inputs(module, platform, cfg, n: int, seed: int):
+    """``n`` ticks' inputs near a closed loop's: a pose, readings within a few mm of its legs (``module``'s
+    IK: the gains decide the commands, unsaturated mostly) and a feed-forward word."""
     rng = np.random.default_rng(seed)
-    fmt = cfg.ik_format
-    poses = workspace_poses(platform, n, seed)
-    words = pose_words(poses, fmt)
-    legs, _ = compile_generated(generate(platform, cfg), constants=True).ik(words)
+    words = pose_words(workspace_poses(platform, n, seed), cfg.ik_format)
+    legs, _ = module.ik(words)
     measured = legs * counts_per_lsb(cfg) + rng.integers(-300, 301, (n, 6))
     return words, measured, rng.integers(-3000, 3001, (n, 6))
 
@@ -100,12 +98,13 @@ def _closed_loop_inputs(platform, cfg, n: int, seed: int):
         (NEWCOMER, QFormat(16, 3e-5, "tfr16")),
     ],
 )
-def test_table_build_equals_the_constants_build(name, fmt):
+def test_host_build_equals_the_targets_c_at_O3(name, fmt):
+    # the firmware is integer C: neither the table nor the optimisation level may change a word
     p = load_machine(name).platform if name.endswith(".yaml") else load_preset(name)
     cfgs = _variants(p, fmt)
     gens = [generate(p, cfg) for cfg in cfgs]
     table = [compile_generated(g) for g in gens]
-    const = [compile_generated(g, constants=True) for g in gens]
+    const = [compile_generated(g, constants=True, opt="-O3") for g in gens]
     # IK: every intermediate word, workspace poses and random words that saturate
     words = np.r_[
         pose_words(workspace_poses(p, 2000, 4), fmt), np.random.default_rng(4).integers(-32768, 32768, (2000, 6))
@@ -117,7 +116,7 @@ def test_table_build_equals_the_constants_build(name, fmt):
     # the tick: the three gain sets' runners interleaved (each table library keeps its own gains)
     runners = [(TickRunner(t), TickRunner(c)) for t, c in zip(table, const)]
     commands = [[] for _ in runners]
-    w, measured, ff = _closed_loop_inputs(p, cfgs[0], 400, 5)
+    w, measured, ff = _closed_loop_inputs(const[0], p, cfgs[0], 400, 5)
     for k in range(len(w)):
         for (rt, rc), out in zip(runners, commands):
             a, b = (
