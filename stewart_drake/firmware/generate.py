@@ -299,7 +299,7 @@ def generate(platform: Platform, config: ControllerConfig) -> GeneratedFirmware:
     for files, host in ((g.files, False), (g.host_files, True)):
         files["sd_firmware.h"] = _header(ctx, config, host).replace(end, "\n" + fk_prototype() + end, 1)
         files["sd_firmware.c"] = _source(ctx, e.lines, table, host) + fk
-    g.gain_words = gain_words(gains)
+    g.gain_words = _gain_words(gains)
     g.files["README.md"] = _readme(ctx, g, config, r_T, B)
     g.fk_ops = fk_ops(ik_ops)
     g.files["README.md"] += fk_readme(g.fk_cycles, config.timing.clock_hz)
@@ -479,14 +479,9 @@ int32_t sd_gains[{len(GAIN_WORDS)}];
 {lines}"""
 
 
-def gain_words(gains: FixedGains) -> tuple[int, ...]:
-    """The words of ``GAIN_WORDS`` for ``gains``: what the host build reads from ``sd_gains``."""
-    g = gains
-    return (
-        *(w for k in (g.kp, g.ki, g.kd, g.kv) for w in (k.mantissa, k.shift)),
-        g.alpha,
-        g.alpha_ff,
-    )
+def _gain_words(g: FixedGains) -> tuple[int, ...]:
+    """The words of ``GAIN_WORDS`` for the gains ``g``: what the host build reads from ``sd_gains``."""
+    return (*(w for k in (g.kp, g.ki, g.kd, g.kv) for w in (k.mantissa, k.shift)), g.alpha, g.alpha_ff)
 
 
 def _source(c: dict, ik_lines: list[str], table: str, host: bool = False) -> str:
