@@ -112,7 +112,7 @@ def main(argv=None) -> int:
 
     cfg = ControllerConfig.for_platform(p)
     g = generate(p, cfg)
-    m = compile_generated(g)  # -O3, the default build
+    m = compile_generated(g, opt="-O3")  # the optimised build (the default, module.HOST_OPT, compiles faster)
     q = workspace_poses(p, min(args.poses, 200_000), seed=1)
     w = pose_words(np.resize(q, (args.poses, 6)), cfg.ik_format)
     w16 = np.ascontiguousarray(w, dtype=m.word_dtype)

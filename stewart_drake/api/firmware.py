@@ -225,7 +225,8 @@ def generate(
     compiled = []
     if compile:
         for cc in compilers():
-            compile_generated(g, compiler=cc)  # -std=c99 -Wall -Wextra -Werror -pedantic
+            # the files written, as a target compiles them: -std=c99 -Wall -Wextra -Werror -pedantic
+            compile_generated(g, compiler=cc, constants=True)
             compiled.append(cc.name)
         if not compiled and on_note:
             on_note("no C compiler found; the module was not compile-checked")

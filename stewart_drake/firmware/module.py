@@ -3,6 +3,7 @@ with cffi: batch IK, traced IK, and the controller tick on an ``sd_state``."""
 
 from __future__ import annotations
 
+import hashlib
 import os
 import re
 from dataclasses import dataclass
@@ -11,9 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from stewart_drake.errors import FirmwareError
-from stewart_drake.firmware.generate import OPS, TRACE_WORDS, GeneratedFirmware
+from stewart_drake.firmware.generate import GAIN_WORDS, OPS, TRACE_WORDS, GeneratedFirmware
 from stewart_drake.firmware.loop_kernel import CDEF as LOOP_CDEF
-from stewart_drake.system.c_build import Compiler, Source, build, library_sources, load
+from stewart_drake.system.c_build import Compiler, Source, build, instance, library_sources, load
 from stewart_drake.system.input_stream import decode_text, read_input
 
 # the closed loop's kernel (``loop_kernel``), linked with the host glue of the tick: its fixed-point law calls
@@ -26,9 +27,15 @@ LOOP_SOURCES, LOOP_HEADERS, LOOP_DEFINES, LOOP_FLAGS = (
 )
 ABI_NAMES = ("sd_ik", "sd_init", "sd_tick", "sd_ik_trace")
 MAX_SOURCE_BYTES = 16_000_000  # a firmware source file; the generated one is ~15 kB
+# The host's optimisation of generated firmware. Its C is integer arithmetic, and the loop's float code keeps
+# numpy's roundings at every level (-ffp-contract=off), so every level gives the same words
+# (tests/firmware/test_host_gains.py compares this build with -O3's); -O1 compiles in about half the CPU of
+# -O3, which a first run on a fresh machine pays per library, at a small cost per tick beside the plant's step.
+# A caller timing the batch IK's throughput asks for -O3.
+HOST_OPT = "-O1"
 
 
-def _cdef(word: str, counting: bool) -> str:
+def _cdef(word: str, counting: bool, gains_table: bool = False) -> str:
     s = f"""
 typedef {word} sd_word;
 typedef int32_t sd_count;
@@ -45,6 +52,8 @@ int sd_host_tick(sd_state *s, const sd_word pose[6], const double L[6], double r
     s += LOOP_CDEF  # the closed loop's kernel, linked with the tick (``loop_kernel``)
     if counting:
         s += f"extern long sd_op_counts[{len(OPS)}];\n"
+    if gains_table:
+        s += f"extern int32_t sd_gains[{len(GAIN_WORDS)}];\n"
     return s
 
 
@@ -125,14 +134,26 @@ class FirmwareModule:
 
 
 def compile_generated(
-    g: GeneratedFirmware, compiler: Compiler | None = None, counting: bool = False, opt: str = "-O3"
+    g: GeneratedFirmware,
+    compiler: Compiler | None = None,
+    counting: bool = False,
+    opt: str = HOST_OPT,
+    constants: bool = False,
 ) -> FirmwareModule:
-    """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue."""
+    """Compile the generated module (strict flags: -Wall -Wextra -Werror -pedantic) with the host batch glue.
+
+    The host's build (``g.host_files``) reads its gains from the table ``sd_gains``, filled here after
+    loading: firmware that differs only in its gains compiles once, and each set of gains is loaded from a
+    copy of that library of its own (``c_build.instance``: a process maps a file's globals once), so that
+    modules with different gains live side by side. ``constants``: compile ``g.files``, the C a target
+    compiles (its gains compile-time constants), as it is. Both give the same words bit for bit, at any
+    optimisation ``opt``."""
+    files = g.files if constants else g.host_files
     sources = [
-        Source("sd_firmware.c", g.files["sd_firmware.c"]),
+        Source("sd_firmware.c", files["sd_firmware.c"]),
         *library_sources("sd_host.c", "sd_host_tick.c", *LOOP_SOURCES),
     ]
-    headers = [Source("sd_firmware.h", g.files["sd_firmware.h"]), *library_sources(*LOOP_HEADERS)]
+    headers = [Source("sd_firmware.h", files["sd_firmware.h"]), *library_sources(*LOOP_HEADERS)]
     path = build(
         sources,
         headers=headers,
@@ -143,7 +164,12 @@ def compile_generated(
         flags=("-lm", *LOOP_FLAGS),
     )
     word = "int16_t"
-    ffi, lib = load(path, _cdef(word, counting))
+    if constants:
+        ffi, lib = load(path, _cdef(word, counting))
+    else:
+        path = instance(path, "g" + hashlib.sha256(repr(g.gain_words).encode()).hexdigest()[:16])
+        ffi, lib = load(path, _cdef(word, counting, gains_table=True))
+        lib.sd_gains[0 : len(GAIN_WORDS)] = g.gain_words
     return FirmwareModule(ffi, lib, path, word, counting)
 
 

@@ -248,6 +248,24 @@ def build(
     return out
 
 
+def instance(path: Path, tag: str) -> Path:
+    """A copy of the cached library ``path`` of its own, ``<name>-<tag>.so`` in the cache (stored like a build).
+    A process maps a library file once, with one set of its globals: a library whose globals its loader sets
+    (``firmware.module``'s gains table) is loaded from one copy per setting, named by ``tag``."""
+    copy = path.with_name(f"{path.stem}-{tag}{path.suffix}")
+    if not intact(copy):
+        _store_copy(path, copy)
+    return copy
+
+
+def _store_copy(library: Path, path: Path) -> None:
+    """Store a copy of ``library`` as the cache entry ``path`` (``store``)."""
+    fd, tmp = tempfile.mkstemp(suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    shutil.copyfile(library, tmp)
+    store(Path(tmp), path)
+
+
 def _digest_path(path: Path) -> Path:
     return path.with_name(path.name + ".sha256")
 
@@ -389,11 +407,7 @@ def source_keyed_library(source: Path, cdef: str, prefix: str, opt: str = "-O2",
     key = hashlib.sha256(source.read_bytes() + cdef.encode() + " ".join((opt, *flags)).encode()).hexdigest()[:32]
     fast = cache_dir() / f"{prefix}-{key}.so"
     if not intact(fast):
-        built = build([Source(source.name, path=source)], opt=opt, flags=flags)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=fast.parent)
-        os.close(fd)
-        shutil.copyfile(built, tmp)
-        store(Path(tmp), fast)
+        _store_copy(build([Source(source.name, path=source)], opt=opt, flags=flags), fast)
     return fast
 
 
