@@ -212,9 +212,6 @@ class Reply:
     clock: int | None = None
 
 
-HELLO_RETRY_S = 0.5  # the handshake's resend interval while the target is silent
-
-
 class LinkHost:
     """The host end of a link: ``handshake()`` then ``tick(...)`` per controller period.
 
@@ -232,12 +229,12 @@ class LinkHost:
         self.seq = 0
         self._pending: list[tuple[int, int, bytes]] = []
 
-    def _await(self, kind: int, seq: int, timeout: float, also: tuple = ()) -> bytes | None:
+    def _await(self, kind: int, seq: int, timeout: float) -> bytes | None:
         end = time.monotonic() + timeout
         while True:
             while self._pending:
                 k, s, body = self._pending.pop(0)
-                if k == kind and (s == seq or s in also):
+                if k == kind and s == seq:
                     return body
                 if k == kind and ((seq - s) & 0xFFFF) < 0x8000:  # a reply to an earlier request, past its deadline
                     self.counters.late += 1
@@ -251,21 +248,14 @@ class LinkHost:
     def handshake(self, timeout: float = 2.0) -> None:
         """Exchange versions and format fingerprints.
 
-        A HELLO is sent again every ``HELLO_RETRY_S`` while the target is silent (a UART drops what arrives before
-        the target has enabled it: a board or an emulator still starting); an answer to any of them counts.
-
         Raises:
             FirmwareError: no answer in ``timeout`` s, or a target of another link version or format.
         """
-        end, sent, body = time.monotonic() + timeout, (), None
-        while body is None:
-            left = end - time.monotonic()
-            if left <= 0:
-                raise FirmwareError(FirmwareError.LINK_SILENT.format(what="the handshake", timeout=timeout))
-            self.seq = (self.seq + 1) & 0xFFFF
-            sent += (self.seq,)
-            self.write(encode_frame(HELLO, self.seq, _HELLO.pack(VERSION, self.fingerprint)))
-            body = self._await(HELLO_ACK, self.seq, min(HELLO_RETRY_S, left), also=sent)
+        self.seq = (self.seq + 1) & 0xFFFF
+        self.write(encode_frame(HELLO, self.seq, _HELLO.pack(VERSION, self.fingerprint)))
+        body = self._await(HELLO_ACK, self.seq, timeout)
+        if body is None:
+            raise FirmwareError(FirmwareError.LINK_SILENT.format(what="the handshake", timeout=timeout))
         version, theirs, accepted = _HELLO_ACK.unpack(body)
         if version != VERSION or theirs != self.fingerprint or not accepted:
             raise FirmwareError(
