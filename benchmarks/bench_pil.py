@@ -3,7 +3,8 @@ motion, ``--record`` s of the host-C loop: its reference poses and measured leg 
 a row through (a) ``sd_tick`` compiled for the host and called through cffi (``TickRunner``: the host-C loop's
 tick), ``--ticks`` times; (b) the PIL link to the host build of the PIL program (``sd_pil_stdio.c``) behind two
 pipes, ``--ticks`` times: the link's framing, CRC, sequence checks and a process round trip; (c) the link to the
-Cortex-M4 build in QEMU (``firmware.pil_target``), ``--qemu-ticks`` times. One SENSOR/COMMAND exchange a tick in
+Cortex-M4 build in QEMU on its UART (``pil.target qemu``), ``--qemu-ticks`` times; (d) the link to the
+semihosting build in QEMU (``pil.target qemu:semihosting``), ``--semihosting-ticks`` times. One SENSOR/COMMAND exchange a tick in
 lock step; the plant is replaced by the replayed log so that the link alone is timed; every command is compared
 with the host C's (the same ``sd_tick``, the same state from ``sd_init``: they must be equal).
 
@@ -11,9 +12,13 @@ A run, quoted (``--ticks 1000000 --qemu-ticks 10000 --record 2``, 2-core machine
 µs/tick; the link to a pipe 137.9 µs/tick (29.6 × host C), commands equal 1000000/1000000; the link to QEMU 4468
 µs/tick (960 × host C, 224 ticks/s), commands equal 10000/10000. An earlier run of 10⁵ ticks to QEMU (load 9-11):
 4258 µs/tick, 235 ticks/s, equal 100000/100000. QEMU's UART model takes one byte per trip through its main loop:
-10⁶ ticks to QEMU would take about 75 min.
+10⁶ ticks over it would take about 75 min; the semihosting console takes a frame a call (``--ticks 100000 --qemu-ticks 5000 --semihosting-ticks 100000``, load 0.1-0.4: host C
+2.34 µs/tick, a pipe 92.6, the UART 2986, semihosting 123.5 µs/tick: 24.2 × faster than the UART, commands equal
+100000/100000). The whole
+closed loop over 10⁶ ticks: ``bench_pil_loop.py``.
 
-Run by hand: ``python benchmarks/bench_pil.py [--ticks 1000000] [--qemu-ticks 10000] [--record 2]``. Prints wall
+Run by hand: ``python benchmarks/bench_pil.py [--ticks 1000000] [--qemu-ticks 10000] [--semihosting-ticks 100000]
+[--record 2]``. Prints wall
 µs per tick for each, their ratios to the host C, the QEMU ticks/s and the load first and last. Measures only.
 """
 
@@ -84,7 +89,8 @@ class PipeTarget:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--ticks", type=int, default=1_000_000, help="through the host C and the link to a pipe")
-    ap.add_argument("--qemu-ticks", type=int, default=10_000, help="through the link to QEMU")
+    ap.add_argument("--qemu-ticks", type=int, default=10_000, help="through the link to QEMU's UART")
+    ap.add_argument("--semihosting-ticks", type=int, default=100_000, help="through the link to QEMU's semihosting")
     ap.add_argument("--record", type=float, default=2.0, help="seconds of the closed loop replayed")
     a = ap.parse_args()
     print(f"load {os.getloadavg()[0]:.2f}")
@@ -93,7 +99,7 @@ def main() -> None:
     n = len(words)
     runner = TickRunner(compile_generated(generate(sc.platform, sc.config)))
     t0 = time.perf_counter()
-    host = np.empty((max(a.ticks, a.qemu_ticks), 6), dtype=np.int16)  # the commands, Q15 words
+    host = np.empty((max(a.ticks, a.qemu_ticks, a.semihosting_ticks), 6), dtype=np.int16)  # the commands, Q15 words
     for k in range(len(host)):
         host[k] = runner.tick(words[k % n], counts[k % n], None)
     t_host = (time.perf_counter() - t0) / len(host)
@@ -101,11 +107,16 @@ def main() -> None:
         exe = build_host(files, Path(work))
         t_pipe, same_pipe = through(PipeTarget(exe), files, words, counts, a.ticks, host)
     t_qemu, same_qemu = through(QemuTarget(target_elf(files)), files, words, counts, a.qemu_ticks, host)
+    semi = QemuTarget(target_elf(files, "cortex-m4-semihosting"), "qemu:semihosting")
+    t_semi, same_semi = through(semi, files, words, counts, a.semihosting_ticks, host)
     print(f"{n} ticks replayed; host C (cffi) {t_host * 1e6:.2f} µs/tick")
     print(f"link to a pipe: {a.ticks} ticks, {t_pipe * 1e6:.1f} µs/tick ({t_pipe / t_host:.1f} × host C), "
           f"equal commands {same_pipe}/{a.ticks}")  # fmt: skip
     print(f"link to QEMU: {a.qemu_ticks} ticks, {t_qemu * 1e6:.0f} µs/tick ({t_qemu / t_host:.0f} × host C, "
           f"{1 / t_qemu:.0f} ticks/s), equal commands {same_qemu}/{a.qemu_ticks}")  # fmt: skip
+    print(f"link to QEMU, semihosting: {a.semihosting_ticks} ticks, {t_semi * 1e6:.1f} µs/tick "
+          f"({t_semi / t_host:.0f} × host C, {t_qemu / t_semi:.1f} × faster than the UART, {1 / t_semi:.0f} ticks/s), "
+          f"equal commands {same_semi}/{a.semihosting_ticks}")  # fmt: skip
     print(f"load {os.getloadavg()[0]:.2f}")
 
 

@@ -880,7 +880,7 @@ class FirmwareError(StewartError):
         "PIL link: the target (link version {version}, format fingerprint {fingerprint}) refused the handshake of "
         "this host (version {our_version}, fingerprint {ours}): rebuild it from the same module and options"
     )
-    NO_QEMU = "pil.target qemu: {tool} not found on PATH (install {package})"
+    NO_QEMU = "pil.target {target}: {tool} not found on PATH (install {package})"
     PIL_START = "pil.target {target}: {what} cannot be started or opened: {detail}"
     PIL_LAW = "pil.target {target} runs the fixed-point firmware (controller.law fixed), not the {law} law"
     PIL_GONE = "PIL link: the target closed the link at tick {tick}"

@@ -293,7 +293,9 @@ def build(
     Args:
         platform: the platform, or a ``Machine``.
         out: the output folder: new, empty, or holding only files this command wrote.
-        target: ``"cortex-m4"`` (the Arm MPS2+ AN386 board, as QEMU's ``mps2-an386`` models it).
+        target: ``"cortex-m4"`` (the Arm MPS2+ AN386 board, as QEMU's ``mps2-an386`` models it, the link on its
+            UART), ``"cortex-m4-semihosting"`` (the same board, the link on the semihosting console: QEMU or a
+            debug probe) or ``"stm32f405"`` (an STM32F405/F407 board, the link on USART2).
         trajectory: design the gains over this reference's poses (as ``generate``).
         platform_source: how the platform is named in the recorded options (as ``generate``).
         **format: the firmware format keywords of ``generate``.

@@ -569,8 +569,8 @@ def simulate(
         **options: the run's options (below, ``plan_run``'s keywords) and any spec path,
             ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values in SI or in the quantity
             grammar). An option left out (or None) keeps the machine's value. ``**{"pil.target": "qemu"}`` runs
-            each tick on the firmware built for a Cortex-M4 in QEMU (``"serial:/dev/ttyX"``: on a board) over the
-            PIL link, in lock step (``summary["pil"]``: the link's counters, faults, round trips and the measured
+            each tick on the firmware built for a Cortex-M4 in QEMU (``"qemu:semihosting"``: its faster build,
+            the link on the semihosting console; ``"serial:/dev/ttyX"``: on a board) over the PIL link, in lock step (``summary["pil"]``: the link's counters, faults, round trips and the measured
             tick; docs/simulation-to-board.md).
 
     Keyword Args:

@@ -101,8 +101,9 @@ def register(sub) -> None:
         "--target",
         default="cortex-m4",
         metavar="NAME",
-        help="the processor: cortex-m4 (the MPS2+ AN386 board, as QEMU models it) or stm32f405 (an STM32F405/F407 "
-        "board such as the STM32F4 Discovery: USART2 on PA2/PA3) (arm-none-eabi-gcc; default cortex-m4)",
+        help="the processor: cortex-m4 (the MPS2+ AN386 board, as QEMU models it), cortex-m4-semihosting (the same "
+        "board, its link on the semihosting console: QEMU or a debug probe) or stm32f405 (an STM32F405/F407 board "
+        "such as the STM32F4 Discovery: USART2 on PA2/PA3) (arm-none-eabi-gcc; default cortex-m4)",
     )
     b.add_argument(
         "--out", required=True, metavar="DIR", help="output folder (created; only its own files are replaced)"

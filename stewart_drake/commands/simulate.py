@@ -118,7 +118,8 @@ def register(sub) -> None:
         default=None,
         metavar="TARGET",
         help="processor in the loop: each tick computed by the firmware on qemu (the Cortex-M4 build in QEMU's "
-        "mps2-an386) or serial:/dev/ttyX (a flashed board) over the PIL link (pil.target)",
+        "mps2-an386, the link on its UART), qemu:semihosting (the same, the link on the semihosting console: "
+        "about 10 times as fast) or serial:/dev/ttyX (a flashed board) over the PIL link (pil.target)",
     )
     p.add_argument(
         "--pil-fault",

@@ -37,7 +37,7 @@ from stewart_drake.firmware.link import (
     format_fingerprint,
     sensor_body,
 )
-from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT, open_target
+from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT, QEMU_LINKS, open_target
 from stewart_drake.fixedpoint.generic import pose_words
 from stewart_drake.spec.machine import PilSpec
 
@@ -90,6 +90,7 @@ class PilLaw(FixedPointLaw):
         if not spec.target:
             raise ValueError("PilLaw without pil.target")  # a caller's bug: the spec chooses this law
         self.spec, self.faults = spec, PilFaults(spec, seed)
+        self.tick_count = 0  # before the handshake: a target gone during it is reported at tick 0
         self.generated = generate(self.platform, self.config)
         self.files = program_module(self.platform, self.config, self.generated)
         self.target = open_target(spec.target, self.files)
@@ -104,7 +105,6 @@ class PilLaw(FixedPointLaw):
         self._state_sent = False
         self._last = None  # the last (command, setpoint, saturated) applied
         self._delayed: bytes | None = None
-        self.tick_count = 0
         # each tick with a command: its number (from 1), round trip (s, SENSOR written to COMMAND read) and the
         # clock counts of the target's sd_tick (None: no clock)
         self.answered: list[int] = []
@@ -215,7 +215,7 @@ class PilLaw(FixedPointLaw):
         timing = None
         if counts:
             T, dsp = self.timing.sample_period, float(self.generated.tick_cycles)
-            if self.spec.target == "qemu":  # counts of 40 instructions (-icount), cycles by the stated model
+            if self.spec.target in QEMU_LINKS:  # counts of 40 instructions (-icount), cycles by the stated model
                 worst, mean = max(counts) * INSTRUCTIONS_PER_COUNT, float(np.mean(counts)) * INSTRUCTIONS_PER_COUNT
                 cycles, resolution, cpi = (
                     worst * M4_CYCLES_PER_INSTRUCTION,

@@ -2,8 +2,11 @@
 Cortex-M4 and run in QEMU, or a board on a serial port. Each is a byte stream with ``write(data)``,
 ``read(timeout)`` (``firmware.link``'s reader) and ``close()``.
 
-QEMU runs ``-M mps2-an386`` with the board's UART0 on its standard input and output (two pipes: no port to
-choose, nothing for another process to connect to) and ``-icount shift=0``: each instruction advances the
+QEMU runs ``-M mps2-an386`` with the link on its standard input and output (two pipes: no port to choose,
+nothing for another process to connect to): ``qemu`` puts the board's UART0 there, the byte-at-a-time path a
+board takes; ``qemu:semihosting`` runs the build whose link is the semihosting console,
+which QEMU reads and writes on the same pipes (``target/sd_semihost.c``: a frame a call instead of a byte a
+trip through QEMU's main loop; the rest of the program is the same). Both run ``-icount shift=0``: each instruction advances the
 virtual clock by 1 ns, so the SysTick counts the PIL program reads around ``sd_tick`` (the AN386's 25 MHz
 processor clock, 40 ns) are whole instructions / 40: ``INSTRUCTIONS_PER_COUNT``. The process is killed by
 ``close()``, by the kernel when this process dies (``PR_SET_PDEATHSIG``) and, as a last resort, when the
@@ -31,7 +34,15 @@ from stewart_drake.system.c_build import cache_dir, intact, store
 from stewart_drake.system.processes import die_with_parent
 
 QEMU = "qemu-system-arm"
-QEMU_ARGS = ("-M", "mps2-an386", "-nographic", "-monitor", "none", "-serial", "stdio", "-icount", "shift=0")
+QEMU_ARGS = ("-M", "mps2-an386", "-nographic", "-monitor", "none", "-icount", "shift=0")
+# pil.target -> (the target build it runs, QEMU's arguments that put its link on standard input and output)
+QEMU_LINKS = {
+    "qemu": ("cortex-m4", ("-serial", "stdio")),
+    "qemu:semihosting": (
+        "cortex-m4-semihosting",
+        ("-serial", "none", "-semihosting-config", "enable=on,target=native"),
+    ),
+}
 INSTRUCTIONS_PER_COUNT = 40  # icount shift=0: 1 ns an instruction; the AN386's SysTick: 25 MHz, 40 ns a count
 SERIAL_BAUD = termios.B115200
 CLOSE_WAIT_S = 5.0
@@ -64,13 +75,13 @@ class QemuTarget:
         FirmwareError: QEMU is not installed or does not start.
     """
 
-    def __init__(self, elf: Path):
+    def __init__(self, elf: Path, target: str = "qemu"):
         qemu = shutil.which(QEMU)
         if qemu is None:
-            raise FirmwareError(FirmwareError.NO_QEMU.format(tool=QEMU, package="qemu-system-arm"))
+            raise FirmwareError(FirmwareError.NO_QEMU.format(target=target, tool=QEMU, package="qemu-system-arm"))
         try:
             self.process = subprocess.Popen(
-                [qemu, *QEMU_ARGS, "-kernel", str(elf)],
+                [qemu, *QEMU_ARGS, *QEMU_LINKS[target][1], "-kernel", str(elf)],
                 stdin=subprocess.PIPE,
                 stdout=subprocess.PIPE,
                 stderr=subprocess.DEVNULL,
@@ -78,7 +89,7 @@ class QemuTarget:
                 preexec_fn=die_with_parent,
             )
         except OSError as e:
-            raise FirmwareError(FirmwareError.PIL_START.format(target="qemu", what=QEMU, detail=e)) from None
+            raise FirmwareError(FirmwareError.PIL_START.format(target=target, what=QEMU, detail=e)) from None
         self.read = pipe_reader(self.process.stdout.fileno())
         self._finalizer = weakref.finalize(self, _stop, self.process)
 
@@ -135,8 +146,8 @@ class SerialTarget:
 
 
 def open_target(target: str, files: dict) -> QemuTarget | SerialTarget:
-    """The link's other end for ``pil.target`` (``qemu``: the ELF of ``files`` built and started in QEMU;
-    ``serial:PATH``: the port, the board already flashed)."""
-    if target == "qemu":
-        return QemuTarget(target_elf(files))
+    """The link's other end for ``pil.target`` (``qemu``, ``qemu:semihosting``: the ELF of ``files`` built and
+    started in QEMU; ``serial:PATH``: the port, the board already flashed)."""
+    if target in QEMU_LINKS:
+        return QemuTarget(target_elf(files, QEMU_LINKS[target][0]), target)
     return SerialTarget(target.split(":", 1)[1])

@@ -38,6 +38,12 @@ TARGETS = {
         "linker_script": "mps2_an386.ld",
         "runtime": ("sd_startup.c", "sd_uart_cmsdk.c"),
     },
+    "cortex-m4-semihosting": {  # the same board, the link on the semihosting console: QEMU or a debug probe
+        **CORTEX_M4,
+        "board": "mps2-an386",
+        "linker_script": "mps2_an386.ld",
+        "runtime": ("sd_startup.c", "sd_semihost.c"),
+    },
     "stm32f405": {  # the STM32F4 Discovery and other STM32F405/F407 boards: flash at 0x08000000, USART2
         **CORTEX_M4,
         "board": "stm32f4",

@@ -29,7 +29,7 @@ LATENCIES = ("sample", "computation", "none")
 ENGINES = ("c", "python")
 
 MOTION_WORDS = ("seed", "rotating")
-PIL_TARGETS = ("qemu", "serial:PATH")
+PIL_TARGETS = ("qemu", "qemu:semihosting", "serial:PATH")
 PIL_FAULTS = ("drop", "corrupt", "delay", "duplicate")
 PIL_REACTIONS = ("hold", "stop")
 PIL_FAULT_RULE = "KIND:RATE (0 < RATE < 1 a tick) or KIND:@K[,K...] (ticks, from 1), KIND one of " + ", ".join(
@@ -291,7 +291,8 @@ class RunSpec:
 @dataclass(frozen=True)
 class PilSpec:
     """Processor in the loop: ``target`` (None: the tick runs on the host; ``qemu``: the firmware built for the
-    Cortex-M4 in QEMU's MPS2 AN386; ``serial:PATH``: a board on the serial port PATH) computes each tick over the
+    Cortex-M4 in QEMU's MPS2 AN386, its link on the board's UART; ``qemu:semihosting``: the same with the link on
+    the semihosting console, a frame a call; ``serial:PATH``: a board on the serial port PATH) computes each tick over the
     link (``firmware.link``); ``fault`` injects link faults (``drop``, ``corrupt``, ``delay``, ``duplicate``) at a
     seeded rate a tick (``drop:0.01``, seeded by ``run.seed``) or at given ticks (``corrupt:@10,200``, counted
     from 1); ``on_fault``: the controller's reaction to a tick without a command, ``hold`` (keep the last
@@ -305,7 +306,7 @@ class PilSpec:
 
     def __post_init__(self):
         t = self.target
-        if t is not None and not (t == "qemu" or (t.startswith("serial:") and len(t) > len("serial:"))):
+        if t is not None and not (t in PIL_TARGETS[:2] or (t.startswith("serial:") and len(t) > len("serial:"))):
             rule = "one of " + ", ".join(PIL_TARGETS)
             raise MachineError(MachineError.RANGE.format(path="pil.target", rule=rule, value=t))
         if self.fault is not None:

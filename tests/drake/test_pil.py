@@ -2,11 +2,12 @@
 plant. The logs equal the host-C loop's bit for bit (the same IEEE conversions on both sides of the same
 ``sd_tick``); each injected link fault is detected by the counters it should move and gets the stated
 reaction; QEMU never outlives the run; the instruction count per tick is measured; the same link runs over a
-pseudo-terminal to the host build of the PIL program.
+pseudo-terminal to the host build of the PIL program. Both QEMU links run: ``qemu`` (the board's UART) and
+``qemu:semihosting`` (the semihosting console; the same program but for its byte driver).
 
-Cost: QEMU passes ~100-200 ticks/s here (each byte of a frame is one trip through its UART model; measured on
-this 2-core machine under load), so the three 10⁴-tick runs (marked slow) take about 1-3 min each; the rest
-run 150-300 ticks.
+Cost: over the UART QEMU passes ~100-200 ticks/s here (each byte of a frame is one trip through its UART
+model; measured on this 2-core machine under load), over semihosting ~2500 (the whole closed loop), so the
+10⁴-tick runs (marked slow) take about 1 min on the UART and 5-10 s on semihosting; the rest run 100-300 ticks.
 """
 
 import json
@@ -27,7 +28,7 @@ from stewart_drake.api.simulation import plan_run
 from stewart_drake.errors import PIL_STOPPED
 from stewart_drake.firmware.generate import generate
 from stewart_drake.firmware.pil import M4_CLOCKS_HZ, PilFaults, program_module
-from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT
+from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT, QemuTarget, target_elf
 from stewart_drake.firmware.target_build import build_host
 from stewart_drake.spec.machine import PilSpec
 from tests.cli._inprocess import cli
@@ -56,9 +57,17 @@ def assert_same_logs(a, b, rows=None):
 
 @needs_qemu
 @pytest.mark.slow
-@pytest.mark.parametrize("machine", ["utn-dynamic", "gonzalez-dutra-2009", NEWCOMER])
-def test_ten_thousand_ticks_in_qemu_equal_the_host_c_loop_bit_for_bit(machine):
-    host, pil = runs(machine, 10.0, target="qemu")
+@pytest.mark.parametrize(
+    "machine, target",
+    [
+        ("utn-dynamic", "qemu:semihosting"),
+        ("gonzalez-dutra-2009", "qemu:semihosting"),
+        (NEWCOMER, "qemu:semihosting"),
+        (NEWCOMER, "qemu"),  # the byte-at-a-time UART path, as a board takes it
+    ],
+)
+def test_ten_thousand_ticks_in_qemu_equal_the_host_c_loop_bit_for_bit(machine, target):
+    host, pil = runs(machine, 10.0, target=target)
     assert pil.summary["ticks"] == host.summary["ticks"] >= 10_000
     assert_same_logs(host, pil)
     report = pil.summary["pil"]
@@ -88,6 +97,38 @@ def test_qemu_run_equals_the_host_c_loop_and_the_emulation_and_measures_the_tick
 
 
 @needs_qemu
+def test_both_qemu_links_run_the_same_tick_and_count_the_same_instructions():
+    """The two QEMU builds differ only in the link's byte driver: the logs are equal, and the instructions
+    counted around sd_tick agree to the SysTick's resolution (the count's phase against the 40 ns clock
+    differs)."""
+    uart = sd.simulate(NEWCOMER, duration=0.2, **{"pil.target": "qemu"})
+    semi = sd.simulate(NEWCOMER, duration=0.2, **{"pil.target": "qemu:semihosting"})
+    assert_same_logs(uart, semi)
+    a, b = uart.summary["pil"], semi.summary["pil"]
+    assert a["per_tick"]["tick"] == b["per_tick"]["tick"] == list(range(1, uart.summary["ticks"] + 1))
+    ca, cb = np.array(a["per_tick"]["clock_counts"]), np.array(b["per_tick"]["clock_counts"])
+    assert np.all(np.abs(ca - cb) <= 1)
+    ta, tb = a["timing"], b["timing"]
+    assert abs(ta["instructions_worst"] - tb["instructions_worst"]) <= INSTRUCTIONS_PER_COUNT
+    assert tb["instructions_resolution"] == INSTRUCTIONS_PER_COUNT
+
+
+@needs_qemu
+def test_the_semihosting_build_ends_when_the_host_closes_the_link():
+    sc = plan_run("utn-dynamic", duration=0.1).scenario
+    target = QemuTarget(target_elf(program_module(sc.platform, sc.config), "cortex-m4-semihosting"), "qemu:semihosting")
+    try:
+        target.process.stdin.close()  # the end of its input: SYS_EXIT, QEMU's exit status 0
+        assert target.process.wait(timeout=30) == 0
+    finally:
+        target.close()
+
+
+QEMU_TARGETS = ("qemu", "qemu:semihosting")
+
+
+@needs_qemu
+@pytest.mark.parametrize("target", QEMU_TARGETS)
 @pytest.mark.parametrize(
     "fault, counts",
     [
@@ -96,8 +137,8 @@ def test_qemu_run_equals_the_host_c_loop_and_the_emulation_and_measures_the_tick
         ("delay", {"lost": 1, "late": 1}),  # the next frame comes first; this one after it
     ],
 )
-def test_a_tick_without_its_command_is_detected_and_held(fault, counts):
-    host, pil = runs("utn-dynamic", 0.15, target="qemu", fault=f"{fault}:@{FAULT_TICK}", timeout=TIMEOUT)
+def test_a_tick_without_its_command_is_detected_and_held(fault, counts, target):
+    host, pil = runs("utn-dynamic", 0.15, target=target, fault=f"{fault}:@{FAULT_TICK}", timeout=TIMEOUT)
     r = pil.summary["pil"]
     assert r["events"] == [{"tick": FAULT_TICK, "fault": fault}, {"tick": FAULT_TICK, "no_command": "hold"}]
     target = {k: r["target_counters"][k] for k in ("corrupt", "lost", "duplicate", "late")}
@@ -115,8 +156,9 @@ def test_a_tick_without_its_command_is_detected_and_held(fault, counts):
 
 
 @needs_qemu
-def test_a_duplicated_frame_is_counted_and_ignored():
-    host, pil = runs("utn-dynamic", 0.1, target="qemu", fault=f"duplicate:@{FAULT_TICK}", timeout=TIMEOUT)
+@pytest.mark.parametrize("target", QEMU_TARGETS)
+def test_a_duplicated_frame_is_counted_and_ignored(target):
+    host, pil = runs("utn-dynamic", 0.1, target=target, fault=f"duplicate:@{FAULT_TICK}", timeout=TIMEOUT)
     r = pil.summary["pil"]
     assert r["target_counters"]["duplicate"] == 1 and r["ticks_without_command"] == 0
     assert_same_logs(host, pil)  # acted on once: nothing changes
@@ -158,7 +200,7 @@ def test_fault_draws_follow_the_seed():
 
 def test_pil_settings_are_checked_with_their_flags(tmp_path, capsys):
     rc, out, err = cli(capsys, "simulate", "--pil", "usb", "--out", str(tmp_path / "s"))
-    assert rc == 2 and err.strip().endswith("--pil must be one of qemu, serial:PATH, got usb")
+    assert rc == 2 and err.strip().endswith("--pil must be one of qemu, qemu:semihosting, serial:PATH, got usb")
     rc, out, err = cli(capsys, "simulate", "--pil", "qemu", "--pil-fault", "drop:3", "--out", str(tmp_path / "s"))
     assert rc == 2 and "--pil-fault must be KIND:RATE" in err and err.strip().endswith("got drop:3")
     rc, out, err = cli(capsys, "simulate", "--pil", "qemu", "--controller", "float", "--out", str(tmp_path / "s"))

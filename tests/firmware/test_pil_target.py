@@ -31,8 +31,9 @@ def test_the_elf_is_cached_by_the_content_of_its_sources(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     "field, value, message",
     [
-        ("target", "qemu2", "pil.target must be one of qemu, serial:PATH, got qemu2"),
-        ("target", "serial:", "pil.target must be one of qemu, serial:PATH, got serial:"),
+        ("target", "qemu2", "pil.target must be one of qemu, qemu:semihosting, serial:PATH, got qemu2"),
+        ("target", "qemu:semihost", "pil.target must be one of qemu, qemu:semihosting, serial:PATH, got qemu:semihost"),
+        ("target", "serial:", "pil.target must be one of qemu, qemu:semihosting, serial:PATH, got serial:"),
         ("fault", "drop:1.5", "pil.fault must be KIND:RATE"),
         ("fault", "flip:0.1", "pil.fault must be KIND:RATE"),
         ("fault", "drop:@0", "pil.fault must be KIND:RATE"),

@@ -162,7 +162,7 @@ def test_cli_reports_code_data_and_stack(tmp_path, capsys):
 def test_cli_refuses_an_unknown_target(tmp_path, capsys):
     rc, out, err = cli(capsys, "firmware", "build", "--target", "cortex-m0", "--out", str(tmp_path / "b"))
     assert rc == 2
-    assert err.strip().endswith("--target must be one of cortex-m4, stm32f405, got 'cortex-m0'")
+    assert err.strip().endswith("--target must be one of cortex-m4, cortex-m4-semihosting, stm32f405, got 'cortex-m0'")
     assert not (tmp_path / "b").exists()
 
 
@@ -226,6 +226,17 @@ def test_the_stm32f405_build_boots_from_flash_with_its_stack_at_the_top_of_sram(
     assert sp == 0x20000000 + 128 * 1024
     assert 0x08000000 < reset < 0x08000000 + b.text and reset & 1  # a Thumb address in the flash
     assert b.stack_bytes is not None and b.data + b.bss + b.stack_bytes < 128 * 1024
+
+
+@needs_cross
+def test_the_semihosting_build_is_the_uart_build_but_for_its_byte_driver(tmp_path):
+    files = generated(tmp_path / "gen")
+    uart = build_target(files, tmp_path / "uart", target="cortex-m4")
+    semi = build_target(files, tmp_path / "semi", target="cortex-m4-semihosting")
+    assert semi.functions == uart.functions  # sd_ik, sd_tick, sd_fk: the same code bytes and stack bounds
+    assert semi.stack_bytes is not None and semi.stack_path[:3] == ("Reset_Handler", "main", "sd_pil_byte")
+    calls = [tool("arm-none-eabi-objdump", "-d", str(b.elf)).count("bkpt\t0x00ab") for b in (uart, semi)]
+    assert calls[0] == 0 and calls[1] >= 3  # open, read and write the console (and exit)
 
 
 def handshake_until_listening(host: link.LinkHost, timeout: float) -> None:
