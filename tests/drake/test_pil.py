@@ -114,6 +114,18 @@ def test_both_qemu_links_run_the_same_tick_and_count_the_same_instructions():
 
 
 @needs_qemu
+@pytest.mark.parametrize("model", ["screw", "hydraulic"])
+def test_the_target_drives_screw_and_hydraulic_actuators_like_the_host(model):
+    """The actuator models run on the Python tick loop; the tick on the target gives the same logs."""
+    options = {"actuators.model": model}
+    host = sd.simulate(NEWCOMER, duration=0.3, engine="c", **options)
+    pil = sd.simulate(NEWCOMER, duration=0.3, **options, **{"pil.target": "qemu:semihosting"})
+    assert pil.summary["tick_loop"] == "pil" and pil.summary["actuator_model"] == model
+    assert_same_logs(host, pil)
+    assert pil.summary["pil"]["ticks_without_command"] == 0
+
+
+@needs_qemu
 def test_the_semihosting_build_ends_when_the_host_closes_the_link():
     sc = plan_run("utn-dynamic", duration=0.1).scenario
     target = QemuTarget(target_elf(program_module(sc.platform, sc.config), "cortex-m4-semihosting"), "qemu:semihosting")
