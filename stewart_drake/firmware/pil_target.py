@@ -79,19 +79,34 @@ class QemuTarget:
         qemu = shutil.which(QEMU)
         if qemu is None:
             raise FirmwareError(FirmwareError.NO_QEMU.format(target=target, tool=QEMU, package="qemu-system-arm"))
+        self.errors = tempfile.TemporaryFile()  # QEMU's messages: the reason it ended, if it ends early
         try:
             self.process = subprocess.Popen(
                 [qemu, *QEMU_ARGS, *QEMU_LINKS[target][1], "-kernel", str(elf)],
                 stdin=subprocess.PIPE,
                 stdout=subprocess.PIPE,
-                stderr=subprocess.DEVNULL,
+                stderr=self.errors,
                 bufsize=0,
                 preexec_fn=die_with_parent,
             )
         except OSError as e:
+            self.errors.close()
             raise FirmwareError(FirmwareError.PIL_START.format(target=target, what=QEMU, detail=e)) from None
         self.read = pipe_reader(self.process.stdout.fileno())
-        self._finalizer = weakref.finalize(self, _stop, self.process)
+        self._finalizer = weakref.finalize(self, _stop, self.process, self.errors)
+
+    def ended(self) -> str:
+        """Why QEMU ended (its exit status and last message), or "" if it still runs a second after the call (its
+        output closed: it is ending)."""
+        try:
+            status = self.process.wait(1.0)
+        except subprocess.TimeoutExpired:
+            return ""
+        if self.errors.closed:
+            return ""
+        self.errors.seek(0)
+        lines = [ln.strip() for ln in self.errors.read().decode(errors="replace").splitlines() if ln.strip()]
+        return f"QEMU exited with status {status}" + (f": {lines[-1]}" if lines else "")
 
     def write(self, data: bytes) -> None:
         try:
@@ -100,14 +115,14 @@ class QemuTarget:
             raise EOFError("QEMU closed the link") from None
 
     def close(self) -> None:
-        """Stop QEMU (killed: the program never ends by itself) and wait for it."""
+        """Stop QEMU (killed: the UART build never ends by itself) and wait for it."""
         self._finalizer()
 
 
-def _stop(process: subprocess.Popen) -> None:
+def _stop(process: subprocess.Popen, errors) -> None:
     process.kill()
     process.wait(CLOSE_WAIT_S)
-    for f in (process.stdin, process.stdout):
+    for f in (process.stdin, process.stdout, errors):
         f.close()
 
 

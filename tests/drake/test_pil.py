@@ -24,6 +24,7 @@ import pytest
 
 import stewart_drake as sd
 import stewart_drake.firmware.pil as pil_module
+import stewart_drake.firmware.pil_target as pil_target
 from stewart_drake.api.simulation import plan_run
 from stewart_drake.errors import PIL_STOPPED
 from stewart_drake.firmware.generate import generate
@@ -281,8 +282,20 @@ def test_a_target_that_dies_mid_run_is_one_error_naming_the_tick(monkeypatch):
         return target
 
     monkeypatch.setattr(pil_module, "open_target", dying)
-    with pytest.raises(sd.StewartError, match=r"^PIL link: the target closed the link at tick \d+$"):
+    gone = r"^PIL link: the target closed the link at tick \d+ \(QEMU exited with status -9\)$"  # SIGKILL
+    with pytest.raises(sd.StewartError, match=gone):
         sd.simulate("utn-dynamic", duration=30.0, **{"pil.target": "qemu"})
+
+
+@needs_qemu
+def test_a_qemu_that_refuses_to_start_is_one_error_with_its_own_message(monkeypatch):
+    link = ("-serial", "none", "-semihosting-config", "enable=on,target=nowhere")  # a QEMU without this option
+    monkeypatch.setitem(pil_target.QEMU_LINKS, "qemu:semihosting", ("cortex-m4-semihosting", link))
+    with pytest.raises(sd.StewartError) as e:
+        sd.simulate("utn-dynamic", duration=0.05, **{"pil.target": "qemu:semihosting"})
+    message = str(e.value)
+    assert message.startswith("PIL link: the target closed the link at tick 0 (QEMU exited with status 1: ")
+    assert "target=nowhere" in message and "\n" not in message
 
 
 @pytest.mark.skipif(shutil.which("cc") is None, reason="no host C compiler")
