@@ -235,9 +235,11 @@ def alive(pid: int) -> bool:
 
 
 @needs_qemu
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL])
-def test_qemu_ends_with_the_run_even_when_it_is_interrupted_or_killed(sig):
-    code = "import stewart_drake as sd; sd.simulate('utn-dynamic', duration=30.0, **{'pil.target': 'qemu'})"
+@pytest.mark.parametrize(
+    "sig, target", [(signal.SIGINT, "qemu"), (signal.SIGKILL, "qemu"), (signal.SIGKILL, "qemu:semihosting")]
+)
+def test_qemu_ends_with_the_run_even_when_it_is_interrupted_or_killed(sig, target):
+    code = f"import stewart_drake as sd; sd.simulate('utn-dynamic', duration=30.0, **{{'pil.target': '{target}'}})"
     p = subprocess.Popen([sys.executable, "-c", code], cwd=os.getcwd(), stderr=subprocess.PIPE)
     try:
         for _ in range(1200):  # QEMU starts once the ELF is built and the plant loaded: seconds here
