@@ -57,7 +57,7 @@ if typing.TYPE_CHECKING:
     from stewart_drake.spec import Machine, load_machine
     from stewart_drake.synthesis.api import OptimizeResult, WorkspaceProof, load_requirements, optimize, prove_workspace
 
-__version__ = "0.4.0"
+__version__ = "0.4.1"
 
 
 # public name -> (module that defines it, its name there). The module is imported on first use of the name:

@@ -118,7 +118,7 @@ def test_version_is_one_in_pyproject_and_package():
     import stewart_drake as sd
 
     meta = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
-    assert meta["project"]["version"] == sd.__version__ == "0.4.0"
+    assert meta["project"]["version"] == sd.__version__ == "0.4.1"
 
 
 def test_all_names_resolve_and_nothing_public_is_unlisted():
