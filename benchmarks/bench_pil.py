@@ -1,25 +1,25 @@
-"""The PIL link's cost per tick beside the host C's: a closed-loop run's sensor stream (utn-dynamic, the seed
-motion, ``--record`` s of the host-C loop: its reference poses and measured leg lengths at each tick) replayed in
-a row through (a) ``sd_tick`` compiled for the host and called through cffi (``TickRunner``: the host-C loop's
-tick), ``--ticks`` times; (b) the PIL link to the host build of the PIL program (``sd_pil_stdio.c``) behind two
-pipes, ``--ticks`` times: the link's framing, CRC, sequence checks and a process round trip; (c) the link to the
-Cortex-M4 build in QEMU on its UART (``pil.target qemu``), ``--qemu-ticks`` times; (d) the link to the
-semihosting build in QEMU (``pil.target qemu:semihosting``), ``--semihosting-ticks`` times. One SENSOR/COMMAND exchange a tick in
-lock step; the plant is replaced by the replayed log so that the link alone is timed; every command is compared
-with the host C's (the same ``sd_tick``, the same state from ``sd_init``: they must be equal).
+"""The PIL link's cost per tick beside the host C's: a closed-loop run's sensor stream (utn-dynamic, the seed motion,
+``--record`` s of the host-C loop: its reference poses and measured leg lengths at each tick) replayed in a row
+through (a) ``sd_tick`` compiled for the host and called through cffi (``TickRunner``: the host-C loop's tick),
+``--ticks`` times; (b) the PIL link to the host build of the PIL program (``sd_pil_stdio.c``) behind two pipes,
+``--ticks`` times: the link's framing, CRC, sequence checks and a process round trip; (c) the link to the Cortex-M4
+build in QEMU on its UART (``pil.target qemu``), ``--qemu-ticks`` times; (d) the link to the semihosting build in
+QEMU (``pil.target qemu:semihosting``), ``--semihosting-ticks`` times. One SENSOR/COMMAND exchange a tick in lock
+step; the plant is replaced by the replayed log so that the link alone is timed; every command is compared with the
+host C's (the same ``sd_tick``, the same state from ``sd_init``: they must be equal).
 
-A run, quoted (``--ticks 1000000 --qemu-ticks 10000 --record 2``, 2-core machine at load 5-7): host C 4.65
-µs/tick; the link to a pipe 137.9 µs/tick (29.6 × host C), commands equal 1000000/1000000; the link to QEMU 4468
-µs/tick (960 × host C, 224 ticks/s), commands equal 10000/10000. An earlier run of 10⁵ ticks to QEMU (load 9-11):
-4258 µs/tick, 235 ticks/s, equal 100000/100000. QEMU's UART model takes one byte per trip through its main loop:
-10⁶ ticks over it would take about 75 min; the semihosting console takes a frame a call (``--ticks 100000 --qemu-ticks 5000 --semihosting-ticks 100000``, load 0.1-0.4: host C
-2.34 µs/tick, a pipe 92.6, the UART 2986, semihosting 123.5 µs/tick: 24.2 × faster than the UART, commands equal
-100000/100000). The whole
-closed loop over 10⁶ ticks: ``bench_pil_loop.py``.
+A run, quoted (``--ticks 1000000 --qemu-ticks 10000 --record 2``, 2-core machine at load 5-7): host C 4.65 µs/tick;
+the link to a pipe 137.9 µs/tick (29.6 × host C), commands equal 1000000/1000000; the link to QEMU 4468 µs/tick (960
+× host C, 224 ticks/s), commands equal 10000/10000. An earlier run of 10⁵ ticks to QEMU (load 9-11): 4258 µs/tick,
+235 ticks/s, equal 100000/100000. QEMU's UART model takes one byte per trip through its main loop: 10⁶ ticks over it
+would take about 75 min; the semihosting console takes a frame a call (``--ticks 100000 --qemu-ticks 5000
+--semihosting-ticks 100000``, load 0.1-0.4: host C 2.34 µs/tick, a pipe 92.6, the UART 2986, semihosting 123.5
+µs/tick: 24.2 × faster than the UART, commands equal 100000/100000). The whole closed loop over 10⁶ ticks:
+``bench_pil_loop.py``.
 
 Run by hand: ``python benchmarks/bench_pil.py [--ticks 1000000] [--qemu-ticks 10000] [--semihosting-ticks 100000]
-[--record 2]``. Prints wall
-µs per tick for each, their ratios to the host C, the QEMU ticks/s and the load first and last. Measures only.
+[--record 2]``. Prints wall µs per tick for each, their ratios to the host C, the QEMU ticks/s and the load first
+and last. Measures only.
 """
 
 from __future__ import annotations

@@ -570,8 +570,9 @@ def simulate(
             ``**{"firmware.length_lsb": "30um", "controller.period": 5e-4}`` (values in SI or in the quantity
             grammar). An option left out (or None) keeps the machine's value. ``**{"pil.target": "qemu"}`` runs
             each tick on the firmware built for a Cortex-M4 in QEMU (``"qemu:semihosting"``: its faster build,
-            the link on the semihosting console; ``"serial:/dev/ttyX"``: on a board) over the PIL link, in lock step (``summary["pil"]``: the link's counters, faults, round trips and the measured
-            tick; docs/simulation-to-board.md).
+            the link on the semihosting console; ``"serial:/dev/ttyX"``: on a board) over the PIL link, in lock
+            step (``summary["pil"]``: the link's counters, faults, round trips and the measured tick;
+            docs/simulation-to-board.md).
 
     Keyword Args:
         controller (str | None): ``"fixed"`` (the DSP's fixed-point law) or ``"float"`` (its float twin) (spec

@@ -4,13 +4,13 @@ Cortex-M4 and run in QEMU, or a board on a serial port. Each is a byte stream wi
 
 QEMU runs ``-M mps2-an386`` with the link on its standard input and output (two pipes: no port to choose,
 nothing for another process to connect to): ``qemu`` puts the board's UART0 there, the byte-at-a-time path a
-board takes; ``qemu:semihosting`` runs the build whose link is the semihosting console,
-which QEMU reads and writes on the same pipes (``target/sd_semihost.c``: a frame a call instead of a byte a
-trip through QEMU's main loop; the rest of the program is the same). Both run ``-icount shift=0``: each instruction advances the
-virtual clock by 1 ns, so the SysTick counts the PIL program reads around ``sd_tick`` (the AN386's 25 MHz
-processor clock, 40 ns) are whole instructions / 40: ``INSTRUCTIONS_PER_COUNT``. The process is killed by
-``close()``, by the kernel when this process dies (``PR_SET_PDEATHSIG``) and, as a last resort, when the
-target object is collected or the interpreter exits (``weakref.finalize``).
+board takes; ``qemu:semihosting`` runs the build whose link is the semihosting console, which QEMU reads and
+writes on the same pipes (``target/sd_semihost.c``: a frame a call instead of a byte a trip through QEMU's main
+loop; the rest of the program is the same). Both run ``-icount shift=0``: each instruction advances the virtual
+clock by 1 ns, so the SysTick counts the PIL program reads around ``sd_tick`` (the AN386's 25 MHz processor
+clock, 40 ns) are whole instructions / 40: ``INSTRUCTIONS_PER_COUNT``. The process is killed by ``close()``, by
+the kernel when this process dies (``PR_SET_PDEATHSIG``) and, as a last resort, when the target object is
+collected or the interpreter exits (``weakref.finalize``).
 
 The ELF is cached by the content hash of its sources, the cross compiler's version and the build flags, like
 the host's C builds (``system.c_build``).

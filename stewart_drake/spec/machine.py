@@ -292,12 +292,12 @@ class RunSpec:
 class PilSpec:
     """Processor in the loop: ``target`` (None: the tick runs on the host; ``qemu``: the firmware built for the
     Cortex-M4 in QEMU's MPS2 AN386, its link on the board's UART; ``qemu:semihosting``: the same with the link on
-    the semihosting console, a frame a call; ``serial:PATH``: a board on the serial port PATH) computes each tick over the
-    link (``firmware.link``); ``fault`` injects link faults (``drop``, ``corrupt``, ``delay``, ``duplicate``) at a
-    seeded rate a tick (``drop:0.01``, seeded by ``run.seed``) or at given ticks (``corrupt:@10,200``, counted
-    from 1); ``on_fault``: the controller's reaction to a tick without a command, ``hold`` (keep the last
-    command) or ``stop`` (zero force from then on: the run fails); ``timeout`` (s): how long the host waits for
-    a tick's command (a lost frame costs that)."""
+    the semihosting console, a frame a call; ``serial:PATH``: a board on the serial port PATH) computes each tick
+    over the link (``firmware.link``); ``fault`` injects link faults (``drop``, ``corrupt``, ``delay``,
+    ``duplicate``) at a seeded rate a tick (``drop:0.01``, seeded by ``run.seed``) or at given ticks
+    (``corrupt:@10,200``, counted from 1); ``on_fault``: the controller's reaction to a tick without a command,
+    ``hold`` (keep the last command) or ``stop`` (zero force from then on: the run fails); ``timeout`` (s): how
+    long the host waits for a tick's command (a lost frame costs that)."""
 
     target: str | None = None
     fault: str | None = None
