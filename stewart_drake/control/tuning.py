@@ -17,6 +17,7 @@ also reach it. The plant (mass, stiffness, delay, lag) is computed once per pose
 from __future__ import annotations
 
 import itertools
+import pickle
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -35,12 +36,14 @@ from stewart_drake.control.gains import ControllerConfig, PidGains
 from stewart_drake.core.geometry import Platform
 from stewart_drake.core.kinematics import leg_lengths
 from stewart_drake.errors import PhysicalLimitError, TuneError
+from stewart_drake.system import results
 
 KD_SCALES = tuple(float(x) for x in np.logspace(-1.2, 0.3, 12))
 KP_SCALES = tuple(float(x) for x in np.logspace(-1.0, 0.6, 7))
 KI_SCALES = (0.05, 0.2, 0.6, 1.5)
 # frequencies per pose for the margins and bandwidth (log-spaced to just below Nyquist)
 FREQUENCIES = 200
+CACHE_KIND = "tune"  # the cache folder of the gains controller.gains: tune ran with (system.results)
 
 
 def grid_poses(platform: Platform, lo, hi) -> np.ndarray:
@@ -202,7 +205,21 @@ def tuned_gains(platform: Platform, config: ControllerConfig, law: str, spec: Lo
     """The gains ``controller.gains: tune`` runs with: the widest-bandwidth candidate around ``config``'s
     designed gains that meets ``MIN_GAIN_MARGIN_DB`` and ``MIN_PHASE_MARGIN_DEG`` at every pose of the grid of
     the box ``lo``..``hi`` (6,), as ``law`` applies them (the fixed law's Q15 words). Raises
-    ``PhysicalLimitError`` (naming the best found) when none does."""
+    ``PhysicalLimitError`` (naming the best found) when none does.
+
+    Each machine is tuned once: the gains are kept on disk (``system.results``) under the package's version and
+    the exact inputs (a pickle of all six), so the next run of the same machine reads them, and a change of the
+    code or of any input tunes again. A failure is not kept."""
+    key = results.key(pickle.dumps((platform, config, law, spec, np.asarray(lo), np.asarray(hi)), protocol=5))
+    kept = results.load(CACHE_KIND, key)
+    if isinstance(kept, PidGains):
+        return kept
+    gains = _tune_for_run(platform, config, law, spec, lo, hi)
+    results.store(CACHE_KIND, key, gains)
+    return gains
+
+
+def _tune_for_run(platform: Platform, config: ControllerConfig, law: str, spec: LoopSpec, lo, hi) -> PidGains:
     poses = grid_poses(platform, lo, hi)
     if not len(poses):
         raise PhysicalLimitError(TuneError.NO_POSES.format(name=platform.name))

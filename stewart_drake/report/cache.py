@@ -2,10 +2,10 @@
 
 A section's key is the SHA-256 of:
 
-- the package's version (``package_version``): every file of the installed ``stewart_drake`` package, sources
-  and data alike, by relative path and content, and the versions of Python and of the libraries that draw or
-  compute (``DEPENDENCIES``). Any edit of the package recomputes every section: simple and sound, where a
-  scan of the imports would miss code reached by a computed name;
+- the package's version (``system.results.package_version``): every file of the installed ``stewart_drake``
+  package, sources and data alike, by relative path and content, and the versions of Python and of the
+  libraries that draw or compute. Any edit of the package recomputes every section: simple and sound, where a
+  scan of the imports would miss code reached by a computed name; and the entry's ``FORMAT``;
 - the analysis' name, the ``quick`` flag and the compiler the C builds would use (``$STEWART_DRAKE_CC``,
   ``$CC``: the compiled firmware is an input of the sections that run it);
 - the subject's declared inputs (``report.subject.Subject.key``: the content of the user's platform or
@@ -21,47 +21,22 @@ undeclared is not cached.
 
 The entry is the pickled ``Section`` (its text, tables, figures' PNG bytes, checks, warnings, original run
 time), so a hit gives back the section exactly as it was computed. Entries live in
-``c_build.cache_dir() / "report"`` (``$STEWART_DRAKE_CACHE``), written atomically; a section whose analysis
-raised is not stored (the failure may be transient); an unreadable entry counts as a miss. Where the cache
-folder cannot be used the report runs without it.
+``c_build.cache_dir() / "report"`` (``$STEWART_DRAKE_CACHE``; ``system.results``), written atomically; a section
+whose analysis raised is not stored (the failure may be transient); an unreadable entry counts as a miss. Where
+the cache folder cannot be used the report runs without it.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
-import pickle
-import sys
-import tempfile
-from functools import cache
-from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-import numpy as np
+from stewart_drake.system import results
+from stewart_drake.system.results import PACKAGE, package_version
 
-from stewart_drake.system.c_build import CacheUnavailable, cache_dir
-
-PACKAGE = Path(__file__).resolve().parents[1]
-FORMAT = 3  # bump when the entry's layout or the key's recipe changes (3: declared inputs only)
-# the libraries whose versions can change a section's numbers or figures (part of the package version)
-DEPENDENCIES = ("drake", "numpy", "scipy", "matplotlib", "pymoo", "python-flint", "cffi")
-
-
-@cache
-def package_version(root: Path = PACKAGE) -> str:
-    """SHA-256 (hex) of every file under ``root`` but the bytecode caches (relative path and bytes, in sorted
-    order), of the Python version and of the ``DEPENDENCIES``' versions. Read once per process: the installed
-    package does not change under a running report."""
-    h = hashlib.sha256()
-    for p in sorted(q for q in root.rglob("*") if q.is_file() and "__pycache__" not in q.parts and q.suffix != ".pyc"):
-        h.update(str(p.relative_to(root)).encode() + b"\0" + hashlib.sha256(p.read_bytes()).digest())
-    for dist in DEPENDENCIES:
-        try:
-            h.update(f"|{dist}={version(dist)}".encode())
-        except PackageNotFoundError:
-            h.update(f"|{dist}=absent".encode())
-    h.update(f"{sys.version}|{np.__version__}|{FORMAT}".encode())
-    return h.hexdigest()
+FORMAT = 4  # bump when the entry's layout or the key's recipe changes (4: the package version in system.results)
+KIND = "report"
 
 
 def path_digest(path: Path) -> bytes:
@@ -95,7 +70,7 @@ def section_key(analysis, quick: bool, subject=None) -> str | None:
     if outside and declared is None:
         return None
     h = hashlib.sha256(package_version().encode())
-    h.update(f"|{analysis.name}|{bool(quick)}".encode())
+    h.update(f"|format={FORMAT}|{analysis.name}|{bool(quick)}".encode())
     if outside:
         h.update(b"|script|" + path_digest(path))
         for name in declared:
@@ -106,39 +81,11 @@ def section_key(analysis, quick: bool, subject=None) -> str | None:
     return h.hexdigest()
 
 
-def folder() -> Path | None:
-    """The cache folder (created), or None where it cannot be used."""
-    try:
-        d = cache_dir() / "report"
-        d.mkdir(parents=True, exist_ok=True)
-        return d
-    except (CacheUnavailable, OSError):
-        return None
-
-
 def load(key: str | None):
     """The cached ``Section`` of ``key``, or None (no key, absent, unreadable, or the cache unusable)."""
-    d = folder() if key is not None else None
-    if d is None:
-        return None
-    try:
-        with open(d / f"{key}.pickle", "rb") as f:
-            return pickle.load(f)
-    except FileNotFoundError:
-        return None
-    except Exception:  # noqa: BLE001 - a truncated or foreign entry is a miss, recomputed and rewritten
-        return None
+    return results.load(KIND, key)
 
 
 def store(key: str | None, section) -> None:
     """Write ``section`` under ``key`` (atomically: a reader never sees half an entry); no key: nothing."""
-    d = folder() if key is not None else None
-    if d is None:
-        return
-    fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            pickle.dump(section, f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, d / f"{key}.pickle")
-    except OSError:
-        Path(tmp).unlink(missing_ok=True)
+    results.store(KIND, key, section)
