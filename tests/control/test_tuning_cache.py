@@ -14,8 +14,8 @@ from stewart_drake.control.gains import ControllerConfig, PidGains
 from stewart_drake.control.tuning import LoopSpec, tuned_gains
 from stewart_drake.core.geometry import load_platform
 from stewart_drake.errors import PhysicalLimitError
-from stewart_drake.system import results
 from stewart_drake.firmware.certify.box import workspace_box
+from stewart_drake.system import results
 
 NEWCOMER = "examples/newcomer-210kg.yaml"
 
