@@ -453,6 +453,7 @@ class UsageError(StewartError):
     MACHINE_AS_PLATFORM = (
         "--platform {path}: a machine file (payload, controller, firmware, ...); give it as {use} {path}"
     )
+    MEASUREMENTS = "--measurements is required: --platform {platform} is not a machine file naming them in calibration:"
 
 
 class OptionError(UsageError):

@@ -21,16 +21,19 @@ from stewart_drake.system.output_folder import OutputFolder
 
 # the top-level keys that make a YAML file a machine file rather than a platform file
 _MACHINE_ONLY = (*SECTIONS, "platform", "motions", "requirements")
+# what a command takes of a machine file given as --platform
+MACHINE_LOADED = "its platform, the payload on the plate"
+MACHINE_KINEMATIC = "its platform: the geometry, without the payload"
 
 
-def add_platform_arg(parser, default: str | None = "utn-kinematic") -> None:
-    """``--platform NAME|FILE``: a built-in preset or a platform YAML file."""
+def add_platform_arg(parser, default: str | None = "utn-kinematic", machine: str = MACHINE_LOADED) -> None:
+    """``--platform NAME|FILE``: a built-in preset, a platform YAML file or a machine file (``machine``: what the
+    command takes of it)."""
     parser.add_argument(
         "--platform",
         default=default,
         metavar="NAME|FILE",
-        help=f"a preset ({', '.join(PRESETS)}), a platform YAML file or a machine file (its platform, the payload on "
-        f"the plate) (default: {default})",
+        help=f"a preset ({', '.join(PRESETS)}), a platform YAML file or a machine file ({machine}) (default: {default})",
     )
 
 
@@ -83,6 +86,14 @@ def platform_arg(args) -> str | Platform | None:
     as the user wrote it), or for a machine file its platform with the payload on the plate."""
     machine = platform_machine(args)
     return args.platform if machine is None else machine.loaded_platform
+
+
+def kinematic_platform_arg(args) -> str | Platform | None:
+    """``--platform`` for the calibration commands: the text as given, or for a machine file its own platform
+    without the payload (the geometry is what they measure; a calibrated platform file written from it must not
+    carry the payload into the plate, where the machine would add it again)."""
+    machine = platform_machine(args)
+    return args.platform if machine is None else machine.platform
 
 
 def platform_from_args(args) -> Platform:

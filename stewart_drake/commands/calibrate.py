@@ -7,12 +7,15 @@ from stewart_drake.api.calibration import calibrate
 from stewart_drake.calibration.identify import CalibrationResult
 from stewart_drake.calibration.measurements import TYPES
 from stewart_drake.commands._common import (
+    MACHINE_KINEMATIC,
     add_force_arg,
+    kinematic_platform_arg,
     output_folder,
+    platform_machine,
     print_json,
 )
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
-from stewart_drake.errors import CalibrationLimitError
+from stewart_drake.errors import CalibrationLimitError, UsageError
 from stewart_drake.system.jsonout import dumps_strict
 
 HELP = "identify a built platform's geometry from measured poses; write a calibrated platform file"
@@ -27,9 +30,16 @@ def register(sub) -> None:
         "from the stated noise; validation on held-out poses. See docs/calibration.md.",
     )
     p.add_argument(
-        "--platform", required=True, metavar="NAME|FILE", help="the nominal platform: a preset or a platform YAML file"
+        "--platform",
+        required=True,
+        metavar="NAME|FILE",
+        help=f"the nominal platform: a preset, a platform YAML file or a machine file ({MACHINE_KINEMATIC})",
     )
-    p.add_argument("--measurements", required=True, metavar="M.csv", help="measurement CSV (header: l1..l6 and ...)")
+    p.add_argument(
+        "--measurements",
+        metavar="M.csv",
+        help="measurement CSV (header: l1..l6 and ...); default: the file a machine file's calibration: names",
+    )
     p.add_argument("--type", choices=TYPES, default=None, help="measurement kind (default: from the header)")
     g = p.add_mutually_exclusive_group()
     g.add_argument(
@@ -101,11 +111,22 @@ def _fmt(s: dict, key: str = "rms") -> str:
     return f"{s[key] * 1e6:.3g} µm" if s["unit"] == "m" else f"{s[key] * 1e6:.3g} µrad"
 
 
+def measurements_arg(args) -> str:
+    """``--measurements``, or the file the machine file given as ``--platform`` names in ``calibration:``."""
+    if args.measurements is not None:
+        return args.measurements
+    machine = platform_machine(args)
+    if machine is None or machine.calibration is None:
+        raise UsageError(UsageError.MEASUREMENTS.format(platform=args.platform))
+    return machine.calibration
+
+
 def run(args) -> int:
+    measurements = measurements_arg(args)
     out = output_folder(args)
     cal = calibrate(
-        args.platform,
-        args.measurements,
+        kinematic_platform_arg(args),
+        measurements,
         type=args.type,
         length_unit=args.length_unit,
         angle_unit=args.angle_unit,

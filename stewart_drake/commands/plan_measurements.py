@@ -6,8 +6,10 @@ from __future__ import annotations
 from stewart_drake.api.calibration import plan_measurements, poses_csv
 from stewart_drake.calibration.measurements import TYPES
 from stewart_drake.commands._common import (
+    MACHINE_KINEMATIC,
     add_force_arg,
     add_platform_arg,
+    kinematic_platform_arg,
     output_folder,
     print_json,
 )
@@ -19,7 +21,7 @@ HELP = "plan calibration poses (D-optimal) inside a workspace box; CSV and a .st
 
 def register(sub) -> None:
     p = sub.add_parser("plan-measurements", help=HELP, description=HELP + ". See docs/calibration.md.")
-    add_platform_arg(p)
+    add_platform_arg(p, machine=MACHINE_KINEMATIC)
     p.add_argument("--poses", type=int, required=True, metavar="N", help="number of poses to plan")
     p.add_argument("--type", choices=TYPES, default="pose", help="the measurement to plan for (default pose)")
     p.add_argument(
@@ -47,7 +49,7 @@ def register(sub) -> None:
 def run(args) -> int:
     out = output_folder(args)
     plan = plan_measurements(
-        args.platform,
+        kinematic_platform_arg(args),
         args.poses,
         type=args.type,
         workspace=args.workspace,

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 from stewart_drake.calibration.measurements import TYPES, measurements_csv
 from stewart_drake.commands._common import (
+    MACHINE_KINEMATIC,
     add_force_arg,
     add_platform_arg,
+    kinematic_platform_arg,
     output_folder,
     print_json,
 )
@@ -21,7 +23,7 @@ HELP = "synthetic calibration measurements of a machine drawn around the nominal
 
 def register(sub) -> None:
     p = sub.add_parser("simulate-measurements", help=HELP, description=HELP + ". See docs/calibration.md.")
-    add_platform_arg(p)
+    add_platform_arg(p, machine=MACHINE_KINEMATIC)
     p.add_argument(
         "--errors",
         nargs="+",
@@ -51,7 +53,7 @@ def register(sub) -> None:
 def run(args) -> int:
     out = output_folder(args)
     sim = simulate_measurements(
-        args.platform,
+        kinematic_platform_arg(args),
         args.poses,
         errors=args.errors,
         noise=args.noise,
