@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from stewart_drake.api.platform import load_platform
+from stewart_drake.api.platform import nominal_geometry
 from stewart_drake.api.result import Result
 from stewart_drake.calibration.identify import CalibrationResult as Identified
 from stewart_drake.calibration.identify import (
@@ -35,6 +35,7 @@ from stewart_drake.core.geometry import CalibrationRecord, Platform
 from stewart_drake.core.platform_file import platform_yaml
 from stewart_drake.core.rotations import angle_scale, length_scale
 from stewart_drake.errors import CalibrationError, UsageError
+from stewart_drake.spec import Machine
 
 MAX_CANDIDATES = 20_000
 
@@ -126,7 +127,7 @@ def _split(data: Measurements, layout: Layout, holdout, validate, seed: int, len
 
 
 def calibrate(
-    platform: str | Path | Platform,
+    platform: str | Path | Platform | Machine,
     measurements: str | Path,
     *,
     type: str | None = None,
@@ -144,7 +145,8 @@ def calibrate(
     stated noise, validation on held-out poses.
 
     Args:
-        platform: the nominal platform (a preset name, a platform file or a ``Platform``).
+        platform: the nominal platform (a preset name, a platform file or a ``Platform``; a machine file or a
+            ``Machine``: its platform, without the payload).
         measurements: the measurement CSV (header ``l1..l6`` and the measured columns; see docs/calibration.md).
         type: ``"pose"``, ``"points"`` or ``"inclinometer"`` (default: from the header).
         length_unit: lengths in the CSV files.
@@ -165,7 +167,7 @@ def calibrate(
     """
     if holdout is not None and validate is not None:
         raise UsageError(UsageError.NOT_BOTH.format(first="holdout (--holdout)", second="validate (--validate)"))
-    nominal = load_platform(platform)
+    nominal = nominal_geometry(platform)
     sigma = parse_noise(noise)
     rows = read_measurements(str(measurements), nominal, type, length_unit, angle_unit)
     data, copies = rows.without_copies()
@@ -231,7 +233,7 @@ class PlanMeasurementsResult(Result):
 
 
 def plan_measurements(
-    platform: str | Path | Platform,
+    platform: str | Path | Platform | Machine,
     poses: int,
     *,
     type: str = "pose",
@@ -249,7 +251,8 @@ def plan_measurements(
     a box about home, and draw as many random ones from the same candidates for comparison.
 
     Args:
-        platform: a preset name, a platform file or a ``Platform``.
+        platform: a preset name, a platform file or a ``Platform`` (a machine file or a ``Machine``: its
+            platform, without the payload).
         poses: the number of poses to plan.
         type: the measurement to plan for: ``"pose"``, ``"points"`` or ``"inclinometer"``.
         workspace: ``(4,)`` the box about home: ±x ±y ±z (``length_unit``) and ±rotation per angle
@@ -269,7 +272,7 @@ def plan_measurements(
     Raises:
         StewartError: counts out of range, too few poses for the unknowns, a box that is not positive.
     """
-    platform = load_platform(platform)
+    platform = nominal_geometry(platform)
     poses, candidates, targets = (
         as_int(v, param(n)) for v, n in ((poses, "poses"), (candidates, "candidates"), (targets, "targets"))
     )

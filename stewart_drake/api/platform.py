@@ -6,6 +6,8 @@ from pathlib import Path
 
 from stewart_drake.core import geometry
 from stewart_drake.core.geometry import Platform
+from stewart_drake.spec import Machine, load_machine
+from stewart_drake.spec.load import is_machine_file
 
 
 def load_platform(name_or_path: str | Path | Platform) -> Platform:
@@ -23,6 +25,18 @@ def load_platform(name_or_path: str | Path | Platform) -> Platform:
             line and field).
     """
     return geometry.load_platform(name_or_path)
+
+
+def nominal_geometry(source: str | Path | Platform | Machine) -> Platform:
+    """The platform whose geometry the calibration functions plan, measure and identify: a preset, a platform
+    file or a ``Platform`` as `load_platform` reads it; a ``Machine`` or a machine file, its platform without the
+    payload (a calibrated platform file must not carry the payload into the plate, where the machine adds it
+    again)."""
+    if isinstance(source, Machine):
+        return source.platform
+    if is_machine_file(source):
+        return load_machine(source).platform
+    return load_platform(source)
 
 
 def presets() -> list[str]:

@@ -6,21 +6,17 @@ import copy
 import math
 import re
 import sys
-from pathlib import Path
 
 import numpy as np
-import yaml
 
 from stewart_drake.core.geometry import PRESETS, Platform, load_platform
 from stewart_drake.core.rotations import ANGLE_UNITS, CONVENTIONS, LENGTH_UNITS
 from stewart_drake.errors import MachineError, QuantityError, StewartError, UsageError
 from stewart_drake.spec import Machine, apply_overrides, load_machine
-from stewart_drake.spec.machine import SECTIONS
+from stewart_drake.spec.load import is_machine_file
 from stewart_drake.system.jsonout import dumps_strict
 from stewart_drake.system.output_folder import OutputFolder
 
-# the top-level keys that make a YAML file a machine file rather than a platform file
-_MACHINE_ONLY = (*SECTIONS, "platform", "motions", "requirements")
 # what a command takes of a machine file given as --platform
 MACHINE_LOADED = "its platform, the payload on the plate"
 MACHINE_KINEMATIC = "its platform: the geometry, without the payload"
@@ -59,20 +55,6 @@ def platform_machine(args) -> Machine | None:
     return load_machine(args.platform) if is_machine_file(args.platform) else None
 
 
-def is_machine_file(source) -> bool:
-    """Whether ``source`` (a ``--platform`` value) names a file with machine sections beside the platform's."""
-    if not isinstance(source, str) or source in PRESETS or not Path(source).is_file():
-        return False
-    try:  # a peek at the top-level keys; a file that does not parse is left to the loader's message
-        keys = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
-        return False
-    if not isinstance(keys, dict):
-        return False
-    # a platform file's calibration is its record (a mapping); a machine's names a measurements file
-    return any(k in _MACHINE_ONLY or (k == "calibration" and not isinstance(v, dict)) for k, v in keys.items())
-
-
 def refuse_machine_file(sources, use: str) -> None:
     """Refuse a machine file among the ``--platform`` values ``sources`` of a command that reads the whole machine
     with another option (``use``, e.g. ``"--machine"``), in one line naming the file as written."""
@@ -86,14 +68,6 @@ def platform_arg(args) -> str | Platform | None:
     as the user wrote it), or for a machine file its platform with the payload on the plate."""
     machine = platform_machine(args)
     return args.platform if machine is None else machine.loaded_platform
-
-
-def kinematic_platform_arg(args) -> str | Platform | None:
-    """``--platform`` for the calibration commands: the text as given, or for a machine file its own platform
-    without the payload (the geometry is what they measure; a calibrated platform file written from it must not
-    carry the payload into the plate, where the machine would add it again)."""
-    machine = platform_machine(args)
-    return args.platform if machine is None else machine.platform
 
 
 def platform_from_args(args) -> Platform:

@@ -9,7 +9,6 @@ from stewart_drake.calibration.measurements import TYPES
 from stewart_drake.commands._common import (
     MACHINE_KINEMATIC,
     add_force_arg,
-    kinematic_platform_arg,
     output_folder,
     platform_machine,
     print_json,
@@ -125,7 +124,7 @@ def run(args) -> int:
     measurements = measurements_arg(args)
     out = output_folder(args)
     cal = calibrate(
-        kinematic_platform_arg(args),
+        args.platform,
         measurements,
         type=args.type,
         length_unit=args.length_unit,

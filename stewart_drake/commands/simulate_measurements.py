@@ -9,7 +9,6 @@ from stewart_drake.commands._common import (
     MACHINE_KINEMATIC,
     add_force_arg,
     add_platform_arg,
-    kinematic_platform_arg,
     output_folder,
     print_json,
 )
@@ -53,7 +52,7 @@ def register(sub) -> None:
 def run(args) -> int:
     out = output_folder(args)
     sim = simulate_measurements(
-        kinematic_platform_arg(args),
+        args.platform,
         args.poses,
         errors=args.errors,
         noise=args.noise,

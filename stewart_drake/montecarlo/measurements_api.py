@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from stewart_drake.api.platform import load_platform
+from stewart_drake.api.platform import nominal_geometry
 from stewart_drake.api.result import Result
 from stewart_drake.calibration.measurements import Measurements, measurements_csv
 from stewart_drake.calibration.noise import parse_noise
@@ -24,6 +24,7 @@ from stewart_drake.core.rotations import pose_to_si
 from stewart_drake.core.sanity import check_poses
 from stewart_drake.errors import API_FILE_EXISTS, CalibrationError, OutputError
 from stewart_drake.montecarlo.spec import parse_spec
+from stewart_drake.spec import Machine
 
 MAX_MEASURED_POSES = 10_000
 GEOMETRIC_KEYS = ("anchor", "leg_offset")
@@ -62,7 +63,7 @@ class MeasurementsResult(Result):
 
 
 def simulate_measurements(
-    platform: str | Path | Platform,
+    platform: str | Path | Platform | Machine,
     poses: str | Path | ArrayLike,
     *,
     errors: str | Sequence[str] = DEFAULT_ERRORS,
@@ -78,7 +79,8 @@ def simulate_measurements(
     grammar) at the given poses with the given noise: data for checking a calibration, the truth kept apart.
 
     Args:
-        platform: the nominal platform (a preset name, a platform file or a ``Platform``).
+        platform: the nominal platform (a preset name, a platform file or a ``Platform``; a machine file or a
+            ``Machine``: its platform, without the payload).
         poses: a CSV file ``px,py,pz,a,b,g`` (in ``length_unit``/``angle_unit``, e.g. a plan's poses) or an
             ``(n, 6)`` array (m, rad).
         errors: the machine's errors, keys ``anchor`` and ``leg_offset`` (default ±1 mm, ±0.5 mm).
@@ -97,7 +99,7 @@ def simulate_measurements(
         StewartError: an error key that is not geometric, a pose outside the stroke (of the nominal, or of the
             machine drawn: errors too large for it to reach the poses), a bad file. A σ of 0 gives noise-free data.
     """
-    platform = load_platform(platform)
+    platform = nominal_geometry(platform)
     spec = parse_spec(errors, where=param("errors"))
     bad = [k for k in spec.laws if k not in GEOMETRIC_KEYS]
     if bad:

@@ -34,6 +34,8 @@ from stewart_drake.spec.machine import FIELDS, GAIN_WORDS, SECTIONS, Gains, Mach
 from stewart_drake.spec.quantity import parse_choice, parse_number, parse_vector
 
 MACHINE_KEYS = (*SECTIONS, "platform", "motions", "requirements", "calibration")
+# the top-level keys that make a YAML file a machine file rather than a platform file
+_MACHINE_ONLY = (*SECTIONS, "platform", "motions", "requirements")
 PLATFORM_KEYS = tuple(f.name for f in dataclasses.fields(PlatformConfig))
 _TRUE, _FALSE = ("true", "yes", "on"), ("false", "no", "off")
 
@@ -159,6 +161,21 @@ def load_machine(source: Machine | Platform | Mapping | str | Path, overrides: I
     else:
         raise MachineError(MachineError.SOURCE.format(got=type(source).__name__))
     return apply_overrides(machine, overrides)
+
+
+def is_machine_file(source) -> bool:
+    """Whether ``source`` (a path, or a ``--platform`` value) names a file with machine sections beside the
+    platform's (a plain platform file, a preset or an object: False)."""
+    if not isinstance(source, (str, Path)) or str(source) in PRESETS or not Path(source).is_file():
+        return False
+    try:  # a peek at the top-level keys; a file that does not parse is left to the loader's message
+        keys = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return False
+    if not isinstance(keys, dict):
+        return False
+    # a platform file's calibration is its record (a mapping); a machine's names a measurements file
+    return any(k in _MACHINE_ONLY or (k == "calibration" and not isinstance(v, dict)) for k, v in keys.items())
 
 
 def _plain(value):

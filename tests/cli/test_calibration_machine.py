@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 import stewart_drake as sd
@@ -67,3 +68,10 @@ def test_calibrate_without_measurements_names_the_option(source, tmp_path, capsy
         "naming them in calibration:"
     )
     assert not (tmp_path / "cal").exists()
+
+
+def test_the_api_takes_a_machine_file_or_a_machine_as_its_platform(machine_and_platform):
+    d = machine_and_platform
+    machine = sd.load_machine(d / "machine.yaml")
+    plans = [sd.plan_measurements(p, 12, candidates=200) for p in (d / "machine.yaml", machine, machine.platform)]
+    assert all(np.array_equal(plans[0].poses, p.poses) for p in plans[1:])
