@@ -26,6 +26,7 @@ import time
 import numpy as np
 
 import stewart_drake as sd
+from stewart_drake.api.simulation import plan_run
 
 LOGS = ("t", "command", "setpoint", "force", "status", "lengths", "pose")
 
@@ -44,7 +45,7 @@ def main() -> int:
     ap.add_argument("--target", default="qemu:semihosting", help="pil.target")
     a = ap.parse_args()
     print(f"load {os.getloadavg()[0]:.2f}", flush=True)
-    period = sd.simulate(a.machine, duration=0.01, engine="c").plan.scenario.config.timing.sample_period
+    period = plan_run(a.machine, duration=0.01).scenario.config.timing.sample_period
     duration = a.ticks * period
     host, t_host = timed(a.machine, duration, engine="c")
     print(f"host C: {host.summary['ticks']} ticks in {t_host:.1f} s", flush=True)

@@ -110,21 +110,22 @@ def _fmt(s: dict, key: str = "rms") -> str:
     return f"{s[key] * 1e6:.3g} µm" if s["unit"] == "m" else f"{s[key] * 1e6:.3g} µrad"
 
 
-def measurements_arg(args) -> str:
-    """``--measurements``, or the file the machine file given as ``--platform`` names in ``calibration:``."""
+def measurements_arg(args, machine) -> str:
+    """``--measurements``, or the file that ``machine`` (the machine file given as ``--platform``, or None) names
+    in ``calibration:``."""
     if args.measurements is not None:
         return args.measurements
-    machine = platform_machine(args)
     if machine is None or machine.calibration is None:
         raise UsageError(UsageError.MEASUREMENTS.format(platform=args.platform))
     return machine.calibration
 
 
 def run(args) -> int:
-    measurements = measurements_arg(args)
+    machine = platform_machine(args)  # read once: for its measurements and its platform
+    measurements = measurements_arg(args, machine)
     out = output_folder(args)
     cal = calibrate(
-        args.platform,
+        args.platform if machine is None else machine,
         measurements,
         type=args.type,
         length_unit=args.length_unit,

@@ -37,7 +37,7 @@ from stewart_drake.firmware.link import (
     format_fingerprint,
     sensor_body,
 )
-from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT, QEMU_LINKS, QemuTarget, open_target
+from stewart_drake.firmware.pil_target import INSTRUCTIONS_PER_COUNT, QEMU_LINKS, open_target
 from stewart_drake.fixedpoint.generic import pose_words
 from stewart_drake.spec.machine import PilSpec
 
@@ -117,7 +117,7 @@ class PilLaw(FixedPointLaw):
         try:
             return call(*args)
         except EOFError:
-            why = self.target.ended() if isinstance(self.target, QemuTarget) else ""
+            why = self.target.ended()
             raise FirmwareError(
                 FirmwareError.PIL_GONE.format(tick=self.tick_count) + (f" ({why})" if why else "")
             ) from None

@@ -154,6 +154,10 @@ class SerialTarget:
         while view:
             view = view[os.write(self.fd, view) :]
 
+    def ended(self) -> str:
+        """Why the board's end closed (a port has no process to ask): ""."""
+        return ""
+
     def close(self) -> None:
         if self.fd >= 0:
             os.close(self.fd)
